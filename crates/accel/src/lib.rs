@@ -1,0 +1,8 @@
+//! CPU data for volgraph, with no GPU in it: volumes and their loaders, generated test volumes,
+//! transfer functions, the min/max block grid and transfer-function classification of
+//! Krüger & Westermann 2003 §2.3, bricks and per-brick octrees of Ruijters & Vilanova 2006
+//! §5 and §7, the orbit camera, and the f64 reference raycaster every GPU image is checked
+//! against. The rendering conventions are in `docs/rendering_model.md`.
+
+pub mod camera;
+pub mod volume;

@@ -1,0 +1,139 @@
+//! The in-memory scalar volume every other part of volgraph reads.
+
+use glam::{DVec3, UVec3};
+
+/// Voxel storage, in the type the file had (i16 is kept as i16; see [`Volume::normalized`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum VoxelData {
+    /// One unsigned byte per voxel.
+    U8(Vec<u8>),
+    /// Two bytes per voxel, native order after loading.
+    U16(Vec<u16>),
+    /// Signed 16-bit (CT Hounsfield units and the like).
+    I16(Vec<i16>),
+    /// 32-bit float; loaders replace NaN/Inf before a volume is built.
+    F32(Vec<f32>),
+}
+
+impl VoxelData {
+    /// Number of voxels stored.
+    pub fn len(&self) -> usize {
+        match self {
+            VoxelData::U8(v) => v.len(),
+            VoxelData::U16(v) => v.len(),
+            VoxelData::I16(v) => v.len(),
+            VoxelData::F32(v) => v.len(),
+        }
+    }
+
+    /// True when no voxel is stored.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The type's name as used in file names (`uint8`, `uint16`, `int16`, `float32`).
+    pub fn type_name(&self) -> &'static str {
+        match self {
+            VoxelData::U8(_) => "uint8",
+            VoxelData::U16(_) => "uint16",
+            VoxelData::I16(_) => "int16",
+            VoxelData::F32(_) => "float32",
+        }
+    }
+}
+
+/// A scalar volume: `dims` voxels, x fastest (`index = x + nx*(y + ny*z)`), with a physical
+/// voxel `spacing`. See `docs/rendering_model.md` for how it maps to world and texture space.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Volume {
+    /// Voxels per axis.
+    pub dims: UVec3,
+    /// Physical size of one voxel per axis (any unit; only ratios matter for rendering).
+    pub spacing: DVec3,
+    /// The voxels.
+    pub data: VoxelData,
+    /// A human-readable name (file stem or generator), used in messages and benchmarks.
+    pub name: String,
+    /// For float data: the (min, max) of the finite values, used to normalize to [0,1].
+    pub value_range: (f64, f64),
+}
+
+impl Volume {
+    /// Number of voxels (`nx*ny*nz`).
+    pub fn voxel_count(&self) -> usize {
+        self.dims.x as usize * self.dims.y as usize * self.dims.z as usize
+    }
+
+    /// Linear index of voxel `(x, y, z)`.
+    #[inline]
+    pub fn index(&self, x: u32, y: u32, z: u32) -> usize {
+        x as usize + self.dims.x as usize * (y as usize + self.dims.y as usize * z as usize)
+    }
+
+    /// The normalized value in [0,1] of voxel `i`, exactly as the GPU texture holds it
+    /// (u8 → v/255, u16 → v/65535, i16 → (v+32768)/65535, f32 → (v-min)/(max-min)).
+    #[inline]
+    pub fn normalized(&self, i: usize) -> f64 {
+        match &self.data {
+            VoxelData::U8(v) => v[i] as f64 / 255.0,
+            VoxelData::U16(v) => v[i] as f64 / 65535.0,
+            VoxelData::I16(v) => (v[i] as f64 + 32768.0) / 65535.0,
+            VoxelData::F32(v) => {
+                let (lo, hi) = self.value_range;
+                if hi > lo { (v[i] as f64 - lo) / (hi - lo) } else { 0.0 }
+            }
+        }
+    }
+
+    /// All voxels normalized to [0,1] as f32 (what an R32Float texture upload wants).
+    pub fn normalized_f32(&self) -> Vec<f32> {
+        (0..self.voxel_count()).map(|i| self.normalized(i) as f32).collect()
+    }
+
+    /// Physical extent `dims * spacing`.
+    pub fn extent(&self) -> DVec3 {
+        self.dims.as_dvec3() * self.spacing
+    }
+
+    /// Half size of the volume box in world space: the longest side has length 1.
+    pub fn half_extent_world(&self) -> DVec3 {
+        let e = self.extent();
+        e / (2.0 * e.max_element())
+    }
+
+    /// The size of one voxel in world units per axis.
+    pub fn voxel_world(&self) -> DVec3 {
+        let e = self.extent();
+        self.spacing / e.max_element()
+    }
+
+    /// The renderer's unit step in world units: the smallest voxel side.
+    pub fn unit_step_world(&self) -> f64 {
+        self.voxel_world().min_element()
+    }
+
+    /// Trilinear sample of the normalized field at texture coordinate `u` with clamp-to-edge,
+    /// voxel centres at `(i+0.5)/n` (`docs/rendering_model.md`).
+    pub fn sample_trilinear(&self, u: DVec3) -> f64 {
+        let n = self.dims.as_dvec3();
+        let p = u * n - 0.5;
+        let base = p.floor();
+        let f = p - base;
+        let clamp = |v: f64, n: u32| -> u32 { v.clamp(0.0, (n - 1) as f64) as u32 };
+        let (bx, by, bz) = (base.x, base.y, base.z);
+        let x0 = clamp(bx, self.dims.x);
+        let x1 = clamp(bx + 1.0, self.dims.x);
+        let y0 = clamp(by, self.dims.y);
+        let y1 = clamp(by + 1.0, self.dims.y);
+        let z0 = clamp(bz, self.dims.z);
+        let z1 = clamp(bz + 1.0, self.dims.z);
+        let v = |x, y, z| self.normalized(self.index(x, y, z));
+        let c00 = v(x0, y0, z0) * (1.0 - f.x) + v(x1, y0, z0) * f.x;
+        let c10 = v(x0, y1, z0) * (1.0 - f.x) + v(x1, y1, z0) * f.x;
+        let c01 = v(x0, y0, z1) * (1.0 - f.x) + v(x1, y0, z1) * f.x;
+        let c11 = v(x0, y1, z1) * (1.0 - f.x) + v(x1, y1, z1) * f.x;
+        let c0 = c00 * (1.0 - f.y) + c10 * f.y;
+        let c1 = c01 * (1.0 - f.y) + c11 * f.y;
+        c0 * (1.0 - f.z) + c1 * f.z
+    }
+}

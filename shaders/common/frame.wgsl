@@ -1,0 +1,43 @@
+// Frame-wide uniforms, bound as `frame` by every pass that declares it.
+// Rust twin: `volgraph_core::FrameUniforms` (crates/core/src/frame_uniforms.rs); keep both in step.
+// Conventions: docs/rendering_model.md.
+
+struct Frame {
+    clip_from_world: mat4x4<f32>,
+    world_from_clip: mat4x4<f32>,
+    // xyz: eye position (world); w: 1.0 when the eye is inside the volume box, else 0.0.
+    eye_world: vec4<f32>,
+    // xyz: half size of the volume box (world); w: unit step (world length of the smallest voxel side).
+    half_extent: vec4<f32>,
+    // xyz: volume dimensions in voxels; w: unused.
+    volume_dims: vec4<f32>,
+    // x, y: viewport width and height in pixels; z, w: their reciprocals.
+    viewport: vec4<f32>,
+    // xyz: unit camera forward (world); w: near-plane distance.
+    camera_forward: vec4<f32>,
+    // Frame counter since the graph was (re)compiled.
+    frame_index: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+
+// World position -> texture-space position (docs/rendering_model.md "Volume and world space").
+fn texture_from_world(p: vec3<f32>) -> vec3<f32> {
+    return p / (2.0 * frame.half_extent.xyz) + vec3<f32>(0.5);
+}
+
+// Texture-space position -> world position.
+fn world_from_texture(u: vec3<f32>) -> vec3<f32> {
+    return (u - vec3<f32>(0.5)) * (2.0 * frame.half_extent.xyz);
+}
+
+// Unit world-space direction of the ray through pixel centre `pixel` (in pixels, row 0 at top).
+fn pixel_ray_dir(pixel: vec2<f32>) -> vec3<f32> {
+    let ndc = vec2<f32>(2.0 * pixel.x * frame.viewport.z - 1.0, 1.0 - 2.0 * pixel.y * frame.viewport.w);
+    let a = frame.world_from_clip * vec4<f32>(ndc, 0.0, 1.0);
+    let b = frame.world_from_clip * vec4<f32>(ndc, 1.0, 1.0);
+    return normalize(b.xyz / b.w - a.xyz / a.w);
+}

@@ -4,5 +4,14 @@
 //! §5 and §7, the orbit camera, and the f64 reference raycaster every GPU image is checked
 //! against. The rendering conventions are in `docs/rendering_model.md`.
 
+pub mod bricks;
 pub mod camera;
+pub mod classify;
+pub mod data_dir;
+pub mod generate;
+pub mod load;
+pub mod minmax;
+pub mod octree;
+pub mod reference;
+pub mod transfer_function;
 pub mod volume;

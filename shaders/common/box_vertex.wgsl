@@ -1,0 +1,22 @@
+// The bounding-box vertex stage shared by Krüger & Westermann 2003 §2.1 passes 1 and 2
+// (entry_points.wgsl, ray_directions.wgsl): draw(0..36, 0..1), no vertex buffer.
+
+#import "common/frame.wgsl"
+#import "common/box.wgsl"
+
+struct BoxVertex {
+    @builtin(position) clip: vec4<f32>,
+    // Texture-space position of the box surface point. Interpolated perspective-correctly, so
+    // at a pixel centre it is the exact intersection of that pixel's ray with the box face.
+    @location(0) u: vec3<f32>,
+}
+
+// Box vertex `vertex_index` (0..36): clip position and texture-space position.
+@vertex
+fn vs_box(@builtin(vertex_index) vertex_index: u32) -> BoxVertex {
+    let corner = box_corner(vertex_index);
+    var out: BoxVertex;
+    out.clip = frame.clip_from_world * vec4<f32>(corner * frame.half_extent.xyz, 1.0);
+    out.u = corner * 0.5 + vec3<f32>(0.5);
+    return out;
+}

@@ -1,0 +1,149 @@
+// The volume-rendering integral shared by every raycaster (fragment and compute), implementing
+// docs/rendering_model.md ("Ray segment inside the box" from `u0` on, "Classification and
+// compositing", "First-hit isosurface") exactly like `volgraph_accel::reference`.
+// Krüger & Westermann 2003 §2.1 (DVR, early ray termination) and §2.2 (first-hit isosurface).
+
+#import "common/frame.wgsl"
+#import "common/volume.wgsl"
+#import "common/raycast_params.wgsl"
+
+// O'Neill's PCG hash (state = v*747796405 + 2891336453, then the RXS-M-XS output permutation).
+fn pcg_hash(v: u32) -> u32 {
+    let state = v * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+// The per-pixel offset of the first sample, in steps, in [-0.5, 0.5]; 0 when jitter is off.
+fn ray_jitter(pixel: vec2<u32>) -> f32 {
+    if (params.jitter == 0u) {
+        return 0.0;
+    }
+    let width = u32(frame.viewport.x);
+    return f32(pcg_hash(pixel.x + pixel.y * width)) / 4294967296.0 - 0.5;
+}
+
+// step_tex = step_voxels * unit_world / |d_tex * 2*half| for a unit texture-space direction.
+fn ray_step_tex(d_tex: vec3<f32>) -> f32 {
+    let world_per_tex = length(d_tex * 2.0 * frame.half_extent.xyz);
+    return params.step_voxels * frame.half_extent.w / world_per_tex;
+}
+
+// True when the ray (u0, d_tex, len_tex) can be marched: positive finite length, a unit
+// direction, a positive finite step. Written with `>`/`<` so NaN fails every test.
+fn ray_is_valid(u0: vec3<f32>, d_tex: vec3<f32>, len_tex: f32) -> bool {
+    let d_len = length(d_tex);
+    if (!(len_tex > 0.0) || !(len_tex < 4.0) || !(d_len > 0.5) || !(d_len < 1.5)) {
+        return false;
+    }
+    if (!all(abs(u0 - vec3<f32>(0.5)) < vec3<f32>(1.0))) {
+        return false;
+    }
+    let step_tex = ray_step_tex(d_tex);
+    return step_tex > 0.0 && step_tex < 1e30;
+}
+
+// Opacity correction from the LUT's per-unit-step alpha to this step: 1 - (1 - a)^step_voxels.
+// The ends are handled explicitly because pow(0, y) is undefined in WGSL.
+fn corrected_alpha(a_tf: f32) -> f32 {
+    let a = clamp(a_tf, 0.0, 1.0);
+    if (a >= 1.0) {
+        return 1.0;
+    }
+    if (a <= 0.0) {
+        return 0.0;
+    }
+    return 1.0 - pow(1.0 - a, params.step_voxels);
+}
+
+// Direct volume rendering along u0 + t·d_tex, t in [0, len_tex): premultiplied linear RGBA,
+// front to back, stopping after the sample that makes A >= threshold or after max_steps samples.
+fn march_dvr(u0: vec3<f32>, d_tex: vec3<f32>, len_tex: f32, pixel: vec2<u32>) -> vec4<f32> {
+    var acc = vec4<f32>(0.0);
+    if (!ray_is_valid(u0, d_tex, len_tex)) {
+        return acc;
+    }
+    let step_tex = ray_step_tex(d_tex);
+    let jitter = ray_jitter(pixel);
+    for (var k = 0u; k < params.max_steps; k += 1u) {
+        let t = (f32(k) + 0.5 + jitter) * step_tex;
+        if (!(t < len_tex)) {
+            break;
+        }
+        let c = sample_tf(sample_volume(u0 + t * d_tex));
+        let w = (1.0 - acc.a) * corrected_alpha(c.a);
+        acc = vec4<f32>(acc.rgb + w * c.rgb, acc.a + w);
+        if (acc.a >= params.threshold) {
+            break;
+        }
+    }
+    return acc;
+}
+
+// First-hit isosurface result: shaded premultiplied colour (alpha 1) and texture-space hit
+// position (w = 1); both (0,0,0,0) when the ray misses.
+struct IsoResult {
+    color: vec4<f32>,
+    hit: vec4<f32>,
+}
+
+// Blinn–Phong headlight shading at texture-space point `u` seen along the unit world direction
+// `d_world` (docs/rendering_model.md "First-hit isosurface").
+fn shade_iso(u: vec3<f32>, d_world: vec3<f32>) -> vec3<f32> {
+    let off = 1.0 / frame.volume_dims.xyz;
+    let g = vec3<f32>(
+        sample_volume(u + vec3<f32>(off.x, 0.0, 0.0)) - sample_volume(u - vec3<f32>(off.x, 0.0, 0.0)),
+        sample_volume(u + vec3<f32>(0.0, off.y, 0.0)) - sample_volume(u - vec3<f32>(0.0, off.y, 0.0)),
+        sample_volume(u + vec3<f32>(0.0, 0.0, off.z)) - sample_volume(u - vec3<f32>(0.0, 0.0, off.z)),
+    );
+    let l = -d_world;
+    var n = l;
+    if (length(g) >= 1e-6) {
+        // g spans two voxels per axis: the world gradient is g / (2 · voxel_world) with
+        // voxel_world = 2·half / dims, so its direction is that of g · dims / half.
+        n = -normalize(g * frame.volume_dims.xyz / frame.half_extent.xyz);
+    }
+    // Headlight: l = v = -d, so h = normalize(l + v) = l.
+    let n_dot_l = abs(dot(n, l));
+    var spec = 0.0;
+    if (n_dot_l > 0.0) {
+        spec = params.specular * pow(n_dot_l, params.shininess);
+    }
+    let base = sample_tf(params.iso_value).rgb;
+    return clamp(base * (params.ambient + params.diffuse * n_dot_l) + vec3<f32>(spec), vec3<f32>(0.0), vec3<f32>(1.0));
+}
+
+// First-hit isosurface along u0 + t·d_tex: the first sample k with s >= iso, refined linearly
+// between samples k-1 and k (t_0 itself when k = 0), shaded with the headlight.
+fn march_iso(u0: vec3<f32>, d_tex: vec3<f32>, len_tex: f32, pixel: vec2<u32>) -> IsoResult {
+    var result = IsoResult(vec4<f32>(0.0), vec4<f32>(0.0));
+    if (!ray_is_valid(u0, d_tex, len_tex)) {
+        return result;
+    }
+    let step_tex = ray_step_tex(d_tex);
+    let jitter = ray_jitter(pixel);
+    let iso = params.iso_value;
+    var t_prev = 0.0;
+    var s_prev = 0.0;
+    for (var k = 0u; k < params.max_steps; k += 1u) {
+        let t = (f32(k) + 0.5 + jitter) * step_tex;
+        if (!(t < len_tex)) {
+            break;
+        }
+        let s = sample_volume(u0 + t * d_tex);
+        if (s >= iso) {
+            var t_hit = t;
+            if (k > 0u) {
+                t_hit = t_prev + (t - t_prev) * (iso - s_prev) / (s - s_prev);
+            }
+            let u = u0 + t_hit * d_tex;
+            let d_world = normalize(d_tex * 2.0 * frame.half_extent.xyz);
+            result.color = vec4<f32>(shade_iso(u, d_world), 1.0);
+            result.hit = vec4<f32>(u, 1.0);
+            return result;
+        }
+        t_prev = t;
+        s_prev = s;
+    }
+    return result;
+}

@@ -1,5 +1,24 @@
 //! volgraph's spine: the RON graph format, validation with located diagnostics, the scheduler
 //! that orders passes, culls what no output needs and pools transient targets, the pass-plugin
 //! API, and the wgpu executor. It knows graphs, ports and scheduling, never a technique.
+//!
+//! Data flow: graph text → [`graph::parse_graph`] → [`compile::compile`] (validation, then
+//! scheduling) → [`plan::Plan`] → the executor records GPU frames.
 
+pub mod compile;
+pub mod diagnostic;
+pub mod executor;
+pub mod format;
+pub mod graph;
+pub mod params;
+pub mod plan;
+pub mod plugin;
 pub mod shader_source;
+pub mod suggest;
+
+pub use compile::{CompileOptions, compile};
+pub use diagnostic::{Diagnostic, Diagnostics, Location};
+pub use format::{TargetFormat, TargetSize};
+pub use params::{ParamSpec, ParamValue, Params};
+pub use plan::Plan;
+pub use plugin::{Access, PassNode, PassPlugin, PortKind, PortSpec, Registry};

@@ -1,0 +1,430 @@
+//! Scheduling: unroll repeat groups, resolve every reference to a concrete value, order the
+//! pass instances, cull what no output needs, and pool transient targets.
+//!
+//! Pooling: WebGPU has no memory aliasing, so reuse by descriptor is the equivalent. A target's
+//! lifetime runs from the step that writes it to the last step that reads it (a Modify chain —
+//! blending into an accumulation target, a depth buffer tested and rewritten — is one texture
+//! from its first write to its last read). Targets are assigned first-fit, in order of first
+//! write, to a slot of the same format and size whose previous holder was last read strictly
+//! before. A chain of N passes each reading the previous output therefore needs 2 slots, and a
+//! repeat group's feedback ping-pongs between two.
+
+use std::cmp::Reverse;
+use std::collections::{BTreeMap, BinaryHeap, HashMap};
+
+use super::CompileOptions;
+use super::check::{Checked, Item, Ref, ValueDesc};
+use crate::diagnostic::{Diagnostic, Location};
+use crate::graph::ast::GraphDoc;
+use crate::plan::{Binding, BoundPort, History, Plan, Resource, ResourceDesc, ResourceId, Slot, Step};
+use crate::plugin::Access;
+
+#[derive(Clone, Debug, PartialEq)]
+enum Val {
+    Out(usize, String),
+    Input(String),
+    History(String),
+    Unbound,
+}
+
+struct Inst {
+    pass: usize,
+    iter: Option<u32>,
+    label: String,
+}
+
+pub(crate) fn schedule(_doc: &GraphDoc, c: Checked, options: &CompileOptions) -> Result<Plan, Vec<Diagnostic>> {
+    // 1. Instances, in document order.
+    let mut insts: Vec<Inst> = Vec::new();
+    let mut inst_of: HashMap<(usize, Option<u32>), usize> = HashMap::new();
+    for item in &c.order {
+        match item {
+            Item::Pass(pi) if c.passes[*pi].enabled => {
+                inst_of.insert((*pi, None), insts.len());
+                insts.push(Inst { pass: *pi, iter: None, label: c.passes[*pi].id.clone() });
+            }
+            Item::Pass(_) => {}
+            Item::Group(gi) => {
+                let g = &c.groups[*gi];
+                for it in 0..g.count {
+                    for &m in &g.members {
+                        if c.passes[m].enabled {
+                            inst_of.insert((m, Some(it)), insts.len());
+                            insts.push(Inst { pass: m, iter: Some(it), label: format!("{}[{it}]/{}", g.id, c.passes[m].id) });
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    let resolver = Resolver { c: &c, inst_of: &inst_of };
+    // 2. Each instance's inputs as concrete values.
+    let mut inputs: Vec<Vec<(usize, Val)>> = Vec::with_capacity(insts.len());
+    for inst in &insts {
+        let p = &c.passes[inst.pass];
+        let mut vals = Vec::new();
+        for (k, spec) in p.ports.iter().enumerate() {
+            if !spec.is_input() {
+                continue;
+            }
+            let v = match p.inputs.get(spec.name) {
+                Some(r) => resolver.resolve(r, p.group, inst.iter, 0).unwrap_or(Val::Unbound),
+                None => Val::Unbound,
+            };
+            vals.push((k, v));
+        }
+        inputs.push(vals);
+    }
+
+    // 3. Dependencies: producer → consumer, and readers of a value before its modifier.
+    let n = insts.len();
+    let mut preds: Vec<Vec<usize>> = vec![Vec::new(); n];
+    let mut readers: HashMap<(usize, String), Vec<usize>> = HashMap::new();
+    let mut modifiers: HashMap<(usize, String), Vec<usize>> = HashMap::new();
+    for (i, vals) in inputs.iter().enumerate() {
+        let p = &c.passes[insts[i].pass];
+        for (k, v) in vals {
+            if let Val::Out(src, port) = v {
+                preds[i].push(*src);
+                let key = (*src, port.clone());
+                if p.ports[*k].access == Access::Modify {
+                    modifiers.entry(key).or_default().push(i);
+                } else {
+                    readers.entry(key).or_default().push(i);
+                }
+            }
+        }
+    }
+    let mut diags = Vec::new();
+    for (key, mods) in &modifiers {
+        if mods.len() > 1 {
+            let a = &insts[mods[0]];
+            let b = &insts[mods[1]];
+            let pa = &c.passes[a.pass];
+            diags.push(
+                Diagnostic::new(
+                    Location::Field { pass: c.passes[b.pass].id.clone(), field: "inputs".to_string() },
+                    format!(
+                        "passes \"{}\" and \"{}\" both modify \"{}.{}\"",
+                        a.label, b.label, insts[key.0].label, key.1
+                    ),
+                    )
+                .with_help(format!("let \"{}\" modify the output of \"{}\" instead", c.passes[b.pass].id, pa.id)),
+            );
+        }
+        for r in readers.get(key).into_iter().flatten() {
+            if !mods.contains(r) {
+                preds[mods[0]].push(*r);
+            }
+        }
+    }
+    if !diags.is_empty() {
+        return Err(diags);
+    }
+
+    // 4. Culling: keep what graph outputs, history and sinks need.
+    let mut needed = vec![false; n];
+    let mut stack: Vec<usize> = Vec::new();
+    let mut output_vals = BTreeMap::new();
+    for (name, r) in &c.outputs {
+        if let Some(v) = resolver.resolve(r, None, None, 0) {
+            if let Val::Out(i, _) = &v {
+                stack.push(*i);
+            }
+            output_vals.insert(name.clone(), v);
+        }
+    }
+    let mut history_vals = BTreeMap::new();
+    for (name, (r, init)) in &c.history {
+        if let Some(v @ Val::Out(i, _)) = resolver.resolve(r, None, None, 0) {
+            stack.push(i);
+            history_vals.insert(name.clone(), (v, init.clone()));
+        }
+    }
+    for (i, inst) in insts.iter().enumerate() {
+        if c.passes[inst.pass].plugin.as_ref().is_some_and(|p| p.is_sink()) {
+            stack.push(i);
+        }
+    }
+    while let Some(i) = stack.pop() {
+        if std::mem::replace(&mut needed[i], true) {
+            continue;
+        }
+        stack.extend(preds[i].iter().copied());
+    }
+
+    // 5. Order: Kahn's algorithm, ties broken by document order.
+    let mut indegree = vec![0usize; n];
+    let mut succs: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (i, ps) in preds.iter().enumerate() {
+        if !needed[i] {
+            continue;
+        }
+        let mut ps = ps.clone();
+        ps.sort_unstable();
+        ps.dedup();
+        for p in ps {
+            if needed[p] {
+                indegree[i] += 1;
+                succs[p].push(i);
+            }
+        }
+    }
+    let mut ready: BinaryHeap<Reverse<usize>> = (0..n).filter(|&i| needed[i] && indegree[i] == 0).map(Reverse).collect();
+    let mut order = Vec::new();
+    while let Some(Reverse(i)) = ready.pop() {
+        order.push(i);
+        for &s in &succs[i] {
+            indegree[s] -= 1;
+            if indegree[s] == 0 {
+                ready.push(Reverse(s));
+            }
+        }
+    }
+    let needed_count = needed.iter().filter(|x| **x).count();
+    if order.len() != needed_count {
+        let stuck: Vec<&str> = (0..n).filter(|&i| needed[i] && !order.contains(&i)).map(|i| insts[i].label.as_str()).collect();
+        return Err(vec![
+            Diagnostic::new(Location::File, format!("passes {} cannot be ordered: a pass reads a value after another pass modified it", stuck.join(", ")))
+                .with_help("read the modified version (\"<modifier>.<port>\") instead of the original".to_string()),
+        ]);
+    }
+    let step_of: HashMap<usize, usize> = order.iter().enumerate().map(|(s, &i)| (i, s)).collect();
+
+    // 6. Resources.
+    let mut resources: Vec<Resource> = Vec::new();
+    let mut rid_of: HashMap<(usize, String), ResourceId> = HashMap::new();
+    let mut steps: Vec<Step> = Vec::new();
+    for (s, &i) in order.iter().enumerate() {
+        let inst = &insts[i];
+        let p = &c.passes[inst.pass];
+        let mut ports = Vec::new();
+        let mut input_iter = inputs[i].iter();
+        for spec in &p.ports {
+            let binding = match spec.access {
+                Access::Read | Access::Modify => {
+                    let v = input_iter.next().map(|(_, v)| v.clone()).unwrap_or(Val::Unbound);
+                    match v {
+                        Val::Out(src, port) => {
+                            let id = rid_of.get(&(src, port.clone())).copied();
+                            match id {
+                                Some(id) => {
+                                    let written = (spec.access == Access::Modify).then(|| {
+                                        let desc = resources[id].desc.clone();
+                                        let w = resources.len();
+                                        resources.push(Resource {
+                                            name: format!("{}.{}", inst.label, spec.name),
+                                            desc,
+                                            producer: s,
+                                            last_use: s,
+                                            slot: None,
+                                            modifies: Some(id),
+                                        });
+                                        rid_of.insert((i, spec.name.to_string()), w);
+                                        w
+                                    });
+                                    resources[id].last_use = resources[id].last_use.max(s);
+                                    Binding::Resource { id, written }
+                                }
+                                None => Binding::Unbound,
+                            }
+                        }
+                        Val::Input(n) => Binding::Input(n),
+                        Val::History(n) => Binding::History(n),
+                        Val::Unbound => Binding::Unbound,
+                    }
+                }
+                Access::Write => {
+                    let desc = match p.outputs.get(spec.name) {
+                        Some(ValueDesc::Target { format, size }) => ResourceDesc::Target {
+                            format: *format,
+                            size: *size,
+                            extent: size.resolve(options.viewport),
+                        },
+                        Some(ValueDesc::Owned(t)) => ResourceDesc::Owned(t.clone()),
+                        _ => ResourceDesc::Owned("value".to_string()),
+                    };
+                    let id = resources.len();
+                    resources.push(Resource {
+                        name: format!("{}.{}", inst.label, spec.name),
+                        desc,
+                        producer: s,
+                        last_use: s,
+                        slot: None,
+                        modifies: None,
+                    });
+                    rid_of.insert((i, spec.name.to_string()), id);
+                    Binding::Resource { id, written: None }
+                }
+            };
+            ports.push(BoundPort { port: spec.name.to_string(), access: spec.access, binding });
+        }
+        steps.push(Step {
+            label: inst.label.clone(),
+            pass_id: p.id.clone(),
+            kind: p.kind.clone(),
+            iteration: inst.iter.map(|it| (it, p.group.map_or(1, |g| c.groups[g].count))),
+            params: p.params.clone(),
+            ports,
+        });
+    }
+    let _ = step_of;
+    let mut outputs = BTreeMap::new();
+    for (name, v) in &output_vals {
+        if let Val::Out(i, port) = v {
+            if let Some(&id) = rid_of.get(&(*i, port.clone())) {
+                resources[id].last_use = usize::MAX;
+                outputs.insert(name.clone(), id);
+            }
+        }
+    }
+    let mut history = BTreeMap::new();
+    let mut persistent_roots = Vec::new();
+    for (name, (v, initial)) in &history_vals {
+        if let Val::Out(i, port) = v {
+            if let Some(&id) = rid_of.get(&(*i, port.clone())) {
+                resources[id].last_use = usize::MAX;
+                persistent_roots.push(root_of(&resources, id));
+                history.insert(name.clone(), History { source: id, initial: initial.clone() });
+            }
+        }
+    }
+
+    // 7. Pool targets over chain lifetimes.
+    let slots = pool(&mut resources, &persistent_roots);
+
+    let culled: Vec<String> = {
+        let mut ids: Vec<String> = Vec::new();
+        for item in &c.order {
+            let members: Vec<usize> = match item {
+                Item::Pass(pi) => vec![*pi],
+                Item::Group(gi) => c.groups[*gi].members.clone(),
+            };
+            for pi in members {
+                if !c.passes[pi].enabled {
+                    continue;
+                }
+                let any_needed = (0..n).any(|i| insts[i].pass == pi && needed[i]);
+                if !any_needed {
+                    ids.push(c.passes[pi].id.clone());
+                }
+            }
+        }
+        ids
+    };
+    let gated = c
+        .passes
+        .iter()
+        .filter(|p| !p.enabled)
+        .map(|p| (p.id.clone(), p.needs.iter().filter(|f| !options.features.contains(*f)).cloned().collect()))
+        .collect();
+    Ok(Plan {
+        name: _doc.name.clone(),
+        viewport: options.viewport,
+        features: options.features.clone(),
+        inputs: c.inputs.clone(),
+        steps,
+        culled,
+        gated,
+        resources,
+        slots,
+        outputs,
+        history,
+    })
+}
+
+fn root_of(resources: &[Resource], mut id: ResourceId) -> ResourceId {
+    while let Some(prev) = resources[id].modifies {
+        id = prev;
+    }
+    id
+}
+
+fn pool(resources: &mut [Resource], persistent_roots: &[ResourceId]) -> Vec<Slot> {
+    // Chain lifetimes, keyed by root.
+    let mut chains: BTreeMap<ResourceId, (usize, usize, Vec<ResourceId>)> = BTreeMap::new();
+    for id in 0..resources.len() {
+        if !matches!(resources[id].desc, ResourceDesc::Target { .. }) {
+            continue;
+        }
+        let root = root_of(resources, id);
+        let e = chains.entry(root).or_insert((resources[root].producer, 0, Vec::new()));
+        e.1 = e.1.max(resources[id].last_use);
+        e.2.push(id);
+    }
+    let mut by_start: Vec<(ResourceId, usize, usize, Vec<ResourceId>)> =
+        chains.into_iter().map(|(root, (start, end, members))| (root, start, end, members)).collect();
+    by_start.sort_by_key(|(root, start, _, _)| (*start, *root));
+    let mut slots: Vec<Slot> = Vec::new();
+    let mut busy_until: Vec<usize> = Vec::new();
+    for (root, start, end, members) in by_start {
+        let ResourceDesc::Target { format, extent, .. } = resources[root].desc else { continue };
+        let persistent = persistent_roots.contains(&root);
+        let reuse = if persistent {
+            None
+        } else {
+            (0..slots.len()).find(|&s| {
+                !slots[s].persistent && slots[s].format == format && slots[s].extent == extent && busy_until[s] < start
+            })
+        };
+        let s = match reuse {
+            Some(s) => s,
+            None => {
+                slots.push(Slot { format, extent, persistent, holds: Vec::new() });
+                busy_until.push(0);
+                slots.len() - 1
+            }
+        };
+        busy_until[s] = end;
+        for m in members {
+            resources[m].slot = Some(s);
+            slots[s].holds.push(m);
+        }
+    }
+    slots
+}
+
+struct Resolver<'a> {
+    c: &'a Checked,
+    inst_of: &'a HashMap<(usize, Option<u32>), usize>,
+}
+
+impl Resolver<'_> {
+    fn resolve(&self, r: &Ref, reader_group: Option<usize>, iter: Option<u32>, depth: usize) -> Option<Val> {
+        if depth > 64 {
+            return None;
+        }
+        let c = self.c;
+        match r {
+            Ref::Input(n) => Some(Val::Input(n.clone())),
+            Ref::History(n) => Some(Val::History(n.clone())),
+            Ref::Output { pass, port } => {
+                let p = &c.passes[*pass];
+                let it = if p.group.is_some() { iter } else { None };
+                if !p.enabled {
+                    let stand_in = p.otherwise.get(port)?;
+                    return self.resolve(stand_in, p.group, it, depth + 1);
+                }
+                if let Some(&i) = self.inst_of.get(&(*pass, it)) {
+                    return Some(Val::Out(i, port.clone()));
+                }
+                // A Modify port's output when the pass is not instantiated cannot happen; a
+                // pass in a group read from outside is rejected by the checker.
+                None
+            }
+            Ref::Carry { group, name } => {
+                let g = &c.groups[*group];
+                let (init, next) = g.carry.get(name)?;
+                if reader_group == Some(*group) {
+                    match iter {
+                        Some(0) | None => self.resolve(init, None, None, depth + 1),
+                        Some(i) => self.resolve(next, Some(*group), Some(i - 1), depth + 1),
+                    }
+                } else {
+                    self.resolve(next, Some(*group), Some(g.count.saturating_sub(1)), depth + 1)
+                }
+            }
+        }
+    }
+}

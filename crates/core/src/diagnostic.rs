@@ -1,0 +1,147 @@
+//! Located, actionable errors about graph files.
+//!
+//! Every problem found while compiling a graph becomes one [`Diagnostic`]: what is wrong, where
+//! (a byte span in the file, or the pass and field when no span can be found) and how to fix it.
+//! Compilation collects all of them before failing ([`Diagnostics`]). `Display` prints the
+//! compiler-style one-liner tests compare word for word,
+//! `graphs/kw03.ron:14:9: pass "march" reads "dirs.dir2", but ...`, followed by an indented
+//! `help:` line; the `miette::Diagnostic` impl lets the app draw the source excerpt.
+
+use std::fmt;
+use std::sync::Arc;
+
+use crate::graph::spans::{Span, line_col};
+
+/// Where a diagnostic points.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Location {
+    /// A byte span in the graph file.
+    Span(Span),
+    /// No span could be found: the pass (or group) id and the field.
+    Field {
+        /// The pass or repeat id.
+        pass: String,
+        /// The field within it (`inputs.dir`, `params.step_voxels`).
+        field: String,
+    },
+    /// The file as a whole.
+    File,
+}
+
+/// One problem in a graph file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Diagnostic {
+    /// What is wrong.
+    pub message: String,
+    /// How to fix it, if we can say.
+    pub help: Option<String>,
+    /// Where.
+    pub location: Location,
+}
+
+impl Diagnostic {
+    /// A diagnostic at `location`.
+    pub fn new(location: Location, message: impl Into<String>) -> Self {
+        Self { message: message.into(), help: None, location }
+    }
+
+    /// Adds the fix.
+    pub fn with_help(mut self, help: impl Into<String>) -> Self {
+        self.help = Some(help.into());
+        self
+    }
+}
+
+/// All problems of one graph file, with the file's name and text for rendering.
+#[derive(Clone, Debug, thiserror::Error)]
+pub struct Diagnostics {
+    /// The file name as given (used as the prefix of every line).
+    pub file: String,
+    /// The file text.
+    pub text: Arc<str>,
+    /// The problems, in the order found.
+    pub items: Vec<Diagnostic>,
+}
+
+impl Diagnostics {
+    /// The `file:line:col` (or `file: pass "x", field y`) prefix of one item.
+    pub fn position(&self, d: &Diagnostic) -> String {
+        match &d.location {
+            Location::Span(s) => {
+                let (line, col) = line_col(&self.text, s.start);
+                format!("{}:{line}:{col}", self.file)
+            }
+            Location::Field { pass, field } => format!("{}: pass \"{pass}\", field {field}", self.file),
+            Location::File => self.file.clone(),
+        }
+    }
+}
+
+impl fmt::Display for Diagnostics {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, d) in self.items.iter().enumerate() {
+            if i > 0 {
+                writeln!(f)?;
+            }
+            write!(f, "{}: {}", self.position(d), d.message)?;
+            if let Some(help) = &d.help {
+                write!(f, "\n  help: {help}")?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One item rendered for miette, with its label in the source.
+#[derive(Debug)]
+struct MietteItem {
+    message: String,
+    help: Option<String>,
+    span: Option<Span>,
+    source: miette::NamedSource<String>,
+}
+
+impl fmt::Display for MietteItem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for MietteItem {}
+
+impl miette::Diagnostic for MietteItem {
+    fn help<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
+        self.help.as_ref().map(|h| Box::new(h) as Box<dyn fmt::Display>)
+    }
+
+    fn source_code(&self) -> Option<&dyn miette::SourceCode> {
+        Some(&self.source)
+    }
+
+    fn labels(&self) -> Option<Box<dyn Iterator<Item = miette::LabeledSpan> + '_>> {
+        let span = self.span?;
+        Some(Box::new(std::iter::once(miette::LabeledSpan::at(span.start..span.end, "here"))))
+    }
+}
+
+impl Diagnostics {
+    /// Each item as a `miette::Report` with the source excerpt (for the CLI).
+    pub fn to_miette_reports(&self) -> Vec<miette::Report> {
+        self.items
+            .iter()
+            .map(|d| {
+                let (span, message) = match &d.location {
+                    Location::Span(s) => (Some(*s), d.message.clone()),
+                    Location::Field { pass, field } => (None, format!("pass \"{pass}\", field {field}: {}", d.message)),
+                    Location::File => (None, d.message.clone()),
+                };
+                miette::Report::new(MietteItem {
+                    message,
+                    help: d.help.clone(),
+                    span,
+                    source: miette::NamedSource::new(self.file.clone(), self.text.to_string()),
+                })
+            })
+            .collect()
+    }
+}

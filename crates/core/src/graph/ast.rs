@@ -1,0 +1,163 @@
+//! The graph file as written: what serde reads from RON, before any validation.
+//! The format is documented with a complete annotated example in `docs/graph_format.md`.
+
+use std::collections::BTreeMap;
+
+use serde::Deserialize;
+
+use crate::format::{TargetFormat, TargetSize};
+
+/// A whole graph file: `Graph( ... )`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GraphDoc {
+    /// A short name, shown in plans and benchmarks.
+    pub name: String,
+    /// What the graph does, for people.
+    #[serde(default)]
+    pub description: String,
+    /// Values the application binds: `{"volume": Volume, "tf": TransferFunction, "segments": Scalar(8.0)}`.
+    #[serde(default)]
+    pub inputs: BTreeMap<String, InputKind>,
+    /// Previous-frame values: `{"prev_hit": (of: "march.hit", initial: Clear((0,0,0,0)))}`.
+    #[serde(default)]
+    pub history: BTreeMap<String, HistoryDoc>,
+    /// Passes and repeat groups, in any order (the scheduler orders them).
+    pub passes: Vec<NodeDoc>,
+    /// Named results: `{"image": "march.color"}`.
+    pub outputs: BTreeMap<String, String>,
+}
+
+/// The kind of a graph input.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+pub enum InputKind {
+    /// The scalar volume, bound as a 3D texture.
+    Volume,
+    /// The transfer function, bound as a LUT texture.
+    TransferFunction,
+    /// A scene scalar with its default value (repeat counts, thresholds).
+    Scalar(f64),
+}
+
+/// A history entry: the previous frame's value of a target.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HistoryDoc {
+    /// The target whose previous-frame value is read, as `"<pass>.<output>"`.
+    pub of: String,
+    /// The value on the first frame and after invalidation.
+    #[serde(default)]
+    pub initial: HistoryInitial,
+}
+
+/// What a history target holds when there is no previous frame.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+pub enum HistoryInitial {
+    /// Cleared to this RGBA value.
+    Clear((f64, f64, f64, f64)),
+}
+
+impl Default for HistoryInitial {
+    fn default() -> Self {
+        HistoryInitial::Clear((0.0, 0.0, 0.0, 0.0))
+    }
+}
+
+/// One entry of `passes`: a pass or a repeat group.
+#[derive(Clone, Debug, Deserialize)]
+pub enum NodeDoc {
+    /// A single pass.
+    Pass(PassDoc),
+    /// A body of passes run several times with feedback.
+    Repeat(RepeatDoc),
+}
+
+/// A pass: one node of the graph.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PassDoc {
+    /// Unique id, used in references (`"<id>.<output>"`), labels and messages.
+    pub id: String,
+    /// The plugin name (`"raycast"`, `"entry_points"`, ...).
+    pub kind: String,
+    /// Typed parameters, checked against the plugin's declaration.
+    #[serde(default)]
+    pub params: BTreeMap<String, ron::Value>,
+    /// Input port → `"<pass>.<output>"`, `"input.<name>"`, `"history.<name>"` or, inside a
+    /// repeat body, `"<repeat id>.<carried name>"`.
+    #[serde(default)]
+    pub inputs: BTreeMap<String, String>,
+    /// Output port → target declaration overriding the plugin's defaults.
+    #[serde(default)]
+    pub outputs: BTreeMap<String, TargetDoc>,
+    /// Scene features that must all be on for this pass to be scheduled.
+    #[serde(default)]
+    pub when: Vec<String>,
+    /// When the pass is gated off: output port → the reference that stands in for it.
+    #[serde(default)]
+    pub otherwise: BTreeMap<String, String>,
+}
+
+/// An output target declaration; every field defaults to the plugin's choice.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TargetDoc {
+    /// Pixel format.
+    #[serde(default)]
+    pub format: Option<TargetFormat>,
+    /// Size relative to the viewport or absolute.
+    #[serde(default)]
+    pub size: Option<TargetSize>,
+}
+
+/// A repeat group: `body` runs `count` times; `carry` feeds values from one iteration to the next.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RepeatDoc {
+    /// Unique id; `"<id>.<carried>"` names a carried value (inside: the previous iteration's,
+    /// after the group: the last iteration's).
+    pub id: String,
+    /// How many iterations.
+    pub count: RepeatCount,
+    /// Carried values: name → where the first iteration's value comes from and which body
+    /// output becomes the next iteration's.
+    pub carry: BTreeMap<String, CarryDoc>,
+    /// The passes of one iteration.
+    pub body: Vec<PassDoc>,
+}
+
+/// The iteration count of a repeat group.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+pub enum RepeatCount {
+    /// A fixed count.
+    Fixed(u32),
+    /// `ceil(scene scalar / divide_by)`, clamped to `1..=max`.
+    Scene {
+        /// The graph input (a `Scalar`) or derived scene quantity to read.
+        name: String,
+        /// Divisor (e.g. Krüger–Westermann's M steps per segment).
+        #[serde(default = "one")]
+        divide_by: f64,
+        /// Upper bound on the count.
+        #[serde(default = "default_max_iterations")]
+        max: u32,
+    },
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+fn default_max_iterations() -> u32 {
+    256
+}
+
+/// One carried value of a repeat group.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CarryDoc {
+    /// The value before the first iteration: a reference from outside the group.
+    pub init: String,
+    /// The body output that becomes the next iteration's value: `"<body pass>.<output>"`.
+    pub next: String,
+}

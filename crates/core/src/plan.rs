@@ -1,0 +1,266 @@
+//! The compiled, scheduled graph: what the executor runs and `volgraph plan` prints.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt::Write as _;
+
+use crate::format::{TargetFormat, TargetSize};
+use crate::graph::ast::{HistoryInitial, InputKind};
+use crate::params::Params;
+use crate::plugin::Access;
+
+/// Index into [`Plan::resources`].
+pub type ResourceId = usize;
+
+/// A compiled graph for one viewport and feature set.
+#[derive(Clone, Debug)]
+pub struct Plan {
+    /// The graph's name.
+    pub name: String,
+    /// Viewport in pixels.
+    pub viewport: (u32, u32),
+    /// Scene features that were on.
+    pub features: BTreeSet<String>,
+    /// Graph inputs the application binds.
+    pub inputs: BTreeMap<String, InputKind>,
+    /// Pass instances in execution order (repeat groups unrolled).
+    pub steps: Vec<Step>,
+    /// Passes that no output needs, with the reason.
+    pub culled: Vec<String>,
+    /// Passes switched off by scene features: (pass id, the features it needs).
+    pub gated: Vec<(String, Vec<String>)>,
+    /// Every value a step writes.
+    pub resources: Vec<Resource>,
+    /// Physical textures: pooled transient slots, then history pairs.
+    pub slots: Vec<Slot>,
+    /// Graph outputs → the resource holding each.
+    pub outputs: BTreeMap<String, ResourceId>,
+    /// History entries: name → what they track.
+    pub history: BTreeMap<String, History>,
+}
+
+/// One pass instance.
+#[derive(Clone, Debug)]
+pub struct Step {
+    /// Unique instance name: the pass id, or `group[i]/pass` inside a repeat group.
+    pub label: String,
+    /// The pass id in the graph file.
+    pub pass_id: String,
+    /// The plugin kind.
+    pub kind: String,
+    /// (iteration, count) when inside a repeat group.
+    pub iteration: Option<(u32, u32)>,
+    /// Checked parameters.
+    pub params: Params,
+    /// Port bindings in port declaration order.
+    pub ports: Vec<BoundPort>,
+}
+
+/// What one port of a step is bound to.
+#[derive(Clone, Debug)]
+pub struct BoundPort {
+    /// Port name.
+    pub port: String,
+    /// Read, write or modify.
+    pub access: Access,
+    /// The value.
+    pub binding: Binding,
+}
+
+/// The value bound to a port.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Binding {
+    /// A resource written by a step (for Modify ports: the version read; the version written is
+    /// in `written`).
+    Resource {
+        /// The resource read (Read/Modify) or written (Write).
+        id: ResourceId,
+        /// For Modify: the new version this step writes (same slot as `id`).
+        written: Option<ResourceId>,
+    },
+    /// A graph input bound by the application.
+    Input(String),
+    /// The previous frame's value of a history entry.
+    History(String),
+    /// An optional input left unwired.
+    Unbound,
+}
+
+/// What a resource is.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ResourceDesc {
+    /// A 2D target.
+    Target {
+        /// Pixel format.
+        format: TargetFormat,
+        /// Declared size.
+        size: TargetSize,
+        /// Resolved pixel size.
+        extent: (u32, u32),
+    },
+    /// A resource owned by its producing pass, shared by type name.
+    Owned(String),
+}
+
+impl ResourceDesc {
+    /// Bytes of a target (0 for owned resources).
+    pub fn bytes(&self) -> u64 {
+        match self {
+            ResourceDesc::Target { format, extent, .. } => format.bytes_per_pixel() * extent.0 as u64 * extent.1 as u64,
+            ResourceDesc::Owned(_) => 0,
+        }
+    }
+}
+
+/// One version of a value.
+#[derive(Clone, Debug)]
+pub struct Resource {
+    /// `pass.port` or `group[i]/pass.port`.
+    pub name: String,
+    /// Format and size.
+    pub desc: ResourceDesc,
+    /// The step that writes it.
+    pub producer: usize,
+    /// The last step that reads it (or any later version in its Modify chain); `usize::MAX`
+    /// when it must live to the end of the frame (graph outputs, history sources).
+    pub last_use: usize,
+    /// The physical slot, for targets.
+    pub slot: Option<usize>,
+    /// For Modify outputs: the version it was made from (same slot).
+    pub modifies: Option<ResourceId>,
+}
+
+/// A physical texture.
+#[derive(Clone, Debug)]
+pub struct Slot {
+    /// Format.
+    pub format: TargetFormat,
+    /// Size in pixels.
+    pub extent: (u32, u32),
+    /// True for a history pair's current-frame texture (kept across frames, never pooled).
+    pub persistent: bool,
+    /// Resources that use it, in order.
+    pub holds: Vec<ResourceId>,
+}
+
+impl Slot {
+    /// Bytes of the texture.
+    pub fn bytes(&self) -> u64 {
+        self.format.bytes_per_pixel() * self.extent.0 as u64 * self.extent.1 as u64
+    }
+}
+
+/// A history entry.
+#[derive(Clone, Debug)]
+pub struct History {
+    /// The resource whose value is kept for the next frame.
+    pub source: ResourceId,
+    /// The value before the first frame and after invalidation.
+    pub initial: HistoryInitial,
+}
+
+/// Transient memory figures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MemoryReport {
+    /// Bytes of the pooled transient slots.
+    pub pooled_bytes: u64,
+    /// Bytes if every transient resource chain had its own texture.
+    pub unpooled_bytes: u64,
+    /// Bytes kept across frames for history (current + previous).
+    pub history_bytes: u64,
+}
+
+impl Plan {
+    /// Pooled vs unpooled transient memory.
+    pub fn memory(&self) -> MemoryReport {
+        let pooled_bytes = self.slots.iter().filter(|s| !s.persistent).map(Slot::bytes).sum();
+        let history_bytes = self.slots.iter().filter(|s| s.persistent).map(|s| 2 * s.bytes()).sum();
+        let unpooled_bytes = self
+            .resources
+            .iter()
+            .filter(|r| r.modifies.is_none())
+            .filter(|r| r.slot.is_some_and(|s| !self.slots[s].persistent))
+            .map(|r| r.desc.bytes())
+            .sum();
+        MemoryReport { pooled_bytes, unpooled_bytes, history_bytes }
+    }
+
+    /// The human-readable plan `volgraph plan` prints (and the golden files hold).
+    pub fn to_text(&self) -> String {
+        let mut s = String::new();
+        let features = if self.features.is_empty() {
+            "none".to_string()
+        } else {
+            self.features.iter().cloned().collect::<Vec<_>>().join(", ")
+        };
+        let _ = writeln!(s, "plan \"{}\" at {}x{}, features: {}", self.name, self.viewport.0, self.viewport.1, features);
+        let _ = writeln!(s, "steps ({}):", self.steps.len());
+        for (i, step) in self.steps.iter().enumerate() {
+            let _ = writeln!(s, "  {i:>3} {} [{}]", step.label, step.kind);
+            for p in &step.ports {
+                let what = match &p.binding {
+                    Binding::Resource { id, written } => {
+                        let r = &self.resources[*id];
+                        let slot = r.slot.map_or(String::new(), |s| format!(" @slot{s}"));
+                        match (p.access, written) {
+                            (Access::Modify, Some(w)) => format!("{}{slot} -> {}", r.name, self.resources[*w].name),
+                            _ => format!("{}{slot}", r.name),
+                        }
+                    }
+                    Binding::Input(n) => format!("input.{n}"),
+                    Binding::History(n) => format!("history.{n}"),
+                    Binding::Unbound => "(unbound)".to_string(),
+                };
+                let arrow = match p.access {
+                    Access::Read => "reads ",
+                    Access::Write => "writes",
+                    Access::Modify => "modify",
+                };
+                let _ = writeln!(s, "        {arrow} {:<10} {what}", p.port);
+            }
+        }
+        let _ = writeln!(s, "culled: {}", if self.culled.is_empty() { "none".to_string() } else { self.culled.join(", ") });
+        if !self.gated.is_empty() {
+            let g: Vec<String> = self.gated.iter().map(|(p, f)| format!("{p} (needs {})", f.join(", "))).collect();
+            let _ = writeln!(s, "off by features: {}", g.join(", "));
+        }
+        let _ = writeln!(s, "slots:");
+        for (i, slot) in self.slots.iter().enumerate() {
+            let names: Vec<&str> = slot.holds.iter().map(|r| self.resources[*r].name.as_str()).collect();
+            let kind = if slot.persistent { "history" } else { "pooled" };
+            let _ = writeln!(
+                s,
+                "  slot{i} {} {}x{} {kind} {}: {}",
+                slot.format,
+                slot.extent.0,
+                slot.extent.1,
+                mib(slot.bytes()),
+                names.join(", ")
+            );
+        }
+        for (name, h) in &self.history {
+            let _ = writeln!(s, "history {name}: previous frame of {}", self.resources[h.source].name);
+        }
+        for (name, r) in &self.outputs {
+            let _ = writeln!(s, "output {name}: {}", self.resources[*r].name);
+        }
+        let m = self.memory();
+        let saved = if m.unpooled_bytes > 0 {
+            100.0 * (1.0 - m.pooled_bytes as f64 / m.unpooled_bytes as f64)
+        } else {
+            0.0
+        };
+        let _ = writeln!(
+            s,
+            "transient memory: pooled {}, unpooled {} ({saved:.0}% saved); history {}",
+            mib(m.pooled_bytes),
+            mib(m.unpooled_bytes),
+            mib(m.history_bytes)
+        );
+        s
+    }
+}
+
+/// Bytes as `12.3 MiB`.
+pub fn mib(bytes: u64) -> String {
+    format!("{:.1} MiB", bytes as f64 / (1024.0 * 1024.0))
+}

@@ -1,0 +1,202 @@
+//! The pass-plugin API: what a pass kind declares (ports, parameters, features) and how it
+//! records GPU work. Built-in passes register through exactly this API (`volgraph_passes::
+//! register_builtin`), so an external crate can add pass kinds the same way.
+
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+use crate::executor::{CreateContext, PassError, RecordContext};
+use crate::format::TargetFormat;
+use crate::params::{ParamSpec, Params};
+
+/// How a pass uses a port.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Access {
+    /// Reads a value produced elsewhere.
+    Read,
+    /// Produces a new value.
+    Write,
+    /// Reads a value and writes the next version of it in place (blending into an accumulation
+    /// target, testing and writing a depth buffer): the output aliases the input's texture.
+    Modify,
+}
+
+/// What size a target port requires.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SizeRule {
+    /// Any size.
+    Any,
+    /// The same size as the pass's other viewport-sized ports (texel-for-pixel access).
+    MatchPass,
+}
+
+/// The type of value a port carries.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PortKind {
+    /// A 2D target from the pool. For outputs the first format is the default.
+    Target {
+        /// Accepted formats.
+        formats: Vec<TargetFormat>,
+        /// Size requirement.
+        size: SizeRule,
+    },
+    /// The scalar volume (a graph input).
+    Volume,
+    /// The transfer-function LUT (a graph input).
+    TransferFunction,
+    /// A resource a pass owns and shares by name, e.g. `"minmax_grid"` (a 3D texture built from
+    /// the volume): producer and consumer must name the same type.
+    Owned(&'static str),
+}
+
+impl PortKind {
+    /// A target accepting `formats`, sized like the pass.
+    pub fn target(formats: &[TargetFormat]) -> Self {
+        PortKind::Target { formats: formats.to_vec(), size: SizeRule::MatchPass }
+    }
+
+    /// The name shown in messages.
+    pub fn describe(&self) -> String {
+        match self {
+            PortKind::Target { formats, .. } => {
+                let names: Vec<_> = formats.iter().map(|f| f.name()).collect();
+                format!("a target ({})", names.join(" or "))
+            }
+            PortKind::Volume => "the volume".to_string(),
+            PortKind::TransferFunction => "the transfer function".to_string(),
+            PortKind::Owned(t) => format!("a {t}"),
+        }
+    }
+}
+
+/// One declared port.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PortSpec {
+    /// Name, used in graph files and as the WGSL global / fragment-output member name.
+    pub name: &'static str,
+    /// Read, write or modify.
+    pub access: Access,
+    /// What it carries.
+    pub kind: PortKind,
+    /// When false, the graph may leave this input unwired.
+    pub required: bool,
+}
+
+impl PortSpec {
+    /// A required input.
+    pub fn read(name: &'static str, kind: PortKind) -> Self {
+        Self { name, access: Access::Read, kind, required: true }
+    }
+
+    /// An output.
+    pub fn write(name: &'static str, kind: PortKind) -> Self {
+        Self { name, access: Access::Write, kind, required: true }
+    }
+
+    /// A read-modify-write port.
+    pub fn modify(name: &'static str, kind: PortKind) -> Self {
+        Self { name, access: Access::Modify, kind, required: true }
+    }
+
+    /// Marks an input optional.
+    pub fn optional(mut self) -> Self {
+        self.required = false;
+        self
+    }
+
+    /// Whether the graph wires this port under `inputs`.
+    pub fn is_input(&self) -> bool {
+        matches!(self.access, Access::Read | Access::Modify)
+    }
+
+    /// Whether this port produces a value others can reference.
+    pub fn is_output(&self) -> bool {
+        matches!(self.access, Access::Write | Access::Modify)
+    }
+}
+
+/// A pass kind. Long-lived: [`PassPlugin::create`] builds the per-graph node that owns pipelines.
+pub trait PassPlugin: Send + Sync {
+    /// The name graph files use in `kind:`.
+    fn kind(&self) -> &'static str;
+
+    /// One line saying what the pass does and which paper section it follows.
+    fn summary(&self) -> &'static str;
+
+    /// Declared parameters.
+    fn params(&self) -> Vec<ParamSpec> {
+        Vec::new()
+    }
+
+    /// Ports, which may depend on parameters (an isosurface raycaster also writes `hit`).
+    fn ports(&self, params: &Params) -> Vec<PortSpec>;
+
+    /// Scene features this pass serves: it is only scheduled when all are on.
+    fn features(&self) -> Vec<&'static str> {
+        Vec::new()
+    }
+
+    /// Shader modules and entry points this pass uses with its parameters, so the compiler can
+    /// check the shaders' bindings against the ports (see [`crate::reflect`]).
+    fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
+        Vec::new()
+    }
+
+    /// True for passes whose effect is outside the graph (writing a file): never culled.
+    fn is_sink(&self) -> bool {
+        false
+    }
+
+    /// Builds the node that records this pass's GPU work for one compiled graph.
+    fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError>;
+}
+
+/// One shader entry point a pass uses.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ShaderUse {
+    /// File under `shaders/`, e.g. `raycast.wgsl`.
+    pub file: &'static str,
+    /// Entry point name.
+    pub entry_point: &'static str,
+}
+
+/// The per-graph instance of a pass kind: owns its pipelines, records each frame.
+pub trait PassNode: Send {
+    /// Records this pass's GPU work into the frame's encoder.
+    fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError>;
+}
+
+/// Maps kind names to plugins.
+#[derive(Clone, Default)]
+pub struct Registry {
+    plugins: BTreeMap<&'static str, Arc<dyn PassPlugin>>,
+}
+
+impl Registry {
+    /// An empty registry.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds a plugin; a later registration of the same kind replaces the earlier one.
+    pub fn register(&mut self, plugin: impl PassPlugin + 'static) -> &mut Self {
+        self.plugins.insert(plugin.kind(), Arc::new(plugin));
+        self
+    }
+
+    /// The plugin for `kind`.
+    pub fn get(&self, kind: &str) -> Option<&Arc<dyn PassPlugin>> {
+        self.plugins.get(kind)
+    }
+
+    /// All kind names, sorted.
+    pub fn kinds(&self) -> Vec<&'static str> {
+        self.plugins.keys().copied().collect()
+    }
+}
+
+impl std::fmt::Debug for Registry {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_list().entries(self.plugins.keys()).finish()
+    }
+}

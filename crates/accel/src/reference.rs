@@ -1,1 +1,429 @@
-//! (to be written)
+//! The f64 CPU reference raycaster: `docs/rendering_model.md` implemented once, slowly and
+//! exactly, so that every GPU image (fragment or compute, DVR or isosurface) can be compared
+//! with it pixel by pixel. The GPU twin of the marching code is `shaders/common/raymarch.wgsl`;
+//! the two follow the same steps in the same order.
+//!
+//! Techniques: Krüger & Westermann 2003 §2.1 (front-to-back compositing along per-pixel rays with
+//! early ray termination) and §2.2 (first-hit isosurface with gradient shading).
+
+use glam::DVec3;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::camera::{CameraFrame, OrbitCamera};
+use crate::volume::Volume;
+
+/// Blinn–Phong headlight coefficients for the isosurface (`docs/rendering_model.md`,
+/// "First-hit isosurface"); WGSL twin: the shading fields of `RaycastParams`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Phong {
+    /// Ambient term, multiplies the base colour (default 0.15).
+    pub ambient: f64,
+    /// Diffuse term, multiplies the base colour and `|n·l|` (default 0.75).
+    pub diffuse: f64,
+    /// Specular term, white, multiplies `|n·h|^shininess` (default 0.25).
+    pub specular: f64,
+    /// Specular exponent (default 32).
+    pub shininess: f64,
+}
+
+impl Default for Phong {
+    fn default() -> Self {
+        Self {
+            ambient: 0.15,
+            diffuse: 0.75,
+            specular: 0.25,
+            shininess: 32.0,
+        }
+    }
+}
+
+/// What a ray computes (`docs/rendering_model.md`, "Classification and compositing" and
+/// "First-hit isosurface").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum RenderMode {
+    /// Direct volume rendering: emission–absorption through the transfer function
+    /// (Krüger & Westermann 2003 §2.1).
+    #[default]
+    Dvr,
+    /// First-hit isosurface, shaded with a headlight (Krüger & Westermann 2003 §2.2).
+    Isosurface {
+        /// The iso value, a normalized scalar in [0,1].
+        iso: f64,
+        /// Shading coefficients.
+        #[serde(default)]
+        shading: Phong,
+    },
+}
+
+/// Raycasting settings shared by the reference and the GPU raycasters (WGSL twin:
+/// `RaycastParams` in `shaders/common/raycast_params.wgsl`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RaycastSettings {
+    /// Sample distance in units of the smallest voxel side (`unit_world`).
+    pub step_voxels: f64,
+    /// Early ray termination: stop after the sample that makes `A >= threshold` (1.0 is lossless).
+    pub threshold: f64,
+    /// Upper bound on samples per ray.
+    pub max_steps: u32,
+    /// Offset each ray's first sample by the per-pixel PCG jitter (`docs/rendering_model.md`,
+    /// "Samples").
+    pub jitter: bool,
+    /// DVR or isosurface.
+    pub mode: RenderMode,
+}
+
+impl Default for RaycastSettings {
+    fn default() -> Self {
+        Self {
+            step_voxels: 0.5,
+            threshold: 1.0,
+            max_steps: 4096,
+            jitter: false,
+            mode: RenderMode::Dvr,
+        }
+    }
+}
+
+/// A reference image: premultiplied linear RGBA and, for isosurfaces, the hit positions.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReferenceImage {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Premultiplied linear RGBA, row 0 at the top, `width * height` entries.
+    pub color: Vec<[f64; 4]>,
+    /// Isosurface mode: texture-space hit position in xyz and 1 in w; zeros on a miss and in DVR.
+    pub hit: Vec<[f64; 4]>,
+    /// Total number of volume samples taken along all rays (gradient samples not counted).
+    pub samples: u64,
+}
+
+impl ReferenceImage {
+    /// Index of pixel `(x, y)` in `color` and `hit`.
+    pub fn index(&self, x: u32, y: u32) -> usize {
+        x as usize + self.width as usize * y as usize
+    }
+}
+
+/// One pixel's ray inside the box, in texture space (`docs/rendering_model.md`, "Ray segment
+/// inside the box"); what passes 1 and 2 of Krüger & Westermann 2003 §2.1 store per pixel.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RaySegment {
+    /// Texture-space start `u(eye + t0·d)`, `t0 = max(t_in, t_near)`.
+    pub u0: DVec3,
+    /// Unit texture-space direction `normalize(u1 - u0)`.
+    pub d_tex: DVec3,
+    /// Texture-space length `|u1 - u0|`.
+    pub len_tex: f64,
+    /// Unit world-space direction of the ray (the headlight comes from `-dir_world`).
+    pub dir_world: DVec3,
+}
+
+/// Segments shorter than this in texture space are no ray. Same constant as
+/// `MIN_RAY_LENGTH_TEX` in `shaders/ray_directions.wgsl` (`docs/rendering_model.md`).
+pub const MIN_RAY_LENGTH_TEX: f64 = 1e-6;
+
+/// Slab intersection of the ray `origin + t·dir` with the box `[-half, half]`: `(t_in, t_out)`,
+/// or `None` when the ray misses or has a non-finite input. A zero direction component is
+/// handled explicitly (the ray is inside that slab for every `t` or for none), so axis-aligned
+/// and face-grazing rays never produce NaN; the box is closed, so a ray lying in a face hits.
+pub fn intersect_box(origin: DVec3, dir: DVec3, half: DVec3) -> Option<(f64, f64)> {
+    if !origin.is_finite() || !dir.is_finite() || !half.is_finite() {
+        return None;
+    }
+    let (mut t_in, mut t_out) = (f64::NEG_INFINITY, f64::INFINITY);
+    for axis in 0..3 {
+        let (o, d, h) = (origin[axis], dir[axis], half[axis]);
+        if d == 0.0 {
+            if o < -h || o > h {
+                return None;
+            }
+            continue;
+        }
+        let (a, b) = ((-h - o) / d, (h - o) / d);
+        t_in = t_in.max(a.min(b));
+        t_out = t_out.min(a.max(b));
+    }
+    (t_in <= t_out && t_in.is_finite() && t_out.is_finite()).then_some((t_in, t_out))
+}
+
+/// The texture-space segment of pixel `(x, y)`'s ray: through the pixel centre
+/// ([`CameraFrame::pixel_ray`]), from `max(t_in, t_near)` to `t_out`; `None` when there is no
+/// ray (it misses, `t_out <= t0`, or the segment is shorter than [`MIN_RAY_LENGTH_TEX`]).
+pub fn ray_segment(
+    volume: &Volume,
+    camera: &OrbitCamera,
+    frame: &CameraFrame,
+    x: u32,
+    y: u32,
+) -> Option<RaySegment> {
+    let half = volume.half_extent_world();
+    let (eye, dir) = frame.pixel_ray(x, y);
+    let (t_in, t_out) = intersect_box(eye, dir, half)?;
+    let t0 = t_in.max(frame.near_t(camera.near, dir));
+    if !(t_out > t0) {
+        return None;
+    }
+    // Clamped like the GPU's entry/exit targets, which clamp interpolation overshoot.
+    let texture = |t: f64| ((eye + t * dir) / (2.0 * half) + 0.5).clamp(DVec3::ZERO, DVec3::ONE);
+    let (u0, u1) = (texture(t0), texture(t_out));
+    let len_tex = (u1 - u0).length();
+    if !(len_tex >= MIN_RAY_LENGTH_TEX) {
+        return None;
+    }
+    Some(RaySegment {
+        u0,
+        d_tex: (u1 - u0) / len_tex,
+        len_tex,
+        dir_world: dir,
+    })
+}
+
+/// The transfer function at scalar `s` as a 1D linear sampler with clamp-to-edge reads it:
+/// linear between texel centres `(i+0.5)/N`, constant beyond the end centres
+/// (`docs/rendering_model.md`, "Classification"). An empty LUT reads as zero; NaN reads as 0.
+pub fn lut_sample(lut: &[[f32; 4]], s: f64) -> [f64; 4] {
+    let n = lut.len();
+    if n == 0 {
+        return [0.0; 4];
+    }
+    let s = if s.is_nan() { 0.0 } else { s };
+    let p = s * n as f64 - 0.5;
+    let base = p.floor();
+    let f = p - base;
+    let last = (n - 1) as f64;
+    let i0 = base.clamp(0.0, last) as usize;
+    let i1 = (base + 1.0).clamp(0.0, last) as usize;
+    std::array::from_fn(|c| lut[i0][c] as f64 * (1.0 - f) + lut[i1][c] as f64 * f)
+}
+
+/// O'Neill's PCG hash as in `shaders/common/raymarch.wgsl` (wrapping u32 arithmetic).
+pub fn pcg_hash(v: u32) -> u32 {
+    let state = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+    let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277_803_737);
+    (word >> 22) ^ word
+}
+
+/// The per-pixel first-sample offset in steps, `pcg_hash(x + y·w) / 2³² − 0.5`
+/// (`docs/rendering_model.md`, "Samples").
+pub fn pixel_jitter(x: u32, y: u32, width: u32) -> f64 {
+    pcg_hash(x.wrapping_add(y.wrapping_mul(width))) as f64 / 4_294_967_296.0 - 0.5
+}
+
+/// Opacity correction of the LUT's per-unit-step alpha to a step of `step_voxels`:
+/// `1 - (1 - a)^step_voxels`, with `a` clamped to [0,1].
+pub fn corrected_alpha(a_tf: f64, step_voxels: f64) -> f64 {
+    let a = a_tf.clamp(0.0, 1.0);
+    if a >= 1.0 {
+        1.0
+    } else if a <= 0.0 {
+        0.0
+    } else {
+        1.0 - (1.0 - a).powf(step_voxels)
+    }
+}
+
+/// A ray's marching parameters, derived once per pixel.
+struct March<'a> {
+    volume: &'a Volume,
+    lut: &'a [[f32; 4]],
+    settings: &'a RaycastSettings,
+    seg: RaySegment,
+    step_tex: f64,
+    jitter: f64,
+}
+
+impl March<'_> {
+    fn t(&self, k: u32) -> f64 {
+        (k as f64 + 0.5 + self.jitter) * self.step_tex
+    }
+
+    fn sample(&self, t: f64) -> f64 {
+        self.volume
+            .sample_trilinear(self.seg.u0 + t * self.seg.d_tex)
+    }
+
+    /// Front-to-back emission–absorption; returns the colour and the number of samples.
+    fn dvr(&self) -> ([f64; 4], u64) {
+        let mut acc = [0.0f64; 4];
+        let mut k = 0;
+        while k < self.settings.max_steps {
+            let t = self.t(k);
+            if !(t < self.seg.len_tex) {
+                break;
+            }
+            let c = lut_sample(self.lut, self.sample(t));
+            k += 1;
+            let w = (1.0 - acc[3]) * corrected_alpha(c[3], self.settings.step_voxels);
+            for i in 0..3 {
+                acc[i] += w * c[i];
+            }
+            acc[3] += w;
+            if acc[3] >= self.settings.threshold {
+                break;
+            }
+        }
+        (acc, k as u64)
+    }
+
+    /// First hit of `s >= iso`, refined linearly; returns colour, hit and samples taken.
+    fn iso(&self, iso: f64, shading: &Phong) -> ([f64; 4], [f64; 4], u64) {
+        let (mut t_prev, mut s_prev) = (0.0, 0.0);
+        let mut k = 0;
+        while k < self.settings.max_steps {
+            let t = self.t(k);
+            if !(t < self.seg.len_tex) {
+                break;
+            }
+            let s = self.sample(t);
+            if s >= iso {
+                let t_hit = if k > 0 {
+                    t_prev + (t - t_prev) * (iso - s_prev) / (s - s_prev)
+                } else {
+                    t
+                };
+                let u = self.seg.u0 + t_hit * self.seg.d_tex;
+                let rgb = self.shade(u, iso, shading);
+                return (
+                    [rgb.x, rgb.y, rgb.z, 1.0],
+                    [u.x, u.y, u.z, 1.0],
+                    k as u64 + 1,
+                );
+            }
+            t_prev = t;
+            s_prev = s;
+            k += 1;
+        }
+        ([0.0; 4], [0.0; 4], k as u64)
+    }
+
+    /// Headlight Blinn–Phong at texture-space `u` (`docs/rendering_model.md`).
+    fn shade(&self, u: DVec3, iso: f64, p: &Phong) -> DVec3 {
+        let dims = self.volume.dims.as_dvec3();
+        let off = 1.0 / dims;
+        let s = |v: DVec3| self.volume.sample_trilinear(v);
+        let g = DVec3::new(
+            s(u + DVec3::new(off.x, 0.0, 0.0)) - s(u - DVec3::new(off.x, 0.0, 0.0)),
+            s(u + DVec3::new(0.0, off.y, 0.0)) - s(u - DVec3::new(0.0, off.y, 0.0)),
+            s(u + DVec3::new(0.0, 0.0, off.z)) - s(u - DVec3::new(0.0, 0.0, off.z)),
+        );
+        let l = -self.seg.dir_world;
+        let n = if g.length() >= ZERO_GRADIENT {
+            // g spans two voxels per axis: world gradient = g / (2·voxel_world), and
+            // voxel_world = 2·half / dims, so its direction is that of g·dims/half.
+            -(g * dims / self.volume.half_extent_world()).normalize()
+        } else {
+            l
+        };
+        // Headlight: l = v, so h = normalize(l + v) = l and n·h = n·l.
+        let n_dot_l = n.dot(l).abs();
+        let spec = if n_dot_l > 0.0 {
+            p.specular * n_dot_l.powf(p.shininess)
+        } else {
+            0.0
+        };
+        let base = lut_sample(self.lut, iso);
+        let base = DVec3::new(base[0], base[1], base[2]);
+        (base * (p.ambient + p.diffuse * n_dot_l) + DVec3::splat(spec))
+            .clamp(DVec3::ZERO, DVec3::ONE)
+    }
+}
+
+/// Gradients shorter than this (in normalized scalar units over two voxels) count as zero and the
+/// normal faces the eye: below one u16 step (1.5e-5), above the f32 rounding of GPU samples
+/// (~1e-7). Same constant in `shaders/common/raymarch.wgsl`.
+pub const ZERO_GRADIENT: f64 = 1e-6;
+
+/// Texture-space step of a ray with unit texture direction `d_tex`:
+/// `step_voxels · unit_world / |d_tex · 2·half|`.
+pub fn step_tex(volume: &Volume, d_tex: DVec3, step_voxels: f64) -> f64 {
+    step_voxels * volume.unit_step_world() / (d_tex * 2.0 * volume.half_extent_world()).length()
+}
+
+/// Renders `volume` through `lut` from `camera` into a `width × height` image following
+/// `docs/rendering_model.md` in f64, one rayon task per row. Bad input (an empty or
+/// inconsistent volume, a zero-sized image, a non-positive step) gives a transparent image,
+/// never a panic.
+pub fn render_reference(
+    volume: &Volume,
+    lut: &[[f32; 4]],
+    camera: &OrbitCamera,
+    width: u32,
+    height: u32,
+    settings: &RaycastSettings,
+) -> ReferenceImage {
+    let pixels = width as usize * height as usize;
+    let mut color = vec![[0.0; 4]; pixels];
+    let mut hit = vec![[0.0; 4]; pixels];
+    let usable = volume.voxel_count() > 0
+        && volume.data.len() == volume.voxel_count()
+        && volume.extent().min_element() > 0.0;
+    if !usable || pixels == 0 {
+        return ReferenceImage {
+            width,
+            height,
+            color,
+            hit,
+            samples: 0,
+        };
+    }
+    let frame = camera.frame(width, height);
+    let row_len = width as usize;
+    let samples = color
+        .par_chunks_mut(row_len)
+        .zip(hit.par_chunks_mut(row_len))
+        .enumerate()
+        .map(|(y, (color_row, hit_row))| {
+            let y = y as u32;
+            let mut row_samples = 0;
+            for x in 0..width {
+                let Some(seg) = ray_segment(volume, camera, &frame, x, y) else {
+                    continue;
+                };
+                let step_tex = step_tex(volume, seg.d_tex, settings.step_voxels);
+                if !(step_tex > 0.0 && step_tex < 1e30) {
+                    continue;
+                }
+                let jitter = if settings.jitter {
+                    pixel_jitter(x, y, width)
+                } else {
+                    0.0
+                };
+                let march = March {
+                    volume,
+                    lut,
+                    settings,
+                    seg,
+                    step_tex,
+                    jitter,
+                };
+                match settings.mode {
+                    RenderMode::Dvr => {
+                        let (c, n) = march.dvr();
+                        color_row[x as usize] = c;
+                        row_samples += n;
+                    }
+                    RenderMode::Isosurface { iso, shading } => {
+                        let (c, h, n) = march.iso(iso, &shading);
+                        color_row[x as usize] = c;
+                        hit_row[x as usize] = h;
+                        row_samples += n;
+                    }
+                }
+            }
+            row_samples
+        })
+        .sum();
+    ReferenceImage {
+        width,
+        height,
+        color,
+        hit,
+        samples,
+    }
+}

@@ -137,3 +137,110 @@ impl Volume {
         c0 * (1.0 - f.z) + c1 * f.z
     }
 }
+
+/// The voxel types volgraph stores, one per [`VoxelData`] variant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum VoxelType {
+    /// `uint8`.
+    U8,
+    /// `uint16`.
+    U16,
+    /// `int16`.
+    I16,
+    /// `float32`.
+    F32,
+}
+
+impl VoxelType {
+    /// Every supported type, in the order error messages list them.
+    pub const ALL: [VoxelType; 4] = [VoxelType::U8, VoxelType::U16, VoxelType::I16, VoxelType::F32];
+
+    /// Bytes per voxel.
+    pub fn size_bytes(self) -> usize {
+        match self {
+            VoxelType::U8 => 1,
+            VoxelType::U16 | VoxelType::I16 => 2,
+            VoxelType::F32 => 4,
+        }
+    }
+
+    /// The name used in file names (`uint8`, `uint16`, `int16`, `float32`).
+    pub fn name(self) -> &'static str {
+        match self {
+            VoxelType::U8 => "uint8",
+            VoxelType::U16 => "uint16",
+            VoxelType::I16 => "int16",
+            VoxelType::F32 => "float32",
+        }
+    }
+
+    /// Parses a file-name type token: `uint8`/`u8`, `uint16`/`u16`, `int16`/`i16`,
+    /// `float32`/`f32` (case-insensitive). `None` for anything else.
+    pub fn from_name(token: &str) -> Option<VoxelType> {
+        match token.to_ascii_lowercase().as_str() {
+            "uint8" | "u8" => Some(VoxelType::U8),
+            "uint16" | "u16" => Some(VoxelType::U16),
+            "int16" | "i16" => Some(VoxelType::I16),
+            "float32" | "f32" => Some(VoxelType::F32),
+            _ => None,
+        }
+    }
+
+    /// The data values that normalize to 0 and 1 for integer types (the full type range,
+    /// see [`Volume::normalized`]); `None` for `float32`, whose range comes from the data.
+    pub fn integer_range(self) -> Option<(f64, f64)> {
+        match self {
+            VoxelType::U8 => Some((0.0, 255.0)),
+            VoxelType::U16 => Some((0.0, 65535.0)),
+            VoxelType::I16 => Some((-32768.0, 32767.0)),
+            VoxelType::F32 => None,
+        }
+    }
+}
+
+impl std::fmt::Display for VoxelType {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl VoxelData {
+    /// The type of the stored voxels.
+    pub fn voxel_type(&self) -> VoxelType {
+        match self {
+            VoxelData::U8(_) => VoxelType::U8,
+            VoxelData::U16(_) => VoxelType::U16,
+            VoxelData::I16(_) => VoxelType::I16,
+            VoxelData::F32(_) => VoxelType::F32,
+        }
+    }
+}
+
+/// The `(min, max)` of the finite values of `values`, or `None` when none is finite.
+pub fn finite_range(values: &[f32]) -> Option<(f64, f64)> {
+    let mut range: Option<(f32, f32)> = None;
+    for &v in values.iter().filter(|v| v.is_finite()) {
+        range = Some(match range {
+            None => (v, v),
+            Some((lo, hi)) => (lo.min(v), hi.max(v)),
+        });
+    }
+    range.map(|(lo, hi)| (lo as f64, hi as f64))
+}
+
+impl Volume {
+    /// Builds a volume and sets `value_range` to the data values that normalize to 0 and 1:
+    /// the full type range for integer types (`uint8` → (0, 255), `uint16` → (0, 65535),
+    /// `int16` → (-32768, 32767), matching [`Volume::normalized`]), the finite (min, max) for
+    /// `float32` ((0, 0) when no value is finite).
+    ///
+    /// The caller promises `data.len() == dims.x * dims.y * dims.z`; loaders check it and return
+    /// an error before they get here.
+    pub fn new(name: impl Into<String>, dims: UVec3, spacing: DVec3, data: VoxelData) -> Volume {
+        let value_range = match &data {
+            VoxelData::F32(v) => finite_range(v).unwrap_or((0.0, 0.0)),
+            other => other.voxel_type().integer_range().unwrap_or((0.0, 1.0)),
+        };
+        Volume { dims, spacing, data, name: name.into(), value_range }
+    }
+}

@@ -1,1 +1,392 @@
-//! (to be written)
+//! Volume loading: headerless `.raw` (layout from the file name or [`RawOptions`]), NRRD
+//! (`.nrrd` attached, `.nhdr` detached; raw or gzip encoding) and MetaImage (`.mhd` detached,
+//! `.mha` with `ElementDataFile = LOCAL`; optionally zlib-compressed).
+//!
+//! [`load_volume`] is the one entry point; it picks the format from the extension. Every loader
+//! returns the volume in native byte order with `value_range` set as [`Volume::new`] documents,
+//! and a [`LoadReport`] saying what was repaired:
+//!
+//! - float32 NaN values are replaced by the minimum finite value of the volume (so they normalize
+//!   to 0 and never widen the range), `+Inf` by the maximum finite value and `-Inf` by the
+//!   minimum; a volume with no finite value at all becomes all zeros with range (0, 0).
+//!
+//! Parsers never panic on any input (`tests/load_fuzz.rs` checks it with proptest).
+
+mod error;
+mod metaimage;
+mod nrrd;
+mod raw;
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+use glam::{DVec3, UVec3};
+
+pub use error::{LoadError, Location};
+pub use raw::parse_raw_name;
+
+use crate::volume::{Volume, VoxelData, VoxelType, finite_range};
+
+/// Byte order of multi-byte voxels in a file.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Endianness {
+    /// Least significant byte first (x86, ARM; what almost every file uses).
+    #[default]
+    Little,
+    /// Most significant byte first.
+    Big,
+}
+
+/// How to read a headerless `.raw` file. Set fields override what the file name says
+/// (`name_XxYxZ_dtype.raw`). For headered formats only `spacing` is used: when set it overrides
+/// the header's spacing.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RawOptions {
+    /// Voxels per axis.
+    pub dims: Option<UVec3>,
+    /// Voxel type.
+    pub dtype: Option<VoxelType>,
+    /// Byte order of 16- and 32-bit voxels (raw files only; default little endian).
+    pub endianness: Endianness,
+    /// Physical voxel size; default (1, 1, 1) for raw files, the header's value otherwise.
+    pub spacing: Option<DVec3>,
+}
+
+/// The file format a volume came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VolumeFormat {
+    /// Headerless `.raw`.
+    Raw,
+    /// NRRD, attached (`.nrrd`) or detached (`.nhdr`).
+    Nrrd,
+    /// MetaImage, `.mhd` or `.mha`.
+    MetaImage,
+}
+
+/// What a loader did besides reading: repairs and ignored header content.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoadReport {
+    /// The format read.
+    pub format: VolumeFormat,
+    /// The file the voxels came from (the header itself when attached).
+    pub data_path: PathBuf,
+    /// NaN voxels replaced by the minimum finite value.
+    pub nan_replaced: usize,
+    /// `+Inf` voxels replaced by the maximum finite value.
+    pub pos_inf_replaced: usize,
+    /// `-Inf` voxels replaced by the minimum finite value.
+    pub neg_inf_replaced: usize,
+    /// Header content that was ignored or defaulted, one sentence each.
+    pub notes: Vec<String>,
+}
+
+impl LoadReport {
+    fn new(format: VolumeFormat, data_path: &Path) -> LoadReport {
+        LoadReport {
+            format,
+            data_path: data_path.to_path_buf(),
+            nan_replaced: 0,
+            pos_inf_replaced: 0,
+            neg_inf_replaced: 0,
+            notes: Vec::new(),
+        }
+    }
+
+    /// Total number of non-finite voxels replaced.
+    pub fn non_finite_replaced(&self) -> usize {
+        self.nan_replaced + self.pos_inf_replaced + self.neg_inf_replaced
+    }
+}
+
+/// A loaded volume and what the loader did to it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoadedVolume {
+    /// The volume, native byte order, NaN/Inf replaced.
+    pub volume: Volume,
+    /// Repairs and ignored header content.
+    pub report: LoadReport,
+}
+
+/// Loads a volume, choosing the format by extension (case-insensitive): `.raw`, `.nrrd`,
+/// `.nhdr`, `.mhd`, `.mha`. `opts` describes raw files; see [`RawOptions`].
+pub fn load_volume(path: &Path, opts: &RawOptions) -> Result<LoadedVolume, LoadError> {
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let mut loaded = match extension.as_str() {
+        "raw" => raw::load(path, opts)?,
+        "nrrd" | "nhdr" => nrrd::load(path)?,
+        "mhd" | "mha" => metaimage::load(path)?,
+        _ => {
+            return Err(LoadError::UnknownFormat {
+                path: path.to_path_buf(),
+                extension,
+            });
+        }
+    };
+    if let Some(spacing) = opts.spacing {
+        check_spacing(&Location::file(path), spacing)?;
+        loaded.volume.spacing = spacing;
+    }
+    Ok(loaded)
+}
+
+/// Parses a NRRD header and data held in memory; `path` is used for messages and to find a
+/// detached data file. Never panics.
+pub fn parse_nrrd(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError> {
+    nrrd::parse(path, bytes)
+}
+
+/// Parses a MetaImage header (and `LOCAL` data) held in memory; `path` is used for messages and
+/// to find a detached data file. Never panics.
+pub fn parse_metaimage(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError> {
+    metaimage::parse(path, bytes)
+}
+
+/// Checks that every dimension of `volume` fits a 3D texture of at most `max_dim` texels per
+/// side (`wgpu::Limits::max_texture_dimension_3d`). A volume that does not fit can still be
+/// rendered in bricks.
+pub fn check_texture_limit(volume: &Volume, max_dim: u32) -> Result<(), LoadError> {
+    for (axis, size) in [
+        ("x", volume.dims.x),
+        ("y", volume.dims.y),
+        ("z", volume.dims.z),
+    ] {
+        if size > max_dim {
+            return Err(LoadError::TextureTooLarge {
+                name: volume.name.clone(),
+                axis,
+                size,
+                max_dim,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Replaces NaN/Inf in float data as the module documentation says, sets `value_range` to the
+/// finite (min, max), and returns the counts `(nan, +inf, -inf)`. Integer volumes are untouched
+/// and give zeros.
+pub fn sanitize_volume(volume: &mut Volume) -> (usize, usize, usize) {
+    let VoxelData::F32(values) = &mut volume.data else {
+        return (0, 0, 0);
+    };
+    let (lo, hi) = finite_range(values).unwrap_or((0.0, 0.0));
+    let (mut nan, mut pos, mut neg) = (0, 0, 0);
+    for v in values.iter_mut() {
+        if v.is_nan() {
+            *v = lo as f32;
+            nan += 1;
+        } else if *v == f32::INFINITY {
+            *v = hi as f32;
+            pos += 1;
+        } else if *v == f32::NEG_INFINITY {
+            *v = lo as f32;
+            neg += 1;
+        }
+    }
+    volume.value_range = (lo, hi);
+    (nan, pos, neg)
+}
+
+/// Reads a whole file, mapping the error to [`LoadError::Io`].
+fn read_file(path: &Path) -> Result<Vec<u8>, LoadError> {
+    std::fs::read(path).map_err(|source| LoadError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// The checked dimensions of a header (`field = value` at `at`): no zero axis, each at most
+/// `u32::MAX`.
+fn check_dims(at: &Location, field: &str, value: &str, dims: [u64; 3]) -> Result<UVec3, LoadError> {
+    let [x, y, z] = dims;
+    if x == 0 || y == 0 || z == 0 {
+        return Err(LoadError::ZeroDimension {
+            at: at.clone(),
+            x,
+            y,
+            z,
+        });
+    }
+    let fit = |n: u64| u32::try_from(n).ok();
+    match (fit(x), fit(y), fit(z)) {
+        (Some(x), Some(y), Some(z)) => Ok(UVec3::new(x, y, z)),
+        _ => Err(LoadError::BadField {
+            at: at.clone(),
+            field: field.to_string(),
+            value: error::clip(value),
+            expected: "three sizes of at most 4294967295 voxels",
+        }),
+    }
+}
+
+fn check_spacing(at: &Location, s: DVec3) -> Result<(), LoadError> {
+    if s.is_finite() && s.min_element() > 0.0 {
+        Ok(())
+    } else {
+        Err(LoadError::BadSpacing {
+            at: at.clone(),
+            x: s.x,
+            y: s.y,
+            z: s.z,
+        })
+    }
+}
+
+/// Bytes needed by `dims` voxels of `dtype`; `None` on overflow.
+fn byte_count(dims: UVec3, dtype: VoxelType) -> Option<u64> {
+    (dims.x as u64)
+        .checked_mul(dims.y as u64)?
+        .checked_mul(dims.z as u64)?
+        .checked_mul(dtype.size_bytes() as u64)
+}
+
+fn dims_text(dims: UVec3) -> String {
+    format!("{}x{}x{}", dims.x, dims.y, dims.z)
+}
+
+/// Inflates gzip (`zlib = false`) or zlib data, reading at most `limit` bytes so that a header
+/// claiming little data cannot make a small file expand without bound.
+fn inflate(path: &Path, data: &[u8], zlib: bool, limit: u64) -> Result<Vec<u8>, LoadError> {
+    let mut out = Vec::new();
+    let result = if zlib {
+        flate2::read::ZlibDecoder::new(data)
+            .take(limit)
+            .read_to_end(&mut out)
+    } else {
+        flate2::read::MultiGzDecoder::new(data)
+            .take(limit)
+            .read_to_end(&mut out)
+    };
+    result.map_err(|source| LoadError::Decompress {
+        path: path.to_path_buf(),
+        codec: if zlib { "zlib" } else { "gzip" },
+        source,
+    })?;
+    Ok(out)
+}
+
+/// Decodes exactly `dims × dtype` bytes (the caller checked the length) into voxels.
+fn decode(bytes: &[u8], dtype: VoxelType, order: Endianness) -> VoxelData {
+    let big = order == Endianness::Big;
+    match dtype {
+        VoxelType::U8 => VoxelData::U8(bytes.to_vec()),
+        VoxelType::U16 => VoxelData::U16(
+            bytes
+                .chunks_exact(2)
+                .map(|c| {
+                    let b = [c[0], c[1]];
+                    if big {
+                        u16::from_be_bytes(b)
+                    } else {
+                        u16::from_le_bytes(b)
+                    }
+                })
+                .collect(),
+        ),
+        VoxelType::I16 => VoxelData::I16(
+            bytes
+                .chunks_exact(2)
+                .map(|c| {
+                    let b = [c[0], c[1]];
+                    if big {
+                        i16::from_be_bytes(b)
+                    } else {
+                        i16::from_le_bytes(b)
+                    }
+                })
+                .collect(),
+        ),
+        VoxelType::F32 => VoxelData::F32(
+            bytes
+                .chunks_exact(4)
+                .map(|c| {
+                    let b = [c[0], c[1], c[2], c[3]];
+                    if big {
+                        f32::from_be_bytes(b)
+                    } else {
+                        f32::from_le_bytes(b)
+                    }
+                })
+                .collect(),
+        ),
+    }
+}
+
+/// What every headered loader does once the header is parsed: check the data length, decode,
+/// sanitize floats and build the volume and report.
+struct Layout {
+    name: String,
+    dims: UVec3,
+    dtype: VoxelType,
+    order: Endianness,
+    spacing: DVec3,
+}
+
+fn finish(
+    layout: Layout,
+    data: &[u8],
+    data_path: &Path,
+    mut report: LoadReport,
+    hint: &'static str,
+) -> Result<LoadedVolume, LoadError> {
+    let expected = byte_count(layout.dims, layout.dtype).unwrap_or(u64::MAX);
+    if data.len() as u64 != expected {
+        return Err(LoadError::DataSize {
+            path: data_path.to_path_buf(),
+            dims: dims_text(layout.dims),
+            dtype: layout.dtype,
+            expected,
+            actual: data.len() as u64,
+            hint,
+        });
+    }
+    let voxels = decode(data, layout.dtype, layout.order);
+    let mut volume = Volume::new(layout.name, layout.dims, layout.spacing, voxels);
+    let (nan, pos, neg) = sanitize_volume(&mut volume);
+    report.nan_replaced = nan;
+    report.pos_inf_replaced = pos;
+    report.neg_inf_replaced = neg;
+    Ok(LoadedVolume { volume, report })
+}
+
+/// The file stem, used as the volume name.
+fn stem(path: &Path) -> String {
+    path.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// Resolves a detached data file name relative to the header's folder.
+fn sibling(header: &Path, name: &str) -> PathBuf {
+    let name = Path::new(name);
+    if name.is_absolute() {
+        name.to_path_buf()
+    } else {
+        header.parent().unwrap_or(Path::new("")).join(name)
+    }
+}
+
+/// Splits `bytes` into header lines: `(1-based line number, text without the line end, byte
+/// offset just past the line end)`. Lines are decoded lossily; the caller decides where the
+/// header stops.
+fn header_lines(bytes: &[u8]) -> impl Iterator<Item = (usize, String, usize)> + '_ {
+    let mut start = 0usize;
+    let mut number = 0usize;
+    std::iter::from_fn(move || {
+        if start >= bytes.len() {
+            return None;
+        }
+        let rest = &bytes[start..];
+        let (line, consumed) = match rest.iter().position(|&b| b == b'\n') {
+            Some(i) => (&rest[..i], i + 1),
+            None => (rest, rest.len()),
+        };
+        let line = line.strip_suffix(b"\r").unwrap_or(line);
+        start += consumed;
+        number += 1;
+        Some((number, String::from_utf8_lossy(line).into_owned(), start))
+    })
+}

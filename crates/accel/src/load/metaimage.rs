@@ -1,0 +1,244 @@
+//! MetaImage (ITK): `.mhd` with a detached `ElementDataFile`, `.mha` with
+//! `ElementDataFile = LOCAL` (the data follows that line). 3D scalar volumes only.
+//!
+//! Read: `NDims`, `DimSize`, `ElementSpacing` (or `ElementSize` when there is no spacing),
+//! `ElementType`, `ElementByteOrderMSB` / `BinaryDataByteOrderMSB`, `HeaderSize` (detached data
+//! only; -1 = data at the end of the file), `CompressedData` (zlib), `BinaryData`,
+//! `ElementNumberOfChannels` (must be 1) and `ElementDataFile`, which must be the last field.
+//! Every other key (`ObjectType`, `Offset`, `TransformMatrix`, `AnatomicalOrientation`, …) is
+//! ignored: MetaImage headers carry free-form keys.
+
+use std::path::Path;
+
+use glam::DVec3;
+
+use super::error::clip;
+use super::{
+    Endianness, Layout, LoadError, LoadReport, LoadedVolume, Location, VolumeFormat, byte_count,
+    check_dims, check_spacing, finish, header_lines, inflate, read_file, sibling, stem,
+};
+use crate::volume::VoxelType;
+
+const SUPPORTED_TYPES: &str = "MET_UCHAR, MET_USHORT, MET_SHORT, MET_FLOAT";
+const HINT: &str = "check DimSize, ElementType, HeaderSize and CompressedData in the header, or whether the data is complete";
+
+fn voxel_type(name: &str) -> Option<VoxelType> {
+    match name {
+        "MET_UCHAR" => Some(VoxelType::U8),
+        "MET_USHORT" => Some(VoxelType::U16),
+        "MET_SHORT" => Some(VoxelType::I16),
+        "MET_FLOAT" => Some(VoxelType::F32),
+        _ => None,
+    }
+}
+
+pub(super) fn load(path: &Path) -> Result<LoadedVolume, LoadError> {
+    let bytes = read_file(path)?;
+    parse(path, &bytes)
+}
+
+pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError> {
+    let mut ndims_seen = false;
+    let mut sizes: Option<(usize, [u64; 3], String)> = None;
+    let mut spacing: Option<(usize, DVec3)> = None;
+    let mut element_size: Option<(usize, DVec3)> = None;
+    let mut dtype = None;
+    let mut order = Endianness::Little;
+    let mut header_size: i64 = 0;
+    let mut compressed = false;
+    let mut data_file: Option<(String, usize)> = None;
+    let mut notes = Vec::new();
+
+    for (number, text, end) in header_lines(bytes) {
+        if text.trim().is_empty() {
+            continue;
+        }
+        let at = Location::line(path, number);
+        let (key, value) = text
+            .split_once('=')
+            .ok_or_else(|| LoadError::MalformedLine {
+                at: at.clone(),
+                text: clip(&text),
+                expected: "`Key = Value`",
+            })?;
+        let (key, value) = (key.trim(), value.trim());
+        let bad = |expected: &'static str| LoadError::BadField {
+            at: at.clone(),
+            field: key.to_string(),
+            value: clip(value),
+            expected,
+        };
+        let boolean = |v: &str| match v.to_ascii_lowercase().as_str() {
+            "true" | "1" => Some(true),
+            "false" | "0" => Some(false),
+            _ => None,
+        };
+        let three = |v: &str| -> Option<[f64; 3]> {
+            let parsed: Option<Vec<f64>> = v.split_whitespace().map(|s| s.parse().ok()).collect();
+            match parsed.as_deref() {
+                Some(&[x, y, z]) => Some([x, y, z]),
+                _ => None,
+            }
+        };
+        match key.to_ascii_lowercase().as_str() {
+            "ndims" => {
+                if value != "3" {
+                    return Err(LoadError::NotThreeD {
+                        at,
+                        field: "NDims",
+                        found: clip(value),
+                    });
+                }
+                ndims_seen = true;
+            }
+            "dimsize" => {
+                let parsed: Option<Vec<u64>> =
+                    value.split_whitespace().map(|s| s.parse().ok()).collect();
+                match parsed.as_deref() {
+                    Some(&[x, y, z]) => sizes = Some((number, [x, y, z], value.to_string())),
+                    _ => return Err(bad("three whole numbers, e.g. `DimSize = 64 64 32`")),
+                }
+            }
+            "elementspacing" => {
+                let s = three(value)
+                    .ok_or_else(|| bad("three numbers, e.g. `ElementSpacing = 1 1 1.5`"))?;
+                spacing = Some((number, DVec3::from_array(s)));
+            }
+            "elementsize" => {
+                let s = three(value)
+                    .ok_or_else(|| bad("three numbers, e.g. `ElementSize = 1 1 1.5`"))?;
+                element_size = Some((number, DVec3::from_array(s)));
+            }
+            "elementtype" => {
+                dtype = Some(voxel_type(&value.to_ascii_uppercase()).ok_or_else(|| {
+                    LoadError::UnsupportedType {
+                        at: at.clone(),
+                        found: clip(value),
+                        supported: SUPPORTED_TYPES,
+                    }
+                })?);
+            }
+            "elementbyteordermsb" | "binarydatabyteordermsb" => {
+                let msb = boolean(value).ok_or_else(|| bad("`True` or `False`"))?;
+                order = if msb {
+                    Endianness::Big
+                } else {
+                    Endianness::Little
+                };
+            }
+            "headersize" => {
+                header_size = value
+                    .parse::<i64>()
+                    .ok()
+                    .filter(|&n| n >= -1)
+                    .ok_or_else(|| {
+                        bad("a whole number ≥ 0, or -1 for data at the end of the file")
+                    })?;
+            }
+            "compresseddata" => {
+                compressed = boolean(value).ok_or_else(|| bad("`True` or `False`"))?;
+            }
+            "binarydata" => {
+                if boolean(value) != Some(true) {
+                    return Err(LoadError::UnsupportedField {
+                        at,
+                        field: key.to_string(),
+                        value: clip(value),
+                        hint: "only binary data is supported; save the image with `BinaryData = True`",
+                    });
+                }
+            }
+            "elementnumberofchannels" => {
+                if value != "1" {
+                    return Err(LoadError::UnsupportedField {
+                        at,
+                        field: key.to_string(),
+                        value: clip(value),
+                        hint: "only scalar volumes (1 channel) are supported; extract one channel first",
+                    });
+                }
+            }
+            "elementdatafile" => {
+                if value.is_empty()
+                    || value.eq_ignore_ascii_case("LIST")
+                    || value.contains('%')
+                    || value.contains(' ')
+                {
+                    return Err(LoadError::UnsupportedField {
+                        at,
+                        field: key.to_string(),
+                        value: clip(value),
+                        hint: "use `LOCAL` or a single data file name; join slice files into one",
+                    });
+                }
+                data_file = Some((value.to_string(), end));
+                break; // ElementDataFile ends the header.
+            }
+            _ => {}
+        }
+    }
+
+    let missing = |field, example| LoadError::MissingField {
+        path: path.to_path_buf(),
+        field,
+        example,
+    };
+    if !ndims_seen {
+        return Err(missing("NDims", "NDims = 3"));
+    }
+    let (sizes_line, sizes, sizes_text) =
+        sizes.ok_or_else(|| missing("DimSize", "DimSize = 64 64 64"))?;
+    let dtype = dtype.ok_or_else(|| missing("ElementType", "ElementType = MET_UCHAR"))?;
+    let (data_name, data_start) =
+        data_file.ok_or_else(|| missing("ElementDataFile", "ElementDataFile = LOCAL"))?;
+    let dims = check_dims(
+        &Location::line(path, sizes_line),
+        "DimSize",
+        &sizes_text,
+        sizes,
+    )?;
+    let spacing = match spacing.or(element_size) {
+        Some((line, s)) => {
+            check_spacing(&Location::line(path, line), s)?;
+            s
+        }
+        None => DVec3::ONE,
+    };
+
+    let local = data_name.eq_ignore_ascii_case("LOCAL");
+    let (data_path, stored) = if local {
+        if header_size != 0 {
+            notes.push(format!("HeaderSize = {header_size} ignored for LOCAL data"));
+        }
+        (
+            path.to_path_buf(),
+            bytes.get(data_start..).unwrap_or(&[]).to_vec(),
+        )
+    } else {
+        let p = sibling(path, &data_name);
+        let all = read_file(&p)?;
+        (p, all)
+    };
+    let expected = byte_count(dims, dtype).unwrap_or(u64::MAX);
+    let data = if compressed {
+        inflate(&data_path, &stored, true, expected.saturating_add(1))?
+    } else if local || header_size == 0 {
+        stored
+    } else if header_size == -1 {
+        let start = (stored.len() as u64).saturating_sub(expected) as usize;
+        stored[start..].to_vec()
+    } else {
+        let skip = (header_size as u64).min(stored.len() as u64) as usize;
+        stored[skip..].to_vec()
+    };
+    let mut report = LoadReport::new(VolumeFormat::MetaImage, &data_path);
+    report.notes = notes;
+    let layout = Layout {
+        name: stem(path),
+        dims,
+        dtype,
+        order,
+        spacing,
+    };
+    finish(layout, &data, &data_path, report, HINT)
+}

@@ -1,0 +1,348 @@
+//! NRRD (<https://teem.sourceforge.net/nrrd/format.html>): attached `.nrrd` and detached `.nhdr`
+//! (`data file:`), raw or gzip encoding, 3D scalar volumes only.
+//!
+//! Read: `type`, `dimension`, `sizes`, `spacings` or `space directions` (spacing = length of each
+//! direction vector), `endian` (little when missing, noted in the report), `encoding`,
+//! `data file`, `byte skip` (≥ 0, or -1 with raw encoding: data at the end of the file) and
+//! `line skip: 0`. Ignored as harmless: comments, `key:=value` pairs, `content`, `space`,
+//! `space origin`, `kinds`, `labels`, `units`, `centers` and the other per-axis or range
+//! annotations. Any other field is an error rather than a silent misreading.
+
+use std::path::Path;
+
+use glam::DVec3;
+
+use super::error::clip;
+use super::{
+    Endianness, Layout, LoadError, LoadReport, LoadedVolume, Location, VolumeFormat, byte_count,
+    check_dims, check_spacing, finish, header_lines, inflate, read_file, sibling, stem,
+};
+use crate::volume::VoxelType;
+
+const SUPPORTED_TYPES: &str = "uchar/uint8, ushort/uint16, short/int16, float";
+const SUPPORTED_ENCODINGS: &str = "raw, gzip";
+const HINT: &str = "check \"sizes\", \"type\", \"encoding\" and \"byte skip\" in the header, or whether the data is complete";
+
+/// Fields that do not change how the voxels are read.
+const IGNORED: &[&str] = &[
+    "content",
+    "space",
+    "space origin",
+    "space units",
+    "space dimension",
+    "kinds",
+    "labels",
+    "units",
+    "centers",
+    "centerings",
+    "thicknesses",
+    "axis mins",
+    "axismins",
+    "axis maxs",
+    "axismaxs",
+    "min",
+    "max",
+    "old min",
+    "oldmin",
+    "old max",
+    "oldmax",
+    "sample units",
+    "sampleunits",
+    "measurement frame",
+    "number",
+];
+
+fn voxel_type(name: &str) -> Option<VoxelType> {
+    match name {
+        "uchar" | "unsigned char" | "uint8" | "uint8_t" => Some(VoxelType::U8),
+        "ushort" | "unsigned short" | "unsigned short int" | "uint16" | "uint16_t" => {
+            Some(VoxelType::U16)
+        }
+        "short" | "short int" | "signed short" | "signed short int" | "int16" | "int16_t" => {
+            Some(VoxelType::I16)
+        }
+        "float" => Some(VoxelType::F32),
+        _ => None,
+    }
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum Encoding {
+    Raw,
+    Gzip,
+}
+
+pub(super) fn load(path: &Path) -> Result<LoadedVolume, LoadError> {
+    let bytes = read_file(path)?;
+    parse(path, &bytes)
+}
+
+pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError> {
+    let mut lines = header_lines(bytes);
+    let magic = lines.next().map(|(_, text, _)| text).unwrap_or_default();
+    let version_ok = magic.len() == 8
+        && magic.starts_with("NRRD000")
+        && matches!(magic.as_bytes()[7], b'1'..=b'5');
+    if !version_ok {
+        return Err(LoadError::NotNrrd {
+            path: path.to_path_buf(),
+            found: clip(&magic),
+        });
+    }
+
+    let mut dtype = None;
+    let mut dimension_seen = false;
+    let mut sizes: Option<(usize, [u64; 3], String)> = None;
+    let mut spacing: Option<(usize, DVec3)> = None;
+    let mut order = None;
+    let mut encoding = None;
+    let mut data_file: Option<String> = None;
+    let mut byte_skip: i64 = 0;
+    let mut data_start = None;
+    let mut notes = Vec::new();
+
+    for (number, text, end) in lines {
+        if text.is_empty() {
+            data_start = Some(end);
+            break;
+        }
+        if text.starts_with('#') {
+            continue;
+        }
+        let at = Location::line(path, number);
+        let malformed = || LoadError::MalformedLine {
+            at: at.clone(),
+            text: clip(&text),
+            expected: "`field: value`, `key:=value` or a `#` comment",
+        };
+        let (key, value) = text.split_once(':').ok_or_else(malformed)?;
+        if value.starts_with('=') {
+            continue; // A key/value pair: free-form metadata.
+        }
+        let value = value.strip_prefix(' ').ok_or_else(malformed)?.trim();
+        let field = key.trim().to_ascii_lowercase();
+        let bad = |expected: &'static str| LoadError::BadField {
+            at: at.clone(),
+            field: field.clone(),
+            value: clip(value),
+            expected,
+        };
+        match field.as_str() {
+            "type" => {
+                let t = voxel_type(&value.to_ascii_lowercase()).ok_or_else(|| {
+                    LoadError::UnsupportedType {
+                        at: at.clone(),
+                        found: clip(value),
+                        supported: SUPPORTED_TYPES,
+                    }
+                })?;
+                dtype = Some(t);
+            }
+            "dimension" => {
+                if value != "3" {
+                    return Err(LoadError::NotThreeD {
+                        at: at.clone(),
+                        field: "dimension",
+                        found: clip(value),
+                    });
+                }
+                dimension_seen = true;
+            }
+            "sizes" => {
+                let parsed: Option<Vec<u64>> =
+                    value.split_whitespace().map(|s| s.parse().ok()).collect();
+                match parsed.as_deref() {
+                    Some(&[x, y, z]) => sizes = Some((number, [x, y, z], value.to_string())),
+                    _ => return Err(bad("three whole numbers, e.g. `sizes: 64 64 32`")),
+                }
+            }
+            "spacings" => {
+                let parsed: Option<Vec<f64>> =
+                    value.split_whitespace().map(|s| s.parse().ok()).collect();
+                match parsed.as_deref() {
+                    Some(&[x, y, z]) => spacing = Some((number, DVec3::new(x, y, z))),
+                    _ => return Err(bad("three numbers, e.g. `spacings: 1 1 1.5`")),
+                }
+            }
+            "space directions" => {
+                let lengths = parse_directions(value).ok_or_else(|| {
+                    bad("three vectors, e.g. `space directions: (1,0,0) (0,1,0) (0,0,1.5)`")
+                })?;
+                spacing = Some((number, lengths));
+            }
+            "endian" => {
+                order = Some(match value.to_ascii_lowercase().as_str() {
+                    "little" => Endianness::Little,
+                    "big" => Endianness::Big,
+                    _ => return Err(bad("`little` or `big`")),
+                });
+            }
+            "encoding" => {
+                encoding = Some(match value.to_ascii_lowercase().as_str() {
+                    "raw" => Encoding::Raw,
+                    "gzip" | "gz" => Encoding::Gzip,
+                    _ => {
+                        return Err(LoadError::UnsupportedEncoding {
+                            at: at.clone(),
+                            found: clip(value),
+                            supported: SUPPORTED_ENCODINGS,
+                        });
+                    }
+                });
+            }
+            "data file" | "datafile" => {
+                if value.starts_with("LIST") || value.contains('%') || value.contains(' ') {
+                    return Err(LoadError::UnsupportedField {
+                        at: at.clone(),
+                        field: field.clone(),
+                        value: clip(value),
+                        hint: "only a single data file is supported; join the slices into one file",
+                    });
+                }
+                data_file = Some(value.to_string());
+            }
+            "byte skip" | "byteskip" => {
+                byte_skip = value
+                    .parse::<i64>()
+                    .ok()
+                    .filter(|&n| n >= -1)
+                    .ok_or_else(|| {
+                        bad("a whole number ≥ 0, or -1 for data at the end of the file")
+                    })?;
+            }
+            "line skip" | "lineskip" => {
+                if value != "0" {
+                    return Err(LoadError::UnsupportedField {
+                        at: at.clone(),
+                        field: field.clone(),
+                        value: clip(value),
+                        hint: "skipping text lines before the data is not supported; use `byte skip` or remove the lines",
+                    });
+                }
+            }
+            "block size" | "blocksize" => {}
+            f if IGNORED.contains(&f) => {}
+            _ => {
+                return Err(LoadError::UnsupportedField {
+                    at: at.clone(),
+                    field: field.clone(),
+                    value: clip(value),
+                    hint: "it is not a NRRD field volgraph knows; remove it or turn it into a `key:=value` pair",
+                });
+            }
+        }
+    }
+
+    let missing = |field, example| LoadError::MissingField {
+        path: path.to_path_buf(),
+        field,
+        example,
+    };
+    let dtype = dtype.ok_or_else(|| missing("type", "type: uchar"))?;
+    if !dimension_seen {
+        return Err(missing("dimension", "dimension: 3"));
+    }
+    let (sizes_line, sizes, sizes_text) =
+        sizes.ok_or_else(|| missing("sizes", "sizes: 64 64 64"))?;
+    let encoding = encoding.ok_or_else(|| missing("encoding", "encoding: raw"))?;
+    let dims = check_dims(
+        &Location::line(path, sizes_line),
+        "sizes",
+        &sizes_text,
+        sizes,
+    )?;
+    let spacing = match spacing {
+        Some((line, s)) => {
+            check_spacing(&Location::line(path, line), s)?;
+            s
+        }
+        None => DVec3::ONE,
+    };
+    let order = order.unwrap_or_else(|| {
+        if dtype.size_bytes() > 1 {
+            notes.push("no \"endian\" field; read as little endian".to_string());
+        }
+        Endianness::Little
+    });
+    if byte_skip == -1 && encoding != Encoding::Raw {
+        return Err(LoadError::UnsupportedField {
+            at: Location::file(path),
+            field: "byte skip".to_string(),
+            value: "-1".to_string(),
+            hint: "-1 (data at the end) only works with raw encoding; give the skip in bytes",
+        });
+    }
+
+    let (data_path, stored) = match &data_file {
+        Some(name) => {
+            let p = sibling(path, name);
+            let bytes = read_file(&p)?;
+            (p, bytes)
+        }
+        None => match data_start {
+            Some(start) => (
+                path.to_path_buf(),
+                bytes.get(start..).unwrap_or(&[]).to_vec(),
+            ),
+            None if path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("nhdr")) =>
+            {
+                return Err(missing("data file", "data file: volume.raw"));
+            }
+            None => {
+                return Err(LoadError::UnterminatedHeader {
+                    path: path.to_path_buf(),
+                });
+            }
+        },
+    };
+    let expected = byte_count(dims, dtype).unwrap_or(u64::MAX);
+    let skip = byte_skip.max(0) as u64;
+    let decoded = match encoding {
+        Encoding::Raw => stored,
+        Encoding::Gzip => inflate(
+            &data_path,
+            &stored,
+            false,
+            expected.saturating_add(skip).saturating_add(1),
+        )?,
+    };
+    let data: &[u8] = if byte_skip == -1 {
+        // Data at the end of the file: the last `expected` bytes (too few bytes fall through to
+        // the size error below).
+        let start = (decoded.len() as u64).saturating_sub(expected) as usize;
+        &decoded[start..]
+    } else {
+        decoded
+            .get(skip.min(decoded.len() as u64) as usize..)
+            .unwrap_or(&[])
+    };
+    let mut report = LoadReport::new(VolumeFormat::Nrrd, &data_path);
+    report.notes = notes;
+    let layout = Layout {
+        name: stem(path),
+        dims,
+        dtype,
+        order,
+        spacing,
+    };
+    finish(layout, data, &data_path, report, HINT)
+}
+
+/// Lengths of the three vectors of a `space directions` value such as `(1,0,0) (0,1,0) (0,0,2)`.
+fn parse_directions(value: &str) -> Option<DVec3> {
+    let compact: String = value.chars().filter(|c| !c.is_whitespace()).collect();
+    let inner = compact.strip_prefix('(')?.strip_suffix(')')?;
+    let lengths: Option<Vec<f64>> = inner
+        .split(")(")
+        .map(|vector| {
+            let components: Option<Vec<f64>> = vector.split(',').map(|c| c.parse().ok()).collect();
+            components.map(|c| c.iter().map(|x| x * x).sum::<f64>().sqrt())
+        })
+        .collect();
+    match lengths.as_deref() {
+        Some(&[x, y, z]) => Some(DVec3::new(x, y, z)),
+        _ => None,
+    }
+}

@@ -1,0 +1,263 @@
+//! Transfer functions: the preset files, RON and ParaView parsing with their errors word for
+//! word, LUT baking and sampling against hand-computed values, opacity correction.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use volgraph_accel::generate;
+use volgraph_accel::transfer_function::{
+    ControlPoint, DEFAULT_LUT_SIZE, Preset, TransferFunction, lut_sample, opacity_correct,
+    opacity_uncorrect,
+};
+
+fn tf_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../graphs/tf")
+}
+
+fn point(value: f64, rgb: f64, alpha: f64) -> ControlPoint {
+    ControlPoint {
+        value,
+        color: [rgb; 3],
+        alpha,
+    }
+}
+
+#[test]
+fn preset_files_load_and_equal_the_presets() {
+    for preset in Preset::ALL {
+        let path = tf_dir().join(format!("{}.ron", preset.name()));
+        let loaded = TransferFunction::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let expected = TransferFunction::preset(preset, (0.0, 255.0));
+        assert_eq!(loaded.domain, expected.domain);
+        assert_eq!(
+            loaded.points.len(),
+            expected.points.len(),
+            "{}",
+            path.display()
+        );
+        for (a, b) in loaded.points.iter().zip(&expected.points) {
+            // The files write t·255 in decimal; the preset computes it in f64.
+            assert!(
+                (a.value - b.value).abs() < 1e-9,
+                "{}: {a:?} vs {b:?}",
+                path.display()
+            );
+            assert_eq!((a.color, a.alpha), (b.color, b.alpha), "{}", path.display());
+        }
+    }
+}
+
+#[test]
+fn presets_do_what_their_names_promise() {
+    let opaque = TransferFunction::preset(Preset::Opaque, (0.0, 255.0));
+    assert_eq!(
+        opaque.eval(20.0)[3],
+        1.0,
+        "opaque: full opacity from 5% of the range"
+    );
+    let sparse = TransferFunction::preset(Preset::Sparse, (0.0, 255.0));
+    let transparent = (0..=255)
+        .filter(|&v| sparse.eval(v as f64)[3] == 0.0)
+        .count();
+    assert!(
+        transparent > 150,
+        "sparse: most values are transparent ({transparent}/256)"
+    );
+    let ml = generate::marschner_lobb(8);
+    assert_eq!(TransferFunction::default_for(&ml).domain, (0.0, 255.0));
+}
+
+#[test]
+fn ron_round_trip() {
+    let tf = TransferFunction::preset(Preset::Default, (-10.0, 30.0));
+    let text = tf.to_ron_string();
+    let back =
+        TransferFunction::from_ron_str(&text, Path::new("mem.ron")).expect("parse own output");
+    assert_eq!(back, tf);
+}
+
+#[test]
+fn eval_is_piecewise_linear_and_clamped() {
+    let tf = TransferFunction {
+        domain: (0.0, 10.0),
+        points: vec![point(2.0, 0.0, 0.0), point(6.0, 1.0, 0.5)],
+    };
+    assert_eq!(tf.eval(0.0), [0.0; 4], "before the first point: its value");
+    assert_eq!(tf.eval(4.0), [0.5, 0.5, 0.5, 0.25], "halfway");
+    assert_eq!(
+        tf.eval(9.0),
+        [1.0, 1.0, 1.0, 0.5],
+        "after the last point: its value"
+    );
+    // A step: two points at the same value.
+    let step = TransferFunction {
+        domain: (0.0, 1.0),
+        points: vec![point(0.5, 0.0, 0.0), point(0.5, 1.0, 1.0)],
+    };
+    assert_eq!(step.eval(0.49)[3], 0.0);
+    assert_eq!(step.eval(0.5)[3], 1.0);
+}
+
+#[test]
+fn lut_texels_and_sampling_match_hand_computed_values() {
+    // alpha = v/255 over the domain (0, 255): texel i of 4 sits at s = (i + 0.5)/4.
+    let ramp = TransferFunction {
+        domain: (0.0, 255.0),
+        points: vec![point(0.0, 0.0, 0.0), point(255.0, 1.0, 1.0)],
+    };
+    let lut = ramp.to_lut(4);
+    let alphas: Vec<f32> = lut.iter().map(|t| t[3]).collect();
+    assert_eq!(alphas, vec![0.125, 0.375, 0.625, 0.875]);
+    // s = 0.3: x = 0.3·4 - 0.5 = 0.7 → 0.3·0.125 + 0.7·0.375 = 0.3.
+    assert!((lut_sample(&lut, 0.3)[3] - 0.3).abs() < 1e-12);
+    assert_eq!(lut_sample(&lut, 0.5)[3], 0.5);
+    assert_eq!(
+        lut_sample(&lut, 0.05)[3],
+        0.125,
+        "below the first texel centre: clamped"
+    );
+    assert_eq!(
+        lut_sample(&lut, 1.0)[3],
+        0.875,
+        "above the last texel centre: clamped"
+    );
+    assert_eq!(lut_sample(&lut, f64::NAN)[3], 0.125, "NaN reads as s = 0");
+    assert_eq!(lut_sample(&[], 0.5), [0.0; 4]);
+
+    // A kink at 100: texels of 2 at v = 63.75 (alpha 0.5·63.75/100 = 0.31875) and
+    // v = 191.25 (0.5); halfway between them (s = 0.5) the sampler gives their mean 0.409375.
+    let kink = TransferFunction {
+        domain: (0.0, 255.0),
+        points: vec![
+            point(0.0, 0.0, 0.0),
+            point(100.0, 1.0, 0.5),
+            point(255.0, 1.0, 0.5),
+        ],
+    };
+    let lut = kink.to_lut(2);
+    assert!((lut[0][3] as f64 - 0.31875).abs() < 1e-7);
+    assert_eq!(lut[1][3], 0.5);
+    assert!((lut_sample(&lut, 0.5)[3] - 0.409375).abs() < 1e-7);
+}
+
+#[test]
+fn lookup_is_the_sampler_on_the_default_lut() {
+    let tf = TransferFunction::preset(Preset::Default, (0.0, 255.0));
+    let lut = tf.to_lut(DEFAULT_LUT_SIZE);
+    for k in 0..=1000 {
+        let s = k as f64 / 1000.0 * 1.2 - 0.1;
+        assert_eq!(tf.lookup(s), lut_sample(&lut, s), "s = {s}");
+    }
+}
+
+#[test]
+fn lut_for_a_volume_uses_its_value_range() {
+    // A float volume whose finite range is (0, 7): a TF with domain (0, 14) covers twice it.
+    let (mut volume, _) = generate::non_finite_f32(8);
+    volgraph_accel::load::sanitize_volume(&mut volume);
+    assert_eq!(volume.value_range, (0.0, 7.0));
+    let tf = TransferFunction {
+        domain: (0.0, 14.0),
+        points: vec![point(0.0, 0.0, 0.0), point(14.0, 1.0, 1.0)],
+    };
+    assert_eq!(tf.normalized_domain_for(&volume), (0.0, 2.0));
+    // Texel 0 of 2 is s = 0.25 → v = 1.75 in data units → alpha 1.75/14 = 0.125.
+    assert_eq!(tf.to_lut_for(&volume, 2)[0][3], 0.125);
+    // to_lut maps s onto the TF's own domain: s = 0.25 → v = 3.5 → alpha 0.25.
+    assert_eq!(tf.to_lut(2)[0][3], 0.25);
+    // For uint8 data the default TF's domain is the volume's range: both LUTs agree.
+    let ml = generate::marschner_lobb(8);
+    let default = TransferFunction::default_for(&ml);
+    assert_eq!(default.normalized_domain_for(&ml), (0.0, 1.0));
+    assert_eq!(default.to_lut(64), default.to_lut_for(&ml, 64));
+}
+
+#[test]
+fn opacity_correction_and_its_inverse() {
+    assert_eq!(opacity_correct(0.5, 1.0), 0.5);
+    assert_eq!(
+        opacity_correct(0.5, 2.0),
+        0.75,
+        "two half-opaque unit steps"
+    );
+    assert!(
+        (opacity_correct(0.75, 0.5) - 0.5).abs() < 1e-15,
+        "half a step of 0.75: 1 - 0.25^0.5"
+    );
+    for &a in &[0.0, 0.01, 0.3, 0.9, 1.0] {
+        for &step in &[0.25, 0.5, 1.0, 3.0] {
+            let back = opacity_uncorrect(opacity_correct(a, step), step);
+            assert!((back - a).abs() < 1e-12, "alpha {a}, step {step}: {back}");
+        }
+    }
+}
+
+fn ron_err(text: &str) -> String {
+    TransferFunction::from_ron_str(text, Path::new("graphs/tf/bad.ron"))
+        .expect_err("invalid")
+        .to_string()
+}
+
+#[test]
+fn ron_errors_word_for_word() {
+    let p = |pts: &str| format!("TransferFunction(domain: (0.0, 255.0), points: [{pts}])");
+    assert_eq!(
+        ron_err(&p(
+            "(value: 10.0, color: (1.0, 1.0, 1.0), alpha: 0.5), (value: 5.0, color: (1.0, 1.0, 1.0), alpha: 0.5)"
+        )),
+        "graphs/tf/bad.ron: points[1].value = 5 is smaller than points[0].value = 10; list the points in increasing value"
+    );
+    assert_eq!(
+        ron_err(&p("(value: 10.0, color: (1.0, 1.0, 1.0), alpha: 1.5)")),
+        "graphs/tf/bad.ron: points[0].alpha = 1.5 is outside [0, 1]; colours are linear RGB in 0..1 and alpha is opacity per unit step in 0..1"
+    );
+    assert_eq!(
+        ron_err(&p(
+            "(value: 0.0, color: (0.0, 0.0, 0.0), alpha: 0.0), (value: 10.0, color: (1.0, -0.1, 1.0), alpha: 0.5)"
+        )),
+        "graphs/tf/bad.ron: points[1].color.g = -0.1 is outside [0, 1]; colours are linear RGB in 0..1 and alpha is opacity per unit step in 0..1"
+    );
+    assert_eq!(
+        ron_err(&p("(value: 300.0, color: (1.0, 1.0, 1.0), alpha: 0.5)")),
+        "graphs/tf/bad.ron: points[0].value = 300 is outside the domain (0, 255); move the point into the domain or widen the domain"
+    );
+    assert_eq!(
+        ron_err(&p("")),
+        "graphs/tf/bad.ron: `points` is empty; add at least one point such as `(value: 0.0, color: (1.0, 1.0, 1.0), alpha: 0.0)`"
+    );
+    assert_eq!(
+        ron_err(
+            "TransferFunction(domain: (255.0, 0.0), points: [(value: 0.0, color: (0.0, 0.0, 0.0), alpha: 0.0)])"
+        ),
+        "graphs/tf/bad.ron: domain (255, 0) is not a range; write `domain: (min, max)` with finite min < max in data units"
+    );
+}
+
+#[test]
+fn ron_syntax_errors_carry_line_and_column() {
+    // Columns are 1-based and point at the offending token: `colour` starts at column 25 of
+    // line 3, `lut_size` at column 3, and the missing comma is found at `color` (column 61).
+    assert_eq!(
+        ron_err(
+            "TransferFunction(\n  domain: (0.0, 255.0),\n  points: [(value: 0.0, colour: (0.0, 0.0, 0.0), alpha: 0.0)],\n)"
+        ),
+        "graphs/tf/bad.ron:3:25: Unexpected field named `colour` in `ControlPoint`, expected one of `value`, `color`, or `alpha` instead; see graphs/tf/default.ron for the format"
+    );
+    assert_eq!(
+        ron_err("TransferFunction(\n  domain: (0.0, 255.0),\n  lut_size: 5,\n  points: [],\n)"),
+        "graphs/tf/bad.ron:3:3: Unexpected field named `lut_size` in `TransferFunction`, expected either `domain` or `points` instead; see graphs/tf/default.ron for the format"
+    );
+    assert_eq!(
+        ron_err(
+            "TransferFunction(\n  domain: (0.0, 255.0),\n  points: [(value: 0.0, color: (0.0, 0.0, 0.0))],\n)"
+        ),
+        "graphs/tf/bad.ron:3:47: Unexpected missing field named `alpha` in `ControlPoint`; see graphs/tf/default.ron for the format"
+    );
+    assert_eq!(
+        ron_err(
+            "TransferFunction(domain: (0.0, 255.0), points: [(value: 0.0 color: (0.0, 0.0, 0.0), alpha: 0.0)]"
+        ),
+        "graphs/tf/bad.ron:1:61: Expected comma; see graphs/tf/default.ron for the format"
+    );
+}

@@ -2,9 +2,9 @@
 //! visible sample may fall in a block classified empty, and the tables agree with the
 //! classifier.
 
-mod common;
+mod accel_support;
 
-use common::{lut_alpha, probe_positions, random_lut, random_volume};
+use accel_support::{lut_alpha, probe_positions, random_lut, random_volume};
 use glam::{DVec3, UVec3};
 use proptest::prelude::*;
 use volgraph_accel::classify::{ClassifyError, FLAG_SET, OpacityClassifier};

@@ -1,0 +1,184 @@
+//! NRRD round trips: generated volumes written as attached `.nrrd` (raw and gzip) and detached
+//! `.nhdr`, in every supported type and both byte orders, read back voxel for voxel.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use glam::{DVec3, UVec3};
+use volgraph_accel::generate;
+use volgraph_accel::load::{RawOptions, VolumeFormat, load_volume};
+use volgraph_accel::volume::{Volume, VoxelData};
+
+fn nrrd_type(data: &VoxelData) -> &'static str {
+    match data {
+        VoxelData::U8(_) => "uchar",
+        VoxelData::U16(_) => "unsigned short",
+        VoxelData::I16(_) => "short",
+        VoxelData::F32(_) => "float",
+    }
+}
+
+/// Writes `volume` as NRRD; `detached` writes `<name>.nhdr` + `<name>.raw(.gz)`.
+fn write_nrrd(
+    dir: &Path,
+    volume: &Volume,
+    gzip: bool,
+    big: bool,
+    detached: bool,
+    extra: &str,
+) -> PathBuf {
+    let d = volume.dims;
+    let mut data = common::voxel_bytes(&volume.data, big);
+    if gzip {
+        data = common::gzip(&data);
+    }
+    let name = &volume.name;
+    let data_name = format!("{name}.raw{}", if gzip { ".gz" } else { "" });
+    let mut header = format!(
+        "NRRD0004\n# written by the volgraph tests\ntype: {}\ndimension: 3\nspace: left-posterior-superior\nsizes: {} {} {}\n{extra}endian: {}\nencoding: {}\ncontent: test:=value\nkinds: domain domain domain\n",
+        nrrd_type(&volume.data),
+        d.x,
+        d.y,
+        d.z,
+        if big { "big" } else { "little" },
+        if gzip { "gzip" } else { "raw" },
+    );
+    let path;
+    if detached {
+        header.push_str(&format!("data file: {data_name}\n"));
+        std::fs::write(dir.join(&data_name), &data).expect("write data");
+        path = dir.join(format!("{name}.nhdr"));
+        std::fs::write(&path, header).expect("write header");
+    } else {
+        header.push('\n');
+        let mut bytes = header.into_bytes();
+        bytes.extend_from_slice(&data);
+        path = dir.join(format!("{name}.nrrd"));
+        std::fs::write(&path, bytes).expect("write nrrd");
+    }
+    path
+}
+
+fn test_volumes() -> Vec<Volume> {
+    let ml = generate::marschner_lobb(12);
+    let dims = UVec3::new(5, 4, 3);
+    let n = 60;
+    let u16s = VoxelData::U16((0..n).map(|i| (i * 1093) as u16).collect());
+    let i16s = VoxelData::I16((0..n).map(|i| (i * 547) as i16 - 16000).collect());
+    let f32s = VoxelData::F32((0..n).map(|i| (i as f32 - 20.0) * 0.37).collect());
+    vec![
+        ml,
+        Volume::new("u16", dims, DVec3::ONE, u16s),
+        Volume::new("i16", dims, DVec3::ONE, i16s),
+        Volume::new("f32", dims, DVec3::ONE, f32s),
+    ]
+}
+
+#[test]
+fn every_type_encoding_and_layout_round_trips() {
+    let dir = common::temp_dir("nrrd");
+    for volume in test_volumes() {
+        for (gzip, big, detached) in [
+            (false, false, false),
+            (true, false, false),
+            (false, true, false),
+            (false, false, true),
+            (true, true, true),
+        ] {
+            let sub = dir.join(format!("{}-{gzip}-{big}-{detached}", volume.name));
+            std::fs::create_dir_all(&sub).expect("mkdir");
+            let path = write_nrrd(&sub, &volume, gzip, big, detached, "spacings: 1 1 1\n");
+            let loaded = load_volume(&path, &RawOptions::default())
+                .unwrap_or_else(|e| panic!("gzip {gzip}, big {big}, detached {detached}: {e}"));
+            let what = format!("{} gzip {gzip} big {big} detached {detached}", volume.name);
+            assert_eq!(loaded.volume.data, volume.data, "{what}");
+            assert_eq!(loaded.volume.dims, volume.dims, "{what}");
+            assert_eq!(loaded.report.format, VolumeFormat::Nrrd);
+            assert_eq!(loaded.report.non_finite_replaced(), 0);
+            let data_file = if detached {
+                format!("{}.raw{}", volume.name, if gzip { ".gz" } else { "" })
+            } else {
+                format!("{}.nrrd", volume.name)
+            };
+            assert_eq!(loaded.report.data_path, sub.join(data_file), "{what}");
+        }
+    }
+}
+
+#[test]
+fn spacing_comes_from_spacings_or_direction_lengths() {
+    let dir = common::temp_dir("nrrd-spacing");
+    let volume = generate::sphere(6, 0.5);
+    let path = write_nrrd(&dir, &volume, false, false, false, "spacings: 0.5 0.5 2\n");
+    assert_eq!(
+        load_volume(&path, &RawOptions::default())
+            .expect("load")
+            .volume
+            .spacing,
+        DVec3::new(0.5, 0.5, 2.0)
+    );
+    // (0.6, 0.8, 0) has length 1; (0, 0, -3) length 3; (0, 2, 0) length 2.
+    let path = write_nrrd(
+        &dir,
+        &volume,
+        false,
+        false,
+        false,
+        "space directions: (0.6,0.8,0) (0, 2, 0) (0,0,-3)\nspace origin: (0,0,0)\n",
+    );
+    let loaded = load_volume(&path, &RawOptions::default()).expect("load");
+    assert_eq!(loaded.volume.spacing, DVec3::new(1.0, 2.0, 3.0));
+    assert_eq!(loaded.volume.name, "sphere_6");
+}
+
+#[test]
+fn float_repairs_are_reported() {
+    let dir = common::temp_dir("nrrd-nan");
+    let (volume, (nan, pos, neg)) = generate::non_finite_f32(6);
+    let path = write_nrrd(&dir, &volume, true, false, false, "");
+    let loaded = load_volume(&path, &RawOptions::default()).expect("load");
+    let r = &loaded.report;
+    assert_eq!(
+        (r.nan_replaced, r.pos_inf_replaced, r.neg_inf_replaced),
+        (nan, pos, neg)
+    );
+    assert_eq!(
+        loaded.volume.value_range,
+        (0.0, 5.0),
+        "finite values are the ramp 0..5"
+    );
+}
+
+#[test]
+fn missing_endian_defaults_to_little_with_a_note() {
+    let dir = common::temp_dir("nrrd-endian");
+    let data: Vec<u16> = vec![1, 256, 65535, 7, 8, 9, 10, 11];
+    let mut bytes =
+        b"NRRD0005\ntype: uint16\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n".to_vec();
+    bytes.extend(data.iter().flat_map(|v| v.to_le_bytes()));
+    let path = dir.join("noendian.nrrd");
+    std::fs::write(&path, bytes).expect("write");
+    let loaded = load_volume(&path, &RawOptions::default()).expect("load");
+    assert_eq!(loaded.volume.data, VoxelData::U16(data));
+    assert_eq!(
+        loaded.report.notes,
+        vec!["no \"endian\" field; read as little endian".to_string()]
+    );
+}
+
+#[test]
+fn byte_skip_minus_one_reads_the_end_of_the_data_file() {
+    let dir = common::temp_dir("nrrd-skip");
+    let mut data = vec![0xAAu8; 10]; // junk before the voxels
+    data.extend(0u8..8);
+    std::fs::write(dir.join("v.bin"), &data).expect("write");
+    let header = "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nbyte skip: -1\ndata file: v.bin\n";
+    std::fs::write(dir.join("v.nhdr"), header).expect("write");
+    let loaded = load_volume(&dir.join("v.nhdr"), &RawOptions::default()).expect("load");
+    assert_eq!(loaded.volume.data, VoxelData::U8((0u8..8).collect()));
+    let header = header.replace("-1", "10");
+    std::fs::write(dir.join("w.nhdr"), header).expect("write");
+    let loaded = load_volume(&dir.join("w.nhdr"), &RawOptions::default()).expect("load");
+    assert_eq!(loaded.volume.data, VoxelData::U8((0u8..8).collect()));
+}

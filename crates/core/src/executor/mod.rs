@@ -1,23 +1,22 @@
-//! The wgpu executor: runs a [`crate::plan::Plan`] frame by frame.
+//! The wgpu executor: opens the GPU, builds each pass's pipelines (checking shader bindings
+//! against ports by name), allocates the plan's pooled targets and runs frames.
 
-/// Context given to [`crate::plugin::PassPlugin::create`].
-pub struct CreateContext<'a> {
-    /// The device.
-    pub device: &'a wgpu::Device,
-}
+pub mod context;
+pub mod frame_uniforms;
+pub mod gpu;
+pub mod readback;
+pub mod reflect;
+pub mod run;
+pub mod shaders;
+pub mod upload;
 
-/// Context given to [`crate::plugin::PassNode::record`].
-pub struct RecordContext<'a> {
-    /// The frame's encoder.
-    pub encoder: &'a mut wgpu::CommandEncoder,
-}
-
-/// A pass failed to build or record.
-#[derive(Debug, thiserror::Error)]
-#[error("pass \"{pass}\": {message}")]
-pub struct PassError {
-    /// The pass label.
-    pub pass: String,
-    /// What went wrong.
-    pub message: String,
-}
+pub use context::{
+    ComputePipelineSpec, CreateContext, DepthSpec, PassError, PassPipeline, PipelineKind, PortInfo, RecordContext,
+    RenderPipelineSpec,
+};
+pub use frame_uniforms::FrameUniforms;
+pub use gpu::{Gpu, GpuError};
+pub use readback::Image;
+pub use run::{Executor, ExecutorError, FrameStats};
+pub use shaders::ShaderLibrary;
+pub use upload::{VolumeFormat, upload_lut, upload_volume};

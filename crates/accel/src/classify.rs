@@ -90,19 +90,17 @@ impl OpacityClassifier {
     pub fn texel_span(&self, lo: f64, hi: f64) -> (usize, usize) {
         let (lo, hi) = if lo <= hi { (lo, hi) } else { (hi, lo) };
         let n = self.texels as f64;
-        let last_texel = n - 1.0;
-        // `f64::clamp` maps NaN to NaN and `as usize` maps NaN to 0: a NaN bound falls back to
-        // the whole LUT below.
-        let first = ((lo - VALUE_MARGIN) * n - 1.5)
-            .ceil()
-            .clamp(0.0, last_texel);
-        let last = ((hi + VALUE_MARGIN) * n + 0.5)
-            .floor()
-            .clamp(0.0, last_texel);
+        let last_texel = self.texels - 1;
+        let first = ((lo - VALUE_MARGIN) * n - 1.5).ceil();
+        let last = ((hi + VALUE_MARGIN) * n + 0.5).floor();
+        // `as usize` saturates (negative → 0); NaN is caught first and widens to the whole LUT.
         if first.is_nan() || last.is_nan() {
-            return (0, self.texels - 1);
+            return (0, last_texel);
         }
-        (first as usize, last as usize)
+        (
+            (first as usize).min(last_texel),
+            (last as usize).min(last_texel),
+        )
     }
 
     /// Whether some value in `[lo, hi]` (normalized) can map to non-zero opacity under the LUT's

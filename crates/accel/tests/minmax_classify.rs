@@ -64,7 +64,7 @@ fn check_grid(volume: &Volume, lut: &[[f32; 4]], block_size: u32, seed: u64) -> 
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 96, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
 
     #[test]
     fn no_visible_sample_in_an_empty_block(

@@ -166,14 +166,14 @@ pub fn ray_segment(
     let (eye, dir) = frame.pixel_ray(x, y);
     let (t_in, t_out) = intersect_box(eye, dir, half)?;
     let t0 = t_in.max(frame.near_t(camera.near, dir));
-    if !(t_out > t0) {
+    if t0.is_nan() || t_out <= t0 {
         return None;
     }
     // Clamped like the GPU's entry/exit targets, which clamp interpolation overshoot.
     let texture = |t: f64| ((eye + t * dir) / (2.0 * half) + 0.5).clamp(DVec3::ZERO, DVec3::ONE);
     let (u0, u1) = (texture(t0), texture(t_out));
     let len_tex = (u1 - u0).length();
-    if !(len_tex >= MIN_RAY_LENGTH_TEX) {
+    if len_tex.is_nan() || len_tex < MIN_RAY_LENGTH_TEX {
         return None;
     }
     Some(RaySegment {
@@ -254,7 +254,7 @@ impl March<'_> {
         let mut k = 0;
         while k < self.settings.max_steps {
             let t = self.t(k);
-            if !(t < self.seg.len_tex) {
+            if t >= self.seg.len_tex {
                 break;
             }
             let c = lut_sample(self.lut, self.sample(t));
@@ -277,7 +277,7 @@ impl March<'_> {
         let mut k = 0;
         while k < self.settings.max_steps {
             let t = self.t(k);
-            if !(t < self.seg.len_tex) {
+            if t >= self.seg.len_tex {
                 break;
             }
             let s = self.sample(t);

@@ -66,13 +66,9 @@ fn centre_ray_through_a_cube_has_the_closed_form_opacity() {
         "A = {}, want {expected_a}",
         image.color[0][3]
     );
-    for c in 0..3 {
-        let want = RGBA[c] as f64 * exact_a;
-        assert!(
-            (image.color[0][c] - want).abs() < 1e-12,
-            "channel {c}: {} vs {want}",
-            image.color[0][c]
-        );
+    for (c, (&got, &rgb)) in image.color[0].iter().zip(&RGBA[..3]).enumerate() {
+        let want = rgb as f64 * exact_a;
+        assert!((got - want).abs() < 1e-12, "channel {c}: {got} vs {want}");
     }
 }
 
@@ -131,7 +127,7 @@ fn every_pixel_matches_the_closed_form_for_several_views() {
         }
         assert_eq!(image.samples, total, "az {az} el {el}: sample count");
         assert!(
-            hits > (w * h) as u32 / 10,
+            hits > w * h / 10,
             "az {az} el {el}: the box covers part of the image ({hits} rays)"
         );
     }

@@ -64,7 +64,8 @@ impl OpacityClassifier {
         let mut count = 0u32;
         prefix.push(0);
         for texel in lut {
-            if !(texel[3] <= 0.0) {
+            // NaN is not `<= 0`, so it counts as non-zero (conservative).
+            if texel[3] > 0.0 || texel[3].is_nan() {
                 count += 1;
             }
             prefix.push(count);

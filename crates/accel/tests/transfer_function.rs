@@ -261,3 +261,70 @@ fn ron_syntax_errors_carry_line_and_column() {
         "graphs/tf/bad.ron:1:61: Expected comma; see graphs/tf/default.ron for the format"
     );
 }
+
+fn pv_err(text: &str) -> String {
+    TransferFunction::from_paraview_json(text, Path::new("t.json"))
+        .expect_err("invalid")
+        .to_string()
+}
+
+#[test]
+fn paraview_import_converts_srgb_and_merges_opacity_points() {
+    let json = r#"[{"ColorSpace": "RGB", "Name": "test", "NanColor": [1, 1, 0],
+        "RGBPoints": [0, 0, 0, 0, 10, 1, 0.5, 0],
+        "Points": [0, 0, 0.5, 0, 5, 0.4, 0.5, 0, 10, 1, 0.5, 0]}]"#;
+    let tf = TransferFunction::from_paraview_json(json, Path::new("t.json")).expect("valid map");
+    assert_eq!(tf.domain, (0.0, 10.0));
+    let values: Vec<f64> = tf.points.iter().map(|p| p.value).collect();
+    assert_eq!(
+        values,
+        vec![0.0, 5.0, 10.0],
+        "union of the colour and opacity x values"
+    );
+    // sRGB 0.5 is linear ((0.5 + 0.055)/1.055)^2.4 = 0.214041…; x = 5 is halfway in linear RGB.
+    let srgb_half = ((0.5f64 + 0.055) / 1.055).powf(2.4);
+    assert!((srgb_half - 0.214041).abs() < 1e-6);
+    assert_eq!(tf.points[2].color, [1.0, srgb_half, 0.0]);
+    assert_eq!(tf.points[1].color, [0.5, srgb_half / 2.0, 0.0]);
+    let alphas: Vec<f64> = tf.points.iter().map(|p| p.alpha).collect();
+    assert_eq!(alphas, vec![0.0, 0.4, 1.0]);
+    // Without "Points" the opacity ramps from 0 to 1 over the domain.
+    let ramp = TransferFunction::from_paraview_json(
+        r#"{"RGBPoints": [-1, 1, 1, 1, 1, 1, 1, 1]}"#,
+        Path::new("t.json"),
+    )
+    .expect("a bare object is accepted too");
+    assert_eq!(ramp.eval(0.0)[3], 0.5);
+}
+
+#[test]
+fn paraview_errors_word_for_word() {
+    assert_eq!(
+        pv_err("[{\"RGBPoints\": [0, 1,"),
+        "t.json:1:21: invalid JSON: EOF while parsing a value"
+    );
+    assert_eq!(
+        pv_err("[]"),
+        "t.json: the JSON array is empty; it needs one colour map object with \"RGBPoints\""
+    );
+    assert_eq!(
+        pv_err("[{\"Name\": \"x\"}]"),
+        "t.json: the colour map has no \"RGBPoints\" array; it needs [x, r, g, b, …]"
+    );
+    assert_eq!(
+        pv_err("[{\"RGBPoints\": [0, 0, 0, 0, 1, 1, 1]}]"),
+        "t.json: \"RGBPoints\" has 7 numbers; it needs groups of four (x, r, g, b)"
+    );
+    assert_eq!(
+        pv_err("[{\"RGBPoints\": [0, 0, 0, \"red\"]}]"),
+        "t.json: RGBPoints[3] is \"red\", not a number"
+    );
+    assert_eq!(
+        pv_err("[{\"RGBPoints\": [1, 0, 0, 0, 0, 1, 1, 1]}]"),
+        "t.json: \"RGBPoints\" x values must increase, but point 1 has x = 0 after x = 1"
+    );
+    assert_eq!(
+        pv_err("[{\"RGBPoints\": [2, 0, 0, 0, 2, 1, 1, 1]}]"),
+        "t.json: every point has x = 2; a colour map needs two different x values"
+    );
+}

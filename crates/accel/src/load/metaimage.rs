@@ -138,25 +138,21 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
             "compresseddata" => {
                 compressed = boolean(value).ok_or_else(|| bad("`True` or `False`"))?;
             }
-            "binarydata" => {
-                if boolean(value) != Some(true) {
-                    return Err(LoadError::UnsupportedField {
-                        at,
-                        field: key.to_string(),
-                        value: clip(value),
-                        hint: "only binary data is supported; save the image with `BinaryData = True`",
-                    });
-                }
+            "binarydata" if boolean(value) != Some(true) => {
+                return Err(LoadError::UnsupportedField {
+                    at,
+                    field: key.to_string(),
+                    value: clip(value),
+                    hint: "only binary data is supported; save the image with `BinaryData = True`",
+                });
             }
-            "elementnumberofchannels" => {
-                if value != "1" {
-                    return Err(LoadError::UnsupportedField {
-                        at,
-                        field: key.to_string(),
-                        value: clip(value),
-                        hint: "only scalar volumes (1 channel) are supported; extract one channel first",
-                    });
-                }
+            "elementnumberofchannels" if value != "1" => {
+                return Err(LoadError::UnsupportedField {
+                    at,
+                    field: key.to_string(),
+                    value: clip(value),
+                    hint: "only scalar volumes (1 channel) are supported; extract one channel first",
+                });
             }
             "elementdatafile" => {
                 if value.is_empty()

@@ -77,11 +77,16 @@ fn interpolate<const N: usize>(rows: &[(f64, [f64; N])], x: f64) -> [f64; N] {
 }
 
 pub(super) fn parse(text: &str, path: &Path) -> Result<TransferFunction, TfError> {
-    let root: Value = serde_json::from_str(text).map_err(|e| TfError::Json {
-        path: path.to_path_buf(),
-        line: e.line(),
-        col: e.column(),
-        message: e.to_string(),
+    let root: Value = serde_json::from_str(text).map_err(|e| {
+        // serde_json appends " at line L column C"; the location is shown in front instead.
+        let full = e.to_string();
+        let message = full.split(" at line ").next().unwrap_or(&full).to_string();
+        TfError::Json {
+            path: path.to_path_buf(),
+            line: e.line(),
+            col: e.column(),
+            message,
+        }
     })?;
     let fail = |message: String| TfError::Paraview {
         path: path.to_path_buf(),

@@ -24,7 +24,7 @@ pub struct OrbitCamera {
 
 impl Default for OrbitCamera {
     fn default() -> Self {
-        Self { azimuth_deg: 30.0, elevation_deg: 20.0, distance: 2.2, fov_y_deg: 30.0, near: 0.01, far: 100.0 }
+        Self { azimuth_deg: 30.0, elevation_deg: 20.0, distance: 3.2, fov_y_deg: 30.0, near: 0.01, far: 100.0 }
     }
 }
 

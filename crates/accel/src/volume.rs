@@ -244,3 +244,17 @@ impl Volume {
         Volume { dims, spacing, data, name: name.into(), value_range }
     }
 }
+
+impl Volume {
+    /// A copy of everything but the voxels (dims, spacing, name, value range), with no data:
+    /// what camera and frame set-up need.
+    pub fn clone_header(&self) -> Volume {
+        Volume {
+            dims: self.dims,
+            spacing: self.spacing,
+            data: VoxelData::U8(Vec::new()),
+            name: self.name.clone(),
+            value_range: self.value_range,
+        }
+    }
+}

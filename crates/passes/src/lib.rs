@@ -1,1 +1,46 @@
-//! placeholder
+//! The technique plugins of volgraph, one module per pass kind with its WGSL beside it by name
+//! in `shaders/` (`entry_points.rs` ↔ `shaders/entry_points.wgsl`). Each registers through the
+//! same public [`volgraph_core::Registry`] API an external crate would use.
+
+pub mod entry_points;
+pub mod present;
+pub mod ray_directions;
+pub mod raycast;
+pub mod raycast_compute;
+pub mod raycast_params;
+pub mod scene;
+pub mod session;
+
+use volgraph_core::Registry;
+
+/// Adds every built-in pass kind to `registry`.
+pub fn register_builtin(registry: &mut Registry) {
+    registry
+        .register(entry_points::EntryPoints)
+        .register(ray_directions::RayDirections)
+        .register(raycast::Raycast)
+        .register(raycast_compute::RaycastCompute)
+        .register(present::Present);
+}
+
+/// A registry holding the built-in pass kinds.
+pub fn builtin_registry() -> Registry {
+    let mut r = Registry::new();
+    register_builtin(&mut r);
+    r
+}
+
+/// Sets `pipeline` and bind group 0 and draws `vertices` (no vertex buffers: every built-in
+/// render pass pulls its vertices from `vertex_index`).
+pub(crate) fn draw(
+    pass: &mut wgpu::RenderPass<'_>,
+    pipeline: &volgraph_core::executor::PassPipeline,
+    bind_group: &wgpu::BindGroup,
+    vertices: std::ops::Range<u32>,
+) {
+    if let volgraph_core::executor::PipelineKind::Render(p) = &pipeline.pipeline {
+        pass.set_pipeline(p);
+        pass.set_bind_group(0, bind_group, &[]);
+        pass.draw(vertices, 0..1);
+    }
+}

@@ -9,7 +9,7 @@ use crate::format::{TargetFormat, TargetSize};
 
 /// A whole graph file: `Graph( ... )`.
 #[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, rename = "Graph")]
 pub struct GraphDoc {
     /// A short name, shown in plans and benchmarks.
     pub name: String,

@@ -1,0 +1,199 @@
+//! Command-line arguments and the subcommands they run.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, anyhow};
+use clap::{Parser, Subcommand};
+use volgraph_accel::camera::OrbitCamera;
+use volgraph_core::executor::{Gpu, ShaderLibrary};
+use volgraph_core::shader_source::default_shader_root;
+use volgraph_core::{CompileOptions, Diagnostics, compile};
+use volgraph_passes::builtin_registry;
+use volgraph_passes::session::{RenderSession, SessionError};
+
+use crate::{image_out, inputs};
+
+/// volgraph: GPU volume rendering assembled from a declarative render graph.
+#[derive(Parser, Debug)]
+#[command(name = "volgraph", version, about)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Compile a graph and print its schedule: ordered passes, culled passes, targets → slots,
+    /// pooled vs unpooled transient memory.
+    Plan {
+        /// The graph file (RON).
+        graph: PathBuf,
+        /// Viewport, WIDTHxHEIGHT.
+        #[arg(long, default_value = "1920x1080")]
+        size: String,
+        /// Scene features that are on, comma separated (e.g. shading,antialias).
+        #[arg(long, value_delimiter = ',')]
+        features: Vec<String>,
+        /// Scene values, NAME=VALUE (repeat counts, ...).
+        #[arg(long = "scalar", value_parser = parse_scalar)]
+        scalars: Vec<(String, f64)>,
+    },
+    /// Render a graph to an image (PNG: 8-bit sRGB; EXR: 32-bit float linear).
+    Render {
+        /// The graph file (RON).
+        graph: PathBuf,
+        /// Volume file (.raw named NAME_XxYxZ_TYPE.raw, .nrrd, .nhdr, .mhd, .mha); default: a
+        /// generated Marschner–Lobb 64³.
+        #[arg(long)]
+        volume: Option<PathBuf>,
+        /// Transfer function (RON, or ParaView color-map .json); default: one fitted to the data.
+        #[arg(long)]
+        tf: Option<PathBuf>,
+        /// Viewport, WIDTHxHEIGHT.
+        #[arg(long, default_value = "512x512")]
+        size: String,
+        /// Orbit camera AZIMUTH,ELEVATION,DISTANCE (degrees, degrees, world units).
+        #[arg(long, default_value = "30,20,3.2")]
+        camera: String,
+        /// Frames to render (the last one is written); each rotates the volume 1° about y.
+        #[arg(long, default_value_t = 1)]
+        frames: u32,
+        /// Scene features that are on, comma separated.
+        #[arg(long, value_delimiter = ',')]
+        features: Vec<String>,
+        /// The graph output to write; default: "display" for PNG when the graph has it, else "image".
+        #[arg(long)]
+        output: Option<String>,
+        /// Where to write the image (.png or .exr).
+        #[arg(short = 'o', long = "out")]
+        out: PathBuf,
+    },
+    /// Measure: `volgraph bench accel` (CPU acceleration structures).
+    Bench {
+        #[command(subcommand)]
+        which: BenchCommand,
+    },
+}
+
+#[derive(Subcommand, Debug)]
+enum BenchCommand {
+    /// Min/max grid + classification of the engine volume; octree rebuild after a TF change.
+    Accel {
+        /// Repetitions per figure (the median is reported).
+        #[arg(long, default_value_t = 7)]
+        repeats: usize,
+        /// Write the figures as JSON here.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
+}
+
+fn parse_scalar(text: &str) -> Result<(String, f64), String> {
+    let (name, value) = text.split_once('=').ok_or_else(|| format!("\"{text}\": expected NAME=VALUE"))?;
+    let value: f64 = value.parse().map_err(|_| format!("\"{text}\": \"{value}\" is not a number"))?;
+    Ok((name.to_string(), value))
+}
+
+/// What went wrong, split so graph diagnostics can be drawn with their source excerpts.
+pub enum CliError {
+    /// Problems in a graph file.
+    Graph(Diagnostics),
+    /// Anything else.
+    Other(anyhow::Error),
+}
+
+impl From<anyhow::Error> for CliError {
+    fn from(e: anyhow::Error) -> Self {
+        CliError::Other(e)
+    }
+}
+
+impl From<SessionError> for CliError {
+    fn from(e: SessionError) -> Self {
+        match e {
+            SessionError::Graph(d) => CliError::Graph(d),
+            other => CliError::Other(anyhow!(other)),
+        }
+    }
+}
+
+fn compile_options(size: &str, features: &[String], scalars: &[(String, f64)]) -> anyhow::Result<CompileOptions> {
+    let (w, h) = inputs::parse_size(size)?;
+    let mut o = CompileOptions::new(w, h).with_features(features.iter().filter(|f| !f.is_empty()).cloned());
+    o.scalars = scalars.iter().cloned().collect::<BTreeMap<_, _>>();
+    Ok(o)
+}
+
+fn display_name(path: &Path) -> String {
+    path.display().to_string()
+}
+
+/// Runs a parsed command line.
+pub fn run(cli: Cli) -> Result<(), CliError> {
+    match cli.command {
+        Command::Plan { graph, size, features, scalars } => {
+            let source = inputs::read_graph(&graph)?;
+            let options = compile_options(&size, &features, &scalars)?;
+            let plan = compile(&display_name(&graph), &source, &builtin_registry(), &options).map_err(CliError::Graph)?;
+            print!("{}", plan.to_text());
+            Ok(())
+        }
+        Command::Render { graph, volume, tf, size, camera, frames, features, output, out } => {
+            let source = inputs::read_graph(&graph)?;
+            let options = compile_options(&size, &features, &[])?;
+            let camera = inputs::parse_camera(&camera)?;
+            let volume = inputs::volume(volume.as_ref())?;
+            let tf = inputs::transfer_function(tf.as_ref(), &volume)?;
+            let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
+            let gpu = Gpu::new_headless().map_err(|e| anyhow!(e))?;
+            let shaders = ShaderLibrary::new(default_shader_root());
+            let registry = builtin_registry();
+            let mut session =
+                RenderSession::new(&gpu, &shaders, &registry, &display_name(&graph), &source, &options, &volume, &lut)?;
+            let is_exr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+            let output = output.unwrap_or_else(|| {
+                if !is_exr && session.plan().outputs.contains_key("display") { "display".to_string() } else { "image".to_string() }
+            });
+            let mut last = None;
+            for f in 0..frames.max(1) {
+                let cam = OrbitCamera { azimuth_deg: camera.azimuth_deg + f as f64, ..camera };
+                last = Some(session.render(&gpu, &cam)?);
+            }
+            let image = session.read(&gpu, &output)?;
+            if is_exr {
+                image_out::write_exr(&out, &image)?;
+            } else {
+                let srgb = image.channels == 4 && session.plan().outputs.get(&output).is_some_and(|&r| {
+                    matches!(
+                        session.plan().resources[r].desc,
+                        volgraph_core::plan::ResourceDesc::Target { format: volgraph_core::TargetFormat::Rgba8Unorm, .. }
+                    )
+                });
+                image_out::write_png(&out, &image, srgb)?;
+            }
+            if let Some(stats) = last {
+                let clock = if stats.wall_time_fallback { "wall time (no GPU timestamps)" } else { "GPU time" };
+                eprintln!(
+                    "{}: {}x{} on {}, last frame {:.2} ms {clock} → {}",
+                    graph.display(),
+                    options.viewport.0,
+                    options.viewport.1,
+                    gpu.adapter_name,
+                    stats.frame_ms,
+                    out.display()
+                );
+            }
+            Ok(())
+        }
+        Command::Bench { which: BenchCommand::Accel { repeats, json } } => {
+            let opts = crate::bench_accel::AccelBenchOptions {
+                data_dir: volgraph_accel::data_dir::data_dir(),
+                repeats,
+                json_out: json,
+            };
+            crate::bench_accel::run(&opts).context("bench accel")?;
+            Ok(())
+        }
+    }
+}

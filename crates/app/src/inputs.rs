@@ -1,0 +1,73 @@
+//! Reading the user's inputs: graph files, volumes (or a generated default), transfer
+//! functions, sizes and cameras from the command line.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, anyhow, bail};
+use volgraph_accel::camera::OrbitCamera;
+use volgraph_accel::load::{RawOptions, load_volume};
+use volgraph_accel::transfer_function::TransferFunction;
+use volgraph_accel::volume::Volume;
+
+/// The LUT resolution uploaded for every transfer function.
+pub const LUT_SIZE: usize = 256;
+
+/// Reads a graph file's text.
+pub fn read_graph(path: &Path) -> anyhow::Result<String> {
+    std::fs::read_to_string(path).with_context(|| format!("{}: cannot read graph file", path.display()))
+}
+
+/// Loads `--volume`, or generates the default (Marschner–Lobb 64³) when none is given.
+pub fn volume(path: Option<&PathBuf>) -> anyhow::Result<Volume> {
+    match path {
+        None => Ok(volgraph_accel::generate::marschner_lobb(64)),
+        Some(p) => {
+            let loaded = load_volume(p, &RawOptions::default()).map_err(|e| anyhow!("{e}"))?;
+            if loaded.report.non_finite_replaced() > 0 {
+                eprintln!("note: {}: replaced {} NaN/Inf voxels", p.display(), loaded.report.non_finite_replaced());
+            }
+            Ok(loaded.volume)
+        }
+    }
+}
+
+/// Loads `--tf` (RON, or ParaView JSON by extension), or the default for the volume.
+pub fn transfer_function(path: Option<&PathBuf>, volume: &Volume) -> anyhow::Result<TransferFunction> {
+    match path {
+        None => Ok(TransferFunction::default_for(volume)),
+        Some(p) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")) => {
+            TransferFunction::load_paraview(p).map_err(|e| anyhow!("{e}"))
+        }
+        Some(p) => TransferFunction::load(p).map_err(|e| anyhow!("{e}")),
+    }
+}
+
+/// Parses `WxH`.
+pub fn parse_size(text: &str) -> anyhow::Result<(u32, u32)> {
+    let fail = || anyhow!("--size \"{text}\": expected WIDTHxHEIGHT, e.g. 512x512, each 1..=16384");
+    let (w, h) = text.split_once(['x', 'X']).ok_or_else(fail)?;
+    let w: u32 = w.trim().parse().map_err(|_| fail())?;
+    let h: u32 = h.trim().parse().map_err(|_| fail())?;
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(fail());
+    }
+    Ok((w, h))
+}
+
+/// Parses `azimuth,elevation,distance` (degrees, degrees, world units; the volume's longest
+/// side is 1).
+pub fn parse_camera(text: &str) -> anyhow::Result<OrbitCamera> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let fail = || anyhow!("--camera \"{text}\": expected AZIMUTH,ELEVATION,DISTANCE in degrees, degrees and world units, e.g. 30,20,3.2");
+    if parts.len() != 3 {
+        return Err(fail());
+    }
+    let v: Vec<f64> = parts.iter().map(|p| p.parse::<f64>().map_err(|_| fail())).collect::<Result<_, _>>()?;
+    if !v.iter().all(|x| x.is_finite()) || v[2] <= 0.0 {
+        bail!("--camera \"{text}\": values must be finite and the distance positive");
+    }
+    if v[1].abs() > 90.0 {
+        bail!("--camera \"{text}\": elevation must be within -90..=90 degrees");
+    }
+    Ok(OrbitCamera { azimuth_deg: v[0], elevation_deg: v[1], distance: v[2], ..OrbitCamera::default() })
+}

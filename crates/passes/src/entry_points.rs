@@ -1,0 +1,66 @@
+//! `entry_points`: Krüger & Westermann 2003 §2.1, pass 1 — the volume box's front faces
+//! rasterized into a float target of texture-space entry positions `(u, 1)`; `(0,0,0,0)` where
+//! the ray misses. With the camera inside the volume the front faces are clipped, and a
+//! screen-covering triangle writes each ray's near-plane point instead (at any pixel at most one
+//! of the two writes, so both are always drawn). Shader: `shaders/entry_points.wgsl`.
+
+use volgraph_core::executor::{CreateContext, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
+use volgraph_core::plugin::ShaderUse;
+use volgraph_core::{Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+
+/// The plugin.
+pub struct EntryPoints;
+
+impl PassPlugin for EntryPoints {
+    fn kind(&self) -> &'static str {
+        "entry_points"
+    }
+
+    fn summary(&self) -> &'static str {
+        "texture-space ray entry points from the box's front faces (Krüger–Westermann 2003 §2.1, pass 1)"
+    }
+
+    fn ports(&self, _params: &Params) -> Vec<PortSpec> {
+        vec![PortSpec::write("entry", PortKind::target(&[TargetFormat::Rgba32Float, TargetFormat::Rgba16Float]))]
+    }
+
+    fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
+        vec![
+            ShaderUse { file: "entry_points.wgsl", entry_point: "fs_entry" },
+            ShaderUse { file: "entry_points.wgsl", entry_point: "fs_near_plane" },
+        ]
+    }
+
+    fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        let faces = ctx.render_pipeline(&RenderPipelineSpec {
+            shader: "entry_points.wgsl",
+            vertex: "vs_box",
+            fragment: "fs_entry",
+            cull: Some(wgpu::Face::Back),
+            ..Default::default()
+        })?;
+        let near_plane = ctx.render_pipeline(&RenderPipelineSpec {
+            shader: "entry_points.wgsl",
+            vertex: "vs_fullscreen",
+            fragment: "fs_near_plane",
+            ..Default::default()
+        })?;
+        Ok(Box::new(EntryPointsNode { faces, near_plane }))
+    }
+}
+
+struct EntryPointsNode {
+    faces: PassPipeline,
+    near_plane: PassPipeline,
+}
+
+impl PassNode for EntryPointsNode {
+    fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
+        let faces_bg = ctx.bind_group(&self.faces, &[])?;
+        let near_bg = ctx.bind_group(&self.near_plane, &[])?;
+        let mut pass = ctx.begin_render_pass(&self.faces, None)?;
+        crate::draw(&mut pass, &self.near_plane, &near_bg, 0..3);
+        crate::draw(&mut pass, &self.faces, &faces_bg, 0..36);
+        Ok(())
+    }
+}

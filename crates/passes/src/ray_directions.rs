@@ -1,0 +1,57 @@
+//! `ray_directions`: Krüger & Westermann 2003 §2.1, pass 2 — the box's back faces give each
+//! ray's exit point; with the entry point from pass 1 this writes the normalized texture-space
+//! direction and, in alpha, the ray length. Shader: `shaders/ray_directions.wgsl`.
+
+use volgraph_core::executor::{CreateContext, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
+use volgraph_core::plugin::ShaderUse;
+use volgraph_core::{Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+
+/// The plugin.
+pub struct RayDirections;
+
+const FLOAT_TARGETS: [TargetFormat; 2] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float];
+
+impl PassPlugin for RayDirections {
+    fn kind(&self) -> &'static str {
+        "ray_directions"
+    }
+
+    fn summary(&self) -> &'static str {
+        "texture-space ray direction and length from the box's back faces (Krüger–Westermann 2003 §2.1, pass 2)"
+    }
+
+    fn ports(&self, _params: &Params) -> Vec<PortSpec> {
+        vec![
+            PortSpec::read("entry", PortKind::target(&FLOAT_TARGETS)),
+            PortSpec::write("dir", PortKind::target(&FLOAT_TARGETS)),
+        ]
+    }
+
+    fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
+        vec![ShaderUse { file: "ray_directions.wgsl", entry_point: "fs_dir" }]
+    }
+
+    fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
+            shader: "ray_directions.wgsl",
+            vertex: "vs_box",
+            fragment: "fs_dir",
+            cull: Some(wgpu::Face::Front),
+            ..Default::default()
+        })?;
+        Ok(Box::new(RayDirectionsNode { pipeline }))
+    }
+}
+
+struct RayDirectionsNode {
+    pipeline: PassPipeline,
+}
+
+impl PassNode for RayDirectionsNode {
+    fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
+        let bg = ctx.bind_group(&self.pipeline, &[])?;
+        let mut pass = ctx.begin_render_pass(&self.pipeline, None)?;
+        crate::draw(&mut pass, &self.pipeline, &bg, 0..36);
+        Ok(())
+    }
+}

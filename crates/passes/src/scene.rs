@@ -1,0 +1,50 @@
+//! Turning CPU scene data (volume, transfer function, orbit camera) into what the executor
+//! binds: frame uniforms and input textures (`docs/rendering_model.md`).
+
+use volgraph_accel::camera::OrbitCamera;
+use volgraph_accel::volume::{Volume, VoxelData};
+use volgraph_core::executor::{FrameUniforms, Gpu, VolumeFormat, upload_lut, upload_volume};
+
+fn mat(m: glam::DMat4) -> [[f32; 4]; 4] {
+    m.as_mat4().to_cols_array_2d()
+}
+
+/// The frame uniforms for `camera` looking at `volume` in a `viewport`.
+pub fn frame_uniforms(camera: &OrbitCamera, volume: &Volume, viewport: (u32, u32)) -> FrameUniforms {
+    let f = camera.frame(viewport.0, viewport.1);
+    let half = volume.half_extent_world();
+    let eye_inside = f.eye.abs().cmple(half).all();
+    FrameUniforms {
+        clip_from_world: mat(f.clip_from_world),
+        world_from_clip: mat(f.world_from_clip),
+        eye_world: [f.eye.x as f32, f.eye.y as f32, f.eye.z as f32, if eye_inside { 1.0 } else { 0.0 }],
+        half_extent: [half.x as f32, half.y as f32, half.z as f32, volume.unit_step_world() as f32],
+        volume_dims: [volume.dims.x as f32, volume.dims.y as f32, volume.dims.z as f32, 0.0],
+        viewport: [viewport.0 as f32, viewport.1 as f32, 1.0 / viewport.0 as f32, 1.0 / viewport.1 as f32],
+        camera_forward: [f.forward.x as f32, f.forward.y as f32, f.forward.z as f32, camera.near as f32],
+        frame_index: 0,
+        _pad: [0; 3],
+    }
+}
+
+/// Uploads a volume as the 3D texture the shaders sample (normalized values,
+/// `docs/rendering_model.md`): u8 → R8Unorm, u16 → R16Unorm, i16 → R16Unorm offset by 32768,
+/// f32 → R32Float normalized by the value range.
+pub fn upload_volume_texture(gpu: &Gpu, volume: &Volume) -> Result<wgpu::Texture, String> {
+    let dims = [volume.dims.x, volume.dims.y, volume.dims.z];
+    let (format, bytes): (VolumeFormat, Vec<u8>) = match &volume.data {
+        VoxelData::U8(v) => (VolumeFormat::R8Unorm, v.clone()),
+        VoxelData::U16(v) => (VolumeFormat::R16Unorm, bytemuck::cast_slice(v).to_vec()),
+        VoxelData::I16(v) => {
+            let shifted: Vec<u16> = v.iter().map(|x| (*x as i32 + 32768) as u16).collect();
+            (VolumeFormat::R16Unorm, bytemuck::cast_slice(&shifted).to_vec())
+        }
+        VoxelData::F32(_) => (VolumeFormat::R32Float, bytemuck::cast_slice(&volume.normalized_f32()).to_vec()),
+    };
+    upload_volume(gpu, &volume.name, dims, format, &bytes)
+}
+
+/// Uploads a transfer-function LUT.
+pub fn upload_lut_texture(gpu: &Gpu, lut: &[[f32; 4]]) -> wgpu::Texture {
+    upload_lut(gpu, "transfer function", lut)
+}

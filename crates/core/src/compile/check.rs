@@ -115,6 +115,17 @@ pub(crate) fn check(
         group_by_id: HashMap::new(),
     };
     let order = c.collect_nodes();
+    for key in options.param_overrides.keys() {
+        let pass = key.split_once('.').map_or(key.as_str(), |(p, _)| p);
+        if !c.pass_by_id.contains_key(pass) {
+            let mut ids: Vec<&str> = c.pass_by_id.keys().map(String::as_str).collect();
+            ids.sort_unstable();
+            c.diags.push(
+                Diagnostic::new(Location::File, format!("parameter override \"{key}\" names no pass of this graph"))
+                    .with_help(format!("write \"<pass>.<param>\"; passes are: {}", comma_list(&ids))),
+            );
+        }
+    }
     c.check_references();
     let outputs = c.check_graph_outputs();
     let history = c.check_history();
@@ -316,7 +327,15 @@ impl Checker<'_> {
     fn check_params(&mut self, p: &PassDoc, path: PassPath, plugin: &dyn PassPlugin) -> Params {
         let specs = plugin.params();
         let mut params = Params::defaults(&specs);
-        for (name, value) in &p.params {
+        let mut values: Vec<(String, ron::Value)> = p.params.iter().map(|(k, v)| (k.clone(), v.clone())).collect();
+        let prefix = format!("{}.", p.id);
+        for (key, value) in &self.options.param_overrides {
+            if let Some(name) = key.strip_prefix(&prefix) {
+                values.retain(|(k, _)| k != name);
+                values.push((name.to_string(), value.clone()));
+            }
+        }
+        for (name, value) in &values {
             let Some(spec) = specs.iter().find(|s| s.name == name) else {
                 let names: Vec<&str> = specs.iter().map(|s| s.name).collect();
                 let mut help = format!("its parameters are: {}", comma_list(&names));

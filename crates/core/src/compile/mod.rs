@@ -23,11 +23,14 @@ pub struct CompileOptions {
     pub features: BTreeSet<String>,
     /// Scene values overriding graph `Scalar` inputs and feeding repeat counts.
     pub scalars: BTreeMap<String, f64>,
+    /// Parameter values overriding the graph file's, keyed `"<pass id>.<param>"` (benchmark
+    /// sweeps, viewer sliders). Checked like values written in the file.
+    pub param_overrides: BTreeMap<String, ron::Value>,
 }
 
 impl Default for CompileOptions {
     fn default() -> Self {
-        Self { viewport: (256, 256), features: BTreeSet::new(), scalars: BTreeMap::new() }
+        Self { viewport: (256, 256), features: BTreeSet::new(), scalars: BTreeMap::new(), param_overrides: BTreeMap::new() }
     }
 }
 
@@ -40,6 +43,12 @@ impl CompileOptions {
     /// Adds features.
     pub fn with_features<S: Into<String>>(mut self, features: impl IntoIterator<Item = S>) -> Self {
         self.features.extend(features.into_iter().map(Into::into));
+        self
+    }
+
+    /// Overrides parameter `param` of pass `pass`.
+    pub fn with_param(mut self, pass: &str, param: &str, value: impl Into<ron::Value>) -> Self {
+        self.param_overrides.insert(format!("{pass}.{param}"), value.into());
         self
     }
 

@@ -164,6 +164,12 @@ pub struct ShaderUse {
 pub trait PassNode: Send {
     /// Records this pass's GPU work into the frame's encoder.
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError>;
+
+    /// For an output port of kind [`PortKind::Owned`]: the texture view this node owns and
+    /// fills (a 3D grid built from the volume, ...). Consumers' ports are bound to it.
+    fn owned_output(&self, _port: &str) -> Option<wgpu::TextureView> {
+        None
+    }
 }
 
 /// Maps kind names to plugins.

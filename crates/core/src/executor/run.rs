@@ -80,6 +80,7 @@ pub struct Executor {
     plan: Plan,
     nodes: HashMap<String, Box<dyn PassNode>>,
     slots: Vec<SlotTextures>,
+    owned: HashMap<usize, wgpu::TextureView>,
     inputs: HashMap<String, InputTexture>,
     system: SystemBindings,
     frame_index: u32,
@@ -151,6 +152,23 @@ impl Executor {
             let node = plugin.create(&ctx)?;
             nodes.insert(step.pass_id.clone(), node);
         }
+        let mut owned = HashMap::new();
+        for step in &plan.steps {
+            for bp in &step.ports {
+                if let Binding::Resource { id, written: None } = &bp.binding {
+                    if bp.access == Access::Write && matches!(plan.resources[*id].desc, ResourceDesc::Owned(_)) {
+                        let node = nodes.get(&step.pass_id).ok_or_else(|| ExecutorError::UnknownKind(step.kind.clone()))?;
+                        let view = node.owned_output(&bp.port).ok_or_else(|| {
+                            ExecutorError::Pass(PassError {
+                                pass: step.pass_id.clone(),
+                                message: format!("declares owned output \"{}\" but its node provides no texture for it", bp.port),
+                            })
+                        })?;
+                        owned.insert(*id, view);
+                    }
+                }
+            }
+        }
         let slots = plan
             .slots
             .iter()
@@ -205,7 +223,7 @@ impl Executor {
             });
             (set, resolve, read)
         });
-        Ok(Self { plan, nodes, slots, inputs: HashMap::new(), system, frame_index: 0, history_valid: false, queries })
+        Ok(Self { plan, nodes, slots, owned, inputs: HashMap::new(), system, frame_index: 0, history_valid: false, queries })
     }
 
     /// The plan being run.
@@ -288,7 +306,11 @@ impl Executor {
                             ResourceDesc::Target { extent, .. } => Some(*extent),
                             ResourceDesc::Owned(_) => None,
                         };
-                        (r.slot.map(|s| &self.slots[s].current_view), extent)
+                        let view = match r.slot {
+                            Some(s) => Some(&self.slots[s].current_view),
+                            None => self.owned.get(&super::run::root_owned(plan, rid)),
+                        };
+                        (view, extent)
                     }
                     Binding::Input(name) => (self.inputs.get(name).map(|t| &t.view), None),
                     Binding::History(name) => {
@@ -374,4 +396,13 @@ fn read_timestamps(gpu: &Gpu, read: &wgpu::Buffer, steps: usize) -> Result<Vec<f
             if b > a { (b - a) as f64 * period_ns / 1e6 } else { 0.0 }
         })
         .collect())
+}
+
+/// The resource an Owned value's chain starts at (Modify ports on owned resources keep the
+/// producer's texture).
+pub(crate) fn root_owned(plan: &Plan, mut rid: usize) -> usize {
+    while let Some(prev) = plan.resources[rid].modifies {
+        rid = prev;
+    }
+    rid
 }

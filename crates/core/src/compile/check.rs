@@ -256,10 +256,14 @@ impl Checker<'_> {
                         .map(|(n, _)| n.as_str())
                         .collect();
                     known.extend(self.options.scalars.keys().map(String::as_str));
+                    let mut help = format!("declare inputs: {{\"{name}\": Scalar(<default>)}}; known scalars: {}", comma_list(&known));
+                    if let Some(best) = closest(name, known.iter().copied()) {
+                        help = format!("did you mean \"{best}\"? {help}");
+                    }
                     self.err(
                         self.loc.pass_field(path, id, "count"),
                         format!("repeat group \"{id}\" counts iterations from \"{name}\", which is neither a Scalar graph input nor a scene value"),
-                        Some(format!("declare inputs: {{\"{name}\": Scalar(<default>)}}; known scalars: {}", comma_list(&known))),
+                        Some(help),
                     );
                     return 1;
                 };
@@ -381,11 +385,15 @@ impl Checker<'_> {
     fn check_port_names(&mut self, p: &PassDoc, path: PassPath, info: &PassInfo) {
         let input_names: Vec<&str> = info.ports.iter().filter(|s| s.is_input()).map(|s| s.name).collect();
         let output_names: Vec<&str> = info.ports.iter().filter(|s| s.is_output()).map(|s| s.name).collect();
+        // A misspelt input is one mistake: report the unknown name with its suggestion, not
+        // also the port it was meant for as missing.
+        let mut meant: Vec<&str> = Vec::new();
         for name in p.inputs.keys() {
             if !input_names.contains(&name.as_str()) {
                 let mut help = format!("its inputs are: {}", comma_list(&input_names));
                 if let Some(best) = closest(name, input_names.iter().copied()) {
                     help = format!("did you mean \"{best}\"? {help}");
+                    meant.push(best);
                 }
                 self.err(
                     self.loc.pass_entry(path, &p.id, "inputs", name, true),
@@ -395,7 +403,7 @@ impl Checker<'_> {
             }
         }
         for port in info.ports.iter().filter(|s| s.is_input() && s.required) {
-            if !p.inputs.contains_key(port.name) {
+            if !p.inputs.contains_key(port.name) && !meant.contains(&port.name) {
                 self.err(
                     self.loc.pass_field(path, &p.id, "inputs"),
                     format!("pass \"{}\" ({}) needs input \"{}\" ({})", p.id, p.kind, port.name, port.kind.describe()),
@@ -522,10 +530,11 @@ impl Checker<'_> {
                 }
                 let outputs: Vec<&str> = producer.ports.iter().filter(|p| p.is_output()).map(|p| p.name).collect();
                 if !outputs.contains(&tail) {
-                    let mut help = None;
-                    if let Some(best) = closest(tail, outputs.iter().copied()) {
-                        help = Some(format!("did you mean \"{head}.{best}\"?"));
-                    }
+                    let full: Vec<String> = outputs.iter().map(|o| format!("{head}.{o}")).collect();
+                    let help = match closest(tail, outputs.iter().copied()) {
+                        Some(best) => Some(format!("did you mean \"{head}.{best}\"?")),
+                        None => Some(format!("read one of {}", quoted_list(&full))),
+                    };
                     self.err(
                         location,
                         format!("{context} reads \"{text}\", but pass \"{head}\" has no output \"{tail}\" (it has: {})", comma_list(&outputs)),
@@ -536,11 +545,13 @@ impl Checker<'_> {
                 if let Some(g) = producer.group {
                     if reader_group != Some(g) {
                         let gid = self.groups[g].id.clone();
-                        self.err(
-                            location,
-                            format!("{context} reads \"{text}\" from inside repeat group \"{gid}\""),
-                            Some(format!("values leave a repeat group through its carry: read \"{gid}.<carried name>\"")),
-                        );
+                        let this = Ref::Output { pass: pi, port: tail.to_string() };
+                        let carried = self.groups[g].carry.iter().find(|(_, (_, next))| *next == this).map(|(n, _)| n.clone());
+                        let help = match carried {
+                            Some(name) => format!("its last iteration's value leaves the group as \"{gid}.{name}\": read that"),
+                            None => format!("values leave a repeat group through its carry: read \"{gid}.<carried name>\""),
+                        };
+                        self.err(location, format!("{context} reads \"{text}\" from inside repeat group \"{gid}\""), Some(help));
                         return None;
                     }
                 }
@@ -675,7 +686,8 @@ impl Checker<'_> {
                 let Some(desc) = self.ref_desc(r, 0) else { continue };
                 let location = self.loc.pass_entry(path, &p.id, "inputs", port, false);
                 let text = &p.inputs[port];
-                self.check_type(&p.id, &spec, text, &desc, location.clone());
+                let producer_formats = self.producer_formats(r);
+                self.check_type(&p.id, &spec, text, &desc, producer_formats.as_deref(), location.clone());
                 if let (PortKind::Target { size: SizeRule::MatchPass, .. }, ValueDesc::Target { size, .. }) = (&spec.kind, &desc) {
                     match &pass_size {
                         None => pass_size = Some((*size, text.clone())),
@@ -757,12 +769,41 @@ impl Checker<'_> {
         self.err(location, msg, Some(help));
     }
 
-    fn check_type(&mut self, reader: &str, spec: &PortSpec, text: &str, desc: &ValueDesc, location: Location) {
+    /// The formats the producing port of a pass output can be declared with (`None` for other
+    /// references: carried values, history, Modify outputs).
+    fn producer_formats(&self, r: &Ref) -> Option<Vec<TargetFormat>> {
+        let Ref::Output { pass, port } = r else { return None };
+        self.passes.get(*pass)?.ports.iter().find(|s| s.name == port && s.access == Access::Write).and_then(|s| match &s.kind {
+            PortKind::Target { formats, .. } => Some(formats.clone()),
+            _ => None,
+        })
+    }
+
+    fn check_type(
+        &mut self,
+        reader: &str,
+        spec: &PortSpec,
+        text: &str,
+        desc: &ValueDesc,
+        producer_formats: Option<&[TargetFormat]>,
+        location: Location,
+    ) {
         let ok = match (&spec.kind, desc) {
             (PortKind::Target { formats, .. }, ValueDesc::Target { format, .. }) => {
                 if !formats.contains(format) {
                     let names: Vec<&str> = formats.iter().map(|f| f.name()).collect();
                     let (head, tail) = text.split_once('.').unwrap_or((text, ""));
+                    // Suggest declaring another format only where the producer can write one
+                    // the reader accepts (with no producer port known: any accepted format).
+                    let fix = producer_formats
+                        .map_or(formats.first().copied(), |can| formats.iter().copied().find(|f| can.contains(f)));
+                    let help = match fix {
+                        Some(f) => format!("declare outputs: {{\"{tail}\": (format: {f})}} on \"{head}\", or read another target"),
+                        None => format!(
+                            "\"{head}\" cannot write {} to \"{tail}\"; read a target of one of those formats instead",
+                            names.join(" or ")
+                        ),
+                    };
                     self.err(
                         location,
                         format!(
@@ -770,7 +811,7 @@ impl Checker<'_> {
                             spec.name,
                             names.join(" or ")
                         ),
-                        Some(format!("declare outputs: {{\"{tail}\": (format: {})}} on \"{head}\", or read another target", names[0])),
+                        Some(help),
                     );
                 }
                 return;
@@ -783,7 +824,12 @@ impl Checker<'_> {
             self.err(
                 location,
                 format!("pass \"{reader}\" input \"{}\" needs {}, but \"{text}\" is {}", spec.name, spec.kind.describe(), desc.describe()),
-                None,
+                Some(match &spec.kind {
+                    PortKind::Volume => "declare inputs: {\"volume\": Volume} and read \"input.volume\"".to_string(),
+                    PortKind::TransferFunction => "declare inputs: {\"tf\": TransferFunction} and read \"input.tf\"".to_string(),
+                    PortKind::Target { .. } => "read \"<pass>.<output>\" of a pass that writes a target".to_string(),
+                    PortKind::Owned(t) => format!("read the output of a pass that makes a {t}"),
+                }),
             );
         }
     }
@@ -837,7 +883,10 @@ impl Checker<'_> {
                 let help = match writer {
                     Some(p) => {
                         let outs: Vec<&str> = p.ports.iter().filter(|s| s.is_output()).map(|s| s.name).collect();
-                        format!("pass \"{head}\" writes: {}", comma_list(&outs))
+                        format!(
+                            "pass \"{head}\" writes {} with these parameters; keep one of those in history, or change the parameters so it writes \"{tail}\"",
+                            comma_list(&outs)
+                        )
                     }
                     None => "name an output of a pass in this graph".to_string(),
                 };

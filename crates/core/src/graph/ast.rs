@@ -72,9 +72,11 @@ pub enum NodeDoc {
     Repeat(RepeatDoc),
 }
 
-/// A pass: one node of the graph.
+/// A pass: one node of the graph. Written `Pass(id: .., kind: ..)` both in `passes` (where
+/// `Pass` is the [`NodeDoc`] variant) and in a repeat group's `body` (where it is this struct's
+/// name; the name may also be left out).
 #[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, rename = "Pass")]
 pub struct PassDoc {
     /// Unique id, used in references (`"<id>.<output>"`), labels and messages.
     pub id: String,

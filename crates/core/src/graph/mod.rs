@@ -71,6 +71,54 @@ fn explain_ron_error(code: &ron::Error) -> (String, Option<String>) {
             "the file ends in the middle of a value".to_string(),
             Some("close every `(`, `[` and `{` and end strings with `\"`".to_string()),
         ),
-        other => (format!("syntax error: {other}"), None),
+        E::ExpectedComma => (
+            "expected `,` here".to_string(),
+            Some("separate fields, list items and map entries with `,`".to_string()),
+        ),
+        E::ExpectedMapColon => (
+            "expected `:` after the map key".to_string(),
+            Some("write map entries as \"key\": value".to_string()),
+        ),
+        E::ExpectedArrayEnd => (
+            "expected `]` or `,` here".to_string(),
+            Some("close the list with `]`, or put `,` between its items".to_string()),
+        ),
+        E::ExpectedMapEnd => (
+            "expected `}` or `,` here".to_string(),
+            Some("close the map with `}`, or put `,` between its entries".to_string()),
+        ),
+        E::ExpectedStructLikeEnd | E::ExpectedOptionEnd => (
+            "expected `)` or `,` here".to_string(),
+            Some("close the parenthesis with `)`, or put `,` between its fields".to_string()),
+        ),
+        E::ExpectedStringEnd => (
+            "this string is never closed".to_string(),
+            Some("end it with `\"`".to_string()),
+        ),
+        E::UnclosedBlockComment => (
+            "this comment is never closed".to_string(),
+            Some("end it with `*/`".to_string()),
+        ),
+        E::TrailingCharacters => (
+            "unexpected text after the end of the graph".to_string(),
+            Some("a graph file holds one Graph(...); remove what follows its closing `)`".to_string()),
+        ),
+        E::ExpectedDifferentStructName { expected, found } => (
+            format!("expected `{expected}(...)` here, found `{found}(...)`"),
+            Some(format!("write `{expected}(...)`, or leave the name out: `(...)`")),
+        ),
+        other => {
+            // ron's own wording starts with a capital ("Expected string"); keep it mid-sentence.
+            let text = other.to_string();
+            let mut chars = text.chars();
+            let text = match chars.next() {
+                Some(c) => c.to_lowercase().chain(chars).collect(),
+                None => text,
+            };
+            (
+                format!("syntax error: {text}"),
+                Some("see docs/graph_format.md for the syntax and the type of every field".to_string()),
+            )
+        }
     }
 }

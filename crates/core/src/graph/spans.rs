@@ -284,7 +284,7 @@ mod tests {
         let pass = tree.field("passes").and_then(|p| p.index(0)).map(|p| p.unwrap_variant());
         let (_, v) = pass.and_then(|p| p.field("inputs")).and_then(|m| m.entry("x")).expect("entry");
         assert_eq!(&src[v.span.start..v.span.end], "\"b.y\"");
-        assert_eq!(line_col(src, v.span.start), (1, 53));
+        assert_eq!(line_col(src, v.span.start), (1, 55));
     }
 
     #[test]

@@ -47,6 +47,8 @@ enum Command {
         /// generated Marschner–Lobb 64³.
         #[arg(long)]
         volume: Option<PathBuf>,
+        #[command(flatten)]
+        raw: RawArgs,
         /// Transfer function (RON, or ParaView color-map .json); default: one fitted to the data.
         #[arg(long)]
         tf: Option<PathBuf>,
@@ -76,6 +78,23 @@ enum Command {
     },
 }
 
+/// How to read a headerless `.raw` volume whose name does not say (or to override the name).
+#[derive(clap::Args, Debug, Default)]
+pub struct RawArgs {
+    /// Raw volume dimensions, XxYxZ (default: from the file name NAME_XxYxZ_TYPE.raw).
+    #[arg(long)]
+    pub dims: Option<String>,
+    /// Raw voxel type: uint8, uint16, int16 or float32 (default: from the file name).
+    #[arg(long)]
+    pub dtype: Option<String>,
+    /// Voxel spacing X,Y,Z (overrides the file's header; default 1,1,1 for raw files).
+    #[arg(long)]
+    pub spacing: Option<String>,
+    /// Raw 16/32-bit voxels are big-endian.
+    #[arg(long)]
+    pub big_endian: bool,
+}
+
 #[derive(Subcommand, Debug)]
 enum BenchCommand {
     /// Min/max grid + classification of the engine volume; octree rebuild after a TF change.
@@ -87,6 +106,9 @@ enum BenchCommand {
         #[arg(long)]
         json: Option<PathBuf>,
     },
+    /// Time render graphs over datasets, transfer functions and viewports (presets: basic,
+    /// kw2003-table1, thesis-tables); speed-ups vs a baseline, samples/s, accuracy sweeps.
+    Graphs(crate::bench_graphs::GraphsArgs),
 }
 
 fn parse_scalar(text: &str) -> Result<(String, f64), String> {
@@ -139,11 +161,11 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             print!("{}", plan.to_text());
             Ok(())
         }
-        Command::Render { graph, volume, tf, size, camera, frames, features, output, out } => {
+        Command::Render { graph, volume, raw, tf, size, camera, frames, features, output, out } => {
             let source = inputs::read_graph(&graph)?;
             let options = compile_options(&size, &features, &[])?;
             let camera = inputs::parse_camera(&camera)?;
-            let volume = inputs::volume(volume.as_ref())?;
+            let volume = inputs::volume(volume.as_ref(), &inputs::raw_options(&raw)?)?;
             let tf = inputs::transfer_function(tf.as_ref(), &volume)?;
             let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
             let gpu = Gpu::new_headless().map_err(|e| anyhow!(e))?;
@@ -193,6 +215,10 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                 json_out: json,
             };
             crate::bench_accel::run(&opts).context("bench accel")?;
+            Ok(())
+        }
+        Command::Bench { which: BenchCommand::Graphs(args) } => {
+            crate::bench_graphs::run_cli(&args).context("bench graphs")?;
             Ok(())
         }
     }

@@ -17,12 +17,47 @@ pub fn read_graph(path: &Path) -> anyhow::Result<String> {
     std::fs::read_to_string(path).with_context(|| format!("{}: cannot read graph file", path.display()))
 }
 
+/// Raw-file options from `--dims`, `--dtype`, `--spacing`, `--big-endian`.
+pub fn raw_options(raw: &crate::cli::RawArgs) -> anyhow::Result<RawOptions> {
+    let mut o = RawOptions::default();
+    if let Some(d) = &raw.dims {
+        let parts: Vec<&str> = d.split(['x', 'X']).collect();
+        let fail = || anyhow!("--dims \"{d}\": expected XxYxZ with positive integers, e.g. 128x128x64");
+        if parts.len() != 3 {
+            return Err(fail());
+        }
+        let v: Vec<u32> = parts.iter().map(|p| p.trim().parse::<u32>().map_err(|_| fail())).collect::<Result<_, _>>()?;
+        if v.contains(&0) {
+            return Err(fail());
+        }
+        o.dims = Some(glam::UVec3::new(v[0], v[1], v[2]));
+    }
+    if let Some(t) = &raw.dtype {
+        o.dtype = Some(
+            volgraph_accel::volume::VoxelType::from_name(t)
+                .ok_or_else(|| anyhow!("--dtype \"{t}\": expected uint8, uint16, int16 or float32"))?,
+        );
+    }
+    if let Some(s) = &raw.spacing {
+        let fail = || anyhow!("--spacing \"{s}\": expected three positive numbers X,Y,Z, e.g. 1,1,1.4");
+        let v: Vec<f64> = s.split(',').map(|p| p.trim().parse::<f64>().map_err(|_| fail())).collect::<Result<_, _>>()?;
+        if v.len() != 3 || v.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
+            return Err(fail());
+        }
+        o.spacing = Some(glam::DVec3::new(v[0], v[1], v[2]));
+    }
+    if raw.big_endian {
+        o.endianness = volgraph_accel::load::Endianness::Big;
+    }
+    Ok(o)
+}
+
 /// Loads `--volume`, or generates the default (Marschner–Lobb 64³) when none is given.
-pub fn volume(path: Option<&PathBuf>) -> anyhow::Result<Volume> {
+pub fn volume(path: Option<&PathBuf>, raw: &RawOptions) -> anyhow::Result<Volume> {
     match path {
         None => Ok(volgraph_accel::generate::marschner_lobb(64)),
         Some(p) => {
-            let loaded = load_volume(p, &RawOptions::default()).map_err(|e| anyhow!("{e}"))?;
+            let loaded = load_volume(p, raw).map_err(|e| anyhow!("{e}"))?;
             if loaded.report.non_finite_replaced() > 0 {
                 eprintln!("note: {}: replaced {} NaN/Inf voxels", p.display(), loaded.report.non_finite_replaced());
             }

@@ -1,0 +1,130 @@
+//! Numerically hard cases, each a named test, rendered on the GPU and compared with the f64
+//! reference: camera inside the volume, axis-aligned rays, rays grazing an edge, tiny steps,
+//! NaN in the data, a one-voxel-thick sheet. Tolerances as in `gpu_vs_reference.rs` (2/255 max,
+//! same reasons) unless a test says otherwise.
+
+use volgraph_accel::camera::OrbitCamera;
+use volgraph_accel::reference::render_reference;
+use volgraph_accel::transfer_function::TransferFunction;
+use volgraph_accel::volume::Volume;
+use volgraph_core::executor::{Gpu, Image, ShaderLibrary};
+use volgraph_core::shader_source::default_shader_root;
+use volgraph_core::{CompileOptions, compile};
+use volgraph_passes::builtin_registry;
+use volgraph_passes::raycast_params::reference_settings;
+use volgraph_passes::session::RenderSession;
+
+const SIZE: u32 = 64;
+
+fn gpu() -> Gpu {
+    Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)")
+}
+
+/// Renders graphs/basic/fragment_raycast.ron and returns (GPU image, reference colour).
+fn render(volume: &Volume, tf: &TransferFunction, camera: &OrbitCamera, options: CompileOptions) -> (Image, Vec<[f64; 4]>) {
+    let gpu = gpu();
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../graphs/basic/fragment_raycast.ron");
+    let source = std::fs::read_to_string(path).expect("graph");
+    let registry = builtin_registry();
+    let plan = compile("fragment_raycast.ron", &source, &registry, &options).expect("compiles");
+    let settings = reference_settings(&plan.steps.iter().find(|s| s.pass_id == "march").expect("march").params);
+    let lut = tf.to_lut_for(volume, 256);
+    let shaders = ShaderLibrary::new(default_shader_root());
+    let mut session = RenderSession::from_plan(&gpu, &shaders, &registry, plan, volume, &lut).expect("session");
+    session.render(&gpu, camera).expect("frame");
+    let image = session.read(&gpu, "image").expect("image");
+    let reference = render_reference(volume, &lut, camera, options.viewport.0, options.viewport.1, &settings);
+    (image, reference.color)
+}
+
+/// Max abs difference, and whether every GPU value is finite.
+fn max_diff(image: &Image, reference: &[[f64; 4]]) -> (f64, bool) {
+    let mut max: f64 = 0.0;
+    let mut finite = true;
+    for y in 0..image.height {
+        for x in 0..image.width {
+            let g = image.rgba(x, y);
+            let r = reference[(y * image.width + x) as usize];
+            for c in 0..4 {
+                finite &= g[c].is_finite();
+                max = max.max((g[c] as f64 - r[c]).abs());
+            }
+        }
+    }
+    (max, finite)
+}
+
+fn coverage(reference: &[[f64; 4]]) -> f64 {
+    reference.iter().filter(|c| c[3] > 1e-3).count() as f64 / reference.len() as f64
+}
+
+fn assert_close(name: &str, image: &Image, reference: &[[f64; 4]], min_coverage: f64) {
+    let (max, finite) = max_diff(image, reference);
+    let cov = coverage(reference);
+    eprintln!("{name}: max {:.3}/255, coverage {cov:.2}", max * 255.0);
+    assert!(finite, "{name}: the GPU image has NaN or Inf");
+    assert!(cov >= min_coverage, "{name}: reference nearly empty ({cov:.2}); the test would prove nothing");
+    assert!(max <= 2.0 / 255.0, "{name}: max abs {:.3}/255 > 2/255", max * 255.0);
+}
+
+fn ml() -> (Volume, TransferFunction) {
+    let v = volgraph_accel::generate::marschner_lobb(32);
+    let tf = TransferFunction::default_for(&v);
+    (v, tf)
+}
+
+#[test]
+fn camera_inside_the_volume_starts_rays_at_the_near_plane() {
+    let (v, tf) = ml();
+    let camera = OrbitCamera { azimuth_deg: 20.0, elevation_deg: 10.0, distance: 0.15, ..OrbitCamera::default() };
+    let (image, reference) = render(&v, &tf, &camera, CompileOptions::new(SIZE, SIZE));
+    assert_close("inside", &image, &reference, 0.9);
+}
+
+#[test]
+fn axis_aligned_rays_have_no_nan() {
+    let (v, tf) = ml();
+    for (az, el) in [(0.0, 0.0), (90.0, 0.0), (180.0, 0.0), (0.0, 90.0), (0.0, -90.0)] {
+        let camera = OrbitCamera { azimuth_deg: az, elevation_deg: el, ..OrbitCamera::default() };
+        let (image, reference) = render(&v, &tf, &camera, CompileOptions::new(SIZE, SIZE));
+        assert_close(&format!("axis az {az} el {el}"), &image, &reference, 0.2);
+    }
+}
+
+#[test]
+fn grazing_rays_along_an_edge_match() {
+    let (v, tf) = ml();
+    // Looking along a box edge: many rays enter and leave within a fraction of a voxel.
+    let camera = OrbitCamera { azimuth_deg: 45.0, elevation_deg: 0.0, distance: 3.2, ..OrbitCamera::default() };
+    let (image, reference) = render(&v, &tf, &camera, CompileOptions::new(SIZE, SIZE));
+    assert_close("grazing edge", &image, &reference, 0.2);
+}
+
+#[test]
+fn tiny_steps_match() {
+    let (v, tf) = ml();
+    let options = CompileOptions::new(32, 32).with_param("march", "step_voxels", 0.02);
+    let (image, reference) = render(&v, &tf, &OrbitCamera::default(), options);
+    // 50× more samples than the default step compound f32 rounding further; still within 2/255.
+    assert_close("step 0.02", &image, &reference, 0.2);
+}
+
+#[test]
+fn nan_in_float_data_is_replaced_and_renders_finite() {
+    let (mut v, counts) = volgraph_accel::generate::non_finite_f32(24);
+    assert!(counts.0 + counts.1 + counts.2 > 0, "the generator put non-finite values in");
+    let replaced = volgraph_accel::load::sanitize_volume(&mut v);
+    assert_eq!(replaced, counts, "every NaN/Inf is counted when replaced");
+    let tf = TransferFunction::default_for(&v);
+    let (image, reference) = render(&v, &tf, &OrbitCamera::default(), CompileOptions::new(SIZE, SIZE));
+    assert_close("NaN replaced", &image, &reference, 0.05);
+}
+
+#[test]
+fn one_voxel_thick_sheet_is_not_missed() {
+    let v = volgraph_accel::generate::sheet(32, volgraph_accel::generate::Axis::X, 16);
+    let tf = TransferFunction::preset(volgraph_accel::transfer_function::Preset::Opaque, (0.0, 255.0));
+    let camera = OrbitCamera { azimuth_deg: 90.0, elevation_deg: 0.0, ..OrbitCamera::default() };
+    let (image, reference) = render(&v, &tf, &camera, CompileOptions::new(SIZE, SIZE));
+    assert_close("sheet", &image, &reference, 0.2);
+}

@@ -54,6 +54,7 @@ fn hits_lie_on_the_sphere() {
         let camera = OrbitCamera {
             azimuth_deg: az,
             elevation_deg: el,
+            distance: 2.2,
             ..Default::default()
         };
         let (w, h) = (40, 40);

@@ -110,7 +110,21 @@ pub(crate) fn schedule(_doc: &GraphDoc, c: Checked, options: &CompileOptions) ->
                         a.label, b.label, insts[key.0].label, key.1
                     ),
                     )
-                .with_help(format!("let \"{}\" modify the output of \"{}\" instead", c.passes[b.pass].id, pa.id)),
+                .with_help(match (a.pass == b.pass, c.passes[b.pass].group) {
+                    // Every iteration of a repeat body modifies the same value: the chain must
+                    // go through the group's carry so iteration i modifies iteration i-1's.
+                    (true, Some(g)) => {
+                        let port = modifier_port(&c, &insts, &inputs, mods[1], key).unwrap_or("<port>");
+                        format!(
+                            "every iteration of repeat group \"{gid}\" modifies it; carry it instead: carry: {{\"{port}\": (init: \"{}.{}\", next: \"{}.{port}\")}} and read \"{gid}.{port}\"",
+                            insts[key.0].label,
+                            key.1,
+                            pa.id,
+                            gid = c.groups[g].id
+                        )
+                    }
+                    _ => format!("let \"{}\" modify the output of \"{}\" instead", c.passes[b.pass].id, pa.id),
+                }),
             );
         }
         for r in readers.get(key).into_iter().flatten() {
@@ -331,6 +345,21 @@ pub(crate) fn schedule(_doc: &GraphDoc, c: Checked, options: &CompileOptions) ->
         slots,
         outputs,
         history,
+    })
+}
+
+/// The name of the Modify port through which instance `inst` modifies the value `key`.
+fn modifier_port<'a>(
+    c: &'a Checked,
+    insts: &[Inst],
+    inputs: &[Vec<(usize, Val)>],
+    inst: usize,
+    key: &(usize, String),
+) -> Option<&'a str> {
+    let ports = &c.passes[insts[inst].pass].ports;
+    inputs[inst].iter().find_map(|(k, v)| match v {
+        Val::Out(src, port) if (*src, port) == (key.0, &key.1) && ports[*k].access == Access::Modify => Some(ports[*k].name),
+        _ => None,
     })
 }
 

@@ -19,7 +19,7 @@ pub struct GraphDoc {
     /// Values the application binds: `{"volume": Volume, "tf": TransferFunction, "segments": Scalar(8.0)}`.
     #[serde(default)]
     pub inputs: BTreeMap<String, InputKind>,
-    /// Previous-frame values: `{"prev_hit": (of: "march.hit", initial: Clear((0,0,0,0)))}`.
+    /// Previous-frame values: `{"prev_hit": (of: "march.hit", initial: Clear(0.0, 0.0, 0.0, 0.0))}`.
     #[serde(default)]
     pub history: BTreeMap<String, HistoryDoc>,
     /// Passes and repeat groups, in any order (the scheduler orders them).
@@ -53,7 +53,8 @@ pub struct HistoryDoc {
 /// What a history target holds when there is no previous frame.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 pub enum HistoryInitial {
-    /// Cleared to this RGBA value.
+    /// Cleared to this RGBA value, written `Clear(r, g, b, a)` (graph files are read with
+    /// RON's `unwrap_variant_newtypes`, so the tuple's own parentheses are left out).
     Clear((f64, f64, f64, f64)),
 }
 

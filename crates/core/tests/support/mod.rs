@@ -160,11 +160,25 @@ pub fn registry() -> Registry {
         iso_ports: vec![PortSpec::write("hit", t(&FLOAT_TARGETS))],
         ..TestPlugin::new("raycast", raycast_ports)
     });
-    // Klein et al.: the raycaster may start from reprojected positions instead of `entry`.
     let mut compute_ports = ray_inputs();
     compute_ports.push(PortSpec::write("color", t(&[TargetFormat::Rgba16Float])));
+    let mut compute_params = raycast_params();
+    compute_params.push(ParamSpec::uint(
+        "workgroup_x",
+        8,
+        1,
+        256,
+        "workgroup width in pixels",
+    ));
+    compute_params.push(ParamSpec::uint(
+        "workgroup_y",
+        8,
+        1,
+        256,
+        "workgroup height in pixels",
+    ));
     r.register(TestPlugin {
-        params: raycast_params(),
+        params: compute_params,
         ..TestPlugin::new("raycast_compute", compute_ports)
     });
     r.register(TestPlugin {

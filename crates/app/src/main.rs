@@ -2,6 +2,7 @@
 //! `bench` measures. This crate is the only one that talks to a user.
 
 mod bench_accel;
+mod bench_graphs;
 mod cli;
 mod image_out;
 mod inputs;

@@ -1,0 +1,341 @@
+//! The command-line flags of `volgraph bench graphs` and their resolution, together with a
+//! preset, into one [`BenchConfig`]. Every bad value is an error naming its flag and the fix.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{anyhow, bail};
+use clap::Args;
+use volgraph_accel::camera::OrbitCamera;
+use volgraph_accel::transfer_function::Preset;
+
+use super::preset::{self, BenchPreset};
+use crate::inputs;
+
+/// Flags of `volgraph bench graphs`. A `--preset` fills in graphs, datasets, sizes, transfer
+/// functions, baseline and frames; any flag given as well replaces the preset's value.
+#[derive(Args, Debug, Clone, Default)]
+pub struct GraphsArgs {
+    /// A named preset: basic, kw2003-table1, thesis-tables.
+    #[arg(long)]
+    pub preset: Option<String>,
+    /// Graph files, comma separated (graphs that do not exist are skipped with a note).
+    #[arg(long, value_delimiter = ',')]
+    pub graphs: Vec<PathBuf>,
+    /// Datasets, comma separated: names in $VOLGRAPH_DATA/volumes (hydrogen_atom, neghip, ...) or
+    /// generated volumes (ml64 = Marschner–Lobb 64³, mlf64 = its f32 twin, sphere64, noise64).
+    #[arg(long, value_delimiter = ',')]
+    pub datasets: Vec<String>,
+    /// Viewports WIDTHxHEIGHT, comma separated (default 512x512).
+    #[arg(long, value_delimiter = ',')]
+    pub size: Vec<String>,
+    /// Shrinks every viewport by this factor (e.g. 0.25 for lavapipe).
+    #[arg(long, default_value_t = 1.0)]
+    pub scale: f64,
+    /// Timed frames per case, after one warm-up frame (default 36).
+    #[arg(long)]
+    pub frames: Option<u32>,
+    /// Degrees the volume turns about y per frame (default 1; see --full-turn).
+    #[arg(long)]
+    pub rotate: Option<f64>,
+    /// Turn 360/FRAMES degrees per frame instead, so the frames cover a whole turn.
+    #[arg(long)]
+    pub full_turn: bool,
+    /// Orbit camera of the first frame, AZIMUTH,ELEVATION,DISTANCE (default 30,20,3.2).
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// The baseline graph (its file stem) speed-ups are measured against; default:
+    /// the preset's, else the first graph.
+    #[arg(long)]
+    pub baseline: Option<String>,
+    /// Transfer-function presets, comma separated: default, opaque, sparse.
+    #[arg(long, value_delimiter = ',')]
+    pub tf: Vec<String>,
+    /// Accuracy sweep PASS.PARAM=V1,V2,... (e.g. march.step_voxels=0.25,0.5,1,2); adds error
+    /// against a converged CPU reference to every row.
+    #[arg(long)]
+    pub sweep: Option<String>,
+    /// Compute error against the converged CPU reference even without --sweep.
+    #[arg(long)]
+    pub accuracy: bool,
+    /// Longest side of the images compared with the CPU reference (error columns).
+    #[arg(long, default_value_t = 128)]
+    pub accuracy_size: u32,
+    /// Step of the converged CPU reference, in voxels.
+    #[arg(long, default_value_t = 0.1)]
+    pub reference_step: f64,
+    /// Longest side of the CPU reference image whose sample count gives samples/pixel
+    /// (0: do not count samples).
+    #[arg(long, default_value_t = 128)]
+    pub spp_size: u32,
+    /// Write the report as JSON here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Write a PNG plot here (ms/frame bars; error vs time when sweeping).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// Also write the markdown table here (it is always printed to stdout).
+    #[arg(long)]
+    pub markdown: Option<PathBuf>,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// One `--sweep`: a pass parameter and the values it takes.
+#[derive(Clone, Debug)]
+pub struct Sweep {
+    /// `pass.param`, the key of `CompileOptions::param_overrides`.
+    pub key: String,
+    /// The values as written (for tables) and as RON values (for the compiler).
+    pub values: Vec<(String, ron::Value)>,
+}
+
+/// Everything one run measures, resolved from a preset and flags.
+#[derive(Clone, Debug)]
+pub struct BenchConfig {
+    /// The preset used, if any.
+    pub preset: Option<&'static BenchPreset>,
+    /// Graph files.
+    pub graphs: Vec<PathBuf>,
+    /// The baseline graph's label.
+    pub baseline: String,
+    /// Dataset names.
+    pub datasets: Vec<String>,
+    /// Viewports after `--scale`.
+    pub viewports: Vec<(u32, u32)>,
+    /// The scale applied.
+    pub scale: f64,
+    /// Transfer-function presets.
+    pub tfs: Vec<Preset>,
+    /// Fixed parameter overrides (from the preset).
+    pub params: Vec<(String, f64)>,
+    /// Timed frames per case.
+    pub frames: u32,
+    /// Degrees about y per frame.
+    pub degrees_per_frame: f64,
+    /// Camera of the first timed frame.
+    pub camera: OrbitCamera,
+    /// The sweep, if any.
+    pub sweep: Option<Sweep>,
+    /// Whether to measure error against the converged reference.
+    pub accuracy: bool,
+    /// Longest side of the accuracy images.
+    pub accuracy_size: u32,
+    /// Step of the converged reference, voxels.
+    pub reference_step: f64,
+    /// Longest side of the samples/pixel reference image (0 = off).
+    pub spp_size: u32,
+    /// JSON output.
+    pub json: Option<PathBuf>,
+    /// Plot output.
+    pub plot: Option<PathBuf>,
+    /// Markdown output (besides stdout).
+    pub markdown: Option<PathBuf>,
+    /// Hide the progress bar.
+    pub quiet: bool,
+}
+
+/// The workspace root, against which preset graph paths are written.
+pub fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// The label of a graph file in tables: its file stem.
+pub fn graph_label(path: &Path) -> String {
+    path.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| path.display().to_string())
+}
+
+/// Parses `--sweep PASS.PARAM=V1,V2,...`.
+pub fn parse_sweep(text: &str) -> anyhow::Result<Sweep> {
+    let fail = |why: &str| {
+        anyhow!(
+            "--sweep \"{text}\": {why}; expected PASS.PARAM=V1,V2,..., e.g. march.step_voxels=0.25,0.5,1,2"
+        )
+    };
+    let (key, values) = text.split_once('=').ok_or_else(|| fail("no '='"))?;
+    let key = key.trim();
+    let Some((pass, param)) = key.split_once('.') else {
+        return Err(fail("the key must be PASS.PARAM"));
+    };
+    if pass.is_empty() || param.is_empty() {
+        return Err(fail("the key must be PASS.PARAM"));
+    }
+    let values: Vec<(String, ron::Value)> = values
+        .split(',')
+        .map(str::trim)
+        .filter(|v| !v.is_empty())
+        .map(|v| {
+            let value = match v {
+                "true" => ron::Value::Bool(true),
+                "false" => ron::Value::Bool(false),
+                _ => match v.parse::<f64>() {
+                    Ok(x) if x.is_finite() => ron::Value::from(x),
+                    Ok(_) => return Err(fail(&format!("\"{v}\" is not finite"))),
+                    Err(_) => ron::Value::String(v.to_string()),
+                },
+            };
+            Ok((v.to_string(), value))
+        })
+        .collect::<anyhow::Result<_>>()?;
+    if values.is_empty() {
+        return Err(fail("no values"));
+    }
+    Ok(Sweep {
+        key: key.to_string(),
+        values,
+    })
+}
+
+/// Scales a viewport, keeping each side at least 1 pixel.
+pub fn scale_viewport((w, h): (u32, u32), scale: f64) -> (u32, u32) {
+    let s = |v: u32| ((v as f64 * scale).round() as u32).max(1);
+    (s(w), s(h))
+}
+
+/// A viewport with the same aspect whose longest side is at most `longest`.
+pub fn reduced_viewport((w, h): (u32, u32), longest: u32) -> (u32, u32) {
+    let m = w.max(h);
+    if m <= longest {
+        return (w, h);
+    }
+    scale_viewport((w, h), longest as f64 / m as f64)
+}
+
+impl GraphsArgs {
+    /// Merges the flags with the preset into a checked configuration.
+    pub fn resolve(&self) -> anyhow::Result<BenchConfig> {
+        let preset = match &self.preset {
+            None => None,
+            Some(name) => Some(preset::find(name).ok_or_else(|| {
+                anyhow!(
+                    "--preset \"{name}\": no such preset; choose one of: {}",
+                    preset::names()
+                )
+            })?),
+        };
+        let graphs: Vec<PathBuf> = if !self.graphs.is_empty() {
+            self.graphs.clone()
+        } else if let Some(p) = preset {
+            p.graphs.iter().map(|g| workspace_root().join(g)).collect()
+        } else {
+            bail!(
+                "no graphs: give --graphs a.ron,b.ron or a --preset ({})",
+                preset::names()
+            );
+        };
+        let labels: Vec<String> = graphs.iter().map(|g| graph_label(g)).collect();
+        let baseline = match (&self.baseline, preset) {
+            (Some(b), _) => b.clone(),
+            (None, Some(p)) if self.graphs.is_empty() => p.baseline.to_string(),
+            _ => labels[0].clone(),
+        };
+        if !labels.contains(&baseline) {
+            bail!(
+                "--baseline \"{baseline}\": not one of the graphs ({}); name a graph by its file stem",
+                labels.join(", ")
+            );
+        }
+        let datasets = if !self.datasets.is_empty() {
+            self.datasets.clone()
+        } else {
+            preset.map_or_else(
+                || vec!["ml64".to_string()],
+                |p| p.datasets.iter().map(|d| d.to_string()).collect(),
+            )
+        };
+        if !(self.scale.is_finite() && self.scale > 0.0 && self.scale <= 8.0) {
+            bail!(
+                "--scale {}: expected a factor in (0, 8], e.g. 0.25 to render a quarter of each side",
+                self.scale
+            );
+        }
+        let base_sizes: Vec<(u32, u32)> = if !self.size.is_empty() {
+            self.size
+                .iter()
+                .map(|s| inputs::parse_size(s))
+                .collect::<anyhow::Result<_>>()?
+        } else {
+            preset.map_or_else(|| vec![(512, 512)], |p| p.viewports.to_vec())
+        };
+        let viewports = base_sizes
+            .into_iter()
+            .map(|v| scale_viewport(v, self.scale))
+            .collect();
+        let tf_names: Vec<String> = if !self.tf.is_empty() {
+            self.tf.clone()
+        } else {
+            preset.map_or_else(
+                || vec!["default".to_string()],
+                |p| p.tfs.iter().map(|t| t.to_string()).collect(),
+            )
+        };
+        let tfs = tf_names
+            .iter()
+            .map(|t| {
+                Preset::from_name(t)
+                    .ok_or_else(|| anyhow!("--tf \"{t}\": expected default, opaque or sparse"))
+            })
+            .collect::<anyhow::Result<_>>()?;
+        let frames = self.frames.or(preset.map(|p| p.frames)).unwrap_or(36);
+        if frames == 0 {
+            bail!("--frames 0: at least one timed frame is needed");
+        }
+        let degrees_per_frame = match (self.full_turn, self.rotate) {
+            (true, Some(_)) => bail!("--rotate and --full-turn both given; use one"),
+            (true, None) => 360.0 / frames as f64,
+            (false, Some(d)) if d.is_finite() => d,
+            (false, Some(d)) => bail!("--rotate {d}: expected a finite number of degrees"),
+            (false, None) => 1.0,
+        };
+        let camera = match &self.camera {
+            Some(c) => inputs::parse_camera(c)?,
+            None => OrbitCamera::default(),
+        };
+        let sweep = self.sweep.as_deref().map(parse_sweep).transpose()?;
+        if !(self.reference_step.is_finite() && self.reference_step > 0.0) {
+            bail!(
+                "--reference-step {}: expected a positive step in voxels, e.g. 0.1",
+                self.reference_step
+            );
+        }
+        if self.accuracy_size == 0 || self.accuracy_size > 4096 {
+            bail!(
+                "--accuracy-size {}: expected 1..=4096 pixels",
+                self.accuracy_size
+            );
+        }
+        if self.spp_size > 4096 {
+            bail!(
+                "--spp-size {}: expected 0 (off) ..=4096 pixels",
+                self.spp_size
+            );
+        }
+        let params = preset
+            .map(|p| p.params.iter().map(|(k, v)| (k.to_string(), *v)).collect())
+            .unwrap_or_default();
+        Ok(BenchConfig {
+            preset,
+            graphs,
+            baseline,
+            datasets,
+            viewports,
+            scale: self.scale,
+            tfs,
+            params,
+            frames,
+            degrees_per_frame,
+            camera,
+            accuracy: self.accuracy || sweep.is_some(),
+            sweep,
+            accuracy_size: self.accuracy_size,
+            reference_step: self.reference_step,
+            spp_size: self.spp_size,
+            json: self.json.clone(),
+            plot: self.plot.clone(),
+            markdown: self.markdown.clone(),
+            quiet: self.quiet,
+        })
+    }
+}

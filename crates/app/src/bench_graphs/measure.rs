@@ -1,0 +1,108 @@
+//! Timing one case: a compiled graph renders one warm-up frame, then `frames` frames with the
+//! volume turning about y; per-frame GPU time from timestamp queries (wall time where the
+//! adapter has none) and per-pass GPU time summed over a pass's repeat-group instances.
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use volgraph_accel::camera::OrbitCamera;
+use volgraph_core::Plan;
+use volgraph_core::executor::Gpu;
+use volgraph_passes::session::{RenderSession, SessionError};
+
+/// Median of `values` (NaN when empty).
+pub fn median(values: &[f64]) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(|a, b| a.total_cmp(b));
+    let n = v.len();
+    match n {
+        0 => f64::NAN,
+        _ if n % 2 == 1 => v[n / 2],
+        _ => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
+}
+
+/// What the timed frames of one case gave.
+#[derive(Clone, Debug)]
+pub struct Timing {
+    /// ms per timed frame (GPU or wall, see `wall_time_fallback`).
+    pub frame_ms: Vec<f64>,
+    /// Wall ms per timed frame, submit to completion as the CPU saw it.
+    pub wall_ms: Vec<f64>,
+    /// True when any frame's `frame_ms` is wall time (no timestamp queries).
+    pub wall_time_fallback: bool,
+    /// Median GPU ms per frame of each pass id (repeat-group instances summed within a frame);
+    /// empty without timestamps.
+    pub pass_ms: BTreeMap<String, f64>,
+}
+
+/// The camera of timed frame `index`: the start camera turned `index · degrees_per_frame` about y.
+pub fn frame_camera(start: &OrbitCamera, degrees_per_frame: f64, index: u32) -> OrbitCamera {
+    OrbitCamera {
+        azimuth_deg: start.azimuth_deg + index as f64 * degrees_per_frame,
+        ..*start
+    }
+}
+
+/// Renders one warm-up frame (pipelines, first uploads), then `frames` timed frames; `tick` is
+/// called after every frame.
+pub fn time_frames(
+    gpu: &Gpu,
+    session: &mut RenderSession,
+    start: &OrbitCamera,
+    degrees_per_frame: f64,
+    frames: u32,
+    mut tick: impl FnMut(),
+) -> Result<Timing, SessionError> {
+    session.render(gpu, start)?;
+    tick();
+    let mut timing = Timing {
+        frame_ms: Vec::new(),
+        wall_ms: Vec::new(),
+        wall_time_fallback: false,
+        pass_ms: BTreeMap::new(),
+    };
+    let mut per_pass: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    for f in 0..frames {
+        let camera = frame_camera(start, degrees_per_frame, f);
+        let t0 = Instant::now();
+        let stats = session.render(gpu, &camera)?;
+        timing.wall_ms.push(t0.elapsed().as_secs_f64() * 1e3);
+        timing.frame_ms.push(stats.frame_ms);
+        timing.wall_time_fallback |= stats.wall_time_fallback;
+        if let Some(steps) = &stats.step_gpu_ms {
+            for (pass, ms) in pass_sums(session.plan(), steps) {
+                per_pass.entry(pass).or_default().push(ms);
+            }
+        }
+        tick();
+    }
+    if !timing.wall_time_fallback {
+        timing.pass_ms = per_pass
+            .into_iter()
+            .map(|(pass, v)| (pass, median(&v)))
+            .collect();
+    }
+    Ok(timing)
+}
+
+/// One frame's step times summed per pass id, so a repeat group's instances count as their pass.
+fn pass_sums(plan: &Plan, step_ms: &[f64]) -> BTreeMap<String, f64> {
+    let mut sums = BTreeMap::new();
+    for (step, ms) in plan.steps.iter().zip(step_ms) {
+        *sums.entry(step.pass_id.clone()).or_insert(0.0) += ms;
+    }
+    sums
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_of_odd_even_and_empty() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
+        assert!(median(&[]).is_nan());
+    }
+}

@@ -1,0 +1,95 @@
+//! The named benchmark presets (`--preset NAME`), written as data: which graphs, datasets,
+//! viewports and transfer functions each paper's comparison needs, and the baseline its speed-ups
+//! are measured against.
+
+/// One preset: everything `volgraph bench graphs --preset NAME` runs unless a flag overrides it.
+#[derive(Clone, Copy, Debug)]
+pub struct BenchPreset {
+    /// The name given to `--preset`.
+    pub name: &'static str,
+    /// What the preset reproduces, printed above the table.
+    pub about: &'static str,
+    /// Graph files, relative to the workspace root.
+    pub graphs: &'static [&'static str],
+    /// The baseline graph (file stem) speed-ups are relative to.
+    pub baseline: &'static str,
+    /// Dataset names (`volgraph_accel::data_dir` names or generated names such as `ml64`).
+    pub datasets: &'static [&'static str],
+    /// Viewports `(width, height)` before `--scale`.
+    pub viewports: &'static [(u32, u32)],
+    /// Transfer-function presets (`default`, `opaque`, `sparse`).
+    pub tfs: &'static [&'static str],
+    /// Parameter overrides applied to every graph, `"pass.param" = value` (e.g. the step the
+    /// issue asks for).
+    pub params: &'static [(&'static str, f64)],
+    /// Timed frames after the warm-up frame.
+    pub frames: u32,
+}
+
+/// Every preset.
+pub const PRESETS: &[BenchPreset] = &[
+    BenchPreset {
+        name: "basic",
+        about: "First light: fragment vs compute raycast, hydrogen_atom 128³ at 512², step 0.5 voxel",
+        graphs: &[
+            "graphs/basic/fragment_raycast.ron",
+            "graphs/basic/compute_raycast.ron",
+        ],
+        baseline: "fragment_raycast",
+        datasets: &["hydrogen_atom"],
+        viewports: &[(512, 512)],
+        tfs: &["default"],
+        params: &[("march.step_voxels", 0.5)],
+        frames: 36,
+    },
+    BenchPreset {
+        name: "kw2003-table1",
+        about: "Krüger & Westermann 2003 Table 1: SBVR vs RC, RC-a (early ray termination), RC-b (+ empty-space skipping) at 512²",
+        graphs: &[
+            "graphs/kruger_westermann_2003/sbvr.ron",
+            "graphs/kruger_westermann_2003/rc.ron",
+            "graphs/kruger_westermann_2003/rc_a.ron",
+            "graphs/kruger_westermann_2003/rc_b.ron",
+        ],
+        baseline: "sbvr",
+        datasets: &[
+            "engine_vollib",
+            "hydrogen_atom",
+            "neghip",
+            "lobster",
+            "fuel",
+        ],
+        viewports: &[(512, 512)],
+        tfs: &["opaque", "sparse"],
+        params: &[],
+        frames: 36,
+    },
+    BenchPreset {
+        name: "thesis-tables",
+        about: "DirectCompute thesis Tables 1–4: pixel-shader vs compute-shader raycast at 800×600 and 1920×1080 over datasets of several sizes",
+        graphs: &[
+            "graphs/compute_raycast_2013/pixel_shader.ron",
+            "graphs/compute_raycast_2013/compute_shader.ron",
+        ],
+        baseline: "pixel_shader",
+        datasets: &["neghip", "hydrogen_atom", "engine_vollib"],
+        viewports: &[(800, 600), (1920, 1080)],
+        tfs: &["default"],
+        params: &[],
+        frames: 36,
+    },
+];
+
+/// The preset named `name`, if any.
+pub fn find(name: &str) -> Option<&'static BenchPreset> {
+    PRESETS.iter().find(|p| p.name == name)
+}
+
+/// The preset names, for messages.
+pub fn names() -> String {
+    PRESETS
+        .iter()
+        .map(|p| p.name)
+        .collect::<Vec<_>>()
+        .join(", ")
+}

@@ -1,0 +1,470 @@
+//! The case loop: load every graph and dataset once (skipping, with a note, what is missing),
+//! then time each graph × dataset × TF × viewport (× sweep value), count samples and measure
+//! error, and finally compute speed-ups and Pareto fronts across rows.
+
+use std::collections::{BTreeSet, HashMap};
+use std::path::PathBuf;
+
+use anyhow::bail;
+use indicatif::{ProgressBar, ProgressStyle};
+use volgraph_accel::camera::OrbitCamera;
+use volgraph_accel::reference::render_reference;
+use volgraph_accel::transfer_function::TransferFunction;
+use volgraph_accel::volume::Volume;
+use volgraph_core::executor::{Gpu, ShaderLibrary};
+use volgraph_core::shader_source::default_shader_root;
+use volgraph_core::{CompileOptions, Registry, compile};
+use volgraph_passes::builtin_registry;
+use volgraph_passes::session::RenderSession;
+
+use super::accuracy::{self, ImageError};
+use super::args::{BenchConfig, graph_label, reduced_viewport};
+use super::dataset;
+use super::measure::{self, frame_camera, median};
+use super::report::{GraphBenchReport, Row, Skipped};
+use crate::inputs::LUT_SIZE;
+
+/// A graph file that could be read.
+struct GraphFile {
+    label: String,
+    path: PathBuf,
+    source: String,
+}
+
+/// A dataset with its volume.
+struct Dataset {
+    name: String,
+    volume: Volume,
+}
+
+/// What stays fixed while a case runs.
+struct Context<'a> {
+    gpu: &'a Gpu,
+    shaders: ShaderLibrary,
+    registry: Registry,
+    config: &'a BenchConfig,
+    progress: ProgressBar,
+    skipped: Vec<Skipped>,
+    skip_seen: BTreeSet<(String, String)>,
+    /// samples/pixel by (dataset, tf, size, settings).
+    spp_cache: HashMap<String, f64>,
+    /// converged reference colour by (dataset, tf, size, settings).
+    reference_cache: HashMap<String, Vec<[f64; 4]>>,
+}
+
+impl Context<'_> {
+    fn skip(&mut self, what: String, reason: String) {
+        if self.skip_seen.insert((what.clone(), reason.clone())) {
+            self.progress
+                .suspend(|| eprintln!("note: skipping {what}: {reason}"));
+            self.skipped.push(Skipped { what, reason });
+        }
+    }
+}
+
+/// One case's inputs.
+struct Case<'a> {
+    graph: &'a GraphFile,
+    dataset: &'a Dataset,
+    tf_name: &'static str,
+    lut: &'a [[f32; 4]],
+    viewport: (u32, u32),
+    sweep_value: Option<&'a (String, ron::Value)>,
+}
+
+impl Case<'_> {
+    fn name(&self) -> String {
+        let sweep = self
+            .sweep_value
+            .map(|(v, _)| format!(" {v}"))
+            .unwrap_or_default();
+        format!(
+            "{} on {} ({}, {}×{}{sweep})",
+            self.graph.label, self.dataset.name, self.tf_name, self.viewport.0, self.viewport.1
+        )
+    }
+
+    fn options(&self, config: &BenchConfig, viewport: (u32, u32)) -> CompileOptions {
+        let mut options = CompileOptions::new(viewport.0, viewport.1);
+        for (key, value) in &config.params {
+            options
+                .param_overrides
+                .insert(key.clone(), ron::Value::from(*value));
+        }
+        if let (Some(sweep), Some((_, value))) = (&config.sweep, self.sweep_value) {
+            options
+                .param_overrides
+                .insert(sweep.key.clone(), value.clone());
+        }
+        options
+    }
+}
+
+/// Measures every case of `config` on `gpu`.
+pub fn run(gpu: &Gpu, config: &BenchConfig) -> anyhow::Result<GraphBenchReport> {
+    let mut ctx = Context {
+        gpu,
+        shaders: ShaderLibrary::new(default_shader_root()),
+        registry: builtin_registry(),
+        config,
+        progress: ProgressBar::hidden(),
+        skipped: Vec::new(),
+        skip_seen: BTreeSet::new(),
+        spp_cache: HashMap::new(),
+        reference_cache: HashMap::new(),
+    };
+    let graphs: Vec<GraphFile> = config
+        .graphs
+        .iter()
+        .filter_map(|path| match std::fs::read_to_string(path) {
+            Ok(source) => Some(GraphFile {
+                label: graph_label(path),
+                path: path.clone(),
+                source,
+            }),
+            Err(e) => {
+                ctx.skip(
+                    format!("graph {}", path.display()),
+                    format!("cannot read the graph file ({e}); it is left out of this run"),
+                );
+                None
+            }
+        })
+        .collect();
+    let datasets: Vec<Dataset> = config
+        .datasets
+        .iter()
+        .filter_map(|name| match dataset::load(name) {
+            Ok(volume) => Some(Dataset {
+                name: name.clone(),
+                volume,
+            }),
+            Err(e) => {
+                ctx.skip(format!("dataset {name}"), format!("{e:#}"));
+                None
+            }
+        })
+        .collect();
+    let sweep_values: Vec<Option<&(String, ron::Value)>> = config
+        .sweep
+        .as_ref()
+        .map_or_else(|| vec![None], |s| s.values.iter().map(Some).collect());
+    let cases = graphs.len()
+        * datasets.len()
+        * config.tfs.len()
+        * config.viewports.len()
+        * sweep_values.len();
+    if !config.quiet {
+        ctx.progress = ProgressBar::new((cases as u64) * (config.frames as u64 + 1));
+        ctx.progress.set_style(
+            ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {pos}/{len} frames {msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> "),
+        );
+    }
+    let mut rows = Vec::new();
+    for dataset in &datasets {
+        for &tf in &config.tfs {
+            let (lo, hi) = dataset.volume.value_range;
+            let tf_fn = TransferFunction::preset(tf, (lo, if hi > lo { hi } else { lo + 1.0 }));
+            let lut = tf_fn.to_lut_for(&dataset.volume, LUT_SIZE);
+            for &viewport in &config.viewports {
+                for &sweep_value in &sweep_values {
+                    for graph in &graphs {
+                        let case = Case {
+                            graph,
+                            dataset,
+                            tf_name: tf.name(),
+                            lut: &lut,
+                            viewport,
+                            sweep_value,
+                        };
+                        ctx.progress.set_message(case.name());
+                        if let Some(row) = run_case(&mut ctx, &case) {
+                            rows.push(row);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    ctx.progress.finish_and_clear();
+    if rows.is_empty() {
+        let why: Vec<String> = ctx
+            .skipped
+            .iter()
+            .map(|s| format!("{}: {}", s.what, s.reason))
+            .collect();
+        bail!("nothing was measured:\n  {}", why.join("\n  "));
+    }
+    if !rows.iter().any(|r| r.graph == config.baseline) {
+        ctx.skip(
+            format!("baseline {}", config.baseline),
+            "the baseline graph was not measured, so there are no speed-ups".to_string(),
+        );
+    }
+    fill_speedups(&mut rows, &config.baseline);
+    if config.sweep.is_some() {
+        fill_pareto(&mut rows);
+    }
+    Ok(GraphBenchReport {
+        program: "volgraph bench graphs".to_string(),
+        preset: config.preset.map(|p| p.name.to_string()),
+        about: config.preset.map(|p| p.about.to_string()),
+        adapter: gpu.adapter_name.clone(),
+        timestamps: rows.iter().all(|r| r.clock == "gpu"),
+        frames: config.frames,
+        warmup_frames: 1,
+        degrees_per_frame: config.degrees_per_frame,
+        camera: [
+            config.camera.azimuth_deg,
+            config.camera.elevation_deg,
+            config.camera.distance,
+        ],
+        scale: config.scale,
+        baseline: config.baseline.clone(),
+        sweep: config.sweep.as_ref().map(|s| s.key.clone()),
+        reference_step_voxels: config.accuracy.then_some(config.reference_step),
+        notes: notes(config),
+        rows,
+        skipped: ctx.skipped,
+    })
+}
+
+fn notes(config: &BenchConfig) -> Vec<String> {
+    let mut notes = Vec::new();
+    if config.spp_size > 0 {
+        notes.push(format!(
+            "samples/px: volume samples per pixel of the f64 CPU reference run with each graph's raycast parameters, \
+             at a reduced size (longest side {} px, same aspect) from the middle frame's view; it counts early ray \
+             termination but not empty-space skipping. Msamples/s = samples/px × viewport pixels / median ms/frame.",
+            config.spp_size
+        ));
+    } else {
+        notes.push("samples/px: not counted (--spp-size 0).".to_string());
+    }
+    if config.accuracy {
+        notes.push(format!(
+            "error: the GPU `image` output (linear premultiplied RGBA, all four channels) at a reduced size (longest side {} px) \
+             from the first frame's view vs the f64 CPU reference at step {} voxel with no early termination; PSNR for a peak of 1.",
+            config.accuracy_size, config.reference_step
+        ));
+    }
+    notes
+}
+
+fn key(case: &Case<'_>, size: (u32, u32), settings: &impl std::fmt::Debug) -> String {
+    format!(
+        "{}|{}|{}x{}|{settings:?}",
+        case.dataset.name, case.tf_name, size.0, size.1
+    )
+}
+
+/// Times one case; `None` (after a note) when it cannot run.
+fn run_case(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<Row> {
+    let config = ctx.config;
+    let file = case.graph.path.display().to_string();
+    let plan = match compile(
+        &file,
+        &case.graph.source,
+        &ctx.registry,
+        &case.options(config, case.viewport),
+    ) {
+        Ok(plan) => plan,
+        Err(d) => {
+            ctx.skip(
+                format!("graph {}", case.graph.label),
+                format!("does not compile for this case: {}", d.to_string().trim()),
+            );
+            ctx.progress.inc(config.frames as u64 + 1);
+            return None;
+        }
+    };
+    let settings = accuracy::raycast_settings(&plan);
+    let timing = RenderSession::from_plan(
+        ctx.gpu,
+        &ctx.shaders,
+        &ctx.registry,
+        plan,
+        &case.dataset.volume,
+        case.lut,
+    )
+    .and_then(|mut session| {
+        let progress = ctx.progress.clone();
+        measure::time_frames(
+            ctx.gpu,
+            &mut session,
+            &config.camera,
+            config.degrees_per_frame,
+            config.frames,
+            || progress.inc(1),
+        )
+    });
+    let timing = match timing {
+        Ok(t) => t,
+        Err(e) => {
+            ctx.skip(case.name(), format!("rendering failed: {e}"));
+            return None;
+        }
+    };
+    let median_ms = median(&timing.frame_ms);
+    let spp_viewport = reduced_viewport(case.viewport, config.spp_size.max(1));
+    let spp = settings.filter(|_| config.spp_size > 0).map(|s| {
+        let k = key(case, spp_viewport, &s);
+        *ctx.spp_cache.entry(k).or_insert_with(|| {
+            let camera = frame_camera(&config.camera, config.degrees_per_frame, config.frames / 2);
+            accuracy::samples_per_pixel(&case.dataset.volume, case.lut, &camera, spp_viewport, &s)
+        })
+    });
+    let pixels = case.viewport.0 as f64 * case.viewport.1 as f64;
+    let error_viewport = reduced_viewport(case.viewport, config.accuracy_size);
+    let error = if config.accuracy {
+        measure_error(ctx, case, settings, error_viewport)
+    } else {
+        None
+    };
+    Some(Row {
+        graph: case.graph.label.clone(),
+        graph_file: file,
+        dataset: case.dataset.name.clone(),
+        dims: case.dataset.volume.dims.to_array(),
+        tf: case.tf_name.to_string(),
+        viewport: [case.viewport.0, case.viewport.1],
+        sweep_value: case.sweep_value.map(|(v, _)| v.clone()),
+        median_ms,
+        min_ms: timing
+            .frame_ms
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min),
+        max_ms: timing
+            .frame_ms
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max),
+        median_wall_ms: median(&timing.wall_ms),
+        clock: if timing.wall_time_fallback {
+            "wall"
+        } else {
+            "gpu"
+        }
+        .to_string(),
+        speedup_vs_baseline: None,
+        pass_ms: timing.pass_ms,
+        samples_per_pixel: spp,
+        spp_viewport: spp.map(|_| [spp_viewport.0, spp_viewport.1]),
+        msamples_per_s: spp.map(|s| s * pixels / (median_ms * 1e-3) / 1e6),
+        error,
+        error_viewport: error.map(|_| [error_viewport.0, error_viewport.1]),
+        pareto: None,
+    })
+}
+
+/// Renders the case once at `size` and compares its `image` output with the converged reference.
+fn measure_error(
+    ctx: &mut Context<'_>,
+    case: &Case<'_>,
+    settings: Option<volgraph_accel::reference::RaycastSettings>,
+    size: (u32, u32),
+) -> Option<ImageError> {
+    let config = ctx.config;
+    let Some(settings) = settings else {
+        ctx.skip(
+            format!("error of {}", case.graph.label),
+            "no step has a step_voxels parameter, so there is no reference integral".to_string(),
+        );
+        return None;
+    };
+    let camera: OrbitCamera = config.camera;
+    let file = case.graph.path.display().to_string();
+    let image = compile(
+        &file,
+        &case.graph.source,
+        &ctx.registry,
+        &case.options(config, size),
+    )
+    .map_err(|d| d.to_string())
+    .and_then(|plan| {
+        if !plan.outputs.contains_key("image") {
+            return Err("the graph has no \"image\" output to compare".to_string());
+        }
+        let mut session = RenderSession::from_plan(
+            ctx.gpu,
+            &ctx.shaders,
+            &ctx.registry,
+            plan,
+            &case.dataset.volume,
+            case.lut,
+        )
+        .map_err(|e| e.to_string())?;
+        session
+            .render(ctx.gpu, &camera)
+            .map_err(|e| e.to_string())?;
+        session.read(ctx.gpu, "image").map_err(|e| e.to_string())
+    });
+    let image = match image {
+        Ok(image) => image,
+        Err(reason) => {
+            ctx.skip(format!("error of {}", case.name()), reason);
+            return None;
+        }
+    };
+    let reference_settings = accuracy::converged(&settings, config.reference_step);
+    let k = key(case, size, &reference_settings);
+    let reference = ctx.reference_cache.entry(k).or_insert_with(|| {
+        render_reference(
+            &case.dataset.volume,
+            case.lut,
+            &camera,
+            size.0,
+            size.1,
+            &reference_settings,
+        )
+        .color
+    });
+    accuracy::image_error(&image, reference)
+}
+
+/// Speed-up = baseline median / row median for rows of the same dataset, TF, viewport and sweep
+/// value.
+fn fill_speedups(rows: &mut [Row], baseline: &str) {
+    let same = |a: &Row, b: &Row| {
+        a.dataset == b.dataset
+            && a.tf == b.tf
+            && a.viewport == b.viewport
+            && a.sweep_value == b.sweep_value
+    };
+    let bases: Vec<Row> = rows
+        .iter()
+        .filter(|r| r.graph == baseline)
+        .cloned()
+        .collect();
+    for row in rows.iter_mut() {
+        row.speedup_vs_baseline = bases
+            .iter()
+            .find(|b| same(b, row))
+            .map(|b| b.median_ms / row.median_ms)
+            .filter(|x| x.is_finite());
+    }
+}
+
+/// Marks the Pareto front of (ms/frame, mean abs error) within each graph × dataset × TF × viewport.
+fn fill_pareto(rows: &mut [Row]) {
+    let group = |r: &Row| format!("{}|{}|{}|{:?}", r.graph, r.dataset, r.tf, r.viewport);
+    let groups: BTreeSet<String> = rows.iter().map(group).collect();
+    for g in groups {
+        let idx: Vec<usize> = (0..rows.len()).filter(|&i| group(&rows[i]) == g).collect();
+        let points: Vec<(f64, f64)> = idx
+            .iter()
+            .map(|&i| {
+                (
+                    rows[i].median_ms,
+                    rows[i].error.map_or(f64::NAN, |e| e.mean_abs),
+                )
+            })
+            .collect();
+        for (&i, on) in idx.iter().zip(accuracy::pareto_front(&points)) {
+            rows[i].pareto = Some(on);
+        }
+    }
+}

@@ -143,12 +143,15 @@ impl CreateContext<'_> {
                         if p.access == Access::Read {
                             return Err(self.error(format!("{shader}: storage texture \"{}\" is an input port; storage textures are outputs", b.name)));
                         }
-                        if p.format.is_some() && *format != p.format {
-                            return Err(self.error(format!(
-                                "{shader}: storage texture \"{}\" is declared {:?} but the port's target is {:?}; \
-                                 declare the output with the shader's format",
-                                b.name, format, p.format
-                            )));
+                        if let Some(port_format) = p.format {
+                            if *format != Some(port_format) {
+                                let declared = format.map_or("an unsupported format".to_string(), |f| format!("{f:?}"));
+                                return Err(self.error(format!(
+                                    "{shader}: storage texture \"{}\" is declared {declared} but the port's target is \
+                                     {port_format:?}; declare the output with the shader's format",
+                                    b.name
+                                )));
+                            }
                         }
                     } else if p.access == Access::Write {
                         return Err(self.error(format!(

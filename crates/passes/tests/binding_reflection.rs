@@ -1,0 +1,133 @@
+//! Shader bindings are reflected with naga and checked against the pass's declared ports when
+//! the graph loads: a mismatch is a clear error naming the pass, the shader, the global and the
+//! ports, never a wgpu panic or a silently unbound texture. The plugins here live outside
+//! crates/passes' registry on purpose: they register through the public API.
+
+use volgraph_core::executor::{
+    ComputePipelineSpec, CreateContext, Executor, Gpu, PassError, RecordContext, RenderPipelineSpec, ShaderLibrary,
+};
+use volgraph_core::shader_source::default_shader_root;
+use volgraph_core::{CompileOptions, Params, PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile};
+
+const FLOATS: [TargetFormat; 3] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float, TargetFormat::Rgba8Unorm];
+
+/// A raycaster whose ports are misnamed relative to `raycast.wgsl`.
+struct Misnamed {
+    kind: &'static str,
+    dir_port: &'static str,
+    color_port: &'static str,
+    compute_color: Option<TargetFormat>,
+}
+
+struct NoOp;
+
+impl PassNode for NoOp {
+    fn record(&mut self, _ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
+        Ok(())
+    }
+}
+
+impl PassPlugin for Misnamed {
+    fn kind(&self) -> &'static str {
+        self.kind
+    }
+
+    fn summary(&self) -> &'static str {
+        "test plugin with ports that do not match its shader"
+    }
+
+    fn ports(&self, _params: &Params) -> Vec<PortSpec> {
+        let color = match self.compute_color {
+            Some(f) => PortKind::target(&[f]),
+            None => PortKind::target(&FLOATS),
+        };
+        vec![
+            PortSpec::read("entry", PortKind::target(&FLOATS)),
+            PortSpec::read(self.dir_port, PortKind::target(&FLOATS)),
+            PortSpec::read("volume", PortKind::Volume),
+            PortSpec::read("tf", PortKind::TransferFunction),
+            PortSpec::write(self.color_port, color),
+        ]
+    }
+
+    fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        if self.compute_color.is_some() {
+            ctx.compute_pipeline(&ComputePipelineSpec {
+                shader: "raycast_compute.wgsl",
+                entry: "cs_dvr",
+                extra_bindings: &["params"],
+                constants: &[],
+            })?;
+        } else {
+            ctx.render_pipeline(&RenderPipelineSpec {
+                shader: "raycast.wgsl",
+                vertex: "vs_fullscreen",
+                fragment: "fs_dvr",
+                extra_bindings: &["params"],
+                ..Default::default()
+            })?;
+        }
+        Ok(Box::new(NoOp))
+    }
+}
+
+fn build_error(plugin: Misnamed) -> String {
+    let kind = plugin.kind;
+    let dir = plugin.dir_port;
+    let color = plugin.color_port;
+    let mut registry = Registry::new();
+    volgraph_passes::register_builtin(&mut registry);
+    registry.register(plugin);
+    let graph = format!(
+        r#"Graph(
+    name: "reflection test",
+    inputs: {{"volume": Volume, "tf": TransferFunction}},
+    passes: [
+        Pass(id: "entry", kind: "entry_points"),
+        Pass(id: "dirs", kind: "ray_directions", inputs: {{"entry": "entry.entry"}}),
+        Pass(id: "march", kind: "{kind}", inputs: {{
+            "entry": "entry.entry", "{dir}": "dirs.dir", "volume": "input.volume", "tf": "input.tf"}}),
+    ],
+    outputs: {{"image": "march.{color}"}},
+)"#
+    );
+    let plan = compile("reflection.ron", &graph, &registry, &CompileOptions::new(16, 16)).expect("the graph itself is valid");
+    let gpu = Gpu::new_headless().expect("a Vulkan adapter (lavapipe without a GPU)");
+    let shaders = ShaderLibrary::new(default_shader_root());
+    match Executor::new(&gpu, &shaders, &registry, plan) {
+        Ok(_) => panic!("a pass whose ports do not match its shader must not build"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn shader_global_without_a_port_is_named() {
+    let msg = build_error(Misnamed { kind: "misnamed_input", dir_port: "direction", color_port: "color", compute_color: None });
+    assert_eq!(
+        msg,
+        "pass \"march\": raycast.wgsl: global \"dir\" is neither a port of this pass (ports: entry, direction, volume, tf, color) \
+         nor a system binding (frame, linear_clamp, nearest_clamp) nor one the pass binds itself (params); \
+         rename it to the port it stands for"
+    );
+}
+
+#[test]
+fn fragment_output_without_a_port_is_named() {
+    let msg = build_error(Misnamed { kind: "misnamed_output", dir_port: "dir", color_port: "colour", compute_color: None });
+    assert_eq!(msg, "pass \"march\": raycast.wgsl: fragment output \"color\" (@location(0)) of fs_dvr is not an output port of this pass");
+}
+
+#[test]
+fn storage_texture_format_must_match_the_target() {
+    let msg = build_error(Misnamed {
+        kind: "wrong_storage_format",
+        dir_port: "dir",
+        color_port: "color",
+        compute_color: Some(TargetFormat::Rgba32Float),
+    });
+    assert_eq!(
+        msg,
+        "pass \"march\": raycast_compute.wgsl: storage texture \"color\" is declared Rgba16Float but the port's target is \
+         Rgba32Float; declare the output with the shader's format"
+    );
+}

@@ -56,21 +56,32 @@ pub fn default_shader_root() -> PathBuf {
 
 /// Loads `relative` (e.g. `raycast.wgsl`) under `root`, inlining imports.
 pub fn load_shader(root: &Path, relative: &str) -> Result<ShaderSource, ShaderSourceError> {
+    load_shader_from(&[root.to_path_buf()], relative)
+}
+
+/// Loads `relative` from the first of `roots` that has it, resolving every import the same way:
+/// an external plugin crate puts its own shader folder first and still imports
+/// `common/frame.wgsl` from volgraph's.
+pub fn load_shader_from(roots: &[PathBuf], relative: &str) -> Result<ShaderSource, ShaderSourceError> {
     let mut out = ShaderSource { text: String::new(), files: Vec::new() };
     let mut included = BTreeSet::new();
     let mut stack = Vec::new();
-    append(root, relative, &mut out, &mut included, &mut stack)?;
+    append(roots, relative, &mut out, &mut included, &mut stack)?;
     Ok(out)
 }
 
 fn append(
-    root: &Path,
+    roots: &[PathBuf],
     relative: &str,
     out: &mut ShaderSource,
     included: &mut BTreeSet<String>,
     stack: &mut Vec<String>,
 ) -> Result<(), ShaderSourceError> {
-    let path = root.join(relative);
+    let path = roots
+        .iter()
+        .map(|r| r.join(relative))
+        .find(|p| p.is_file())
+        .unwrap_or_else(|| roots.first().map_or_else(|| PathBuf::from(relative), |r| r.join(relative)));
     if stack.iter().any(|s| s == relative) {
         let mut chain = stack.clone();
         chain.push(relative.to_string());
@@ -88,7 +99,7 @@ fn append(
         if let Some(rest) = trimmed.strip_prefix("#import") {
             let target = rest.trim().strip_prefix('"').and_then(|r| r.strip_suffix('"'));
             match target {
-                Some(t) if !t.is_empty() => append(root, t, out, included, stack)?,
+                Some(t) if !t.is_empty() => append(roots, t, out, included, stack)?,
                 _ => return Err(ShaderSourceError::MalformedImport { path, line: i + 1 }),
             }
         } else {

@@ -72,7 +72,12 @@ fn setup(graph: &str) -> (Gpu, Executor) {
     registry.register(AddOne).register(Fill);
     let plan = compile("semantics.ron", graph, &registry, &CompileOptions::new(8, 4)).expect("valid graph");
     let gpu = Gpu::new_headless().expect("a Vulkan adapter (lavapipe without a GPU)");
-    let shaders = ShaderLibrary::new(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/shaders"));
+    // The test's own shader folder first; its `#import "common/fullscreen.wgsl"` comes from
+    // volgraph's, as it would for an external plugin crate.
+    let shaders = ShaderLibrary::with_roots(vec![
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/shaders"),
+        volgraph_core::shader_source::default_shader_root(),
+    ]);
     let exec = Executor::new(&gpu, &shaders, &registry, plan).expect("builds");
     (gpu, exec)
 }

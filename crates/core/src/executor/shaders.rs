@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
 use super::gpu::Gpu;
-use crate::shader_source::{ShaderSource, load_shader};
+use crate::shader_source::{ShaderSource, load_shader_from};
 
 /// A loaded shader: the wgpu module, naga's module and analysis, and the files it came from.
 pub struct LoadedShader {
@@ -24,7 +24,7 @@ pub struct LoadedShader {
 
 /// Loads and caches shader modules by file name.
 pub struct ShaderLibrary {
-    root: PathBuf,
+    roots: Vec<PathBuf>,
     cache: Mutex<HashMap<String, Arc<LoadedShader>>>,
 }
 
@@ -40,12 +40,18 @@ pub fn parse_and_validate(file: &str, text: &str) -> Result<(naga::Module, naga:
 impl ShaderLibrary {
     /// A library reading from `root` (usually [`crate::shader_source::default_shader_root`]).
     pub fn new(root: PathBuf) -> Self {
-        Self { root, cache: Mutex::new(HashMap::new()) }
+        Self::with_roots(vec![root])
     }
 
-    /// The shader root.
-    pub fn root(&self) -> &PathBuf {
-        &self.root
+    /// A library searching `roots` in order for every file and import (an external plugin's
+    /// shader folder first, then volgraph's).
+    pub fn with_roots(roots: Vec<PathBuf>) -> Self {
+        Self { roots, cache: Mutex::new(HashMap::new()) }
+    }
+
+    /// The shader roots, searched in order.
+    pub fn roots(&self) -> &[PathBuf] {
+        &self.roots
     }
 
     /// Forgets every cached module (hot reload: the next [`Self::get`] reads the files again).
@@ -60,7 +66,7 @@ impl ShaderLibrary {
         if let Some(s) = self.cache.lock().ok().and_then(|c| c.get(file).cloned()) {
             return Ok(s);
         }
-        let source = load_shader(&self.root, file).map_err(|e| e.to_string())?;
+        let source = load_shader_from(&self.roots, file).map_err(|e| e.to_string())?;
         let (module, info) = parse_and_validate(file, &source.text)?;
         let wgpu = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(file),

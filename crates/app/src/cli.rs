@@ -109,6 +109,13 @@ enum BenchCommand {
     /// Time render graphs over datasets, transfer functions and viewports (presets: basic,
     /// kw2003-table1, thesis-tables); speed-ups vs a baseline, samples/s, accuracy sweeps.
     Graphs(crate::bench_graphs::GraphsArgs),
+    /// Compile time of a generated 30-pass graph; pooled vs unpooled transient memory of every
+    /// graph in graphs/ at 1920x1080.
+    Compile {
+        /// Write the figures as JSON here.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
 }
 
 fn parse_scalar(text: &str) -> Result<(String, f64), String> {
@@ -215,6 +222,10 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                 json_out: json,
             };
             crate::bench_accel::run(&opts).context("bench accel")?;
+            Ok(())
+        }
+        Command::Bench { which: BenchCommand::Compile { json } } => {
+            crate::bench_compile::run(json.as_deref()).context("bench compile")?;
             Ok(())
         }
         Command::Bench { which: BenchCommand::Graphs(args) } => {

@@ -2,7 +2,6 @@
 //! `bench` measures. This crate is the only one that talks to a user.
 
 mod bench_accel;
-#[allow(dead_code, reason = "`volgraph bench compile` is wired in cli.rs next; until then only its tests call it")]
 mod bench_compile;
 mod bench_graphs;
 mod cli;

@@ -53,13 +53,25 @@ type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
 type DrawResult = Result<(), Box<dyn std::error::Error>>;
 
 fn bar_plot(root: &Area<'_>, report: &GraphBenchReport) -> DrawResult {
+    // One viewport for all rows: leave it out of the labels so they fit under their bars.
+    let one_viewport = report
+        .rows
+        .iter()
+        .all(|r| r.viewport == report.rows[0].viewport);
+    let label = |r: &Row| {
+        if one_viewport {
+            format!("{} {}", r.dataset, r.tf)
+        } else {
+            case_label(r)
+        }
+    };
     let mut graphs: Vec<&str> = Vec::new();
     let mut cases: Vec<String> = Vec::new();
     for r in &report.rows {
         if !graphs.contains(&r.graph.as_str()) {
             graphs.push(&r.graph);
         }
-        let c = case_label(r);
+        let c = label(r);
         if !cases.contains(&c) {
             cases.push(c);
         }
@@ -89,6 +101,7 @@ fn bar_plot(root: &Area<'_>, report: &GraphBenchReport) -> DrawResult {
         .configure_mesh()
         .disable_x_mesh()
         .x_labels(cases.len().max(1) * 2 + 1)
+        .x_label_style(("sans-serif", 11))
         .x_label_formatter(&|x| {
             let i = x.floor() as usize;
             if (x - i as f64 - 0.5).abs() < 0.26 {
@@ -107,7 +120,7 @@ fn bar_plot(root: &Area<'_>, report: &GraphBenchReport) -> DrawResult {
             .iter()
             .filter(|r| r.graph == *graph && r.median_ms.is_finite())
             .filter_map(|r| {
-                let c = cases.iter().position(|c| *c == case_label(r))?;
+                let c = cases.iter().position(|c| *c == label(r))?;
                 let x0 = c as f64 + 0.1 + g as f64 * width;
                 Some(Rectangle::new(
                     [(x0, 0.0), (x0 + width * 0.9, r.median_ms)],

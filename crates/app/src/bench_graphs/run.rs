@@ -13,7 +13,7 @@ use volgraph_accel::transfer_function::TransferFunction;
 use volgraph_accel::volume::Volume;
 use volgraph_core::executor::{Gpu, ShaderLibrary};
 use volgraph_core::shader_source::default_shader_root;
-use volgraph_core::{CompileOptions, Registry, compile};
+use volgraph_core::{CompileOptions, Diagnostics, Plan, Registry, compile};
 use volgraph_passes::builtin_registry;
 use volgraph_passes::session::RenderSession;
 
@@ -84,8 +84,16 @@ impl Case<'_> {
         )
     }
 
-    fn options(&self, config: &BenchConfig, viewport: (u32, u32)) -> CompileOptions {
-        let mut options = CompileOptions::new(viewport.0, viewport.1);
+    fn options(
+        &self,
+        config: &BenchConfig,
+        viewport: (u32, u32),
+        step_voxels: f64,
+    ) -> CompileOptions {
+        let mut options = CompileOptions::new(viewport.0, viewport.1).with_scalar(
+            LONGEST_RAY_STEPS,
+            longest_ray_steps(&self.dataset.volume, step_voxels),
+        );
         for (key, value) in &config.params {
             options
                 .param_overrides
@@ -97,6 +105,44 @@ impl Case<'_> {
                 .insert(sweep.key.clone(), value.clone());
         }
         options
+    }
+}
+
+/// The scene scalar multipass graphs size their segment loop with (Krüger & Westermann 2003 §3).
+const LONGEST_RAY_STEPS: &str = "longest_ray_steps";
+
+/// The step the first compile assumes before the graph's own step is known.
+const PROVISIONAL_STEP_VOXELS: f64 = 0.5;
+
+/// K of Krüger & Westermann 2003 §3: steps of `step_voxels` along the box diagonal, the longest
+/// ray, so `ceil(K / M)` segments of M steps cover every ray (0 when degenerate).
+fn longest_ray_steps(volume: &Volume, step_voxels: f64) -> f64 {
+    let k = 2.0 * volume.half_extent_world().length() / (step_voxels * volume.unit_step_world());
+    if k.is_finite() && k > 0.0 { k } else { 0.0 }
+}
+
+/// Compiles the case at `viewport`, with the scene scalar K computed for the graph's own raycast
+/// step (known only after a first compile; recompiled when it differs from the provisional one).
+fn compile_case(
+    ctx: &Context<'_>,
+    case: &Case<'_>,
+    viewport: (u32, u32),
+) -> Result<Plan, Diagnostics> {
+    let file = case.graph.path.display().to_string();
+    let build = |step: f64| {
+        compile(
+            &file,
+            &case.graph.source,
+            &ctx.registry,
+            &case.options(ctx.config, viewport, step),
+        )
+    };
+    let plan = build(PROVISIONAL_STEP_VOXELS)?;
+    match accuracy::raycast_settings(&plan) {
+        Some(s) if s.step_voxels != PROVISIONAL_STEP_VOXELS && s.step_voxels > 0.0 => {
+            build(s.step_voxels)
+        }
+        _ => Ok(plan),
     }
 }
 
@@ -264,12 +310,7 @@ fn key(case: &Case<'_>, size: (u32, u32), settings: &impl std::fmt::Debug) -> St
 fn run_case(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<Row> {
     let config = ctx.config;
     let file = case.graph.path.display().to_string();
-    let plan = match compile(
-        &file,
-        &case.graph.source,
-        &ctx.registry,
-        &case.options(config, case.viewport),
-    ) {
+    let plan = match compile_case(ctx, case, case.viewport) {
         Ok(plan) => plan,
         Err(d) => {
             ctx.skip(
@@ -376,32 +417,26 @@ fn measure_error(
         return None;
     };
     let camera: OrbitCamera = config.camera;
-    let file = case.graph.path.display().to_string();
-    let image = compile(
-        &file,
-        &case.graph.source,
-        &ctx.registry,
-        &case.options(config, size),
-    )
-    .map_err(|d| d.to_string())
-    .and_then(|plan| {
-        if !plan.outputs.contains_key("image") {
-            return Err("the graph has no \"image\" output to compare".to_string());
-        }
-        let mut session = RenderSession::from_plan(
-            ctx.gpu,
-            &ctx.shaders,
-            &ctx.registry,
-            plan,
-            &case.dataset.volume,
-            case.lut,
-        )
-        .map_err(|e| e.to_string())?;
-        session
-            .render(ctx.gpu, &camera)
+    let image = compile_case(ctx, case, size)
+        .map_err(|d| d.to_string())
+        .and_then(|plan| {
+            if !plan.outputs.contains_key("image") {
+                return Err("the graph has no \"image\" output to compare".to_string());
+            }
+            let mut session = RenderSession::from_plan(
+                ctx.gpu,
+                &ctx.shaders,
+                &ctx.registry,
+                plan,
+                &case.dataset.volume,
+                case.lut,
+            )
             .map_err(|e| e.to_string())?;
-        session.read(ctx.gpu, "image").map_err(|e| e.to_string())
-    });
+            session
+                .render(ctx.gpu, &camera)
+                .map_err(|e| e.to_string())?;
+            session.read(ctx.gpu, "image").map_err(|e| e.to_string())
+        });
     let image = match image {
         Ok(image) => image,
         Err(reason) => {

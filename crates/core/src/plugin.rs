@@ -166,7 +166,10 @@ pub trait PassNode: Send {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError>;
 
     /// For an output port of kind [`PortKind::Owned`]: the texture view this node owns and
-    /// fills (a 3D grid built from the volume, ...). Consumers' ports are bound to it.
+    /// fills (a 3D grid built from the volume, ...). Consumers' ports are bound to it. Asked
+    /// after [`PassPlugin::create`] and again after every [`PassNode::record`], so a node whose
+    /// texture is sized by a graph input (the volume's dims are only known when recording) may
+    /// return `None` until its first `record`, which must then create it.
     fn owned_output(&self, _port: &str) -> Option<wgpu::TextureView> {
         None
     }

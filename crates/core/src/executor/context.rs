@@ -184,6 +184,12 @@ impl CreateContext<'_> {
                     Some(f) => self.gpu.filterable(f),
                     None => true,
                 };
+                // Writable storage in a vertex stage needs VERTEX_WRITABLE_STORAGE; volgraph's
+                // render passes write storage (debug counters) from fragment shaders only.
+                let stages = match b.ty {
+                    BindingKind::Storage { read_only: false } => stages - wgpu::ShaderStages::VERTEX,
+                    _ => stages,
+                };
                 layout_entry(b, stages, filterable)
             })
             .collect();

@@ -33,6 +33,10 @@ pub struct Gpu {
     pub float32_filterable: bool,
     /// Whether 32-bit float targets can be blended into.
     pub float32_blendable: bool,
+    /// Whether fragment shaders may force early depth tests (`@early_depth_test(force)`,
+    /// Vulkan only): needed where a shader with side effects, such as a debug counter, must
+    /// still be skipped by early-z (Krüger–Westermann 2003 §2.1).
+    pub early_depth_test: bool,
     /// The device limits.
     pub limits: wgpu::Limits,
 }
@@ -56,7 +60,8 @@ impl Gpu {
         let wanted = wgpu::Features::TIMESTAMP_QUERY
             | wgpu::Features::FLOAT32_FILTERABLE
             | wgpu::Features::FLOAT32_BLENDABLE
-            | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+            | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
+            | wgpu::Features::SHADER_EARLY_DEPTH_TEST;
         let features = adapter.features() & wanted;
         let limits = adapter.limits();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
@@ -73,6 +78,7 @@ impl Gpu {
             has_timestamps: features.contains(wgpu::Features::TIMESTAMP_QUERY),
             float32_filterable: features.contains(wgpu::Features::FLOAT32_FILTERABLE),
             float32_blendable: features.contains(wgpu::Features::FLOAT32_BLENDABLE),
+            early_depth_test: features.contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST),
             limits,
         })
     }

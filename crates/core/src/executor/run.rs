@@ -158,13 +158,11 @@ impl Executor {
                 if let Binding::Resource { id, written: None } = &bp.binding {
                     if bp.access == Access::Write && matches!(plan.resources[*id].desc, ResourceDesc::Owned(_)) {
                         let node = nodes.get(&step.pass_id).ok_or_else(|| ExecutorError::UnknownKind(step.kind.clone()))?;
-                        let view = node.owned_output(&bp.port).ok_or_else(|| {
-                            ExecutorError::Pass(PassError {
-                                pass: step.pass_id.clone(),
-                                message: format!("declares owned output \"{}\" but its node provides no texture for it", bp.port),
-                            })
-                        })?;
-                        owned.insert(*id, view);
+                        // A node whose texture depends on a graph input (a grid sized by the
+                        // volume) creates it in its first `record`; `run_frame` picks it up then.
+                        if let Some(view) = node.owned_output(&bp.port) {
+                            owned.insert(*id, view);
+                        }
                     }
                 }
             }
@@ -335,6 +333,21 @@ impl Executor {
                 began_pass: false,
             };
             node.record(&mut ctx)?;
+            // Owned outputs created or replaced while recording (sized by a graph input).
+            for bp in &step.ports {
+                if let Binding::Resource { id, written: None } = &bp.binding
+                    && bp.access == Access::Write
+                    && matches!(plan.resources[*id].desc, ResourceDesc::Owned(_))
+                {
+                    let view = node.owned_output(&bp.port).ok_or_else(|| {
+                        ExecutorError::Pass(PassError {
+                            pass: step.label.clone(),
+                            message: format!("declares owned output \"{}\" but its node provides no texture for it", bp.port),
+                        })
+                    })?;
+                    self.owned.insert(*id, view);
+                }
+            }
         }
         if let Some((set, resolve, read)) = &self.queries {
             let count = 2 * plan.steps.len() as u32;

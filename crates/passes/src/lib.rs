@@ -2,14 +2,22 @@
 //! in `shaders/` (`entry_points.rs` ↔ `shaders/entry_points.wgsl`). Each registers through the
 //! same public [`volgraph_core::Registry`] API an external crate would use.
 
+pub mod empty_space;
 pub mod entry_points;
+pub mod grid_tap;
+pub mod minmax_grid;
 pub mod present;
 pub mod ray_directions;
 pub mod raycast;
 pub mod raycast_compute;
+pub mod raycast_ess;
 pub mod raycast_params;
+pub mod raycast_segment;
 pub mod scene;
+pub mod segment_init;
 pub mod session;
+pub mod slice_render;
+pub mod termination_test;
 
 use volgraph_core::Registry;
 
@@ -20,6 +28,13 @@ pub fn register_builtin(registry: &mut Registry) {
         .register(ray_directions::RayDirections)
         .register(raycast::Raycast)
         .register(raycast_compute::RaycastCompute)
+        .register(segment_init::SegmentInit)
+        .register(raycast_segment::RaycastSegment::default())
+        .register(termination_test::TerminationTest)
+        .register(minmax_grid::MinMaxGridPass::default())
+        .register(empty_space::EmptySpace::default())
+        .register(raycast_ess::RaycastEss)
+        .register(slice_render::SliceRender)
         .register(present::Present);
 }
 

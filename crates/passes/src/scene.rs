@@ -48,3 +48,16 @@ pub fn upload_volume_texture(gpu: &Gpu, volume: &Volume) -> Result<wgpu::Texture
 pub fn upload_lut_texture(gpu: &Gpu, lut: &[[f32; 4]]) -> wgpu::Texture {
     upload_lut(gpu, "transfer function", lut)
 }
+
+/// K of Krüger & Westermann 2003 §3: the number of steps of `step_voxels` along the longest ray
+/// through `volume`'s box, its diagonal (`|2·half|` in world units over `step_voxels ·
+/// unit_world`). A segment loop of `ceil(K / M)` passes of M samples covers every ray: a ray of
+/// texture length L takes at most `ceil(L / step)` samples (jitter included), and `L / step ≤ K`.
+/// Feed it to a graph as the scene scalar `longest_ray_steps`
+/// (`CompileOptions::with_scalar("longest_ray_steps", k)`). 0 for a degenerate volume or step.
+pub fn longest_ray_steps(volume: &Volume, step_voxels: f64) -> f64 {
+    let diagonal = 2.0 * volume.half_extent_world().length();
+    let step_world = step_voxels * volume.unit_step_world();
+    let k = diagonal / step_world;
+    if k.is_finite() && k > 0.0 { k } else { 0.0 }
+}

@@ -1,0 +1,111 @@
+//! `empty_space`: Krüger & Westermann 2003 §2.3's transfer-function classification of the
+//! min/max grid on the GPU — per block, whether any LUT texel reachable by linear interpolation
+//! on `[min, max]` has non-zero alpha, mirroring `volgraph_accel::classify::OpacityClassifier`
+//! (the paper's "CT" texture, evaluated per block instead of looked up). Output: an Owned
+//! `R32Float` 3D texture of empty flags (1 = skip), consumed by `termination_test` (the paper's
+//! way) and `raycast_ess` (single-pass empty-block leaping). Runs every frame (one invocation
+//! per block) so a changed transfer function takes effect at once. Shader:
+//! `shaders/empty_space.wgsl`.
+
+use volgraph_core::executor::{ComputePipelineSpec, CreateContext, PassError, PassPipeline, RecordContext};
+use volgraph_core::plugin::ShaderUse;
+use volgraph_core::{Params, PassNode, PassPlugin, PortKind, PortSpec};
+
+use crate::grid_tap::GridTap;
+pub(crate) use crate::minmax_grid::block_size_spec;
+use crate::minmax_grid::{MINMAX_GRID, bound_size, create_grid_texture, dispatch_grid};
+
+/// The Owned type name of the empty-block flags.
+pub const EMPTY_BLOCKS: &str = "empty_blocks";
+
+/// The plugin; [`EmptySpace::tapped`] also hands the flag texture to a [`GridTap`].
+#[derive(Default)]
+pub struct EmptySpace {
+    tap: Option<GridTap>,
+}
+
+impl EmptySpace {
+    /// An `empty_space` pass that stores its texture in `tap` (tests, tools).
+    pub fn tapped(tap: GridTap) -> Self {
+        Self { tap: Some(tap) }
+    }
+}
+
+/// Checks that the empty-block grid bound to `port` has `ceil(volume / block_size)` blocks per
+/// axis, i.e. that a consumer's `block_size` matches the `minmax_grid` pass's.
+pub(crate) fn check_block_grid(ctx: &RecordContext<'_>, port: &str, block_size: u32, volume: [u32; 3]) -> Result<(), PassError> {
+    let grid = bound_size(ctx, port)?;
+    let expected = volume.map(|n| n.div_ceil(block_size.max(1)));
+    if grid != expected {
+        return Err(PassError {
+            pass: ctx.label.to_string(),
+            message: format!(
+                "block_size {block_size} gives a {expected:?} block grid for the {volume:?} volume, but \"{port}\" is {grid:?}; \
+                 set the same block_size as the minmax_grid pass"
+            ),
+        });
+    }
+    Ok(())
+}
+
+impl PassPlugin for EmptySpace {
+    fn kind(&self) -> &'static str {
+        "empty_space"
+    }
+
+    fn summary(&self) -> &'static str {
+        "per-block empty flags from the min/max grid and the transfer function (Krüger–Westermann 2003 §2.3)"
+    }
+
+    fn ports(&self, _params: &Params) -> Vec<PortSpec> {
+        vec![
+            PortSpec::read("grid", PortKind::Owned(MINMAX_GRID)),
+            PortSpec::read("tf", PortKind::TransferFunction),
+            PortSpec::write("empty", PortKind::Owned(EMPTY_BLOCKS)),
+        ]
+    }
+
+    fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
+        vec![ShaderUse { file: "empty_space.wgsl", entry_point: "cs_classify" }]
+    }
+
+    fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec { shader: "empty_space.wgsl", entry: "cs_classify", ..Default::default() })?;
+        Ok(Box::new(EmptySpaceNode { pipeline, flags: None, tap: self.tap.clone() }))
+    }
+}
+
+struct EmptySpaceNode {
+    pipeline: PassPipeline,
+    flags: Option<(wgpu::Texture, wgpu::TextureView, [u32; 3])>,
+    tap: Option<GridTap>,
+}
+
+impl PassNode for EmptySpaceNode {
+    fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
+        let dims = bound_size(ctx, "grid")?;
+        if self.flags.as_ref().is_none_or(|(_, _, d)| *d != dims) {
+            let texture = create_grid_texture(ctx, &format!("{} empty blocks", ctx.label), wgpu::TextureFormat::R32Float, dims);
+            let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+            if let Some(tap) = &self.tap {
+                tap.set(&texture);
+            }
+            self.flags = Some((texture, view, dims));
+        }
+        let view = self
+            .flags
+            .as_ref()
+            .map(|(_, v, _)| v.clone())
+            .ok_or_else(|| PassError { pass: ctx.label.to_string(), message: "empty-block texture missing right after creation".to_string() })?;
+        let bg = ctx.bind_group(&self.pipeline, &[("empty", wgpu::BindingResource::TextureView(&view))])?;
+        dispatch_grid(ctx, &self.pipeline, Some(&bg), dims);
+        Ok(())
+    }
+
+    fn owned_output(&self, port: &str) -> Option<wgpu::TextureView> {
+        match port {
+            "empty" => self.flags.as_ref().map(|(_, view, _)| view.clone()),
+            _ => None,
+        }
+    }
+}

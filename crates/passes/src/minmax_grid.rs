@@ -1,0 +1,153 @@
+//! `minmax_grid`: Krüger & Westermann 2003 §2.3's min/max grid of `block_size³` blocks, built
+//! on the GPU from the volume texture in a compute pass. Conservative for trilinear
+//! interpolation exactly like `volgraph_accel::minmax::MinMaxGrid` (each block's range includes
+//! a one-voxel apron), so a block classified empty holds no visible sample. The grid is an
+//! Owned `Rg32Float` 3D texture (r = min, g = max) of `ceil(dims / block_size)` texels, created
+//! on the first frame (its size comes from the bound volume) and built once; it is rebuilt when
+//! the volume's size changes. Shader: `shaders/minmax_grid.wgsl`.
+
+use volgraph_core::executor::{ComputePipelineSpec, CreateContext, PassError, PassPipeline, PipelineKind, RecordContext};
+use volgraph_core::plugin::ShaderUse;
+use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec};
+
+use crate::grid_tap::GridTap;
+
+/// The Owned type name of the grid.
+pub const MINMAX_GRID: &str = "minmax_grid";
+
+/// The plugin; [`MinMaxGridPass::tapped`] also hands the grid texture to a [`GridTap`].
+#[derive(Default)]
+pub struct MinMaxGridPass {
+    tap: Option<GridTap>,
+}
+
+impl MinMaxGridPass {
+    /// A `minmax_grid` pass that stores its texture in `tap` (tests, tools).
+    pub fn tapped(tap: GridTap) -> Self {
+        Self { tap: Some(tap) }
+    }
+}
+
+/// Rust twin of `struct MinMaxParams` in `shaders/minmax_grid.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct MinMaxParamsGpu {
+    block_size: u32,
+    _pad: [u32; 3],
+}
+
+const _: () = assert!(std::mem::size_of::<MinMaxParamsGpu>() == 16);
+
+/// Workgroup edge of `cs_minmax` and `cs_classify` (4³ blocks per workgroup).
+pub(crate) const GRID_WORKGROUP: u32 = 4;
+
+/// The `block_size` parameter (K-W 2003 §2.3 used 8).
+pub(crate) fn block_size_spec() -> ParamSpec {
+    ParamSpec::uint("block_size", 8, 1, 256, "edge of an empty-space block in voxels (Krüger–Westermann used 8)")
+}
+
+/// A 3D float texture usable as a storage output and a sampled input.
+pub(crate) fn create_grid_texture(ctx: &RecordContext<'_>, label: &str, format: wgpu::TextureFormat, dims: [u32; 3]) -> wgpu::Texture {
+    ctx.gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width: dims[0], height: dims[1], depth_or_array_layers: dims[2] },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D3,
+        format,
+        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+/// Size of the texture bound to `port` (a 3D input or owned grid).
+pub(crate) fn bound_size(ctx: &RecordContext<'_>, port: &str) -> Result<[u32; 3], PassError> {
+    let s = ctx.view(port)?.texture().size();
+    Ok([s.width, s.height, s.depth_or_array_layers])
+}
+
+/// Records one dispatch of `pipeline` over `dims` texels (4³ per workgroup); `dims = None`
+/// records an empty pass, which keeps the step's label and timestamps.
+pub(crate) fn dispatch_grid(ctx: &mut RecordContext<'_>, pipeline: &PassPipeline, bind_group: Option<&wgpu::BindGroup>, dims: [u32; 3]) {
+    let mut pass = ctx.begin_compute_pass();
+    if let (PipelineKind::Compute(p), Some(bg)) = (&pipeline.pipeline, bind_group) {
+        pass.set_pipeline(p);
+        pass.set_bind_group(0, bg, &[]);
+        pass.dispatch_workgroups(dims[0].div_ceil(GRID_WORKGROUP), dims[1].div_ceil(GRID_WORKGROUP), dims[2].div_ceil(GRID_WORKGROUP));
+    }
+}
+
+impl PassPlugin for MinMaxGridPass {
+    fn kind(&self) -> &'static str {
+        "minmax_grid"
+    }
+
+    fn summary(&self) -> &'static str {
+        "GPU min/max grid of the volume's blocks, trilinear-conservative (Krüger–Westermann 2003 §2.3)"
+    }
+
+    fn params(&self) -> Vec<ParamSpec> {
+        vec![block_size_spec()]
+    }
+
+    fn ports(&self, _params: &Params) -> Vec<PortSpec> {
+        vec![PortSpec::read("volume", PortKind::Volume), PortSpec::write("grid", PortKind::Owned(MINMAX_GRID))]
+    }
+
+    fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
+        vec![ShaderUse { file: "minmax_grid.wgsl", entry_point: "cs_minmax" }]
+    }
+
+    fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
+            shader: "minmax_grid.wgsl",
+            entry: "cs_minmax",
+            extra_bindings: &["minmax"],
+            ..Default::default()
+        })?;
+        let block_size = ctx.params.uint("block_size").max(1) as u32;
+        let params = ctx.uniform_buffer("minmax", 16);
+        ctx.gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&MinMaxParamsGpu { block_size, _pad: [0; 3] }));
+        Ok(Box::new(MinMaxGridNode { pipeline, params, block_size, grid: None, tap: self.tap.clone() }))
+    }
+}
+
+struct MinMaxGridNode {
+    pipeline: PassPipeline,
+    params: wgpu::Buffer,
+    block_size: u32,
+    /// The grid, the volume size it was built for, and whether it has been built.
+    grid: Option<(wgpu::Texture, wgpu::TextureView, [u32; 3])>,
+    tap: Option<GridTap>,
+}
+
+impl PassNode for MinMaxGridNode {
+    fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
+        let volume = bound_size(ctx, "volume")?;
+        if self.grid.as_ref().is_some_and(|(_, _, built_for)| *built_for == volume) {
+            // Built for this volume already: an empty pass keeps the step's label and timing.
+            dispatch_grid(ctx, &self.pipeline, None, [0; 3]);
+            return Ok(());
+        }
+        let dims = volume.map(|n| n.div_ceil(self.block_size));
+        let texture = create_grid_texture(ctx, &format!("{} min/max grid", ctx.label), wgpu::TextureFormat::Rg32Float, dims);
+        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+        if let Some(tap) = &self.tap {
+            tap.set(&texture);
+        }
+        let bg = {
+            let grid_view = view.clone();
+            ctx.bind_group(&self.pipeline, &[("minmax", self.params.as_entire_binding()), ("grid", wgpu::BindingResource::TextureView(&grid_view))])?
+        };
+        dispatch_grid(ctx, &self.pipeline, Some(&bg), dims);
+        self.grid = Some((texture, view, volume));
+        Ok(())
+    }
+
+    fn owned_output(&self, port: &str) -> Option<wgpu::TextureView> {
+        match port {
+            "grid" => self.grid.as_ref().map(|(_, view, _)| view.clone()),
+            _ => None,
+        }
+    }
+}

@@ -1,0 +1,255 @@
+//! `raycast_segment`: Krüger & Westermann 2003 §2.1 "main passes 3 to N" — each pass performs
+//! M steps along every ray from where the previous segment stopped and blends the segment into
+//! the accumulation target RES front to back. Segment `i` (the repeat group's iteration) covers
+//! samples `[i·M, (i+1)·M)` of the single-pass raycaster's sample sequence
+//! (`docs/rendering_model.md`), and the blend `RES += (1 - RES.a)·segment` (src factor
+//! OneMinusDstAlpha, dst factor One) composites exactly like the single pass, so with no
+//! termination the result equals the single-pass raycast.
+//!
+//! RES is a Modify port (blended in place: the scheduler keeps the whole loop in one texture
+//! instead of ping-ponging). When the optional `depth` port is wired, segments are drawn with
+//! the depth test GREATER against the early-z buffer that `termination_test` writes, so
+//! fragments of terminated rays never run (§2.1; the shader writes no depth, keeping early-z
+//! on). Mode `iso` is §2.2: the closest hit of each segment, shaded, alpha 1.
+//!
+//! Debugging early-z: [`RaycastSegment::counting`] registers a variant whose fragment shader
+//! counts its invocations (`shaders/raycast_segment_counted.wgsl`, forced early depth test).
+//! Shader: `shaders/raycast_segment.wgsl`.
+
+use std::sync::{Arc, Mutex};
+
+use volgraph_core::executor::{CreateContext, DepthSpec, Gpu, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
+use volgraph_core::plugin::ShaderUse;
+use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+
+use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
+use crate::segment_init::ACCUM_FORMATS;
+
+const FLOAT_TARGETS: [TargetFormat; 2] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float];
+
+/// The plugin. [`Default`] is the production pass; [`RaycastSegment::counting`] adds the debug
+/// invocation counter.
+#[derive(Default)]
+pub struct RaycastSegment {
+    counter: Option<InvocationCounter>,
+}
+
+impl RaycastSegment {
+    /// A `raycast_segment` whose fragment shader counts its invocations into `counter` (cleared
+    /// at the first segment of every frame). Register it in place of the built-in one.
+    pub fn counting(counter: InvocationCounter) -> Self {
+        Self { counter: Some(counter) }
+    }
+}
+
+/// A handle on the fragment-invocation counter of a counting [`RaycastSegment`]; clone it, give
+/// one clone to [`RaycastSegment::counting`], and read it after a frame.
+#[derive(Clone, Default)]
+pub struct InvocationCounter {
+    buffer: Arc<Mutex<Option<wgpu::Buffer>>>,
+}
+
+impl InvocationCounter {
+    /// A counter not yet attached to a pass.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The number of segment fragment invocations of the last frame, or an error when no
+    /// counting pass has been built (or the readback failed).
+    pub fn read(&self, gpu: &Gpu) -> Result<u32, String> {
+        let guard = self.buffer.lock().map_err(|_| "invocation counter lock poisoned".to_string())?;
+        let buffer = guard.as_ref().ok_or("no counting raycast_segment pass has been built")?;
+        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("invocation counter readback"),
+            size: 4,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("counter readback") });
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, 4);
+        gpu.queue.submit([encoder.finish()]);
+        let slice = staging.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |_| {});
+        gpu.wait_idle();
+        let value = {
+            let data = slice.get_mapped_range().map_err(|e| format!("invocation counter readback: {e}"))?;
+            u32::from_le_bytes([data[0], data[1], data[2], data[3]])
+        };
+        staging.unmap();
+        Ok(value)
+    }
+}
+
+/// Rust twin of `struct SegmentParams` in `shaders/common/segment.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct SegmentParamsGpu {
+    /// M: samples per segment.
+    pub steps: u32,
+    /// Empty-space block edge in voxels.
+    pub block_size: u32,
+    /// T: termination threshold on the accumulated alpha.
+    pub threshold: f32,
+    /// Padding.
+    pub _pad: u32,
+}
+
+const _: () = assert!(std::mem::size_of::<SegmentParamsGpu>() == 16);
+
+impl SegmentParamsGpu {
+    /// From checked parameters (`segment_steps`, `block_size`, `threshold`; absent ones are 0).
+    pub fn from_params(p: &Params) -> Self {
+        Self {
+            steps: p.uint("segment_steps") as u32,
+            block_size: p.uint("block_size").max(1) as u32,
+            threshold: p.float("threshold") as f32,
+            _pad: 0,
+        }
+    }
+}
+
+/// The `segment_steps` parameter, shared with `termination_test` (both must agree).
+pub(crate) fn segment_steps_spec() -> ParamSpec {
+    ParamSpec::uint("segment_steps", 8, 1, 4096, "M: samples per segment (Krüger–Westermann used 8); the repeat count divides by it")
+}
+
+/// The segment's blend: `dst + (1 - dst.a)·src` for colour and alpha.
+pub(crate) fn front_to_back_blend() -> wgpu::BlendState {
+    let c = wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::OneMinusDstAlpha,
+        dst_factor: wgpu::BlendFactor::One,
+        operation: wgpu::BlendOperation::Add,
+    };
+    wgpu::BlendState { color: c, alpha: c }
+}
+
+/// The segment index this record is for: the repeat iteration (0 outside a repeat group).
+pub(crate) fn segment_index(ctx: &RecordContext<'_>) -> u32 {
+    ctx.iteration.map_or(0, |(i, _)| i)
+}
+
+impl PassPlugin for RaycastSegment {
+    fn kind(&self) -> &'static str {
+        "raycast_segment"
+    }
+
+    fn summary(&self) -> &'static str {
+        "M raycasting steps per pass blended into an accumulation target, early-z tested (Krüger–Westermann 2003 §2.1–2.2)"
+    }
+
+    fn params(&self) -> Vec<ParamSpec> {
+        let mut p = raycast_param_specs();
+        p.push(segment_steps_spec());
+        p
+    }
+
+    fn ports(&self, _params: &Params) -> Vec<PortSpec> {
+        vec![
+            PortSpec::read("entry", PortKind::target(&FLOAT_TARGETS)),
+            PortSpec::read("dir", PortKind::target(&FLOAT_TARGETS)),
+            PortSpec::read("volume", PortKind::Volume),
+            PortSpec::read("tf", PortKind::TransferFunction),
+            PortSpec::modify("accum", PortKind::target(&ACCUM_FORMATS)),
+            PortSpec::read("depth", PortKind::target(&[TargetFormat::Depth32Float])).optional(),
+        ]
+    }
+
+    fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
+        let (file, entry_point) = self.entry(params);
+        vec![ShaderUse { file, entry_point }]
+    }
+
+    fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        let error = |message: String| PassError { pass: ctx.pass_id.to_string(), message };
+        let accum_format = ctx.ports.iter().find(|p| p.name == "accum").and_then(|p| p.format);
+        if accum_format == Some(wgpu::TextureFormat::Rgba32Float) && !ctx.gpu.float32_blendable {
+            return Err(error(format!(
+                "the accumulation target is Rgba32Float, which {} cannot blend into; declare it Rgba16Float \
+                 (outputs: {{\"accum\": (format: Rgba16Float)}} on the pass that creates it)",
+                ctx.gpu.adapter_name
+            )));
+        }
+        if self.counter.is_some() && !ctx.gpu.early_depth_test {
+            return Err(error(format!(
+                "the invocation counter needs forced early depth tests (SHADER_EARLY_DEPTH_TEST), which {} lacks",
+                ctx.gpu.adapter_name
+            )));
+        }
+        let (shader, fragment) = self.entry(ctx.params);
+        let extra: &[&str] = if self.counter.is_some() { &["params", "segment", "invocations"] } else { &["params", "segment"] };
+        let spec = |depth: Option<DepthSpec<'static>>| RenderPipelineSpec {
+            shader,
+            vertex: "vs_segment",
+            fragment,
+            extra_bindings: extra,
+            blend: Some(front_to_back_blend()),
+            depth,
+            ..Default::default()
+        };
+        let free = ctx.render_pipeline(&spec(None))?;
+        let early_z = ctx.render_pipeline(&spec(Some(DepthSpec { port: "depth", write: false, compare: wgpu::CompareFunction::Greater })))?;
+        let params = ctx.uniform_buffer("params", std::mem::size_of::<RaycastParamsGpu>() as u64);
+        ctx.gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(ctx.params)));
+        let segment = ctx.uniform_buffer("segment", std::mem::size_of::<SegmentParamsGpu>() as u64);
+        ctx.gpu.queue.write_buffer(&segment, 0, bytemuck::bytes_of(&SegmentParamsGpu::from_params(ctx.params)));
+        let invocations = match &self.counter {
+            Some(counter) => {
+                let buffer = ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(&format!("{}.invocations", ctx.pass_id)),
+                    size: 4,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                });
+                let mut slot = counter.buffer.lock().map_err(|_| error("invocation counter lock poisoned".to_string()))?;
+                *slot = Some(buffer.clone());
+                Some(buffer)
+            }
+            None => None,
+        };
+        Ok(Box::new(RaycastSegmentNode { free, early_z, params, segment, invocations }))
+    }
+}
+
+impl RaycastSegment {
+    fn entry(&self, params: &Params) -> (&'static str, &'static str) {
+        match (self.counter.is_some(), is_iso(params)) {
+            (false, false) => ("raycast_segment.wgsl", "fs_dvr"),
+            (false, true) => ("raycast_segment.wgsl", "fs_iso"),
+            (true, false) => ("raycast_segment_counted.wgsl", "fs_dvr_counted"),
+            (true, true) => ("raycast_segment_counted.wgsl", "fs_iso_counted"),
+        }
+    }
+}
+
+struct RaycastSegmentNode {
+    /// Without the depth test (RC: no termination pass wired).
+    free: PassPipeline,
+    /// With the early-z test against `depth`.
+    early_z: PassPipeline,
+    params: wgpu::Buffer,
+    segment: wgpu::Buffer,
+    invocations: Option<wgpu::Buffer>,
+}
+
+impl PassNode for RaycastSegmentNode {
+    fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
+        let index = segment_index(ctx);
+        let pipeline = if ctx.is_bound("depth") { &self.early_z } else { &self.free };
+        let mut extra = vec![("params", self.params.as_entire_binding()), ("segment", self.segment.as_entire_binding())];
+        if let Some(counter) = &self.invocations {
+            if index == 0 {
+                ctx.encoder.clear_buffer(counter, 0, None);
+            }
+            extra.push(("invocations", counter.as_entire_binding()));
+        }
+        let bg = ctx.bind_group(pipeline, &extra)?;
+        let mut pass = ctx.begin_render_pass(pipeline, None)?;
+        if let volgraph_core::executor::PipelineKind::Render(p) = &pipeline.pipeline {
+            pass.set_pipeline(p);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.draw(0..3, index..index + 1);
+        }
+        Ok(())
+    }
+}

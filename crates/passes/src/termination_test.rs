@@ -1,0 +1,108 @@
+//! `termination_test`: Krüger & Westermann 2003 §2.1 "intermediate passes" (and §2.3 with
+//! empty-space skipping). Runs after each `raycast_segment` and writes the early-z buffer for
+//! the next segment: depth 1 (the paper's MAX, rejected by the segments' GREATER test) where
+//! the accumulated alpha has reached the threshold T or the ray has no sample left, and — when
+//! the optional `empty` port carries `empty_space`'s block flags — where every sample of the
+//! next segment lies in an empty block; depth 0 elsewhere, which re-enables a ray after an
+//! empty segment. A fullscreen pass that reads RES and writes `@builtin(frag_depth)` through a
+//! Modify depth port (depth compare Always); it has no colour targets.
+//!
+//! Error bound of termination: stopping a ray once its accumulated alpha `A ≥ T` drops what the
+//! rest of the ray would add, at most `(1 - A) ≤ (1 - T)` per premultiplied channel.
+//!
+//! `step_voxels`, `max_steps`, `jitter` and `segment_steps` must equal the segment pass's (the
+//! test recomputes where the next segment's samples lie), and `block_size` the `minmax_grid`
+//! pass's. Shader: `shaders/termination_test.wgsl`.
+
+use volgraph_core::executor::{CreateContext, DepthSpec, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
+use volgraph_core::plugin::ShaderUse;
+use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+
+use crate::empty_space::{EMPTY_BLOCKS, block_size_spec};
+use crate::raycast_params::RaycastParamsGpu;
+use crate::raycast_segment::{SegmentParamsGpu, segment_index, segment_steps_spec};
+use crate::segment_init::ACCUM_FORMATS;
+
+/// The plugin.
+pub struct TerminationTest;
+
+const FLOAT_TARGETS: [TargetFormat; 2] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float];
+
+impl PassPlugin for TerminationTest {
+    fn kind(&self) -> &'static str {
+        "termination_test"
+    }
+
+    fn summary(&self) -> &'static str {
+        "early-z buffer for the next segment: saturated, finished or empty rays rejected (Krüger–Westermann 2003 §2.1, §2.3)"
+    }
+
+    fn params(&self) -> Vec<ParamSpec> {
+        vec![
+            ParamSpec::float("threshold", 0.95, 0.0, 1.0, "T: rays whose accumulated alpha is >= T stop (1 = only fully opaque rays, lossless)"),
+            ParamSpec::float("step_voxels", 0.5, 0.01, 16.0, "the segment pass's sample distance (must match it)"),
+            ParamSpec::uint("max_steps", 4096, 1, 1 << 20, "the segment pass's max_steps (must match it)"),
+            ParamSpec::boolean("jitter", false, "the segment pass's jitter (must match it)"),
+            segment_steps_spec(),
+            block_size_spec(),
+        ]
+    }
+
+    fn ports(&self, _params: &Params) -> Vec<PortSpec> {
+        vec![
+            PortSpec::read("entry", PortKind::target(&FLOAT_TARGETS)),
+            PortSpec::read("dir", PortKind::target(&FLOAT_TARGETS)),
+            PortSpec::read("accum", PortKind::target(&ACCUM_FORMATS)),
+            PortSpec::read("empty", PortKind::Owned(EMPTY_BLOCKS)).optional(),
+            PortSpec::modify("depth", PortKind::target(&[TargetFormat::Depth32Float])),
+        ]
+    }
+
+    fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
+        vec![
+            ShaderUse { file: "termination_test.wgsl", entry_point: "fs_terminate" },
+            ShaderUse { file: "termination_test.wgsl", entry_point: "fs_terminate_empty" },
+        ]
+    }
+
+    fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        let spec = |fragment| RenderPipelineSpec {
+            shader: "termination_test.wgsl",
+            vertex: "vs_segment",
+            fragment,
+            extra_bindings: &["params", "segment"],
+            depth: Some(DepthSpec { port: "depth", write: true, compare: wgpu::CompareFunction::Always }),
+            ..Default::default()
+        };
+        let alpha_only = ctx.render_pipeline(&spec("fs_terminate"))?;
+        let with_empty = ctx.render_pipeline(&spec("fs_terminate_empty"))?;
+        let params = ctx.uniform_buffer("params", std::mem::size_of::<RaycastParamsGpu>() as u64);
+        ctx.gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(ctx.params)));
+        let segment = ctx.uniform_buffer("segment", std::mem::size_of::<SegmentParamsGpu>() as u64);
+        ctx.gpu.queue.write_buffer(&segment, 0, bytemuck::bytes_of(&SegmentParamsGpu::from_params(ctx.params)));
+        Ok(Box::new(TerminationTestNode { alpha_only, with_empty, params, segment }))
+    }
+}
+
+struct TerminationTestNode {
+    alpha_only: PassPipeline,
+    with_empty: PassPipeline,
+    params: wgpu::Buffer,
+    segment: wgpu::Buffer,
+}
+
+impl PassNode for TerminationTestNode {
+    fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
+        // This pass decides for the segment after the one just drawn.
+        let next = segment_index(ctx) + 1;
+        let pipeline = if ctx.is_bound("empty") { &self.with_empty } else { &self.alpha_only };
+        let bg = ctx.bind_group(pipeline, &[("params", self.params.as_entire_binding()), ("segment", self.segment.as_entire_binding())])?;
+        let mut pass = ctx.begin_render_pass(pipeline, None)?;
+        if let volgraph_core::executor::PipelineKind::Render(p) = &pipeline.pipeline {
+            pass.set_pipeline(p);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.draw(0..3, next..next + 1);
+        }
+        Ok(())
+    }
+}

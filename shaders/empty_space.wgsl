@@ -1,0 +1,47 @@
+// Krüger & Westermann 2003 §2.3's classification ("CT": is anything in [min, max] visible after
+// the transfer function?) evaluated per block on the GPU, mirroring
+// `volgraph_accel::classify::OpacityClassifier`: with a LUT of N texels sampled linearly between
+// texel centres (i+0.5)/N and clamped at the ends, [lo, hi] may be visible iff some texel
+// i ∈ [ceil(lo·N − 1.5), floor(hi·N + 0.5)] (clamped to the LUT) has alpha > 0 (or NaN), the
+// range first widened by VALUE_MARGIN. Run every frame (cheap: one invocation per block), so a
+// changed transfer function is picked up at once.
+//
+// Entry point: `cs_classify` → `empty` (R32Float 3D: 1 = empty, 0 = may be visible).
+
+#import "common/volume.wgsl"
+
+// The min/max grid of minmax_grid.wgsl (r = min, g = max).
+@group(0) @binding(5) var grid: texture_3d<f32>;
+@group(0) @binding(6) var empty: texture_storage_3d<r32float, write>;
+
+// `volgraph_accel::classify::VALUE_MARGIN`: covers f32 rounding of interpolated values.
+const VALUE_MARGIN: f32 = 1e-6;
+
+@compute @workgroup_size(4, 4, 4)
+fn cs_classify(@builtin(global_invocation_id) id: vec3<u32>) {
+    let blocks = textureDimensions(empty);
+    if (any(id >= blocks)) {
+        return;
+    }
+    let range = textureLoad(grid, vec3<i32>(id), 0).rg;
+    let texels = i32(textureDimensions(tf).x);
+    let n = f32(texels);
+    var first = 0;
+    var last = texels - 1;
+    // NaN bounds widen to the whole LUT (the conservative choice).
+    if (range.x == range.x && range.y == range.y) {
+        let lo = min(range.x, range.y) - VALUE_MARGIN;
+        let hi = max(range.x, range.y) + VALUE_MARGIN;
+        first = clamp(i32(clamp(ceil(lo * n - 1.5), -1.0, n)), 0, texels - 1);
+        last = clamp(i32(clamp(floor(hi * n + 0.5), -1.0, n)), 0, texels - 1);
+    }
+    var visible = false;
+    for (var i = first; i <= last; i += 1) {
+        let a = textureLoad(tf, vec2<i32>(i, 0), 0).a;
+        if (a > 0.0 || a != a) {
+            visible = true;
+            break;
+        }
+    }
+    textureStore(empty, vec3<i32>(id), vec4<f32>(select(1.0, 0.0, visible), 0.0, 0.0, 0.0));
+}

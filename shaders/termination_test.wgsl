@@ -1,0 +1,66 @@
+// Krüger & Westermann 2003 §2.1 "intermediate passes" and §2.3: between two segments, write
+// the early-z buffer so the next segment's fragments are rejected for rays that are done:
+//   z = 1 (MAX) if RES.a >= T, or the next segment has no sample on the ray (the ray left the
+//           volume; the paper marks this with alpha 1 in RES, which would change the image's
+//           alpha, so it is recomputed here from the same sample sequence instead),
+//           or — with empty-space skipping — every sample of the next segment lies in an
+//           empty block;
+//   z = 0 otherwise (re-enabling a ray that only skipped an empty segment).
+// The test runs for segment i+1 after segment i: the instance index of the draw is i+1.
+//
+// Empty-space test: the paper steps the coarse min/max grid at 8·D, which can step over a
+// block corner; here every sample position of the next segment looks up its own block, so
+// skipping is lossless (each sample's value is inside its block's conservative range).
+//
+// Pipelines: `vs_segment` + `fs_terminate` / `fs_terminate_empty` → `depth` (frag_depth,
+// compare Always, no colour targets).
+
+#import "common/segment.wgsl"
+#import "common/empty_blocks.wgsl"
+
+// The accumulated colour RES after the segment just drawn.
+@group(0) @binding(9) var accum: texture_2d<f32>;
+
+struct DepthOut {
+    @builtin(frag_depth) depth: f32,
+}
+
+const TERMINATED: f32 = 1.0;
+const LIVE: f32 = 0.0;
+
+// Saturated, or no sample left for segment `index`.
+fn ray_is_done(pixel: vec2<u32>, ray: PixelRay, index: u32) -> bool {
+    let a = textureLoad(accum, vec2<i32>(pixel), 0).a;
+    return !(a < segment.threshold) || segment_is_outside(ray, index);
+}
+
+// True when every sample of segment `index` lies in an empty block.
+fn segment_is_empty(ray: PixelRay, index: u32) -> bool {
+    for (var k = index * segment.steps; k < segment_end(index); k += 1u) {
+        let t = sample_t(ray, k);
+        if (!(t < ray.len_tex)) {
+            break;
+        }
+        if (!block_is_empty(block_of(ray.u0 + t * ray.d_tex, segment.block_size))) {
+            return false;
+        }
+    }
+    return true;
+}
+
+// RC-a: early ray termination only.
+@fragment
+fn fs_terminate(in: SegmentVertex) -> DepthOut {
+    let pixel = vec2<u32>(in.clip.xy);
+    let ray = pixel_ray(pixel);
+    return DepthOut(select(LIVE, TERMINATED, ray_is_done(pixel, ray, in.index)));
+}
+
+// RC-b: early ray termination and empty-space skipping.
+@fragment
+fn fs_terminate_empty(in: SegmentVertex) -> DepthOut {
+    let pixel = vec2<u32>(in.clip.xy);
+    let ray = pixel_ray(pixel);
+    let done = ray_is_done(pixel, ray, in.index) || segment_is_empty(ray, in.index);
+    return DepthOut(select(LIVE, TERMINATED, done));
+}

@@ -474,3 +474,17 @@ fn sbvr_approximates_the_reference() {
     assert!(over_16 <= 0.01, "sbvr: {:.2}% of pixels beyond 16/255", 100.0 * over_16);
     let _ = max_abs;
 }
+
+#[test]
+fn thesis_pixel_and_compute_shader_graphs_agree_and_match_the_reference() {
+    let gpu = gpu();
+    let v = ml();
+    let l = lut(&v, Preset::Default);
+    let opts = options(&v);
+    let pixel = render(&gpu, "compute_raycast_2013/pixel_shader.ron", &v, &l, &CAMERA, &opts);
+    let compute = render(&gpu, "compute_raycast_2013/compute_shader.ron", &v, &l, &CAMERA, &opts);
+    // The same integral written to the same Rgba16Float format: equal up to rounding.
+    assert_close("thesis compute vs pixel shader", &compute, &pixel, LOSSLESS);
+    assert_matches_reference("thesis pixel shader", &pixel, &v, &l, &CAMERA, 0.0);
+    assert_matches_reference("thesis compute shader", &compute, &v, &l, &CAMERA, 0.0);
+}

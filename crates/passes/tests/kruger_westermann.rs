@@ -530,3 +530,17 @@ fn segment_graphs_agree_on_the_sample_sequence() {
         }
     }
 }
+
+#[test]
+fn jittered_segments_with_skipping_equal_the_jittered_single_pass() {
+    // Jitter shifts every sample of a ray; segments and the termination test must shift theirs
+    // the same way, or skipping would drop or repeat samples at segment boundaries.
+    let gpu = gpu();
+    let v = sphere();
+    let l = lut(&v, Preset::Default);
+    let single = render(&gpu, "basic/fragment_raycast.ron", &v, &l, &CAMERA, &options(&v).with_param("march", "jitter", true));
+    let graph = "kruger_westermann_2003/rc_b.ron";
+    let opts = lossless(options(&v), graph).with_param("march", "jitter", true).with_param("terminate", "jitter", true);
+    let rc_b = render(&gpu, graph, &v, &l, &CAMERA, &opts);
+    assert_close("jittered rc_b(T=1) vs jittered single pass", &rc_b, &single, LOSSLESS);
+}

@@ -50,7 +50,8 @@ pub struct GraphsArgs {
     /// Transfer-function presets, comma separated: default, opaque, sparse.
     #[arg(long, value_delimiter = ',')]
     pub tf: Vec<String>,
-    /// Accuracy sweep PASS.PARAM=V1,V2,... (e.g. march.step_voxels=0.25,0.5,1,2); adds error
+    /// Accuracy sweep PASS.PARAM=V1,V2,... (e.g. march.step_voxels=0.25,0.5,1,2), or
+    /// input.NAME=... for a Scalar graph input shared by several passes; adds error
     /// against a converged CPU reference to every row.
     #[arg(long)]
     pub sweep: Option<String>,

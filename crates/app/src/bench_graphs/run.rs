@@ -95,16 +95,25 @@ impl Case<'_> {
             longest_ray_steps(&self.dataset.volume, step_voxels),
         );
         for (key, value) in &config.params {
-            options
-                .param_overrides
-                .insert(key.clone(), ron::Value::from(*value));
+            set_knob(&mut options, key, &ron::Value::from(*value));
         }
         if let (Some(sweep), Some((_, value))) = (&config.sweep, self.sweep_value) {
-            options
-                .param_overrides
-                .insert(sweep.key.clone(), value.clone());
+            set_knob(&mut options, &sweep.key, value);
         }
         options
+    }
+}
+
+/// Sets one knob: `input.NAME` is a Scalar graph input (a scene value shared by several passes,
+/// e.g. Krüger–Westermann's segment length M), anything else `pass.param`.
+fn set_knob(options: &mut CompileOptions, key: &str, value: &ron::Value) {
+    match (key.strip_prefix("input."), value) {
+        (Some(name), ron::Value::Number(n)) => {
+            options.scalars.insert(name.to_string(), n.clone().into_f64());
+        }
+        _ => {
+            options.param_overrides.insert(key.to_string(), value.clone());
+        }
     }
 }
 

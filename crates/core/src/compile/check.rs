@@ -231,6 +231,15 @@ impl Checker<'_> {
         order
     }
 
+    /// The value of Scalar graph input `name`: the scene's (CompileOptions::scalars) or the
+    /// declared default.
+    fn scalar_value(&self, name: &str) -> Option<f64> {
+        match self.doc.inputs.get(name) {
+            Some(InputKind::Scalar(default)) => Some(self.options.scalars.get(name).copied().unwrap_or(*default)),
+            _ => None,
+        }
+    }
+
     fn repeat_count(&mut self, id: &str, path: PassPath, count: &RepeatCount) -> u32 {
         match count {
             RepeatCount::Fixed(0) => {
@@ -242,7 +251,22 @@ impl Checker<'_> {
                 1
             }
             RepeatCount::Fixed(n) => *n,
-            RepeatCount::Scene { name, divide_by, max } => {
+            RepeatCount::Scene { name, divide_by, divide_by_input, max } => {
+                let divide_by = match divide_by_input {
+                    None => *divide_by,
+                    Some(input) => match self.scalar_value(input) {
+                        Some(v) => v,
+                        None => {
+                            self.err(
+                                self.loc.pass_field(path, id, "count"),
+                                format!("repeat group \"{id}\" divides by \"{input}\", which is not a Scalar graph input"),
+                                Some(format!("declare inputs: {{\"{input}\": Scalar(<default>)}}")),
+                            );
+                            return 1;
+                        }
+                    },
+                };
+                let divide_by = &divide_by;
                 let value = self.options.scalars.get(name).copied().or_else(|| match self.doc.inputs.get(name) {
                     Some(InputKind::Scalar(v)) => Some(*v),
                     _ => None,
@@ -339,7 +363,27 @@ impl Checker<'_> {
                 values.push((name.to_string(), value.clone()));
             }
         }
-        for (name, value) in &values {
+        for (name, written) in &values {
+            // `"input.NAME"` stands for the value of a Scalar graph input (the scene's value
+            // when the application sets one), shared by every pass that names it.
+            let value = match written {
+                ron::Value::String(text) if text.starts_with("input.") => {
+                    let input = &text["input.".len()..];
+                    match self.scalar_value(input) {
+                        Some(v) => ron::Value::from(v),
+                        None => {
+                            self.err(
+                                self.loc.pass_entry(path, &p.id, "params", name, false),
+                                format!("parameter \"{name}\" of pass \"{}\" reads \"{text}\", which is not a Scalar graph input", p.id),
+                                Some(format!("declare inputs: {{\"{input}\": Scalar(<default>)}}, or write the value itself")),
+                            );
+                            continue;
+                        }
+                    }
+                }
+                other => other.clone(),
+            };
+            let value = &value;
             let Some(spec) = specs.iter().find(|s| s.name == name) else {
                 let names: Vec<&str> = specs.iter().map(|s| s.name).collect();
                 let mut help = format!("its parameters are: {}", comma_list(&names));

@@ -141,6 +141,11 @@ pub enum RepeatCount {
         /// Divisor (e.g. Krüger–Westermann's M steps per segment).
         #[serde(default = "one")]
         divide_by: f64,
+        /// A Scalar graph input to divide by instead of `divide_by`, so the count and the
+        /// passes that read the same scalar (`params: {"segment_steps": "input.segment_steps"}`)
+        /// can never disagree.
+        #[serde(default)]
+        divide_by_input: Option<String>,
         /// Upper bound on the count.
         #[serde(default = "default_max_iterations")]
         max: u32,

@@ -10,10 +10,7 @@ use volgraph_tests::{check_golden, graph_files, relative_name};
 #[test]
 fn every_graph_matches_its_golden_plan() {
     let files = graph_files().expect("graphs/ is readable");
-    assert!(
-        files.len() >= 3,
-        "expected the graphs/basic files, found {files:?}"
-    );
+    assert!(files.len() >= 3, "expected the graphs/basic files, found {files:?}");
     let registry = builtin_registry();
     let options = CompileOptions::new(1920, 1080);
     let mut failures = Vec::new();
@@ -36,13 +33,7 @@ fn every_graph_matches_its_golden_plan() {
             Err(diagnostics) => failures.push(format!("{name} does not compile:\n{diagnostics}")),
         }
     }
-    assert!(
-        failures.is_empty(),
-        "{} of {} graphs failed:\n\n{}",
-        failures.len(),
-        files.len(),
-        failures.join("\n\n")
-    );
+    assert!(failures.is_empty(), "{} of {} graphs failed:\n\n{}", failures.len(), files.len(), failures.join("\n\n"));
 }
 
 /// The golden text is what `volgraph plan` prints: a pooled plan of the fragment raycaster
@@ -51,18 +42,10 @@ fn every_graph_matches_its_golden_plan() {
 fn fragment_raycast_plan_names_outputs_and_slots() {
     let path = volgraph_tests::repo_root().join("graphs/basic/fragment_raycast.ron");
     let source = std::fs::read_to_string(&path).expect("graphs/basic/fragment_raycast.ron exists");
-    let plan = compile(
-        "fragment_raycast.ron",
-        &source,
-        &builtin_registry(),
-        &CompileOptions::new(1920, 1080),
-    )
-    .unwrap_or_else(|d| panic!("{d}"));
+    let plan = compile("fragment_raycast.ron", &source, &builtin_registry(), &CompileOptions::new(1920, 1080))
+        .unwrap_or_else(|d| panic!("{d}"));
     let text = plan.to_text();
-    assert!(
-        text.starts_with("plan \"fragment_raycast\" at 1920x1080, features: none\n"),
-        "{text}"
-    );
+    assert!(text.starts_with("plan \"fragment_raycast\" at 1920x1080, features: none\n"), "{text}");
     assert!(text.contains("output image: march.color\n"), "{text}");
     assert!(text.contains("output display: present.display\n"), "{text}");
     let labels: Vec<&str> = plan.steps.iter().map(|s| s.label.as_str()).collect();

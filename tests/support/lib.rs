@@ -50,10 +50,7 @@ fn collect_ron(dir: &Path, skip: &Path, out: &mut Vec<PathBuf>) -> std::io::Resu
 /// as the file name when compiling (so golden text does not depend on the checkout location).
 pub fn relative_name(path: &Path) -> String {
     let rel = path.strip_prefix(repo_root()).unwrap_or(path);
-    rel.components()
-        .map(|c| c.as_os_str().to_string_lossy())
-        .collect::<Vec<_>>()
-        .join("/")
+    rel.components().map(|c| c.as_os_str().to_string_lossy()).collect::<Vec<_>>().join("/")
 }
 
 /// Compares `actual` with the golden file at `golden`. With `VOLGRAPH_BLESS=1` the file is
@@ -61,14 +58,10 @@ pub fn relative_name(path: &Path) -> String {
 /// describing the first differing line, so a failing test says what changed.
 pub fn check_golden(golden: &Path, actual: &str) -> Result<(), String> {
     if blessing() {
-        return fs::write(golden, actual)
-            .map_err(|e| format!("{}: cannot write: {e}", golden.display()));
+        return fs::write(golden, actual).map_err(|e| format!("{}: cannot write: {e}", golden.display()));
     }
     let expected = fs::read_to_string(golden).map_err(|e| {
-        format!(
-            "{}: cannot read the golden file ({e}); run with {BLESS_VAR}=1 to create it",
-            golden.display()
-        )
+        format!("{}: cannot read the golden file ({e}); run with {BLESS_VAR}=1 to create it", golden.display())
     })?;
     if expected == actual {
         return Ok(());
@@ -90,11 +83,7 @@ pub fn first_difference(expected: &str, actual: &str) -> String {
             (None, None) => return "the texts differ only in line endings".to_string(),
             (x, y) if x == y => n += 1,
             (x, y) => {
-                return format!(
-                    "line {n}: expected {:?} but got {:?}",
-                    x.unwrap_or("<end>"),
-                    y.unwrap_or("<end>")
-                );
+                return format!("line {n}: expected {:?} but got {:?}", x.unwrap_or("<end>"), y.unwrap_or("<end>"));
             }
         }
     }
@@ -106,28 +95,14 @@ mod tests {
 
     #[test]
     fn first_difference_names_the_line() {
-        assert_eq!(
-            first_difference("a\nb\nc", "a\nx\nc"),
-            "line 2: expected \"b\" but got \"x\""
-        );
-        assert_eq!(
-            first_difference("a\n", "a\nb"),
-            "line 2: expected \"<end>\" but got \"b\""
-        );
+        assert_eq!(first_difference("a\nb\nc", "a\nx\nc"), "line 2: expected \"b\" but got \"x\"");
+        assert_eq!(first_difference("a\n", "a\nb"), "line 2: expected \"<end>\" but got \"b\"");
     }
 
     #[test]
     fn graph_files_skip_transfer_functions() {
         let files = graph_files().expect("graphs/ is readable");
-        assert!(
-            files
-                .iter()
-                .any(|f| f.ends_with("graphs/basic/fragment_raycast.ron"))
-        );
-        assert!(
-            files
-                .iter()
-                .all(|f| !f.starts_with(repo_root().join("graphs/tf")))
-        );
+        assert!(files.iter().any(|f| f.ends_with("graphs/basic/fragment_raycast.ron")));
+        assert!(files.iter().all(|f| !f.starts_with(repo_root().join("graphs/tf"))));
     }
 }

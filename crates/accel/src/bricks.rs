@@ -65,26 +65,16 @@ impl BrickLayout {
     /// (trilinear with on-the-fly central-difference gradients).
     pub fn new(volume_dims: UVec3, brick_cells: u32, overlap: u32) -> Result<Self, GridError> {
         if brick_cells == 0 {
-            return Err(GridError::ZeroSize {
-                what: "brick_cells",
-            });
+            return Err(GridError::ZeroSize { what: "brick_cells" });
         }
         if !(1..=2).contains(&overlap) {
             return Err(GridError::UnsupportedOverlap { overlap });
         }
         if volume_dims.min_element() == 0 {
-            return Err(GridError::EmptyVolume {
-                name: "(layout)".into(),
-                dims: volume_dims,
-            });
+            return Err(GridError::EmptyVolume { name: "(layout)".into(), dims: volume_dims });
         }
         let grid_dims = (cell_dims(volume_dims) - 1) / brick_cells + 1;
-        Ok(Self {
-            volume_dims,
-            brick_cells,
-            overlap,
-            grid_dims,
-        })
+        Ok(Self { volume_dims, brick_cells, overlap, grid_dims })
     }
 
     /// Dims of the volume.
@@ -241,13 +231,7 @@ impl BrickSet {
                 }
             })
             .collect();
-        Ok(Self {
-            layout,
-            bricks,
-            name: volume.name.clone(),
-            spacing: volume.spacing,
-            value_range: volume.value_range,
-        })
+        Ok(Self { layout, bricks, name: volume.name.clone(), spacing: volume.spacing, value_range: volume.value_range })
     }
 
     /// The layout.
@@ -282,10 +266,7 @@ impl BrickSet {
     /// Per brick: true when the brick is empty under the classifier (all of its samples are
     /// transparent). Only re-classifies the stored ranges; the bricks stay as they are.
     pub fn empty_bricks(&self, classifier: &OpacityClassifier) -> Vec<bool> {
-        self.bricks
-            .iter()
-            .map(|b| !classifier.is_range_visible(b.range))
-            .collect()
+        self.bricks.iter().map(|b| !classifier.is_range_visible(b.range)).collect()
     }
 
     /// The volume again, from the bricks' voxels (every voxel lies in at least one brick).
@@ -301,13 +282,7 @@ impl BrickSet {
         for b in &self.bricks {
             paste_box(&mut data, n, b.origin, b.dims, &b.data);
         }
-        Volume {
-            dims: n,
-            spacing: self.spacing,
-            data,
-            name: self.name.clone(),
-            value_range: self.value_range,
-        }
+        Volume { dims: n, spacing: self.spacing, data, name: self.name.clone(), value_range: self.value_range }
     }
 }
 

@@ -70,10 +70,7 @@ impl OpacityClassifier {
             }
             prefix.push(count);
         }
-        Ok(Self {
-            texels: lut.len(),
-            prefix,
-        })
+        Ok(Self { texels: lut.len(), prefix })
     }
 
     /// Number of LUT texels.
@@ -98,10 +95,7 @@ impl OpacityClassifier {
         if first.is_nan() || last.is_nan() {
             return (0, last_texel);
         }
-        (
-            (first as usize).min(last_texel),
-            (last as usize).min(last_texel),
-        )
+        ((first as usize).min(last_texel), (last as usize).min(last_texel))
     }
 
     /// Whether some value in `[lo, hi]` (normalized) can map to non-zero opacity under the LUT's
@@ -124,28 +118,22 @@ impl OpacityClassifier {
     /// 0 otherwise (raw u8 values; the table is symmetric, so swapped pairs read the same).
     pub fn table_u8(&self) -> Vec<u8> {
         let mut table = vec![0u8; 256 * 256];
-        table
-            .par_chunks_mut(256)
-            .enumerate()
-            .for_each(|(max, row)| {
-                for (min, entry) in row.iter_mut().enumerate() {
-                    let (a, b) = (min.min(max) as f64 / 255.0, min.max(max) as f64 / 255.0);
-                    let (first, last) = self.texel_span(a, b);
-                    if self.prefix[last + 1] > self.prefix[first] {
-                        *entry = FLAG_SET;
-                    }
+        table.par_chunks_mut(256).enumerate().for_each(|(max, row)| {
+            for (min, entry) in row.iter_mut().enumerate() {
+                let (a, b) = (min.min(max) as f64 / 255.0, min.max(max) as f64 / 255.0);
+                let (first, last) = self.texel_span(a, b);
+                if self.prefix[last + 1] > self.prefix[first] {
+                    *entry = FLAG_SET;
                 }
-            });
+            }
+        });
         table
     }
 
     /// A `bins × bins` table for 16-bit and float data; see [`QuantizedTable`].
     pub fn quantized_table(&self, bins: u32) -> Result<QuantizedTable, ClassifyError> {
         if bins == 0 || bins > MAX_TABLE_BINS {
-            return Err(ClassifyError::BinCount {
-                bins,
-                max: MAX_TABLE_BINS,
-            });
+            return Err(ClassifyError::BinCount { bins, max: MAX_TABLE_BINS });
         }
         let q = bins as usize;
         let mut data = vec![0u8; q * q];
@@ -167,10 +155,7 @@ impl OpacityClassifier {
     /// Fraction in `[0,1]` of the grid's blocks that are empty under this LUT.
     pub fn empty_fraction(&self, grid: &MinMaxGrid) -> f64 {
         let ranges = grid.ranges();
-        let empty = ranges
-            .par_iter()
-            .filter(|r| !self.is_range_visible(**r))
-            .count();
+        let empty = ranges.par_iter().filter(|r| !self.is_range_visible(**r)).count();
         empty as f64 / ranges.len().max(1) as f64
     }
 
@@ -178,16 +163,7 @@ impl OpacityClassifier {
     /// [`FLAG_SET`] = empty (skip it), 0 = may be visible. Ready for an `R8Unorm`/`R8Uint` 3D
     /// texture of size `grid.dims()`.
     pub fn empty_flags(&self, grid: &MinMaxGrid) -> Vec<u8> {
-        grid.ranges()
-            .par_iter()
-            .map(|r| {
-                if self.is_range_visible(*r) {
-                    0
-                } else {
-                    FLAG_SET
-                }
-            })
-            .collect()
+        grid.ranges().par_iter().map(|r| if self.is_range_visible(*r) { 0 } else { FLAG_SET }).collect()
     }
 }
 
@@ -217,9 +193,7 @@ impl QuantizedTable {
     /// The bin of normalized value `v`: `floor(v·bins)` clamped to `[0, bins−1]` (NaN → 0).
     #[inline]
     pub fn bin_of(&self, v: f32) -> u32 {
-        ((v as f64 * self.bins as f64)
-            .floor()
-            .clamp(0.0, (self.bins - 1) as f64)) as u32
+        ((v as f64 * self.bins as f64).floor().clamp(0.0, (self.bins - 1) as f64)) as u32
     }
 
     /// Whether `[lo, hi]` may be visible, via the table. Conservative like the table.

@@ -90,10 +90,7 @@ pub fn volumes_dir() -> PathBuf {
 /// `name_XxYxZ_dtype.raw`.
 pub fn available_datasets() -> Result<Vec<(String, PathBuf)>, DataError> {
     let dir = volumes_dir();
-    let entries = std::fs::read_dir(&dir).map_err(|source| DataError::NoVolumesDir {
-        dir: dir.clone(),
-        source,
-    })?;
+    let entries = std::fs::read_dir(&dir).map_err(|source| DataError::NoVolumesDir { dir: dir.clone(), source })?;
     let mut found: Vec<(String, PathBuf)> = entries
         .filter_map(|entry| entry.ok())
         .filter_map(|entry| {
@@ -117,8 +114,7 @@ pub fn dataset_path(name: &str) -> Result<PathBuf, DataError> {
         return Ok(path.clone());
     }
     let prefix = format!("{name}_");
-    let matches: Vec<&(String, PathBuf)> =
-        all.iter().filter(|(n, _)| n.starts_with(&prefix)).collect();
+    let matches: Vec<&(String, PathBuf)> = all.iter().filter(|(n, _)| n.starts_with(&prefix)).collect();
     match matches.as_slice() {
         [(_, path)] => Ok(path.clone()),
         [] => Err(DataError::NotFound {
@@ -171,10 +167,8 @@ pub struct ManifestEntry {
 /// `.raw` file name; the spacing and SHA-256 columns are found by header name.
 pub fn read_manifest() -> Result<Vec<ManifestEntry>, DataError> {
     let path = volumes_dir().join("MANIFEST.md");
-    let text = std::fs::read_to_string(&path).map_err(|e| DataError::Manifest {
-        path: path.clone(),
-        message: format!("cannot read the manifest: {e}"),
-    })?;
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| DataError::Manifest { path: path.clone(), message: format!("cannot read the manifest: {e}") })?;
     parse_manifest(&path, &text)
 }
 
@@ -190,10 +184,7 @@ fn between_backticks(cell: &str) -> Option<&str> {
 }
 
 fn parse_manifest(path: &Path, text: &str) -> Result<Vec<ManifestEntry>, DataError> {
-    let bad = |message: String| DataError::Manifest {
-        path: path.to_path_buf(),
-        message,
-    };
+    let bad = |message: String| DataError::Manifest { path: path.to_path_buf(), message };
     let mut columns: Option<(usize, usize)> = None;
     let mut entries = Vec::new();
     for line in text.lines().filter(|l| l.trim_start().starts_with('|')) {
@@ -232,9 +223,7 @@ fn parse_manifest(path: &Path, text: &str) -> Result<Vec<ManifestEntry>, DataErr
         });
     }
     if entries.is_empty() {
-        return Err(bad(
-            "no file table (| File | … | Voxel spacing | … | SHA-256 |) found".to_string(),
-        ));
+        return Err(bad("no file table (| File | … | Voxel spacing | … | SHA-256 |) found".to_string()));
     }
     Ok(entries)
 }
@@ -243,19 +232,8 @@ fn parse_manifest(path: &Path, text: &str) -> Result<Vec<ManifestEntry>, DataErr
 /// `lobster` is 1 × 1 × 1.4). Without a manifest row the spacing is (1, 1, 1).
 pub fn load_dataset(name: &str) -> Result<LoadedVolume, DataError> {
     let path = dataset_path(name)?;
-    let file_name = path
-        .file_name()
-        .map(|f| f.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let spacing = read_manifest()
-        .ok()
-        .and_then(|rows| rows.into_iter().find(|r| r.file == file_name))
-        .map(|r| r.spacing);
-    Ok(load_volume(
-        &path,
-        &RawOptions {
-            spacing,
-            ..RawOptions::default()
-        },
-    )?)
+    let file_name = path.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default();
+    let spacing =
+        read_manifest().ok().and_then(|rows| rows.into_iter().find(|r| r.file == file_name)).map(|r| r.spacing);
+    Ok(load_volume(&path, &RawOptions { spacing, ..RawOptions::default() })?)
 }

@@ -51,14 +51,12 @@ pub fn voxel_centre(n: u32, x: u32, y: u32, z: u32) -> DVec3 {
 fn fill<T: Send + Copy + Default>(n: u32, f: impl Fn(UVec3) -> T + Sync) -> Vec<T> {
     let slice = n as usize * n as usize;
     let mut out = vec![T::default(); slice * n as usize];
-    out.par_chunks_mut(slice.max(1))
-        .enumerate()
-        .for_each(|(z, chunk)| {
-            for (i, v) in chunk.iter_mut().enumerate() {
-                let (x, y) = ((i % n as usize) as u32, (i / n as usize) as u32);
-                *v = f(UVec3::new(x, y, z as u32));
-            }
-        });
+    out.par_chunks_mut(slice.max(1)).enumerate().for_each(|(z, chunk)| {
+        for (i, v) in chunk.iter_mut().enumerate() {
+            let (x, y) = ((i % n as usize) as u32, (i / n as usize) as u32);
+            *v = f(UVec3::new(x, y, z as u32));
+        }
+    });
     out
 }
 
@@ -79,8 +77,7 @@ pub fn marschner_lobb_value(p: DVec3) -> f64 {
     use std::f64::consts::PI;
     let r = (p.x * p.x + p.y * p.y).sqrt();
     let rho_r = (2.0 * PI * MARSCHNER_LOBB_FM * (PI * r / 2.0).cos()).cos();
-    (1.0 - (PI * p.z / 2.0).sin() + MARSCHNER_LOBB_ALPHA * (1.0 + rho_r))
-        / (2.0 * (1.0 + MARSCHNER_LOBB_ALPHA))
+    (1.0 - (PI * p.z / 2.0).sin() + MARSCHNER_LOBB_ALPHA * (1.0 + rho_r)) / (2.0 * (1.0 + MARSCHNER_LOBB_ALPHA))
 }
 
 /// Marschner–Lobb sampled on `n³` voxels as `uint8` (`round(255 ρ)`), named
@@ -90,27 +87,15 @@ pub fn marschner_lobb(n: u32) -> Volume {
         let rho = marschner_lobb_value(voxel_centre(n, v.x, v.y, v.z));
         (rho * 255.0).round().clamp(0.0, 255.0) as u8
     });
-    Volume::new(
-        format!("marschner_lobb_{n}"),
-        UVec3::splat(n),
-        DVec3::ONE,
-        VoxelData::U8(data),
-    )
+    Volume::new(format!("marschner_lobb_{n}"), UVec3::splat(n), DVec3::ONE, VoxelData::U8(data))
 }
 
 /// Marschner–Lobb sampled on `n³` voxels as `float32` ρ, named `marschner_lobb_f32_<n>`. Its
 /// `value_range` is the function's range (0, 1), not the sampled min/max, so
 /// [`Volume::normalized`] returns ρ itself.
 pub fn marschner_lobb_f32(n: u32) -> Volume {
-    let data = fill(n, |v| {
-        marschner_lobb_value(voxel_centre(n, v.x, v.y, v.z)) as f32
-    });
-    let mut volume = Volume::new(
-        format!("marschner_lobb_f32_{n}"),
-        UVec3::splat(n),
-        DVec3::ONE,
-        VoxelData::F32(data),
-    );
+    let data = fill(n, |v| marschner_lobb_value(voxel_centre(n, v.x, v.y, v.z)) as f32);
+    let mut volume = Volume::new(format!("marschner_lobb_f32_{n}"), UVec3::splat(n), DVec3::ONE, VoxelData::F32(data));
     volume.value_range = (0.0, 1.0);
     volume
 }
@@ -118,9 +103,7 @@ pub fn marschner_lobb_f32(n: u32) -> Volume {
 /// A solid sphere of `radius` (in box units, the box being `[-1, 1]³`) centred in an `n³`
 /// volume: 255 where `|p| ≤ radius`. Named `sphere_<n>`.
 pub fn sphere(n: u32, radius: f64) -> Volume {
-    binary(format!("sphere_{n}"), n, |v| {
-        voxel_centre(n, v.x, v.y, v.z).length() <= radius
-    })
+    binary(format!("sphere_{n}"), n, |v| voxel_centre(n, v.x, v.y, v.z).length() <= radius)
 }
 
 /// A spherical shell: 255 where `inner ≤ |p| ≤ outer` (box units). Named `shell_<n>`.
@@ -135,26 +118,20 @@ pub fn spherical_shell(n: u32, inner: f64, outer: f64) -> Volume {
 /// at index 0. Named `slabs_<axis>_<n>`. `slab_voxels = 0` is treated as 1.
 pub fn slabs(n: u32, axis: Axis, slab_voxels: u32) -> Volume {
     let thick = slab_voxels.max(1);
-    binary(format!("slabs_{}_{n}", axis.name()), n, |v| {
-        (axis.pick(v) / thick) % 2 == 1
-    })
+    binary(format!("slabs_{}_{n}", axis.name()), n, |v| (axis.pick(v) / thick) % 2 == 1)
 }
 
 /// A 3D checkerboard of cubes `cell_voxels` wide: 255 where `x/c + y/c + z/c` is odd. Named
 /// `checkerboard_<n>`. `cell_voxels = 0` is treated as 1.
 pub fn checkerboard(n: u32, cell_voxels: u32) -> Volume {
     let c = cell_voxels.max(1);
-    binary(format!("checkerboard_{n}"), n, |v| {
-        (v.x / c + v.y / c + v.z / c) % 2 == 1
-    })
+    binary(format!("checkerboard_{n}"), n, |v| (v.x / c + v.y / c + v.z / c) % 2 == 1)
 }
 
 /// A one-voxel-thick sheet: 255 on the plane `axis = index`, 0 elsewhere (thin features that
 /// large steps or coarse empty-space skipping must not lose). Named `sheet_<axis>_<n>`.
 pub fn sheet(n: u32, axis: Axis, index: u32) -> Volume {
-    binary(format!("sheet_{}_{n}", axis.name()), n, |v| {
-        axis.pick(v) == index
-    })
+    binary(format!("sheet_{}_{n}", axis.name()), n, |v| axis.pick(v) == index)
 }
 
 /// SplitMix64 (Steele, Lea & Flood 2014): a tiny, well-mixed, seedable generator; the same seed
@@ -179,12 +156,7 @@ pub fn noise(n: u32, seed: u64) -> Volume {
     let mut rng = SplitMix64(seed);
     let count = n as usize * n as usize * n as usize;
     let data: Vec<u8> = (0..count).map(|_| (rng.next_u64() >> 56) as u8).collect();
-    Volume::new(
-        format!("noise_{n}_seed{seed}"),
-        UVec3::splat(n),
-        DVec3::ONE,
-        VoxelData::U8(data),
-    )
+    Volume::new(format!("noise_{n}_seed{seed}"), UVec3::splat(n), DVec3::ONE, VoxelData::U8(data))
 }
 
 /// All zeros (`uint8`), named `zeros_<n>`: nothing to see, every skip structure is empty.
@@ -196,12 +168,7 @@ pub fn zeros(n: u32) -> Volume {
 /// outside the volume gives all zeros.
 pub fn one_voxel(n: u32, at: UVec3, value: u8) -> Volume {
     let data = fill(n, |v| if v == at { value } else { 0 });
-    Volume::new(
-        format!("one_voxel_{n}"),
-        UVec3::splat(n),
-        DVec3::ONE,
-        VoxelData::U8(data),
-    )
+    Volume::new(format!("one_voxel_{n}"), UVec3::splat(n), DVec3::ONE, VoxelData::U8(data))
 }
 
 /// A `float32` ramp along x (`value = x`) with non-finite voxels planted, named
@@ -231,11 +198,6 @@ pub fn non_finite_f32(n: u32) -> (Volume, (usize, usize, usize)) {
             }
         })
         .collect();
-    let volume = Volume::new(
-        format!("non_finite_{n}"),
-        UVec3::splat(n),
-        DVec3::ONE,
-        VoxelData::F32(data),
-    );
+    let volume = Volume::new(format!("non_finite_{n}"), UVec3::splat(n), DVec3::ONE, VoxelData::F32(data));
     (volume, (nan, pos, neg))
 }

@@ -59,9 +59,7 @@ pub enum GridError {
         found: usize,
     },
     /// A brick overlap other than 1 (trilinear) or 2 (trilinear + central differences).
-    #[error(
-        "brick overlap must be 1 (trilinear) or 2 (trilinear with on-the-fly gradients), got {overlap}"
-    )]
+    #[error("brick overlap must be 1 (trilinear) or 2 (trilinear with on-the-fly gradients), got {overlap}")]
     UnsupportedOverlap {
         /// The overlap asked for.
         overlap: u32,
@@ -81,20 +79,12 @@ pub enum GridError {
 /// Checks that `volume` is non-empty and its voxel array matches its dims.
 pub(crate) fn check_volume(volume: &Volume) -> Result<(), GridError> {
     if volume.dims.min_element() == 0 {
-        return Err(GridError::EmptyVolume {
-            name: volume.name.clone(),
-            dims: volume.dims,
-        });
+        return Err(GridError::EmptyVolume { name: volume.name.clone(), dims: volume.dims });
     }
     let expected = volume.voxel_count();
     let found = volume.data.len();
     if expected != found {
-        return Err(GridError::DataLength {
-            name: volume.name.clone(),
-            dims: volume.dims,
-            expected,
-            found,
-        });
+        return Err(GridError::DataLength { name: volume.name.clone(), dims: volume.dims, expected, found });
     }
     Ok(())
 }
@@ -148,22 +138,12 @@ pub(crate) fn voxel_box_range(volume: &Volume, lo: UVec3, hi: UVec3) -> [f32; 2]
         }
         VoxelData::I16(v) => {
             let (a, b) = raw_box_minmax(v, dims, lo, hi);
-            (
-                (a as f64 + 32768.0) / 65535.0,
-                (b as f64 + 32768.0) / 65535.0,
-            )
+            ((a as f64 + 32768.0) / 65535.0, (b as f64 + 32768.0) / 65535.0)
         }
         VoxelData::F32(v) => {
             let (a, b) = raw_box_minmax(v, dims, lo, hi);
             let (vlo, vhi) = volume.value_range;
-            if vhi > vlo {
-                (
-                    (a as f64 - vlo) / (vhi - vlo),
-                    (b as f64 - vlo) / (vhi - vlo),
-                )
-            } else {
-                (0.0, 0.0)
-            }
+            if vhi > vlo { ((a as f64 - vlo) / (vhi - vlo), (b as f64 - vlo) / (vhi - vlo)) } else { (0.0, 0.0) }
         }
     };
     [f32_down(mn), f32_up(mx)]
@@ -191,24 +171,16 @@ impl MinMaxGrid {
         let dims = (n - 1) / block_size + 1; // ceil without overflow for huge block sizes
         let slab = (dims.x * dims.y) as usize;
         let mut ranges = vec![[0.0f32; 2]; slab * dims.z as usize];
-        ranges
-            .par_chunks_mut(slab)
-            .enumerate()
-            .for_each(|(bz, out)| {
-                for by in 0..dims.y {
-                    for bx in 0..dims.x {
-                        let block = UVec3::new(bx, by, bz as u32);
-                        let (lo, hi) = apron_box(n, block_size, block);
-                        out[(bx + dims.x * by) as usize] = voxel_box_range(volume, lo, hi);
-                    }
+        ranges.par_chunks_mut(slab).enumerate().for_each(|(bz, out)| {
+            for by in 0..dims.y {
+                for bx in 0..dims.x {
+                    let block = UVec3::new(bx, by, bz as u32);
+                    let (lo, hi) = apron_box(n, block_size, block);
+                    out[(bx + dims.x * by) as usize] = voxel_box_range(volume, lo, hi);
                 }
-            });
-        Ok(Self {
-            volume_dims: n,
-            block_size,
-            dims,
-            ranges,
-        })
+            }
+        });
+        Ok(Self { volume_dims: n, block_size, dims, ranges })
     }
 
     /// Blocks per axis: `ceil(volume_dims / block_size)`.
@@ -264,9 +236,7 @@ impl MinMaxGrid {
     pub fn block_texture_box(&self, b: UVec3) -> (glam::DVec3, glam::DVec3) {
         let n = self.volume_dims.as_dvec3();
         let lo = (b * self.block_size).as_dvec3() / n;
-        let hi = (b + 1)
-            .saturating_mul(UVec3::splat(self.block_size))
-            .min(self.volume_dims);
+        let hi = (b + 1).saturating_mul(UVec3::splat(self.block_size)).min(self.volume_dims);
         let hi = hi.as_dvec3() / n;
         (lo, hi)
     }

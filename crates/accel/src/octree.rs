@@ -113,15 +113,9 @@ pub struct DrawBox {
 impl OctreeHierarchy {
     /// Builds every brick's leaf ranges and node cell counts, in parallel over bricks. Leaves
     /// are `min_node_cells³` cells (the paper's octree limit, e.g. 8).
-    pub fn build(
-        volume: &Volume,
-        layout: &BrickLayout,
-        min_node_cells: u32,
-    ) -> Result<Self, GridError> {
+    pub fn build(volume: &Volume, layout: &BrickLayout, min_node_cells: u32) -> Result<Self, GridError> {
         if min_node_cells == 0 {
-            return Err(GridError::ZeroSize {
-                what: "min_node_cells",
-            });
+            return Err(GridError::ZeroSize { what: "min_node_cells" });
         }
         check_volume(volume)?;
         if layout.volume_dims() != volume.dims {
@@ -138,11 +132,7 @@ impl OctreeHierarchy {
                 build_tree(volume, lo, hi, min_node_cells)
             })
             .collect();
-        Ok(Self {
-            layout: *layout,
-            min_node_cells,
-            trees,
-        })
+        Ok(Self { layout: *layout, min_node_cells, trees })
     }
 
     /// The brick layout.
@@ -176,35 +166,22 @@ impl OctreeHierarchy {
     /// levels (§7: a node's ratio is the average of its children's, weighted by cells). Work is
     /// proportional to the number of nodes; in parallel over bricks.
     pub fn classify_into(&self, classifier: &OpacityClassifier, visibility: &mut OctreeVisibility) {
-        visibility
-            .visible_cells
-            .resize_with(self.trees.len(), Vec::new);
-        self.trees
-            .par_iter()
-            .zip(visibility.visible_cells.par_iter_mut())
-            .for_each(|(tree, counts)| {
-                counts.resize(tree.node_cells.len(), 0);
-                let leaves = tree.leaf_ranges.len();
-                for ((count, range), cells) in counts[..leaves]
-                    .iter_mut()
-                    .zip(&tree.leaf_ranges)
-                    .zip(&tree.node_cells)
-                {
-                    *count = if classifier.is_range_visible(*range) {
-                        *cells
-                    } else {
-                        0
-                    };
-                }
-                for pair in tree.levels.windows(2) {
-                    let (child, parent) = (pair[0], pair[1]);
-                    let (below, above) = counts.split_at_mut(parent.offset);
-                    let children = &below[child.offset..];
-                    let parents = &mut above[..parent.dims.element_product() as usize];
-                    parents.fill(0);
-                    sum_into_parents(children, child.dims, parents, parent.dims);
-                }
-            });
+        visibility.visible_cells.resize_with(self.trees.len(), Vec::new);
+        self.trees.par_iter().zip(visibility.visible_cells.par_iter_mut()).for_each(|(tree, counts)| {
+            counts.resize(tree.node_cells.len(), 0);
+            let leaves = tree.leaf_ranges.len();
+            for ((count, range), cells) in counts[..leaves].iter_mut().zip(&tree.leaf_ranges).zip(&tree.node_cells) {
+                *count = if classifier.is_range_visible(*range) { *cells } else { 0 };
+            }
+            for pair in tree.levels.windows(2) {
+                let (child, parent) = (pair[0], pair[1]);
+                let (below, above) = counts.split_at_mut(parent.offset);
+                let children = &below[child.offset..];
+                let parents = &mut above[..parent.dims.element_product() as usize];
+                parents.fill(0);
+                sum_into_parents(children, child.dims, parents, parent.dims);
+            }
+        });
     }
 
     /// Appends to `out` the boxes of brick `brick` to draw, front to back for `view`
@@ -239,10 +216,7 @@ impl OctreeHierarchy {
         (lo, hi)
     }
 
-    #[allow(
-        clippy::too_many_arguments,
-        reason = "private recursion carrying its context"
-    )]
+    #[allow(clippy::too_many_arguments, reason = "private recursion carrying its context")]
     fn visit(
         &self,
         tree: &BrickTree,
@@ -263,12 +237,7 @@ impl OctreeHierarchy {
         let ratio = visible as f32 / total as f32;
         if ratio >= threshold || level == 0 {
             let (cells_lo, cells_hi) = self.node_cells_box(tree, level, coord);
-            out.push(DrawBox {
-                brick: brick as u32,
-                cells_lo,
-                cells_hi,
-                ratio,
-            });
+            out.push(DrawBox { brick: brick as u32, cells_lo, cells_hi, ratio });
             return;
         }
         let signs = match view {
@@ -327,9 +296,7 @@ fn build_tree(volume: &Volume, cells_lo: UVec3, cells_hi: UVec3, min_node_cells:
         for y in 0..leaf_dims.y {
             for x in 0..leaf_dims.x {
                 let lo = cells_lo + UVec3::new(x, y, z) * min_node_cells;
-                let hi = lo
-                    .saturating_add(UVec3::splat(min_node_cells))
-                    .min(cells_hi);
+                let hi = lo.saturating_add(UVec3::splat(min_node_cells)).min(cells_hi);
                 let (vlo, vhi) = cells_corner_voxels(volume.dims, lo, hi);
                 node_cells[leaf_ranges.len()] = (hi - lo).element_product();
                 leaf_ranges.push(voxel_box_range(volume, vlo, vhi));
@@ -341,11 +308,5 @@ fn build_tree(volume: &Volume, cells_lo: UVec3, cells_hi: UVec3, min_node_cells:
         let (below, above) = node_cells.split_at_mut(parent.offset);
         sum_into_parents(&below[child.offset..], child.dims, above, parent.dims);
     }
-    BrickTree {
-        cells_lo,
-        cells_hi,
-        levels,
-        leaf_ranges,
-        node_cells,
-    }
+    BrickTree { cells_lo, cells_hi, levels, leaf_ranges, node_cells }
 }

@@ -30,12 +30,7 @@ pub struct Phong {
 
 impl Default for Phong {
     fn default() -> Self {
-        Self {
-            ambient: 0.15,
-            diffuse: 0.75,
-            specular: 0.25,
-            shininess: 32.0,
-        }
+        Self { ambient: 0.15, diffuse: 0.75, specular: 0.25, shininess: 32.0 }
     }
 }
 
@@ -78,13 +73,7 @@ pub struct RaycastSettings {
 
 impl Default for RaycastSettings {
     fn default() -> Self {
-        Self {
-            step_voxels: 0.5,
-            threshold: 1.0,
-            max_steps: 4096,
-            jitter: false,
-            mode: RenderMode::Dvr,
-        }
+        Self { step_voxels: 0.5, threshold: 1.0, max_steps: 4096, jitter: false, mode: RenderMode::Dvr }
     }
 }
 
@@ -155,13 +144,7 @@ pub fn intersect_box(origin: DVec3, dir: DVec3, half: DVec3) -> Option<(f64, f64
 /// The texture-space segment of pixel `(x, y)`'s ray: through the pixel centre
 /// ([`CameraFrame::pixel_ray`]), from `max(t_in, t_near)` to `t_out`; `None` when there is no
 /// ray (it misses, `t_out <= t0`, or the segment is shorter than [`MIN_RAY_LENGTH_TEX`]).
-pub fn ray_segment(
-    volume: &Volume,
-    camera: &OrbitCamera,
-    frame: &CameraFrame,
-    x: u32,
-    y: u32,
-) -> Option<RaySegment> {
+pub fn ray_segment(volume: &Volume, camera: &OrbitCamera, frame: &CameraFrame, x: u32, y: u32) -> Option<RaySegment> {
     let half = volume.half_extent_world();
     let (eye, dir) = frame.pixel_ray(x, y);
     let (t_in, t_out) = intersect_box(eye, dir, half)?;
@@ -176,12 +159,7 @@ pub fn ray_segment(
     if len_tex.is_nan() || len_tex < MIN_RAY_LENGTH_TEX {
         return None;
     }
-    Some(RaySegment {
-        u0,
-        d_tex: (u1 - u0) / len_tex,
-        len_tex,
-        dir_world: dir,
-    })
+    Some(RaySegment { u0, d_tex: (u1 - u0) / len_tex, len_tex, dir_world: dir })
 }
 
 /// The transfer function at scalar `s` as a 1D linear sampler with clamp-to-edge reads it:
@@ -244,8 +222,7 @@ impl March<'_> {
     }
 
     fn sample(&self, t: f64) -> f64 {
-        self.volume
-            .sample_trilinear(self.seg.u0 + t * self.seg.d_tex)
+        self.volume.sample_trilinear(self.seg.u0 + t * self.seg.d_tex)
     }
 
     /// Front-to-back emission–absorption; returns the colour and the number of samples.
@@ -282,18 +259,10 @@ impl March<'_> {
             }
             let s = self.sample(t);
             if s >= iso {
-                let t_hit = if k > 0 {
-                    t_prev + (t - t_prev) * (iso - s_prev) / (s - s_prev)
-                } else {
-                    t
-                };
+                let t_hit = if k > 0 { t_prev + (t - t_prev) * (iso - s_prev) / (s - s_prev) } else { t };
                 let u = self.seg.u0 + t_hit * self.seg.d_tex;
                 let rgb = self.shade(u, iso, shading);
-                return (
-                    [rgb.x, rgb.y, rgb.z, 1.0],
-                    [u.x, u.y, u.z, 1.0],
-                    k as u64 + 1,
-                );
+                return ([rgb.x, rgb.y, rgb.z, 1.0], [u.x, u.y, u.z, 1.0], k as u64 + 1);
             }
             t_prev = t;
             s_prev = s;
@@ -322,15 +291,10 @@ impl March<'_> {
         };
         // Headlight: l = v, so h = normalize(l + v) = l and n·h = n·l.
         let n_dot_l = n.dot(l).abs();
-        let spec = if n_dot_l > 0.0 {
-            p.specular * n_dot_l.powf(p.shininess)
-        } else {
-            0.0
-        };
+        let spec = if n_dot_l > 0.0 { p.specular * n_dot_l.powf(p.shininess) } else { 0.0 };
         let base = lut_sample(self.lut, iso);
         let base = DVec3::new(base[0], base[1], base[2]);
-        (base * (p.ambient + p.diffuse * n_dot_l) + DVec3::splat(spec))
-            .clamp(DVec3::ZERO, DVec3::ONE)
+        (base * (p.ambient + p.diffuse * n_dot_l) + DVec3::splat(spec)).clamp(DVec3::ZERO, DVec3::ONE)
     }
 }
 
@@ -360,17 +324,10 @@ pub fn render_reference(
     let pixels = width as usize * height as usize;
     let mut color = vec![[0.0; 4]; pixels];
     let mut hit = vec![[0.0; 4]; pixels];
-    let usable = volume.voxel_count() > 0
-        && volume.data.len() == volume.voxel_count()
-        && volume.extent().min_element() > 0.0;
+    let usable =
+        volume.voxel_count() > 0 && volume.data.len() == volume.voxel_count() && volume.extent().min_element() > 0.0;
     if !usable || pixels == 0 {
-        return ReferenceImage {
-            width,
-            height,
-            color,
-            hit,
-            samples: 0,
-        };
+        return ReferenceImage { width, height, color, hit, samples: 0 };
     }
     let frame = camera.frame(width, height);
     let row_len = width as usize;
@@ -389,19 +346,8 @@ pub fn render_reference(
                 if !(step_tex > 0.0 && step_tex < 1e30) {
                     continue;
                 }
-                let jitter = if settings.jitter {
-                    pixel_jitter(x, y, width)
-                } else {
-                    0.0
-                };
-                let march = March {
-                    volume,
-                    lut,
-                    settings,
-                    seg,
-                    step_tex,
-                    jitter,
-                };
+                let jitter = if settings.jitter { pixel_jitter(x, y, width) } else { 0.0 };
+                let march = March { volume, lut, settings, seg, step_tex, jitter };
                 match settings.mode {
                     RenderMode::Dvr => {
                         let (c, n) = march.dvr();
@@ -419,11 +365,5 @@ pub fn render_reference(
             row_samples
         })
         .sum();
-    ReferenceImage {
-        width,
-        height,
-        color,
-        hit,
-        samples,
-    }
+    ReferenceImage { width, height, color, hit, samples }
 }

@@ -214,11 +214,7 @@ impl Preset {
                 (0.6, [0.9, 0.6, 0.2], 0.25),
                 (1.0, [1.0, 1.0, 1.0], 0.6),
             ],
-            Preset::Opaque => &[
-                (0.0, [0.0, 0.0, 0.0], 0.0),
-                (0.05, [0.8, 0.7, 0.6], 1.0),
-                (1.0, [1.0, 1.0, 1.0], 1.0),
-            ],
+            Preset::Opaque => &[(0.0, [0.0, 0.0, 0.0], 0.0), (0.05, [0.8, 0.7, 0.6], 1.0), (1.0, [1.0, 1.0, 1.0], 1.0)],
             Preset::Sparse => &[
                 (0.0, [0.0, 0.0, 0.0], 0.0),
                 (0.6, [0.2, 0.5, 1.0], 0.0),
@@ -236,11 +232,7 @@ impl TransferFunction {
         let points = preset
             .shape()
             .iter()
-            .map(|&(t, color, alpha)| ControlPoint {
-                value: lo + t * (hi - lo),
-                color,
-                alpha,
-            })
+            .map(|&(t, color, alpha)| ControlPoint { value: lo + t * (hi - lo), color, alpha })
             .collect();
         TransferFunction { domain, points }
     }
@@ -259,24 +251,14 @@ impl TransferFunction {
         let path_buf = || path.to_path_buf();
         let (lo, hi) = self.domain;
         if !(lo.is_finite() && hi.is_finite() && lo < hi) {
-            return Err(TfError::BadDomain {
-                path: path_buf(),
-                lo,
-                hi,
-            });
+            return Err(TfError::BadDomain { path: path_buf(), lo, hi });
         }
         if self.points.is_empty() {
             return Err(TfError::NoPoints { path: path_buf() });
         }
         for (index, p) in self.points.iter().enumerate() {
             if !(lo..=hi).contains(&p.value) {
-                return Err(TfError::OutsideDomain {
-                    path: path_buf(),
-                    index,
-                    value: p.value,
-                    lo,
-                    hi,
-                });
+                return Err(TfError::OutsideDomain { path: path_buf(), index, value: p.value, lo, hi });
             }
             if index > 0 && p.value < self.points[index - 1].value {
                 return Err(TfError::Unsorted {
@@ -287,19 +269,10 @@ impl TransferFunction {
                     previous: self.points[index - 1].value,
                 });
             }
-            let channels = [
-                ("color.r", p.color[0]),
-                ("color.g", p.color[1]),
-                ("color.b", p.color[2]),
-            ];
+            let channels = [("color.r", p.color[0]), ("color.g", p.color[1]), ("color.b", p.color[2])];
             for (field, value) in channels.into_iter().chain([("alpha", p.alpha)]) {
                 if !(0.0..=1.0).contains(&value) {
-                    return Err(TfError::OutOfUnitRange {
-                        path: path_buf(),
-                        index,
-                        field,
-                        value,
-                    });
+                    return Err(TfError::OutOfUnitRange { path: path_buf(), index, field, value });
                 }
             }
         }
@@ -320,10 +293,7 @@ impl TransferFunction {
 
     /// Reads and validates a RON transfer function file.
     pub fn load(path: &Path) -> Result<TransferFunction, TfError> {
-        let text = std::fs::read_to_string(path).map_err(|source| TfError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = std::fs::read_to_string(path).map_err(|source| TfError::Io { path: path.to_path_buf(), source })?;
         TransferFunction::from_ron_str(&text, path)
     }
 
@@ -345,10 +315,7 @@ impl TransferFunction {
     /// in linear RGB whatever its `ColorSpace`; midpoint and sharpness are ignored; without
     /// `Points` the opacity ramps from 0 to 1 over the domain. The domain is the range of all x.
     pub fn load_paraview(path: &Path) -> Result<TransferFunction, TfError> {
-        let text = std::fs::read_to_string(path).map_err(|source| TfError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = std::fs::read_to_string(path).map_err(|source| TfError::Io { path: path.to_path_buf(), source })?;
         paraview::parse(&text, path)
     }
 
@@ -390,31 +357,20 @@ impl TransferFunction {
     /// function at the data value whose normalized value is `(i + 0.5)/n`. Use this one when the
     /// TF's domain may differ from the volume's range.
     pub fn to_lut_for(&self, volume: &Volume, n: usize) -> Vec<[f32; 4]> {
-        (0..n)
-            .map(|i| self.texel(i, n, volume.value_range))
-            .collect()
+        (0..n).map(|i| self.texel(i, n, volume.value_range)).collect()
     }
 
     /// Where the TF's domain lies in the volume's normalized values `s`: `(0, 1)` when the
     /// domain equals `volume.value_range`. An empty volume range gives `(0, 1)`.
     pub fn normalized_domain_for(&self, volume: &Volume) -> (f64, f64) {
         let (lo, hi) = volume.value_range;
-        if hi > lo {
-            (
-                (self.domain.0 - lo) / (hi - lo),
-                (self.domain.1 - lo) / (hi - lo),
-            )
-        } else {
-            (0.0, 1.0)
-        }
+        if hi > lo { ((self.domain.0 - lo) / (hi - lo), (self.domain.1 - lo) / (hi - lo)) } else { (0.0, 1.0) }
     }
 
     /// What a linear 1D sampler returns at `s` on `self.to_lut(DEFAULT_LUT_SIZE)`, computed
     /// without building the LUT (bit-identical to [`lut_sample`] on it).
     pub fn lookup(&self, s: f64) -> [f64; 4] {
-        sample_with(DEFAULT_LUT_SIZE, s, |i| {
-            self.texel(i, DEFAULT_LUT_SIZE, self.domain)
-        })
+        sample_with(DEFAULT_LUT_SIZE, s, |i| self.texel(i, DEFAULT_LUT_SIZE, self.domain))
     }
 }
 

@@ -10,22 +10,14 @@ use volgraph_accel::camera::OrbitCamera;
 /// `BOX_CORNER_INDICES` from shaders/common/box.wgsl.
 fn box_indices() -> Vec<u32> {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shaders/common/box.wgsl");
-    let text =
-        std::fs::read_to_string(path).expect("shaders/common/box.wgsl is part of the repository");
-    let start = text
-        .find("BOX_CORNER_INDICES = array<u32, 36>(")
-        .expect("box.wgsl declares BOX_CORNER_INDICES");
+    let text = std::fs::read_to_string(path).expect("shaders/common/box.wgsl is part of the repository");
+    let start = text.find("BOX_CORNER_INDICES = array<u32, 36>(").expect("box.wgsl declares BOX_CORNER_INDICES");
     let body = &text[start..];
     let open = body.find('(').expect("array constructor has '('") + 1;
     let close = body.find(')').expect("array constructor has ')'");
     body[open..close]
         .split(',')
-        .map(|t| {
-            t.trim()
-                .trim_end_matches('u')
-                .parse::<u32>()
-                .expect("indices are u32 literals")
-        })
+        .map(|t| t.trim().trim_end_matches('u').parse::<u32>().expect("indices are u32 literals"))
         .collect()
 }
 
@@ -38,9 +30,7 @@ fn corner(i: u32) -> DVec3 {
 fn triangles() -> Vec<[DVec3; 3]> {
     let idx = box_indices();
     assert_eq!(idx.len(), 36, "12 triangles");
-    idx.chunks(3)
-        .map(|t| [corner(t[0]), corner(t[1]), corner(t[2])])
-        .collect()
+    idx.chunks(3).map(|t| [corner(t[0]), corner(t[1]), corner(t[2])]).collect()
 }
 
 /// Twice the signed area of a 2D triangle (shoelace): positive when counter-clockwise in a
@@ -57,11 +47,7 @@ fn every_triangle_is_counter_clockwise_from_outside() {
         // The box is centred at the origin, so outward means along the centroid. |normal| is
         // twice the area, 4, for a right triangle with legs 2, and the centroid lies on the face
         // plane at distance 1, so the product is exactly 4 for an outward triangle, -4 inward.
-        assert_eq!(
-            normal.dot(centroid),
-            4.0,
-            "triangle {i} {t:?} faces inward (normal {normal})"
-        );
+        assert_eq!(normal.dot(centroid), 4.0, "triangle {i} {t:?} faces inward (normal {normal})");
     }
 }
 
@@ -89,27 +75,17 @@ fn faces_toward_the_eye_are_ccw_in_ndc_and_in_framebuffer_terms() {
     let mut checked_nearest = 0;
     for az in (-180..180).step_by(25) {
         for el in [-80.0, -45.0, -10.0, 0.0, 10.0, 45.0, 80.0, 90.0] {
-            let camera = OrbitCamera {
-                azimuth_deg: az as f64,
-                elevation_deg: el,
-                distance: 2.2,
-                ..Default::default()
-            };
+            let camera = OrbitCamera { azimuth_deg: az as f64, elevation_deg: el, distance: 2.2, ..Default::default() };
             let frame = camera.frame(w, h);
             let mut nearest: Option<(f64, bool, bool)> = None;
             for t in triangles() {
                 let world = t.map(|c| c * half);
                 // vs_box: clip = clip_from_world * (corner * half, 1); the rasterizer divides by w.
                 let clip = world.map(|p| frame.clip_from_world * DVec4::from((p, 1.0)));
-                assert!(
-                    clip.iter().all(|c| c.w > 0.0),
-                    "camera at distance 2.2 sees the box in front"
-                );
+                assert!(clip.iter().all(|c| c.w > 0.0), "camera at distance 2.2 sees the box in front");
                 let ndc = clip.map(|c| DVec2::new(c.x / c.w, c.y / c.w));
                 // Framebuffer coordinates, y down (row 0 at the top), as wgpu rasterizes.
-                let fb = ndc.map(|p| {
-                    DVec2::new((p.x + 1.0) * 0.5 * w as f64, (1.0 - p.y) * 0.5 * h as f64)
-                });
+                let fb = ndc.map(|p| DVec2::new((p.x + 1.0) * 0.5 * w as f64, (1.0 - p.y) * 0.5 * h as f64));
                 let normal = (world[1] - world[0]).cross(world[2] - world[0]).normalize();
                 let centroid = (world[0] + world[1] + world[2]) / 3.0;
                 let to_eye = (frame.eye - centroid).normalize();
@@ -121,25 +97,15 @@ fn faces_toward_the_eye_are_ccw_in_ndc_and_in_framebuffer_terms() {
                 // y-down flips the sign: a triangle that looks counter-clockwise on screen has a
                 // negative shoelace area in framebuffer coordinates.
                 let ccw_on_screen = signed_area2(fb) < 0.0;
-                assert_eq!(
-                    ccw_ndc, ccw_on_screen,
-                    "NDC and framebuffer must agree (az {az}, el {el})"
-                );
-                assert_eq!(
-                    facing > 0.0,
-                    ccw_ndc,
-                    "az {az}, el {el}: triangle {world:?} facing {facing}"
-                );
+                assert_eq!(ccw_ndc, ccw_on_screen, "NDC and framebuffer must agree (az {az}, el {el})");
+                assert_eq!(facing > 0.0, ccw_ndc, "az {az}, el {el}: triangle {world:?} facing {facing}");
                 let dist = (frame.eye - centroid).length();
                 if nearest.is_none_or(|(d, _, _)| dist < d) {
                     nearest = Some((dist, facing > 0.0, ccw_ndc));
                 }
             }
             let (_, facing, ccw) = nearest.expect("some triangle is not edge-on");
-            assert!(
-                facing && ccw,
-                "az {az}, el {el}: the triangle nearest the eye must face it and be CCW"
-            );
+            assert!(facing && ccw, "az {az}, el {el}: the triangle nearest the eye must face it and be CCW");
             checked_nearest += 1;
         }
     }

@@ -21,11 +21,7 @@ fn inside(u: DVec3, (lo, hi): (DVec3, DVec3)) -> bool {
 
 fn check_bricks(volume: &Volume, lut: &[[f32; 4]], brick_cells: u32, overlap: u32, seed: u64) {
     let set = BrickSet::build(volume, brick_cells, overlap).expect("valid input");
-    assert_eq!(
-        &set.reassemble(),
-        volume,
-        "bricks do not reassemble to the volume"
-    );
+    assert_eq!(&set.reassemble(), volume, "bricks do not reassemble to the volume");
     let n = volume.dims;
     for brick in set.bricks() {
         // Each brick on its own holds exactly the volume's voxels at its place.
@@ -39,11 +35,7 @@ fn check_bricks(volume: &Volume, lut: &[[f32; 4]], brick_cells: u32, overlap: u3
                         VoxelData::U8(d) => d[local] as f64 / 255.0,
                         VoxelData::F32(d) => {
                             let (lo, hi) = volume.value_range;
-                            if hi > lo {
-                                (d[local] as f64 - lo) / (hi - lo)
-                            } else {
-                                0.0
-                            }
+                            if hi > lo { (d[local] as f64 - lo) / (hi - lo) } else { 0.0 }
                         }
                         _ => unreachable!("tests only build u8 and f32 volumes"),
                     };
@@ -61,11 +53,7 @@ fn check_bricks(volume: &Volume, lut: &[[f32; 4]], brick_cells: u32, overlap: u3
         let s = volume.sample_trilinear(u);
         // Probes on faces come out a few ulps off (e.g. 6.5/23·23 − 0.5); snap them back.
         let p = u * n.as_dvec3() - 0.5;
-        let p = DVec3::select(
-            (p - p.round()).abs().cmplt(DVec3::splat(1e-9)),
-            p.round(),
-            p,
-        );
+        let p = DVec3::select((p - p.round()).abs().cmplt(DVec3::splat(1e-9)), p.round(), p);
         let mut holders = 0;
         for (i, brick) in set.bricks().iter().enumerate() {
             if !inside(u, layout.brick_texture_box(brick.coord)) {
@@ -81,11 +69,7 @@ fn check_bricks(volume: &Volume, lut: &[[f32; 4]], brick_cells: u32, overlap: u3
                 brick.range
             );
             if lut_alpha(lut, s) > 0.0 {
-                assert!(
-                    !empty[i],
-                    "visible sample {s} at {u} in empty brick {}",
-                    brick.coord
-                );
+                assert!(!empty[i], "visible sample {s} at {u} in empty brick {}", brick.coord);
             }
             // The voxels trilinear interpolation reads (and, with overlap 2, those of the
             // central differences at ±1 voxel) with a non-zero weight are stored in the brick;
@@ -124,16 +108,8 @@ fn visible_cells(volume: &Volume, classifier: &OpacityClassifier) -> Vec<bool> {
                         }
                     }
                 }
-                let lo32 = if (lo as f32 as f64) > lo {
-                    (lo as f32).next_down()
-                } else {
-                    lo as f32
-                };
-                let hi32 = if ((hi as f32) as f64) < hi {
-                    (hi as f32).next_up()
-                } else {
-                    hi as f32
-                };
+                let lo32 = if (lo as f32 as f64) > lo { (lo as f32).next_down() } else { lo as f32 };
+                let hi32 = if ((hi as f32) as f64) < hi { (hi as f32).next_up() } else { hi as f32 };
                 out.push(classifier.is_visible(lo32, hi32));
             }
         }
@@ -169,14 +145,9 @@ fn check_front_to_back(h: &OctreeHierarchy, boxes: &[DrawBox], view: ViewPoint, 
         for k in 0..4000 {
             let u = origin + dir * (k as f64 * 0.001);
             // Strictly inside a box (faces are shared, so they say nothing about order).
-            let hit = tex
-                .iter()
-                .position(|(lo, hi)| (*lo + 1e-9).cmplt(u).all() && u.cmplt(*hi - 1e-9).all());
+            let hit = tex.iter().position(|(lo, hi)| (*lo + 1e-9).cmplt(u).all() && u.cmplt(*hi - 1e-9).all());
             if let Some(i) = hit {
-                assert!(
-                    i >= last,
-                    "ray {origin}->{dir} meets box {i} after box {last}"
-                );
+                assert!(i >= last, "ray {origin}->{dir} meets box {i} after box {last}");
                 last = i;
             }
         }
@@ -320,12 +291,7 @@ fn one_voxel_volume() {
     let h = OctreeHierarchy::build(&volume, &layout, 8).expect("valid");
     assert_eq!((h.node_count(), h.leaf_count()), (1, 1));
     let opaque = OpacityClassifier::new(&lut_constant(1.0)).expect("non-empty");
-    let boxes = all_boxes(
-        &h,
-        &h.classify(&opaque),
-        0.5,
-        ViewPoint::Direction(DVec3::X),
-    );
+    let boxes = all_boxes(&h, &h.classify(&opaque), 0.5, ViewPoint::Direction(DVec3::X));
     assert_eq!(boxes.len(), 1);
     assert_eq!(h.texture_box(&boxes[0]), (DVec3::ZERO, DVec3::ONE));
     check_bricks(&volume, &lut_constant(1.0), 1, 1, 3);
@@ -338,16 +304,10 @@ fn dims_not_a_multiple_of_the_brick_size() {
     let set = BrickSet::build(&volume, 8, 1).expect("valid");
     assert_eq!(set.layout().grid_dims(), UVec3::new(3, 1, 1));
     let last = &set.bricks()[2];
-    assert_eq!(
-        (last.origin, last.dims),
-        (UVec3::new(16, 0, 0), UVec3::new(4, 9, 5))
-    );
+    assert_eq!((last.origin, last.dims), (UVec3::new(16, 0, 0), UVec3::new(4, 9, 5)));
     let with_gradients = BrickSet::build(&volume, 8, 2).expect("valid");
     let middle = &with_gradients.bricks()[1];
-    assert_eq!(
-        (middle.origin, middle.dims),
-        (UVec3::new(7, 0, 0), UVec3::new(11, 9, 5))
-    );
+    assert_eq!((middle.origin, middle.dims), (UVec3::new(7, 0, 0), UVec3::new(11, 9, 5)));
     assert!(with_gradients.memory().ratio > set.memory().ratio);
     for seed in 0..10 {
         check_bricks(&volume, &random_lut(seed), 8, 1 + (seed % 2) as u32, seed);
@@ -372,10 +332,7 @@ fn all_transparent_and_all_opaque_luts() {
     let boxes = all_boxes(&h, &vis, 1.0, ViewPoint::Direction(DVec3::ONE));
     assert_eq!(boxes.len(), layout.brick_count());
     for b in &boxes {
-        assert_eq!(
-            (b.cells_lo, b.cells_hi),
-            layout.brick_cells_box(layout.brick_coord(b.brick as usize))
-        );
+        assert_eq!((b.cells_lo, b.cells_hi), layout.brick_cells_box(layout.brick_coord(b.brick as usize)));
         assert_eq!(b.ratio, 1.0);
     }
 }
@@ -383,29 +340,17 @@ fn all_transparent_and_all_opaque_luts() {
 #[test]
 fn bad_input_is_a_typed_error() {
     let volume = random_volume(UVec3::new(4, 4, 4), false, 1);
-    assert_eq!(
-        BrickSet::build(&volume, 0, 1),
-        Err(GridError::ZeroSize {
-            what: "brick_cells"
-        })
-    );
+    assert_eq!(BrickSet::build(&volume, 0, 1), Err(GridError::ZeroSize { what: "brick_cells" }));
     let err = BrickSet::build(&volume, 8, 3).expect_err("overlap 3");
     assert_eq!(
         err.to_string(),
         "brick overlap must be 1 (trilinear) or 2 (trilinear with on-the-fly gradients), got 3"
     );
     let layout = BrickLayout::new(volume.dims, 8, 1).expect("valid");
-    assert_eq!(
-        OctreeHierarchy::build(&volume, &layout, 0),
-        Err(GridError::ZeroSize {
-            what: "min_node_cells"
-        })
-    );
+    assert_eq!(OctreeHierarchy::build(&volume, &layout, 0), Err(GridError::ZeroSize { what: "min_node_cells" }));
     let other = BrickLayout::new(UVec3::new(5, 4, 4), 8, 1).expect("valid");
     assert_eq!(
-        OctreeHierarchy::build(&volume, &other, 8)
-            .expect_err("mismatch")
-            .to_string(),
+        OctreeHierarchy::build(&volume, &other, 8).expect_err("mismatch").to_string(),
         "brick layout was built for a volume of dims [5, 4, 4], but the volume has dims [4, 4, 4]"
     );
 }

@@ -36,10 +36,7 @@ fn marschner_lobb_matches_hand_values() {
     let f = generate::marschner_lobb_f32(16);
     assert_eq!(f.value_range, (0.0, 1.0));
     let i = f.index(5, 9, 2);
-    assert!(
-        (f.normalized(i) - marschner_lobb_value(voxel_centre(16, 5, 9, 2))).abs() < 1e-6,
-        "normalized is ρ"
-    );
+    assert!((f.normalized(i) - marschner_lobb_value(voxel_centre(16, 5, 9, 2))).abs() < 1e-6, "normalized is ρ");
 }
 
 #[test]
@@ -49,20 +46,14 @@ fn sphere_and_shell_volumes_match_their_analytic_size() {
     let sphere = generate::sphere(n, 0.5);
     let expected = 4.0 / 3.0 * std::f64::consts::PI * 0.125 / 8.0 * (n as f64).powi(3);
     let got = count_on(&sphere) as f64;
-    assert!(
-        (got / expected - 1.0).abs() < 0.02,
-        "sphere voxels {got} vs {expected}"
-    );
+    assert!((got / expected - 1.0).abs() < 0.02, "sphere voxels {got} vs {expected}");
     assert_eq!(bytes(&sphere)[sphere.index(32, 32, 32)], 255);
     assert_eq!(bytes(&sphere)[sphere.index(0, 0, 0)], 0);
 
     let shell = generate::spherical_shell(n, 0.4, 0.6);
     let expected = 4.0 / 3.0 * std::f64::consts::PI * (0.216 - 0.064) / 8.0 * (n as f64).powi(3);
     let got = count_on(&shell) as f64;
-    assert!(
-        (got / expected - 1.0).abs() < 0.02,
-        "shell voxels {got} vs {expected}"
-    );
+    assert!((got / expected - 1.0).abs() < 0.02, "shell voxels {got} vs {expected}");
     assert_eq!(bytes(&shell)[shell.index(32, 32, 32)], 0, "hollow centre");
 }
 
@@ -70,9 +61,7 @@ fn sphere_and_shell_volumes_match_their_analytic_size() {
 fn slabs_checkerboard_and_sheet() {
     let slabs = generate::slabs(8, Axis::X, 2);
     assert_eq!(slabs.name, "slabs_x_8");
-    let row: Vec<u8> = (0..8)
-        .map(|x| bytes(&slabs)[slabs.index(x, 5, 6)])
-        .collect();
+    let row: Vec<u8> = (0..8).map(|x| bytes(&slabs)[slabs.index(x, 5, 6)]).collect();
     assert_eq!(row, vec![0, 0, 255, 255, 0, 0, 255, 255]);
 
     let board = generate::checkerboard(8, 2);
@@ -105,28 +94,14 @@ fn edge_case_volumes() {
     let zeros = generate::zeros(8);
     assert!(bytes(&zeros).iter().all(|&b| b == 0));
     let one = generate::one_voxel(8, UVec3::new(1, 2, 3), 200);
-    let lit: Vec<usize> = bytes(&one)
-        .iter()
-        .enumerate()
-        .filter(|(_, b)| **b != 0)
-        .map(|(i, _)| i)
-        .collect();
+    let lit: Vec<usize> = bytes(&one).iter().enumerate().filter(|(_, b)| **b != 0).map(|(i, _)| i).collect();
     assert_eq!(lit, vec![one.index(1, 2, 3)]);
     assert_eq!(bytes(&one)[one.index(1, 2, 3)], 200);
 
     let (nf, (nan, pos, neg)) = generate::non_finite_f32(8);
-    let VoxelData::F32(values) = &nf.data else {
-        panic!("float32")
-    };
+    let VoxelData::F32(values) = &nf.data else { panic!("float32") };
     assert_eq!(values.iter().filter(|v| v.is_nan()).count(), nan);
     assert_eq!(values.iter().filter(|&&v| v == f32::INFINITY).count(), pos);
-    assert_eq!(
-        values.iter().filter(|&&v| v == f32::NEG_INFINITY).count(),
-        neg
-    );
-    assert_eq!(
-        nf.value_range,
-        (0.0, 7.0),
-        "Volume::new takes the finite range"
-    );
+    assert_eq!(values.iter().filter(|&&v| v == f32::NEG_INFINITY).count(), neg);
+    assert_eq!(nf.value_range, (0.0, 7.0), "Volume::new takes the finite range");
 }

@@ -6,24 +6,17 @@ use std::path::Path;
 use volgraph_accel::load::{parse_metaimage, parse_nrrd};
 
 fn nrrd_err(bytes: &[u8]) -> String {
-    parse_nrrd(Path::new("bad.nrrd"), bytes)
-        .expect_err("malformed NRRD")
-        .to_string()
+    parse_nrrd(Path::new("bad.nrrd"), bytes).expect_err("malformed NRRD").to_string()
 }
 
 fn mhd_err(name: &str, bytes: &[u8]) -> String {
-    parse_metaimage(Path::new(name), bytes)
-        .expect_err("malformed MetaImage")
-        .to_string()
+    parse_metaimage(Path::new(name), bytes).expect_err("malformed MetaImage").to_string()
 }
 
 /// A valid 2x2x2 uint8 header with `line` (1-based, after the magic) replaced by `with`.
 fn nrrd_with(replace: &str, with: &str) -> Vec<u8> {
     let header = "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n";
-    assert!(
-        header.contains(replace),
-        "test bug: {replace:?} is not in the header"
-    );
+    assert!(header.contains(replace), "test bug: {replace:?} is not in the header");
     let mut bytes = header.replacen(replace, with, 1).into_bytes();
     bytes.extend_from_slice(&[1u8; 8]);
     bytes
@@ -68,10 +61,7 @@ fn nrrd_errors_word_for_word() {
         "bad.nrrd:6: unsupported header field \"frobnicate\" = \"3\"; it is not a NRRD field volgraph knows; remove it or turn it into a `key:=value` pair"
     );
     assert_eq!(
-        nrrd_err(&nrrd_with(
-            "encoding: raw",
-            "encoding: raw\nspacings: 1 -1 1"
-        )),
+        nrrd_err(&nrrd_with("encoding: raw", "encoding: raw\nspacings: 1 -1 1")),
         "bad.nrrd:6: spacing (1, -1, 1) must be finite and positive on every axis"
     );
     assert_eq!(
@@ -83,43 +73,26 @@ fn nrrd_errors_word_for_word() {
         "bad.nrrd: the NRRD header does not end with an empty line before the data; the file is truncated or not a NRRD file"
     );
     assert_eq!(
-        nrrd_err(&nrrd_with(
-            "encoding: raw",
-            "encoding: raw\ndata file: slice%03d.raw 1 10 1"
-        )),
+        nrrd_err(&nrrd_with("encoding: raw", "encoding: raw\ndata file: slice%03d.raw 1 10 1")),
         "bad.nrrd:6: unsupported header field \"data file\" = \"slice%03d.raw 1 10 1\"; only a single data file is supported; join the slices into one file"
     );
     // Raw bytes claimed to be gzip: the decoder's message is flate2's, so only the frame is
     // compared here.
     let gz = nrrd_err(&nrrd_with("encoding: raw", "encoding: gzip"));
-    assert!(
-        gz.starts_with("bad.nrrd: cannot decompress the gzip data: "),
-        "{gz}"
-    );
-    assert!(
-        gz.ends_with("; the file is truncated or not compressed as its header says"),
-        "{gz}"
-    );
+    assert!(gz.starts_with("bad.nrrd: cannot decompress the gzip data: "), "{gz}");
+    assert!(gz.ends_with("; the file is truncated or not compressed as its header says"), "{gz}");
 }
 
 #[test]
 fn detached_nhdr_without_data_file_is_an_error() {
     let header = b"NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n";
-    let err = parse_nrrd(Path::new("v.nhdr"), header)
-        .expect_err("no data file")
-        .to_string();
-    assert_eq!(
-        err,
-        "v.nhdr: the header has no \"data file\" field; add a line like `data file: volume.raw`"
-    );
+    let err = parse_nrrd(Path::new("v.nhdr"), header).expect_err("no data file").to_string();
+    assert_eq!(err, "v.nhdr: the header has no \"data file\" field; add a line like `data file: volume.raw`");
 }
 
 fn mha_with(replace: &str, with: &str, data: &[u8]) -> Vec<u8> {
     let header = "NDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\nElementDataFile = LOCAL\n";
-    assert!(
-        header.contains(replace),
-        "test bug: {replace:?} is not in the header"
-    );
+    assert!(header.contains(replace), "test bug: {replace:?} is not in the header");
     let mut bytes = header.replacen(replace, with, 1).into_bytes();
     bytes.extend_from_slice(data);
     bytes
@@ -146,28 +119,15 @@ fn metaimage_errors_word_for_word() {
         "bad.mha: 2x2x2 uint16 voxels need 16 bytes, but the data has 8 bytes; check DimSize, ElementType, HeaderSize and CompressedData in the header, or whether the data is complete"
     );
     assert_eq!(
-        mhd_err(
-            "bad.mha",
-            &mha_with("DimSize = 2 2 2", "DimSize: 2 2 2", &ok)
-        ),
+        mhd_err("bad.mha", &mha_with("DimSize = 2 2 2", "DimSize: 2 2 2", &ok)),
         "bad.mha:2: cannot parse header line \"DimSize: 2 2 2\"; expected `Key = Value`"
     );
     assert_eq!(
-        mhd_err(
-            "bad.mha",
-            &mha_with("NDims = 3", "NDims = 3\nElementNumberOfChannels = 3", &ok)
-        ),
+        mhd_err("bad.mha", &mha_with("NDims = 3", "NDims = 3\nElementNumberOfChannels = 3", &ok)),
         "bad.mha:2: unsupported header field \"ElementNumberOfChannels\" = \"3\"; only scalar volumes (1 channel) are supported; extract one channel first"
     );
     assert_eq!(
-        mhd_err(
-            "bad.mha",
-            &mha_with(
-                "NDims = 3",
-                "NDims = 3\nBinaryDataByteOrderMSB = maybe",
-                &ok
-            )
-        ),
+        mhd_err("bad.mha", &mha_with("NDims = 3", "NDims = 3\nBinaryDataByteOrderMSB = maybe", &ok)),
         "bad.mha:2: cannot use BinaryDataByteOrderMSB = \"maybe\"; expected `True` or `False`"
     );
     assert_eq!(

@@ -25,19 +25,13 @@ fn valid_nrrd(gzip: bool) -> Vec<u8> {
 
 /// A valid `.mha`: 3x2x2 MET_FLOAT (48 bytes), plain or zlib.
 fn valid_mha(compressed: bool) -> Vec<u8> {
-    let data: Vec<u8> = (0..12)
-        .flat_map(|i| (i as f32 * 0.5).to_le_bytes())
-        .collect();
+    let data: Vec<u8> = (0..12).flat_map(|i| (i as f32 * 0.5).to_le_bytes()).collect();
     let header = format!(
         "ObjectType = Image\nNDims = 3\nDimSize = 3 2 2\nElementSpacing = 1 1 2\nElementByteOrderMSB = False\nCompressedData = {}\nElementType = MET_FLOAT\nElementDataFile = LOCAL\n",
         if compressed { "True" } else { "False" }
     );
     let mut bytes = header.into_bytes();
-    bytes.extend(if compressed {
-        common::zlib(&data)
-    } else {
-        data
-    });
+    bytes.extend(if compressed { common::zlib(&data) } else { data });
     bytes
 }
 
@@ -86,13 +80,7 @@ fn mutate(mut bytes: Vec<u8>, edits: &[(usize, u8)], splice: Option<(usize, usiz
     if let Some((at, line)) = splice {
         // Insert a hostile line at a line start so it parses as a field.
         let starts: Vec<usize> = std::iter::once(0)
-            .chain(
-                bytes
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, b)| **b == b'\n')
-                    .map(|(i, _)| i + 1),
-            )
+            .chain(bytes.iter().enumerate().filter(|(_, b)| **b == b'\n').map(|(i, _)| i + 1))
             .collect();
         let pos = starts[at % starts.len()].min(bytes.len());
         let text = format!("{}\n", HOSTILE_LINES[line % HOSTILE_LINES.len()]);

@@ -25,11 +25,7 @@ fn write_meta(dir: &Path, volume: &Volume, compressed: bool, big: bool, local: b
     if compressed {
         data = common::zlib(&data);
     }
-    let data_name = format!(
-        "{}.{}",
-        volume.name,
-        if compressed { "zraw" } else { "raw" }
-    );
+    let data_name = format!("{}.{}", volume.name, if compressed { "zraw" } else { "raw" });
     let header = format!(
         "ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = {}\nCompressedData = {}\nTransformMatrix = 1 0 0 0 1 0 0 0 1\nOffset = 0 0 0\nElementSpacing = 1 0.5 2\nDimSize = {} {} {}\nElementType = {}\nElementDataFile = {}\n",
         if big { "True" } else { "False" },
@@ -61,36 +57,17 @@ fn every_type_compression_and_layout_round_trips() {
     let n = 60;
     let volumes = [
         generate::checkerboard(10, 3),
-        Volume::new(
-            "u16",
-            dims,
-            DVec3::ONE,
-            VoxelData::U16((0..n).map(|i| (i * 1091) as u16).collect()),
-        ),
-        Volume::new(
-            "i16",
-            dims,
-            DVec3::ONE,
-            VoxelData::I16((0..n).map(|i| (i * 541) as i16 - 16000).collect()),
-        ),
-        Volume::new(
-            "f32",
-            dims,
-            DVec3::ONE,
-            VoxelData::F32((0..n).map(|i| (i as f32).sqrt() - 3.0).collect()),
-        ),
+        Volume::new("u16", dims, DVec3::ONE, VoxelData::U16((0..n).map(|i| (i * 1091) as u16).collect())),
+        Volume::new("i16", dims, DVec3::ONE, VoxelData::I16((0..n).map(|i| (i * 541) as i16 - 16000).collect())),
+        Volume::new("f32", dims, DVec3::ONE, VoxelData::F32((0..n).map(|i| (i as f32).sqrt() - 3.0).collect())),
     ];
     for volume in &volumes {
         for compressed in [false, true] {
             for big in [false, true] {
                 for local in [false, true] {
-                    let what = format!(
-                        "{} compressed {compressed} big {big} local {local}",
-                        volume.name
-                    );
+                    let what = format!("{} compressed {compressed} big {big} local {local}", volume.name);
                     let path = write_meta(&dir, volume, compressed, big, local);
-                    let loaded = load_volume(&path, &RawOptions::default())
-                        .unwrap_or_else(|e| panic!("{what}: {e}"));
+                    let loaded = load_volume(&path, &RawOptions::default()).unwrap_or_else(|e| panic!("{what}: {e}"));
                     assert_eq!(loaded.volume.data, volume.data, "{what}");
                     assert_eq!(loaded.volume.dims, volume.dims, "{what}");
                     assert_eq!(loaded.volume.spacing, DVec3::new(1.0, 0.5, 2.0), "{what}");
@@ -113,11 +90,7 @@ fn header_size_skips_bytes_of_a_detached_file() {
         );
         std::fs::write(dir.join(name), header).expect("write");
         let loaded = load_volume(&dir.join(name), &RawOptions::default()).expect("load");
-        assert_eq!(
-            loaded.volume.data,
-            VoxelData::U8((0u8..8).collect()),
-            "HeaderSize = {size}"
-        );
+        assert_eq!(loaded.volume.data, VoxelData::U8((0u8..8).collect()), "HeaderSize = {size}");
     }
 }
 
@@ -125,12 +98,6 @@ fn header_size_skips_bytes_of_a_detached_file() {
 fn spacing_option_overrides_the_header() {
     let dir = common::temp_dir("meta-sp");
     let path = write_meta(&dir, &generate::zeros(4), false, false, true);
-    let opts = RawOptions {
-        spacing: Some(DVec3::new(2.0, 2.0, 3.0)),
-        ..RawOptions::default()
-    };
-    assert_eq!(
-        load_volume(&path, &opts).expect("load").volume.spacing,
-        DVec3::new(2.0, 2.0, 3.0)
-    );
+    let opts = RawOptions { spacing: Some(DVec3::new(2.0, 2.0, 3.0)), ..RawOptions::default() };
+    assert_eq!(load_volume(&path, &opts).expect("load").volume.spacing, DVec3::new(2.0, 2.0, 3.0));
 }

@@ -20,14 +20,7 @@ fn nrrd_type(data: &VoxelData) -> &'static str {
 }
 
 /// Writes `volume` as NRRD; `detached` writes `<name>.nhdr` + `<name>.raw(.gz)`.
-fn write_nrrd(
-    dir: &Path,
-    volume: &Volume,
-    gzip: bool,
-    big: bool,
-    detached: bool,
-    extra: &str,
-) -> PathBuf {
+fn write_nrrd(dir: &Path, volume: &Volume, gzip: bool, big: bool, detached: bool, extra: &str) -> PathBuf {
     let d = volume.dims;
     let mut data = common::voxel_bytes(&volume.data, big);
     if gzip {
@@ -111,13 +104,7 @@ fn spacing_comes_from_spacings_or_direction_lengths() {
     let dir = common::temp_dir("nrrd-spacing");
     let volume = generate::sphere(6, 0.5);
     let path = write_nrrd(&dir, &volume, false, false, false, "spacings: 0.5 0.5 2\n");
-    assert_eq!(
-        load_volume(&path, &RawOptions::default())
-            .expect("load")
-            .volume
-            .spacing,
-        DVec3::new(0.5, 0.5, 2.0)
-    );
+    assert_eq!(load_volume(&path, &RawOptions::default()).expect("load").volume.spacing, DVec3::new(0.5, 0.5, 2.0));
     // (0.6, 0.8, 0) has length 1; (0, 0, -3) length 3; (0, 2, 0) length 2.
     let path = write_nrrd(
         &dir,
@@ -139,32 +126,21 @@ fn float_repairs_are_reported() {
     let path = write_nrrd(&dir, &volume, true, false, false, "");
     let loaded = load_volume(&path, &RawOptions::default()).expect("load");
     let r = &loaded.report;
-    assert_eq!(
-        (r.nan_replaced, r.pos_inf_replaced, r.neg_inf_replaced),
-        (nan, pos, neg)
-    );
-    assert_eq!(
-        loaded.volume.value_range,
-        (0.0, 5.0),
-        "finite values are the ramp 0..5"
-    );
+    assert_eq!((r.nan_replaced, r.pos_inf_replaced, r.neg_inf_replaced), (nan, pos, neg));
+    assert_eq!(loaded.volume.value_range, (0.0, 5.0), "finite values are the ramp 0..5");
 }
 
 #[test]
 fn missing_endian_defaults_to_little_with_a_note() {
     let dir = common::temp_dir("nrrd-endian");
     let data: Vec<u16> = vec![1, 256, 65535, 7, 8, 9, 10, 11];
-    let mut bytes =
-        b"NRRD0005\ntype: uint16\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n".to_vec();
+    let mut bytes = b"NRRD0005\ntype: uint16\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n".to_vec();
     bytes.extend(data.iter().flat_map(|v| v.to_le_bytes()));
     let path = dir.join("noendian.nrrd");
     std::fs::write(&path, bytes).expect("write");
     let loaded = load_volume(&path, &RawOptions::default()).expect("load");
     assert_eq!(loaded.volume.data, VoxelData::U16(data));
-    assert_eq!(
-        loaded.report.notes,
-        vec!["no \"endian\" field; read as little endian".to_string()]
-    );
+    assert_eq!(loaded.report.notes, vec!["no \"endian\" field; read as little endian".to_string()]);
 }
 
 #[test]

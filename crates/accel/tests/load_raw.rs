@@ -6,8 +6,7 @@ mod common;
 use glam::{DVec3, UVec3};
 use volgraph_accel::generate;
 use volgraph_accel::load::{
-    Endianness, LoadError, RawOptions, VolumeFormat, check_texture_limit, load_volume,
-    parse_raw_name,
+    Endianness, LoadError, RawOptions, VolumeFormat, check_texture_limit, load_volume, parse_raw_name,
 };
 use volgraph_accel::volume::{Volume, VoxelData, VoxelType};
 
@@ -21,36 +20,18 @@ fn write(dir: &std::path::Path, name: &str, bytes: &[u8]) -> std::path::PathBuf 
 fn name_convention_is_parsed() {
     assert_eq!(
         parse_raw_name("hydrogen_atom_128x128x128_uint8.raw"),
-        Some((
-            "hydrogen_atom".to_string(),
-            [128, 128, 128],
-            Some("uint8".to_string())
-        ))
+        Some(("hydrogen_atom".to_string(), [128, 128, 128], Some("uint8".to_string())))
     );
     assert_eq!(
         parse_raw_name("lobster_301x324x56_u16"),
-        Some((
-            "lobster".to_string(),
-            [301, 324, 56],
-            Some("u16".to_string())
-        ))
+        Some(("lobster".to_string(), [301, 324, 56], Some("u16".to_string())))
     );
-    assert_eq!(
-        parse_raw_name("ct_8x8x8.raw"),
-        Some(("ct".to_string(), [8, 8, 8], None))
-    );
+    assert_eq!(parse_raw_name("ct_8x8x8.raw"), Some(("ct".to_string(), [8, 8, 8], None)));
     assert_eq!(parse_raw_name("plain.raw"), None);
-    assert_eq!(
-        parse_raw_name("a_8x8_uint8.raw"),
-        None,
-        "two dimensions are not a volume"
-    );
-    for (token, t) in [
-        ("uint8", VoxelType::U8),
-        ("u16", VoxelType::U16),
-        ("I16", VoxelType::I16),
-        ("float32", VoxelType::F32),
-    ] {
+    assert_eq!(parse_raw_name("a_8x8_uint8.raw"), None, "two dimensions are not a volume");
+    for (token, t) in
+        [("uint8", VoxelType::U8), ("u16", VoxelType::U16), ("I16", VoxelType::I16), ("float32", VoxelType::F32)]
+    {
         assert_eq!(VoxelType::from_name(token), Some(t));
     }
 }
@@ -59,11 +40,7 @@ fn name_convention_is_parsed() {
 fn uint8_round_trip_by_name() {
     let dir = common::temp_dir("raw-u8");
     let ml = generate::marschner_lobb(20);
-    let path = write(
-        &dir,
-        "ml_20x20x20_uint8.raw",
-        &common::voxel_bytes(&ml.data, false),
-    );
+    let path = write(&dir, "ml_20x20x20_uint8.raw", &common::voxel_bytes(&ml.data, false));
     let loaded = load_volume(&path, &RawOptions::default()).expect("load");
     assert_eq!(loaded.volume.data, ml.data);
     assert_eq!(loaded.volume.dims, UVec3::splat(20));
@@ -81,18 +58,11 @@ fn sixteen_bit_round_trips_in_both_byte_orders() {
     let u16s: Vec<u16> = (0..30u16).map(|i| i * 2001).collect();
     let i16s: Vec<i16> = (0..30i16).map(|i| i * 1000 - 15000).collect();
     for big in [false, true] {
-        let endianness = if big {
-            Endianness::Big
-        } else {
-            Endianness::Little
-        };
+        let endianness = if big { Endianness::Big } else { Endianness::Little };
         for data in [VoxelData::U16(u16s.clone()), VoxelData::I16(i16s.clone())] {
             let name = format!("v_5x3x2_{}.raw", data.type_name());
             let path = write(&dir, &name, &common::voxel_bytes(&data, big));
-            let opts = RawOptions {
-                endianness,
-                ..RawOptions::default()
-            };
+            let opts = RawOptions { endianness, ..RawOptions::default() };
             let loaded = load_volume(&path, &opts).expect("load");
             assert_eq!(loaded.volume.dims, dims);
             assert_eq!(loaded.volume.data, data, "{name}, big endian = {big}");
@@ -105,11 +75,7 @@ fn options_override_the_name_and_set_spacing() {
     let dir = common::temp_dir("raw-opts");
     let data = VoxelData::U16((0..24u16).collect());
     // The name claims uint8 4x4x4 (64 bytes); the file is 2x3x4 uint16 (48 bytes).
-    let path = write(
-        &dir,
-        "x_4x4x4_uint8.raw",
-        &common::voxel_bytes(&data, false),
-    );
+    let path = write(&dir, "x_4x4x4_uint8.raw", &common::voxel_bytes(&data, false));
     let opts = RawOptions {
         dims: Some(UVec3::new(2, 3, 4)),
         dtype: Some(VoxelType::U16),
@@ -128,34 +94,16 @@ fn options_override_the_name_and_set_spacing() {
 fn float_nan_and_inf_are_replaced_and_counted() {
     let dir = common::temp_dir("raw-f32");
     let (volume, (nan, pos, neg)) = generate::non_finite_f32(8);
-    assert!(
-        nan > 0 && pos > 0 && neg > 0,
-        "the generator plants all three kinds"
-    );
-    let path = write(
-        &dir,
-        "nf_8x8x8_f32.raw",
-        &common::voxel_bytes(&volume.data, false),
-    );
+    assert!(nan > 0 && pos > 0 && neg > 0, "the generator plants all three kinds");
+    let path = write(&dir, "nf_8x8x8_f32.raw", &common::voxel_bytes(&volume.data, false));
     let loaded = load_volume(&path, &RawOptions::default()).expect("load");
     let report = &loaded.report;
-    assert_eq!(
-        (
-            report.nan_replaced,
-            report.pos_inf_replaced,
-            report.neg_inf_replaced
-        ),
-        (nan, pos, neg)
-    );
+    assert_eq!((report.nan_replaced, report.pos_inf_replaced, report.neg_inf_replaced), (nan, pos, neg));
     // The finite values are the ramp x = 0..7, so the range is (0, 7); NaN and -Inf become the
     // minimum 0, +Inf the maximum 7.
     assert_eq!(loaded.volume.value_range, (0.0, 7.0));
-    let VoxelData::F32(out) = &loaded.volume.data else {
-        panic!("float32 expected")
-    };
-    let VoxelData::F32(orig) = &volume.data else {
-        panic!("float32 expected")
-    };
+    let VoxelData::F32(out) = &loaded.volume.data else { panic!("float32 expected") };
+    let VoxelData::F32(orig) = &volume.data else { panic!("float32 expected") };
     for (i, (&o, &l)) in orig.iter().zip(out).enumerate() {
         let expected = if o.is_nan() || o == f32::NEG_INFINITY {
             0.0
@@ -172,8 +120,7 @@ fn float_nan_and_inf_are_replaced_and_counted() {
 fn size_mismatch_says_expected_and_actual_bytes() {
     let dir = common::temp_dir("raw-size");
     let path = write(&dir, "short_4x4x4_uint16.raw", &[0u8; 100]);
-    let err =
-        load_volume(&path, &RawOptions::default()).expect_err("100 bytes is not 4x4x4 uint16");
+    let err = load_volume(&path, &RawOptions::default()).expect_err("100 bytes is not 4x4x4 uint16");
     assert_eq!(
         err.to_string(),
         format!(
@@ -197,10 +144,7 @@ fn unknown_layout_unsupported_type_and_zero_dims_are_errors() {
     );
     let no_type = write(&dir, "t_2x2x2.raw", &[0u8; 8]);
     let err = load_volume(&no_type, &RawOptions::default()).expect_err("no type");
-    assert!(
-        matches!(err, LoadError::RawUnknownLayout { field: "dtype", .. }),
-        "{err}"
-    );
+    assert!(matches!(err, LoadError::RawUnknownLayout { field: "dtype", .. }), "{err}");
 
     let double = write(&dir, "d_2x2x2_float64.raw", &[0u8; 64]);
     let err = load_volume(&double, &RawOptions::default()).expect_err("float64");
@@ -215,41 +159,23 @@ fn unknown_layout_unsupported_type_and_zero_dims_are_errors() {
     let err = load_volume(&zero, &RawOptions::default()).expect_err("zero dim");
     assert_eq!(
         err.to_string(),
-        format!(
-            "{}: dimensions 0x4x4 contain a zero; every axis needs at least one voxel",
-            zero.display()
-        )
+        format!("{}: dimensions 0x4x4 contain a zero; every axis needs at least one voxel", zero.display())
     );
     let missing = dir.join("gone_2x2x2_uint8.raw");
-    assert!(matches!(
-        load_volume(&missing, &RawOptions::default()),
-        Err(LoadError::Io { .. })
-    ));
+    assert!(matches!(load_volume(&missing, &RawOptions::default()), Err(LoadError::Io { .. })));
     let unknown = dir.join("volume.vtk");
     assert_eq!(
-        load_volume(&unknown, &RawOptions::default())
-            .expect_err("vtk")
-            .to_string(),
-        format!(
-            "{}: unknown volume format \"vtk\"; use .raw, .nrrd, .nhdr, .mhd or .mha",
-            unknown.display()
-        )
+        load_volume(&unknown, &RawOptions::default()).expect_err("vtk").to_string(),
+        format!("{}: unknown volume format \"vtk\"; use .raw, .nrrd, .nhdr, .mhd or .mha", unknown.display())
     );
 }
 
 #[test]
 fn texture_limit_names_the_axis_and_bricking() {
-    let volume = Volume::new(
-        "tall",
-        UVec3::new(4, 4, 3000),
-        DVec3::ONE,
-        VoxelData::U8(vec![0; 4 * 4 * 3000]),
-    );
+    let volume = Volume::new("tall", UVec3::new(4, 4, 3000), DVec3::ONE, VoxelData::U8(vec![0; 4 * 4 * 3000]));
     assert!(check_texture_limit(&volume, 4096).is_ok());
     assert_eq!(
-        check_texture_limit(&volume, 2048)
-            .expect_err("3000 > 2048")
-            .to_string(),
+        check_texture_limit(&volume, 2048).expect_err("3000 > 2048").to_string(),
         "volume \"tall\": z size 3000 exceeds the device's 3D texture limit of 2048; split it into bricks (volgraph_accel::bricks), which lifts this limit, or downsample it"
     );
 }

@@ -55,10 +55,7 @@ fn check_grid(volume: &Volume, lut: &[[f32; 4]], block_size: u32, seed: u64) -> 
                 "sample {s} at {u} outside block {b} range {range:?}"
             );
             if lut_alpha(lut, s) > 0.0 {
-                assert!(
-                    classifier.is_range_visible(range),
-                    "visible sample {s} at {u} in empty block {b}"
-                );
+                assert!(classifier.is_range_visible(range), "visible sample {s} at {u} in empty block {b}");
                 assert_eq!(flags[grid.block_index(b)], 0);
             }
         }
@@ -158,10 +155,7 @@ fn dims_not_a_multiple_of_the_block_size() {
     let volume = random_volume(UVec3::new(19, 8, 13), false, 42);
     let grid = MinMaxGrid::build(&volume, 8).expect("valid");
     assert_eq!(grid.dims(), UVec3::new(3, 1, 2));
-    assert_eq!(
-        grid.block_voxel_box(UVec3::new(2, 0, 1)),
-        (UVec3::new(15, 0, 7), UVec3::new(18, 7, 12))
-    );
+    assert_eq!(grid.block_voxel_box(UVec3::new(2, 0, 1)), (UVec3::new(15, 0, 7), UVec3::new(18, 7, 12)));
     assert_eq!(grid.to_rg32float_bytes().len(), (3 * 2) * 8); // 3×1×2 blocks, 8 bytes each
     for seed in 0..20 {
         check_grid(&volume, &random_lut(seed), 8, seed);
@@ -194,14 +188,7 @@ fn all_transparent_and_all_opaque_luts() {
     assert!(transparent.all_transparent());
     assert_eq!(transparent.empty_fraction(&grid), 1.0);
     assert!(transparent.table_u8().iter().all(|e| *e == 0));
-    assert!(
-        transparent
-            .quantized_table(64)
-            .expect("ok")
-            .data()
-            .iter()
-            .all(|e| *e == 0)
-    );
+    assert!(transparent.quantized_table(64).expect("ok").data().iter().all(|e| *e == 0));
     let opaque = OpacityClassifier::new(&lut_constant(1.0, 64)).expect("non-empty");
     assert_eq!(opaque.empty_fraction(&grid), 0.0);
     assert!(opaque.empty_flags(&grid).iter().all(|e| *e == 0));
@@ -211,10 +198,7 @@ fn all_transparent_and_all_opaque_luts() {
 #[test]
 fn bad_input_is_a_typed_error() {
     let volume = random_volume(UVec3::new(4, 4, 4), false, 1);
-    assert_eq!(
-        MinMaxGrid::build(&volume, 0),
-        Err(GridError::ZeroSize { what: "block_size" })
-    );
+    assert_eq!(MinMaxGrid::build(&volume, 0), Err(GridError::ZeroSize { what: "block_size" }));
     let mut broken = volume.clone();
     broken.data = VoxelData::U8(vec![0; 5]);
     let err = MinMaxGrid::build(&broken, 8).expect_err("length mismatch");
@@ -225,8 +209,5 @@ fn bad_input_is_a_typed_error() {
     );
     assert_eq!(OpacityClassifier::new(&[]), Err(ClassifyError::EmptyLut));
     let classifier = OpacityClassifier::new(&lut_constant(1.0, 4)).expect("non-empty");
-    assert_eq!(
-        classifier.quantized_table(0),
-        Err(ClassifyError::BinCount { bins: 0, max: 4096 })
-    );
+    assert_eq!(classifier.quantized_table(0), Err(ClassifyError::BinCount { bins: 0, max: 4096 }));
 }

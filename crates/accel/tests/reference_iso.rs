@@ -44,19 +44,11 @@ fn hits_lie_on_the_sphere() {
     let (volume, lo, hi) = radial_volume();
     let radius = 0.3;
     let settings = RaycastSettings {
-        mode: RenderMode::Isosurface {
-            iso: iso_for_radius(radius, lo, hi),
-            shading: Phong::default(),
-        },
+        mode: RenderMode::Isosurface { iso: iso_for_radius(radius, lo, hi), shading: Phong::default() },
         ..Default::default()
     };
     for (az, el) in [(0.0, 0.0), (37.0, 23.0), (-120.0, -60.0)] {
-        let camera = OrbitCamera {
-            azimuth_deg: az,
-            elevation_deg: el,
-            distance: 2.2,
-            ..Default::default()
-        };
+        let camera = OrbitCamera { azimuth_deg: az, elevation_deg: el, distance: 2.2, ..Default::default() };
         let (w, h) = (40, 40);
         let image = render_reference(&volume, &[BASE; 4], &camera, w, h, &settings);
         let frame = camera.frame(w, h);
@@ -84,10 +76,7 @@ fn hits_lie_on_the_sphere() {
                 assert_eq!(c[3], 1.0, "isosurface pixels are opaque");
                 let r = (DVec3::new(hit[0], hit[1], hit[2]) - 0.5).length();
                 worst = worst.max((r - radius).abs());
-                assert!(
-                    miss_distance < radius + 1.0 / N as f64,
-                    "a ray passing outside the sphere cannot hit"
-                );
+                assert!(miss_distance < radius + 1.0 / N as f64, "a ray passing outside the sphere cannot hit");
             }
         }
         // The secant refinement is exact for a field linear between samples; the error left is
@@ -105,36 +94,22 @@ fn centre_pixel_hits_the_pole_facing_the_eye() {
     let (volume, lo, hi) = radial_volume();
     let shading = Phong::default();
     let settings = RaycastSettings {
-        mode: RenderMode::Isosurface {
-            iso: iso_for_radius(0.25, lo, hi),
-            shading,
-        },
+        mode: RenderMode::Isosurface { iso: iso_for_radius(0.25, lo, hi), shading },
         ..Default::default()
     };
-    let camera = OrbitCamera {
-        azimuth_deg: 0.0,
-        elevation_deg: 0.0,
-        ..Default::default()
-    };
+    let camera = OrbitCamera { azimuth_deg: 0.0, elevation_deg: 0.0, ..Default::default() };
     let image = render_reference(&volume, &[BASE; 2], &camera, 1, 1, &settings);
     let hit = image.hit[0];
     // The ray runs down -z through the centre: it meets r = 0.25 at u = (0.5, 0.5, 0.75).
     // 1e-3: the trilinear error bound of `hits_lie_on_the_sphere` at r = 0.25.
-    assert!(
-        (hit[0] - 0.5).abs() < 1e-9 && (hit[1] - 0.5).abs() < 1e-9,
-        "hit {hit:?}"
-    );
+    assert!((hit[0] - 0.5).abs() < 1e-9 && (hit[1] - 0.5).abs() < 1e-9, "hit {hit:?}");
     assert!((hit[2] - 0.75).abs() < 1e-3, "hit {hit:?}");
     // The normal is the sphere's, along +z, toward the eye: |n·l| = 1, so
     // rgb = base·(0.15 + 0.75) + 0.25 = (0.7, 0.43, 0.25), all below the clamp.
     // 1e-9: the symmetric gradient cancels in x and y up to f64 rounding.
     let want = [0.5 * 0.9 + 0.25, 0.2f32 as f64 * 0.9 + 0.25, 0.25, 1.0];
     for c in 0..4 {
-        assert!(
-            (image.color[0][c] - want[c]).abs() < 1e-9,
-            "colour {:?} want {want:?}",
-            image.color[0]
-        );
+        assert!((image.color[0][c] - want[c]).abs() < 1e-9, "colour {:?} want {want:?}", image.color[0]);
     }
     // Samples stop at the hit: from u_z = 1 with step 1/64, the first t_k = (k + 0.5)/64 past
     // the surface at t = 0.25 is k = 16, so samples k = 0..=16 are taken.
@@ -152,35 +127,17 @@ fn a_constant_field_above_iso_hits_at_the_first_sample_with_a_headlight_normal()
         value_range: (0.0, 255.0),
     };
     let settings = RaycastSettings {
-        mode: RenderMode::Isosurface {
-            iso: 0.5,
-            shading: Phong {
-                specular: 0.0,
-                ..Default::default()
-            },
-        },
+        mode: RenderMode::Isosurface { iso: 0.5, shading: Phong { specular: 0.0, ..Default::default() } },
         ..Default::default()
     };
-    let camera = OrbitCamera {
-        azimuth_deg: 0.0,
-        elevation_deg: 0.0,
-        ..Default::default()
-    };
+    let camera = OrbitCamera { azimuth_deg: 0.0, elevation_deg: 0.0, ..Default::default() };
     let image = render_reference(&volume, &[[1.0, 1.0, 1.0, 1.0]], &camera, 1, 1, &settings);
     // k = 0 hit: t = t_0 = 0.5·step_tex; 1 voxel → unit_world = 1, step_tex = 0.5, entry at
     // u_z = 1, so the hit is at u_z = 0.75.
     assert_eq!(image.samples, 1);
-    assert!(
-        (image.hit[0][2] - 0.75).abs() < 1e-12,
-        "hit {:?}",
-        image.hit[0]
-    );
+    assert!((image.hit[0][2] - 0.75).abs() < 1e-12, "hit {:?}", image.hit[0]);
     // base·(ambient + diffuse) = 0.9; 1e-12 for the f64 rounding of the ray direction.
-    assert!(
-        (image.color[0][0] - 0.9).abs() < 1e-12,
-        "colour {:?}",
-        image.color[0]
-    );
+    assert!((image.color[0][0] - 0.9).abs() < 1e-12, "colour {:?}", image.color[0]);
 }
 
 #[test]
@@ -191,12 +148,7 @@ fn settings_deserialize_with_defaults_and_reject_unknown_fields() {
         s.mode,
         RenderMode::Isosurface {
             iso: 0.4,
-            shading: Phong {
-                ambient: 0.15,
-                diffuse: 0.75,
-                specular: 0.25,
-                shininess: 32.0
-            }
+            shading: Phong { ambient: 0.15, diffuse: 0.75, specular: 0.25, shininess: 32.0 }
         }
     );
     let err = ron::from_str::<RaycastSettings>("(step: 0.5)").expect_err("`step` is not a field");
@@ -215,13 +167,8 @@ fn normals_are_world_space_on_anisotropic_volumes() {
     // white LUT the colour is |a·d|.
     let dims = UVec3::new(24, 16, 12);
     let spacing = DVec3::new(1.0, 1.5, 3.0);
-    let mut volume = Volume {
-        dims,
-        spacing,
-        data: VoxelData::F32(vec![]),
-        name: "plane".into(),
-        value_range: (0.0, 1.0),
-    };
+    let mut volume =
+        Volume { dims, spacing, data: VoxelData::F32(vec![]), name: "plane".into(), value_range: (0.0, 1.0) };
     let half = volume.half_extent_world();
     let a = DVec3::new(1.0, 2.0, 3.0).normalize();
     let mut data = Vec::new();
@@ -237,25 +184,11 @@ fn normals_are_world_space_on_anisotropic_volumes() {
     let hi = data.iter().copied().fold(f32::NEG_INFINITY, f32::max) as f64;
     volume.data = VoxelData::F32(data);
     volume.value_range = (lo, hi);
-    let shading = Phong {
-        ambient: 0.0,
-        diffuse: 1.0,
-        specular: 0.0,
-        shininess: 1.0,
-    };
-    let settings = RaycastSettings {
-        mode: RenderMode::Isosurface {
-            iso: (0.0 - lo) / (hi - lo),
-            shading,
-        },
-        ..Default::default()
-    };
+    let shading = Phong { ambient: 0.0, diffuse: 1.0, specular: 0.0, shininess: 1.0 };
+    let settings =
+        RaycastSettings { mode: RenderMode::Isosurface { iso: (0.0 - lo) / (hi - lo), shading }, ..Default::default() };
     // Looking from the low side of f, so rays cross the plane inside rather than starting above it.
-    let camera = OrbitCamera {
-        azimuth_deg: 205.0,
-        elevation_deg: -30.0,
-        ..Default::default()
-    };
+    let camera = OrbitCamera { azimuth_deg: 205.0, elevation_deg: -30.0, ..Default::default() };
     let (w, h) = (32, 32);
     let image = render_reference(&volume, &[[1.0; 4]], &camera, w, h, &settings);
     let frame = camera.frame(w, h);
@@ -275,10 +208,7 @@ fn normals_are_world_space_on_anisotropic_volumes() {
             // -normalize(g / (2·half)) ∝ -a/dims, tilts the normal by ~10° here and moves |n·l|
             // by ~0.02 at the centre pixel, far outside this tolerance.
             let got = image.color[image.index(x, y)][0];
-            assert!(
-                (got - want).abs() < 1e-5,
-                "({x},{y}): |n·l| {got}, want {want}"
-            );
+            assert!((got - want).abs() < 1e-5, "({x},{y}): |n·l| {got}, want {want}");
             checked += 1;
         }
     }

@@ -7,8 +7,7 @@ use std::path::{Path, PathBuf};
 
 use volgraph_accel::generate;
 use volgraph_accel::transfer_function::{
-    ControlPoint, DEFAULT_LUT_SIZE, Preset, TransferFunction, lut_sample, opacity_correct,
-    opacity_uncorrect,
+    ControlPoint, DEFAULT_LUT_SIZE, Preset, TransferFunction, lut_sample, opacity_correct, opacity_uncorrect,
 };
 
 fn tf_dir() -> PathBuf {
@@ -16,11 +15,7 @@ fn tf_dir() -> PathBuf {
 }
 
 fn point(value: f64, rgb: f64, alpha: f64) -> ControlPoint {
-    ControlPoint {
-        value,
-        color: [rgb; 3],
-        alpha,
-    }
+    ControlPoint { value, color: [rgb; 3], alpha }
 }
 
 #[test]
@@ -30,19 +25,10 @@ fn preset_files_load_and_equal_the_presets() {
         let loaded = TransferFunction::load(&path).unwrap_or_else(|e| panic!("{e}"));
         let expected = TransferFunction::preset(preset, (0.0, 255.0));
         assert_eq!(loaded.domain, expected.domain);
-        assert_eq!(
-            loaded.points.len(),
-            expected.points.len(),
-            "{}",
-            path.display()
-        );
+        assert_eq!(loaded.points.len(), expected.points.len(), "{}", path.display());
         for (a, b) in loaded.points.iter().zip(&expected.points) {
             // The files write t·255 in decimal; the preset computes it in f64.
-            assert!(
-                (a.value - b.value).abs() < 1e-9,
-                "{}: {a:?} vs {b:?}",
-                path.display()
-            );
+            assert!((a.value - b.value).abs() < 1e-9, "{}: {a:?} vs {b:?}", path.display());
             assert_eq!((a.color, a.alpha), (b.color, b.alpha), "{}", path.display());
         }
     }
@@ -51,19 +37,10 @@ fn preset_files_load_and_equal_the_presets() {
 #[test]
 fn presets_do_what_their_names_promise() {
     let opaque = TransferFunction::preset(Preset::Opaque, (0.0, 255.0));
-    assert_eq!(
-        opaque.eval(20.0)[3],
-        1.0,
-        "opaque: full opacity from 5% of the range"
-    );
+    assert_eq!(opaque.eval(20.0)[3], 1.0, "opaque: full opacity from 5% of the range");
     let sparse = TransferFunction::preset(Preset::Sparse, (0.0, 255.0));
-    let transparent = (0..=255)
-        .filter(|&v| sparse.eval(v as f64)[3] == 0.0)
-        .count();
-    assert!(
-        transparent > 150,
-        "sparse: most values are transparent ({transparent}/256)"
-    );
+    let transparent = (0..=255).filter(|&v| sparse.eval(v as f64)[3] == 0.0).count();
+    assert!(transparent > 150, "sparse: most values are transparent ({transparent}/256)");
     let ml = generate::marschner_lobb(8);
     assert_eq!(TransferFunction::default_for(&ml).domain, (0.0, 255.0));
 }
@@ -72,29 +49,18 @@ fn presets_do_what_their_names_promise() {
 fn ron_round_trip() {
     let tf = TransferFunction::preset(Preset::Default, (-10.0, 30.0));
     let text = tf.to_ron_string();
-    let back =
-        TransferFunction::from_ron_str(&text, Path::new("mem.ron")).expect("parse own output");
+    let back = TransferFunction::from_ron_str(&text, Path::new("mem.ron")).expect("parse own output");
     assert_eq!(back, tf);
 }
 
 #[test]
 fn eval_is_piecewise_linear_and_clamped() {
-    let tf = TransferFunction {
-        domain: (0.0, 10.0),
-        points: vec![point(2.0, 0.0, 0.0), point(6.0, 1.0, 0.5)],
-    };
+    let tf = TransferFunction { domain: (0.0, 10.0), points: vec![point(2.0, 0.0, 0.0), point(6.0, 1.0, 0.5)] };
     assert_eq!(tf.eval(0.0), [0.0; 4], "before the first point: its value");
     assert_eq!(tf.eval(4.0), [0.5, 0.5, 0.5, 0.25], "halfway");
-    assert_eq!(
-        tf.eval(9.0),
-        [1.0, 1.0, 1.0, 0.5],
-        "after the last point: its value"
-    );
+    assert_eq!(tf.eval(9.0), [1.0, 1.0, 1.0, 0.5], "after the last point: its value");
     // A step: two points at the same value.
-    let step = TransferFunction {
-        domain: (0.0, 1.0),
-        points: vec![point(0.5, 0.0, 0.0), point(0.5, 1.0, 1.0)],
-    };
+    let step = TransferFunction { domain: (0.0, 1.0), points: vec![point(0.5, 0.0, 0.0), point(0.5, 1.0, 1.0)] };
     assert_eq!(step.eval(0.49)[3], 0.0);
     assert_eq!(step.eval(0.5)[3], 1.0);
 }
@@ -102,26 +68,15 @@ fn eval_is_piecewise_linear_and_clamped() {
 #[test]
 fn lut_texels_and_sampling_match_hand_computed_values() {
     // alpha = v/255 over the domain (0, 255): texel i of 4 sits at s = (i + 0.5)/4.
-    let ramp = TransferFunction {
-        domain: (0.0, 255.0),
-        points: vec![point(0.0, 0.0, 0.0), point(255.0, 1.0, 1.0)],
-    };
+    let ramp = TransferFunction { domain: (0.0, 255.0), points: vec![point(0.0, 0.0, 0.0), point(255.0, 1.0, 1.0)] };
     let lut = ramp.to_lut(4);
     let alphas: Vec<f32> = lut.iter().map(|t| t[3]).collect();
     assert_eq!(alphas, vec![0.125, 0.375, 0.625, 0.875]);
     // s = 0.3: x = 0.3·4 - 0.5 = 0.7 → 0.3·0.125 + 0.7·0.375 = 0.3.
     assert!((lut_sample(&lut, 0.3)[3] - 0.3).abs() < 1e-12);
     assert_eq!(lut_sample(&lut, 0.5)[3], 0.5);
-    assert_eq!(
-        lut_sample(&lut, 0.05)[3],
-        0.125,
-        "below the first texel centre: clamped"
-    );
-    assert_eq!(
-        lut_sample(&lut, 1.0)[3],
-        0.875,
-        "above the last texel centre: clamped"
-    );
+    assert_eq!(lut_sample(&lut, 0.05)[3], 0.125, "below the first texel centre: clamped");
+    assert_eq!(lut_sample(&lut, 1.0)[3], 0.875, "above the last texel centre: clamped");
     assert_eq!(lut_sample(&lut, f64::NAN)[3], 0.125, "NaN reads as s = 0");
     assert_eq!(lut_sample(&[], 0.5), [0.0; 4]);
 
@@ -129,11 +84,7 @@ fn lut_texels_and_sampling_match_hand_computed_values() {
     // v = 191.25 (0.5); halfway between them (s = 0.5) the sampler gives their mean 0.409375.
     let kink = TransferFunction {
         domain: (0.0, 255.0),
-        points: vec![
-            point(0.0, 0.0, 0.0),
-            point(100.0, 1.0, 0.5),
-            point(255.0, 1.0, 0.5),
-        ],
+        points: vec![point(0.0, 0.0, 0.0), point(100.0, 1.0, 0.5), point(255.0, 1.0, 0.5)],
     };
     let lut = kink.to_lut(2);
     assert!((lut[0][3] as f64 - 0.31875).abs() < 1e-7);
@@ -157,10 +108,7 @@ fn lut_for_a_volume_uses_its_value_range() {
     let (mut volume, _) = generate::non_finite_f32(8);
     volgraph_accel::load::sanitize_volume(&mut volume);
     assert_eq!(volume.value_range, (0.0, 7.0));
-    let tf = TransferFunction {
-        domain: (0.0, 14.0),
-        points: vec![point(0.0, 0.0, 0.0), point(14.0, 1.0, 1.0)],
-    };
+    let tf = TransferFunction { domain: (0.0, 14.0), points: vec![point(0.0, 0.0, 0.0), point(14.0, 1.0, 1.0)] };
     assert_eq!(tf.normalized_domain_for(&volume), (0.0, 2.0));
     // Texel 0 of 2 is s = 0.25 → v = 1.75 in data units → alpha 1.75/14 = 0.125.
     assert_eq!(tf.to_lut_for(&volume, 2)[0][3], 0.125);
@@ -176,15 +124,8 @@ fn lut_for_a_volume_uses_its_value_range() {
 #[test]
 fn opacity_correction_and_its_inverse() {
     assert_eq!(opacity_correct(0.5, 1.0), 0.5);
-    assert_eq!(
-        opacity_correct(0.5, 2.0),
-        0.75,
-        "two half-opaque unit steps"
-    );
-    assert!(
-        (opacity_correct(0.75, 0.5) - 0.5).abs() < 1e-15,
-        "half a step of 0.75: 1 - 0.25^0.5"
-    );
+    assert_eq!(opacity_correct(0.5, 2.0), 0.75, "two half-opaque unit steps");
+    assert!((opacity_correct(0.75, 0.5) - 0.5).abs() < 1e-15, "half a step of 0.75: 1 - 0.25^0.5");
     for &a in &[0.0, 0.01, 0.3, 0.9, 1.0] {
         for &step in &[0.25, 0.5, 1.0, 3.0] {
             let back = opacity_uncorrect(opacity_correct(a, step), step);
@@ -194,9 +135,7 @@ fn opacity_correction_and_its_inverse() {
 }
 
 fn ron_err(text: &str) -> String {
-    TransferFunction::from_ron_str(text, Path::new("graphs/tf/bad.ron"))
-        .expect_err("invalid")
-        .to_string()
+    TransferFunction::from_ron_str(text, Path::new("graphs/tf/bad.ron")).expect_err("invalid").to_string()
 }
 
 #[test]
@@ -227,9 +166,7 @@ fn ron_errors_word_for_word() {
         "graphs/tf/bad.ron: `points` is empty; add at least one point such as `(value: 0.0, color: (1.0, 1.0, 1.0), alpha: 0.0)`"
     );
     assert_eq!(
-        ron_err(
-            "TransferFunction(domain: (255.0, 0.0), points: [(value: 0.0, color: (0.0, 0.0, 0.0), alpha: 0.0)])"
-        ),
+        ron_err("TransferFunction(domain: (255.0, 0.0), points: [(value: 0.0, color: (0.0, 0.0, 0.0), alpha: 0.0)])"),
         "graphs/tf/bad.ron: domain (255, 0) is not a range; write `domain: (min, max)` with finite min < max in data units"
     );
 }
@@ -249,23 +186,17 @@ fn ron_syntax_errors_carry_line_and_column() {
         "graphs/tf/bad.ron:3:3: Unexpected field named `lut_size` in `TransferFunction`, expected either `domain` or `points` instead; see graphs/tf/default.ron for the format"
     );
     assert_eq!(
-        ron_err(
-            "TransferFunction(\n  domain: (0.0, 255.0),\n  points: [(value: 0.0, color: (0.0, 0.0, 0.0))],\n)"
-        ),
+        ron_err("TransferFunction(\n  domain: (0.0, 255.0),\n  points: [(value: 0.0, color: (0.0, 0.0, 0.0))],\n)"),
         "graphs/tf/bad.ron:3:47: Unexpected missing field named `alpha` in `ControlPoint`; see graphs/tf/default.ron for the format"
     );
     assert_eq!(
-        ron_err(
-            "TransferFunction(domain: (0.0, 255.0), points: [(value: 0.0 color: (0.0, 0.0, 0.0), alpha: 0.0)]"
-        ),
+        ron_err("TransferFunction(domain: (0.0, 255.0), points: [(value: 0.0 color: (0.0, 0.0, 0.0), alpha: 0.0)]"),
         "graphs/tf/bad.ron:1:61: Expected comma; see graphs/tf/default.ron for the format"
     );
 }
 
 fn pv_err(text: &str) -> String {
-    TransferFunction::from_paraview_json(text, Path::new("t.json"))
-        .expect_err("invalid")
-        .to_string()
+    TransferFunction::from_paraview_json(text, Path::new("t.json")).expect_err("invalid").to_string()
 }
 
 #[test]
@@ -276,11 +207,7 @@ fn paraview_import_converts_srgb_and_merges_opacity_points() {
     let tf = TransferFunction::from_paraview_json(json, Path::new("t.json")).expect("valid map");
     assert_eq!(tf.domain, (0.0, 10.0));
     let values: Vec<f64> = tf.points.iter().map(|p| p.value).collect();
-    assert_eq!(
-        values,
-        vec![0.0, 5.0, 10.0],
-        "union of the colour and opacity x values"
-    );
+    assert_eq!(values, vec![0.0, 5.0, 10.0], "union of the colour and opacity x values");
     // sRGB 0.5 is linear ((0.5 + 0.055)/1.055)^2.4 = 0.214041…; x = 5 is halfway in linear RGB.
     let srgb_half = ((0.5f64 + 0.055) / 1.055).powf(2.4);
     assert!((srgb_half - 0.214041).abs() < 1e-6);
@@ -289,24 +216,15 @@ fn paraview_import_converts_srgb_and_merges_opacity_points() {
     let alphas: Vec<f64> = tf.points.iter().map(|p| p.alpha).collect();
     assert_eq!(alphas, vec![0.0, 0.4, 1.0]);
     // Without "Points" the opacity ramps from 0 to 1 over the domain.
-    let ramp = TransferFunction::from_paraview_json(
-        r#"{"RGBPoints": [-1, 1, 1, 1, 1, 1, 1, 1]}"#,
-        Path::new("t.json"),
-    )
-    .expect("a bare object is accepted too");
+    let ramp = TransferFunction::from_paraview_json(r#"{"RGBPoints": [-1, 1, 1, 1, 1, 1, 1, 1]}"#, Path::new("t.json"))
+        .expect("a bare object is accepted too");
     assert_eq!(ramp.eval(0.0)[3], 0.5);
 }
 
 #[test]
 fn paraview_errors_word_for_word() {
-    assert_eq!(
-        pv_err("[{\"RGBPoints\": [0, 1,"),
-        "t.json:1:21: invalid JSON: EOF while parsing a value"
-    );
-    assert_eq!(
-        pv_err("[]"),
-        "t.json: the JSON array is empty; it needs one colour map object with \"RGBPoints\""
-    );
+    assert_eq!(pv_err("[{\"RGBPoints\": [0, 1,"), "t.json:1:21: invalid JSON: EOF while parsing a value");
+    assert_eq!(pv_err("[]"), "t.json: the JSON array is empty; it needs one colour map object with \"RGBPoints\"");
     assert_eq!(
         pv_err("[{\"Name\": \"x\"}]"),
         "t.json: the colour map has no \"RGBPoints\" array; it needs [x, r, g, b, …]"
@@ -315,10 +233,7 @@ fn paraview_errors_word_for_word() {
         pv_err("[{\"RGBPoints\": [0, 0, 0, 0, 1, 1, 1]}]"),
         "t.json: \"RGBPoints\" has 7 numbers; it needs groups of four (x, r, g, b)"
     );
-    assert_eq!(
-        pv_err("[{\"RGBPoints\": [0, 0, 0, \"red\"]}]"),
-        "t.json: RGBPoints[3] is \"red\", not a number"
-    );
+    assert_eq!(pv_err("[{\"RGBPoints\": [0, 0, 0, \"red\"]}]"), "t.json: RGBPoints[3] is \"red\", not a number");
     assert_eq!(
         pv_err("[{\"RGBPoints\": [1, 0, 0, 0, 0, 1, 1, 1]}]"),
         "t.json: \"RGBPoints\" x values must increase, but point 1 has x = 0 after x = 1"

@@ -130,11 +130,7 @@ fn window_lut(lo: f64, hi: f64) -> Vec<[f32; 4]> {
     (0..256)
         .map(|i| {
             let s = (i as f64 + 0.5) / 256.0;
-            let a = if s >= lo && s <= hi {
-                ((s - lo) / (hi - lo).max(1e-9)).max(0.05)
-            } else {
-                0.0
-            };
+            let a = if s >= lo && s <= hi { ((s - lo) / (hi - lo).max(1e-9)).max(0.05) } else { 0.0 };
             [1.0, 0.8, 0.6, a as f32]
         })
         .collect()
@@ -145,25 +141,17 @@ pub fn run(opts: &AccelBenchOptions) -> anyhow::Result<AccelBenchReport> {
     let repeats = opts.repeats.max(1);
     let minmax = bench_minmax(opts, repeats)?;
     let octree = bench_octree(repeats)?;
-    let report = AccelBenchReport {
-        threads: rayon::current_num_threads(),
-        repeats,
-        minmax,
-        octree,
-    };
+    let report = AccelBenchReport { threads: rayon::current_num_threads(), repeats, minmax, octree };
     print_table(&report);
     if let Some(path) = &opts.json_out {
         let json = serde_json::to_string_pretty(&report)?;
-        std::fs::write(path, json)
-            .with_context(|| format!("writing the JSON report to {}", path.display()))?;
+        std::fs::write(path, json).with_context(|| format!("writing the JSON report to {}", path.display()))?;
     }
     Ok(report)
 }
 
 fn bench_minmax(opts: &AccelBenchOptions, repeats: usize) -> anyhow::Result<MinMaxBench> {
-    let path = opts
-        .data_dir
-        .join("volumes/engine_vollib_256x256x256_uint8.raw");
+    let path = opts.data_dir.join("volumes/engine_vollib_256x256x256_uint8.raw");
     let bytes = std::fs::read(&path).with_context(|| {
         format!(
             "cannot read the engine volume {} (256³ uint8 raw, 16 MiB); put it there or pass \
@@ -263,18 +251,13 @@ fn bench_octree(repeats: usize) -> anyhow::Result<OctreeBench> {
     let (volume, generate_ms) = time_ms(|| generate_blobs(n));
     let (brick_cells, min_node_cells) = (64, 8);
     let layout = BrickLayout::new(volume.dims, brick_cells, 1)?;
-    let (hierarchy, hierarchy_build_ms) =
-        time_ms(|| OctreeHierarchy::build(&volume, &layout, min_node_cells));
+    let (hierarchy, hierarchy_build_ms) = time_ms(|| OctreeHierarchy::build(&volume, &layout, min_node_cells));
     let hierarchy = hierarchy?;
     drop(volume); // Only the hierarchy is needed from here on.
     // TF changes: windows sliding over the value range, as when a user drags a TF editor.
-    let windows: Vec<(f64, f64)> = (0..8)
-        .map(|k| (0.05 + 0.1 * k as f64, 0.25 + 0.1 * k as f64))
-        .collect();
-    let classifiers = windows
-        .iter()
-        .map(|(lo, hi)| OpacityClassifier::new(&window_lut(*lo, *hi)))
-        .collect::<Result<Vec<_>, _>>()?;
+    let windows: Vec<(f64, f64)> = (0..8).map(|k| (0.05 + 0.1 * k as f64, 0.25 + 0.1 * k as f64)).collect();
+    let classifiers =
+        windows.iter().map(|(lo, hi)| OpacityClassifier::new(&window_lut(*lo, *hi))).collect::<Result<Vec<_>, _>>()?;
     let mut visibility = OctreeVisibility::default();
     hierarchy.classify_into(&classifiers[0], &mut visibility); // warm-up: allocations
     let mut rebuild = Vec::new();
@@ -322,25 +305,15 @@ fn bench_octree(repeats: usize) -> anyhow::Result<OctreeBench> {
 fn print_table(r: &AccelBenchReport) {
     let m = &r.minmax;
     let o = &r.octree;
-    println!(
-        "## volgraph bench accel ({} threads, median of {} repeats)\n",
-        r.threads, r.repeats
-    );
+    println!("## volgraph bench accel ({} threads, median of {} repeats)\n", r.threads, r.repeats);
     println!("| measurement | ms | notes |");
     println!("|---|---:|---|");
     println!(
         "| min/max grid build, engine 256³ u8, {}³ blocks | {:.2} | grid {:?} |",
         m.block_size, m.build_ms, m.grid_dims
     );
-    println!(
-        "| classify all blocks (empty flags) | {:.3} | {:.1}% empty |",
-        m.classify_ms,
-        100.0 * m.empty_fraction
-    );
-    println!(
-        "| build + classify | {:.2} | K-W 2003 §2.3 |",
-        m.build_and_classify_ms
-    );
+    println!("| classify all blocks (empty flags) | {:.3} | {:.1}% empty |", m.classify_ms, 100.0 * m.empty_fraction);
+    println!("| build + classify | {:.2} | K-W 2003 §2.3 |", m.build_and_classify_ms);
     println!("| 256×256 u8 table | {:.3} | |", m.table_u8_ms);
     println!(
         "| octree hierarchy build (once per volume), 512³ u16 | {:.1} | {} bricks, {} nodes, {} leaves |",
@@ -350,12 +323,6 @@ fn print_table(r: &AccelBenchReport) {
         "| **octree rebuild after a TF change** | **{:.3}** | min {:.3}; {} TF changes |",
         o.rebuild_ms, o.rebuild_min_ms, o.tf_changes
     );
-    println!(
-        "| R-V 2006 §8 (3.0 GHz Xeon) | {:.1} | ours / paper = {:.3} |",
-        o.paper_ms, o.ratio_to_paper
-    );
-    println!(
-        "| octree traversal, all bricks, threshold 0.5 | {:.3} | {} boxes |",
-        o.traverse_ms, o.boxes
-    );
+    println!("| R-V 2006 §8 (3.0 GHz Xeon) | {:.1} | ours / paper = {:.3} |", o.paper_ms, o.ratio_to_paper);
+    println!("| octree traversal, all bricks, threshold 0.5 | {:.3} | {} boxes |", o.traverse_ms, o.boxes);
 }

@@ -94,21 +94,9 @@ pub fn run(json_out: Option<&Path>) -> anyhow::Result<()> {
 pub fn measure() -> anyhow::Result<CompileBenchReport> {
     let timing = time_generated_graph()?;
     let viewport = (1920, 1080);
-    let mut graphs = vec![memory_of(
-        "(generated bench_30)",
-        &thirty_pass_graph(),
-        viewport,
-    )];
-    graphs.extend(
-        graph_files()?
-            .iter()
-            .map(|(path, name)| graph_memory(path, name, viewport)),
-    );
-    Ok(CompileBenchReport {
-        viewport,
-        timing,
-        graphs,
-    })
+    let mut graphs = vec![memory_of("(generated bench_30)", &thirty_pass_graph(), viewport)];
+    graphs.extend(graph_files()?.iter().map(|(path, name)| graph_memory(path, name, viewport)));
+    Ok(CompileBenchReport { viewport, timing, graphs })
 }
 
 /// The generated 30-pass graph: `entry` → a chain `d1..d10` of direction passes; raycasts
@@ -118,33 +106,19 @@ pub fn measure() -> anyhow::Result<CompileBenchReport> {
 pub fn thirty_pass_graph() -> String {
     let mut passes: Vec<String> = vec![r#"Pass(id: "entry", kind: "entry_points")"#.to_string()];
     for i in 1..=10 {
-        let src = if i == 1 {
-            "entry.entry".to_string()
-        } else {
-            format!("d{}.dir", i - 1)
-        };
-        passes.push(format!(
-            r#"Pass(id: "d{i}", kind: "ray_directions", inputs: {{"entry": "{src}"}})"#
-        ));
+        let src = if i == 1 { "entry.entry".to_string() } else { format!("d{}.dir", i - 1) };
+        passes.push(format!(r#"Pass(id: "d{i}", kind: "ray_directions", inputs: {{"entry": "{src}"}})"#));
     }
-    let mut outputs = vec![
-        r#""image": "final.color""#.to_string(),
-        r#""display": "final_present.display""#.to_string(),
-    ];
+    let mut outputs =
+        vec![r#""image": "final.color""#.to_string(), r#""display": "final_present.display""#.to_string()];
     for k in 1..=8 {
-        let kind = if k % 2 == 0 {
-            "raycast_compute"
-        } else {
-            "raycast"
-        };
+        let kind = if k % 2 == 0 { "raycast_compute" } else { "raycast" };
         passes.push(format!(
             r#"Pass(id: "r{k}", kind: "{kind}", params: {{"step_voxels": 0.5}}, inputs: {{"entry": "entry.entry", "dir": "d{}.dir", "volume": "input.volume", "tf": "input.tf"}})"#,
             k + 2
         ));
         if k <= 5 {
-            passes.push(format!(
-                r#"Pass(id: "p{k}", kind: "present", inputs: {{"color": "r{k}.color"}})"#
-            ));
+            passes.push(format!(r#"Pass(id: "p{k}", kind: "present", inputs: {{"color": "r{k}.color"}})"#));
             outputs.push(format!(r#""display{k}": "p{k}.display""#));
         } else {
             outputs.push(format!(r#""image{k}": "r{k}.color""#));
@@ -161,14 +135,9 @@ pub fn thirty_pass_graph() -> String {
         r#"Pass(id: "final", kind: "raycast", inputs: {"entry": "entry.entry", "dir": "refine.v", "volume": "input.volume", "tf": "input.tf"})"#
             .to_string(),
     );
-    passes.push(
-        r#"Pass(id: "final_present", kind: "present", inputs: {"color": "final.color"})"#
-            .to_string(),
-    );
-    passes
-        .push(r#"Pass(id: "x1", kind: "ray_directions", inputs: {"entry": "d5.dir"})"#.to_string());
-    passes
-        .push(r#"Pass(id: "x2", kind: "ray_directions", inputs: {"entry": "x1.dir"})"#.to_string());
+    passes.push(r#"Pass(id: "final_present", kind: "present", inputs: {"color": "final.color"})"#.to_string());
+    passes.push(r#"Pass(id: "x1", kind: "ray_directions", inputs: {"entry": "d5.dir"})"#.to_string());
+    passes.push(r#"Pass(id: "x2", kind: "ray_directions", inputs: {"entry": "x1.dir"})"#.to_string());
     format!(
         "Graph(\n    name: \"bench_30\",\n    inputs: {{\"volume\": Volume, \"tf\": TransferFunction}},\n    passes: [\n        {}\n    ],\n    outputs: {{{}}},\n)\n",
         passes.join(",\n        "),
@@ -189,15 +158,7 @@ fn time_generated_graph() -> anyhow::Result<CompileTiming> {
     let mut us: Vec<f64> = (0..ITERATIONS)
         .map(|_| {
             let start = Instant::now();
-            std::hint::black_box(
-                compile(
-                    "bench_30.ron",
-                    std::hint::black_box(&text),
-                    &registry,
-                    &options,
-                )
-                .ok(),
-            );
+            std::hint::black_box(compile("bench_30.ron", std::hint::black_box(&text), &registry, &options).ok());
             start.elapsed().as_secs_f64() * 1e6
         })
         .collect();
@@ -218,11 +179,7 @@ fn time_generated_graph() -> anyhow::Result<CompileTiming> {
 /// crate's sources.
 fn graphs_dir() -> PathBuf {
     let here = PathBuf::from("graphs");
-    if here.is_dir() {
-        here
-    } else {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../graphs")
-    }
+    if here.is_dir() { here } else { Path::new(env!("CARGO_MANIFEST_DIR")).join("../../graphs") }
 }
 
 /// `(path, display name)` of every graph file, sorted, skipping `graphs/tf/`.
@@ -231,20 +188,14 @@ fn graph_files() -> anyhow::Result<Vec<(PathBuf, String)>> {
     let mut files = Vec::new();
     let mut stack = vec![root.clone()];
     while let Some(dir) = stack.pop() {
-        for entry in
-            std::fs::read_dir(&dir).with_context(|| format!("reading {}", dir.display()))?
-        {
+        for entry in std::fs::read_dir(&dir).with_context(|| format!("reading {}", dir.display()))? {
             let path = entry?.path();
             if path.is_dir() {
                 if path.file_name().is_some_and(|n| n != "tf") || dir != root {
                     stack.push(path);
                 }
             } else if path.extension().is_some_and(|e| e == "ron") {
-                let rel = path
-                    .strip_prefix(&root)
-                    .unwrap_or(&path)
-                    .to_string_lossy()
-                    .replace('\\', "/");
+                let rel = path.strip_prefix(&root).unwrap_or(&path).to_string_lossy().replace('\\', "/");
                 files.push((path.clone(), format!("graphs/{rel}")));
             }
         }
@@ -281,12 +232,7 @@ fn memory_of(name: &str, source: &str, viewport: (u32, u32)) -> GraphMemory {
         history_bytes: None,
         error: Some(error),
     };
-    match compile(
-        name,
-        source,
-        &builtin_registry(),
-        &CompileOptions::new(viewport.0, viewport.1),
-    ) {
+    match compile(name, source, &builtin_registry(), &CompileOptions::new(viewport.0, viewport.1)) {
         Ok(plan) => {
             let m = plan.memory();
             GraphMemory {
@@ -311,15 +257,8 @@ fn mib(bytes: u64) -> f64 {
 pub fn to_markdown(r: &CompileBenchReport) -> String {
     let mut s = String::new();
     let t = &r.timing;
-    let _ = writeln!(
-        s,
-        "## Compile time (generated graph, {} passes → {} steps)\n",
-        t.passes, t.steps
-    );
-    let _ = writeln!(
-        s,
-        "| iterations | median µs | p10 µs | p90 µs | goal µs | median / goal |"
-    );
+    let _ = writeln!(s, "## Compile time (generated graph, {} passes → {} steps)\n", t.passes, t.steps);
+    let _ = writeln!(s, "| iterations | median µs | p10 µs | p90 µs | goal µs | median / goal |");
     let _ = writeln!(s, "|---:|---:|---:|---:|---:|---:|");
     let _ = writeln!(
         s,
@@ -331,30 +270,13 @@ pub fn to_markdown(r: &CompileBenchReport) -> String {
         t.goal_us,
         t.median_us / t.goal_us
     );
-    let _ = writeln!(
-        s,
-        "## Transient memory at {}x{}, no features\n",
-        r.viewport.0, r.viewport.1
-    );
-    let _ = writeln!(
-        s,
-        "| graph | steps | slots | pooled MiB | unpooled MiB | pooled / unpooled | history MiB |"
-    );
+    let _ = writeln!(s, "## Transient memory at {}x{}, no features\n", r.viewport.0, r.viewport.1);
+    let _ = writeln!(s, "| graph | steps | slots | pooled MiB | unpooled MiB | pooled / unpooled | history MiB |");
     let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|");
     for g in &r.graphs {
-        match (
-            g.steps,
-            g.slots,
-            g.pooled_bytes,
-            g.unpooled_bytes,
-            g.history_bytes,
-        ) {
+        match (g.steps, g.slots, g.pooled_bytes, g.unpooled_bytes, g.history_bytes) {
             (Some(steps), Some(slots), Some(p), Some(u), Some(h)) => {
-                let ratio = if u > 0 {
-                    format!("{:.2}", p as f64 / u as f64)
-                } else {
-                    "-".to_string()
-                };
+                let ratio = if u > 0 { format!("{:.2}", p as f64 / u as f64) } else { "-".to_string() };
                 let _ = writeln!(
                     s,
                     "| {} | {steps} | {slots} | {:.1} | {:.1} | {ratio} | {:.1} |",
@@ -365,17 +287,8 @@ pub fn to_markdown(r: &CompileBenchReport) -> String {
                 );
             }
             _ => {
-                let first = g
-                    .error
-                    .as_deref()
-                    .and_then(|e| e.lines().next())
-                    .unwrap_or("failed");
-                let _ = writeln!(
-                    s,
-                    "| {} | does not compile: {} | | | | | |",
-                    g.file,
-                    first.replace('|', "\\|")
-                );
+                let first = g.error.as_deref().and_then(|e| e.lines().next()).unwrap_or("failed");
+                let _ = writeln!(s, "| {} | does not compile: {} | | | | | |", g.file, first.replace('|', "\\|"));
             }
         }
     }
@@ -390,13 +303,8 @@ mod tests {
     fn generated_graph_has_thirty_passes_and_culls_two() {
         let text = thirty_pass_graph();
         assert_eq!(text.matches("Pass(").count(), 30);
-        let plan = compile(
-            "bench_30.ron",
-            &text,
-            &builtin_registry(),
-            &CompileOptions::new(1920, 1080),
-        )
-        .unwrap_or_else(|d| panic!("{d}\n{text}"));
+        let plan = compile("bench_30.ron", &text, &builtin_registry(), &CompileOptions::new(1920, 1080))
+            .unwrap_or_else(|d| panic!("{d}\n{text}"));
         assert_eq!(plan.culled, ["x1", "x2"]);
         // 28 live passes, the 2-pass body run 4 times instead of once.
         assert_eq!(plan.steps.len(), 28 + 2 * 3);
@@ -405,16 +313,8 @@ mod tests {
     #[test]
     fn graph_files_skip_transfer_functions() {
         let files = graph_files().expect("graphs/ is readable");
-        assert!(
-            files
-                .iter()
-                .any(|(_, n)| n == "graphs/basic/fragment_raycast.ron"),
-            "{files:?}"
-        );
-        assert!(
-            files.iter().all(|(_, n)| !n.starts_with("graphs/tf/")),
-            "{files:?}"
-        );
+        assert!(files.iter().any(|(_, n)| n == "graphs/basic/fragment_raycast.ron"), "{files:?}");
+        assert!(files.iter().all(|(_, n)| !n.starts_with("graphs/tf/")), "{files:?}");
     }
 
     /// The benchmark itself, for a run without the CLI:

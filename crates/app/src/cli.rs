@@ -96,6 +96,7 @@ pub struct RawArgs {
 }
 
 #[derive(Subcommand, Debug)]
+#[allow(clippy::large_enum_variant, reason = "parsed once per process; boxing would only obscure the clap derive")]
 enum BenchCommand {
     /// Min/max grid + classification of the engine volume; octree rebuild after a TF change.
     Accel {
@@ -164,7 +165,8 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Plan { graph, size, features, scalars } => {
             let source = inputs::read_graph(&graph)?;
             let options = compile_options(&size, &features, &scalars)?;
-            let plan = compile(&display_name(&graph), &source, &builtin_registry(), &options).map_err(CliError::Graph)?;
+            let plan =
+                compile(&display_name(&graph), &source, &builtin_registry(), &options).map_err(CliError::Graph)?;
             print!("{}", plan.to_text());
             Ok(())
         }
@@ -182,7 +184,11 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                 RenderSession::new(&gpu, &shaders, &registry, &display_name(&graph), &source, &options, &volume, &lut)?;
             let is_exr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
             let output = output.unwrap_or_else(|| {
-                if !is_exr && session.plan().outputs.contains_key("display") { "display".to_string() } else { "image".to_string() }
+                if !is_exr && session.plan().outputs.contains_key("display") {
+                    "display".to_string()
+                } else {
+                    "image".to_string()
+                }
             });
             let mut last = None;
             for f in 0..frames.max(1) {
@@ -193,12 +199,16 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             if is_exr {
                 image_out::write_exr(&out, &image)?;
             } else {
-                let srgb = image.channels == 4 && session.plan().outputs.get(&output).is_some_and(|&r| {
-                    matches!(
-                        session.plan().resources[r].desc,
-                        volgraph_core::plan::ResourceDesc::Target { format: volgraph_core::TargetFormat::Rgba8Unorm, .. }
-                    )
-                });
+                let srgb = image.channels == 4
+                    && session.plan().outputs.get(&output).is_some_and(|&r| {
+                        matches!(
+                            session.plan().resources[r].desc,
+                            volgraph_core::plan::ResourceDesc::Target {
+                                format: volgraph_core::TargetFormat::Rgba8Unorm,
+                                ..
+                            }
+                        )
+                    });
                 image_out::write_png(&out, &image, srgb)?;
             }
             if let Some(stats) = last {

@@ -18,8 +18,8 @@ pub fn write_png(path: &Path, image: &Image, already_srgb: bool) -> anyhow::Resu
     for y in 0..image.height {
         for x in 0..image.width {
             let p = image.rgba(x, y);
-            for c in 0..3 {
-                let v = if already_srgb { p[c] } else { srgb_encode(p[c]) };
+            for v in &p[..3] {
+                let v = if already_srgb { *v } else { srgb_encode(*v) };
                 bytes.push((v.clamp(0.0, 1.0) * 255.0).round() as u8);
             }
             bytes.push(255);

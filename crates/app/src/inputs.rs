@@ -26,7 +26,8 @@ pub fn raw_options(raw: &crate::cli::RawArgs) -> anyhow::Result<RawOptions> {
         if parts.len() != 3 {
             return Err(fail());
         }
-        let v: Vec<u32> = parts.iter().map(|p| p.trim().parse::<u32>().map_err(|_| fail())).collect::<Result<_, _>>()?;
+        let v: Vec<u32> =
+            parts.iter().map(|p| p.trim().parse::<u32>().map_err(|_| fail())).collect::<Result<_, _>>()?;
         if v.contains(&0) {
             return Err(fail());
         }
@@ -40,7 +41,8 @@ pub fn raw_options(raw: &crate::cli::RawArgs) -> anyhow::Result<RawOptions> {
     }
     if let Some(s) = &raw.spacing {
         let fail = || anyhow!("--spacing \"{s}\": expected three positive numbers X,Y,Z, e.g. 1,1,1.4");
-        let v: Vec<f64> = s.split(',').map(|p| p.trim().parse::<f64>().map_err(|_| fail())).collect::<Result<_, _>>()?;
+        let v: Vec<f64> =
+            s.split(',').map(|p| p.trim().parse::<f64>().map_err(|_| fail())).collect::<Result<_, _>>()?;
         if v.len() != 3 || v.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
             return Err(fail());
         }
@@ -93,7 +95,11 @@ pub fn parse_size(text: &str) -> anyhow::Result<(u32, u32)> {
 /// side is 1).
 pub fn parse_camera(text: &str) -> anyhow::Result<OrbitCamera> {
     let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    let fail = || anyhow!("--camera \"{text}\": expected AZIMUTH,ELEVATION,DISTANCE in degrees, degrees and world units, e.g. 30,20,3.2");
+    let fail = || {
+        anyhow!(
+            "--camera \"{text}\": expected AZIMUTH,ELEVATION,DISTANCE in degrees, degrees and world units, e.g. 30,20,3.2"
+        )
+    };
     if parts.len() != 3 {
         return Err(fail());
     }

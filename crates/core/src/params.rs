@@ -204,7 +204,7 @@ pub fn check_param(spec: &ParamSpec, value: &ron::Value) -> Result<ParamValue, P
     use ron::Value as V;
     let number = |v: &V| -> Option<f64> {
         match v {
-            V::Number(n) => Some(n.clone().into_f64()),
+            V::Number(n) => Some((*n).into_f64()),
             _ => None,
         }
     };
@@ -245,7 +245,7 @@ pub fn describe(value: &ron::Value) -> String {
         V::Bool(b) => format!("the boolean {b}"),
         V::Char(c) => format!("the character '{c}'"),
         V::String(s) => format!("the string \"{s}\""),
-        V::Number(n) => format!("the number {}", n.clone().into_f64()),
+        V::Number(n) => format!("the number {}", (*n).into_f64()),
         V::Option(_) => "an option".to_string(),
         V::Seq(_) => "a list".to_string(),
         V::Map(_) => "a map".to_string(),

@@ -192,7 +192,8 @@ impl Plan {
         } else {
             self.features.iter().cloned().collect::<Vec<_>>().join(", ")
         };
-        let _ = writeln!(s, "plan \"{}\" at {}x{}, features: {}", self.name, self.viewport.0, self.viewport.1, features);
+        let _ =
+            writeln!(s, "plan \"{}\" at {}x{}, features: {}", self.name, self.viewport.0, self.viewport.1, features);
         let _ = writeln!(s, "steps ({}):", self.steps.len());
         for (i, step) in self.steps.iter().enumerate() {
             let _ = writeln!(s, "  {i:>3} {} [{}]", step.label, step.kind);
@@ -218,7 +219,8 @@ impl Plan {
                 let _ = writeln!(s, "        {arrow} {:<10} {what}", p.port);
             }
         }
-        let _ = writeln!(s, "culled: {}", if self.culled.is_empty() { "none".to_string() } else { self.culled.join(", ") });
+        let _ =
+            writeln!(s, "culled: {}", if self.culled.is_empty() { "none".to_string() } else { self.culled.join(", ") });
         if !self.gated.is_empty() {
             let g: Vec<String> = self.gated.iter().map(|(p, f)| format!("{p} (needs {})", f.join(", "))).collect();
             let _ = writeln!(s, "off by features: {}", g.join(", "));
@@ -244,11 +246,8 @@ impl Plan {
             let _ = writeln!(s, "output {name}: {}", self.resources[*r].name);
         }
         let m = self.memory();
-        let saved = if m.unpooled_bytes > 0 {
-            100.0 * (1.0 - m.pooled_bytes as f64 / m.unpooled_bytes as f64)
-        } else {
-            0.0
-        };
+        let saved =
+            if m.unpooled_bytes > 0 { 100.0 * (1.0 - m.pooled_bytes as f64 / m.unpooled_bytes as f64) } else { 0.0 };
         let _ = writeln!(
             s,
             "transient memory: pooled {}, unpooled {} ({saved:.0}% saved); history {}",

@@ -76,11 +76,7 @@ fn check(text: &str) -> Result<(), String> {
         match &item.location {
             Location::Span(span) => {
                 if span.start > text.len() || span.end < span.start {
-                    return Err(format!(
-                        "span {span:?} outside a {}-byte file: {}",
-                        text.len(),
-                        item.message
-                    ));
+                    return Err(format!("span {span:?} outside a {}-byte file: {}", text.len(), item.message));
                 }
                 let rest = position.strip_prefix("fuzz.ron:").unwrap_or_default();
                 let nums: Vec<usize> = rest.split(':').filter_map(|n| n.parse().ok()).collect();
@@ -90,10 +86,7 @@ fn check(text: &str) -> Result<(), String> {
             }
             Location::Field { pass, field } => {
                 if pass.is_empty() || field.is_empty() {
-                    return Err(format!(
-                        "empty pass or field in {position:?}: {}",
-                        item.message
-                    ));
+                    return Err(format!("empty pass or field in {position:?}: {}", item.message));
                 }
             }
             Location::File => return Err(format!("unlocated diagnostic: {}", item.message)),
@@ -120,11 +113,9 @@ fn tokens(text: &str) -> Vec<&str> {
         } else if "()[]{},:".contains(c) {
             1
         } else if c.is_whitespace() {
-            rest.find(|x: char| !x.is_whitespace())
-                .unwrap_or(rest.len())
+            rest.find(|x: char| !x.is_whitespace()).unwrap_or(rest.len())
         } else {
-            rest.find(|x: char| x.is_whitespace() || "()[]{},:\"".contains(x))
-                .unwrap_or(rest.len())
+            rest.find(|x: char| x.is_whitespace() || "()[]{},:\"".contains(x)).unwrap_or(rest.len())
         };
         out.push(&rest[..len]);
         rest = &rest[len..];
@@ -133,9 +124,7 @@ fn tokens(text: &str) -> Vec<&str> {
 }
 
 /// Inserted text: multibyte characters, RON punctuation and words the format uses.
-const SNIPPETS: [&str; 12] = [
-    "é", "→", "🦀", "\u{0}", "\"", "(", "]", "}", ":", ",", "Repeat(", "...",
-];
+const SNIPPETS: [&str; 12] = ["é", "→", "🦀", "\u{0}", "\"", "(", "]", "}", ":", ",", "Repeat(", "..."];
 
 #[derive(Clone, Debug)]
 enum Mutation {
@@ -163,11 +152,7 @@ fn mutation() -> impl Strategy<Value = Mutation> {
 fn apply(text: &str, m: &Mutation) -> String {
     let bytes = text.as_bytes();
     let at = |i: usize| {
-        if bytes.is_empty() {
-            0
-        } else {
-            i % (bytes.len() + 1)
-        }
+        if bytes.is_empty() { 0 } else { i % (bytes.len() + 1) }
     };
     match m {
         Mutation::Truncate(i) => String::from_utf8_lossy(&bytes[..at(*i)]).into_owned(),
@@ -226,10 +211,7 @@ fn apply(text: &str, m: &Mutation) -> String {
 }
 
 fn fuzz_cases() -> u32 {
-    std::env::var("VOLGRAPH_FUZZ_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(1024)
+    std::env::var("VOLGRAPH_FUZZ_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(1024)
 }
 
 #[test]
@@ -275,18 +257,9 @@ proptest! {
 /// The property is not vacuous: a mutation that breaks the file fails with a located error.
 #[test]
 fn broken_files_fail_with_a_location() {
-    for m in [
-        Mutation::Truncate(MULTIPASS.len() / 2),
-        Mutation::Insert(MULTIPASS.find("passes").unwrap_or(0), 2),
-    ] {
+    for m in [Mutation::Truncate(MULTIPASS.len() / 2), Mutation::Insert(MULTIPASS.find("passes").unwrap_or(0), 2)] {
         let text = apply(MULTIPASS, &m);
-        let err = compile(
-            FILE,
-            &text,
-            &support::registry(),
-            &CompileOptions::new(320, 200),
-        )
-        .expect_err("broken file");
+        let err = compile(FILE, &text, &support::registry(), &CompileOptions::new(320, 200)).expect_err("broken file");
         assert!(err.to_string().starts_with("fuzz.ron:"), "{err}");
         assert_eq!(check(&text), Ok(()));
     }

@@ -33,18 +33,11 @@ fn doc() -> String {
 #[test]
 fn every_ron_example_in_the_graph_format_doc_compiles() {
     let blocks = ron_blocks(&doc());
-    assert!(
-        blocks.len() >= 3,
-        "expected the multipass, history and minimal examples, found {}",
-        blocks.len()
-    );
+    assert!(blocks.len() >= 3, "expected the multipass, history and minimal examples, found {}", blocks.len());
     let all_features = ["reprojection", "antialias", "shading"];
     for (line, text) in &blocks {
         let name = format!("docs/graph_format.md (block at line {line})");
-        for options in [
-            CompileOptions::new(1920, 1080),
-            CompileOptions::new(1920, 1080).with_features(all_features),
-        ] {
+        for options in [CompileOptions::new(1920, 1080), CompileOptions::new(1920, 1080).with_features(all_features)] {
             if let Err(d) = compile(&name, text, &support::registry(), &options) {
                 panic!("{d}\n\n{text}");
             }
@@ -55,45 +48,23 @@ fn every_ron_example_in_the_graph_format_doc_compiles() {
 #[test]
 fn multipass_example_unrolls_its_segments() {
     let blocks = ron_blocks(&doc());
-    let (_, text) = blocks
-        .iter()
-        .find(|(_, t)| t.contains("kw_multipass"))
-        .expect("the multipass example");
-    let plan = compile(
-        "kw.ron",
-        text,
-        &support::registry(),
-        &CompileOptions::new(800, 600),
-    )
-    .unwrap_or_else(|d| panic!("{d}"));
+    let (_, text) = blocks.iter().find(|(_, t)| t.contains("kw_multipass")).expect("the multipass example");
+    let plan =
+        compile("kw.ron", text, &support::registry(), &CompileOptions::new(800, 600)).unwrap_or_else(|d| panic!("{d}"));
     // ceil(512 / 8) = 64 iterations of two passes, plus entry, dirs, clear and present, less
     // the last termination test: nothing reads the depth after the final segment, so it is culled.
     assert_eq!(plan.steps.len(), 4 + 2 * 64 - 1);
-    let last: Vec<&str> = plan.steps[plan.steps.len() - 3..]
-        .iter()
-        .map(|s| s.label.as_str())
-        .collect();
+    let last: Vec<&str> = plan.steps[plan.steps.len() - 3..].iter().map(|s| s.label.as_str()).collect();
     assert_eq!(last, ["segments[62]/term", "segments[63]/seg", "present"]);
-    assert_eq!(
-        plan.resources[plan.outputs["image"]].name,
-        "segments[63]/seg.color"
-    );
+    assert_eq!(plan.resources[plan.outputs["image"]].name, "segments[63]/seg.color");
 }
 
 #[test]
 fn history_example_gates_reprojection_and_antialiasing() {
     let blocks = ron_blocks(&doc());
-    let (_, text) = blocks
-        .iter()
-        .find(|(_, t)| t.contains("klein_coherence"))
-        .expect("the history example");
-    let off = compile(
-        "klein.ron",
-        text,
-        &support::registry(),
-        &CompileOptions::new(800, 600),
-    )
-    .unwrap_or_else(|d| panic!("{d}"));
+    let (_, text) = blocks.iter().find(|(_, t)| t.contains("klein_coherence")).expect("the history example");
+    let off = compile("klein.ron", text, &support::registry(), &CompileOptions::new(800, 600))
+        .unwrap_or_else(|d| panic!("{d}"));
     let labels: Vec<&str> = off.steps.iter().map(|s| s.label.as_str()).collect();
     assert_eq!(labels, ["entry", "dirs", "march", "present"]);
     let on = compile(
@@ -104,23 +75,12 @@ fn history_example_gates_reprojection_and_antialiasing() {
     )
     .unwrap_or_else(|d| panic!("{d}"));
     let labels: Vec<&str> = on.steps.iter().map(|s| s.label.as_str()).collect();
-    assert_eq!(
-        labels,
-        ["entry", "dirs", "splat", "fill", "march", "aa", "present"]
-    );
-    assert!(
-        on.slots[on.resources[on.history["prev_hit"].source]
-            .slot
-            .expect("a target")]
-        .persistent
-    );
+    assert_eq!(labels, ["entry", "dirs", "splat", "fill", "march", "aa", "present"]);
+    assert!(on.slots[on.resources[on.history["prev_hit"].source].slot.expect("a target")].persistent);
 }
 
 #[test]
 fn block_extraction_finds_fenced_ron_only() {
     let md = "text\n```ron\nGraph()\n```\n```rust\nfn x() {}\n```\n```ron\nA\nB\n```\n";
-    assert_eq!(
-        ron_blocks(md),
-        [(3, "Graph()\n".to_string()), (9, "A\nB\n".to_string())]
-    );
+    assert_eq!(ron_blocks(md), [(3, "Graph()\n".to_string()), (9, "A\nB\n".to_string())]);
 }

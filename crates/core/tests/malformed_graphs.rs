@@ -33,20 +33,10 @@ fn cases() -> Vec<PathBuf> {
 
 /// The diagnostics text of one file, named as it would be from the workspace root.
 fn diagnostics_of(path: &Path) -> Result<String, String> {
-    let name = format!(
-        "tests/graphs/malformed/{}",
-        path.file_name().and_then(|n| n.to_str()).unwrap_or("?")
-    );
+    let name = format!("tests/graphs/malformed/{}", path.file_name().and_then(|n| n.to_str()).unwrap_or("?"));
     let source = fs::read_to_string(path).map_err(|e| format!("{name}: cannot read: {e}"))?;
-    match compile(
-        &name,
-        &source,
-        &support::registry(),
-        &CompileOptions::new(1920, 1080),
-    ) {
-        Ok(_) => Err(format!(
-            "{name} compiled, but it is in the malformed folder"
-        )),
+    match compile(&name, &source, &support::registry(), &CompileOptions::new(1920, 1080)) {
+        Ok(_) => Err(format!("{name} compiled, but it is in the malformed folder")),
         Err(d) => Ok(format!("{d}\n")),
     }
 }
@@ -54,11 +44,7 @@ fn diagnostics_of(path: &Path) -> Result<String, String> {
 #[test]
 fn malformed_graphs_report_exact_messages() {
     let cases = cases();
-    assert!(
-        cases.len() >= 12,
-        "expected at least 12 malformed graphs, found {}",
-        cases.len()
-    );
+    assert!(cases.len() >= 12, "expected at least 12 malformed graphs, found {}", cases.len());
     let mut failures = Vec::new();
     for path in &cases {
         let actual = match diagnostics_of(path) {
@@ -75,23 +61,15 @@ fn malformed_graphs_report_exact_messages() {
         }
         match fs::read_to_string(&expected_path) {
             Ok(expected) if expected == actual => {}
-            Ok(expected) => failures.push(format!(
-                "{}:\n--- expected\n{expected}--- actual\n{actual}",
-                expected_path.display()
-            )),
-            Err(e) => failures.push(format!(
-                "{}: {e} (run with VOLGRAPH_BLESS=1 to create it)",
-                expected_path.display()
-            )),
+            Ok(expected) => {
+                failures.push(format!("{}:\n--- expected\n{expected}--- actual\n{actual}", expected_path.display()))
+            }
+            Err(e) => {
+                failures.push(format!("{}: {e} (run with VOLGRAPH_BLESS=1 to create it)", expected_path.display()))
+            }
         }
     }
-    assert!(
-        failures.is_empty(),
-        "{} of {} cases failed:\n\n{}",
-        failures.len(),
-        cases.len(),
-        failures.join("\n")
-    );
+    assert!(failures.is_empty(), "{} of {} cases failed:\n\n{}", failures.len(), cases.len(), failures.join("\n"));
 }
 
 /// Each expected file is located: every problem line starts with the file name and either a
@@ -100,37 +78,18 @@ fn malformed_graphs_report_exact_messages() {
 fn every_expected_message_is_located_and_helpful() {
     for path in cases() {
         let expected = fs::read_to_string(path.with_extension("expected")).unwrap_or_default();
-        let name = format!(
-            "tests/graphs/malformed/{}",
-            path.file_name().and_then(|n| n.to_str()).unwrap_or("?")
-        );
-        let problems: Vec<&str> = expected
-            .lines()
-            .filter(|l| !l.starts_with("  help: "))
-            .collect();
-        assert!(
-            !problems.is_empty(),
-            "{}: no problem reported",
-            path.display()
-        );
+        let name = format!("tests/graphs/malformed/{}", path.file_name().and_then(|n| n.to_str()).unwrap_or("?"));
+        let problems: Vec<&str> = expected.lines().filter(|l| !l.starts_with("  help: ")).collect();
+        assert!(!problems.is_empty(), "{}: no problem reported", path.display());
         for line in &problems {
             let rest = line
                 .strip_prefix(&format!("{name}:"))
                 .unwrap_or_else(|| panic!("{line:?} does not start with {name}:"));
-            let located = rest.split(':').take(2).all(|n| n.parse::<u32>().is_ok())
-                || rest.starts_with(" pass \"");
+            let located = rest.split(':').take(2).all(|n| n.parse::<u32>().is_ok()) || rest.starts_with(" pass \"");
             assert!(located, "{line:?} has no line:col and no pass/field");
         }
-        let helps = expected
-            .lines()
-            .filter(|l| l.starts_with("  help: "))
-            .count();
-        assert_eq!(
-            helps,
-            problems.len(),
-            "{}: every problem needs a help line:\n{expected}",
-            path.display()
-        );
+        let helps = expected.lines().filter(|l| l.starts_with("  help: ")).count();
+        assert_eq!(helps, problems.len(), "{}: every problem needs a help line:\n{expected}", path.display());
     }
 }
 

@@ -58,7 +58,8 @@ fn a_scalar_reference_is_checked_like_a_written_value() {
     assert!(text.contains("parameter \"steps\" of pass \"seg\" is 5000, outside its range"), "{text}");
     // A reference to something that is not a Scalar input.
     let broken = GRAPH.replace("\"steps\": \"input.M\"", "\"steps\": \"input.volume\"");
-    let err = compile("shared.ron", &broken, &support::registry(), &CompileOptions::new(8, 8)).expect_err("not a scalar");
+    let err =
+        compile("shared.ron", &broken, &support::registry(), &CompileOptions::new(8, 8)).expect_err("not a scalar");
     let text = err.to_string();
     assert!(
         text.contains("parameter \"steps\" of pass \"seg\" reads \"input.volume\", which is not a Scalar graph input"),

@@ -8,8 +8,8 @@
 use volgraph_core::executor::{CreateContext, PassError, RecordContext};
 use volgraph_core::plan::{Binding, ResourceDesc};
 use volgraph_core::{
-    Access, CompileOptions, ParamSpec, Params, PassNode, PassPlugin, Plan, PortKind, PortSpec,
-    Registry, TargetFormat, compile,
+    Access, CompileOptions, ParamSpec, Params, PassNode, PassPlugin, Plan, PortKind, PortSpec, Registry, TargetFormat,
+    compile,
 };
 
 /// A pass kind described as data: a name, ports, parameters and features.
@@ -22,29 +22,21 @@ struct Kind {
 
 impl Kind {
     fn new(name: &'static str) -> Self {
-        Self {
-            name,
-            ports: Vec::new(),
-            params: Vec::new(),
-            features: Vec::new(),
-        }
+        Self { name, ports: Vec::new(), params: Vec::new(), features: Vec::new() }
     }
 
     fn read(mut self, port: &'static str, format: TargetFormat) -> Self {
-        self.ports
-            .push(PortSpec::read(port, PortKind::target(&[format])));
+        self.ports.push(PortSpec::read(port, PortKind::target(&[format])));
         self
     }
 
     fn write(mut self, port: &'static str, format: TargetFormat) -> Self {
-        self.ports
-            .push(PortSpec::write(port, PortKind::target(&[format])));
+        self.ports.push(PortSpec::write(port, PortKind::target(&[format])));
         self
     }
 
     fn modify(mut self, port: &'static str, format: TargetFormat) -> Self {
-        self.ports
-            .push(PortSpec::modify(port, PortKind::target(&[format])));
+        self.ports.push(PortSpec::modify(port, PortKind::target(&[format])));
         self
     }
 
@@ -104,17 +96,8 @@ fn registry() -> Registry {
     r.register(Kind::new("source16").write("out", RGBA16));
     r.register(Kind::new("filter").read("src", RGBA32).write("out", RGBA32));
     r.register(Kind::new("to16").read("src", RGBA32).write("out", RGBA16));
-    r.register(
-        Kind::new("blend")
-            .read("a", RGBA32)
-            .read("b", RGBA32)
-            .write("out", RGBA32),
-    );
-    r.register(
-        Kind::new("clear")
-            .write("color", RGBA32)
-            .write("depth", DEPTH),
-    );
+    r.register(Kind::new("blend").read("a", RGBA32).read("b", RGBA32).write("out", RGBA32));
+    r.register(Kind::new("clear").write("color", RGBA32).write("depth", DEPTH));
     r.register(
         Kind::new("segment")
             .read("accum", RGBA32)
@@ -122,22 +105,9 @@ fn registry() -> Registry {
             .write("color", RGBA32)
             .param(ParamSpec::uint("steps", 8, 1, 1024, "samples per segment")),
     );
-    r.register(
-        Kind::new("depth_peek")
-            .read("depth", DEPTH)
-            .write("out", RGBA32),
-    );
-    r.register(
-        Kind::new("terminate")
-            .read("color", RGBA32)
-            .modify("depth", DEPTH),
-    );
-    r.register(
-        Kind::new("antialias")
-            .read("src", RGBA32)
-            .write("out", RGBA32)
-            .feature("antialias"),
-    );
+    r.register(Kind::new("depth_peek").read("depth", DEPTH).write("out", RGBA32));
+    r.register(Kind::new("terminate").read("color", RGBA32).modify("depth", DEPTH));
+    r.register(Kind::new("antialias").read("src", RGBA32).write("out", RGBA32).feature("antialias"));
     r
 }
 
@@ -146,8 +116,7 @@ fn plan(source: &str) -> Plan {
 }
 
 fn plan_with(source: &str, options: &CompileOptions) -> Plan {
-    compile("test.ron", source, &registry(), options)
-        .unwrap_or_else(|d| panic!("does not compile:\n{d}"))
+    compile("test.ron", source, &registry(), options).unwrap_or_else(|d| panic!("does not compile:\n{d}"))
 }
 
 fn labels(plan: &Plan) -> Vec<&str> {
@@ -156,17 +125,8 @@ fn labels(plan: &Plan) -> Vec<&str> {
 
 /// The binding of `port` on the step labelled `label`.
 fn binding<'a>(plan: &'a Plan, label: &str, port: &str) -> &'a Binding {
-    let step = plan
-        .steps
-        .iter()
-        .find(|s| s.label == label)
-        .unwrap_or_else(|| panic!("no step {label}"));
-    &step
-        .ports
-        .iter()
-        .find(|p| p.port == port)
-        .unwrap_or_else(|| panic!("{label} has no port {port}"))
-        .binding
+    let step = plan.steps.iter().find(|s| s.label == label).unwrap_or_else(|| panic!("no step {label}"));
+    &step.ports.iter().find(|p| p.port == port).unwrap_or_else(|| panic!("{label} has no port {port}")).binding
 }
 
 /// The name of the resource `port` of step `label` reads (or writes, for Write ports).
@@ -178,11 +138,7 @@ fn resource_of(plan: &Plan, label: &str, port: &str) -> String {
 }
 
 fn slot_of(plan: &Plan, resource: &str) -> usize {
-    let r = plan
-        .resources
-        .iter()
-        .find(|r| r.name == resource)
-        .unwrap_or_else(|| panic!("no resource {resource}"));
+    let r = plan.resources.iter().find(|r| r.name == resource).unwrap_or_else(|| panic!("no resource {resource}"));
     r.slot.unwrap_or_else(|| panic!("{resource} has no slot"))
 }
 
@@ -193,15 +149,8 @@ fn assert_slots_never_overlap(plan: &Plan) {
         let mut previous_end: Option<usize> = None;
         for &id in &slot.holds {
             let r = &plan.resources[id];
-            let ResourceDesc::Target { format, extent, .. } = r.desc else {
-                panic!("{} is not a target", r.name)
-            };
-            assert_eq!(
-                (format, extent),
-                (slot.format, slot.extent),
-                "{} in slot{s}",
-                r.name
-            );
+            let ResourceDesc::Target { format, extent, .. } = r.desc else { panic!("{} is not a target", r.name) };
+            assert_eq!((format, extent), (slot.format, slot.extent), "{} in slot{s}", r.name);
             if r.modifies.is_some() {
                 continue; // the next version of a chain already holding the slot
             }
@@ -268,24 +217,15 @@ fn culling_drops_passes_no_output_needs_and_reports_them() {
 fn chain_of_eight_passes_needs_two_targets() {
     let mut passes = vec![r#"Pass(id: "p0", kind: "source")"#.to_string()];
     for i in 1..8 {
-        passes.push(format!(
-            r#"Pass(id: "p{i}", kind: "filter", inputs: {{"src": "p{}.out"}})"#,
-            i - 1
-        ));
+        passes.push(format!(r#"Pass(id: "p{i}", kind: "filter", inputs: {{"src": "p{}.out"}})"#, i - 1));
     }
-    let src = format!(
-        r#"Graph(name: "chain", passes: [{}], outputs: {{"image": "p7.out"}})"#,
-        passes.join(",\n")
-    );
+    let src = format!(r#"Graph(name: "chain", passes: [{}], outputs: {{"image": "p7.out"}})"#, passes.join(",\n"));
     let p = plan(&src);
     assert_eq!(p.steps.len(), 8);
     assert_eq!(p.slots.len(), 2, "{}", p.to_text());
     // Each pass reads the slot the previous one wrote and writes the other.
     for i in 1..8 {
-        assert_ne!(
-            slot_of(&p, &format!("p{}.out", i - 1)),
-            slot_of(&p, &format!("p{i}.out"))
-        );
+        assert_ne!(slot_of(&p, &format!("p{}.out", i - 1)), slot_of(&p, &format!("p{i}.out")));
     }
     let m = p.memory();
     assert_eq!(m.unpooled_bytes, 8 * 64 * 32 * 16);
@@ -306,18 +246,8 @@ fn differing_formats_and_sizes_never_share_a_slot() {
     );
     // a (dead after b) and d (64x32 = the viewport, same format) may share; c is half size and b
     // another format, so neither shares with anything.
-    let (a, b, c, d) = (
-        slot_of(&p, "a.out"),
-        slot_of(&p, "b.out"),
-        slot_of(&p, "c.out"),
-        slot_of(&p, "d.out"),
-    );
-    assert_eq!(
-        a,
-        d,
-        "Absolute(64, 32) at a 64x32 viewport is the same descriptor:\n{}",
-        p.to_text()
-    );
+    let (a, b, c, d) = (slot_of(&p, "a.out"), slot_of(&p, "b.out"), slot_of(&p, "c.out"), slot_of(&p, "d.out"));
+    assert_eq!(a, d, "Absolute(64, 32) at a 64x32 viewport is the same descriptor:\n{}", p.to_text());
     assert!(b != a && b != c && c != a, "{}", p.to_text());
     assert_eq!(p.slots[c].extent, (32, 16));
     assert_eq!(p.slots[b].format, RGBA16);
@@ -360,62 +290,28 @@ const SEGMENTS: &str = r#"Graph(name: "segments", passes: [
 #[test]
 fn repeat_group_unrolls_with_ping_pong() {
     let p = plan(SEGMENTS);
-    assert_eq!(
-        labels(&p),
-        [
-            "clear",
-            "segments[0]/seg",
-            "segments[1]/seg",
-            "segments[2]/seg",
-            "segments[3]/seg"
-        ]
-    );
+    assert_eq!(labels(&p), ["clear", "segments[0]/seg", "segments[1]/seg", "segments[2]/seg", "segments[3]/seg"]);
     assert_eq!(p.steps[2].iteration, Some((1, 4)));
     assert_eq!(p.steps[2].pass_id, "seg");
     assert_eq!(resource_of(&p, "segments[0]/seg", "accum"), "clear.color");
     for i in 1..4 {
-        assert_eq!(
-            resource_of(&p, &format!("segments[{i}]/seg"), "accum"),
-            format!("segments[{}]/seg.color", i - 1)
-        );
+        assert_eq!(resource_of(&p, &format!("segments[{i}]/seg"), "accum"), format!("segments[{}]/seg.color", i - 1));
     }
     // After the group, the carried value is the last iteration's.
-    assert_eq!(
-        p.resources[p.outputs["image"]].name,
-        "segments[3]/seg.color"
-    );
-    let color_slots: Vec<usize> = p
-        .slots
-        .iter()
-        .enumerate()
-        .filter(|(_, s)| s.format == RGBA32)
-        .map(|(i, _)| i)
-        .collect();
-    assert_eq!(
-        color_slots.len(),
-        2,
-        "accumulation ping-pongs between two targets:\n{}",
-        p.to_text()
-    );
+    assert_eq!(p.resources[p.outputs["image"]].name, "segments[3]/seg.color");
+    let color_slots: Vec<usize> =
+        p.slots.iter().enumerate().filter(|(_, s)| s.format == RGBA32).map(|(i, _)| i).collect();
+    assert_eq!(color_slots.len(), 2, "accumulation ping-pongs between two targets:\n{}", p.to_text());
     assert_slots_never_overlap(&p);
 }
 
 #[test]
 fn modify_port_keeps_one_slot_through_the_iterations() {
     let p = plan(SEGMENTS);
-    let depth_slots: Vec<usize> = p
-        .slots
-        .iter()
-        .enumerate()
-        .filter(|(_, s)| s.format == DEPTH)
-        .map(|(i, _)| i)
-        .collect();
+    let depth_slots: Vec<usize> =
+        p.slots.iter().enumerate().filter(|(_, s)| s.format == DEPTH).map(|(i, _)| i).collect();
     assert_eq!(depth_slots.len(), 1, "{}", p.to_text());
-    let holds: Vec<&str> = p.slots[depth_slots[0]]
-        .holds
-        .iter()
-        .map(|&r| p.resources[r].name.as_str())
-        .collect();
+    let holds: Vec<&str> = p.slots[depth_slots[0]].holds.iter().map(|&r| p.resources[r].name.as_str()).collect();
     assert_eq!(
         holds,
         [
@@ -428,21 +324,14 @@ fn modify_port_keeps_one_slot_through_the_iterations() {
     );
     // Iteration 1 modifies the version iteration 0 wrote.
     match binding(&p, "segments[1]/seg", "depth") {
-        Binding::Resource {
-            id,
-            written: Some(w),
-        } => {
+        Binding::Resource { id, written: Some(w) } => {
             assert_eq!(p.resources[*id].name, "segments[0]/seg.depth");
             assert_eq!(p.resources[*w].name, "segments[1]/seg.depth");
             assert_eq!(p.resources[*w].modifies, Some(*id));
         }
         other => panic!("depth bound to {other:?}"),
     }
-    assert_eq!(
-        p.steps[1].params.uint("steps"),
-        16,
-        "the test plugin's parameter reaches the step"
-    );
+    assert_eq!(p.steps[1].params.uint("steps"), 16, "the test plugin's parameter reaches the step");
 }
 
 #[test]
@@ -459,12 +348,7 @@ fn readers_of_the_old_version_run_before_the_modifier() {
         ], outputs: {"image": "mix.out"})"#,
     );
     let order = labels(&p);
-    let pos = |l: &str| {
-        order
-            .iter()
-            .position(|x| *x == l)
-            .unwrap_or_else(|| panic!("{l} not scheduled"))
-    };
+    let pos = |l: &str| order.iter().position(|x| *x == l).unwrap_or_else(|| panic!("{l} not scheduled"));
     assert!(pos("peek") < pos("term"), "{order:?}");
     assert!(pos("term") < pos("after"), "{order:?}");
     assert_eq!(resource_of(&p, "peek", "depth"), "clear.depth");
@@ -486,29 +370,14 @@ fn history_source_is_persistent_and_never_pooled() {
             ],
             outputs: {"image": "post3.out"})"#,
     );
-    assert_eq!(
-        binding(&p, "splat", "src"),
-        &Binding::History("prev".to_string())
-    );
+    assert_eq!(binding(&p, "splat", "src"), &Binding::History("prev".to_string()));
     let s = slot_of(&p, "march.out");
     assert!(p.slots[s].persistent);
-    assert_eq!(
-        p.slots[s].holds.len(),
-        1,
-        "the history source shares its texture with nobody:\n{}",
-        p.to_text()
-    );
+    assert_eq!(p.slots[s].holds.len(), 1, "the history source shares its texture with nobody:\n{}", p.to_text());
     assert_eq!(p.resources[p.history["prev"].source].name, "march.out");
     let m = p.memory();
-    assert_eq!(
-        m.history_bytes,
-        2 * 64 * 32 * 16,
-        "current and previous frame"
-    );
-    assert!(
-        p.to_text()
-            .contains("history prev: previous frame of march.out\n")
-    );
+    assert_eq!(m.history_bytes, 2 * 64 * 32 * 16, "current and previous frame");
+    assert!(p.to_text().contains("history prev: previous frame of march.out\n"));
     assert_slots_never_overlap(&p);
 }
 
@@ -525,29 +394,17 @@ fn gated_passes_run_only_with_all_their_features() {
     assert_eq!(labels(&off), ["march", "present"]);
     assert_eq!(
         off.gated,
-        [
-            ("aa".to_string(), vec!["antialias".to_string()]),
-            ("shade".to_string(), vec!["shading".to_string()])
-        ]
+        [("aa".to_string(), vec!["antialias".to_string()]), ("shade".to_string(), vec!["shading".to_string()])]
     );
     // Both stand-ins chain: present reads march's output directly.
     assert_eq!(resource_of(&off, "present", "src"), "march.out");
-    assert!(
-        off.to_text()
-            .contains("off by features: aa (needs antialias), shade (needs shading)\n")
-    );
+    assert!(off.to_text().contains("off by features: aa (needs antialias), shade (needs shading)\n"));
 
-    let aa_only = plan_with(
-        GATED,
-        &CompileOptions::new(64, 32).with_features(["antialias"]),
-    );
+    let aa_only = plan_with(GATED, &CompileOptions::new(64, 32).with_features(["antialias"]));
     assert_eq!(labels(&aa_only), ["march", "aa", "present"]);
     assert_eq!(resource_of(&aa_only, "present", "src"), "aa.out");
 
-    let all = plan_with(
-        GATED,
-        &CompileOptions::new(64, 32).with_features(["antialias", "shading"]),
-    );
+    let all = plan_with(GATED, &CompileOptions::new(64, 32).with_features(["antialias", "shading"]));
     assert_eq!(labels(&all), ["march", "aa", "shade", "present"]);
     assert!(all.gated.is_empty());
     assert_eq!(resource_of(&all, "present", "src"), "shade.out");
@@ -561,14 +418,8 @@ fn when_and_plugin_features_combine() {
     ], outputs: {"image": "aa.out"})"#;
     let hq_only = plan_with(src, &CompileOptions::new(64, 32).with_features(["hq"]));
     assert_eq!(labels(&hq_only), ["march"]);
-    assert_eq!(
-        hq_only.gated,
-        [("aa".to_string(), vec!["antialias".to_string()])]
-    );
-    let both = plan_with(
-        src,
-        &CompileOptions::new(64, 32).with_features(["hq", "antialias"]),
-    );
+    assert_eq!(hq_only.gated, [("aa".to_string(), vec!["antialias".to_string()])]);
+    let both = plan_with(src, &CompileOptions::new(64, 32).with_features(["hq", "antialias"]));
     assert_eq!(labels(&both), ["march", "aa"]);
 }
 
@@ -597,25 +448,10 @@ fn scene_derived_repeat_count() {
     let scene = CompileOptions::new(64, 32).with_scalar("longest_ray", 100.0);
     let p = plan_with(SCENE_COUNT, &scene);
     assert_eq!(iterations(&p), 13);
-    assert_eq!(
-        p.steps.last().map(|s| s.label.as_str()),
-        Some("segments[12]/seg")
-    );
+    assert_eq!(p.steps.last().map(|s| s.label.as_str()), Some("segments[12]/seg"));
     // Clamped to max, and to at least one iteration.
-    assert_eq!(
-        iterations(&plan_with(
-            SCENE_COUNT,
-            &CompileOptions::new(64, 32).with_scalar("longest_ray", 1e6)
-        )),
-        64
-    );
-    assert_eq!(
-        iterations(&plan_with(
-            SCENE_COUNT,
-            &CompileOptions::new(64, 32).with_scalar("longest_ray", 0.0)
-        )),
-        1
-    );
+    assert_eq!(iterations(&plan_with(SCENE_COUNT, &CompileOptions::new(64, 32).with_scalar("longest_ray", 1e6))), 64);
+    assert_eq!(iterations(&plan_with(SCENE_COUNT, &CompileOptions::new(64, 32).with_scalar("longest_ray", 0.0))), 1);
 }
 
 /// Regression: a repeat body written `Pass(...)` was rejected ("Expected struct `PassDoc` but
@@ -631,25 +467,17 @@ fn repeat_body_accepts_pass_named_and_unnamed() {
 fn modify_port_access_is_reported_in_the_plan() {
     let p = plan(SEGMENTS);
     let step = &p.steps[1];
-    let depth = step
-        .ports
-        .iter()
-        .find(|b| b.port == "depth")
-        .expect("segment declares depth");
+    let depth = step.ports.iter().find(|b| b.port == "depth").expect("segment declares depth");
     assert_eq!(depth.access, Access::Modify);
-    assert!(
-        p.to_text().contains("modify depth      clear.depth @slot"),
-        "{}",
-        p.to_text()
-    );
+    assert!(p.to_text().contains("modify depth      clear.depth @slot"), "{}", p.to_text());
 }
 
 /// Every iteration modifying the same (uncarried) value is an error whose help shows the carry.
 #[test]
 fn modifying_an_uncarried_value_in_every_iteration_explains_the_carry() {
     let src = SEGMENTS.replace(r#""depth": "segments.depth""#, r#""depth": "clear.depth""#);
-    let err = compile("test.ron", &src, &registry(), &CompileOptions::new(64, 32))
-        .expect_err("two modifiers of one value");
+    let err =
+        compile("test.ron", &src, &registry(), &CompileOptions::new(64, 32)).expect_err("two modifiers of one value");
     assert_eq!(
         err.to_string(),
         "test.ron: pass \"seg\", field inputs: passes \"segments[0]/seg\" and \"segments[1]/seg\" both modify \"clear.depth\"\n  \

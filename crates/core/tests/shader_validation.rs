@@ -51,48 +51,28 @@ fn every_shader_validates() {
     let top = wgsl_files(&root, "");
     let common = wgsl_files(&root.join("common"), "common/");
     // A project with no shaders would pass vacuously; these are the ones the passes need.
-    for needed in [
-        "entry_points.wgsl",
-        "ray_directions.wgsl",
-        "raycast.wgsl",
-        "raycast_compute.wgsl",
-    ] {
-        assert!(
-            top.iter().any(|t| t == needed),
-            "shaders/{needed} is missing (found: {top:?})"
-        );
+    for needed in ["entry_points.wgsl", "ray_directions.wgsl", "raycast.wgsl", "raycast_compute.wgsl"] {
+        assert!(top.iter().any(|t| t == needed), "shaders/{needed} is missing (found: {top:?})");
     }
 
     let mut failures = Vec::new();
     let mut imported = BTreeSet::new();
     for name in &top {
         match validate(&root, name) {
-            Ok((_, files)) => {
-                imported.extend(files.into_iter().filter_map(|f| f.canonicalize().ok()))
-            }
+            Ok((_, files)) => imported.extend(files.into_iter().filter_map(|f| f.canonicalize().ok())),
             Err(e) => failures.push(format!("shaders/{name}: {e}")),
         }
     }
     for name in &common {
-        let path = root
-            .join(name)
-            .canonicalize()
-            .unwrap_or_else(|_| root.join(name));
+        let path = root.join(name).canonicalize().unwrap_or_else(|_| root.join(name));
         if imported.contains(&path) {
             continue;
         }
         if let Err(e) = validate(&root, name) {
-            failures.push(format!(
-                "shaders/{name} (imported by no module, validated alone): {e}"
-            ));
+            failures.push(format!("shaders/{name} (imported by no module, validated alone): {e}"));
         }
     }
-    assert!(
-        failures.is_empty(),
-        "{} shader(s) failed:\n\n{}",
-        failures.len(),
-        failures.join("\n\n")
-    );
+    assert!(failures.is_empty(), "{} shader(s) failed:\n\n{}", failures.len(), failures.join("\n\n"));
 }
 
 /// The executor binds by global name (naga reflection), so binding numbers are free per module,
@@ -118,9 +98,7 @@ fn bindings_are_in_group_zero_and_shared_globals_keep_their_slots() {
         let imports = |common: &str| files.iter().any(|f| f.ends_with(common));
         for (global, group, binding) in bindings(&module) {
             if group != 0 {
-                failures.push(format!(
-                    "shaders/{name}: `{global}` is in @group({group}); everything is in @group(0)"
-                ));
+                failures.push(format!("shaders/{name}: `{global}` is in @group({group}); everything is in @group(0)"));
             }
             if let Some((_, file, want)) = shared.iter().find(|(n, _, _)| *n == global)
                 && imports(file)
@@ -132,10 +110,5 @@ fn bindings_are_in_group_zero_and_shared_globals_keep_their_slots() {
             }
         }
     }
-    assert!(
-        failures.is_empty(),
-        "{} binding problem(s):\n{}",
-        failures.len(),
-        failures.join("\n")
-    );
+    assert!(failures.is_empty(), "{} binding problem(s):\n{}", failures.len(), failures.join("\n"));
 }

@@ -33,7 +33,12 @@ impl EmptySpace {
 
 /// Checks that the empty-block grid bound to `port` has `ceil(volume / block_size)` blocks per
 /// axis, i.e. that a consumer's `block_size` matches the `minmax_grid` pass's.
-pub(crate) fn check_block_grid(ctx: &RecordContext<'_>, port: &str, block_size: u32, volume: [u32; 3]) -> Result<(), PassError> {
+pub(crate) fn check_block_grid(
+    ctx: &RecordContext<'_>,
+    port: &str,
+    block_size: u32,
+    volume: [u32; 3],
+) -> Result<(), PassError> {
     let grid = bound_size(ctx, port)?;
     let expected = volume.map(|n| n.div_ceil(block_size.max(1)));
     if grid != expected {
@@ -70,7 +75,11 @@ impl PassPlugin for EmptySpace {
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec { shader: "empty_space.wgsl", entry: "cs_classify", ..Default::default() })?;
+        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
+            shader: "empty_space.wgsl",
+            entry: "cs_classify",
+            ..Default::default()
+        })?;
         Ok(Box::new(EmptySpaceNode { pipeline, flags: None, tap: self.tap.clone() }))
     }
 }
@@ -85,18 +94,18 @@ impl PassNode for EmptySpaceNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let dims = bound_size(ctx, "grid")?;
         if self.flags.as_ref().is_none_or(|(_, _, d)| *d != dims) {
-            let texture = create_grid_texture(ctx, &format!("{} empty blocks", ctx.label), wgpu::TextureFormat::R32Float, dims);
+            let texture =
+                create_grid_texture(ctx, &format!("{} empty blocks", ctx.label), wgpu::TextureFormat::R32Float, dims);
             let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
             if let Some(tap) = &self.tap {
                 tap.set(&texture);
             }
             self.flags = Some((texture, view, dims));
         }
-        let view = self
-            .flags
-            .as_ref()
-            .map(|(_, v, _)| v.clone())
-            .ok_or_else(|| PassError { pass: ctx.label.to_string(), message: "empty-block texture missing right after creation".to_string() })?;
+        let view = self.flags.as_ref().map(|(_, v, _)| v.clone()).ok_or_else(|| PassError {
+            pass: ctx.label.to_string(),
+            message: "empty-block texture missing right after creation".to_string(),
+        })?;
         let bg = ctx.bind_group(&self.pipeline, &[("empty", wgpu::BindingResource::TextureView(&view))])?;
         dispatch_grid(ctx, &self.pipeline, Some(&bg), dims);
         Ok(())

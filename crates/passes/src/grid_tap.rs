@@ -47,12 +47,17 @@ impl GridTap {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("grid tap readback") });
+        let mut encoder =
+            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("grid tap readback") });
         encoder.copy_texture_to_buffer(
             texture.as_image_copy(),
             wgpu::TexelCopyBufferInfo {
                 buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded), rows_per_image: Some(size.height) },
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded),
+                    rows_per_image: Some(size.height),
+                },
             },
             size,
         );
@@ -60,7 +65,8 @@ impl GridTap {
         let slice = buffer.slice(..);
         slice.map_async(wgpu::MapMode::Read, |_| {});
         gpu.wait_idle();
-        let mut values = Vec::with_capacity((size.width * size.height * size.depth_or_array_layers * channels) as usize);
+        let mut values =
+            Vec::with_capacity((size.width * size.height * size.depth_or_array_layers * channels) as usize);
         {
             let data = slice.get_mapped_range().map_err(|e| format!("grid tap readback: {e}"))?;
             for z in 0..size.depth_or_array_layers {

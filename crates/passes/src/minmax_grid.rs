@@ -6,7 +6,9 @@
 //! on the first frame (its size comes from the bound volume) and built once; it is rebuilt when
 //! the volume's size changes. Shader: `shaders/minmax_grid.wgsl`.
 
-use volgraph_core::executor::{ComputePipelineSpec, CreateContext, PassError, PassPipeline, PipelineKind, RecordContext};
+use volgraph_core::executor::{
+    ComputePipelineSpec, CreateContext, PassError, PassPipeline, PipelineKind, RecordContext,
+};
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec};
 
@@ -47,7 +49,12 @@ pub(crate) fn block_size_spec() -> ParamSpec {
 }
 
 /// A 3D float texture usable as a storage output and a sampled input.
-pub(crate) fn create_grid_texture(ctx: &RecordContext<'_>, label: &str, format: wgpu::TextureFormat, dims: [u32; 3]) -> wgpu::Texture {
+pub(crate) fn create_grid_texture(
+    ctx: &RecordContext<'_>,
+    label: &str,
+    format: wgpu::TextureFormat,
+    dims: [u32; 3],
+) -> wgpu::Texture {
     ctx.gpu.device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d { width: dims[0], height: dims[1], depth_or_array_layers: dims[2] },
@@ -55,7 +62,9 @@ pub(crate) fn create_grid_texture(ctx: &RecordContext<'_>, label: &str, format: 
         sample_count: 1,
         dimension: wgpu::TextureDimension::D3,
         format,
-        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        usage: wgpu::TextureUsages::STORAGE_BINDING
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC,
         view_formats: &[],
     })
 }
@@ -68,12 +77,21 @@ pub(crate) fn bound_size(ctx: &RecordContext<'_>, port: &str) -> Result<[u32; 3]
 
 /// Records one dispatch of `pipeline` over `dims` texels (4³ per workgroup); `dims = None`
 /// records an empty pass, which keeps the step's label and timestamps.
-pub(crate) fn dispatch_grid(ctx: &mut RecordContext<'_>, pipeline: &PassPipeline, bind_group: Option<&wgpu::BindGroup>, dims: [u32; 3]) {
+pub(crate) fn dispatch_grid(
+    ctx: &mut RecordContext<'_>,
+    pipeline: &PassPipeline,
+    bind_group: Option<&wgpu::BindGroup>,
+    dims: [u32; 3],
+) {
     let mut pass = ctx.begin_compute_pass();
     if let (PipelineKind::Compute(p), Some(bg)) = (&pipeline.pipeline, bind_group) {
         pass.set_pipeline(p);
         pass.set_bind_group(0, bg, &[]);
-        pass.dispatch_workgroups(dims[0].div_ceil(GRID_WORKGROUP), dims[1].div_ceil(GRID_WORKGROUP), dims[2].div_ceil(GRID_WORKGROUP));
+        pass.dispatch_workgroups(
+            dims[0].div_ceil(GRID_WORKGROUP),
+            dims[1].div_ceil(GRID_WORKGROUP),
+            dims[2].div_ceil(GRID_WORKGROUP),
+        );
     }
 }
 
@@ -130,14 +148,21 @@ impl PassNode for MinMaxGridNode {
             return Ok(());
         }
         let dims = volume.map(|n| n.div_ceil(self.block_size));
-        let texture = create_grid_texture(ctx, &format!("{} min/max grid", ctx.label), wgpu::TextureFormat::Rg32Float, dims);
+        let texture =
+            create_grid_texture(ctx, &format!("{} min/max grid", ctx.label), wgpu::TextureFormat::Rg32Float, dims);
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
         if let Some(tap) = &self.tap {
             tap.set(&texture);
         }
         let bg = {
             let grid_view = view.clone();
-            ctx.bind_group(&self.pipeline, &[("minmax", self.params.as_entire_binding()), ("grid", wgpu::BindingResource::TextureView(&grid_view))])?
+            ctx.bind_group(
+                &self.pipeline,
+                &[
+                    ("minmax", self.params.as_entire_binding()),
+                    ("grid", wgpu::BindingResource::TextureView(&grid_view)),
+                ],
+            )?
         };
         dispatch_grid(ctx, &self.pipeline, Some(&bg), dims);
         self.grid = Some((texture, view, volume));

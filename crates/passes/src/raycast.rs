@@ -47,7 +47,11 @@ impl PassPlugin for Raycast {
     }
 
     fn ports(&self, params: &Params) -> Vec<PortSpec> {
-        raycast_ports(params, &[TargetFormat::Rgba16Float, TargetFormat::Rgba32Float], &[TargetFormat::Rgba32Float, TargetFormat::Rgba16Float])
+        raycast_ports(
+            params,
+            &[TargetFormat::Rgba16Float, TargetFormat::Rgba32Float],
+            &[TargetFormat::Rgba32Float, TargetFormat::Rgba16Float],
+        )
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {

@@ -3,7 +3,9 @@
 //! (`RAYCASTSIMPLE_CS`). The workgroup size is a parameter (pipeline-overridable constants).
 //! Shader: `shaders/raycast_compute.wgsl`.
 
-use volgraph_core::executor::{ComputePipelineSpec, CreateContext, PassError, PassPipeline, PipelineKind, RecordContext};
+use volgraph_core::executor::{
+    ComputePipelineSpec, CreateContext, PassError, PassPipeline, PipelineKind, RecordContext,
+};
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortSpec, TargetFormat};
 

@@ -40,8 +40,10 @@ impl PassPlugin for RaycastEss {
 
     fn params(&self) -> Vec<ParamSpec> {
         // DVR only: the isosurface parameters of `raycast` do not apply.
-        let mut p: Vec<ParamSpec> =
-            raycast_param_specs().into_iter().filter(|s| matches!(s.name, "step_voxels" | "threshold" | "max_steps" | "jitter")).collect();
+        let mut p: Vec<ParamSpec> = raycast_param_specs()
+            .into_iter()
+            .filter(|s| matches!(s.name, "step_voxels" | "threshold" | "max_steps" | "jitter"))
+            .collect();
         p.push(block_size_spec());
         p
     }
@@ -89,7 +91,10 @@ impl PassNode for RaycastEssNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let volume = bound_size(ctx, "volume")?;
         check_block_grid(ctx, "empty", self.block_size, volume)?;
-        let bg = ctx.bind_group(&self.pipeline, &[("params", self.params.as_entire_binding()), ("ess", self.ess.as_entire_binding())])?;
+        let bg = ctx.bind_group(
+            &self.pipeline,
+            &[("params", self.params.as_entire_binding()), ("ess", self.ess.as_entire_binding())],
+        )?;
         let mut pass = ctx.begin_render_pass(&self.pipeline, None)?;
         crate::draw(&mut pass, &self.pipeline, &bg, 0..3);
         Ok(())

@@ -7,9 +7,19 @@ use volgraph_core::{ParamSpec, Params};
 pub fn raycast_param_specs() -> Vec<ParamSpec> {
     vec![
         ParamSpec::float("step_voxels", 0.5, 0.01, 16.0, "sample distance in units of the smallest voxel side"),
-        ParamSpec::float("threshold", 1.0, 0.0, 1.0, "early ray termination once accumulated alpha reaches this (1 = off, lossless)"),
+        ParamSpec::float(
+            "threshold",
+            1.0,
+            0.0,
+            1.0,
+            "early ray termination once accumulated alpha reaches this (1 = off, lossless)",
+        ),
         ParamSpec::uint("max_steps", 4096, 1, 1 << 20, "upper bound on samples per ray"),
-        ParamSpec::boolean("jitter", false, "offset each ray's first sample by a per-pixel hash (trades banding for noise)"),
+        ParamSpec::boolean(
+            "jitter",
+            false,
+            "offset each ray's first sample by a per-pixel hash (trades banding for noise)",
+        ),
         ParamSpec::choice("mode", "dvr", &["dvr", "iso"], "direct volume rendering or first-hit isosurface"),
         ParamSpec::float("iso_value", 0.5, 0.0, 1.0, "isovalue in normalized scalar units (mode \"iso\")"),
         ParamSpec::float("ambient", 0.15, 0.0, 1.0, "Blinn–Phong ambient coefficient (mode \"iso\")"),

@@ -18,7 +18,9 @@
 
 use std::sync::{Arc, Mutex};
 
-use volgraph_core::executor::{CreateContext, DepthSpec, Gpu, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
+use volgraph_core::executor::{
+    CreateContext, DepthSpec, Gpu, PassError, PassPipeline, RecordContext, RenderPipelineSpec,
+};
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
@@ -66,7 +68,8 @@ impl InvocationCounter {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("counter readback") });
+        let mut encoder =
+            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("counter readback") });
         encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, 4);
         gpu.queue.submit([encoder.finish()]);
         let slice = staging.slice(..);
@@ -111,7 +114,13 @@ impl SegmentParamsGpu {
 
 /// The `segment_steps` parameter, shared with `termination_test` (both must agree).
 pub(crate) fn segment_steps_spec() -> ParamSpec {
-    ParamSpec::uint("segment_steps", 8, 1, 4096, "M: samples per segment (Krüger–Westermann used 8); the repeat count divides by it")
+    ParamSpec::uint(
+        "segment_steps",
+        8,
+        1,
+        4096,
+        "M: samples per segment (Krüger–Westermann used 8); the repeat count divides by it",
+    )
 }
 
 /// The segment's blend: `dst + (1 - dst.a)·src` for colour and alpha.
@@ -177,7 +186,8 @@ impl PassPlugin for RaycastSegment {
             )));
         }
         let (shader, fragment) = self.entry(ctx.params);
-        let extra: &[&str] = if self.counter.is_some() { &["params", "segment", "invocations"] } else { &["params", "segment"] };
+        let extra: &[&str] =
+            if self.counter.is_some() { &["params", "segment", "invocations"] } else { &["params", "segment"] };
         let spec = |depth: Option<DepthSpec<'static>>| RenderPipelineSpec {
             shader,
             vertex: "vs_segment",
@@ -188,7 +198,11 @@ impl PassPlugin for RaycastSegment {
             ..Default::default()
         };
         let free = ctx.render_pipeline(&spec(None))?;
-        let early_z = ctx.render_pipeline(&spec(Some(DepthSpec { port: "depth", write: false, compare: wgpu::CompareFunction::Greater })))?;
+        let early_z = ctx.render_pipeline(&spec(Some(DepthSpec {
+            port: "depth",
+            write: false,
+            compare: wgpu::CompareFunction::Greater,
+        })))?;
         let params = ctx.uniform_buffer("params", std::mem::size_of::<RaycastParamsGpu>() as u64);
         ctx.gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(ctx.params)));
         let segment = ctx.uniform_buffer("segment", std::mem::size_of::<SegmentParamsGpu>() as u64);
@@ -201,7 +215,8 @@ impl PassPlugin for RaycastSegment {
                     usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
                     mapped_at_creation: false,
                 });
-                let mut slot = counter.buffer.lock().map_err(|_| error("invocation counter lock poisoned".to_string()))?;
+                let mut slot =
+                    counter.buffer.lock().map_err(|_| error("invocation counter lock poisoned".to_string()))?;
                 *slot = Some(buffer.clone());
                 Some(buffer)
             }
@@ -236,7 +251,8 @@ impl PassNode for RaycastSegmentNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let index = segment_index(ctx);
         let pipeline = if ctx.is_bound("depth") { &self.early_z } else { &self.free };
-        let mut extra = vec![("params", self.params.as_entire_binding()), ("segment", self.segment.as_entire_binding())];
+        let mut extra =
+            vec![("params", self.params.as_entire_binding()), ("segment", self.segment.as_entire_binding())];
         if let Some(counter) = &self.invocations {
             if index == 0 {
                 ctx.encoder.clear_buffer(counter, 0, None);

@@ -27,7 +27,10 @@ impl PassPlugin for SegmentInit {
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
-        vec![PortSpec::write("accum", PortKind::target(&ACCUM_FORMATS)), PortSpec::write("depth", PortKind::target(&[TargetFormat::Depth32Float]))]
+        vec![
+            PortSpec::write("accum", PortKind::target(&ACCUM_FORMATS)),
+            PortSpec::write("depth", PortKind::target(&[TargetFormat::Depth32Float])),
+        ]
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {

@@ -33,6 +33,7 @@ pub struct RenderSession {
 impl RenderSession {
     /// Compiles `source` (named `file` in messages) for `options`, builds its passes, and binds
     /// `volume` and `lut` to the graph's Volume and TransferFunction inputs.
+    #[allow(clippy::too_many_arguments, reason = "the GPU context, the graph and the scene, each needed once")]
     pub fn new(
         gpu: &Gpu,
         shaders: &ShaderLibrary,
@@ -61,7 +62,9 @@ impl RenderSession {
         let mut executor = Executor::new(gpu, shaders, registry, plan)?;
         for (name, kind) in &inputs {
             match kind {
-                InputKind::Volume => executor.bind_input(name, upload_volume_texture(gpu, volume).map_err(SessionError::Upload)?),
+                InputKind::Volume => {
+                    executor.bind_input(name, upload_volume_texture(gpu, volume).map_err(SessionError::Upload)?)
+                }
                 InputKind::TransferFunction => executor.bind_input(name, upload_lut_texture(gpu, lut)),
                 InputKind::Scalar(_) => {}
             }

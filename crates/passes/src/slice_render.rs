@@ -36,7 +36,13 @@ impl PassPlugin for SliceRender {
 
     fn params(&self) -> Vec<ParamSpec> {
         vec![
-            ParamSpec::float("slice_voxels", 0.5, 0.01, 16.0, "distance between planes in units of the smallest voxel side"),
+            ParamSpec::float(
+                "slice_voxels",
+                0.5,
+                0.01,
+                16.0,
+                "distance between planes in units of the smallest voxel side",
+            ),
             ParamSpec::uint(
                 "max_slices",
                 8192,

@@ -39,7 +39,13 @@ impl PassPlugin for TerminationTest {
 
     fn params(&self) -> Vec<ParamSpec> {
         vec![
-            ParamSpec::float("threshold", 0.95, 0.0, 1.0, "T: rays whose accumulated alpha is >= T stop (1 = only fully opaque rays, lossless)"),
+            ParamSpec::float(
+                "threshold",
+                0.95,
+                0.0,
+                1.0,
+                "T: rays whose accumulated alpha is >= T stop (1 = only fully opaque rays, lossless)",
+            ),
             ParamSpec::float("step_voxels", 0.5, 0.01, 16.0, "the segment pass's sample distance (must match it)"),
             ParamSpec::uint("max_steps", 4096, 1, 1 << 20, "the segment pass's max_steps (must match it)"),
             ParamSpec::boolean("jitter", false, "the segment pass's jitter (must match it)"),
@@ -96,7 +102,10 @@ impl PassNode for TerminationTestNode {
         // This pass decides for the segment after the one just drawn.
         let next = segment_index(ctx) + 1;
         let pipeline = if ctx.is_bound("empty") { &self.with_empty } else { &self.alpha_only };
-        let bg = ctx.bind_group(pipeline, &[("params", self.params.as_entire_binding()), ("segment", self.segment.as_entire_binding())])?;
+        let bg = ctx.bind_group(
+            pipeline,
+            &[("params", self.params.as_entire_binding()), ("segment", self.segment.as_entire_binding())],
+        )?;
         let mut pass = ctx.begin_render_pass(pipeline, None)?;
         if let volgraph_core::executor::PipelineKind::Render(p) = &pipeline.pipeline {
             pass.set_pipeline(p);

@@ -7,7 +7,9 @@ use volgraph_core::executor::{
     ComputePipelineSpec, CreateContext, Executor, Gpu, PassError, RecordContext, RenderPipelineSpec, ShaderLibrary,
 };
 use volgraph_core::shader_source::default_shader_root;
-use volgraph_core::{CompileOptions, Params, PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile};
+use volgraph_core::{
+    CompileOptions, Params, PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile,
+};
 
 const FLOATS: [TargetFormat; 3] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float, TargetFormat::Rgba8Unorm];
 
@@ -91,7 +93,8 @@ fn build_error(plugin: Misnamed) -> String {
     outputs: {{"image": "march.{color}"}},
 )"#
     );
-    let plan = compile("reflection.ron", &graph, &registry, &CompileOptions::new(16, 16)).expect("the graph itself is valid");
+    let plan =
+        compile("reflection.ron", &graph, &registry, &CompileOptions::new(16, 16)).expect("the graph itself is valid");
     let gpu = Gpu::new_headless().expect("a Vulkan adapter (lavapipe without a GPU)");
     let shaders = ShaderLibrary::new(default_shader_root());
     match Executor::new(&gpu, &shaders, &registry, plan) {
@@ -102,7 +105,12 @@ fn build_error(plugin: Misnamed) -> String {
 
 #[test]
 fn shader_global_without_a_port_is_named() {
-    let msg = build_error(Misnamed { kind: "misnamed_input", dir_port: "direction", color_port: "color", compute_color: None });
+    let msg = build_error(Misnamed {
+        kind: "misnamed_input",
+        dir_port: "direction",
+        color_port: "color",
+        compute_color: None,
+    });
     assert_eq!(
         msg,
         "pass \"march\": raycast.wgsl: global \"dir\" is neither a port of this pass (ports: entry, direction, volume, tf, color) \
@@ -113,8 +121,12 @@ fn shader_global_without_a_port_is_named() {
 
 #[test]
 fn fragment_output_without_a_port_is_named() {
-    let msg = build_error(Misnamed { kind: "misnamed_output", dir_port: "dir", color_port: "colour", compute_color: None });
-    assert_eq!(msg, "pass \"march\": raycast.wgsl: fragment output \"color\" (@location(0)) of fs_dvr is not an output port of this pass");
+    let msg =
+        build_error(Misnamed { kind: "misnamed_output", dir_port: "dir", color_port: "colour", compute_color: None });
+    assert_eq!(
+        msg,
+        "pass \"march\": raycast.wgsl: fragment output \"color\" (@location(0)) of fs_dvr is not an output port of this pass"
+    );
 }
 
 #[test]

@@ -4,8 +4,13 @@
 //! carry while ping-ponging between two pooled textures. The test plugins and their shader
 //! (`tests/shaders/add_one.wgsl`) live here and register through the public API.
 
-use volgraph_core::executor::{CreateContext, Executor, Gpu, PassError, PassPipeline, PipelineKind, RecordContext, RenderPipelineSpec, ShaderLibrary};
-use volgraph_core::{CompileOptions, Params, PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile};
+use volgraph_core::executor::{
+    CreateContext, Executor, Gpu, PassError, PassPipeline, PipelineKind, RecordContext, RenderPipelineSpec,
+    ShaderLibrary,
+};
+use volgraph_core::{
+    CompileOptions, Params, PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile,
+};
 
 /// `next = value + (1, 0, 0, 0)`.
 struct AddOne;
@@ -30,7 +35,12 @@ impl PassNode for Node {
 }
 
 fn node(ctx: &CreateContext<'_>, fragment: &str) -> Result<Box<dyn PassNode>, PassError> {
-    let pipeline = ctx.render_pipeline(&RenderPipelineSpec { shader: "add_one.wgsl", vertex: "vs_fullscreen", fragment, ..Default::default() })?;
+    let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
+        shader: "add_one.wgsl",
+        vertex: "vs_fullscreen",
+        fragment,
+        ..Default::default()
+    })?;
     Ok(Box::new(Node { pipeline }))
 }
 

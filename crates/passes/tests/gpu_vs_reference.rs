@@ -70,7 +70,13 @@ fn compare(gpu: &Image, reference: &[[f64; 4]]) -> Comparison {
     Comparison { max_abs, mean_abs: sum / (4.0 * n), frac_over_2: over as f64 / n, frac_over_16: over16 as f64 / n }
 }
 
-fn render_both(gpu: &Gpu, graph: &str, volume: &Volume, tf: &TransferFunction, camera: &OrbitCamera) -> (Comparison, Option<Comparison>, f64) {
+fn render_both(
+    gpu: &Gpu,
+    graph: &str,
+    volume: &Volume,
+    tf: &TransferFunction,
+    camera: &OrbitCamera,
+) -> (Comparison, Option<Comparison>, f64) {
     render_with(gpu, graph, volume, tf, camera, CompileOptions::new(SIZE, SIZE))
 }
 
@@ -147,7 +153,8 @@ fn hydrogen() -> Option<(Volume, TransferFunction)> {
     Some((v, tf))
 }
 
-const CAMERA: OrbitCamera = OrbitCamera { azimuth_deg: 30.0, elevation_deg: 20.0, distance: 3.2, fov_y_deg: 30.0, near: 0.01, far: 100.0 };
+const CAMERA: OrbitCamera =
+    OrbitCamera { azimuth_deg: 30.0, elevation_deg: 20.0, distance: 3.2, fov_y_deg: 30.0, near: 0.01, far: 100.0 };
 
 #[test]
 fn fragment_raycast_matches_reference_on_marschner_lobb() {
@@ -187,8 +194,17 @@ fn isosurface_matches_reference_on_marschner_lobb_and_hydrogen() {
         let iso = if name == "hydrogen" { 0.05 } else { 0.3 };
         let options = CompileOptions::new(SIZE, SIZE).with_param("march", "iso_value", iso);
         let (c, hit, cov) = render_with(&gpu, "basic/isosurface.ron", &v, &tf, &camera, options);
-        eprintln!("iso/{name}: max {:.3}/255 mean {:.4}/255 over2 {:.4} over16 {:.4} coverage {:.2}", c.max_abs * 255.0, c.mean_abs * 255.0, c.frac_over_2, c.frac_over_16, cov);
-        if let Some(h) = &hit { eprintln!("   hit: max {:.4} mean {:.6} over2/255 {:.4}", h.max_abs, h.mean_abs, h.frac_over_2); }
+        eprintln!(
+            "iso/{name}: max {:.3}/255 mean {:.4}/255 over2 {:.4} over16 {:.4} coverage {:.2}",
+            c.max_abs * 255.0,
+            c.mean_abs * 255.0,
+            c.frac_over_2,
+            c.frac_over_16,
+            cov
+        );
+        if let Some(h) = &hit {
+            eprintln!("   hit: max {:.4} mean {:.6} over2/255 {:.4}", h.max_abs, h.mean_abs, h.frac_over_2);
+        }
         assert!(cov > 0.05, "iso/{name}: no surface visible");
         let hit = hit.expect("iso graph has a hit output");
         if name.ends_with("f32") {
@@ -205,7 +221,11 @@ fn isosurface_matches_reference_on_marschner_lobb_and_hydrogen() {
             // 16/255, 0.4% of rays hitting on one side only. The bounds leave ~2x headroom.
             assert!(c.mean_abs <= 1.0 / 255.0, "iso/{name}: mean {:.4}/255", c.mean_abs * 255.0);
             assert!(c.frac_over_16 <= 0.02, "iso/{name}: {:.2}% of pixels beyond 16/255", 100.0 * c.frac_over_16);
-            assert!(hit.frac_over_2 <= 0.01, "iso/{name}: hit positions differ on {:.2}% of pixels", 100.0 * hit.frac_over_2);
+            assert!(
+                hit.frac_over_2 <= 0.01,
+                "iso/{name}: hit positions differ on {:.2}% of pixels",
+                100.0 * hit.frac_over_2
+            );
         }
     }
 }

@@ -21,7 +21,12 @@ fn gpu() -> Gpu {
 }
 
 /// Renders graphs/basic/fragment_raycast.ron and returns (GPU image, reference colour).
-fn render(volume: &Volume, tf: &TransferFunction, camera: &OrbitCamera, options: CompileOptions) -> (Image, Vec<[f64; 4]>) {
+fn render(
+    volume: &Volume,
+    tf: &TransferFunction,
+    camera: &OrbitCamera,
+    options: CompileOptions,
+) -> (Image, Vec<[f64; 4]>) {
     let gpu = gpu();
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../graphs/basic/fragment_raycast.ron");
     let source = std::fs::read_to_string(path).expect("graph");

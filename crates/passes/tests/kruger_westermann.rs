@@ -66,22 +66,33 @@ fn render_with(
     camera: &OrbitCamera,
     options: &CompileOptions,
 ) -> Rendered {
-    let plan = compile(graph, &graph_source(graph), registry, options).unwrap_or_else(|d| panic!("{graph} compiles:\n{d}"));
+    let plan =
+        compile(graph, &graph_source(graph), registry, options).unwrap_or_else(|d| panic!("{graph} compiles:\n{d}"));
     let shaders = ShaderLibrary::new(default_shader_root());
-    let mut session = RenderSession::from_plan(gpu, &shaders, registry, plan.clone(), volume, lut).unwrap_or_else(|e| panic!("{graph}: {e}"));
+    let mut session = RenderSession::from_plan(gpu, &shaders, registry, plan.clone(), volume, lut)
+        .unwrap_or_else(|e| panic!("{graph}: {e}"));
     session.render(gpu, camera).unwrap_or_else(|e| panic!("{graph}: {e}"));
     let image = session.read(gpu, "image").unwrap_or_else(|e| panic!("{graph}: {e}"));
     Rendered { image, plan }
 }
 
-fn render(gpu: &Gpu, graph: &str, volume: &Volume, lut: &[[f32; 4]], camera: &OrbitCamera, options: &CompileOptions) -> Rendered {
+fn render(
+    gpu: &Gpu,
+    graph: &str,
+    volume: &Volume,
+    lut: &[[f32; 4]],
+    camera: &OrbitCamera,
+    options: &CompileOptions,
+) -> Rendered {
     render_with(gpu, &builtin_registry(), graph, volume, lut, camera, options)
 }
 
 /// (max abs, mean abs) per channel between two GPU images; panics on NaN.
 fn diff_images(a: &Image, b: &Image) -> (f64, f64) {
-    let reference: Vec<[f64; 4]> =
-        (0..b.height).flat_map(|y| (0..b.width).map(move |x| (x, y))).map(|(x, y)| b.rgba(x, y).map(|c| c as f64)).collect();
+    let reference: Vec<[f64; 4]> = (0..b.height)
+        .flat_map(|y| (0..b.width).map(move |x| (x, y)))
+        .map(|(x, y)| b.rgba(x, y).map(|c| c as f64))
+        .collect();
     diff_reference(a, &reference)
 }
 
@@ -146,7 +157,14 @@ fn coverage(image: &Image) -> f64 {
 
 /// Checks `rendered` against the reference for its "march" pass's settings (overridden by
 /// `threshold` when given), with the single-pass raycaster's bounds plus `extra`.
-fn assert_matches_reference(name: &str, rendered: &Rendered, volume: &Volume, lut: &[[f32; 4]], camera: &OrbitCamera, extra: f64) {
+fn assert_matches_reference(
+    name: &str,
+    rendered: &Rendered,
+    volume: &Volume,
+    lut: &[[f32; 4]],
+    camera: &OrbitCamera,
+    extra: f64,
+) {
     let march = rendered.plan.steps.iter().find(|s| s.pass_id == "march").expect("a march step");
     let settings = reference_settings(&march.params);
     let reference = render_reference(volume, lut, camera, SIZE, SIZE, &settings);
@@ -160,12 +178,18 @@ fn assert_matches_reference(name: &str, rendered: &Rendered, volume: &Volume, lu
 fn assert_close(name: &str, a: &Rendered, b: &Rendered, bound: f64) {
     let (max_abs, mean_abs) = diff_images(&a.image, &b.image);
     let cov = coverage(&b.image);
-    eprintln!("{name}: max {:.3}/255 mean {:.4}/255 (bound {:.2}/255), coverage {cov:.2}", max_abs * 255.0, mean_abs * 255.0, bound * 255.0);
+    eprintln!(
+        "{name}: max {:.3}/255 mean {:.4}/255 (bound {:.2}/255), coverage {cov:.2}",
+        max_abs * 255.0,
+        mean_abs * 255.0,
+        bound * 255.0
+    );
     assert!(cov > 0.05, "{name}: the image is nearly empty ({cov:.2}); pick a visible camera/TF");
     assert!(max_abs <= bound, "{name}: max abs {:.3}/255 > {:.3}/255", max_abs * 255.0, bound * 255.0);
 }
 
-const CAMERA: OrbitCamera = OrbitCamera { azimuth_deg: 30.0, elevation_deg: 20.0, distance: 3.2, fov_y_deg: 30.0, near: 0.01, far: 100.0 };
+const CAMERA: OrbitCamera =
+    OrbitCamera { azimuth_deg: 30.0, elevation_deg: 20.0, distance: 3.2, fov_y_deg: 30.0, near: 0.01, far: 100.0 };
 
 fn ml() -> Volume {
     volgraph_accel::generate::marschner_lobb(64)
@@ -191,7 +215,11 @@ fn hydrogen() -> Option<Volume> {
 /// has one, its termination test.
 fn lossless(options: CompileOptions, graph: &str) -> CompileOptions {
     let options = options.with_param("march", "threshold", 1.0);
-    if graph_source(graph).contains("id: \"terminate\"") { options.with_param("terminate", "threshold", 1.0) } else { options }
+    if graph_source(graph).contains("id: \"terminate\"") {
+        options.with_param("terminate", "threshold", 1.0)
+    } else {
+        options
+    }
 }
 
 #[test]
@@ -217,7 +245,14 @@ fn rc_a_with_lossless_threshold_equals_rc_and_stays_within_the_termination_bound
         let opts = options(&v);
         let rc = render(&gpu, "kruger_westermann_2003/rc.ron", &v, &l, &CAMERA, &opts);
         // T = 1: only rays that left the volume (or are fully opaque) stop — lossless.
-        let exact = render(&gpu, "kruger_westermann_2003/rc_a.ron", &v, &l, &CAMERA, &lossless(opts.clone(), "kruger_westermann_2003/rc_a.ron"));
+        let exact = render(
+            &gpu,
+            "kruger_westermann_2003/rc_a.ron",
+            &v,
+            &l,
+            &CAMERA,
+            &lossless(opts.clone(), "kruger_westermann_2003/rc_a.ron"),
+        );
         assert_close(&format!("rc_a(T=1) vs rc, {}", preset.name()), &exact, &rc, LOSSLESS);
         let rc_a = render(&gpu, "kruger_westermann_2003/rc_a.ron", &v, &l, &CAMERA, &opts);
         let t = rc_a.plan.steps.iter().find(|s| s.pass_id == "terminate").expect("terminate").params.float("threshold");
@@ -243,7 +278,14 @@ fn rc_b_empty_space_skipping_is_lossless() {
         let l = lut(&v, preset);
         let opts = options(&v);
         let rc = render(&gpu, "kruger_westermann_2003/rc.ron", &v, &l, &CAMERA, &opts);
-        let rc_b = render(&gpu, "kruger_westermann_2003/rc_b.ron", &v, &l, &CAMERA, &lossless(opts.clone(), "kruger_westermann_2003/rc_b.ron"));
+        let rc_b = render(
+            &gpu,
+            "kruger_westermann_2003/rc_b.ron",
+            &v,
+            &l,
+            &CAMERA,
+            &lossless(opts.clone(), "kruger_westermann_2003/rc_b.ron"),
+        );
         assert_close(&format!("rc_b(T=1) vs rc, {name}"), &rc_b, &rc, LOSSLESS);
         if preset == Preset::Default {
             // The sparse TF's steep ramp on 8-bit data exceeds the reference bound for the
@@ -259,7 +301,8 @@ fn rc_b_empty_space_skipping_is_lossless() {
 #[test]
 fn single_pass_empty_block_leaping_equals_the_plain_raycast() {
     let gpu = gpu();
-    let mut cases = vec![("sphere", sphere(), Preset::Default), ("ML", ml(), Preset::Default), ("ML sparse", ml(), Preset::Sparse)];
+    let mut cases =
+        vec![("sphere", sphere(), Preset::Default), ("ML", ml(), Preset::Default), ("ML sparse", ml(), Preset::Sparse)];
     if let Some(h) = hydrogen() {
         cases.push(("hydrogen", h, Preset::Default));
     }
@@ -267,7 +310,14 @@ fn single_pass_empty_block_leaping_equals_the_plain_raycast() {
         let l = lut(&v, preset);
         let opts = options(&v);
         let plain = render(&gpu, "basic/fragment_raycast.ron", &v, &l, &CAMERA, &opts);
-        let leaping = render(&gpu, "modern/single_pass_ess_ert.ron", &v, &l, &CAMERA, &opts.clone().with_param("march", "threshold", 1.0));
+        let leaping = render(
+            &gpu,
+            "modern/single_pass_ess_ert.ron",
+            &v,
+            &l,
+            &CAMERA,
+            &opts.clone().with_param("march", "threshold", 1.0),
+        );
         assert_close(&format!("leaping(T=1) vs raycast, {name}"), &leaping, &plain, LOSSLESS);
         let ert = render(&gpu, "modern/single_pass_ess_ert.ron", &v, &l, &CAMERA, &opts);
         let t = ert.plan.steps.iter().find(|s| s.pass_id == "march").expect("march").params.float("threshold");
@@ -317,7 +367,11 @@ fn gpu_minmax_grid_and_empty_flags_equal_the_cpu_ones() {
             let (_, gpu_flags) = flags_tap.read_f32(&gpu, 1).expect("GPU flags");
             let mismatches = cpu_flags.iter().zip(&gpu_flags).filter(|(c, g)| (**c != 0) != (**g > 0.5)).count();
             let empty = cpu_flags.iter().filter(|c| **c != 0).count();
-            eprintln!("{name}/{}: {} blocks, {empty} empty on the CPU, {mismatches} flags differ", preset.name(), cpu_flags.len());
+            eprintln!(
+                "{name}/{}: {} blocks, {empty} empty on the CPU, {mismatches} flags differ",
+                preset.name(),
+                cpu_flags.len()
+            );
             assert_eq!(mismatches, 0, "{name}/{}: GPU empty flags differ from the CPU classification", preset.name());
         }
     }
@@ -326,7 +380,17 @@ fn gpu_minmax_grid_and_empty_flags_equal_the_cpu_ones() {
 /// Segments of pixel `(x, y)` that the early depth test lets through with termination at `t`:
 /// segment 0 always (the depth buffer starts "live"), segment i ≥ 1 while the alpha after i·M
 /// samples is below `t` and the ray has a sample at i·M (`docs/rendering_model.md` samples).
-fn live_segments(volume: &Volume, lut: &[[f32; 4]], camera: &OrbitCamera, x: u32, y: u32, m: u32, segments: u32, t: f64) -> u32 {
+#[allow(clippy::too_many_arguments, reason = "a test helper mirroring the shader's inputs one to one")]
+fn live_segments(
+    volume: &Volume,
+    lut: &[[f32; 4]],
+    camera: &OrbitCamera,
+    x: u32,
+    y: u32,
+    m: u32,
+    segments: u32,
+    t: f64,
+) -> u32 {
     let frame = camera.frame(SIZE, SIZE);
     let Some(seg) = ray_segment(volume, camera, &frame, x, y) else { return 1 };
     let step = step_tex(volume, seg.d_tex, STEP_VOXELS);
@@ -370,10 +434,15 @@ fn early_z_rejects_terminated_fragments_before_the_segment_shader_runs() {
     let rc_a = render_with(&gpu, &registry, "kruger_westermann_2003/rc_a.ron", &v, &l, &CAMERA, &opts);
     let with = counter.read(&gpu).expect("counter") as u64;
     let t = rc_a.plan.steps.iter().find(|s| s.pass_id == "terminate").expect("terminate").params.float("threshold");
-    let m = rc_a.plan.steps.iter().find(|s| s.pass_id == "terminate").expect("terminate").params.uint("segment_steps") as u32;
-    let expected: u64 =
-        (0..SIZE).flat_map(|y| (0..SIZE).map(move |x| (x, y))).map(|(x, y)| live_segments(&v, &l, &CAMERA, x, y, m, segments as u32, t) as u64).sum();
-    eprintln!("segment fragments: {without} without termination, {with} with (expected {expected}), {segments} segments");
+    let m = rc_a.plan.steps.iter().find(|s| s.pass_id == "terminate").expect("terminate").params.uint("segment_steps")
+        as u32;
+    let expected: u64 = (0..SIZE)
+        .flat_map(|y| (0..SIZE).map(move |x| (x, y)))
+        .map(|(x, y)| live_segments(&v, &l, &CAMERA, x, y, m, segments as u32, t) as u64)
+        .sum();
+    eprintln!(
+        "segment fragments: {without} without termination, {with} with (expected {expected}), {segments} segments"
+    );
     assert!(with * 5 < without, "termination should reject most fragments: {with} of {without} ran");
     // Within reason: pixels whose alpha lands within f32 rounding of T, or rays that graze an
     // edge (rasterized vs analytic entry), can run one segment more or less; 2% covers them.
@@ -402,7 +471,8 @@ fn camera_inside_the_volume_with_multipass_segments() {
     let v = sphere();
     let l = lut(&v, Preset::Default);
     // Inside the box, looking at the sphere from its edge: rays start at the near plane.
-    let camera = OrbitCamera { azimuth_deg: 20.0, elevation_deg: 10.0, distance: 0.45, fov_y_deg: 60.0, near: 0.01, far: 100.0 };
+    let camera =
+        OrbitCamera { azimuth_deg: 20.0, elevation_deg: 10.0, distance: 0.45, fov_y_deg: 60.0, near: 0.01, far: 100.0 };
     let opts = options(&v);
     for graph in ["kruger_westermann_2003/rc.ron", "kruger_westermann_2003/rc_b.ron"] {
         let r = render(&gpu, graph, &v, &l, &camera, &lossless(opts.clone(), graph));
@@ -417,9 +487,11 @@ fn axis_aligned_view_with_multipass_segments() {
     let v = ml();
     let l = lut(&v, Preset::Default);
     // Rays parallel to the z axis through the centre column: zero direction components.
-    let camera = OrbitCamera { azimuth_deg: 0.0, elevation_deg: 0.0, distance: 3.2, fov_y_deg: 30.0, near: 0.01, far: 100.0 };
+    let camera =
+        OrbitCamera { azimuth_deg: 0.0, elevation_deg: 0.0, distance: 3.2, fov_y_deg: 30.0, near: 0.01, far: 100.0 };
     let opts = options(&v);
-    for graph in ["kruger_westermann_2003/rc.ron", "kruger_westermann_2003/rc_b.ron", "modern/single_pass_ess_ert.ron"] {
+    for graph in ["kruger_westermann_2003/rc.ron", "kruger_westermann_2003/rc_b.ron", "modern/single_pass_ess_ert.ron"]
+    {
         let r = render(&gpu, graph, &v, &l, &camera, &lossless(opts.clone(), graph));
         assert_matches_reference(&format!("axis-aligned {graph}"), &r, &v, &l, &camera, 0.0);
     }
@@ -508,7 +580,12 @@ fn empty_space_skipping_rejects_segments_in_empty_blocks() {
     // Measured 52634 vs 24277 at 96²: skipping rejects more than half the segments that
     // termination alone lets through (the lossless images are checked in
     // rc_b_empty_space_skipping_is_lossless).
-    assert!(counts[1] * 2 < counts[0], "empty-space skipping should reject most segments: rc_a {}, rc_b {}", counts[0], counts[1]);
+    assert!(
+        counts[1] * 2 < counts[0],
+        "empty-space skipping should reject most segments: rc_a {}, rc_b {}",
+        counts[0],
+        counts[1]
+    );
 }
 
 #[test]
@@ -519,13 +596,22 @@ fn segment_graphs_agree_on_the_sample_sequence() {
     let k = longest_ray_steps(&v, STEP_VOXELS);
     for graph in ["rc", "rc_a", "rc_b", "iso"] {
         let name = format!("kruger_westermann_2003/{graph}.ron");
-        let plan = compile(&name, &graph_source(&name), &builtin_registry(), &options(&v)).unwrap_or_else(|d| panic!("{d}"));
+        let plan =
+            compile(&name, &graph_source(&name), &builtin_registry(), &options(&v)).unwrap_or_else(|d| panic!("{d}"));
         let march: Vec<_> = plan.steps.iter().filter(|s| s.pass_id == "march").collect();
         let m = march[0].params.uint("segment_steps");
-        assert_eq!(march.len() as f64, (k / m as f64).ceil(), "{name}: the repeat count's divide_by must be segment_steps");
+        assert_eq!(
+            march.len() as f64,
+            (k / m as f64).ceil(),
+            "{name}: the repeat count's divide_by must be segment_steps"
+        );
         if let Some(t) = plan.steps.iter().find(|s| s.pass_id == "terminate") {
             for p in ["step_voxels", "segment_steps", "max_steps", "jitter"] {
-                assert_eq!(t.params.iter().find(|(n, _)| *n == p), march[0].params.iter().find(|(n, _)| *n == p), "{name}: {p}");
+                assert_eq!(
+                    t.params.iter().find(|(n, _)| *n == p),
+                    march[0].params.iter().find(|(n, _)| *n == p),
+                    "{name}: {p}"
+                );
             }
         }
     }
@@ -538,7 +624,8 @@ fn jittered_segments_with_skipping_equal_the_jittered_single_pass() {
     let gpu = gpu();
     let v = sphere();
     let l = lut(&v, Preset::Default);
-    let single = render(&gpu, "basic/fragment_raycast.ron", &v, &l, &CAMERA, &options(&v).with_param("march", "jitter", true));
+    let single =
+        render(&gpu, "basic/fragment_raycast.ron", &v, &l, &CAMERA, &options(&v).with_param("march", "jitter", true));
     let graph = "kruger_westermann_2003/rc_b.ron";
     let opts = lossless(options(&v), graph).with_param("march", "jitter", true).with_param("terminate", "jitter", true);
     let rc_b = render(&gpu, graph, &v, &l, &CAMERA, &opts);

@@ -17,18 +17,12 @@ pub struct Location {
 impl Location {
     /// The whole file.
     pub fn file(path: &Path) -> Location {
-        Location {
-            path: path.to_path_buf(),
-            line: None,
-        }
+        Location { path: path.to_path_buf(), line: None }
     }
 
     /// One header line (1-based) of `path`.
     pub fn line(path: &Path, line: usize) -> Location {
-        Location {
-            path: path.to_path_buf(),
-            line: Some(line),
-        }
+        Location { path: path.to_path_buf(), line: Some(line) }
     }
 }
 
@@ -82,9 +76,7 @@ pub enum LoadError {
     },
 
     /// A voxel type volgraph does not store.
-    #[error(
-        "{at}: unsupported voxel type \"{found}\"; supported: {supported} (convert the data to one of them)"
-    )]
+    #[error("{at}: unsupported voxel type \"{found}\"; supported: {supported} (convert the data to one of them)")]
     UnsupportedType {
         /// The file and header line.
         at: Location,
@@ -95,9 +87,7 @@ pub enum LoadError {
     },
 
     /// A data encoding volgraph cannot decode.
-    #[error(
-        "{at}: unsupported encoding \"{found}\"; supported: {supported} (re-save the file with one of them)"
-    )]
+    #[error("{at}: unsupported encoding \"{found}\"; supported: {supported} (re-save the file with one of them)")]
     UnsupportedEncoding {
         /// The file and header line.
         at: Location,
@@ -121,9 +111,7 @@ pub enum LoadError {
     },
 
     /// Not a 3D volume.
-    #[error(
-        "{at}: {field} is {found}, but only 3D scalar volumes can be loaded (set it to 3 with three sizes)"
-    )]
+    #[error("{at}: {field} is {found}, but only 3D scalar volumes can be loaded (set it to 3 with three sizes)")]
     NotThreeD {
         /// The file and header line.
         at: Location,

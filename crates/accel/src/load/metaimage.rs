@@ -14,13 +14,14 @@ use glam::DVec3;
 
 use super::error::clip;
 use super::{
-    Endianness, Layout, LoadError, LoadReport, LoadedVolume, Location, VolumeFormat, byte_count,
-    check_dims, check_spacing, finish, header_lines, inflate, read_file, sibling, stem,
+    Endianness, Layout, LoadError, LoadReport, LoadedVolume, Location, VolumeFormat, byte_count, check_dims,
+    check_spacing, finish, header_lines, inflate, read_file, sibling, stem,
 };
 use crate::volume::VoxelType;
 
 const SUPPORTED_TYPES: &str = "MET_UCHAR, MET_USHORT, MET_SHORT, MET_FLOAT";
-const HINT: &str = "check DimSize, ElementType, HeaderSize and CompressedData in the header, or whether the data is complete";
+const HINT: &str =
+    "check DimSize, ElementType, HeaderSize and CompressedData in the header, or whether the data is complete";
 
 fn voxel_type(name: &str) -> Option<VoxelType> {
     match name {
@@ -54,13 +55,11 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
             continue;
         }
         let at = Location::line(path, number);
-        let (key, value) = text
-            .split_once('=')
-            .ok_or_else(|| LoadError::MalformedLine {
-                at: at.clone(),
-                text: clip(&text),
-                expected: "`Key = Value`",
-            })?;
+        let (key, value) = text.split_once('=').ok_or_else(|| LoadError::MalformedLine {
+            at: at.clone(),
+            text: clip(&text),
+            expected: "`Key = Value`",
+        })?;
         let (key, value) = (key.trim(), value.trim());
         let bad = |expected: &'static str| LoadError::BadField {
             at: at.clone(),
@@ -83,57 +82,42 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
         match key.to_ascii_lowercase().as_str() {
             "ndims" => {
                 if value != "3" {
-                    return Err(LoadError::NotThreeD {
-                        at,
-                        field: "NDims",
-                        found: clip(value),
-                    });
+                    return Err(LoadError::NotThreeD { at, field: "NDims", found: clip(value) });
                 }
                 ndims_seen = true;
             }
             "dimsize" => {
-                let parsed: Option<Vec<u64>> =
-                    value.split_whitespace().map(|s| s.parse().ok()).collect();
+                let parsed: Option<Vec<u64>> = value.split_whitespace().map(|s| s.parse().ok()).collect();
                 match parsed.as_deref() {
                     Some(&[x, y, z]) => sizes = Some((number, [x, y, z], value.to_string())),
                     _ => return Err(bad("three whole numbers, e.g. `DimSize = 64 64 32`")),
                 }
             }
             "elementspacing" => {
-                let s = three(value)
-                    .ok_or_else(|| bad("three numbers, e.g. `ElementSpacing = 1 1 1.5`"))?;
+                let s = three(value).ok_or_else(|| bad("three numbers, e.g. `ElementSpacing = 1 1 1.5`"))?;
                 spacing = Some((number, DVec3::from_array(s)));
             }
             "elementsize" => {
-                let s = three(value)
-                    .ok_or_else(|| bad("three numbers, e.g. `ElementSize = 1 1 1.5`"))?;
+                let s = three(value).ok_or_else(|| bad("three numbers, e.g. `ElementSize = 1 1 1.5`"))?;
                 element_size = Some((number, DVec3::from_array(s)));
             }
             "elementtype" => {
-                dtype = Some(voxel_type(&value.to_ascii_uppercase()).ok_or_else(|| {
-                    LoadError::UnsupportedType {
-                        at: at.clone(),
-                        found: clip(value),
-                        supported: SUPPORTED_TYPES,
-                    }
+                dtype = Some(voxel_type(&value.to_ascii_uppercase()).ok_or_else(|| LoadError::UnsupportedType {
+                    at: at.clone(),
+                    found: clip(value),
+                    supported: SUPPORTED_TYPES,
                 })?);
             }
             "elementbyteordermsb" | "binarydatabyteordermsb" => {
                 let msb = boolean(value).ok_or_else(|| bad("`True` or `False`"))?;
-                order = if msb {
-                    Endianness::Big
-                } else {
-                    Endianness::Little
-                };
+                order = if msb { Endianness::Big } else { Endianness::Little };
             }
             "headersize" => {
                 header_size = value
                     .parse::<i64>()
                     .ok()
                     .filter(|&n| n >= -1)
-                    .ok_or_else(|| {
-                        bad("a whole number ≥ 0, or -1 for data at the end of the file")
-                    })?;
+                    .ok_or_else(|| bad("a whole number ≥ 0, or -1 for data at the end of the file"))?;
             }
             "compresseddata" => {
                 compressed = boolean(value).ok_or_else(|| bad("`True` or `False`"))?;
@@ -155,10 +139,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
                 });
             }
             "elementdatafile" => {
-                if value.is_empty()
-                    || value.eq_ignore_ascii_case("LIST")
-                    || value.contains('%')
-                    || value.contains(' ')
+                if value.is_empty() || value.eq_ignore_ascii_case("LIST") || value.contains('%') || value.contains(' ')
                 {
                     return Err(LoadError::UnsupportedField {
                         at,
@@ -174,25 +155,14 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
         }
     }
 
-    let missing = |field, example| LoadError::MissingField {
-        path: path.to_path_buf(),
-        field,
-        example,
-    };
+    let missing = |field, example| LoadError::MissingField { path: path.to_path_buf(), field, example };
     if !ndims_seen {
         return Err(missing("NDims", "NDims = 3"));
     }
-    let (sizes_line, sizes, sizes_text) =
-        sizes.ok_or_else(|| missing("DimSize", "DimSize = 64 64 64"))?;
+    let (sizes_line, sizes, sizes_text) = sizes.ok_or_else(|| missing("DimSize", "DimSize = 64 64 64"))?;
     let dtype = dtype.ok_or_else(|| missing("ElementType", "ElementType = MET_UCHAR"))?;
-    let (data_name, data_start) =
-        data_file.ok_or_else(|| missing("ElementDataFile", "ElementDataFile = LOCAL"))?;
-    let dims = check_dims(
-        &Location::line(path, sizes_line),
-        "DimSize",
-        &sizes_text,
-        sizes,
-    )?;
+    let (data_name, data_start) = data_file.ok_or_else(|| missing("ElementDataFile", "ElementDataFile = LOCAL"))?;
+    let dims = check_dims(&Location::line(path, sizes_line), "DimSize", &sizes_text, sizes)?;
     let spacing = match spacing.or(element_size) {
         Some((line, s)) => {
             check_spacing(&Location::line(path, line), s)?;
@@ -206,10 +176,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
         if header_size != 0 {
             notes.push(format!("HeaderSize = {header_size} ignored for LOCAL data"));
         }
-        (
-            path.to_path_buf(),
-            bytes.get(data_start..).unwrap_or(&[]).to_vec(),
-        )
+        (path.to_path_buf(), bytes.get(data_start..).unwrap_or(&[]).to_vec())
     } else {
         let p = sibling(path, &data_name);
         let all = read_file(&p)?;
@@ -229,12 +196,6 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
     };
     let mut report = LoadReport::new(VolumeFormat::MetaImage, &data_path);
     report.notes = notes;
-    let layout = Layout {
-        name: stem(path),
-        dims,
-        dtype,
-        order,
-        spacing,
-    };
+    let layout = Layout { name: stem(path), dims, dtype, order, spacing };
     finish(layout, &data, &data_path, report, HINT)
 }

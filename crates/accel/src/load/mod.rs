@@ -110,19 +110,13 @@ pub struct LoadedVolume {
 /// Loads a volume, choosing the format by extension (case-insensitive): `.raw`, `.nrrd`,
 /// `.nhdr`, `.mhd`, `.mha`. `opts` describes raw files; see [`RawOptions`].
 pub fn load_volume(path: &Path, opts: &RawOptions) -> Result<LoadedVolume, LoadError> {
-    let extension = path
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
+    let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
     let mut loaded = match extension.as_str() {
         "raw" => raw::load(path, opts)?,
         "nrrd" | "nhdr" => nrrd::load(path)?,
         "mhd" | "mha" => metaimage::load(path)?,
         _ => {
-            return Err(LoadError::UnknownFormat {
-                path: path.to_path_buf(),
-                extension,
-            });
+            return Err(LoadError::UnknownFormat { path: path.to_path_buf(), extension });
         }
     };
     if let Some(spacing) = opts.spacing {
@@ -148,18 +142,9 @@ pub fn parse_metaimage(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadEr
 /// side (`wgpu::Limits::max_texture_dimension_3d`). A volume that does not fit can still be
 /// rendered in bricks.
 pub fn check_texture_limit(volume: &Volume, max_dim: u32) -> Result<(), LoadError> {
-    for (axis, size) in [
-        ("x", volume.dims.x),
-        ("y", volume.dims.y),
-        ("z", volume.dims.z),
-    ] {
+    for (axis, size) in [("x", volume.dims.x), ("y", volume.dims.y), ("z", volume.dims.z)] {
         if size > max_dim {
-            return Err(LoadError::TextureTooLarge {
-                name: volume.name.clone(),
-                axis,
-                size,
-                max_dim,
-            });
+            return Err(LoadError::TextureTooLarge { name: volume.name.clone(), axis, size, max_dim });
         }
     }
     Ok(())
@@ -192,10 +177,7 @@ pub fn sanitize_volume(volume: &mut Volume) -> (usize, usize, usize) {
 
 /// Reads a whole file, mapping the error to [`LoadError::Io`].
 fn read_file(path: &Path) -> Result<Vec<u8>, LoadError> {
-    std::fs::read(path).map_err(|source| LoadError::Io {
-        path: path.to_path_buf(),
-        source,
-    })
+    std::fs::read(path).map_err(|source| LoadError::Io { path: path.to_path_buf(), source })
 }
 
 /// The checked dimensions of a header (`field = value` at `at`): no zero axis, each at most
@@ -203,12 +185,7 @@ fn read_file(path: &Path) -> Result<Vec<u8>, LoadError> {
 fn check_dims(at: &Location, field: &str, value: &str, dims: [u64; 3]) -> Result<UVec3, LoadError> {
     let [x, y, z] = dims;
     if x == 0 || y == 0 || z == 0 {
-        return Err(LoadError::ZeroDimension {
-            at: at.clone(),
-            x,
-            y,
-            z,
-        });
+        return Err(LoadError::ZeroDimension { at: at.clone(), x, y, z });
     }
     let fit = |n: u64| u32::try_from(n).ok();
     match (fit(x), fit(y), fit(z)) {
@@ -226,21 +203,13 @@ fn check_spacing(at: &Location, s: DVec3) -> Result<(), LoadError> {
     if s.is_finite() && s.min_element() > 0.0 {
         Ok(())
     } else {
-        Err(LoadError::BadSpacing {
-            at: at.clone(),
-            x: s.x,
-            y: s.y,
-            z: s.z,
-        })
+        Err(LoadError::BadSpacing { at: at.clone(), x: s.x, y: s.y, z: s.z })
     }
 }
 
 /// Bytes needed by `dims` voxels of `dtype`; `None` on overflow.
 fn byte_count(dims: UVec3, dtype: VoxelType) -> Option<u64> {
-    (dims.x as u64)
-        .checked_mul(dims.y as u64)?
-        .checked_mul(dims.z as u64)?
-        .checked_mul(dtype.size_bytes() as u64)
+    (dims.x as u64).checked_mul(dims.y as u64)?.checked_mul(dims.z as u64)?.checked_mul(dtype.size_bytes() as u64)
 }
 
 fn dims_text(dims: UVec3) -> String {
@@ -252,13 +221,9 @@ fn dims_text(dims: UVec3) -> String {
 fn inflate(path: &Path, data: &[u8], zlib: bool, limit: u64) -> Result<Vec<u8>, LoadError> {
     let mut out = Vec::new();
     let result = if zlib {
-        flate2::read::ZlibDecoder::new(data)
-            .take(limit)
-            .read_to_end(&mut out)
+        flate2::read::ZlibDecoder::new(data).take(limit).read_to_end(&mut out)
     } else {
-        flate2::read::MultiGzDecoder::new(data)
-            .take(limit)
-            .read_to_end(&mut out)
+        flate2::read::MultiGzDecoder::new(data).take(limit).read_to_end(&mut out)
     };
     result.map_err(|source| LoadError::Decompress {
         path: path.to_path_buf(),
@@ -278,11 +243,7 @@ fn decode(bytes: &[u8], dtype: VoxelType, order: Endianness) -> VoxelData {
                 .chunks_exact(2)
                 .map(|c| {
                     let b = [c[0], c[1]];
-                    if big {
-                        u16::from_be_bytes(b)
-                    } else {
-                        u16::from_le_bytes(b)
-                    }
+                    if big { u16::from_be_bytes(b) } else { u16::from_le_bytes(b) }
                 })
                 .collect(),
         ),
@@ -291,11 +252,7 @@ fn decode(bytes: &[u8], dtype: VoxelType, order: Endianness) -> VoxelData {
                 .chunks_exact(2)
                 .map(|c| {
                     let b = [c[0], c[1]];
-                    if big {
-                        i16::from_be_bytes(b)
-                    } else {
-                        i16::from_le_bytes(b)
-                    }
+                    if big { i16::from_be_bytes(b) } else { i16::from_le_bytes(b) }
                 })
                 .collect(),
         ),
@@ -304,11 +261,7 @@ fn decode(bytes: &[u8], dtype: VoxelType, order: Endianness) -> VoxelData {
                 .chunks_exact(4)
                 .map(|c| {
                     let b = [c[0], c[1], c[2], c[3]];
-                    if big {
-                        f32::from_be_bytes(b)
-                    } else {
-                        f32::from_le_bytes(b)
-                    }
+                    if big { f32::from_be_bytes(b) } else { f32::from_le_bytes(b) }
                 })
                 .collect(),
         ),
@@ -354,19 +307,13 @@ fn finish(
 
 /// The file stem, used as the volume name.
 fn stem(path: &Path) -> String {
-    path.file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default()
+    path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
 }
 
 /// Resolves a detached data file name relative to the header's folder.
 fn sibling(header: &Path, name: &str) -> PathBuf {
     let name = Path::new(name);
-    if name.is_absolute() {
-        name.to_path_buf()
-    } else {
-        header.parent().unwrap_or(Path::new("")).join(name)
-    }
+    if name.is_absolute() { name.to_path_buf() } else { header.parent().unwrap_or(Path::new("")).join(name) }
 }
 
 /// Splits `bytes` into header lines: `(1-based line number, text without the line end, byte

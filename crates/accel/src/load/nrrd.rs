@@ -14,14 +14,15 @@ use glam::DVec3;
 
 use super::error::clip;
 use super::{
-    Endianness, Layout, LoadError, LoadReport, LoadedVolume, Location, VolumeFormat, byte_count,
-    check_dims, check_spacing, finish, header_lines, inflate, read_file, sibling, stem,
+    Endianness, Layout, LoadError, LoadReport, LoadedVolume, Location, VolumeFormat, byte_count, check_dims,
+    check_spacing, finish, header_lines, inflate, read_file, sibling, stem,
 };
 use crate::volume::VoxelType;
 
 const SUPPORTED_TYPES: &str = "uchar/uint8, ushort/uint16, short/int16, float";
 const SUPPORTED_ENCODINGS: &str = "raw, gzip";
-const HINT: &str = "check \"sizes\", \"type\", \"encoding\" and \"byte skip\" in the header, or whether the data is complete";
+const HINT: &str =
+    "check \"sizes\", \"type\", \"encoding\" and \"byte skip\" in the header, or whether the data is complete";
 
 /// Fields that do not change how the voxels are read.
 const IGNORED: &[&str] = &[
@@ -55,12 +56,8 @@ const IGNORED: &[&str] = &[
 fn voxel_type(name: &str) -> Option<VoxelType> {
     match name {
         "uchar" | "unsigned char" | "uint8" | "uint8_t" => Some(VoxelType::U8),
-        "ushort" | "unsigned short" | "unsigned short int" | "uint16" | "uint16_t" => {
-            Some(VoxelType::U16)
-        }
-        "short" | "short int" | "signed short" | "signed short int" | "int16" | "int16_t" => {
-            Some(VoxelType::I16)
-        }
+        "ushort" | "unsigned short" | "unsigned short int" | "uint16" | "uint16_t" => Some(VoxelType::U16),
+        "short" | "short int" | "signed short" | "signed short int" | "int16" | "int16_t" => Some(VoxelType::I16),
         "float" => Some(VoxelType::F32),
         _ => None,
     }
@@ -80,14 +77,9 @@ pub(super) fn load(path: &Path) -> Result<LoadedVolume, LoadError> {
 pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError> {
     let mut lines = header_lines(bytes);
     let magic = lines.next().map(|(_, text, _)| text).unwrap_or_default();
-    let version_ok = magic.len() == 8
-        && magic.starts_with("NRRD000")
-        && matches!(magic.as_bytes()[7], b'1'..=b'5');
+    let version_ok = magic.len() == 8 && magic.starts_with("NRRD000") && matches!(magic.as_bytes()[7], b'1'..=b'5');
     if !version_ok {
-        return Err(LoadError::NotNrrd {
-            path: path.to_path_buf(),
-            found: clip(&magic),
-        });
+        return Err(LoadError::NotNrrd { path: path.to_path_buf(), found: clip(&magic) });
     }
 
     let mut dtype = None;
@@ -129,45 +121,36 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
         };
         match field.as_str() {
             "type" => {
-                let t = voxel_type(&value.to_ascii_lowercase()).ok_or_else(|| {
-                    LoadError::UnsupportedType {
-                        at: at.clone(),
-                        found: clip(value),
-                        supported: SUPPORTED_TYPES,
-                    }
+                let t = voxel_type(&value.to_ascii_lowercase()).ok_or_else(|| LoadError::UnsupportedType {
+                    at: at.clone(),
+                    found: clip(value),
+                    supported: SUPPORTED_TYPES,
                 })?;
                 dtype = Some(t);
             }
             "dimension" => {
                 if value != "3" {
-                    return Err(LoadError::NotThreeD {
-                        at: at.clone(),
-                        field: "dimension",
-                        found: clip(value),
-                    });
+                    return Err(LoadError::NotThreeD { at: at.clone(), field: "dimension", found: clip(value) });
                 }
                 dimension_seen = true;
             }
             "sizes" => {
-                let parsed: Option<Vec<u64>> =
-                    value.split_whitespace().map(|s| s.parse().ok()).collect();
+                let parsed: Option<Vec<u64>> = value.split_whitespace().map(|s| s.parse().ok()).collect();
                 match parsed.as_deref() {
                     Some(&[x, y, z]) => sizes = Some((number, [x, y, z], value.to_string())),
                     _ => return Err(bad("three whole numbers, e.g. `sizes: 64 64 32`")),
                 }
             }
             "spacings" => {
-                let parsed: Option<Vec<f64>> =
-                    value.split_whitespace().map(|s| s.parse().ok()).collect();
+                let parsed: Option<Vec<f64>> = value.split_whitespace().map(|s| s.parse().ok()).collect();
                 match parsed.as_deref() {
                     Some(&[x, y, z]) => spacing = Some((number, DVec3::new(x, y, z))),
                     _ => return Err(bad("three numbers, e.g. `spacings: 1 1 1.5`")),
                 }
             }
             "space directions" => {
-                let lengths = parse_directions(value).ok_or_else(|| {
-                    bad("three vectors, e.g. `space directions: (1,0,0) (0,1,0) (0,0,1.5)`")
-                })?;
+                let lengths = parse_directions(value)
+                    .ok_or_else(|| bad("three vectors, e.g. `space directions: (1,0,0) (0,1,0) (0,0,1.5)`"))?;
                 spacing = Some((number, lengths));
             }
             "endian" => {
@@ -206,9 +189,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
                     .parse::<i64>()
                     .ok()
                     .filter(|&n| n >= -1)
-                    .ok_or_else(|| {
-                        bad("a whole number ≥ 0, or -1 for data at the end of the file")
-                    })?;
+                    .ok_or_else(|| bad("a whole number ≥ 0, or -1 for data at the end of the file"))?;
             }
             "line skip" | "lineskip" => {
                 if value != "0" {
@@ -233,24 +214,14 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
         }
     }
 
-    let missing = |field, example| LoadError::MissingField {
-        path: path.to_path_buf(),
-        field,
-        example,
-    };
+    let missing = |field, example| LoadError::MissingField { path: path.to_path_buf(), field, example };
     let dtype = dtype.ok_or_else(|| missing("type", "type: uchar"))?;
     if !dimension_seen {
         return Err(missing("dimension", "dimension: 3"));
     }
-    let (sizes_line, sizes, sizes_text) =
-        sizes.ok_or_else(|| missing("sizes", "sizes: 64 64 64"))?;
+    let (sizes_line, sizes, sizes_text) = sizes.ok_or_else(|| missing("sizes", "sizes: 64 64 64"))?;
     let encoding = encoding.ok_or_else(|| missing("encoding", "encoding: raw"))?;
-    let dims = check_dims(
-        &Location::line(path, sizes_line),
-        "sizes",
-        &sizes_text,
-        sizes,
-    )?;
+    let dims = check_dims(&Location::line(path, sizes_line), "sizes", &sizes_text, sizes)?;
     let spacing = match spacing {
         Some((line, s)) => {
             check_spacing(&Location::line(path, line), s)?;
@@ -280,20 +251,12 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
             (p, bytes)
         }
         None => match data_start {
-            Some(start) => (
-                path.to_path_buf(),
-                bytes.get(start..).unwrap_or(&[]).to_vec(),
-            ),
-            None if path
-                .extension()
-                .is_some_and(|e| e.eq_ignore_ascii_case("nhdr")) =>
-            {
+            Some(start) => (path.to_path_buf(), bytes.get(start..).unwrap_or(&[]).to_vec()),
+            None if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("nhdr")) => {
                 return Err(missing("data file", "data file: volume.raw"));
             }
             None => {
-                return Err(LoadError::UnterminatedHeader {
-                    path: path.to_path_buf(),
-                });
+                return Err(LoadError::UnterminatedHeader { path: path.to_path_buf() });
             }
         },
     };
@@ -301,12 +264,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
     let skip = byte_skip.max(0) as u64;
     let decoded = match encoding {
         Encoding::Raw => stored,
-        Encoding::Gzip => inflate(
-            &data_path,
-            &stored,
-            false,
-            expected.saturating_add(skip).saturating_add(1),
-        )?,
+        Encoding::Gzip => inflate(&data_path, &stored, false, expected.saturating_add(skip).saturating_add(1))?,
     };
     let data: &[u8] = if byte_skip == -1 {
         // Data at the end of the file: the last `expected` bytes (too few bytes fall through to
@@ -314,19 +272,11 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
         let start = (decoded.len() as u64).saturating_sub(expected) as usize;
         &decoded[start..]
     } else {
-        decoded
-            .get(skip.min(decoded.len() as u64) as usize..)
-            .unwrap_or(&[])
+        decoded.get(skip.min(decoded.len() as u64) as usize..).unwrap_or(&[])
     };
     let mut report = LoadReport::new(VolumeFormat::Nrrd, &data_path);
     report.notes = notes;
-    let layout = Layout {
-        name: stem(path),
-        dims,
-        dtype,
-        order,
-        spacing,
-    };
+    let layout = Layout { name: stem(path), dims, dtype, order, spacing };
     finish(layout, data, &data_path, report, HINT)
 }
 

@@ -6,8 +6,8 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::{
-    Layout, LoadError, LoadReport, LoadedVolume, Location, RawOptions, VolumeFormat, byte_count,
-    check_dims, dims_text, finish, read_file,
+    Layout, LoadError, LoadReport, LoadedVolume, Location, RawOptions, VolumeFormat, byte_count, check_dims, dims_text,
+    finish, read_file,
 };
 use crate::volume::VoxelType;
 
@@ -41,52 +41,31 @@ pub fn parse_raw_name(file_name: &str) -> Option<(String, [u64; 3], Option<Strin
 
 pub(super) fn load(path: &Path, opts: &RawOptions) -> Result<LoadedVolume, LoadError> {
     let at = Location::file(path);
-    let file_name = path
-        .file_name()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
+    let file_name = path.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let parsed = parse_raw_name(&file_name);
     let name = match &parsed {
         Some((name, _, _)) if !name.is_empty() => name.clone(),
         _ => super::stem(path),
     };
-    let unknown = |what, field| LoadError::RawUnknownLayout {
-        path: path.to_path_buf(),
-        what,
-        field,
-    };
+    let unknown = |what, field| LoadError::RawUnknownLayout { path: path.to_path_buf(), what, field };
     let dims = match (opts.dims, &parsed) {
         (Some(d), _) => [d.x as u64, d.y as u64, d.z as u64],
         (None, Some((_, dims, _))) => *dims,
         (None, None) => return Err(unknown("dimensions", "dims")),
     };
-    let dtype = match (opts.dtype, &parsed) {
-        (Some(t), _) => t,
-        (None, Some((_, _, Some(token)))) => {
-            VoxelType::from_name(token).ok_or_else(|| LoadError::UnsupportedType {
-                at: at.clone(),
-                found: token.clone(),
-                supported: SUPPORTED,
-            })?
-        }
-        (None, _) => return Err(unknown("type", "dtype")),
-    };
-    let dims = check_dims(
-        &at,
-        "dims",
-        &format!("{}x{}x{}", dims[0], dims[1], dims[2]),
-        dims,
-    )?;
+    let dtype =
+        match (opts.dtype, &parsed) {
+            (Some(t), _) => t,
+            (None, Some((_, _, Some(token)))) => VoxelType::from_name(token).ok_or_else(|| {
+                LoadError::UnsupportedType { at: at.clone(), found: token.clone(), supported: SUPPORTED }
+            })?,
+            (None, _) => return Err(unknown("type", "dtype")),
+        };
+    let dims = check_dims(&at, "dims", &format!("{}x{}x{}", dims[0], dims[1], dims[2]), dims)?;
     let expected = byte_count(dims, dtype).unwrap_or(u64::MAX);
-    let hint =
-        "check the dimensions and type in the file name (name_XxYxZ_dtype.raw) or in RawOptions";
+    let hint = "check the dimensions and type in the file name (name_XxYxZ_dtype.raw) or in RawOptions";
     // Compare sizes before reading, so a wrong name never makes us read a huge file for nothing.
-    let actual = std::fs::metadata(path)
-        .map_err(|source| LoadError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?
-        .len();
+    let actual = std::fs::metadata(path).map_err(|source| LoadError::Io { path: path.to_path_buf(), source })?.len();
     if actual != expected {
         return Err(LoadError::DataSize {
             path: path.to_path_buf(),
@@ -98,18 +77,6 @@ pub(super) fn load(path: &Path, opts: &RawOptions) -> Result<LoadedVolume, LoadE
         });
     }
     let bytes = read_file(path)?;
-    let layout = Layout {
-        name,
-        dims,
-        dtype,
-        order: opts.endianness,
-        spacing: DVec3::ONE,
-    };
-    finish(
-        layout,
-        &bytes,
-        path,
-        LoadReport::new(VolumeFormat::Raw, path),
-        hint,
-    )
+    let layout = Layout { name, dims, dtype, order: opts.endianness, spacing: DVec3::ONE };
+    finish(layout, &bytes, path, LoadReport::new(VolumeFormat::Raw, path), hint)
 }

@@ -10,24 +10,14 @@ use super::{ControlPoint, TfError, TransferFunction};
 /// sRGB-encoded channel → linear (IEC 61966-2-1).
 fn srgb_to_linear(c: f64) -> f64 {
     let c = c.clamp(0.0, 1.0);
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
 }
 
 /// Groups a flat number array `[x, a, b, c, x, …]` into `[x, a, b, c]` quadruples, checking the
 /// shape and that x never decreases.
-fn quads(
-    object: &serde_json::Map<String, Value>,
-    key: &str,
-    layout: &str,
-) -> Result<Vec<[f64; 4]>, String> {
+fn quads(object: &serde_json::Map<String, Value>, key: &str, layout: &str) -> Result<Vec<[f64; 4]>, String> {
     let Some(value) = object.get(key) else {
-        return Err(format!(
-            "the colour map has no \"{key}\" array; it needs [{layout}, …]"
-        ));
+        return Err(format!("the colour map has no \"{key}\" array; it needs [{layout}, …]"));
     };
     let Some(items) = value.as_array() else {
         return Err(format!("\"{key}\" is not an array; it needs [{layout}, …]"));
@@ -40,15 +30,9 @@ fn quads(
         }
     }
     if numbers.is_empty() || numbers.len() % 4 != 0 {
-        return Err(format!(
-            "\"{key}\" has {} numbers; it needs groups of four ({layout})",
-            numbers.len()
-        ));
+        return Err(format!("\"{key}\" has {} numbers; it needs groups of four ({layout})", numbers.len()));
     }
-    let groups: Vec<[f64; 4]> = numbers
-        .chunks_exact(4)
-        .map(|c| [c[0], c[1], c[2], c[3]])
-        .collect();
+    let groups: Vec<[f64; 4]> = numbers.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect();
     for (i, pair) in groups.windows(2).enumerate() {
         if pair[1][0] < pair[0][0] {
             return Err(format!(
@@ -81,29 +65,17 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<TransferFunction, TfError
         // serde_json appends " at line L column C"; the location is shown in front instead.
         let full = e.to_string();
         let message = full.split(" at line ").next().unwrap_or(&full).to_string();
-        TfError::Json {
-            path: path.to_path_buf(),
-            line: e.line(),
-            col: e.column(),
-            message,
-        }
+        TfError::Json { path: path.to_path_buf(), line: e.line(), col: e.column(), message }
     })?;
-    let fail = |message: String| TfError::Paraview {
-        path: path.to_path_buf(),
-        message,
-    };
+    let fail = |message: String| TfError::Paraview { path: path.to_path_buf(), message };
     let map = match &root {
-        Value::Array(items) => items.first().ok_or_else(|| {
-            fail(
-                "the JSON array is empty; it needs one colour map object with \"RGBPoints\"".into(),
-            )
-        })?,
+        Value::Array(items) => items
+            .first()
+            .ok_or_else(|| fail("the JSON array is empty; it needs one colour map object with \"RGBPoints\"".into()))?,
         other => other,
     };
     let Some(object) = map.as_object() else {
-        return Err(fail(
-            "expected a colour map object (or an array of them) with \"RGBPoints\"".into(),
-        ));
+        return Err(fail("expected a colour map object (or an array of them) with \"RGBPoints\"".into()));
     };
     let rgb = quads(object, "RGBPoints", "x, r, g, b").map_err(&fail)?;
     let opacity = match object.get("Points") {
@@ -120,20 +92,12 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<TransferFunction, TfError
         return Err(fail("no finite x value in \"RGBPoints\"".into()));
     };
     if lo >= hi {
-        return Err(fail(format!(
-            "every point has x = {lo}; a colour map needs two different x values"
-        )));
+        return Err(fail(format!("every point has x = {lo}; a colour map needs two different x values")));
     }
 
-    let colors: Vec<(f64, [f64; 3])> = rgb
-        .iter()
-        .map(|q| (q[0], [q[1], q[2], q[3]].map(srgb_to_linear)))
-        .collect();
+    let colors: Vec<(f64, [f64; 3])> = rgb.iter().map(|q| (q[0], [q[1], q[2], q[3]].map(srgb_to_linear))).collect();
     let alphas: Vec<(f64, [f64; 1])> = match &opacity {
-        Some(points) => points
-            .iter()
-            .map(|q| (q[0], [q[1].clamp(0.0, 1.0)]))
-            .collect(),
+        Some(points) => points.iter().map(|q| (q[0], [q[1].clamp(0.0, 1.0)])).collect(),
         None => vec![(lo, [0.0]), (hi, [1.0])],
     };
     let points = xs
@@ -144,10 +108,7 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<TransferFunction, TfError
             alpha: interpolate(&alphas, x)[0],
         })
         .collect();
-    let tf = TransferFunction {
-        domain: (lo, hi),
-        points,
-    };
+    let tf = TransferFunction { domain: (lo, hi), points };
     tf.validate(path)?;
     Ok(tf)
 }

@@ -1,10 +1,7 @@
 //! Shared helpers of the acceleration-structure tests: seeded random volumes and LUTs, and an
 //! independent f64 model of the LUT's 1D linear sampler.
 
-#![allow(
-    dead_code,
-    reason = "each test binary uses a different subset of the helpers"
-)]
+#![allow(dead_code, reason = "each test binary uses a different subset of the helpers")]
 
 use glam::{DVec3, UVec3};
 use volgraph_accel::volume::{Volume, VoxelData};
@@ -36,11 +33,7 @@ pub fn random_volume(dims: UVec3, float: bool, seed: u64) -> Volume {
     let count = (dims.x * dims.y * dims.z) as usize;
     let background = if rng.below(2) == 0 { 0.0 } else { rng.unit() };
     let mut values = vec![background; count];
-    let noise = if rng.below(3) == 0 {
-        rng.unit() * 0.3
-    } else {
-        0.0
-    };
+    let noise = if rng.below(3) == 0 { rng.unit() * 0.3 } else { 0.0 };
     for v in values.iter_mut() {
         *v = (*v + (rng.unit() - 0.5) * noise).clamp(0.0, 1.0);
     }
@@ -51,11 +44,7 @@ pub fn random_volume(dims: UVec3, float: bool, seed: u64) -> Volume {
             rng.below(dims.y as u64) as u32,
             rng.below(dims.z as u64) as u32,
         );
-        let size = UVec3::new(
-            1 + rng.below(6) as u32,
-            1 + rng.below(6) as u32,
-            1 + rng.below(6) as u32,
-        );
+        let size = UVec3::new(1 + rng.below(6) as u32, 1 + rng.below(6) as u32, 1 + rng.below(6) as u32);
         let hi = (lo + size).min(dims);
         for z in lo.z..hi.z {
             for y in lo.y..hi.y {
@@ -67,26 +56,14 @@ pub fn random_volume(dims: UVec3, float: bool, seed: u64) -> Volume {
     }
     let (data, value_range) = if float {
         // Float data with an arbitrary affine scale, normalized by its own range.
-        let scaled: Vec<f32> = values
-            .iter()
-            .map(|v| (*v * 1000.0 - 200.0) as f32)
-            .collect();
+        let scaled: Vec<f32> = values.iter().map(|v| (*v * 1000.0 - 200.0) as f32).collect();
         let lo = scaled.iter().copied().fold(f32::INFINITY, f32::min) as f64;
         let hi = scaled.iter().copied().fold(f32::NEG_INFINITY, f32::max) as f64;
         (VoxelData::F32(scaled), (lo, hi))
     } else {
-        (
-            VoxelData::U8(values.iter().map(|v| (v * 255.0).round() as u8).collect()),
-            (0.0, 255.0),
-        )
+        (VoxelData::U8(values.iter().map(|v| (v * 255.0).round() as u8).collect()), (0.0, 255.0))
     };
-    Volume {
-        dims,
-        spacing: DVec3::ONE,
-        data,
-        name: format!("random-{seed}"),
-        value_range,
-    }
+    Volume { dims, spacing: DVec3::ONE, data, name: format!("random-{seed}"), value_range }
 }
 
 /// A LUT of 1..=64 texels whose alpha is zero in runs, so classification has gaps.
@@ -100,11 +77,7 @@ pub fn random_lut(seed: u64) -> Vec<[f32; 4]> {
         if rng.below(4) == 0 {
             visible = rng.unit() < p_visible;
         }
-        let a = if visible {
-            0.001 + rng.unit() as f32
-        } else {
-            0.0
-        };
+        let a = if visible { 0.001 + rng.unit() as f32 } else { 0.0 };
         lut.push([1.0, 1.0, 1.0, a]);
     }
     lut

@@ -20,36 +20,15 @@ pub fn temp_dir(tag: &str) -> PathBuf {
 pub fn voxel_bytes(data: &VoxelData, big_endian: bool) -> Vec<u8> {
     match data {
         VoxelData::U8(v) => v.clone(),
-        VoxelData::U16(v) => v
-            .iter()
-            .flat_map(|x| {
-                if big_endian {
-                    x.to_be_bytes()
-                } else {
-                    x.to_le_bytes()
-                }
-            })
-            .collect(),
-        VoxelData::I16(v) => v
-            .iter()
-            .flat_map(|x| {
-                if big_endian {
-                    x.to_be_bytes()
-                } else {
-                    x.to_le_bytes()
-                }
-            })
-            .collect(),
-        VoxelData::F32(v) => v
-            .iter()
-            .flat_map(|x| {
-                if big_endian {
-                    x.to_be_bytes()
-                } else {
-                    x.to_le_bytes()
-                }
-            })
-            .collect(),
+        VoxelData::U16(v) => {
+            v.iter().flat_map(|x| if big_endian { x.to_be_bytes() } else { x.to_le_bytes() }).collect()
+        }
+        VoxelData::I16(v) => {
+            v.iter().flat_map(|x| if big_endian { x.to_be_bytes() } else { x.to_le_bytes() }).collect()
+        }
+        VoxelData::F32(v) => {
+            v.iter().flat_map(|x| if big_endian { x.to_be_bytes() } else { x.to_le_bytes() }).collect()
+        }
     }
 }
 

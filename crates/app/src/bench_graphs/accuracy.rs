@@ -17,10 +17,7 @@ use volgraph_passes::raycast_params::reference_settings;
 /// The reference settings of the plan's raycast: the first step declaring `step_voxels`,
 /// parameters it lacks taken from [`RaycastSettings::default`]. `None` when no step marches rays.
 pub fn raycast_settings(plan: &Plan) -> Option<RaycastSettings> {
-    let step = plan
-        .steps
-        .iter()
-        .find(|s| s.params.iter().any(|(name, _)| name == "step_voxels"))?;
+    let step = plan.steps.iter().find(|s| s.params.iter().any(|(name, _)| name == "step_voxels"))?;
     let declared: BTreeSet<&str> = step.params.iter().map(|(name, _)| name).collect();
     let mut settings = reference_settings(&step.params);
     let defaults = RaycastSettings::default();
@@ -39,13 +36,7 @@ pub fn raycast_settings(plan: &Plan) -> Option<RaycastSettings> {
 /// The converged version of `settings`: step `reference_step`, no early termination, no jitter,
 /// enough steps for any ray.
 pub fn converged(settings: &RaycastSettings, reference_step: f64) -> RaycastSettings {
-    RaycastSettings {
-        step_voxels: reference_step,
-        threshold: 1.0,
-        jitter: false,
-        max_steps: 1 << 20,
-        ..*settings
-    }
+    RaycastSettings { step_voxels: reference_step, threshold: 1.0, jitter: false, max_steps: 1 << 20, ..*settings }
 }
 
 /// Average volume samples per pixel of the reference with `settings` at `size`.
@@ -93,11 +84,7 @@ pub fn image_error(gpu: &Image, reference: &[[f64; 4]]) -> Option<ImageError> {
     let n = 4.0 * pixels as f64;
     let mse = sum_sq / n;
     let psnr_db = (mse > 0.0).then(|| 10.0 * (1.0 / mse).log10());
-    Some(ImageError {
-        max_abs,
-        mean_abs: sum_abs / n,
-        psnr_db,
-    })
+    Some(ImageError { max_abs, mean_abs: sum_abs / n, psnr_db })
 }
 
 /// Which points `(ms, error)` are on the Pareto front: no other point is at least as fast and at
@@ -106,11 +93,7 @@ pub fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
     points
         .iter()
         .map(|&(t, e)| {
-            t.is_finite()
-                && e.is_finite()
-                && !points
-                    .iter()
-                    .any(|&(t2, e2)| t2 <= t && e2 <= e && (t2 < t || e2 < e))
+            t.is_finite() && e.is_finite() && !points.iter().any(|&(t2, e2)| t2 <= t && e2 <= e && (t2 < t || e2 < e))
         })
         .collect()
 }
@@ -121,24 +104,13 @@ mod tests {
 
     #[test]
     fn pareto_keeps_only_undominated_points() {
-        let front = pareto_front(&[
-            (1.0, 0.5),
-            (2.0, 0.1),
-            (3.0, 0.2),
-            (1.5, 0.5),
-            (f64::NAN, 0.0),
-        ]);
+        let front = pareto_front(&[(1.0, 0.5), (2.0, 0.1), (3.0, 0.2), (1.5, 0.5), (f64::NAN, 0.0)]);
         assert_eq!(front, vec![true, true, false, false, false]);
     }
 
     #[test]
     fn identical_images_have_zero_error_and_no_psnr() {
-        let image = Image {
-            width: 2,
-            height: 1,
-            channels: 4,
-            data: vec![0.5; 8],
-        };
+        let image = Image { width: 2, height: 1, channels: 4, data: vec![0.5; 8] };
         let e = image_error(&image, &[[0.5; 4]; 2]).expect("same size");
         assert_eq!((e.max_abs, e.mean_abs, e.psnr_db), (0.0, 0.0, None));
         let e = image_error(&image, &[[0.4; 4]; 2]).expect("same size");

@@ -143,17 +143,13 @@ pub fn workspace_root() -> PathBuf {
 
 /// The label of a graph file in tables: its file stem.
 pub fn graph_label(path: &Path) -> String {
-    path.file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| path.display().to_string())
+    path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| path.display().to_string())
 }
 
 /// Parses `--sweep PASS.PARAM=V1,V2,...`.
 pub fn parse_sweep(text: &str) -> anyhow::Result<Sweep> {
     let fail = |why: &str| {
-        anyhow!(
-            "--sweep \"{text}\": {why}; expected PASS.PARAM=V1,V2,..., e.g. march.step_voxels=0.25,0.5,1,2"
-        )
+        anyhow!("--sweep \"{text}\": {why}; expected PASS.PARAM=V1,V2,..., e.g. march.step_voxels=0.25,0.5,1,2")
     };
     let (key, values) = text.split_once('=').ok_or_else(|| fail("no '='"))?;
     let key = key.trim();
@@ -183,10 +179,7 @@ pub fn parse_sweep(text: &str) -> anyhow::Result<Sweep> {
     if values.is_empty() {
         return Err(fail("no values"));
     }
-    Ok(Sweep {
-        key: key.to_string(),
-        values,
-    })
+    Ok(Sweep { key: key.to_string(), values })
 }
 
 /// Scales a viewport, keeping each side at least 1 pixel.
@@ -207,24 +200,19 @@ pub fn reduced_viewport((w, h): (u32, u32), longest: u32) -> (u32, u32) {
 impl GraphsArgs {
     /// Merges the flags with the preset into a checked configuration.
     pub fn resolve(&self) -> anyhow::Result<BenchConfig> {
-        let preset = match &self.preset {
-            None => None,
-            Some(name) => Some(preset::find(name).ok_or_else(|| {
-                anyhow!(
-                    "--preset \"{name}\": no such preset; choose one of: {}",
-                    preset::names()
-                )
-            })?),
-        };
+        let preset =
+            match &self.preset {
+                None => None,
+                Some(name) => Some(preset::find(name).ok_or_else(|| {
+                    anyhow!("--preset \"{name}\": no such preset; choose one of: {}", preset::names())
+                })?),
+            };
         let graphs: Vec<PathBuf> = if !self.graphs.is_empty() {
             self.graphs.clone()
         } else if let Some(p) = preset {
             p.graphs.iter().map(|g| workspace_root().join(g)).collect()
         } else {
-            bail!(
-                "no graphs: give --graphs a.ron,b.ron or a --preset ({})",
-                preset::names()
-            );
+            bail!("no graphs: give --graphs a.ron,b.ron or a --preset ({})", preset::names());
         };
         let labels: Vec<String> = graphs.iter().map(|g| graph_label(g)).collect();
         let baseline = match (&self.baseline, preset) {
@@ -241,43 +229,25 @@ impl GraphsArgs {
         let datasets = if !self.datasets.is_empty() {
             self.datasets.clone()
         } else {
-            preset.map_or_else(
-                || vec!["ml64".to_string()],
-                |p| p.datasets.iter().map(|d| d.to_string()).collect(),
-            )
+            preset.map_or_else(|| vec!["ml64".to_string()], |p| p.datasets.iter().map(|d| d.to_string()).collect())
         };
         if !(self.scale.is_finite() && self.scale > 0.0 && self.scale <= 8.0) {
-            bail!(
-                "--scale {}: expected a factor in (0, 8], e.g. 0.25 to render a quarter of each side",
-                self.scale
-            );
+            bail!("--scale {}: expected a factor in (0, 8], e.g. 0.25 to render a quarter of each side", self.scale);
         }
         let base_sizes: Vec<(u32, u32)> = if !self.size.is_empty() {
-            self.size
-                .iter()
-                .map(|s| inputs::parse_size(s))
-                .collect::<anyhow::Result<_>>()?
+            self.size.iter().map(|s| inputs::parse_size(s)).collect::<anyhow::Result<_>>()?
         } else {
             preset.map_or_else(|| vec![(512, 512)], |p| p.viewports.to_vec())
         };
-        let viewports = base_sizes
-            .into_iter()
-            .map(|v| scale_viewport(v, self.scale))
-            .collect();
+        let viewports = base_sizes.into_iter().map(|v| scale_viewport(v, self.scale)).collect();
         let tf_names: Vec<String> = if !self.tf.is_empty() {
             self.tf.clone()
         } else {
-            preset.map_or_else(
-                || vec!["default".to_string()],
-                |p| p.tfs.iter().map(|t| t.to_string()).collect(),
-            )
+            preset.map_or_else(|| vec!["default".to_string()], |p| p.tfs.iter().map(|t| t.to_string()).collect())
         };
         let tfs = tf_names
             .iter()
-            .map(|t| {
-                Preset::from_name(t)
-                    .ok_or_else(|| anyhow!("--tf \"{t}\": expected default, opaque or sparse"))
-            })
+            .map(|t| Preset::from_name(t).ok_or_else(|| anyhow!("--tf \"{t}\": expected default, opaque or sparse")))
             .collect::<anyhow::Result<_>>()?;
         let frames = self.frames.or(preset.map(|p| p.frames)).unwrap_or(36);
         if frames == 0 {
@@ -296,26 +266,15 @@ impl GraphsArgs {
         };
         let sweep = self.sweep.as_deref().map(parse_sweep).transpose()?;
         if !(self.reference_step.is_finite() && self.reference_step > 0.0) {
-            bail!(
-                "--reference-step {}: expected a positive step in voxels, e.g. 0.1",
-                self.reference_step
-            );
+            bail!("--reference-step {}: expected a positive step in voxels, e.g. 0.1", self.reference_step);
         }
         if self.accuracy_size == 0 || self.accuracy_size > 4096 {
-            bail!(
-                "--accuracy-size {}: expected 1..=4096 pixels",
-                self.accuracy_size
-            );
+            bail!("--accuracy-size {}: expected 1..=4096 pixels", self.accuracy_size);
         }
         if self.spp_size > 4096 {
-            bail!(
-                "--spp-size {}: expected 0 (off) ..=4096 pixels",
-                self.spp_size
-            );
+            bail!("--spp-size {}: expected 0 (off) ..=4096 pixels", self.spp_size);
         }
-        let params = preset
-            .map(|p| p.params.iter().map(|(k, v)| (k.to_string(), *v)).collect())
-            .unwrap_or_default();
+        let params = preset.map(|p| p.params.iter().map(|(k, v)| (k.to_string(), *v)).collect()).unwrap_or_default();
         Ok(BenchConfig {
             preset,
             graphs,

@@ -38,10 +38,7 @@ pub struct Timing {
 
 /// The camera of timed frame `index`: the start camera turned `index · degrees_per_frame` about y.
 pub fn frame_camera(start: &OrbitCamera, degrees_per_frame: f64, index: u32) -> OrbitCamera {
-    OrbitCamera {
-        azimuth_deg: start.azimuth_deg + index as f64 * degrees_per_frame,
-        ..*start
-    }
+    OrbitCamera { azimuth_deg: start.azimuth_deg + index as f64 * degrees_per_frame, ..*start }
 }
 
 /// Renders one warm-up frame (pipelines, first uploads), then `frames` timed frames; `tick` is
@@ -56,12 +53,8 @@ pub fn time_frames(
 ) -> Result<Timing, SessionError> {
     session.render(gpu, start)?;
     tick();
-    let mut timing = Timing {
-        frame_ms: Vec::new(),
-        wall_ms: Vec::new(),
-        wall_time_fallback: false,
-        pass_ms: BTreeMap::new(),
-    };
+    let mut timing =
+        Timing { frame_ms: Vec::new(), wall_ms: Vec::new(), wall_time_fallback: false, pass_ms: BTreeMap::new() };
     let mut per_pass: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     for f in 0..frames {
         let camera = frame_camera(start, degrees_per_frame, f);
@@ -78,10 +71,7 @@ pub fn time_frames(
         tick();
     }
     if !timing.wall_time_fallback {
-        timing.pass_ms = per_pass
-            .into_iter()
-            .map(|(pass, v)| (pass, median(&v)))
-            .collect();
+        timing.pass_ms = per_pass.into_iter().map(|(pass, v)| (pass, median(&v))).collect();
     }
     Ok(timing)
 }

@@ -40,11 +40,7 @@ pub fn run_cli(args: &GraphsArgs) -> anyhow::Result<GraphBenchReport> {
 }
 
 /// Writes the files `config` names.
-pub fn write_outputs(
-    config: &args::BenchConfig,
-    report: &GraphBenchReport,
-    markdown: &str,
-) -> anyhow::Result<()> {
+pub fn write_outputs(config: &args::BenchConfig, report: &GraphBenchReport, markdown: &str) -> anyhow::Result<()> {
     if let Some(path) = &config.json {
         let text = serde_json::to_string_pretty(report).context("serializing the report")?;
         std::fs::write(path, text + "\n")

@@ -31,10 +31,7 @@ pub const PRESETS: &[BenchPreset] = &[
     BenchPreset {
         name: "basic",
         about: "First light: fragment vs compute raycast, hydrogen_atom 128³ at 512², step 0.5 voxel",
-        graphs: &[
-            "graphs/basic/fragment_raycast.ron",
-            "graphs/basic/compute_raycast.ron",
-        ],
+        graphs: &["graphs/basic/fragment_raycast.ron", "graphs/basic/compute_raycast.ron"],
         baseline: "fragment_raycast",
         datasets: &["hydrogen_atom"],
         viewports: &[(512, 512)],
@@ -56,13 +53,7 @@ pub const PRESETS: &[BenchPreset] = &[
             "graphs/modern/single_pass_ess_ert.ron",
         ],
         baseline: "sbvr",
-        datasets: &[
-            "engine_vollib",
-            "hydrogen_atom",
-            "neghip",
-            "lobster",
-            "fuel",
-        ],
+        datasets: &["engine_vollib", "hydrogen_atom", "neghip", "lobster", "fuel"],
         viewports: &[(512, 512)],
         tfs: &["opaque", "sparse"],
         params: &[],
@@ -71,10 +62,7 @@ pub const PRESETS: &[BenchPreset] = &[
     BenchPreset {
         name: "thesis-tables",
         about: "DirectCompute thesis Tables 1–4: pixel-shader vs compute-shader raycast at 800×600 and 1920×1080 over datasets of several sizes",
-        graphs: &[
-            "graphs/compute_raycast_2013/pixel_shader.ron",
-            "graphs/compute_raycast_2013/compute_shader.ron",
-        ],
+        graphs: &["graphs/compute_raycast_2013/pixel_shader.ron", "graphs/compute_raycast_2013/compute_shader.ron"],
         baseline: "pixel_shader",
         datasets: &["neghip", "hydrogen_atom", "engine_vollib"],
         viewports: &[(800, 600), (1920, 1080)],
@@ -91,9 +79,5 @@ pub fn find(name: &str) -> Option<&'static BenchPreset> {
 
 /// The preset names, for messages.
 pub fn names() -> String {
-    PRESETS
-        .iter()
-        .map(|p| p.name)
-        .collect::<Vec<_>>()
-        .join(", ")
+    PRESETS.iter().map(|p| p.name).collect::<Vec<_>>().join(", ")
 }

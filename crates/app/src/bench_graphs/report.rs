@@ -101,27 +101,19 @@ pub struct Row {
 }
 
 fn opt(v: Option<f64>, digits: usize) -> String {
-    v.filter(|x| x.is_finite())
-        .map_or_else(|| "n/a".to_string(), |x| format!("{x:.digits$}"))
+    v.filter(|x| x.is_finite()).map_or_else(|| "n/a".to_string(), |x| format!("{x:.digits$}"))
 }
 
 impl GraphBenchReport {
     /// The markdown table (with a short header naming adapter, clock and settings).
     pub fn to_markdown(&self) -> String {
         let mut s = String::new();
-        let title = self
-            .preset
-            .as_deref()
-            .map_or_else(|| "ad hoc".to_string(), |p| format!("preset `{p}`"));
+        let title = self.preset.as_deref().map_or_else(|| "ad hoc".to_string(), |p| format!("preset `{p}`"));
         let _ = writeln!(s, "## volgraph bench graphs — {title}\n");
         if let Some(about) = &self.about {
             let _ = writeln!(s, "{about}\n");
         }
-        let clock = if self.timestamps {
-            "GPU time from timestamp queries"
-        } else {
-            "wall time (no GPU timestamps)"
-        };
+        let clock = if self.timestamps { "GPU time from timestamp queries" } else { "wall time (no GPU timestamps)" };
         let _ = writeln!(
             s,
             "Adapter: {}. ms/frame: median of {} frames after {} warm-up frame, {clock}; volume turns {}°/frame about y from camera {:?}; viewport scale {}; speed-up = median of `{}` / median of the row, same run.\n",
@@ -146,14 +138,7 @@ impl GraphBenchReport {
         if sweeping {
             header.push(&sweep_key);
         }
-        header.extend([
-            "ms/frame",
-            "clock",
-            "speed-up",
-            "samples/px",
-            "Msamples/s",
-            "per pass (ms)",
-        ]);
+        header.extend(["ms/frame", "clock", "speed-up", "samples/px", "Msamples/s", "per pass (ms)"]);
         if errors {
             header.extend(["max err", "mean err", "PSNR dB"]);
         }
@@ -161,11 +146,7 @@ impl GraphBenchReport {
             header.push("Pareto");
         }
         let _ = writeln!(s, "| {} |", header.join(" | "));
-        let _ = writeln!(
-            s,
-            "|{}|",
-            header.iter().map(|_| "---").collect::<Vec<_>>().join("|")
-        );
+        let _ = writeln!(s, "|{}|", header.iter().map(|_| "---").collect::<Vec<_>>().join("|"));
         for r in &self.rows {
             let mut cells = vec![
                 r.graph.clone(),
@@ -176,42 +157,25 @@ impl GraphBenchReport {
             if sweeping {
                 cells.push(r.sweep_value.clone().unwrap_or_default());
             }
-            let passes = r
-                .pass_ms
-                .iter()
-                .map(|(p, ms)| format!("{p} {ms:.2}"))
-                .collect::<Vec<_>>()
-                .join(", ");
+            let passes = r.pass_ms.iter().map(|(p, ms)| format!("{p} {ms:.2}")).collect::<Vec<_>>().join(", ");
             cells.extend([
                 format!("{:.2}", r.median_ms),
                 r.clock.clone(),
-                r.speedup_vs_baseline
-                    .map_or_else(|| "n/a".to_string(), |x| format!("{x:.2}×")),
+                r.speedup_vs_baseline.map_or_else(|| "n/a".to_string(), |x| format!("{x:.2}×")),
                 opt(r.samples_per_pixel, 1),
                 opt(r.msamples_per_s, 1),
-                if passes.is_empty() {
-                    "n/a".to_string()
-                } else {
-                    passes
-                },
+                if passes.is_empty() { "n/a".to_string() } else { passes },
             ]);
             if errors {
                 cells.push(opt(r.error.map(|e| e.max_abs), 4));
-                cells.push(
-                    r.error
-                        .map_or_else(|| "n/a".to_string(), |e| format!("{:.2e}", e.mean_abs)),
-                );
+                cells.push(r.error.map_or_else(|| "n/a".to_string(), |e| format!("{:.2e}", e.mean_abs)));
                 cells.push(match r.error {
                     Some(ImageError { psnr_db: None, .. }) => "∞".to_string(),
                     e => opt(e.and_then(|e| e.psnr_db), 1),
                 });
             }
             if sweeping {
-                cells.push(if r.pareto == Some(true) {
-                    "★".to_string()
-                } else {
-                    String::new()
-                });
+                cells.push(if r.pareto == Some(true) { "★".to_string() } else { String::new() });
             }
             let _ = writeln!(s, "| {} |", cells.join(" | "));
         }

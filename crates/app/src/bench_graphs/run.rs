@@ -55,8 +55,7 @@ struct Context<'a> {
 impl Context<'_> {
     fn skip(&mut self, what: String, reason: String) {
         if self.skip_seen.insert((what.clone(), reason.clone())) {
-            self.progress
-                .suspend(|| eprintln!("note: skipping {what}: {reason}"));
+            self.progress.suspend(|| eprintln!("note: skipping {what}: {reason}"));
             self.skipped.push(Skipped { what, reason });
         }
     }
@@ -74,26 +73,16 @@ struct Case<'a> {
 
 impl Case<'_> {
     fn name(&self) -> String {
-        let sweep = self
-            .sweep_value
-            .map(|(v, _)| format!(" {v}"))
-            .unwrap_or_default();
+        let sweep = self.sweep_value.map(|(v, _)| format!(" {v}")).unwrap_or_default();
         format!(
             "{} on {} ({}, {}×{}{sweep})",
             self.graph.label, self.dataset.name, self.tf_name, self.viewport.0, self.viewport.1
         )
     }
 
-    fn options(
-        &self,
-        config: &BenchConfig,
-        viewport: (u32, u32),
-        step_voxels: f64,
-    ) -> CompileOptions {
-        let mut options = CompileOptions::new(viewport.0, viewport.1).with_scalar(
-            LONGEST_RAY_STEPS,
-            longest_ray_steps(&self.dataset.volume, step_voxels),
-        );
+    fn options(&self, config: &BenchConfig, viewport: (u32, u32), step_voxels: f64) -> CompileOptions {
+        let mut options = CompileOptions::new(viewport.0, viewport.1)
+            .with_scalar(LONGEST_RAY_STEPS, longest_ray_steps(&self.dataset.volume, step_voxels));
         for (key, value) in &config.params {
             set_knob(&mut options, key, &ron::Value::from(*value));
         }
@@ -109,7 +98,7 @@ impl Case<'_> {
 fn set_knob(options: &mut CompileOptions, key: &str, value: &ron::Value) {
     match (key.strip_prefix("input."), value) {
         (Some(name), ron::Value::Number(n)) => {
-            options.scalars.insert(name.to_string(), n.clone().into_f64());
+            options.scalars.insert(name.to_string(), (*n).into_f64());
         }
         _ => {
             options.param_overrides.insert(key.to_string(), value.clone());
@@ -132,25 +121,13 @@ fn longest_ray_steps(volume: &Volume, step_voxels: f64) -> f64 {
 
 /// Compiles the case at `viewport`, with the scene scalar K computed for the graph's own raycast
 /// step (known only after a first compile; recompiled when it differs from the provisional one).
-fn compile_case(
-    ctx: &Context<'_>,
-    case: &Case<'_>,
-    viewport: (u32, u32),
-) -> Result<Plan, Diagnostics> {
+fn compile_case(ctx: &Context<'_>, case: &Case<'_>, viewport: (u32, u32)) -> Result<Plan, Diagnostics> {
     let file = case.graph.path.display().to_string();
-    let build = |step: f64| {
-        compile(
-            &file,
-            &case.graph.source,
-            &ctx.registry,
-            &case.options(ctx.config, viewport, step),
-        )
-    };
+    let build =
+        |step: f64| compile(&file, &case.graph.source, &ctx.registry, &case.options(ctx.config, viewport, step));
     let plan = build(PROVISIONAL_STEP_VOXELS)?;
     match accuracy::raycast_settings(&plan) {
-        Some(s) if s.step_voxels != PROVISIONAL_STEP_VOXELS && s.step_voxels > 0.0 => {
-            build(s.step_voxels)
-        }
+        Some(s) if s.step_voxels != PROVISIONAL_STEP_VOXELS && s.step_voxels > 0.0 => build(s.step_voxels),
         _ => Ok(plan),
     }
 }
@@ -172,11 +149,7 @@ pub fn run(gpu: &Gpu, config: &BenchConfig) -> anyhow::Result<GraphBenchReport> 
         .graphs
         .iter()
         .filter_map(|path| match std::fs::read_to_string(path) {
-            Ok(source) => Some(GraphFile {
-                label: graph_label(path),
-                path: path.clone(),
-                source,
-            }),
+            Ok(source) => Some(GraphFile { label: graph_label(path), path: path.clone(), source }),
             Err(e) => {
                 ctx.skip(
                     format!("graph {}", path.display()),
@@ -190,25 +163,16 @@ pub fn run(gpu: &Gpu, config: &BenchConfig) -> anyhow::Result<GraphBenchReport> 
         .datasets
         .iter()
         .filter_map(|name| match dataset::load(name) {
-            Ok(volume) => Some(Dataset {
-                name: name.clone(),
-                volume,
-            }),
+            Ok(volume) => Some(Dataset { name: name.clone(), volume }),
             Err(e) => {
                 ctx.skip(format!("dataset {name}"), format!("{e:#}"));
                 None
             }
         })
         .collect();
-    let sweep_values: Vec<Option<&(String, ron::Value)>> = config
-        .sweep
-        .as_ref()
-        .map_or_else(|| vec![None], |s| s.values.iter().map(Some).collect());
-    let cases = graphs.len()
-        * datasets.len()
-        * config.tfs.len()
-        * config.viewports.len()
-        * sweep_values.len();
+    let sweep_values: Vec<Option<&(String, ron::Value)>> =
+        config.sweep.as_ref().map_or_else(|| vec![None], |s| s.values.iter().map(Some).collect());
+    let cases = graphs.len() * datasets.len() * config.tfs.len() * config.viewports.len() * sweep_values.len();
     if !config.quiet {
         ctx.progress = ProgressBar::new((cases as u64) * (config.frames as u64 + 1));
         ctx.progress.set_style(
@@ -226,14 +190,7 @@ pub fn run(gpu: &Gpu, config: &BenchConfig) -> anyhow::Result<GraphBenchReport> 
             for &viewport in &config.viewports {
                 for &sweep_value in &sweep_values {
                     for graph in &graphs {
-                        let case = Case {
-                            graph,
-                            dataset,
-                            tf_name: tf.name(),
-                            lut: &lut,
-                            viewport,
-                            sweep_value,
-                        };
+                        let case = Case { graph, dataset, tf_name: tf.name(), lut: &lut, viewport, sweep_value };
                         ctx.progress.set_message(case.name());
                         if let Some(row) = run_case(&mut ctx, &case) {
                             rows.push(row);
@@ -245,11 +202,7 @@ pub fn run(gpu: &Gpu, config: &BenchConfig) -> anyhow::Result<GraphBenchReport> 
     }
     ctx.progress.finish_and_clear();
     if rows.is_empty() {
-        let why: Vec<String> = ctx
-            .skipped
-            .iter()
-            .map(|s| format!("{}: {}", s.what, s.reason))
-            .collect();
+        let why: Vec<String> = ctx.skipped.iter().map(|s| format!("{}: {}", s.what, s.reason)).collect();
         bail!("nothing was measured:\n  {}", why.join("\n  "));
     }
     if !rows.iter().any(|r| r.graph == config.baseline) {
@@ -271,11 +224,7 @@ pub fn run(gpu: &Gpu, config: &BenchConfig) -> anyhow::Result<GraphBenchReport> 
         frames: config.frames,
         warmup_frames: 1,
         degrees_per_frame: config.degrees_per_frame,
-        camera: [
-            config.camera.azimuth_deg,
-            config.camera.elevation_deg,
-            config.camera.distance,
-        ],
+        camera: [config.camera.azimuth_deg, config.camera.elevation_deg, config.camera.distance],
         scale: config.scale,
         baseline: config.baseline.clone(),
         sweep: config.sweep.as_ref().map(|s| s.key.clone()),
@@ -309,10 +258,7 @@ fn notes(config: &BenchConfig) -> Vec<String> {
 }
 
 fn key(case: &Case<'_>, size: (u32, u32), settings: &impl std::fmt::Debug) -> String {
-    format!(
-        "{}|{}|{}x{}|{settings:?}",
-        case.dataset.name, case.tf_name, size.0, size.1
-    )
+    format!("{}|{}|{}x{}|{settings:?}", case.dataset.name, case.tf_name, size.0, size.1)
 }
 
 /// Times one case; `None` (after a note) when it cannot run.
@@ -331,25 +277,13 @@ fn run_case(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<Row> {
         }
     };
     let settings = accuracy::raycast_settings(&plan);
-    let timing = RenderSession::from_plan(
-        ctx.gpu,
-        &ctx.shaders,
-        &ctx.registry,
-        plan,
-        &case.dataset.volume,
-        case.lut,
-    )
-    .and_then(|mut session| {
-        let progress = ctx.progress.clone();
-        measure::time_frames(
-            ctx.gpu,
-            &mut session,
-            &config.camera,
-            config.degrees_per_frame,
-            config.frames,
-            || progress.inc(1),
-        )
-    });
+    let timing = RenderSession::from_plan(ctx.gpu, &ctx.shaders, &ctx.registry, plan, &case.dataset.volume, case.lut)
+        .and_then(|mut session| {
+            let progress = ctx.progress.clone();
+            measure::time_frames(ctx.gpu, &mut session, &config.camera, config.degrees_per_frame, config.frames, || {
+                progress.inc(1)
+            })
+        });
     let timing = match timing {
         Ok(t) => t,
         Err(e) => {
@@ -368,11 +302,7 @@ fn run_case(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<Row> {
     });
     let pixels = case.viewport.0 as f64 * case.viewport.1 as f64;
     let error_viewport = reduced_viewport(case.viewport, config.accuracy_size);
-    let error = if config.accuracy {
-        measure_error(ctx, case, settings, error_viewport)
-    } else {
-        None
-    };
+    let error = if config.accuracy { measure_error(ctx, case, settings, error_viewport) } else { None };
     Some(Row {
         graph: case.graph.label.clone(),
         graph_file: file,
@@ -382,23 +312,10 @@ fn run_case(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<Row> {
         viewport: [case.viewport.0, case.viewport.1],
         sweep_value: case.sweep_value.map(|(v, _)| v.clone()),
         median_ms,
-        min_ms: timing
-            .frame_ms
-            .iter()
-            .copied()
-            .fold(f64::INFINITY, f64::min),
-        max_ms: timing
-            .frame_ms
-            .iter()
-            .copied()
-            .fold(f64::NEG_INFINITY, f64::max),
+        min_ms: timing.frame_ms.iter().copied().fold(f64::INFINITY, f64::min),
+        max_ms: timing.frame_ms.iter().copied().fold(f64::NEG_INFINITY, f64::max),
         median_wall_ms: median(&timing.wall_ms),
-        clock: if timing.wall_time_fallback {
-            "wall"
-        } else {
-            "gpu"
-        }
-        .to_string(),
+        clock: if timing.wall_time_fallback { "wall" } else { "gpu" }.to_string(),
         speedup_vs_baseline: None,
         pass_ms: timing.pass_ms,
         samples_per_pixel: spp,
@@ -426,26 +343,16 @@ fn measure_error(
         return None;
     };
     let camera: OrbitCamera = config.camera;
-    let image = compile_case(ctx, case, size)
-        .map_err(|d| d.to_string())
-        .and_then(|plan| {
-            if !plan.outputs.contains_key("image") {
-                return Err("the graph has no \"image\" output to compare".to_string());
-            }
-            let mut session = RenderSession::from_plan(
-                ctx.gpu,
-                &ctx.shaders,
-                &ctx.registry,
-                plan,
-                &case.dataset.volume,
-                case.lut,
-            )
-            .map_err(|e| e.to_string())?;
-            session
-                .render(ctx.gpu, &camera)
+    let image = compile_case(ctx, case, size).map_err(|d| d.to_string()).and_then(|plan| {
+        if !plan.outputs.contains_key("image") {
+            return Err("the graph has no \"image\" output to compare".to_string());
+        }
+        let mut session =
+            RenderSession::from_plan(ctx.gpu, &ctx.shaders, &ctx.registry, plan, &case.dataset.volume, case.lut)
                 .map_err(|e| e.to_string())?;
-            session.read(ctx.gpu, "image").map_err(|e| e.to_string())
-        });
+        session.render(ctx.gpu, &camera).map_err(|e| e.to_string())?;
+        session.read(ctx.gpu, "image").map_err(|e| e.to_string())
+    });
     let image = match image {
         Ok(image) => image,
         Err(reason) => {
@@ -456,15 +363,7 @@ fn measure_error(
     let reference_settings = accuracy::converged(&settings, config.reference_step);
     let k = key(case, size, &reference_settings);
     let reference = ctx.reference_cache.entry(k).or_insert_with(|| {
-        render_reference(
-            &case.dataset.volume,
-            case.lut,
-            &camera,
-            size.0,
-            size.1,
-            &reference_settings,
-        )
-        .color
+        render_reference(&case.dataset.volume, case.lut, &camera, size.0, size.1, &reference_settings).color
     });
     accuracy::image_error(&image, reference)
 }
@@ -473,22 +372,12 @@ fn measure_error(
 /// value.
 fn fill_speedups(rows: &mut [Row], baseline: &str) {
     let same = |a: &Row, b: &Row| {
-        a.dataset == b.dataset
-            && a.tf == b.tf
-            && a.viewport == b.viewport
-            && a.sweep_value == b.sweep_value
+        a.dataset == b.dataset && a.tf == b.tf && a.viewport == b.viewport && a.sweep_value == b.sweep_value
     };
-    let bases: Vec<Row> = rows
-        .iter()
-        .filter(|r| r.graph == baseline)
-        .cloned()
-        .collect();
+    let bases: Vec<Row> = rows.iter().filter(|r| r.graph == baseline).cloned().collect();
     for row in rows.iter_mut() {
-        row.speedup_vs_baseline = bases
-            .iter()
-            .find(|b| same(b, row))
-            .map(|b| b.median_ms / row.median_ms)
-            .filter(|x| x.is_finite());
+        row.speedup_vs_baseline =
+            bases.iter().find(|b| same(b, row)).map(|b| b.median_ms / row.median_ms).filter(|x| x.is_finite());
     }
 }
 
@@ -498,15 +387,8 @@ fn fill_pareto(rows: &mut [Row]) {
     let groups: BTreeSet<String> = rows.iter().map(group).collect();
     for g in groups {
         let idx: Vec<usize> = (0..rows.len()).filter(|&i| group(&rows[i]) == g).collect();
-        let points: Vec<(f64, f64)> = idx
-            .iter()
-            .map(|&i| {
-                (
-                    rows[i].median_ms,
-                    rows[i].error.map_or(f64::NAN, |e| e.mean_abs),
-                )
-            })
-            .collect();
+        let points: Vec<(f64, f64)> =
+            idx.iter().map(|&i| (rows[i].median_ms, rows[i].error.map_or(f64::NAN, |e| e.mean_abs))).collect();
         for (&i, on) in idx.iter().zip(accuracy::pareto_front(&points)) {
             rows[i].pareto = Some(on);
         }

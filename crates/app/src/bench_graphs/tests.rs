@@ -13,9 +13,7 @@ fn basic_graph(name: &str) -> PathBuf {
 }
 
 fn finite(v: &serde_json::Value, field: &str) -> f64 {
-    let x = v[field]
-        .as_f64()
-        .unwrap_or_else(|| panic!("field {field} is not a number in {v}"));
+    let x = v[field].as_f64().unwrap_or_else(|| panic!("field {field} is not a number in {v}"));
     assert!(x.is_finite(), "field {field} = {x} is not finite");
     x
 }
@@ -23,8 +21,7 @@ fn finite(v: &serde_json::Value, field: &str) -> f64 {
 #[test]
 fn tiny_sweep_writes_json_with_every_field_finite() {
     // Under CI a missing adapter is a failure, never a skip.
-    let gpu =
-        Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)");
+    let gpu = Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)");
     let dir = std::env::temp_dir().join(format!("volgraph-bench-graphs-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir is writable");
     let args = GraphsArgs {
@@ -71,23 +68,15 @@ fn tiny_sweep_writes_json_with_every_field_finite() {
         assert!(row["pareto"].is_boolean());
         if row["clock"] == "gpu" {
             let passes = row["pass_ms"].as_object().expect("pass_ms");
-            assert!(
-                passes.contains_key("march"),
-                "per-pass times name the march pass: {passes:?}"
-            );
+            assert!(passes.contains_key("march"), "per-pass times name the march pass: {passes:?}");
         }
     }
     let skipped = json["skipped"].as_array().expect("skipped");
     assert!(
-        skipped.iter().any(|s| s["what"]
-            .as_str()
-            .is_some_and(|w| w.ends_with("not_written_yet.ron"))),
+        skipped.iter().any(|s| s["what"].as_str().is_some_and(|w| w.ends_with("not_written_yet.ron"))),
         "a missing graph is reported as skipped: {skipped:?}"
     );
-    assert!(
-        std::fs::metadata(dir.join("bench.png")).is_ok_and(|m| m.len() > 0),
-        "plot written"
-    );
+    assert!(std::fs::metadata(dir.join("bench.png")).is_ok_and(|m| m.len() > 0), "plot written");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -102,11 +91,7 @@ fn error_of(args: GraphsArgs) -> String {
 fn bad_flags_name_the_flag_and_the_fix() {
     let graphs = vec![basic_graph("fragment_raycast.ron")];
     assert_eq!(
-        error_of(GraphsArgs {
-            preset: Some("kw".to_string()),
-            scale: 1.0,
-            ..GraphsArgs::default()
-        }),
+        error_of(GraphsArgs { preset: Some("kw".to_string()), scale: 1.0, ..GraphsArgs::default() }),
         "--preset \"kw\": no such preset; choose one of: basic, kw2003-table1, thesis-tables"
     );
     assert_eq!(
@@ -128,11 +113,7 @@ fn bad_flags_name_the_flag_and_the_fix() {
         "--sweep \"step=1,2\": the key must be PASS.PARAM; expected PASS.PARAM=V1,V2,..., e.g. march.step_voxels=0.25,0.5,1,2"
     );
     assert_eq!(
-        error_of(GraphsArgs {
-            graphs,
-            scale: 0.0,
-            ..GraphsArgs::default()
-        }),
+        error_of(GraphsArgs { graphs, scale: 0.0, ..GraphsArgs::default() }),
         "--scale 0: expected a factor in (0, 8], e.g. 0.25 to render a quarter of each side"
     );
 }

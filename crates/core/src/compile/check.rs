@@ -173,7 +173,11 @@ impl Checker<'_> {
                 }
                 _ => String::new(),
             };
-            self.err(location, format!("duplicate id \"{id}\"{at}"), Some("ids must be unique; rename one of them".to_string()));
+            self.err(
+                location,
+                format!("duplicate id \"{id}\"{at}"),
+                Some("ids must be unique; rename one of them".to_string()),
+            );
             return false;
         }
         first.insert(id.to_string(), location);
@@ -201,7 +205,12 @@ impl Checker<'_> {
                         self.group_by_id.insert(r.id.clone(), gi);
                     }
                     let count = self.repeat_count(&r.id, path, &r.count);
-                    self.groups.push(GroupInfo { id: r.id.clone(), count, members: Vec::new(), carry: BTreeMap::new() });
+                    self.groups.push(GroupInfo {
+                        id: r.id.clone(),
+                        count,
+                        members: Vec::new(),
+                        carry: BTreeMap::new(),
+                    });
                     if r.body.is_empty() {
                         self.err(
                             self.loc.pass_field(path, &r.id, "body"),
@@ -254,17 +263,19 @@ impl Checker<'_> {
             RepeatCount::Scene { name, divide_by, divide_by_input, max } => {
                 let divide_by = match divide_by_input {
                     None => *divide_by,
-                    Some(input) => match self.scalar_value(input) {
-                        Some(v) => v,
-                        None => {
-                            self.err(
+                    Some(input) => {
+                        match self.scalar_value(input) {
+                            Some(v) => v,
+                            None => {
+                                self.err(
                                 self.loc.pass_field(path, id, "count"),
                                 format!("repeat group \"{id}\" divides by \"{input}\", which is not a Scalar graph input"),
                                 Some(format!("declare inputs: {{\"{input}\": Scalar(<default>)}}")),
                             );
-                            return 1;
+                                return 1;
+                            }
                         }
-                    },
+                    }
                 };
                 let divide_by = &divide_by;
                 let value = self.options.scalars.get(name).copied().or_else(|| match self.doc.inputs.get(name) {
@@ -280,7 +291,10 @@ impl Checker<'_> {
                         .map(|(n, _)| n.as_str())
                         .collect();
                     known.extend(self.options.scalars.keys().map(String::as_str));
-                    let mut help = format!("declare inputs: {{\"{name}\": Scalar(<default>)}}; known scalars: {}", comma_list(&known));
+                    let mut help = format!(
+                        "declare inputs: {{\"{name}\": Scalar(<default>)}}; known scalars: {}",
+                        comma_list(&known)
+                    );
                     if let Some(best) = closest(name, known.iter().copied()) {
                         help = format!("did you mean \"{best}\"? {help}");
                     }
@@ -291,7 +305,7 @@ impl Checker<'_> {
                     );
                     return 1;
                 };
-                if !(*divide_by > 0.0) || !value.is_finite() {
+                if !divide_by.is_finite() || *divide_by <= 0.0 || !value.is_finite() {
                     self.err(
                         self.loc.pass_field(path, id, "count"),
                         format!("repeat group \"{id}\" divides \"{name}\" ({value}) by {divide_by}"),
@@ -304,7 +318,13 @@ impl Checker<'_> {
         }
     }
 
-    fn add_pass(&mut self, p: &PassDoc, path: PassPath, group: Option<usize>, first: &mut HashMap<String, Location>) -> usize {
+    fn add_pass(
+        &mut self,
+        p: &PassDoc,
+        path: PassPath,
+        group: Option<usize>,
+        first: &mut HashMap<String, Location>,
+    ) -> usize {
         let idx = self.passes.len();
         if self.claim_id(&p.id, self.loc.pass_field(path, &p.id, "id"), first) {
             self.pass_by_id.insert(p.id.clone(), idx);
@@ -401,14 +421,20 @@ impl Checker<'_> {
                 ParamKind::Float { default, min, max } => format!("default {default}, range {min} to {max}"),
                 ParamKind::UInt { default, min, max } => format!("default {default}, range {min} to {max}"),
                 ParamKind::Bool { default } => format!("default {default}"),
-                ParamKind::Choice { default, options } => format!("default \"{default}\", one of {}", quoted_list(options)),
+                ParamKind::Choice { default, options } => {
+                    format!("default \"{default}\", one of {}", quoted_list(options))
+                }
             };
             let location = self.loc.pass_entry(path, &p.id, "params", name, false);
             match check_param(spec, value) {
                 Ok(v) => params.set(name, v),
                 Err(ParamProblem::WrongType { found }) => self.err(
                     location,
-                    format!("parameter \"{name}\" of pass \"{}\" must be {}, found {found}", p.id, spec.kind.type_name()),
+                    format!(
+                        "parameter \"{name}\" of pass \"{}\" must be {}, found {found}",
+                        p.id,
+                        spec.kind.type_name()
+                    ),
                     Some(format!("{} ({range})", spec.doc)),
                 ),
                 Err(ParamProblem::OutOfRange { value }) => self.err(
@@ -496,7 +522,10 @@ impl Checker<'_> {
                         self.err(
                             self.loc.pass_entry(path, &p.id, "outputs", port.name, false),
                             format!("output \"{}\" of pass \"{}\" has size {size}", port.name, p.id),
-                            Some("use Viewport(scale) with 0 < scale <= 16, or Absolute(w, h) with 1..=16384 pixels".to_string()),
+                            Some(
+                                "use Viewport(scale) with 0 < scale <= 16, or Absolute(w, h) with 1..=16384 pixels"
+                                    .to_string(),
+                            ),
                         );
                     }
                     ValueDesc::Target { format, size }
@@ -528,7 +557,11 @@ impl Checker<'_> {
                     if let Some(best) = closest(tail, names.iter().copied()) {
                         help = format!("did you mean \"input.{best}\"? {help}");
                     }
-                    self.err(location, format!("{context} reads \"{text}\", but the graph has no input \"{tail}\""), Some(help));
+                    self.err(
+                        location,
+                        format!("{context} reads \"{text}\", but the graph has no input \"{tail}\""),
+                        Some(help),
+                    );
                     return None;
                 }
                 Some(Ref::Input(tail.to_string()))
@@ -539,7 +572,10 @@ impl Checker<'_> {
                     self.err(
                         location,
                         format!("{context} reads \"{text}\", but the graph declares no history \"{tail}\""),
-                        Some(format!("declare history: {{\"{tail}\": (of: \"<pass>.<output>\")}}; declared: {}", comma_list(&names))),
+                        Some(format!(
+                            "declare history: {{\"{tail}\": (of: \"<pass>.<output>\")}}; declared: {}",
+                            comma_list(&names)
+                        )),
                     );
                     return None;
                 }
@@ -547,7 +583,8 @@ impl Checker<'_> {
             }
             _ => {
                 if let Some(&gi) = self.group_by_id.get(head) {
-                    let carried: Vec<String> = self.doc_group(gi).map(|r| r.carry.keys().cloned().collect()).unwrap_or_default();
+                    let carried: Vec<String> =
+                        self.doc_group(gi).map(|r| r.carry.keys().cloned().collect()).unwrap_or_default();
                     if !carried.iter().any(|c| c == tail) {
                         self.err(
                             location,
@@ -565,13 +602,15 @@ impl Checker<'_> {
                     if let Some(best) = closest(head, ids.iter().copied()) {
                         help = format!("did you mean \"{best}\"? {help}");
                     }
-                    self.err(location, format!("{context} reads \"{text}\", but there is no pass \"{head}\""), Some(help));
+                    self.err(
+                        location,
+                        format!("{context} reads \"{text}\", but there is no pass \"{head}\""),
+                        Some(help),
+                    );
                     return None;
                 };
                 let producer = &self.passes[pi];
-                if producer.plugin.is_none() {
-                    return None; // its unknown kind is already reported
-                }
+                producer.plugin.as_ref()?;
                 let outputs: Vec<&str> = producer.ports.iter().filter(|p| p.is_output()).map(|p| p.name).collect();
                 if !outputs.contains(&tail) {
                     let full: Vec<String> = outputs.iter().map(|o| format!("{head}.{o}")).collect();
@@ -581,23 +620,35 @@ impl Checker<'_> {
                     };
                     self.err(
                         location,
-                        format!("{context} reads \"{text}\", but pass \"{head}\" has no output \"{tail}\" (it has: {})", comma_list(&outputs)),
+                        format!(
+                            "{context} reads \"{text}\", but pass \"{head}\" has no output \"{tail}\" (it has: {})",
+                            comma_list(&outputs)
+                        ),
                         help,
                     );
                     return None;
                 }
-                if let Some(g) = producer.group {
-                    if reader_group != Some(g) {
-                        let gid = self.groups[g].id.clone();
-                        let this = Ref::Output { pass: pi, port: tail.to_string() };
-                        let carried = self.groups[g].carry.iter().find(|(_, (_, next))| *next == this).map(|(n, _)| n.clone());
-                        let help = match carried {
-                            Some(name) => format!("its last iteration's value leaves the group as \"{gid}.{name}\": read that"),
-                            None => format!("values leave a repeat group through its carry: read \"{gid}.<carried name>\""),
-                        };
-                        self.err(location, format!("{context} reads \"{text}\" from inside repeat group \"{gid}\""), Some(help));
-                        return None;
-                    }
+                if let Some(g) = producer.group
+                    && reader_group != Some(g)
+                {
+                    let gid = self.groups[g].id.clone();
+                    let this = Ref::Output { pass: pi, port: tail.to_string() };
+                    let carried =
+                        self.groups[g].carry.iter().find(|(_, (_, next))| *next == this).map(|(n, _)| n.clone());
+                    let help = match carried {
+                        Some(name) => {
+                            format!("its last iteration's value leaves the group as \"{gid}.{name}\": read that")
+                        }
+                        None => {
+                            format!("values leave a repeat group through its carry: read \"{gid}.<carried name>\"")
+                        }
+                    };
+                    self.err(
+                        location,
+                        format!("{context} reads \"{text}\" from inside repeat group \"{gid}\""),
+                        Some(help),
+                    );
+                    return None;
                 }
                 Some(Ref::Output { pass: pi, port: tail.to_string() })
             }
@@ -672,14 +723,20 @@ impl Checker<'_> {
                     if self.passes[*pass].group != Some(gi) {
                         self.err(
                             next_loc.clone(),
-                            format!("{ctx} takes its next value from \"{}\", which is not an output of a pass in its body", carry.next),
+                            format!(
+                                "{ctx} takes its next value from \"{}\", which is not an output of a pass in its body",
+                                carry.next
+                            ),
                             Some("next must name \"<body pass>.<output>\"".to_string()),
                         );
                     }
                 } else if next.is_some() {
                     self.err(
                         next_loc.clone(),
-                        format!("{ctx} takes its next value from \"{}\", which is not an output of a pass in its body", carry.next),
+                        format!(
+                            "{ctx} takes its next value from \"{}\", which is not an output of a pass in its body",
+                            carry.next
+                        ),
                         Some("next must name \"<body pass>.<output>\"".to_string()),
                     );
                 }
@@ -697,7 +754,9 @@ impl Checker<'_> {
             }
             let group = self.passes[pi].group;
             for (port, text) in &p.inputs {
-                if !self.passes[pi].ports.iter().any(|s| s.name == port && s.is_input()) { continue; }
+                if !self.passes[pi].ports.iter().any(|s| s.name == port && s.is_input()) {
+                    continue;
+                }
                 let location = self.loc.pass_entry(path, &p.id, "inputs", port, false);
                 let ctx = format!("pass \"{}\"", p.id);
                 if let Some(r) = self.parse_ref(text, group, &ctx, location.clone()) {
@@ -720,7 +779,9 @@ impl Checker<'_> {
             let mut pass_size: Option<(TargetSize, String)> = self.passes[pi]
                 .ports
                 .iter()
-                .filter(|s| matches!(s.kind, PortKind::Target { size: SizeRule::MatchPass, .. }) && s.access == Access::Write)
+                .filter(|s| {
+                    matches!(s.kind, PortKind::Target { size: SizeRule::MatchPass, .. }) && s.access == Access::Write
+                })
                 .find_map(|s| match self.passes[pi].outputs.get(s.name) {
                     Some(ValueDesc::Target { size, .. }) => Some((*size, format!("{}.{}", p.id, s.name))),
                     _ => None,
@@ -732,13 +793,18 @@ impl Checker<'_> {
                 let text = &p.inputs[port];
                 let producer_formats = self.producer_formats(r);
                 self.check_type(&p.id, &spec, text, &desc, producer_formats.as_deref(), location.clone());
-                if let (PortKind::Target { size: SizeRule::MatchPass, .. }, ValueDesc::Target { size, .. }) = (&spec.kind, &desc) {
+                if let (PortKind::Target { size: SizeRule::MatchPass, .. }, ValueDesc::Target { size, .. }) =
+                    (&spec.kind, &desc)
+                {
                     match &pass_size {
                         None => pass_size = Some((*size, text.clone())),
                         Some((expected, from)) if expected != size => self.err(
                             location,
                             format!("pass \"{}\" reads \"{text}\" of size {size}, but \"{from}\" is {expected}", p.id),
-                            Some(format!("the targets of pass \"{}\" must have one size; declare the same size on both", p.id)),
+                            Some(format!(
+                                "the targets of pass \"{}\" must have one size; declare the same size on both",
+                                p.id
+                            )),
                         ),
                         _ => {}
                     }
@@ -746,7 +812,9 @@ impl Checker<'_> {
             }
             let otherwise = self.passes[pi].otherwise.clone();
             for (port, r) in &otherwise {
-                let (Some(want), Some(got)) = (self.passes[pi].outputs.get(port).cloned(), self.ref_desc(r, 0)) else { continue };
+                let (Some(want), Some(got)) = (self.passes[pi].outputs.get(port).cloned(), self.ref_desc(r, 0)) else {
+                    continue;
+                };
                 if want != got {
                     self.err(
                         self.loc.pass_entry(path, &p.id, "otherwise", port, false),
@@ -769,10 +837,15 @@ impl Checker<'_> {
             for (name, (init, next)) in carry {
                 let (Some(a), Some(b)) = (self.ref_desc(&init, 0), self.ref_desc(&next, 0)) else { continue };
                 if a != b {
-                    let top = self.doc.passes.iter().position(|n| matches!(n, NodeDoc::Repeat(x) if x.id == id)).unwrap_or(0);
+                    let top =
+                        self.doc.passes.iter().position(|n| matches!(n, NodeDoc::Repeat(x) if x.id == id)).unwrap_or(0);
                     self.err(
                         self.loc.pass_entry(PassPath { top, body: None }, &id, "carry", &name, true),
-                        format!("carry \"{name}\" of repeat group \"{id}\" starts as {} but its next value is {}", a.describe(), b.describe()),
+                        format!(
+                            "carry \"{name}\" of repeat group \"{id}\" starts as {} but its next value is {}",
+                            a.describe(),
+                            b.describe()
+                        ),
                         Some("give init and next the same format and size".to_string()),
                     );
                 }
@@ -788,7 +861,12 @@ impl Checker<'_> {
             }
             for (port, r) in inputs {
                 if let Ref::Output { pass, port: out } = &r {
-                    self.require_stand_in(*pass, out, &format!("pass \"{id}\""), self.loc.pass_entry(path, &id, "inputs", &port, false));
+                    self.require_stand_in(
+                        *pass,
+                        out,
+                        &format!("pass \"{id}\""),
+                        self.loc.pass_entry(path, &id, "inputs", &port, false),
+                    );
                 }
             }
         }
@@ -799,7 +877,8 @@ impl Checker<'_> {
         if p.enabled || p.otherwise.contains_key(port) {
             return;
         }
-        let missing: Vec<&str> = p.needs.iter().filter(|f| !self.options.features.contains(*f)).map(String::as_str).collect();
+        let missing: Vec<&str> =
+            p.needs.iter().filter(|f| !self.options.features.contains(*f)).map(String::as_str).collect();
         let features = quoted_list(&missing);
         let msg = format!(
             "{reader} reads \"{}.{port}\", but pass \"{}\" is off (feature {features} not enabled) and gives no otherwise for \"{port}\"",
@@ -817,10 +896,12 @@ impl Checker<'_> {
     /// references: carried values, history, Modify outputs).
     fn producer_formats(&self, r: &Ref) -> Option<Vec<TargetFormat>> {
         let Ref::Output { pass, port } = r else { return None };
-        self.passes.get(*pass)?.ports.iter().find(|s| s.name == port && s.access == Access::Write).and_then(|s| match &s.kind {
-            PortKind::Target { formats, .. } => Some(formats.clone()),
-            _ => None,
-        })
+        self.passes.get(*pass)?.ports.iter().find(|s| s.name == port && s.access == Access::Write).and_then(
+            |s| match &s.kind {
+                PortKind::Target { formats, .. } => Some(formats.clone()),
+                _ => None,
+            },
+        )
     }
 
     fn check_type(
@@ -842,7 +923,9 @@ impl Checker<'_> {
                     let fix = producer_formats
                         .map_or(formats.first().copied(), |can| formats.iter().copied().find(|f| can.contains(f)));
                     let help = match fix {
-                        Some(f) => format!("declare outputs: {{\"{tail}\": (format: {f})}} on \"{head}\", or read another target"),
+                        Some(f) => format!(
+                            "declare outputs: {{\"{tail}\": (format: {f})}} on \"{head}\", or read another target"
+                        ),
                         None => format!(
                             "\"{head}\" cannot write {} to \"{tail}\"; read a target of one of those formats instead",
                             names.join(" or ")
@@ -867,10 +950,17 @@ impl Checker<'_> {
         if !ok {
             self.err(
                 location,
-                format!("pass \"{reader}\" input \"{}\" needs {}, but \"{text}\" is {}", spec.name, spec.kind.describe(), desc.describe()),
+                format!(
+                    "pass \"{reader}\" input \"{}\" needs {}, but \"{text}\" is {}",
+                    spec.name,
+                    spec.kind.describe(),
+                    desc.describe()
+                ),
                 Some(match &spec.kind {
                     PortKind::Volume => "declare inputs: {\"volume\": Volume} and read \"input.volume\"".to_string(),
-                    PortKind::TransferFunction => "declare inputs: {\"tf\": TransferFunction} and read \"input.tf\"".to_string(),
+                    PortKind::TransferFunction => {
+                        "declare inputs: {\"tf\": TransferFunction} and read \"input.tf\"".to_string()
+                    }
                     PortKind::Target { .. } => "read \"<pass>.<output>\" of a pass that writes a target".to_string(),
                     PortKind::Owned(t) => format!("read the output of a pass that makes a {t}"),
                 }),

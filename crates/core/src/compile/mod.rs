@@ -30,7 +30,12 @@ pub struct CompileOptions {
 
 impl Default for CompileOptions {
     fn default() -> Self {
-        Self { viewport: (256, 256), features: BTreeSet::new(), scalars: BTreeMap::new(), param_overrides: BTreeMap::new() }
+        Self {
+            viewport: (256, 256),
+            features: BTreeSet::new(),
+            scalars: BTreeMap::new(),
+            param_overrides: BTreeMap::new(),
+        }
     }
 }
 

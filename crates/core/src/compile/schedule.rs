@@ -50,7 +50,11 @@ pub(crate) fn schedule(_doc: &GraphDoc, c: Checked, options: &CompileOptions) ->
                     for &m in &g.members {
                         if c.passes[m].enabled {
                             inst_of.insert((m, Some(it)), insts.len());
-                            insts.push(Inst { pass: m, iter: Some(it), label: format!("{}[{it}]/{}", g.id, c.passes[m].id) });
+                            insts.push(Inst {
+                                pass: m,
+                                iter: Some(it),
+                                label: format!("{}[{it}]/{}", g.id, c.passes[m].id),
+                            });
                         }
                     }
                 }
@@ -185,7 +189,8 @@ pub(crate) fn schedule(_doc: &GraphDoc, c: Checked, options: &CompileOptions) ->
             }
         }
     }
-    let mut ready: BinaryHeap<Reverse<usize>> = (0..n).filter(|&i| needed[i] && indegree[i] == 0).map(Reverse).collect();
+    let mut ready: BinaryHeap<Reverse<usize>> =
+        (0..n).filter(|&i| needed[i] && indegree[i] == 0).map(Reverse).collect();
     let mut order = Vec::new();
     while let Some(Reverse(i)) = ready.pop() {
         order.push(i);
@@ -198,10 +203,17 @@ pub(crate) fn schedule(_doc: &GraphDoc, c: Checked, options: &CompileOptions) ->
     }
     let needed_count = needed.iter().filter(|x| **x).count();
     if order.len() != needed_count {
-        let stuck: Vec<&str> = (0..n).filter(|&i| needed[i] && !order.contains(&i)).map(|i| insts[i].label.as_str()).collect();
+        let stuck: Vec<&str> =
+            (0..n).filter(|&i| needed[i] && !order.contains(&i)).map(|i| insts[i].label.as_str()).collect();
         return Err(vec![
-            Diagnostic::new(Location::File, format!("passes {} cannot be ordered: a pass reads a value after another pass modified it", stuck.join(", ")))
-                .with_help("read the modified version (\"<modifier>.<port>\") instead of the original".to_string()),
+            Diagnostic::new(
+                Location::File,
+                format!(
+                    "passes {} cannot be ordered: a pass reads a value after another pass modified it",
+                    stuck.join(", ")
+                ),
+            )
+            .with_help("read the modified version (\"<modifier>.<port>\") instead of the original".to_string()),
         ]);
     }
     let step_of: HashMap<usize, usize> = order.iter().enumerate().map(|(s, &i)| (i, s)).collect();
@@ -286,22 +298,22 @@ pub(crate) fn schedule(_doc: &GraphDoc, c: Checked, options: &CompileOptions) ->
     let _ = step_of;
     let mut outputs = BTreeMap::new();
     for (name, v) in &output_vals {
-        if let Val::Out(i, port) = v {
-            if let Some(&id) = rid_of.get(&(*i, port.clone())) {
-                resources[id].last_use = usize::MAX;
-                outputs.insert(name.clone(), id);
-            }
+        if let Val::Out(i, port) = v
+            && let Some(&id) = rid_of.get(&(*i, port.clone()))
+        {
+            resources[id].last_use = usize::MAX;
+            outputs.insert(name.clone(), id);
         }
     }
     let mut history = BTreeMap::new();
     let mut persistent_roots = Vec::new();
     for (name, (v, initial)) in &history_vals {
-        if let Val::Out(i, port) = v {
-            if let Some(&id) = rid_of.get(&(*i, port.clone())) {
-                resources[id].last_use = usize::MAX;
-                persistent_roots.push(root_of(&resources, id));
-                history.insert(name.clone(), History { source: id, initial: initial.clone() });
-            }
+        if let Val::Out(i, port) = v
+            && let Some(&id) = rid_of.get(&(*i, port.clone()))
+        {
+            resources[id].last_use = usize::MAX;
+            persistent_roots.push(root_of(&resources, id));
+            history.insert(name.clone(), History { source: id, initial: initial.clone() });
         }
     }
 
@@ -358,7 +370,9 @@ fn modifier_port<'a>(
 ) -> Option<&'a str> {
     let ports = &c.passes[insts[inst].pass].ports;
     inputs[inst].iter().find_map(|(k, v)| match v {
-        Val::Out(src, port) if (*src, port) == (key.0, &key.1) && ports[*k].access == Access::Modify => Some(ports[*k].name),
+        Val::Out(src, port) if (*src, port) == (key.0, &key.1) && ports[*k].access == Access::Modify => {
+            Some(ports[*k].name)
+        }
         _ => None,
     })
 }

@@ -141,17 +141,20 @@ impl CreateContext<'_> {
                 Some(p) => {
                     if let BindingKind::StorageTexture { format, .. } = &b.ty {
                         if p.access == Access::Read {
-                            return Err(self.error(format!("{shader}: storage texture \"{}\" is an input port; storage textures are outputs", b.name)));
+                            return Err(self.error(format!(
+                                "{shader}: storage texture \"{}\" is an input port; storage textures are outputs",
+                                b.name
+                            )));
                         }
-                        if let Some(port_format) = p.format {
-                            if *format != Some(port_format) {
-                                let declared = format.map_or("an unsupported format".to_string(), |f| format!("{f:?}"));
-                                return Err(self.error(format!(
-                                    "{shader}: storage texture \"{}\" is declared {declared} but the port's target is \
+                        if let Some(port_format) = p.format
+                            && *format != Some(port_format)
+                        {
+                            let declared = format.map_or("an unsupported format".to_string(), |f| format!("{f:?}"));
+                            return Err(self.error(format!(
+                                "{shader}: storage texture \"{}\" is declared {declared} but the port's target is \
                                      {port_format:?}; declare the output with the shader's format",
-                                    b.name
-                                )));
-                            }
+                                b.name
+                            )));
                         }
                     } else if p.access == Access::Write {
                         return Err(self.error(format!(
@@ -193,7 +196,9 @@ impl CreateContext<'_> {
                 layout_entry(b, stages, filterable)
             })
             .collect();
-        self.gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries })
+        self.gpu
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries })
     }
 
     /// Builds a render pipeline drawing a fragment shader into this pass's output ports, named
@@ -215,17 +220,25 @@ impl CreateContext<'_> {
                 )));
             };
             if *location as usize != targets.len() {
-                return Err(self.error(format!("{}: fragment outputs must use consecutive locations from 0", spec.shader)));
+                return Err(
+                    self.error(format!("{}: fragment outputs must use consecutive locations from 0", spec.shader))
+                );
             }
             let Some(format) = port.format else {
                 return Err(self.error(format!("output port \"{name}\" has no target format")));
             };
-            targets.push(Some(wgpu::ColorTargetState { format, blend: spec.blend, write_mask: wgpu::ColorWrites::ALL }));
+            targets.push(Some(wgpu::ColorTargetState {
+                format,
+                blend: spec.blend,
+                write_mask: wgpu::ColorWrites::ALL,
+            }));
             color_ports.push(name.clone());
         }
         let depth_stencil = match &spec.depth {
             Some(d) => {
-                let port = self.port(d.port).ok_or_else(|| self.error(format!("depth port \"{}\" is not a port of this pass", d.port)))?;
+                let port = self
+                    .port(d.port)
+                    .ok_or_else(|| self.error(format!("depth port \"{}\" is not a port of this pass", d.port)))?;
                 Some(wgpu::DepthStencilState {
                     format: port.format.unwrap_or(wgpu::TextureFormat::Depth32Float),
                     depth_write_enabled: Some(d.write),
@@ -250,7 +263,10 @@ impl CreateContext<'_> {
             vertex: wgpu::VertexState {
                 module: &shader.wgpu,
                 entry_point: Some(spec.vertex),
-                compilation_options: wgpu::PipelineCompilationOptions { constants: spec.constants, ..Default::default() },
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: spec.constants,
+                    ..Default::default()
+                },
                 buffers: &[],
             },
             primitive: wgpu::PrimitiveState {
@@ -264,7 +280,10 @@ impl CreateContext<'_> {
             fragment: Some(wgpu::FragmentState {
                 module: &shader.wgpu,
                 entry_point: Some(spec.fragment),
-                compilation_options: wgpu::PipelineCompilationOptions { constants: spec.constants, ..Default::default() },
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: spec.constants,
+                    ..Default::default()
+                },
                 targets: &targets,
             }),
             multiview_mask: None,
@@ -287,7 +306,8 @@ impl CreateContext<'_> {
     /// the ports.
     pub fn compute_pipeline(&self, spec: &ComputePipelineSpec<'_>) -> Result<PassPipeline, PassError> {
         let shader = self.shaders.get(self.gpu, spec.shader).map_err(|e| self.error(e))?;
-        let r = reflect(&shader.module, &shader.info, &[spec.entry]).map_err(|e| self.error(format!("{} {e}", spec.shader)))?;
+        let r = reflect(&shader.module, &shader.info, &[spec.entry])
+            .map_err(|e| self.error(format!("{} {e}", spec.shader)))?;
         self.check_bindings(spec.shader, &r.bindings, spec.extra_bindings)?;
         let label = format!("{}/{}", self.pass_id, spec.entry);
         let layout = self.layout(&label, &r.bindings, wgpu::ShaderStages::COMPUTE);
@@ -393,7 +413,11 @@ impl<'a> RecordContext<'a> {
 
     /// Builds bind group 0 of `pipeline`, resolving every binding by name: system bindings,
     /// then `extra` (the pass's own buffers), then ports.
-    pub fn bind_group(&self, pipeline: &PassPipeline, extra: &[(&str, wgpu::BindingResource<'_>)]) -> Result<wgpu::BindGroup, PassError> {
+    pub fn bind_group(
+        &self,
+        pipeline: &PassPipeline,
+        extra: &[(&str, wgpu::BindingResource<'_>)],
+    ) -> Result<wgpu::BindGroup, PassError> {
         let mut entries = Vec::new();
         for b in &pipeline.bindings {
             let resource = match b.name.as_str() {
@@ -424,12 +448,20 @@ impl<'a> RecordContext<'a> {
     /// Begins a render pass into `pipeline`'s colour ports (Write ports cleared to 0, Modify
     /// ports loaded) and its depth port (`depth_clear`: Some(value) clears, None loads),
     /// labelled and timed.
-    pub fn begin_render_pass(&mut self, pipeline: &PassPipeline, depth_clear: Option<f32>) -> Result<wgpu::RenderPass<'static>, PassError> {
+    pub fn begin_render_pass(
+        &mut self,
+        pipeline: &PassPipeline,
+        depth_clear: Option<f32>,
+    ) -> Result<wgpu::RenderPass<'static>, PassError> {
         let mut colors = Vec::new();
         for port in &pipeline.color_ports {
             let p = self.ports.iter().find(|p| &p.name == port).ok_or_else(|| self.error(format!("no port {port}")))?;
             let view = p.view.ok_or_else(|| self.error(format!("port \"{port}\" is not bound")))?;
-            let load = if p.access == Access::Modify { wgpu::LoadOp::Load } else { wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT) };
+            let load = if p.access == Access::Modify {
+                wgpu::LoadOp::Load
+            } else {
+                wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
+            };
             colors.push(Some(wgpu::RenderPassColorAttachment {
                 view,
                 depth_slice: None,

@@ -22,9 +22,8 @@ impl Image {
         let c = self.channels as usize;
         let i = (y as usize * self.width as usize + x as usize) * c;
         let mut out = [0.0, 0.0, 0.0, 1.0];
-        for k in 0..c.min(4) {
-            out[k] = self.data[i + k];
-        }
+        let n = c.min(4);
+        out[..n].copy_from_slice(&self.data[i..i + n]);
         out
     }
 }
@@ -38,7 +37,12 @@ fn channels(format: TargetFormat) -> u32 {
 }
 
 /// Copies `texture` to the CPU and converts it to f32.
-pub fn read_texture(gpu: &Gpu, texture: &wgpu::Texture, format: TargetFormat, extent: (u32, u32)) -> Result<Image, String> {
+pub fn read_texture(
+    gpu: &Gpu,
+    texture: &wgpu::Texture,
+    format: TargetFormat,
+    extent: (u32, u32),
+) -> Result<Image, String> {
     let bpp = format.bytes_per_pixel() as u32;
     let unpadded = extent.0 * bpp;
     let padded = unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
@@ -58,7 +62,11 @@ pub fn read_texture(gpu: &Gpu, texture: &wgpu::Texture, format: TargetFormat, ex
         },
         wgpu::TexelCopyBufferInfo {
             buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded), rows_per_image: Some(extent.1) },
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(extent.1),
+            },
         },
         wgpu::Extent3d { width: extent.0, height: extent.1, depth_or_array_layers: 1 },
     );
@@ -81,7 +89,9 @@ pub fn read_texture(gpu: &Gpu, texture: &wgpu::Texture, format: TargetFormat, ex
         let line = &bytes[row * padded as usize..row * padded as usize + unpadded as usize];
         match format {
             TargetFormat::Rgba8Unorm | TargetFormat::R8Unorm => data.extend(line.iter().map(|b| *b as f32 / 255.0)),
-            TargetFormat::Rgba16Float => data.extend(line.chunks_exact(2).map(|h| f16_to_f32(u16::from_le_bytes([h[0], h[1]])))),
+            TargetFormat::Rgba16Float => {
+                data.extend(line.chunks_exact(2).map(|h| f16_to_f32(u16::from_le_bytes([h[0], h[1]]))))
+            }
             _ => data.extend(line.chunks_exact(4).map(|f| f32::from_le_bytes([f[0], f[1], f[2], f[3]]))),
         }
     }

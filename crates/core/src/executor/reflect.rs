@@ -63,7 +63,11 @@ pub struct Reflection {
 }
 
 /// Reflects `entry_points` of a parsed and validated module.
-pub fn reflect(module: &naga::Module, info: &naga::valid::ModuleInfo, entry_points: &[&str]) -> Result<Reflection, String> {
+pub fn reflect(
+    module: &naga::Module,
+    info: &naga::valid::ModuleInfo,
+    entry_points: &[&str],
+) -> Result<Reflection, String> {
     let mut out = Reflection::default();
     for name in entry_points {
         let Some(index) = module.entry_points.iter().position(|e| e.name == *name) else {
@@ -84,21 +88,21 @@ pub fn reflect(module: &naga::Module, info: &naga::valid::ModuleInfo, entry_poin
             let ty = binding_kind(module, var)?;
             out.bindings.push(ReflectedBinding { name: var_name, group: rb.group, binding: rb.binding, ty });
         }
-        if ep.stage == naga::ShaderStage::Fragment {
-            if let Some(result) = &ep.function.result {
-                match (&module.types[result.ty].inner, &result.binding) {
-                    (TypeInner::Struct { members, .. }, _) => {
-                        for m in members {
-                            if let Some(naga::Binding::Location { location, .. }) = m.binding {
-                                out.fragment_outputs.push((m.name.clone().unwrap_or_default(), location));
-                            }
+        if ep.stage == naga::ShaderStage::Fragment
+            && let Some(result) = &ep.function.result
+        {
+            match (&module.types[result.ty].inner, &result.binding) {
+                (TypeInner::Struct { members, .. }, _) => {
+                    for m in members {
+                        if let Some(naga::Binding::Location { location, .. }) = m.binding {
+                            out.fragment_outputs.push((m.name.clone().unwrap_or_default(), location));
                         }
                     }
-                    (_, Some(naga::Binding::Location { location, .. })) => {
-                        out.fragment_outputs.push((String::new(), *location));
-                    }
-                    _ => {}
                 }
+                (_, Some(naga::Binding::Location { location, .. })) => {
+                    out.fragment_outputs.push((String::new(), *location));
+                }
+                _ => {}
             }
         }
     }
@@ -138,7 +142,9 @@ fn binding_kind(module: &naga::Module, var: &naga::GlobalVariable) -> Result<Bin
                     };
                     Ok(BindingKind::StorageTexture { format: storage_format(*format), access, dim })
                 }
-                ImageClass::External => Err(format!("global \"{name}\" is an external texture, which volgraph does not bind")),
+                ImageClass::External => {
+                    Err(format!("global \"{name}\" is an external texture, which volgraph does not bind"))
+                }
             }
         }
         _ => Err(format!("global \"{name}\" has a type volgraph cannot bind")),
@@ -174,11 +180,17 @@ fn storage_format(f: naga::StorageFormat) -> Option<wgpu::TextureFormat> {
 
 /// The wgpu layout entry for a reflected binding. `filterable` says whether a sampled float
 /// texture's bound format can be linearly filtered.
-pub fn layout_entry(b: &ReflectedBinding, visibility: wgpu::ShaderStages, filterable: bool) -> wgpu::BindGroupLayoutEntry {
+pub fn layout_entry(
+    b: &ReflectedBinding,
+    visibility: wgpu::ShaderStages,
+    filterable: bool,
+) -> wgpu::BindGroupLayoutEntry {
     let ty = match &b.ty {
-        BindingKind::Uniform => {
-            wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None }
-        }
+        BindingKind::Uniform => wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
         BindingKind::Storage { read_only } => wgpu::BindingType::Buffer {
             ty: wgpu::BufferBindingType::Storage { read_only: *read_only },
             has_dynamic_offset: false,

@@ -95,14 +95,23 @@ fn usage_for(format: TargetFormat) -> wgpu::TextureUsages {
         | wgpu::TextureUsages::COPY_DST;
     if matches!(
         format,
-        TargetFormat::Rgba16Float | TargetFormat::Rgba32Float | TargetFormat::R32Float | TargetFormat::Rg32Float | TargetFormat::Rgba8Unorm
+        TargetFormat::Rgba16Float
+            | TargetFormat::Rgba32Float
+            | TargetFormat::R32Float
+            | TargetFormat::Rg32Float
+            | TargetFormat::Rgba8Unorm
     ) {
         u |= wgpu::TextureUsages::STORAGE_BINDING;
     }
     u
 }
 
-fn create_target(gpu: &Gpu, label: &str, format: TargetFormat, extent: (u32, u32)) -> (wgpu::Texture, wgpu::TextureView) {
+fn create_target(
+    gpu: &Gpu,
+    label: &str,
+    format: TargetFormat,
+    extent: (u32, u32),
+) -> (wgpu::Texture, wgpu::TextureView) {
     let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d { width: extent.0, height: extent.1, depth_or_array_layers: 1 },
@@ -136,10 +145,12 @@ impl Executor {
                             ResourceDesc::Target { format, .. } => Some(format.wgpu()),
                             ResourceDesc::Owned(_) => None,
                         },
-                        Binding::History(name) => plan.history.get(name).and_then(|h| match &plan.resources[h.source].desc {
-                            ResourceDesc::Target { format, .. } => Some(format.wgpu()),
-                            ResourceDesc::Owned(_) => None,
-                        }),
+                        Binding::History(name) => {
+                            plan.history.get(name).and_then(|h| match &plan.resources[h.source].desc {
+                                ResourceDesc::Target { format, .. } => Some(format.wgpu()),
+                                ResourceDesc::Owned(_) => None,
+                            })
+                        }
                         _ => specs.iter().find(|s| s.name == bp.port).and_then(|s| match &s.kind {
                             PortKind::Target { formats, .. } => formats.first().map(|f| f.wgpu()),
                             _ => None,
@@ -155,14 +166,15 @@ impl Executor {
         let mut owned = HashMap::new();
         for step in &plan.steps {
             for bp in &step.ports {
-                if let Binding::Resource { id, written: None } = &bp.binding {
-                    if bp.access == Access::Write && matches!(plan.resources[*id].desc, ResourceDesc::Owned(_)) {
-                        let node = nodes.get(&step.pass_id).ok_or_else(|| ExecutorError::UnknownKind(step.kind.clone()))?;
-                        // A node whose texture depends on a graph input (a grid sized by the
-                        // volume) creates it in its first `record`; `run_frame` picks it up then.
-                        if let Some(view) = node.owned_output(&bp.port) {
-                            owned.insert(*id, view);
-                        }
+                if let Binding::Resource { id, written: None } = &bp.binding
+                    && bp.access == Access::Write
+                    && matches!(plan.resources[*id].desc, ResourceDesc::Owned(_))
+                {
+                    let node = nodes.get(&step.pass_id).ok_or_else(|| ExecutorError::UnknownKind(step.kind.clone()))?;
+                    // A node whose texture depends on a graph input (a grid sized by the
+                    // volume) creates it in its first `record`; `run_frame` picks it up then.
+                    if let Some(view) = node.owned_output(&bp.port) {
+                        owned.insert(*id, view);
                     }
                 }
             }
@@ -174,7 +186,8 @@ impl Executor {
             .map(|(i, s)| {
                 let label = format!("slot{i} {}", s.format);
                 let (current, current_view) = create_target(gpu, &label, s.format, s.extent);
-                let previous = s.persistent.then(|| create_target(gpu, &format!("{label} (previous frame)"), s.format, s.extent));
+                let previous =
+                    s.persistent.then(|| create_target(gpu, &format!("{label} (previous frame)"), s.format, s.extent));
                 SlotTextures { current, current_view, previous }
             })
             .collect();
@@ -221,7 +234,17 @@ impl Executor {
             });
             (set, resolve, read)
         });
-        Ok(Self { plan, nodes, slots, owned, inputs: HashMap::new(), system, frame_index: 0, history_valid: false, queries })
+        Ok(Self {
+            plan,
+            nodes,
+            slots,
+            owned,
+            inputs: HashMap::new(),
+            system,
+            frame_index: 0,
+            history_valid: false,
+            queries,
+        })
     }
 
     /// The plan being run.
@@ -249,14 +272,21 @@ impl Executor {
 
     fn check_inputs(&self) -> Result<(), ExecutorError> {
         for (name, kind) in &self.plan.inputs {
-            let used = self.plan.steps.iter().any(|s| s.ports.iter().any(|p| p.binding == Binding::Input(name.clone())));
+            let used =
+                self.plan.steps.iter().any(|s| s.ports.iter().any(|p| p.binding == Binding::Input(name.clone())));
             if used && !self.inputs.contains_key(name) {
                 let (kind, hint) = match kind {
                     InputKind::Volume => ("Volume", "bind a 3D texture with Executor::bind_input"),
-                    InputKind::TransferFunction => ("TransferFunction", "bind the LUT texture with Executor::bind_input"),
+                    InputKind::TransferFunction => {
+                        ("TransferFunction", "bind the LUT texture with Executor::bind_input")
+                    }
                     InputKind::Scalar(_) => ("Scalar", "scalars are compile-time scene values"),
                 };
-                return Err(ExecutorError::UnboundInput { name: name.clone(), kind: kind.to_string(), hint: hint.to_string() });
+                return Err(ExecutorError::UnboundInput {
+                    name: name.clone(),
+                    kind: kind.to_string(),
+                    hint: hint.to_string(),
+                });
             }
         }
         Ok(())
@@ -266,7 +296,8 @@ impl Executor {
     pub fn run_frame(&mut self, gpu: &Gpu) -> Result<FrameStats, ExecutorError> {
         self.check_inputs()?;
         let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(&self.plan.name) });
+        let mut encoder =
+            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(&self.plan.name) });
         // History pairs: swap, and clear "previous" when there is no previous frame.
         for (slot, textures) in self.plan.slots.iter().zip(self.slots.iter_mut()) {
             if let Some(prev) = textures.previous.as_mut() {
@@ -286,7 +317,10 @@ impl Executor {
                         view,
                         depth_slice: None,
                         resolve_target: None,
-                        ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a }), store: wgpu::StoreOp::Store },
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a }),
+                            store: wgpu::StoreOp::Store,
+                        },
                     })],
                     ..Default::default()
                 });
@@ -319,7 +353,8 @@ impl Executor {
                 };
                 ports.push(BoundView { name: bp.port.clone(), access: bp.access, view, extent });
             }
-            let node = self.nodes.get_mut(&step.pass_id).ok_or_else(|| ExecutorError::UnknownKind(step.kind.clone()))?;
+            let node =
+                self.nodes.get_mut(&step.pass_id).ok_or_else(|| ExecutorError::UnknownKind(step.kind.clone()))?;
             let mut ctx = RecordContext {
                 gpu,
                 encoder: &mut encoder,
@@ -342,7 +377,10 @@ impl Executor {
                     let view = node.owned_output(&bp.port).ok_or_else(|| {
                         ExecutorError::Pass(PassError {
                             pass: step.label.clone(),
-                            message: format!("declares owned output \"{}\" but its node provides no texture for it", bp.port),
+                            message: format!(
+                                "declares owned output \"{}\" but its node provides no texture for it",
+                                bp.port
+                            ),
                         })
                     })?;
                     self.owned.insert(*id, view);

@@ -32,7 +32,13 @@ impl VolumeFormat {
 }
 
 /// Uploads a volume (`dims`, x fastest, little-endian texels) as a 3D texture.
-pub fn upload_volume(gpu: &Gpu, label: &str, dims: [u32; 3], format: VolumeFormat, bytes: &[u8]) -> Result<wgpu::Texture, String> {
+pub fn upload_volume(
+    gpu: &Gpu,
+    label: &str,
+    dims: [u32; 3],
+    format: VolumeFormat,
+    bytes: &[u8],
+) -> Result<wgpu::Texture, String> {
     let max = gpu.limits.max_texture_dimension_3d;
     if dims.iter().any(|d| *d == 0 || *d > max) {
         return Err(format!(
@@ -61,7 +67,12 @@ pub fn upload_volume(gpu: &Gpu, label: &str, dims: [u32; 3], format: VolumeForma
         view_formats: &[],
     });
     gpu.queue.write_texture(
-        wgpu::TexelCopyTextureInfo { texture: &texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
+        wgpu::TexelCopyTextureInfo {
+            texture: &texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
         bytes,
         wgpu::TexelCopyBufferLayout {
             offset: 0,
@@ -95,7 +106,12 @@ pub fn upload_lut(gpu: &Gpu, label: &str, rgba: &[[f32; 4]]) -> wgpu::Texture {
     });
     let bpp = format.block_copy_size(None).unwrap_or(16);
     gpu.queue.write_texture(
-        wgpu::TexelCopyTextureInfo { texture: &texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
+        wgpu::TexelCopyTextureInfo {
+            texture: &texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
         &bytes,
         wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(width * bpp), rows_per_image: Some(1) },
         wgpu::Extent3d { width, height: 1, depth_or_array_layers: 1 },

@@ -77,10 +77,7 @@ impl Locator {
 
     /// The value of a top-level map entry (`outputs."image"`), or its key.
     pub fn top_entry(&self, map: &str, key: &str, want_key: bool) -> Location {
-        let span = self
-            .top_field(map)
-            .and_then(|m| m.entry(key))
-            .map(|(k, v)| if want_key { k.span } else { v.span });
+        let span = self.top_field(map).and_then(|m| m.entry(key)).map(|(k, v)| if want_key { k.span } else { v.span });
         match span {
             Some(s) => Location::Span(s),
             None => Location::Field { pass: "(graph)".to_string(), field: format!("{map}.{key}") },

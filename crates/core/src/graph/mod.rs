@@ -71,14 +71,12 @@ fn explain_ron_error(code: &ron::Error) -> (String, Option<String>) {
             "the file ends in the middle of a value".to_string(),
             Some("close every `(`, `[` and `{` and end strings with `\"`".to_string()),
         ),
-        E::ExpectedComma => (
-            "expected `,` here".to_string(),
-            Some("separate fields, list items and map entries with `,`".to_string()),
-        ),
-        E::ExpectedMapColon => (
-            "expected `:` after the map key".to_string(),
-            Some("write map entries as \"key\": value".to_string()),
-        ),
+        E::ExpectedComma => {
+            ("expected `,` here".to_string(), Some("separate fields, list items and map entries with `,`".to_string()))
+        }
+        E::ExpectedMapColon => {
+            ("expected `:` after the map key".to_string(), Some("write map entries as \"key\": value".to_string()))
+        }
         E::ExpectedArrayEnd => (
             "expected `]` or `,` here".to_string(),
             Some("close the list with `]`, or put `,` between its items".to_string()),
@@ -91,14 +89,8 @@ fn explain_ron_error(code: &ron::Error) -> (String, Option<String>) {
             "expected `)` or `,` here".to_string(),
             Some("close the parenthesis with `)`, or put `,` between its fields".to_string()),
         ),
-        E::ExpectedStringEnd => (
-            "this string is never closed".to_string(),
-            Some("end it with `\"`".to_string()),
-        ),
-        E::UnclosedBlockComment => (
-            "this comment is never closed".to_string(),
-            Some("end it with `*/`".to_string()),
-        ),
+        E::ExpectedStringEnd => ("this string is never closed".to_string(), Some("end it with `\"`".to_string())),
+        E::UnclosedBlockComment => ("this comment is never closed".to_string(), Some("end it with `*/`".to_string())),
         E::TrailingCharacters => (
             "unexpected text after the end of the graph".to_string(),
             Some("a graph file holds one Graph(...); remove what follows its closing `)`".to_string()),

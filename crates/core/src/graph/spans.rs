@@ -91,10 +91,9 @@ impl SpannedValue {
     /// For a map with string keys: the entry whose key is `key` → (key, value).
     pub fn entry(&self, key: &str) -> Option<(&SpannedValue, &SpannedValue)> {
         match &self.node {
-            Node::Map(entries) => entries
-                .iter()
-                .find(|(k, _)| matches!(&k.node, Node::Str(s) if s == key))
-                .map(|(k, v)| (k, v)),
+            Node::Map(entries) => {
+                entries.iter().find(|(k, _)| matches!(&k.node, Node::Str(s) if s == key)).map(|(k, v)| (k, v))
+            }
             _ => None,
         }
     }
@@ -165,7 +164,8 @@ fn tokenize(src: &str) -> Vec<(Tok, Span)> {
             let start = i;
             while i < bytes.len() {
                 let b = bytes[i];
-                if b.is_ascii_whitespace() || matches!(b, b'(' | b')' | b'[' | b']' | b'{' | b'}' | b',' | b':' | b'"') {
+                if b.is_ascii_whitespace() || matches!(b, b'(' | b')' | b'[' | b']' | b'{' | b'}' | b',' | b':' | b'"')
+                {
                     break;
                 }
                 i += 1;

@@ -7,10 +7,7 @@
 //! `reprojection_splat`, `hole_fill`, `antialias` for Klein et al.), so error messages read as
 //! they would for real graphs. Their nodes record nothing: these tests never run a frame.
 
-#![allow(
-    dead_code,
-    reason = "each test file uses a different subset of the helpers"
-)]
+#![allow(dead_code, reason = "each test file uses a different subset of the helpers")]
 
 use volgraph_core::executor::{CreateContext, PassError, RecordContext};
 use volgraph_core::params::ParamSpec;
@@ -35,13 +32,7 @@ pub struct TestPlugin {
 
 impl TestPlugin {
     fn new(kind: &'static str, ports: Vec<PortSpec>) -> Self {
-        Self {
-            kind,
-            ports,
-            iso_ports: Vec::new(),
-            params: Vec::new(),
-            features: Vec::new(),
-        }
+        Self { kind, ports, iso_ports: Vec::new(), params: Vec::new(), features: Vec::new() }
     }
 }
 
@@ -85,45 +76,12 @@ impl PassPlugin for TestPlugin {
 
 fn raycast_params() -> Vec<ParamSpec> {
     vec![
-        ParamSpec::float(
-            "step_voxels",
-            0.5,
-            0.01,
-            16.0,
-            "sample distance in units of the smallest voxel side",
-        ),
-        ParamSpec::float(
-            "threshold",
-            1.0,
-            0.0,
-            1.0,
-            "early ray termination once accumulated alpha reaches this",
-        ),
-        ParamSpec::uint(
-            "max_steps",
-            4096,
-            1,
-            1 << 20,
-            "upper bound on samples per ray",
-        ),
-        ParamSpec::boolean(
-            "jitter",
-            false,
-            "offset each ray's first sample by a per-pixel hash",
-        ),
-        ParamSpec::choice(
-            "mode",
-            "dvr",
-            &["dvr", "iso"],
-            "direct volume rendering or first-hit isosurface",
-        ),
-        ParamSpec::float(
-            "iso_value",
-            0.5,
-            0.0,
-            1.0,
-            "isovalue in normalized scalar units",
-        ),
+        ParamSpec::float("step_voxels", 0.5, 0.01, 16.0, "sample distance in units of the smallest voxel side"),
+        ParamSpec::float("threshold", 1.0, 0.0, 1.0, "early ray termination once accumulated alpha reaches this"),
+        ParamSpec::uint("max_steps", 4096, 1, 1 << 20, "upper bound on samples per ray"),
+        ParamSpec::boolean("jitter", false, "offset each ray's first sample by a per-pixel hash"),
+        ParamSpec::choice("mode", "dvr", &["dvr", "iso"], "direct volume rendering or first-hit isosurface"),
+        ParamSpec::float("iso_value", 0.5, 0.0, 1.0, "isovalue in normalized scalar units"),
     ]
 }
 
@@ -131,16 +89,10 @@ fn raycast_params() -> Vec<ParamSpec> {
 pub fn registry() -> Registry {
     let t = PortKind::target;
     let mut r = Registry::new();
-    r.register(TestPlugin::new(
-        "entry_points",
-        vec![PortSpec::write("entry", t(&FLOAT_TARGETS))],
-    ));
+    r.register(TestPlugin::new("entry_points", vec![PortSpec::write("entry", t(&FLOAT_TARGETS))]));
     r.register(TestPlugin::new(
         "ray_directions",
-        vec![
-            PortSpec::read("entry", t(&FLOAT_TARGETS)),
-            PortSpec::write("dir", t(&FLOAT_TARGETS)),
-        ],
+        vec![PortSpec::read("entry", t(&FLOAT_TARGETS)), PortSpec::write("dir", t(&FLOAT_TARGETS))],
     ));
     let ray_inputs = || {
         vec![
@@ -151,10 +103,7 @@ pub fn registry() -> Registry {
         ]
     };
     let mut raycast_ports = ray_inputs();
-    raycast_ports.push(PortSpec::write(
-        "color",
-        t(&[TargetFormat::Rgba16Float, TargetFormat::Rgba32Float]),
-    ));
+    raycast_ports.push(PortSpec::write("color", t(&[TargetFormat::Rgba16Float, TargetFormat::Rgba32Float])));
     r.register(TestPlugin {
         params: raycast_params(),
         iso_ports: vec![PortSpec::write("hit", t(&FLOAT_TARGETS))],
@@ -163,39 +112,15 @@ pub fn registry() -> Registry {
     let mut compute_ports = ray_inputs();
     compute_ports.push(PortSpec::write("color", t(&[TargetFormat::Rgba16Float])));
     let mut compute_params = raycast_params();
-    compute_params.push(ParamSpec::uint(
-        "workgroup_x",
-        8,
-        1,
-        256,
-        "workgroup width in pixels",
-    ));
-    compute_params.push(ParamSpec::uint(
-        "workgroup_y",
-        8,
-        1,
-        256,
-        "workgroup height in pixels",
-    ));
+    compute_params.push(ParamSpec::uint("workgroup_x", 8, 1, 256, "workgroup width in pixels"));
+    compute_params.push(ParamSpec::uint("workgroup_y", 8, 1, 256, "workgroup height in pixels"));
+    r.register(TestPlugin { params: compute_params, ..TestPlugin::new("raycast_compute", compute_ports) });
     r.register(TestPlugin {
-        params: compute_params,
-        ..TestPlugin::new("raycast_compute", compute_ports)
-    });
-    r.register(TestPlugin {
-        params: vec![ParamSpec::float(
-            "background",
-            0.0,
-            0.0,
-            1.0,
-            "linear grey level behind the volume",
-        )],
+        params: vec![ParamSpec::float("background", 0.0, 0.0, 1.0, "linear grey level behind the volume")],
         ..TestPlugin::new(
             "present",
             vec![
-                PortSpec::read(
-                    "color",
-                    t(&[TargetFormat::Rgba16Float, TargetFormat::Rgba32Float]),
-                ),
+                PortSpec::read("color", t(&[TargetFormat::Rgba16Float, TargetFormat::Rgba32Float])),
                 PortSpec::write("display", t(&[TargetFormat::Rgba8Unorm])),
             ],
         )
@@ -204,50 +129,26 @@ pub fn registry() -> Registry {
     r.register(TestPlugin::new(
         "clear_targets",
         vec![
-            PortSpec::write(
-                "color",
-                t(&[TargetFormat::Rgba32Float, TargetFormat::Rgba16Float]),
-            ),
+            PortSpec::write("color", t(&[TargetFormat::Rgba32Float, TargetFormat::Rgba16Float])),
             PortSpec::write("depth", t(&[TargetFormat::Depth32Float])),
         ],
     ));
     let mut segment_ports = ray_inputs();
     segment_ports.extend([
-        PortSpec::read(
-            "accum",
-            t(&[TargetFormat::Rgba32Float, TargetFormat::Rgba16Float]),
-        ),
+        PortSpec::read("accum", t(&[TargetFormat::Rgba32Float, TargetFormat::Rgba16Float])),
         PortSpec::modify("depth", t(&[TargetFormat::Depth32Float])),
-        PortSpec::write(
-            "color",
-            t(&[TargetFormat::Rgba32Float, TargetFormat::Rgba16Float]),
-        ),
+        PortSpec::write("color", t(&[TargetFormat::Rgba32Float, TargetFormat::Rgba16Float])),
     ]);
     r.register(TestPlugin {
-        params: vec![ParamSpec::uint(
-            "steps",
-            8,
-            1,
-            1024,
-            "samples per segment (the paper's M)",
-        )],
+        params: vec![ParamSpec::uint("steps", 8, 1, 1024, "samples per segment (the paper's M)")],
         ..TestPlugin::new("raycast_segment", segment_ports)
     });
     r.register(TestPlugin {
-        params: vec![ParamSpec::float(
-            "alpha",
-            0.95,
-            0.0,
-            1.0,
-            "opacity above which a ray terminates (the paper's T)",
-        )],
+        params: vec![ParamSpec::float("alpha", 0.95, 0.0, 1.0, "opacity above which a ray terminates (the paper's T)")],
         ..TestPlugin::new(
             "termination_test",
             vec![
-                PortSpec::read(
-                    "color",
-                    t(&[TargetFormat::Rgba32Float, TargetFormat::Rgba16Float]),
-                ),
+                PortSpec::read("color", t(&[TargetFormat::Rgba32Float, TargetFormat::Rgba16Float])),
                 PortSpec::modify("depth", t(&[TargetFormat::Depth32Float])),
             ],
         )
@@ -255,10 +156,7 @@ pub fn registry() -> Registry {
     // Klein et al. 2005: start positions from the previous frame's hits.
     r.register(TestPlugin::new(
         "reprojection_splat",
-        vec![
-            PortSpec::read("hit", t(&FLOAT_TARGETS)),
-            PortSpec::write("start", t(&FLOAT_TARGETS)),
-        ],
+        vec![PortSpec::read("hit", t(&FLOAT_TARGETS)), PortSpec::write("start", t(&FLOAT_TARGETS))],
     ));
     r.register(TestPlugin::new(
         "hole_fill",
@@ -273,15 +171,9 @@ pub fn registry() -> Registry {
         ..TestPlugin::new(
             "antialias",
             vec![
-                PortSpec::read(
-                    "color",
-                    t(&[TargetFormat::Rgba16Float, TargetFormat::Rgba32Float]),
-                ),
+                PortSpec::read("color", t(&[TargetFormat::Rgba16Float, TargetFormat::Rgba32Float])),
                 PortSpec::read("hit", t(&FLOAT_TARGETS)),
-                PortSpec::write(
-                    "smooth",
-                    t(&[TargetFormat::Rgba16Float, TargetFormat::Rgba32Float]),
-                ),
+                PortSpec::write("smooth", t(&[TargetFormat::Rgba16Float, TargetFormat::Rgba32Float])),
             ],
         )
     });

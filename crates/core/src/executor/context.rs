@@ -32,6 +32,9 @@ pub struct PortInfo {
     pub access: Access,
     /// Texture format, when known at build time (targets; graph inputs are filterable formats).
     pub format: Option<wgpu::TextureFormat>,
+    /// A texture another pass owns (a min/max grid): bound as unfilterable float, read with
+    /// `textureLoad`, so 32-bit float grids need no FLOAT32_FILTERABLE.
+    pub owned: bool,
 }
 
 /// Given to [`crate::plugin::PassPlugin::create`].
@@ -183,9 +186,10 @@ impl CreateContext<'_> {
         let entries: Vec<wgpu::BindGroupLayoutEntry> = bindings
             .iter()
             .map(|b| {
-                let filterable = match self.port(&b.name).and_then(|p| p.format) {
-                    Some(f) => self.gpu.filterable(f),
-                    None => true,
+                let filterable = match self.port(&b.name) {
+                    Some(p) if p.owned => false,
+                    Some(PortInfo { format: Some(f), .. }) => self.gpu.filterable(*f),
+                    _ => true,
                 };
                 // Writable storage in a vertex stage needs VERTEX_WRITABLE_STORAGE; volgraph's
                 // render passes write storage (debug counters) from fragment shaders only.

@@ -156,7 +156,11 @@ impl Executor {
                             _ => None,
                         }),
                     };
-                    PortInfo { name: bp.port.clone(), access: bp.access, format }
+                    let owned = matches!(
+                        &bp.binding,
+                        Binding::Resource { id, .. } if matches!(plan.resources[*id].desc, ResourceDesc::Owned(_))
+                    );
+                    PortInfo { name: bp.port.clone(), access: bp.access, format, owned }
                 })
                 .collect();
             let ctx = CreateContext { gpu, shaders, pass_id: &step.pass_id, params: &step.params, ports: &ports };

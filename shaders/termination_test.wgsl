@@ -48,12 +48,25 @@ fn segment_is_empty(ray: PixelRay, index: u32) -> bool {
     return true;
 }
 
-// RC-a: early ray termination only.
+// RC-a: early ray termination only. A ray never comes back once terminated, so this test can
+// itself be culled by early-z: `vs_terminate_alpha` draws at depth TERMINATED with compare
+// Greater, rays already at TERMINATED are rejected before the shader runs, and a live ray either
+// keeps the fragment (its depth becomes TERMINATED) or is discarded (stays LIVE). No frag_depth
+// is written, so the depth test stays early.
+@vertex
+fn vs_terminate_alpha(@builtin(vertex_index) vertex_index: u32, @builtin(instance_index) instance: u32) -> SegmentVertex {
+    let x = f32((vertex_index & 1u) << 2u) - 1.0;
+    let y = f32((vertex_index & 2u) << 1u) - 1.0;
+    return SegmentVertex(vec4<f32>(x, y, TERMINATED, 1.0), instance);
+}
+
 @fragment
-fn fs_terminate(in: SegmentVertex) -> DepthOut {
+fn fs_terminate(in: SegmentVertex) {
     let pixel = vec2<u32>(in.clip.xy);
     let ray = pixel_ray(pixel);
-    return DepthOut(select(LIVE, TERMINATED, ray_is_done(pixel, ray, in.index)));
+    if (!ray_is_done(pixel, ray, in.index)) {
+        discard;
+    }
 }
 
 // RC-b: early ray termination and empty-space skipping.

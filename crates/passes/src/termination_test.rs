@@ -80,7 +80,12 @@ impl PassPlugin for TerminationTest {
             depth: Some(DepthSpec { port: "depth", write: true, compare: wgpu::CompareFunction::Always }),
             ..Default::default()
         };
-        let alpha_only = ctx.render_pipeline(&spec("fs_terminate"))?;
+        // RC-a never re-enables a ray, so its test is culled by early-z itself (see the shader).
+        let alpha_only = ctx.render_pipeline(&RenderPipelineSpec {
+            vertex: "vs_terminate_alpha",
+            depth: Some(DepthSpec { port: "depth", write: true, compare: wgpu::CompareFunction::Greater }),
+            ..spec("fs_terminate")
+        })?;
         let with_empty = ctx.render_pipeline(&spec("fs_terminate_empty"))?;
         let params = ctx.uniform_buffer("params", std::mem::size_of::<RaycastParamsGpu>() as u64);
         ctx.gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(ctx.params)));

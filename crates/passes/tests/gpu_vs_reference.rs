@@ -24,16 +24,11 @@ use volgraph_passes::builtin_registry;
 use volgraph_passes::raycast_params::reference_settings;
 use volgraph_passes::session::RenderSession;
 
+mod support;
+
+use support::{gpu, graph_path, save_images};
+
 const SIZE: u32 = 128;
-
-fn gpu() -> Gpu {
-    // Under CI a missing adapter is a failure, never a skip.
-    Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)")
-}
-
-fn graph_path(name: &str) -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../graphs").join(name)
-}
 
 struct Comparison {
     max_abs: f64,
@@ -105,31 +100,6 @@ fn render_with(
     let hit = session.read(gpu, "hit").ok().map(|h| compare(&h, &reference.hit));
     let coverage = reference.color.iter().filter(|c| c[3] > 0.0).count() as f64 / reference.color.len() as f64;
     (color, hit, coverage)
-}
-
-/// Writes GPU, reference and 10×-amplified difference images under `target/test-images/` so a
-/// failing comparison can be looked at.
-fn save_images(name: &str, gpu: &Image, reference: &[[f64; 4]]) {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target/test-images");
-    let _ = std::fs::create_dir_all(&dir);
-    let (w, h) = (gpu.width, gpu.height);
-    let to8 = |v: f64| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
-    let mut g = image::RgbaImage::new(w, h);
-    let mut r = image::RgbaImage::new(w, h);
-    let mut d = image::RgbaImage::new(w, h);
-    for y in 0..h {
-        for x in 0..w {
-            let a = gpu.rgba(x, y);
-            let b = reference[(y * w + x) as usize];
-            g.put_pixel(x, y, image::Rgba([to8(a[0] as f64), to8(a[1] as f64), to8(a[2] as f64), 255]));
-            r.put_pixel(x, y, image::Rgba([to8(b[0]), to8(b[1]), to8(b[2]), 255]));
-            let diff = |c: usize| to8(10.0 * (a[c] as f64 - b[c]).abs());
-            d.put_pixel(x, y, image::Rgba([diff(0), diff(1), diff(3), 255]));
-        }
-    }
-    let _ = g.save(dir.join(format!("{name}_gpu.png")));
-    let _ = r.save(dir.join(format!("{name}_reference.png")));
-    let _ = d.save(dir.join(format!("{name}_diff_x10.png")));
 }
 
 fn assert_dvr(name: &str, c: &Comparison, coverage: f64) {

@@ -7,18 +7,18 @@ use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::reference::render_reference;
 use volgraph_accel::transfer_function::TransferFunction;
 use volgraph_accel::volume::Volume;
-use volgraph_core::executor::{Gpu, Image, ShaderLibrary};
+use volgraph_core::executor::{Image, ShaderLibrary};
 use volgraph_core::shader_source::default_shader_root;
 use volgraph_core::{CompileOptions, compile};
 use volgraph_passes::builtin_registry;
 use volgraph_passes::raycast_params::reference_settings;
 use volgraph_passes::session::RenderSession;
 
-const SIZE: u32 = 64;
+mod support;
 
-fn gpu() -> Gpu {
-    Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)")
-}
+use support::{diff_reference, gpu, graph_source};
+
+const SIZE: u32 = 64;
 
 /// Renders graphs/basic/fragment_raycast.ron and returns (GPU image, reference colour).
 fn render(
@@ -28,8 +28,7 @@ fn render(
     options: CompileOptions,
 ) -> (Image, Vec<[f64; 4]>) {
     let gpu = gpu();
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../graphs/basic/fragment_raycast.ron");
-    let source = std::fs::read_to_string(path).expect("graph");
+    let source = graph_source("basic/fragment_raycast.ron");
     let registry = builtin_registry();
     let plan = compile("fragment_raycast.ron", &source, &registry, &options).expect("compiles");
     let settings = reference_settings(&plan.steps.iter().find(|s| s.pass_id == "march").expect("march").params);
@@ -42,29 +41,14 @@ fn render(
     (image, reference.color)
 }
 
-/// Max abs difference, and whether every GPU value is finite.
-fn max_diff(image: &Image, reference: &[[f64; 4]]) -> (f64, bool) {
-    let mut max: f64 = 0.0;
-    let mut finite = true;
-    for y in 0..image.height {
-        for x in 0..image.width {
-            let g = image.rgba(x, y);
-            let r = reference[(y * image.width + x) as usize];
-            for c in 0..4 {
-                finite &= g[c].is_finite();
-                max = max.max((g[c] as f64 - r[c]).abs());
-            }
-        }
-    }
-    (max, finite)
-}
-
 fn coverage(reference: &[[f64; 4]]) -> f64 {
     reference.iter().filter(|c| c[3] > 1e-3).count() as f64 / reference.len() as f64
 }
 
 fn assert_close(name: &str, image: &Image, reference: &[[f64; 4]], min_coverage: f64) {
-    let (max, finite) = max_diff(image, reference);
+    // NaN or Inf anywhere makes the max difference infinite.
+    let (max, _) = diff_reference(image, reference);
+    let finite = max.is_finite();
     let cov = coverage(reference);
     eprintln!("{name}: max {:.3}/255, coverage {cov:.2}", max * 255.0);
     assert!(finite, "{name}: the GPU image has NaN or Inf");

@@ -32,20 +32,14 @@ use volgraph_passes::raycast_segment::{InvocationCounter, RaycastSegment};
 use volgraph_passes::scene::longest_ray_steps;
 use volgraph_passes::session::RenderSession;
 
+mod support;
+
+use support::{as_reference, diff_reference, gpu, graph_source, save_images};
+
 const SIZE: u32 = 96;
 const STEP_VOXELS: f64 = 0.5;
 /// One 8-bit display level: the bound for lossless accelerations.
 const LOSSLESS: f64 = 1.0 / 255.0;
-
-fn gpu() -> Gpu {
-    // Under CI a missing adapter is a failure, never a skip.
-    Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)")
-}
-
-fn graph_source(name: &str) -> String {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../graphs").join(name);
-    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
 
 /// Options for `volume`: the viewport and the scene's K (longest ray in steps).
 fn options(volume: &Volume) -> CompileOptions {
@@ -87,59 +81,9 @@ fn render(
     render_with(gpu, &builtin_registry(), graph, volume, lut, camera, options)
 }
 
-/// (max abs, mean abs) per channel between two GPU images; panics on NaN.
+/// (max abs, mean abs) per channel between two GPU images; NaN counts as infinite.
 fn diff_images(a: &Image, b: &Image) -> (f64, f64) {
-    let reference: Vec<[f64; 4]> = (0..b.height)
-        .flat_map(|y| (0..b.width).map(move |x| (x, y)))
-        .map(|(x, y)| b.rgba(x, y).map(|c| c as f64))
-        .collect();
-    diff_reference(a, &reference)
-}
-
-/// (max abs, mean abs) per channel between a GPU image and reference colours; NaN counts as
-/// an infinite difference.
-fn diff_reference(gpu: &Image, reference: &[[f64; 4]]) -> (f64, f64) {
-    let mut max_abs: f64 = 0.0;
-    let mut sum = 0.0;
-    for y in 0..gpu.height {
-        for x in 0..gpu.width {
-            let g = gpu.rgba(x, y);
-            let r = reference[(y * gpu.width + x) as usize];
-            for c in 0..4 {
-                let d = (g[c] as f64 - r[c]).abs();
-                let d = if d.is_nan() { f64::INFINITY } else { d };
-                max_abs = max_abs.max(d);
-                sum += d;
-            }
-        }
-    }
-    (max_abs, sum / (4.0 * (gpu.width * gpu.height) as f64))
-}
-
-/// Writes GPU, reference and 10×-amplified difference images under `target/test-images/`
-/// (`kw_<name>_*.png`) so a failing comparison can be looked at.
-fn save_images(name: &str, gpu: &Image, reference: &[[f64; 4]]) {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target/test-images");
-    let _ = std::fs::create_dir_all(&dir);
-    let name: String = name.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '_' }).collect();
-    let (w, h) = (gpu.width, gpu.height);
-    let to8 = |v: f64| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
-    let mut g = image::RgbaImage::new(w, h);
-    let mut r = image::RgbaImage::new(w, h);
-    let mut d = image::RgbaImage::new(w, h);
-    for y in 0..h {
-        for x in 0..w {
-            let a = gpu.rgba(x, y);
-            let b = reference[(y * w + x) as usize];
-            g.put_pixel(x, y, image::Rgba([to8(a[0] as f64), to8(a[1] as f64), to8(a[2] as f64), 255]));
-            r.put_pixel(x, y, image::Rgba([to8(b[0]), to8(b[1]), to8(b[2]), 255]));
-            let diff = |c: usize| to8(10.0 * (a[c] as f64 - b[c]).abs());
-            d.put_pixel(x, y, image::Rgba([diff(0), diff(1), diff(3), 255]));
-        }
-    }
-    let _ = g.save(dir.join(format!("kw_{name}_gpu.png")));
-    let _ = r.save(dir.join(format!("kw_{name}_reference.png")));
-    let _ = d.save(dir.join(format!("kw_{name}_diff_x10.png")));
+    diff_reference(a, &as_reference(b))
 }
 
 /// Fraction of pixels with non-zero alpha (a comparison of empty images proves nothing).
@@ -169,7 +113,7 @@ fn assert_matches_reference(
     let settings = reference_settings(&march.params);
     let reference = render_reference(volume, lut, camera, SIZE, SIZE, &settings);
     let (max_abs, mean_abs) = diff_reference(&rendered.image, &reference.color);
-    save_images(name, &rendered.image, &reference.color);
+    save_images(&format!("kw_{name}"), &rendered.image, &reference.color);
     eprintln!("{name} vs reference: max {:.3}/255 mean {:.4}/255", max_abs * 255.0, mean_abs * 255.0);
     assert!(max_abs <= 2.0 / 255.0 + extra, "{name}: max abs {:.3}/255 vs the reference", max_abs * 255.0);
     assert!(mean_abs <= 0.5 / 255.0 + extra, "{name}: mean abs {:.4}/255 vs the reference", mean_abs * 255.0);
@@ -513,7 +457,7 @@ fn sbvr_approximates_the_reference() {
     };
     let reference = render_reference(&v, &l, &CAMERA, SIZE, SIZE, &settings);
     let (max_abs, mean_abs) = diff_reference(&sbvr.image, &reference.color);
-    save_images("sbvr", &sbvr.image, &reference.color);
+    save_images("kw_sbvr", &sbvr.image, &reference.color);
     let cov = coverage(&sbvr.image);
     eprintln!("sbvr vs reference: max {:.3}/255 mean {:.4}/255 coverage {cov:.2}", max_abs * 255.0, mean_abs * 255.0);
     assert!(cov > 0.05, "sbvr: nearly empty image");

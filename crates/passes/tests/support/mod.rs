@@ -1,0 +1,79 @@
+//! Helpers shared by the GPU integration tests of crates/passes: the adapter, graph files, image
+//! comparison against the f64 reference, and failure images.
+
+#![allow(dead_code, reason = "each test binary uses the subset it needs")]
+
+use std::path::PathBuf;
+
+use volgraph_core::executor::{Gpu, Image};
+
+/// The headless GPU. Under CI a missing adapter is a failure, never a skip.
+pub fn gpu() -> Gpu {
+    Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)")
+}
+
+/// `graphs/<name>` in the workspace.
+pub fn graph_path(name: &str) -> PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../graphs").join(name)
+}
+
+/// The text of `graphs/<name>`.
+pub fn graph_source(name: &str) -> String {
+    let path = graph_path(name);
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// A GPU image as f64 RGBA rows (to compare two GPU images with [`diff_reference`]).
+pub fn as_reference(image: &Image) -> Vec<[f64; 4]> {
+    (0..image.height)
+        .flat_map(|y| (0..image.width).map(move |x| (x, y)))
+        .map(|(x, y)| image.rgba(x, y).map(|c| c as f64))
+        .collect()
+}
+
+/// (max abs, mean abs) per channel between a GPU image and reference colours; NaN counts as an
+/// infinite difference.
+pub fn diff_reference(gpu: &Image, reference: &[[f64; 4]]) -> (f64, f64) {
+    let mut max_abs: f64 = 0.0;
+    let mut sum = 0.0;
+    for y in 0..gpu.height {
+        for x in 0..gpu.width {
+            let g = gpu.rgba(x, y);
+            let r = reference[(y * gpu.width + x) as usize];
+            for c in 0..4 {
+                let d = (g[c] as f64 - r[c]).abs();
+                let d = if d.is_nan() { f64::INFINITY } else { d };
+                max_abs = max_abs.max(d);
+                sum += d;
+            }
+        }
+    }
+    (max_abs, sum / (4.0 * (gpu.width * gpu.height) as f64))
+}
+
+/// Writes GPU, reference and 10×-amplified difference images to
+/// `target/test-images/<name>_{gpu,reference,diff_x10}.png` so a failing comparison can be
+/// looked at.
+pub fn save_images(name: &str, gpu: &Image, reference: &[[f64; 4]]) {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target/test-images");
+    let _ = std::fs::create_dir_all(&dir);
+    let name: String = name.chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '_' }).collect();
+    let (w, h) = (gpu.width, gpu.height);
+    let to8 = |v: f64| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+    let mut g = image::RgbaImage::new(w, h);
+    let mut r = image::RgbaImage::new(w, h);
+    let mut d = image::RgbaImage::new(w, h);
+    for y in 0..h {
+        for x in 0..w {
+            let a = gpu.rgba(x, y);
+            let b = reference[(y * w + x) as usize];
+            g.put_pixel(x, y, image::Rgba([to8(a[0] as f64), to8(a[1] as f64), to8(a[2] as f64), 255]));
+            r.put_pixel(x, y, image::Rgba([to8(b[0]), to8(b[1]), to8(b[2]), 255]));
+            let diff = |c: usize| to8(10.0 * (a[c] as f64 - b[c]).abs());
+            d.put_pixel(x, y, image::Rgba([diff(0), diff(1), diff(3), 255]));
+        }
+    }
+    let _ = g.save(dir.join(format!("{name}_gpu.png")));
+    let _ = r.save(dir.join(format!("{name}_reference.png")));
+    let _ = d.save(dir.join(format!("{name}_diff_x10.png")));
+}

@@ -34,16 +34,28 @@ fn ray_is_done(pixel: vec2<u32>, ray: PixelRay, index: u32) -> bool {
     return !(a < segment.threshold) || segment_is_outside(ray, index);
 }
 
-// True when every sample of segment `index` lies in an empty block.
+// True when every sample of segment `index` lies in an empty block. Walks the segment block by
+// block: after an empty block it leaps to the first sample past that block's exit (the samples
+// it leaps over lie inside the block's closed box, which its conservative range covers), so a
+// segment costs one look-up per block it crosses rather than one per sample.
 fn segment_is_empty(ray: PixelRay, index: u32) -> bool {
-    for (var k = index * segment.steps; k < segment_end(index); k += 1u) {
+    let end = segment_end(index);
+    var k = index * segment.steps;
+    loop {
+        if (k >= end) {
+            break;
+        }
         let t = sample_t(ray, k);
         if (!(t < ray.len_tex)) {
             break;
         }
-        if (!block_is_empty(block_of(ray.u0 + t * ray.d_tex, segment.block_size))) {
+        let b = block_of(ray.u0 + t * ray.d_tex, segment.block_size);
+        if (!block_is_empty(b)) {
             return false;
         }
+        let t_exit = block_exit_t(b, segment.block_size, ray.u0, ray.d_tex);
+        let next = floor(t_exit / ray.step_tex - 0.5 - ray.jitter) + 1.0;
+        k = max(k + 1u, u32(clamp(next, 0.0, f32(end))));
     }
     return true;
 }

@@ -33,7 +33,7 @@ struct Inst {
     label: String,
 }
 
-pub(crate) fn schedule(_doc: &GraphDoc, c: Checked, options: &CompileOptions) -> Result<Plan, Vec<Diagnostic>> {
+pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> Result<Plan, Vec<Diagnostic>> {
     // 1. Instances, in document order.
     let mut insts: Vec<Inst> = Vec::new();
     let mut inst_of: HashMap<(usize, Option<u32>), usize> = HashMap::new();
@@ -216,7 +216,6 @@ pub(crate) fn schedule(_doc: &GraphDoc, c: Checked, options: &CompileOptions) ->
             .with_help("read the modified version (\"<modifier>.<port>\") instead of the original".to_string()),
         ]);
     }
-    let step_of: HashMap<usize, usize> = order.iter().enumerate().map(|(s, &i)| (i, s)).collect();
 
     // 6. Resources.
     let mut resources: Vec<Resource> = Vec::new();
@@ -295,7 +294,6 @@ pub(crate) fn schedule(_doc: &GraphDoc, c: Checked, options: &CompileOptions) ->
             ports,
         });
     }
-    let _ = step_of;
     let mut outputs = BTreeMap::new();
     for (name, v) in &output_vals {
         if let Val::Out(i, port) = v
@@ -346,7 +344,7 @@ pub(crate) fn schedule(_doc: &GraphDoc, c: Checked, options: &CompileOptions) ->
         .map(|p| (p.id.clone(), p.needs.iter().filter(|f| !options.features.contains(*f)).cloned().collect()))
         .collect();
     Ok(Plan {
-        name: _doc.name.clone(),
+        name: doc.name.clone(),
         viewport: options.viewport,
         features: options.features.clone(),
         inputs: c.inputs.clone(),

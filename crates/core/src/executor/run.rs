@@ -303,11 +303,10 @@ impl Executor {
         let mut encoder =
             gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(&self.plan.name) });
         // History pairs: swap, and clear "previous" when there is no previous frame.
-        for (slot, textures) in self.plan.slots.iter().zip(self.slots.iter_mut()) {
+        for textures in &mut self.slots {
             if let Some(prev) = textures.previous.as_mut() {
                 std::mem::swap(&mut textures.current, &mut prev.0);
                 std::mem::swap(&mut textures.current_view, &mut prev.1);
-                let _ = slot;
             }
         }
         if !self.history_valid {

@@ -40,6 +40,8 @@ fn march_dvr_leaping(u0: vec3<f32>, d_tex: vec3<f32>, len_tex: f32, pixel: vec2<
     let step_tex = ray_step_tex(d_tex);
     let jitter = ray_jitter(pixel);
     var k = 0u;
+    var known_block = vec3<u32>(0xffffffffu);
+    var known_empty = false;
     loop {
         if (k >= params.max_steps) {
             break;
@@ -50,7 +52,12 @@ fn march_dvr_leaping(u0: vec3<f32>, d_tex: vec3<f32>, len_tex: f32, pixel: vec2<
         }
         let u = u0 + t * d_tex;
         let b = block_of(u, ess.block_size);
-        if (block_is_empty(b)) {
+        // One flag look-up per block entered, not per sample.
+        if (any(b != known_block)) {
+            known_block = b;
+            known_empty = block_is_empty(b);
+        }
+        if (known_empty) {
             // First sample index with t_k > t_exit: floor(t_exit / step - 0.5 - jitter) + 1.
             let t_exit = block_exit_t(b, ess.block_size, u0, d_tex);
             let next = floor(t_exit / step_tex - 0.5 - jitter) + 1.0;

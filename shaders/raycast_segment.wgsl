@@ -9,6 +9,7 @@
 // Pipelines: `vs_segment` + `fs_dvr` / `fs_iso` → `accum` (Modify port, blended).
 
 #import "common/segment.wgsl"
+#import "common/empty_blocks.wgsl"
 
 struct SegmentOut {
     @location(0) accum: vec4<f32>,
@@ -24,4 +25,53 @@ fn fs_dvr(in: SegmentVertex) -> SegmentOut {
 @fragment
 fn fs_iso(in: SegmentVertex) -> SegmentOut {
     return SegmentOut(segment_iso(pixel_ray(vec2<u32>(in.clip.xy)), in.index));
+}
+
+// DVR of segment `index` leaping over empty blocks (§2.3's skipping inside the segment): a
+// sample in an empty block contributes exactly nothing, so the segment jumps to its first sample
+// past that block's exit — the same leap rule as raycast_ess.wgsl, so the image is unchanged.
+fn segment_dvr_leap(ray: PixelRay, index: u32) -> vec4<f32> {
+    var acc = vec4<f32>(0.0);
+    if (!ray.valid) {
+        return acc;
+    }
+    let end = segment_end(index);
+    var k = index * segment.steps;
+    var known_block = vec3<u32>(0xffffffffu);
+    var known_empty = false;
+    loop {
+        if (k >= end) {
+            break;
+        }
+        let t = sample_t(ray, k);
+        if (!(t < ray.len_tex)) {
+            break;
+        }
+        let u = ray.u0 + t * ray.d_tex;
+        let b = block_of(u, segment.block_size);
+        // One flag look-up per block entered, not per sample.
+        if (any(b != known_block)) {
+            known_block = b;
+            known_empty = block_is_empty(b);
+        }
+        if (known_empty) {
+            let t_exit = block_exit_t(b, segment.block_size, ray.u0, ray.d_tex);
+            let next = floor(t_exit / ray.step_tex - 0.5 - ray.jitter) + 1.0;
+            k = max(k + 1u, u32(clamp(next, 0.0, f32(end))));
+            continue;
+        }
+        let c = sample_tf(sample_volume(u));
+        let w = (1.0 - acc.a) * corrected_alpha(c.a);
+        acc = vec4<f32>(acc.rgb + w * c.rgb, acc.a + w);
+        if (acc.a >= params.threshold) {
+            break;
+        }
+        k += 1u;
+    }
+    return acc;
+}
+
+@fragment
+fn fs_dvr_leap(in: SegmentVertex) -> SegmentOut {
+    return SegmentOut(segment_dvr_leap(pixel_ray(vec2<u32>(in.clip.xy)), in.index));
 }

@@ -24,6 +24,7 @@ use volgraph_core::executor::{
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
+use crate::empty_space::{EMPTY_BLOCKS, block_size_spec};
 use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
 use crate::segment_init::ACCUM_FORMATS;
 
@@ -150,6 +151,7 @@ impl PassPlugin for RaycastSegment {
     fn params(&self) -> Vec<ParamSpec> {
         let mut p = raycast_param_specs();
         p.push(segment_steps_spec());
+        p.push(block_size_spec());
         p
     }
 
@@ -161,6 +163,9 @@ impl PassPlugin for RaycastSegment {
             PortSpec::read("tf", PortKind::TransferFunction),
             PortSpec::modify("accum", PortKind::target(&ACCUM_FORMATS)),
             PortSpec::read("depth", PortKind::target(&[TargetFormat::Depth32Float])).optional(),
+            // With the block flags wired, a DVR segment leaps over empty blocks inside its M
+            // samples (§2.3's skipping done in the segment instead of by the depth test).
+            PortSpec::read("empty", PortKind::Owned(EMPTY_BLOCKS)).optional(),
         ]
     }
 
@@ -185,7 +190,17 @@ impl PassPlugin for RaycastSegment {
                 ctx.gpu.adapter_name
             )));
         }
-        let (shader, fragment) = self.entry(ctx.params);
+        let leap = ctx.ports.iter().any(|p| p.name == "empty" && p.owned);
+        let (shader, fragment) = match (leap, self.entry(ctx.params)) {
+            (true, ("raycast_segment.wgsl", "fs_dvr")) => ("raycast_segment.wgsl", "fs_dvr_leap"),
+            (true, (_, entry)) => {
+                return Err(error(format!(
+                    "empty-block leaping is implemented for the DVR segment shader only, not {entry}; \
+                     leave \"empty\" unwired"
+                )));
+            }
+            (false, entry) => entry,
+        };
         let extra: &[&str] =
             if self.counter.is_some() { &["params", "segment", "invocations"] } else { &["params", "segment"] };
         let spec = |depth: Option<DepthSpec<'static>>| RenderPipelineSpec {

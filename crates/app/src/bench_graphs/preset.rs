@@ -47,6 +47,7 @@ pub const PRESETS: &[BenchPreset] = &[
             "graphs/kruger_westermann_2003/rc.ron",
             "graphs/kruger_westermann_2003/rc_a.ron",
             "graphs/kruger_westermann_2003/rc_b.ron",
+            "graphs/kruger_westermann_2003/rc_b_leap.ron",
             // The modern answer to the same question: one pass, leaping over empty blocks with
             // a DDA and terminating in the loop, beside the plain single pass.
             "graphs/basic/fragment_raycast.ron",

@@ -159,6 +159,39 @@ fn display_name(path: &Path) -> String {
     path.display().to_string()
 }
 
+/// Multipass graphs size their segment loop by the scene value `longest_ray_steps` (K of
+/// Krüger–Westermann §3): when the graph declares it and the user did not set it, compute it for
+/// this volume and the graph's own step.
+fn with_longest_ray(
+    file: &str,
+    source: &str,
+    registry: &volgraph_core::Registry,
+    mut options: CompileOptions,
+    volume: &volgraph_accel::volume::Volume,
+) -> Result<CompileOptions, CliError> {
+    const K: &str = "longest_ray_steps";
+    let plan = compile(file, source, registry, &options).map_err(CliError::Graph)?;
+    if !plan.inputs.contains_key(K) || options.scalars.contains_key(K) {
+        return Ok(options);
+    }
+    let step = plan
+        .steps
+        .iter()
+        .find(|s| s.params.iter().any(|(name, _)| name == "step_voxels"))
+        .map_or(0.5, |s| s.params.float("step_voxels"));
+    options.scalars.insert(K.to_string(), volgraph_passes::scene::longest_ray_steps(volume, step));
+    Ok(options)
+}
+
+/// Writes to stdout; a closed pipe (`volgraph plan … | head`) ends quietly instead of panicking.
+fn write_stdout(text: &str) -> anyhow::Result<()> {
+    use std::io::Write as _;
+    match std::io::stdout().lock().write_all(text.as_bytes()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        other => other.context("cannot write to standard output"),
+    }
+}
+
 /// Runs a parsed command line.
 pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
@@ -167,7 +200,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             let options = compile_options(&size, &features, &scalars)?;
             let plan =
                 compile(&display_name(&graph), &source, &builtin_registry(), &options).map_err(CliError::Graph)?;
-            print!("{}", plan.to_text());
+            write_stdout(&plan.to_text())?;
             Ok(())
         }
         Command::Render { graph, volume, raw, tf, size, camera, frames, features, output, out } => {
@@ -180,8 +213,10 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             let gpu = Gpu::new_headless().map_err(|e| anyhow!(e))?;
             let shaders = ShaderLibrary::new(default_shader_root());
             let registry = builtin_registry();
-            let mut session =
-                RenderSession::new(&gpu, &shaders, &registry, &display_name(&graph), &source, &options, &volume, &lut)?;
+            let file = display_name(&graph);
+            let options = with_longest_ray(&file, &source, &registry, options, &volume)?;
+            let plan = compile(&file, &source, &registry, &options).map_err(CliError::Graph)?;
+            let mut session = RenderSession::from_plan(&gpu, &shaders, &registry, plan, &volume, &lut)?;
             let is_exr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
             let output = output.unwrap_or_else(|| {
                 if !is_exr && session.plan().outputs.contains_key("display") {

@@ -207,8 +207,9 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             let source = inputs::read_graph(&graph)?;
             let options = compile_options(&size, &features, &[])?;
             let camera = inputs::parse_camera(&camera)?;
+            let generated = volume.is_none();
             let volume = inputs::volume(volume.as_ref(), &inputs::raw_options(&raw)?)?;
-            let tf = inputs::transfer_function(tf.as_ref(), &volume)?;
+            let tf = inputs::transfer_function(tf.as_ref(), &volume, generated)?;
             let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
             let gpu = Gpu::new_headless().map_err(|e| anyhow!(e))?;
             let shaders = ShaderLibrary::new(default_shader_root());

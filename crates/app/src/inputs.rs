@@ -68,9 +68,19 @@ pub fn volume(path: Option<&PathBuf>, raw: &RawOptions) -> anyhow::Result<Volume
     }
 }
 
-/// Loads `--tf` (RON, or ParaView JSON by extension), or the default for the volume.
-pub fn transfer_function(path: Option<&PathBuf>, volume: &Volume) -> anyhow::Result<TransferFunction> {
+/// The transfer function for the generated default volume: an opaque band around ρ = 0.5 that
+/// shows Marschner–Lobb's rings (`graphs/tf/marschner_lobb.ron`, compiled in so a fresh clone
+/// renders it from any directory).
+const MARSCHNER_LOBB_TF: &str = include_str!("../../../graphs/tf/marschner_lobb.ron");
+
+/// Loads `--tf` (RON, or ParaView JSON by extension), or the default for the volume (for the
+/// generated default volume, `graphs/tf/marschner_lobb.ron`).
+pub fn transfer_function(path: Option<&PathBuf>, volume: &Volume, generated: bool) -> anyhow::Result<TransferFunction> {
     match path {
+        None if generated => {
+            TransferFunction::from_ron_str(MARSCHNER_LOBB_TF, Path::new("graphs/tf/marschner_lobb.ron"))
+                .map_err(|e| anyhow!("{e}"))
+        }
         None => Ok(TransferFunction::default_for(volume)),
         Some(p) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")) => {
             TransferFunction::load_paraview(p).map_err(|e| anyhow!("{e}"))

@@ -22,9 +22,15 @@ fn fs_dvr(in: SegmentVertex) -> SegmentOut {
 }
 
 // Isosurface segment `in.index` of this pixel's ray.
+struct SegmentIsoOut {
+    @location(0) accum: vec4<f32>,
+    @location(1) hit: vec4<f32>,
+}
+
 @fragment
-fn fs_iso(in: SegmentVertex) -> SegmentOut {
-    return SegmentOut(segment_iso(pixel_ray(vec2<u32>(in.clip.xy)), in.index));
+fn fs_iso(in: SegmentVertex) -> SegmentIsoOut {
+    let r = segment_iso(pixel_ray(vec2<u32>(in.clip.xy)), in.index);
+    return SegmentIsoOut(r.color, r.hit);
 }
 
 // DVR of segment `index` leaping over empty blocks (§2.3's skipping inside the segment): a

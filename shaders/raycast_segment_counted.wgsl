@@ -22,9 +22,15 @@ fn fs_dvr_counted(in: SegmentVertex) -> SegmentOut {
     return SegmentOut(segment_dvr(pixel_ray(vec2<u32>(in.clip.xy)), in.index));
 }
 
+struct SegmentIsoOut {
+    @location(0) accum: vec4<f32>,
+    @location(1) hit: vec4<f32>,
+}
+
 @fragment
 @early_depth_test(force)
-fn fs_iso_counted(in: SegmentVertex) -> SegmentOut {
+fn fs_iso_counted(in: SegmentVertex) -> SegmentIsoOut {
     atomicAdd(&invocations, 1u);
-    return SegmentOut(segment_iso(pixel_ray(vec2<u32>(in.clip.xy)), in.index));
+    let r = segment_iso(pixel_ray(vec2<u32>(in.clip.xy)), in.index);
+    return SegmentIsoOut(r.color, r.hit);
 }

@@ -15,3 +15,14 @@ struct InitOut {
 fn fs_init(in: FullscreenVertex) -> InitOut {
     return InitOut(vec4<f32>(0.0));
 }
+
+struct InitHitOut {
+    @location(0) accum: vec4<f32>,
+    @location(1) hit: vec4<f32>,
+}
+
+// With a hit target (isosurface segments): both cleared to (0,0,0,0), "no hit yet".
+@fragment
+fn fs_init_hit(in: FullscreenVertex) -> InitHitOut {
+    return InitHitOut(vec4<f32>(0.0), vec4<f32>(0.0));
+}

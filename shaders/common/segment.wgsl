@@ -116,10 +116,11 @@ fn segment_dvr(ray: PixelRay, index: u32) -> vec4<f32> {
 // First-hit isosurface within segment `index` (§2.2): the first sample k of the segment with
 // s >= iso, refined against sample k-1 exactly like the single pass (sample k-1 is fetched again
 // when it belongs to the previous segment), shaded, alpha 1 — so the blend keeps the closest
-// hit and the termination test stops the ray. Zero when the segment has no hit.
-fn segment_iso(ray: PixelRay, index: u32) -> vec4<f32> {
+// hit and the termination test stops the ray. The hit is the texture-space position with w = 1
+// (blended like the colour, so the closest hit stays). Zero when the segment has no hit.
+fn segment_iso(ray: PixelRay, index: u32) -> IsoResult {
     if (!ray.valid) {
-        return vec4<f32>(0.0);
+        return IsoResult(vec4<f32>(0.0), vec4<f32>(0.0));
     }
     let iso = params.iso_value;
     let k0 = index * segment.steps;
@@ -141,10 +142,11 @@ fn segment_iso(ray: PixelRay, index: u32) -> vec4<f32> {
                 t_hit = t_prev + (t - t_prev) * (iso - s_prev) / (s - s_prev);
             }
             let d_world = normalize(ray.d_tex * 2.0 * frame.half_extent.xyz);
-            return vec4<f32>(shade_iso(ray.u0 + t_hit * ray.d_tex, d_world), 1.0);
+            let u_hit = ray.u0 + t_hit * ray.d_tex;
+            return IsoResult(vec4<f32>(shade_iso(u_hit, d_world), 1.0), vec4<f32>(u_hit, 1.0));
         }
         t_prev = t;
         s_prev = s;
     }
-    return vec4<f32>(0.0);
+    return IsoResult(vec4<f32>(0.0), vec4<f32>(0.0));
 }

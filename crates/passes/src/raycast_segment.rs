@@ -26,7 +26,7 @@ use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec,
 
 use crate::empty_space::{EMPTY_BLOCKS, block_size_spec};
 use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
-use crate::segment_init::ACCUM_FORMATS;
+use crate::segment_init::{ACCUM_FORMATS, HIT_FORMATS};
 
 const FLOAT_TARGETS: [TargetFormat; 2] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float];
 
@@ -155,8 +155,8 @@ impl PassPlugin for RaycastSegment {
         p
     }
 
-    fn ports(&self, _params: &Params) -> Vec<PortSpec> {
-        vec![
+    fn ports(&self, params: &Params) -> Vec<PortSpec> {
+        let mut ports = vec![
             PortSpec::read("entry", PortKind::target(&FLOAT_TARGETS)),
             PortSpec::read("dir", PortKind::target(&FLOAT_TARGETS)),
             PortSpec::read("volume", PortKind::Volume),
@@ -166,7 +166,12 @@ impl PassPlugin for RaycastSegment {
             // With the block flags wired, a DVR segment leaps over empty blocks inside its M
             // samples (§2.3's skipping done in the segment instead of by the depth test).
             PortSpec::read("empty", PortKind::Owned(EMPTY_BLOCKS)).optional(),
-        ]
+        ];
+        if is_iso(params) {
+            // §2.2: the closest hit's texture-space position, blended like the colour.
+            ports.push(PortSpec::modify("hit", PortKind::target(&HIT_FORMATS)));
+        }
+        ports
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {

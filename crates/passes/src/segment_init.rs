@@ -6,13 +6,20 @@
 
 use volgraph_core::executor::{CreateContext, DepthSpec, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::{Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
 pub struct SegmentInit;
 
 /// Formats an accumulation target may have (blendable float formats).
 pub(crate) const ACCUM_FORMATS: [TargetFormat; 2] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float];
+
+/// Formats a hit-position target may have (blendable float formats; f32 keeps positions exact).
+pub(crate) const HIT_FORMATS: [TargetFormat; 2] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float];
+
+fn fragment(params: &Params) -> &'static str {
+    if params.boolean("with_hit") { "fs_init_hit" } else { "fs_init" }
+}
 
 /// The value the early-z buffer holds for a live ray (the paper's "z = 0").
 pub(crate) const DEPTH_LIVE: f32 = 0.0;
@@ -26,22 +33,30 @@ impl PassPlugin for SegmentInit {
         "cleared accumulation target and early-z buffer before the segment loop (Krüger–Westermann 2003 §2.1)"
     }
 
-    fn ports(&self, _params: &Params) -> Vec<PortSpec> {
-        vec![
-            PortSpec::write("accum", PortKind::target(&ACCUM_FORMATS)),
-            PortSpec::write("depth", PortKind::target(&[TargetFormat::Depth32Float])),
-        ]
+    fn params(&self) -> Vec<ParamSpec> {
+        vec![ParamSpec::boolean("with_hit", false, "also clear a hit-position target for isosurface segments")]
     }
 
-    fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "segment_init.wgsl", entry_point: "fs_init" }]
+    fn ports(&self, params: &Params) -> Vec<PortSpec> {
+        let mut ports = vec![
+            PortSpec::write("accum", PortKind::target(&ACCUM_FORMATS)),
+            PortSpec::write("depth", PortKind::target(&[TargetFormat::Depth32Float])),
+        ];
+        if params.boolean("with_hit") {
+            ports.push(PortSpec::write("hit", PortKind::target(&HIT_FORMATS)));
+        }
+        ports
+    }
+
+    fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
+        vec![ShaderUse { file: "segment_init.wgsl", entry_point: fragment(params) }]
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
             shader: "segment_init.wgsl",
             vertex: "vs_fullscreen",
-            fragment: "fs_init",
+            fragment: fragment(ctx.params),
             depth: Some(DepthSpec { port: "depth", write: true, compare: wgpu::CompareFunction::Always }),
             ..Default::default()
         })?;

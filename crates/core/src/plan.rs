@@ -228,6 +228,12 @@ impl Plan {
         let _ = writeln!(s, "slots:");
         for (i, slot) in self.slots.iter().enumerate() {
             let names: Vec<&str> = slot.holds.iter().map(|r| self.resources[*r].name.as_str()).collect();
+            // A repeat group's carried target holds one version per iteration: show the ends.
+            let held = if names.len() > 6 {
+                format!("{}, {}, … {} ({} values)", names[0], names[1], names[names.len() - 1], names.len())
+            } else {
+                names.join(", ")
+            };
             let kind = if slot.persistent { "history" } else { "pooled" };
             let _ = writeln!(
                 s,
@@ -236,7 +242,7 @@ impl Plan {
                 slot.extent.0,
                 slot.extent.1,
                 mib(slot.bytes()),
-                names.join(", ")
+                held
             );
         }
         for (name, h) in &self.history {

@@ -142,7 +142,7 @@ pub fn run(opts: &AccelBenchOptions) -> anyhow::Result<AccelBenchReport> {
     let minmax = bench_minmax(opts, repeats)?;
     let octree = bench_octree(repeats)?;
     let report = AccelBenchReport { threads: rayon::current_num_threads(), repeats, minmax, octree };
-    print_table(&report);
+    print_table(&report)?;
     if let Some(path) = &opts.json_out {
         let json = serde_json::to_string_pretty(&report)?;
         std::fs::write(path, json).with_context(|| format!("writing the JSON report to {}", path.display()))?;
@@ -302,27 +302,39 @@ fn bench_octree(repeats: usize) -> anyhow::Result<OctreeBench> {
     })
 }
 
-fn print_table(r: &AccelBenchReport) {
+fn print_table(r: &AccelBenchReport) -> anyhow::Result<()> {
+    use std::fmt::Write as _;
+    let mut out = String::new();
     let m = &r.minmax;
     let o = &r.octree;
-    println!("## volgraph bench accel ({} threads, median of {} repeats)\n", r.threads, r.repeats);
-    println!("| measurement | ms | notes |");
-    println!("|---|---:|---|");
-    println!(
+    let _ = writeln!(out, "## volgraph bench accel ({} threads, median of {} repeats)\n", r.threads, r.repeats);
+    let _ = writeln!(out, "| measurement | ms | notes |");
+    let _ = writeln!(out, "|---|---:|---|");
+    let _ = writeln!(
+        out,
         "| min/max grid build, engine 256³ u8, {}³ blocks | {:.2} | grid {:?} |",
         m.block_size, m.build_ms, m.grid_dims
     );
-    println!("| classify all blocks (empty flags) | {:.3} | {:.1}% empty |", m.classify_ms, 100.0 * m.empty_fraction);
-    println!("| build + classify | {:.2} | K-W 2003 §2.3 |", m.build_and_classify_ms);
-    println!("| 256×256 u8 table | {:.3} | |", m.table_u8_ms);
-    println!(
+    let _ = writeln!(
+        out,
+        "| classify all blocks (empty flags) | {:.3} | {:.1}% empty |",
+        m.classify_ms,
+        100.0 * m.empty_fraction
+    );
+    let _ = writeln!(out, "| build + classify | {:.2} | K-W 2003 §2.3 |", m.build_and_classify_ms);
+    let _ = writeln!(out, "| 256×256 u8 table | {:.3} | |", m.table_u8_ms);
+    let _ = writeln!(
+        out,
         "| octree hierarchy build (once per volume), 512³ u16 | {:.1} | {} bricks, {} nodes, {} leaves |",
         o.hierarchy_build_ms, o.bricks, o.nodes, o.leaves
     );
-    println!(
+    let _ = writeln!(
+        out,
         "| **octree rebuild after a TF change** | **{:.3}** | min {:.3}; {} TF changes |",
         o.rebuild_ms, o.rebuild_min_ms, o.tf_changes
     );
-    println!("| R-V 2006 §8 (3.0 GHz Xeon) | {:.1} | ours / paper = {:.3} |", o.paper_ms, o.ratio_to_paper);
-    println!("| octree traversal, all bricks, threshold 0.5 | {:.3} | {} boxes |", o.traverse_ms, o.boxes);
+    let _ =
+        writeln!(out, "| R-V 2006 §8 (3.0 GHz Xeon) | {:.1} | ours / paper = {:.3} |", o.paper_ms, o.ratio_to_paper);
+    let _ = writeln!(out, "| octree traversal, all bricks, threshold 0.5 | {:.3} | {} boxes |", o.traverse_ms, o.boxes);
+    crate::stdout::write_stdout(&out)
 }

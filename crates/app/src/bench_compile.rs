@@ -81,11 +81,11 @@ pub struct CompileBenchReport {
 /// `json_out` when given.
 pub fn run(json_out: Option<&Path>) -> anyhow::Result<()> {
     let report = measure()?;
-    print!("{}", to_markdown(&report));
+    crate::stdout::write_stdout(&to_markdown(&report))?;
     if let Some(path) = json_out {
         let json = serde_json::to_string_pretty(&report).context("serializing the report")?;
         std::fs::write(path, json).with_context(|| format!("writing {}", path.display()))?;
-        println!("\nJSON written to {}", path.display());
+        crate::stdout::write_stdout(&format!("\nJSON written to {}\n", path.display()))?;
     }
     Ok(())
 }

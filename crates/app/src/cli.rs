@@ -183,15 +183,6 @@ fn with_longest_ray(
     Ok(options)
 }
 
-/// Writes to stdout; a closed pipe (`volgraph plan … | head`) ends quietly instead of panicking.
-fn write_stdout(text: &str) -> anyhow::Result<()> {
-    use std::io::Write as _;
-    match std::io::stdout().lock().write_all(text.as_bytes()) {
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-        other => other.context("cannot write to standard output"),
-    }
-}
-
 /// Runs a parsed command line.
 pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
@@ -200,7 +191,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             let options = compile_options(&size, &features, &scalars)?;
             let plan =
                 compile(&display_name(&graph), &source, &builtin_registry(), &options).map_err(CliError::Graph)?;
-            write_stdout(&plan.to_text())?;
+            crate::stdout::write_stdout(&plan.to_text())?;
             Ok(())
         }
         Command::Render { graph, volume, raw, tf, size, camera, frames, features, output, out } => {

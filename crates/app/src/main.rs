@@ -7,6 +7,7 @@ mod bench_graphs;
 mod cli;
 mod image_out;
 mod inputs;
+mod stdout;
 
 use std::process::ExitCode;
 

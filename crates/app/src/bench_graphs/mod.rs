@@ -34,7 +34,7 @@ pub fn run_cli(args: &GraphsArgs) -> anyhow::Result<GraphBenchReport> {
     let gpu = Gpu::new_headless().map_err(|e| anyhow!(e))?;
     let report = run::run(&gpu, &config)?;
     let markdown = report.to_markdown();
-    print!("{markdown}");
+    crate::stdout::write_stdout(&markdown)?;
     write_outputs(&config, &report, &markdown)?;
     Ok(report)
 }

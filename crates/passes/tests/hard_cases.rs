@@ -117,3 +117,14 @@ fn one_voxel_thick_sheet_is_not_missed() {
     let (image, reference) = render(&v, &tf, &camera, CompileOptions::new(SIZE, SIZE));
     assert_close("sheet", &image, &reference, 0.2);
 }
+
+#[test]
+fn anisotropic_spacing_is_carried_to_the_gpu() {
+    // Like the lobster (1, 1, 1.4), exaggerated: the box is flattened in z and the unit step is
+    // the smallest voxel side, on both sides of the comparison.
+    let (mut v, tf) = ml();
+    v.spacing = glam::DVec3::new(1.0, 1.0, 2.0);
+    let camera = OrbitCamera { azimuth_deg: 60.0, elevation_deg: 35.0, ..OrbitCamera::default() };
+    let (image, reference) = render(&v, &tf, &camera, CompileOptions::new(SIZE, SIZE));
+    assert_close("spacing 1,1,2", &image, &reference, 0.1);
+}

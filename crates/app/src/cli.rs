@@ -249,6 +249,18 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                     stats.frame_ms,
                     out.display()
                 );
+                if let Some(step_ms) = &stats.step_gpu_ms {
+                    // Per pass, repeat-group instances summed, in schedule order.
+                    let mut per_pass: Vec<(String, f64)> = Vec::new();
+                    for (step, ms) in session.plan().steps.iter().zip(step_ms) {
+                        match per_pass.iter_mut().find(|(id, _)| *id == step.pass_id) {
+                            Some((_, total)) => *total += ms,
+                            None => per_pass.push((step.pass_id.clone(), *ms)),
+                        }
+                    }
+                    let list: Vec<String> = per_pass.iter().map(|(id, ms)| format!("{id} {ms:.2}")).collect();
+                    eprintln!("  per pass (ms): {}", list.join(", "));
+                }
             }
             Ok(())
         }

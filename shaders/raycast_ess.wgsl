@@ -58,15 +58,11 @@ fn march_dvr_leaping(u0: vec3<f32>, d_tex: vec3<f32>, len_tex: f32, pixel: vec2<
             known_empty = block_is_empty(b);
         }
         if (known_empty) {
-            // First sample index with t_k > t_exit: floor(t_exit / step - 0.5 - jitter) + 1.
-            let t_exit = block_exit_t(b, ess.block_size, u0, d_tex);
-            let next = floor(t_exit / step_tex - 0.5 - jitter) + 1.0;
+            let next = first_sample_past_block(b, ess.block_size, u0, d_tex, step_tex, jitter);
             k = max(k + 1u, u32(clamp(next, 0.0, f32(params.max_steps))));
             continue;
         }
-        let c = sample_tf(sample_volume(u));
-        let w = (1.0 - acc.a) * corrected_alpha(c.a);
-        acc = vec4<f32>(acc.rgb + w * c.rgb, acc.a + w);
+        acc = composite_sample(acc, u);
         if (acc.a >= params.threshold) {
             break;
         }

@@ -61,14 +61,11 @@ fn segment_dvr_leap(ray: PixelRay, index: u32) -> vec4<f32> {
             known_empty = block_is_empty(b);
         }
         if (known_empty) {
-            let t_exit = block_exit_t(b, segment.block_size, ray.u0, ray.d_tex);
-            let next = floor(t_exit / ray.step_tex - 0.5 - ray.jitter) + 1.0;
+            let next = first_sample_past_block(b, segment.block_size, ray.u0, ray.d_tex, ray.step_tex, ray.jitter);
             k = max(k + 1u, u32(clamp(next, 0.0, f32(end))));
             continue;
         }
-        let c = sample_tf(sample_volume(u));
-        let w = (1.0 - acc.a) * corrected_alpha(c.a);
-        acc = vec4<f32>(acc.rgb + w * c.rgb, acc.a + w);
+        acc = composite_sample(acc, u);
         if (acc.a >= params.threshold) {
             break;
         }

@@ -53,8 +53,7 @@ fn segment_is_empty(ray: PixelRay, index: u32) -> bool {
         if (!block_is_empty(b)) {
             return false;
         }
-        let t_exit = block_exit_t(b, segment.block_size, ray.u0, ray.d_tex);
-        let next = floor(t_exit / ray.step_tex - 0.5 - ray.jitter) + 1.0;
+        let next = first_sample_past_block(b, segment.block_size, ray.u0, ray.d_tex, ray.step_tex, ray.jitter);
         k = max(k + 1u, u32(clamp(next, 0.0, f32(end))));
     }
     return true;

@@ -33,3 +33,12 @@ fn block_exit_t(b: vec3<u32>, block_size: u32, u0: vec3<f32>, d: vec3<f32>) -> f
     let t_axis = select(vec3<f32>(3.0e38), t, d != vec3<f32>(0.0));
     return min(t_axis.x, min(t_axis.y, t_axis.z));
 }
+
+// The leap rule every empty-space skip uses: the index of the first sample whose t lies past
+// block b's exit (t_k = (k + 0.5 + jitter)·step_tex > t_exit), as a float to clamp by the caller.
+// The samples leapt over lie inside b's closed box, which its conservative range covers, so a
+// skip over an empty block is lossless.
+fn first_sample_past_block(b: vec3<u32>, block_size: u32, u0: vec3<f32>, d: vec3<f32>, step_tex: f32, jitter: f32) -> f32 {
+    let t_exit = block_exit_t(b, block_size, u0, d);
+    return floor(t_exit / step_tex - 0.5 - jitter) + 1.0;
+}

@@ -56,6 +56,15 @@ fn corrected_alpha(a_tf: f32) -> f32 {
     return 1.0 - pow(1.0 - a, params.step_voxels);
 }
 
+// One front-to-back compositing step (docs/rendering_model.md): the sample at texture-space
+// `u` classified by the TF, opacity-corrected, added behind the premultiplied `acc`. Every DVR
+// loop (single pass, segments, empty-space leaping) composites through this function.
+fn composite_sample(acc: vec4<f32>, u: vec3<f32>) -> vec4<f32> {
+    let c = sample_tf(sample_volume(u));
+    let w = (1.0 - acc.a) * corrected_alpha(c.a);
+    return vec4<f32>(acc.rgb + w * c.rgb, acc.a + w);
+}
+
 // Direct volume rendering along u0 + t·d_tex, t in [0, len_tex): premultiplied linear RGBA,
 // front to back, stopping after the sample that makes A >= threshold or after max_steps samples.
 fn march_dvr(u0: vec3<f32>, d_tex: vec3<f32>, len_tex: f32, pixel: vec2<u32>) -> vec4<f32> {
@@ -70,9 +79,7 @@ fn march_dvr(u0: vec3<f32>, d_tex: vec3<f32>, len_tex: f32, pixel: vec2<u32>) ->
         if (!(t < len_tex)) {
             break;
         }
-        let c = sample_tf(sample_volume(u0 + t * d_tex));
-        let w = (1.0 - acc.a) * corrected_alpha(c.a);
-        acc = vec4<f32>(acc.rgb + w * c.rgb, acc.a + w);
+        acc = composite_sample(acc, u0 + t * d_tex);
         if (acc.a >= params.threshold) {
             break;
         }

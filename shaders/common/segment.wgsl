@@ -103,9 +103,7 @@ fn segment_dvr(ray: PixelRay, index: u32) -> vec4<f32> {
         if (!(t < ray.len_tex)) {
             break;
         }
-        let c = sample_tf(sample_volume(ray.u0 + t * ray.d_tex));
-        let w = (1.0 - acc.a) * corrected_alpha(c.a);
-        acc = vec4<f32>(acc.rgb + w * c.rgb, acc.a + w);
+        acc = composite_sample(acc, ray.u0 + t * ray.d_tex);
         if (acc.a >= params.threshold) {
             break;
         }

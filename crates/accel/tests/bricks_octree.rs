@@ -133,7 +133,7 @@ fn all_boxes(
 
 /// Along rays through the volume, the boxes met must have non-decreasing positions in `boxes`.
 fn check_front_to_back(h: &OctreeHierarchy, boxes: &[DrawBox], view: ViewPoint, seed: u64) {
-    let mut rng = Rng(seed ^ 0xF00D);
+    let mut rng = Rng::new(seed ^ 0xF00D);
     let tex: Vec<(DVec3, DVec3)> = boxes.iter().map(|b| h.texture_box(b)).collect();
     for _ in 0..40 {
         let target = DVec3::new(rng.unit(), rng.unit(), rng.unit());
@@ -194,7 +194,7 @@ proptest! {
         let h = OctreeHierarchy::build(&volume, &layout, min_node_cells).expect("valid");
         let classifier = OpacityClassifier::new(&lut).expect("non-empty");
         let vis = h.classify(&classifier);
-        let view = random_view(&mut Rng(seed));
+        let view = random_view(&mut Rng::new(seed));
         let boxes = all_boxes(&h, &vis, threshold, view);
         let tex: Vec<_> = boxes.iter().map(|b| h.texture_box(b)).collect();
         for u in probe_positions(volume.dims, seed, 1500) {
@@ -252,7 +252,7 @@ proptest! {
         let mut sorted = order;
         sorted.sort_unstable();
         prop_assert_eq!(sorted, [0, 1, 2, 3, 4, 5, 6, 7]);
-        let mut rng = Rng(seed);
+        let mut rng = Rng::new(seed);
         let dir = d.normalize();
         for _ in 0..50 {
             let start = DVec3::new(rng.unit(), rng.unit(), rng.unit()) * 2.0 - dir * 4.0;

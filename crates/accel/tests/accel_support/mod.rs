@@ -6,16 +6,17 @@
 use glam::{DVec3, UVec3};
 use volgraph_accel::volume::{Volume, VoxelData};
 
-/// splitmix64: a tiny deterministic generator, so a proptest case is reproducible from a seed.
-pub struct Rng(pub u64);
+/// The library's SplitMix64 with the draws these tests need, so a proptest case is
+/// reproducible from a seed.
+pub struct Rng(volgraph_accel::generate::SplitMix64);
 
 impl Rng {
+    pub fn new(seed: u64) -> Self {
+        Rng(volgraph_accel::generate::SplitMix64(seed))
+    }
+
     pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        self.0.next_u64()
     }
     /// Uniform in [0, 1).
     pub fn unit(&mut self) -> f64 {
@@ -29,7 +30,7 @@ impl Rng {
 /// A volume with structure: a background level, a few boxes of other values and some noise, so
 /// that blocks are sometimes empty and sometimes not under a random LUT.
 pub fn random_volume(dims: UVec3, float: bool, seed: u64) -> Volume {
-    let mut rng = Rng(seed);
+    let mut rng = Rng::new(seed);
     let count = (dims.x * dims.y * dims.z) as usize;
     let background = if rng.below(2) == 0 { 0.0 } else { rng.unit() };
     let mut values = vec![background; count];
@@ -68,7 +69,7 @@ pub fn random_volume(dims: UVec3, float: bool, seed: u64) -> Volume {
 
 /// A LUT of 1..=64 texels whose alpha is zero in runs, so classification has gaps.
 pub fn random_lut(seed: u64) -> Vec<[f32; 4]> {
-    let mut rng = Rng(seed ^ 0x5EED);
+    let mut rng = Rng::new(seed ^ 0x5EED);
     let n = 1 + rng.below(64) as usize;
     let p_visible = rng.unit();
     let mut lut = Vec::with_capacity(n);
@@ -97,7 +98,7 @@ pub fn lut_alpha(lut: &[[f32; 4]], s: f64) -> f64 {
 
 /// Positions to probe: random ones (some slightly outside [0,1]) plus voxel corners and centres.
 pub fn probe_positions(dims: UVec3, seed: u64, random: usize) -> Vec<DVec3> {
-    let mut rng = Rng(seed ^ 0xABCD);
+    let mut rng = Rng::new(seed ^ 0xABCD);
     let n = dims.as_dvec3();
     let mut out = Vec::new();
     for _ in 0..random {

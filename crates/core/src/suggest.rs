@@ -11,6 +11,15 @@ pub fn closest<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>) ->
         .map(|(_, c)| c)
 }
 
+/// `help` prefixed with `did you mean "<prefix><closest>"? ` when one of `candidates` is a
+/// plausible typo of `word`; the help every "unknown name" diagnostic gives.
+pub fn guess_then<'a>(word: &str, candidates: impl IntoIterator<Item = &'a str>, prefix: &str, help: String) -> String {
+    match closest(word, candidates) {
+        Some(best) => format!("did you mean \"{prefix}{best}\"? {help}"),
+        None => help,
+    }
+}
+
 /// `"a", "b" or "c"`.
 pub fn quoted_list<S: AsRef<str>>(items: &[S]) -> String {
     let quoted: Vec<String> = items.iter().map(|s| format!("\"{}\"", s.as_ref())).collect();

@@ -12,7 +12,7 @@ use crate::graph::ast::{GraphDoc, HistoryInitial, InputKind, NodeDoc, PassDoc, R
 use crate::graph::locate::{Locator, PassPath};
 use crate::params::{ParamKind, ParamProblem, Params, check_param};
 use crate::plugin::{Access, PassPlugin, PortKind, PortSpec, Registry, SizeRule};
-use crate::suggest::{closest, comma_list, quoted_list};
+use crate::suggest::{closest, comma_list, guess_then, quoted_list};
 
 /// A resolved reference to a value.
 #[derive(Clone, Debug, PartialEq)]
@@ -295,9 +295,7 @@ impl Checker<'_> {
                         "declare inputs: {{\"{name}\": Scalar(<default>)}}; known scalars: {}",
                         comma_list(&known)
                     );
-                    if let Some(best) = closest(name, known.iter().copied()) {
-                        help = format!("did you mean \"{best}\"? {help}");
-                    }
+                    help = guess_then(name, known.iter().copied(), "", help);
                     self.err(
                         self.loc.pass_field(path, id, "count"),
                         format!("repeat group \"{id}\" counts iterations from \"{name}\", which is neither a Scalar graph input nor a scene value"),
@@ -347,9 +345,7 @@ impl Checker<'_> {
         let Some(plugin) = plugin else {
             let kinds = self.registry.kinds();
             let mut help = format!("known kinds: {}", comma_list(&kinds));
-            if let Some(best) = closest(&p.kind, kinds.iter().copied()) {
-                help = format!("did you mean \"{best}\"? {help}");
-            }
+            help = guess_then(&p.kind, kinds.iter().copied(), "", help);
             self.err(
                 self.loc.pass_field(path, &p.id, "kind"),
                 format!("pass \"{}\" has unknown kind \"{}\"", p.id, p.kind),
@@ -407,9 +403,7 @@ impl Checker<'_> {
             let Some(spec) = specs.iter().find(|s| s.name == name) else {
                 let names: Vec<&str> = specs.iter().map(|s| s.name).collect();
                 let mut help = format!("its parameters are: {}", comma_list(&names));
-                if let Some(best) = closest(name, names.iter().copied()) {
-                    help = format!("did you mean \"{best}\"? {help}");
-                }
+                help = guess_then(name, names.iter().copied(), "", help);
                 self.err(
                     self.loc.pass_entry(path, &p.id, "params", name, true),
                     format!("pass \"{}\" ({}) has no parameter \"{name}\"", p.id, p.kind),
@@ -484,9 +478,7 @@ impl Checker<'_> {
         for name in p.outputs.keys().chain(p.otherwise.keys()) {
             if !output_names.contains(&name.as_str()) {
                 let mut help = format!("its outputs are: {}", comma_list(&output_names));
-                if let Some(best) = closest(name, output_names.iter().copied()) {
-                    help = format!("did you mean \"{best}\"? {help}");
-                }
+                help = guess_then(name, output_names.iter().copied(), "", help);
                 let map = if p.outputs.contains_key(name) { "outputs" } else { "otherwise" };
                 self.err(
                     self.loc.pass_entry(path, &p.id, map, name, true),
@@ -554,9 +546,7 @@ impl Checker<'_> {
                 if !self.doc.inputs.contains_key(tail) {
                     let names: Vec<&str> = self.doc.inputs.keys().map(String::as_str).collect();
                     let mut help = format!("declare it under inputs, or use one of: {}", comma_list(&names));
-                    if let Some(best) = closest(tail, names.iter().copied()) {
-                        help = format!("did you mean \"input.{best}\"? {help}");
-                    }
+                    help = guess_then(tail, names.iter().copied(), "input.", help);
                     self.err(
                         location,
                         format!("{context} reads \"{text}\", but the graph has no input \"{tail}\""),
@@ -599,9 +589,7 @@ impl Checker<'_> {
                     let mut ids: Vec<&str> = self.pass_by_id.keys().map(String::as_str).collect();
                     ids.sort_unstable();
                     let mut help = format!("passes are: {}", comma_list(&ids));
-                    if let Some(best) = closest(head, ids.iter().copied()) {
-                        help = format!("did you mean \"{best}\"? {help}");
-                    }
+                    help = guess_then(head, ids.iter().copied(), "", help);
                     self.err(
                         location,
                         format!("{context} reads \"{text}\", but there is no pass \"{head}\""),

@@ -18,7 +18,9 @@ pub struct OrbitCamera {
     pub fov_y_deg: f64,
     /// Near plane distance.
     pub near: f64,
-    /// Far plane distance.
+    /// Far plane distance; [`OrbitCamera::frame`] moves it out to `distance + 1` when that is
+    /// farther, so the volume (longest side 1, inside a sphere of radius √3/2 about the origin)
+    /// is never clipped however far away the camera is.
     pub far: f64,
 }
 
@@ -62,8 +64,12 @@ impl OrbitCamera {
         let up = if self.elevation_deg.to_radians().cos().abs() < 1e-6 { DVec3::Z } else { DVec3::Y };
         let view_from_world = glam::dcamera::rh::view::look_at_mat4(eye, DVec3::ZERO, up);
         let aspect = width.max(1) as f64 / height.max(1) as f64;
-        let clip_from_view =
-            glam::dcamera::rh::proj::directx::perspective(self.fov_y_deg.to_radians(), aspect, self.near, self.far);
+        let clip_from_view = glam::dcamera::rh::proj::directx::perspective(
+            self.fov_y_deg.to_radians(),
+            aspect,
+            self.near,
+            self.far.max(self.distance + 1.0),
+        );
         let clip_from_world = clip_from_view * view_from_world;
         CameraFrame {
             eye,

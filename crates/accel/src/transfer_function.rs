@@ -24,6 +24,8 @@
 
 mod paraview;
 
+pub use paraview::ParaviewColorMap;
+
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -281,6 +283,7 @@ impl TransferFunction {
 
     /// Parses and validates RON text; `path` names the source in messages.
     pub fn from_ron_str(text: &str, path: &Path) -> Result<TransferFunction, TfError> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let tf: TransferFunction = ron::from_str(text).map_err(|e| TfError::Ron {
             path: path.to_path_buf(),
             line: e.span.start.line,
@@ -306,7 +309,7 @@ impl TransferFunction {
 
     /// Imports a ParaView colour-map JSON text (see [`Self::load_paraview`]).
     pub fn from_paraview_json(text: &str, path: &Path) -> Result<TransferFunction, TfError> {
-        paraview::parse(text, path)
+        paraview::parse_map(text, path, None).map(|m| m.tf)
     }
 
     /// Imports a ParaView colour-map JSON file: an array whose first object has `RGBPoints`
@@ -315,8 +318,14 @@ impl TransferFunction {
     /// in linear RGB whatever its `ColorSpace`; midpoint and sharpness are ignored; without
     /// `Points` the opacity ramps from 0 to 1 over the domain. The domain is the range of all x.
     pub fn load_paraview(path: &Path) -> Result<TransferFunction, TfError> {
+        Self::load_paraview_map(path, None).map(|m| m.tf)
+    }
+
+    /// Like [`Self::load_paraview`], choosing the colour map named `name` (its `"Name"`, or `#i`
+    /// for the i-th) from a file that holds several, and saying which was used.
+    pub fn load_paraview_map(path: &Path, name: Option<&str>) -> Result<ParaviewColorMap, TfError> {
         let text = std::fs::read_to_string(path).map_err(|source| TfError::Io { path: path.to_path_buf(), source })?;
-        paraview::parse(&text, path)
+        paraview::parse_map(&text, path, name)
     }
 
     /// RGBA at data value `v`: linear between the control points around it, the end points'

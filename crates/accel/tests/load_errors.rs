@@ -135,3 +135,46 @@ fn metaimage_errors_word_for_word() {
         "bad.mhd:4: unsupported header field \"ElementDataFile\" = \"LIST\"; use `LOCAL` or a single data file name; join slice files into one"
     );
 }
+
+#[test]
+fn a_directory_or_fifo_is_named_for_what_it_is() {
+    use volgraph_accel::load::{RawOptions, load_volume};
+    let dir = std::env::temp_dir().join("volgraph-not-a-file_4x4x4_uint8.raw");
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let err = load_volume(&dir, &RawOptions::default()).expect_err("a directory");
+    assert!(
+        err.to_string()
+            .ends_with("is a directory, not a volume file; give the path of a .raw, .nrrd, .nhdr, .mhd or .mha file"),
+        "{err}"
+    );
+    #[cfg(unix)]
+    {
+        let fifo = std::env::temp_dir().join(format!("volgraph-fifo-{}_4x4x4_uint8.raw", std::process::id()));
+        let _ = std::fs::remove_file(&fifo);
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status().is_ok_and(|s| s.success());
+        if made {
+            // Reading a FIFO nobody writes to would block forever; it is refused up front.
+            let err = load_volume(&fifo, &RawOptions::default()).expect_err("a FIFO");
+            assert!(err.to_string().contains("is a FIFO (named pipe), not a volume file"), "{err}");
+            let _ = std::fs::remove_file(&fifo);
+        }
+    }
+}
+
+#[test]
+fn raw_layout_options_on_a_headered_file_are_refused() {
+    use volgraph_accel::load::{Endianness, RawOptions, load_volume};
+    let dir = std::env::temp_dir().join("volgraph-raw-opts");
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join("h.nrrd");
+    let mut bytes = b"NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n".to_vec();
+    bytes.extend(0u8..8);
+    std::fs::write(&path, bytes).expect("write");
+    let opts = RawOptions { dims: Some(glam::UVec3::splat(2)), endianness: Endianness::Big, ..RawOptions::default() };
+    let err = load_volume(&path, &opts).expect_err("the header gives the layout");
+    assert!(err.to_string().ends_with(
+        "h.nrrd: --dims, --big-endian describe headerless .raw files, but this file has a header that gives the layout; remove --dims, --big-endian (--spacing alone may override a header)"
+    ), "{err}");
+    let spacing_only = RawOptions { spacing: Some(glam::DVec3::new(1.0, 1.0, 2.0)), ..RawOptions::default() };
+    assert_eq!(load_volume(&path, &spacing_only).expect("spacing may override").volume.spacing.z, 2.0);
+}

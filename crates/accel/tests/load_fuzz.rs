@@ -52,6 +52,17 @@ const HOSTILE_LINES: &[&str] = &[
     "space directions: (",
     "space directions: ()()()",
     "space directions: (1,0,0) (0,1,0) none",
+    "space directions: (0,-1,0) (1,0,0) (0,0,-2)",
+    "space directions: (-1,0,0) (0,-1,0) (0,0,-1)",
+    "space directions: (1,0,0) (1,0,0) (0,0,1)",
+    "space directions: (0.6,0.8,0) (0,1,0) (0,0,1)",
+    "space directions: (0,0,0) (0,1,0) (0,0,1)",
+    "space directions: (nan,0,0) (0,1,0) (0,0,1)",
+    "space directions: (1e308,0,0) (0,1e-308,0) (0,0,inf)",
+    "TransformMatrix = 0 1 0 -1 0 0 0 0 1",
+    "TransformMatrix = 0 0 0 0 0 0 0 0 0",
+    "TransformMatrix = 1 0 0 0 1",
+    "\u{feff}NRRD0004",
     "endian: big",
     "data file: LIST",
     "line skip: 3",
@@ -89,6 +100,10 @@ fn mutate(mut bytes: Vec<u8>, edits: &[(usize, u8)], splice: Option<(usize, usiz
     bytes
 }
 
+fn fuzz_cases(default: u32) -> u32 {
+    std::env::var("VOLGRAPH_FUZZ_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(default)
+}
+
 fn parse_all(bytes: &[u8]) {
     let _ = parse_nrrd(Path::new("fuzz.nrrd"), bytes);
     let _ = parse_nrrd(Path::new("fuzz.nhdr"), bytes);
@@ -106,7 +121,8 @@ fn valid_fuzz_bases_parse() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 2000, ..ProptestConfig::default() })]
+    // VOLGRAPH_FUZZ_CASES raises the count for a long hunt (the 1,000,000 per target).
+    #![proptest_config(ProptestConfig { cases: fuzz_cases(2000), failure_persistence: None, ..ProptestConfig::default() })]
 
     #[test]
     fn random_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..512)) {

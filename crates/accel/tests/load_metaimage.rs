@@ -101,3 +101,21 @@ fn spacing_option_overrides_the_header() {
     let opts = RawOptions { spacing: Some(DVec3::new(2.0, 2.0, 3.0)), ..RawOptions::default() };
     assert_eq!(load_volume(&path, &opts).expect("load").volume.spacing, DVec3::new(2.0, 2.0, 3.0));
 }
+
+#[test]
+fn transform_matrix_flips_are_honoured_and_rotations_rejected() {
+    let dir = common::temp_dir("mhd-transform");
+    // File axis 0 runs along −x: the stored rows are mirrored.
+    let stored: Vec<u8> = vec![1, 0, 3, 2, 5, 4, 7, 6];
+    std::fs::write(dir.join("f.raw"), &stored).expect("write");
+    let header = "NDims = 3\nTransformMatrix = -1 0 0 0 1 0 0 0 1\nElementSpacing = 2 1 1\nDimSize = 2 2 2\nElementType = MET_UCHAR\nElementDataFile = f.raw\n";
+    std::fs::write(dir.join("f.mhd"), header).expect("write");
+    let loaded = load_volume(&dir.join("f.mhd"), &RawOptions::default()).expect("a flip is honoured");
+    assert_eq!(loaded.volume.data, VoxelData::U8((0u8..8).collect()));
+    assert_eq!(loaded.volume.spacing, glam::DVec3::new(2.0, 1.0, 1.0));
+    let rotated = header.replace("-1 0 0 0 1 0 0 0 1", "0.8 0.6 0 -0.6 0.8 0 0 0 1");
+    std::fs::write(dir.join("r.mhd"), rotated).expect("write");
+    let err = load_volume(&dir.join("r.mhd"), &RawOptions::default()).expect_err("rotated");
+    assert!(err.to_string().contains("r.mhd:2: TransformMatrix"), "{err}");
+    assert!(err.to_string().contains("are not along the volume's axes"), "{err}");
+}

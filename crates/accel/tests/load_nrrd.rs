@@ -105,18 +105,88 @@ fn spacing_comes_from_spacings_or_direction_lengths() {
     let volume = generate::sphere(6, 0.5);
     let path = write_nrrd(&dir, &volume, false, false, false, "spacings: 0.5 0.5 2\n");
     assert_eq!(load_volume(&path, &RawOptions::default()).expect("load").volume.spacing, DVec3::new(0.5, 0.5, 2.0));
-    // (0.6, 0.8, 0) has length 1; (0, 0, -3) length 3; (0, 2, 0) length 2.
-    let path = write_nrrd(
-        &dir,
-        &volume,
-        false,
-        false,
-        false,
-        "space directions: (0.6,0.8,0) (0, 2, 0) (0,0,-3)\nspace origin: (0,0,0)\n",
-    );
+    let path = write_nrrd(&dir, &volume, false, false, false, "space directions: (1,0,0) (0, 2, 0) (0,0,3)\n");
     let loaded = load_volume(&path, &RawOptions::default()).expect("load");
     assert_eq!(loaded.volume.spacing, DVec3::new(1.0, 2.0, 3.0));
     assert_eq!(loaded.volume.name, "sphere_6");
+    assert!(loaded.report.notes.is_empty(), "axis directions need no reordering: {:?}", loaded.report.notes);
+}
+
+/// A volume whose every voxel differs, so any flip or swap shows.
+fn ramp(dims: UVec3) -> Volume {
+    let n = (dims.x * dims.y * dims.z) as usize;
+    Volume::new("ramp", dims, DVec3::ONE, VoxelData::U16((0..n).map(|i| i as u16).collect()))
+}
+
+/// `volume` stored the way a scanner that lists file axis 0 along −y, file axis 1 along +x and
+/// file axis 2 along −z would store it.
+fn stored_flipped_and_swapped(volume: &Volume) -> Volume {
+    let d = volume.dims;
+    let VoxelData::U16(values) = &volume.data else { unreachable!() };
+    let file_dims = UVec3::new(d.y, d.x, d.z);
+    let mut out = Vec::new();
+    for k in 0..file_dims.z {
+        for j in 0..file_dims.y {
+            for i in 0..file_dims.x {
+                // world x = j, world y = (ny-1) - i, world z = (nz-1) - k
+                let (x, y, z) = (j, d.y - 1 - i, d.z - 1 - k);
+                out.push(values[volume.index(x, y, z)]);
+            }
+        }
+    }
+    Volume::new("flipped", file_dims, DVec3::ONE, VoxelData::U16(out))
+}
+
+#[test]
+fn flipped_and_swapped_axes_are_reordered_into_world_order() {
+    let dir = common::temp_dir("nrrd-flip");
+    let world = ramp(UVec3::new(4, 3, 2));
+    let stored = stored_flipped_and_swapped(&world);
+    let path = write_nrrd(&dir, &stored, false, true, false, "space directions: (0,-1.5,0) (1,0,0) (0,0,-2)\n");
+    let loaded = load_volume(&path, &RawOptions::default()).expect("load");
+    assert_eq!(loaded.volume.dims, world.dims);
+    assert_eq!(loaded.volume.data, world.data, "the voxels come back in world order");
+    assert_eq!(loaded.volume.spacing, DVec3::new(1.0, 1.5, 2.0));
+    assert_eq!(
+        loaded.report.notes,
+        vec!["voxels reordered to world axes (file axis 0 → −y, 1 → +x, 2 → −z): flips and axis swaps in the header are honoured".to_string()]
+    );
+}
+
+#[test]
+fn oblique_directions_are_rejected_with_the_header_line() {
+    let dir = common::temp_dir("nrrd-oblique");
+    let volume = generate::sphere(6, 0.5);
+    let path = write_nrrd(&dir, &volume, false, false, false, "space directions: (0.6,0.8,0) (0, 2, 0) (0,0,-3)\n");
+    let err = load_volume(&path, &RawOptions::default()).expect_err("a rotated grid cannot be drawn unresampled");
+    let text = err.to_string();
+    assert!(
+        text.contains("sphere_6.nrrd:7: space directions (0.6,0.8,0) (0,2,0) (0,0,-3) are not along the volume's axes"),
+        "{text}"
+    );
+    assert!(text.contains("resample the volume"), "{text}");
+}
+
+#[test]
+fn a_missing_detached_data_file_names_the_header_line() {
+    let dir = common::temp_dir("nrrd-missing-data");
+    let header = "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\ndata file: gone.raw\n";
+    std::fs::write(dir.join("v.nhdr"), header).expect("write");
+    let err = load_volume(&dir.join("v.nhdr"), &RawOptions::default()).expect_err("no data file");
+    let text = err.to_string();
+    assert!(text.contains("v.nhdr:6: the header's data file \"gone.raw\" points to"), "{text}");
+    assert!(text.contains("gone.raw, which cannot be read"), "{text}");
+}
+
+#[test]
+fn a_byte_order_mark_before_the_magic_is_accepted() {
+    let dir = common::temp_dir("nrrd-bom");
+    let mut bytes = vec![0xEF, 0xBB, 0xBF];
+    bytes.extend_from_slice(b"NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n");
+    bytes.extend(0u8..8);
+    std::fs::write(dir.join("bom.nrrd"), bytes).expect("write");
+    let loaded = load_volume(&dir.join("bom.nrrd"), &RawOptions::default()).expect("a BOM is not part of the magic");
+    assert_eq!(loaded.volume.data, VoxelData::U8((0u8..8).collect()));
 }
 
 #[test]

@@ -124,7 +124,7 @@ fn size_mismatch_says_expected_and_actual_bytes() {
     assert_eq!(
         err.to_string(),
         format!(
-            "{}: 4x4x4 uint16 voxels need 128 bytes, but the data has 100 bytes; check the dimensions and type in the file name (name_XxYxZ_dtype.raw) or in RawOptions",
+            "{}: 4x4x4 uint16 voxels need 128 bytes, but the data has 100 bytes; check the dimensions and type in the file name (name_XxYxZ_dtype.raw), or give them with --dims XxYxZ --dtype TYPE (RawOptions::dims and ::dtype in code)",
             path.display()
         )
     );
@@ -138,7 +138,7 @@ fn unknown_layout_unsupported_type_and_zero_dims_are_errors() {
     assert_eq!(
         err.to_string(),
         format!(
-            "{}: cannot tell the voxel dimensions of a raw file; name the file like `name_256x256x128_uint8.raw` (types: uint8, uint16, int16, float32) or set RawOptions::dims",
+            "{}: cannot tell the voxel dimensions of a raw file; name the file like `name_256x256x128_uint8.raw` (types: uint8, uint16, int16, float32) or give it with --dims (RawOptions::dims in code)",
             plain.display()
         )
     );

@@ -243,3 +243,60 @@ fn paraview_errors_word_for_word() {
         "t.json: every point has x = 2; a colour map needs two different x values"
     );
 }
+
+#[test]
+fn paraview_values_outside_the_unit_range_are_rejected_like_ron() {
+    // The RON loader rejects the same values; ParaView import used to clamp them silently.
+    assert_eq!(
+        pv_err("[{\"RGBPoints\": [0, 0, 0, 0, 1, 1, 1.2, 1]}]"),
+        "t.json: RGBPoints point 1 (g, RGBPoints[6]) = 1.2 is outside [0, 1]; ParaView colours are sRGB in 0..1"
+    );
+    assert_eq!(
+        pv_err("[{\"RGBPoints\": [0, 0, 0, 0, 1, 1, 1, 1], \"Points\": [0, -0.5, 0.5, 0, 1, 1, 0.5, 0]}]"),
+        "t.json: Points point 0 (alpha, Points[1]) = -0.5 is outside [0, 1]; opacity is in 0..1"
+    );
+    assert_eq!(
+        pv_err("[{\"RGBPoints\": [0, 0, 0, 0, 1, 1, 1, 1], \"Points\": [0, 0, 0.5, 0, 1, 1.5, 0.5, 0]}]"),
+        "t.json: Points point 1 (alpha, Points[5]) = 1.5 is outside [0, 1]; opacity is in 0..1"
+    );
+}
+
+#[test]
+fn a_paraview_file_with_several_maps_says_which_was_used_and_picks_by_name() {
+    let dir = std::env::temp_dir().join("volgraph-pv-maps");
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join("maps.json");
+    // A byte-order mark first, as some editors write: accepted.
+    std::fs::write(
+        &path,
+        "\u{feff}[{\"Name\": \"Cool\", \"RGBPoints\": [0, 0, 0, 1, 1, 0, 0, 1]},
+          {\"Name\": \"Warm\", \"RGBPoints\": [0, 1, 0, 0, 1, 1, 0, 0], \"Points\": [0, 0, 0.3, 0, 1, 1, 0.5, 0]}]",
+    )
+    .expect("write");
+    let first = TransferFunction::load_paraview_map(&path, None).expect("first map");
+    assert_eq!((first.name.as_deref(), first.index), (Some("Cool"), 0));
+    assert_eq!(first.all, vec!["Cool".to_string(), "Warm".to_string()]);
+    assert!(first.notes.is_empty());
+    let warm = TransferFunction::load_paraview_map(&path, Some("Warm")).expect("by name");
+    assert_eq!(warm.index, 1);
+    assert_eq!(warm.tf.points[0].color, [1.0, 0.0, 0.0]);
+    assert_eq!(
+        warm.notes,
+        vec!["Points point 0 has midpoint 0.3 and sharpness 0; volgraph interpolates opacity linearly (midpoint 0.5, sharpness 0)".to_string()]
+    );
+    let err = TransferFunction::load_paraview_map(&path, Some("warm")).expect_err("names are exact");
+    assert!(
+        err.to_string()
+            .ends_with("holds no colour map named \"warm\"; did you mean \"Warm\"? it holds: \"Cool\", \"Warm\""),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_byte_order_mark_before_ron_is_accepted() {
+    let text = format!(
+        "\u{feff}{}",
+        TransferFunction::preset(volgraph_accel::transfer_function::Preset::Default, (0.0, 1.0)).to_ron_string()
+    );
+    TransferFunction::from_ron_str(&text, Path::new("bom.ron")).expect("a BOM is not part of the RON");
+}

@@ -10,6 +10,9 @@
 //! 1920x1080 with no features; [`volgraph_core::Plan::memory`] gives the pooled and unpooled peak
 //! transient bytes; the generated graph's row comes first.
 //!
+//! (c) Scaling: Krüger–Westermann's RC-a graph with its segment loop fixed at 256 … 4096
+//! iterations (the limit); compile time per unrolled step should stay flat (linear compile).
+//!
 //! Prints markdown tables; writes the same figures as JSON when asked. Never asserts a timing.
 
 use std::fmt::Write as _;
@@ -66,6 +69,19 @@ pub struct GraphMemory {
     pub error: Option<String>,
 }
 
+/// Compile time of an unrolled repeat group of one size.
+#[derive(Clone, Debug, Serialize)]
+pub struct ScalingRow {
+    /// Iterations of the segment loop.
+    pub iterations: u32,
+    /// Steps in the plan.
+    pub steps: usize,
+    /// Median compile time, ms.
+    pub median_ms: f64,
+    /// Median µs per step.
+    pub us_per_step: f64,
+}
+
 /// Everything `volgraph bench compile` measures (the JSON report).
 #[derive(Clone, Debug, Serialize)]
 pub struct CompileBenchReport {
@@ -73,6 +89,8 @@ pub struct CompileBenchReport {
     pub viewport: (u32, u32),
     /// Compile time of the generated 30-pass graph.
     pub timing: CompileTiming,
+    /// Compile time vs unrolled size.
+    pub scaling: Vec<ScalingRow>,
     /// Memory of each graph file.
     pub graphs: Vec<GraphMemory>,
 }
@@ -96,7 +114,43 @@ pub fn measure() -> anyhow::Result<CompileBenchReport> {
     let viewport = (1920, 1080);
     let mut graphs = vec![memory_of("(generated bench_30)", &thirty_pass_graph(), viewport)];
     graphs.extend(graph_files()?.iter().map(|(path, name)| graph_memory(path, name, viewport)));
-    Ok(CompileBenchReport { viewport, timing, graphs })
+    Ok(CompileBenchReport { viewport, timing, scaling: time_scaling()?, graphs })
+}
+
+/// (c): RC-a with `Fixed(n)` segments, n = 256 … 4096.
+fn time_scaling() -> anyhow::Result<Vec<ScalingRow>> {
+    let path = graphs_dir().join("kruger_westermann_2003/rc_a.ron");
+    let source = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let count = "count: Scene(name: \"longest_ray_steps\", divide_by_input: \"segment_steps\")";
+    anyhow::ensure!(
+        source.contains(count),
+        "{} no longer has the segment count this benchmark replaces",
+        path.display()
+    );
+    let registry = builtin_registry();
+    let options = CompileOptions::new(512, 512);
+    let mut rows = Vec::new();
+    for n in [256u32, 512, 1024, 2048, 4096] {
+        let text = source.replace(count, &format!("count: Fixed({n})"));
+        let plan = compile("rc_a.ron", &text, &registry, &options).map_err(|d| anyhow::anyhow!("{d}"))?;
+        let repeats = (40_000 / n as usize).clamp(5, 200);
+        let mut ms: Vec<f64> = (0..repeats)
+            .map(|_| {
+                let start = Instant::now();
+                std::hint::black_box(compile("rc_a.ron", &text, &registry, &options).ok());
+                start.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        ms.sort_by(f64::total_cmp);
+        let median_ms = ms[ms.len() / 2];
+        rows.push(ScalingRow {
+            iterations: n,
+            steps: plan.steps.len(),
+            median_ms,
+            us_per_step: median_ms * 1e3 / plan.steps.len() as f64,
+        });
+    }
+    Ok(rows)
 }
 
 /// The generated 30-pass graph: `entry` → a chain `d1..d10` of direction passes; raycasts
@@ -270,6 +324,23 @@ pub fn to_markdown(r: &CompileBenchReport) -> String {
         t.goal_us,
         t.median_us / t.goal_us
     );
+    if let Some(first) = r.scaling.first() {
+        let _ = writeln!(s, "## Compile time vs unrolled size (K-W RC-a, segment loop Fixed(n))\n");
+        let _ = writeln!(s, "| iterations | steps | median ms | µs per step | per step vs n = {} |", first.iterations);
+        let _ = writeln!(s, "|---:|---:|---:|---:|---:|");
+        for row in &r.scaling {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {:.2} | {:.2} | {:.2} |",
+                row.iterations,
+                row.steps,
+                row.median_ms,
+                row.us_per_step,
+                row.us_per_step / first.us_per_step
+            );
+        }
+        let _ = writeln!(s);
+    }
     let _ = writeln!(s, "## Transient memory at {}x{}, no features\n", r.viewport.0, r.viewport.1);
     let _ = writeln!(s, "| graph | steps | slots | pooled MiB | unpooled MiB | pooled / unpooled | history MiB |");
     let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|");

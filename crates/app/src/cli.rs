@@ -5,14 +5,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, anyhow};
 use clap::{Parser, Subcommand};
-use volgraph_accel::camera::OrbitCamera;
-use volgraph_core::executor::{Gpu, ShaderLibrary};
-use volgraph_core::shader_source::default_shader_root;
 use volgraph_core::{CompileOptions, Diagnostics, compile};
 use volgraph_passes::builtin_registry;
-use volgraph_passes::session::{RenderSession, SessionError};
+use volgraph_passes::session::SessionError;
 
-use crate::{image_out, inputs};
+use crate::inputs;
 
 /// volgraph: GPU volume rendering assembled from a declarative render graph.
 #[derive(Parser, Debug)]
@@ -52,6 +49,9 @@ enum Command {
         /// Transfer function (RON, or ParaView color-map .json); default: one fitted to the data.
         #[arg(long)]
         tf: Option<PathBuf>,
+        /// The colour map to use from a ParaView .json holding several (its "Name"); default: the first.
+        #[arg(long = "tf-map")]
+        tf_map: Option<String>,
         /// Viewport, WIDTHxHEIGHT.
         #[arg(long, default_value = "512x512")]
         size: String,
@@ -59,7 +59,7 @@ enum Command {
         #[arg(long, default_value = "30,20,3.2")]
         camera: String,
         /// Frames to render (the last one is written); each rotates the volume 1° about y.
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100_000))]
         frames: u32,
         /// Scene features that are on, comma separated.
         #[arg(long, value_delimiter = ',')]
@@ -148,21 +148,62 @@ impl From<SessionError> for CliError {
     }
 }
 
-fn compile_options(size: &str, features: &[String], scalars: &[(String, f64)]) -> anyhow::Result<CompileOptions> {
+pub fn compile_options(size: &str, features: &[String], scalars: &[(String, f64)]) -> anyhow::Result<CompileOptions> {
     let (w, h) = inputs::parse_size(size)?;
     let mut o = CompileOptions::new(w, h).with_features(features.iter().filter(|f| !f.is_empty()).cloned());
     o.scalars = scalars.iter().cloned().collect::<BTreeMap<_, _>>();
     Ok(o)
 }
 
-fn display_name(path: &Path) -> String {
+pub fn display_name(path: &Path) -> String {
     path.display().to_string()
+}
+
+/// Every `--features` and `--scalar` name must be one the graph reads: a typo would otherwise
+/// render without the effect and exit 0.
+pub fn check_user_names(plan: &volgraph_core::Plan, options: &CompileOptions) -> Result<(), CliError> {
+    use volgraph_core::suggest::{comma_list, guess_then};
+    let mut problems = Vec::new();
+    let known: Vec<&str> = plan.known_features.iter().map(String::as_str).collect();
+    for f in options.features.iter().filter(|f| !plan.known_features.contains(*f)) {
+        let help = format!("its features are: {}", comma_list(&known));
+        problems.push(format!(
+            "--features \"{f}\": graph \"{}\" has no such feature; {}",
+            plan.name,
+            guess_then(f, known.iter().copied(), "", help)
+        ));
+    }
+    let known: Vec<&str> = plan.known_scalars.iter().map(String::as_str).collect();
+    for name in options.scalars.keys().filter(|n| !plan.known_scalars.contains(*n)) {
+        let help = format!("its scalars are: {}", comma_list(&known));
+        problems.push(format!(
+            "--scalar \"{name}\": graph \"{}\" reads no such scalar; {}",
+            plan.name,
+            guess_then(name, known.iter().copied(), "", help)
+        ));
+    }
+    if problems.is_empty() { Ok(()) } else { Err(CliError::Other(anyhow!(problems.join("\nerror: ")))) }
+}
+
+/// The plan's warnings (a repeat count capped by its max, ...) as stderr lines.
+pub fn warning_lines(plan: &volgraph_core::Plan) -> Vec<String> {
+    plan.warnings
+        .items
+        .iter()
+        .map(|d| {
+            let mut line = format!("warning: {}: {}", plan.warnings.position(d), d.message);
+            if let Some(help) = &d.help {
+                line.push_str(&format!("\n  help: {help}"));
+            }
+            line
+        })
+        .collect()
 }
 
 /// Multipass graphs size their segment loop by the scene value `longest_ray_steps` (K of
 /// Krüger–Westermann §3): when the graph declares it and the user did not set it, compute it for
 /// this volume and the graph's own step.
-fn with_longest_ray(
+pub fn with_longest_ray(
     file: &str,
     source: &str,
     registry: &volgraph_core::Registry,
@@ -183,87 +224,69 @@ fn with_longest_ray(
     Ok(options)
 }
 
-/// Runs a parsed command line.
-pub fn run(cli: Cli) -> Result<(), CliError> {
+/// A `plan` or `render` command line with every input read and checked, no GPU touched.
+pub enum Checked {
+    /// `plan`: the text to print and the notes for stderr.
+    Plan {
+        /// The plan text.
+        text: String,
+        /// Warnings for stderr.
+        notes: Vec<String>,
+    },
+    /// `render`: ready to open the GPU.
+    Render(Box<crate::render::Prepared>),
+}
+
+/// Reads and checks the inputs of a `plan` or `render` command line: what a user's typo can
+/// break, without the GPU (the CLI fuzzer runs this). Other commands are not checked here.
+pub fn check(cli: Cli) -> Result<Checked, CliError> {
     match cli.command {
         Command::Plan { graph, size, features, scalars } => {
             let source = inputs::read_graph(&graph)?;
             let options = compile_options(&size, &features, &scalars)?;
             let plan =
                 compile(&display_name(&graph), &source, &builtin_registry(), &options).map_err(CliError::Graph)?;
-            crate::stdout::write_stdout(&plan.to_text())?;
-            Ok(())
+            check_user_names(&plan, &options)?;
+            Ok(Checked::Plan { text: plan.to_text(), notes: warning_lines(&plan) })
         }
-        Command::Render { graph, volume, raw, tf, size, camera, frames, features, output, out } => {
-            let source = inputs::read_graph(&graph)?;
-            let options = compile_options(&size, &features, &[])?;
-            let camera = inputs::parse_camera(&camera)?;
-            let generated = volume.is_none();
-            let volume = inputs::volume(volume.as_ref(), &inputs::raw_options(&raw)?)?;
-            let tf = inputs::transfer_function(tf.as_ref(), &volume, generated)?;
-            let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
-            let gpu = Gpu::new_headless().map_err(|e| anyhow!(e))?;
-            let shaders = ShaderLibrary::new(default_shader_root());
-            let registry = builtin_registry();
-            let file = display_name(&graph);
-            let options = with_longest_ray(&file, &source, &registry, options, &volume)?;
-            let plan = compile(&file, &source, &registry, &options).map_err(CliError::Graph)?;
-            let mut session = RenderSession::from_plan(&gpu, &shaders, &registry, plan, &volume, &lut)?;
-            let is_exr = out.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-            let output = output.unwrap_or_else(|| {
-                if !is_exr && session.plan().outputs.contains_key("display") {
-                    "display".to_string()
-                } else {
-                    "image".to_string()
-                }
-            });
-            let mut last = None;
-            for f in 0..frames.max(1) {
-                let cam = OrbitCamera { azimuth_deg: camera.azimuth_deg + f as f64, ..camera };
-                last = Some(session.render(&gpu, &cam)?);
-            }
-            let image = session.read(&gpu, &output)?;
-            if is_exr {
-                image_out::write_exr(&out, &image)?;
-            } else {
-                let srgb = image.channels == 4
-                    && session.plan().outputs.get(&output).is_some_and(|&r| {
-                        matches!(
-                            session.plan().resources[r].desc,
-                            volgraph_core::plan::ResourceDesc::Target {
-                                format: volgraph_core::TargetFormat::Rgba8Unorm,
-                                ..
-                            }
-                        )
-                    });
-                image_out::write_png(&out, &image, srgb)?;
-            }
-            if let Some(stats) = last {
-                let clock = if stats.wall_time_fallback { "wall time (no GPU timestamps)" } else { "GPU time" };
-                eprintln!(
-                    "{}: {}x{} on {}, last frame {:.2} ms {clock} → {}",
-                    graph.display(),
-                    options.viewport.0,
-                    options.viewport.1,
-                    gpu.adapter_name,
-                    stats.frame_ms,
-                    out.display()
-                );
-                if let Some(step_ms) = &stats.step_gpu_ms {
-                    // Per pass, repeat-group instances summed, in schedule order.
-                    let mut per_pass: Vec<(String, f64)> = Vec::new();
-                    for (step, ms) in session.plan().steps.iter().zip(step_ms) {
-                        match per_pass.iter_mut().find(|(id, _)| *id == step.pass_id) {
-                            Some((_, total)) => *total += ms,
-                            None => per_pass.push((step.pass_id.clone(), *ms)),
-                        }
-                    }
-                    let list: Vec<String> = per_pass.iter().map(|(id, ms)| format!("{id} {ms:.2}")).collect();
-                    eprintln!("  per pass (ms): {}", list.join(", "));
-                }
-            }
-            Ok(())
+        Command::Render { graph, volume, raw, tf, tf_map, size, camera, frames, features, output, out } => {
+            let args = crate::render::RenderArgs {
+                graph,
+                volume,
+                raw,
+                tf,
+                tf_map,
+                size,
+                camera,
+                frames,
+                features,
+                output,
+                out,
+            };
+            Ok(Checked::Render(Box::new(crate::render::prepare(args)?)))
         }
+        Command::Bench { .. } => Err(CliError::Other(anyhow!("bench commands are not checked ahead of running"))),
+    }
+}
+
+/// Runs a parsed command line.
+pub fn run(cli: Cli) -> Result<(), CliError> {
+    match cli.command {
+        Command::Plan { .. } | Command::Render { .. } => match check(cli)? {
+            Checked::Plan { text, notes } => {
+                for note in notes {
+                    eprintln!("{note}");
+                }
+                crate::stdout::write_stdout(&text)?;
+                Ok(())
+            }
+            Checked::Render(prepared) => {
+                for note in &prepared.notes {
+                    eprintln!("{note}");
+                }
+                crate::render::execute(*prepared)
+            }
+        },
         Command::Bench { which: BenchCommand::Accel { repeats, json } } => {
             let opts = crate::bench_accel::AccelBenchOptions {
                 data_dir: volgraph_accel::data_dir::data_dir(),

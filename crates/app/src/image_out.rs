@@ -5,6 +5,35 @@ use std::path::Path;
 use anyhow::{Context, bail};
 use volgraph_core::executor::Image;
 
+/// The image file kinds `-o` accepts, told by the extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageKind {
+    /// 8-bit sRGB PNG.
+    Png,
+    /// 32-bit float linear EXR.
+    Exr,
+}
+
+impl ImageKind {
+    /// The kind of `path`, checked before any GPU work so a typo costs nothing.
+    pub fn from_path(path: &Path) -> anyhow::Result<ImageKind> {
+        let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+        match extension.as_deref() {
+            Some("png") => Ok(ImageKind::Png),
+            Some("exr") => Ok(ImageKind::Exr),
+            Some(other) => bail!(
+                "-o {}: volgraph writes .png (8-bit sRGB) or .exr (32-bit float, linear), not .{other}; \
+                 change the extension",
+                path.display()
+            ),
+            None => bail!(
+                "-o {}: the file name has no extension; end it in .png (8-bit sRGB) or .exr (32-bit float, linear)",
+                path.display()
+            ),
+        }
+    }
+}
+
 /// The sRGB transfer function.
 fn srgb_encode(c: f32) -> f32 {
     let c = c.clamp(0.0, 1.0);

@@ -54,18 +54,26 @@ pub fn raw_options(raw: &crate::cli::RawArgs) -> anyhow::Result<RawOptions> {
     Ok(o)
 }
 
-/// Loads `--volume`, or generates the default (Marschner–Lobb 64³) when none is given.
-pub fn volume(path: Option<&PathBuf>, raw: &RawOptions) -> anyhow::Result<Volume> {
+/// Loads `--volume`, or generates the default (Marschner–Lobb 64³) when none is given. What the
+/// loader repaired or reordered comes back as notes for stderr.
+pub fn volume(path: Option<&PathBuf>, raw: &RawOptions) -> anyhow::Result<(Volume, Vec<String>)> {
     match path {
-        None => Ok(volgraph_accel::generate::marschner_lobb(64)),
+        None => Ok((default_volume().clone(), Vec::new())),
         Some(p) => {
             let loaded = load_volume(p, raw).map_err(|e| anyhow!("{e}"))?;
+            let mut notes: Vec<String> = loaded.report.notes.iter().map(|n| format!("{}: {n}", p.display())).collect();
             if loaded.report.non_finite_replaced() > 0 {
-                eprintln!("note: {}: replaced {} NaN/Inf voxels", p.display(), loaded.report.non_finite_replaced());
+                notes.push(format!("{}: replaced {} NaN/Inf voxels", p.display(), loaded.report.non_finite_replaced()));
             }
-            Ok(loaded.volume)
+            Ok((loaded.volume, notes))
         }
     }
+}
+
+/// The generated default volume, made once per process.
+pub fn default_volume() -> &'static Volume {
+    static DEFAULT: std::sync::OnceLock<Volume> = std::sync::OnceLock::new();
+    DEFAULT.get_or_init(|| volgraph_accel::generate::marschner_lobb(64))
 }
 
 /// The transfer function for the generated default volume: an opaque band around ρ = 0.5 that
@@ -73,20 +81,77 @@ pub fn volume(path: Option<&PathBuf>, raw: &RawOptions) -> anyhow::Result<Volume
 /// renders it from any directory).
 const MARSCHNER_LOBB_TF: &str = include_str!("../../../graphs/tf/marschner_lobb.ron");
 
-/// Loads `--tf` (RON, or ParaView JSON by extension), or the default for the volume (for the
-/// generated default volume, `graphs/tf/marschner_lobb.ron`).
-pub fn transfer_function(path: Option<&PathBuf>, volume: &Volume, generated: bool) -> anyhow::Result<TransferFunction> {
-    match path {
+/// Loads `--tf` (RON, or ParaView JSON by extension; `map` picks a colour map from a ParaView
+/// file holding several), or the default for the volume (for the generated default volume,
+/// `graphs/tf/marschner_lobb.ron`), with notes about the choice for stderr.
+pub fn transfer_function(
+    path: Option<&PathBuf>,
+    map: Option<&str>,
+    volume: &Volume,
+    generated: bool,
+) -> anyhow::Result<(TransferFunction, Vec<String>)> {
+    let is_json = path.is_some_and(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")));
+    if let Some(name) = map
+        && !is_json
+    {
+        bail!(
+            "--tf-map \"{name}\" picks a colour map from a ParaView .json file, but {} is not one; remove --tf-map",
+            path.map_or_else(|| "no --tf was given".to_string(), |p| format!("--tf {}", p.display()))
+        );
+    }
+    let mut notes = Vec::new();
+    let tf = match path {
         None if generated => {
             TransferFunction::from_ron_str(MARSCHNER_LOBB_TF, Path::new("graphs/tf/marschner_lobb.ron"))
-                .map_err(|e| anyhow!("{e}"))
+                .map_err(|e| anyhow!("{e}"))?
         }
-        None => Ok(TransferFunction::default_for(volume)),
-        Some(p) if p.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")) => {
-            TransferFunction::load_paraview(p).map_err(|e| anyhow!("{e}"))
+        None => TransferFunction::default_for(volume),
+        Some(p) if is_json => {
+            let chosen = TransferFunction::load_paraview_map(p, map).map_err(|e| anyhow!("{e}"))?;
+            if chosen.all.len() > 1 && map.is_none() {
+                let names: Vec<String> = chosen.all.iter().map(|n| format!("\"{n}\"")).collect();
+                notes.push(format!(
+                    "{} holds {} colour maps ({}); using the first, \"{}\"; choose another with --tf-map NAME",
+                    p.display(),
+                    chosen.all.len(),
+                    names.join(", "),
+                    chosen.all[chosen.index]
+                ));
+            }
+            notes.extend(chosen.notes.iter().map(|n| format!("{}: {n}", p.display())));
+            chosen.tf
         }
-        Some(p) => TransferFunction::load(p).map_err(|e| anyhow!("{e}")),
+        Some(p) => TransferFunction::load(p).map_err(|e| anyhow!("{e}"))?,
+    };
+    Ok((tf, notes))
+}
+
+/// A note when nothing of `volume` can be seen under `lut`: every LUT entry its values reach
+/// (with the neighbours linear filtering blends in) has opacity 0, so the image would show only
+/// the background. `None` when something may be visible.
+pub fn invisible_volume_note(volume: &Volume, lut: &[[f32; 4]]) -> Option<String> {
+    let n = volume.voxel_count();
+    if n == 0 || lut.is_empty() {
+        return None;
     }
+    let (lo, hi) = (0..n)
+        .map(|i| volume.normalized(i))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+    let size = lut.len() as f64;
+    let first = ((lo * size - 0.5).floor().max(0.0) as usize).min(lut.len() - 1);
+    let last = ((hi * size - 0.5).ceil().max(0.0) as usize).min(lut.len() - 1);
+    if lut[first..=last].iter().any(|texel| texel[3] > 0.0) {
+        return None;
+    }
+    let what = if lo == hi {
+        format!("volume \"{}\" is constant (every voxel normalizes to {lo:.4})", volume.name)
+    } else {
+        format!("volume \"{}\" holds values {lo:.4}..={hi:.4} (normalized)", volume.name)
+    };
+    Some(format!(
+        "{what}, and the transfer function gives all of them opacity 0, so the image shows only the background; \
+         pass --tf with a transfer function that makes those values visible"
+    ))
 }
 
 /// Parses `WxH`.

@@ -5,8 +5,11 @@ mod bench_accel;
 mod bench_compile;
 mod bench_graphs;
 mod cli;
+#[cfg(test)]
+mod cli_fuzz;
 mod image_out;
 mod inputs;
+mod render;
 mod stdout;
 
 use std::process::ExitCode;
@@ -15,6 +18,21 @@ use clap::Parser;
 
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    // No input may crash volgraph; should a bug do so anyway, say so in one line instead of a
+    // Rust backtrace.
+    std::panic::set_hook(Box::new(|info| {
+        let location = info.location().map_or(String::new(), |l| format!(" at {}:{}", l.file(), l.line()));
+        let message = info
+            .payload()
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| info.payload().downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        eprintln!(
+            "error: volgraph hit an internal error{location}: {message}\n  this is a bug in volgraph, not in your \
+             input; please report it with the command you ran"
+        );
+    }));
     let args = cli::Cli::parse();
     match cli::run(args) {
         Ok(()) => ExitCode::SUCCESS,

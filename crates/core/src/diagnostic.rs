@@ -39,21 +39,35 @@ pub struct Diagnostic {
     pub location: Location,
 }
 
+/// The longest message or help kept whole; longer ones (a 100 KB string pasted into a graph
+/// file and quoted back) keep their start and end around an ellipsis.
+const MAX_MESSAGE_CHARS: usize = 600;
+
+fn clip_message(text: String) -> String {
+    let count = text.chars().count();
+    if count <= MAX_MESSAGE_CHARS {
+        return text;
+    }
+    let head: String = text.chars().take(MAX_MESSAGE_CHARS - 120).collect();
+    let tail: String = text.chars().skip(count - 100).collect();
+    format!("{head} … ({} characters left out) … {tail}", count - (MAX_MESSAGE_CHARS - 20))
+}
+
 impl Diagnostic {
     /// A diagnostic at `location`.
     pub fn new(location: Location, message: impl Into<String>) -> Self {
-        Self { message: message.into(), help: None, location }
+        Self { message: clip_message(message.into()), help: None, location }
     }
 
     /// Adds the fix.
     pub fn with_help(mut self, help: impl Into<String>) -> Self {
-        self.help = Some(help.into());
+        self.help = Some(clip_message(help.into()));
         self
     }
 }
 
 /// All problems of one graph file, with the file's name and text for rendering.
-#[derive(Clone, Debug, thiserror::Error)]
+#[derive(Clone, Debug, Default, thiserror::Error)]
 pub struct Diagnostics {
     /// The file name as given (used as the prefix of every line).
     pub file: String,
@@ -90,6 +104,18 @@ impl fmt::Display for Diagnostics {
         }
         Ok(())
     }
+}
+
+/// Lines longer than this get no source excerpt.
+const MAX_EXCERPT_LINE: usize = 240;
+
+/// The length in bytes of the line holding byte `offset` and of its neighbours (miette shows
+/// one line of context on each side).
+fn longest_line_around(text: &str, offset: usize) -> usize {
+    let offset = offset.min(text.len());
+    let start = text[..offset].rfind('\n').map_or(0, |i| i + 1);
+    let before = text[..start.saturating_sub(1)].rfind('\n').map_or(0, |i| i + 1);
+    text[before..].split('\n').take(3).map(str::len).max().unwrap_or(0)
 }
 
 /// One item rendered for miette, with its label in the source.
@@ -131,6 +157,12 @@ impl Diagnostics {
             .iter()
             .map(|d| {
                 let (span, message) = match &d.location {
+                    // An excerpt of a very long line (minified or generated files) would print the
+                    // whole line; the one-line form already gives line and column.
+                    Location::Span(s) if longest_line_around(&self.text, s.start) > MAX_EXCERPT_LINE => {
+                        let (line, col) = line_col(&self.text, s.start);
+                        (None, format!("line {line}, column {col}: {}", d.message))
+                    }
                     Location::Span(s) => (Some(*s), d.message.clone()),
                     Location::Field { pass, field } => (None, format!("pass \"{pass}\", field {field}: {}", d.message)),
                     Location::File => (None, d.message.clone()),

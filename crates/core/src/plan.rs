@@ -36,6 +36,14 @@ pub struct Plan {
     pub outputs: BTreeMap<String, ResourceId>,
     /// History entries: name → what they track.
     pub history: BTreeMap<String, History>,
+    /// Every scene feature some pass of the graph needs, on or off (what a viewer offers as
+    /// toggles, and what `--features` may name).
+    pub known_features: BTreeSet<String>,
+    /// Every scene value the graph reads: its Scalar inputs and the values repeat counts read.
+    pub known_scalars: BTreeSet<String>,
+    /// Problems that did not stop compiling (a repeat count capped by its max, a feature or
+    /// scalar the graph does not use), located in the graph file.
+    pub warnings: crate::diagnostic::Diagnostics,
 }
 
 /// One pass instance.

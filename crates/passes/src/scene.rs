@@ -3,7 +3,9 @@
 
 use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::volume::{Volume, VoxelData};
-use volgraph_core::executor::{FrameUniforms, Gpu, VolumeFormat, upload_lut, upload_volume};
+use volgraph_core::executor::{
+    FrameUniforms, Gpu, GpuFault, UploadError, UploadedVolume, VolumeTexels, upload_lut, upload_volume,
+};
 
 fn mat(m: glam::DMat4) -> [[f32; 4]; 4] {
     m.as_mat4().to_cols_array_2d()
@@ -28,24 +30,24 @@ pub fn frame_uniforms(camera: &OrbitCamera, volume: &Volume, viewport: (u32, u32
 }
 
 /// Uploads a volume as the 3D texture the shaders sample (normalized values,
-/// `docs/rendering_model.md`): u8 → R8Unorm, u16 → R16Unorm, i16 → R16Unorm offset by 32768,
-/// f32 → R32Float normalized by the value range.
-pub fn upload_volume_texture(gpu: &Gpu, volume: &Volume) -> Result<wgpu::Texture, String> {
+/// `docs/rendering_model.md`): u8 → `v / 255`, u16 → `v / 65535`, i16 → `(v + 32768) / 65535`,
+/// f32 → normalized by the value range. The texture format is the device's best for the data
+/// ([`volgraph_core::executor::volume_format_for`]).
+pub fn upload_volume_texture(gpu: &Gpu, volume: &Volume) -> Result<UploadedVolume, UploadError> {
     let dims = [volume.dims.x, volume.dims.y, volume.dims.z];
-    let (format, bytes): (VolumeFormat, Vec<u8>) = match &volume.data {
-        VoxelData::U8(v) => (VolumeFormat::R8Unorm, v.clone()),
-        VoxelData::U16(v) => (VolumeFormat::R16Unorm, bytemuck::cast_slice(v).to_vec()),
+    match &volume.data {
+        VoxelData::U8(v) => upload_volume(gpu, &volume.name, dims, &VolumeTexels::Unorm8(v)),
+        VoxelData::U16(v) => upload_volume(gpu, &volume.name, dims, &VolumeTexels::Unorm16(v)),
         VoxelData::I16(v) => {
             let shifted: Vec<u16> = v.iter().map(|x| (*x as i32 + 32768) as u16).collect();
-            (VolumeFormat::R16Unorm, bytemuck::cast_slice(&shifted).to_vec())
+            upload_volume(gpu, &volume.name, dims, &VolumeTexels::Unorm16(&shifted))
         }
-        VoxelData::F32(_) => (VolumeFormat::R32Float, bytemuck::cast_slice(&volume.normalized_f32()).to_vec()),
-    };
-    upload_volume(gpu, &volume.name, dims, format, &bytes)
+        VoxelData::F32(_) => upload_volume(gpu, &volume.name, dims, &VolumeTexels::Float(&volume.normalized_f32())),
+    }
 }
 
 /// Uploads a transfer-function LUT.
-pub fn upload_lut_texture(gpu: &Gpu, lut: &[[f32; 4]]) -> wgpu::Texture {
+pub fn upload_lut_texture(gpu: &Gpu, lut: &[[f32; 4]]) -> Result<wgpu::Texture, GpuFault> {
     upload_lut(gpu, "transfer function", lut)
 }
 

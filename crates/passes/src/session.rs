@@ -19,8 +19,11 @@ pub enum SessionError {
     #[error(transparent)]
     Executor(#[from] ExecutorError),
     /// The volume could not be uploaded.
-    #[error("{0}")]
-    Upload(String),
+    #[error(transparent)]
+    Upload(#[from] volgraph_core::executor::UploadError),
+    /// The GPU rejected an upload.
+    #[error(transparent)]
+    Gpu(#[from] volgraph_core::executor::GpuFault),
 }
 
 /// One graph ready to render frames of one volume.
@@ -28,6 +31,7 @@ pub struct RenderSession {
     executor: Executor,
     volume_dims: Volume,
     viewport: (u32, u32),
+    volume_format: Option<volgraph_core::executor::VolumeFormat>,
 }
 
 impl RenderSession {
@@ -60,17 +64,20 @@ impl RenderSession {
         let viewport = plan.viewport;
         let inputs = plan.inputs.clone();
         let mut executor = Executor::new(gpu, shaders, registry, plan)?;
+        let mut volume_format = None;
         for (name, kind) in &inputs {
             match kind {
                 InputKind::Volume => {
-                    executor.bind_input(name, upload_volume_texture(gpu, volume).map_err(SessionError::Upload)?)
+                    let uploaded = upload_volume_texture(gpu, volume)?;
+                    volume_format = Some(uploaded.format);
+                    executor.bind_input(name, uploaded.texture)
                 }
-                InputKind::TransferFunction => executor.bind_input(name, upload_lut_texture(gpu, lut)),
+                InputKind::TransferFunction => executor.bind_input(name, upload_lut_texture(gpu, lut)?),
                 InputKind::Scalar(_) => {}
             }
         }
         let volume_dims = volume.clone_header();
-        Ok(Self { executor, volume_dims, viewport })
+        Ok(Self { executor, volume_dims, viewport, volume_format })
     }
 
     /// Renders one frame from `camera`.
@@ -87,6 +94,11 @@ impl RenderSession {
     /// The executor (plan, history invalidation).
     pub fn executor_mut(&mut self) -> &mut Executor {
         &mut self.executor
+    }
+
+    /// The texture format the volume was uploaded in (None when the graph reads no volume).
+    pub fn volume_format(&self) -> Option<volgraph_core::executor::VolumeFormat> {
+        self.volume_format
     }
 
     /// The compiled plan.

@@ -27,16 +27,26 @@ fn render(
     camera: &OrbitCamera,
     options: CompileOptions,
 ) -> (Image, Vec<[f64; 4]>) {
-    let gpu = gpu();
+    render_on(&gpu(), volume, tf, camera, options)
+}
+
+/// [`render`] on a given device (one opened without some optional feature).
+fn render_on(
+    gpu: &volgraph_core::executor::Gpu,
+    volume: &Volume,
+    tf: &TransferFunction,
+    camera: &OrbitCamera,
+    options: CompileOptions,
+) -> (Image, Vec<[f64; 4]>) {
     let source = graph_source("basic/fragment_raycast.ron");
     let registry = builtin_registry();
     let plan = compile("fragment_raycast.ron", &source, &registry, &options).expect("compiles");
     let settings = reference_settings(&plan.steps.iter().find(|s| s.pass_id == "march").expect("march").params);
     let lut = tf.to_lut_for(volume, 256);
     let shaders = ShaderLibrary::new(default_shader_root());
-    let mut session = RenderSession::from_plan(&gpu, &shaders, &registry, plan, volume, &lut).expect("session");
-    session.render(&gpu, camera).expect("frame");
-    let image = session.read(&gpu, "image").expect("image");
+    let mut session = RenderSession::from_plan(gpu, &shaders, &registry, plan, volume, &lut).expect("session");
+    session.render(gpu, camera).expect("frame");
+    let image = session.read(gpu, "image").expect("image");
     let reference = render_reference(volume, &lut, camera, options.viewport.0, options.viewport.1, &settings);
     (image, reference.color)
 }
@@ -127,4 +137,89 @@ fn anisotropic_spacing_is_carried_to_the_gpu() {
     let camera = OrbitCamera { azimuth_deg: 60.0, elevation_deg: 35.0, ..OrbitCamera::default() };
     let (image, reference) = render(&v, &tf, &camera, CompileOptions::new(SIZE, SIZE));
     assert_close("spacing 1,1,2", &image, &reference, 0.1);
+}
+
+/// Marschner–Lobb quantized to 16 bits, written as a raw file of `dtype` in `endianness` and
+/// read back through the loader, so the test covers file decoding, upload and sampling.
+fn sixteen_bit_ml(dtype: &str, endianness: volgraph_accel::load::Endianness) -> Volume {
+    use volgraph_accel::load::{Endianness, RawOptions, load_volume};
+    let ml = volgraph_accel::generate::marschner_lobb_f32(24);
+    let unorm: Vec<u16> = ml.normalized_f32().iter().map(|v| (v * 65535.0).round() as u16).collect();
+    let bytes: Vec<u8> = unorm
+        .iter()
+        .flat_map(|&u| {
+            // i16 stores u - 32768, so both types normalize to the same value.
+            let raw = if dtype == "int16" { (u as i32 - 32768) as i16 as u16 } else { u };
+            match endianness {
+                Endianness::Little => raw.to_le_bytes(),
+                Endianness::Big => raw.to_be_bytes(),
+            }
+        })
+        .collect();
+    let order = if endianness == Endianness::Big { "be" } else { "le" };
+    let path = std::env::temp_dir().join(format!("volgraph_hard_ml{order}_24x24x24_{dtype}.raw"));
+    std::fs::write(&path, bytes).expect("temp file");
+    let loaded = load_volume(&path, &RawOptions { endianness, ..RawOptions::default() }).expect("loads");
+    loaded.volume
+}
+
+#[test]
+fn sixteen_bit_volumes_in_both_byte_orders_match_the_reference() {
+    use volgraph_accel::load::Endianness;
+    let gpu = gpu();
+    let camera = OrbitCamera { azimuth_deg: 35.0, elevation_deg: 25.0, ..OrbitCamera::default() };
+    for dtype in ["uint16", "int16"] {
+        for order in [Endianness::Little, Endianness::Big] {
+            let v = sixteen_bit_ml(dtype, order);
+            let tf = TransferFunction::default_for(&v);
+            let (image, reference) = render_on(&gpu, &v, &tf, &camera, CompileOptions::new(SIZE, SIZE));
+            // 16-bit normalized texels filter like 8-bit ones on lavapipe (same 2/255 bound).
+            assert_close(&format!("{dtype} {order:?}"), &image, &reference, 0.2);
+        }
+    }
+}
+
+#[test]
+fn sixteen_bit_volume_without_norm16_is_widened_to_float() {
+    use volgraph_core::executor::{Gpu, GpuOptions};
+    let gpu = Gpu::new_headless_with(&GpuOptions { without_features: wgpu::Features::TEXTURE_FORMAT_16BIT_NORM })
+        .expect("a Vulkan adapter");
+    assert!(!gpu.norm16);
+    let v = sixteen_bit_ml("uint16", volgraph_accel::load::Endianness::Little);
+    let tf = TransferFunction::default_for(&v);
+    let uploaded = volgraph_passes::scene::upload_volume_texture(&gpu, &v).expect("uploads without the feature");
+    let expected = if gpu.float32_filterable {
+        volgraph_core::executor::VolumeFormat::R32Float
+    } else {
+        volgraph_core::executor::VolumeFormat::R16Float
+    };
+    assert_eq!(uploaded.format, expected);
+    let (image, reference) = render_on(&gpu, &v, &tf, &OrbitCamera::default(), CompileOptions::new(SIZE, SIZE));
+    assert_close("uint16 as float", &image, &reference, 0.2);
+}
+
+#[test]
+fn sixteen_bit_volume_on_a_device_with_neither_format_uses_half_floats() {
+    use volgraph_core::executor::{Gpu, GpuOptions, VolumeFormat};
+    let without = wgpu::Features::TEXTURE_FORMAT_16BIT_NORM | wgpu::Features::FLOAT32_FILTERABLE;
+    let gpu = Gpu::new_headless_with(&GpuOptions { without_features: without }).expect("a Vulkan adapter");
+    let v = sixteen_bit_ml("int16", volgraph_accel::load::Endianness::Big);
+    let uploaded = volgraph_passes::scene::upload_volume_texture(&gpu, &v).expect("uploads");
+    assert_eq!(uploaded.format, VolumeFormat::R16Float);
+    let tf = TransferFunction::default_for(&v);
+    let (image, reference) = render_on(&gpu, &v, &tf, &OrbitCamera::default(), CompileOptions::new(SIZE, SIZE));
+    // f16 keeps 11 significant bits: a normalized value moves by up to 2⁻¹², which the
+    // default TF's slope turns into well under 1/255 of opacity per sample; the 2/255 bound holds.
+    assert_close("int16 as f16", &image, &reference, 0.2);
+}
+
+#[test]
+fn camera_beyond_the_default_far_plane_still_sees_the_volume() {
+    // Distance 150 is past the camera's nominal far plane (100): the clip planes follow the
+    // camera, so the volume is drawn, not clipped away to a black image. A narrow field of view
+    // keeps the volume large on screen.
+    let (v, tf) = ml();
+    let camera = OrbitCamera { distance: 150.0, fov_y_deg: 0.5, ..OrbitCamera::default() };
+    let (image, reference) = render(&v, &tf, &camera, CompileOptions::new(SIZE, SIZE));
+    assert_close("far camera", &image, &reference, 0.2);
 }

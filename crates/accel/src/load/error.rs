@@ -47,6 +47,69 @@ pub enum LoadError {
         source: std::io::Error,
     },
 
+    /// The path is a directory, a FIFO, a socket or a device rather than a file.
+    #[error("{}: is {what}, not a volume file; give the path of a .raw, .nrrd, .nhdr, .mhd or .mha file", .path.display())]
+    NotAFile {
+        /// The path.
+        path: PathBuf,
+        /// `"a directory"`, `"a FIFO (named pipe)"`, ...
+        what: &'static str,
+    },
+
+    /// A detached data file named in the header cannot be read.
+    #[error("{at}: the header's {field} \"{name}\" points to {}, which cannot be read: {source}", .path.display())]
+    DataFile {
+        /// The header file and the line naming the data file.
+        at: Location,
+        /// `data file` or `ElementDataFile`.
+        field: &'static str,
+        /// The name as written in the header.
+        name: String,
+        /// The resolved path.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+
+    /// Raw layout options given for a file whose header describes the layout.
+    #[error(
+        "{}: {options} describe headerless .raw files, but this file has a header that gives the layout; \
+         remove {options} (--spacing alone may override a header)",
+        .path.display()
+    )]
+    RawOptionsOnHeader {
+        /// The file.
+        path: PathBuf,
+        /// The options given, as the command line spells them (`--dims, --dtype`).
+        options: String,
+    },
+
+    /// Direction vectors that are rotated or oblique to the grid axes.
+    #[error(
+        "{at}: {field} {value} are not along the volume's axes; volgraph renders axis-aligned grids \
+         (flips and axis swaps are honoured): resample the volume onto an axis-aligned grid (e.g. 3D Slicer's \
+         \"Resample Scalar Volume\") or write axis vectors such as (1,0,0) (0,-1,0) (0,0,2)"
+    )]
+    ObliqueAxes {
+        /// The header line.
+        at: Location,
+        /// `space directions` or `TransformMatrix`.
+        field: String,
+        /// The directions, as read.
+        value: String,
+    },
+
+    /// Two direction vectors along the same axis.
+    #[error("{at}: {field} {value} put two file axes along the same world axis; each axis needs its own direction")]
+    DegenerateAxes {
+        /// The header line.
+        at: Location,
+        /// `space directions` or `TransformMatrix`.
+        field: String,
+        /// The directions, as read.
+        value: String,
+    },
+
     /// The extension is not one of the supported formats.
     #[error(
         "{}: unknown volume format \"{extension}\"; use .raw, .nrrd, .nhdr, .mhd or .mha",
@@ -63,7 +126,8 @@ pub enum LoadError {
     /// [`super::RawOptions`].
     #[error(
         "{}: cannot tell the voxel {what} of a raw file; name the file like \
-         `name_256x256x128_uint8.raw` (types: uint8, uint16, int16, float32) or set RawOptions::{field}",
+         `name_256x256x128_uint8.raw` (types: uint8, uint16, int16, float32) or give it with --{field} \
+         (RawOptions::{field} in code)",
         .path.display()
     )]
     RawUnknownLayout {

@@ -4,9 +4,11 @@
 //! Read: `NDims`, `DimSize`, `ElementSpacing` (or `ElementSize` when there is no spacing),
 //! `ElementType`, `ElementByteOrderMSB` / `BinaryDataByteOrderMSB`, `HeaderSize` (detached data
 //! only; -1 = data at the end of the file), `CompressedData` (zlib), `BinaryData`,
-//! `ElementNumberOfChannels` (must be 1) and `ElementDataFile`, which must be the last field.
-//! Every other key (`ObjectType`, `Offset`, `TransformMatrix`, `AnatomicalOrientation`, …) is
-//! ignored: MetaImage headers carry free-form keys.
+//! `ElementNumberOfChannels` (must be 1), `TransformMatrix` (`Rotation`, `Orientation`: the
+//! direction of each file axis; flips and axis swaps are honoured by reordering the voxels,
+//! rotated or oblique directions are rejected, see [`super::AxisOrientation`]) and
+//! `ElementDataFile`, which must be the last field. Every other key (`ObjectType`, `Offset`,
+//! `AnatomicalOrientation`, …) is ignored: MetaImage headers carry free-form keys.
 
 use std::path::Path;
 
@@ -15,7 +17,7 @@ use glam::DVec3;
 use super::error::clip;
 use super::{
     Endianness, Layout, LoadError, LoadReport, LoadedVolume, Location, VolumeFormat, byte_count, check_dims,
-    check_spacing, finish, header_lines, inflate, read_file, sibling, stem,
+    check_spacing, finish, header_lines, inflate, read_data_file, read_file, stem,
 };
 use crate::volume::VoxelType;
 
@@ -47,7 +49,8 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
     let mut order = Endianness::Little;
     let mut header_size: i64 = 0;
     let mut compressed = false;
-    let mut data_file: Option<(String, usize)> = None;
+    let mut data_file: Option<(String, usize, usize)> = None;
+    let mut directions: Option<(usize, [DVec3; 3])> = None;
     let mut notes = Vec::new();
 
     for (number, text, end) in header_lines(bytes) {
@@ -119,6 +122,16 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
                     .filter(|&n| n >= -1)
                     .ok_or_else(|| bad("a whole number ≥ 0, or -1 for data at the end of the file"))?;
             }
+            "transformmatrix" | "rotation" | "orientation" => {
+                let parsed: Option<Vec<f64>> = value.split_whitespace().map(|s| s.parse().ok()).collect();
+                match parsed.as_deref() {
+                    Some(&[a, b, c, d, e, f, g, h, i]) => {
+                        // Row k is the world direction of file axis k (ITK's MetaImageIO).
+                        directions = Some((number, [DVec3::new(a, b, c), DVec3::new(d, e, f), DVec3::new(g, h, i)]));
+                    }
+                    _ => return Err(bad("nine numbers, e.g. `TransformMatrix = 1 0 0 0 1 0 0 0 1`")),
+                }
+            }
             "compresseddata" => {
                 compressed = boolean(value).ok_or_else(|| bad("`True` or `False`"))?;
             }
@@ -148,7 +161,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
                         hint: "use `LOCAL` or a single data file name; join slice files into one",
                     });
                 }
-                data_file = Some((value.to_string(), end));
+                data_file = Some((value.to_string(), end, number));
                 break; // ElementDataFile ends the header.
             }
             _ => {}
@@ -161,14 +174,28 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
     }
     let (sizes_line, sizes, sizes_text) = sizes.ok_or_else(|| missing("DimSize", "DimSize = 64 64 64"))?;
     let dtype = dtype.ok_or_else(|| missing("ElementType", "ElementType = MET_UCHAR"))?;
-    let (data_name, data_start) = data_file.ok_or_else(|| missing("ElementDataFile", "ElementDataFile = LOCAL"))?;
+    let (data_name, data_start, data_line) =
+        data_file.ok_or_else(|| missing("ElementDataFile", "ElementDataFile = LOCAL"))?;
     let dims = check_dims(&Location::line(path, sizes_line), "DimSize", &sizes_text, sizes)?;
-    let spacing = match spacing.or(element_size) {
+    let file_spacing = match spacing.or(element_size) {
         Some((line, s)) => {
             check_spacing(&Location::line(path, line), s)?;
             s
         }
         None => DVec3::ONE,
+    };
+    // The matrix gives directions; the spacing stays ElementSpacing's, moved to world axes.
+    let (orientation, spacing) = match directions {
+        Some((line, d)) => {
+            let unit = d.map(|v| v.normalize_or_zero());
+            let (o, _) = super::AxisOrientation::from_directions(unit, &Location::line(path, line), "TransformMatrix")?;
+            let mut world = DVec3::ONE;
+            for i in 0..3 {
+                world[o.world_axis[i]] = file_spacing[i];
+            }
+            (o, world)
+        }
+        None => (super::AxisOrientation::default(), file_spacing),
     };
 
     let local = data_name.eq_ignore_ascii_case("LOCAL");
@@ -178,9 +205,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
         }
         (path.to_path_buf(), bytes.get(data_start..).unwrap_or(&[]).to_vec())
     } else {
-        let p = sibling(path, &data_name);
-        let all = read_file(&p)?;
-        (p, all)
+        read_data_file(path, Location::line(path, data_line), "ElementDataFile", &data_name)?
     };
     let expected = byte_count(dims, dtype).unwrap_or(u64::MAX);
     let data = if compressed {
@@ -196,6 +221,6 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
     };
     let mut report = LoadReport::new(VolumeFormat::MetaImage, &data_path);
     report.notes = notes;
-    let layout = Layout { name: stem(path), dims, dtype, order, spacing };
+    let layout = Layout { name: stem(path), dims, dtype, order, spacing, orientation };
     finish(layout, &data, &data_path, report, HINT)
 }

@@ -15,6 +15,7 @@
 mod error;
 mod metaimage;
 mod nrrd;
+mod orientation;
 mod raw;
 
 use std::io::Read;
@@ -23,6 +24,7 @@ use std::path::{Path, PathBuf};
 use glam::{DVec3, UVec3};
 
 pub use error::{LoadError, Location};
+pub use orientation::AxisOrientation;
 pub use raw::parse_raw_name;
 
 use crate::volume::{Volume, VoxelData, VoxelType, finite_range};
@@ -110,7 +112,27 @@ pub struct LoadedVolume {
 /// Loads a volume, choosing the format by extension (case-insensitive): `.raw`, `.nrrd`,
 /// `.nhdr`, `.mhd`, `.mha`. `opts` describes raw files; see [`RawOptions`].
 pub fn load_volume(path: &Path, opts: &RawOptions) -> Result<LoadedVolume, LoadError> {
+    // A directory or FIFO is named as such before its (missing) extension is; a path that does
+    // not exist gets the extension check first and the read error after.
+    if path.exists() {
+        check_is_file(path)?;
+    }
     let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+    if matches!(extension.as_str(), "nrrd" | "nhdr" | "mhd" | "mha") {
+        let mut given = Vec::new();
+        if opts.dims.is_some() {
+            given.push("--dims");
+        }
+        if opts.dtype.is_some() {
+            given.push("--dtype");
+        }
+        if opts.endianness != Endianness::Little {
+            given.push("--big-endian");
+        }
+        if !given.is_empty() {
+            return Err(LoadError::RawOptionsOnHeader { path: path.to_path_buf(), options: given.join(", ") });
+        }
+    }
     let mut loaded = match extension.as_str() {
         "raw" => raw::load(path, opts)?,
         "nrrd" | "nhdr" => nrrd::load(path)?,
@@ -175,9 +197,60 @@ pub fn sanitize_volume(volume: &mut Volume) -> (usize, usize, usize) {
     (nan, pos, neg)
 }
 
+/// Fails unless `path` is a regular file (or a link to one): a directory or a FIFO would
+/// otherwise surface as a puzzling size error, or block.
+fn check_is_file(path: &Path) -> Result<(), LoadError> {
+    let meta = std::fs::metadata(path).map_err(|source| LoadError::Io { path: path.to_path_buf(), source })?;
+    let kind = meta.file_type();
+    if kind.is_file() {
+        return Ok(());
+    }
+    let what = if kind.is_dir() {
+        "a directory"
+    } else {
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::FileTypeExt;
+            if kind.is_fifo() {
+                "a FIFO (named pipe)"
+            } else if kind.is_socket() {
+                "a socket"
+            } else if kind.is_block_device() || kind.is_char_device() {
+                "a device"
+            } else {
+                "not a regular file"
+            }
+        }
+        #[cfg(not(unix))]
+        {
+            "not a regular file"
+        }
+    };
+    Err(LoadError::NotAFile { path: path.to_path_buf(), what })
+}
+
 /// Reads a whole file, mapping the error to [`LoadError::Io`].
 fn read_file(path: &Path) -> Result<Vec<u8>, LoadError> {
+    check_is_file(path)?;
     std::fs::read(path).map_err(|source| LoadError::Io { path: path.to_path_buf(), source })
+}
+
+/// Reads the detached data file `name` that header line `at` names (`field`).
+fn read_data_file(
+    header: &Path,
+    at: Location,
+    field: &'static str,
+    name: &str,
+) -> Result<(PathBuf, Vec<u8>), LoadError> {
+    let path = sibling(header, name);
+    let as_data_file_error = |e: LoadError| match e {
+        LoadError::Io { path, source } => {
+            LoadError::DataFile { at: at.clone(), field, name: name.to_string(), path, source }
+        }
+        other => other,
+    };
+    let bytes = read_file(&path).map_err(as_data_file_error)?;
+    Ok((path, bytes))
 }
 
 /// The checked dimensions of a header (`field = value` at `at`): no zero axis, each at most
@@ -272,10 +345,14 @@ fn decode(bytes: &[u8], dtype: VoxelType, order: Endianness) -> VoxelData {
 /// sanitize floats and build the volume and report.
 struct Layout {
     name: String,
+    /// Voxels per file axis.
     dims: UVec3,
     dtype: VoxelType,
     order: Endianness,
+    /// Spacing along world x, y, z.
     spacing: DVec3,
+    /// How file axes lie in the world (headers with direction vectors).
+    orientation: AxisOrientation,
 }
 
 fn finish(
@@ -296,8 +373,15 @@ fn finish(
             hint,
         });
     }
-    let voxels = decode(data, layout.dtype, layout.order);
-    let mut volume = Volume::new(layout.name, layout.dims, layout.spacing, voxels);
+    let voxels = layout.orientation.reorder(layout.dims, decode(data, layout.dtype, layout.order));
+    if !layout.orientation.is_identity() {
+        report.notes.push(format!(
+            "voxels reordered to world axes ({}): flips and axis swaps in the header are honoured",
+            layout.orientation.describe()
+        ));
+    }
+    let dims = layout.orientation.world_dims(layout.dims);
+    let mut volume = Volume::new(layout.name, dims, layout.spacing, voxels);
     let (nan, pos, neg) = sanitize_volume(&mut volume);
     report.nan_replaced = nan;
     report.pos_inf_replaced = pos;
@@ -320,7 +404,8 @@ fn sibling(header: &Path, name: &str) -> PathBuf {
 /// offset just past the line end)`. Lines are decoded lossily; the caller decides where the
 /// header stops.
 fn header_lines(bytes: &[u8]) -> impl Iterator<Item = (usize, String, usize)> + '_ {
-    let mut start = 0usize;
+    // A UTF-8 byte-order mark (editors on Windows write one) is not part of the first line.
+    let mut start = if bytes.starts_with(&[0xEF, 0xBB, 0xBF]) { 3 } else { 0 };
     let mut number = 0usize;
     std::iter::from_fn(move || {
         if start >= bytes.len() {

@@ -2,7 +2,8 @@
 //! (`data file:`), raw or gzip encoding, 3D scalar volumes only.
 //!
 //! Read: `type`, `dimension`, `sizes`, `spacings` or `space directions` (spacing = length of each
-//! direction vector), `endian` (little when missing, noted in the report), `encoding`,
+//! direction vector; flips and axis swaps are honoured by reordering the voxels, rotated or oblique
+//! directions are rejected: see [`super::AxisOrientation`]), `endian` (little when missing, noted in the report), `encoding`,
 //! `data file`, `byte skip` (≥ 0, or -1 with raw encoding: data at the end of the file) and
 //! `line skip: 0`. Ignored as harmless: comments, `key:=value` pairs, `content`, `space`,
 //! `space origin`, `kinds`, `labels`, `units`, `centers` and the other per-axis or range
@@ -15,7 +16,7 @@ use glam::DVec3;
 use super::error::clip;
 use super::{
     Endianness, Layout, LoadError, LoadReport, LoadedVolume, Location, VolumeFormat, byte_count, check_dims,
-    check_spacing, finish, header_lines, inflate, read_file, sibling, stem,
+    check_spacing, finish, header_lines, inflate, read_data_file, read_file, stem,
 };
 use crate::volume::VoxelType;
 
@@ -86,9 +87,10 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
     let mut dimension_seen = false;
     let mut sizes: Option<(usize, [u64; 3], String)> = None;
     let mut spacing: Option<(usize, DVec3)> = None;
+    let mut orientation = super::AxisOrientation::default();
     let mut order = None;
     let mut encoding = None;
-    let mut data_file: Option<String> = None;
+    let mut data_file: Option<(String, usize)> = None;
     let mut byte_skip: i64 = 0;
     let mut data_start = None;
     let mut notes = Vec::new();
@@ -149,8 +151,10 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
                 }
             }
             "space directions" => {
-                let lengths = parse_directions(value)
+                let directions = parse_directions(value)
                     .ok_or_else(|| bad("three vectors, e.g. `space directions: (1,0,0) (0,1,0) (0,0,1.5)`"))?;
+                let (o, lengths) = super::AxisOrientation::from_directions(directions, &at, "space directions")?;
+                orientation = o;
                 spacing = Some((number, lengths));
             }
             "endian" => {
@@ -182,7 +186,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
                         hint: "only a single data file is supported; join the slices into one file",
                     });
                 }
-                data_file = Some(value.to_string());
+                data_file = Some((value.to_string(), number));
             }
             "byte skip" | "byteskip" => {
                 byte_skip = value
@@ -245,11 +249,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
     }
 
     let (data_path, stored) = match &data_file {
-        Some(name) => {
-            let p = sibling(path, name);
-            let bytes = read_file(&p)?;
-            (p, bytes)
-        }
+        Some((name, line)) => read_data_file(path, Location::line(path, *line), "data file", name)?,
         None => match data_start {
             Some(start) => (path.to_path_buf(), bytes.get(start..).unwrap_or(&[]).to_vec()),
             None if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("nhdr")) => {
@@ -276,23 +276,26 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
     };
     let mut report = LoadReport::new(VolumeFormat::Nrrd, &data_path);
     report.notes = notes;
-    let layout = Layout { name: stem(path), dims, dtype, order, spacing };
+    let layout = Layout { name: stem(path), dims, dtype, order, spacing, orientation };
     finish(layout, data, &data_path, report, HINT)
 }
 
-/// Lengths of the three vectors of a `space directions` value such as `(1,0,0) (0,1,0) (0,0,2)`.
-fn parse_directions(value: &str) -> Option<DVec3> {
+/// The three vectors of a `space directions` value such as `(1,0,0) (0,1,0) (0,0,2)`.
+fn parse_directions(value: &str) -> Option<[DVec3; 3]> {
     let compact: String = value.chars().filter(|c| !c.is_whitespace()).collect();
     let inner = compact.strip_prefix('(')?.strip_suffix(')')?;
-    let lengths: Option<Vec<f64>> = inner
+    let vectors: Option<Vec<DVec3>> = inner
         .split(")(")
         .map(|vector| {
             let components: Option<Vec<f64>> = vector.split(',').map(|c| c.parse().ok()).collect();
-            components.map(|c| c.iter().map(|x| x * x).sum::<f64>().sqrt())
+            match components.as_deref() {
+                Some(&[x, y, z]) => Some(DVec3::new(x, y, z)),
+                _ => None,
+            }
         })
         .collect();
-    match lengths.as_deref() {
-        Some(&[x, y, z]) => Some(DVec3::new(x, y, z)),
+    match vectors.as_deref() {
+        Some(&[a, b, c]) => Some([a, b, c]),
         _ => None,
     }
 }

@@ -63,7 +63,8 @@ pub(super) fn load(path: &Path, opts: &RawOptions) -> Result<LoadedVolume, LoadE
         };
     let dims = check_dims(&at, "dims", &format!("{}x{}x{}", dims[0], dims[1], dims[2]), dims)?;
     let expected = byte_count(dims, dtype).unwrap_or(u64::MAX);
-    let hint = "check the dimensions and type in the file name (name_XxYxZ_dtype.raw) or in RawOptions";
+    let hint = "check the dimensions and type in the file name (name_XxYxZ_dtype.raw), or give them with \
+                --dims XxYxZ --dtype TYPE (RawOptions::dims and ::dtype in code)";
     // Compare sizes before reading, so a wrong name never makes us read a huge file for nothing.
     let actual = std::fs::metadata(path).map_err(|source| LoadError::Io { path: path.to_path_buf(), source })?.len();
     if actual != expected {
@@ -77,6 +78,7 @@ pub(super) fn load(path: &Path, opts: &RawOptions) -> Result<LoadedVolume, LoadE
         });
     }
     let bytes = read_file(path)?;
-    let layout = Layout { name, dims, dtype, order: opts.endianness, spacing: DVec3::ONE };
+    let layout =
+        Layout { name, dims, dtype, order: opts.endianness, spacing: DVec3::ONE, orientation: Default::default() };
     finish(layout, &bytes, path, LoadReport::new(VolumeFormat::Raw, path), hint)
 }

@@ -60,7 +60,29 @@ fn interpolate<const N: usize>(rows: &[(f64, [f64; N])], x: f64) -> [f64; N] {
     }
 }
 
-pub(super) fn parse(text: &str, path: &Path) -> Result<TransferFunction, TfError> {
+/// One colour map chosen from a ParaView file, with what the user should know about the choice.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParaviewColorMap {
+    /// The transfer function.
+    pub tf: TransferFunction,
+    /// The map's `"Name"`, when it has one.
+    pub name: Option<String>,
+    /// Its index in the file's array (0 for a single object).
+    pub index: usize,
+    /// Every map's name (or `#i` for unnamed ones), in file order.
+    pub all: Vec<String>,
+    /// What was approximated (midpoint/sharpness other than linear), one sentence each.
+    pub notes: Vec<String>,
+}
+
+fn map_label(map: &Value, i: usize) -> String {
+    map.get("Name").and_then(Value::as_str).map_or_else(|| format!("#{i}"), str::to_string)
+}
+
+/// Parses ParaView colour-map JSON and picks map `wanted` (its `"Name"`, or `#i`), the first
+/// when `None`.
+pub(super) fn parse_map(text: &str, path: &Path, wanted: Option<&str>) -> Result<ParaviewColorMap, TfError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let root: Value = serde_json::from_str(text).map_err(|e| {
         // serde_json appends " at line L column C"; the location is shown in front instead.
         let full = e.to_string();
@@ -68,12 +90,28 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<TransferFunction, TfError
         TfError::Json { path: path.to_path_buf(), line: e.line(), col: e.column(), message }
     })?;
     let fail = |message: String| TfError::Paraview { path: path.to_path_buf(), message };
-    let map = match &root {
-        Value::Array(items) => items
-            .first()
-            .ok_or_else(|| fail("the JSON array is empty; it needs one colour map object with \"RGBPoints\"".into()))?,
-        other => other,
+    let maps: Vec<&Value> = match &root {
+        Value::Array(items) => items.iter().collect(),
+        other => vec![other],
     };
+    if maps.is_empty() {
+        return Err(fail("the JSON array is empty; it needs one colour map object with \"RGBPoints\"".into()));
+    }
+    let all: Vec<String> = maps.iter().enumerate().map(|(i, m)| map_label(m, i)).collect();
+    let index = match wanted {
+        None => 0,
+        Some(w) => all.iter().position(|n| n == w).ok_or_else(|| {
+            let list = all.iter().map(|n| format!("\"{n}\"")).collect::<Vec<_>>().join(", ");
+            let guess = all
+                .iter()
+                .map(|n| (strsim::normalized_levenshtein(w, n), n))
+                .filter(|(score, _)| *score >= 0.6)
+                .max_by(|a, b| a.0.total_cmp(&b.0))
+                .map_or(String::new(), |(_, g)| format!("did you mean \"{g}\"? "));
+            fail(format!("holds no colour map named \"{w}\"; {guess}it holds: {list}"))
+        })?,
+    };
+    let map = maps[index];
     let Some(object) = map.as_object() else {
         return Err(fail("expected a colour map object (or an array of them) with \"RGBPoints\"".into()));
     };
@@ -82,6 +120,35 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<TransferFunction, TfError
         Some(_) => Some(quads(object, "Points", "x, alpha, midpoint, sharpness").map_err(&fail)?),
         None => None,
     };
+    // Same rule as the RON format: colours and opacities are in [0, 1], never clamped silently.
+    for (i, q) in rgb.iter().enumerate() {
+        for (k, channel) in ["r", "g", "b"].iter().enumerate() {
+            let v = q[k + 1];
+            if !(0.0..=1.0).contains(&v) {
+                return Err(fail(format!(
+                    "RGBPoints point {i} ({channel}, RGBPoints[{}]) = {v} is outside [0, 1]; ParaView colours are sRGB in 0..1",
+                    4 * i + k + 1
+                )));
+            }
+        }
+    }
+    let mut notes = Vec::new();
+    for (i, q) in opacity.iter().flatten().enumerate() {
+        if !(0.0..=1.0).contains(&q[1]) {
+            return Err(fail(format!(
+                "Points point {i} (alpha, Points[{}]) = {} is outside [0, 1]; opacity is in 0..1",
+                4 * i + 1,
+                q[1]
+            )));
+        }
+        if (q[2] - 0.5).abs() > 1e-9 || q[3].abs() > 1e-9 {
+            notes.push(format!(
+                "Points point {i} has midpoint {} and sharpness {}; volgraph interpolates opacity linearly \
+                 (midpoint 0.5, sharpness 0)",
+                q[2], q[3]
+            ));
+        }
+    }
 
     let xs_rgb = rgb.iter().map(|q| q[0]);
     let xs_alpha = opacity.iter().flatten().map(|q| q[0]);
@@ -97,7 +164,7 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<TransferFunction, TfError
 
     let colors: Vec<(f64, [f64; 3])> = rgb.iter().map(|q| (q[0], [q[1], q[2], q[3]].map(srgb_to_linear))).collect();
     let alphas: Vec<(f64, [f64; 1])> = match &opacity {
-        Some(points) => points.iter().map(|q| (q[0], [q[1].clamp(0.0, 1.0)])).collect(),
+        Some(points) => points.iter().map(|q| (q[0], [q[1]])).collect(),
         None => vec![(lo, [0.0]), (hi, [1.0])],
     };
     let points = xs
@@ -110,5 +177,6 @@ pub(super) fn parse(text: &str, path: &Path) -> Result<TransferFunction, TfError
         .collect();
     let tf = TransferFunction { domain: (lo, hi), points };
     tf.validate(path)?;
-    Ok(tf)
+    let name = map.get("Name").and_then(Value::as_str).map(str::to_string);
+    Ok(ParaviewColorMap { tf, name, index, all, notes })
 }

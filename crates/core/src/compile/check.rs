@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use petgraph::graph::{DiGraph, NodeIndex};
 
-use super::CompileOptions;
+use super::{CompileOptions, MAX_REPEAT_ITERATIONS};
 use crate::diagnostic::{Diagnostic, Location};
 use crate::format::{TargetFormat, TargetSize};
 use crate::graph::ast::{GraphDoc, HistoryInitial, InputKind, NodeDoc, PassDoc, RepeatCount};
@@ -79,6 +79,10 @@ pub(crate) struct Checked {
     pub outputs: BTreeMap<String, Ref>,
     pub history: BTreeMap<String, (Ref, HistoryInitial)>,
     pub inputs: BTreeMap<String, InputKind>,
+    /// Problems that do not stop compiling (a repeat count capped by its max).
+    pub warnings: Vec<Diagnostic>,
+    /// Scene values a repeat count reads that the graph does not declare as Scalar inputs.
+    pub scene_values: Vec<String>,
 }
 
 const RESERVED: [&str; 2] = ["input", "history"];
@@ -90,6 +94,7 @@ struct Checker<'a> {
     registry: &'a Registry,
     options: &'a CompileOptions,
     diags: Vec<Diagnostic>,
+    warnings: Vec<Diagnostic>,
     passes: Vec<PassInfo>,
     groups: Vec<GroupInfo>,
     pass_by_id: HashMap<String, usize>,
@@ -109,6 +114,7 @@ pub(crate) fn check(
         registry,
         options,
         diags: Vec::new(),
+        warnings: Vec::new(),
         passes: Vec::new(),
         groups: Vec::new(),
         pass_by_id: HashMap::new(),
@@ -133,7 +139,27 @@ pub(crate) fn check(
         c.check_cycles();
     }
     if c.diags.is_empty() {
-        Ok(Checked { passes: c.passes, groups: c.groups, order, outputs, history, inputs: doc.inputs.clone() })
+        let scene_values = doc
+            .passes
+            .iter()
+            .filter_map(|n| match n {
+                NodeDoc::Repeat(r) => match &r.count {
+                    RepeatCount::Scene { name, .. } if !doc.inputs.contains_key(name) => Some(name.clone()),
+                    _ => None,
+                },
+                NodeDoc::Pass(_) => None,
+            })
+            .collect();
+        Ok(Checked {
+            passes: c.passes,
+            groups: c.groups,
+            order,
+            outputs,
+            history,
+            inputs: doc.inputs.clone(),
+            warnings: c.warnings,
+            scene_values,
+        })
     } else {
         Err(c.diags)
     }
@@ -259,7 +285,31 @@ impl Checker<'_> {
                 );
                 1
             }
+            RepeatCount::Fixed(n) if *n > MAX_REPEAT_ITERATIONS => {
+                self.err(
+                    self.loc.pass_field(path, id, "count"),
+                    format!(
+                        "repeat group \"{id}\" has count {n}, over the limit of {MAX_REPEAT_ITERATIONS} iterations per group"
+                    ),
+                    Some(format!(
+                        "use at most Fixed({MAX_REPEAT_ITERATIONS}) and do more work per iteration \
+                         (volgraph_core::compile::MAX_REPEAT_ITERATIONS)"
+                    )),
+                );
+                1
+            }
             RepeatCount::Fixed(n) => *n,
+            RepeatCount::Scene { max, .. } if *max == 0 || *max > MAX_REPEAT_ITERATIONS => {
+                self.err(
+                    self.loc.pass_field(path, id, "count"),
+                    format!(
+                        "repeat group \"{id}\" has max: {max}; it must be 1..={MAX_REPEAT_ITERATIONS} \
+                         (a group runs at least once, and at most {MAX_REPEAT_ITERATIONS} iterations)"
+                    ),
+                    Some(format!("write max: N with 1 <= N <= {MAX_REPEAT_ITERATIONS}, or leave it out (default 256)")),
+                );
+                1
+            }
             RepeatCount::Scene { name, divide_by, divide_by_input, max } => {
                 let divide_by = match divide_by_input {
                     None => *divide_by,
@@ -311,7 +361,25 @@ impl Checker<'_> {
                     );
                     return 1;
                 }
-                ((value / divide_by).ceil().max(1.0) as u32).min((*max).max(1))
+                let wanted = (value / divide_by).ceil().max(1.0);
+                if wanted > *max as f64 {
+                    let by = divide_by_input
+                        .as_deref()
+                        .map_or_else(|| divide_by.to_string(), |i| format!("\"{i}\" ({divide_by})"));
+                    self.warnings.push(
+                        Diagnostic::new(
+                            self.loc.pass_field(path, id, "count"),
+                            format!(
+                                "repeat group \"{id}\" needs {wanted} iterations (\"{name}\" = {value} divided by {by}) \
+                                 but is capped at max: {max}; the work past iteration {max} is not done"
+                            ),
+                        )
+                        .with_help(format!(
+                            "raise max (up to {MAX_REPEAT_ITERATIONS}) or do more per iteration (a larger divisor)"
+                        )),
+                    );
+                }
+                wanted.min(*max as f64) as u32
             }
         }
     }

@@ -14,6 +14,14 @@ use crate::diagnostic::Diagnostics;
 use crate::plan::Plan;
 use crate::plugin::Registry;
 
+/// The most iterations one repeat group may have: a bound, so that a typo such as
+/// `Fixed(1000000)` is a located error rather than a hang. Krüger–Westermann's loop on a 4096-voxel
+/// diagonal at half-voxel steps with M = 2 still fits.
+pub const MAX_REPEAT_ITERATIONS: u32 = 4096;
+
+/// The most pass instances a compiled plan may hold (repeat groups unrolled).
+pub const MAX_PLAN_STEPS: usize = 16384;
+
 /// What a graph is compiled for.
 #[derive(Clone, Debug)]
 pub struct CompileOptions {
@@ -66,8 +74,46 @@ impl CompileOptions {
 
 /// Compiles graph text named `file` (used in messages) into a plan.
 pub fn compile(file: &str, source: &str, registry: &Registry, options: &CompileOptions) -> Result<Plan, Diagnostics> {
+    // A UTF-8 byte-order mark (some Windows editors write one) is not part of the graph.
+    let source = source.strip_prefix('\u{feff}').unwrap_or(source);
     let fail = |items| Diagnostics { file: file.to_string(), text: Arc::from(source), items };
     let doc = crate::graph::parse_graph(source).map_err(|d| fail(vec![d]))?;
     let checked = check::check(&doc, source, registry, options).map_err(fail)?;
-    schedule::schedule(&doc, checked, options).map_err(fail)
+    let mut warnings = checked.warnings.clone();
+    let mut plan = schedule::schedule(&doc, checked, options).map_err(fail)?;
+    warnings.extend(unused_option_warnings(&plan, options));
+    plan.warnings = fail(warnings);
+    Ok(plan)
+}
+
+/// Scene features and values the options set that this graph never reads: named, with a
+/// "did you mean" where a known name is close. Applications that take them from a user (the
+/// CLI's `--features` and `--scalar`) treat them as errors.
+fn unused_option_warnings(plan: &Plan, options: &CompileOptions) -> Vec<crate::diagnostic::Diagnostic> {
+    use crate::diagnostic::{Diagnostic, Location};
+    use crate::suggest::{comma_list, guess_then};
+    let mut out = Vec::new();
+    let known: Vec<&str> = plan.known_features.iter().map(String::as_str).collect();
+    for f in options.features.iter().filter(|f| !plan.known_features.contains(*f)) {
+        let help = format!(
+            "this graph's features are: {}",
+            if known.is_empty() { "none".to_string() } else { comma_list(&known) }
+        );
+        out.push(
+            Diagnostic::new(Location::File, format!("feature \"{f}\" is not used by graph \"{}\"", plan.name))
+                .with_help(guess_then(f, known.iter().copied(), "", help)),
+        );
+    }
+    let known: Vec<&str> = plan.known_scalars.iter().map(String::as_str).collect();
+    for name in options.scalars.keys().filter(|n| !plan.known_scalars.contains(*n)) {
+        let help = format!(
+            "this graph's scalars are: {}",
+            if known.is_empty() { "none".to_string() } else { comma_list(&known) }
+        );
+        out.push(
+            Diagnostic::new(Location::File, format!("scalar \"{name}\" is not read by graph \"{}\"", plan.name))
+                .with_help(guess_then(name, known.iter().copied(), "", help)),
+        );
+    }
+    out
 }

@@ -12,8 +12,8 @@
 use std::cmp::Reverse;
 use std::collections::{BTreeMap, BinaryHeap, HashMap};
 
-use super::CompileOptions;
 use super::check::{Checked, Item, Ref, ValueDesc};
+use super::{CompileOptions, MAX_PLAN_STEPS};
 use crate::diagnostic::{Diagnostic, Location};
 use crate::graph::ast::GraphDoc;
 use crate::plan::{Binding, BoundPort, History, Plan, Resource, ResourceDesc, ResourceId, Slot, Step};
@@ -34,6 +34,30 @@ struct Inst {
 }
 
 pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> Result<Plan, Vec<Diagnostic>> {
+    // 0. Bound the unrolled size before allocating anything for it.
+    let total: u64 = c
+        .order
+        .iter()
+        .map(|item| match item {
+            Item::Pass(_) => 1,
+            Item::Group(gi) => c.groups[*gi].count as u64 * c.groups[*gi].members.len() as u64,
+        })
+        .sum();
+    if total > MAX_PLAN_STEPS as u64 {
+        let groups: Vec<String> =
+            c.groups.iter().map(|g| format!("\"{}\" {} × {} passes", g.id, g.count, g.members.len())).collect();
+        return Err(vec![
+            Diagnostic::new(
+                Location::File,
+                format!(
+                    "the graph unrolls to {total} pass instances ({}), over the limit of {MAX_PLAN_STEPS}",
+                    groups.join(", ")
+                ),
+            )
+            .with_help("use fewer repeat iterations (more work per iteration) or fewer passes in the body"),
+        ]);
+    }
+
     // 1. Instances, in document order.
     let mut insts: Vec<Inst> = Vec::new();
     let mut inst_of: HashMap<(usize, Option<u32>), usize> = HashMap::new();
@@ -203,8 +227,11 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
     }
     let needed_count = needed.iter().filter(|x| **x).count();
     if order.len() != needed_count {
-        let stuck: Vec<&str> =
-            (0..n).filter(|&i| needed[i] && !order.contains(&i)).map(|i| insts[i].label.as_str()).collect();
+        let mut ordered = vec![false; n];
+        for &i in &order {
+            ordered[i] = true;
+        }
+        let stuck: Vec<&str> = (0..n).filter(|&i| needed[i] && !ordered[i]).map(|i| insts[i].label.as_str()).collect();
         return Err(vec![
             Diagnostic::new(
                 Location::File,
@@ -311,6 +338,7 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
         {
             resources[id].last_use = usize::MAX;
             persistent_roots.push(root_of(&resources, id));
+            // (one walk per history entry: few, however long the chain)
             history.insert(name.clone(), History { source: id, initial: initial.clone() });
         }
     }
@@ -318,6 +346,10 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
     // 7. Pool targets over chain lifetimes.
     let slots = pool(&mut resources, &persistent_roots);
 
+    let mut pass_needed = vec![false; c.passes.len()];
+    for (i, inst) in insts.iter().enumerate() {
+        pass_needed[inst.pass] |= needed[i];
+    }
     let culled: Vec<String> = {
         let mut ids: Vec<String> = Vec::new();
         for item in &c.order {
@@ -329,7 +361,7 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
                 if !c.passes[pi].enabled {
                     continue;
                 }
-                let any_needed = (0..n).any(|i| insts[i].pass == pi && needed[i]);
+                let any_needed = pass_needed[pi];
                 if !any_needed {
                     ids.push(c.passes[pi].id.clone());
                 }
@@ -355,6 +387,15 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
         slots,
         outputs,
         history,
+        known_features: c.passes.iter().flat_map(|p| p.needs.iter().cloned()).collect(),
+        known_scalars: c
+            .inputs
+            .iter()
+            .filter(|(_, k)| matches!(k, crate::graph::ast::InputKind::Scalar(_)))
+            .map(|(n, _)| n.clone())
+            .chain(c.scene_values.iter().cloned())
+            .collect(),
+        warnings: Default::default(),
     })
 }
 
@@ -383,13 +424,25 @@ fn root_of(resources: &[Resource], mut id: ResourceId) -> ResourceId {
 }
 
 fn pool(resources: &mut [Resource], persistent_roots: &[ResourceId]) -> Vec<Slot> {
+    // Chain roots in one forward pass (a Modify output is always created after the version it
+    // modifies), so a repeat group's carried chain of N versions costs O(N), not O(N²).
+    let mut roots: Vec<ResourceId> = Vec::with_capacity(resources.len());
+    for id in 0..resources.len() {
+        let root = match resources[id].modifies {
+            Some(prev) if prev < id => roots[prev],
+            Some(prev) => root_of(resources, prev),
+            None => id,
+        };
+        roots.push(root);
+    }
+    let persistent: std::collections::BTreeSet<ResourceId> = persistent_roots.iter().copied().collect();
     // Chain lifetimes, keyed by root.
     let mut chains: BTreeMap<ResourceId, (usize, usize, Vec<ResourceId>)> = BTreeMap::new();
     for id in 0..resources.len() {
         if !matches!(resources[id].desc, ResourceDesc::Target { .. }) {
             continue;
         }
-        let root = root_of(resources, id);
+        let root = roots[id];
         let e = chains.entry(root).or_insert((resources[root].producer, 0, Vec::new()));
         e.1 = e.1.max(resources[id].last_use);
         e.2.push(id);
@@ -401,7 +454,7 @@ fn pool(resources: &mut [Resource], persistent_roots: &[ResourceId]) -> Vec<Slot
     let mut busy_until: Vec<usize> = Vec::new();
     for (root, start, end, members) in by_start {
         let ResourceDesc::Target { format, extent, .. } = resources[root].desc else { continue };
-        let persistent = persistent_roots.contains(&root);
+        let persistent = persistent.contains(&root);
         let reuse = if persistent {
             None
         } else {

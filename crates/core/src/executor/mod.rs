@@ -15,8 +15,10 @@ pub use context::{
     RenderPipelineSpec,
 };
 pub use frame_uniforms::FrameUniforms;
-pub use gpu::{Gpu, GpuError};
+pub use gpu::{Gpu, GpuError, GpuFault, GpuFaultKind, GpuOptions};
 pub use readback::Image;
 pub use run::{Executor, ExecutorError, FrameStats};
 pub use shaders::ShaderLibrary;
-pub use upload::{VolumeFormat, upload_lut, upload_volume};
+pub use upload::{
+    UploadError, UploadedVolume, VolumeFormat, VolumeTexels, upload_lut, upload_volume, volume_format_for,
+};

@@ -44,9 +44,9 @@ pub enum ExecutorError {
     /// Texture upload or readback failed.
     #[error("{0}")]
     Transfer(String),
-    /// wgpu reported a validation error while running a frame.
-    #[error("the GPU rejected frame work: {0}")]
-    Validation(String),
+    /// The GPU rejected work (validation, out of memory), with what was being done.
+    #[error(transparent)]
+    Gpu(#[from] super::gpu::GpuFault),
 }
 
 /// A graph input texture bound by the application.
@@ -183,18 +183,22 @@ impl Executor {
                 }
             }
         }
-        let slots = plan
-            .slots
-            .iter()
-            .enumerate()
-            .map(|(i, s)| {
-                let label = format!("slot{i} {}", s.format);
-                let (current, current_view) = create_target(gpu, &label, s.format, s.extent);
-                let previous =
-                    s.persistent.then(|| create_target(gpu, &format!("{label} (previous frame)"), s.format, s.extent));
-                SlotTextures { current, current_view, previous }
-            })
-            .collect();
+        let mut slots = Vec::with_capacity(plan.slots.len());
+        for (i, s) in plan.slots.iter().enumerate() {
+            let label = format!("slot{i} {}", s.format);
+            let held = s.holds.first().map_or(String::new(), |r| format!(" for \"{}\"", plan.resources[*r].name));
+            let textures = gpu.checked(
+                || format!("creating target {label} {}x{}{held}", s.extent.0, s.extent.1),
+                || {
+                    let (current, current_view) = create_target(gpu, &label, s.format, s.extent);
+                    let previous = s
+                        .persistent
+                        .then(|| create_target(gpu, &format!("{label} (previous frame)"), s.format, s.extent));
+                    SlotTextures { current, current_view, previous }
+                },
+            )?;
+            slots.push(textures);
+        }
         let sampler = |label: &str, filter: wgpu::FilterMode| {
             gpu.device.create_sampler(&wgpu::SamplerDescriptor {
                 label: Some(label),
@@ -296,10 +300,33 @@ impl Executor {
         Ok(())
     }
 
-    /// Records, submits and waits for one frame.
+    /// Records, submits and waits for one frame. An error the GPU reports for the frame comes
+    /// back as [`ExecutorError::Gpu`] naming the graph (wgpu's message names the pass label).
     pub fn run_frame(&mut self, gpu: &Gpu) -> Result<FrameStats, ExecutorError> {
         self.check_inputs()?;
-        let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let what = || format!("frame {} of graph \"{}\"", self.frame_index, self.plan.name);
+        let what = what();
+        let wall_ms = gpu.checked(
+            || what,
+            || -> Result<f64, ExecutorError> {
+                let commands = self.record_frame(gpu)?;
+                let start = Instant::now();
+                gpu.queue.submit([commands]);
+                gpu.wait_idle();
+                Ok(start.elapsed().as_secs_f64() * 1e3)
+            },
+        )??;
+        self.frame_index += 1;
+        self.history_valid = true;
+        let step_gpu_ms = match &self.queries {
+            Some((_, _, read)) => Some(read_timestamps(gpu, read, self.plan.steps.len())?),
+            None => None,
+        };
+        let frame_ms = step_gpu_ms.as_ref().map_or(wall_ms, |v| v.iter().sum());
+        Ok(FrameStats { wall_time_fallback: step_gpu_ms.is_none(), step_gpu_ms, frame_ms })
+    }
+
+    fn record_frame(&mut self, gpu: &Gpu) -> Result<wgpu::CommandBuffer, ExecutorError> {
         let mut encoder =
             gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(&self.plan.name) });
         // History pairs: swap, and clear "previous" when there is no previous frame.
@@ -395,21 +422,7 @@ impl Executor {
             encoder.resolve_query_set(set, 0..count, resolve, 0);
             encoder.copy_buffer_to_buffer(resolve, 0, read, 0, count as u64 * 8);
         }
-        let start = Instant::now();
-        gpu.queue.submit([encoder.finish()]);
-        gpu.wait_idle();
-        let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(ExecutorError::Validation(e.to_string()));
-        }
-        self.frame_index += 1;
-        self.history_valid = true;
-        let step_gpu_ms = match &self.queries {
-            Some((_, _, read)) => Some(read_timestamps(gpu, read, plan.steps.len())?),
-            None => None,
-        };
-        let frame_ms = step_gpu_ms.as_ref().map_or(wall_ms, |v| v.iter().sum());
-        Ok(FrameStats { wall_time_fallback: step_gpu_ms.is_none(), step_gpu_ms, frame_ms })
+        Ok(encoder.finish())
     }
 
     /// Reads back a graph output after a frame.

@@ -1,23 +1,33 @@
 //! Uploading graph inputs: the volume as a 3D texture, the transfer function as a LUT.
+//!
+//! The texture format follows what the device offers, with the same normalisation on every path
+//! (`docs/rendering_model.md`, "Volume and world space"): 16-bit voxels go up as R16Unorm where
+//! `TEXTURE_FORMAT_16BIT_NORM` exists, else as R32Float holding `v / 65535` where 32-bit floats
+//! filter, else as R16Float (11 significant bits). Every GPU error comes back as a value.
 
-use super::gpu::Gpu;
+use super::gpu::{Gpu, GpuFault};
 
 /// The voxel formats a volume texture can have.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum VolumeFormat {
     /// 8-bit normalized.
     R8Unorm,
-    /// 16-bit normalized.
+    /// 16-bit normalized (needs `TEXTURE_FORMAT_16BIT_NORM`).
     R16Unorm,
+    /// 16-bit float: the fallback where neither 16-bit normalized nor filterable 32-bit float
+    /// textures exist (relative precision 2⁻¹¹).
+    R16Float,
     /// 32-bit float (linear filtering needs the adapter's FLOAT32_FILTERABLE).
     R32Float,
 }
 
 impl VolumeFormat {
-    fn wgpu(self) -> wgpu::TextureFormat {
+    /// The wgpu format.
+    pub fn wgpu(self) -> wgpu::TextureFormat {
         match self {
             VolumeFormat::R8Unorm => wgpu::TextureFormat::R8Unorm,
             VolumeFormat::R16Unorm => wgpu::TextureFormat::R16Unorm,
+            VolumeFormat::R16Float => wgpu::TextureFormat::R16Float,
             VolumeFormat::R32Float => wgpu::TextureFormat::R32Float,
         }
     }
@@ -25,68 +35,160 @@ impl VolumeFormat {
     fn bytes(self) -> u32 {
         match self {
             VolumeFormat::R8Unorm => 1,
-            VolumeFormat::R16Unorm => 2,
+            VolumeFormat::R16Unorm | VolumeFormat::R16Float => 2,
             VolumeFormat::R32Float => 4,
         }
     }
 }
 
-/// Uploads a volume (`dims`, x fastest, little-endian texels) as a 3D texture.
+/// Normalized voxels ready to upload, x fastest.
+#[derive(Clone, Debug)]
+pub enum VolumeTexels<'a> {
+    /// 8-bit values, `v / 255` in the shader.
+    Unorm8(&'a [u8]),
+    /// 16-bit values, `v / 65535` in the shader (i16 data offset by 32768 first).
+    Unorm16(&'a [u16]),
+    /// Values already normalized to [0, 1].
+    Float(&'a [f32]),
+}
+
+impl VolumeTexels<'_> {
+    fn len(&self) -> usize {
+        match self {
+            VolumeTexels::Unorm8(v) => v.len(),
+            VolumeTexels::Unorm16(v) => v.len(),
+            VolumeTexels::Float(v) => v.len(),
+        }
+    }
+}
+
+/// Why a volume could not be uploaded.
+#[derive(Debug, thiserror::Error)]
+pub enum UploadError {
+    /// A side is zero or beyond the device's 3D texture limit.
+    #[error(
+        "volume \"{label}\" is {}x{}x{}, but this GPU's 3D textures are limited to 1..={max} per side; \
+         bricking (Ruijters–Vilanova) lifts this limit", .dims[0], .dims[1], .dims[2]
+    )]
+    TooLarge {
+        /// The volume's name.
+        label: String,
+        /// Its dimensions.
+        dims: [u32; 3],
+        /// The device limit.
+        max: u32,
+    },
+    /// The voxel count does not match the dimensions.
+    #[error("volume \"{label}\": {given} voxels given, {expected} expected")]
+    Size {
+        /// The volume's name.
+        label: String,
+        /// Voxels given.
+        given: usize,
+        /// Voxels the dimensions need.
+        expected: u64,
+    },
+    /// The GPU rejected the texture or the copy.
+    #[error(transparent)]
+    Gpu(#[from] GpuFault),
+}
+
+/// A volume on the GPU.
+pub struct UploadedVolume {
+    /// The 3D texture.
+    pub texture: wgpu::Texture,
+    /// The format chosen for this device.
+    pub format: VolumeFormat,
+}
+
+/// The texture format `texels` get on `gpu` (see the module documentation).
+pub fn volume_format_for(gpu: &Gpu, texels: &VolumeTexels<'_>) -> VolumeFormat {
+    match texels {
+        VolumeTexels::Unorm8(_) => VolumeFormat::R8Unorm,
+        VolumeTexels::Unorm16(_) if gpu.norm16 => VolumeFormat::R16Unorm,
+        VolumeTexels::Unorm16(_) | VolumeTexels::Float(_) if gpu.float32_filterable => VolumeFormat::R32Float,
+        VolumeTexels::Unorm16(_) | VolumeTexels::Float(_) => VolumeFormat::R16Float,
+    }
+}
+
+/// The bytes of `texels` in `format`.
+fn texel_bytes(texels: &VolumeTexels<'_>, format: VolumeFormat) -> Vec<u8> {
+    let as_f32 = |t: &VolumeTexels<'_>| -> Vec<f32> {
+        match t {
+            VolumeTexels::Unorm8(v) => v.iter().map(|x| *x as f32 / 255.0).collect(),
+            VolumeTexels::Unorm16(v) => v.iter().map(|x| *x as f32 / 65535.0).collect(),
+            VolumeTexels::Float(v) => v.to_vec(),
+        }
+    };
+    match (format, texels) {
+        (VolumeFormat::R8Unorm, VolumeTexels::Unorm8(v)) => v.to_vec(),
+        (VolumeFormat::R16Unorm, VolumeTexels::Unorm16(v)) => bytemuck::cast_slice(v).to_vec(),
+        (VolumeFormat::R32Float, t) => bytemuck::cast_slice(&as_f32(t)).to_vec(),
+        (VolumeFormat::R16Float, t) => {
+            let halves: Vec<u16> = as_f32(t).into_iter().map(f32_to_f16).collect();
+            bytemuck::cast_slice(&halves).to_vec()
+        }
+        // Unorm formats only ever hold their own kind (volume_format_for); widen anything else.
+        (_, t) => bytemuck::cast_slice(&as_f32(t)).to_vec(),
+    }
+}
+
+/// Uploads a volume (`dims`, x fastest) as a 3D texture in the format [`volume_format_for`]
+/// picks for this device.
 pub fn upload_volume(
     gpu: &Gpu,
     label: &str,
     dims: [u32; 3],
-    format: VolumeFormat,
-    bytes: &[u8],
-) -> Result<wgpu::Texture, String> {
+    texels: &VolumeTexels<'_>,
+) -> Result<UploadedVolume, UploadError> {
     let max = gpu.limits.max_texture_dimension_3d;
     if dims.iter().any(|d| *d == 0 || *d > max) {
-        return Err(format!(
-            "volume \"{label}\" is {}x{}x{}, but this GPU's 3D textures are limited to 1..={max} per side; \
-             bricking (Ruijters–Vilanova) lifts this limit",
-            dims[0], dims[1], dims[2]
-        ));
+        return Err(UploadError::TooLarge { label: label.to_string(), dims, max });
     }
-    if format == VolumeFormat::R32Float && !gpu.float32_filterable {
-        return Err(format!(
-            "volume \"{label}\" is float32, but this GPU cannot filter 32-bit float textures; convert it to 16-bit"
-        ));
+    let expected = dims[0] as u64 * dims[1] as u64 * dims[2] as u64;
+    if texels.len() as u64 != expected {
+        return Err(UploadError::Size { label: label.to_string(), given: texels.len(), expected });
     }
-    let expected = dims[0] as u64 * dims[1] as u64 * dims[2] as u64 * format.bytes() as u64;
-    if bytes.len() as u64 != expected {
-        return Err(format!("volume \"{label}\": {} bytes given, {expected} expected", bytes.len()));
-    }
-    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d { width: dims[0], height: dims[1], depth_or_array_layers: dims[2] },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D3,
-        format: format.wgpu(),
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
-    gpu.queue.write_texture(
-        wgpu::TexelCopyTextureInfo {
-            texture: &texture,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect: wgpu::TextureAspect::All,
+    let format = volume_format_for(gpu, texels);
+    let bytes = texel_bytes(texels, format);
+    let size = wgpu::Extent3d { width: dims[0], height: dims[1], depth_or_array_layers: dims[2] };
+    let texture = gpu.checked(
+        || format!("uploading volume \"{label}\" ({}x{}x{} {format:?})", dims[0], dims[1], dims[2]),
+        || {
+            let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D3,
+                format: format.wgpu(),
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            });
+            gpu.queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d::ZERO,
+                    aspect: wgpu::TextureAspect::All,
+                },
+                &bytes,
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(dims[0] * format.bytes()),
+                    rows_per_image: Some(dims[1]),
+                },
+                size,
+            );
+            texture
         },
-        bytes,
-        wgpu::TexelCopyBufferLayout {
-            offset: 0,
-            bytes_per_row: Some(dims[0] * format.bytes()),
-            rows_per_image: Some(dims[1]),
-        },
-        wgpu::Extent3d { width: dims[0], height: dims[1], depth_or_array_layers: dims[2] },
-    );
-    Ok(texture)
+    )?;
+    Ok(UploadedVolume { texture, format })
 }
 
 /// Uploads an RGBA LUT as an `N × 1` texture: Rgba32Float where the adapter filters 32-bit
 /// floats, else Rgba16Float.
-pub fn upload_lut(gpu: &Gpu, label: &str, rgba: &[[f32; 4]]) -> wgpu::Texture {
+pub fn upload_lut(gpu: &Gpu, label: &str, rgba: &[[f32; 4]]) -> Result<wgpu::Texture, GpuFault> {
     let width = rgba.len().max(1) as u32;
     let (format, bytes): (wgpu::TextureFormat, Vec<u8>) = if gpu.float32_filterable {
         (wgpu::TextureFormat::Rgba32Float, bytemuck::cast_slice(rgba).to_vec())
@@ -94,29 +196,35 @@ pub fn upload_lut(gpu: &Gpu, label: &str, rgba: &[[f32; 4]]) -> wgpu::Texture {
         let halves: Vec<u16> = rgba.iter().flatten().map(|v| f32_to_f16(*v)).collect();
         (wgpu::TextureFormat::Rgba16Float, bytemuck::cast_slice(&halves).to_vec())
     };
-    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d { width, height: 1, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
     let bpp = format.block_copy_size(None).unwrap_or(16);
-    gpu.queue.write_texture(
-        wgpu::TexelCopyTextureInfo {
-            texture: &texture,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect: wgpu::TextureAspect::All,
+    let size = wgpu::Extent3d { width, height: 1, depth_or_array_layers: 1 };
+    gpu.checked(
+        || format!("uploading the transfer-function LUT \"{label}\" ({width} entries)"),
+        || {
+            let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            });
+            gpu.queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d::ZERO,
+                    aspect: wgpu::TextureAspect::All,
+                },
+                &bytes,
+                wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(width * bpp), rows_per_image: Some(1) },
+                size,
+            );
+            texture
         },
-        &bytes,
-        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(width * bpp), rows_per_image: Some(1) },
-        wgpu::Extent3d { width, height: 1, depth_or_array_layers: 1 },
-    );
-    texture
+    )
 }
 
 /// IEEE single → half, round to nearest even (for the f16 LUT fallback).

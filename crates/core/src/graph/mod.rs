@@ -89,6 +89,14 @@ fn explain_ron_error(code: &ron::Error) -> (String, Option<String>) {
             "expected `)` or `,` here".to_string(),
             Some("close the parenthesis with `)`, or put `,` between its fields".to_string()),
         ),
+        E::ExceededRecursionLimit => (
+            "brackets nest more than 128 levels deep here".to_string(),
+            Some(
+                "a graph file needs only a few levels of `(`, `[` and `{`; look for brackets opened here and never \
+                 closed, or a generated value nested too deeply"
+                    .to_string(),
+            ),
+        ),
         E::ExpectedStringEnd => ("this string is never closed".to_string(), Some("end it with `\"`".to_string())),
         E::UnclosedBlockComment => ("this comment is never closed".to_string(), Some("end it with `*/`".to_string())),
         E::TrailingCharacters => (

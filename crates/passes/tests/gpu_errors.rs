@@ -1,0 +1,72 @@
+//! wgpu's default error handler panics; volgraph turns every GPU error into a value that names
+//! what was being done (issue "bad input never crashes"). Each test provokes one real error.
+
+use volgraph_core::executor::{Executor, ExecutorError, GpuFaultKind, GpuOptions, ShaderLibrary, VolumeTexels};
+use volgraph_core::shader_source::default_shader_root;
+use volgraph_core::{CompileOptions, compile};
+use volgraph_passes::builtin_registry;
+
+mod support;
+
+use support::{gpu, graph_source};
+
+#[test]
+fn a_texture_the_device_cannot_make_is_a_fault_not_a_panic() {
+    let gpu = volgraph_core::executor::Gpu::new_headless_with(&GpuOptions {
+        without_features: wgpu::Features::TEXTURE_FORMAT_16BIT_NORM,
+    })
+    .expect("a Vulkan adapter");
+    let fault = gpu
+        .checked(
+            || "making an R16Unorm texture".to_string(),
+            || {
+                gpu.device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some("r16"),
+                    size: wgpu::Extent3d { width: 4, height: 4, depth_or_array_layers: 4 },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D3,
+                    format: wgpu::TextureFormat::R16Unorm,
+                    usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                    view_formats: &[],
+                })
+            },
+        )
+        .expect_err("R16Unorm needs TEXTURE_FORMAT_16BIT_NORM");
+    assert_eq!(fault.kind, GpuFaultKind::Validation);
+    let text = fault.to_string();
+    assert!(text.starts_with("making an R16Unorm texture: the GPU rejected it:"), "{text}");
+    // The device keeps working after a captured error.
+    assert!(gpu.checked(|| "nothing".to_string(), || ()).is_ok());
+}
+
+#[test]
+fn a_volume_over_the_texture_limit_names_the_volume_and_the_limit() {
+    let gpu = gpu();
+    let side = gpu.limits.max_texture_dimension_3d + 1;
+    let texels = vec![0u8; side as usize];
+    let err = volgraph_core::executor::upload_volume(&gpu, "tall", [1, 1, side], &VolumeTexels::Unorm8(&texels))
+        .err()
+        .expect("over the limit");
+    let text = err.to_string();
+    assert!(text.contains("volume \"tall\" is 1x1x") && text.contains("bricking"), "{text}");
+}
+
+#[test]
+fn a_viewport_over_the_texture_limit_is_an_error_naming_the_target() {
+    let gpu = gpu();
+    let side = gpu.limits.max_texture_dimension_2d + 1;
+    let registry = builtin_registry();
+    let plan = compile(
+        "fragment_raycast.ron",
+        &graph_source("basic/fragment_raycast.ron"),
+        &registry,
+        &CompileOptions::new(side, 8),
+    )
+    .expect("compiles: the size is only known to be too big on this device");
+    let shaders = ShaderLibrary::new(default_shader_root());
+    let err = Executor::new(&gpu, &shaders, &registry, plan).err().expect("the GPU refuses the targets");
+    let ExecutorError::Gpu(fault) = &err else { panic!("expected a GPU fault, got {err}") };
+    assert_eq!(fault.kind, GpuFaultKind::Validation);
+    assert!(fault.what.starts_with("creating target slot0") && fault.what.contains("entry.entry"), "{}", fault.what);
+}

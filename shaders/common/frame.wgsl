@@ -1,10 +1,13 @@
 // Frame-wide uniforms, bound as `frame` by every pass that declares it.
-// Rust twin: `volgraph_core::FrameUniforms` (crates/core/src/frame_uniforms.rs); keep both in step.
+// Rust twin: `volgraph_core::runtime::FrameUniforms` (crates/core/src/runtime/frame.rs); keep both in step.
 // Conventions: docs/rendering_model.md.
 
 struct Frame {
     clip_from_world: mat4x4<f32>,
     world_from_clip: mat4x4<f32>,
+    // The previous frame's world -> clip (this frame's on the first frame and after history
+    // invalidation): Klein et al. 2005 reproject last frame's hits with it.
+    prev_clip_from_world: mat4x4<f32>,
     // xyz: eye position (world); w: 1.0 when the eye is inside the volume box, else 0.0.
     eye_world: vec4<f32>,
     // xyz: half size of the volume box (world); w: unit step (world length of the smallest voxel side).
@@ -15,11 +18,12 @@ struct Frame {
     viewport: vec4<f32>,
     // xyz: unit camera forward (world); w: near-plane distance.
     camera_forward: vec4<f32>,
-    // Frame counter since the graph was (re)compiled.
+    // Frames the runtime submitted before this one.
     frame_index: u32,
+    // Frames since history was invalidated: 0 while history holds initial values.
+    history_age: u32,
     _pad0: u32,
     _pad1: u32,
-    _pad2: u32,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;

@@ -121,7 +121,7 @@ pub fn measure() -> anyhow::Result<CompileBenchReport> {
 fn time_scaling() -> anyhow::Result<Vec<ScalingRow>> {
     let path = graphs_dir().join("kruger_westermann_2003/rc_a.ron");
     let source = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
-    let count = "count: Scene(name: \"longest_ray_steps\", divide_by_input: \"segment_steps\")";
+    let count = "count: Scene(name: \"longest_ray_voxels\", divide_by_inputs: [\"step_voxels\", \"segment_steps\"])";
     anyhow::ensure!(
         source.contains(count),
         "{} no longer has the segment count this benchmark replaces",

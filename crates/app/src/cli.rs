@@ -7,7 +7,6 @@ use anyhow::{Context, anyhow};
 use clap::{Parser, Subcommand};
 use volgraph_core::{CompileOptions, Diagnostics, compile};
 use volgraph_passes::builtin_registry;
-use volgraph_passes::session::SessionError;
 
 use crate::inputs;
 
@@ -70,6 +69,10 @@ enum Command {
         /// Where to write the image (.png or .exr).
         #[arg(short = 'o', long = "out")]
         out: PathBuf,
+        /// A shader folder to read instead of the built-in shaders (default: a `shaders/` folder
+        /// beside the graph's workspace, if there is one).
+        #[arg(long)]
+        shaders: Option<PathBuf>,
     },
     /// Measure: `volgraph bench accel` (CPU acceleration structures).
     Bench {
@@ -139,15 +142,6 @@ impl From<anyhow::Error> for CliError {
     }
 }
 
-impl From<SessionError> for CliError {
-    fn from(e: SessionError) -> Self {
-        match e {
-            SessionError::Graph(d) => CliError::Graph(d),
-            other => CliError::Other(anyhow!(other)),
-        }
-    }
-}
-
 pub fn compile_options(size: &str, features: &[String], scalars: &[(String, f64)]) -> anyhow::Result<CompileOptions> {
     let (w, h) = inputs::parse_size(size)?;
     let mut o = CompileOptions::new(w, h).with_features(features.iter().filter(|f| !f.is_empty()).cloned());
@@ -200,30 +194,6 @@ pub fn warning_lines(plan: &volgraph_core::Plan) -> Vec<String> {
         .collect()
 }
 
-/// Multipass graphs size their segment loop by the scene value `longest_ray_steps` (K of
-/// Krüger–Westermann §3): when the graph declares it and the user did not set it, compute it for
-/// this volume and the graph's own step.
-pub fn with_longest_ray(
-    file: &str,
-    source: &str,
-    registry: &volgraph_core::Registry,
-    mut options: CompileOptions,
-    volume: &volgraph_accel::volume::Volume,
-) -> Result<CompileOptions, CliError> {
-    const K: &str = "longest_ray_steps";
-    let plan = compile(file, source, registry, &options).map_err(CliError::Graph)?;
-    if !plan.inputs.contains_key(K) || options.scalars.contains_key(K) {
-        return Ok(options);
-    }
-    let step = plan
-        .steps
-        .iter()
-        .find(|s| s.params.iter().any(|(name, _)| name == "step_voxels"))
-        .map_or(0.5, |s| s.params.float("step_voxels"));
-    options.scalars.insert(K.to_string(), volgraph_passes::scene::longest_ray_steps(volume, step));
-    Ok(options)
-}
-
 /// A `plan` or `render` command line with every input read and checked, no GPU touched.
 pub enum Checked {
     /// `plan`: the text to print and the notes for stderr.
@@ -249,7 +219,7 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
             check_user_names(&plan, &options)?;
             Ok(Checked::Plan { text: plan.to_text(), notes: warning_lines(&plan) })
         }
-        Command::Render { graph, volume, raw, tf, tf_map, size, camera, frames, features, output, out } => {
+        Command::Render { graph, volume, raw, tf, tf_map, size, camera, frames, features, output, out, shaders } => {
             let args = crate::render::RenderArgs {
                 graph,
                 volume,
@@ -262,6 +232,7 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
                 features,
                 output,
                 out,
+                shaders,
             };
             Ok(Checked::Render(Box::new(crate::render::prepare(args)?)))
         }

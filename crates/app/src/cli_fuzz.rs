@@ -128,7 +128,7 @@ const HOSTILE: &[&str] = &[
     "jitter",
     "",
     "a,b,,c",
-    "longest_ray_steps=1e300",
+    "longest_ray_voxels=1e300",
     "segment_steps=0",
     "segment_steps=-5",
     "segment_steps=nan",
@@ -184,7 +184,7 @@ fn plausible(flag: &str) -> Vec<String> {
     match flag {
         "--size" => fixed(&["16x16", "24x8", "8x32"]),
         "--features" => fixed(&["shading", "jitter"]),
-        "--scalar" => fixed(&["segment_steps=4", "step_voxels=1", "longest_ray_steps=40", "threshold=0.9"]),
+        "--scalar" => fixed(&["segment_steps=4", "step_voxels=1", "longest_ray_voxels=40", "threshold=0.9"]),
         "--volume" => [pick(".raw"), pick(".nrrd"), pick(".nhdr"), pick(".mha")].concat(),
         "--dims" => fixed(&["4x4x4", "2x2x2"]),
         "--dtype" => fixed(&["uint8", "uint16", "int16"]),

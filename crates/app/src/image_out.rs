@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use anyhow::{Context, bail};
-use volgraph_core::executor::Image;
+use volgraph_core::runtime::Image;
 
 /// The image file kinds `-o` accepts, told by the extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -10,6 +10,7 @@ mod cli_fuzz;
 mod image_out;
 mod inputs;
 mod render;
+mod shader_dir;
 mod stdout;
 
 use std::process::ExitCode;

@@ -3,17 +3,16 @@
 //! written.
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use anyhow::anyhow;
 use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::volume::VoxelData;
 use volgraph_core::compile;
-use volgraph_core::executor::{Gpu, ShaderLibrary, VolumeFormat};
-use volgraph_core::shader_source::default_shader_root;
+use volgraph_core::runtime::{CameraData, Gpu, Runtime, ShaderLibrary, VolumeDesc, VolumeFormat, scene_values_of};
 use volgraph_passes::builtin_registry;
-use volgraph_passes::session::RenderSession;
 
-use crate::cli::{CliError, RawArgs, check_user_names, compile_options, display_name, warning_lines, with_longest_ray};
+use crate::cli::{CliError, RawArgs, check_user_names, compile_options, display_name, warning_lines};
 use crate::image_out::{self, ImageKind};
 use crate::inputs;
 
@@ -30,6 +29,7 @@ pub struct RenderArgs {
     pub features: Vec<String>,
     pub output: Option<String>,
     pub out: PathBuf,
+    pub shaders: Option<PathBuf>,
 }
 
 /// Everything `render` needs, read and checked, before the GPU is opened.
@@ -58,7 +58,8 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
     let registry = builtin_registry();
     let file = display_name(&args.graph);
-    let options = with_longest_ray(&file, &source, &registry, options, &volume)?;
+    let mut options = options;
+    options.scene = scene_values_of(&VolumeDesc::of(&volume));
     let plan = compile(&file, &source, &registry, &options).map_err(CliError::Graph)?;
     check_user_names(&plan, &options)?;
     notes.extend(warning_lines(&plan));
@@ -92,29 +93,32 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
 pub fn execute(prepared: Prepared) -> Result<(), CliError> {
     let Prepared { args, kind, camera, volume, lut, plan, output, .. } = prepared;
     let registry = builtin_registry();
-    let options_viewport = plan.viewport;
-    let gpu = Gpu::new_headless().map_err(|e| anyhow!(e))?;
-    let shaders = ShaderLibrary::new(default_shader_root());
-    let mut session = RenderSession::from_plan(&gpu, &shaders, &registry, plan, &volume, &lut)?;
-    if session.volume_format() == Some(VolumeFormat::R16Float) && !matches!(volume.data, VoxelData::U8(_)) {
+    let viewport = plan.viewport;
+    let gpu = Arc::new(Gpu::new_headless().map_err(|e| anyhow!(e))?);
+    let (sources, _) = crate::shader_dir::sources_for(&args.graph, args.shaders.as_deref());
+    let mut runtime = Runtime::new(gpu, ShaderLibrary::new(sources));
+    runtime.bind_scene(&plan.inputs, &volume, &lut).map_err(|e| anyhow!(e))?;
+    if runtime.volume().is_some_and(|(_, f)| f == VolumeFormat::R16Float) && !matches!(volume.data, VoxelData::U8(_)) {
         eprintln!(
             "note: this GPU filters neither 16-bit normalized nor 32-bit float textures; the volume is sampled as \
              16-bit float (11 significant bits)"
         );
     }
-    let mut last = None;
+    runtime.apply(plan, &registry).map_err(|e| anyhow!(e))?;
     for f in 0..args.frames {
         let cam = OrbitCamera { azimuth_deg: camera.azimuth_deg + f as f64, ..camera };
-        last = Some(session.render(&gpu, &cam)?);
+        runtime.submit(CameraData::from_orbit(&cam, viewport), None).map_err(|e| anyhow!(e))?;
     }
-    let image = session.read(&gpu, &output)?;
+    let last = runtime.finish().pop();
+    let image = runtime.read_output(&output).map_err(|e| anyhow!(e))?;
+    let plan = runtime.plan().ok_or_else(|| anyhow!("internal: no plan after rendering"))?;
     match kind {
         ImageKind::Exr => image_out::write_exr(&args.out, &image)?,
         ImageKind::Png => {
             let srgb = image.channels == 4
-                && session.plan().outputs.get(&output).is_some_and(|&r| {
+                && plan.outputs.get(&output).is_some_and(|&r| {
                     matches!(
-                        session.plan().resources[r].desc,
+                        plan.resources[r].desc,
                         volgraph_core::plan::ResourceDesc::Target {
                             format: volgraph_core::TargetFormat::Rgba8Unorm,
                             ..
@@ -129,22 +133,15 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
         eprintln!(
             "{}: {}x{} on {}, last frame {:.2} ms {clock} → {}",
             args.graph.display(),
-            options_viewport.0,
-            options_viewport.1,
-            gpu.adapter_name,
+            viewport.0,
+            viewport.1,
+            runtime.gpu().adapter_name,
             stats.frame_ms,
             args.out.display()
         );
-        if let Some(step_ms) = &stats.step_gpu_ms {
+        if stats.step_gpu_ms.is_some() {
             // Per pass, repeat-group instances summed, in schedule order.
-            let mut per_pass: Vec<(String, f64)> = Vec::new();
-            for (step, ms) in session.plan().steps.iter().zip(step_ms) {
-                match per_pass.iter_mut().find(|(id, _)| *id == step.pass_id) {
-                    Some((_, total)) => *total += ms,
-                    None => per_pass.push((step.pass_id.clone(), *ms)),
-                }
-            }
-            let list: Vec<String> = per_pass.iter().map(|(id, ms)| format!("{id} {ms:.2}")).collect();
+            let list: Vec<String> = stats.per_pass_ms().iter().map(|(id, ms)| format!("{id} {ms:.2}")).collect();
             eprintln!("  per pass (ms): {}", list.join(", "));
         }
     }

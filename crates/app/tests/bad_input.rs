@@ -243,7 +243,7 @@ fn a_repeat_count_without_bound_is_a_located_error_not_a_hang() {
     )
     .expect("graph");
     let huge = text.replace(
-        "count: Scene(name: \"longest_ray_steps\", divide_by_input: \"segment_steps\")",
+        "count: Scene(name: \"longest_ray_voxels\", divide_by_inputs: [\"step_voxels\", \"segment_steps\"])",
         "count: Fixed(1000000)",
     );
     assert_ne!(huge, text, "the count was replaced");

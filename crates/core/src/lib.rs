@@ -1,18 +1,18 @@
 //! volgraph's spine: the RON graph format, validation with located diagnostics, the scheduler
 //! that orders passes, culls what no output needs and pools transient targets, the pass-plugin
-//! API, and the wgpu executor. It knows graphs, ports and scheduling, never a technique.
+//! API, and the live wgpu runtime. It knows graphs, ports and scheduling, never a technique.
 //!
 //! Data flow: graph text → [`graph::parse_graph`] → [`compile::compile`] (validation, then
-//! scheduling) → [`plan::Plan`] → the executor records GPU frames.
+//! scheduling) → [`plan::Plan`] → [`runtime::Runtime::apply`] → frames submitted by the runtime.
 
 pub mod compile;
 pub mod diagnostic;
-pub mod executor;
 pub mod format;
 pub mod graph;
 pub mod params;
 pub mod plan;
 pub mod plugin;
+pub mod runtime;
 pub mod shader_source;
 pub mod suggest;
 

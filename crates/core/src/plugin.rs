@@ -5,12 +5,12 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use crate::executor::{CreateContext, PassError, RecordContext};
 use crate::format::TargetFormat;
 use crate::params::{ParamSpec, Params};
+use crate::runtime::{CreateContext, Gpu, PassError, RecordContext};
 
 /// How a pass uses a port.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Access {
     /// Reads a value produced elsewhere.
     Read,
@@ -149,6 +149,13 @@ pub trait PassPlugin: Send + Sync {
 
     /// Builds the node that records this pass's GPU work for one compiled graph.
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError>;
+
+    /// Whether a node built with `old` parameters can take `new` ones through
+    /// [`PassNode::update_params`] (uniform values) instead of being rebuilt (pipeline changes:
+    /// a mode switch, a workgroup size). A parameter edit in the viewer then rebuilds nothing.
+    fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
+        false
+    }
 }
 
 /// One shader entry point a pass uses.
@@ -173,6 +180,10 @@ pub trait PassNode: Send {
     fn owned_output(&self, _port: &str) -> Option<wgpu::TextureView> {
         None
     }
+
+    /// Takes new parameter values in place (write them to the node's uniform buffer); called
+    /// only when [`PassPlugin::updates_in_place`] said it can.
+    fn update_params(&mut self, _gpu: &Gpu, _params: &Params) {}
 }
 
 /// Maps kind names to plugins.

@@ -5,8 +5,8 @@
 //! [`PassPlugin`] API: this is also the proof that a crate other than the built-in one can add
 //! pass kinds and have them scheduled. Their nodes record nothing; these tests never touch a GPU.
 
-use volgraph_core::executor::{CreateContext, PassError, RecordContext};
 use volgraph_core::plan::{Binding, ResourceDesc};
+use volgraph_core::runtime::{CreateContext, PassError, RecordContext};
 use volgraph_core::{
     Access, CompileOptions, ParamSpec, Params, PassNode, PassPlugin, Plan, PortKind, PortSpec, Registry, TargetFormat,
     compile,

@@ -30,7 +30,7 @@ fn validate(root: &Path, relative: &str) -> Result<(naga::Module, Vec<PathBuf>),
     Validator::new(ValidationFlags::all(), Capabilities::all())
         .validate(&module)
         .map_err(|e| format!("validation error:\n{}", e.emit_to_string(&source.text)))?;
-    Ok((module, source.files))
+    Ok((module, source.disk_paths()))
 }
 
 /// The resource globals of `module`: name → (group, binding).

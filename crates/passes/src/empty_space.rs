@@ -7,8 +7,8 @@
 //! per block) so a changed transfer function takes effect at once. Shader:
 //! `shaders/empty_space.wgsl`.
 
-use volgraph_core::executor::{ComputePipelineSpec, CreateContext, PassError, PassPipeline, RecordContext};
 use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::{ComputePipelineSpec, CreateContext, PassError, PassPipeline, RecordContext};
 use volgraph_core::{Params, PassNode, PassPlugin, PortKind, PortSpec};
 
 use crate::grid_tap::GridTap;

@@ -4,8 +4,8 @@
 //! screen-covering triangle writes each ray's near-plane point instead (at any pixel at most one
 //! of the two writes, so both are always drawn). Shader: `shaders/entry_points.wgsl`.
 
-use volgraph_core::executor::{CreateContext, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
 use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::{CreateContext, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
 use volgraph_core::{Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.

@@ -4,7 +4,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use volgraph_core::executor::Gpu;
+use volgraph_core::runtime::Gpu;
 
 /// Shared access to one owned 3D texture; cheap to clone.
 #[derive(Clone, Default)]

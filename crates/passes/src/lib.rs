@@ -13,13 +13,20 @@ pub mod raycast_compute;
 pub mod raycast_ess;
 pub mod raycast_params;
 pub mod raycast_segment;
-pub mod scene;
 pub mod segment_init;
-pub mod session;
 pub mod slice_render;
 pub mod termination_test;
 
 use volgraph_core::Registry;
+use volgraph_core::shader_source::ShaderSources;
+
+include!(concat!(env!("OUT_DIR"), "/embedded_shaders.rs"));
+
+/// The built-in shaders as a source layer, compiled into the binary. Put a folder on disk in
+/// front of it ([`ShaderSources::prepend_disk`]) to read (and hot-reload) a working copy.
+pub fn builtin_shaders() -> ShaderSources {
+    ShaderSources::new().with_embedded(EMBEDDED_SHADERS)
+}
 
 /// Adds every built-in pass kind to `registry`.
 pub fn register_builtin(registry: &mut Registry) {
@@ -49,11 +56,11 @@ pub fn builtin_registry() -> Registry {
 /// render pass pulls its vertices from `vertex_index`).
 pub(crate) fn draw(
     pass: &mut wgpu::RenderPass<'_>,
-    pipeline: &volgraph_core::executor::PassPipeline,
+    pipeline: &volgraph_core::runtime::PassPipeline,
     bind_group: &wgpu::BindGroup,
     vertices: std::ops::Range<u32>,
 ) {
-    if let volgraph_core::executor::PipelineKind::Render(p) = &pipeline.pipeline {
+    if let volgraph_core::runtime::PipelineKind::Render(p) = &pipeline.pipeline {
         pass.set_pipeline(p);
         pass.set_bind_group(0, bind_group, &[]);
         pass.draw(vertices, 0..1);

@@ -6,10 +6,10 @@
 //! on the first frame (its size comes from the bound volume) and built once; it is rebuilt when
 //! the volume's size changes. Shader: `shaders/minmax_grid.wgsl`.
 
-use volgraph_core::executor::{
+use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::{
     ComputePipelineSpec, CreateContext, PassError, PassPipeline, PipelineKind, RecordContext,
 };
-use volgraph_core::plugin::ShaderUse;
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec};
 
 use crate::grid_tap::GridTap;

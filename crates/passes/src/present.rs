@@ -3,8 +3,8 @@
 //! Writing files (PNG from this output, EXR from the float input) is the application's job.
 //! Shader: `shaders/present.wgsl`.
 
-use volgraph_core::executor::{CreateContext, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
 use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::{CreateContext, Gpu, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
@@ -44,6 +44,10 @@ impl PassPlugin for Present {
         vec![ShaderUse { file: "present.wgsl", entry_point: "fs_present" }]
     }
 
+    fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
+        true
+    }
+
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
             shader: "present.wgsl",
@@ -70,5 +74,10 @@ impl PassNode for PresentNode {
         let mut pass = ctx.begin_render_pass(&self.pipeline, None)?;
         crate::draw(&mut pass, &self.pipeline, &bg, 0..3);
         Ok(())
+    }
+
+    fn update_params(&mut self, gpu: &Gpu, params: &Params) {
+        let p = PresentParamsGpu { background: params.float("background") as f32, _pad: [0.0; 3] };
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
     }
 }

@@ -2,8 +2,8 @@
 //! ray's exit point; with the entry point from pass 1 this writes the normalized texture-space
 //! direction and, in alpha, the ray length. Shader: `shaders/ray_directions.wgsl`.
 
-use volgraph_core::executor::{CreateContext, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
 use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::{CreateContext, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
 use volgraph_core::{Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.

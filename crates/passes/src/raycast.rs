@@ -6,8 +6,8 @@
 //! `shaders/common/raymarch.wgsl`, shared with `raycast_compute`; the conventions are
 //! `docs/rendering_model.md`. Shader: `shaders/raycast.wgsl`.
 
-use volgraph_core::executor::{CreateContext, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
 use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::{CreateContext, Gpu, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
@@ -59,6 +59,11 @@ impl PassPlugin for Raycast {
         vec![ShaderUse { file: "raycast.wgsl", entry_point: fragment }]
     }
 
+    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
+        // Every parameter but the mode is a uniform value.
+        is_iso(old) == is_iso(new)
+    }
+
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let fragment = if is_iso(ctx.params) { "fs_iso" } else { "fs_dvr" };
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
@@ -68,8 +73,7 @@ impl PassPlugin for Raycast {
             extra_bindings: &["params"],
             ..Default::default()
         })?;
-        let params = ctx.uniform_buffer("params", std::mem::size_of::<RaycastParamsGpu>() as u64);
-        ctx.gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(ctx.params)));
+        let params = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
         Ok(Box::new(RaycastNode { pipeline, params }))
     }
 }
@@ -85,5 +89,9 @@ impl PassNode for RaycastNode {
         let mut pass = ctx.begin_render_pass(&self.pipeline, None)?;
         crate::draw(&mut pass, &self.pipeline, &bg, 0..3);
         Ok(())
+    }
+
+    fn update_params(&mut self, gpu: &Gpu, params: &Params) {
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
     }
 }

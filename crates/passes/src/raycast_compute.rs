@@ -3,10 +3,10 @@
 //! (`RAYCASTSIMPLE_CS`). The workgroup size is a parameter (pipeline-overridable constants).
 //! Shader: `shaders/raycast_compute.wgsl`.
 
-use volgraph_core::executor::{
-    ComputePipelineSpec, CreateContext, PassError, PassPipeline, PipelineKind, RecordContext,
-};
 use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::{
+    ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, PipelineKind, RecordContext,
+};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortSpec, TargetFormat};
 
 use crate::raycast::raycast_ports;
@@ -41,6 +41,13 @@ impl PassPlugin for RaycastCompute {
         vec![ShaderUse { file: "raycast_compute.wgsl", entry_point: entry }]
     }
 
+    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
+        // The mode picks the entry point and the workgroup size is a pipeline constant.
+        is_iso(old) == is_iso(new)
+            && old.uint("workgroup_x") == new.uint("workgroup_x")
+            && old.uint("workgroup_y") == new.uint("workgroup_y")
+    }
+
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let wg = (ctx.params.uint("workgroup_x") as u32, ctx.params.uint("workgroup_y") as u32);
         if wg.0 * wg.1 > ctx.gpu.limits.max_compute_invocations_per_workgroup {
@@ -62,8 +69,7 @@ impl PassPlugin for RaycastCompute {
             extra_bindings: &["params"],
             constants: &[("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)],
         })?;
-        let params = ctx.uniform_buffer("params", std::mem::size_of::<RaycastParamsGpu>() as u64);
-        ctx.gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(ctx.params)));
+        let params = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
         Ok(Box::new(RaycastComputeNode { pipeline, params, workgroup: wg }))
     }
 }
@@ -85,5 +91,9 @@ impl PassNode for RaycastComputeNode {
         pass.set_bind_group(0, &bg, &[]);
         pass.dispatch_workgroups(w.div_ceil(self.workgroup.0), h.div_ceil(self.workgroup.1), 1);
         Ok(())
+    }
+
+    fn update_params(&mut self, gpu: &Gpu, params: &Params) {
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
     }
 }

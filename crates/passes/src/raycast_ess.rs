@@ -6,8 +6,8 @@
 //! the image is equal up to f32 rounding (the blocks are conservative); early ray termination
 //! at `threshold` as in `raycast`. Shader: `shaders/raycast_ess.wgsl`.
 
-use volgraph_core::executor::{CreateContext, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
 use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::{CreateContext, Gpu, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::empty_space::{EMPTY_BLOCKS, block_size_spec, check_block_grid};
@@ -63,6 +63,11 @@ impl PassPlugin for RaycastEss {
         vec![ShaderUse { file: "raycast_ess.wgsl", entry_point: "fs_dvr" }]
     }
 
+    fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
+        // Every parameter is a uniform value (the block size too).
+        true
+    }
+
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
             shader: "raycast_ess.wgsl",
@@ -98,5 +103,12 @@ impl PassNode for RaycastEssNode {
         let mut pass = ctx.begin_render_pass(&self.pipeline, None)?;
         crate::draw(&mut pass, &self.pipeline, &bg, 0..3);
         Ok(())
+    }
+
+    fn update_params(&mut self, gpu: &Gpu, params: &Params) {
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
+        self.block_size = params.uint("block_size").max(1) as u32;
+        let ess = EssParamsGpu { block_size: self.block_size, _pad: [0; 3] };
+        gpu.queue.write_buffer(&self.ess, 0, bytemuck::bytes_of(&ess));
     }
 }

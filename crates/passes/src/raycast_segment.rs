@@ -18,10 +18,10 @@
 
 use std::sync::{Arc, Mutex};
 
-use volgraph_core::executor::{
+use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::{
     CreateContext, DepthSpec, Gpu, PassError, PassPipeline, RecordContext, RenderPipelineSpec,
 };
-use volgraph_core::plugin::ShaderUse;
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::empty_space::{EMPTY_BLOCKS, block_size_spec};
@@ -281,7 +281,7 @@ impl PassNode for RaycastSegmentNode {
         }
         let bg = ctx.bind_group(pipeline, &extra)?;
         let mut pass = ctx.begin_render_pass(pipeline, None)?;
-        if let volgraph_core::executor::PipelineKind::Render(p) = &pipeline.pipeline {
+        if let volgraph_core::runtime::PipelineKind::Render(p) = &pipeline.pipeline {
             pass.set_pipeline(p);
             pass.set_bind_group(0, &bg, &[]);
             pass.draw(0..3, index..index + 1);

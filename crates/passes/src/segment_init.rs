@@ -4,8 +4,8 @@
 //! into RES and test against the depth buffer through Modify/Read ports from the start.
 //! Shader: `shaders/segment_init.wgsl`.
 
-use volgraph_core::executor::{CreateContext, DepthSpec, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
 use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::{CreateContext, DepthSpec, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.

@@ -6,8 +6,8 @@
 //! same integral with a different sampling pattern. `max_slices` bounds the instance count;
 //! planes past the box draw nothing. Shader: `shaders/slice_render.wgsl`.
 
-use volgraph_core::executor::{CreateContext, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
 use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::{CreateContext, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::raycast_segment::front_to_back_blend;
@@ -91,7 +91,7 @@ impl PassNode for SliceRenderNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let bg = ctx.bind_group(&self.pipeline, &[("slices", self.slices.as_entire_binding())])?;
         let mut pass = ctx.begin_render_pass(&self.pipeline, None)?;
-        if let volgraph_core::executor::PipelineKind::Render(p) = &self.pipeline.pipeline {
+        if let volgraph_core::runtime::PipelineKind::Render(p) = &self.pipeline.pipeline {
             pass.set_pipeline(p);
             pass.set_bind_group(0, &bg, &[]);
             pass.draw(0..12, 0..self.max_slices);

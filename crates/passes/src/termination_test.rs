@@ -14,8 +14,8 @@
 //! test recomputes where the next segment's samples lie), and `block_size` the `minmax_grid`
 //! pass's. Shader: `shaders/termination_test.wgsl`.
 
-use volgraph_core::executor::{CreateContext, DepthSpec, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
 use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::{CreateContext, DepthSpec, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::empty_space::{EMPTY_BLOCKS, block_size_spec};
@@ -112,7 +112,7 @@ impl PassNode for TerminationTestNode {
             &[("params", self.params.as_entire_binding()), ("segment", self.segment.as_entire_binding())],
         )?;
         let mut pass = ctx.begin_render_pass(pipeline, None)?;
-        if let volgraph_core::executor::PipelineKind::Render(p) = &pipeline.pipeline {
+        if let volgraph_core::runtime::PipelineKind::Render(p) = &pipeline.pipeline {
             pass.set_pipeline(p);
             pass.set_bind_group(0, &bg, &[]);
             pass.draw(0..3, next..next + 1);

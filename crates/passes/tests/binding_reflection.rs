@@ -3,10 +3,9 @@
 //! ports, never a wgpu panic or a silently unbound texture. The plugins here live outside
 //! crates/passes' registry on purpose: they register through the public API.
 
-use volgraph_core::executor::{
-    ComputePipelineSpec, CreateContext, Executor, Gpu, PassError, RecordContext, RenderPipelineSpec, ShaderLibrary,
+use volgraph_core::runtime::{
+    ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, RenderPipelineSpec, Runtime, ShaderLibrary,
 };
-use volgraph_core::shader_source::default_shader_root;
 use volgraph_core::{
     CompileOptions, Params, PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile,
 };
@@ -95,9 +94,9 @@ fn build_error(plugin: Misnamed) -> String {
     );
     let plan =
         compile("reflection.ron", &graph, &registry, &CompileOptions::new(16, 16)).expect("the graph itself is valid");
-    let gpu = Gpu::new_headless().expect("a Vulkan adapter (lavapipe without a GPU)");
-    let shaders = ShaderLibrary::new(default_shader_root());
-    match Executor::new(&gpu, &shaders, &registry, plan) {
+    let gpu = std::sync::Arc::new(Gpu::new_headless().expect("a Vulkan adapter (lavapipe without a GPU)"));
+    let mut runtime = Runtime::new(gpu, ShaderLibrary::new(volgraph_passes::builtin_shaders()));
+    match runtime.apply(plan, &registry) {
         Ok(_) => panic!("a pass whose ports do not match its shader must not build"),
         Err(e) => e.to_string(),
     }

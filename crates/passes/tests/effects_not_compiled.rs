@@ -6,7 +6,7 @@
 
 use std::collections::BTreeSet;
 
-use volgraph_core::executor::shaders::parse_and_validate;
+use volgraph_core::runtime::shaders::parse_and_validate;
 use volgraph_core::shader_source::{default_shader_root, load_shader};
 use volgraph_core::{CompileOptions, compile};
 use volgraph_passes::builtin_registry;

@@ -1,18 +1,17 @@
 //! wgpu's default error handler panics; volgraph turns every GPU error into a value that names
 //! what was being done (issue "bad input never crashes"). Each test provokes one real error.
 
-use volgraph_core::executor::{Executor, ExecutorError, GpuFaultKind, GpuOptions, ShaderLibrary, VolumeTexels};
-use volgraph_core::shader_source::default_shader_root;
+use volgraph_core::runtime::{ApplyError, GpuFaultKind, GpuOptions, RuntimeError, VolumeTexels};
 use volgraph_core::{CompileOptions, compile};
 use volgraph_passes::builtin_registry;
 
 mod support;
 
-use support::{gpu, graph_source};
+use support::{gpu, graph_source, runtime};
 
 #[test]
 fn a_texture_the_device_cannot_make_is_a_fault_not_a_panic() {
-    let gpu = volgraph_core::executor::Gpu::new_headless_with(&GpuOptions {
+    let gpu = volgraph_core::runtime::Gpu::new_headless_with(&GpuOptions {
         without_features: wgpu::Features::TEXTURE_FORMAT_16BIT_NORM,
     })
     .expect("a Vulkan adapter");
@@ -45,7 +44,7 @@ fn a_volume_over_the_texture_limit_names_the_volume_and_the_limit() {
     let gpu = gpu();
     let side = gpu.limits.max_texture_dimension_3d + 1;
     let texels = vec![0u8; side as usize];
-    let err = volgraph_core::executor::upload_volume(&gpu, "tall", [1, 1, side], &VolumeTexels::Unorm8(&texels))
+    let err = volgraph_core::runtime::upload_volume(&gpu, "tall", [1, 1, side], &VolumeTexels::Unorm8(&texels))
         .err()
         .expect("over the limit");
     let text = err.to_string();
@@ -64,9 +63,10 @@ fn a_viewport_over_the_texture_limit_is_an_error_naming_the_target() {
         &CompileOptions::new(side, 8),
     )
     .expect("compiles: the size is only known to be too big on this device");
-    let shaders = ShaderLibrary::new(default_shader_root());
-    let err = Executor::new(&gpu, &shaders, &registry, plan).err().expect("the GPU refuses the targets");
-    let ExecutorError::Gpu(fault) = &err else { panic!("expected a GPU fault, got {err}") };
+    let mut runtime = runtime(&gpu);
+    let err = runtime.apply(plan, &registry).expect_err("the GPU refuses the targets");
+    let RuntimeError::Apply(ApplyError::Gpu(fault)) = &err else { panic!("expected a GPU fault, got {err}") };
     assert_eq!(fault.kind, GpuFaultKind::Validation);
     assert!(fault.what.starts_with("creating target slot0") && fault.what.contains("entry.entry"), "{}", fault.what);
+    assert!(runtime.plan().is_none(), "nothing half-applied");
 }

@@ -17,16 +17,14 @@ use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::reference::render_reference;
 use volgraph_accel::transfer_function::TransferFunction;
 use volgraph_accel::volume::Volume;
-use volgraph_core::executor::{Gpu, Image, ShaderLibrary};
-use volgraph_core::shader_source::default_shader_root;
+use volgraph_core::runtime::{Gpu, Image};
 use volgraph_core::{CompileOptions, compile};
 use volgraph_passes::builtin_registry;
 use volgraph_passes::raycast_params::reference_settings;
-use volgraph_passes::session::RenderSession;
 
 mod support;
 
-use support::{gpu, graph_path, save_images};
+use support::{gpu, graph_path, render_once, save_images};
 
 const SIZE: u32 = 128;
 
@@ -66,7 +64,7 @@ fn compare(gpu: &Image, reference: &[[f64; 4]]) -> Comparison {
 }
 
 fn render_both(
-    gpu: &Gpu,
+    gpu: &std::sync::Arc<Gpu>,
     graph: &str,
     volume: &Volume,
     tf: &TransferFunction,
@@ -76,7 +74,7 @@ fn render_both(
 }
 
 fn render_with(
-    gpu: &Gpu,
+    gpu: &std::sync::Arc<Gpu>,
     graph: &str,
     volume: &Volume,
     tf: &TransferFunction,
@@ -90,14 +88,13 @@ fn render_with(
     let march = plan.steps.iter().find(|s| s.pass_id == "march").expect("a march step");
     let settings = reference_settings(&march.params);
     let lut = tf.to_lut_for(volume, 256);
-    let shaders = ShaderLibrary::new(default_shader_root());
-    let mut session = RenderSession::from_plan(gpu, &shaders, &registry, plan, volume, &lut).expect("session");
-    session.render(gpu, camera).expect("frame");
-    let image = session.read(gpu, "image").expect("image output");
+    let (mut runtime, _) =
+        render_once(gpu, &registry, graph, &source, &options, volume, &lut, camera).expect("renders");
+    let image = runtime.read_output("image").expect("image output");
     let reference = render_reference(volume, &lut, camera, SIZE, SIZE, &settings);
     let color = compare(&image, &reference.color);
     save_images(&format!("{}_{}", graph.replace(['/', '.'], "_"), volume.name), &image, &reference.color);
-    let hit = session.read(gpu, "hit").ok().map(|h| compare(&h, &reference.hit));
+    let hit = runtime.read_output("hit").ok().map(|h| compare(&h, &reference.hit));
     let coverage = reference.color.iter().filter(|c| c[3] > 0.0).count() as f64 / reference.color.len() as f64;
     (color, hit, coverage)
 }

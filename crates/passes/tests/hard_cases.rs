@@ -7,16 +7,14 @@ use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::reference::render_reference;
 use volgraph_accel::transfer_function::TransferFunction;
 use volgraph_accel::volume::Volume;
-use volgraph_core::executor::{Image, ShaderLibrary};
-use volgraph_core::shader_source::default_shader_root;
+use volgraph_core::runtime::Image;
 use volgraph_core::{CompileOptions, compile};
 use volgraph_passes::builtin_registry;
 use volgraph_passes::raycast_params::reference_settings;
-use volgraph_passes::session::RenderSession;
 
 mod support;
 
-use support::{diff_reference, gpu, graph_source};
+use support::{diff_reference, gpu, graph_source, render_once};
 
 const SIZE: u32 = 64;
 
@@ -32,7 +30,7 @@ fn render(
 
 /// [`render`] on a given device (one opened without some optional feature).
 fn render_on(
-    gpu: &volgraph_core::executor::Gpu,
+    gpu: &std::sync::Arc<volgraph_core::runtime::Gpu>,
     volume: &Volume,
     tf: &TransferFunction,
     camera: &OrbitCamera,
@@ -43,10 +41,9 @@ fn render_on(
     let plan = compile("fragment_raycast.ron", &source, &registry, &options).expect("compiles");
     let settings = reference_settings(&plan.steps.iter().find(|s| s.pass_id == "march").expect("march").params);
     let lut = tf.to_lut_for(volume, 256);
-    let shaders = ShaderLibrary::new(default_shader_root());
-    let mut session = RenderSession::from_plan(gpu, &shaders, &registry, plan, volume, &lut).expect("session");
-    session.render(gpu, camera).expect("frame");
-    let image = session.read(gpu, "image").expect("image");
+    let (mut runtime, _) =
+        render_once(gpu, &registry, "fragment_raycast.ron", &source, &options, volume, &lut, camera).expect("renders");
+    let image = runtime.read_output("image").expect("image");
     let reference = render_reference(volume, &lut, camera, options.viewport.0, options.viewport.1, &settings);
     (image, reference.color)
 }
@@ -181,17 +178,19 @@ fn sixteen_bit_volumes_in_both_byte_orders_match_the_reference() {
 
 #[test]
 fn sixteen_bit_volume_without_norm16_is_widened_to_float() {
-    use volgraph_core::executor::{Gpu, GpuOptions};
-    let gpu = Gpu::new_headless_with(&GpuOptions { without_features: wgpu::Features::TEXTURE_FORMAT_16BIT_NORM })
-        .expect("a Vulkan adapter");
+    use volgraph_core::runtime::{Gpu, GpuOptions};
+    let gpu = std::sync::Arc::new(
+        Gpu::new_headless_with(&GpuOptions { without_features: wgpu::Features::TEXTURE_FORMAT_16BIT_NORM })
+            .expect("a Vulkan adapter"),
+    );
     assert!(!gpu.norm16);
     let v = sixteen_bit_ml("uint16", volgraph_accel::load::Endianness::Little);
     let tf = TransferFunction::default_for(&v);
-    let uploaded = volgraph_passes::scene::upload_volume_texture(&gpu, &v).expect("uploads without the feature");
+    let uploaded = volgraph_core::runtime::upload_volume_texture(&gpu, &v).expect("uploads without the feature");
     let expected = if gpu.float32_filterable {
-        volgraph_core::executor::VolumeFormat::R32Float
+        volgraph_core::runtime::VolumeFormat::R32Float
     } else {
-        volgraph_core::executor::VolumeFormat::R16Float
+        volgraph_core::runtime::VolumeFormat::R16Float
     };
     assert_eq!(uploaded.format, expected);
     let (image, reference) = render_on(&gpu, &v, &tf, &OrbitCamera::default(), CompileOptions::new(SIZE, SIZE));
@@ -200,11 +199,13 @@ fn sixteen_bit_volume_without_norm16_is_widened_to_float() {
 
 #[test]
 fn sixteen_bit_volume_on_a_device_with_neither_format_uses_half_floats() {
-    use volgraph_core::executor::{Gpu, GpuOptions, VolumeFormat};
+    use volgraph_core::runtime::{Gpu, GpuOptions, VolumeFormat};
     let without = wgpu::Features::TEXTURE_FORMAT_16BIT_NORM | wgpu::Features::FLOAT32_FILTERABLE;
-    let gpu = Gpu::new_headless_with(&GpuOptions { without_features: without }).expect("a Vulkan adapter");
+    let gpu = std::sync::Arc::new(
+        Gpu::new_headless_with(&GpuOptions { without_features: without }).expect("a Vulkan adapter"),
+    );
     let v = sixteen_bit_ml("int16", volgraph_accel::load::Endianness::Big);
-    let uploaded = volgraph_passes::scene::upload_volume_texture(&gpu, &v).expect("uploads");
+    let uploaded = volgraph_core::runtime::upload_volume_texture(&gpu, &v).expect("uploads");
     assert_eq!(uploaded.format, VolumeFormat::R16Float);
     let tf = TransferFunction::default_for(&v);
     let (image, reference) = render_on(&gpu, &v, &tf, &OrbitCamera::default(), CompileOptions::new(SIZE, SIZE));

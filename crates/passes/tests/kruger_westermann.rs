@@ -20,8 +20,7 @@ use volgraph_accel::minmax::MinMaxGrid;
 use volgraph_accel::reference::{corrected_alpha, lut_sample, ray_segment, render_reference, step_tex};
 use volgraph_accel::transfer_function::{Preset, TransferFunction};
 use volgraph_accel::volume::Volume;
-use volgraph_core::executor::{Gpu, Image, ShaderLibrary};
-use volgraph_core::shader_source::default_shader_root;
+use volgraph_core::runtime::{Gpu, Image, VolumeDesc, scene_values_of};
 use volgraph_core::{CompileOptions, Plan, Registry, compile};
 use volgraph_passes::builtin_registry;
 use volgraph_passes::empty_space::EmptySpace;
@@ -29,21 +28,27 @@ use volgraph_passes::grid_tap::GridTap;
 use volgraph_passes::minmax_grid::MinMaxGridPass;
 use volgraph_passes::raycast_params::reference_settings;
 use volgraph_passes::raycast_segment::{InvocationCounter, RaycastSegment};
-use volgraph_passes::scene::longest_ray_steps;
-use volgraph_passes::session::RenderSession;
 
 mod support;
 
-use support::{as_reference, diff_reference, gpu, graph_source, save_images};
+use support::{as_reference, diff_reference, gpu, graph_source, render_once, save_images};
 
 const SIZE: u32 = 96;
 const STEP_VOXELS: f64 = 0.5;
 /// One 8-bit display level: the bound for lossless accelerations.
 const LOSSLESS: f64 = 1.0 / 255.0;
 
-/// Options for `volume`: the viewport and the scene's K (longest ray in steps).
+/// Options for `volume`: the viewport and the scene values the runtime gives graphs (the longest
+/// ray in voxels, which the segment loop's count divides by step and M).
 fn options(volume: &Volume) -> CompileOptions {
-    CompileOptions::new(SIZE, SIZE).with_scalar("longest_ray_steps", longest_ray_steps(volume, STEP_VOXELS))
+    let mut options = CompileOptions::new(SIZE, SIZE);
+    options.scene = scene_values_of(&VolumeDesc::of(volume));
+    options
+}
+
+/// K of Krüger & Westermann 2003 §3: steps of `step_voxels` along the longest ray.
+fn longest_ray_steps(volume: &Volume, step_voxels: f64) -> f64 {
+    VolumeDesc::of(volume).longest_ray_voxels() / step_voxels
 }
 
 struct Rendered {
@@ -54,7 +59,7 @@ struct Rendered {
 }
 
 fn render_with(
-    gpu: &Gpu,
+    gpu: &std::sync::Arc<Gpu>,
     registry: &Registry,
     graph: &str,
     volume: &Volume,
@@ -64,18 +69,16 @@ fn render_with(
 ) -> Rendered {
     let plan =
         compile(graph, &graph_source(graph), registry, options).unwrap_or_else(|d| panic!("{graph} compiles:\n{d}"));
-    let shaders = ShaderLibrary::new(default_shader_root());
-    let mut session = RenderSession::from_plan(gpu, &shaders, registry, plan.clone(), volume, lut)
+    let (mut runtime, _) = render_once(gpu, registry, graph, &graph_source(graph), options, volume, lut, camera)
         .unwrap_or_else(|e| panic!("{graph}: {e}"));
-    session.render(gpu, camera).unwrap_or_else(|e| panic!("{graph}: {e}"));
-    let image = session.read(gpu, "image").unwrap_or_else(|e| panic!("{graph}: {e}"));
+    let image = runtime.read_output("image").unwrap_or_else(|e| panic!("{graph}: {e}"));
     let hit =
-        plan.outputs.contains_key("hit").then(|| session.read(gpu, "hit").unwrap_or_else(|e| panic!("{graph}: {e}")));
+        plan.outputs.contains_key("hit").then(|| runtime.read_output("hit").unwrap_or_else(|e| panic!("{graph}: {e}")));
     Rendered { image, hit, plan }
 }
 
 fn render(
-    gpu: &Gpu,
+    gpu: &std::sync::Arc<Gpu>,
     graph: &str,
     volume: &Volume,
     lut: &[[f32; 4]],

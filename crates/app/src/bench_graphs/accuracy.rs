@@ -11,7 +11,7 @@ use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::reference::{RaycastSettings, render_reference};
 use volgraph_accel::volume::Volume;
 use volgraph_core::Plan;
-use volgraph_core::executor::Image;
+use volgraph_core::runtime::Image;
 use volgraph_passes::raycast_params::reference_settings;
 
 /// The reference settings of the plan's raycast: the first step declaring `step_voxels`,

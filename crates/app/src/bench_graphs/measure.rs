@@ -6,9 +6,7 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 use volgraph_accel::camera::OrbitCamera;
-use volgraph_core::Plan;
-use volgraph_core::executor::Gpu;
-use volgraph_passes::session::{RenderSession, SessionError};
+use volgraph_core::runtime::{CameraData, Runtime, RuntimeError};
 
 /// Median of `values` (NaN when empty).
 pub fn median(values: &[f64]) -> f64 {
@@ -41,17 +39,17 @@ pub fn frame_camera(start: &OrbitCamera, degrees_per_frame: f64, index: u32) -> 
     OrbitCamera { azimuth_deg: start.azimuth_deg + index as f64 * degrees_per_frame, ..*start }
 }
 
-/// Renders one warm-up frame (pipelines, first uploads), then `frames` timed frames; `tick` is
-/// called after every frame.
+/// Renders one warm-up frame (pipelines, first uploads) of the runtime's applied plan, then
+/// `frames` timed frames, each submitted and waited for; `tick` is called after every frame.
 pub fn time_frames(
-    gpu: &Gpu,
-    session: &mut RenderSession,
+    runtime: &mut Runtime,
     start: &OrbitCamera,
     degrees_per_frame: f64,
     frames: u32,
     mut tick: impl FnMut(),
-) -> Result<Timing, SessionError> {
-    session.render(gpu, start)?;
+) -> Result<Timing, RuntimeError> {
+    let viewport = runtime.plan().ok_or(RuntimeError::NoPlan)?.viewport;
+    runtime.render(CameraData::from_orbit(start, viewport))?;
     tick();
     let mut timing =
         Timing { frame_ms: Vec::new(), wall_ms: Vec::new(), wall_time_fallback: false, pass_ms: BTreeMap::new() };
@@ -59,14 +57,12 @@ pub fn time_frames(
     for f in 0..frames {
         let camera = frame_camera(start, degrees_per_frame, f);
         let t0 = Instant::now();
-        let stats = session.render(gpu, &camera)?;
+        let stats = runtime.render(CameraData::from_orbit(&camera, viewport))?;
         timing.wall_ms.push(t0.elapsed().as_secs_f64() * 1e3);
         timing.frame_ms.push(stats.frame_ms);
         timing.wall_time_fallback |= stats.wall_time_fallback;
-        if let Some(steps) = &stats.step_gpu_ms {
-            for (pass, ms) in pass_sums(session.plan(), steps) {
-                per_pass.entry(pass).or_default().push(ms);
-            }
+        for (pass, ms) in stats.per_pass_ms() {
+            per_pass.entry(pass).or_default().push(ms);
         }
         tick();
     }
@@ -74,15 +70,6 @@ pub fn time_frames(
         timing.pass_ms = per_pass.into_iter().map(|(pass, v)| (pass, median(&v))).collect();
     }
     Ok(timing)
-}
-
-/// One frame's step times summed per pass id, so a repeat group's instances count as their pass.
-fn pass_sums(plan: &Plan, step_ms: &[f64]) -> BTreeMap<String, f64> {
-    let mut sums = BTreeMap::new();
-    for (step, ms) in plan.steps.iter().zip(step_ms) {
-        *sums.entry(step.pass_id.clone()).or_insert(0.0) += ms;
-    }
-    sums
 }
 
 #[cfg(test)]

@@ -22,7 +22,7 @@ pub mod run;
 mod tests;
 
 use anyhow::{Context, anyhow};
-use volgraph_core::executor::Gpu;
+use volgraph_core::runtime::Gpu;
 
 pub use args::GraphsArgs;
 pub use report::GraphBenchReport;
@@ -31,8 +31,8 @@ pub use report::GraphBenchReport;
 /// and writes the JSON, plot and markdown files asked for.
 pub fn run_cli(args: &GraphsArgs) -> anyhow::Result<GraphBenchReport> {
     let config = args.resolve()?;
-    let gpu = Gpu::new_headless().map_err(|e| anyhow!(e))?;
-    let report = run::run(&gpu, &config)?;
+    let gpu = std::sync::Arc::new(Gpu::new_headless().map_err(|e| anyhow!(e))?);
+    let report = run::run(gpu, &config)?;
     let markdown = report.to_markdown();
     crate::stdout::write_stdout(&markdown)?;
     write_outputs(&config, &report, &markdown)?;

@@ -11,11 +11,9 @@ use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::reference::render_reference;
 use volgraph_accel::transfer_function::TransferFunction;
 use volgraph_accel::volume::Volume;
-use volgraph_core::executor::{Gpu, ShaderLibrary};
-use volgraph_core::shader_source::default_shader_root;
-use volgraph_core::{CompileOptions, Diagnostics, Plan, Registry, compile};
-use volgraph_passes::builtin_registry;
-use volgraph_passes::session::RenderSession;
+use volgraph_core::runtime::{CameraData, Gpu, Runtime, ShaderLibrary};
+use volgraph_core::{CompileOptions, Diagnostics, Plan, Registry};
+use volgraph_passes::{builtin_registry, builtin_shaders};
 
 use super::accuracy::{self, ImageError};
 use super::args::{BenchConfig, graph_label, reduced_viewport};
@@ -39,8 +37,9 @@ struct Dataset {
 
 /// What stays fixed while a case runs.
 struct Context<'a> {
-    gpu: &'a Gpu,
-    shaders: ShaderLibrary,
+    /// One runtime for every case: a dataset's volume is uploaded once for all graphs, and a
+    /// graph's pipelines are built once for all datasets.
+    runtime: Runtime,
     registry: Registry,
     config: &'a BenchConfig,
     progress: ProgressBar,
@@ -80,9 +79,8 @@ impl Case<'_> {
         )
     }
 
-    fn options(&self, config: &BenchConfig, viewport: (u32, u32), step_voxels: f64) -> CompileOptions {
-        let mut options = CompileOptions::new(viewport.0, viewport.1)
-            .with_scalar(LONGEST_RAY_STEPS, longest_ray_steps(&self.dataset.volume, step_voxels));
+    fn options(&self, config: &BenchConfig, viewport: (u32, u32)) -> CompileOptions {
+        let mut options = CompileOptions::new(viewport.0, viewport.1);
         for (key, value) in &config.params {
             set_knob(&mut options, key, &ron::Value::from(*value));
         }
@@ -106,37 +104,33 @@ fn set_knob(options: &mut CompileOptions, key: &str, value: &ron::Value) {
     }
 }
 
-/// The scene scalar multipass graphs size their segment loop with (Krüger & Westermann 2003 §3).
-const LONGEST_RAY_STEPS: &str = "longest_ray_steps";
-
-/// The step the first compile assumes before the graph's own step is known.
-const PROVISIONAL_STEP_VOXELS: f64 = 0.5;
-
-/// K of Krüger & Westermann 2003 §3: steps of `step_voxels` along the box diagonal, the longest
-/// ray, so `ceil(K / M)` segments of M steps cover every ray (0 when degenerate).
-fn longest_ray_steps(volume: &Volume, step_voxels: f64) -> f64 {
-    let k = 2.0 * volume.half_extent_world().length() / (step_voxels * volume.unit_step_world());
-    if k.is_finite() && k > 0.0 { k } else { 0.0 }
-}
-
-/// Compiles the case at `viewport`, with the scene scalar K computed for the graph's own raycast
-/// step (known only after a first compile; recompiled when it differs from the provisional one).
-fn compile_case(ctx: &Context<'_>, case: &Case<'_>, viewport: (u32, u32)) -> Result<Plan, Diagnostics> {
+/// Binds the case's volume and LUT (uploads only what changed) and compiles the case at
+/// `viewport` with the runtime's scene values (the volume's longest ray, which multipass graphs
+/// size their segment loop by).
+fn compile_case(ctx: &mut Context<'_>, case: &Case<'_>, viewport: (u32, u32)) -> Result<Plan, String> {
     let file = case.graph.path.display().to_string();
-    let build =
-        |step: f64| compile(&file, &case.graph.source, &ctx.registry, &case.options(ctx.config, viewport, step));
-    let plan = build(PROVISIONAL_STEP_VOXELS)?;
-    match accuracy::raycast_settings(&plan) {
-        Some(s) if s.step_voxels != PROVISIONAL_STEP_VOXELS && s.step_voxels > 0.0 => build(s.step_voxels),
-        _ => Ok(plan),
-    }
+    let options = case.options(ctx.config, viewport);
+    let bind = |runtime: &mut Runtime| {
+        let inputs = std::collections::BTreeMap::from([
+            ("volume".to_string(), volgraph_core::graph::ast::InputKind::Volume),
+            ("tf".to_string(), volgraph_core::graph::ast::InputKind::TransferFunction),
+        ]);
+        runtime.bind_scene(&inputs, &case.dataset.volume, case.lut).map_err(|e| e.to_string())
+    };
+    bind(&mut ctx.runtime)?;
+    let plan = ctx
+        .runtime
+        .compile(&file, &case.graph.source, &ctx.registry, &options)
+        .map_err(|d: Diagnostics| d.to_string())?;
+    ctx.runtime.bind_scene(&plan.inputs, &case.dataset.volume, case.lut).map_err(|e| e.to_string())?;
+    Ok(plan)
 }
 
 /// Measures every case of `config` on `gpu`.
-pub fn run(gpu: &Gpu, config: &BenchConfig) -> anyhow::Result<GraphBenchReport> {
+pub fn run(gpu: std::sync::Arc<Gpu>, config: &BenchConfig) -> anyhow::Result<GraphBenchReport> {
+    let adapter = gpu.adapter_name.clone();
     let mut ctx = Context {
-        gpu,
-        shaders: ShaderLibrary::new(default_shader_root()),
+        runtime: Runtime::new(gpu, ShaderLibrary::new(builtin_shaders())),
         registry: builtin_registry(),
         config,
         progress: ProgressBar::hidden(),
@@ -219,7 +213,7 @@ pub fn run(gpu: &Gpu, config: &BenchConfig) -> anyhow::Result<GraphBenchReport> 
         program: "volgraph bench graphs".to_string(),
         preset: config.preset.map(|p| p.name.to_string()),
         about: config.preset.map(|p| p.about.to_string()),
-        adapter: gpu.adapter_name.clone(),
+        adapter,
         timestamps: rows.iter().all(|r| r.clock == "gpu"),
         frames: config.frames,
         warmup_frames: 1,
@@ -268,22 +262,18 @@ fn run_case(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<Row> {
     let plan = match compile_case(ctx, case, case.viewport) {
         Ok(plan) => plan,
         Err(d) => {
-            ctx.skip(
-                format!("graph {}", case.graph.label),
-                format!("does not compile for this case: {}", d.to_string().trim()),
-            );
+            ctx.skip(format!("graph {}", case.graph.label), format!("does not compile for this case: {}", d.trim()));
             ctx.progress.inc(config.frames as u64 + 1);
             return None;
         }
     };
     let settings = accuracy::raycast_settings(&plan);
-    let timing = RenderSession::from_plan(ctx.gpu, &ctx.shaders, &ctx.registry, plan, &case.dataset.volume, case.lut)
-        .and_then(|mut session| {
-            let progress = ctx.progress.clone();
-            measure::time_frames(ctx.gpu, &mut session, &config.camera, config.degrees_per_frame, config.frames, || {
-                progress.inc(1)
-            })
-        });
+    let progress = ctx.progress.clone();
+    let timing = ctx.runtime.apply(plan, &ctx.registry).and_then(|_| {
+        measure::time_frames(&mut ctx.runtime, &config.camera, config.degrees_per_frame, config.frames, || {
+            progress.inc(1)
+        })
+    });
     let timing = match timing {
         Ok(t) => t,
         Err(e) => {
@@ -343,15 +333,14 @@ fn measure_error(
         return None;
     };
     let camera: OrbitCamera = config.camera;
-    let image = compile_case(ctx, case, size).map_err(|d| d.to_string()).and_then(|plan| {
+    let image = compile_case(ctx, case, size).and_then(|plan| {
         if !plan.outputs.contains_key("image") {
             return Err("the graph has no \"image\" output to compare".to_string());
         }
-        let mut session =
-            RenderSession::from_plan(ctx.gpu, &ctx.shaders, &ctx.registry, plan, &case.dataset.volume, case.lut)
-                .map_err(|e| e.to_string())?;
-        session.render(ctx.gpu, &camera).map_err(|e| e.to_string())?;
-        session.read(ctx.gpu, "image").map_err(|e| e.to_string())
+        let viewport = plan.viewport;
+        ctx.runtime.apply(plan, &ctx.registry).map_err(|e| e.to_string())?;
+        ctx.runtime.render(CameraData::from_orbit(&camera, viewport)).map_err(|e| e.to_string())?;
+        ctx.runtime.read_output("image").map_err(|e| e.to_string())
     });
     let image = match image {
         Ok(image) => image,

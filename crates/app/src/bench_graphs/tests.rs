@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use volgraph_core::executor::Gpu;
+use volgraph_core::runtime::Gpu;
 
 use super::args::{GraphsArgs, workspace_root};
 use super::{run, write_outputs};
@@ -21,7 +21,8 @@ fn finite(v: &serde_json::Value, field: &str) -> f64 {
 #[test]
 fn tiny_sweep_writes_json_with_every_field_finite() {
     // Under CI a missing adapter is a failure, never a skip.
-    let gpu = Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)");
+    let gpu =
+        std::sync::Arc::new(Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)"));
     let dir = std::env::temp_dir().join(format!("volgraph-bench-graphs-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir is writable");
     let args = GraphsArgs {
@@ -45,7 +46,7 @@ fn tiny_sweep_writes_json_with_every_field_finite() {
         ..GraphsArgs::default()
     };
     let config = args.resolve().expect("valid flags");
-    let report = run::run(&gpu, &config).expect("the bench runs");
+    let report = run::run(gpu.clone(), &config).expect("the bench runs");
     write_outputs(&config, &report, &report.to_markdown()).expect("outputs are written");
 
     let text = std::fs::read_to_string(dir.join("bench.json")).expect("JSON written");

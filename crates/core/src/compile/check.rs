@@ -270,9 +270,14 @@ impl Checker<'_> {
     /// declared default.
     fn scalar_value(&self, name: &str) -> Option<f64> {
         match self.doc.inputs.get(name) {
-            Some(InputKind::Scalar(default)) => Some(self.options.scalars.get(name).copied().unwrap_or(*default)),
+            Some(InputKind::Scalar(default)) => Some(self.option_value(name).unwrap_or(*default)),
             _ => None,
         }
+    }
+
+    /// The value the application gives `name`: the user's, else the scene's.
+    fn option_value(&self, name: &str) -> Option<f64> {
+        self.options.scalars.get(name).or_else(|| self.options.scene.get(name)).copied()
     }
 
     fn repeat_count(&mut self, id: &str, path: PassPath, count: &RepeatCount) -> u32 {
@@ -310,25 +315,26 @@ impl Checker<'_> {
                 );
                 1
             }
-            RepeatCount::Scene { name, divide_by, divide_by_input, max } => {
-                let divide_by = match divide_by_input {
-                    None => *divide_by,
-                    Some(input) => {
-                        match self.scalar_value(input) {
-                            Some(v) => v,
-                            None => {
-                                self.err(
+            RepeatCount::Scene { name, divide_by, divide_by_input, divide_by_inputs, max } => {
+                let mut divisor = *divide_by;
+                for input in divide_by_input.iter().chain(divide_by_inputs) {
+                    match self.scalar_value(input) {
+                        Some(v) => divisor *= v,
+                        None => {
+                            self.err(
                                 self.loc.pass_field(path, id, "count"),
-                                format!("repeat group \"{id}\" divides by \"{input}\", which is not a Scalar graph input"),
+                                format!(
+                                    "repeat group \"{id}\" divides by \"{input}\", which is not a Scalar graph input"
+                                ),
                                 Some(format!("declare inputs: {{\"{input}\": Scalar(<default>)}}")),
                             );
-                                return 1;
-                            }
+                            return 1;
                         }
                     }
-                };
-                let divide_by = &divide_by;
-                let value = self.options.scalars.get(name).copied().or_else(|| match self.doc.inputs.get(name) {
+                }
+                let divide_by = &divisor;
+                let by_inputs: Vec<&String> = divide_by_input.iter().chain(divide_by_inputs).collect();
+                let value = self.option_value(name).or_else(|| match self.doc.inputs.get(name) {
                     Some(InputKind::Scalar(v)) => Some(*v),
                     _ => None,
                 });
@@ -341,6 +347,7 @@ impl Checker<'_> {
                         .map(|(n, _)| n.as_str())
                         .collect();
                     known.extend(self.options.scalars.keys().map(String::as_str));
+                    known.extend(self.options.scene.keys().map(String::as_str));
                     let mut help = format!(
                         "declare inputs: {{\"{name}\": Scalar(<default>)}}; known scalars: {}",
                         comma_list(&known)
@@ -363,9 +370,12 @@ impl Checker<'_> {
                 }
                 let wanted = (value / divide_by).ceil().max(1.0);
                 if wanted > *max as f64 {
-                    let by = divide_by_input
-                        .as_deref()
-                        .map_or_else(|| divide_by.to_string(), |i| format!("\"{i}\" ({divide_by})"));
+                    let by = if by_inputs.is_empty() {
+                        divide_by.to_string()
+                    } else {
+                        let names: Vec<String> = by_inputs.iter().map(|i| format!("\"{i}\"")).collect();
+                        format!("{} ({divide_by})", names.join(" × "))
+                    };
                     self.warnings.push(
                         Diagnostic::new(
                             self.loc.pass_field(path, id, "count"),

@@ -29,8 +29,13 @@ pub struct CompileOptions {
     pub viewport: (u32, u32),
     /// Scene features that are on (`"shading"`, `"antialias"`, ...).
     pub features: BTreeSet<String>,
-    /// Scene values overriding graph `Scalar` inputs and feeding repeat counts.
+    /// Values the user sets: they override graph `Scalar` inputs and feed repeat counts (a name
+    /// the graph does not read is a warning).
     pub scalars: BTreeMap<String, f64>,
+    /// Values derived from the scene by the runtime (the bound volume's
+    /// `longest_ray_voxels`): read like `scalars`, which win over them; a graph that does not read
+    /// one is not warned about it.
+    pub scene: BTreeMap<String, f64>,
     /// Parameter values overriding the graph file's, keyed `"<pass id>.<param>"` (benchmark
     /// sweeps, viewer sliders). Checked like values written in the file.
     pub param_overrides: BTreeMap<String, ron::Value>,
@@ -42,6 +47,7 @@ impl Default for CompileOptions {
             viewport: (256, 256),
             features: BTreeSet::new(),
             scalars: BTreeMap::new(),
+            scene: BTreeMap::new(),
             param_overrides: BTreeMap::new(),
         }
     }

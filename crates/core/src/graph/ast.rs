@@ -146,6 +146,10 @@ pub enum RepeatCount {
         /// can never disagree.
         #[serde(default)]
         divide_by_input: Option<String>,
+        /// Scalar graph inputs whose product divides instead (with `divide_by`): Krüger &
+        /// Westermann's loop counts `longest_ray_voxels / (step_voxels · segment_steps)`.
+        #[serde(default)]
+        divide_by_inputs: Vec<String>,
         /// Upper bound on the count.
         #[serde(default = "default_max_iterations")]
         max: u32,

@@ -9,8 +9,8 @@
 
 #![allow(dead_code, reason = "each test file uses a different subset of the helpers")]
 
-use volgraph_core::executor::{CreateContext, PassError, RecordContext};
 use volgraph_core::params::ParamSpec;
+use volgraph_core::runtime::{CreateContext, PassError, RecordContext};
 use volgraph_core::{PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat};
 
 /// Float targets the ray passes accept (first is the default for outputs).

@@ -1,7 +1,16 @@
-// Test shader for executor semantics: `next = value + 1` per pixel, `fill` writes a constant.
+// Test shader for runtime semantics: `next = value + amount` per pixel, `fill` writes a constant.
 #import "common/fullscreen.wgsl"
 
 @group(0) @binding(0) var value: texture_2d<f32>;
+
+struct AddParams {
+    amount: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
+}
+
+@group(0) @binding(1) var<uniform> params: AddParams;
 
 struct AddOut {
     @location(0) next: vec4<f32>,
@@ -9,7 +18,7 @@ struct AddOut {
 
 @fragment
 fn fs_add_one(in: FullscreenVertex) -> AddOut {
-    return AddOut(textureLoad(value, vec2<i32>(in.clip.xy), 0) + vec4<f32>(1.0, 0.0, 0.0, 0.0));
+    return AddOut(textureLoad(value, vec2<i32>(in.clip.xy), 0) + vec4<f32>(params.amount, 0.0, 0.0, 0.0));
 }
 
 struct FillOut {

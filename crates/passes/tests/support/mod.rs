@@ -4,12 +4,45 @@
 #![allow(dead_code, reason = "each test binary uses the subset it needs")]
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
-use volgraph_core::executor::{Gpu, Image};
+use volgraph_accel::camera::OrbitCamera;
+use volgraph_accel::volume::Volume;
+use volgraph_core::runtime::{CameraData, Gpu, Image, Runtime, ShaderLibrary};
+use volgraph_core::{CompileOptions, Plan, Registry};
 
 /// The headless GPU. Under CI a missing adapter is a failure, never a skip.
-pub fn gpu() -> Gpu {
-    Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)")
+pub fn gpu() -> Arc<Gpu> {
+    Arc::new(Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)"))
+}
+
+/// A runtime on `gpu` with the built-in shaders.
+pub fn runtime(gpu: &Arc<Gpu>) -> Runtime {
+    Runtime::new(gpu.clone(), ShaderLibrary::new(volgraph_passes::builtin_shaders()))
+}
+
+/// Renders graph `source` (named `file`) once on a fresh runtime: binds `volume` and `lut`,
+/// compiles with the volume's scene values, applies, renders one frame from `camera`. The
+/// runtime comes back for reading outputs.
+#[allow(clippy::too_many_arguments, reason = "the graph, the scene and the camera, each needed once")]
+pub fn render_once(
+    gpu: &Arc<Gpu>,
+    registry: &Registry,
+    file: &str,
+    source: &str,
+    options: &CompileOptions,
+    volume: &Volume,
+    lut: &[[f32; 4]],
+    camera: &OrbitCamera,
+) -> Result<(Runtime, Plan), String> {
+    let mut runtime = runtime(gpu);
+    let mut options = options.clone();
+    options.scene = volgraph_core::runtime::scene_values_of(&volgraph_core::runtime::VolumeDesc::of(volume));
+    let plan = volgraph_core::compile(file, source, registry, &options).map_err(|d| d.to_string())?;
+    runtime.bind_scene(&plan.inputs, volume, lut).map_err(|e| e.to_string())?;
+    runtime.apply(plan.clone(), registry).map_err(|e| e.to_string())?;
+    runtime.render(CameraData::from_orbit(camera, plan.viewport)).map_err(|e| e.to_string())?;
+    Ok((runtime, plan))
 }
 
 /// `graphs/<name>` in the workspace.

@@ -1,0 +1,519 @@
+//! What a pass plugin sees when it builds its node: [`CreateContext`]. Pipelines are built through
+//! [`CreateContext::render_pipeline`] and [`CreateContext::compute_pipeline`], which reflect the
+//! shader, check every binding and fragment output against the pass's ports by name, and look the
+//! pipeline up in the runtime's [`PipelineCache`] first: a pipeline is keyed by everything that
+//! defines it (module source hash, entry points, override constants, bind group layout, target
+//! formats, blend, depth, culling, topology), so rebuilding a node after an edit that did not
+//! touch its shaders costs no pipeline compilation.
+
+use std::cell::RefCell;
+use std::collections::{BTreeSet, HashMap};
+use std::sync::Mutex;
+
+use super::gpu::Gpu;
+use super::reflect::{BindingKind, ReflectedBinding, layout_entry, reflect};
+use super::shaders::ShaderLibrary;
+use crate::params::Params;
+use crate::plugin::Access;
+
+/// Names the runtime binds itself, in every pass that declares them.
+pub const SYSTEM_BINDINGS: [&str; 3] = ["frame", "linear_clamp", "nearest_clamp"];
+
+/// A pass failed to build or record.
+#[derive(Clone, Debug, thiserror::Error, PartialEq, Eq)]
+#[error("pass \"{pass}\": {message}")]
+pub struct PassError {
+    /// The pass id or instance label.
+    pub pass: String,
+    /// What went wrong and how to fix it.
+    pub message: String,
+}
+
+/// What a port of a pass is, as the runtime resolved it.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct PortInfo {
+    /// Port name.
+    pub name: String,
+    /// Read, write or modify.
+    pub access: Access,
+    /// Texture format, when known at build time (targets; graph inputs are filterable formats).
+    pub format: Option<wgpu::TextureFormat>,
+    /// A texture another pass owns (a min/max grid): bound as unfilterable float, read with
+    /// `textureLoad`, so 32-bit float grids need no FLOAT32_FILTERABLE.
+    pub owned: bool,
+    /// A storage buffer (counters, point lists) rather than a texture.
+    pub buffer: bool,
+}
+
+/// Depth test of a render pipeline.
+#[derive(Clone, Copy, Debug)]
+pub struct DepthSpec<'a> {
+    /// The port holding the depth target (Read: test only; Modify/Write: test and write).
+    pub port: &'a str,
+    /// Whether fragments write depth.
+    pub write: bool,
+    /// The comparison.
+    pub compare: wgpu::CompareFunction,
+}
+
+/// A render pipeline request.
+#[derive(Clone, Debug, Default)]
+pub struct RenderPipelineSpec<'a> {
+    /// Shader file, e.g. `raycast.wgsl`.
+    pub shader: &'a str,
+    /// Vertex entry point.
+    pub vertex: &'a str,
+    /// Fragment entry point.
+    pub fragment: &'a str,
+    /// Names the pass binds itself (its `params` uniform, ...).
+    pub extra_bindings: &'a [&'a str],
+    /// Face culling.
+    pub cull: Option<wgpu::Face>,
+    /// Blending for every colour target.
+    pub blend: Option<wgpu::BlendState>,
+    /// Depth test.
+    pub depth: Option<DepthSpec<'a>>,
+    /// Pipeline-overridable constants (shader specialization).
+    pub constants: &'a [(&'a str, f64)],
+    /// Primitive topology (instanced quads, point lists drawn as triangles, lines).
+    pub topology: wgpu::PrimitiveTopology,
+}
+
+/// A compute pipeline request.
+#[derive(Clone, Debug, Default)]
+pub struct ComputePipelineSpec<'a> {
+    /// Shader file.
+    pub shader: &'a str,
+    /// Entry point.
+    pub entry: &'a str,
+    /// Names the pass binds itself.
+    pub extra_bindings: &'a [&'a str],
+    /// Pipeline-overridable constants (workgroup size, features).
+    pub constants: &'a [(&'a str, f64)],
+}
+
+/// The compiled pipeline of a pass with its reflected bindings; cheap to clone.
+#[derive(Clone, Debug)]
+pub struct PassPipeline {
+    /// Debug label (`pass/entry`).
+    pub label: String,
+    /// Render or compute.
+    pub pipeline: PipelineKind,
+    /// Layout of bind group 0.
+    pub layout: wgpu::BindGroupLayout,
+    /// Bindings by name.
+    pub bindings: Vec<ReflectedBinding>,
+    /// Colour-target ports in location order (render pipelines).
+    pub color_ports: Vec<String>,
+    /// The depth port, if any.
+    pub depth_port: Option<String>,
+}
+
+/// A render or compute pipeline.
+#[derive(Clone, Debug)]
+pub enum PipelineKind {
+    /// Render.
+    Render(wgpu::RenderPipeline),
+    /// Compute.
+    Compute(wgpu::ComputePipeline),
+}
+
+/// Pipelines by the key of everything that defines them. Lives as long as the runtime.
+#[derive(Default)]
+pub struct PipelineCache {
+    pipelines: Mutex<HashMap<String, PassPipeline>>,
+    counts: Mutex<(u64, u64)>,
+}
+
+impl PipelineCache {
+    /// `(hits, misses)` since creation: a graph edit that changes no shader should only hit.
+    pub fn counts(&self) -> (u64, u64) {
+        self.counts.lock().map(|c| *c).unwrap_or_default()
+    }
+
+    /// Cached pipelines.
+    pub fn len(&self) -> usize {
+        self.pipelines.lock().map(|p| p.len()).unwrap_or(0)
+    }
+
+    /// True when nothing is cached.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Drops the pipelines built from a module whose source hash is no longer current.
+    pub fn retain(&self, keep: impl Fn(&str) -> bool) {
+        if let Ok(mut p) = self.pipelines.lock() {
+            p.retain(|k, _| keep(k));
+        }
+    }
+
+    fn get_or_build(
+        &self,
+        key: String,
+        build: impl FnOnce() -> Result<PassPipeline, PassError>,
+    ) -> Result<PassPipeline, PassError> {
+        if let Some(p) = self.pipelines.lock().ok().and_then(|p| p.get(&key).cloned()) {
+            if let Ok(mut c) = self.counts.lock() {
+                c.0 += 1;
+            }
+            return Ok(p);
+        }
+        let built = build()?;
+        if let Ok(mut c) = self.counts.lock() {
+            c.1 += 1;
+        }
+        if let Ok(mut p) = self.pipelines.lock() {
+            p.insert(key, built.clone());
+        }
+        Ok(built)
+    }
+}
+
+/// Given to [`crate::plugin::PassPlugin::create`].
+pub struct CreateContext<'a> {
+    /// The GPU.
+    pub gpu: &'a Gpu,
+    /// Shader modules.
+    pub shaders: &'a ShaderLibrary,
+    /// The pass id.
+    pub pass_id: &'a str,
+    /// Its checked parameters.
+    pub params: &'a Params,
+    /// Its ports with formats.
+    pub ports: &'a [PortInfo],
+    pub(crate) pipelines: &'a PipelineCache,
+    /// Shader modules this node's pipelines came from (a shader edit rebuilds exactly these nodes).
+    pub(crate) modules: RefCell<BTreeSet<String>>,
+}
+
+impl<'a> CreateContext<'a> {
+    /// A context for building pass `pass_id` outside a runtime (tools, tests of plugins).
+    pub fn new(
+        gpu: &'a Gpu,
+        shaders: &'a ShaderLibrary,
+        pipelines: &'a PipelineCache,
+        pass_id: &'a str,
+        params: &'a Params,
+        ports: &'a [PortInfo],
+    ) -> Self {
+        Self { gpu, shaders, pass_id, params, ports, pipelines, modules: RefCell::new(BTreeSet::new()) }
+    }
+
+    fn error(&self, message: String) -> PassError {
+        PassError { pass: self.pass_id.to_string(), message }
+    }
+
+    /// The port named `name`.
+    pub fn port(&self, name: &str) -> Option<&PortInfo> {
+        self.ports.iter().find(|p| p.name == name)
+    }
+
+    fn check_bindings(&self, shader: &str, bindings: &[ReflectedBinding], extra: &[&str]) -> Result<(), PassError> {
+        for b in bindings {
+            if b.group != 0 {
+                return Err(self.error(format!(
+                    "{shader}: global \"{}\" is in @group({}); volgraph binds everything in @group(0)",
+                    b.name, b.group
+                )));
+            }
+            if SYSTEM_BINDINGS.contains(&b.name.as_str()) || extra.contains(&b.name.as_str()) {
+                continue;
+            }
+            let Some(p) = self.port(&b.name) else {
+                let ports: Vec<&str> = self.ports.iter().map(|p| p.name.as_str()).collect();
+                return Err(self.error(format!(
+                    "{shader}: global \"{}\" is neither a port of this pass (ports: {}) nor a system binding ({}) \
+                     nor one the pass binds itself ({}); rename it to the port it stands for",
+                    b.name,
+                    ports.join(", "),
+                    SYSTEM_BINDINGS.join(", "),
+                    if extra.is_empty() { "none".to_string() } else { extra.join(", ") }
+                )));
+            };
+            match &b.ty {
+                BindingKind::Storage { read_only } => {
+                    if !p.buffer {
+                        return Err(self.error(format!(
+                            "{shader}: global \"{}\" is a storage buffer but port \"{}\" is a texture",
+                            b.name, b.name
+                        )));
+                    }
+                    if !*read_only && p.access == Access::Read {
+                        return Err(self.error(format!(
+                            "{shader}: storage buffer \"{}\" is read_write but the port is an input; declare it \
+                             var<storage, read>",
+                            b.name
+                        )));
+                    }
+                }
+                _ if p.buffer => {
+                    return Err(self.error(format!(
+                        "{shader}: global \"{}\" is not a storage buffer but port \"{}\" is a buffer; declare it \
+                         var<storage, read> or var<storage, read_write>",
+                        b.name, b.name
+                    )));
+                }
+                BindingKind::StorageTexture { format, .. } => {
+                    if p.access == Access::Read {
+                        return Err(self.error(format!(
+                            "{shader}: storage texture \"{}\" is an input port; storage textures are outputs",
+                            b.name
+                        )));
+                    }
+                    if let Some(port_format) = p.format
+                        && *format != Some(port_format)
+                    {
+                        let declared = format.map_or("an unsupported format".to_string(), |f| format!("{f:?}"));
+                        return Err(self.error(format!(
+                            "{shader}: storage texture \"{}\" is declared {declared} but the port's target is \
+                             {port_format:?}; declare the output with the shader's format",
+                            b.name
+                        )));
+                    }
+                }
+                _ if p.access == Access::Write => {
+                    return Err(self.error(format!(
+                        "{shader}: global \"{}\" samples output port \"{}\"; outputs are written, not read",
+                        b.name, b.name
+                    )));
+                }
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
+    fn layout_entries(
+        &self,
+        bindings: &[ReflectedBinding],
+        stages: wgpu::ShaderStages,
+    ) -> Vec<wgpu::BindGroupLayoutEntry> {
+        bindings
+            .iter()
+            .map(|b| {
+                let filterable = match self.port(&b.name) {
+                    Some(p) if p.owned => false,
+                    Some(PortInfo { format: Some(f), .. }) => self.gpu.filterable(*f),
+                    _ => true,
+                };
+                // Writable storage in a vertex stage needs VERTEX_WRITABLE_STORAGE; volgraph's
+                // render passes write storage (counters) from fragment shaders only.
+                let stages = match b.ty {
+                    BindingKind::Storage { read_only: false } => stages - wgpu::ShaderStages::VERTEX,
+                    _ => stages,
+                };
+                layout_entry(b, stages, filterable)
+            })
+            .collect()
+    }
+
+    fn shader(&self, file: &str) -> Result<std::sync::Arc<super::shaders::LoadedShader>, PassError> {
+        self.modules.borrow_mut().insert(file.to_string());
+        self.shaders.get(self.gpu, file).map_err(|e| self.error(e))
+    }
+
+    /// Builds (or takes from the cache) a render pipeline drawing a fragment shader into this
+    /// pass's output ports, named by the fragment output struct's members.
+    pub fn render_pipeline(&self, spec: &RenderPipelineSpec<'_>) -> Result<PassPipeline, PassError> {
+        let shader = self.shader(spec.shader)?;
+        let r = reflect(&shader.module, &shader.info, &[spec.vertex, spec.fragment])
+            .map_err(|e| self.error(format!("{} {e}", spec.shader)))?;
+        self.check_bindings(spec.shader, &r.bindings, spec.extra_bindings)?;
+        let mut outputs = r.fragment_outputs.clone();
+        outputs.sort_by_key(|(_, loc)| *loc);
+        let mut targets = Vec::new();
+        let mut color_ports = Vec::new();
+        for (name, location) in &outputs {
+            let Some(port) = self.port(name).filter(|p| p.access != Access::Read) else {
+                return Err(self.error(format!(
+                    "{}: fragment output \"{name}\" (@location({location})) of {} is not an output port of this pass",
+                    spec.shader, spec.fragment
+                )));
+            };
+            if *location as usize != targets.len() {
+                return Err(
+                    self.error(format!("{}: fragment outputs must use consecutive locations from 0", spec.shader))
+                );
+            }
+            let Some(format) = port.format else {
+                return Err(self.error(format!("output port \"{name}\" has no target format")));
+            };
+            targets.push(Some(wgpu::ColorTargetState {
+                format,
+                blend: spec.blend,
+                write_mask: wgpu::ColorWrites::ALL,
+            }));
+            color_ports.push(name.clone());
+        }
+        let depth_stencil = match &spec.depth {
+            Some(d) => {
+                let port = self
+                    .port(d.port)
+                    .ok_or_else(|| self.error(format!("depth port \"{}\" is not a port of this pass", d.port)))?;
+                Some(wgpu::DepthStencilState {
+                    format: port.format.unwrap_or(wgpu::TextureFormat::Depth32Float),
+                    depth_write_enabled: Some(d.write),
+                    depth_compare: Some(d.compare),
+                    stencil: wgpu::StencilState::default(),
+                    bias: wgpu::DepthBiasState::default(),
+                })
+            }
+            None => None,
+        };
+        let entries = self.layout_entries(&r.bindings, wgpu::ShaderStages::VERTEX_FRAGMENT);
+        let key = format!(
+            "render|{}|{:016x}|{}|{}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
+            spec.shader,
+            shader.hash,
+            spec.vertex,
+            spec.fragment,
+            spec.constants,
+            entries,
+            targets,
+            depth_stencil,
+            spec.cull,
+            spec.topology
+        );
+        let label = format!("{}/{}", self.pass_id, spec.fragment);
+        self.pipelines
+            .get_or_build(key, || {
+                let device = &self.gpu.device;
+                let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some(&label),
+                    entries: &entries,
+                });
+                let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some(&label),
+                    bind_group_layouts: &[Some(&layout)],
+                    immediate_size: 0,
+                });
+                let pipeline = self
+                    .gpu
+                    .checked(
+                        || format!("{}: building the pipeline {}/{}", spec.shader, spec.vertex, spec.fragment),
+                        || {
+                            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                                label: Some(&label),
+                                layout: Some(&pipeline_layout),
+                                vertex: wgpu::VertexState {
+                                    module: &shader.wgpu,
+                                    entry_point: Some(spec.vertex),
+                                    compilation_options: wgpu::PipelineCompilationOptions {
+                                        constants: spec.constants,
+                                        ..Default::default()
+                                    },
+                                    buffers: &[],
+                                },
+                                primitive: wgpu::PrimitiveState {
+                                    topology: spec.topology,
+                                    front_face: wgpu::FrontFace::Ccw,
+                                    cull_mode: spec.cull,
+                                    ..Default::default()
+                                },
+                                depth_stencil: depth_stencil.clone(),
+                                multisample: wgpu::MultisampleState::default(),
+                                fragment: Some(wgpu::FragmentState {
+                                    module: &shader.wgpu,
+                                    entry_point: Some(spec.fragment),
+                                    compilation_options: wgpu::PipelineCompilationOptions {
+                                        constants: spec.constants,
+                                        ..Default::default()
+                                    },
+                                    targets: &targets,
+                                }),
+                                multiview_mask: None,
+                                cache: None,
+                            })
+                        },
+                    )
+                    .map_err(|e| self.error(e.to_string()))?;
+                Ok(PassPipeline {
+                    label: label.clone(),
+                    pipeline: PipelineKind::Render(pipeline),
+                    layout,
+                    bindings: r.bindings.clone(),
+                    color_ports: color_ports.clone(),
+                    depth_port: spec.depth.map(|d| d.port.to_string()),
+                })
+            })
+            .map(|mut p| {
+                p.label = label.clone();
+                p
+            })
+    }
+
+    /// Builds (or takes from the cache) a compute pipeline writing this pass's outputs as storage
+    /// textures or buffers named after the ports.
+    pub fn compute_pipeline(&self, spec: &ComputePipelineSpec<'_>) -> Result<PassPipeline, PassError> {
+        let shader = self.shader(spec.shader)?;
+        let r = reflect(&shader.module, &shader.info, &[spec.entry])
+            .map_err(|e| self.error(format!("{} {e}", spec.shader)))?;
+        self.check_bindings(spec.shader, &r.bindings, spec.extra_bindings)?;
+        let entries = self.layout_entries(&r.bindings, wgpu::ShaderStages::COMPUTE);
+        let key =
+            format!("compute|{}|{:016x}|{}|{:?}|{:?}", spec.shader, shader.hash, spec.entry, spec.constants, entries);
+        let label = format!("{}/{}", self.pass_id, spec.entry);
+        self.pipelines
+            .get_or_build(key, || {
+                let device = &self.gpu.device;
+                let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some(&label),
+                    entries: &entries,
+                });
+                let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some(&label),
+                    bind_group_layouts: &[Some(&layout)],
+                    immediate_size: 0,
+                });
+                let pipeline = self
+                    .gpu
+                    .checked(
+                        || format!("{}: building the compute pipeline {}", spec.shader, spec.entry),
+                        || {
+                            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                                label: Some(&label),
+                                layout: Some(&pipeline_layout),
+                                module: &shader.wgpu,
+                                entry_point: Some(spec.entry),
+                                compilation_options: wgpu::PipelineCompilationOptions {
+                                    constants: spec.constants,
+                                    ..Default::default()
+                                },
+                                cache: None,
+                            })
+                        },
+                    )
+                    .map_err(|e| self.error(e.to_string()))?;
+                Ok(PassPipeline {
+                    label: label.clone(),
+                    pipeline: PipelineKind::Compute(pipeline),
+                    layout,
+                    bindings: r.bindings.clone(),
+                    color_ports: Vec::new(),
+                    depth_port: None,
+                })
+            })
+            .map(|mut p| {
+                p.label = label.clone();
+                p
+            })
+    }
+
+    /// A uniform buffer for this pass (e.g. its `params`).
+    pub fn uniform_buffer(&self, name: &str, size: u64) -> wgpu::Buffer {
+        self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(&format!("{}.{name}", self.pass_id)),
+            size,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    }
+
+    /// A uniform buffer holding `value` (a `#[repr(C)]` twin of a WGSL struct).
+    pub fn uniform_with<T: bytemuck::Pod>(&self, name: &str, value: &T) -> wgpu::Buffer {
+        let buffer = self.uniform_buffer(name, std::mem::size_of::<T>() as u64);
+        self.gpu.queue.write_buffer(&buffer, 0, bytemuck::bytes_of(value));
+        buffer
+    }
+}

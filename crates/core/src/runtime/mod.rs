@@ -1,0 +1,550 @@
+//! The live runtime: one object that lives as long as the GPU device and owns everything that
+//! outlives a plan — the shader library, the pipeline cache, the texture pool, the named history
+//! store, the bound graph inputs and the frames in flight. Plans come and go through
+//! [`Runtime::apply`], which reuses every pipeline, texture, history entry and input whose key did
+//! not change and keeps the previous plan running when the new one fails. Frames are submitted
+//! without waiting ([`Runtime::submit`]); timings come back asynchronously.
+//!
+//! Data flow: `compile` (pure) → [`Runtime::apply`] (nodes, slots) → per frame
+//! [`Runtime::submit`] (frame contract → uniforms, history swap, record every step, optional
+//! window blit, submit) → [`Runtime::poll`] / [`Runtime::finish`] (timings) and
+//! [`Runtime::read_output`] (readback).
+
+pub mod create;
+pub mod frame;
+pub mod frames;
+pub mod gpu;
+pub mod history;
+pub mod inputs;
+pub mod present;
+pub mod readback;
+pub mod record;
+pub mod reflect;
+pub mod schedule;
+pub mod shaders;
+pub mod textures;
+pub mod upload;
+
+use std::collections::BTreeMap;
+use std::sync::Arc;
+use std::time::Instant;
+
+pub use create::{
+    ComputePipelineSpec, CreateContext, DepthSpec, PassError, PassPipeline, PipelineCache, PipelineKind, PortInfo,
+    RenderPipelineSpec,
+};
+pub use frame::{CameraData, FrameData, FrameUniforms, LONGEST_RAY_VOXELS, VolumeDesc, scene_values_of};
+pub use frames::{FrameStats, MAX_FRAMES_IN_FLIGHT};
+pub use gpu::{Gpu, GpuError, GpuFault, GpuFaultKind, GpuOptions};
+pub use inputs::upload_volume_texture;
+pub use present::PresentTarget;
+pub use readback::Image;
+pub use record::{RecordContext, SystemBindings};
+pub use schedule::{ApplyError, ApplyReport};
+pub use shaders::ShaderLibrary;
+pub use upload::{
+    UploadError, UploadedVolume, VolumeFormat, VolumeTexels, upload_lut, upload_volume, volume_format_for,
+};
+
+use crate::diagnostic::Diagnostics;
+use crate::graph::ast::InputKind;
+use crate::plan::{Binding, Plan, ResourceDesc};
+use crate::plugin::{Access, Registry};
+use crate::{CompileOptions, compile};
+use record::BoundPort;
+use schedule::{Schedule, SlotTexture};
+
+/// Why the runtime could not do what was asked.
+#[derive(Debug, thiserror::Error)]
+pub enum RuntimeError {
+    /// No plan has been applied yet.
+    #[error("no graph is loaded; apply a compiled plan first")]
+    NoPlan,
+    /// Applying a plan failed (the previous plan keeps running).
+    #[error(transparent)]
+    Apply(#[from] ApplyError),
+    /// A pass failed to record.
+    #[error(transparent)]
+    Pass(#[from] PassError),
+    /// The application did not bind a graph input the plan reads.
+    #[error("graph input \"{name}\" ({kind}) is not bound; {hint}")]
+    UnboundInput {
+        /// Input name.
+        name: String,
+        /// Its kind.
+        kind: String,
+        /// How to bind it.
+        hint: String,
+    },
+    /// A requested output does not exist.
+    #[error("the graph has no output \"{name}\" (it has: {known})")]
+    UnknownOutput {
+        /// Requested name.
+        name: String,
+        /// Existing names.
+        known: String,
+    },
+    /// An upload failed.
+    #[error(transparent)]
+    Upload(#[from] UploadError),
+    /// The GPU rejected work (validation, out of memory), with what was being done.
+    #[error(transparent)]
+    Gpu(#[from] GpuFault),
+    /// Reading a result back failed.
+    #[error("{0}")]
+    Readback(String),
+}
+
+/// Memory the runtime holds, for reports and soak tests.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MemoryInUse {
+    /// Transient targets of the current plan.
+    pub transient_bytes: u64,
+    /// Free textures kept in the pool.
+    pub pooled_free_bytes: u64,
+    /// History entries (both textures).
+    pub history_bytes: u64,
+    /// Bound inputs (volume, LUT).
+    pub input_bytes: u64,
+    /// Cached pipelines.
+    pub pipelines: usize,
+    /// Textures created since start.
+    pub textures_created: u64,
+    /// Bind groups created since the current plan was applied.
+    pub bind_groups_created: u64,
+}
+
+/// The long-lived runtime.
+pub struct Runtime {
+    gpu: Arc<Gpu>,
+    shaders: ShaderLibrary,
+    pipelines: PipelineCache,
+    textures: textures::TexturePool,
+    history: history::HistoryStore,
+    inputs: inputs::InputStore,
+    frames: frames::FrameRing,
+    blitter: present::Blitter,
+    system: SystemBindings,
+    schedule: Option<Schedule>,
+    /// Shader modules edited since the current schedule was built.
+    stale_modules: Vec<String>,
+    frame_index: u64,
+    history_age: u64,
+    last_camera: Option<(CameraData, (u32, u32))>,
+}
+
+impl Runtime {
+    /// A runtime on `gpu` reading shaders from `shaders`.
+    pub fn new(gpu: Arc<Gpu>, shaders: ShaderLibrary) -> Self {
+        let system = SystemBindings::new(&gpu);
+        Self {
+            gpu,
+            shaders,
+            pipelines: PipelineCache::default(),
+            textures: textures::TexturePool::default(),
+            history: history::HistoryStore::default(),
+            inputs: inputs::InputStore::default(),
+            frames: frames::FrameRing::default(),
+            blitter: present::Blitter::default(),
+            system,
+            schedule: None,
+            stale_modules: Vec::new(),
+            frame_index: 0,
+            history_age: 0,
+            last_camera: None,
+        }
+    }
+
+    /// The GPU.
+    pub fn gpu(&self) -> &Gpu {
+        &self.gpu
+    }
+
+    /// A shared handle to the GPU.
+    pub fn gpu_arc(&self) -> Arc<Gpu> {
+        self.gpu.clone()
+    }
+
+    /// The shader library.
+    pub fn shaders(&self) -> &ShaderLibrary {
+        &self.shaders
+    }
+
+    /// The pipeline cache (hit and miss counts for reload reports).
+    pub fn pipelines(&self) -> &PipelineCache {
+        &self.pipelines
+    }
+
+    /// The applied plan.
+    pub fn plan(&self) -> Option<&Plan> {
+        self.schedule.as_ref().map(|s| &s.plan)
+    }
+
+    /// The bound volume's description and texture format.
+    pub fn volume(&self) -> Option<(VolumeDesc, VolumeFormat)> {
+        self.inputs.volume()
+    }
+
+    /// Binds a volume to graph input `name` (uploads only new content).
+    pub fn bind_volume(&mut self, name: &str, volume: &volgraph_accel::volume::Volume) -> Result<bool, RuntimeError> {
+        Ok(self.inputs.bind_volume(&self.gpu, name, volume)?)
+    }
+
+    /// Binds a transfer-function LUT to graph input `name` (uploads only new content).
+    pub fn bind_lut(&mut self, name: &str, lut: &[[f32; 4]]) -> Result<bool, RuntimeError> {
+        Ok(self.inputs.bind_lut(&self.gpu, name, lut)?)
+    }
+
+    /// Binds an application-made texture to graph input `name`.
+    pub fn bind_texture(&mut self, name: &str, texture: wgpu::Texture) {
+        self.inputs.bind_texture(name, texture);
+    }
+
+    /// Uploads done since start (a plan change re-uploads nothing).
+    pub fn uploads(&self) -> u64 {
+        self.inputs.uploads()
+    }
+
+    /// Scene values of what is bound, for compiling: the bound volume's
+    /// [`LONGEST_RAY_VOXELS`]. Computed in this one place.
+    pub fn scene_values(&self) -> BTreeMap<String, f64> {
+        self.inputs.volume().map(|(v, _)| frame::scene_values_of(&v)).unwrap_or_default()
+    }
+
+    /// Binds `volume` and `lut` to every graph input of kind Volume and TransferFunction in
+    /// `inputs` (a plan's inputs).
+    pub fn bind_scene(
+        &mut self,
+        inputs: &BTreeMap<String, InputKind>,
+        volume: &volgraph_accel::volume::Volume,
+        lut: &[[f32; 4]],
+    ) -> Result<(), RuntimeError> {
+        for (name, kind) in inputs {
+            match kind {
+                InputKind::Volume => {
+                    self.bind_volume(name, volume)?;
+                }
+                InputKind::TransferFunction => {
+                    self.bind_lut(name, lut)?;
+                }
+                InputKind::Scalar(_) => {}
+            }
+        }
+        Ok(())
+    }
+
+    /// Compiles graph text with the scene values of what is bound (a pure function; nothing is
+    /// applied).
+    pub fn compile(
+        &self,
+        file: &str,
+        source: &str,
+        registry: &Registry,
+        options: &CompileOptions,
+    ) -> Result<Plan, Diagnostics> {
+        let mut options = options.clone();
+        for (k, v) in self.scene_values() {
+            options.scene.entry(k).or_insert(v);
+        }
+        compile(file, source, registry, &options)
+    }
+
+    /// Makes `plan` the running plan, reusing what did not change; on error the previous plan
+    /// keeps running.
+    pub fn apply(&mut self, plan: Plan, registry: &Registry) -> Result<ApplyReport, RuntimeError> {
+        let viewport_changed = self.plan().is_some_and(|p| p.viewport != plan.viewport);
+        let old = self.schedule.take();
+        let resources = schedule::Resources {
+            gpu: &self.gpu,
+            shaders: &self.shaders,
+            pipelines: &self.pipelines,
+            textures: &mut self.textures,
+            history: &mut self.history,
+        };
+        match schedule::build(resources, registry, plan, old, &self.stale_modules) {
+            Ok((schedule, report)) => {
+                self.schedule = Some(schedule);
+                self.stale_modules.clear();
+                if viewport_changed {
+                    // Klein et al. 2005 §4: a resize starts from scratch.
+                    self.invalidate_history();
+                }
+                Ok(report)
+            }
+            Err((e, old)) => {
+                self.schedule = old;
+                Err(e.into())
+            }
+        }
+    }
+
+    /// Forgets the cached modules built from `changed` files; the next [`Self::apply`] rebuilds
+    /// exactly the nodes whose pipelines use them. Returns the modules affected.
+    pub fn shaders_changed(&mut self, changed: &[std::path::PathBuf]) -> Vec<String> {
+        let stale = self.shaders.invalidate(changed);
+        self.stale_modules.extend(stale.iter().cloned());
+        stale
+    }
+
+    /// Forgets history: the next frame reads every entry's initial value (resize, transfer
+    /// function or isovalue change, camera jump; Klein et al. 2005 §4).
+    pub fn invalidate_history(&mut self) {
+        self.history.invalidate();
+        self.history_age = 0;
+        self.last_camera = None;
+    }
+
+    /// The frame data the next frame will see for `camera`.
+    pub fn frame_data(&self, camera: CameraData) -> Result<FrameData, RuntimeError> {
+        let plan = self.plan().ok_or(RuntimeError::NoPlan)?;
+        let previous = self.last_camera.filter(|(_, vp)| *vp == plan.viewport).map(|(c, _)| c);
+        Ok(FrameData {
+            viewport: plan.viewport,
+            camera,
+            previous_camera: previous,
+            frame_index: self.frame_index,
+            history_age: self.history_age,
+            volume: self.inputs.volume().map(|(v, _)| v),
+        })
+    }
+
+    /// Records and submits one frame seen by `camera`, optionally presenting an output to a
+    /// window; returns the frame's index at once (at most [`MAX_FRAMES_IN_FLIGHT`] frames are
+    /// queued: a further submit waits for the oldest).
+    pub fn submit(&mut self, camera: CameraData, present: Option<&PresentTarget<'_>>) -> Result<u64, RuntimeError> {
+        let frame = self.frame_data(camera)?;
+        let Some(schedule) = self.schedule.as_mut() else { return Err(RuntimeError::NoPlan) };
+        Self::check_inputs_of(&self.inputs, &schedule.plan)?;
+        let gpu = self.gpu.clone();
+        self.gpu.queue.write_buffer(&self.system.frame, 0, bytemuck::bytes_of(&FrameUniforms::of(&frame)));
+        let steps = schedule.plan.steps.len();
+        let timestamps = self.frames.begin(&gpu, steps);
+        let what = format!("frame {} of graph \"{}\"", frame.frame_index, schedule.plan.name);
+        let history = &mut self.history;
+        let inputs = &self.inputs;
+        let system = &self.system;
+        let frames = &self.frames;
+        let blitter = &mut self.blitter;
+        let commands = gpu.checked(
+            || what.clone(),
+            || -> Result<wgpu::CommandBuffer, RuntimeError> {
+                let mut encoder = gpu
+                    .device
+                    .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(&schedule.plan.name) });
+                history.begin_frame(&mut encoder);
+                record_steps(&gpu, schedule, history, inputs, system, &frame, &mut encoder, timestamps.as_ref())?;
+                if let Some(target) = present {
+                    let (view, encoded) = output_view(schedule, history, target.output)?;
+                    blitter.record(&gpu, &mut encoder, &view, encoded, target)?;
+                }
+                frames.resolve(&mut encoder, steps);
+                Ok(encoder.finish())
+            },
+        )??;
+        let submitted = Instant::now();
+        let submission = gpu.checked(|| what.clone(), || gpu.queue.submit([commands]))?;
+        self.history.end_frame();
+        let pass_ids = schedule.pass_ids.clone();
+        self.frames.submitted(&gpu, submission, frame.frame_index, pass_ids, submitted);
+        schedule.bind_groups.borrow_mut().evict_older_than(frame.frame_index, 8);
+        self.last_camera = Some((camera, frame.viewport));
+        self.frame_index += 1;
+        self.history_age += 1;
+        Ok(frame.frame_index)
+    }
+
+    fn check_inputs_of(inputs: &inputs::InputStore, plan: &Plan) -> Result<(), RuntimeError> {
+        for (name, kind) in &plan.inputs {
+            let used = plan.steps.iter().any(|s| s.ports.iter().any(|p| p.binding == Binding::Input(name.clone())));
+            if used && inputs.get(name).is_none() {
+                let (kind, hint) = match kind {
+                    InputKind::Volume => ("Volume", "bind it with Runtime::bind_volume"),
+                    InputKind::TransferFunction => ("TransferFunction", "bind the LUT with Runtime::bind_lut"),
+                    InputKind::Scalar(_) => ("Scalar", "scalars are compile-time scene values"),
+                };
+                return Err(RuntimeError::UnboundInput {
+                    name: name.clone(),
+                    kind: kind.to_string(),
+                    hint: hint.to_string(),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Submits a frame and waits for it: its stats.
+    pub fn render(&mut self, camera: CameraData) -> Result<FrameStats, RuntimeError> {
+        let index = self.submit(camera, None)?;
+        let stats = self.finish();
+        stats
+            .into_iter()
+            .find(|s| s.frame_index == index)
+            .ok_or_else(|| RuntimeError::Readback(format!("frame {index} finished without stats")))
+    }
+
+    /// Stats of the frames the GPU has finished, without blocking.
+    pub fn poll(&mut self) -> Vec<FrameStats> {
+        self.frames.poll(&self.gpu)
+    }
+
+    /// Waits for every frame in flight: their stats, oldest first.
+    pub fn finish(&mut self) -> Vec<FrameStats> {
+        self.frames.finish(&self.gpu)
+    }
+
+    /// Frames submitted and not yet collected.
+    pub fn in_flight(&self) -> usize {
+        self.frames.in_flight()
+    }
+
+    /// Reads back a graph output of the last frame (waits for it).
+    pub fn read_output(&mut self, name: &str) -> Result<Image, RuntimeError> {
+        let schedule = self.schedule.as_ref().ok_or(RuntimeError::NoPlan)?;
+        let Some(&rid) = schedule.plan.outputs.get(name) else {
+            return Err(RuntimeError::UnknownOutput {
+                name: name.to_string(),
+                known: schedule.plan.outputs.keys().cloned().collect::<Vec<_>>().join(", "),
+            });
+        };
+        self.read_resource(rid)
+    }
+
+    /// Reads back any target resource of the last frame (valid while its slot was not reused
+    /// later in the frame: outputs and the last holder of a slot).
+    pub fn read_resource(&mut self, rid: usize) -> Result<Image, RuntimeError> {
+        let _ = self.frames.finish(&self.gpu);
+        let schedule = self.schedule.as_ref().ok_or(RuntimeError::NoPlan)?;
+        let r = &schedule.plan.resources[rid];
+        let (Some(slot), ResourceDesc::Target { format, extent, .. }) = (r.slot, &r.desc) else {
+            return Err(RuntimeError::Readback(format!("\"{}\" is not a target", r.name)));
+        };
+        let texture = match &schedule.slots[slot] {
+            SlotTexture::Transient(t) => t.texture.clone(),
+            SlotTexture::History(name) => self
+                .history
+                .get(name)
+                .map(|e| e.current().texture.clone())
+                .ok_or_else(|| RuntimeError::Readback(format!("history \"{name}\" is gone")))?,
+        };
+        readback::read_texture(&self.gpu, &texture, *format, *extent).map_err(RuntimeError::Readback)
+    }
+
+    /// Memory held, for reports and soak tests.
+    pub fn memory(&self) -> MemoryInUse {
+        MemoryInUse {
+            transient_bytes: self.plan().map_or(0, |p| p.memory().pooled_bytes),
+            pooled_free_bytes: self.textures.free_bytes(),
+            history_bytes: self.history.bytes(),
+            input_bytes: self.inputs.bytes(),
+            pipelines: self.pipelines.len(),
+            textures_created: self.textures.created(),
+            bind_groups_created: self.schedule.as_ref().map_or(0, |s| s.bind_groups.borrow().created()),
+        }
+    }
+}
+
+/// The view of output `name` and whether it holds sRGB-encoded values (an 8-bit target).
+fn output_view(
+    schedule: &Schedule,
+    history: &history::HistoryStore,
+    name: &str,
+) -> Result<(wgpu::TextureView, bool), RuntimeError> {
+    let Some(&rid) = schedule.plan.outputs.get(name) else {
+        return Err(RuntimeError::UnknownOutput {
+            name: name.to_string(),
+            known: schedule.plan.outputs.keys().cloned().collect::<Vec<_>>().join(", "),
+        });
+    };
+    let r = &schedule.plan.resources[rid];
+    let (Some(slot), ResourceDesc::Target { format, .. }) = (r.slot, &r.desc) else {
+        return Err(RuntimeError::Readback(format!("output \"{name}\" is not a target")));
+    };
+    let view = match &schedule.slots[slot] {
+        SlotTexture::Transient(t) => t.view.clone(),
+        SlotTexture::History(h) => history
+            .get(h)
+            .map(|e| e.current().view.clone())
+            .ok_or_else(|| RuntimeError::Readback(format!("history \"{h}\" is gone")))?,
+    };
+    Ok((view, *format == crate::format::TargetFormat::Rgba8Unorm))
+}
+
+#[allow(clippy::too_many_arguments, reason = "the frame's parts, each borrowed separately")]
+fn record_steps(
+    gpu: &Gpu,
+    schedule: &mut Schedule,
+    history: &history::HistoryStore,
+    inputs: &inputs::InputStore,
+    system: &SystemBindings,
+    frame: &FrameData,
+    encoder: &mut wgpu::CommandEncoder,
+    timestamps: Option<&(wgpu::QuerySet, u32)>,
+) -> Result<(), RuntimeError> {
+    let Schedule { plan, nodes, slots, owned, bind_groups, .. } = schedule;
+    for (i, step) in plan.steps.iter().enumerate() {
+        let mut ports = Vec::with_capacity(step.ports.len());
+        for bp in &step.ports {
+            let (view, extent) = match &bp.binding {
+                Binding::Resource { id, written } => {
+                    let rid = if bp.access == Access::Modify { written.unwrap_or(*id) } else { *id };
+                    let r = &plan.resources[rid];
+                    let extent = match &r.desc {
+                        ResourceDesc::Target { extent, .. } => Some(*extent),
+                        ResourceDesc::Owned(_) => None,
+                    };
+                    let view = match r.slot {
+                        Some(s) => match &slots[s] {
+                            SlotTexture::Transient(t) => Some(&t.view),
+                            SlotTexture::History(name) => history.get(name).map(|e| &e.current().view),
+                        },
+                        None => owned.get(&root_owned(plan, rid)),
+                    };
+                    (view, extent)
+                }
+                Binding::Input(name) => (inputs.get(name).map(|t| &t.view), None),
+                Binding::History(name) => (history.get(name).map(|e| &e.previous().view), None),
+                Binding::Unbound => (None, None),
+            };
+            ports.push(BoundPort { name: bp.port.clone(), access: bp.access, view, buffer: None, extent });
+        }
+        let entry = nodes.get_mut(&step.pass_id).ok_or_else(|| ApplyError::UnknownKind(step.kind.clone()))?;
+        let mut ctx = RecordContext {
+            gpu,
+            encoder,
+            label: &step.label,
+            iteration: step.iteration,
+            params: &step.params,
+            viewport: plan.viewport,
+            frame,
+            ports,
+            system,
+            timestamps: timestamps.map(|(set, base)| (set, base + 2 * i as u32)),
+            began_pass: false,
+            bind_groups,
+        };
+        entry.node.record(&mut ctx)?;
+        // Owned outputs created or replaced while recording (sized by a graph input).
+        for bp in &step.ports {
+            if let Binding::Resource { id, written: None } = &bp.binding
+                && bp.access == Access::Write
+                && matches!(plan.resources[*id].desc, ResourceDesc::Owned(_))
+            {
+                let view = entry.node.owned_output(&bp.port).ok_or_else(|| PassError {
+                    pass: step.label.clone(),
+                    message: format!("declares owned output \"{}\" but its node provides no texture for it", bp.port),
+                })?;
+                owned.insert(*id, view);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The resource an Owned value's chain starts at (Modify ports on owned resources keep the
+/// producer's texture).
+fn root_owned(plan: &Plan, mut rid: usize) -> usize {
+    while let Some(prev) = plan.resources[rid].modifies {
+        rid = prev;
+    }
+    rid
+}

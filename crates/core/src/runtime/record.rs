@@ -1,0 +1,288 @@
+//! What a pass node sees while it records one step of one frame: [`RecordContext`]. Bind groups
+//! are assembled by binding name and cached by the exact resources they hold, so a steady frame
+//! creates none (history ping-pong simply keeps two).
+
+use std::cell::RefCell;
+use std::collections::HashMap;
+
+use super::create::{PassError, PassPipeline};
+use super::frame::FrameData;
+use super::gpu::Gpu;
+use crate::plugin::Access;
+
+/// One port of a step as bound for recording.
+pub(crate) struct BoundPort<'a> {
+    pub name: String,
+    pub access: Access,
+    pub view: Option<&'a wgpu::TextureView>,
+    pub buffer: Option<&'a wgpu::Buffer>,
+    pub extent: Option<(u32, u32)>,
+}
+
+/// Samplers and the frame uniform buffer.
+pub struct SystemBindings {
+    /// `frame`.
+    pub frame: wgpu::Buffer,
+    /// `linear_clamp`.
+    pub linear_clamp: wgpu::Sampler,
+    /// `nearest_clamp`.
+    pub nearest_clamp: wgpu::Sampler,
+}
+
+impl SystemBindings {
+    pub(crate) fn new(gpu: &Gpu) -> Self {
+        let sampler = |label: &str, filter: wgpu::FilterMode| {
+            gpu.device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some(label),
+                address_mode_u: wgpu::AddressMode::ClampToEdge,
+                address_mode_v: wgpu::AddressMode::ClampToEdge,
+                address_mode_w: wgpu::AddressMode::ClampToEdge,
+                mag_filter: filter,
+                min_filter: filter,
+                ..Default::default()
+            })
+        };
+        Self {
+            frame: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("frame uniforms"),
+                size: std::mem::size_of::<super::frame::FrameUniforms>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            linear_clamp: sampler("linear_clamp", wgpu::FilterMode::Linear),
+            nearest_clamp: sampler("nearest_clamp", wgpu::FilterMode::Nearest),
+        }
+    }
+}
+
+/// The identity of one bound resource (wgpu handles compare by identity).
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+enum ResourceKey {
+    View(wgpu::TextureView),
+    Buffer(wgpu::Buffer, u64, Option<u64>),
+    Sampler(wgpu::Sampler),
+}
+
+type BindKey = (wgpu::BindGroupLayout, Vec<(u32, ResourceKey)>);
+
+/// Bind groups by layout and resources, with the frame each was last used in.
+#[derive(Default)]
+pub(crate) struct BindGroupCache {
+    groups: HashMap<BindKey, (wgpu::BindGroup, u64)>,
+    created: u64,
+}
+
+impl BindGroupCache {
+    /// Drops groups not used in the last `frames` frames (their resources were replaced).
+    pub(crate) fn evict_older_than(&mut self, frame: u64, frames: u64) {
+        self.groups.retain(|_, (_, used)| *used + frames >= frame);
+    }
+
+    pub(crate) fn created(&self) -> u64 {
+        self.created
+    }
+}
+
+/// Given to [`crate::plugin::PassNode::record`] for one step of one frame.
+pub struct RecordContext<'a> {
+    /// The GPU.
+    pub gpu: &'a Gpu,
+    /// The frame's encoder.
+    pub encoder: &'a mut wgpu::CommandEncoder,
+    /// Instance label (debug label of every GPU pass recorded).
+    pub label: &'a str,
+    /// `(iteration, count)` inside a repeat group.
+    pub iteration: Option<(u32, u32)>,
+    /// The pass's parameters.
+    pub params: &'a crate::params::Params,
+    /// The viewport.
+    pub viewport: (u32, u32),
+    /// The frame contract: cameras (this and the previous frame), counters, the volume.
+    pub frame: &'a FrameData,
+    pub(crate) ports: Vec<BoundPort<'a>>,
+    pub(crate) system: &'a SystemBindings,
+    pub(crate) timestamps: Option<(&'a wgpu::QuerySet, u32)>,
+    pub(crate) began_pass: bool,
+    pub(crate) bind_groups: &'a RefCell<BindGroupCache>,
+}
+
+impl<'a> RecordContext<'a> {
+    fn error(&self, message: String) -> PassError {
+        PassError { pass: self.label.to_string(), message }
+    }
+
+    fn port(&self, name: &str) -> Option<&BoundPort<'a>> {
+        self.ports.iter().find(|p| p.name == name)
+    }
+
+    /// The texture view bound to `port` (an input's value, or the target an output writes).
+    pub fn view(&self, port: &str) -> Result<&'a wgpu::TextureView, PassError> {
+        self.port(port)
+            .and_then(|p| p.view)
+            .ok_or_else(|| self.error(format!("port \"{port}\" is not bound to a texture")))
+    }
+
+    /// The storage buffer bound to `port`.
+    pub fn buffer(&self, port: &str) -> Result<&'a wgpu::Buffer, PassError> {
+        self.port(port)
+            .and_then(|p| p.buffer)
+            .ok_or_else(|| self.error(format!("port \"{port}\" is not bound to a buffer")))
+    }
+
+    /// Whether an optional port is bound.
+    pub fn is_bound(&self, port: &str) -> bool {
+        self.port(port).is_some_and(|p| p.view.is_some() || p.buffer.is_some())
+    }
+
+    /// Pixel size of the target bound to `port`.
+    pub fn extent(&self, port: &str) -> (u32, u32) {
+        self.port(port).and_then(|p| p.extent).unwrap_or(self.viewport)
+    }
+
+    /// Zeroes the buffer bound to `port` (a counter at the start of a frame).
+    pub fn clear_buffer(&mut self, port: &str) -> Result<(), PassError> {
+        let buffer = self.buffer(port)?;
+        self.encoder.clear_buffer(buffer, 0, None);
+        Ok(())
+    }
+
+    /// Uploads `data` into `buffer` at `offset` before this frame's work runs (per-frame CPU
+    /// data: brick tables, streamed bricks).
+    pub fn write_buffer(&self, buffer: &wgpu::Buffer, offset: u64, data: &[u8]) {
+        self.gpu.queue.write_buffer(buffer, offset, data);
+    }
+
+    /// Bind group 0 of `pipeline`, every binding resolved by name: system bindings, then `extra`
+    /// (the pass's own buffers), then ports. Cached by the resources it holds.
+    pub fn bind_group(
+        &self,
+        pipeline: &PassPipeline,
+        extra: &[(&str, wgpu::BindingResource<'_>)],
+    ) -> Result<wgpu::BindGroup, PassError> {
+        let mut entries = Vec::with_capacity(pipeline.bindings.len());
+        let mut key = Vec::with_capacity(pipeline.bindings.len());
+        for b in &pipeline.bindings {
+            let resource = match b.name.as_str() {
+                "frame" => self.system.frame.as_entire_binding(),
+                "linear_clamp" => wgpu::BindingResource::Sampler(&self.system.linear_clamp),
+                "nearest_clamp" => wgpu::BindingResource::Sampler(&self.system.nearest_clamp),
+                name => match extra.iter().find(|(n, _)| *n == name) {
+                    Some((_, r)) => r.clone(),
+                    None => match self.port(name).and_then(|p| p.buffer) {
+                        Some(buffer) => buffer.as_entire_binding(),
+                        None => wgpu::BindingResource::TextureView(self.view(name)?),
+                    },
+                },
+            };
+            let resource_key = match &resource {
+                wgpu::BindingResource::TextureView(v) => Some(ResourceKey::View((*v).clone())),
+                wgpu::BindingResource::Sampler(s) => Some(ResourceKey::Sampler((*s).clone())),
+                wgpu::BindingResource::Buffer(bb) => {
+                    Some(ResourceKey::Buffer(bb.buffer.clone(), bb.offset, bb.size.map(|s| s.get())))
+                }
+                _ => None,
+            };
+            match resource_key {
+                Some(k) => key.push((b.binding, k)),
+                None => key.clear(),
+            }
+            entries.push(wgpu::BindGroupEntry { binding: b.binding, resource });
+        }
+        let cacheable = key.len() == entries.len();
+        let frame = self.frame.frame_index;
+        let key = (pipeline.layout.clone(), key);
+        if cacheable && let Some((group, used)) = self.bind_groups.borrow_mut().groups.get_mut(&key) {
+            *used = frame;
+            return Ok(group.clone());
+        }
+        let group = self.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(&pipeline.label),
+            layout: &pipeline.layout,
+            entries: &entries,
+        });
+        let mut cache = self.bind_groups.borrow_mut();
+        cache.created += 1;
+        if cacheable {
+            cache.groups.insert(key, (group.clone(), frame));
+        }
+        Ok(group)
+    }
+
+    fn timestamp_indices(&mut self) -> Option<(&'a wgpu::QuerySet, Option<u32>, u32)> {
+        let (set, base) = self.timestamps?;
+        let begin = (!self.began_pass).then_some(base);
+        self.began_pass = true;
+        Some((set, begin, base + 1))
+    }
+
+    /// Begins a render pass into `pipeline`'s colour ports (Write ports cleared to 0, Modify
+    /// ports loaded) and its depth port (`depth_clear`: Some(value) clears, None loads),
+    /// labelled and timed.
+    pub fn begin_render_pass(
+        &mut self,
+        pipeline: &PassPipeline,
+        depth_clear: Option<f32>,
+    ) -> Result<wgpu::RenderPass<'static>, PassError> {
+        let mut colors = Vec::new();
+        for port in &pipeline.color_ports {
+            let p = self.port(port).ok_or_else(|| self.error(format!("no port {port}")))?;
+            let view = p.view.ok_or_else(|| self.error(format!("port \"{port}\" is not bound")))?;
+            let load = if p.access == Access::Modify {
+                wgpu::LoadOp::Load
+            } else {
+                wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
+            };
+            colors.push(Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
+            }));
+        }
+        let depth = match &pipeline.depth_port {
+            Some(port) => {
+                let view = self.view(port)?;
+                Some(wgpu::RenderPassDepthStencilAttachment {
+                    view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: depth_clear.map_or(wgpu::LoadOp::Load, wgpu::LoadOp::Clear),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                })
+            }
+            None => None,
+        };
+        let ts = self.timestamp_indices();
+        let label = self.label.to_string();
+        let pass = self.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(&label),
+            color_attachments: &colors,
+            depth_stencil_attachment: depth,
+            timestamp_writes: ts.map(|(query_set, b, e)| wgpu::RenderPassTimestampWrites {
+                query_set,
+                beginning_of_pass_write_index: b,
+                end_of_pass_write_index: Some(e),
+            }),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        Ok(pass.forget_lifetime())
+    }
+
+    /// Begins a compute pass, labelled and timed.
+    pub fn begin_compute_pass(&mut self) -> wgpu::ComputePass<'static> {
+        let ts = self.timestamp_indices();
+        let label = self.label.to_string();
+        self.encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(&label),
+                timestamp_writes: ts.map(|(query_set, b, e)| wgpu::ComputePassTimestampWrites {
+                    query_set,
+                    beginning_of_pass_write_index: b,
+                    end_of_pass_write_index: Some(e),
+                }),
+            })
+            .forget_lifetime()
+    }
+}

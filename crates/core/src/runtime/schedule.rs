@@ -1,0 +1,289 @@
+//! A plan made live: one node per pass, a texture per slot, the owned resources nodes publish and
+//! a bind-group cache. [`build`] makes one from a plan and the previous schedule, reusing what did
+//! not change: a node whose kind, ports and shaders are unchanged is kept (its parameters updated
+//! in place where the plugin can), everything else is created with pipelines from the runtime's
+//! cache. Building is all-or-nothing: on any error the previous schedule is untouched.
+
+use std::cell::RefCell;
+use std::collections::{BTreeSet, HashMap};
+use std::sync::Arc;
+
+use super::create::{CreateContext, PassError, PipelineCache, PortInfo};
+use super::gpu::{Gpu, GpuFault};
+use super::history::HistoryStore;
+use super::record::BindGroupCache;
+use super::shaders::ShaderLibrary;
+use super::textures::{PooledTexture, TextureKey, TexturePool};
+use crate::params::Params;
+use crate::plan::{Binding, Plan, ResourceDesc, ResourceId};
+use crate::plugin::{Access, PassNode, PortKind, Registry};
+
+/// A node with what it was built from.
+pub(crate) struct NodeEntry {
+    pub node: Box<dyn PassNode>,
+    kind: String,
+    params: Params,
+    ports: Vec<PortInfo>,
+    /// Shader modules its pipelines came from.
+    modules: BTreeSet<String>,
+}
+
+/// The texture behind one plan slot.
+pub(crate) enum SlotTexture {
+    /// A pooled transient target.
+    Transient(PooledTexture),
+    /// The current-frame texture of a history entry.
+    History(String),
+}
+
+/// A live plan.
+pub(crate) struct Schedule {
+    pub plan: Plan,
+    pub nodes: HashMap<String, NodeEntry>,
+    pub slots: Vec<SlotTexture>,
+    pub owned: HashMap<ResourceId, wgpu::TextureView>,
+    pub bind_groups: RefCell<BindGroupCache>,
+    pub pass_ids: Arc<Vec<String>>,
+}
+
+/// What applying a plan reused and rebuilt.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ApplyReport {
+    /// Nodes kept as they were.
+    pub nodes_kept: usize,
+    /// Nodes kept with their parameters written in place.
+    pub nodes_updated: usize,
+    /// Nodes built anew.
+    pub nodes_created: usize,
+    /// Pipelines compiled for this plan.
+    pub pipelines_built: u64,
+    /// Pipelines taken from the cache.
+    pub pipelines_reused: u64,
+    /// Textures created (the rest came from the pool or were kept).
+    pub textures_created: u64,
+    /// History entries whose content survived.
+    pub history_kept: Vec<String>,
+    /// History entries that start over from their initial value.
+    pub history_reset: Vec<String>,
+}
+
+/// Why a plan could not be applied.
+#[derive(Debug, thiserror::Error)]
+pub enum ApplyError {
+    /// A step's kind is not in the registry (the plan came from another registry).
+    #[error("pass kind \"{0}\" is not registered")]
+    UnknownKind(String),
+    /// A pass failed to build.
+    #[error(transparent)]
+    Pass(#[from] PassError),
+    /// The GPU refused a texture.
+    #[error(transparent)]
+    Gpu(#[from] GpuFault),
+}
+
+/// The ports of `step` as the runtime resolves them (formats from the plan's resources).
+fn port_infos(plan: &Plan, step: &crate::plan::Step, specs: &[crate::plugin::PortSpec]) -> Vec<PortInfo> {
+    step.ports
+        .iter()
+        .map(|bp| {
+            let desc_format = |rid: ResourceId| match &plan.resources[rid].desc {
+                ResourceDesc::Target { format, .. } => Some(format.wgpu()),
+                ResourceDesc::Owned(_) => None,
+            };
+            let format = match &bp.binding {
+                Binding::Resource { id, .. } => desc_format(*id),
+                Binding::History(name) => plan.history.get(name).and_then(|h| desc_format(h.source)),
+                _ => specs.iter().find(|s| s.name == bp.port).and_then(|s| match &s.kind {
+                    PortKind::Target { formats, .. } => formats.first().map(|f| f.wgpu()),
+                    _ => None,
+                }),
+            };
+            let owned = matches!(
+                &bp.binding,
+                Binding::Resource { id, .. } if matches!(plan.resources[*id].desc, ResourceDesc::Owned(_))
+            );
+            PortInfo { name: bp.port.clone(), access: bp.access, format, owned, buffer: false }
+        })
+        .collect()
+}
+
+/// The slot's history entry name, if it is the current-frame texture of one.
+fn history_of_slot(plan: &Plan, slot: usize) -> Option<&str> {
+    plan.history.iter().find(|(_, h)| plan.resources[h.source].slot == Some(slot)).map(|(n, _)| n.as_str())
+}
+
+enum Decision {
+    Keep,
+    Update,
+    Create(Box<dyn PassNode>, BTreeSet<String>),
+}
+
+/// The runtime's long-lived state a schedule is built against.
+pub(crate) struct Resources<'a> {
+    pub gpu: &'a Gpu,
+    pub shaders: &'a ShaderLibrary,
+    pub pipelines: &'a PipelineCache,
+    pub textures: &'a mut TexturePool,
+    pub history: &'a mut HistoryStore,
+}
+
+#[allow(clippy::result_large_err, reason = "the old schedule is handed back by value on failure, once per plan change")]
+/// Builds the schedule of `plan`, reusing from `old` (consumed only on success: on error `old`
+/// is handed back untouched). `stale_modules` are shader modules edited since `old` was built.
+pub(crate) fn build(
+    r: Resources<'_>,
+    registry: &Registry,
+    plan: Plan,
+    old: Option<Schedule>,
+    stale_modules: &[String],
+) -> Result<(Schedule, ApplyReport), (ApplyError, Option<Schedule>)> {
+    let (hits0, misses0) = r.pipelines.counts();
+    let created0 = r.textures.created();
+    // 1. Decide per pass; build new nodes (fallible, no side effects on `old`).
+    let mut decisions: Vec<(String, Decision, String, Params, Vec<PortInfo>)> = Vec::new();
+    for step in &plan.steps {
+        if decisions.iter().any(|(id, ..)| *id == step.pass_id) {
+            continue;
+        }
+        let Some(plugin) = registry.get(&step.kind) else {
+            return Err((ApplyError::UnknownKind(step.kind.clone()), old));
+        };
+        let ports = port_infos(&plan, step, &plugin.ports(&step.params));
+        let previous = old.as_ref().and_then(|o| o.nodes.get(&step.pass_id));
+        let reusable = previous.filter(|e| {
+            e.kind == step.kind && e.ports == ports && !e.modules.iter().any(|m| stale_modules.contains(m))
+        });
+        let decision = match reusable {
+            Some(e) if e.params == step.params => Decision::Keep,
+            Some(e) if plugin.updates_in_place(&e.params, &step.params) => Decision::Update,
+            _ => {
+                let ctx = CreateContext::new(r.gpu, r.shaders, r.pipelines, &step.pass_id, &step.params, &ports);
+                match plugin.create(&ctx) {
+                    Ok(node) => Decision::Create(node, ctx.modules.into_inner()),
+                    Err(e) => return Err((e.into(), old)),
+                }
+            }
+        };
+        decisions.push((step.pass_id.clone(), decision, step.kind.clone(), step.params.clone(), ports));
+    }
+    // 2. Textures for the transient slots: the old schedule's texture of the same descriptor
+    //    (shared, handed over on commit), else one from the pool (given back on failure).
+    let mut claimed = vec![false; old.as_ref().map_or(0, |o| o.slots.len())];
+    let mut fresh: Vec<Option<(PooledTexture, bool)>> = Vec::with_capacity(plan.slots.len());
+    for (i, slot) in plan.slots.iter().enumerate() {
+        if slot.persistent && history_of_slot(&plan, i).is_some() {
+            fresh.push(None);
+            continue;
+        }
+        let key = TextureKey { format: slot.format, extent: slot.extent };
+        let inherited = old.as_ref().and_then(|o| {
+            o.slots.iter().enumerate().find_map(|(k, s)| match s {
+                SlotTexture::Transient(t) if t.key == key && !claimed[k] => Some((k, t.clone())),
+                _ => None,
+            })
+        });
+        if let Some((k, t)) = inherited {
+            claimed[k] = true;
+            fresh.push(Some((t, true)));
+            continue;
+        }
+        let held = slot.holds.first().map_or(String::new(), |rid| format!(" for \"{}\"", plan.resources[*rid].name));
+        match r.textures.acquire(r.gpu, key, &format!("slot{i}{held}")) {
+            Ok(t) => fresh.push(Some((t, false))),
+            Err(e) => {
+                for (t, inherited) in fresh.into_iter().flatten() {
+                    if !inherited {
+                        r.textures.release(t);
+                    }
+                }
+                return Err((e.into(), old));
+            }
+        }
+    }
+    // 3. History entries (kept when their descriptor is unchanged).
+    let mut report = ApplyReport::default();
+    for (name, h) in &plan.history {
+        let Some(slot) = plan.resources[h.source].slot else { continue };
+        let s = &plan.slots[slot];
+        let key = TextureKey { format: s.format, extent: s.extent };
+        match r.history.ensure(r.gpu, r.textures, name, key, &h.initial) {
+            Ok(true) => report.history_kept.push(name.clone()),
+            Ok(false) => report.history_reset.push(name.clone()),
+            Err(e) => {
+                for (t, inherited) in fresh.into_iter().flatten() {
+                    if !inherited {
+                        r.textures.release(t);
+                    }
+                }
+                return Err((e.into(), old));
+            }
+        }
+    }
+    let names: Vec<&str> = plan.history.keys().map(String::as_str).collect();
+    r.history.retain(r.textures, &names);
+
+    // 4. Commit: take kept nodes from `old`, give its textures back.
+    let mut old_nodes = HashMap::new();
+    if let Some(old) = old {
+        old_nodes = old.nodes;
+        for (k, slot) in old.slots.into_iter().enumerate() {
+            if let SlotTexture::Transient(t) = slot
+                && !claimed[k]
+            {
+                r.textures.release(t);
+            }
+        }
+    }
+    let mut nodes = HashMap::new();
+    for (id, decision, kind, params, ports) in decisions {
+        let entry = match decision {
+            Decision::Keep => {
+                report.nodes_kept += 1;
+                old_nodes.remove(&id)
+            }
+            Decision::Update => {
+                report.nodes_updated += 1;
+                old_nodes.remove(&id).map(|mut e| {
+                    e.node.update_params(r.gpu, &params);
+                    e.params = params.clone();
+                    e
+                })
+            }
+            Decision::Create(node, modules) => {
+                report.nodes_created += 1;
+                Some(NodeEntry { node, kind: kind.clone(), params: params.clone(), ports: ports.clone(), modules })
+            }
+        };
+        if let Some(e) = entry {
+            nodes.insert(id, e);
+        }
+    }
+    let slots = fresh
+        .into_iter()
+        .enumerate()
+        .map(|(i, t)| match t {
+            Some((t, _)) => SlotTexture::Transient(t),
+            None => SlotTexture::History(history_of_slot(&plan, i).unwrap_or_default().to_string()),
+        })
+        .collect();
+    // Owned outputs that kept nodes already hold (sized by a graph input, created when recording).
+    let mut owned = HashMap::new();
+    for step in &plan.steps {
+        for bp in &step.ports {
+            if let Binding::Resource { id, written: None } = &bp.binding
+                && bp.access == Access::Write
+                && matches!(plan.resources[*id].desc, ResourceDesc::Owned(_))
+                && let Some(view) = nodes.get(&step.pass_id).and_then(|e: &NodeEntry| e.node.owned_output(&bp.port))
+            {
+                owned.insert(*id, view);
+            }
+        }
+    }
+    let (hits, misses) = r.pipelines.counts();
+    report.pipelines_reused = hits - hits0;
+    report.pipelines_built = misses - misses0;
+    report.textures_created = r.textures.created() - created0;
+    r.textures.next_generation();
+    let pass_ids = Arc::new(plan.steps.iter().map(|s| s.pass_id.clone()).collect());
+    Ok((Schedule { plan, nodes, slots, owned, bind_groups: RefCell::new(BindGroupCache::default()), pass_ids }, report))
+}

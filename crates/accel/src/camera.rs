@@ -18,6 +18,9 @@ pub struct OrbitCamera {
     pub fov_y_deg: f64,
     /// Near plane distance.
     pub near: f64,
+    /// The point looked at (world); the orbit turns about it. The origin (the volume's centre)
+    /// unless panned.
+    pub target: [f64; 3],
     /// Far plane distance; [`OrbitCamera::frame`] moves it out to `distance + 1` when that is
     /// farther, so the volume (longest side 1, inside a sphere of radius √3/2 about the origin)
     /// is never clipped however far away the camera is.
@@ -26,7 +29,15 @@ pub struct OrbitCamera {
 
 impl Default for OrbitCamera {
     fn default() -> Self {
-        Self { azimuth_deg: 30.0, elevation_deg: 20.0, distance: 3.2, fov_y_deg: 30.0, near: 0.01, far: 100.0 }
+        Self {
+            azimuth_deg: 30.0,
+            elevation_deg: 20.0,
+            distance: 3.2,
+            fov_y_deg: 30.0,
+            near: 0.01,
+            far: 100.0,
+            target: [0.0; 3],
+        }
     }
 }
 
@@ -55,20 +66,21 @@ impl OrbitCamera {
     /// The eye position in world space.
     pub fn eye(&self) -> DVec3 {
         let (az, el) = (self.azimuth_deg.to_radians(), self.elevation_deg.to_radians());
-        self.distance * DVec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos())
+        DVec3::from_array(self.target) + self.distance * DVec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos())
     }
 
     /// Matrices for a `width × height` viewport.
     pub fn frame(&self, width: u32, height: u32) -> CameraFrame {
         let eye = self.eye();
         let up = if self.elevation_deg.to_radians().cos().abs() < 1e-6 { DVec3::Z } else { DVec3::Y };
-        let view_from_world = glam::dcamera::rh::view::look_at_mat4(eye, DVec3::ZERO, up);
+        let target = DVec3::from_array(self.target);
+        let view_from_world = glam::dcamera::rh::view::look_at_mat4(eye, target, up);
         let aspect = width.max(1) as f64 / height.max(1) as f64;
         let clip_from_view = glam::dcamera::rh::proj::directx::perspective(
             self.fov_y_deg.to_radians(),
             aspect,
             self.near,
-            self.far.max(self.distance + 1.0),
+            self.far.max(self.distance + DVec3::from_array(self.target).length() + 1.0),
         );
         let clip_from_world = clip_from_view * view_from_world;
         CameraFrame {
@@ -77,7 +89,7 @@ impl OrbitCamera {
             clip_from_view,
             clip_from_world,
             world_from_clip: clip_from_world.inverse(),
-            forward: (-eye).normalize_or(DVec3::NEG_Z),
+            forward: (target - eye).normalize_or(DVec3::NEG_Z),
             width,
             height,
         }

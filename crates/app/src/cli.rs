@@ -74,6 +74,9 @@ enum Command {
         #[arg(long)]
         shaders: Option<PathBuf>,
     },
+    /// Show a graph live in a window, hot-reloading the graph, its shaders and its transfer
+    /// function; an overlay shows per-pass GPU time, the plan and every parameter.
+    View(crate::view::ViewArgs),
     /// Measure: `volgraph bench accel` (CPU acceleration structures).
     Bench {
         #[command(subcommand)]
@@ -82,7 +85,7 @@ enum Command {
 }
 
 /// How to read a headerless `.raw` volume whose name does not say (or to override the name).
-#[derive(clap::Args, Debug, Default)]
+#[derive(clap::Args, Debug, Default, Clone)]
 pub struct RawArgs {
     /// Raw volume dimensions, XxYxZ (default: from the file name NAME_XxYxZ_TYPE.raw).
     #[arg(long)]
@@ -236,7 +239,9 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
             };
             Ok(Checked::Render(Box::new(crate::render::prepare(args)?)))
         }
-        Command::Bench { .. } => Err(CliError::Other(anyhow!("bench commands are not checked ahead of running"))),
+        Command::Bench { .. } | Command::View(_) => {
+            Err(CliError::Other(anyhow!("only plan and render are checked ahead of running")))
+        }
     }
 }
 
@@ -258,6 +263,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
                 crate::render::execute(*prepared)
             }
         },
+        Command::View(args) => crate::view::run(args),
         Command::Bench { which: BenchCommand::Accel { repeats, json } } => {
             let opts = crate::bench_accel::AccelBenchOptions {
                 data_dir: volgraph_accel::data_dir::data_dir(),

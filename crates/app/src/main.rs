@@ -12,6 +12,7 @@ mod inputs;
 mod render;
 mod shader_dir;
 mod stdout;
+mod view;
 
 use std::process::ExitCode;
 

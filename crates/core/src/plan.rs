@@ -105,18 +105,50 @@ pub enum ResourceDesc {
         /// Resolved pixel size.
         extent: (u32, u32),
     },
+    /// A storage buffer from the pool.
+    Buffer {
+        /// Its size in bytes.
+        size: u64,
+    },
     /// A resource owned by its producing pass, shared by type name.
     Owned(String),
 }
 
 impl ResourceDesc {
-    /// Bytes of a target (0 for owned resources).
+    /// Bytes of a target or buffer (0 for owned resources).
     pub fn bytes(&self) -> u64 {
         match self {
             ResourceDesc::Target { format, extent, .. } => format.bytes_per_pixel() * extent.0 as u64 * extent.1 as u64,
+            ResourceDesc::Buffer { size } => *size,
             ResourceDesc::Owned(_) => 0,
         }
     }
+
+    /// What a physical slot holding this resource must be (`None` for owned resources).
+    pub fn slot_desc(&self) -> Option<SlotDesc> {
+        match self {
+            ResourceDesc::Target { format, extent, .. } => Some(SlotDesc::Target { format: *format, extent: *extent }),
+            ResourceDesc::Buffer { size } => Some(SlotDesc::Buffer { size: *size }),
+            ResourceDesc::Owned(_) => None,
+        }
+    }
+}
+
+/// What a physical slot is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SlotDesc {
+    /// A 2D texture.
+    Target {
+        /// Format.
+        format: TargetFormat,
+        /// Size in pixels.
+        extent: (u32, u32),
+    },
+    /// A storage buffer.
+    Buffer {
+        /// Size in bytes.
+        size: u64,
+    },
 }
 
 /// One version of a value.
@@ -137,13 +169,11 @@ pub struct Resource {
     pub modifies: Option<ResourceId>,
 }
 
-/// A physical texture.
+/// A physical texture or buffer.
 #[derive(Clone, Debug)]
 pub struct Slot {
-    /// Format.
-    pub format: TargetFormat,
-    /// Size in pixels.
-    pub extent: (u32, u32),
+    /// What it is.
+    pub desc: SlotDesc,
     /// True for a history pair's current-frame texture (kept across frames, never pooled).
     pub persistent: bool,
     /// Resources that use it, in order.
@@ -151,9 +181,28 @@ pub struct Slot {
 }
 
 impl Slot {
-    /// Bytes of the texture.
+    /// Bytes of the texture or buffer.
     pub fn bytes(&self) -> u64 {
-        self.format.bytes_per_pixel() * self.extent.0 as u64 * self.extent.1 as u64
+        match self.desc {
+            SlotDesc::Target { format, extent } => format.bytes_per_pixel() * extent.0 as u64 * extent.1 as u64,
+            SlotDesc::Buffer { size } => size,
+        }
+    }
+
+    /// The texture format, for a target slot.
+    pub fn format(&self) -> Option<TargetFormat> {
+        match self.desc {
+            SlotDesc::Target { format, .. } => Some(format),
+            SlotDesc::Buffer { .. } => None,
+        }
+    }
+
+    /// The size in pixels, for a target slot.
+    pub fn extent(&self) -> Option<(u32, u32)> {
+        match self.desc {
+            SlotDesc::Target { extent, .. } => Some(extent),
+            SlotDesc::Buffer { .. } => None,
+        }
     }
 }
 
@@ -243,15 +292,11 @@ impl Plan {
                 names.join(", ")
             };
             let kind = if slot.persistent { "history" } else { "pooled" };
-            let _ = writeln!(
-                s,
-                "  slot{i} {} {}x{} {kind} {}: {}",
-                slot.format,
-                slot.extent.0,
-                slot.extent.1,
-                mib(slot.bytes()),
-                held
-            );
+            let what = match slot.desc {
+                SlotDesc::Target { format, extent } => format!("{format} {}x{}", extent.0, extent.1),
+                SlotDesc::Buffer { size } => format!("buffer {size} B"),
+            };
+            let _ = writeln!(s, "  slot{i} {what} {kind} {}: {}", mib(slot.bytes()), held);
         }
         for (name, h) in &self.history {
             let _ = writeln!(s, "history {name}: previous frame of {}", self.resources[h.source].name);

@@ -47,6 +47,15 @@ pub enum PortKind {
     /// A resource a pass owns and shares by name, e.g. `"minmax_grid"` (a 3D texture built from
     /// the volume): producer and consumer must name the same type.
     Owned(&'static str),
+    /// A storage buffer from the pool (counters, point lists, brick tables), bound by name as
+    /// `var<storage>`: `bytes` plus `bytes_per_pixel` for every viewport pixel. Zeroed with
+    /// [`crate::runtime::RecordContext::clear_buffer`] where a pass needs it.
+    Buffer {
+        /// Fixed bytes.
+        bytes: u64,
+        /// Bytes per viewport pixel.
+        bytes_per_pixel: u64,
+    },
 }
 
 impl PortKind {
@@ -55,9 +64,15 @@ impl PortKind {
         PortKind::Target { formats: formats.to_vec(), size: SizeRule::MatchPass }
     }
 
+    /// A buffer of `bytes`.
+    pub fn buffer(bytes: u64) -> Self {
+        PortKind::Buffer { bytes, bytes_per_pixel: 0 }
+    }
+
     /// The name shown in messages.
     pub fn describe(&self) -> String {
         match self {
+            PortKind::Buffer { .. } => "a storage buffer".to_string(),
             PortKind::Target { formats, .. } => {
                 let names: Vec<_> = formats.iter().map(|f| f.name()).collect();
                 format!("a target ({})", names.join(" or "))

@@ -150,7 +150,7 @@ fn assert_slots_never_overlap(plan: &Plan) {
         for &id in &slot.holds {
             let r = &plan.resources[id];
             let ResourceDesc::Target { format, extent, .. } = r.desc else { panic!("{} is not a target", r.name) };
-            assert_eq!((format, extent), (slot.format, slot.extent), "{} in slot{s}", r.name);
+            assert_eq!((Some(format), Some(extent)), (slot.format(), slot.extent()), "{} in slot{s}", r.name);
             if r.modifies.is_some() {
                 continue; // the next version of a chain already holding the slot
             }
@@ -249,8 +249,8 @@ fn differing_formats_and_sizes_never_share_a_slot() {
     let (a, b, c, d) = (slot_of(&p, "a.out"), slot_of(&p, "b.out"), slot_of(&p, "c.out"), slot_of(&p, "d.out"));
     assert_eq!(a, d, "Absolute(64, 32) at a 64x32 viewport is the same descriptor:\n{}", p.to_text());
     assert!(b != a && b != c && c != a, "{}", p.to_text());
-    assert_eq!(p.slots[c].extent, (32, 16));
-    assert_eq!(p.slots[b].format, RGBA16);
+    assert_eq!(p.slots[c].extent(), Some((32, 16)));
+    assert_eq!(p.slots[b].format(), Some(RGBA16));
     assert_slots_never_overlap(&p);
 }
 
@@ -300,7 +300,7 @@ fn repeat_group_unrolls_with_ping_pong() {
     // After the group, the carried value is the last iteration's.
     assert_eq!(p.resources[p.outputs["image"]].name, "segments[3]/seg.color");
     let color_slots: Vec<usize> =
-        p.slots.iter().enumerate().filter(|(_, s)| s.format == RGBA32).map(|(i, _)| i).collect();
+        p.slots.iter().enumerate().filter(|(_, s)| s.format() == Some(RGBA32)).map(|(i, _)| i).collect();
     assert_eq!(color_slots.len(), 2, "accumulation ping-pongs between two targets:\n{}", p.to_text());
     assert_slots_never_overlap(&p);
 }
@@ -309,7 +309,7 @@ fn repeat_group_unrolls_with_ping_pong() {
 fn modify_port_keeps_one_slot_through_the_iterations() {
     let p = plan(SEGMENTS);
     let depth_slots: Vec<usize> =
-        p.slots.iter().enumerate().filter(|(_, s)| s.format == DEPTH).map(|(i, _)| i).collect();
+        p.slots.iter().enumerate().filter(|(_, s)| s.format() == Some(DEPTH)).map(|(i, _)| i).collect();
     assert_eq!(depth_slots.len(), 1, "{}", p.to_text());
     let holds: Vec<&str> = p.slots[depth_slots[0]].holds.iter().map(|&r| p.resources[r].name.as_str()).collect();
     assert_eq!(

@@ -39,45 +39,8 @@ impl GridTap {
             return Err(format!("the tapped texture is {:?}, not {channels} f32 channels", texture.format()));
         }
         let size = texture.size();
-        let row = size.width * texel_bytes;
-        let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("grid tap readback"),
-            size: padded as u64 * size.height as u64 * size.depth_or_array_layers as u64,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder =
-            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("grid tap readback") });
-        encoder.copy_texture_to_buffer(
-            texture.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(padded),
-                    rows_per_image: Some(size.height),
-                },
-            },
-            size,
-        );
-        gpu.queue.submit([encoder.finish()]);
-        let slice = buffer.slice(..);
-        slice.map_async(wgpu::MapMode::Read, |_| {});
-        gpu.wait_idle();
-        let mut values =
-            Vec::with_capacity((size.width * size.height * size.depth_or_array_layers * channels) as usize);
-        {
-            let data = slice.get_mapped_range().map_err(|e| format!("grid tap readback: {e}"))?;
-            for z in 0..size.depth_or_array_layers {
-                for y in 0..size.height {
-                    let start = ((z * size.height + y) * padded) as usize;
-                    let bytes = &data[start..start + row as usize];
-                    values.extend(bytes.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])));
-                }
-            }
-        }
-        buffer.unmap();
+        let bytes = volgraph_core::runtime::readback::read_texture_bytes(gpu, &texture)?;
+        let values: Vec<f32> = bytes.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
         Ok(([size.width, size.height, size.depth_or_array_layers], values))
     }
 }

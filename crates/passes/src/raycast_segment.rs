@@ -63,24 +63,8 @@ impl InvocationCounter {
     pub fn read(&self, gpu: &Gpu) -> Result<u32, String> {
         let guard = self.buffer.lock().map_err(|_| "invocation counter lock poisoned".to_string())?;
         let buffer = guard.as_ref().ok_or("no counting raycast_segment pass has been built")?;
-        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("invocation counter readback"),
-            size: 4,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder =
-            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("counter readback") });
-        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, 4);
-        gpu.queue.submit([encoder.finish()]);
-        let slice = staging.slice(..);
-        slice.map_async(wgpu::MapMode::Read, |_| {});
-        gpu.wait_idle();
-        let value = {
-            let data = slice.get_mapped_range().map_err(|e| format!("invocation counter readback: {e}"))?;
-            u32::from_le_bytes([data[0], data[1], data[2], data[3]])
-        };
-        staging.unmap();
+        let bytes = volgraph_core::runtime::readback::read_buffer(gpu, buffer, 0, 4)?;
+        let value = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
         Ok(value)
     }
 }

@@ -121,7 +121,7 @@ fn hydrogen() -> Option<(Volume, TransferFunction)> {
 }
 
 const CAMERA: OrbitCamera =
-    OrbitCamera { azimuth_deg: 30.0, elevation_deg: 20.0, distance: 3.2, fov_y_deg: 30.0, near: 0.01, far: 100.0 };
+    OrbitCamera { azimuth_deg: 30.0, elevation_deg: 20.0, distance: 3.2, fov_y_deg: 30.0, near: 0.01, far: 100.0, target: [0.0; 3] };
 
 #[test]
 fn fragment_raycast_matches_reference_on_marschner_lobb() {

@@ -140,7 +140,7 @@ fn assert_close(name: &str, a: &Rendered, b: &Rendered, bound: f64) {
 }
 
 const CAMERA: OrbitCamera =
-    OrbitCamera { azimuth_deg: 30.0, elevation_deg: 20.0, distance: 3.2, fov_y_deg: 30.0, near: 0.01, far: 100.0 };
+    OrbitCamera { azimuth_deg: 30.0, elevation_deg: 20.0, distance: 3.2, fov_y_deg: 30.0, near: 0.01, far: 100.0, target: [0.0; 3] };
 
 fn ml() -> Volume {
     volgraph_accel::generate::marschner_lobb(64)
@@ -426,7 +426,7 @@ fn camera_inside_the_volume_with_multipass_segments() {
     let l = lut(&v, Preset::Default);
     // Inside the box, looking at the sphere from its edge: rays start at the near plane.
     let camera =
-        OrbitCamera { azimuth_deg: 20.0, elevation_deg: 10.0, distance: 0.45, fov_y_deg: 60.0, near: 0.01, far: 100.0 };
+        OrbitCamera { azimuth_deg: 20.0, elevation_deg: 10.0, distance: 0.45, fov_y_deg: 60.0, near: 0.01, far: 100.0, target: [0.0; 3] };
     let opts = options(&v);
     for graph in ["kruger_westermann_2003/rc.ron", "kruger_westermann_2003/rc_b.ron"] {
         let r = render(&gpu, graph, &v, &l, &camera, &lossless(opts.clone(), graph));
@@ -442,7 +442,7 @@ fn axis_aligned_view_with_multipass_segments() {
     let l = lut(&v, Preset::Default);
     // Rays parallel to the z axis through the centre column: zero direction components.
     let camera =
-        OrbitCamera { azimuth_deg: 0.0, elevation_deg: 0.0, distance: 3.2, fov_y_deg: 30.0, near: 0.01, far: 100.0 };
+        OrbitCamera { azimuth_deg: 0.0, elevation_deg: 0.0, distance: 3.2, fov_y_deg: 30.0, near: 0.01, far: 100.0, target: [0.0; 3] };
     let opts = options(&v);
     for graph in ["kruger_westermann_2003/rc.ron", "kruger_westermann_2003/rc_b.ron", "modern/single_pass_ess_ert.ron"]
     {

@@ -286,7 +286,7 @@ fn a_resize_reallocates_only_viewport_sized_targets() {
     apply(&mut rt, CHAIN, &CompileOptions::new(8, 4));
     frame(&mut rt);
     let plan = rt.plan().expect("plan").clone();
-    let viewport_slots = plan.slots.iter().filter(|s| s.extent == (8, 4)).count();
+    let viewport_slots = plan.slots.iter().filter(|s| s.extent() == Some((8, 4))).count();
     let report = apply(&mut rt, CHAIN, &CompileOptions::new(16, 8));
     assert_eq!(report.pipelines_built, 0, "{report:?}");
     assert_eq!(report.nodes_created, 0, "no node depends on the viewport: {report:?}");

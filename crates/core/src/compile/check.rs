@@ -27,6 +27,7 @@ pub(crate) enum Ref {
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) enum ValueDesc {
     Target { format: TargetFormat, size: TargetSize },
+    Buffer { bytes: u64, bytes_per_pixel: u64 },
     Owned(String),
     Volume,
     TransferFunction,
@@ -37,6 +38,7 @@ impl ValueDesc {
     fn describe(&self) -> String {
         match self {
             ValueDesc::Target { format, size } => format!("{format} {size}"),
+            ValueDesc::Buffer { .. } => "a storage buffer".to_string(),
             ValueDesc::Owned(t) => format!("a {t}"),
             ValueDesc::Volume => "the volume".to_string(),
             ValueDesc::TransferFunction => "the transfer function".to_string(),
@@ -600,6 +602,9 @@ impl Checker<'_> {
                     }
                     ValueDesc::Target { format, size }
                 }
+                PortKind::Buffer { bytes, bytes_per_pixel } => {
+                    ValueDesc::Buffer { bytes: *bytes, bytes_per_pixel: *bytes_per_pixel }
+                }
                 PortKind::Owned(t) => ValueDesc::Owned((*t).to_string()),
                 PortKind::Volume => ValueDesc::Volume,
                 PortKind::TransferFunction => ValueDesc::TransferFunction,
@@ -1011,6 +1016,7 @@ impl Checker<'_> {
             }
             (PortKind::Volume, ValueDesc::Volume) | (PortKind::TransferFunction, ValueDesc::TransferFunction) => true,
             (PortKind::Owned(a), ValueDesc::Owned(b)) => a == b,
+            (PortKind::Buffer { .. }, ValueDesc::Buffer { .. }) => true,
             _ => false,
         };
         if !ok {
@@ -1029,6 +1035,7 @@ impl Checker<'_> {
                     }
                     PortKind::Target { .. } => "read \"<pass>.<output>\" of a pass that writes a target".to_string(),
                     PortKind::Owned(t) => format!("read the output of a pass that makes a {t}"),
+                    PortKind::Buffer { .. } => "read the output of a pass that writes a buffer".to_string(),
                 }),
             );
         }
@@ -1048,7 +1055,7 @@ impl Checker<'_> {
             let ctx = format!("graph output \"{name}\"");
             if let Some(r) = self.parse_ref(text, None, &ctx, location.clone()) {
                 match self.ref_desc(&r, 0) {
-                    Some(ValueDesc::Target { .. }) | None => {
+                    Some(ValueDesc::Target { .. } | ValueDesc::Buffer { .. }) | None => {
                         if let Ref::Output { pass, port } = &r {
                             self.require_stand_in(*pass, port, &ctx, location);
                         }
@@ -1056,8 +1063,8 @@ impl Checker<'_> {
                     }
                     Some(other) => self.err(
                         location,
-                        format!("{ctx} is \"{text}\", which is {}, not a target", other.describe()),
-                        Some("graph outputs name targets written by passes".to_string()),
+                        format!("{ctx} is \"{text}\", which is {}, not a target or buffer", other.describe()),
+                        Some("graph outputs name targets or buffers written by passes".to_string()),
                     ),
                 }
             }
@@ -1094,6 +1101,15 @@ impl Checker<'_> {
                 continue;
             }
             if let Some(&pi) = self.pass_by_id.get(head) {
+                let kept_kind = self.passes[pi].ports.iter().find(|s| s.name == tail).map(|s| s.kind.clone());
+                if !matches!(kept_kind, Some(PortKind::Target { .. })) {
+                    self.err(
+                        location,
+                        format!("history \"{name}\" reads \"{}\", which is not a target", h.of),
+                        Some("history keeps 2D targets; keep a target the pass writes".to_string()),
+                    );
+                    continue;
+                }
                 if self.passes[pi].group.is_some() {
                     self.err(
                         location,

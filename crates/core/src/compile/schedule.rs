@@ -294,6 +294,10 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
                             size: *size,
                             extent: size.resolve(options.viewport),
                         },
+                        Some(ValueDesc::Buffer { bytes, bytes_per_pixel }) => ResourceDesc::Buffer {
+                            size: (bytes + bytes_per_pixel * options.viewport.0 as u64 * options.viewport.1 as u64)
+                                .max(4),
+                        },
                         Some(ValueDesc::Owned(t)) => ResourceDesc::Owned(t.clone()),
                         _ => ResourceDesc::Owned("value".to_string()),
                     };
@@ -439,7 +443,7 @@ fn pool(resources: &mut [Resource], persistent_roots: &[ResourceId]) -> Vec<Slot
     // Chain lifetimes, keyed by root.
     let mut chains: BTreeMap<ResourceId, (usize, usize, Vec<ResourceId>)> = BTreeMap::new();
     for id in 0..resources.len() {
-        if !matches!(resources[id].desc, ResourceDesc::Target { .. }) {
+        if resources[id].desc.slot_desc().is_none() {
             continue;
         }
         let root = roots[id];
@@ -453,19 +457,17 @@ fn pool(resources: &mut [Resource], persistent_roots: &[ResourceId]) -> Vec<Slot
     let mut slots: Vec<Slot> = Vec::new();
     let mut busy_until: Vec<usize> = Vec::new();
     for (root, start, end, members) in by_start {
-        let ResourceDesc::Target { format, extent, .. } = resources[root].desc else { continue };
+        let Some(desc) = resources[root].desc.slot_desc() else { continue };
         let persistent = persistent.contains(&root);
         let reuse = if persistent {
             None
         } else {
-            (0..slots.len()).find(|&s| {
-                !slots[s].persistent && slots[s].format == format && slots[s].extent == extent && busy_until[s] < start
-            })
+            (0..slots.len()).find(|&s| !slots[s].persistent && slots[s].desc == desc && busy_until[s] < start)
         };
         let s = match reuse {
             Some(s) => s,
             None => {
-                slots.push(Slot { format, extent, persistent, holds: Vec::new() });
+                slots.push(Slot { desc, persistent, holds: Vec::new() });
                 busy_until.push(0);
                 slots.len() - 1
             }

@@ -420,6 +420,7 @@ impl Runtime {
         };
         let texture = match &schedule.slots[slot] {
             SlotTexture::Transient(t) => t.texture.clone(),
+            SlotTexture::Buffer(_) => return Err(RuntimeError::Readback(format!("\"{}\" is a buffer", r.name))),
             SlotTexture::History(name) => self
                 .history
                 .get(name)
@@ -427,6 +428,50 @@ impl Runtime {
                 .ok_or_else(|| RuntimeError::Readback(format!("history \"{name}\" is gone")))?,
         };
         readback::read_texture(&self.gpu, &texture, *format, *extent).map_err(RuntimeError::Readback)
+    }
+
+    /// What a window of `format` and `size` shows of `output` after the last frame: the same
+    /// blit, drawn into an offscreen texture and read back as `format`'s bytes (a screenshot
+    /// without the overlay). Waits for the frame.
+    pub fn capture(&mut self, output: &str, format: wgpu::TextureFormat, size: (u32, u32)) -> Result<Vec<u8>, RuntimeError> {
+        let _ = self.frames.finish(&self.gpu);
+        let schedule = self.schedule.as_ref().ok_or(RuntimeError::NoPlan)?;
+        let (source, encoded) = output_view(schedule, &self.history, output)?;
+        let texture = self.gpu.checked(
+            || format!("creating a {}x{} {format:?} capture", size.0, size.1),
+            || {
+                self.gpu.device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some("capture"),
+                    size: wgpu::Extent3d { width: size.0.max(1), height: size.1.max(1), depth_or_array_layers: 1 },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format,
+                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                    view_formats: &[],
+                })
+            },
+        )?;
+        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let target = PresentTarget { view: &view, format, size, output };
+        let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("capture") });
+        self.blitter.record(&self.gpu, &mut encoder, &source, encoded, &target)?;
+        self.gpu.queue.submit([encoder.finish()]);
+        readback::read_texture_bytes(&self.gpu, &texture).map_err(RuntimeError::Readback)
+    }
+
+    /// Reads back the bytes of a buffer output of the last frame (waits for it).
+    pub fn read_buffer_output(&mut self, name: &str) -> Result<Vec<u8>, RuntimeError> {
+        let _ = self.frames.finish(&self.gpu);
+        let schedule = self.schedule.as_ref().ok_or(RuntimeError::NoPlan)?;
+        let rid = *schedule.plan.outputs.get(name).ok_or_else(|| RuntimeError::UnknownOutput {
+            name: name.to_string(),
+            known: schedule.plan.outputs.keys().cloned().collect::<Vec<_>>().join(", "),
+        })?;
+        match schedule.plan.resources[rid].slot.map(|s| &schedule.slots[s]) {
+            Some(SlotTexture::Buffer(b)) => readback::read_buffer(&self.gpu, &b.buffer, 0, b.size).map_err(RuntimeError::Readback),
+            _ => Err(RuntimeError::Readback(format!("output \"{name}\" is not a buffer"))),
+        }
     }
 
     /// Memory held, for reports and soak tests.
@@ -461,6 +506,7 @@ fn output_view(
     };
     let view = match &schedule.slots[slot] {
         SlotTexture::Transient(t) => t.view.clone(),
+        SlotTexture::Buffer(_) => return Err(RuntimeError::Readback(format!("output \"{name}\" is a buffer"))),
         SlotTexture::History(h) => history
             .get(h)
             .map(|e| e.current().view.clone())
@@ -484,17 +530,22 @@ fn record_steps(
     for (i, step) in plan.steps.iter().enumerate() {
         let mut ports = Vec::with_capacity(step.ports.len());
         for bp in &step.ports {
+            let mut buffer = None;
             let (view, extent) = match &bp.binding {
                 Binding::Resource { id, written } => {
                     let rid = if bp.access == Access::Modify { written.unwrap_or(*id) } else { *id };
                     let r = &plan.resources[rid];
                     let extent = match &r.desc {
                         ResourceDesc::Target { extent, .. } => Some(*extent),
-                        ResourceDesc::Owned(_) => None,
+                        ResourceDesc::Buffer { .. } | ResourceDesc::Owned(_) => None,
                     };
                     let view = match r.slot {
                         Some(s) => match &slots[s] {
                             SlotTexture::Transient(t) => Some(&t.view),
+                            SlotTexture::Buffer(b) => {
+                                buffer = Some(&b.buffer);
+                                None
+                            }
                             SlotTexture::History(name) => history.get(name).map(|e| &e.current().view),
                         },
                         None => owned.get(&root_owned(plan, rid)),
@@ -505,7 +556,7 @@ fn record_steps(
                 Binding::History(name) => (history.get(name).map(|e| &e.previous().view), None),
                 Binding::Unbound => (None, None),
             };
-            ports.push(BoundPort { name: bp.port.clone(), access: bp.access, view, buffer: None, extent });
+            ports.push(BoundPort { name: bp.port.clone(), access: bp.access, view, buffer, extent });
         }
         let entry = nodes.get_mut(&step.pass_id).ok_or_else(|| ApplyError::UnknownKind(step.kind.clone()))?;
         let mut ctx = RecordContext {

@@ -36,41 +36,8 @@ fn channels(format: TargetFormat) -> u32 {
     }
 }
 
-/// Copies `texture` to the CPU and converts it to f32.
-pub fn read_texture(
-    gpu: &Gpu,
-    texture: &wgpu::Texture,
-    format: TargetFormat,
-    extent: (u32, u32),
-) -> Result<Image, String> {
-    let bpp = format.bytes_per_pixel() as u32;
-    let unpadded = extent.0 * bpp;
-    let padded = unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size: padded as u64 * extent.1 as u64,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
-    encoder.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo {
-            texture,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect: if format.is_depth() { wgpu::TextureAspect::DepthOnly } else { wgpu::TextureAspect::All },
-        },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(padded),
-                rows_per_image: Some(extent.1),
-            },
-        },
-        wgpu::Extent3d { width: extent.0, height: extent.1, depth_or_array_layers: 1 },
-    );
-    gpu.queue.submit([encoder.finish()]);
+/// Waits for `buffer` (MAP_READ) to map and returns `range` of it.
+fn map_and_copy(gpu: &Gpu, buffer: &wgpu::Buffer) -> Result<Vec<u8>, String> {
     let slice = buffer.slice(..);
     let (tx, rx) = std::sync::mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |r| {
@@ -82,21 +49,91 @@ pub fn read_texture(
         Ok(Err(e)) => return Err(format!("readback failed: {e}")),
         Err(_) => return Err("readback never completed".to_string()),
     }
-    let bytes = slice.get_mapped_range().map_err(|e| format!("readback failed: {e}"))?;
+    let bytes = slice.get_mapped_range().map_err(|e| format!("readback failed: {e}"))?.to_vec();
+    buffer.unmap();
+    Ok(bytes)
+}
+
+/// The one readback of volgraph: the bytes of `buffer[offset..offset + size]`, waiting for the GPU.
+pub fn read_buffer(gpu: &Gpu, buffer: &wgpu::Buffer, offset: u64, size: u64) -> Result<Vec<u8>, String> {
+    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: size.max(4).next_multiple_of(4),
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+    encoder.copy_buffer_to_buffer(buffer, offset, &staging, 0, size.next_multiple_of(4));
+    gpu.queue.submit([encoder.finish()]);
+    let mut bytes = map_and_copy(gpu, &staging)?;
+    bytes.truncate(size as usize);
+    Ok(bytes)
+}
+
+/// The texels of mip 0 of `texture` (2D or 3D), tightly packed, x fastest, then y, then z.
+pub fn read_texture_bytes(gpu: &Gpu, texture: &wgpu::Texture) -> Result<Vec<u8>, String> {
+    let format = texture.format();
+    let texel = format.block_copy_size(Some(wgpu::TextureAspect::All)).or_else(|| {
+        format.block_copy_size(Some(wgpu::TextureAspect::DepthOnly))
+    });
+    let Some(texel) = texel else {
+        return Err(format!("cannot read back {format:?} textures"));
+    };
+    let size = texture.size();
+    let layers = if texture.dimension() == wgpu::TextureDimension::D3 { size.depth_or_array_layers } else { 1 };
+    let row = size.width * texel;
+    let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: padded as u64 * size.height as u64 * layers as u64,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: if format.is_depth_stencil_format() {
+                wgpu::TextureAspect::DepthOnly
+            } else {
+                wgpu::TextureAspect::All
+            },
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &staging,
+            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded), rows_per_image: Some(size.height) },
+        },
+        wgpu::Extent3d { width: size.width, height: size.height, depth_or_array_layers: layers },
+    );
+    gpu.queue.submit([encoder.finish()]);
+    let padded_bytes = map_and_copy(gpu, &staging)?;
+    let mut out = Vec::with_capacity((row * size.height * layers) as usize);
+    for line in 0..(size.height * layers) as usize {
+        let start = line * padded as usize;
+        out.extend_from_slice(&padded_bytes[start..start + row as usize]);
+    }
+    Ok(out)
+}
+
+/// Copies a target to the CPU and converts it to f32 channels.
+pub fn read_texture(
+    gpu: &Gpu,
+    texture: &wgpu::Texture,
+    format: TargetFormat,
+    extent: (u32, u32),
+) -> Result<Image, String> {
+    let bytes = read_texture_bytes(gpu, texture)?;
     let c = channels(format);
     let mut data = Vec::with_capacity((extent.0 * extent.1 * c) as usize);
-    for row in 0..extent.1 as usize {
-        let line = &bytes[row * padded as usize..row * padded as usize + unpadded as usize];
-        match format {
-            TargetFormat::Rgba8Unorm | TargetFormat::R8Unorm => data.extend(line.iter().map(|b| *b as f32 / 255.0)),
-            TargetFormat::Rgba16Float => {
-                data.extend(line.chunks_exact(2).map(|h| f16_to_f32(u16::from_le_bytes([h[0], h[1]]))))
-            }
-            _ => data.extend(line.chunks_exact(4).map(|f| f32::from_le_bytes([f[0], f[1], f[2], f[3]]))),
+    match format {
+        TargetFormat::Rgba8Unorm | TargetFormat::R8Unorm => data.extend(bytes.iter().map(|b| *b as f32 / 255.0)),
+        TargetFormat::Rgba16Float => {
+            data.extend(bytes.chunks_exact(2).map(|h| f16_to_f32(u16::from_le_bytes([h[0], h[1]]))))
         }
+        _ => data.extend(bytes.chunks_exact(4).map(|f| f32::from_le_bytes([f[0], f[1], f[2], f[3]]))),
     }
-    drop(bytes);
-    buffer.unmap();
     Ok(Image { width: extent.0, height: extent.1, channels: c, data })
 }
 

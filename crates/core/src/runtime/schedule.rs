@@ -13,9 +13,9 @@ use super::gpu::{Gpu, GpuFault};
 use super::history::HistoryStore;
 use super::record::BindGroupCache;
 use super::shaders::ShaderLibrary;
-use super::textures::{PooledTexture, TextureKey, TexturePool};
+use super::textures::{PooledBuffer, PooledTexture, TextureKey, TexturePool};
 use crate::params::Params;
-use crate::plan::{Binding, Plan, ResourceDesc, ResourceId};
+use crate::plan::{Binding, Plan, ResourceDesc, ResourceId, SlotDesc};
 use crate::plugin::{Access, PassNode, PortKind, Registry};
 
 /// A node with what it was built from.
@@ -28,12 +28,30 @@ pub(crate) struct NodeEntry {
     modules: BTreeSet<String>,
 }
 
-/// The texture behind one plan slot.
+/// The texture or buffer behind one plan slot.
 pub(crate) enum SlotTexture {
     /// A pooled transient target.
     Transient(PooledTexture),
+    /// A pooled storage buffer.
+    Buffer(PooledBuffer),
     /// The current-frame texture of a history entry.
     History(String),
+}
+
+/// What a fresh slot got: a texture or buffer, and whether it is shared with the old schedule.
+enum Fresh {
+    Texture(PooledTexture, bool),
+    Buffer(PooledBuffer, bool),
+}
+
+impl Fresh {
+    fn give_back(self, pool: &mut TexturePool) {
+        match self {
+            Fresh::Texture(t, false) => pool.release(t),
+            Fresh::Buffer(b, false) => pool.release_buffer(b),
+            _ => {}
+        }
+    }
 }
 
 /// A live plan.
@@ -88,7 +106,7 @@ fn port_infos(plan: &Plan, step: &crate::plan::Step, specs: &[crate::plugin::Por
         .map(|bp| {
             let desc_format = |rid: ResourceId| match &plan.resources[rid].desc {
                 ResourceDesc::Target { format, .. } => Some(format.wgpu()),
-                ResourceDesc::Owned(_) => None,
+                ResourceDesc::Buffer { .. } | ResourceDesc::Owned(_) => None,
             };
             let format = match &bp.binding {
                 Binding::Resource { id, .. } => desc_format(*id),
@@ -98,11 +116,15 @@ fn port_infos(plan: &Plan, step: &crate::plan::Step, specs: &[crate::plugin::Por
                     _ => None,
                 }),
             };
-            let owned = matches!(
-                &bp.binding,
-                Binding::Resource { id, .. } if matches!(plan.resources[*id].desc, ResourceDesc::Owned(_))
-            );
-            PortInfo { name: bp.port.clone(), access: bp.access, format, owned, buffer: false }
+            let desc = match &bp.binding {
+                Binding::Resource { id, .. } => Some(&plan.resources[*id].desc),
+                _ => None,
+            };
+            let owned = matches!(desc, Some(ResourceDesc::Owned(_)));
+            let buffer = matches!(desc, Some(ResourceDesc::Buffer { .. }))
+                || (matches!(bp.binding, Binding::Unbound)
+                    && specs.iter().any(|s| s.name == bp.port && matches!(s.kind, PortKind::Buffer { .. })));
+            PortInfo { name: bp.port.clone(), access: bp.access, format, owned, buffer }
         })
         .collect()
 }
@@ -166,35 +188,46 @@ pub(crate) fn build(
         };
         decisions.push((step.pass_id.clone(), decision, step.kind.clone(), step.params.clone(), ports));
     }
-    // 2. Textures for the transient slots: the old schedule's texture of the same descriptor
+    // 2. Textures and buffers for the transient slots: the old schedule's of the same descriptor
     //    (shared, handed over on commit), else one from the pool (given back on failure).
     let mut claimed = vec![false; old.as_ref().map_or(0, |o| o.slots.len())];
-    let mut fresh: Vec<Option<(PooledTexture, bool)>> = Vec::with_capacity(plan.slots.len());
+    let mut fresh: Vec<Option<Fresh>> = Vec::with_capacity(plan.slots.len());
     for (i, slot) in plan.slots.iter().enumerate() {
         if slot.persistent && history_of_slot(&plan, i).is_some() {
             fresh.push(None);
             continue;
         }
-        let key = TextureKey { format: slot.format, extent: slot.extent };
         let inherited = old.as_ref().and_then(|o| {
-            o.slots.iter().enumerate().find_map(|(k, s)| match s {
-                SlotTexture::Transient(t) if t.key == key && !claimed[k] => Some((k, t.clone())),
+            o.slots.iter().enumerate().find_map(|(k, s)| match (s, slot.desc) {
+                (SlotTexture::Transient(t), SlotDesc::Target { format, extent })
+                    if t.key == (TextureKey { format, extent }) && !claimed[k] =>
+                {
+                    Some((k, Fresh::Texture(t.clone(), true)))
+                }
+                (SlotTexture::Buffer(b), SlotDesc::Buffer { size }) if b.size == size && !claimed[k] => {
+                    Some((k, Fresh::Buffer(b.clone(), true)))
+                }
                 _ => None,
             })
         });
-        if let Some((k, t)) = inherited {
+        if let Some((k, f)) = inherited {
             claimed[k] = true;
-            fresh.push(Some((t, true)));
+            fresh.push(Some(f));
             continue;
         }
         let held = slot.holds.first().map_or(String::new(), |rid| format!(" for \"{}\"", plan.resources[*rid].name));
-        match r.textures.acquire(r.gpu, key, &format!("slot{i}{held}")) {
-            Ok(t) => fresh.push(Some((t, false))),
+        let label = format!("slot{i}{held}");
+        let made = match slot.desc {
+            SlotDesc::Target { format, extent } => {
+                r.textures.acquire(r.gpu, TextureKey { format, extent }, &label).map(|t| Fresh::Texture(t, false))
+            }
+            SlotDesc::Buffer { size } => r.textures.acquire_buffer(r.gpu, size, &label).map(|b| Fresh::Buffer(b, false)),
+        };
+        match made {
+            Ok(f) => fresh.push(Some(f)),
             Err(e) => {
-                for (t, inherited) in fresh.into_iter().flatten() {
-                    if !inherited {
-                        r.textures.release(t);
-                    }
+                for f in fresh.into_iter().flatten() {
+                    f.give_back(r.textures);
                 }
                 return Err((e.into(), old));
             }
@@ -204,16 +237,14 @@ pub(crate) fn build(
     let mut report = ApplyReport::default();
     for (name, h) in &plan.history {
         let Some(slot) = plan.resources[h.source].slot else { continue };
-        let s = &plan.slots[slot];
-        let key = TextureKey { format: s.format, extent: s.extent };
+        let SlotDesc::Target { format, extent } = plan.slots[slot].desc else { continue };
+        let key = TextureKey { format, extent };
         match r.history.ensure(r.gpu, r.textures, name, key, &h.initial) {
             Ok(true) => report.history_kept.push(name.clone()),
             Ok(false) => report.history_reset.push(name.clone()),
             Err(e) => {
-                for (t, inherited) in fresh.into_iter().flatten() {
-                    if !inherited {
-                        r.textures.release(t);
-                    }
+                for f in fresh.into_iter().flatten() {
+                    f.give_back(r.textures);
                 }
                 return Err((e.into(), old));
             }
@@ -227,10 +258,10 @@ pub(crate) fn build(
     if let Some(old) = old {
         old_nodes = old.nodes;
         for (k, slot) in old.slots.into_iter().enumerate() {
-            if let SlotTexture::Transient(t) = slot
-                && !claimed[k]
-            {
-                r.textures.release(t);
+            match slot {
+                SlotTexture::Transient(t) if !claimed[k] => r.textures.release(t),
+                SlotTexture::Buffer(b) if !claimed[k] => r.textures.release_buffer(b),
+                _ => {}
             }
         }
     }
@@ -262,7 +293,8 @@ pub(crate) fn build(
         .into_iter()
         .enumerate()
         .map(|(i, t)| match t {
-            Some((t, _)) => SlotTexture::Transient(t),
+            Some(Fresh::Texture(t, _)) => SlotTexture::Transient(t),
+            Some(Fresh::Buffer(b, _)) => SlotTexture::Buffer(b),
             None => SlotTexture::History(history_of_slot(&plan, i).unwrap_or_default().to_string()),
         })
         .collect();

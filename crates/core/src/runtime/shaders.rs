@@ -31,6 +31,9 @@ pub struct LoadedShader {
 pub struct ShaderLibrary {
     sources: ShaderSources,
     cache: Mutex<HashMap<String, Arc<LoadedShader>>>,
+    /// Modules invalidated and not loaded again since (a broken edit): name → the disk files
+    /// they were last read from, still watched so that fixing any of them reloads the module.
+    unloaded: Mutex<HashMap<String, Vec<PathBuf>>>,
 }
 
 /// `path:line:col: message` for a naga error at `location` of the assembled text, pointing at
@@ -77,7 +80,7 @@ pub fn parse_and_validate(file: &str, text: &str) -> Result<(naga::Module, naga:
 impl ShaderLibrary {
     /// A library over `sources`.
     pub fn new(sources: ShaderSources) -> Self {
-        Self { sources, cache: Mutex::new(HashMap::new()) }
+        Self { sources, cache: Mutex::new(HashMap::new()), unloaded: Mutex::new(HashMap::new()) }
     }
 
     /// A library reading the folder `root` only.
@@ -101,24 +104,35 @@ impl ShaderLibrary {
     /// their relative names: the pipelines of exactly these modules must be rebuilt.
     pub fn invalidate(&self, changed: &[PathBuf]) -> Vec<String> {
         let same = |a: &Path, b: &Path| {
-            a == b || (a.canonicalize().ok().is_some() && a.canonicalize().ok() == b.canonicalize().ok())
+            a == b || matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
         };
-        let Ok(mut cache) = self.cache.lock() else { return Vec::new() };
-        let stale: Vec<String> = cache
-            .iter()
-            .filter(|(_, s)| s.source.disk_paths().iter().any(|p| changed.iter().any(|c| same(p, c))))
-            .map(|(name, _)| name.clone())
-            .collect();
+        let touches = |files: &[PathBuf]| files.iter().any(|p| changed.iter().any(|c| same(p, c)));
+        let (Ok(mut cache), Ok(mut unloaded)) = (self.cache.lock(), self.unloaded.lock()) else { return Vec::new() };
+        let mut stale: Vec<String> =
+            cache.iter().filter(|(_, s)| touches(&s.source.disk_paths())).map(|(name, _)| name.clone()).collect();
         for name in &stale {
-            cache.remove(name);
+            if let Some(s) = cache.remove(name) {
+                unloaded.insert(name.clone(), s.source.disk_paths());
+            }
         }
+        // Modules a broken edit left unloaded: a change to their files is what fixes them.
+        let broken: Vec<String> =
+            unloaded.iter().filter(|(n, files)| !stale.contains(n) && touches(files)).map(|(n, _)| n.clone()).collect();
+        stale.extend(broken);
+        stale.sort();
         stale
     }
 
-    /// Every disk file the cached modules were read from (what a watcher follows).
+    /// Every disk file the loaded modules were read from, and the files of modules a broken
+    /// edit left unloaded (what a watcher follows).
     pub fn watched_files(&self) -> Vec<PathBuf> {
-        let Ok(cache) = self.cache.lock() else { return Vec::new() };
-        let mut files: Vec<PathBuf> = cache.values().flat_map(|s| s.source.disk_paths()).collect();
+        let mut files: Vec<PathBuf> = match self.cache.lock() {
+            Ok(cache) => cache.values().flat_map(|s| s.source.disk_paths()).collect(),
+            Err(_) => Vec::new(),
+        };
+        if let Ok(unloaded) = self.unloaded.lock() {
+            files.extend(unloaded.values().flatten().cloned());
+        }
         files.sort();
         files.dedup();
         files
@@ -153,6 +167,9 @@ impl ShaderLibrary {
         let loaded = Arc::new(LoadedShader { file: file.to_string(), source, hash, module, info, wgpu });
         if let Ok(mut c) = self.cache.lock() {
             c.insert(file.to_string(), loaded.clone());
+        }
+        if let Ok(mut u) = self.unloaded.lock() {
+            u.remove(file);
         }
         Ok(loaded)
     }

@@ -49,10 +49,20 @@ pub(crate) fn usage_for(format: TargetFormat) -> wgpu::TextureUsages {
     u
 }
 
-/// Free textures by descriptor, each with the plan generation it was given back in.
+/// A storage buffer from the pool.
+#[derive(Clone, Debug)]
+pub struct PooledBuffer {
+    /// The buffer.
+    pub buffer: wgpu::Buffer,
+    /// Its size in bytes.
+    pub size: u64,
+}
+
+/// Free textures and buffers by descriptor, each with the plan generation it was given back in.
 #[derive(Default)]
 pub struct TexturePool {
     free: HashMap<TextureKey, Vec<(PooledTexture, u64)>>,
+    free_buffers: HashMap<u64, Vec<(PooledBuffer, u64)>>,
     generation: u64,
     created: u64,
 }
@@ -90,6 +100,37 @@ impl TexturePool {
         self.free.entry(texture.key).or_default().push((texture, self.generation));
     }
 
+    /// A storage buffer of `size` bytes: a free one, or a new one.
+    pub fn acquire_buffer(&mut self, gpu: &Gpu, size: u64, label: &str) -> Result<PooledBuffer, GpuFault> {
+        if let Some(list) = self.free_buffers.get_mut(&size)
+            && let Some((b, _)) = list.pop()
+        {
+            return Ok(b);
+        }
+        let buffer = gpu.checked(
+            || format!("creating buffer {label} ({size} bytes)"),
+            || {
+                gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size,
+                    usage: wgpu::BufferUsages::STORAGE
+                        | wgpu::BufferUsages::COPY_SRC
+                        | wgpu::BufferUsages::COPY_DST
+                        | wgpu::BufferUsages::INDIRECT
+                        | wgpu::BufferUsages::VERTEX,
+                    mapped_at_creation: false,
+                })
+            },
+        )?;
+        self.created += 1;
+        Ok(PooledBuffer { buffer, size })
+    }
+
+    /// Gives a buffer back.
+    pub fn release_buffer(&mut self, buffer: PooledBuffer) {
+        self.free_buffers.entry(buffer.size).or_default().push((buffer, self.generation));
+    }
+
     /// Called after each plan change: frees what was given back before the previous change and
     /// not taken since.
     pub fn next_generation(&mut self) {
@@ -98,6 +139,10 @@ impl TexturePool {
             list.retain(|(_, g)| *g + 1 >= generation);
         }
         self.free.retain(|_, l| !l.is_empty());
+        for list in self.free_buffers.values_mut() {
+            list.retain(|(_, g)| *g + 1 >= generation);
+        }
+        self.free_buffers.retain(|_, l| !l.is_empty());
         self.generation += 1;
     }
 
@@ -108,9 +153,11 @@ impl TexturePool {
 
     /// Bytes held by free textures.
     pub fn free_bytes(&self) -> u64 {
-        self.free
+        let textures: u64 = self
+            .free
             .iter()
             .map(|(k, l)| k.format.bytes_per_pixel() * k.extent.0 as u64 * k.extent.1 as u64 * l.len() as u64)
-            .sum()
+            .sum();
+        textures + self.free_buffers.iter().map(|(size, l)| size * l.len() as u64).sum::<u64>()
     }
 }

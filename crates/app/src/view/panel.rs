@@ -1,0 +1,201 @@
+//! The viewer's overlay: per-pass GPU milliseconds (numbers and bars, smoothed), the plan, every
+//! declared parameter as a slider or field, the graph's Scalar inputs, scene feature toggles,
+//! the last error, and the key help line. Edits come back as [`Action`]s the window applies
+//! after the frame.
+
+use std::collections::BTreeMap;
+
+use volgraph_core::graph::ast::InputKind;
+use volgraph_core::params::{ParamKind, ParamValue};
+
+use super::session::LiveSession;
+
+/// A change asked for in the panel.
+pub enum Action {
+    /// Set a pass parameter.
+    Param(String, String, ron::Value),
+    /// Set a Scalar graph input.
+    Scalar(String, f64),
+    /// Turn a scene feature on or off.
+    Feature(String, bool),
+    /// Save a screenshot.
+    Screenshot,
+    /// Reset the camera.
+    ResetCamera,
+}
+
+/// Exponentially smoothed per-pass milliseconds.
+#[derive(Default)]
+pub struct Timings {
+    per_pass: Vec<(String, f64)>,
+    frame_ms: f64,
+    wall_fallback: bool,
+    /// Frames presented.
+    pub frames: u64,
+}
+
+/// Weight of the newest frame in the smoothed figures.
+const SMOOTHING: f64 = 0.1;
+
+impl Timings {
+    /// Folds in a finished frame's stats.
+    pub fn add(&mut self, stats: &volgraph_core::runtime::FrameStats) {
+        let blend = |old: f64, new: f64| if old == 0.0 { new } else { old + SMOOTHING * (new - old) };
+        self.frame_ms = blend(self.frame_ms, stats.frame_ms);
+        self.wall_fallback = stats.wall_time_fallback;
+        let fresh = stats.per_pass_ms();
+        let mut merged = Vec::with_capacity(fresh.len());
+        for (pass, ms) in fresh {
+            let old = self.per_pass.iter().find(|(p, _)| *p == pass).map_or(0.0, |(_, m)| *m);
+            merged.push((pass, blend(old, ms)));
+        }
+        self.per_pass = merged;
+    }
+}
+
+/// The help line.
+pub const HELP: &str =
+    "drag: rotate · wheel: zoom · shift/middle-drag: pan · R: reset camera · S: screenshot · F1: panel · Esc: quit";
+
+fn param_widget(ui: &mut egui::Ui, name: &str, kind: &ParamKind, value: &ParamValue) -> Option<ron::Value> {
+    match (kind, value) {
+        (ParamKind::Float { min, max, .. }, ParamValue::Float(v)) => {
+            let mut x = *v;
+            let logarithmic = *min > 0.0 && max / min > 100.0;
+            ui.add(egui::Slider::new(&mut x, *min..=*max).text(name).logarithmic(logarithmic))
+                .changed()
+                .then(|| ron::Value::from(x))
+        }
+        (ParamKind::UInt { min, max, .. }, ParamValue::UInt(v)) => {
+            let mut x = *v;
+            let logarithmic = *min > 0 && max / min.max(&1) > 100;
+            ui.add(egui::Slider::new(&mut x, *min..=*max).text(name).logarithmic(logarithmic))
+                .changed()
+                .then(|| ron::Value::from(x))
+        }
+        (ParamKind::Bool { .. }, ParamValue::Bool(v)) => {
+            let mut x = *v;
+            ui.checkbox(&mut x, name).changed().then(|| ron::Value::from(x))
+        }
+        (ParamKind::Choice { options, .. }, ParamValue::Choice(v)) => {
+            let mut chosen = None;
+            egui::ComboBox::from_label(name).selected_text(v.as_str()).show_ui(ui, |ui| {
+                for o in options.iter() {
+                    if ui.selectable_label(*o == v.as_str(), *o).clicked() && *o != v.as_str() {
+                        chosen = Some(ron::Value::String(o.to_string()));
+                    }
+                }
+            });
+            chosen
+        }
+        _ => {
+            ui.label(format!("{name} = {value}"));
+            None
+        }
+    }
+}
+
+/// Draws the panel; returns what the user changed.
+pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapter: &str) -> Vec<Action> {
+    let mut actions = Vec::new();
+    egui::Panel::right("volgraph").default_size(320.0).show(root, |ui| {
+        let Some(plan) = session.plan() else { return };
+        ui.heading(&plan.name);
+        let clock = if timings.wall_fallback { "wall" } else { "GPU" };
+        ui.label(format!(
+            "{:.2} ms/frame {clock} ({:.0} fps) · {}x{} · {adapter}",
+            timings.frame_ms,
+            1000.0 / timings.frame_ms.max(1e-3),
+            plan.viewport.0,
+            plan.viewport.1
+        ));
+        if let Some((what, message)) = session.error() {
+            ui.colored_label(egui::Color32::from_rgb(255, 110, 110), format!("error in {what} (keeping the last good graph):"));
+            egui::ScrollArea::vertical().id_salt("error").max_height(160.0).show(ui, |ui| {
+                ui.add(egui::Label::new(egui::RichText::new(message).monospace().small()).wrap());
+            });
+        }
+        ui.separator();
+        let max = timings.per_pass.iter().map(|(_, ms)| *ms).fold(1e-6, f64::max);
+        egui::Grid::new("passes").num_columns(3).show(ui, |ui| {
+            for (pass, ms) in &timings.per_pass {
+                ui.label(pass);
+                ui.add(egui::ProgressBar::new((ms / max) as f32).desired_width(120.0));
+                ui.label(format!("{ms:.2} ms"));
+                ui.end_row();
+            }
+        });
+        ui.separator();
+        egui::ScrollArea::vertical().show(ui, |ui| {
+            let known = &plan.known_features;
+            if !known.is_empty() {
+                ui.collapsing("Features", |ui| {
+                    for f in known {
+                        let mut on = plan.features.contains(f);
+                        if ui.checkbox(&mut on, f.as_str()).changed() {
+                            actions.push(Action::Feature(f.clone(), on));
+                        }
+                    }
+                });
+            }
+            let scalars: BTreeMap<&String, f64> = plan
+                .inputs
+                .iter()
+                .filter_map(|(n, k)| match k {
+                    InputKind::Scalar(default) => {
+                        Some((n, session.options().scalars.get(n).copied().unwrap_or(*default)))
+                    }
+                    _ => None,
+                })
+                .collect();
+            if !scalars.is_empty() {
+                ui.collapsing("Scalars", |ui| {
+                    for (name, value) in scalars {
+                        let mut v = value;
+                        let r = ui.add(egui::DragValue::new(&mut v).speed((value.abs() * 0.01).max(0.001)).prefix(format!("{name} = ")));
+                        if r.drag_stopped() || (r.changed() && !r.dragged()) {
+                            actions.push(Action::Scalar(name.clone(), v));
+                        }
+                    }
+                });
+            }
+            ui.collapsing("Parameters", |ui| {
+                let mut seen = Vec::new();
+                for step in &plan.steps {
+                    if seen.contains(&step.pass_id) {
+                        continue;
+                    }
+                    seen.push(step.pass_id.clone());
+                    let Some(plugin) = session.registry().get(&step.kind) else { continue };
+                    let specs = plugin.params();
+                    if specs.is_empty() {
+                        continue;
+                    }
+                    ui.collapsing(format!("{} [{}]", step.pass_id, step.kind), |ui| {
+                        for spec in specs {
+                            let Some((_, value)) = step.params.iter().find(|(n, _)| *n == spec.name) else { continue };
+                            if let Some(v) = param_widget(ui, spec.name, &spec.kind, value) {
+                                actions.push(Action::Param(step.pass_id.clone(), spec.name.to_string(), v));
+                            }
+                        }
+                    });
+                }
+            });
+            ui.collapsing("Plan", |ui| {
+                ui.add(egui::Label::new(egui::RichText::new(plan.to_text()).monospace().small()).extend());
+            });
+        });
+        ui.separator();
+        ui.horizontal(|ui| {
+            if ui.button("screenshot").clicked() {
+                actions.push(Action::Screenshot);
+            }
+            if ui.button("reset camera").clicked() {
+                actions.push(Action::ResetCamera);
+            }
+        });
+        ui.small(HELP);
+    });
+    actions
+}
+

@@ -1,0 +1,396 @@
+//! The viewer's live session, without a window: a runtime with the scene bound and the graph
+//! applied, and every way the graph can change — a file edit (graph, shader, transfer function),
+//! a parameter slider, a scene feature or scalar, a resize. Each change recompiles (a pure
+//! function) and applies; any failure leaves the last good graph running and becomes an
+//! [`Event::Error`] with located diagnostics; the next good change is an [`Event::Recovered`].
+//! The window (`window.rs`) and the tests drive the same object.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::anyhow;
+use volgraph_accel::transfer_function::TransferFunction;
+use volgraph_accel::volume::Volume;
+use volgraph_core::runtime::{ApplyReport, CameraData, Gpu, PresentTarget, Runtime, ShaderLibrary};
+use volgraph_core::{CompileOptions, Plan, Registry};
+
+use crate::inputs;
+
+/// What the session reports, one line each on stdout.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Event {
+    /// The graph was loaded at start.
+    Loaded {
+        /// The graph file.
+        graph: String,
+        /// Milliseconds from reading the file to the plan applied.
+        ms: f64,
+        /// Steps and slots of the plan.
+        summary: String,
+    },
+    /// Something changed and the new graph is running.
+    Reloaded {
+        /// What changed (`graph`, `shader raycast.wgsl`, `transfer function`, `parameter march.step_voxels`).
+        what: String,
+        /// What was rebuilt and reused.
+        detail: String,
+        /// Milliseconds from noticing the change to the plan applied.
+        ms: f64,
+    },
+    /// A change failed; the last good graph keeps rendering.
+    Error {
+        /// What changed.
+        what: String,
+        /// The located diagnostics (file:line:col, the fix).
+        message: String,
+    },
+    /// The first good change after an error.
+    Recovered {
+        /// What changed.
+        what: String,
+    },
+}
+
+impl fmt::Display for Event {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Event::Loaded { graph, ms, summary } => write!(f, "loaded {graph} in {ms:.1} ms ({summary})"),
+            Event::Reloaded { what, detail, ms } => write!(f, "reloaded {what} in {ms:.1} ms ({detail})"),
+            Event::Error { what, message } => {
+                let first = message.lines().next().unwrap_or_default();
+                write!(f, "error in {what}: {first}; keeping the last good graph")
+            }
+            Event::Recovered { what } => write!(f, "recovered: {what} is good again"),
+        }
+    }
+}
+
+fn describe(report: &ApplyReport) -> String {
+    format!(
+        "{} nodes kept, {} updated in place, {} built; {} pipelines built, {} reused; {} textures created",
+        report.nodes_kept,
+        report.nodes_updated,
+        report.nodes_created,
+        report.pipelines_built,
+        report.pipelines_reused,
+        report.textures_created
+    )
+}
+
+fn summary(plan: &Plan) -> String {
+    format!("{} steps, {} slots, {} culled", plan.steps.len(), plan.slots.len(), plan.culled.len())
+}
+
+/// How the session was started.
+#[derive(Clone, Debug)]
+pub struct SessionArgs {
+    /// The graph file.
+    pub graph: PathBuf,
+    /// The volume file (None: the generated default).
+    pub volume: Option<PathBuf>,
+    /// Raw layout options.
+    pub raw: volgraph_accel::load::RawOptions,
+    /// The transfer-function file.
+    pub tf: Option<PathBuf>,
+    /// A ParaView colour map's name.
+    pub tf_map: Option<String>,
+    /// The first viewport.
+    pub viewport: (u32, u32),
+    /// Scene features on at start.
+    pub features: Vec<String>,
+    /// A shader folder to read (and watch) instead of the built-in shaders.
+    pub shaders: Option<PathBuf>,
+}
+
+/// A graph running on a runtime, with everything that can change it.
+pub struct LiveSession {
+    /// The runtime.
+    pub runtime: Runtime,
+    registry: Registry,
+    graph: PathBuf,
+    graph_name: String,
+    /// The text of the graph that is running.
+    source: String,
+    tf_path: Option<PathBuf>,
+    tf_map: Option<String>,
+    volume: Volume,
+    lut: Vec<[f32; 4]>,
+    generated: bool,
+    options: CompileOptions,
+    shader_dir: Option<PathBuf>,
+    /// The last change's error, while it lasts.
+    error: Option<(String, String)>,
+}
+
+impl LiveSession {
+    /// Loads the scene and the graph on `gpu`; fails (with located diagnostics) when the graph
+    /// does not compile or build at all.
+    pub fn open(gpu: Arc<Gpu>, args: &SessionArgs) -> Result<(Self, Event), crate::cli::CliError> {
+        let start = Instant::now();
+        let source = inputs::read_graph(&args.graph)?;
+        let generated = args.volume.is_none();
+        let (volume, notes) = inputs::volume(args.volume.as_ref(), &args.raw)?;
+        for note in notes {
+            eprintln!("note: {note}");
+        }
+        let (tf, tf_notes) = inputs::transfer_function(args.tf.as_ref(), args.tf_map.as_deref(), &volume, generated)?;
+        for note in tf_notes {
+            eprintln!("note: {note}");
+        }
+        let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
+        let (sources, shader_dir) = crate::shader_dir::sources_for(&args.graph, args.shaders.as_deref());
+        let mut runtime = Runtime::new(gpu, ShaderLibrary::new(sources));
+        let registry = volgraph_passes::builtin_registry();
+        let options = CompileOptions::new(args.viewport.0, args.viewport.1)
+            .with_features(args.features.iter().filter(|f| !f.is_empty()).cloned());
+        let graph_name = args.graph.display().to_string();
+        let plan = compile_for(&graph_name, &source, &registry, &options, &volume).map_err(crate::cli::CliError::Graph)?;
+        crate::cli::check_user_names(&plan, &options)?;
+        let shaders = match &shader_dir {
+            Some(dir) => format!("shaders from {}", dir.display()),
+            None => "built-in shaders".to_string(),
+        };
+        let loaded = format!("{}, {shaders}", summary(&plan));
+        runtime.bind_scene(&plan.inputs, &volume, &lut).map_err(|e| crate::cli::CliError::Other(anyhow!(e)))?;
+        runtime.apply(plan, &registry).map_err(|e| crate::cli::CliError::Other(anyhow!(e)))?;
+        let session = Self {
+            runtime,
+            registry,
+            graph: args.graph.clone(),
+            graph_name: graph_name.clone(),
+            source,
+            tf_path: args.tf.clone(),
+            tf_map: args.tf_map.clone(),
+            volume,
+            lut,
+            generated,
+            options,
+            shader_dir,
+            error: None,
+        };
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        Ok((session, Event::Loaded { graph: graph_name, ms, summary: loaded }))
+    }
+
+    /// The running plan.
+    pub fn plan(&self) -> Option<&Plan> {
+        self.runtime.plan()
+    }
+
+    /// The registry (for parameter specs).
+    pub fn registry(&self) -> &Registry {
+        &self.registry
+    }
+
+    /// The current compile options (features, scalars, parameter overrides, viewport).
+    pub fn options(&self) -> &CompileOptions {
+        &self.options
+    }
+
+    /// The error of the last change, while the last good graph runs: (what, message).
+    pub fn error(&self) -> Option<&(String, String)> {
+        self.error.as_ref()
+    }
+
+    /// The shader folder read from disk, if any.
+    pub fn shader_dir(&self) -> Option<&Path> {
+        self.shader_dir.as_deref()
+    }
+
+    /// Every file whose edit changes what is shown: the graph, the transfer function, and every
+    /// shader file the running pipelines were built from (imports included).
+    pub fn watched_files(&self) -> Vec<PathBuf> {
+        let mut files = vec![self.graph.clone()];
+        files.extend(self.tf_path.clone());
+        files.extend(self.runtime.shaders().watched_files());
+        files
+    }
+
+    /// Compiles `source` with `options` and applies it; the report, or the error message.
+    fn compile_and_apply(&mut self, source: &str, options: &CompileOptions) -> Result<ApplyReport, String> {
+        let plan = compile_for(&self.graph_name, source, &self.registry, options, &self.volume).map_err(|d| d.to_string())?;
+        crate::cli::check_user_names(&plan, options).map_err(|e| match e {
+            crate::cli::CliError::Graph(d) => d.to_string(),
+            crate::cli::CliError::Other(e) => e.to_string(),
+        })?;
+        self.runtime.bind_scene(&plan.inputs, &self.volume, &self.lut).map_err(|e| e.to_string())?;
+        self.runtime.apply(plan, &self.registry).map_err(|e| e.to_string())
+    }
+
+    /// Turns a change's outcome into events (an error keeps the last good graph).
+    fn outcome(&mut self, what: String, start: Instant, result: Result<String, String>) -> Vec<Event> {
+        match result {
+            Ok(detail) => {
+                let ms = start.elapsed().as_secs_f64() * 1e3;
+                let mut events = vec![Event::Reloaded { what: what.clone(), detail, ms }];
+                if self.error.take().is_some() {
+                    events.push(Event::Recovered { what });
+                }
+                events
+            }
+            Err(message) => {
+                self.error = Some((what.clone(), message.clone()));
+                vec![Event::Error { what, message }]
+            }
+        }
+    }
+
+    /// The graph file changed: recompile it and apply.
+    pub fn reload_graph(&mut self) -> Vec<Event> {
+        let start = Instant::now();
+        let result = inputs::read_graph(&self.graph).map_err(|e| format!("{e:#}")).and_then(|source| {
+            let options = self.options.clone();
+            let report = self.compile_and_apply(&source, &options)?;
+            self.source = source;
+            Ok(describe(&report))
+        });
+        self.outcome("graph".to_string(), start, result)
+    }
+
+    /// Shader files changed: rebuild exactly the nodes whose pipelines use them.
+    pub fn reload_shaders(&mut self, changed: &[PathBuf]) -> Vec<Event> {
+        let start = Instant::now();
+        let modules = self.runtime.shaders_changed(changed);
+        if modules.is_empty() {
+            return Vec::new();
+        }
+        let what = format!("shader {}", modules.join(", "));
+        let source = self.source.clone();
+        let options = self.options.clone();
+        let result = self.compile_and_apply(&source, &options).map(|r| describe(&r));
+        self.outcome(what, start, result)
+    }
+
+    /// The transfer-function file changed: read it and upload the new LUT (history restarts:
+    /// Klein et al. 2005 §4).
+    pub fn reload_transfer_function(&mut self) -> Vec<Event> {
+        let start = Instant::now();
+        let result = inputs::transfer_function(self.tf_path.as_ref(), self.tf_map.as_deref(), &self.volume, self.generated)
+            .map_err(|e| format!("{e:#}"))
+            .and_then(|(tf, _)| self.set_transfer_function(&tf).map_err(|e| format!("{e:#}")))
+            .map(|_| "LUT uploaded, history restarted".to_string());
+        self.outcome("transfer function".to_string(), start, result)
+    }
+
+    /// Uploads `tf` as the LUT of every transfer-function input.
+    pub fn set_transfer_function(&mut self, tf: &TransferFunction) -> anyhow::Result<()> {
+        self.lut = tf.to_lut_for(&self.volume, inputs::LUT_SIZE);
+        let inputs = self.plan().map(|p| p.inputs.clone()).unwrap_or_default();
+        self.runtime.bind_scene(&inputs, &self.volume, &self.lut).map_err(|e| anyhow!(e))?;
+        self.runtime.invalidate_history();
+        Ok(())
+    }
+
+    /// Files changed on disk: the events of reloading what they affect.
+    pub fn files_changed(&mut self, changed: &[PathBuf]) -> Vec<Event> {
+        let same = |a: &Path, b: &Path| a == b || matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y);
+        let mut events = Vec::new();
+        if changed.iter().any(|c| same(c, &self.graph)) {
+            events.extend(self.reload_graph());
+        }
+        if let Some(tf) = self.tf_path.clone()
+            && changed.iter().any(|c| same(c, &tf))
+        {
+            events.extend(self.reload_transfer_function());
+        }
+        let shaders: Vec<PathBuf> =
+            changed.iter().filter(|c| c.extension().is_some_and(|e| e == "wgsl")).cloned().collect();
+        if !shaders.is_empty() {
+            events.extend(self.reload_shaders(&shaders));
+        }
+        events
+    }
+
+    /// Sets a pass parameter (a slider): written in place where the pass allows.
+    pub fn set_param(&mut self, pass: &str, param: &str, value: ron::Value) -> Vec<Event> {
+        let start = Instant::now();
+        let mut options = self.options.clone();
+        options.param_overrides.insert(format!("{pass}.{param}"), value);
+        let source = self.source.clone();
+        let result = self.compile_and_apply(&source, &options).map(|r| describe(&r));
+        if result.is_ok() {
+            self.options = options;
+        }
+        self.outcome(format!("parameter {pass}.{param}"), start, result)
+    }
+
+    /// Sets a scene scalar (a Scalar graph input).
+    pub fn set_scalar(&mut self, name: &str, value: f64) -> Vec<Event> {
+        let start = Instant::now();
+        let mut options = self.options.clone();
+        options.scalars.insert(name.to_string(), value);
+        let source = self.source.clone();
+        let result = self.compile_and_apply(&source, &options).map(|r| describe(&r));
+        if result.is_ok() {
+            self.options = options;
+        }
+        self.outcome(format!("scalar {name}"), start, result)
+    }
+
+    /// Turns a scene feature on or off: gated passes appear and disappear.
+    pub fn set_feature(&mut self, name: &str, on: bool) -> Vec<Event> {
+        let start = Instant::now();
+        let mut options = self.options.clone();
+        if on {
+            options.features.insert(name.to_string());
+        } else {
+            options.features.remove(name);
+        }
+        let source = self.source.clone();
+        let result = self.compile_and_apply(&source, &options).map(|r| describe(&r));
+        if result.is_ok() {
+            self.options = options;
+        }
+        self.outcome(format!("feature {name} {}", if on { "on" } else { "off" }), start, result)
+    }
+
+    /// The window was resized: only viewport-sized targets are reallocated.
+    pub fn resize(&mut self, width: u32, height: u32) -> Vec<Event> {
+        if (width, height) == self.options.viewport || width == 0 || height == 0 {
+            return Vec::new();
+        }
+        let start = Instant::now();
+        let mut options = self.options.clone();
+        options.viewport = (width, height);
+        let source = self.source.clone();
+        let result = self.compile_and_apply(&source, &options).map(|r| describe(&r));
+        if result.is_ok() {
+            self.options = options;
+        }
+        self.outcome(format!("viewport {width}x{height}"), start, result)
+    }
+
+    /// Submits a frame seen by `camera`, presented to `target` when given.
+    pub fn submit(
+        &mut self,
+        camera: &volgraph_accel::camera::OrbitCamera,
+        target: Option<&PresentTarget<'_>>,
+    ) -> Result<u64, volgraph_core::runtime::RuntimeError> {
+        let viewport = self.options.viewport;
+        self.runtime.submit(CameraData::from_orbit(camera, viewport), target)
+    }
+
+    /// The output the window shows: `display` when the graph has it, else `image`.
+    pub fn shown_output(&self) -> &'static str {
+        match self.plan() {
+            Some(p) if p.outputs.contains_key("display") => "display",
+            _ => "image",
+        }
+    }
+}
+
+/// Compiles `source` with the scene values of `volume` (its longest ray: computed in one place,
+/// `volgraph_core::runtime::scene_values_of`).
+fn compile_for(
+    file: &str,
+    source: &str,
+    registry: &Registry,
+    options: &CompileOptions,
+    volume: &Volume,
+) -> Result<Plan, volgraph_core::Diagnostics> {
+    let mut options = options.clone();
+    options.scene = volgraph_core::runtime::scene_values_of(&volgraph_core::runtime::VolumeDesc::of(volume));
+    volgraph_core::compile(file, source, registry, &options)
+}

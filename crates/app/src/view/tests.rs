@@ -1,0 +1,170 @@
+//! The reload logic without a window: a live session on the headless GPU, changed the way the
+//! viewer changes it (file edits, sliders, features, resizes), with its events and images checked.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use volgraph_accel::camera::OrbitCamera;
+use volgraph_core::runtime::Gpu;
+
+use super::session::{Event, LiveSession, SessionArgs};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// A scratch copy of a graph and of the shader folder, so tests can edit both.
+struct Scratch {
+    dir: PathBuf,
+    graph: PathBuf,
+    shaders: PathBuf,
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("scratch dir");
+    for entry in std::fs::read_dir(from).expect("readable").flatten() {
+        let target = to.join(entry.file_name());
+        if entry.path().is_dir() {
+            copy_dir(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).expect("copy");
+        }
+    }
+}
+
+fn scratch(name: &str, graph: &str) -> Scratch {
+    let dir = std::env::temp_dir().join(format!("volgraph-live-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    copy_dir(&root().join("shaders"), &dir.join("shaders"));
+    let graph_path = dir.join("graph.ron");
+    std::fs::copy(root().join(graph), &graph_path).expect("graph copy");
+    Scratch { shaders: dir.join("shaders"), graph: graph_path, dir }
+}
+
+fn open(s: &Scratch, tf: Option<PathBuf>) -> LiveSession {
+    let gpu = Arc::new(Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)"));
+    let args = SessionArgs {
+        graph: s.graph.clone(),
+        volume: None,
+        raw: Default::default(),
+        tf,
+        tf_map: None,
+        viewport: (48, 48),
+        features: Vec::new(),
+        shaders: Some(s.shaders.clone()),
+    };
+    let (session, loaded) = LiveSession::open(gpu, &args).unwrap_or_else(|_| panic!("the scratch graph loads"));
+    assert!(matches!(loaded, Event::Loaded { .. }), "{loaded}");
+    session
+}
+
+fn frame(session: &mut LiveSession) -> Vec<f32> {
+    session.submit(&OrbitCamera::default(), None).expect("frame");
+    session.runtime.finish();
+    session.runtime.read_output("image").expect("image").data
+}
+
+fn edit(path: &Path, from: &str, to: &str) {
+    let text = std::fs::read_to_string(path).expect("readable");
+    assert!(text.contains(from), "{} has no {from:?}", path.display());
+    std::fs::write(path, text.replacen(from, to, 1)).expect("writable");
+}
+
+#[test]
+fn a_parameter_edit_is_written_in_place_and_changes_the_image() {
+    let s = scratch("param", "graphs/basic/fragment_raycast.ron");
+    let mut session = open(&s, None);
+    let before = frame(&mut session);
+    let events = session.set_param("march", "step_voxels", ron::Value::from(1.5));
+    assert_eq!(events.len(), 1, "{events:?}");
+    let Event::Reloaded { what, detail, .. } = &events[0] else { panic!("{}", events[0]) };
+    assert_eq!(what, "parameter march.step_voxels");
+    assert!(detail.contains("1 updated in place, 0 built; 0 pipelines built"), "{detail}");
+    assert_ne!(frame(&mut session), before, "the new step reached the shader");
+    let _ = std::fs::remove_dir_all(&s.dir);
+}
+
+#[test]
+fn a_broken_graph_keeps_the_last_good_one_and_a_fix_recovers() {
+    let s = scratch("graph", "graphs/basic/fragment_raycast.ron");
+    let mut session = open(&s, None);
+    let good = frame(&mut session);
+    edit(&s.graph, "kind: \"raycast\"", "kind: \"raycats\"");
+    let events = session.files_changed(std::slice::from_ref(&s.graph));
+    let [Event::Error { what, message }] = events.as_slice() else { panic!("{events:?}") };
+    assert_eq!(what, "graph");
+    assert!(message.contains("graph.ron:") && message.contains("did you mean \"raycast\"?"), "{message}");
+    assert!(events[0].to_string().ends_with("keeping the last good graph"), "{}", events[0]);
+    assert_eq!(frame(&mut session), good, "the last good graph keeps rendering");
+    edit(&s.graph, "kind: \"raycats\"", "kind: \"raycast\"");
+    let events = session.files_changed(std::slice::from_ref(&s.graph));
+    assert!(matches!(events.as_slice(), [Event::Reloaded { .. }, Event::Recovered { .. }]), "{events:?}");
+    assert!(session.error().is_none());
+    let _ = std::fs::remove_dir_all(&s.dir);
+}
+
+#[test]
+fn a_shader_edit_rebuilds_only_its_pipelines_and_a_broken_shader_is_located() {
+    let s = scratch("shader", "graphs/basic/fragment_raycast.ron");
+    let mut session = open(&s, None);
+    let good = frame(&mut session);
+    let present = s.shaders.join("present.wgsl");
+    assert!(session.watched_files().iter().any(|f| f.ends_with("shaders/present.wgsl")), "shaders are watched");
+    // A change that compiles: only the present pass is rebuilt.
+    edit(&present, "fn fs_present", "// edited\nfn fs_present");
+    let events = session.files_changed(std::slice::from_ref(&present));
+    let [Event::Reloaded { what, detail, .. }] = events.as_slice() else { panic!("{events:?}") };
+    assert_eq!(what, "shader present.wgsl");
+    assert!(detail.contains("3 nodes kept, 0 updated in place, 1 built; 1 pipelines built"), "{detail}");
+    // A broken import: located in the imported file, and the image stays.
+    let common = s.shaders.join("common/fullscreen.wgsl");
+    edit(&common, "fn vs_fullscreen", "fn vs_fullscreen oops");
+    let events = session.files_changed(std::slice::from_ref(&common));
+    let [Event::Error { message, .. }] = events.as_slice() else { panic!("{events:?}") };
+    assert!(message.contains("common/fullscreen.wgsl:"), "the error names the imported file: {message}");
+    assert_eq!(frame(&mut session), good);
+    edit(&common, "fn vs_fullscreen oops", "fn vs_fullscreen");
+    let events = session.files_changed(std::slice::from_ref(&common));
+    assert!(matches!(events.as_slice(), [Event::Reloaded { .. }, Event::Recovered { .. }]), "{events:?}");
+    assert_eq!(frame(&mut session), good, "a comment changes no pixel");
+    let _ = std::fs::remove_dir_all(&s.dir);
+}
+
+#[test]
+fn a_transfer_function_edit_uploads_the_lut_and_a_bad_one_is_kept_out() {
+    let s = scratch("tf", "graphs/basic/fragment_raycast.ron");
+    let tf = s.dir.join("tf.ron");
+    std::fs::copy(root().join("graphs/tf/default.ron"), &tf).expect("tf copy");
+    let mut session = open(&s, Some(tf.clone()));
+    let before = frame(&mut session);
+    let uploads = session.runtime.uploads();
+    std::fs::copy(root().join("graphs/tf/opaque.ron"), &tf).expect("another tf");
+    let events = session.files_changed(std::slice::from_ref(&tf));
+    assert!(matches!(events.as_slice(), [Event::Reloaded { .. }]), "{events:?}");
+    assert_eq!(session.runtime.uploads(), uploads + 1, "one LUT upload, no volume upload");
+    assert_ne!(frame(&mut session), before);
+    std::fs::write(&tf, "(domain: (1, 0), points: [])").expect("tf");
+    let events = session.files_changed(std::slice::from_ref(&tf));
+    let [Event::Error { what, message }] = events.as_slice() else { panic!("{events:?}") };
+    assert_eq!(what, "transfer function");
+    assert!(message.contains("tf.ron: domain (1, 0) is not a range"), "{message}");
+    let _ = std::fs::remove_dir_all(&s.dir);
+}
+
+#[test]
+fn a_resize_rebuilds_no_pipeline() {
+    let s = scratch("resize", "graphs/basic/fragment_raycast.ron");
+    let mut session = open(&s, None);
+    frame(&mut session);
+    let events = session.resize(64, 40);
+    let [Event::Reloaded { what, detail, .. }] = events.as_slice() else { panic!("{events:?}") };
+    assert_eq!(what, "viewport 64x40");
+    assert!(detail.contains("0 pipelines built"), "{detail}");
+    assert!(detail.contains("0 built"), "no node depends on the viewport: {detail}");
+    let image = {
+        session.submit(&OrbitCamera::default(), None).expect("frame");
+        session.runtime.read_output("image").expect("image")
+    };
+    assert_eq!((image.width, image.height), (64, 40));
+    let _ = std::fs::remove_dir_all(&s.dir);
+}

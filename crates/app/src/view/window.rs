@@ -1,0 +1,375 @@
+//! The viewer window: winit, a wgpu surface the runtime presents the graph output onto
+//! (sRGB-correct), and the egui overlay drawn on top. Frames render continuously; between
+//! frames the watcher's debounced file changes and the script lines from stdin are applied.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::mpsc::Receiver;
+
+use volgraph_core::runtime::{Gpu, GpuOptions, PresentTarget};
+use winit::application::ApplicationHandler;
+use winit::dpi::PhysicalSize;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::keyboard::{Key, ModifiersState, NamedKey};
+use winit::window::{Window, WindowId};
+
+use super::orbit::Orbit;
+use super::panel::{self, Action, Timings};
+use super::session::{Event, LiveSession, SessionArgs};
+use super::watch::FileWatch;
+use super::{ViewOptions, emit};
+
+struct Gfx {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    gpu: Arc<Gpu>,
+    egui: egui_winit::State,
+    renderer: egui_wgpu::Renderer,
+}
+
+/// The viewer's state across the event loop.
+pub struct Viewer {
+    session_args: SessionArgs,
+    view: ViewOptions,
+    script: Option<Receiver<String>>,
+    gfx: Option<Gfx>,
+    session: Option<LiveSession>,
+    orbit: Orbit,
+    watch: Option<FileWatch>,
+    timings: Timings,
+    modifiers: ModifiersState,
+    panel_open: bool,
+    screenshot_now: Option<PathBuf>,
+    quit: bool,
+    /// The outcome: an error ends the program with status 1.
+    pub failure: Option<String>,
+}
+
+impl Viewer {
+    fn new(session_args: SessionArgs, view: ViewOptions, script: Option<Receiver<String>>) -> Self {
+        let orbit = Orbit::new(view.camera);
+        Self {
+            panel_open: view.panel,
+            session_args,
+            view,
+            script,
+            gfx: None,
+            session: None,
+            orbit,
+            watch: None,
+            timings: Timings::default(),
+            modifiers: ModifiersState::empty(),
+            screenshot_now: None,
+            quit: false,
+            failure: None,
+        }
+    }
+
+    fn fail(&mut self, event_loop: &ActiveEventLoop, message: String) {
+        self.failure = Some(message);
+        event_loop.exit();
+    }
+
+    fn start(&mut self, event_loop: &ActiveEventLoop) -> Result<(), String> {
+        let (w, h) = self.session_args.viewport;
+        let attributes =
+            Window::default_attributes().with_title("volgraph view").with_inner_size(PhysicalSize::new(w, h));
+        let window = Arc::new(event_loop.create_window(attributes).map_err(|e| format!("cannot open a window: {e}"))?);
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        if std::env::var_os("WGPU_BACKEND").is_none() {
+            desc.backends = wgpu::Backends::VULKAN | wgpu::Backends::METAL | wgpu::Backends::DX12;
+        }
+        let instance = wgpu::Instance::new(desc);
+        let surface = instance.create_surface(window.clone()).map_err(|e| format!("cannot draw into the window: {e}"))?;
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            compatible_surface: Some(&surface),
+            ..Default::default()
+        }))
+        .map_err(|e| format!("no GPU adapter can draw into the window ({e})"))?;
+        let gpu = Arc::new(Gpu::from_adapter(&adapter, &GpuOptions::default()).map_err(|e| e.to_string())?);
+        let caps = surface.get_capabilities(&adapter);
+        let format = caps.formats.iter().copied().find(wgpu::TextureFormat::is_srgb).or(caps.formats.first().copied());
+        let Some(format) = format else { return Err("the window surface offers no format".to_string()) };
+        let size = window.inner_size();
+        let mut config = surface
+            .get_default_config(&adapter, size.width.max(1), size.height.max(1))
+            .ok_or("the window surface is not supported by the adapter")?;
+        config.format = format;
+        config.present_mode = wgpu::PresentMode::AutoNoVsync;
+        surface.configure(&gpu.device, &config);
+        let (session, loaded) = LiveSession::open(gpu.clone(), &SessionArgs {
+            viewport: (config.width, config.height),
+            ..self.session_args.clone()
+        })
+        .map_err(|e| match e {
+            crate::cli::CliError::Graph(d) => d.to_string(),
+            crate::cli::CliError::Other(e) => format!("{e:#}"),
+        })?;
+        let ctx = egui::Context::default();
+        let egui = egui_winit::State::new(ctx, egui::ViewportId::ROOT, &window, Some(window.scale_factor() as f32), None, None);
+        let renderer = egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default());
+        let mut watch = FileWatch::new().map_err(|e| format!("cannot watch files: {e}"))?;
+        watch.set_files(&session.watched_files());
+        self.watch = Some(watch);
+        self.session = Some(session);
+        self.gfx = Some(Gfx { window, surface, config, gpu, egui, renderer });
+        // Only now: an edit made as soon as this line appears is seen by the watcher.
+        emit(&loaded);
+        Ok(())
+    }
+
+    fn handle(&mut self, events: Vec<Event>) {
+        for e in &events {
+            emit(e);
+            if let Event::Error { message, .. } = e {
+                eprintln!("{message}");
+            }
+        }
+        if !events.is_empty()
+            && let (Some(watch), Some(session)) = (self.watch.as_mut(), self.session.as_ref())
+        {
+            watch.set_files(&session.watched_files());
+        }
+    }
+
+    fn apply_actions(&mut self, actions: Vec<Action>) {
+        for action in actions {
+            let Some(session) = self.session.as_mut() else { return };
+            let events = match action {
+                Action::Param(pass, param, value) => session.set_param(&pass, &param, value),
+                Action::Scalar(name, value) => session.set_scalar(&name, value),
+                Action::Feature(name, on) => session.set_feature(&name, on),
+                Action::Screenshot => {
+                    self.screenshot_now = Some(self.view.screenshot.clone().unwrap_or_else(|| PathBuf::from("volgraph.png")));
+                    Vec::new()
+                }
+                Action::ResetCamera => {
+                    self.orbit.reset();
+                    Vec::new()
+                }
+            };
+            self.handle(events);
+        }
+    }
+
+    /// Script lines from stdin: `quit`, `screenshot PATH`, `param PASS.NAME VALUE`.
+    fn run_script(&mut self) {
+        let lines: Vec<String> = self.script.as_ref().map(|rx| rx.try_iter().collect()).unwrap_or_default();
+        for line in lines {
+            let mut words = line.split_whitespace();
+            match (words.next(), words.next(), words.next()) {
+                (Some("quit"), _, _) => self.quit = true,
+                (Some("screenshot"), Some(path), _) => self.screenshot_now = Some(PathBuf::from(path)),
+                (Some("param"), Some(key), Some(value)) => match (key.split_once('.'), ron::from_str::<ron::Value>(value)) {
+                    (Some((pass, name)), Ok(v)) => self.apply_actions(vec![Action::Param(pass.to_string(), name.to_string(), v)]),
+                    _ => eprintln!("script: cannot read \"{line}\"; write param PASS.NAME VALUE"),
+                },
+                _ if line.trim().is_empty() => {}
+                _ => eprintln!("script: unknown line \"{line}\"; known: quit, screenshot PATH, param PASS.NAME VALUE"),
+            }
+        }
+    }
+
+    fn save_screenshot(&mut self, path: &PathBuf) -> Result<(), String> {
+        let (Some(session), Some(gfx)) = (self.session.as_mut(), self.gfx.as_ref()) else { return Ok(()) };
+        let output = session.shown_output();
+        let (w, h) = (gfx.config.width, gfx.config.height);
+        let bytes = session.runtime.capture(output, gfx.config.format, (w, h)).map_err(|e| e.to_string())?;
+        let bgra = matches!(gfx.config.format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb);
+        let mut rgba = bytes;
+        if bgra {
+            for px in rgba.chunks_exact_mut(4) {
+                px.swap(0, 2);
+            }
+        }
+        for px in rgba.chunks_exact_mut(4) {
+            px[3] = 255;
+        }
+        let image = image::RgbaImage::from_raw(w, h, rgba).ok_or("screenshot size mismatch")?;
+        image.save(path).map_err(|e| format!("{}: cannot write the screenshot: {e}", path.display()))?;
+        println!("screenshot {}", path.display());
+        Ok(())
+    }
+
+    fn redraw(&mut self, event_loop: &ActiveEventLoop) {
+        let Some(session) = self.session.as_mut() else { return };
+        for stats in session.runtime.poll() {
+            self.timings.add(&stats);
+        }
+        let Some(gfx) = self.gfx.as_mut() else { return };
+        let frame = match gfx.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(f) | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                gfx.surface.configure(&gfx.gpu.device, &gfx.config);
+                return;
+            }
+            _ => return,
+        };
+        let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let size = (gfx.config.width, gfx.config.height);
+        let target = PresentTarget { view: &view, format: gfx.config.format, size, output: session.shown_output() };
+        if let Some(turn) = self.view.turn_degrees {
+            self.orbit.turn(turn);
+        }
+        if let Err(e) = session.submit(&self.orbit.camera, Some(&target)) {
+            let events = vec![Event::Error { what: "frame".to_string(), message: e.to_string() }];
+            self.handle(events);
+            self.fail(event_loop, format!("a frame failed: {e}"));
+            return;
+        }
+        let mut actions = Vec::new();
+        if self.panel_open {
+            let raw = gfx.egui.take_egui_input(&gfx.window);
+            let ctx = gfx.egui.egui_ctx().clone();
+            let adapter = gfx.gpu.adapter_name.clone();
+            let output = ctx.run_ui(raw, |ui| {
+                actions = panel::show(ui, session, &self.timings, &adapter);
+            });
+            let egui::FullOutput { platform_output, mut textures_delta, shapes, pixels_per_point, .. } = output;
+            gfx.egui.handle_platform_output(&gfx.window, platform_output);
+            let jobs = ctx.tessellate(shapes, pixels_per_point);
+            for (id, deltas) in textures_delta.set.drain() {
+                for delta in &deltas {
+                    gfx.renderer.update_texture(&gfx.gpu.device, &gfx.gpu.queue, id, delta);
+                }
+            }
+            let screen = egui_wgpu::ScreenDescriptor { size_in_pixels: [size.0, size.1], pixels_per_point };
+            let mut encoder = gfx.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("overlay") });
+            let uploads = gfx.renderer.update_buffers(&gfx.gpu.device, &gfx.gpu.queue, &mut encoder, &jobs, &screen);
+            {
+                let mut pass = encoder
+                    .begin_render_pass(&wgpu::RenderPassDescriptor {
+                        label: Some("overlay"),
+                        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                            view: &view,
+                            depth_slice: None,
+                            resolve_target: None,
+                            ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+                        })],
+                        ..Default::default()
+                    })
+                    .forget_lifetime();
+                gfx.renderer.render(&mut pass, &jobs, &screen);
+            }
+            gfx.gpu.queue.submit(uploads.into_iter().chain([encoder.finish()]));
+            for id in textures_delta.free.drain() {
+                gfx.renderer.free_texture(&id);
+            }
+        }
+        gfx.gpu.queue.present(frame);
+        self.timings.frames += 1;
+        self.apply_actions(actions);
+        if let Some(path) = self.screenshot_now.take()
+            && let Err(e) = self.save_screenshot(&path)
+        {
+            eprintln!("error: {e}");
+        }
+        let done = self.view.frames.is_some_and(|n| self.timings.frames >= n);
+        if done || self.quit {
+            if let Some(path) = self.view.screenshot.clone()
+                && let Err(e) = self.save_screenshot(&path)
+            {
+                self.fail(event_loop, e);
+                return;
+            }
+            println!("presented {} frames", self.timings.frames);
+            event_loop.exit();
+        }
+    }
+}
+
+impl ApplicationHandler for Viewer {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.gfx.is_none()
+            && let Err(e) = self.start(event_loop)
+        {
+            self.fail(event_loop, e);
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let consumed = match self.gfx.as_mut() {
+            Some(gfx) if self.panel_open => gfx.egui.on_window_event(&gfx.window, &event).consumed,
+            _ => false,
+        };
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) => {
+                if let Some(gfx) = self.gfx.as_mut()
+                    && size.width > 0
+                    && size.height > 0
+                {
+                    gfx.config.width = size.width;
+                    gfx.config.height = size.height;
+                    gfx.surface.configure(&gfx.gpu.device, &gfx.config);
+                }
+                if let Some(session) = self.session.as_mut() {
+                    let events = session.resize(size.width, size.height);
+                    self.handle(events);
+                }
+            }
+            WindowEvent::RedrawRequested => self.redraw(event_loop),
+            WindowEvent::ModifiersChanged(m) => self.modifiers = m.state(),
+            WindowEvent::KeyboardInput { event, .. } if !consumed && event.state == ElementState::Pressed => {
+                match event.logical_key {
+                    Key::Named(NamedKey::Escape) => event_loop.exit(),
+                    Key::Named(NamedKey::F1) => self.panel_open = !self.panel_open,
+                    Key::Character(c) if c.eq_ignore_ascii_case("r") => self.orbit.reset(),
+                    Key::Character(c) if c.eq_ignore_ascii_case("s") => {
+                        self.apply_actions(vec![Action::Screenshot]);
+                    }
+                    _ => {}
+                }
+            }
+            WindowEvent::MouseInput { state, button, .. } if !consumed => {
+                let pan = button == MouseButton::Middle || self.modifiers.shift_key();
+                if matches!(button, MouseButton::Left | MouseButton::Middle) {
+                    self.orbit.button(state == ElementState::Pressed, pan);
+                }
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                let height = self.gfx.as_ref().map_or(1.0, |g| g.config.height as f64);
+                self.orbit.moved(position.x, position.y, height);
+            }
+            WindowEvent::MouseWheel { delta, .. } if !consumed => {
+                let lines = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y as f64,
+                    MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
+                };
+                self.orbit.wheel(lines);
+            }
+            _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+        self.run_script();
+        let changed = self.watch.as_mut().map(FileWatch::poll).unwrap_or_default();
+        if !changed.is_empty()
+            && let Some(session) = self.session.as_mut()
+        {
+            let events = session.files_changed(&changed);
+            self.handle(events);
+        }
+        if let Some(gfx) = &self.gfx {
+            gfx.window.request_redraw();
+        }
+    }
+}
+
+/// Runs the viewer until the window closes, `--frames` are presented or the script says quit.
+pub fn run(session_args: SessionArgs, view: ViewOptions, script: Option<Receiver<String>>) -> Result<(), String> {
+    let event_loop = EventLoop::new().map_err(|e| {
+        format!("cannot open a window ({e}); volgraph view needs a display (X11: set DISPLAY, or run under Xvfb)")
+    })?;
+    event_loop.set_control_flow(ControlFlow::Poll);
+    let mut viewer = Viewer::new(session_args, view, script);
+    event_loop.run_app(&mut viewer).map_err(|e| format!("the window's event loop failed: {e}"))?;
+    match viewer.failure {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}

@@ -116,6 +116,9 @@ enum BenchCommand {
     /// Time render graphs over datasets, transfer functions and viewports (presets: basic,
     /// kw2003-table1, thesis-tables); speed-ups vs a baseline, samples/s, accuracy sweeps.
     Graphs(crate::bench_graphs::GraphsArgs),
+    /// The live runtime: reload latency (parameter, graph and shader edits), frames in flight vs
+    /// blocking, and a soak of frames and reloads with memory at start and end.
+    Live(crate::bench_live::LiveArgs),
     /// Compile time of a generated 30-pass graph; pooled vs unpooled transient memory of every
     /// graph in graphs/ at 1920x1080.
     Compile {
@@ -275,6 +278,10 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         }
         Command::Bench { which: BenchCommand::Compile { json } } => {
             crate::bench_compile::run(json.as_deref()).context("bench compile")?;
+            Ok(())
+        }
+        Command::Bench { which: BenchCommand::Live(args) } => {
+            crate::bench_live::run(&args).context("bench live")?;
             Ok(())
         }
         Command::Bench { which: BenchCommand::Graphs(args) } => {

@@ -4,6 +4,7 @@
 mod bench_accel;
 mod bench_compile;
 mod bench_graphs;
+mod bench_live;
 mod cli;
 #[cfg(test)]
 mod cli_fuzz;
@@ -19,7 +20,7 @@ use std::process::ExitCode;
 use clap::Parser;
 
 fn main() -> ExitCode {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn,notify=error")).init();
     // No input may crash volgraph; should a bug do so anyway, say so in one line instead of a
     // Rust backtrace.
     std::panic::set_hook(Box::new(|info| {

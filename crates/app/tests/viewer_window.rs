@@ -31,7 +31,10 @@ impl Drop for Xvfb {
 fn start_xvfb() -> Option<Xvfb> {
     let found = Command::new("Xvfb").arg("-help").stdout(Stdio::null()).stderr(Stdio::null()).status().is_ok();
     if !found {
-        assert!(std::env::var_os("CI").is_none(), "Xvfb is missing under CI; .ci/run installs it (apt-get install xvfb)");
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "Xvfb is missing under CI; .ci/run installs it (apt-get install xvfb)"
+        );
         eprintln!("note: skipping the window test: Xvfb is not installed (apt-get install xvfb)");
         return None;
     }
@@ -41,7 +44,14 @@ fn start_xvfb() -> Option<Xvfb> {
             continue;
         }
         let child = Command::new("Xvfb")
-            .args([format!(":{n}"), "-screen".into(), "0".into(), "640x480x24".into(), "-nolisten".into(), "tcp".into()])
+            .args([
+                format!(":{n}"),
+                "-screen".into(),
+                "0".into(),
+                "640x480x24".into(),
+                "-nolisten".into(),
+                "tcp".into(),
+            ])
             .stdout(Stdio::null())
             .stderr(Stdio::null())
             .spawn()

@@ -120,8 +120,15 @@ fn hydrogen() -> Option<(Volume, TransferFunction)> {
     Some((v, tf))
 }
 
-const CAMERA: OrbitCamera =
-    OrbitCamera { azimuth_deg: 30.0, elevation_deg: 20.0, distance: 3.2, fov_y_deg: 30.0, near: 0.01, far: 100.0, target: [0.0; 3] };
+const CAMERA: OrbitCamera = OrbitCamera {
+    azimuth_deg: 30.0,
+    elevation_deg: 20.0,
+    distance: 3.2,
+    fov_y_deg: 30.0,
+    near: 0.01,
+    far: 100.0,
+    target: [0.0; 3],
+};
 
 #[test]
 fn fragment_raycast_matches_reference_on_marschner_lobb() {

@@ -139,8 +139,15 @@ fn assert_close(name: &str, a: &Rendered, b: &Rendered, bound: f64) {
     assert!(max_abs <= bound, "{name}: max abs {:.3}/255 > {:.3}/255", max_abs * 255.0, bound * 255.0);
 }
 
-const CAMERA: OrbitCamera =
-    OrbitCamera { azimuth_deg: 30.0, elevation_deg: 20.0, distance: 3.2, fov_y_deg: 30.0, near: 0.01, far: 100.0, target: [0.0; 3] };
+const CAMERA: OrbitCamera = OrbitCamera {
+    azimuth_deg: 30.0,
+    elevation_deg: 20.0,
+    distance: 3.2,
+    fov_y_deg: 30.0,
+    near: 0.01,
+    far: 100.0,
+    target: [0.0; 3],
+};
 
 fn ml() -> Volume {
     volgraph_accel::generate::marschner_lobb(64)
@@ -425,8 +432,15 @@ fn camera_inside_the_volume_with_multipass_segments() {
     let v = sphere();
     let l = lut(&v, Preset::Default);
     // Inside the box, looking at the sphere from its edge: rays start at the near plane.
-    let camera =
-        OrbitCamera { azimuth_deg: 20.0, elevation_deg: 10.0, distance: 0.45, fov_y_deg: 60.0, near: 0.01, far: 100.0, target: [0.0; 3] };
+    let camera = OrbitCamera {
+        azimuth_deg: 20.0,
+        elevation_deg: 10.0,
+        distance: 0.45,
+        fov_y_deg: 60.0,
+        near: 0.01,
+        far: 100.0,
+        target: [0.0; 3],
+    };
     let opts = options(&v);
     for graph in ["kruger_westermann_2003/rc.ron", "kruger_westermann_2003/rc_b.ron"] {
         let r = render(&gpu, graph, &v, &l, &camera, &lossless(opts.clone(), graph));
@@ -441,8 +455,15 @@ fn axis_aligned_view_with_multipass_segments() {
     let v = ml();
     let l = lut(&v, Preset::Default);
     // Rays parallel to the z axis through the centre column: zero direction components.
-    let camera =
-        OrbitCamera { azimuth_deg: 0.0, elevation_deg: 0.0, distance: 3.2, fov_y_deg: 30.0, near: 0.01, far: 100.0, target: [0.0; 3] };
+    let camera = OrbitCamera {
+        azimuth_deg: 0.0,
+        elevation_deg: 0.0,
+        distance: 3.2,
+        fov_y_deg: 30.0,
+        near: 0.01,
+        far: 100.0,
+        target: [0.0; 3],
+    };
     let opts = options(&v);
     for graph in ["kruger_westermann_2003/rc.ron", "kruger_westermann_2003/rc_b.ron", "modern/single_pass_ess_ert.ron"]
     {

@@ -6,12 +6,14 @@
 use std::sync::Arc;
 
 use volgraph_accel::camera::OrbitCamera;
+use volgraph_core::plugin::SizeRule;
 use volgraph_core::runtime::{
     CameraData, ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, PipelineKind, RecordContext,
     RenderPipelineSpec, Runtime, ShaderLibrary,
 };
-use volgraph_core::plugin::SizeRule;
-use volgraph_core::{CompileOptions, Params, PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile};
+use volgraph_core::{
+    CompileOptions, Params, PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile,
+};
 
 const SHADER: &str = "splat_count.wgsl";
 
@@ -73,7 +75,10 @@ impl PassPlugin for PointList {
         "test: four NDC points in an N×1 target"
     }
     fn ports(&self, _p: &Params) -> Vec<PortSpec> {
-        vec![PortSpec::write("points", PortKind::Target { formats: vec![TargetFormat::Rgba32Float], size: SizeRule::Any })]
+        vec![PortSpec::write(
+            "points",
+            PortKind::Target { formats: vec![TargetFormat::Rgba32Float], size: SizeRule::Any },
+        )]
     }
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
@@ -95,7 +100,10 @@ impl PassPlugin for Splat {
     }
     fn ports(&self, _p: &Params) -> Vec<PortSpec> {
         vec![
-            PortSpec::read("points", PortKind::Target { formats: vec![TargetFormat::Rgba32Float], size: SizeRule::Any }),
+            PortSpec::read(
+                "points",
+                PortKind::Target { formats: vec![TargetFormat::Rgba32Float], size: SizeRule::Any },
+            ),
             PortSpec::write("image", PortKind::target(&[TargetFormat::Rgba32Float])),
         ]
     }
@@ -125,7 +133,8 @@ impl PassPlugin for CountLit {
         ]
     }
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec { shader: SHADER, entry: "cs_count", ..Default::default() })?;
+        let pipeline =
+            ctx.compute_pipeline(&ComputePipelineSpec { shader: SHADER, entry: "cs_count", ..Default::default() })?;
         Ok(Box::new(Count { pipeline }))
     }
 }

@@ -96,7 +96,10 @@ pub fn run(args: ViewArgs) -> Result<(), CliError> {
     if let Some(path) = &args.screenshot {
         let kind = crate::image_out::ImageKind::from_path(path)?;
         if kind != crate::image_out::ImageKind::Png {
-            return Err(CliError::Other(anyhow::anyhow!("--screenshot {}: screenshots are PNG; end the name in .png", path.display())));
+            return Err(CliError::Other(anyhow::anyhow!(
+                "--screenshot {}: screenshots are PNG; end the name in .png",
+                path.display()
+            )));
         }
     }
     let session_args = session::SessionArgs {

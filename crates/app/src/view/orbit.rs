@@ -55,7 +55,8 @@ impl Orbit {
                 let right = forward.cross(DVec3::Y).normalize_or(DVec3::X);
                 let up = right.cross(forward);
                 // One window height of drag moves the target by the visible height at its distance.
-                let scale = 2.0 * self.camera.distance * (self.camera.fov_y_deg.to_radians() / 2.0).tan() / height.max(1.0);
+                let scale =
+                    2.0 * self.camera.distance * (self.camera.fov_y_deg.to_radians() / 2.0).tan() / height.max(1.0);
                 let t = DVec3::from_array(self.camera.target) - right * dx * scale + up * dy * scale;
                 self.camera.target = t.to_array();
             }

@@ -109,8 +109,15 @@ pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapt
             plan.viewport.0,
             plan.viewport.1
         ));
+        match session.shader_dir() {
+            Some(dir) => ui.small(format!("shaders: {} (watched)", dir.display())),
+            None => ui.small("shaders: built into the binary"),
+        };
         if let Some((what, message)) = session.error() {
-            ui.colored_label(egui::Color32::from_rgb(255, 110, 110), format!("error in {what} (keeping the last good graph):"));
+            ui.colored_label(
+                egui::Color32::from_rgb(255, 110, 110),
+                format!("error in {what} (keeping the last good graph):"),
+            );
             egui::ScrollArea::vertical().id_salt("error").max_height(160.0).show(ui, |ui| {
                 ui.add(egui::Label::new(egui::RichText::new(message).monospace().small()).wrap());
             });
@@ -152,7 +159,11 @@ pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapt
                 ui.collapsing("Scalars", |ui| {
                     for (name, value) in scalars {
                         let mut v = value;
-                        let r = ui.add(egui::DragValue::new(&mut v).speed((value.abs() * 0.01).max(0.001)).prefix(format!("{name} = ")));
+                        let r = ui.add(
+                            egui::DragValue::new(&mut v)
+                                .speed((value.abs() * 0.01).max(0.001))
+                                .prefix(format!("{name} = ")),
+                        );
                         if r.drag_stopped() || (r.changed() && !r.dragged()) {
                             actions.push(Action::Scalar(name.clone(), v));
                         }
@@ -198,4 +209,3 @@ pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapt
     });
     actions
 }
-

@@ -146,7 +146,8 @@ impl LiveSession {
         let options = CompileOptions::new(args.viewport.0, args.viewport.1)
             .with_features(args.features.iter().filter(|f| !f.is_empty()).cloned());
         let graph_name = args.graph.display().to_string();
-        let plan = compile_for(&graph_name, &source, &registry, &options, &volume).map_err(crate::cli::CliError::Graph)?;
+        let plan =
+            compile_for(&graph_name, &source, &registry, &options, &volume).map_err(crate::cli::CliError::Graph)?;
         crate::cli::check_user_names(&plan, &options)?;
         let shaders = match &shader_dir {
             Some(dir) => format!("shaders from {}", dir.display()),
@@ -210,7 +211,8 @@ impl LiveSession {
 
     /// Compiles `source` with `options` and applies it; the report, or the error message.
     fn compile_and_apply(&mut self, source: &str, options: &CompileOptions) -> Result<ApplyReport, String> {
-        let plan = compile_for(&self.graph_name, source, &self.registry, options, &self.volume).map_err(|d| d.to_string())?;
+        let plan =
+            compile_for(&self.graph_name, source, &self.registry, options, &self.volume).map_err(|d| d.to_string())?;
         crate::cli::check_user_names(&plan, options).map_err(|e| match e {
             crate::cli::CliError::Graph(d) => d.to_string(),
             crate::cli::CliError::Other(e) => e.to_string(),
@@ -267,10 +269,11 @@ impl LiveSession {
     /// Klein et al. 2005 §4).
     pub fn reload_transfer_function(&mut self) -> Vec<Event> {
         let start = Instant::now();
-        let result = inputs::transfer_function(self.tf_path.as_ref(), self.tf_map.as_deref(), &self.volume, self.generated)
-            .map_err(|e| format!("{e:#}"))
-            .and_then(|(tf, _)| self.set_transfer_function(&tf).map_err(|e| format!("{e:#}")))
-            .map(|_| "LUT uploaded, history restarted".to_string());
+        let result =
+            inputs::transfer_function(self.tf_path.as_ref(), self.tf_map.as_deref(), &self.volume, self.generated)
+                .map_err(|e| format!("{e:#}"))
+                .and_then(|(tf, _)| self.set_transfer_function(&tf).map_err(|e| format!("{e:#}")))
+                .map(|_| "LUT uploaded, history restarted".to_string());
         self.outcome("transfer function".to_string(), start, result)
     }
 
@@ -285,7 +288,8 @@ impl LiveSession {
 
     /// Files changed on disk: the events of reloading what they affect.
     pub fn files_changed(&mut self, changed: &[PathBuf]) -> Vec<Event> {
-        let same = |a: &Path, b: &Path| a == b || matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y);
+        let same =
+            |a: &Path, b: &Path| a == b || matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y);
         let mut events = Vec::new();
         if changed.iter().any(|c| same(c, &self.graph)) {
             events.extend(self.reload_graph());

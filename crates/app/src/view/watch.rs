@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 use notify::{RecursiveMode, Watcher};
 
 /// How long files must be quiet before a change is delivered.
-pub const QUIET: Duration = Duration::from_millis(30);
+pub const QUIET: Duration = Duration::from_millis(15);
 
 /// A debounced watch over a set of files.
 pub struct FileWatch {

@@ -82,7 +82,8 @@ impl Viewer {
             desc.backends = wgpu::Backends::VULKAN | wgpu::Backends::METAL | wgpu::Backends::DX12;
         }
         let instance = wgpu::Instance::new(desc);
-        let surface = instance.create_surface(window.clone()).map_err(|e| format!("cannot draw into the window: {e}"))?;
+        let surface =
+            instance.create_surface(window.clone()).map_err(|e| format!("cannot draw into the window: {e}"))?;
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
             compatible_surface: Some(&surface),
@@ -100,16 +101,23 @@ impl Viewer {
         config.format = format;
         config.present_mode = wgpu::PresentMode::AutoNoVsync;
         surface.configure(&gpu.device, &config);
-        let (session, loaded) = LiveSession::open(gpu.clone(), &SessionArgs {
-            viewport: (config.width, config.height),
-            ..self.session_args.clone()
-        })
+        let (session, loaded) = LiveSession::open(
+            gpu.clone(),
+            &SessionArgs { viewport: (config.width, config.height), ..self.session_args.clone() },
+        )
         .map_err(|e| match e {
             crate::cli::CliError::Graph(d) => d.to_string(),
             crate::cli::CliError::Other(e) => format!("{e:#}"),
         })?;
         let ctx = egui::Context::default();
-        let egui = egui_winit::State::new(ctx, egui::ViewportId::ROOT, &window, Some(window.scale_factor() as f32), None, None);
+        let egui = egui_winit::State::new(
+            ctx,
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            None,
+            None,
+        );
         let renderer = egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default());
         let mut watch = FileWatch::new().map_err(|e| format!("cannot watch files: {e}"))?;
         watch.set_files(&session.watched_files());
@@ -143,7 +151,8 @@ impl Viewer {
                 Action::Scalar(name, value) => session.set_scalar(&name, value),
                 Action::Feature(name, on) => session.set_feature(&name, on),
                 Action::Screenshot => {
-                    self.screenshot_now = Some(self.view.screenshot.clone().unwrap_or_else(|| PathBuf::from("volgraph.png")));
+                    self.screenshot_now =
+                        Some(self.view.screenshot.clone().unwrap_or_else(|| PathBuf::from("volgraph.png")));
                     Vec::new()
                 }
                 Action::ResetCamera => {
@@ -163,10 +172,14 @@ impl Viewer {
             match (words.next(), words.next(), words.next()) {
                 (Some("quit"), _, _) => self.quit = true,
                 (Some("screenshot"), Some(path), _) => self.screenshot_now = Some(PathBuf::from(path)),
-                (Some("param"), Some(key), Some(value)) => match (key.split_once('.'), ron::from_str::<ron::Value>(value)) {
-                    (Some((pass, name)), Ok(v)) => self.apply_actions(vec![Action::Param(pass.to_string(), name.to_string(), v)]),
-                    _ => eprintln!("script: cannot read \"{line}\"; write param PASS.NAME VALUE"),
-                },
+                (Some("param"), Some(key), Some(value)) => {
+                    match (key.split_once('.'), ron::from_str::<ron::Value>(value)) {
+                        (Some((pass, name)), Ok(v)) => {
+                            self.apply_actions(vec![Action::Param(pass.to_string(), name.to_string(), v)])
+                        }
+                        _ => eprintln!("script: cannot read \"{line}\"; write param PASS.NAME VALUE"),
+                    }
+                }
                 _ if line.trim().is_empty() => {}
                 _ => eprintln!("script: unknown line \"{line}\"; known: quit, screenshot PATH, param PASS.NAME VALUE"),
             }
@@ -237,7 +250,8 @@ impl Viewer {
                 }
             }
             let screen = egui_wgpu::ScreenDescriptor { size_in_pixels: [size.0, size.1], pixels_per_point };
-            let mut encoder = gfx.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("overlay") });
+            let mut encoder =
+                gfx.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("overlay") });
             let uploads = gfx.renderer.update_buffers(&gfx.gpu.device, &gfx.gpu.queue, &mut encoder, &jobs, &screen);
             {
                 let mut pass = encoder

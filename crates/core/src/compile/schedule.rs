@@ -15,7 +15,7 @@ use std::collections::{BTreeMap, BinaryHeap, HashMap};
 use super::check::{Checked, Item, Ref, ValueDesc};
 use super::{CompileOptions, MAX_PLAN_STEPS};
 use crate::diagnostic::{Diagnostic, Location};
-use crate::graph::ast::GraphDoc;
+use crate::graph::ast::{GraphDoc, HistoryInitial};
 use crate::plan::{Binding, BoundPort, History, Plan, Resource, ResourceDesc, ResourceId, Slot, Step};
 use crate::plugin::Access;
 
@@ -33,8 +33,69 @@ struct Inst {
     label: String,
 }
 
+/// Each instance's inputs: (index of the input port among its pass's ports, the value it reads).
+type Inputs = Vec<Vec<(usize, Val)>>;
+
+/// The instance of each (pass, iteration).
+type InstanceOf = HashMap<(usize, Option<u32>), usize>;
+
+/// The resource that holds each (instance, output port) value.
+type ResourceOf = HashMap<(usize, String), ResourceId>;
+
+/// What culling keeps: which instances are needed, and the values graph outputs and history read.
+struct Needed {
+    needed: Vec<bool>,
+    output_vals: BTreeMap<String, Val>,
+    history_vals: BTreeMap<String, (Val, HistoryInitial)>,
+}
+
+/// The resources graph outputs and history hold past the last step.
+struct Kept {
+    outputs: BTreeMap<String, ResourceId>,
+    history: BTreeMap<String, History>,
+    persistent_roots: Vec<ResourceId>,
+}
+
 pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> Result<Plan, Vec<Diagnostic>> {
-    // 0. Bound the unrolled size before allocating anything for it.
+    bound(&c)?;
+    let (insts, inst_of) = instantiate(&c);
+    let resolver = Resolver { c: &c, inst_of: &inst_of };
+    let inputs = resolve_inputs(&c, &insts, &resolver);
+    let preds = dependencies(&c, &insts, &inputs)?;
+    let Needed { needed, output_vals, history_vals } = cull(&c, &insts, &resolver, &preds);
+    let order = order(&c, &insts, &preds, &needed)?;
+    let (mut resources, steps, rid_of) = build_resources(&c, options, &insts, &inputs, &order);
+    let Kept { outputs, history, persistent_roots } =
+        keep_results(&mut resources, &rid_of, &output_vals, &history_vals);
+    let slots = pool(&mut resources, &persistent_roots);
+    let culled = culled(&c, &insts, &needed);
+    let gated = gated(&c, options);
+    Ok(Plan {
+        name: doc.name.clone(),
+        viewport: options.viewport,
+        features: options.features.clone(),
+        inputs: c.inputs.clone(),
+        steps,
+        culled,
+        gated,
+        resources,
+        slots,
+        outputs,
+        history,
+        known_features: c.passes.iter().flat_map(|p| p.needs.iter().cloned()).collect(),
+        known_scalars: c
+            .inputs
+            .iter()
+            .filter(|(_, k)| matches!(k, crate::graph::ast::InputKind::Scalar(_)))
+            .map(|(n, _)| n.clone())
+            .chain(c.scene_values.iter().cloned())
+            .collect(),
+        warnings: Default::default(),
+    })
+}
+
+/// 0. Bound the unrolled size before allocating anything for it.
+fn bound(c: &Checked) -> Result<(), Vec<Diagnostic>> {
     let total: u64 = c
         .order
         .iter()
@@ -57,10 +118,13 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
             .with_help("use fewer repeat iterations (more work per iteration) or fewer passes in the body"),
         ]);
     }
+    Ok(())
+}
 
-    // 1. Instances, in document order.
+/// 1. Instances, in document order.
+fn instantiate(c: &Checked) -> (Vec<Inst>, InstanceOf) {
     let mut insts: Vec<Inst> = Vec::new();
-    let mut inst_of: HashMap<(usize, Option<u32>), usize> = HashMap::new();
+    let mut inst_of: InstanceOf = HashMap::new();
     for item in &c.order {
         match item {
             Item::Pass(pi) if c.passes[*pi].enabled => {
@@ -85,11 +149,13 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
             }
         }
     }
+    (insts, inst_of)
+}
 
-    let resolver = Resolver { c: &c, inst_of: &inst_of };
-    // 2. Each instance's inputs as concrete values.
+/// 2. Each instance's inputs as concrete values.
+fn resolve_inputs(c: &Checked, insts: &[Inst], resolver: &Resolver) -> Inputs {
     let mut inputs: Vec<Vec<(usize, Val)>> = Vec::with_capacity(insts.len());
-    for inst in &insts {
+    for inst in insts {
         let p = &c.passes[inst.pass];
         let mut vals = Vec::new();
         for (k, spec) in p.ports.iter().enumerate() {
@@ -104,8 +170,11 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
         }
         inputs.push(vals);
     }
+    inputs
+}
 
-    // 3. Dependencies: producer → consumer, and readers of a value before its modifier.
+/// 3. Dependencies: producer → consumer, and readers of a value before its modifier.
+fn dependencies(c: &Checked, insts: &[Inst], inputs: &Inputs) -> Result<Vec<Vec<usize>>, Vec<Diagnostic>> {
     let n = insts.len();
     let mut preds: Vec<Vec<usize>> = vec![Vec::new(); n];
     let mut readers: HashMap<(usize, String), Vec<usize>> = HashMap::new();
@@ -142,7 +211,7 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
                     // Every iteration of a repeat body modifies the same value: the chain must
                     // go through the group's carry so iteration i modifies iteration i-1's.
                     (true, Some(g)) => {
-                        let port = modifier_port(&c, &insts, &inputs, mods[1], key).unwrap_or("<port>");
+                        let port = modifier_port(c, insts, inputs, mods[1], key).unwrap_or("<port>");
                         format!(
                             "every iteration of repeat group \"{gid}\" modifies it; carry it instead: carry: {{\"{port}\": (init: \"{}.{}\", next: \"{}.{port}\")}} and read \"{gid}.{port}\"",
                             insts[key.0].label,
@@ -164,8 +233,12 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
     if !diags.is_empty() {
         return Err(diags);
     }
+    Ok(preds)
+}
 
-    // 4. Culling: keep what graph outputs, history and sinks need.
+/// 4. Culling: keep what graph outputs, history and sinks need.
+fn cull(c: &Checked, insts: &[Inst], resolver: &Resolver, preds: &[Vec<usize>]) -> Needed {
+    let n = insts.len();
     let mut needed = vec![false; n];
     let mut stack: Vec<usize> = Vec::new();
     let mut output_vals = BTreeMap::new();
@@ -195,8 +268,12 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
         }
         stack.extend(preds[i].iter().copied());
     }
+    Needed { needed, output_vals, history_vals }
+}
 
-    // 5. Order: Kahn's algorithm, ties broken by document order.
+/// 5. Order: Kahn's algorithm, ties broken by document order.
+fn order(c: &Checked, insts: &[Inst], preds: &[Vec<usize>], needed: &[bool]) -> Result<Vec<usize>, Vec<Diagnostic>> {
+    let n = insts.len();
     let mut indegree = vec![0usize; n];
     let mut succs: Vec<Vec<usize>> = vec![Vec::new(); n];
     for (i, ps) in preds.iter().enumerate() {
@@ -232,9 +309,10 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
             ordered[i] = true;
         }
         let stuck: Vec<&str> = (0..n).filter(|&i| needed[i] && !ordered[i]).map(|i| insts[i].label.as_str()).collect();
+        let first = (0..n).find(|&i| needed[i] && !ordered[i]).map_or(0, |i| insts[i].pass);
         return Err(vec![
             Diagnostic::new(
-                Location::File,
+                Location::Field { pass: c.passes[first].id.clone(), field: "inputs".to_string() },
                 format!(
                     "passes {} cannot be ordered: a pass reads a value after another pass modified it",
                     stuck.join(", ")
@@ -243,8 +321,17 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
             .with_help("read the modified version (\"<modifier>.<port>\") instead of the original".to_string()),
         ]);
     }
+    Ok(order)
+}
 
-    // 6. Resources.
+/// 6. Resources: the steps in order, each port bound to the resource it reads or writes.
+fn build_resources(
+    c: &Checked,
+    options: &CompileOptions,
+    insts: &[Inst],
+    inputs: &Inputs,
+    order: &[usize],
+) -> (Vec<Resource>, Vec<Step>, ResourceOf) {
     let mut resources: Vec<Resource> = Vec::new();
     let mut rid_of: HashMap<(usize, String), ResourceId> = HashMap::new();
     let mut steps: Vec<Step> = Vec::new();
@@ -325,8 +412,18 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
             ports,
         });
     }
+    (resources, steps, rid_of)
+}
+
+/// 6. Resources, continued: what graph outputs and history read lives past the last step.
+fn keep_results(
+    resources: &mut [Resource],
+    rid_of: &ResourceOf,
+    output_vals: &BTreeMap<String, Val>,
+    history_vals: &BTreeMap<String, (Val, HistoryInitial)>,
+) -> Kept {
     let mut outputs = BTreeMap::new();
-    for (name, v) in &output_vals {
+    for (name, v) in output_vals {
         if let Val::Out(i, port) = v
             && let Some(&id) = rid_of.get(&(*i, port.clone()))
         {
@@ -336,71 +433,51 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
     }
     let mut history = BTreeMap::new();
     let mut persistent_roots = Vec::new();
-    for (name, (v, initial)) in &history_vals {
+    for (name, (v, initial)) in history_vals {
         if let Val::Out(i, port) = v
             && let Some(&id) = rid_of.get(&(*i, port.clone()))
         {
             resources[id].last_use = usize::MAX;
-            persistent_roots.push(root_of(&resources, id));
+            persistent_roots.push(root_of(resources, id));
             // (one walk per history entry: few, however long the chain)
             history.insert(name.clone(), History { source: id, initial: initial.clone() });
         }
     }
+    Kept { outputs, history, persistent_roots }
+}
 
-    // 7. Pool targets over chain lifetimes.
-    let slots = pool(&mut resources, &persistent_roots);
-
+/// Culled: enabled passes none of whose instances is needed, in document order.
+fn culled(c: &Checked, insts: &[Inst], needed: &[bool]) -> Vec<String> {
     let mut pass_needed = vec![false; c.passes.len()];
     for (i, inst) in insts.iter().enumerate() {
         pass_needed[inst.pass] |= needed[i];
     }
-    let culled: Vec<String> = {
-        let mut ids: Vec<String> = Vec::new();
-        for item in &c.order {
-            let members: Vec<usize> = match item {
-                Item::Pass(pi) => vec![*pi],
-                Item::Group(gi) => c.groups[*gi].members.clone(),
-            };
-            for pi in members {
-                if !c.passes[pi].enabled {
-                    continue;
-                }
-                let any_needed = pass_needed[pi];
-                if !any_needed {
-                    ids.push(c.passes[pi].id.clone());
-                }
+    let mut ids: Vec<String> = Vec::new();
+    for item in &c.order {
+        let members: Vec<usize> = match item {
+            Item::Pass(pi) => vec![*pi],
+            Item::Group(gi) => c.groups[*gi].members.clone(),
+        };
+        for pi in members {
+            if !c.passes[pi].enabled {
+                continue;
+            }
+            let any_needed = pass_needed[pi];
+            if !any_needed {
+                ids.push(c.passes[pi].id.clone());
             }
         }
-        ids
-    };
-    let gated = c
-        .passes
+    }
+    ids
+}
+
+/// Gated: passes that are off for these features, with the features they miss.
+fn gated(c: &Checked, options: &CompileOptions) -> Vec<(String, Vec<String>)> {
+    c.passes
         .iter()
         .filter(|p| !p.enabled)
         .map(|p| (p.id.clone(), p.needs.iter().filter(|f| !options.features.contains(*f)).cloned().collect()))
-        .collect();
-    Ok(Plan {
-        name: doc.name.clone(),
-        viewport: options.viewport,
-        features: options.features.clone(),
-        inputs: c.inputs.clone(),
-        steps,
-        culled,
-        gated,
-        resources,
-        slots,
-        outputs,
-        history,
-        known_features: c.passes.iter().flat_map(|p| p.needs.iter().cloned()).collect(),
-        known_scalars: c
-            .inputs
-            .iter()
-            .filter(|(_, k)| matches!(k, crate::graph::ast::InputKind::Scalar(_)))
-            .map(|(n, _)| n.clone())
-            .chain(c.scene_values.iter().cloned())
-            .collect(),
-        warnings: Default::default(),
-    })
+        .collect()
 }
 
 /// The name of the Modify port through which instance `inst` modifies the value `key`.
@@ -427,6 +504,7 @@ fn root_of(resources: &[Resource], mut id: ResourceId) -> ResourceId {
     id
 }
 
+/// 7. Pool targets over chain lifetimes.
 fn pool(resources: &mut [Resource], persistent_roots: &[ResourceId]) -> Vec<Slot> {
     // Chain roots in one forward pass (a Modify output is always created after the version it
     // modifies), so a repeat group's carried chain of N versions costs O(N), not O(N²).
@@ -483,7 +561,7 @@ fn pool(resources: &mut [Resource], persistent_roots: &[ResourceId]) -> Vec<Slot
 
 struct Resolver<'a> {
     c: &'a Checked,
-    inst_of: &'a HashMap<(usize, Option<u32>), usize>,
+    inst_of: &'a InstanceOf,
 }
 
 impl Resolver<'_> {

@@ -433,7 +433,12 @@ impl Runtime {
     /// What a window of `format` and `size` shows of `output` after the last frame: the same
     /// blit, drawn into an offscreen texture and read back as `format`'s bytes (a screenshot
     /// without the overlay). Waits for the frame.
-    pub fn capture(&mut self, output: &str, format: wgpu::TextureFormat, size: (u32, u32)) -> Result<Vec<u8>, RuntimeError> {
+    pub fn capture(
+        &mut self,
+        output: &str,
+        format: wgpu::TextureFormat,
+        size: (u32, u32),
+    ) -> Result<Vec<u8>, RuntimeError> {
         let _ = self.frames.finish(&self.gpu);
         let schedule = self.schedule.as_ref().ok_or(RuntimeError::NoPlan)?;
         let (source, encoded) = output_view(schedule, &self.history, output)?;
@@ -454,7 +459,8 @@ impl Runtime {
         )?;
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
         let target = PresentTarget { view: &view, format, size, output };
-        let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("capture") });
+        let mut encoder =
+            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("capture") });
         self.blitter.record(&self.gpu, &mut encoder, &source, encoded, &target)?;
         self.gpu.queue.submit([encoder.finish()]);
         readback::read_texture_bytes(&self.gpu, &texture).map_err(RuntimeError::Readback)
@@ -469,7 +475,9 @@ impl Runtime {
             known: schedule.plan.outputs.keys().cloned().collect::<Vec<_>>().join(", "),
         })?;
         match schedule.plan.resources[rid].slot.map(|s| &schedule.slots[s]) {
-            Some(SlotTexture::Buffer(b)) => readback::read_buffer(&self.gpu, &b.buffer, 0, b.size).map_err(RuntimeError::Readback),
+            Some(SlotTexture::Buffer(b)) => {
+                readback::read_buffer(&self.gpu, &b.buffer, 0, b.size).map_err(RuntimeError::Readback)
+            }
             _ => Err(RuntimeError::Readback(format!("output \"{name}\" is not a buffer"))),
         }
     }

@@ -73,9 +73,9 @@ pub fn read_buffer(gpu: &Gpu, buffer: &wgpu::Buffer, offset: u64, size: u64) -> 
 /// The texels of mip 0 of `texture` (2D or 3D), tightly packed, x fastest, then y, then z.
 pub fn read_texture_bytes(gpu: &Gpu, texture: &wgpu::Texture) -> Result<Vec<u8>, String> {
     let format = texture.format();
-    let texel = format.block_copy_size(Some(wgpu::TextureAspect::All)).or_else(|| {
-        format.block_copy_size(Some(wgpu::TextureAspect::DepthOnly))
-    });
+    let texel = format
+        .block_copy_size(Some(wgpu::TextureAspect::All))
+        .or_else(|| format.block_copy_size(Some(wgpu::TextureAspect::DepthOnly)));
     let Some(texel) = texel else {
         return Err(format!("cannot read back {format:?} textures"));
     };
@@ -103,7 +103,11 @@ pub fn read_texture_bytes(gpu: &Gpu, texture: &wgpu::Texture) -> Result<Vec<u8>,
         },
         wgpu::TexelCopyBufferInfo {
             buffer: &staging,
-            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded), rows_per_image: Some(size.height) },
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(size.height),
+            },
         },
         wgpu::Extent3d { width: size.width, height: size.height, depth_or_array_layers: layers },
     );

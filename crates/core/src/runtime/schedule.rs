@@ -221,7 +221,9 @@ pub(crate) fn build(
             SlotDesc::Target { format, extent } => {
                 r.textures.acquire(r.gpu, TextureKey { format, extent }, &label).map(|t| Fresh::Texture(t, false))
             }
-            SlotDesc::Buffer { size } => r.textures.acquire_buffer(r.gpu, size, &label).map(|b| Fresh::Buffer(b, false)),
+            SlotDesc::Buffer { size } => {
+                r.textures.acquire_buffer(r.gpu, size, &label).map(|b| Fresh::Buffer(b, false))
+            }
         };
         match made {
             Ok(f) => fresh.push(Some(f)),

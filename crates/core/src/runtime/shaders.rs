@@ -103,9 +103,8 @@ impl ShaderLibrary {
     /// Forgets the modules built from any of `changed` (disk paths; imports count) and returns
     /// their relative names: the pipelines of exactly these modules must be rebuilt.
     pub fn invalidate(&self, changed: &[PathBuf]) -> Vec<String> {
-        let same = |a: &Path, b: &Path| {
-            a == b || matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
-        };
+        let same =
+            |a: &Path, b: &Path| a == b || matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y);
         let touches = |files: &[PathBuf]| files.iter().any(|p| changed.iter().any(|c| same(p, c)));
         let (Ok(mut cache), Ok(mut unloaded)) = (self.cache.lock(), self.unloaded.lock()) else { return Vec::new() };
         let mut stale: Vec<String> =

@@ -1,0 +1,223 @@
+//! Validation: every problem of a graph file, located, with a fix, all at once.
+
+mod cycles;
+mod nodes;
+mod outputs;
+mod params;
+mod ports;
+mod references;
+
+use std::collections::{BTreeMap, HashMap};
+use std::sync::Arc;
+
+use super::CompileOptions;
+use crate::diagnostic::{Diagnostic, Location};
+use crate::format::{TargetFormat, TargetSize};
+use crate::graph::ast::{GraphDoc, HistoryInitial, InputKind, NodeDoc, RepeatCount};
+use crate::graph::locate::{Locator, PassPath};
+use crate::params::Params;
+use crate::plugin::{PassPlugin, PortSpec, Registry};
+use crate::suggest::comma_list;
+
+/// A resolved reference to a value.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum Ref {
+    Input(String),
+    History(String),
+    Carry { group: usize, name: String },
+    Output { pass: usize, port: String },
+}
+
+/// What a value is, for type checks.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum ValueDesc {
+    Target { format: TargetFormat, size: TargetSize },
+    Buffer { bytes: u64, bytes_per_pixel: u64 },
+    Owned(String),
+    Volume,
+    TransferFunction,
+    Scalar,
+}
+
+impl ValueDesc {
+    fn describe(&self) -> String {
+        match self {
+            ValueDesc::Target { format, size } => format!("{format} {size}"),
+            ValueDesc::Buffer { .. } => "a storage buffer".to_string(),
+            ValueDesc::Owned(t) => format!("a {t}"),
+            ValueDesc::Volume => "the volume".to_string(),
+            ValueDesc::TransferFunction => "the transfer function".to_string(),
+            ValueDesc::Scalar => "a scalar".to_string(),
+        }
+    }
+}
+
+pub(crate) struct PassInfo {
+    pub id: String,
+    pub kind: String,
+    pub path: PassPath,
+    pub group: Option<usize>,
+    pub plugin: Option<Arc<dyn PassPlugin>>,
+    pub params: Params,
+    pub ports: Vec<PortSpec>,
+    pub outputs: BTreeMap<String, ValueDesc>,
+    pub inputs: BTreeMap<String, Ref>,
+    pub enabled: bool,
+    pub needs: Vec<String>,
+    pub otherwise: BTreeMap<String, Ref>,
+}
+
+pub(crate) struct GroupInfo {
+    pub id: String,
+    pub count: u32,
+    pub members: Vec<usize>,
+    pub carry: BTreeMap<String, (Ref, Ref)>,
+}
+
+pub(crate) enum Item {
+    Pass(usize),
+    Group(usize),
+}
+
+pub(crate) struct Checked {
+    pub passes: Vec<PassInfo>,
+    pub groups: Vec<GroupInfo>,
+    pub order: Vec<Item>,
+    pub outputs: BTreeMap<String, Ref>,
+    pub history: BTreeMap<String, (Ref, HistoryInitial)>,
+    pub inputs: BTreeMap<String, InputKind>,
+    /// Problems that do not stop compiling (a repeat count capped by its max).
+    pub warnings: Vec<Diagnostic>,
+    /// Scene values a repeat count reads that the graph does not declare as Scalar inputs.
+    pub scene_values: Vec<String>,
+}
+
+const RESERVED: [&str; 2] = ["input", "history"];
+
+struct Checker<'a> {
+    doc: &'a GraphDoc,
+    source: &'a str,
+    loc: Locator,
+    registry: &'a Registry,
+    options: &'a CompileOptions,
+    diags: Vec<Diagnostic>,
+    warnings: Vec<Diagnostic>,
+    passes: Vec<PassInfo>,
+    groups: Vec<GroupInfo>,
+    pass_by_id: HashMap<String, usize>,
+    group_by_id: HashMap<String, usize>,
+}
+
+pub(crate) fn check(
+    doc: &GraphDoc,
+    source: &str,
+    registry: &Registry,
+    options: &CompileOptions,
+) -> Result<Checked, Vec<Diagnostic>> {
+    let mut c = Checker {
+        doc,
+        source,
+        loc: Locator::new(source),
+        registry,
+        options,
+        diags: Vec::new(),
+        warnings: Vec::new(),
+        passes: Vec::new(),
+        groups: Vec::new(),
+        pass_by_id: HashMap::new(),
+        group_by_id: HashMap::new(),
+    };
+    let order = c.collect_nodes();
+    for key in options.param_overrides.keys() {
+        let pass = key.split_once('.').map_or(key.as_str(), |(p, _)| p);
+        if !c.pass_by_id.contains_key(pass) {
+            let mut ids: Vec<&str> = c.pass_by_id.keys().map(String::as_str).collect();
+            ids.sort_unstable();
+            c.diags.push(
+                Diagnostic::new(Location::File, format!("parameter override \"{key}\" names no pass of this graph"))
+                    .with_help(format!("write \"<pass>.<param>\"; passes are: {}", comma_list(&ids))),
+            );
+        }
+    }
+    c.check_references();
+    let outputs = c.check_graph_outputs();
+    let history = c.check_history();
+    if c.diags.is_empty() {
+        c.check_cycles();
+    }
+    if c.diags.is_empty() {
+        let scene_values = doc
+            .passes
+            .iter()
+            .filter_map(|n| match n {
+                NodeDoc::Repeat(r) => match &r.count {
+                    RepeatCount::Scene { name, .. } if !doc.inputs.contains_key(name) => Some(name.clone()),
+                    _ => None,
+                },
+                NodeDoc::Pass(_) => None,
+            })
+            .collect();
+        Ok(Checked {
+            passes: c.passes,
+            groups: c.groups,
+            order,
+            outputs,
+            history,
+            inputs: doc.inputs.clone(),
+            warnings: c.warnings,
+            scene_values,
+        })
+    } else {
+        Err(c.diags)
+    }
+}
+
+impl Checker<'_> {
+    fn err(&mut self, location: Location, message: String, help: Option<String>) {
+        let mut d = Diagnostic::new(location, message);
+        if let Some(h) = help {
+            d = d.with_help(h);
+        }
+        self.diags.push(d);
+    }
+
+    fn claim_id(&mut self, id: &str, location: Location, first: &mut HashMap<String, Location>) -> bool {
+        if RESERVED.contains(&id) {
+            self.err(
+                location,
+                format!("id \"{id}\" is reserved"),
+                Some(format!("\"{id}.<name>\" refers to graph {id}s; choose another id")),
+            );
+            return false;
+        }
+        if id.is_empty() || id.contains('.') || id.contains('/') || id.contains('[') {
+            self.err(
+                location,
+                format!("id \"{id}\" is not a valid id"),
+                Some("use letters, digits and underscores".to_string()),
+            );
+            return false;
+        }
+        if let Some(prev) = first.get(id) {
+            let at = match prev {
+                Location::Span(s) => {
+                    let (line, _) = crate::graph::spans::line_col(self.loc_source(), s.start);
+                    format!(" (first used on line {line})")
+                }
+                _ => String::new(),
+            };
+            self.err(
+                location,
+                format!("duplicate id \"{id}\"{at}"),
+                Some("ids must be unique; rename one of them".to_string()),
+            );
+            return false;
+        }
+        first.insert(id.to_string(), location);
+        true
+    }
+
+    fn loc_source(&self) -> &str {
+        self.source
+    }
+}

@@ -168,3 +168,4 @@ fn a_resize_rebuilds_no_pipeline() {
     assert_eq!((image.width, image.height), (64, 40));
     let _ = std::fs::remove_dir_all(&s.dir);
 }
+

@@ -122,12 +122,26 @@ pub struct LiveSession {
     shader_dir: Option<PathBuf>,
     /// The last change's error, while it lasts.
     error: Option<(String, String)>,
+    /// The graph text and options whose frames last rendered without a GPU error: what a frame
+    /// failure falls back to.
+    validated: Option<(String, CompileOptions)>,
+    /// True until a frame of the current plan has rendered.
+    unproven: bool,
 }
 
 impl LiveSession {
     /// Loads the scene and the graph on `gpu`; fails (with located diagnostics) when the graph
     /// does not compile or build at all.
     pub fn open(gpu: Arc<Gpu>, args: &SessionArgs) -> Result<(Self, Event), crate::cli::CliError> {
+        Self::open_with(gpu, args, volgraph_passes::builtin_registry())
+    }
+
+    /// [`Self::open`] with another registry (built-ins plus a plugin crate's kinds).
+    pub fn open_with(
+        gpu: Arc<Gpu>,
+        args: &SessionArgs,
+        registry: Registry,
+    ) -> Result<(Self, Event), crate::cli::CliError> {
         let start = Instant::now();
         let source = inputs::read_graph(&args.graph)?;
         let generated = args.volume.is_none();
@@ -142,7 +156,6 @@ impl LiveSession {
         let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
         let (sources, shader_dir) = crate::shader_dir::sources_for(&args.graph, args.shaders.as_deref());
         let mut runtime = Runtime::new(gpu, ShaderLibrary::new(sources));
-        let registry = volgraph_passes::builtin_registry();
         let options = CompileOptions::new(args.viewport.0, args.viewport.1)
             .with_features(args.features.iter().filter(|f| !f.is_empty()).cloned());
         let graph_name = args.graph.display().to_string();
@@ -170,6 +183,8 @@ impl LiveSession {
             options,
             shader_dir,
             error: None,
+            validated: None,
+            unproven: true,
         };
         let ms = start.elapsed().as_secs_f64() * 1e3;
         Ok((session, Event::Loaded { graph: graph_name, ms, summary: loaded }))
@@ -225,6 +240,7 @@ impl LiveSession {
     fn outcome(&mut self, what: String, start: Instant, result: Result<String, String>) -> Vec<Event> {
         match result {
             Ok(detail) => {
+                self.unproven = true;
                 let ms = start.elapsed().as_secs_f64() * 1e3;
                 let mut events = vec![Event::Reloaded { what: what.clone(), detail, ms }];
                 if self.error.take().is_some() {
@@ -374,6 +390,42 @@ impl LiveSession {
     ) -> Result<u64, volgraph_core::runtime::RuntimeError> {
         let viewport = self.options.viewport;
         self.runtime.submit(CameraData::from_orbit(camera, viewport), target)
+    }
+
+    /// Renders a frame; a GPU error in the frame of a newly applied plan (a validation error
+    /// wgpu only reports when the commands run) puts the last plan that rendered back, so the
+    /// window is never left blank. The events say what happened; `Err` only when even the last
+    /// good plan fails (a lost device).
+    pub fn frame(
+        &mut self,
+        camera: &volgraph_accel::camera::OrbitCamera,
+        target: Option<&PresentTarget<'_>>,
+    ) -> Result<Vec<Event>, volgraph_core::runtime::RuntimeError> {
+        match self.submit(camera, target) {
+            Ok(_) => {
+                if self.unproven {
+                    self.unproven = false;
+                    self.validated = Some((self.source.clone(), self.options.clone()));
+                }
+                Ok(Vec::new())
+            }
+            Err(e) => {
+                let Some((source, options)) = self.validated.clone().filter(|_| self.unproven) else { return Err(e) };
+                let what = "frame".to_string();
+                let message =
+                    format!("{e}\n(the GPU rejected the new graph's frame; the last graph that rendered is back)");
+                self.error = Some((what.clone(), message.clone()));
+                if let Err(revert) = self.compile_and_apply(&source, &options) {
+                    return Err(volgraph_core::runtime::RuntimeError::Readback(format!(
+                        "{e}; and the last good graph no longer applies: {revert}"
+                    )));
+                }
+                self.source = source;
+                self.options = options;
+                self.unproven = false;
+                Ok(vec![Event::Error { what, message }])
+            }
+        }
     }
 
     /// The output the window shows: `display` when the graph has it, else `image`.

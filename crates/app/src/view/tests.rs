@@ -169,3 +169,94 @@ fn a_resize_rebuilds_no_pipeline() {
     let _ = std::fs::remove_dir_all(&s.dir);
 }
 
+/// A pass that builds fine but records a draw with no pipeline set: wgpu only rejects it when
+/// the frame's commands are finished, after the plan was applied.
+struct BadDraw;
+
+struct BadDrawNode {
+    pipeline: volgraph_core::runtime::PassPipeline,
+}
+
+impl volgraph_core::PassNode for BadDrawNode {
+    fn record(
+        &mut self,
+        ctx: &mut volgraph_core::runtime::RecordContext<'_>,
+    ) -> Result<(), volgraph_core::runtime::PassError> {
+        let mut pass = ctx.begin_render_pass(&self.pipeline, None)?;
+        pass.draw(0..3, 0..1);
+        Ok(())
+    }
+}
+
+impl volgraph_core::PassPlugin for BadDraw {
+    fn kind(&self) -> &'static str {
+        "bad_draw"
+    }
+    fn summary(&self) -> &'static str {
+        "test: records an invalid draw"
+    }
+    fn ports(&self, _p: &volgraph_core::Params) -> Vec<volgraph_core::PortSpec> {
+        vec![
+            volgraph_core::PortSpec::read(
+                "color",
+                volgraph_core::PortKind::target(&[
+                    volgraph_core::TargetFormat::Rgba32Float,
+                    volgraph_core::TargetFormat::Rgba16Float,
+                ]),
+            ),
+            volgraph_core::PortSpec::write(
+                "display",
+                volgraph_core::PortKind::target(&[volgraph_core::TargetFormat::Rgba8Unorm]),
+            ),
+        ]
+    }
+    fn create(
+        &self,
+        ctx: &volgraph_core::runtime::CreateContext<'_>,
+    ) -> Result<Box<dyn volgraph_core::PassNode>, volgraph_core::runtime::PassError> {
+        let pipeline = ctx.render_pipeline(&volgraph_core::runtime::RenderPipelineSpec {
+            shader: "present.wgsl",
+            vertex: "vs_fullscreen",
+            fragment: "fs_present",
+            extra_bindings: &["params"],
+            ..Default::default()
+        })?;
+        Ok(Box::new(BadDrawNode { pipeline }))
+    }
+}
+
+#[test]
+fn a_frame_the_gpu_rejects_puts_the_last_good_graph_back() {
+    let s = scratch("frame-error", "graphs/basic/fragment_raycast.ron");
+    let gpu = Arc::new(Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)"));
+    let mut registry = volgraph_passes::builtin_registry();
+    registry.register(BadDraw);
+    let args = SessionArgs {
+        graph: s.graph.clone(),
+        volume: None,
+        raw: Default::default(),
+        tf: None,
+        tf_map: None,
+        viewport: (48, 48),
+        features: Vec::new(),
+        shaders: Some(s.shaders.clone()),
+    };
+    let (mut session, _) = LiveSession::open_with(gpu, &args, registry).unwrap_or_else(|_| panic!("loads"));
+    let camera = OrbitCamera::default();
+    assert!(session.frame(&camera, None).expect("a good frame").is_empty());
+    session.runtime.finish();
+    let good = session.runtime.read_output("image").expect("image").data;
+    // The edit applies (the pass builds), but its frame fails on the GPU.
+    edit(&s.graph, "kind: \"present\"", "kind: \"bad_draw\"");
+    let events = session.reload_graph();
+    assert!(matches!(events.as_slice(), [Event::Reloaded { .. }]), "{events:?}");
+    let events = session.frame(&camera, None).expect("recovers by itself");
+    let [Event::Error { what, message }] = events.as_slice() else { panic!("{events:?}") };
+    assert_eq!(what, "frame");
+    assert!(message.contains("the last graph that rendered is back"), "{message}");
+    assert!(session.frame(&camera, None).expect("the last good graph renders").is_empty());
+    session.runtime.finish();
+    assert_eq!(session.runtime.read_output("image").expect("image").data, good);
+    assert_eq!(session.plan().expect("plan").steps.iter().filter(|s| s.kind == "present").count(), 1);
+    let _ = std::fs::remove_dir_all(&s.dir);
+}

@@ -227,12 +227,22 @@ impl Viewer {
         if let Some(turn) = self.view.turn_degrees {
             self.orbit.turn(turn);
         }
-        if let Err(e) = session.submit(&self.orbit.camera, Some(&target)) {
-            let events = vec![Event::Error { what: "frame".to_string(), message: e.to_string() }];
-            self.handle(events);
-            self.fail(event_loop, format!("a frame failed: {e}"));
+        let events = match session.frame(&self.orbit.camera, Some(&target)) {
+            Ok(events) => events,
+            Err(e) => {
+                drop(frame);
+                self.fail(event_loop, format!("a frame failed and no earlier graph renders: {e}"));
+                return;
+            }
+        };
+        let reverted = !events.is_empty();
+        self.handle(events);
+        if reverted {
+            // This frame's surface texture was not drawn: show the next one.
             return;
         }
+        let Some(session) = self.session.as_mut() else { return };
+        let Some(gfx) = self.gfx.as_mut() else { return };
         let mut actions = Vec::new();
         if self.panel_open {
             let raw = gfx.egui.take_egui_input(&gfx.window);

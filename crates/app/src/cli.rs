@@ -77,7 +77,8 @@ enum Command {
     /// Show a graph live in a window, hot-reloading the graph, its shaders and its transfer
     /// function; an overlay shows per-pass GPU time, the plan and every parameter.
     View(crate::view::ViewArgs),
-    /// Measure: `volgraph bench accel` (CPU acceleration structures).
+    /// Measure: graphs (speed, samples, accuracy), fetch (the device's sampling ceiling), live
+    /// (reload latency, soak), compile, accel (CPU acceleration structures).
     Bench {
         #[command(subcommand)]
         which: BenchCommand,
@@ -114,8 +115,12 @@ enum BenchCommand {
         json: Option<PathBuf>,
     },
     /// Time render graphs over datasets, transfer functions and viewports (presets: basic,
-    /// kw2003-table1, thesis-tables); speed-ups vs a baseline, samples/s, accuracy sweeps.
+    /// kw2003-table1, thesis-tables, peer); speed-ups vs a baseline, samples counted on the GPU
+    /// as a fraction of the fetch ceiling, accuracy sweeps.
     Graphs(crate::bench_graphs::GraphsArgs),
+    /// The fetch ceiling: trilinear samples per second of a pass that only samples the volume
+    /// along the raycaster's rays (no classification, no compositing).
+    Fetch(crate::bench_fetch::FetchArgs),
     /// The live runtime: reload latency (parameter, graph and shader edits), frames in flight vs
     /// blocking, and a soak of frames and reloads with memory at start and end.
     Live(crate::bench_live::LiveArgs),
@@ -286,6 +291,10 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         }
         Command::Bench { which: BenchCommand::Graphs(args) } => {
             crate::bench_graphs::run_cli(&args).context("bench graphs")?;
+            Ok(())
+        }
+        Command::Bench { which: BenchCommand::Fetch(args) } => {
+            crate::bench_fetch::run(&args).context("bench fetch")?;
             Ok(())
         }
     }

@@ -3,6 +3,7 @@
 
 mod bench_accel;
 mod bench_compile;
+mod bench_fetch;
 mod bench_graphs;
 mod bench_live;
 mod cli;

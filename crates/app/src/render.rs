@@ -105,11 +105,14 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
         );
     }
     runtime.apply(plan, &registry).map_err(|e| anyhow!(e))?;
+    // Frames one at a time, so each has its own time (the first includes pipeline JIT).
+    let mut stats = Vec::new();
     for f in 0..args.frames {
         let cam = OrbitCamera { azimuth_deg: camera.azimuth_deg + f as f64, ..camera };
-        runtime.submit(CameraData::from_orbit(&cam, viewport), None).map_err(|e| anyhow!(e))?;
+        stats.push(runtime.render(CameraData::from_orbit(&cam, viewport)).map_err(|e| anyhow!(e))?);
     }
-    let last = runtime.finish().pop();
+    let warm: Vec<f64> = stats.iter().skip(1).map(|s| s.frame_ms).collect();
+    let last = stats.pop();
     let image = runtime.read_output(&output).map_err(|e| anyhow!(e))?;
     let plan = runtime.plan().ok_or_else(|| anyhow!("internal: no plan after rendering"))?;
     match kind {
@@ -129,7 +132,7 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
         }
     }
     if let Some(stats) = last {
-        let clock = if stats.wall_time_fallback { "wall time (no GPU timestamps)" } else { "GPU time" };
+        let clock = if stats.wall_time_fallback { "wall time" } else { "GPU time" };
         eprintln!(
             "{}: {}x{} on {}, last frame {:.2} ms {clock} → {}",
             args.graph.display(),
@@ -139,10 +142,22 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
             stats.frame_ms,
             args.out.display()
         );
+        if !warm.is_empty() {
+            eprintln!(
+                "  median of frames 2..{}: {:.2} ms {clock}",
+                warm.len() + 1,
+                crate::bench_graphs::measure::median(&warm)
+            );
+        }
         if stats.step_gpu_ms.is_some() {
             // Per pass, repeat-group instances summed, in schedule order.
             let list: Vec<String> = stats.per_pass_ms().iter().map(|(id, ms)| format!("{id} {ms:.2}")).collect();
-            eprintln!("  per pass (ms): {}", list.join(", "));
+            let caveat = if runtime.gpu().timestamps_cover_work {
+                ""
+            } else {
+                " (timestamps of a CPU adapter: compute passes are not covered)"
+            };
+            eprintln!("  per pass (ms){caveat}: {}", list.join(", "));
         }
     }
     Ok(())

@@ -153,7 +153,7 @@ fn hot_reload_in_a_window_keeps_the_last_good_graph_and_matches_the_headless_ren
     assert!(line.contains("graph.ron:") && line.ends_with("keeping the last good graph"), "{line}");
     // 3. Break a shader the running graph uses.
     let present = dir.join("shaders/present.wgsl");
-    edit(&present, "fn fs_present", "fn fs_present(((");
+    edit(&present, "fn cs_present", "fn cs_present(((");
     let line = expect_line(&lines, "error in shader present.wgsl", &mut log);
     assert!(line.contains("present.wgsl:"), "the shader error is located: {line}");
     // 4. Fix the graph: still an error, now the shader's.
@@ -161,7 +161,7 @@ fn hot_reload_in_a_window_keeps_the_last_good_graph_and_matches_the_headless_ren
     let line = expect_line(&lines, "error in graph", &mut log);
     assert!(line.contains("present.wgsl"), "{line}");
     // 5. Fix the shader: recovered.
-    edit(&present, "fn fs_present(((", "fn fs_present");
+    edit(&present, "fn cs_present(((", "fn cs_present");
     expect_line(&lines, "reloaded shader present.wgsl", &mut log);
     expect_line(&lines, "recovered", &mut log);
 

@@ -21,4 +21,4 @@ pub use diagnostic::{Diagnostic, Diagnostics, Location};
 pub use format::{TargetFormat, TargetSize};
 pub use params::{ParamSpec, ParamValue, Params};
 pub use plan::Plan;
-pub use plugin::{Access, PassNode, PassPlugin, PortKind, PortSpec, Registry};
+pub use plugin::{Access, PassNode, PassPlugin, PortKind, PortSpec, Registry, Rerun};

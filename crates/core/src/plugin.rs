@@ -130,6 +130,21 @@ impl PortSpec {
     }
 }
 
+/// When a pass's work is redone.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Rerun {
+    /// Every frame: anything that depends on the camera, the frame or a transient target.
+    #[default]
+    EveryFrame,
+    /// Only when something it reads changed since it last ran — a graph input's content, an
+    /// Owned resource rebuilt upstream — or its node was built or given new parameters. For a
+    /// pass that is a pure function of its inputs and parameters and writes only Owned outputs
+    /// (Krüger & Westermann 2003 §2.3: the empty-space grid is rebuilt when the transfer
+    /// function changes, not every frame). The runtime falls back to every frame for a pass
+    /// that also writes a transient target or whose output a later pass modifies in place.
+    WhenInputsChange,
+}
+
 /// A pass kind. Long-lived: [`PassPlugin::create`] builds the per-graph node that owns pipelines.
 pub trait PassPlugin: Send + Sync {
     /// The name graph files use in `kind:`.
@@ -160,6 +175,12 @@ pub trait PassPlugin: Send + Sync {
     /// True for passes whose effect is outside the graph (writing a file): never culled.
     fn is_sink(&self) -> bool {
         false
+    }
+
+    /// When the runtime records this pass: every frame (the default), or only when what it
+    /// reads changed ([`Rerun::WhenInputsChange`]).
+    fn rerun(&self) -> Rerun {
+        Rerun::EveryFrame
     }
 
     /// Builds the node that records this pass's GPU work for one compiled graph.

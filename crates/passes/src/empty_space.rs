@@ -3,13 +3,14 @@
 //! on `[min, max]` has non-zero alpha, mirroring `volgraph_accel::classify::OpacityClassifier`
 //! (the paper's "CT" texture, evaluated per block instead of looked up). Output: an Owned
 //! `R32Float` 3D texture of empty flags (1 = skip), consumed by `termination_test` (the paper's
-//! way) and `raycast_ess` (single-pass empty-block leaping). Runs every frame (one invocation
-//! per block) so a changed transfer function takes effect at once. Shader:
+//! way) and `raycast_ess` (single-pass empty-block leaping). Runs (one invocation per block)
+//! only when the grid or the transfer function changed, so a new TF takes effect in the next
+//! frame and a steady one costs nothing. Shader:
 //! `shaders/empty_space.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePipelineSpec, CreateContext, PassError, PassPipeline, RecordContext};
-use volgraph_core::{Params, PassNode, PassPlugin, PortKind, PortSpec};
+use volgraph_core::{Params, PassNode, PassPlugin, PortKind, PortSpec, Rerun};
 
 use crate::grid_tap::GridTap;
 pub(crate) use crate::minmax_grid::block_size_spec;
@@ -62,6 +63,11 @@ impl PassPlugin for EmptySpace {
         "per-block empty flags from the min/max grid and the transfer function (Krüger–Westermann 2003 §2.3)"
     }
 
+    fn rerun(&self) -> Rerun {
+        // A function of the grid and the TF: rebuilt when either changes.
+        Rerun::WhenInputsChange
+    }
+
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
         vec![
             PortSpec::read("grid", PortKind::Owned(MINMAX_GRID)),
@@ -107,7 +113,7 @@ impl PassNode for EmptySpaceNode {
             message: "empty-block texture missing right after creation".to_string(),
         })?;
         let bg = ctx.bind_group(&self.pipeline, &[("empty", wgpu::BindingResource::TextureView(&view))])?;
-        dispatch_grid(ctx, &self.pipeline, Some(&bg), dims);
+        dispatch_grid(ctx, &self.pipeline, &bg, dims);
         Ok(())
     }
 

@@ -2,15 +2,19 @@
 //! in `shaders/` (`entry_points.rs` ↔ `shaders/entry_points.wgsl`). Each registers through the
 //! same public [`volgraph_core::Registry`] API an external crate would use.
 
+pub mod empty_distance;
 pub mod empty_space;
 pub mod entry_points;
+pub mod fetch_probe;
 pub mod grid_tap;
 pub mod minmax_grid;
+pub mod opacity_lut;
 pub mod present;
 pub mod ray_directions;
 pub mod raycast;
 pub mod raycast_compute;
 pub mod raycast_ess;
+pub mod raycast_fast;
 pub mod raycast_params;
 pub mod raycast_segment;
 pub mod segment_init;
@@ -40,7 +44,10 @@ pub fn register_builtin(registry: &mut Registry) {
         .register(termination_test::TerminationTest)
         .register(minmax_grid::MinMaxGridPass::default())
         .register(empty_space::EmptySpace::default())
+        .register(empty_distance::EmptyDistance)
         .register(raycast_ess::RaycastEss)
+        .register(raycast_fast::RaycastFast)
+        .register(fetch_probe::FetchProbe)
         .register(slice_render::SliceRender)
         .register(present::Present);
 }

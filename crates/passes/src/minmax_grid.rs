@@ -3,14 +3,14 @@
 //! interpolation exactly like `volgraph_accel::minmax::MinMaxGrid` (each block's range includes
 //! a one-voxel apron), so a block classified empty holds no visible sample. The grid is an
 //! Owned `Rg32Float` 3D texture (r = min, g = max) of `ceil(dims / block_size)` texels, created
-//! on the first frame (its size comes from the bound volume) and built once; it is rebuilt when
-//! the volume's size changes. Shader: `shaders/minmax_grid.wgsl`.
+//! on the first frame (its size comes from the bound volume) and rebuilt only when the volume's
+//! content changes (`Rerun::WhenInputsChange`). Shader: `shaders/minmax_grid.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{
     ComputePipelineSpec, CreateContext, PassError, PassPipeline, PipelineKind, RecordContext,
 };
-use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec};
+use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, Rerun};
 
 use crate::grid_tap::GridTap;
 
@@ -80,13 +80,13 @@ pub(crate) fn bound_size(ctx: &RecordContext<'_>, port: &str) -> Result<[u32; 3]
 pub(crate) fn dispatch_grid(
     ctx: &mut RecordContext<'_>,
     pipeline: &PassPipeline,
-    bind_group: Option<&wgpu::BindGroup>,
+    bind_group: &wgpu::BindGroup,
     dims: [u32; 3],
 ) {
     let mut pass = ctx.begin_compute_pass();
-    if let (PipelineKind::Compute(p), Some(bg)) = (&pipeline.pipeline, bind_group) {
+    if let PipelineKind::Compute(p) = &pipeline.pipeline {
         pass.set_pipeline(p);
-        pass.set_bind_group(0, bg, &[]);
+        pass.set_bind_group(0, bind_group, &[]);
         pass.dispatch_workgroups(
             dims[0].div_ceil(GRID_WORKGROUP),
             dims[1].div_ceil(GRID_WORKGROUP),
@@ -102,6 +102,10 @@ impl PassPlugin for MinMaxGridPass {
 
     fn summary(&self) -> &'static str {
         "GPU min/max grid of the volume's blocks, trilinear-conservative (Krüger–Westermann 2003 §2.3)"
+    }
+
+    fn rerun(&self) -> Rerun {
+        Rerun::WhenInputsChange
     }
 
     fn params(&self) -> Vec<ParamSpec> {
@@ -141,16 +145,23 @@ struct MinMaxGridNode {
 
 impl PassNode for MinMaxGridNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
+        // Recorded only when the volume changed (`Rerun::WhenInputsChange`); a new texture only
+        // when its size did.
         let volume = bound_size(ctx, "volume")?;
-        if self.grid.as_ref().is_some_and(|(_, _, built_for)| *built_for == volume) {
-            // Built for this volume already: an empty pass keeps the step's label and timing.
-            dispatch_grid(ctx, &self.pipeline, None, [0; 3]);
-            return Ok(());
-        }
         let dims = volume.map(|n| n.div_ceil(self.block_size));
-        let texture =
-            create_grid_texture(ctx, &format!("{} min/max grid", ctx.label), wgpu::TextureFormat::Rg32Float, dims);
-        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let (texture, view) = match self.grid.take() {
+            Some((texture, view, built_for)) if built_for == volume => (texture, view),
+            _ => {
+                let texture = create_grid_texture(
+                    ctx,
+                    &format!("{} min/max grid", ctx.label),
+                    wgpu::TextureFormat::Rg32Float,
+                    dims,
+                );
+                let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+                (texture, view)
+            }
+        };
         if let Some(tap) = &self.tap {
             tap.set(&texture);
         }
@@ -164,7 +175,7 @@ impl PassNode for MinMaxGridNode {
                 ],
             )?
         };
-        dispatch_grid(ctx, &self.pipeline, Some(&bg), dims);
+        dispatch_grid(ctx, &self.pipeline, &bg, dims);
         self.grid = Some((texture, view, volume));
         Ok(())
     }

@@ -179,7 +179,7 @@ impl PassPlugin for RaycastSegment {
                 ctx.gpu.adapter_name
             )));
         }
-        let leap = ctx.ports.iter().any(|p| p.name == "empty" && p.owned);
+        let leap = ctx.ports.iter().any(|p| p.name == "empty" && p.bound);
         let (shader, fragment) = match (leap, self.entry(ctx.params)) {
             (true, ("raycast_segment.wgsl", "fs_dvr")) => ("raycast_segment.wgsl", "fs_dvr_leap"),
             (true, (_, entry)) => {

@@ -6,16 +6,16 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail};
 use clap::Args;
 use volgraph_accel::camera::OrbitCamera;
-use volgraph_accel::transfer_function::Preset;
 
 use super::preset::{self, BenchPreset};
+use super::tf_choice::TfChoice;
 use crate::inputs;
 
 /// Flags of `volgraph bench graphs`. A `--preset` fills in graphs, datasets, sizes, transfer
 /// functions, baseline and frames; any flag given as well replaces the preset's value.
 #[derive(Args, Debug, Clone, Default)]
 pub struct GraphsArgs {
-    /// A named preset: basic, kw2003-table1, thesis-tables.
+    /// A named preset: basic, kw2003-table1, thesis-tables, peer.
     #[arg(long)]
     pub preset: Option<String>,
     /// Graph files, comma separated (graphs that do not exist are skipped with a note).
@@ -47,9 +47,22 @@ pub struct GraphsArgs {
     /// the preset's, else the first graph.
     #[arg(long)]
     pub baseline: Option<String>,
-    /// Transfer-function presets, comma separated: default, opaque, sparse.
+    /// Transfer functions, comma separated: presets stretched over each volume's values (default,
+    /// opaque, sparse), .ron/.json files, or names of files in $VOLGRAPH_DATA/tf (engine_opaque,
+    /// hydrogen, ...).
     #[arg(long, value_delimiter = ',')]
     pub tf: Vec<String>,
+    /// A shader folder to read before the built-in shaders (default: the `shaders/` folder of the
+    /// workspace holding the first graph, if there is one).
+    #[arg(long)]
+    pub shaders: Option<PathBuf>,
+    /// Do not run the preset's peer program (the `peer` preset's VTK CPU raycaster).
+    #[arg(long)]
+    pub no_peer: bool,
+    /// Do not count the samples graphs take on the GPU (passes with a `count_samples`
+    /// parameter); by default one extra frame per case counts them.
+    #[arg(long)]
+    pub no_gpu_count: bool,
     /// Accuracy sweep PASS.PARAM=V1,V2,... (e.g. march.step_voxels=0.25,0.5,1,2), or
     /// input.NAME=... for a Scalar graph input shared by several passes; adds error
     /// against a converged CPU reference to every row.
@@ -100,14 +113,14 @@ pub struct BenchConfig {
     pub graphs: Vec<PathBuf>,
     /// The baseline graph's label.
     pub baseline: String,
-    /// Dataset names.
+    /// Dataset names, each once, in the order they are measured.
     pub datasets: Vec<String>,
+    /// `(dataset, transfer function)` pairs, grouped by dataset.
+    pub cases: Vec<(String, TfChoice)>,
     /// Viewports after `--scale`.
     pub viewports: Vec<(u32, u32)>,
     /// The scale applied.
     pub scale: f64,
-    /// Transfer-function presets.
-    pub tfs: Vec<Preset>,
     /// Fixed parameter overrides (from the preset).
     pub params: Vec<(String, f64)>,
     /// Timed frames per case.
@@ -126,6 +139,12 @@ pub struct BenchConfig {
     pub reference_step: f64,
     /// Longest side of the samples/pixel reference image (0 = off).
     pub spp_size: u32,
+    /// Count samples on the GPU where a pass can.
+    pub gpu_count: bool,
+    /// Run the preset's peer.
+    pub peer: bool,
+    /// A shader folder read before the built-in shaders.
+    pub shaders: Option<PathBuf>,
     /// JSON output.
     pub json: Option<PathBuf>,
     /// Plot output.
@@ -198,6 +217,30 @@ pub fn reduced_viewport((w, h): (u32, u32), longest: u32) -> (u32, u32) {
 }
 
 impl GraphsArgs {
+    /// The `(dataset, TF)` pairs: `--datasets` × `--tf` where either is given (the other from the
+    /// preset's lists, else `ml64` / `default`), else the preset's pairs, else its datasets × tfs.
+    fn cases(&self, preset: Option<&BenchPreset>) -> anyhow::Result<Vec<(String, TfChoice)>> {
+        let explicit = !self.datasets.is_empty() || !self.tf.is_empty();
+        if let Some(p) = preset.filter(|p| !explicit && !p.cases.is_empty()) {
+            return p.cases.iter().map(|&(d, t)| Ok((d.to_string(), TfChoice::parse(t)?))).collect();
+        }
+        let or_preset = |given: &[String], from: fn(&BenchPreset) -> &'static [&'static str], fallback: &str| {
+            if !given.is_empty() {
+                return given.to_vec();
+            }
+            match preset.map(from).filter(|l| !l.is_empty()) {
+                Some(list) => list.iter().map(|s| s.to_string()).collect(),
+                None => vec![fallback.to_string()],
+            }
+        };
+        let datasets = or_preset(&self.datasets, |p| p.datasets, "ml64");
+        let tfs: Vec<TfChoice> = or_preset(&self.tf, |p| p.tfs, "default")
+            .iter()
+            .map(|t| TfChoice::parse(t))
+            .collect::<anyhow::Result<_>>()?;
+        Ok(datasets.iter().flat_map(|d| tfs.iter().map(move |t| (d.clone(), t.clone()))).collect())
+    }
+
     /// Merges the flags with the preset into a checked configuration.
     pub fn resolve(&self) -> anyhow::Result<BenchConfig> {
         let preset =
@@ -214,7 +257,10 @@ impl GraphsArgs {
         } else {
             bail!("no graphs: give --graphs a.ron,b.ron or a --preset ({})", preset::names());
         };
-        let labels: Vec<String> = graphs.iter().map(|g| graph_label(g)).collect();
+        let mut labels: Vec<String> = graphs.iter().map(|g| graph_label(g)).collect();
+        if let Some(peer) = preset.and_then(|p| p.peer).filter(|_| !self.no_peer) {
+            labels.push(peer.label.to_string());
+        }
         let baseline = match (&self.baseline, preset) {
             (Some(b), _) => b.clone(),
             (None, Some(p)) if self.graphs.is_empty() => p.baseline.to_string(),
@@ -226,11 +272,6 @@ impl GraphsArgs {
                 labels.join(", ")
             );
         }
-        let datasets = if !self.datasets.is_empty() {
-            self.datasets.clone()
-        } else {
-            preset.map_or_else(|| vec!["ml64".to_string()], |p| p.datasets.iter().map(|d| d.to_string()).collect())
-        };
         if !(self.scale.is_finite() && self.scale > 0.0 && self.scale <= 8.0) {
             bail!("--scale {}: expected a factor in (0, 8], e.g. 0.25 to render a quarter of each side", self.scale);
         }
@@ -240,15 +281,13 @@ impl GraphsArgs {
             preset.map_or_else(|| vec![(512, 512)], |p| p.viewports.to_vec())
         };
         let viewports = base_sizes.into_iter().map(|v| scale_viewport(v, self.scale)).collect();
-        let tf_names: Vec<String> = if !self.tf.is_empty() {
-            self.tf.clone()
-        } else {
-            preset.map_or_else(|| vec!["default".to_string()], |p| p.tfs.iter().map(|t| t.to_string()).collect())
-        };
-        let tfs = tf_names
-            .iter()
-            .map(|t| Preset::from_name(t).ok_or_else(|| anyhow!("--tf \"{t}\": expected default, opaque or sparse")))
-            .collect::<anyhow::Result<_>>()?;
+        let cases = self.cases(preset)?;
+        let mut datasets: Vec<String> = Vec::new();
+        for (d, _) in &cases {
+            if !datasets.contains(d) {
+                datasets.push(d.clone());
+            }
+        }
         let frames = self.frames.or(preset.map(|p| p.frames)).unwrap_or(36);
         if frames == 0 {
             bail!("--frames 0: at least one timed frame is needed");
@@ -258,11 +297,15 @@ impl GraphsArgs {
             (true, None) => 360.0 / frames as f64,
             (false, Some(d)) if d.is_finite() => d,
             (false, Some(d)) => bail!("--rotate {d}: expected a finite number of degrees"),
+            (false, None) if preset.is_some_and(|p| p.full_turn) => 360.0 / frames as f64,
             (false, None) => 1.0,
         };
-        let camera = match &self.camera {
-            Some(c) => inputs::parse_camera(c)?,
-            None => OrbitCamera::default(),
+        let camera = match (&self.camera, preset.and_then(|p| p.camera)) {
+            (Some(c), _) => inputs::parse_camera(c)?,
+            (None, Some([azimuth_deg, elevation_deg, distance])) => {
+                OrbitCamera { azimuth_deg, elevation_deg, distance, ..OrbitCamera::default() }
+            }
+            (None, None) => OrbitCamera::default(),
         };
         let sweep = self.sweep.as_deref().map(parse_sweep).transpose()?;
         if !(self.reference_step.is_finite() && self.reference_step > 0.0) {
@@ -280,9 +323,9 @@ impl GraphsArgs {
             graphs,
             baseline,
             datasets,
+            cases,
             viewports,
             scale: self.scale,
-            tfs,
             params,
             frames,
             degrees_per_frame,
@@ -292,6 +335,9 @@ impl GraphsArgs {
             accuracy_size: self.accuracy_size,
             reference_step: self.reference_step,
             spp_size: self.spp_size,
+            gpu_count: !self.no_gpu_count,
+            peer: !self.no_peer && preset.is_some_and(|p| p.peer.is_some()),
+            shaders: self.shaders.clone(),
             json: self.json.clone(),
             plot: self.plot.clone(),
             markdown: self.markdown.clone(),

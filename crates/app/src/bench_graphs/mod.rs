@@ -12,11 +12,14 @@
 pub mod accuracy;
 pub mod args;
 pub mod dataset;
+pub mod gpu_count;
 pub mod measure;
+pub mod peer;
 pub mod plot;
 pub mod preset;
 pub mod report;
 pub mod run;
+pub mod tf_choice;
 
 #[cfg(test)]
 mod tests;

@@ -2,6 +2,8 @@
 //! viewports and transfer functions each paper's comparison needs, and the baseline its speed-ups
 //! are measured against.
 
+use super::peer::PeerSpec;
+
 /// One preset: everything `volgraph bench graphs --preset NAME` runs unless a flag overrides it.
 #[derive(Clone, Copy, Debug)]
 pub struct BenchPreset {
@@ -17,13 +19,23 @@ pub struct BenchPreset {
     pub datasets: &'static [&'static str],
     /// Viewports `(width, height)` before `--scale`.
     pub viewports: &'static [(u32, u32)],
-    /// Transfer-function presets (`default`, `opaque`, `sparse`).
+    /// Transfer functions (`default`, `opaque`, `sparse`, or names in `$VOLGRAPH_DATA/tf`); every
+    /// dataset is measured with every one.
     pub tfs: &'static [&'static str],
+    /// `(dataset, transfer function)` pairs measured instead of datasets × tfs when not empty
+    /// (a TF written for one dataset's values).
+    pub cases: &'static [(&'static str, &'static str)],
     /// Parameter overrides applied to every graph, `"pass.param" = value` (e.g. the step the
     /// issue asks for).
     pub params: &'static [(&'static str, f64)],
     /// Timed frames after the warm-up frame.
     pub frames: u32,
+    /// Start camera (azimuth, elevation, distance), default 30,20,3.2.
+    pub camera: Option<[f64; 3]>,
+    /// Whether the timed frames cover a whole turn (360/frames degrees each) instead of 1°.
+    pub full_turn: bool,
+    /// A peer program measured in the same run (its rows join the table), if any.
+    pub peer: Option<PeerSpec>,
 }
 
 /// Every preset.
@@ -38,6 +50,10 @@ pub const PRESETS: &[BenchPreset] = &[
         tfs: &["default"],
         params: &[("march.step_voxels", 0.5)],
         frames: 36,
+        cases: &[],
+        camera: None,
+        full_turn: false,
+        peer: None,
     },
     BenchPreset {
         name: "kw2003-table1",
@@ -59,6 +75,10 @@ pub const PRESETS: &[BenchPreset] = &[
         tfs: &["opaque", "sparse"],
         params: &[],
         frames: 36,
+        cases: &[],
+        camera: None,
+        full_turn: false,
+        peer: None,
     },
     BenchPreset {
         name: "thesis-tables",
@@ -70,6 +90,39 @@ pub const PRESETS: &[BenchPreset] = &[
         tfs: &["default"],
         params: &[],
         frames: 36,
+        cases: &[],
+        camera: None,
+        full_turn: false,
+        peer: None,
+    },
+    BenchPreset {
+        name: "peer",
+        about: "The peer comparison (issue \"the fastest path\"): VTK's CPU raycaster \
+                (vtkFixedPointVolumeRayCastMapper), run in the same session by bench/peer/vtk_cpu_raycast.py, against \
+                volgraph's graphs; 512², step 0.5 voxel, early termination at α ≥ 1 − 1/255, camera as VTK's reset \
+                camera (azimuth 0, elevation 0, distance 3.2), 12 views over a full turn about y. Speed-up = VTK's \
+                median / the row's (the issue's goal: ≥ 2×; its own VTK figures were 112–120, 144–154 and 116–124 ms)",
+        graphs: &[
+            "graphs/modern/single_pass_ess_ert.ron",
+            "graphs/basic/compute_raycast.ron",
+            "graphs/modern/fastest.ron",
+        ],
+        baseline: "vtk_fixed_point",
+        datasets: &[],
+        viewports: &[(512, 512)],
+        tfs: &[],
+        cases: &[("engine_vollib", "engine_opaque"), ("engine_vollib", "engine_sparse"), ("hydrogen_atom", "hydrogen")],
+        params: &[("march.step_voxels", 0.5), ("march.threshold", 1.0 - 1.0 / 255.0)],
+        frames: 12,
+        camera: Some([0.0, 0.0, 3.2]),
+        full_turn: true,
+        peer: Some(PeerSpec {
+            label: "vtk_fixed_point",
+            about: "vtk_fixed_point: VTK's vtkFixedPointVolumeRayCastMapper on this machine's CPU cores, offscreen, \
+                    timed per Render() by bench/peer/vtk_cpu_raycast.py in this run",
+            script: "bench/peer/vtk_cpu_raycast.py",
+            install: "install the peer with `pip install vtk==9.7.2`, or pass --no-peer",
+        }),
     },
 ];
 

@@ -91,6 +91,16 @@ pub struct Row {
     pub spp_viewport: Option<[u32; 2]>,
     /// `samples_per_pixel · pixels / median time`, in millions per second.
     pub msamples_per_s: Option<f64>,
+    /// Samples per pixel the GPU took, counted by the graph's own passes in an extra frame of
+    /// the middle view (passes with `count_samples`; includes empty-space leaping).
+    pub gpu_samples_per_pixel: Option<f64>,
+    /// `gpu_samples_per_pixel · pixels / median time`, in millions per second.
+    pub gpu_msamples_per_s: Option<f64>,
+    /// The fetch ceiling of this dataset and viewport measured in the same run (`fetch_probe`:
+    /// samples only, no compositing), millions of trilinear samples per second.
+    pub fetch_ceiling_msamples_per_s: Option<f64>,
+    /// `gpu_msamples_per_s / fetch_ceiling_msamples_per_s`.
+    pub fraction_of_fetch_ceiling: Option<f64>,
     /// Error of the GPU image against the converged CPU reference.
     pub error: Option<ImageError>,
     /// Size of the images the error was measured on.
@@ -133,12 +143,17 @@ impl GraphBenchReport {
         }
         let sweeping = self.sweep.is_some();
         let errors = self.rows.iter().any(|r| r.error.is_some());
+        let counted = self.rows.iter().any(|r| r.gpu_samples_per_pixel.is_some());
         let mut header = vec!["graph", "dataset", "TF", "viewport"];
         let sweep_key = self.sweep.clone().unwrap_or_default();
         if sweeping {
             header.push(&sweep_key);
         }
-        header.extend(["ms/frame", "clock", "speed-up", "samples/px", "Msamples/s", "per pass (ms)"]);
+        header.extend(["ms/frame", "clock", "speed-up", "samples/px", "Msamples/s"]);
+        if counted {
+            header.extend(["GPU samples/px", "GPU Msamples/s", "of fetch ceiling"]);
+        }
+        header.push("per pass (ms)");
         if errors {
             header.extend(["max err", "mean err", "PSNR dB"]);
         }
@@ -164,8 +179,15 @@ impl GraphBenchReport {
                 r.speedup_vs_baseline.map_or_else(|| "n/a".to_string(), |x| format!("{x:.2}×")),
                 opt(r.samples_per_pixel, 1),
                 opt(r.msamples_per_s, 1),
-                if passes.is_empty() { "n/a".to_string() } else { passes },
             ]);
+            if counted {
+                cells.push(opt(r.gpu_samples_per_pixel, 1));
+                cells.push(opt(r.gpu_msamples_per_s, 1));
+                cells.push(
+                    r.fraction_of_fetch_ceiling.map_or_else(|| "n/a".to_string(), |f| format!("{:.0} %", f * 100.0)),
+                );
+            }
+            cells.push(if passes.is_empty() { "n/a".to_string() } else { passes });
             if errors {
                 cells.push(opt(r.error.map(|e| e.max_abs), 4));
                 cells.push(r.error.map_or_else(|| "n/a".to_string(), |e| format!("{:.2e}", e.mean_abs)));

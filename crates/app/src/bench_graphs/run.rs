@@ -9,18 +9,18 @@ use anyhow::bail;
 use indicatif::{ProgressBar, ProgressStyle};
 use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::reference::render_reference;
-use volgraph_accel::transfer_function::TransferFunction;
 use volgraph_accel::volume::Volume;
 use volgraph_core::runtime::{CameraData, Gpu, Runtime, ShaderLibrary};
 use volgraph_core::{CompileOptions, Diagnostics, Plan, Registry};
-use volgraph_passes::{builtin_registry, builtin_shaders};
+use volgraph_passes::builtin_registry;
 
 use super::accuracy::{self, ImageError};
 use super::args::{BenchConfig, graph_label, reduced_viewport};
 use super::dataset;
+use super::gpu_count;
 use super::measure::{self, frame_camera, median};
+use super::peer;
 use super::report::{GraphBenchReport, Row, Skipped};
-use crate::inputs::LUT_SIZE;
 
 /// A graph file that could be read.
 struct GraphFile {
@@ -49,6 +49,8 @@ struct Context<'a> {
     spp_cache: HashMap<String, f64>,
     /// converged reference colour by (dataset, tf, size, settings).
     reference_cache: HashMap<String, Vec<[f64; 4]>>,
+    /// fetch ceiling by (dataset, size, step); `None` when it could not be measured.
+    ceiling_cache: HashMap<String, Option<crate::bench_fetch::Ceiling>>,
 }
 
 impl Context<'_> {
@@ -64,7 +66,7 @@ impl Context<'_> {
 struct Case<'a> {
     graph: &'a GraphFile,
     dataset: &'a Dataset,
-    tf_name: &'static str,
+    tf_name: String,
     lut: &'a [[f32; 4]],
     viewport: (u32, u32),
     sweep_value: Option<&'a (String, ron::Value)>,
@@ -111,11 +113,7 @@ fn compile_case(ctx: &mut Context<'_>, case: &Case<'_>, viewport: (u32, u32)) ->
     let file = case.graph.path.display().to_string();
     let options = case.options(ctx.config, viewport);
     let bind = |runtime: &mut Runtime| {
-        let inputs = std::collections::BTreeMap::from([
-            ("volume".to_string(), volgraph_core::graph::ast::InputKind::Volume),
-            ("tf".to_string(), volgraph_core::graph::ast::InputKind::TransferFunction),
-        ]);
-        runtime.bind_scene(&inputs, &case.dataset.volume, case.lut).map_err(|e| e.to_string())
+        runtime.bind_scene(&gpu_count::scene_inputs(), &case.dataset.volume, case.lut).map_err(|e| e.to_string())
     };
     bind(&mut ctx.runtime)?;
     let plan = ctx
@@ -129,8 +127,10 @@ fn compile_case(ctx: &mut Context<'_>, case: &Case<'_>, viewport: (u32, u32)) ->
 /// Measures every case of `config` on `gpu`.
 pub fn run(gpu: std::sync::Arc<Gpu>, config: &BenchConfig) -> anyhow::Result<GraphBenchReport> {
     let adapter = gpu.adapter_name.clone();
+    let first_graph = config.graphs.first().cloned().unwrap_or_default();
+    let (sources, _) = crate::shader_dir::sources_for(&first_graph, config.shaders.as_deref());
     let mut ctx = Context {
-        runtime: Runtime::new(gpu, ShaderLibrary::new(builtin_shaders())),
+        runtime: Runtime::new(gpu, ShaderLibrary::new(sources)),
         registry: builtin_registry(),
         config,
         progress: ProgressBar::hidden(),
@@ -138,6 +138,7 @@ pub fn run(gpu: std::sync::Arc<Gpu>, config: &BenchConfig) -> anyhow::Result<Gra
         skip_seen: BTreeSet::new(),
         spp_cache: HashMap::new(),
         reference_cache: HashMap::new(),
+        ceiling_cache: HashMap::new(),
     };
     let graphs: Vec<GraphFile> = config
         .graphs
@@ -166,7 +167,8 @@ pub fn run(gpu: std::sync::Arc<Gpu>, config: &BenchConfig) -> anyhow::Result<Gra
         .collect();
     let sweep_values: Vec<Option<&(String, ron::Value)>> =
         config.sweep.as_ref().map_or_else(|| vec![None], |s| s.values.iter().map(Some).collect());
-    let cases = graphs.len() * datasets.len() * config.tfs.len() * config.viewports.len() * sweep_values.len();
+    let measured_cases = config.cases.iter().filter(|(d, _)| datasets.iter().any(|ds| &ds.name == d)).count();
+    let cases = graphs.len() * measured_cases * config.viewports.len() * sweep_values.len();
     if !config.quiet {
         ctx.progress = ProgressBar::new((cases as u64) * (config.frames as u64 + 1));
         ctx.progress.set_style(
@@ -177,10 +179,14 @@ pub fn run(gpu: std::sync::Arc<Gpu>, config: &BenchConfig) -> anyhow::Result<Gra
     }
     let mut rows = Vec::new();
     for dataset in &datasets {
-        for &tf in &config.tfs {
-            let (lo, hi) = dataset.volume.value_range;
-            let tf_fn = TransferFunction::preset(tf, (lo, if hi > lo { hi } else { lo + 1.0 }));
-            let lut = tf_fn.to_lut_for(&dataset.volume, LUT_SIZE);
+        for (_, tf) in config.cases.iter().filter(|(d, _)| *d == dataset.name) {
+            let lut = match tf.lut_for(&dataset.volume) {
+                Ok(lut) => lut,
+                Err(e) => {
+                    ctx.skip(format!("transfer function {}", tf.name()), format!("{e:#}"));
+                    continue;
+                }
+            };
             for &viewport in &config.viewports {
                 for &sweep_value in &sweep_values {
                     for graph in &graphs {
@@ -195,6 +201,21 @@ pub fn run(gpu: std::sync::Arc<Gpu>, config: &BenchConfig) -> anyhow::Result<Gra
         }
     }
     ctx.progress.finish_and_clear();
+    let mut notes = notes(config);
+    if config.peer
+        && let Some(spec) = config.preset.and_then(|p| p.peer)
+    {
+        match run_peer(config, &spec, &rows) {
+            Ok(peer) => {
+                notes.push(format!("{} ({}).", spec.about, peer.ran));
+                rows.extend(peer.rows);
+                // Each peer row beside the rows of its case.
+                let case_index = |r: &Row| config.cases.iter().position(|(d, t)| *d == r.dataset && t.name() == r.tf);
+                rows.sort_by_key(|r| (case_index(r), r.viewport));
+            }
+            Err(reason) => ctx.skip(format!("peer {}", spec.label), reason),
+        }
+    }
     if rows.is_empty() {
         let why: Vec<String> = ctx.skipped.iter().map(|s| format!("{}: {}", s.what, s.reason)).collect();
         bail!("nothing was measured:\n  {}", why.join("\n  "));
@@ -223,14 +244,54 @@ pub fn run(gpu: std::sync::Arc<Gpu>, config: &BenchConfig) -> anyhow::Result<Gra
         baseline: config.baseline.clone(),
         sweep: config.sweep.as_ref().map(|s| s.key.clone()),
         reference_step_voxels: config.accuracy.then_some(config.reference_step),
-        notes: notes(config),
+        notes,
         rows,
         skipped: ctx.skipped,
     })
 }
 
+/// Runs the preset's peer on the measured cases whose TF is a named file (the peer reads
+/// `$VOLGRAPH_DATA/tf/<name>.ron`), at each viewport, with the run's frames and step.
+fn run_peer(config: &BenchConfig, spec: &peer::PeerSpec, rows: &[Row]) -> Result<peer::PeerResult, String> {
+    let mut cases: Vec<peer::PeerCase> = Vec::new();
+    for (dataset, tf) in &config.cases {
+        let measured = rows.iter().any(|r| &r.dataset == dataset && r.tf == tf.name());
+        if measured && matches!(tf, super::tf_choice::TfChoice::File { .. }) {
+            cases.push(peer::PeerCase { dataset: dataset.clone(), tf: tf.name() });
+        }
+    }
+    if cases.is_empty() {
+        return Err("no measured case has a transfer function from $VOLGRAPH_DATA/tf for the peer to read".into());
+    }
+    let step = config.params.iter().find(|(k, _)| k.ends_with("step_voxels")).map_or(0.5, |(_, v)| *v);
+    let mut result = peer::PeerResult { rows: Vec::new(), ran: String::new() };
+    for &viewport in &config.viewports {
+        let r = peer::run(
+            spec,
+            &super::args::workspace_root(),
+            &volgraph_accel::data_dir::data_dir(),
+            &cases,
+            viewport,
+            config.frames,
+            step,
+        )?;
+        result.rows.extend(r.rows);
+        result.ran = r.ran;
+    }
+    Ok(result)
+}
+
 fn notes(config: &BenchConfig) -> Vec<String> {
     let mut notes = Vec::new();
+    if config.gpu_count {
+        notes.push(
+            "GPU samples/px: samples the graph's own passes took (passes with `count_samples`), counted in an extra \
+             frame of the middle view; GPU Msamples/s = that × viewport pixels / median ms/frame; of fetch ceiling = \
+             GPU Msamples/s / the Msamples/s of `volgraph bench fetch`'s probe on the same dataset, viewport, step \
+             and views, measured in this run."
+                .to_string(),
+        );
+    }
     if config.spp_size > 0 {
         notes.push(format!(
             "samples/px: volume samples per pixel of the f64 CPU reference run with each graph's raycast parameters, \
@@ -282,6 +343,9 @@ fn run_case(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<Row> {
         }
     };
     let median_ms = median(&timing.frame_ms);
+    let counted = if config.gpu_count { count_on_gpu(ctx, case) } else { None };
+    let step = settings.map_or(0.5, |s| s.step_voxels);
+    let ceiling = counted.and_then(|_| fetch_ceiling(ctx, case, step));
     let spp_viewport = reduced_viewport(case.viewport, config.spp_size.max(1));
     let spp = settings.filter(|_| config.spp_size > 0).map(|s| {
         let k = key(case, spp_viewport, &s);
@@ -298,7 +362,7 @@ fn run_case(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<Row> {
         graph_file: file,
         dataset: case.dataset.name.clone(),
         dims: case.dataset.volume.dims.to_array(),
-        tf: case.tf_name.to_string(),
+        tf: case.tf_name.clone(),
         viewport: [case.viewport.0, case.viewport.1],
         sweep_value: case.sweep_value.map(|(v, _)| v.clone()),
         median_ms,
@@ -311,10 +375,83 @@ fn run_case(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<Row> {
         samples_per_pixel: spp,
         spp_viewport: spp.map(|_| [spp_viewport.0, spp_viewport.1]),
         msamples_per_s: spp.map(|s| s * pixels / (median_ms * 1e-3) / 1e6),
+        gpu_samples_per_pixel: counted.map(|c| c.samples_per_pixel),
+        gpu_msamples_per_s: counted.map(|c| c.samples_per_pixel * pixels / (median_ms * 1e-3) / 1e6),
+        fetch_ceiling_msamples_per_s: ceiling.map(|c| c.msamples_per_s),
+        fraction_of_fetch_ceiling: counted
+            .zip(ceiling)
+            .map(|(c, ceiling)| c.samples_per_pixel * pixels / (median_ms * 1e-3) / 1e6 / ceiling.msamples_per_s),
         error,
         error_viewport: error.map(|_| [error_viewport.0, error_viewport.1]),
         pareto: None,
     })
+}
+
+/// Renders the middle frame's view once more with every sample-counting pass counting (see
+/// [`gpu_count`]); `None` (with a note the first time) when no pass of the graph counts.
+fn count_on_gpu(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<gpu_count::Counted> {
+    let config = ctx.config;
+    let camera = frame_camera(&config.camera, config.degrees_per_frame, config.frames / 2);
+    let mut options = case.options(config, case.viewport);
+    let result = ctx
+        .runtime
+        .bind_scene(&gpu_count::scene_inputs(), &case.dataset.volume, case.lut)
+        .map_err(|e| e.to_string())
+        .and_then(|_| {
+            gpu_count::count(
+                &mut ctx.runtime,
+                &ctx.registry,
+                &case.graph.path.display().to_string(),
+                &case.graph.source,
+                &mut options,
+                &camera,
+            )
+        });
+    match result {
+        Ok(Some(counted)) => Some(counted),
+        Ok(None) => {
+            ctx.skip(
+                format!("GPU sample count of {}", case.graph.label),
+                "no pass of the graph counts its samples (a `count_samples` parameter); samples/px comes from the CPU \
+                 reference"
+                    .to_string(),
+            );
+            None
+        }
+        Err(reason) => {
+            ctx.skip(format!("GPU sample count of {}", case.name()), reason);
+            None
+        }
+    }
+}
+
+/// The fetch ceiling of the case's dataset and viewport at `step` (measured once per run, with
+/// the case's views; see `volgraph bench fetch`).
+fn fetch_ceiling(ctx: &mut Context<'_>, case: &Case<'_>, step: f64) -> Option<crate::bench_fetch::Ceiling> {
+    let config = ctx.config;
+    let k = format!("{}|{}x{}|{step}", case.dataset.name, case.viewport.0, case.viewport.1);
+    if let Some(c) = ctx.ceiling_cache.get(&k) {
+        return *c;
+    }
+    let measured = crate::bench_fetch::measure_ceiling(
+        &mut ctx.runtime,
+        &ctx.registry,
+        &case.dataset.volume,
+        case.viewport,
+        &config.camera,
+        config.degrees_per_frame,
+        config.frames,
+        step,
+    );
+    let ceiling = match measured {
+        Ok(c) => Some(c),
+        Err(reason) => {
+            ctx.skip(format!("fetch ceiling of {}", case.dataset.name), reason);
+            None
+        }
+    };
+    ctx.ceiling_cache.insert(k, ceiling);
+    ceiling
 }
 
 /// Renders the case once at `size` and compares its `image` output with the converged reference.

@@ -111,7 +111,7 @@ fn a_shader_edit_rebuilds_only_its_pipelines_and_a_broken_shader_is_located() {
     let present = s.shaders.join("present.wgsl");
     assert!(session.watched_files().iter().any(|f| f.ends_with("shaders/present.wgsl")), "shaders are watched");
     // A change that compiles: only the present pass is rebuilt.
-    edit(&present, "fn fs_present", "// edited\nfn fs_present");
+    edit(&present, "fn cs_present", "// edited\nfn cs_present");
     let events = session.files_changed(std::slice::from_ref(&present));
     let [Event::Reloaded { what, detail, .. }] = events.as_slice() else { panic!("{events:?}") };
     assert_eq!(what, "shader present.wgsl");
@@ -169,8 +169,8 @@ fn a_resize_rebuilds_no_pipeline() {
     let _ = std::fs::remove_dir_all(&s.dir);
 }
 
-/// A pass that builds fine but records a draw with no pipeline set: wgpu only rejects it when
-/// the frame's commands are finished, after the plan was applied.
+/// A pass that builds fine but records a dispatch with no pipeline set: wgpu only rejects it
+/// when the frame's commands are finished, after the plan was applied.
 struct BadDraw;
 
 struct BadDrawNode {
@@ -182,8 +182,9 @@ impl volgraph_core::PassNode for BadDrawNode {
         &mut self,
         ctx: &mut volgraph_core::runtime::RecordContext<'_>,
     ) -> Result<(), volgraph_core::runtime::PassError> {
-        let mut pass = ctx.begin_render_pass(&self.pipeline, None)?;
-        pass.draw(0..3, 0..1);
+        let _ = &self.pipeline;
+        let mut pass = ctx.begin_compute_pass();
+        pass.dispatch_workgroups(1, 1, 1);
         Ok(())
     }
 }
@@ -193,7 +194,7 @@ impl volgraph_core::PassPlugin for BadDraw {
         "bad_draw"
     }
     fn summary(&self) -> &'static str {
-        "test: records an invalid draw"
+        "test: records an invalid dispatch"
     }
     fn ports(&self, _p: &volgraph_core::Params) -> Vec<volgraph_core::PortSpec> {
         vec![
@@ -214,10 +215,9 @@ impl volgraph_core::PassPlugin for BadDraw {
         &self,
         ctx: &volgraph_core::runtime::CreateContext<'_>,
     ) -> Result<Box<dyn volgraph_core::PassNode>, volgraph_core::runtime::PassError> {
-        let pipeline = ctx.render_pipeline(&volgraph_core::runtime::RenderPipelineSpec {
+        let pipeline = ctx.compute_pipeline(&volgraph_core::runtime::ComputePipelineSpec {
             shader: "present.wgsl",
-            vertex: "vs_fullscreen",
-            fragment: "fs_present",
+            entry: "cs_present",
             extra_bindings: &["params"],
             ..Default::default()
         })?;

@@ -39,10 +39,14 @@ pub struct PortInfo {
     /// Texture format, when known at build time (targets; graph inputs are filterable formats).
     pub format: Option<wgpu::TextureFormat>,
     /// A texture another pass owns (a min/max grid): bound as unfilterable float, read with
-    /// `textureLoad`, so 32-bit float grids need no FLOAT32_FILTERABLE.
+    /// `textureLoad`, so 32-bit float grids need no FLOAT32_FILTERABLE. True for an Owned port
+    /// whether or not it is wired (see `bound`).
     pub owned: bool,
     /// A storage buffer (counters, point lists) rather than a texture.
     pub buffer: bool,
+    /// Whether the graph wires this port (optional inputs may be left unwired; a node binds a
+    /// stand-in or picks a variant without it).
+    pub bound: bool,
 }
 
 /// Depth test of a render pipeline.

@@ -22,7 +22,8 @@ pub struct FrameStats {
     pub pass_ids: Arc<Vec<String>>,
     /// GPU milliseconds per step, when timestamps exist.
     pub step_gpu_ms: Option<Vec<f64>>,
-    /// Sum of the steps' GPU time, or wall time from submit to completion as a fallback.
+    /// Sum of the steps' GPU time, or wall time from submit to completion where timestamps do not
+    /// measure the work (no timestamps, or a CPU adapter: see `Gpu::timestamps_cover_work`).
     pub frame_ms: f64,
     /// Wall milliseconds from submit until the GPU reported the frame done.
     pub wall_ms: f64,
@@ -201,11 +202,12 @@ impl FrameRing {
             }
             q.read.unmap();
         }
-        let frame_ms = step_gpu_ms.as_ref().map_or(wall_ms, |v: &Vec<f64>| v.iter().sum());
+        let gpu_ms = step_gpu_ms.as_ref().filter(|_| gpu.timestamps_cover_work).map(|v: &Vec<f64>| v.iter().sum());
+        let frame_ms = gpu_ms.unwrap_or(wall_ms);
         self.finished.push_back(FrameStats {
             frame_index: p.frame_index,
             pass_ids: p.pass_ids,
-            wall_time_fallback: step_gpu_ms.is_none(),
+            wall_time_fallback: gpu_ms.is_none(),
             step_gpu_ms,
             frame_ms,
             wall_ms,

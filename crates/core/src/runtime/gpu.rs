@@ -86,6 +86,10 @@ pub struct Gpu {
     pub adapter_name: String,
     /// Whether per-pass GPU timestamps are available.
     pub has_timestamps: bool,
+    /// Whether timestamps measure the work: false on CPU adapters (Mesa lavapipe), whose
+    /// timestamps do not cover compute dispatches (a compute pass reads ~0 ms while the frame
+    /// takes the full time on the wall clock); frame times there are wall time.
+    pub timestamps_cover_work: bool,
     /// Whether 32-bit float textures can be linearly filtered (R32Float volumes, f32 LUTs).
     pub float32_filterable: bool,
     /// Whether 32-bit float targets can be blended into.
@@ -156,6 +160,8 @@ impl Gpu {
             queue,
             adapter_name,
             has_timestamps: features.contains(wgpu::Features::TIMESTAMP_QUERY),
+            timestamps_cover_work: features.contains(wgpu::Features::TIMESTAMP_QUERY)
+                && info.device_type != wgpu::DeviceType::Cpu,
             float32_filterable: features.contains(wgpu::Features::FLOAT32_FILTERABLE),
             float32_blendable: features.contains(wgpu::Features::FLOAT32_BLENDABLE),
             norm16: features.contains(wgpu::Features::TEXTURE_FORMAT_16BIT_NORM),

@@ -51,6 +51,14 @@ pub fn upload_volume_texture(gpu: &Gpu, volume: &Volume) -> Result<UploadedVolum
     }
 }
 
+impl BoundInput {
+    /// A version of the content: equal content, equal version (passes that run only when their
+    /// inputs change compare it).
+    pub fn version(&self) -> u64 {
+        self.content
+    }
+}
+
 impl InputStore {
     /// Binds `volume` to input `name`; uploads only when its content differs from what is bound.
     /// Returns whether it uploaded.

@@ -25,7 +25,7 @@ pub mod shaders;
 pub mod textures;
 pub mod upload;
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -468,17 +468,25 @@ impl Runtime {
 
     /// Reads back the bytes of a buffer output of the last frame (waits for it).
     pub fn read_buffer_output(&mut self, name: &str) -> Result<Vec<u8>, RuntimeError> {
-        let _ = self.frames.finish(&self.gpu);
         let schedule = self.schedule.as_ref().ok_or(RuntimeError::NoPlan)?;
         let rid = *schedule.plan.outputs.get(name).ok_or_else(|| RuntimeError::UnknownOutput {
             name: name.to_string(),
             known: schedule.plan.outputs.keys().cloned().collect::<Vec<_>>().join(", "),
         })?;
+        self.read_buffer_resource(rid)
+    }
+
+    /// Reads back the bytes of buffer resource `rid` after the last frame (valid while its slot
+    /// was not reused later in the frame; a pass's unread output keeps its slot).
+    pub fn read_buffer_resource(&mut self, rid: usize) -> Result<Vec<u8>, RuntimeError> {
+        let _ = self.frames.finish(&self.gpu);
+        let schedule = self.schedule.as_ref().ok_or(RuntimeError::NoPlan)?;
+        let name = schedule.plan.resources.get(rid).map_or_else(String::new, |r| r.name.clone());
         match schedule.plan.resources[rid].slot.map(|s| &schedule.slots[s]) {
             Some(SlotTexture::Buffer(b)) => {
                 readback::read_buffer(&self.gpu, &b.buffer, 0, b.size).map_err(RuntimeError::Readback)
             }
-            _ => Err(RuntimeError::Readback(format!("output \"{name}\" is not a buffer"))),
+            _ => Err(RuntimeError::Readback(format!("\"{name}\" is not a buffer"))),
         }
     }
 
@@ -534,8 +542,11 @@ fn record_steps(
     encoder: &mut wgpu::CommandEncoder,
     timestamps: Option<&(wgpu::QuerySet, u32)>,
 ) -> Result<(), RuntimeError> {
-    let Schedule { plan, nodes, slots, owned, bind_groups, .. } = schedule;
+    let Schedule { plan, nodes, slots, owned, bind_groups, skippable, owned_versions, next_version, .. } = schedule;
     for (i, step) in plan.steps.iter().enumerate() {
+        // A pass that runs only when its inputs change: the versions of what it reads (None when
+        // it reads something made every frame).
+        let read_versions = if skippable[i] { input_versions(plan, step, inputs, owned_versions) } else { None };
         let mut ports = Vec::with_capacity(step.ports.len());
         for bp in &step.ports {
             let mut buffer = None;
@@ -567,6 +578,11 @@ fn record_steps(
             ports.push(BoundPort { name: bp.port.clone(), access: bp.access, view, buffer, extent });
         }
         let entry = nodes.get_mut(&step.pass_id).ok_or_else(|| ApplyError::UnknownKind(step.kind.clone()))?;
+        let outputs_published = step.ports.iter().all(|bp| match &bp.binding {
+            Binding::Resource { id, .. } if bp.access == Access::Write => owned.contains_key(id),
+            _ => true,
+        });
+        let unchanged = read_versions.is_some() && read_versions == entry.last_inputs && outputs_published;
         let mut ctx = RecordContext {
             gpu,
             encoder,
@@ -581,7 +597,23 @@ fn record_steps(
             began_pass: false,
             bind_groups,
         };
+        if unchanged {
+            // Nothing it reads changed: its Owned outputs still hold what it wrote. An empty
+            // pass keeps the step's label and timestamps.
+            drop(ctx.begin_compute_pass());
+            continue;
+        }
         entry.node.record(&mut ctx)?;
+        entry.last_inputs = read_versions;
+        for bp in &step.ports {
+            if let Binding::Resource { id, .. } = &bp.binding
+                && bp.access != Access::Read
+                && matches!(plan.resources[*id].desc, ResourceDesc::Owned(_))
+            {
+                owned_versions.insert(plan.resources[root_owned(plan, *id)].name.clone(), *next_version);
+                *next_version += 1;
+            }
+        }
         // Owned outputs created or replaced while recording (sized by a graph input).
         for bp in &step.ports {
             if let Binding::Resource { id, written: None } = &bp.binding
@@ -597,6 +629,29 @@ fn record_steps(
         }
     }
     Ok(())
+}
+
+/// Versions of what `step` reads — graph inputs' content, Owned resources' versions, 0 for an
+/// unwired port — or `None` when it reads a transient target or history, which change every
+/// frame.
+fn input_versions(
+    plan: &Plan,
+    step: &crate::plan::Step,
+    inputs: &inputs::InputStore,
+    owned_versions: &HashMap<String, u64>,
+) -> Option<Vec<u64>> {
+    let mut versions = Vec::new();
+    for bp in step.ports.iter().filter(|bp| bp.access != Access::Write) {
+        versions.push(match &bp.binding {
+            Binding::Input(name) => inputs.get(name).map_or(0, |i| i.version()),
+            Binding::Resource { id, .. } if matches!(plan.resources[*id].desc, ResourceDesc::Owned(_)) => {
+                owned_versions.get(&plan.resources[root_owned(plan, *id)].name).copied().unwrap_or(0)
+            }
+            Binding::Unbound => 0,
+            Binding::Resource { .. } | Binding::History(_) => return None,
+        });
+    }
+    Some(versions)
 }
 
 /// The resource an Owned value's chain starts at (Modify ports on owned resources keep the

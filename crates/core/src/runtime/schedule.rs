@@ -16,11 +16,16 @@ use super::shaders::ShaderLibrary;
 use super::textures::{PooledBuffer, PooledTexture, TextureKey, TexturePool};
 use crate::params::Params;
 use crate::plan::{Binding, Plan, ResourceDesc, ResourceId, SlotDesc};
-use crate::plugin::{Access, PassNode, PortKind, Registry};
+use crate::plugin::{Access, PassNode, PortKind, Registry, Rerun};
 
 /// A node with what it was built from.
 pub(crate) struct NodeEntry {
     pub node: Box<dyn PassNode>,
+    /// When the node is recorded (see [`crate::plugin::Rerun`]).
+    pub rerun: Rerun,
+    /// For a [`Rerun::WhenInputsChange`] node: the versions of what it read when it last ran
+    /// (cleared when its parameters change).
+    pub last_inputs: Option<Vec<u64>>,
     kind: String,
     params: Params,
     ports: Vec<PortInfo>,
@@ -62,6 +67,31 @@ pub(crate) struct Schedule {
     pub owned: HashMap<ResourceId, wgpu::TextureView>,
     pub bind_groups: RefCell<BindGroupCache>,
     pub pass_ids: Arc<Vec<String>>,
+    /// Per step: whether it may be skipped when its inputs are unchanged (its node says
+    /// [`Rerun::WhenInputsChange`] and the plan lets it: see [`skippable`]).
+    pub skippable: Vec<bool>,
+    /// Version of each Owned resource (by name, so it survives a plan change): bumped whenever
+    /// the step writing it runs.
+    pub owned_versions: HashMap<String, u64>,
+    /// The next version handed out.
+    pub next_version: u64,
+}
+
+/// Whether `step` of `plan` may be skipped when nothing it reads changed: it is outside repeat
+/// groups, modifies nothing, writes only Owned resources, and no later step modifies those in
+/// place (their content must stay what this step wrote).
+pub(crate) fn skippable(plan: &Plan, step: &crate::plan::Step) -> bool {
+    if step.iteration.is_some() {
+        return false;
+    }
+    step.ports.iter().all(|bp| match (&bp.binding, bp.access) {
+        (_, Access::Modify) => false,
+        (Binding::Resource { id, .. }, Access::Write) => {
+            matches!(plan.resources[*id].desc, ResourceDesc::Owned(_))
+                && !plan.resources.iter().any(|r| r.modifies == Some(*id))
+        }
+        _ => true,
+    })
 }
 
 /// What applying a plan reused and rebuilt.
@@ -120,11 +150,13 @@ fn port_infos(plan: &Plan, step: &crate::plan::Step, specs: &[crate::plugin::Por
                 Binding::Resource { id, .. } => Some(&plan.resources[*id].desc),
                 _ => None,
             };
-            let owned = matches!(desc, Some(ResourceDesc::Owned(_)));
+            let declared = specs.iter().find(|s| s.name == bp.port).map(|s| &s.kind);
+            let owned = matches!(desc, Some(ResourceDesc::Owned(_))) || matches!(declared, Some(PortKind::Owned(_)));
             let buffer = matches!(desc, Some(ResourceDesc::Buffer { .. }))
                 || (matches!(bp.binding, Binding::Unbound)
                     && specs.iter().any(|s| s.name == bp.port && matches!(s.kind, PortKind::Buffer { .. })));
-            PortInfo { name: bp.port.clone(), access: bp.access, format, owned, buffer }
+            let bound = !matches!(bp.binding, Binding::Unbound);
+            PortInfo { name: bp.port.clone(), access: bp.access, format, owned, buffer, bound }
         })
         .collect()
 }
@@ -257,8 +289,10 @@ pub(crate) fn build(
 
     // 4. Commit: take kept nodes from `old`, give its textures back.
     let mut old_nodes = HashMap::new();
+    let (mut owned_versions, mut next_version) = (HashMap::new(), 1);
     if let Some(old) = old {
         old_nodes = old.nodes;
+        (owned_versions, next_version) = (old.owned_versions, old.next_version);
         for (k, slot) in old.slots.into_iter().enumerate() {
             match slot {
                 SlotTexture::Transient(t) if !claimed[k] => r.textures.release(t),
@@ -279,12 +313,22 @@ pub(crate) fn build(
                 old_nodes.remove(&id).map(|mut e| {
                     e.node.update_params(r.gpu, &params);
                     e.params = params.clone();
+                    e.last_inputs = None;
                     e
                 })
             }
             Decision::Create(node, modules) => {
                 report.nodes_created += 1;
-                Some(NodeEntry { node, kind: kind.clone(), params: params.clone(), ports: ports.clone(), modules })
+                let rerun = registry.get(&kind).map_or(Rerun::EveryFrame, |p| p.rerun());
+                Some(NodeEntry {
+                    node,
+                    rerun,
+                    last_inputs: None,
+                    kind: kind.clone(),
+                    params: params.clone(),
+                    ports: ports.clone(),
+                    modules,
+                })
             }
         };
         if let Some(e) = entry {
@@ -319,5 +363,24 @@ pub(crate) fn build(
     report.textures_created = r.textures.created() - created0;
     r.textures.next_generation();
     let pass_ids = Arc::new(plan.steps.iter().map(|s| s.pass_id.clone()).collect());
-    Ok((Schedule { plan, nodes, slots, owned, bind_groups: RefCell::new(BindGroupCache::default()), pass_ids }, report))
+    let skippable = plan
+        .steps
+        .iter()
+        .map(|step| {
+            nodes.get(&step.pass_id).is_some_and(|e| e.rerun == Rerun::WhenInputsChange) && skippable(&plan, step)
+        })
+        .collect();
+    owned_versions.retain(|name, _| plan.resources.iter().any(|r| &r.name == name));
+    let schedule = Schedule {
+        plan,
+        nodes,
+        slots,
+        owned,
+        bind_groups: RefCell::new(BindGroupCache::default()),
+        pass_ids,
+        skippable,
+        owned_versions,
+        next_version,
+    };
+    Ok((schedule, report))
 }

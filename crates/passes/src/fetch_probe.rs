@@ -1,0 +1,109 @@
+//! `fetch_probe`: the fetch ceiling of `volgraph bench fetch` — a compute pass that takes every
+//! sample a raycaster with the same step would take along each pixel's ray (the analytic ray of
+//! `raycast_fast`, no leaping, no termination) and does nothing else with them (no
+//! classification, no compositing). Its trilinear samples per second bound any raycaster's on
+//! the same device, volume and texture format, so `volgraph bench graphs` reports each graph's
+//! counted samples per second as a fraction of it. Writes the mean scalar along the ray (an
+//! average-intensity projection) to `color`, and with `count_samples` the samples it took to
+//! `samples`. Shader: `shaders/fetch_probe.wgsl`.
+
+use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::{
+    ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, PipelineKind, RecordContext,
+};
+use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+
+use crate::raycast_fast::SAMPLE_ROWS;
+use crate::raycast_params::{RaycastParamsGpu, raycast_param_specs};
+
+/// The plugin.
+pub struct FetchProbe;
+
+impl PassPlugin for FetchProbe {
+    fn kind(&self) -> &'static str {
+        "fetch_probe"
+    }
+
+    fn summary(&self) -> &'static str {
+        "fetch ceiling: every raycast sample along each pixel's ray, no classification or compositing (benchmarks)"
+    }
+
+    fn params(&self) -> Vec<ParamSpec> {
+        let mut p: Vec<ParamSpec> = raycast_param_specs()
+            .into_iter()
+            .filter(|s| matches!(s.name, "step_voxels" | "max_steps" | "jitter"))
+            .collect();
+        p.push(ParamSpec::boolean("count_samples", false, "write the number of samples taken to the `samples` buffer"));
+        p.push(ParamSpec::uint("workgroup_x", 8, 1, 256, "workgroup width in pixels"));
+        p.push(ParamSpec::uint("workgroup_y", 8, 1, 256, "workgroup height in pixels"));
+        p
+    }
+
+    fn ports(&self, params: &Params) -> Vec<PortSpec> {
+        let mut ports = vec![
+            PortSpec::read("volume", PortKind::Volume),
+            PortSpec::write("color", PortKind::target(&[TargetFormat::Rgba16Float])),
+        ];
+        if params.boolean("count_samples") {
+            ports.push(PortSpec::write("samples", PortKind::buffer(4 * SAMPLE_ROWS)));
+        }
+        ports
+    }
+
+    fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
+        let entry_point = if params.boolean("count_samples") { "cs_counted" } else { "cs_main" };
+        vec![ShaderUse { file: "fetch_probe.wgsl", entry_point }]
+    }
+
+    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
+        ["workgroup_x", "workgroup_y"].iter().all(|p| old.uint(p) == new.uint(p))
+            && old.boolean("count_samples") == new.boolean("count_samples")
+    }
+
+    fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        let wg = (ctx.params.uint("workgroup_x") as u32, ctx.params.uint("workgroup_y") as u32);
+        if wg.0 * wg.1 > ctx.gpu.limits.max_compute_invocations_per_workgroup {
+            return Err(PassError {
+                pass: ctx.pass_id.to_string(),
+                message: format!("workgroup {}x{} is over this GPU's invocation limit", wg.0, wg.1),
+            });
+        }
+        let counted = ctx.params.boolean("count_samples");
+        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
+            shader: "fetch_probe.wgsl",
+            entry: if counted { "cs_counted" } else { "cs_main" },
+            extra_bindings: &["params"],
+            constants: &[("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)],
+        })?;
+        let params = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
+        Ok(Box::new(FetchProbeNode { pipeline, params, workgroup: wg, counted }))
+    }
+}
+
+struct FetchProbeNode {
+    pipeline: PassPipeline,
+    params: wgpu::Buffer,
+    workgroup: (u32, u32),
+    counted: bool,
+}
+
+impl PassNode for FetchProbeNode {
+    fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
+        if self.counted {
+            ctx.clear_buffer("samples")?;
+        }
+        let bg = ctx.bind_group(&self.pipeline, &[("params", self.params.as_entire_binding())])?;
+        let (w, h) = ctx.extent("color");
+        let mut pass = ctx.begin_compute_pass();
+        if let PipelineKind::Compute(p) = &self.pipeline.pipeline {
+            pass.set_pipeline(p);
+        }
+        pass.set_bind_group(0, &bg, &[]);
+        pass.dispatch_workgroups(w.div_ceil(self.workgroup.0), h.div_ceil(self.workgroup.1), 1);
+        Ok(())
+    }
+
+    fn update_params(&mut self, gpu: &Gpu, params: &Params) {
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
+    }
+}

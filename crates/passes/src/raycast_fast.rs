@@ -1,0 +1,280 @@
+//! `raycast_fast`: the fastest DVR raycaster of volgraph (issue "the fastest path"), one compute
+//! pass that
+//! - needs no entry or direction targets: the pixel's ray meets the volume box analytically
+//!   (`shaders/common/analytic_ray.wgsl`);
+//! - leaps over empty space with `empty_distance`'s Chebyshev map of Krüger & Westermann 2003
+//!   §2.3's empty blocks (`leap`: out of the largest cube of empty blocks around the sample, out
+//!   of its block, or not at all), looking at the map once per run of `check_every` samples so
+//!   the lanes of a SIMD group stay together;
+//! - classifies through the TF with the exact per-sample opacity correction (`classify:
+//!   "exact"`; a square root, not a `pow`, at the common half-voxel step) or through a
+//!   pre-multiplied, corrected table it builds itself from its own step (`"table"`,
+//!   [`crate::opacity_lut`]: one filtered lookup, no `pow`; ~14% faster than `pow` at other
+//!   steps, but the correction 1 - (1 - α)^step is singular at α = 1, so a TF that reaches
+//!   full opacity is off by up to ~1/255 there — bench/peer-ablation.md, tests/fastest.rs);
+//! - stops at `threshold` (§2.1's early ray termination, in the loop); and
+//! - counts the samples it takes into its `samples` buffer when `count_samples` is on
+//!   (benchmarks: `volgraph bench graphs` reads it).
+//!
+//! Its samples are `raycast`'s (same step, same first sample), so the image equals the plain
+//! raycast's up to rounding — a leap skips only samples whose classified alpha is 0
+//! (crates/passes/tests/fastest.rs). Variants are pipeline-overridable constants; with leaping
+//! off the unwired `distance` input is bound to a 1-texel stand-in the variant never reads.
+//! Shader: `shaders/raycast_fast.wgsl`.
+
+use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::{
+    ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, PipelineKind, RecordContext,
+};
+use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+
+use crate::empty_distance::EMPTY_DISTANCE;
+use crate::empty_space::block_size_spec;
+use crate::minmax_grid::bound_size;
+use crate::opacity_lut::{OpacityTable, TABLE_SHADERS};
+use crate::raycast_params::{RaycastParamsGpu, raycast_param_specs};
+
+/// The plugin.
+pub struct RaycastFast;
+
+/// Rows of the `samples` buffer (`SAMPLE_ROWS` in the shader): image row y counts into word
+/// y mod SAMPLE_ROWS, so a word holds at most a row's samples.
+pub const SAMPLE_ROWS: u64 = 4096;
+
+/// Rust twin of `struct FastParams` in `shaders/raycast_fast.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct FastParamsGpu {
+    block_size: u32,
+    _pad: [u32; 3],
+}
+
+const _: () = assert!(std::mem::size_of::<FastParamsGpu>() == 16);
+
+/// The parameters whose change needs a new pipeline (override constants, ports).
+const PIPELINE_UINTS: [&str; 3] = ["workgroup_x", "workgroup_y", "check_every"];
+const PIPELINE_CHOICES: [&str; 2] = ["leap", "classify"];
+
+impl PassPlugin for RaycastFast {
+    fn kind(&self) -> &'static str {
+        "raycast_fast"
+    }
+
+    fn summary(&self) -> &'static str {
+        "compute DVR raycaster: analytic ray-box entry, leaping over empty cubes of blocks, pre-corrected TF table, \
+         early termination, sample counting (Krüger–Westermann 2003 §2.1–2.3 in one compute pass)"
+    }
+
+    fn params(&self) -> Vec<ParamSpec> {
+        let mut p: Vec<ParamSpec> = raycast_param_specs()
+            .into_iter()
+            .filter(|s| matches!(s.name, "step_voxels" | "threshold" | "max_steps" | "jitter"))
+            .collect();
+        p.push(block_size_spec());
+        p.push(ParamSpec::choice(
+            "leap",
+            "cubes",
+            &["cubes", "blocks", "none"],
+            "with `distance` wired: leap out of the largest cube of empty blocks, out of one block at a time, or \
+             take every sample (unwired: none)",
+        ));
+        p.push(ParamSpec::uint(
+            "check_every",
+            16,
+            1,
+            1024,
+            "samples in a run between two looks at the distance map (all lanes look together)",
+        ));
+        p.push(ParamSpec::choice(
+            "classify",
+            "exact",
+            &["exact", "table"],
+            "exact: the TF and the exact per-sample opacity correction (sqrt at step 0.5, else pow); table: one \
+             lookup in a table pre-corrected for the step, rebuilt each frame (faster than pow, up to ~1/255 off \
+             where the TF reaches alpha 1)",
+        ));
+        p.push(ParamSpec::boolean(
+            "count_samples",
+            false,
+            "write the number of samples taken to the `samples` buffer (benchmarks; one atomic per pixel)",
+        ));
+        p.push(ParamSpec::uint("workgroup_x", 8, 1, 256, "workgroup width in pixels"));
+        p.push(ParamSpec::uint("workgroup_y", 8, 1, 256, "workgroup height in pixels"));
+        p
+    }
+
+    fn ports(&self, params: &Params) -> Vec<PortSpec> {
+        let mut ports = vec![
+            PortSpec::read("volume", PortKind::Volume),
+            PortSpec::read("tf", PortKind::TransferFunction),
+            // Leave unwired to take every sample.
+            PortSpec::read("distance", PortKind::Owned(EMPTY_DISTANCE)).optional(),
+            PortSpec::write("color", PortKind::target(&[TargetFormat::Rgba16Float])),
+        ];
+        if params.boolean("count_samples") {
+            // One u32 per image row (mod SAMPLE_ROWS): samples taken this frame.
+            ports.push(PortSpec::write("samples", PortKind::buffer(4 * SAMPLE_ROWS)));
+        }
+        ports
+    }
+
+    fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
+        let entry_point = if params.boolean("count_samples") { "cs_counted" } else { "cs_main" };
+        let mut uses = vec![ShaderUse { file: "raycast_fast.wgsl", entry_point }];
+        if params.choice("classify") == "table" {
+            uses.extend(TABLE_SHADERS);
+        }
+        uses
+    }
+
+    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
+        PIPELINE_UINTS.iter().all(|p| old.uint(p) == new.uint(p))
+            && PIPELINE_CHOICES.iter().all(|p| old.choice(p) == new.choice(p))
+            && old.boolean("count_samples") == new.boolean("count_samples")
+            && (old.float("step_voxels") == 0.5) == (new.float("step_voxels") == 0.5)
+    }
+
+    fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        let wg = (ctx.params.uint("workgroup_x") as u32, ctx.params.uint("workgroup_y") as u32);
+        if wg.0 * wg.1 > ctx.gpu.limits.max_compute_invocations_per_workgroup {
+            return Err(PassError {
+                pass: ctx.pass_id.to_string(),
+                message: format!(
+                    "workgroup {}x{} has {} invocations, over this GPU's limit of {}",
+                    wg.0,
+                    wg.1,
+                    wg.0 * wg.1,
+                    ctx.gpu.limits.max_compute_invocations_per_workgroup
+                ),
+            });
+        }
+        let distance_wired = ctx.port("distance").is_some_and(|p| p.bound);
+        let leap = match (distance_wired, ctx.params.choice("leap")) {
+            (false, _) | (true, "none") => 0.0,
+            (true, "blocks") => 1.0,
+            (true, _) => 2.0,
+        };
+        let table = match ctx.params.choice("classify") {
+            "table" => Some(OpacityTable::new(ctx)?),
+            _ => None,
+        };
+        let counted = ctx.params.boolean("count_samples");
+        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
+            shader: "raycast_fast.wgsl",
+            entry: if counted { "cs_counted" } else { "cs_main" },
+            extra_bindings: &["params", "fast", "corrected"],
+            constants: &[
+                ("WORKGROUP_X", wg.0 as f64),
+                ("WORKGROUP_Y", wg.1 as f64),
+                ("LEAP", leap),
+                ("CORRECTED", if table.is_some() { 1.0 } else { 0.0 }),
+                ("CHECK_EVERY", ctx.params.uint("check_every").max(1) as f64),
+                ("HALF_STEP", if ctx.params.float("step_voxels") == 0.5 { 1.0 } else { 0.0 }),
+            ],
+        })?;
+        let params = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
+        let block_size = ctx.params.uint("block_size").max(1) as u32;
+        let fast = ctx.uniform_with("fast", &FastParamsGpu { block_size, _pad: [0; 3] });
+        let stand_in = |dimension, format, label: &str| {
+            ctx.gpu
+                .device
+                .create_texture(&wgpu::TextureDescriptor {
+                    label: Some(label),
+                    size: wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: 1 },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension,
+                    format,
+                    usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                    view_formats: &[],
+                })
+                .create_view(&wgpu::TextureViewDescriptor::default())
+        };
+        let no_distance = (leap == 0.0)
+            .then(|| stand_in(wgpu::TextureDimension::D3, wgpu::TextureFormat::R32Float, "no distance map"));
+        let no_table = table
+            .is_none()
+            .then(|| stand_in(wgpu::TextureDimension::D2, wgpu::TextureFormat::Rgba16Float, "no corrected table"));
+        Ok(Box::new(RaycastFastNode {
+            pipeline,
+            params,
+            fast,
+            block_size,
+            workgroup: wg,
+            counted,
+            table,
+            no_distance,
+            no_table,
+        }))
+    }
+}
+
+struct RaycastFastNode {
+    pipeline: PassPipeline,
+    params: wgpu::Buffer,
+    fast: wgpu::Buffer,
+    block_size: u32,
+    workgroup: (u32, u32),
+    counted: bool,
+    table: Option<OpacityTable>,
+    no_distance: Option<wgpu::TextureView>,
+    no_table: Option<wgpu::TextureView>,
+}
+
+impl RaycastFastNode {
+    /// The distance map must be `block_size`'s grid of the bound volume.
+    fn check_grid(&self, ctx: &RecordContext<'_>) -> Result<(), PassError> {
+        let volume = bound_size(ctx, "volume")?;
+        let grid = bound_size(ctx, "distance")?;
+        let expected = volume.map(|n| n.div_ceil(self.block_size));
+        if grid == expected {
+            return Ok(());
+        }
+        Err(PassError {
+            pass: ctx.label.to_string(),
+            message: format!(
+                "block_size {} gives a {expected:?} block grid for the {volume:?} volume, but \"distance\" is \
+                 {grid:?}; set the same block_size as the minmax_grid pass (share a Scalar input)",
+                self.block_size
+            ),
+        })
+    }
+}
+
+impl PassNode for RaycastFastNode {
+    fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
+        if self.no_distance.is_none() {
+            self.check_grid(ctx)?;
+        }
+        if self.counted {
+            ctx.clear_buffer("samples")?;
+        }
+        if let Some(table) = &self.table {
+            table.record(ctx, &self.params)?;
+        }
+        let corrected = self.table.as_ref().map_or(self.no_table.as_ref(), |t| Some(&t.view));
+        let mut extra = vec![("params", self.params.as_entire_binding()), ("fast", self.fast.as_entire_binding())];
+        if let Some(v) = corrected {
+            extra.push(("corrected", wgpu::BindingResource::TextureView(v)));
+        }
+        if let Some(v) = &self.no_distance {
+            extra.push(("distance", wgpu::BindingResource::TextureView(v)));
+        }
+        let bg = ctx.bind_group(&self.pipeline, &extra)?;
+        let (w, h) = ctx.extent("color");
+        let mut pass = ctx.begin_compute_pass();
+        if let PipelineKind::Compute(p) = &self.pipeline.pipeline {
+            pass.set_pipeline(p);
+        }
+        pass.set_bind_group(0, &bg, &[]);
+        pass.dispatch_workgroups(w.div_ceil(self.workgroup.0), h.div_ceil(self.workgroup.1), 1);
+        Ok(())
+    }
+
+    fn update_params(&mut self, gpu: &Gpu, params: &Params) {
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
+        self.block_size = params.uint("block_size").max(1) as u32;
+        let fast = FastParamsGpu { block_size: self.block_size, _pad: [0; 3] };
+        gpu.queue.write_buffer(&self.fast, 0, bytemuck::bytes_of(&fast));
+    }
+}

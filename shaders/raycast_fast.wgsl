@@ -169,7 +169,13 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (!in_viewport(p)) {
         return;
     }
-    textureStore(color, vec2<i32>(p), march(analytic_ray(p), p).color);
+    // A row of pixels that misses the box skips the march altogether.
+    let ray = analytic_ray(p);
+    var c = vec4<f32>(0.0);
+    if (ray.len > 0.0) {
+        c = march(ray, p).color;
+    }
+    textureStore(color, vec2<i32>(p), c);
 }
 
 @compute @workgroup_size(WORKGROUP_X, WORKGROUP_Y)
@@ -178,7 +184,11 @@ fn cs_counted(@builtin(global_invocation_id) id: vec3<u32>) {
     if (!in_viewport(p)) {
         return;
     }
-    let m = march(analytic_ray(p), p);
+    let ray = analytic_ray(p);
+    var m = Marched(vec4<f32>(0.0), 0u);
+    if (ray.len > 0.0) {
+        m = march(ray, p);
+    }
     textureStore(color, vec2<i32>(p), m.color);
     atomicAdd(&samples[p.y % SAMPLE_ROWS], m.samples);
 }

@@ -14,46 +14,33 @@ struct Ray {
     len: f32,
 }
 
-// The ray of pixel centre `pixel` clipped to the box and the near plane, exactly like
-// `volgraph_accel::reference::ray_segment` (slab test; start at max(t_in, t_near); the ends
-// clamped to [0,1]³; rays shorter than 1e-6 dropped).
+// The ray of pixel centre `pixel` clipped to the box and the near plane, as
+// `volgraph_accel::reference::ray_segment` clips it (slab test; start at max(t_in, t_near); the
+// ends clamped to [0,1]³; rays shorter than 1e-6 dropped), computed in texture space from the
+// frame's per-pixel ray (FrameUniforms::ray_*_texture): the box is [0,1]³ and, the direction
+// being scaled to unit forward distance, the near plane is at t = near. No loop, no early
+// return: the lanes of a SIMD group stay together.
 fn analytic_ray(pixel: vec2<u32>) -> Ray {
-    var ray = Ray(vec3<f32>(0.0), vec3<f32>(0.0, 0.0, 1.0), 0.0);
-    let dir = pixel_ray_dir(vec2<f32>(pixel) + vec2<f32>(0.5));
-    let eye = frame.eye_world.xyz;
-    let half = frame.half_extent.xyz;
-    var t_in = -3.0e38;
-    var t_out = 3.0e38;
-    for (var axis = 0u; axis < 3u; axis += 1u) {
-        let o = eye[axis];
-        let d = dir[axis];
-        let h = half[axis];
-        if (d == 0.0) {
-            if (o < -h || o > h) {
-                return ray;
-            }
-            continue;
-        }
-        let a = (-h - o) / d;
-        let b = (h - o) / d;
-        t_in = max(t_in, min(a, b));
-        t_out = min(t_out, max(a, b));
-    }
-    let t_near = frame.camera_forward.w / max(dot(dir, frame.camera_forward.xyz), 1e-12);
-    let t0 = max(t_in, t_near);
-    if (!(t_in <= t_out) || !(t0 < t_out)) {
-        return ray;
-    }
-    let u0 = clamp(texture_from_world(eye + t0 * dir), vec3<f32>(0.0), vec3<f32>(1.0));
-    let u1 = clamp(texture_from_world(eye + t_out * dir), vec3<f32>(0.0), vec3<f32>(1.0));
+    let centre = vec2<f32>(pixel) + vec2<f32>(0.5);
+    let dir = frame.ray_base_texture.xyz + centre.x * frame.ray_dx_texture.xyz + centre.y * frame.ray_dy_texture.xyz;
+    let eye = frame.eye_texture.xyz;
+    let far = vec3<f32>(3.0e38);
+    let parallel = dir == vec3<f32>(0.0);
+    let inv = 1.0 / select(dir, vec3<f32>(1.0), parallel);
+    let ta = -eye * inv;
+    let tb = (vec3<f32>(1.0) - eye) * inv;
+    // An axis the ray runs parallel to: no constraint when the eye is within the slab, else no ray.
+    let inside = (eye >= vec3<f32>(0.0)) & (eye <= vec3<f32>(1.0));
+    let lo = select(min(ta, tb), select(far, -far, inside), parallel);
+    let hi = select(max(ta, tb), select(-far, far, inside), parallel);
+    let t_in = max(lo.x, max(lo.y, lo.z));
+    let t_out = min(hi.x, min(hi.y, hi.z));
+    let t0 = max(t_in, frame.camera_forward.w);
+    let u0 = clamp(eye + t0 * dir, vec3<f32>(0.0), vec3<f32>(1.0));
+    let u1 = clamp(eye + t_out * dir, vec3<f32>(0.0), vec3<f32>(1.0));
     let len = length(u1 - u0);
-    if (!(len >= 1e-6)) {
-        return ray;
-    }
-    ray.u0 = u0;
-    ray.d = (u1 - u0) / len;
-    ray.len = len;
-    return ray;
+    let hit = t_in <= t_out && t0 < t_out && len >= 1e-6;
+    return Ray(u0, select(vec3<f32>(0.0, 0.0, 1.0), (u1 - u0) / len, hit), select(0.0, len, hit));
 }
 
 // Sample k of a ray lies at `first + k · delta` (texture space): `first` the first sample,

@@ -18,6 +18,14 @@ struct Frame {
     viewport: vec4<f32>,
     // xyz: unit camera forward (world); w: near-plane distance.
     camera_forward: vec4<f32>,
+    // xyz: the eye in texture space.
+    eye_texture: vec4<f32>,
+    // The texture-space pixel ray: pixel centre (x, y) looks along ray_base + x·ray_dx + y·ray_dy,
+    // scaled to advance one world unit along camera_forward per unit of the ray parameter (the
+    // near plane is at parameter camera_forward.w). See common/analytic_ray.wgsl.
+    ray_base_texture: vec4<f32>,
+    ray_dx_texture: vec4<f32>,
+    ray_dy_texture: vec4<f32>,
     // Frames the runtime submitted before this one.
     frame_index: u32,
     // Frames since history was invalidated: 0 while history holds initial values.

@@ -90,6 +90,37 @@ pub struct FrameData {
     pub volume: Option<VolumeDesc>,
 }
 
+/// The pixel rays of a camera in texture space: pixel centre (x, y) (pixels, row 0 at the top)
+/// looks along `base + x·dx + y·dy` from the eye, with the world direction scaled to advance one
+/// unit along the camera's forward axis per unit of the ray parameter. Affine in the pixel
+/// because every point of the near plane has the same clip w.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PixelRays {
+    /// The ray of pixel centre (0, 0) — the corner, not a pixel centre.
+    pub base: DVec3,
+    /// Change per pixel in x.
+    pub dx: DVec3,
+    /// Change per pixel in y.
+    pub dy: DVec3,
+}
+
+impl PixelRays {
+    /// The rays of `camera` at `viewport` for a volume box of half size `half`.
+    pub fn of(camera: &CameraData, viewport: (u32, u32), half: DVec3) -> Self {
+        let (w, h) = (viewport.0.max(1) as f64, viewport.1.max(1) as f64);
+        // The world direction through pixel centre (x, y), scaled to unit forward distance.
+        let world = |x: f64, y: f64| {
+            let ndc = glam::DVec4::new(2.0 * x / w - 1.0, 1.0 - 2.0 * y / h, 0.0, 1.0);
+            let p = camera.world_from_clip * ndc;
+            let d = p.truncate() / p.w - camera.eye;
+            d / d.dot(camera.forward)
+        };
+        let to_texture = |d: DVec3| d / (2.0 * half);
+        let base = world(0.0, 0.0);
+        Self { base: to_texture(base), dx: to_texture(world(1.0, 0.0) - base), dy: to_texture(world(0.0, 1.0) - base) }
+    }
+}
+
 /// Rust twin of `struct Frame` in `shaders/common/frame.wgsl`; keep both in step.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
@@ -110,6 +141,17 @@ pub struct FrameUniforms {
     pub viewport: [f32; 4],
     /// Unit camera forward (xyz); w = near-plane distance.
     pub camera_forward: [f32; 4],
+    /// Eye position in texture space (xyz).
+    pub eye_texture: [f32; 4],
+    /// The texture-space pixel ray: pixel centre (x, y) looks along
+    /// `ray_base + x·ray_dx + y·ray_dy` (xyz), scaled so that its world direction advances one
+    /// world unit along `camera_forward` per unit of the ray parameter — the near plane is at
+    /// parameter `near` (`shaders/common/analytic_ray.wgsl`).
+    pub ray_base_texture: [f32; 4],
+    /// See `ray_base_texture`.
+    pub ray_dx_texture: [f32; 4],
+    /// See `ray_base_texture`.
+    pub ray_dy_texture: [f32; 4],
     /// Frames submitted before this one (wraps).
     pub frame_index: u32,
     /// Frames since history was invalidated (saturates).
@@ -118,7 +160,7 @@ pub struct FrameUniforms {
     pub _pad: [u32; 2],
 }
 
-const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 288);
+const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 352);
 
 fn mat(m: DMat4) -> [[f32; 4]; 4] {
     m.as_mat4().to_cols_array_2d()
@@ -134,6 +176,8 @@ impl FrameUniforms {
         };
         let eye_inside = c.eye.abs().cmple(half).all();
         let (w, h) = (frame.viewport.0.max(1) as f32, frame.viewport.1.max(1) as f32);
+        let ray = PixelRays::of(c, frame.viewport, half);
+        let v4 = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
         Self {
             clip_from_world: mat(c.clip_from_world),
             world_from_clip: mat(c.world_from_clip),
@@ -143,9 +187,39 @@ impl FrameUniforms {
             volume_dims: [dims.x as f32, dims.y as f32, dims.z as f32, 0.0],
             viewport: [w, h, 1.0 / w, 1.0 / h],
             camera_forward: [c.forward.x as f32, c.forward.y as f32, c.forward.z as f32, c.near as f32],
+            eye_texture: v4(c.eye / (2.0 * half) + DVec3::splat(0.5)),
+            ray_base_texture: v4(ray.base),
+            ray_dx_texture: v4(ray.dx),
+            ray_dy_texture: v4(ray.dy),
             frame_index: frame.frame_index as u32,
             history_age: frame.history_age.min(u32::MAX as u64) as u32,
             _pad: [0; 2],
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The affine pixel rays point where the reference's per-pixel unprojection does, and put the
+    /// near plane at parameter `near` (unit forward distance).
+    #[test]
+    fn pixel_rays_match_the_reference_rays() {
+        let half = DVec3::new(0.5, 0.4, 0.25);
+        for (azimuth, elevation, distance) in [(0.0, 0.0, 3.2), (35.0, 25.0, 2.6), (200.0, -60.0, 0.3)] {
+            let orbit = OrbitCamera { azimuth_deg: azimuth, elevation_deg: elevation, distance, ..Default::default() };
+            let viewport = (37, 23);
+            let camera = CameraData::from_orbit(&orbit, viewport);
+            let rays = PixelRays::of(&camera, viewport, half);
+            let frame = orbit.frame(viewport.0, viewport.1);
+            for (x, y) in [(0, 0), (36, 22), (18, 11), (5, 20)] {
+                let d_tex = rays.base + (x as f64 + 0.5) * rays.dx + (y as f64 + 0.5) * rays.dy;
+                let d_world = d_tex * (2.0 * half);
+                let (_, reference) = frame.pixel_ray(x, y);
+                assert!((d_world.normalize() - reference).length() < 1e-9, "pixel ({x}, {y}) of {orbit:?}");
+                assert!((d_world.dot(camera.forward) - 1.0).abs() < 1e-9, "unit forward distance");
+            }
         }
     }
 }

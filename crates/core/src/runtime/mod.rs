@@ -33,7 +33,7 @@ pub use create::{
     ComputePipelineSpec, CreateContext, DepthSpec, PassError, PassPipeline, PipelineCache, PipelineKind, PortInfo,
     RenderPipelineSpec,
 };
-pub use frame::{CameraData, FrameData, FrameUniforms, LONGEST_RAY_VOXELS, VolumeDesc, scene_values_of};
+pub use frame::{CameraData, FrameData, FrameUniforms, LONGEST_RAY_VOXELS, PixelRays, VolumeDesc, scene_values_of};
 pub use frames::{FrameStats, MAX_FRAMES_IN_FLIGHT};
 pub use gpu::{Gpu, GpuError, GpuFault, GpuFaultKind, GpuOptions};
 pub use inputs::upload_volume_texture;

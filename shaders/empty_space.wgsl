@@ -23,13 +23,32 @@ fn cs_classify(@builtin(global_invocation_id) id: vec3<u32>) {
     if (any(id >= blocks)) {
         return;
     }
+#if SEGMENTS
+    // Pre-integrated segments run between samples in adjacent blocks: the values a segment
+    // through this block can take lie in the union of its 3×3×3 neighbourhood's ranges.
+    var range = vec2<f32>(3.0e38, -3.0e38);
+    var unknown = false;
+    let last_block = vec3<i32>(blocks) - vec3<i32>(1);
+    for (var dz = -1; dz <= 1; dz += 1) {
+        for (var dy = -1; dy <= 1; dy += 1) {
+            for (var dx = -1; dx <= 1; dx += 1) {
+                let b = clamp(vec3<i32>(id) + vec3<i32>(dx, dy, dz), vec3<i32>(0), last_block);
+                let r = textureLoad(grid, b, 0).rg;
+                unknown = unknown || r.x != r.x || r.y != r.y;
+                range = vec2<f32>(min(range.x, r.x), max(range.y, r.y));
+            }
+        }
+    }
+#else
     let range = textureLoad(grid, vec3<i32>(id), 0).rg;
+    let unknown = false;
+#endif
     let texels = i32(textureDimensions(tf).x);
     let n = f32(texels);
     var first = 0;
     var last = texels - 1;
     // NaN bounds widen to the whole LUT (the conservative choice).
-    if (range.x == range.x && range.y == range.y) {
+    if (!unknown && range.x == range.x && range.y == range.y) {
         let lo = min(range.x, range.y) - VALUE_MARGIN;
         let hi = max(range.x, range.y) + VALUE_MARGIN;
         first = clamp(i32(clamp(ceil(lo * n - 1.5), -1.0, n)), 0, texels - 1);

@@ -2,7 +2,7 @@
 // for trilinear interpolation exactly like `volgraph_accel::minmax::MinMaxGrid`: block b's range
 // is the min/max over its own voxels [b·B, min((b+1)·B, n)) plus a one-voxel apron on each side,
 // clamped to the volume (the voxels any trilinear sample inside the block's texel footprints can
-// read). One invocation per block; values are the volume texture's normalized texels, i.e. what
+// read; two voxels with TRICUBIC, the B-spline's footprint). One invocation per block; values are the volume texture's normalized texels, i.e. what
 // the raycasters sample.
 //
 // Entry point: `cs_minmax` → `grid` (Rg32Float 3D: r = min, g = max).
@@ -31,8 +31,14 @@ fn cs_minmax(@builtin(global_invocation_id) id: vec3<u32>) {
     let b = minmax.block_size;
     let start = id * b;
     let end = min((id + vec3<u32>(1u)) * b, n); // exclusive
+#if TRICUBIC
+    // The tricubic B-spline reads two voxels beyond the trilinear footprint's one.
+    let lo = max(start, vec3<u32>(2u)) - vec3<u32>(2u);
+    let hi = min(end + vec3<u32>(1u), n - vec3<u32>(1u));
+#else
     let lo = max(start, vec3<u32>(1u)) - vec3<u32>(1u);
     let hi = min(end, n - vec3<u32>(1u)); // inclusive: the apron voxel past the block
+#endif
     var mn = 3.0e38;
     var mx = -3.0e38;
     for (var z = lo.z; z <= hi.z; z += 1u) {

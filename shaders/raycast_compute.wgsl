@@ -17,8 +17,12 @@ override WORKGROUP_Y: u32 = 8u;
 @group(0) @binding(5) var entry: texture_2d<f32>;
 // (d_tex, len_tex); (0,0,0,0) for no ray.
 @group(0) @binding(6) var dir: texture_2d<f32>;
-// Premultiplied linear RGBA.
+// Premultiplied linear RGBA (Rgba32Float when the scene asks for f32 precision).
+#if COLOR_F32
+@group(0) @binding(7) var color: texture_storage_2d<rgba32float, write>;
+#else
 @group(0) @binding(7) var color: texture_storage_2d<rgba16float, write>;
+#endif
 // Texture-space hit position (w = 1), zero on a miss; only `cs_iso` writes it.
 @group(0) @binding(8) var hit: texture_storage_2d<rgba32float, write>;
 

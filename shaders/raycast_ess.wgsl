@@ -39,9 +39,11 @@ fn march_dvr_leaping(u0: vec3<f32>, d_tex: vec3<f32>, len_tex: f32, pixel: vec2<
     }
     let step_tex = ray_step_tex(d_tex);
     let jitter = ray_jitter(pixel);
+    begin_ray(u0 + (0.5 + jitter) * step_tex * d_tex, step_tex * d_tex);
     var k = 0u;
     var known_block = vec3<u32>(0xffffffffu);
     var known_empty = false;
+    var leaped = false;
     loop {
         if (k >= params.max_steps) {
             break;
@@ -60,7 +62,13 @@ fn march_dvr_leaping(u0: vec3<f32>, d_tex: vec3<f32>, len_tex: f32, pixel: vec2<
         if (known_empty) {
             let next = first_sample_past_block(b, ess.block_size, u0, d_tex, step_tex, jitter);
             k = max(k + 1u, u32(clamp(next, 0.0, f32(params.max_steps))));
+            leaped = true;
             continue;
+        }
+        if (leaped) {
+            // The segment in front of this sample starts at the skipped sample k - 1.
+            resume_ray(u0 + (f32(k) - 0.5 + jitter) * step_tex * d_tex);
+            leaped = false;
         }
         acc = composite_sample(acc, u);
         if (acc.a >= params.threshold) {

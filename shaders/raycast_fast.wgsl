@@ -37,7 +37,11 @@ struct FastParams {
     _pad2: u32,
 }
 
+#if COLOR_F32
+@group(0) @binding(9) var color: texture_storage_2d<rgba32float, write>;
+#else
 @group(0) @binding(9) var color: texture_storage_2d<rgba16float, write>;
+#endif
 @group(0) @binding(10) var<uniform> fast: FastParams;
 // Chebyshev distance in blocks to the nearest block that may be visible (0: this one may be).
 @group(0) @binding(11) var distance: texture_3d<f32>;
@@ -49,8 +53,12 @@ const SAMPLE_ROWS: u32 = 4096u;
 
 // One front-to-back step at `u` (common/raymarch.wgsl's composite_sample when !CORRECTED).
 fn composite(acc: vec4<f32>, u: vec3<f32>) -> vec4<f32> {
+#if EFFECTS
+    // Shading or pre-integration: the shared classification with every effect compiled in.
+    return composite_sample(acc, u);
+#else
     if (!CORRECTED) {
-        if (HALF_STEP) {
+        if (HALF_STEP && frame.volume_dims.w == 1.0) {
             // The exact correction for a half-voxel step: 1 - (1 - a)^0.5, a square root.
             let c = sample_tf(sample_volume(u));
             let a = 1.0 - sqrt(1.0 - clamp(c.a, 0.0, 1.0));
@@ -62,6 +70,7 @@ fn composite(acc: vec4<f32>, u: vec3<f32>) -> vec4<f32> {
     let c = textureSampleLevel(corrected, linear_clamp, vec2<f32>(sample_volume(u), 0.5), 0.0);
     let w = 1.0 - acc.a;
     return vec4<f32>(acc.rgb + w * c.rgb, acc.a + w * c.a);
+#endif
 }
 
 struct Marched {
@@ -121,10 +130,12 @@ fn march(ray: Ray, pixel: vec2<u32>) -> Marched {
         return out;
     }
     let s = ray_samples(ray, pixel);
+    begin_ray(s.first, s.delta);
     var k = 0u;
     loop {
         if (LEAP != 0u) {
             // Leap over consecutive empty regions (a cube is usually left in one leap).
+            let before = k;
             loop {
                 if (k >= s.count) {
                     break;
@@ -135,6 +146,11 @@ fn march(ray: Ray, pixel: vec2<u32>) -> Marched {
                 }
                 k = next;
             }
+#if PREINTEGRATION
+            if (k != before && k < s.count) {
+                resume_ray(s.first + (f32(k) - 1.0) * s.delta);
+            }
+#endif
         }
         // A run of up to CHECK_EVERY samples with nothing else in the loop.
         let end = min(k + CHECK_EVERY, s.count);

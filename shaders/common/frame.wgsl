@@ -12,7 +12,8 @@ struct Frame {
     eye_world: vec4<f32>,
     // xyz: half size of the volume box (world); w: unit step (world length of the smallest voxel side).
     half_extent: vec4<f32>,
-    // xyz: volume dimensions in voxels; w: unused.
+    // xyz: volume dimensions in voxels; w: the transfer function's opacity unit in voxels (1 for
+    // opacity per voxel, 1/unit_world for opacity per world unit).
     volume_dims: vec4<f32>,
     // x, y: viewport width and height in pixels; z, w: their reciprocals.
     viewport: vec4<f32>,

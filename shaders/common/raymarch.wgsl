@@ -1,7 +1,13 @@
 // The volume-rendering integral shared by every raycaster (fragment and compute), implementing
 // docs/rendering_model.md ("Ray segment inside the box" from `u0` on, "Classification and
-// compositing", "First-hit isosurface") exactly like `volgraph_accel::reference`.
+// compositing", "Effects", "First-hit isosurface") exactly like `volgraph_accel::reference`.
 // Krüger & Westermann 2003 §2.1 (DVR, early ray termination) and §2.2 (first-hit isosurface).
+//
+// Effects a scene turns on are compiled in with `#if` (crates/core/src/shader_source.rs):
+// SHADING (Blinn–Phong of every DVR sample with the gradient), PREINTEGRATION (Engel et al.
+// 2001: each sample composites the segment from the previous one through a 2D table), TRICUBIC
+// (common/volume.wgsl). A loop that uses them calls `begin_ray` before its first sample and
+// `resume_ray` after skipping samples.
 
 #import "common/frame.wgsl"
 #import "common/volume.wgsl"
@@ -14,13 +20,15 @@ fn pcg_hash(v: u32) -> u32 {
     return (word >> 22u) ^ word;
 }
 
-// The per-pixel offset of the first sample, in steps, in [-0.5, 0.5]; 0 when jitter is off.
+// The per-pixel offset of the first sample, in steps, in [-0.5, 0.5); compiled in only with
+// JITTER (the `jitter` effect), else 0.
 fn ray_jitter(pixel: vec2<u32>) -> f32 {
-    if (params.jitter == 0u) {
-        return 0.0;
-    }
+#if JITTER
     let width = u32(frame.viewport.x);
     return f32(pcg_hash(pixel.x + pixel.y * width)) / 4294967296.0 - 0.5;
+#else
+    return 0.0;
+#endif
 }
 
 // step_tex = step_voxels * unit_world / |d_tex * 2*half| for a unit texture-space direction.
@@ -43,7 +51,13 @@ fn ray_is_valid(u0: vec3<f32>, d_tex: vec3<f32>, len_tex: f32) -> bool {
     return step_tex > 0.0 && step_tex < 1e30;
 }
 
-// Opacity correction from the LUT's per-unit-step alpha to this step: 1 - (1 - a)^step_voxels.
+// The opacity-correction exponent of one step: step_voxels over the TF's opacity unit in voxels
+// (frame.volume_dims.w: 1 for opacity per voxel, 1/unit_world for opacity per world unit).
+fn step_exponent() -> f32 {
+    return params.step_voxels / frame.volume_dims.w;
+}
+
+// Opacity correction from the LUT's per-unit alpha to this step: 1 - (1 - a)^step_exponent.
 // The ends are handled explicitly because pow(0, y) is undefined in WGSL.
 fn corrected_alpha(a_tf: f32) -> f32 {
     let a = clamp(a_tf, 0.0, 1.0);
@@ -53,16 +67,69 @@ fn corrected_alpha(a_tf: f32) -> f32 {
     if (a <= 0.0) {
         return 0.0;
     }
-    return 1.0 - pow(1.0 - a, params.step_voxels);
+    return 1.0 - pow(1.0 - a, step_exponent());
+}
+
+#if PREINTEGRATION
+// The pre-integration table (crates/passes/src/preintegration.rs): texel (i, j) holds the
+// premultiplied RGBA of a segment from scalar i/(N-1) to j/(N-1), N×N, filtered linearly.
+@group(0) @binding(14) var preintegrated: texture_2d<f32>;
+
+fn lookup_preintegrated(s_front: f32, s_back: f32) -> vec4<f32> {
+    let n = vec2<f32>(textureDimensions(preintegrated));
+    let st = (clamp(vec2<f32>(s_front, s_back), vec2<f32>(0.0), vec2<f32>(1.0)) * (n - 1.0) + 0.5) / n;
+    return textureSampleLevel(preintegrated, linear_clamp, st, 0.0);
+}
+#endif
+
+// Per-ray state of the effects: the unit world view direction (SHADING) and the scalar of the
+// previous sample, the front of the next segment (PREINTEGRATION).
+var<private> ray_view_world: vec3<f32>;
+var<private> ray_prev_scalar: f32;
+
+// Starts a ray whose sample k lies at first + k·delta: the view direction, and the front value
+// of sample 0's segment (the field one step before it).
+fn begin_ray(first: vec3<f32>, delta: vec3<f32>) {
+    ray_view_world = normalize(delta * 2.0 * frame.half_extent.xyz);
+#if PREINTEGRATION
+    ray_prev_scalar = sample_volume(first - delta);
+#endif
+}
+
+// After skipping samples: `before` is the position of the sample just before the next one
+// taken, the front of its segment.
+fn resume_ray(before: vec3<f32>) {
+#if PREINTEGRATION
+    ray_prev_scalar = sample_volume(before);
+#endif
+}
+
+// The premultiplied, opacity-corrected colour the sample at texture-space `u` adds, with the
+// effects compiled in.
+fn classify_sample(u: vec3<f32>) -> vec4<f32> {
+    let s = sample_volume(u);
+#if PREINTEGRATION
+    var p = lookup_preintegrated(ray_prev_scalar, s);
+    ray_prev_scalar = s;
+#else
+    let c = sample_tf(s);
+    let a = corrected_alpha(c.a);
+    var p = vec4<f32>(c.rgb * a, a);
+#endif
+#if SHADING
+    if (p.a > 0.0) {
+        let light = headlight(u, ray_view_world);
+        p = vec4<f32>(p.rgb * light.x + vec3<f32>(p.a * light.y), p.a);
+    }
+#endif
+    return p;
 }
 
 // One front-to-back compositing step (docs/rendering_model.md): the sample at texture-space
-// `u` classified by the TF, opacity-corrected, added behind the premultiplied `acc`. Every DVR
-// loop (single pass, segments, empty-space leaping) composites through this function.
+// `u` classified, added behind the premultiplied `acc`. Every DVR loop (single pass, segments,
+// empty-space leaping) composites through this function.
 fn composite_sample(acc: vec4<f32>, u: vec3<f32>) -> vec4<f32> {
-    let c = sample_tf(sample_volume(u));
-    let w = (1.0 - acc.a) * corrected_alpha(c.a);
-    return vec4<f32>(acc.rgb + w * c.rgb, acc.a + w);
+    return acc + (1.0 - acc.a) * classify_sample(u);
 }
 
 // Direct volume rendering along u0 + t·d_tex, t in [0, len_tex): premultiplied linear RGBA,
@@ -74,6 +141,7 @@ fn march_dvr(u0: vec3<f32>, d_tex: vec3<f32>, len_tex: f32, pixel: vec2<u32>) ->
     }
     let step_tex = ray_step_tex(d_tex);
     let jitter = ray_jitter(pixel);
+    begin_ray(u0 + (0.5 + jitter) * step_tex * d_tex, step_tex * d_tex);
     for (var k = 0u; k < params.max_steps; k += 1u) {
         let t = (f32(k) + 0.5 + jitter) * step_tex;
         if (!(t < len_tex)) {
@@ -94,9 +162,11 @@ struct IsoResult {
     hit: vec4<f32>,
 }
 
-// Blinn–Phong headlight shading at texture-space point `u` seen along the unit world direction
-// `d_world` (docs/rendering_model.md "First-hit isosurface").
-fn shade_iso(u: vec3<f32>, d_world: vec3<f32>) -> vec3<f32> {
+// Blinn–Phong headlight at texture-space point `u` seen along the unit world direction `d_world`
+// (docs/rendering_model.md "First-hit isosurface", "Effects"): (ambient + diffuse·|n·l|, the
+// white specular term), n from the central-difference gradient of the reconstructed field, the
+// light facing the eye where the gradient vanishes (constant regions: no NaN).
+fn headlight(u: vec3<f32>, d_world: vec3<f32>) -> vec2<f32> {
     let off = 1.0 / frame.volume_dims.xyz;
     let g = vec3<f32>(
         sample_volume(u + vec3<f32>(off.x, 0.0, 0.0)) - sample_volume(u - vec3<f32>(off.x, 0.0, 0.0)),
@@ -116,8 +186,14 @@ fn shade_iso(u: vec3<f32>, d_world: vec3<f32>) -> vec3<f32> {
     if (n_dot_l > 0.0) {
         spec = params.specular * pow(n_dot_l, params.shininess);
     }
+    return vec2<f32>(params.ambient + params.diffuse * n_dot_l, spec);
+}
+
+// The shaded colour of the isosurface at `u`.
+fn shade_iso(u: vec3<f32>, d_world: vec3<f32>) -> vec3<f32> {
+    let light = headlight(u, d_world);
     let base = sample_tf(params.iso_value).rgb;
-    return clamp(base * (params.ambient + params.diffuse * n_dot_l) + vec3<f32>(spec), vec3<f32>(0.0), vec3<f32>(1.0));
+    return clamp(base * light.x + vec3<f32>(light.y), vec3<f32>(0.0), vec3<f32>(1.0));
 }
 
 // First-hit isosurface along u0 + t·d_tex: the first sample k with s >= iso, refined linearly

@@ -53,6 +53,22 @@ pub enum RenderMode {
     },
 }
 
+/// Scene effects of the DVR integral (`docs/rendering_model.md`, "Effects"): each one the GPU
+/// compiles only when a scene asks for it, computed here in f64 so every GPU image is compared
+/// with the exact answer of the same model.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Effects {
+    /// Blinn–Phong headlight shading of every DVR sample with the gradient of the reconstructed
+    /// field (central differences one voxel apart, world space, anisotropic spacing respected).
+    pub shading: bool,
+    /// Pre-integrated classification (Engel et al. 2001): each sample composites the segment
+    /// from the previous sample with the scalar linear in between, integrated exactly.
+    pub preintegration: bool,
+    /// Tricubic B-spline reconstruction ([`Volume::sample_tricubic`]) instead of trilinear.
+    pub tricubic: bool,
+}
+
 /// Raycasting settings shared by the reference and the GPU raycasters (WGSL twin:
 /// `RaycastParams` in `shaders/common/raycast_params.wgsl`).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -69,11 +85,35 @@ pub struct RaycastSettings {
     pub jitter: bool,
     /// DVR or isosurface.
     pub mode: RenderMode,
+    /// Effects of the DVR integral.
+    pub effects: Effects,
+    /// Shading coefficients of DVR samples (`effects.shading`).
+    pub dvr_shading: Phong,
+    /// The TF's opacity is per this many voxel units of distance: 1 for "per voxel" (the
+    /// default), `1 / unit_world` for "per world unit" (a scene's opacity reference length).
+    /// The correction exponent is `step_voxels / opacity_unit_voxels`.
+    pub opacity_unit_voxels: f64,
 }
 
 impl Default for RaycastSettings {
     fn default() -> Self {
-        Self { step_voxels: 0.5, threshold: 1.0, max_steps: 4096, jitter: false, mode: RenderMode::Dvr }
+        Self {
+            step_voxels: 0.5,
+            threshold: 1.0,
+            max_steps: 4096,
+            jitter: false,
+            mode: RenderMode::Dvr,
+            effects: Effects::default(),
+            dvr_shading: Phong::default(),
+            opacity_unit_voxels: 1.0,
+        }
+    }
+}
+
+impl RaycastSettings {
+    /// The opacity-correction exponent of one step.
+    pub fn step_exponent(&self) -> f64 {
+        self.step_voxels / self.opacity_unit_voxels
     }
 }
 
@@ -221,31 +261,82 @@ impl March<'_> {
         (k as f64 + 0.5 + self.jitter) * self.step_tex
     }
 
+    /// The reconstructed field at texture-space `u`: trilinear, or the tricubic B-spline.
+    fn field(&self, u: DVec3) -> f64 {
+        if self.settings.effects.tricubic { self.volume.sample_tricubic(u) } else { self.volume.sample_trilinear(u) }
+    }
+
     fn sample(&self, t: f64) -> f64 {
-        self.volume.sample_trilinear(self.seg.u0 + t * self.seg.d_tex)
+        self.field(self.seg.u0 + t * self.seg.d_tex)
+    }
+
+    /// The premultiplied, opacity-corrected colour sample `t` adds (front value `s_prev` for
+    /// pre-integration), shaded when asked.
+    fn classify(&self, t: f64, s: f64, s_prev: f64) -> [f64; 4] {
+        let exponent = self.settings.step_exponent();
+        let mut p = if self.settings.effects.preintegration {
+            preintegrate(self.lut, s_prev, s, exponent)
+        } else {
+            let c = lut_sample(self.lut, s);
+            let a = corrected_alpha(c[3], exponent);
+            [c[0] * a, c[1] * a, c[2] * a, a]
+        };
+        if self.settings.effects.shading && p[3] > 0.0 {
+            let u = self.seg.u0 + t * self.seg.d_tex;
+            let (diffuse, specular) = self.lighting(u, &self.settings.dvr_shading);
+            for c in p.iter_mut().take(3) {
+                *c *= diffuse;
+            }
+            for i in 0..3 {
+                p[i] += p[3] * specular;
+            }
+        }
+        p
     }
 
     /// Front-to-back emission–absorption; returns the colour and the number of samples.
     fn dvr(&self) -> ([f64; 4], u64) {
         let mut acc = [0.0f64; 4];
         let mut k = 0;
+        // Pre-integration: the front value of sample 0's segment is the field one step before it.
+        let mut s_prev =
+            if self.settings.effects.preintegration { self.sample(self.t(0) - self.step_tex) } else { 0.0 };
         while k < self.settings.max_steps {
             let t = self.t(k);
             if t >= self.seg.len_tex {
                 break;
             }
-            let c = lut_sample(self.lut, self.sample(t));
+            let s = self.sample(t);
+            let p = self.classify(t, s, s_prev);
+            s_prev = s;
             k += 1;
-            let w = (1.0 - acc[3]) * corrected_alpha(c[3], self.settings.step_voxels);
-            for i in 0..3 {
-                acc[i] += w * c[i];
+            let w = 1.0 - acc[3];
+            for i in 0..4 {
+                acc[i] += w * p[i];
             }
-            acc[3] += w;
             if acc[3] >= self.settings.threshold {
                 break;
             }
         }
         (acc, k as u64)
+    }
+
+    /// The headlight's factors at `u`: `ambient + diffuse·|n·l|` and the white specular term,
+    /// `n` from the gradient (facing the eye where the gradient vanishes).
+    fn lighting(&self, u: DVec3, p: &Phong) -> (f64, f64) {
+        let dims = self.volume.dims.as_dvec3();
+        let off = 1.0 / dims;
+        let s = |v: DVec3| self.field(v);
+        let g = DVec3::new(
+            s(u + DVec3::new(off.x, 0.0, 0.0)) - s(u - DVec3::new(off.x, 0.0, 0.0)),
+            s(u + DVec3::new(0.0, off.y, 0.0)) - s(u - DVec3::new(0.0, off.y, 0.0)),
+            s(u + DVec3::new(0.0, 0.0, off.z)) - s(u - DVec3::new(0.0, 0.0, off.z)),
+        );
+        let l = -self.seg.dir_world;
+        let n = if g.length() >= ZERO_GRADIENT { -(g * dims / self.volume.half_extent_world()).normalize() } else { l };
+        let n_dot_l = n.dot(l).abs();
+        let spec = if n_dot_l > 0.0 { p.specular * n_dot_l.powf(p.shininess) } else { 0.0 };
+        (p.ambient + p.diffuse * n_dot_l, spec)
     }
 
     /// First hit of `s >= iso`, refined linearly; returns colour, hit and samples taken.
@@ -271,31 +362,41 @@ impl March<'_> {
         ([0.0; 4], [0.0; 4], k as u64)
     }
 
-    /// Headlight Blinn–Phong at texture-space `u` (`docs/rendering_model.md`).
+    /// Headlight Blinn–Phong at texture-space `u` (`docs/rendering_model.md`): the gradient
+    /// spans two voxels per axis, so the world gradient is g / (2·voxel_world) with voxel_world
+    /// = 2·half / dims and its direction that of g·dims/half; with a headlight l = v, so
+    /// h = normalize(l + v) = l and n·h = n·l.
     fn shade(&self, u: DVec3, iso: f64, p: &Phong) -> DVec3 {
-        let dims = self.volume.dims.as_dvec3();
-        let off = 1.0 / dims;
-        let s = |v: DVec3| self.volume.sample_trilinear(v);
-        let g = DVec3::new(
-            s(u + DVec3::new(off.x, 0.0, 0.0)) - s(u - DVec3::new(off.x, 0.0, 0.0)),
-            s(u + DVec3::new(0.0, off.y, 0.0)) - s(u - DVec3::new(0.0, off.y, 0.0)),
-            s(u + DVec3::new(0.0, 0.0, off.z)) - s(u - DVec3::new(0.0, 0.0, off.z)),
-        );
-        let l = -self.seg.dir_world;
-        let n = if g.length() >= ZERO_GRADIENT {
-            // g spans two voxels per axis: world gradient = g / (2·voxel_world), and
-            // voxel_world = 2·half / dims, so its direction is that of g·dims/half.
-            -(g * dims / self.volume.half_extent_world()).normalize()
-        } else {
-            l
-        };
-        // Headlight: l = v, so h = normalize(l + v) = l and n·h = n·l.
-        let n_dot_l = n.dot(l).abs();
-        let spec = if n_dot_l > 0.0 { p.specular * n_dot_l.powf(p.shininess) } else { 0.0 };
+        let (diffuse, spec) = self.lighting(u, p);
         let base = lut_sample(self.lut, iso);
         let base = DVec3::new(base[0], base[1], base[2]);
-        (base * (p.ambient + p.diffuse * n_dot_l) + DVec3::splat(spec)).clamp(DVec3::ZERO, DVec3::ONE)
+        (base * diffuse + DVec3::splat(spec)).clamp(DVec3::ZERO, DVec3::ONE)
     }
+}
+
+/// Pre-integrated classification of a segment of `exponent` opacity units (Engel et al. 2001):
+/// the scalar runs linearly from `s_front` to `s_back`; extinction `τ(s) = −ln(1 − α_tf(s))` per
+/// unit, emission the LUT colour; integrated front to back in f64 with sub-steps fine enough to
+/// resolve every LUT texel the segment crosses (at least 4 per texel, at least 64). Returns
+/// premultiplied RGBA. For `s_front = s_back` it is the point-sampled correction
+/// `1 − (1 − α)^exponent`. The GPU's pre-integration table holds this function on a 256² grid.
+pub fn preintegrate(lut: &[[f32; 4]], s_front: f64, s_back: f64, exponent: f64) -> [f64; 4] {
+    let texels = lut.len().max(1) as f64;
+    let crossed = ((s_back - s_front).abs() * texels).ceil();
+    let n = ((4.0 * crossed) as usize).clamp(64, 1 << 16);
+    let dx = exponent / n as f64;
+    let mut acc = [0.0f64; 4];
+    for i in 0..n {
+        let s = s_front + (s_back - s_front) * (i as f64 + 0.5) / n as f64;
+        let c = lut_sample(lut, s);
+        let a = corrected_alpha(c[3], dx);
+        let w = (1.0 - acc[3]) * a;
+        for k in 0..3 {
+            acc[k] += w * c[k];
+        }
+        acc[3] += w;
+    }
+    acc
 }
 
 /// Gradients shorter than this (in normalized scalar units over two voxels) count as zero and the

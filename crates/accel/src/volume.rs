@@ -136,6 +136,40 @@ impl Volume {
         let c1 = c01 * (1.0 - f.y) + c11 * f.y;
         c0 * (1.0 - f.z) + c1 * f.z
     }
+
+    /// Tricubic B-spline sample at texture coordinate `u`: the 4×4×4 voxels around it weighted by
+    /// the uniform cubic B-spline, indices clamped to the volume (clamp-to-edge), voxel centres at
+    /// `(i+0.5)/n`. A smoothing filter (it does not pass through the voxel values); the GPU
+    /// evaluates it with 8 trilinear fetches (Sigg & Hadwiger 2005, `shaders/common/volume.wgsl`).
+    pub fn sample_tricubic(&self, u: DVec3) -> f64 {
+        let n = self.dims.as_dvec3();
+        let p = u * n - 0.5;
+        let base = p.floor();
+        let f = p - base;
+        let weights = |t: f64| {
+            let it = 1.0 - t;
+            [
+                it * it * it / 6.0,
+                (3.0 * t * t * t - 6.0 * t * t + 4.0) / 6.0,
+                (-3.0 * t * t * t + 3.0 * t * t + 3.0 * t + 1.0) / 6.0,
+                t * t * t / 6.0,
+            ]
+        };
+        let (wx, wy, wz) = (weights(f.x), weights(f.y), weights(f.z));
+        let clamp = |v: f64, n: u32| -> u32 { v.clamp(0.0, (n - 1) as f64) as u32 };
+        let mut sum = 0.0;
+        for (k, w_z) in wz.iter().enumerate() {
+            let z = clamp(base.z + k as f64 - 1.0, self.dims.z);
+            for (j, w_y) in wy.iter().enumerate() {
+                let y = clamp(base.y + j as f64 - 1.0, self.dims.y);
+                for (i, w_x) in wx.iter().enumerate() {
+                    let x = clamp(base.x + i as f64 - 1.0, self.dims.x);
+                    sum += w_x * w_y * w_z * self.normalized(self.index(x, y, z));
+                }
+            }
+        }
+        sum
+    }
 }
 
 /// The voxel types volgraph stores, one per [`VoxelData`] variant.

@@ -238,6 +238,7 @@ pub fn run(args: &LiveArgs) -> anyhow::Result<()> {
         LiveSession::open(
             gpu.clone(),
             &SessionArgs {
+                scene: None,
                 graph: graph.clone(),
                 volume: None,
                 raw: Default::default(),

@@ -37,8 +37,12 @@ enum Command {
     },
     /// Render a graph to an image (PNG: 8-bit sRGB; EXR: 32-bit float linear).
     Render {
-        /// The graph file (RON).
-        graph: PathBuf,
+        /// The graph file (RON); default: the scene's graph.
+        graph: Option<PathBuf>,
+        /// A scene file (scenes/*.ron): volume, transfer function, camera or camera path,
+        /// viewport, graph, effects, precision; flags given as well win over it.
+        #[arg(long)]
+        scene: Option<PathBuf>,
         /// Volume file (.raw named NAME_XxYxZ_TYPE.raw, .nrrd, .nhdr, .mhd, .mha); default: a
         /// generated Marschner–Lobb 64³.
         #[arg(long)]
@@ -51,16 +55,19 @@ enum Command {
         /// The colour map to use from a ParaView .json holding several (its "Name"); default: the first.
         #[arg(long = "tf-map")]
         tf_map: Option<String>,
-        /// Viewport, WIDTHxHEIGHT.
-        #[arg(long, default_value = "512x512")]
-        size: String,
-        /// Orbit camera AZIMUTH,ELEVATION,DISTANCE (degrees, degrees, world units).
-        #[arg(long, default_value = "30,20,3.2")]
-        camera: String,
-        /// Frames to render (the last one is written); each rotates the volume 1° about y.
-        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100_000))]
-        frames: u32,
-        /// Scene features that are on, comma separated.
+        /// Viewport, WIDTHxHEIGHT [default: the scene's, else 512x512].
+        #[arg(long)]
+        size: Option<String>,
+        /// Orbit camera AZIMUTH,ELEVATION,DISTANCE (degrees, degrees, world units) [default: the
+        /// scene's, else 30,20,3.2].
+        #[arg(long)]
+        camera: Option<String>,
+        /// Frames to render (the last one is written); each rotates the volume 1° about y, or
+        /// follows the scene's camera path [default: the scene's, else 1].
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+        frames: Option<u32>,
+        /// Scene features (effects) that are on, comma separated: shading, preintegration,
+        /// jitter, tricubic (added to the scene's).
         #[arg(long, value_delimiter = ',')]
         features: Vec<String>,
         /// The graph output to write; default: "display" for PNG when the graph has it, else "image".
@@ -230,9 +237,24 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
             check_user_names(&plan, &options)?;
             Ok(Checked::Plan { text: plan.to_text(), notes: warning_lines(&plan) })
         }
-        Command::Render { graph, volume, raw, tf, tf_map, size, camera, frames, features, output, out, shaders } => {
+        Command::Render {
+            graph,
+            scene,
+            volume,
+            raw,
+            tf,
+            tf_map,
+            size,
+            camera,
+            frames,
+            features,
+            output,
+            out,
+            shaders,
+        } => {
             let args = crate::render::RenderArgs {
                 graph,
+                scene,
                 volume,
                 raw,
                 tf,

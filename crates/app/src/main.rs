@@ -12,6 +12,7 @@ mod cli_fuzz;
 mod image_out;
 mod inputs;
 mod render;
+mod scene;
 mod shader_dir;
 mod stdout;
 mod view;

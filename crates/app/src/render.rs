@@ -1,6 +1,6 @@
-//! `volgraph render`: every input is read and checked (graph, volume, transfer function, sizes,
-//! the output file's kind) before the GPU is opened, then frames are drawn and the last one is
-//! written.
+//! `volgraph render`: every input is read and checked (scene, graph, volume, transfer function,
+//! sizes, the output file's kind) before the GPU is opened, then frames are drawn and the last
+//! one is written. A scene (`--scene`) supplies what flags do not.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -15,17 +15,20 @@ use volgraph_passes::builtin_registry;
 use crate::cli::{CliError, RawArgs, check_user_names, compile_options, display_name, warning_lines};
 use crate::image_out::{self, ImageKind};
 use crate::inputs;
+use crate::scene::{CameraSpec, Scene};
+use volgraph_core::runtime::OpacityReference;
 
 /// The arguments of `volgraph render`.
 pub struct RenderArgs {
-    pub graph: PathBuf,
+    pub graph: Option<PathBuf>,
+    pub scene: Option<PathBuf>,
     pub volume: Option<PathBuf>,
     pub raw: RawArgs,
     pub tf: Option<PathBuf>,
     pub tf_map: Option<String>,
-    pub size: String,
-    pub camera: String,
-    pub frames: u32,
+    pub size: Option<String>,
+    pub camera: Option<String>,
+    pub frames: Option<u32>,
     pub features: Vec<String>,
     pub output: Option<String>,
     pub out: PathBuf,
@@ -35,8 +38,11 @@ pub struct RenderArgs {
 /// Everything `render` needs, read and checked, before the GPU is opened.
 pub struct Prepared {
     args: RenderArgs,
+    graph: PathBuf,
     kind: ImageKind,
-    camera: OrbitCamera,
+    camera: CameraSpec,
+    frames: u32,
+    opacity: OpacityReference,
     volume: volgraph_accel::volume::Volume,
     lut: Vec<[f32; 4]>,
     plan: volgraph_core::Plan,
@@ -48,17 +54,50 @@ pub struct Prepared {
 /// Reads and checks every input of `volgraph render`; touches no GPU, prints nothing.
 pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     let kind = ImageKind::from_path(&args.out)?;
-    let source = inputs::read_graph(&args.graph)?;
-    let options = compile_options(&args.size, &args.features, &[])?;
-    let camera = inputs::parse_camera(&args.camera)?;
-    let generated = args.volume.is_none();
-    let (volume, mut notes) = inputs::volume(args.volume.as_ref(), &inputs::raw_options(&args.raw)?)?;
-    let (tf, tf_notes) = inputs::transfer_function(args.tf.as_ref(), args.tf_map.as_deref(), &volume, generated)?;
+    let scene = args.scene.as_deref().map(Scene::load).transpose().map_err(|e| anyhow!(e))?;
+    let graph = match (&args.graph, scene.as_ref().and_then(|s| s.graph.clone())) {
+        (Some(g), _) => g.clone(),
+        (None, Some(g)) => g,
+        (None, None) => {
+            return Err(CliError::Other(anyhow!(
+                "no graph: give a graph file (volgraph render GRAPH -o out.png), or a --scene whose file names one \
+                 (graph: \"../graphs/modern/fastest.ron\")"
+            )));
+        }
+    };
+    let source = inputs::read_graph(&graph)?;
+    let size = args.size.clone().or_else(|| scene.as_ref().and_then(|s| s.viewport).map(|(w, h)| format!("{w}x{h}")));
+    let mut features = scene.as_ref().map(|s| s.effects.clone()).unwrap_or_default();
+    features.extend(args.features.iter().cloned());
+    let mut options = compile_options(size.as_deref().unwrap_or("512x512"), &features, &[])?;
+    options.precision = scene.as_ref().and_then(|s| s.precision);
+    let camera = match (&args.camera, scene.as_ref().and_then(|s| s.camera.clone())) {
+        (Some(text), _) => orbit_spec(&inputs::parse_camera(text)?),
+        (None, Some(spec)) => spec,
+        (None, None) => orbit_spec(&inputs::parse_camera("30,20,3.2")?),
+    };
+    let frames = args.frames.or(scene.as_ref().map(Scene::frame_count)).unwrap_or(1);
+    let raw = inputs::raw_options(&args.raw)?;
+    let (volume, generated, mut notes) = match (&args.volume, &scene) {
+        (None, Some(scene)) => crate::scene::load_volume(scene, &raw)?,
+        (volume, _) => {
+            let (v, notes) = inputs::volume(volume.as_ref(), &raw)?;
+            (v, volume.is_none(), notes)
+        }
+    };
+    let (tf, tf_notes) = match (&args.tf, &scene) {
+        (None, Some(scene)) => {
+            let (tf, _, notes) =
+                crate::scene::load_transfer_function(scene, args.tf_map.as_deref(), &volume, generated)?;
+            (tf, notes)
+        }
+        (tf, _) => inputs::transfer_function(tf.as_ref(), args.tf_map.as_deref(), &volume, generated)?,
+    };
     notes.extend(tf_notes);
     let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
     let registry = builtin_registry();
-    let file = display_name(&args.graph);
-    let mut options = options;
+    let file = display_name(&graph);
+    let opacity = scene.as_ref().map(|s| s.opacity_reference).unwrap_or_default();
     options.scene = scene_values_of(&VolumeDesc::of(&volume));
     let plan = compile(&file, &source, &registry, &options).map_err(CliError::Graph)?;
     check_user_names(&plan, &options)?;
@@ -86,17 +125,23 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     {
         notes.push(note);
     }
-    Ok(Prepared { args, kind, camera, volume, lut, plan, output, notes })
+    Ok(Prepared { args, graph, kind, camera, frames, opacity, volume, lut, plan, output, notes })
+}
+
+/// The camera spec of one orbit camera (turning 1° per frame).
+fn orbit_spec(c: &OrbitCamera) -> CameraSpec {
+    CameraSpec::Orbit { azimuth: c.azimuth_deg, elevation: c.elevation_deg, distance: c.distance }
 }
 
 /// Opens the GPU, renders the frames and writes the image.
 pub fn execute(prepared: Prepared) -> Result<(), CliError> {
-    let Prepared { args, kind, camera, volume, lut, plan, output, .. } = prepared;
+    let Prepared { args, graph, kind, camera, frames, opacity, volume, lut, plan, output, .. } = prepared;
     let registry = builtin_registry();
     let viewport = plan.viewport;
     let gpu = Arc::new(Gpu::new_headless().map_err(|e| anyhow!(e))?);
-    let (sources, _) = crate::shader_dir::sources_for(&args.graph, args.shaders.as_deref());
+    let (sources, _) = crate::shader_dir::sources_for(&graph, args.shaders.as_deref());
     let mut runtime = Runtime::new(gpu, ShaderLibrary::new(sources));
+    runtime.set_opacity_reference(opacity);
     runtime.bind_scene(&plan.inputs, &volume, &lut).map_err(|e| anyhow!(e))?;
     if runtime.volume().is_some_and(|(_, f)| f == VolumeFormat::R16Float) && !matches!(volume.data, VoxelData::U8(_)) {
         eprintln!(
@@ -107,9 +152,8 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
     runtime.apply(plan, &registry).map_err(|e| anyhow!(e))?;
     // Frames one at a time, so each has its own time (the first includes pipeline JIT).
     let mut stats = Vec::new();
-    for f in 0..args.frames {
-        let cam = OrbitCamera { azimuth_deg: camera.azimuth_deg + f as f64, ..camera };
-        stats.push(runtime.render(CameraData::from_orbit(&cam, viewport)).map_err(|e| anyhow!(e))?);
+    for f in 0..frames {
+        stats.push(runtime.render(CameraData::from_orbit(&camera.at(f), viewport)).map_err(|e| anyhow!(e))?);
     }
     let warm: Vec<f64> = stats.iter().skip(1).map(|s| s.frame_ms).collect();
     let last = stats.pop();
@@ -135,7 +179,7 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
         let clock = if stats.wall_time_fallback { "wall time" } else { "GPU time" };
         eprintln!(
             "{}: {}x{} on {}, last frame {:.2} ms {clock} → {}",
-            args.graph.display(),
+            graph.display(),
             viewport.0,
             viewport.1,
             runtime.gpu().adapter_name,

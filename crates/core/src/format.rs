@@ -21,6 +21,38 @@ pub enum TargetFormat {
     R8Unorm,
 }
 
+/// The float precision a scene asks for its colour, accumulation and history targets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Precision {
+    /// Rgba16Float: half the memory and bandwidth, 11 significant bits.
+    F16,
+    /// Rgba32Float: 24 significant bits (blending into it needs FLOAT32_BLENDABLE).
+    F32,
+}
+
+impl Precision {
+    /// The RGBA target format of this precision.
+    pub fn rgba(self) -> TargetFormat {
+        match self {
+            Precision::F16 => TargetFormat::Rgba16Float,
+            Precision::F32 => TargetFormat::Rgba32Float,
+        }
+    }
+
+    /// `f16` / `f32`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Precision::F16 => "f16",
+            Precision::F32 => "f32",
+        }
+    }
+
+    /// The precision named `name` (`f16`, `f32`).
+    pub fn from_name(name: &str) -> Option<Precision> {
+        [Precision::F16, Precision::F32].into_iter().find(|p| p.name() == name)
+    }
+}
+
 impl TargetFormat {
     /// Every format, in declaration order (used to list the alternatives in errors).
     pub const ALL: [TargetFormat; 7] = [

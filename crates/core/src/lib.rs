@@ -18,7 +18,7 @@ pub mod suggest;
 
 pub use compile::{CompileOptions, compile};
 pub use diagnostic::{Diagnostic, Diagnostics, Location};
-pub use format::{TargetFormat, TargetSize};
+pub use format::{Precision, TargetFormat, TargetSize};
 pub use params::{ParamSpec, ParamValue, Params};
 pub use plan::Plan;
 pub use plugin::{Access, PassNode, PassPlugin, PortKind, PortSpec, Registry, Rerun};

@@ -172,6 +172,12 @@ pub trait PassPlugin: Send + Sync {
         Vec::new()
     }
 
+    /// The `#if` names its shaders are assembled with for these parameters (the scene effects it
+    /// specializes for), so tools that walk the shaders see exactly what the GPU compiles.
+    fn shader_defines(&self, _params: &Params) -> Vec<&'static str> {
+        Vec::new()
+    }
+
     /// True for passes whose effect is outside the graph (writing a file): never culled.
     fn is_sink(&self) -> bool {
         false

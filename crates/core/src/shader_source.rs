@@ -4,6 +4,12 @@
 //! by that file's text. Each file is pulled in once per module however often it is imported,
 //! imports nest, and cycles are an error. naga never sees the `#import` lines.
 //!
+//! Effects a scene may leave off are written between `#if NAME` (or `#if !NAME`), optional
+//! `#else`, and `#endif` lines, which nest and must close in the file that opens them. A module
+//! is assembled for a set of defines (`assemble_with`): lines in inactive branches — imports
+//! included — are dropped, so an unused effect's code is not in the module at all (not merely
+//! unreachable), and naga, the pipeline and the GPU never see it.
+//!
 //! Files come from [`ShaderSources`]: folders on disk first (what a developer edits and the
 //! viewer watches), then tables compiled into the binary (`volgraph_passes::EMBEDDED_SHADERS`),
 //! so an installed binary works from any directory. An external plugin crate puts its own
@@ -38,6 +44,16 @@ pub enum ShaderSourceError {
         path: PathBuf,
         /// 1-based line.
         line: usize,
+    },
+    /// An `#if`/`#else`/`#endif` line that does not match, or an `#if` left open.
+    #[error("{path}:{line}: {problem}; write #if NAME (or #if !NAME), #else and #endif, closed in the same file")]
+    MalformedDirective {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line.
+        line: usize,
+        /// What is wrong.
+        problem: String,
     },
     /// Files import each other in a cycle.
     #[error("{path}: import cycle: {chain}")]
@@ -199,18 +215,46 @@ pub fn load_shader(root: &Path, relative: &str) -> Result<ShaderSource, ShaderSo
     assemble(&ShaderSources::new().with_disk(root), relative)
 }
 
-/// Assembles `relative` from `sources`, resolving every import through the same layers.
+/// Assembles `relative` from `sources`, resolving every import through the same layers, with no
+/// defines (every `#if NAME` branch off).
 pub fn assemble(sources: &ShaderSources, relative: &str) -> Result<ShaderSource, ShaderSourceError> {
+    assemble_with(sources, relative, &BTreeSet::new())
+}
+
+/// Assembles `relative` with `defines` on: `#if NAME` branches for names in the set are kept.
+pub fn assemble_with(
+    sources: &ShaderSources,
+    relative: &str,
+    defines: &BTreeSet<String>,
+) -> Result<ShaderSource, ShaderSourceError> {
     let mut out = ShaderSource { text: String::new(), files: Vec::new(), line_origins: Vec::new() };
     let mut included = BTreeSet::new();
     let mut stack = Vec::new();
-    append(sources, relative, &mut out, &mut included, &mut stack)?;
+    append(sources, relative, defines, &mut out, &mut included, &mut stack)?;
     Ok(out)
+}
+
+/// One open `#if`: whether its current branch is kept, whether the enclosing one is, and whether
+/// `#else` was seen.
+struct OpenIf {
+    line: usize,
+    active: bool,
+    parent_active: bool,
+    in_else: bool,
+}
+
+/// A conditional directive on `line`, if it is one: `Some(Ok((keyword, argument)))`.
+fn directive(line: &str) -> Option<(&str, &str)> {
+    let t = line.trim();
+    let rest = t.strip_prefix('#')?;
+    let (keyword, argument) = rest.split_once(char::is_whitespace).unwrap_or((rest, ""));
+    matches!(keyword, "if" | "else" | "endif").then_some((keyword, argument.trim()))
 }
 
 fn append(
     sources: &ShaderSources,
     relative: &str,
+    defines: &BTreeSet<String>,
     out: &mut ShaderSource,
     included: &mut BTreeSet<String>,
     stack: &mut Vec<String>,
@@ -228,13 +272,52 @@ fn append(
     let index = out.files.len();
     out.files.push(file);
     stack.push(relative.to_string());
+    let mut open: Vec<OpenIf> = Vec::new();
+    let malformed = |line: usize, problem: &str| ShaderSourceError::MalformedDirective {
+        path: path.clone(),
+        line,
+        problem: problem.to_string(),
+    };
     for (i, line) in text.lines().enumerate() {
+        let active = open.last().is_none_or(|o| o.active);
+        if let Some((keyword, argument)) = directive(line) {
+            match keyword {
+                "if" => {
+                    let (negated, name) = match argument.strip_prefix('!') {
+                        Some(n) => (true, n.trim()),
+                        None => (false, argument),
+                    };
+                    if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+                        return Err(malformed(i + 1, "#if needs one NAME (letters, digits, _)"));
+                    }
+                    let on = defines.contains(name) != negated;
+                    open.push(OpenIf { line: i + 1, active: active && on, parent_active: active, in_else: false });
+                }
+                "else" => match open.last_mut() {
+                    Some(o) if !o.in_else => {
+                        o.in_else = true;
+                        o.active = o.parent_active && !o.active;
+                    }
+                    Some(_) => return Err(malformed(i + 1, "a second #else for one #if")),
+                    None => return Err(malformed(i + 1, "#else without #if")),
+                },
+                _ => {
+                    if open.pop().is_none() {
+                        return Err(malformed(i + 1, "#endif without #if"));
+                    }
+                }
+            }
+            continue;
+        }
+        if !active {
+            continue;
+        }
         let trimmed = line.trim_start();
         if let Some(rest) = trimmed.strip_prefix("#import") {
             let target = rest.trim().strip_prefix('"').and_then(|r| r.strip_suffix('"'));
             match target {
-                Some(t) if !t.is_empty() => append(sources, t, out, included, stack)?,
-                _ => return Err(ShaderSourceError::MalformedImport { path, line: i + 1 }),
+                Some(t) if !t.is_empty() => append(sources, t, defines, out, included, stack)?,
+                _ => return Err(ShaderSourceError::MalformedImport { path: path.clone(), line: i + 1 }),
             }
         } else {
             out.text.push_str(line);
@@ -242,6 +325,53 @@ fn append(
             out.line_origins.push((index, i + 1));
         }
     }
+    if let Some(o) = open.last() {
+        return Err(malformed(o.line, "#if without #endif"));
+    }
     stack.pop();
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TABLE: EmbeddedShaders = &[
+        (
+            "main.wgsl",
+            "a\n#if SHADING\n#import \"lit.wgsl\"\nb\n#if !TRICUBIC\nc\n#else\nd\n#endif\n#else\ne\n#endif\nf\n",
+        ),
+        ("lit.wgsl", "lit\n"),
+        ("open.wgsl", "#if X\na\n"),
+        ("stray.wgsl", "a\n#endif\n"),
+        ("twice.wgsl", "#if X\n#else\n#else\n#endif\n"),
+    ];
+
+    fn lines(defines: &[&str]) -> Vec<String> {
+        let sources = ShaderSources::new().with_embedded(TABLE);
+        let defines: BTreeSet<String> = defines.iter().map(|d| d.to_string()).collect();
+        let s = assemble_with(&sources, "main.wgsl", &defines).expect("assembles");
+        s.text.lines().map(str::to_string).collect()
+    }
+
+    #[test]
+    fn conditional_branches_follow_the_defines_and_skip_their_imports() {
+        assert_eq!(lines(&[]), ["a", "e", "f"]);
+        assert_eq!(lines(&["SHADING"]), ["a", "lit", "b", "c", "f"]);
+        assert_eq!(lines(&["SHADING", "TRICUBIC"]), ["a", "lit", "b", "d", "f"]);
+        assert_eq!(lines(&["TRICUBIC"]), ["a", "e", "f"]);
+    }
+
+    #[test]
+    fn unbalanced_directives_are_located() {
+        let sources = ShaderSources::new().with_embedded(TABLE);
+        for (file, line, problem) in [
+            ("open.wgsl", 1, "#if without #endif"),
+            ("stray.wgsl", 2, "#endif without #if"),
+            ("twice.wgsl", 3, "a second #else"),
+        ] {
+            let err = assemble(&sources, file).expect_err("malformed").to_string();
+            assert!(err.contains(&format!("{file}:{line}: {problem}")), "{err}");
+        }
+    }
 }

@@ -10,7 +10,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePipelineSpec, CreateContext, PassError, PassPipeline, RecordContext};
-use volgraph_core::{Params, PassNode, PassPlugin, PortKind, PortSpec, Rerun};
+use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, Rerun};
 
 use crate::grid_tap::GridTap;
 pub(crate) use crate::minmax_grid::block_size_spec;
@@ -76,14 +76,29 @@ impl PassPlugin for EmptySpace {
         ]
     }
 
+    fn params(&self) -> Vec<ParamSpec> {
+        vec![ParamSpec::boolean(
+            "segments",
+            false,
+            "classify for pre-integrated segments: a block is empty only if its neighbours' values are invisible \
+             too (a segment spans two adjacent blocks; wire to feature.preintegration)",
+        )]
+    }
+
+    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
+        if params.boolean("segments") { vec!["SEGMENTS"] } else { Vec::new() }
+    }
+
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         vec![ShaderUse { file: "empty_space.wgsl", entry_point: "cs_classify" }]
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        let defines = self.shader_defines(ctx.params);
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
             shader: "empty_space.wgsl",
             entry: "cs_classify",
+            defines: &defines,
             ..Default::default()
         })?;
         Ok(Box::new(EmptySpaceNode { pipeline, flags: None, tap: self.tap.clone() }))

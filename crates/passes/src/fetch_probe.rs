@@ -58,6 +58,7 @@ impl PassPlugin for FetchProbe {
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
         ["workgroup_x", "workgroup_y"].iter().all(|p| old.uint(p) == new.uint(p))
             && old.boolean("count_samples") == new.boolean("count_samples")
+            && old.boolean("jitter") == new.boolean("jitter")
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
@@ -74,6 +75,7 @@ impl PassPlugin for FetchProbe {
             entry: if counted { "cs_counted" } else { "cs_main" },
             extra_bindings: &["params"],
             constants: &[("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)],
+            defines: &crate::effects::jitter_defines(ctx.params),
         })?;
         let params = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
         Ok(Box::new(FetchProbeNode { pipeline, params, workgroup: wg, counted }))

@@ -2,6 +2,7 @@
 //! in `shaders/` (`entry_points.rs` ↔ `shaders/entry_points.wgsl`). Each registers through the
 //! same public [`volgraph_core::Registry`] API an external crate would use.
 
+pub mod effects;
 pub mod empty_distance;
 pub mod empty_space;
 pub mod entry_points;
@@ -9,6 +10,7 @@ pub mod fetch_probe;
 pub mod grid_tap;
 pub mod minmax_grid;
 pub mod opacity_lut;
+pub mod preintegration;
 pub mod present;
 pub mod ray_directions;
 pub mod raycast;

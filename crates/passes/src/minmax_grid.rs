@@ -109,7 +109,18 @@ impl PassPlugin for MinMaxGridPass {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        vec![block_size_spec()]
+        vec![
+            block_size_spec(),
+            ParamSpec::boolean(
+                "tricubic",
+                false,
+                "widen each block's range by a two-voxel apron, what the tricubic B-spline reads (wire to feature.tricubic)",
+            ),
+        ]
+    }
+
+    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
+        if params.boolean("tricubic") { vec!["TRICUBIC"] } else { Vec::new() }
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -121,10 +132,12 @@ impl PassPlugin for MinMaxGridPass {
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        let defines = self.shader_defines(ctx.params);
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
             shader: "minmax_grid.wgsl",
             entry: "cs_minmax",
             extra_bindings: &["minmax"],
+            defines: &defines,
             ..Default::default()
         })?;
         let block_size = ctx.params.uint("block_size").max(1) as u32;

@@ -10,6 +10,7 @@ use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
+use crate::effects::{EffectState, effect_defines, effect_param_specs, same_effects, with_effect_bindings};
 use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
 
 /// The plugin.
@@ -43,7 +44,13 @@ impl PassPlugin for Raycast {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        raycast_param_specs()
+        let mut p = raycast_param_specs();
+        p.extend(effect_param_specs());
+        p
+    }
+
+    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
+        effect_defines(params)
     }
 
     fn ports(&self, params: &Params) -> Vec<PortSpec> {
@@ -60,32 +67,40 @@ impl PassPlugin for Raycast {
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        // Every parameter but the mode is a uniform value.
-        is_iso(old) == is_iso(new)
+        // Every parameter but the mode and the effects is a uniform value.
+        is_iso(old) == is_iso(new) && same_effects(old, new)
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let fragment = if is_iso(ctx.params) { "fs_iso" } else { "fs_dvr" };
+        let defines = effect_defines(ctx.params);
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
             shader: "raycast.wgsl",
             vertex: "vs_fullscreen",
             fragment,
-            extra_bindings: &["params"],
+            extra_bindings: &with_effect_bindings(&["params"]),
+            defines: &defines,
             ..Default::default()
         })?;
         let params = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
-        Ok(Box::new(RaycastNode { pipeline, params }))
+        let effects = EffectState::new(ctx)?;
+        Ok(Box::new(RaycastNode { pipeline, params, effects, step_voxels: ctx.params.float("step_voxels") }))
     }
 }
 
 struct RaycastNode {
     pipeline: PassPipeline,
     params: wgpu::Buffer,
+    effects: EffectState,
+    step_voxels: f64,
 }
 
 impl PassNode for RaycastNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
-        let bg = ctx.bind_group(&self.pipeline, &[("params", self.params.as_entire_binding())])?;
+        self.effects.update(ctx, &self.params, self.step_voxels)?;
+        let mut extra = vec![("params", self.params.as_entire_binding())];
+        extra.extend(self.effects.bindings());
+        let bg = ctx.bind_group(&self.pipeline, &extra)?;
         let mut pass = ctx.begin_render_pass(&self.pipeline, None)?;
         crate::draw(&mut pass, &self.pipeline, &bg, 0..3);
         Ok(())
@@ -93,5 +108,7 @@ impl PassNode for RaycastNode {
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
+        self.step_voxels = params.float("step_voxels");
+        self.effects.invalidate();
     }
 }

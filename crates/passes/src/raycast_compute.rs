@@ -9,6 +9,7 @@ use volgraph_core::runtime::{
 };
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortSpec, TargetFormat};
 
+use crate::effects::{EffectState, effect_defines, effect_param_specs, same_effects, with_effect_bindings};
 use crate::raycast::raycast_ports;
 use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
 
@@ -26,14 +27,20 @@ impl PassPlugin for RaycastCompute {
 
     fn params(&self) -> Vec<ParamSpec> {
         let mut p = raycast_param_specs();
+        p.extend(effect_param_specs());
         p.push(ParamSpec::uint("workgroup_x", 8, 1, 256, "workgroup width in pixels"));
         p.push(ParamSpec::uint("workgroup_y", 8, 1, 256, "workgroup height in pixels"));
         p
     }
 
+    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
+        effect_defines(params)
+    }
+
     fn ports(&self, params: &Params) -> Vec<PortSpec> {
-        // The storage formats are fixed by the shader: rgba16float colour, rgba32float hits.
-        raycast_ports(params, &[TargetFormat::Rgba16Float], &[TargetFormat::Rgba32Float])
+        // Storage formats: rgba16float or (a scene's f32 precision) rgba32float colour, chosen by
+        // a shader define; rgba32float hits.
+        raycast_ports(params, &[TargetFormat::Rgba16Float, TargetFormat::Rgba32Float], &[TargetFormat::Rgba32Float])
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
@@ -44,6 +51,7 @@ impl PassPlugin for RaycastCompute {
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
         // The mode picks the entry point and the workgroup size is a pipeline constant.
         is_iso(old) == is_iso(new)
+            && same_effects(old, new)
             && old.uint("workgroup_x") == new.uint("workgroup_x")
             && old.uint("workgroup_y") == new.uint("workgroup_y")
     }
@@ -63,26 +71,48 @@ impl PassPlugin for RaycastCompute {
             });
         }
         let entry = if is_iso(ctx.params) { "cs_iso" } else { "cs_dvr" };
+        let mut defines = effect_defines(ctx.params);
+        if color_is_f32(ctx) {
+            defines.push("COLOR_F32");
+        }
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
             shader: "raycast_compute.wgsl",
             entry,
-            extra_bindings: &["params"],
+            extra_bindings: &with_effect_bindings(&["params"]),
             constants: &[("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)],
+            defines: &defines,
         })?;
         let params = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
-        Ok(Box::new(RaycastComputeNode { pipeline, params, workgroup: wg }))
+        let effects = EffectState::new(ctx)?;
+        Ok(Box::new(RaycastComputeNode {
+            pipeline,
+            params,
+            workgroup: wg,
+            effects,
+            step_voxels: ctx.params.float("step_voxels"),
+        }))
     }
+}
+
+/// Whether the graph (or the scene's precision) made `color` an Rgba32Float target.
+pub(crate) fn color_is_f32(ctx: &CreateContext<'_>) -> bool {
+    ctx.port("color").and_then(|p| p.format) == Some(wgpu::TextureFormat::Rgba32Float)
 }
 
 struct RaycastComputeNode {
     pipeline: PassPipeline,
     params: wgpu::Buffer,
     workgroup: (u32, u32),
+    effects: EffectState,
+    step_voxels: f64,
 }
 
 impl PassNode for RaycastComputeNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
-        let bg = ctx.bind_group(&self.pipeline, &[("params", self.params.as_entire_binding())])?;
+        self.effects.update(ctx, &self.params, self.step_voxels)?;
+        let mut extra = vec![("params", self.params.as_entire_binding())];
+        extra.extend(self.effects.bindings());
+        let bg = ctx.bind_group(&self.pipeline, &extra)?;
         let (w, h) = ctx.extent("color");
         let mut pass = ctx.begin_compute_pass();
         if let PipelineKind::Compute(p) = &self.pipeline.pipeline {
@@ -95,5 +125,7 @@ impl PassNode for RaycastComputeNode {
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
+        self.step_voxels = params.float("step_voxels");
+        self.effects.invalidate();
     }
 }

@@ -10,6 +10,9 @@ use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
+use crate::effects::{
+    EffectState, SHADING_PARAMS, effect_defines, effect_param_specs, same_effects, with_effect_bindings,
+};
 use crate::empty_space::{EMPTY_BLOCKS, block_size_spec, check_block_grid};
 use crate::minmax_grid::bound_size;
 use crate::raycast_params::{RaycastParamsGpu, raycast_param_specs};
@@ -39,13 +42,22 @@ impl PassPlugin for RaycastEss {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        // DVR only: the isosurface parameters of `raycast` do not apply.
+        // DVR only: the isosurface parameters of `raycast` do not apply (its shading
+        // coefficients do, for the shading effect).
         let mut p: Vec<ParamSpec> = raycast_param_specs()
             .into_iter()
-            .filter(|s| matches!(s.name, "step_voxels" | "threshold" | "max_steps" | "jitter"))
+            .filter(|s| {
+                matches!(s.name, "step_voxels" | "threshold" | "max_steps" | "jitter")
+                    || SHADING_PARAMS.contains(&s.name)
+            })
             .collect();
         p.push(block_size_spec());
+        p.extend(effect_param_specs());
         p
+    }
+
+    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
+        effect_defines(params)
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -63,17 +75,19 @@ impl PassPlugin for RaycastEss {
         vec![ShaderUse { file: "raycast_ess.wgsl", entry_point: "fs_dvr" }]
     }
 
-    fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
-        // Every parameter is a uniform value (the block size too).
-        true
+    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
+        // Every parameter but the effects is a uniform value (the block size too).
+        same_effects(old, new)
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        let defines = effect_defines(ctx.params);
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
             shader: "raycast_ess.wgsl",
             vertex: "vs_fullscreen",
             fragment: "fs_dvr",
-            extra_bindings: &["params", "ess"],
+            extra_bindings: &with_effect_bindings(&["params", "ess"]),
+            defines: &defines,
             ..Default::default()
         })?;
         let params = ctx.uniform_buffer("params", std::mem::size_of::<RaycastParamsGpu>() as u64);
@@ -81,7 +95,9 @@ impl PassPlugin for RaycastEss {
         let block_size = ctx.params.uint("block_size").max(1) as u32;
         let ess = ctx.uniform_buffer("ess", 16);
         ctx.gpu.queue.write_buffer(&ess, 0, bytemuck::bytes_of(&EssParamsGpu { block_size, _pad: [0; 3] }));
-        Ok(Box::new(RaycastEssNode { pipeline, params, ess, block_size }))
+        let effects = EffectState::new(ctx)?;
+        let step_voxels = ctx.params.float("step_voxels");
+        Ok(Box::new(RaycastEssNode { pipeline, params, ess, block_size, effects, step_voxels }))
     }
 }
 
@@ -90,16 +106,18 @@ struct RaycastEssNode {
     params: wgpu::Buffer,
     ess: wgpu::Buffer,
     block_size: u32,
+    effects: EffectState,
+    step_voxels: f64,
 }
 
 impl PassNode for RaycastEssNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let volume = bound_size(ctx, "volume")?;
         check_block_grid(ctx, "empty", self.block_size, volume)?;
-        let bg = ctx.bind_group(
-            &self.pipeline,
-            &[("params", self.params.as_entire_binding()), ("ess", self.ess.as_entire_binding())],
-        )?;
+        self.effects.update(ctx, &self.params, self.step_voxels)?;
+        let mut extra = vec![("params", self.params.as_entire_binding()), ("ess", self.ess.as_entire_binding())];
+        extra.extend(self.effects.bindings());
+        let bg = ctx.bind_group(&self.pipeline, &extra)?;
         let mut pass = ctx.begin_render_pass(&self.pipeline, None)?;
         crate::draw(&mut pass, &self.pipeline, &bg, 0..3);
         Ok(())
@@ -107,6 +125,8 @@ impl PassNode for RaycastEssNode {
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
+        self.step_voxels = params.float("step_voxels");
+        self.effects.invalidate();
         self.block_size = params.uint("block_size").max(1) as u32;
         let ess = EssParamsGpu { block_size: self.block_size, _pad: [0; 3] };
         gpu.queue.write_buffer(&self.ess, 0, bytemuck::bytes_of(&ess));

@@ -28,6 +28,9 @@ use volgraph_core::runtime::{
 };
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
+use crate::effects::{
+    EffectState, SHADING_PARAMS, effect_defines, effect_param_specs, same_effects, with_effect_bindings,
+};
 use crate::empty_distance::EMPTY_DISTANCE;
 use crate::empty_space::block_size_spec;
 use crate::minmax_grid::bound_size;
@@ -68,9 +71,13 @@ impl PassPlugin for RaycastFast {
     fn params(&self) -> Vec<ParamSpec> {
         let mut p: Vec<ParamSpec> = raycast_param_specs()
             .into_iter()
-            .filter(|s| matches!(s.name, "step_voxels" | "threshold" | "max_steps" | "jitter"))
+            .filter(|s| {
+                matches!(s.name, "step_voxels" | "threshold" | "max_steps" | "jitter")
+                    || SHADING_PARAMS.contains(&s.name)
+            })
             .collect();
         p.push(block_size_spec());
+        p.extend(effect_param_specs());
         p.push(ParamSpec::choice(
             "leap",
             "cubes",
@@ -109,13 +116,21 @@ impl PassPlugin for RaycastFast {
             PortSpec::read("tf", PortKind::TransferFunction),
             // Leave unwired to take every sample.
             PortSpec::read("distance", PortKind::Owned(EMPTY_DISTANCE)).optional(),
-            PortSpec::write("color", PortKind::target(&[TargetFormat::Rgba16Float])),
+            PortSpec::write("color", PortKind::target(&[TargetFormat::Rgba16Float, TargetFormat::Rgba32Float])),
         ];
         if params.boolean("count_samples") {
             // One u32 per image row (mod SAMPLE_ROWS): samples taken this frame.
             ports.push(PortSpec::write("samples", PortKind::buffer(4 * SAMPLE_ROWS)));
         }
         ports
+    }
+
+    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
+        let mut defines = effect_defines(params);
+        if params.boolean("shading") || params.boolean("preintegration") {
+            defines.push("EFFECTS");
+        }
+        defines
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
@@ -131,6 +146,7 @@ impl PassPlugin for RaycastFast {
         PIPELINE_UINTS.iter().all(|p| old.uint(p) == new.uint(p))
             && PIPELINE_CHOICES.iter().all(|p| old.choice(p) == new.choice(p))
             && old.boolean("count_samples") == new.boolean("count_samples")
+            && same_effects(old, new)
             && (old.float("step_voxels") == 0.5) == (new.float("step_voxels") == 0.5)
     }
 
@@ -159,10 +175,15 @@ impl PassPlugin for RaycastFast {
             _ => None,
         };
         let counted = ctx.params.boolean("count_samples");
+        let mut defines = self.shader_defines(ctx.params);
+        if crate::raycast_compute::color_is_f32(ctx) {
+            defines.push("COLOR_F32");
+        }
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
             shader: "raycast_fast.wgsl",
             entry: if counted { "cs_counted" } else { "cs_main" },
-            extra_bindings: &["params", "fast", "corrected"],
+            extra_bindings: &with_effect_bindings(&["params", "fast", "corrected"]),
+            defines: &defines,
             constants: &[
                 ("WORKGROUP_X", wg.0 as f64),
                 ("WORKGROUP_Y", wg.1 as f64),
@@ -195,6 +216,7 @@ impl PassPlugin for RaycastFast {
         let no_table = table
             .is_none()
             .then(|| stand_in(wgpu::TextureDimension::D2, wgpu::TextureFormat::Rgba16Float, "no corrected table"));
+        let effects = EffectState::new(ctx)?;
         Ok(Box::new(RaycastFastNode {
             pipeline,
             params,
@@ -205,6 +227,8 @@ impl PassPlugin for RaycastFast {
             table,
             no_distance,
             no_table,
+            effects,
+            step_voxels: ctx.params.float("step_voxels"),
         }))
     }
 }
@@ -219,6 +243,8 @@ struct RaycastFastNode {
     table: Option<OpacityTable>,
     no_distance: Option<wgpu::TextureView>,
     no_table: Option<wgpu::TextureView>,
+    effects: EffectState,
+    step_voxels: f64,
 }
 
 impl RaycastFastNode {
@@ -252,6 +278,7 @@ impl PassNode for RaycastFastNode {
         if let Some(table) = &self.table {
             table.record(ctx, &self.params)?;
         }
+        self.effects.update(ctx, &self.params, self.step_voxels)?;
         let corrected = self.table.as_ref().map_or(self.no_table.as_ref(), |t| Some(&t.view));
         let mut extra = vec![("params", self.params.as_entire_binding()), ("fast", self.fast.as_entire_binding())];
         if let Some(v) = corrected {
@@ -260,6 +287,7 @@ impl PassNode for RaycastFastNode {
         if let Some(v) = &self.no_distance {
             extra.push(("distance", wgpu::BindingResource::TextureView(v)));
         }
+        extra.extend(self.effects.bindings());
         let bg = ctx.bind_group(&self.pipeline, &extra)?;
         let (w, h) = ctx.extent("color");
         let mut pass = ctx.begin_compute_pass();
@@ -273,6 +301,8 @@ impl PassNode for RaycastFastNode {
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
+        self.step_voxels = params.float("step_voxels");
+        self.effects.invalidate();
         self.block_size = params.uint("block_size").max(1) as u32;
         let fast = FastParamsGpu { block_size: self.block_size, _pad: [0; 3] };
         gpu.queue.write_buffer(&self.fast, 0, bytemuck::bytes_of(&fast));

@@ -88,6 +88,18 @@ pub fn reference_settings(p: &Params) -> RaycastSettings {
         threshold: p.float("threshold"),
         max_steps: p.uint("max_steps") as u32,
         jitter: p.boolean("jitter"),
+        effects: volgraph_accel::reference::Effects {
+            shading: p.boolean("shading"),
+            preintegration: p.boolean("preintegration"),
+            tricubic: p.boolean("tricubic"),
+        },
+        dvr_shading: Phong {
+            ambient: p.float("ambient"),
+            diffuse: p.float("diffuse"),
+            specular: p.float("specular"),
+            shininess: p.float("shininess"),
+        },
+        opacity_unit_voxels: 1.0,
         mode: if is_iso(p) {
             RenderMode::Isosurface {
                 iso: p.float("iso_value"),

@@ -163,6 +163,10 @@ impl PassPlugin for RaycastSegment {
         vec![ShaderUse { file, entry_point }]
     }
 
+    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
+        crate::effects::jitter_defines(params)
+    }
+
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let error = |message: String| PassError { pass: ctx.pass_id.to_string(), message };
         let accum_format = ctx.ports.iter().find(|p| p.name == "accum").and_then(|p| p.format);
@@ -192,6 +196,7 @@ impl PassPlugin for RaycastSegment {
         };
         let extra: &[&str] =
             if self.counter.is_some() { &["params", "segment", "invocations"] } else { &["params", "segment"] };
+        let defines = crate::effects::jitter_defines(ctx.params);
         let spec = |depth: Option<DepthSpec<'static>>| RenderPipelineSpec {
             shader,
             vertex: "vs_segment",
@@ -199,6 +204,7 @@ impl PassPlugin for RaycastSegment {
             extra_bindings: extra,
             blend: Some(front_to_back_blend()),
             depth,
+            defines: &defines,
             ..Default::default()
         };
         let free = ctx.render_pipeline(&spec(None))?;

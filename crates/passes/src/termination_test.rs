@@ -71,13 +71,19 @@ impl PassPlugin for TerminationTest {
         ]
     }
 
+    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
+        crate::effects::jitter_defines(params)
+    }
+
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        let defines = crate::effects::jitter_defines(ctx.params);
         let spec = |fragment| RenderPipelineSpec {
             shader: "termination_test.wgsl",
             vertex: "vs_segment",
             fragment,
             extra_bindings: &["params", "segment"],
             depth: Some(DepthSpec { port: "depth", write: true, compare: wgpu::CompareFunction::Always }),
+            defines: &defines,
             ..Default::default()
         };
         // RC-a never re-enables a ray, so its test is culled by early-z itself (see the shader).

@@ -58,6 +58,7 @@ impl PassPlugin for Misnamed {
                 entry: "cs_dvr",
                 extra_bindings: &["params"],
                 constants: &[],
+                defines: &[],
             })?;
         } else {
             ctx.render_pipeline(&RenderPipelineSpec {

@@ -1,19 +1,29 @@
 //! "Simulate only the effects a scene calls for": a pass compiles only the shader code its
-//! parameters ask for. Each plugin names the entry points it will use (`PassPlugin::shaders`);
-//! wgpu hands the driver one entry point at a time and naga's backends emit only the functions
-//! reachable from it, so code unreachable from the chosen entry point is never compiled. These
-//! tests walk naga's IR from each entry point and check which effects' code is reachable.
+//! parameters ask for. Each plugin names the entry points it will use (`PassPlugin::shaders`)
+//! and the `#if` names its modules are assembled with (`PassPlugin::shader_defines`: the scene
+//! effects it was asked for); code in an `#if` that is off is not in the module at all, and of
+//! what is, wgpu hands the driver one entry point at a time and naga's backends emit only the
+//! functions reachable from it. These tests assemble each module as the pass does, walk naga's
+//! IR from each entry point and check which effects' code is reachable — for the isosurface and
+//! every scene effect (shading, pre-integration, tricubic, jitter) on every graph that takes it.
 
 use std::collections::BTreeSet;
 
 use volgraph_core::runtime::shaders::parse_and_validate;
-use volgraph_core::shader_source::{default_shader_root, load_shader};
+use volgraph_core::shader_source::{ShaderSources, assemble_with, default_shader_root};
 use volgraph_core::{CompileOptions, compile};
 use volgraph_passes::builtin_registry;
 
 /// Names of the functions reachable from entry point `entry` of `file`.
 fn reachable(file: &str, entry: &str) -> BTreeSet<String> {
-    let source = load_shader(&default_shader_root(), file).expect("shader loads");
+    reachable_with(file, entry, &[])
+}
+
+/// Names of the functions reachable from entry point `entry` of `file` assembled with `defines`.
+fn reachable_with(file: &str, entry: &str, defines: &[&str]) -> BTreeSet<String> {
+    let sources = ShaderSources::new().with_disk(default_shader_root());
+    let defines: BTreeSet<String> = defines.iter().map(|d| d.to_string()).collect();
+    let source = assemble_with(&sources, file, &defines).expect("shader loads");
     let (module, _) = parse_and_validate(file, &source.text).expect("shader validates");
     let ep = module.entry_points.iter().find(|e| e.name == entry).unwrap_or_else(|| panic!("{file} has {entry}"));
     let mut seen = BTreeSet::new();
@@ -59,7 +69,43 @@ fn march_code(graph: &str, options: CompileOptions) -> BTreeSet<String> {
     let plugin = registry.get(&step.kind).expect("registered");
     let uses = plugin.shaders(&step.params);
     assert!(!uses.is_empty(), "{} declares its shaders", step.kind);
-    uses.iter().flat_map(|u| reachable(u.file, u.entry_point)).collect()
+    let defines = plugin.shader_defines(&step.params);
+    uses.iter().flat_map(|u| reachable_with(u.file, u.entry_point, &defines)).collect()
+}
+
+/// Each scene effect and a function only its code calls.
+const EFFECT_MARKERS: [(&str, &str); 4] = [
+    ("shading", "headlight"),
+    ("preintegration", "lookup_preintegrated"),
+    ("tricubic", "sample_tricubic"),
+    ("jitter", "pcg_hash"),
+];
+
+/// The DVR graphs that take every effect (graphs/basic and graphs/modern).
+const DVR_GRAPHS: [&str; 4] =
+    ["basic/fragment_raycast.ron", "basic/compute_raycast.ron", "modern/single_pass_ess_ert.ron", "modern/fastest.ron"];
+
+#[test]
+fn every_scene_effect_is_compiled_only_when_the_scene_turns_it_on() {
+    for graph in DVR_GRAPHS {
+        let none = march_code(graph, CompileOptions::new(64, 64));
+        for (effect, marker) in EFFECT_MARKERS {
+            assert!(!none.contains(marker), "{graph}: {effect} is off, yet {marker} is compiled: {none:?}");
+            let on = march_code(graph, CompileOptions::new(64, 64).with_features([effect]));
+            assert!(on.contains(marker), "{graph}: {effect} is on, so {marker} is compiled: {on:?}");
+            for (other, other_marker) in EFFECT_MARKERS.iter().filter(|(o, _)| *o != effect) {
+                assert!(!on.contains(*other_marker), "{graph} with {effect} only compiles no {other}: {on:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn the_isosurface_takes_tricubic_and_jitter() {
+    let plain = march_code("basic/isosurface.ron", CompileOptions::new(64, 64));
+    let both = march_code("basic/isosurface.ron", CompileOptions::new(64, 64).with_features(["tricubic", "jitter"]));
+    assert!(!plain.contains("sample_tricubic") && !plain.contains("pcg_hash"), "{plain:?}");
+    assert!(both.contains("sample_tricubic") && both.contains("pcg_hash"), "{both:?}");
 }
 
 #[test]

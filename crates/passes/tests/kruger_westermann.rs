@@ -485,6 +485,7 @@ fn sbvr_approximates_the_reference() {
         max_steps: 1 << 16,
         jitter: false,
         mode: volgraph_accel::reference::RenderMode::Dvr,
+        ..Default::default()
     };
     let reference = render_reference(&v, &l, &CAMERA, SIZE, SIZE, &settings);
     let (max_abs, mean_abs) = diff_reference(&sbvr.image, &reference.color);

@@ -30,6 +30,15 @@ fn generated(name: &str) -> Option<anyhow::Result<Volume>> {
     Some(Ok(make(edge)))
 }
 
+/// The generated volume `name` (`ml64`, `mlf64`, `sphere64`, `noise64`), or an error listing them.
+pub fn load_generated(name: &str) -> anyhow::Result<Volume> {
+    generated(name).unwrap_or_else(|| {
+        Err(anyhow!(
+            "Generated(\"{name}\") names no generated volume; use ml<N>, mlf<N>, sphere<N> or noise<N>, e.g. ml64"
+        ))
+    })
+}
+
 /// Loads dataset `name`: a generated volume when the name is one (`ml64`), else the data folder's
 /// volume of that name with its manifest spacing.
 pub fn load(name: &str) -> anyhow::Result<Volume> {

@@ -24,8 +24,12 @@ use crate::inputs;
 /// The arguments of `volgraph view`.
 #[derive(clap::Args, Debug)]
 pub struct ViewArgs {
-    /// The graph file (RON).
-    pub graph: PathBuf,
+    /// The graph file (RON); default: the scene's graph.
+    pub graph: Option<PathBuf>,
+    /// A scene file (scenes/*.ron): volume, transfer function, camera, viewport, graph, effects
+    /// (on at start; the panel toggles them), precision; flags given as well win over it.
+    #[arg(long)]
+    pub scene: Option<PathBuf>,
     /// Volume file (.raw, .nrrd, .nhdr, .mhd, .mha); default: a generated Marschner–Lobb 64³.
     #[arg(long)]
     pub volume: Option<PathBuf>,
@@ -37,12 +41,13 @@ pub struct ViewArgs {
     /// The colour map to use from a ParaView .json holding several.
     #[arg(long = "tf-map")]
     pub tf_map: Option<String>,
-    /// Window size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "800x600")]
-    pub size: String,
-    /// Orbit camera AZIMUTH,ELEVATION,DISTANCE (degrees, degrees, world units).
-    #[arg(long, default_value = "30,20,3.2")]
-    pub camera: String,
+    /// Window size, WIDTHxHEIGHT [default: the scene's viewport, else 800x600].
+    #[arg(long)]
+    pub size: Option<String>,
+    /// Orbit camera AZIMUTH,ELEVATION,DISTANCE (degrees, degrees, world units) [default: the
+    /// scene's first camera, else 30,20,3.2].
+    #[arg(long)]
+    pub camera: Option<String>,
     /// Scene features on at start, comma separated.
     #[arg(long, value_delimiter = ',')]
     pub features: Vec<String>,
@@ -91,8 +96,23 @@ pub fn emit(event: &session::Event) {
 
 /// Runs `volgraph view`.
 pub fn run(args: ViewArgs) -> Result<(), CliError> {
-    let viewport = inputs::parse_size(&args.size)?;
-    let camera = inputs::parse_camera(&args.camera)?;
+    let scene = args.scene.as_deref().map(crate::scene::Scene::load).transpose().map_err(|e| anyhow::anyhow!(e))?;
+    let graph = match (&args.graph, scene.as_ref().and_then(|s| s.graph.clone())) {
+        (Some(g), _) => g.clone(),
+        (None, Some(g)) => g,
+        (None, None) => {
+            return Err(CliError::Other(anyhow::anyhow!(
+                "no graph: give a graph file (volgraph view GRAPH), or a --scene whose file names one"
+            )));
+        }
+    };
+    let size = args.size.clone().or_else(|| scene.as_ref().and_then(|s| s.viewport).map(|(w, h)| format!("{w}x{h}")));
+    let viewport = inputs::parse_size(size.as_deref().unwrap_or("800x600"))?;
+    let camera = match (&args.camera, scene.as_ref().and_then(|s| s.camera.as_ref())) {
+        (Some(text), _) => inputs::parse_camera(text)?,
+        (None, Some(spec)) => spec.at(0),
+        (None, None) => inputs::parse_camera("30,20,3.2")?,
+    };
     if let Some(path) = &args.screenshot {
         let kind = crate::image_out::ImageKind::from_path(path)?;
         if kind != crate::image_out::ImageKind::Png {
@@ -103,7 +123,8 @@ pub fn run(args: ViewArgs) -> Result<(), CliError> {
         }
     }
     let session_args = session::SessionArgs {
-        graph: args.graph,
+        graph,
+        scene,
         volume: args.volume,
         raw: inputs::raw_options(&args.raw)?,
         tf: args.tf,

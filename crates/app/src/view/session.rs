@@ -102,6 +102,9 @@ pub struct SessionArgs {
     pub features: Vec<String>,
     /// A shader folder to read (and watch) instead of the built-in shaders.
     pub shaders: Option<PathBuf>,
+    /// A scene supplying the volume and transfer function where `volume` and `tf` are not
+    /// given, and its precision and opacity reference.
+    pub scene: Option<crate::scene::Scene>,
 }
 
 /// A graph running on a runtime, with everything that can change it.
@@ -144,20 +147,38 @@ impl LiveSession {
     ) -> Result<(Self, Event), crate::cli::CliError> {
         let start = Instant::now();
         let source = inputs::read_graph(&args.graph)?;
-        let generated = args.volume.is_none();
-        let (volume, notes) = inputs::volume(args.volume.as_ref(), &args.raw)?;
+        let (volume, generated, notes) = match (&args.volume, &args.scene) {
+            (None, Some(scene)) => crate::scene::load_volume(scene, &args.raw)?,
+            (volume, _) => {
+                let (v, notes) = inputs::volume(volume.as_ref(), &args.raw)?;
+                (v, volume.is_none(), notes)
+            }
+        };
         for note in notes {
             eprintln!("note: {note}");
         }
-        let (tf, tf_notes) = inputs::transfer_function(args.tf.as_ref(), args.tf_map.as_deref(), &volume, generated)?;
+        let (tf, tf_path, tf_notes) = match (&args.tf, &args.scene) {
+            (None, Some(scene)) => {
+                crate::scene::load_transfer_function(scene, args.tf_map.as_deref(), &volume, generated)?
+            }
+            (tf, _) => {
+                let (t, notes) = inputs::transfer_function(tf.as_ref(), args.tf_map.as_deref(), &volume, generated)?;
+                (t, tf.clone(), notes)
+            }
+        };
         for note in tf_notes {
             eprintln!("note: {note}");
         }
         let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
         let (sources, shader_dir) = crate::shader_dir::sources_for(&args.graph, args.shaders.as_deref());
         let mut runtime = Runtime::new(gpu, ShaderLibrary::new(sources));
-        let options = CompileOptions::new(args.viewport.0, args.viewport.1)
+        let mut options = CompileOptions::new(args.viewport.0, args.viewport.1)
             .with_features(args.features.iter().filter(|f| !f.is_empty()).cloned());
+        if let Some(scene) = &args.scene {
+            options.features.extend(scene.effects.iter().cloned());
+            options.precision = scene.precision;
+            runtime.set_opacity_reference(scene.opacity_reference);
+        }
         let graph_name = args.graph.display().to_string();
         let plan =
             compile_for(&graph_name, &source, &registry, &options, &volume).map_err(crate::cli::CliError::Graph)?;
@@ -175,7 +196,7 @@ impl LiveSession {
             graph: args.graph.clone(),
             graph_name: graph_name.clone(),
             source,
-            tf_path: args.tf.clone(),
+            tf_path,
             tf_map: args.tf_map.clone(),
             volume,
             lut,

@@ -44,6 +44,7 @@ fn scratch(name: &str, graph: &str) -> Scratch {
 fn open(s: &Scratch, tf: Option<PathBuf>) -> LiveSession {
     let gpu = Arc::new(Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)"));
     let args = SessionArgs {
+        scene: None,
         graph: s.graph.clone(),
         volume: None,
         raw: Default::default(),
@@ -232,6 +233,7 @@ fn a_frame_the_gpu_rejects_puts_the_last_good_graph_back() {
     let mut registry = volgraph_passes::builtin_registry();
     registry.register(BadDraw);
     let args = SessionArgs {
+        scene: None,
         graph: s.graph.clone(),
         volume: None,
         raw: Default::default(),

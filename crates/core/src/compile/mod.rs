@@ -39,6 +39,10 @@ pub struct CompileOptions {
     /// Parameter values overriding the graph file's, keyed `"<pass id>.<param>"` (benchmark
     /// sweeps, viewer sliders). Checked like values written in the file.
     pub param_overrides: BTreeMap<String, ron::Value>,
+    /// The scene's float precision: every RGBA float target (colour, accumulation and, through
+    /// them, history) whose pass can write it takes this format instead of its default or
+    /// declared one. `None`: the graph's formats.
+    pub precision: Option<crate::format::Precision>,
 }
 
 impl Default for CompileOptions {
@@ -49,6 +53,7 @@ impl Default for CompileOptions {
             scalars: BTreeMap::new(),
             scene: BTreeMap::new(),
             param_overrides: BTreeMap::new(),
+            precision: None,
         }
     }
 }

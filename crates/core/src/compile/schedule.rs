@@ -82,7 +82,12 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
         slots,
         outputs,
         history,
-        known_features: c.passes.iter().flat_map(|p| p.needs.iter().cloned()).collect(),
+        known_features: c
+            .passes
+            .iter()
+            .flat_map(|p| p.needs.iter().cloned())
+            .chain(c.features_read.iter().cloned())
+            .collect(),
         known_scalars: c
             .inputs
             .iter()

@@ -81,6 +81,8 @@ pub struct RenderPipelineSpec<'a> {
     pub constants: &'a [(&'a str, f64)],
     /// Primitive topology (instanced quads, point lists drawn as triangles, lines).
     pub topology: wgpu::PrimitiveTopology,
+    /// `#if` names the module is assembled with (effects a scene turned on).
+    pub defines: &'a [&'a str],
 }
 
 /// A compute pipeline request.
@@ -94,6 +96,8 @@ pub struct ComputePipelineSpec<'a> {
     pub extra_bindings: &'a [&'a str],
     /// Pipeline-overridable constants (workgroup size, features).
     pub constants: &'a [(&'a str, f64)],
+    /// `#if` names the module is assembled with (effects a scene turned on).
+    pub defines: &'a [&'a str],
 }
 
 /// The compiled pipeline of a pass with its reflected bindings; cheap to clone.
@@ -312,15 +316,15 @@ impl<'a> CreateContext<'a> {
             .collect()
     }
 
-    fn shader(&self, file: &str) -> Result<std::sync::Arc<super::shaders::LoadedShader>, PassError> {
+    fn shader(&self, file: &str, defines: &[&str]) -> Result<std::sync::Arc<super::shaders::LoadedShader>, PassError> {
         self.modules.borrow_mut().insert(file.to_string());
-        self.shaders.get(self.gpu, file).map_err(|e| self.error(e))
+        self.shaders.get_with(self.gpu, file, defines).map_err(|e| self.error(e))
     }
 
     /// Builds (or takes from the cache) a render pipeline drawing a fragment shader into this
     /// pass's output ports, named by the fragment output struct's members.
     pub fn render_pipeline(&self, spec: &RenderPipelineSpec<'_>) -> Result<PassPipeline, PassError> {
-        let shader = self.shader(spec.shader)?;
+        let shader = self.shader(spec.shader, spec.defines)?;
         let r = reflect(&shader.module, &shader.info, &[spec.vertex, spec.fragment])
             .map_err(|e| self.error(format!("{} {e}", spec.shader)))?;
         self.check_bindings(spec.shader, &r.bindings, spec.extra_bindings)?;
@@ -450,7 +454,7 @@ impl<'a> CreateContext<'a> {
     /// Builds (or takes from the cache) a compute pipeline writing this pass's outputs as storage
     /// textures or buffers named after the ports.
     pub fn compute_pipeline(&self, spec: &ComputePipelineSpec<'_>) -> Result<PassPipeline, PassError> {
-        let shader = self.shader(spec.shader)?;
+        let shader = self.shader(spec.shader, spec.defines)?;
         let r = reflect(&shader.module, &shader.info, &[spec.entry])
             .map_err(|e| self.error(format!("{} {e}", spec.shader)))?;
         self.check_bindings(spec.shader, &r.bindings, spec.extra_bindings)?;

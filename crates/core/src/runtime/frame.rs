@@ -46,12 +46,42 @@ pub struct VolumeDesc {
     pub half_extent: DVec3,
     /// World length of the smallest voxel side: the unit of `step_voxels`.
     pub unit_step: f64,
+    /// The transfer function's opacity is per this many voxel units of distance (the scene's
+    /// opacity reference length): 1 for "per voxel", `1 / unit_step` for "per world unit".
+    pub opacity_unit_voxels: f64,
+}
+
+/// What a transfer function's opacity is per (a scene setting).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum OpacityReference {
+    /// Per voxel of distance (the smallest voxel side): the default, independent of the volume's
+    /// world size.
+    #[default]
+    Voxel,
+    /// Per world unit (the volume's longest side is 1): the look stays the same when the
+    /// resolution changes.
+    World,
 }
 
 impl VolumeDesc {
-    /// The description of `volume`.
+    /// The description of `volume`, opacity per voxel.
     pub fn of(volume: &Volume) -> Self {
-        Self { dims: volume.dims, half_extent: volume.half_extent_world(), unit_step: volume.unit_step_world() }
+        Self {
+            dims: volume.dims,
+            half_extent: volume.half_extent_world(),
+            unit_step: volume.unit_step_world(),
+            opacity_unit_voxels: 1.0,
+        }
+    }
+
+    /// The same volume with opacity per `reference`.
+    pub fn with_opacity_reference(self, reference: OpacityReference) -> Self {
+        let opacity_unit_voxels = match reference {
+            OpacityReference::Voxel => 1.0,
+            OpacityReference::World if self.unit_step > 0.0 => 1.0 / self.unit_step,
+            OpacityReference::World => 1.0,
+        };
+        Self { opacity_unit_voxels, ..self }
     }
 
     /// The box diagonal in unit steps: the longest ray through the volume, in voxels. Graphs read
@@ -135,7 +165,7 @@ pub struct FrameUniforms {
     pub eye_world: [f32; 4],
     /// Half size of the volume box (xyz); w = unit step in world units.
     pub half_extent: [f32; 4],
-    /// Volume dimensions in voxels (xyz).
+    /// Volume dimensions in voxels (xyz); w = the opacity unit in voxels.
     pub volume_dims: [f32; 4],
     /// Viewport width, height, 1/width, 1/height.
     pub viewport: [f32; 4],
@@ -170,9 +200,9 @@ impl FrameUniforms {
     /// The uniform block of `frame`.
     pub fn of(frame: &FrameData) -> Self {
         let c = &frame.camera;
-        let (half, unit, dims) = match &frame.volume {
-            Some(v) => (v.half_extent, v.unit_step, v.dims.as_dvec3()),
-            None => (DVec3::splat(0.5), 1.0, DVec3::ONE),
+        let (half, unit, dims, opacity_unit) = match &frame.volume {
+            Some(v) => (v.half_extent, v.unit_step, v.dims.as_dvec3(), v.opacity_unit_voxels),
+            None => (DVec3::splat(0.5), 1.0, DVec3::ONE, 1.0),
         };
         let eye_inside = c.eye.abs().cmple(half).all();
         let (w, h) = (frame.viewport.0.max(1) as f32, frame.viewport.1.max(1) as f32);
@@ -184,7 +214,7 @@ impl FrameUniforms {
             prev_clip_from_world: mat(frame.previous_camera.unwrap_or(*c).clip_from_world),
             eye_world: [c.eye.x as f32, c.eye.y as f32, c.eye.z as f32, if eye_inside { 1.0 } else { 0.0 }],
             half_extent: [half.x as f32, half.y as f32, half.z as f32, unit as f32],
-            volume_dims: [dims.x as f32, dims.y as f32, dims.z as f32, 0.0],
+            volume_dims: [dims.x as f32, dims.y as f32, dims.z as f32, opacity_unit as f32],
             viewport: [w, h, 1.0 / w, 1.0 / h],
             camera_forward: [c.forward.x as f32, c.forward.y as f32, c.forward.z as f32, c.near as f32],
             eye_texture: v4(c.eye / (2.0 * half) + DVec3::splat(0.5)),

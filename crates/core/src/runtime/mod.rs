@@ -33,7 +33,9 @@ pub use create::{
     ComputePipelineSpec, CreateContext, DepthSpec, PassError, PassPipeline, PipelineCache, PipelineKind, PortInfo,
     RenderPipelineSpec,
 };
-pub use frame::{CameraData, FrameData, FrameUniforms, LONGEST_RAY_VOXELS, PixelRays, VolumeDesc, scene_values_of};
+pub use frame::{
+    CameraData, FrameData, FrameUniforms, LONGEST_RAY_VOXELS, OpacityReference, PixelRays, VolumeDesc, scene_values_of,
+};
 pub use frames::{FrameStats, MAX_FRAMES_IN_FLIGHT};
 pub use gpu::{Gpu, GpuError, GpuFault, GpuFaultKind, GpuOptions};
 pub use inputs::upload_volume_texture;
@@ -131,6 +133,8 @@ pub struct Runtime {
     frame_index: u64,
     history_age: u64,
     last_camera: Option<(CameraData, (u32, u32))>,
+    /// What the transfer function's opacity is per (a scene setting).
+    opacity_reference: OpacityReference,
 }
 
 impl Runtime {
@@ -152,7 +156,19 @@ impl Runtime {
             frame_index: 0,
             history_age: 0,
             last_camera: None,
+            opacity_reference: OpacityReference::default(),
         }
+    }
+
+    /// Sets what the transfer function's opacity is per (per voxel by default; per world unit
+    /// keeps the look when the resolution changes). Takes effect with the next frame.
+    pub fn set_opacity_reference(&mut self, reference: OpacityReference) {
+        self.opacity_reference = reference;
+    }
+
+    /// What the transfer function's opacity is per.
+    pub fn opacity_reference(&self) -> OpacityReference {
+        self.opacity_reference
     }
 
     /// The GPU.
@@ -304,7 +320,7 @@ impl Runtime {
             previous_camera: previous,
             frame_index: self.frame_index,
             history_age: self.history_age,
-            volume: self.inputs.volume().map(|(v, _)| v),
+            volume: self.inputs.volume().map(|(v, _)| v.with_opacity_reference(self.opacity_reference)),
         })
     }
 
@@ -550,6 +566,13 @@ fn record_steps(
         let mut ports = Vec::with_capacity(step.ports.len());
         for bp in &step.ports {
             let mut buffer = None;
+            let version = match &bp.binding {
+                Binding::Input(name) => inputs.get(name).map(|i| i.version()),
+                Binding::Resource { id, .. } if matches!(plan.resources[*id].desc, ResourceDesc::Owned(_)) => {
+                    owned_versions.get(&plan.resources[root_owned(plan, *id)].name).copied()
+                }
+                _ => None,
+            };
             let (view, extent) = match &bp.binding {
                 Binding::Resource { id, written } => {
                     let rid = if bp.access == Access::Modify { written.unwrap_or(*id) } else { *id };
@@ -575,7 +598,7 @@ fn record_steps(
                 Binding::History(name) => (history.get(name).map(|e| &e.previous().view), None),
                 Binding::Unbound => (None, None),
             };
-            ports.push(BoundPort { name: bp.port.clone(), access: bp.access, view, buffer, extent });
+            ports.push(BoundPort { name: bp.port.clone(), access: bp.access, view, buffer, extent, version });
         }
         let entry = nodes.get_mut(&step.pass_id).ok_or_else(|| ApplyError::UnknownKind(step.kind.clone()))?;
         let outputs_published = step.ports.iter().all(|bp| match &bp.binding {

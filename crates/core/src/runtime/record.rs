@@ -17,6 +17,9 @@ pub(crate) struct BoundPort<'a> {
     pub view: Option<&'a wgpu::TextureView>,
     pub buffer: Option<&'a wgpu::Buffer>,
     pub extent: Option<(u32, u32)>,
+    /// Version of a graph input's content or of an Owned resource (equal content, equal
+    /// version); `None` for targets, which change every frame.
+    pub version: Option<u64>,
 }
 
 /// Samplers and the frame uniform buffer.
@@ -113,6 +116,13 @@ impl<'a> RecordContext<'a> {
 
     fn port(&self, name: &str) -> Option<&BoundPort<'a>> {
         self.ports.iter().find(|p| p.name == name)
+    }
+
+    /// The content version of what `port` reads — a graph input (the volume, the transfer
+    /// function) or an Owned resource — so a node can keep data derived from it until it changes
+    /// (a pre-integration table rebuilt when the TF changes); `None` for targets and unwired ports.
+    pub fn input_version(&self, port: &str) -> Option<u64> {
+        self.port(port).and_then(|p| p.version)
     }
 
     /// The texture view bound to `port` (an input's value, or the target an output writes).

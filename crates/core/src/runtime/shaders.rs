@@ -9,12 +9,14 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
 use super::gpu::Gpu;
-use crate::shader_source::{ShaderSource, ShaderSources, assemble};
+use crate::shader_source::{ShaderSource, ShaderSources, assemble_with};
 
 /// A loaded shader: the wgpu module, naga's module and analysis, and the files it came from.
 pub struct LoadedShader {
     /// Relative name, `raycast.wgsl`.
     pub file: String,
+    /// The `#if` names it was assembled with (sorted).
+    pub defines: Vec<String>,
     /// The assembled source.
     pub source: ShaderSource,
     /// Hash of the assembled text: part of every pipeline key built from this module.
@@ -27,7 +29,17 @@ pub struct LoadedShader {
     pub wgpu: wgpu::ShaderModule,
 }
 
-/// Loads and caches shader modules by relative name.
+/// The cache key of `file` assembled with `defines`: `raycast.wgsl` or `raycast.wgsl#SHADING,TRICUBIC`.
+fn module_key(file: &str, defines: &[String]) -> String {
+    if defines.is_empty() { file.to_string() } else { format!("{file}#{}", defines.join(",")) }
+}
+
+/// The file of a module key.
+fn file_of_key(key: &str) -> &str {
+    key.split_once('#').map_or(key, |(file, _)| file)
+}
+
+/// Loads and caches shader modules by relative name and defines.
 pub struct ShaderLibrary {
     sources: ShaderSources,
     cache: Mutex<HashMap<String, Arc<LoadedShader>>>,
@@ -107,18 +119,21 @@ impl ShaderLibrary {
             |a: &Path, b: &Path| a == b || matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y);
         let touches = |files: &[PathBuf]| files.iter().any(|p| changed.iter().any(|c| same(p, c)));
         let (Ok(mut cache), Ok(mut unloaded)) = (self.cache.lock(), self.unloaded.lock()) else { return Vec::new() };
-        let mut stale: Vec<String> =
-            cache.iter().filter(|(_, s)| touches(&s.source.disk_paths())).map(|(name, _)| name.clone()).collect();
-        for name in &stale {
-            if let Some(s) = cache.remove(name) {
-                unloaded.insert(name.clone(), s.source.disk_paths());
+        let keys: Vec<String> =
+            cache.iter().filter(|(_, s)| touches(&s.source.disk_paths())).map(|(key, _)| key.clone()).collect();
+        let mut stale: Vec<String> = Vec::new();
+        for key in &keys {
+            if let Some(s) = cache.remove(key) {
+                unloaded.insert(file_of_key(key).to_string(), s.source.disk_paths());
             }
+            stale.push(file_of_key(key).to_string());
         }
         // Modules a broken edit left unloaded: a change to their files is what fixes them.
         let broken: Vec<String> =
             unloaded.iter().filter(|(n, files)| !stale.contains(n) && touches(files)).map(|(n, _)| n.clone()).collect();
         stale.extend(broken);
         stale.sort();
+        stale.dedup();
         stale
     }
 
@@ -137,17 +152,26 @@ impl ShaderLibrary {
         files
     }
 
-    /// The cached module `file`, if loaded.
+    /// The cached module `file` (assembled without defines), if loaded.
     pub fn cached(&self, file: &str) -> Option<Arc<LoadedShader>> {
         self.cache.lock().ok().and_then(|c| c.get(file).cloned())
     }
 
-    /// The module for `file`, loading and compiling it on first use.
+    /// The module for `file` without defines, loading and compiling it on first use.
     pub fn get(&self, gpu: &Gpu, file: &str) -> Result<Arc<LoadedShader>, String> {
-        if let Some(s) = self.cached(file) {
+        self.get_with(gpu, file, &[])
+    }
+
+    /// The module for `file` assembled with the `#if` names `defines` (order and repeats do not
+    /// matter), loading and compiling it on first use; each define set is its own module.
+    pub fn get_with(&self, gpu: &Gpu, file: &str, defines: &[&str]) -> Result<Arc<LoadedShader>, String> {
+        let set: std::collections::BTreeSet<String> = defines.iter().map(|d| d.to_string()).collect();
+        let defines: Vec<String> = set.iter().cloned().collect();
+        let key = module_key(file, &defines);
+        if let Some(s) = self.cache.lock().ok().and_then(|c| c.get(&key).cloned()) {
             return Ok(s);
         }
-        let source = assemble(&self.sources, file).map_err(|e| e.to_string())?;
+        let source = assemble_with(&self.sources, file, &set).map_err(|e| e.to_string())?;
         let (module, info) = parse_and_validate_source(file, &source)?;
         let mut hasher = std::collections::hash_map::DefaultHasher::new();
         source.text.hash(&mut hasher);
@@ -163,9 +187,9 @@ impl ShaderLibrary {
                 },
             )
             .map_err(|e| e.to_string())?;
-        let loaded = Arc::new(LoadedShader { file: file.to_string(), source, hash, module, info, wgpu });
+        let loaded = Arc::new(LoadedShader { file: file.to_string(), defines, source, hash, module, info, wgpu });
         if let Ok(mut c) = self.cache.lock() {
-            c.insert(file.to_string(), loaded.clone());
+            c.insert(key, loaded.clone());
         }
         if let Ok(mut u) = self.unloaded.lock() {
             u.remove(file);

@@ -82,6 +82,10 @@ fn raycast_params() -> Vec<ParamSpec> {
         ParamSpec::boolean("jitter", false, "offset each ray's first sample by a per-pixel hash"),
         ParamSpec::choice("mode", "dvr", &["dvr", "iso"], "direct volume rendering or first-hit isosurface"),
         ParamSpec::float("iso_value", 0.5, 0.0, 1.0, "isovalue in normalized scalar units"),
+        // The scene effects graphs wire to features ("feature.shading").
+        ParamSpec::boolean("shading", false, "gradient shading"),
+        ParamSpec::boolean("preintegration", false, "pre-integrated classification"),
+        ParamSpec::boolean("tricubic", false, "tricubic reconstruction"),
     ]
 }
 

@@ -90,6 +90,8 @@ pub(crate) struct Checked {
     pub warnings: Vec<Diagnostic>,
     /// Scene values a repeat count reads that the graph does not declare as Scalar inputs.
     pub scene_values: Vec<String>,
+    /// Scene features parameters read as `"feature.NAME"` (effects a pass specializes for).
+    pub features_read: std::collections::BTreeSet<String>,
 }
 
 const RESERVED: [&str; 2] = ["input", "history"];
@@ -106,6 +108,7 @@ struct Checker<'a> {
     groups: Vec<GroupInfo>,
     pass_by_id: HashMap<String, usize>,
     group_by_id: HashMap<String, usize>,
+    features_read: std::collections::BTreeSet<String>,
 }
 
 pub(crate) fn check(
@@ -126,6 +129,7 @@ pub(crate) fn check(
         groups: Vec::new(),
         pass_by_id: HashMap::new(),
         group_by_id: HashMap::new(),
+        features_read: Default::default(),
     };
     let order = c.collect_nodes();
     for key in options.param_overrides.keys() {
@@ -166,6 +170,7 @@ pub(crate) fn check(
             inputs: doc.inputs.clone(),
             warnings: c.warnings,
             scene_values,
+            features_read: c.features_read,
         })
     } else {
         Err(c.diags)

@@ -38,6 +38,24 @@ impl Checker<'_> {
                         }
                     }
                 }
+                // `"feature.NAME"`: whether the scene turned effect NAME on (a bool the pass
+                // specializes its shaders with).
+                ron::Value::String(text) if text.starts_with("feature.") => {
+                    let feature = &text["feature.".len()..];
+                    if feature.is_empty() || !feature.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+                        self.err(
+                            self.loc.pass_entry(path, &p.id, "params", name, false),
+                            format!(
+                                "parameter \"{name}\" of pass \"{}\" reads \"{text}\", which names no feature",
+                                p.id
+                            ),
+                            Some("write \"feature.shading\" (letters, digits and _ after \"feature.\")".to_string()),
+                        );
+                        continue;
+                    }
+                    self.features_read.insert(feature.to_string());
+                    ron::Value::Bool(self.options.features.contains(feature))
+                }
                 other => other.clone(),
             };
             let value = &value;

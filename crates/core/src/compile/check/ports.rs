@@ -60,7 +60,15 @@ impl Checker<'_> {
             let desc = match &port.kind {
                 PortKind::Target { formats, .. } => {
                     let default = formats.first().copied().unwrap_or(TargetFormat::Rgba32Float);
-                    let format = decl.format.unwrap_or(default);
+                    let mut format = decl.format.unwrap_or(default);
+                    // The scene's precision wins over the graph's float RGBA formats where the
+                    // pass can write it.
+                    if let Some(precision) = self.options.precision
+                        && matches!(format, TargetFormat::Rgba16Float | TargetFormat::Rgba32Float)
+                        && formats.contains(&precision.rgba())
+                    {
+                        format = precision.rgba();
+                    }
                     if !formats.contains(&format) {
                         let names: Vec<&str> = formats.iter().map(|f| f.name()).collect();
                         self.err(

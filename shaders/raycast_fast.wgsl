@@ -24,7 +24,9 @@ override WORKGROUP_Y: u32 = 8u;
 override LEAP: u32 = 2u;
 // Classify with the corrected table instead of the TF and pow.
 override CORRECTED: bool = true;
-// The step is exactly half a voxel: the exact correction is a square root, no pow.
+// The correction exponent (step over opacity unit) is exactly 0.5: the exact correction is a
+// square root, no pow. The node picks this pipeline per frame (the opacity unit is frame data):
+// no branch on it may sit in the sample loop, which on llvmpipe slows every sample.
 override HALF_STEP: bool = false;
 // Samples between two looks at the distance map (see `march`).
 override CHECK_EVERY: u32 = 16u;
@@ -58,7 +60,7 @@ fn composite(acc: vec4<f32>, u: vec3<f32>) -> vec4<f32> {
     return composite_sample(acc, u);
 #else
     if (!CORRECTED) {
-        if (HALF_STEP && frame.volume_dims.w == 1.0) {
+        if (HALF_STEP) {
             // The exact correction for a half-voxel step: 1 - (1 - a)^0.5, a square root.
             let c = sample_tf(sample_volume(u));
             let a = 1.0 - sqrt(1.0 - clamp(c.a, 0.0, 1.0));

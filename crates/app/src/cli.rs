@@ -84,6 +84,10 @@ enum Command {
     /// Show a graph live in a window, hot-reloading the graph, its shaders and its transfer
     /// function; an overlay shows per-pass GPU time, the plan and every parameter.
     View(crate::view::ViewArgs),
+    /// What accuracy costs in time: every knob (step, threshold, precision, block size, shading,
+    /// pre-integration, jitter, filter) swept on several datasets, error against the converged
+    /// f64 reference beside ms per frame; a table, JSON rows and one plot per knob.
+    Sweep(crate::sweep::SweepArgs),
     /// Measure: graphs (speed, samples, accuracy), fetch (the device's sampling ceiling), live
     /// (reload latency, soak), compile, accel (CPU acceleration structures).
     Bench {
@@ -269,7 +273,7 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
             };
             Ok(Checked::Render(Box::new(crate::render::prepare(args)?)))
         }
-        Command::Bench { .. } | Command::View(_) => {
+        Command::Bench { .. } | Command::View(_) | Command::Sweep(_) => {
             Err(CliError::Other(anyhow!("only plan and render are checked ahead of running")))
         }
     }
@@ -294,6 +298,10 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             }
         },
         Command::View(args) => crate::view::run(args),
+        Command::Sweep(args) => {
+            crate::sweep::run(&args).context("sweep")?;
+            Ok(())
+        }
         Command::Bench { which: BenchCommand::Accel { repeats, json } } => {
             let opts = crate::bench_accel::AccelBenchOptions {
                 data_dir: volgraph_accel::data_dir::data_dir(),

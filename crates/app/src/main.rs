@@ -15,6 +15,7 @@ mod render;
 mod scene;
 mod shader_dir;
 mod stdout;
+mod sweep;
 mod view;
 
 use std::process::ExitCode;

@@ -100,7 +100,21 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     let opacity = scene.as_ref().map(|s| s.opacity_reference).unwrap_or_default();
     options.scene = scene_values_of(&VolumeDesc::of(&volume));
     let plan = compile(&file, &source, &registry, &options).map_err(CliError::Graph)?;
-    check_user_names(&plan, &options)?;
+    // A scene's effect the graph does not offer is a note (the scene may be shown with another
+    // graph); a --features name it does not know is the user's typo: an error.
+    let mut user = options.clone();
+    user.features.retain(|f| {
+        let from_scene = scene.as_ref().is_some_and(|s| s.effects.contains(f)) && !args.features.contains(f);
+        if from_scene && !plan.known_features.contains(f) {
+            notes.push(format!(
+                "note: graph \"{}\" does not offer the scene's effect \"{f}\"; it is left out",
+                plan.name
+            ));
+            return false;
+        }
+        true
+    });
+    check_user_names(&plan, &user)?;
     notes.extend(warning_lines(&plan));
     let output = match &args.output {
         Some(name) => name.clone(),

@@ -179,20 +179,27 @@ impl PassPlugin for RaycastFast {
         if crate::raycast_compute::color_is_f32(ctx) {
             defines.push("COLOR_F32");
         }
-        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
-            shader: "raycast_fast.wgsl",
-            entry: if counted { "cs_counted" } else { "cs_main" },
-            extra_bindings: &with_effect_bindings(&["params", "fast", "corrected"]),
-            defines: &defines,
-            constants: &[
-                ("WORKGROUP_X", wg.0 as f64),
-                ("WORKGROUP_Y", wg.1 as f64),
-                ("LEAP", leap),
-                ("CORRECTED", if table.is_some() { 1.0 } else { 0.0 }),
-                ("CHECK_EVERY", ctx.params.uint("check_every").max(1) as f64),
-                ("HALF_STEP", if ctx.params.float("step_voxels") == 0.5 { 1.0 } else { 0.0 }),
-            ],
-        })?;
+        let variant = |half_step: bool| {
+            ctx.compute_pipeline(&ComputePipelineSpec {
+                shader: "raycast_fast.wgsl",
+                entry: if counted { "cs_counted" } else { "cs_main" },
+                extra_bindings: &with_effect_bindings(&["params", "fast", "corrected"]),
+                defines: &defines,
+                constants: &[
+                    ("WORKGROUP_X", wg.0 as f64),
+                    ("WORKGROUP_Y", wg.1 as f64),
+                    ("LEAP", leap),
+                    ("CORRECTED", if table.is_some() { 1.0 } else { 0.0 }),
+                    ("CHECK_EVERY", ctx.params.uint("check_every").max(1) as f64),
+                    ("HALF_STEP", if half_step { 1.0 } else { 0.0 }),
+                ],
+            })
+        };
+        let pipeline = variant(false)?;
+        // The square-root variant, for frames whose correction exponent is exactly 0.5 (step
+        // 0.5 with opacity per voxel); only the exact classification without effects uses it.
+        let exact_plain = table.is_none() && !ctx.params.boolean("shading") && !ctx.params.boolean("preintegration");
+        let half_step = (exact_plain && ctx.params.float("step_voxels") == 0.5).then(|| variant(true)).transpose()?;
         let params = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
         let block_size = ctx.params.uint("block_size").max(1) as u32;
         let fast = ctx.uniform_with("fast", &FastParamsGpu { block_size, _pad: [0; 3] });
@@ -219,6 +226,7 @@ impl PassPlugin for RaycastFast {
         let effects = EffectState::new(ctx)?;
         Ok(Box::new(RaycastFastNode {
             pipeline,
+            half_step,
             params,
             fast,
             block_size,
@@ -235,6 +243,8 @@ impl PassPlugin for RaycastFast {
 
 struct RaycastFastNode {
     pipeline: PassPipeline,
+    /// The HALF_STEP variant, when the step is 0.5 voxel.
+    half_step: Option<PassPipeline>,
     params: wgpu::Buffer,
     fast: wgpu::Buffer,
     block_size: u32,
@@ -288,10 +298,15 @@ impl PassNode for RaycastFastNode {
             extra.push(("distance", wgpu::BindingResource::TextureView(v)));
         }
         extra.extend(self.effects.bindings());
-        let bg = ctx.bind_group(&self.pipeline, &extra)?;
+        let unit = ctx.frame.volume.map_or(1.0, |v| v.opacity_unit_voxels);
+        let pipeline = match &self.half_step {
+            Some(half) if self.step_voxels / unit == 0.5 => half,
+            _ => &self.pipeline,
+        };
+        let bg = ctx.bind_group(pipeline, &extra)?;
         let (w, h) = ctx.extent("color");
         let mut pass = ctx.begin_compute_pass();
-        if let PipelineKind::Compute(p) = &self.pipeline.pipeline {
+        if let PipelineKind::Compute(p) = &pipeline.pipeline {
             pass.set_pipeline(p);
         }
         pass.set_bind_group(0, &bg, &[]);

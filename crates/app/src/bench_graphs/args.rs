@@ -15,7 +15,7 @@ use crate::inputs;
 /// functions, baseline and frames; any flag given as well replaces the preset's value.
 #[derive(Args, Debug, Clone, Default)]
 pub struct GraphsArgs {
-    /// A named preset: basic, kw2003-table1, thesis-tables, peer.
+    /// A named preset: basic, kw2003-table1, thesis-tables, peer, effects-off.
     #[arg(long)]
     pub preset: Option<String>,
     /// Graph files, comma separated (graphs that do not exist are skipped with a note).
@@ -63,9 +63,10 @@ pub struct GraphsArgs {
     /// parameter); by default one extra frame per case counts them.
     #[arg(long)]
     pub no_gpu_count: bool,
-    /// Accuracy sweep PASS.PARAM=V1,V2,... (e.g. march.step_voxels=0.25,0.5,1,2), or
-    /// input.NAME=... for a Scalar graph input shared by several passes; adds error
-    /// against a converged CPU reference to every row.
+    /// Accuracy sweep PASS.PARAM=V1,V2,... (e.g. march.step_voxels=0.25,0.5,1,2), input.NAME=...
+    /// for a Scalar graph input shared by several passes, feature.NAME=off,on for a scene effect,
+    /// scene.precision=f16,f32; adds error against a converged CPU reference (of the same
+    /// effects) to every row.
     #[arg(long)]
     pub sweep: Option<String>,
     /// Compute error against the converged CPU reference even without --sweep.
@@ -197,6 +198,23 @@ pub fn parse_sweep(text: &str) -> anyhow::Result<Sweep> {
         .collect::<anyhow::Result<_>>()?;
     if values.is_empty() {
         return Err(fail("no values"));
+    }
+    if pass == "feature" {
+        for (text, _) in &values {
+            if !matches!(text.as_str(), "on" | "off") {
+                return Err(fail(&format!("a feature is \"on\" or \"off\", not \"{text}\"")));
+            }
+        }
+    }
+    if pass == "scene" {
+        if param != "precision" {
+            return Err(fail("the scene knob is scene.precision"));
+        }
+        for (text, _) in &values {
+            if volgraph_core::Precision::from_name(text).is_none() {
+                return Err(fail(&format!("precision is f16 or f32, not \"{text}\"")));
+            }
+        }
     }
     Ok(Sweep { key: key.to_string(), values })
 }

@@ -124,6 +124,22 @@ pub const PRESETS: &[BenchPreset] = &[
             install: "install the peer with `pip install vtk==9.7.2`, or pass --no-peer",
         }),
     },
+    BenchPreset {
+        name: "effects-off",
+        about: "A graph that offers every scene effect, with the effects off, against the same graph written by hand \
+                without them (graphs/bench/fastest_minimal.ron): the ratio should be 1 within noise",
+        graphs: &["graphs/bench/fastest_minimal.ron", "graphs/modern/fastest.ron"],
+        baseline: "fastest_minimal",
+        datasets: &["ml64", "hydrogen_atom", "neghip"],
+        viewports: &[(512, 512)],
+        tfs: &["default"],
+        cases: &[],
+        params: &[],
+        frames: 24,
+        camera: None,
+        full_turn: false,
+        peer: None,
+    },
 ];
 
 /// The preset named `name`, if any.

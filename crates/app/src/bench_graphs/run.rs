@@ -94,8 +94,24 @@ impl Case<'_> {
 }
 
 /// Sets one knob: `input.NAME` is a Scalar graph input (a scene value shared by several passes,
-/// e.g. Krüger–Westermann's segment length M), anything else `pass.param`.
+/// e.g. Krüger–Westermann's segment length M), `feature.NAME` a scene effect (`on`/`off`),
+/// `scene.precision` the float target precision (`f16`/`f32`), anything else `pass.param`.
 fn set_knob(options: &mut CompileOptions, key: &str, value: &ron::Value) {
+    if let Some(name) = key.strip_prefix("feature.") {
+        let on = matches!(value, ron::Value::Bool(true)) || matches!(value, ron::Value::String(s) if s == "on");
+        if on {
+            options.features.insert(name.to_string());
+        } else {
+            options.features.remove(name);
+        }
+        return;
+    }
+    if key == "scene.precision" {
+        if let ron::Value::String(s) = value {
+            options.precision = volgraph_core::Precision::from_name(s);
+        }
+        return;
+    }
     match (key.strip_prefix("input."), value) {
         (Some(name), ron::Value::Number(n)) => {
             options.scalars.insert(name.to_string(), (*n).into_f64());

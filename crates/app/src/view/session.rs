@@ -182,6 +182,19 @@ impl LiveSession {
         let graph_name = args.graph.display().to_string();
         let plan =
             compile_for(&graph_name, &source, &registry, &options, &volume).map_err(crate::cli::CliError::Graph)?;
+        // A scene's effect the graph does not offer is left out with a note; a --features typo is
+        // an error.
+        if let Some(scene) = &args.scene {
+            for effect in &scene.effects {
+                if !plan.known_features.contains(effect) && !args.features.contains(effect) {
+                    eprintln!(
+                        "note: graph \"{}\" does not offer the scene's effect \"{effect}\"; it is left out",
+                        plan.name
+                    );
+                    options.features.remove(effect);
+                }
+            }
+        }
         crate::cli::check_user_names(&plan, &options)?;
         let shaders = match &shader_dir {
             Some(dir) => format!("shaders from {}", dir.display()),

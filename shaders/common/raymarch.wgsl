@@ -21,11 +21,17 @@ fn pcg_hash(v: u32) -> u32 {
 }
 
 // The per-pixel offset of the first sample, in steps, in [-0.5, 0.5); compiled in only with
-// JITTER (the `jitter` effect), else 0.
+// JITTER (the `jitter` effect), else 0. Stable across frames, unless JITTER_PER_FRAME
+// (`jitter_per_frame`) moves it every frame (the hash of pixel + frame · pixels; frame 0 equals
+// the stable offsets) so that accumulating frames averages the noise away.
 fn ray_jitter(pixel: vec2<u32>) -> f32 {
 #if JITTER
     let width = u32(frame.viewport.x);
-    return f32(pcg_hash(pixel.x + pixel.y * width)) / 4294967296.0 - 0.5;
+    var key = pixel.x + pixel.y * width;
+#if JITTER_PER_FRAME
+    key = key + frame.frame_index * width * u32(frame.viewport.y);
+#endif
+    return f32(pcg_hash(key)) / 4294967296.0 - 0.5;
 #else
     return 0.0;
 #endif

@@ -35,21 +35,27 @@ pub const SHADING_PARAMS: [&str; 4] = ["ambient", "diffuse", "specular", "shinin
 pub fn effect_defines(params: &Params) -> Vec<&'static str> {
     let mut defines: Vec<&'static str> =
         EFFECTS.iter().filter(|(name, ..)| params.boolean(name)).map(|&(_, define, _)| define).collect();
-    if params.boolean("jitter") {
-        defines.push("JITTER");
-    }
+    defines.extend(jitter_defines(params));
     defines
 }
 
 /// `JITTER` when the `jitter` parameter is on: for passes that march the raycast samples
 /// without the other effects (the segment loop, its termination test, the fetch probe).
 pub fn jitter_defines(params: &Params) -> Vec<&'static str> {
-    if params.boolean("jitter") { vec!["JITTER"] } else { Vec::new() }
+    match (params.boolean("jitter"), params.boolean("jitter_per_frame")) {
+        (false, _) => Vec::new(),
+        (true, false) => vec!["JITTER"],
+        (true, true) => vec!["JITTER", "JITTER_PER_FRAME"],
+    }
 }
 
 /// Whether two parameter sets compile the same effects (else the node is rebuilt).
 pub fn same_effects(old: &Params, new: &Params) -> bool {
-    EFFECTS.iter().map(|(name, ..)| *name).chain(["jitter"]).all(|name| old.boolean(name) == new.boolean(name))
+    EFFECTS
+        .iter()
+        .map(|(name, ..)| *name)
+        .chain(["jitter", "jitter_per_frame"])
+        .all(|name| old.boolean(name) == new.boolean(name))
 }
 
 /// What a raycaster node keeps for its effects: the pre-integration table when that effect is on.

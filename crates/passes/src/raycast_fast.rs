@@ -72,7 +72,7 @@ impl PassPlugin for RaycastFast {
         let mut p: Vec<ParamSpec> = raycast_param_specs()
             .into_iter()
             .filter(|s| {
-                matches!(s.name, "step_voxels" | "threshold" | "max_steps" | "jitter")
+                matches!(s.name, "step_voxels" | "threshold" | "max_steps" | "jitter" | "jitter_per_frame")
                     || SHADING_PARAMS.contains(&s.name)
             })
             .collect();

@@ -20,6 +20,11 @@ pub fn raycast_param_specs() -> Vec<ParamSpec> {
             false,
             "offset each ray's first sample by a per-pixel hash (trades banding for noise)",
         ),
+        ParamSpec::boolean(
+            "jitter_per_frame",
+            false,
+            "with jitter: move the offsets every frame (frame 0 keeps the stable ones), for accumulation",
+        ),
         ParamSpec::choice("mode", "dvr", &["dvr", "iso"], "direct volume rendering or first-hit isosurface"),
         ParamSpec::float("iso_value", 0.5, 0.0, 1.0, "isovalue in normalized scalar units (mode \"iso\")"),
         ParamSpec::float("ambient", 0.15, 0.0, 1.0, "Blinn–Phong ambient coefficient (mode \"iso\")"),

@@ -243,3 +243,31 @@ fn jitter_with_early_termination_matches_the_reference() {
         assert!(max.is_finite() && mean <= 1.0 / 255.0, "{graph}: mean {:.4}/255", mean * 255.0);
     }
 }
+
+#[test]
+fn jitter_per_frame_moves_the_offsets_and_keeps_frame_zero() {
+    // Stable jitter (the default) draws the same image every frame; jitter_per_frame draws frame
+    // 0 like it and moves the offsets from frame 1 on.
+    let v = ml();
+    let t = TransferFunction::default_for(&v);
+    let registry = builtin_registry();
+    let source = graph_source("modern/fastest.ron");
+    let lut = t.to_lut_for(&v, 256);
+    let frames = |per_frame: bool| {
+        let options = CompileOptions::new(SIZE, SIZE).with_features(["jitter"]).with_param(
+            "march",
+            "jitter_per_frame",
+            per_frame,
+        );
+        let (mut rt, plan) = render_once(&gpu(), &registry, "modern/fastest.ron", &source, &options, &v, &lut, &CAMERA)
+            .expect("renders");
+        let first = rt.read_output("image").expect("image");
+        rt.render(volgraph_core::runtime::CameraData::from_orbit(&CAMERA, plan.viewport)).expect("frame 1");
+        (first, rt.read_output("image").expect("image"))
+    };
+    let (stable0, stable1) = frames(false);
+    let (moving0, moving1) = frames(true);
+    assert_eq!(stable0.data, stable1.data, "stable jitter repeats itself");
+    assert_eq!(stable0.data, moving0.data, "frame 0 of per-frame jitter is the stable one");
+    assert_ne!(moving0.data, moving1.data, "per-frame jitter moves");
+}

@@ -21,8 +21,23 @@ struct Ray {
 // being scaled to unit forward distance, the near plane is at t = near. No loop, no early
 // return: the lanes of a SIMD group stay together.
 fn analytic_ray(pixel: vec2<u32>) -> Ray {
-    let centre = vec2<f32>(pixel) + vec2<f32>(0.5);
-    let dir = frame.ray_base_texture.xyz + centre.x * frame.ray_dx_texture.xyz + centre.y * frame.ray_dy_texture.xyz;
+    return analytic_ray_at(vec2<f32>(pixel) + vec2<f32>(0.5));
+}
+
+// The texture-space direction of the ray through image position `at` (pixels; pixel centres at
+// +0.5), scaled to unit forward distance.
+fn pixel_ray_texture(at: vec2<f32>) -> vec3<f32> {
+    return frame.ray_base_texture.xyz + at.x * frame.ray_dx_texture.xyz + at.y * frame.ray_dy_texture.xyz;
+}
+
+// The ray through image position `at` (any sub-pixel position), clipped like `analytic_ray`.
+fn analytic_ray_at(at: vec2<f32>) -> Ray {
+    return analytic_ray_along(pixel_ray_texture(at));
+}
+
+// The ray from the eye along texture-space direction `dir` (scaled to unit forward distance),
+// clipped to the box and the near plane like `analytic_ray`.
+fn analytic_ray_along(dir: vec3<f32>) -> Ray {
     let eye = frame.eye_texture.xyz;
     let far = vec3<f32>(3.0e38);
     let parallel = dir == vec3<f32>(0.0);

@@ -18,7 +18,8 @@ struct RaycastParams {
     diffuse: f32,
     specular: f32,
     shininess: f32,
-    _pad0: f32,
+    // Klein et al. 2005 §4.2: samples a leap hit is moved back along the ray.
+    step_back: f32,
     _pad1: f32,
     _pad2: f32,
 }

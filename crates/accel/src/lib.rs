@@ -14,4 +14,5 @@ pub mod minmax;
 pub mod octree;
 pub mod reference;
 pub mod transfer_function;
+pub mod vessels;
 pub mod volume;

@@ -125,7 +125,7 @@ pub fn measure_ceiling(
     runtime.apply(plan, registry).map_err(|e| e.to_string())?;
     let timing = measure::time_frames(runtime, camera, degrees_per_frame, frames, || {}).map_err(|e| e.to_string())?;
     let middle = frame_camera(camera, degrees_per_frame, frames / 2);
-    let counted = gpu_count::count(runtime, registry, FETCH_GRAPH_FILE, FETCH_GRAPH, &mut options, &middle)?
+    let counted = gpu_count::count(runtime, registry, FETCH_GRAPH_FILE, FETCH_GRAPH, &mut options, &middle, &middle)?
         .ok_or_else(|| "the fetch probe did not count its samples".to_string())?;
     let median_ms = median(&timing.frame_ms);
     let pixels = viewport.0 as f64 * viewport.1 as f64;

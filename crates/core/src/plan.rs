@@ -87,6 +87,9 @@ pub enum Binding {
     },
     /// A graph input bound by the application.
     Input(String),
+    /// A volume input the pass reads as voxels on the CPU ([`crate::plugin::PortKind::VolumeVoxels`]):
+    /// no texture is made for it.
+    InputVoxels(String),
     /// The previous frame's value of a history entry.
     History(String),
     /// An optional input left unwired.
@@ -213,6 +216,10 @@ pub struct History {
     pub source: ResourceId,
     /// The value before the first frame and after invalidation.
     pub initial: HistoryInitial,
+    /// Pass ids whose parameter changes restart this history.
+    pub reset_on_params_of: Vec<String>,
+    /// The largest camera turn between frames (degrees) this history survives.
+    pub max_camera_degrees: Option<f64>,
 }
 
 /// Transient memory figures.
@@ -265,6 +272,7 @@ impl Plan {
                         }
                     }
                     Binding::Input(n) => format!("input.{n}"),
+                    Binding::InputVoxels(n) => format!("input.{n} (voxels)"),
                     Binding::History(n) => format!("history.{n}"),
                     Binding::Unbound => "(unbound)".to_string(),
                 };

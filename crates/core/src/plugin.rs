@@ -40,8 +40,13 @@ pub enum PortKind {
         /// Size requirement.
         size: SizeRule,
     },
-    /// The scalar volume (a graph input).
+    /// The scalar volume (a graph input), bound as a 3D texture.
     Volume,
+    /// The scalar volume's voxels on the CPU ([`crate::runtime::RecordContext::voxels`]), for a
+    /// pass that uploads the parts it needs itself (the brick pool of Ruijters & Vilanova 2006
+    /// §5): no 3D texture of the whole volume is made for it, so a volume beyond the texture
+    /// limit or the memory budget still renders.
+    VolumeVoxels,
     /// The transfer-function LUT (a graph input).
     TransferFunction,
     /// A resource a pass owns and shares by name, e.g. `"minmax_grid"` (a 3D texture built from
@@ -77,7 +82,7 @@ impl PortKind {
                 let names: Vec<_> = formats.iter().map(|f| f.name()).collect();
                 format!("a target ({})", names.join(" or "))
             }
-            PortKind::Volume => "the volume".to_string(),
+            PortKind::Volume | PortKind::VolumeVoxels => "the volume".to_string(),
             PortKind::TransferFunction => "the transfer function".to_string(),
             PortKind::Owned(t) => format!("a {t}"),
         }
@@ -226,6 +231,13 @@ pub trait PassNode: Send {
     /// Takes new parameter values in place (write them to the node's uniform buffer); called
     /// only when [`PassPlugin::updates_in_place`] said it can.
     fn update_params(&mut self, _gpu: &Gpu, _params: &Params) {}
+
+    /// Figures of the node's last recorded frame that the CLI, the viewer and benchmarks show
+    /// (bytes a brick pool uploaded, its occupancy), as `(name, value)`; see
+    /// [`crate::runtime::Runtime::pass_counters`].
+    fn counters(&self) -> Vec<(&'static str, f64)> {
+        Vec::new()
+    }
 }
 
 /// Maps kind names to plugins.

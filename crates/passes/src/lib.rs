@@ -2,12 +2,14 @@
 //! in `shaders/` (`entry_points.rs` ↔ `shaders/entry_points.wgsl`). Each registers through the
 //! same public [`volgraph_core::Registry`] API an external crate would use.
 
+pub mod antialias;
 pub mod effects;
 pub mod empty_distance;
 pub mod empty_space;
 pub mod entry_points;
 pub mod fetch_probe;
 pub mod grid_tap;
+pub mod hole_fill;
 pub mod minmax_grid;
 pub mod opacity_lut;
 pub mod preintegration;
@@ -19,6 +21,7 @@ pub mod raycast_ess;
 pub mod raycast_fast;
 pub mod raycast_params;
 pub mod raycast_segment;
+pub mod reprojection_splat;
 pub mod segment_init;
 pub mod slice_render;
 pub mod termination_test;
@@ -51,6 +54,9 @@ pub fn register_builtin(registry: &mut Registry) {
         .register(raycast_fast::RaycastFast)
         .register(fetch_probe::FetchProbe)
         .register(slice_render::SliceRender)
+        .register(reprojection_splat::ReprojectionSplat)
+        .register(hole_fill::HoleFill)
+        .register(antialias::Antialias)
         .register(present::Present);
 }
 

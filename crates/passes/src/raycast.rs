@@ -4,7 +4,15 @@
 //! isosurface with Blinn–Phong shading from central differences (mode `iso`, which also writes a
 //! `hit` target of texture-space hit positions). The integral itself is
 //! `shaders/common/raymarch.wgsl`, shared with `raycast_compute`; the conventions are
-//! `docs/rendering_model.md`. Shader: `shaders/raycast.wgsl`.
+//! `docs/rendering_model.md`.
+//!
+//! Klein et al. 2005 §4.2: with `leap_hits` it also writes `leap_hit` — the first sample that is
+//! not fully transparent (DVR) or the isosurface hit, moved back `step_back` samples (or the
+//! conservative ⌈|voxel diagonal| / h⌉ with `step_back_rule: "conservative"`), the exit point
+//! for a ray that met nothing, w = 0 where there is no ray — and, with its optional `start`
+//! input wired, begins each ray at that estimate on the same step grid (common/leap.wgsl). With
+//! `count_samples` it adds the samples it takes to its `samples` buffer. Shader:
+//! `shaders/raycast.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
@@ -46,34 +54,64 @@ impl PassPlugin for Raycast {
     fn params(&self) -> Vec<ParamSpec> {
         let mut p = raycast_param_specs();
         p.extend(effect_param_specs());
+        p.extend(leap_param_specs());
         p
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        effect_defines(params)
+        let mut defines = effect_defines(params);
+        if params.boolean("count_samples") {
+            defines.push("COUNT");
+        }
+        if analytic(params) {
+            defines.push("ANALYTIC");
+        }
+        defines
     }
 
     fn ports(&self, params: &Params) -> Vec<PortSpec> {
-        raycast_ports(
+        let mut ports = raycast_ports(
             params,
             &[TargetFormat::Rgba16Float, TargetFormat::Rgba32Float],
             &[TargetFormat::Rgba32Float, TargetFormat::Rgba16Float],
-        )
+        );
+        if analytic(params) {
+            ports.retain(|p| p.name != "entry" && p.name != "dir");
+        }
+        if leaps(params) {
+            // The leap variant writes `leap_hit` instead of the exact isosurface `hit`.
+            ports.retain(|p| p.name != "hit");
+        }
+        if leaps(params) {
+            // Leave unwired to start every ray at the box (the first frame of Klein's loop).
+            ports.push(PortSpec::read("start", PortKind::target(&[TargetFormat::Rgba32Float])).optional());
+            ports.push(PortSpec::write("leap_hit", PortKind::target(&[TargetFormat::Rgba32Float])));
+        }
+        if params.boolean("count_samples") {
+            ports.push(PortSpec::write("samples", PortKind::buffer(4 * crate::raycast_fast::SAMPLE_ROWS)));
+        }
+        ports
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        let fragment = if is_iso(params) { "fs_iso" } else { "fs_dvr" };
-        vec![ShaderUse { file: "raycast.wgsl", entry_point: fragment }]
+        vec![ShaderUse { file: "raycast.wgsl", entry_point: fragment_entry(params) }]
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        // Every parameter but the mode and the effects is a uniform value.
-        is_iso(old) == is_iso(new) && same_effects(old, new)
+        // Every parameter but the mode, the effects and the leap outputs is a uniform value.
+        is_iso(old) == is_iso(new)
+            && same_effects(old, new)
+            && leaps(old) == leaps(new)
+            && analytic(old) == analytic(new)
+            && old.boolean("count_samples") == new.boolean("count_samples")
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let fragment = if is_iso(ctx.params) { "fs_iso" } else { "fs_dvr" };
-        let defines = effect_defines(ctx.params);
+        let fragment = fragment_entry(ctx.params);
+        let mut defines = self.shader_defines(ctx.params);
+        if ctx.port("start").is_some_and(|p| p.bound) {
+            defines.push("START");
+        }
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
             shader: "raycast.wgsl",
             vertex: "vs_fullscreen",
@@ -84,20 +122,102 @@ impl PassPlugin for Raycast {
         })?;
         let params = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
         let effects = EffectState::new(ctx)?;
-        Ok(Box::new(RaycastNode { pipeline, params, effects, step_voxels: ctx.params.float("step_voxels") }))
+        Ok(Box::new(RaycastNode {
+            pipeline,
+            params,
+            effects,
+            settings: RaycastParamsGpu::from_params(ctx.params),
+            conservative: ctx.params.choice("step_back_rule") == "conservative",
+            counted: ctx.params.boolean("count_samples"),
+            written_step_back: None,
+        }))
     }
+}
+
+/// The Klein et al. 2005 parameters of the raycaster.
+fn leap_param_specs() -> Vec<ParamSpec> {
+    vec![
+        ParamSpec::choice(
+            "rays",
+            "raster",
+            &["raster", "analytic"],
+            "raster: entry and direction from the `entry` and `dir` inputs (K-W 2003 §2.1); analytic: met with the box in \
+             the shader, no inputs needed",
+        ),
+        ParamSpec::boolean(
+            "leap_hits",
+            false,
+            "write `leap_hit` (where the next frame's ray starts) and read the optional `start` estimate (Klein et al. 2005 §4.2)",
+        ),
+        ParamSpec::uint(
+            "step_back",
+            2,
+            0,
+            64,
+            "samples a leap hit is moved back along the ray (the paper: one to three suffice)",
+        ),
+        ParamSpec::choice(
+            "step_back_rule",
+            "fixed",
+            &["fixed", "conservative"],
+            "fixed: step_back samples; conservative: ⌈|voxel diagonal| / step⌉, never missing a voxel (Klein et al. 2005 §4.2)",
+        ),
+        ParamSpec::boolean("count_samples", false, "add the samples taken to the `samples` buffer (benchmarks)"),
+    ]
+}
+
+/// Whether the rays meet the box analytically (no `entry` / `dir` inputs).
+fn analytic(params: &Params) -> bool {
+    params.choice("rays") == "analytic"
+}
+
+/// Whether the pass runs Klein's variant (leap hits written, or samples counted).
+fn leaps(params: &Params) -> bool {
+    params.boolean("leap_hits") || params.boolean("count_samples")
+}
+
+fn fragment_entry(params: &Params) -> &'static str {
+    match (is_iso(params), leaps(params)) {
+        (false, false) => "fs_dvr",
+        (true, false) => "fs_iso",
+        (false, true) => "fs_dvr_leap",
+        (true, true) => "fs_iso_leap",
+    }
+}
+
+/// ⌈|voxel diagonal| / h⌉ for the bound volume (Klein et al. 2005 §4.2's conservative bound).
+fn conservative_step_back(volume: &volgraph_core::runtime::VolumeDesc, step_voxels: f64) -> f32 {
+    let voxel = 2.0 * volume.half_extent / volume.dims.as_dvec3();
+    (voxel.length() / (step_voxels * volume.unit_step)).ceil() as f32
 }
 
 struct RaycastNode {
     pipeline: PassPipeline,
     params: wgpu::Buffer,
     effects: EffectState,
-    step_voxels: f64,
+    /// What `params` holds (the conservative step back is filled in per volume).
+    settings: RaycastParamsGpu,
+    conservative: bool,
+    counted: bool,
+    written_step_back: Option<f32>,
 }
 
 impl PassNode for RaycastNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
-        self.effects.update(ctx, &self.params, self.step_voxels)?;
+        if self.conservative
+            && let Some(volume) = &ctx.frame.volume
+        {
+            let n = conservative_step_back(volume, self.settings.step_voxels as f64);
+            if self.written_step_back != Some(n) {
+                self.settings.step_back = n;
+                ctx.write_buffer(&self.params, 0, bytemuck::bytes_of(&self.settings));
+                self.written_step_back = Some(n);
+            }
+        }
+        if self.counted {
+            ctx.clear_buffer("samples")?;
+        }
+        self.effects.update(ctx, &self.params, self.settings.step_voxels as f64)?;
         let mut extra = vec![("params", self.params.as_entire_binding())];
         extra.extend(self.effects.bindings());
         let bg = ctx.bind_group(&self.pipeline, &extra)?;
@@ -107,8 +227,10 @@ impl PassNode for RaycastNode {
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
-        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
-        self.step_voxels = params.float("step_voxels");
+        self.settings = RaycastParamsGpu::from_params(params);
+        self.conservative = params.choice("step_back_rule") == "conservative";
+        self.written_step_back = None;
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&self.settings));
         self.effects.invalidate();
     }
 }

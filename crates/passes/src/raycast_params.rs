@@ -56,8 +56,11 @@ pub struct RaycastParamsGpu {
     pub specular: f32,
     /// Phong exponent.
     pub shininess: f32,
+    /// Klein et al. 2005 §4.2: samples a leap hit is moved back (the `step_back` parameter, or
+    /// the conservative count the node computes for the bound volume).
+    pub step_back: f32,
     /// Padding.
-    pub _pad: [f32; 3],
+    pub _pad: [f32; 2],
 }
 
 const _: () = assert!(std::mem::size_of::<RaycastParamsGpu>() == 48);
@@ -75,7 +78,8 @@ impl RaycastParamsGpu {
             diffuse: p.float("diffuse") as f32,
             specular: p.float("specular") as f32,
             shininess: p.float("shininess") as f32,
-            _pad: [0.0; 3],
+            step_back: p.uint("step_back") as f32,
+            _pad: [0.0; 2],
         }
     }
 }

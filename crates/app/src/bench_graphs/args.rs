@@ -15,7 +15,7 @@ use crate::inputs;
 /// functions, baseline and frames; any flag given as well replaces the preset's value.
 #[derive(Args, Debug, Clone, Default)]
 pub struct GraphsArgs {
-    /// A named preset: basic, kw2003-table1, thesis-tables, peer, effects-off.
+    /// A named preset: basic, kw2003-table1, thesis-tables, peer, effects-off, klein2005.
     #[arg(long)]
     pub preset: Option<String>,
     /// Graph files, comma separated (graphs that do not exist are skipped with a note).
@@ -154,6 +154,16 @@ pub struct BenchConfig {
     pub markdown: Option<PathBuf>,
     /// Hide the progress bar.
     pub quiet: bool,
+    /// `(graph, baseline)` pairs measured against their own baseline (the preset's, when its
+    /// graphs and baseline are used).
+    pub baselines: Vec<(String, String)>,
+    /// `(dataset, knob, value)` overrides for one dataset's cases (the preset's).
+    pub dataset_params: Vec<(String, String, f64)>,
+    /// The preset's antialiasing study and its viewport after `--scale` (when the preset's
+    /// graphs are measured).
+    pub antialias: Option<(super::antialias_study::AntialiasStudy, (u32, u32))>,
+    /// Graphs whose transient memory the report states, at a viewport (the preset's).
+    pub memory: Vec<(PathBuf, (u32, u32))>,
 }
 
 /// The workspace root, against which preset graph paths are written.
@@ -336,6 +346,19 @@ impl GraphsArgs {
             bail!("--spp-size {}: expected 0 (off) ..=4096 pixels", self.spp_size);
         }
         let params = preset.map(|p| p.params.iter().map(|(k, v)| (k.to_string(), *v)).collect()).unwrap_or_default();
+        // The preset's own comparison: its pairs of graphs, its studies.
+        let own = preset.filter(|_| self.graphs.is_empty());
+        let baselines = own
+            .filter(|_| self.baseline.is_none())
+            .map(|p| p.baselines.iter().map(|(g, b)| (g.to_string(), b.to_string())).collect())
+            .unwrap_or_default();
+        let dataset_params = preset
+            .map(|p| p.dataset_params.iter().map(|(d, k, v)| (d.to_string(), k.to_string(), *v)).collect())
+            .unwrap_or_default();
+        let antialias = own.and_then(|p| p.antialias).map(|study| (study, scale_viewport(study.size, self.scale)));
+        let memory = own
+            .map(|p| p.memory.iter().map(|(g, size)| (workspace_root().join(g), *size)).collect())
+            .unwrap_or_default();
         Ok(BenchConfig {
             preset,
             graphs,
@@ -360,6 +383,10 @@ impl GraphsArgs {
             plot: self.plot.clone(),
             markdown: self.markdown.clone(),
             quiet: self.quiet,
+            baselines,
+            dataset_params,
+            antialias,
+            memory,
         })
     }
 }

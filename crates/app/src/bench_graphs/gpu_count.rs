@@ -47,15 +47,18 @@ pub fn sum_rows(bytes: &[u8]) -> u64 {
     bytes.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]) as u64).sum()
 }
 
-/// Compiles the graph with every counting pass counting, renders one frame from `camera` and adds
-/// up their `samples` buffers; `Ok(None)` when no pass of the graph counts. The runtime keeps the
-/// counting plan applied.
+/// Compiles the graph with every counting pass counting, renders one frame from `previous` and
+/// then the counted one from `camera` (a graph with history — Klein's reprojected starts — counts
+/// the samples of a frame that follows another, as in the timed frames), and adds up their
+/// `samples` buffers; `Ok(None)` when no pass of the graph counts. The runtime keeps the counting
+/// plan applied.
 pub fn count(
     runtime: &mut Runtime,
     registry: &Registry,
     file: &str,
     source: &str,
     options: &mut CompileOptions,
+    previous: &OrbitCamera,
     camera: &OrbitCamera,
 ) -> Result<Option<Counted>, String> {
     let compile = |runtime: &mut Runtime, options: &CompileOptions| {
@@ -81,6 +84,7 @@ pub fn count(
         .map(|(rid, _)| rid)
         .collect();
     runtime.apply(plan, registry).map_err(|e| e.to_string())?;
+    runtime.render(CameraData::from_orbit(previous, viewport)).map_err(|e| e.to_string())?;
     runtime.render(CameraData::from_orbit(camera, viewport)).map_err(|e| e.to_string())?;
     let mut samples = 0u64;
     for rid in buffers {

@@ -2,6 +2,7 @@
 //! viewports and transfer functions each paper's comparison needs, and the baseline its speed-ups
 //! are measured against.
 
+use super::antialias_study::AntialiasStudy;
 use super::peer::PeerSpec;
 
 /// One preset: everything `volgraph bench graphs --preset NAME` runs unless a flag overrides it.
@@ -15,6 +16,9 @@ pub struct BenchPreset {
     pub graphs: &'static [&'static str],
     /// The baseline graph (file stem) speed-ups are relative to.
     pub baseline: &'static str,
+    /// `(graph, its own baseline)` pairs (file stems): rows of `graph` are measured against
+    /// that graph instead of `baseline` (e.g. each leaping graph against its plain twin).
+    pub baselines: &'static [(&'static str, &'static str)],
     /// Dataset names (`volgraph_accel::data_dir` names or generated names such as `ml64`).
     pub datasets: &'static [&'static str],
     /// Viewports `(width, height)` before `--scale`.
@@ -28,6 +32,9 @@ pub struct BenchPreset {
     /// Parameter overrides applied to every graph, `"pass.param" = value` (e.g. the step the
     /// issue asks for).
     pub params: &'static [(&'static str, f64)],
+    /// Overrides for one dataset's cases, `(dataset, knob, value)` (e.g. the isovalue that shows
+    /// its surface, `input.iso_value`); they win over `params`.
+    pub dataset_params: &'static [(&'static str, &'static str, f64)],
     /// Timed frames after the warm-up frame.
     pub frames: u32,
     /// Start camera (azimuth, elevation, distance), default 30,20,3.2.
@@ -36,6 +43,10 @@ pub struct BenchPreset {
     pub full_turn: bool,
     /// A peer program measured in the same run (its rows join the table), if any.
     pub peer: Option<PeerSpec>,
+    /// Klein et al. 2005 §5's antialiasing study, run after the table, if any.
+    pub antialias: Option<AntialiasStudy>,
+    /// Graphs whose pooled vs unpooled transient memory the report states, at a viewport.
+    pub memory: &'static [(&'static str, (u32, u32))],
 }
 
 /// Every preset.
@@ -54,6 +65,10 @@ pub const PRESETS: &[BenchPreset] = &[
         camera: None,
         full_turn: false,
         peer: None,
+        baselines: &[],
+        dataset_params: &[],
+        antialias: None,
+        memory: &[],
     },
     BenchPreset {
         name: "kw2003-table1",
@@ -79,6 +94,10 @@ pub const PRESETS: &[BenchPreset] = &[
         camera: None,
         full_turn: false,
         peer: None,
+        baselines: &[],
+        dataset_params: &[],
+        antialias: None,
+        memory: &[],
     },
     BenchPreset {
         name: "thesis-tables",
@@ -94,6 +113,10 @@ pub const PRESETS: &[BenchPreset] = &[
         camera: None,
         full_turn: false,
         peer: None,
+        baselines: &[],
+        dataset_params: &[],
+        antialias: None,
+        memory: &[],
     },
     BenchPreset {
         name: "peer",
@@ -123,6 +146,56 @@ pub const PRESETS: &[BenchPreset] = &[
             script: "bench/peer/vtk_cpu_raycast.py",
             install: "install the peer with `pip install vtk==9.7.2`, or pass --no-peer",
         }),
+        baselines: &[],
+        dataset_params: &[],
+        antialias: None,
+        memory: &[],
+    },
+    BenchPreset {
+        name: "klein2005",
+        about: "Klein et al. 2005 Table 1: the plain single-pass raycast against empty-space leaping by reprojected \
+                hit points (splats, hole fill, raycast from the estimates), isosurface and DVR, while the volume turns \
+                1° per frame at 512², step 0.5 voxel; samples per pixel with and without leaping counted on the GPU. \
+                Speed-up: each leaping graph against its baseline (the paper: engine 1.8×, head 2.2×, foot 2.7×; \
+                177 → 25 samples per pixel on its abdomen). Then §5's antialiasing study and the pooled memory of \
+                leap_iso_aa at 1920×1080",
+        graphs: &[
+            "graphs/klein_2005/baseline_iso.ron",
+            "graphs/klein_2005/leap_iso.ron",
+            "graphs/klein_2005/baseline_dvr.ron",
+            "graphs/klein_2005/leap_dvr.ron",
+        ],
+        baseline: "baseline_iso",
+        baselines: &[("leap_iso", "baseline_iso"), ("baseline_dvr", "baseline_dvr"), ("leap_dvr", "baseline_dvr")],
+        datasets: &[],
+        viewports: &[(512, 512)],
+        tfs: &[],
+        cases: &[
+            ("engine_vollib", "engine_sparse"),
+            ("lobster", "default"),
+            ("hydrogen_atom", "hydrogen"),
+            ("neghip", "default"),
+        ],
+        params: &[("input.step_voxels", 0.5)],
+        dataset_params: &[
+            ("engine_vollib", "input.iso_value", 0.3),
+            ("lobster", "input.iso_value", 0.2),
+            ("hydrogen_atom", "input.iso_value", 0.12),
+            ("neghip", "input.iso_value", 0.25),
+        ],
+        frames: 24,
+        camera: None,
+        full_turn: false,
+        peer: None,
+        antialias: Some(AntialiasStudy {
+            dataset: "engine_vollib",
+            tf: "engine_sparse",
+            iso_value: 0.3,
+            size: (512, 512),
+            reference_rays_per_side: 4,
+            frames: 12,
+        }),
+        memory: &[("graphs/klein_2005/leap_iso_aa.ron", (1920, 1080))],
     },
     BenchPreset {
         name: "effects-off",
@@ -139,6 +212,10 @@ pub const PRESETS: &[BenchPreset] = &[
         camera: None,
         full_turn: false,
         peer: None,
+        baselines: &[],
+        dataset_params: &[],
+        antialias: None,
+        memory: &[],
     },
 ];
 

@@ -33,6 +33,8 @@ pub struct GraphBenchReport {
     pub scale: f64,
     /// The graph speed-ups are relative to (file stem), measured in this run.
     pub baseline: String,
+    /// `(graph, baseline)` pairs measured against their own baseline instead.
+    pub baselines: Vec<(String, String)>,
     /// The swept `pass.param`, if any.
     pub sweep: Option<String>,
     /// Step of the converged CPU reference (voxels), when error is measured.
@@ -43,6 +45,27 @@ pub struct GraphBenchReport {
     pub rows: Vec<Row>,
     /// Cases or inputs that were skipped, with the reason.
     pub skipped: Vec<Skipped>,
+    /// The preset's antialiasing study, when it has one.
+    pub antialias: Option<super::antialias_study::AntialiasReport>,
+    /// Pooled vs unpooled transient memory of the preset's graphs.
+    pub memory: Vec<MemoryFigure>,
+}
+
+/// Transient memory of one graph's plan at one viewport.
+#[derive(Clone, Debug, Serialize)]
+pub struct MemoryFigure {
+    /// Graph file.
+    pub graph: String,
+    /// Viewport.
+    pub viewport: [u32; 2],
+    /// Bytes of the pooled slots.
+    pub pooled_bytes: u64,
+    /// Bytes if every transient target had its own texture.
+    pub unpooled_bytes: u64,
+    /// Bytes of history (both frames).
+    pub history_bytes: u64,
+    /// Slots holding more than one target: their targets, in order.
+    pub shared_slots: Vec<Vec<String>>,
 }
 
 /// Something that was not measured.
@@ -110,6 +133,10 @@ pub struct Row {
     pub pareto: Option<bool>,
 }
 
+fn mib(bytes: u64) -> String {
+    format!("{:.1}", bytes as f64 / (1024.0 * 1024.0))
+}
+
 fn opt(v: Option<f64>, digits: usize) -> String {
     v.filter(|x| x.is_finite()).map_or_else(|| "n/a".to_string(), |x| format!("{x:.digits$}"))
 }
@@ -123,17 +150,17 @@ impl GraphBenchReport {
         if let Some(about) = &self.about {
             let _ = writeln!(s, "{about}\n");
         }
+        let speedup = if self.baselines.is_empty() {
+            format!("median of `{}` / median of the row", self.baseline)
+        } else {
+            let pairs: Vec<String> = self.baselines.iter().map(|(g, b)| format!("`{g}` against `{b}`")).collect();
+            format!("median of the row's baseline / median of the row ({})", pairs.join(", "))
+        };
         let clock = if self.timestamps { "GPU time from timestamp queries" } else { "wall time (no GPU timestamps)" };
         let _ = writeln!(
             s,
-            "Adapter: {}. ms/frame: median of {} frames after {} warm-up frame, {clock}; volume turns {}°/frame about y from camera {:?}; viewport scale {}; speed-up = median of `{}` / median of the row, same run.\n",
-            self.adapter,
-            self.frames,
-            self.warmup_frames,
-            self.degrees_per_frame,
-            self.camera,
-            self.scale,
-            self.baseline
+            "Adapter: {}. ms/frame: median of {} frames after {} warm-up frame, {clock}; volume turns {}°/frame about y from camera {:?}; viewport scale {}; speed-up = {speedup}, same run.\n",
+            self.adapter, self.frames, self.warmup_frames, self.degrees_per_frame, self.camera, self.scale,
         );
         for note in &self.notes {
             let _ = writeln!(s, "- {note}");
@@ -200,6 +227,27 @@ impl GraphBenchReport {
                 cells.push(if r.pareto == Some(true) { "★".to_string() } else { String::new() });
             }
             let _ = writeln!(s, "| {} |", cells.join(" | "));
+        }
+        if let Some(aa) = &self.antialias {
+            s.push_str(&aa.to_markdown());
+        }
+        if !self.memory.is_empty() {
+            let _ = writeln!(s, "\n### Transient memory\n");
+            for m in &self.memory {
+                let shared: Vec<String> = m.shared_slots.iter().map(|h| h.join(" + ")).collect();
+                let _ = writeln!(
+                    s,
+                    "- `{}` at {}×{}: pooled {} MiB, unpooled {} MiB ({:.1} % of unpooled); history {} MiB; shared slots: {}",
+                    m.graph,
+                    m.viewport[0],
+                    m.viewport[1],
+                    mib(m.pooled_bytes),
+                    mib(m.unpooled_bytes),
+                    100.0 * m.pooled_bytes as f64 / m.unpooled_bytes.max(1) as f64,
+                    mib(m.history_bytes),
+                    if shared.is_empty() { "none".to_string() } else { shared.join("; ") }
+                );
+            }
         }
         if !self.skipped.is_empty() {
             let _ = writeln!(s, "\nSkipped:");

@@ -20,7 +20,7 @@ use super::dataset;
 use super::gpu_count;
 use super::measure::{self, frame_camera, median};
 use super::peer;
-use super::report::{GraphBenchReport, Row, Skipped};
+use super::report::{GraphBenchReport, MemoryFigure, Row, Skipped};
 
 /// A graph file that could be read.
 struct GraphFile {
@@ -84,6 +84,9 @@ impl Case<'_> {
     fn options(&self, config: &BenchConfig, viewport: (u32, u32)) -> CompileOptions {
         let mut options = CompileOptions::new(viewport.0, viewport.1);
         for (key, value) in &config.params {
+            set_knob(&mut options, key, &ron::Value::from(*value));
+        }
+        for (_, key, value) in config.dataset_params.iter().filter(|(d, _, _)| *d == self.dataset.name) {
             set_knob(&mut options, key, &ron::Value::from(*value));
         }
         if let (Some(sweep), Some((_, value))) = (&config.sweep, self.sweep_value) {
@@ -242,7 +245,27 @@ pub fn run(gpu: std::sync::Arc<Gpu>, config: &BenchConfig) -> anyhow::Result<Gra
             "the baseline graph was not measured, so there are no speed-ups".to_string(),
         );
     }
-    fill_speedups(&mut rows, &config.baseline);
+    fill_speedups(&mut rows, &config.baseline, &config.baselines);
+    let antialias = config.antialias.as_ref().and_then(|(study, viewport)| {
+        let run = super::antialias_study::run(
+            &mut ctx.runtime,
+            &ctx.registry,
+            study,
+            *viewport,
+            &config.camera,
+            config.degrees_per_frame,
+        );
+        run.map_err(|reason| ctx.skip("the antialiasing study".to_string(), reason)).ok()
+    });
+    let memory = config
+        .memory
+        .iter()
+        .filter_map(|(graph, size)| {
+            memory_figure(&mut ctx.runtime, &ctx.registry, graph, *size)
+                .map_err(|reason| ctx.skip(format!("memory of {}", graph.display()), reason))
+                .ok()
+        })
+        .collect();
     if config.sweep.is_some() {
         fill_pareto(&mut rows);
     }
@@ -258,11 +281,43 @@ pub fn run(gpu: std::sync::Arc<Gpu>, config: &BenchConfig) -> anyhow::Result<Gra
         camera: [config.camera.azimuth_deg, config.camera.elevation_deg, config.camera.distance],
         scale: config.scale,
         baseline: config.baseline.clone(),
+        baselines: config.baselines.clone(),
         sweep: config.sweep.as_ref().map(|s| s.key.clone()),
         reference_step_voxels: config.accuracy.then_some(config.reference_step),
         notes,
         rows,
         skipped: ctx.skipped,
+        antialias,
+        memory,
+    })
+}
+
+/// The pooled vs unpooled transient memory of `graph`'s plan at `size` (compiled, not run).
+fn memory_figure(
+    runtime: &mut Runtime,
+    registry: &Registry,
+    graph: &std::path::Path,
+    size: (u32, u32),
+) -> Result<MemoryFigure, String> {
+    let source = std::fs::read_to_string(graph).map_err(|e| e.to_string())?;
+    let file = graph.display().to_string();
+    let plan = runtime
+        .compile(&file, &source, registry, &CompileOptions::new(size.0, size.1))
+        .map_err(|d: Diagnostics| d.to_string())?;
+    let memory = plan.memory();
+    let shared_slots = plan
+        .slots
+        .iter()
+        .filter(|s| s.holds.len() > 1)
+        .map(|s| s.holds.iter().map(|&r| plan.resources[r].name.clone()).collect())
+        .collect();
+    Ok(MemoryFigure {
+        graph: graph.strip_prefix(super::args::workspace_root()).unwrap_or(graph).display().to_string(),
+        viewport: [size.0, size.1],
+        pooled_bytes: memory.pooled_bytes,
+        unpooled_bytes: memory.unpooled_bytes,
+        history_bytes: memory.history_bytes,
+        shared_slots,
     })
 }
 
@@ -408,6 +463,7 @@ fn run_case(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<Row> {
 fn count_on_gpu(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<gpu_count::Counted> {
     let config = ctx.config;
     let camera = frame_camera(&config.camera, config.degrees_per_frame, config.frames / 2);
+    let previous = OrbitCamera { azimuth_deg: camera.azimuth_deg - config.degrees_per_frame, ..camera };
     let mut options = case.options(config, case.viewport);
     let result = ctx
         .runtime
@@ -420,6 +476,7 @@ fn count_on_gpu(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<gpu_count::Cou
                 &case.graph.path.display().to_string(),
                 &case.graph.source,
                 &mut options,
+                &previous,
                 &camera,
             )
         });
@@ -511,15 +568,19 @@ fn measure_error(
 }
 
 /// Speed-up = baseline median / row median for rows of the same dataset, TF, viewport and sweep
-/// value.
-fn fill_speedups(rows: &mut [Row], baseline: &str) {
+/// value; a graph of `pairs` is measured against its own baseline.
+fn fill_speedups(rows: &mut [Row], baseline: &str, pairs: &[(String, String)]) {
     let same = |a: &Row, b: &Row| {
         a.dataset == b.dataset && a.tf == b.tf && a.viewport == b.viewport && a.sweep_value == b.sweep_value
     };
-    let bases: Vec<Row> = rows.iter().filter(|r| r.graph == baseline).cloned().collect();
+    let all: Vec<Row> = rows.to_vec();
     for row in rows.iter_mut() {
-        row.speedup_vs_baseline =
-            bases.iter().find(|b| same(b, row)).map(|b| b.median_ms / row.median_ms).filter(|x| x.is_finite());
+        let base = pairs.iter().find(|(g, _)| *g == row.graph).map_or(baseline, |(_, b)| b.as_str());
+        row.speedup_vs_baseline = all
+            .iter()
+            .find(|b| b.graph == base && same(b, row))
+            .map(|b| b.median_ms / row.median_ms)
+            .filter(|x| x.is_finite());
     }
 }
 

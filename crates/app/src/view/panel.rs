@@ -95,6 +95,15 @@ fn param_widget(ui: &mut egui::Ui, name: &str, kind: &ParamKind, value: &ParamVa
     }
 }
 
+/// How the graph's history was used, for a graph that has one (Klein et al. 2005: frames that
+/// ran from reprojected starts instead of the box).
+pub fn history_line(stats: &volgraph_core::runtime::HistoryStats) -> String {
+    format!(
+        "history: {} frames from the last frame's ({} in a row now), {} restarts",
+        stats.frames_from_history, stats.run, stats.restarts
+    )
+}
+
 /// Draws the panel; returns what the user changed.
 pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapter: &str) -> Vec<Action> {
     let mut actions = Vec::new();
@@ -121,6 +130,9 @@ pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapt
             egui::ScrollArea::vertical().id_salt("error").max_height(160.0).show(ui, |ui| {
                 ui.add(egui::Label::new(egui::RichText::new(message).monospace().small()).wrap());
             });
+        }
+        if !plan.history.is_empty() {
+            ui.label(history_line(&session.runtime.history_stats()));
         }
         ui.separator();
         let max = timings.per_pass.iter().map(|(_, ms)| *ms).fold(1e-6, f64::max);

@@ -262,3 +262,29 @@ fn a_frame_the_gpu_rejects_puts_the_last_good_graph_back() {
     assert_eq!(session.plan().expect("plan").steps.iter().filter(|s| s.kind == "present").count(), 1);
     let _ = std::fs::remove_dir_all(&s.dir);
 }
+
+#[test]
+fn the_viewer_counts_frames_from_reprojected_starts_and_an_isovalue_edit_restarts_them() {
+    let s = scratch("klein", "graphs/klein_2005/leap_iso.ron");
+    let mut session = open(&s, None);
+    for f in 0..3 {
+        let camera = OrbitCamera { azimuth_deg: 30.0 + f as f64, ..OrbitCamera::default() };
+        session.submit(&camera, None).expect("frame");
+    }
+    let stats = session.runtime.history_stats();
+    assert_eq!((stats.frames_from_history, stats.run, stats.restarts), (2, 2, 0), "{stats:?}");
+    assert_eq!(
+        super::panel::history_line(&stats),
+        "history: 2 frames from the last frame's (2 in a row now), 0 restarts"
+    );
+    // An isovalue edit changes the raycaster, which the graph's history resets on.
+    edit(&s.graph, "\"iso_value\": Scalar(0.3)", "\"iso_value\": Scalar(0.4)");
+    let events = session.files_changed(std::slice::from_ref(&s.graph));
+    assert!(matches!(events.as_slice(), [Event::Reloaded { .. }]), "{events:?}");
+    session.submit(&OrbitCamera { azimuth_deg: 33.0, ..OrbitCamera::default() }, None).expect("frame");
+    let stats = session.runtime.history_stats();
+    assert_eq!((stats.frames_from_history, stats.run, stats.restarts), (2, 0, 1), "{stats:?}");
+    session.submit(&OrbitCamera { azimuth_deg: 34.0, ..OrbitCamera::default() }, None).expect("frame");
+    assert_eq!(session.runtime.history_stats().run, 1);
+    let _ = std::fs::remove_dir_all(&s.dir);
+}

@@ -17,7 +17,7 @@ use super::{CompileOptions, MAX_PLAN_STEPS};
 use crate::diagnostic::{Diagnostic, Location};
 use crate::graph::ast::{GraphDoc, HistoryInitial};
 use crate::plan::{Binding, BoundPort, History, Plan, Resource, ResourceDesc, ResourceId, Slot, Step};
-use crate::plugin::Access;
+use crate::plugin::{Access, PortKind};
 
 #[derive(Clone, Debug, PartialEq)]
 enum Val {
@@ -70,6 +70,13 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
     let slots = pool(&mut resources, &persistent_roots);
     let culled = culled(&c, &insts, &needed);
     let gated = gated(&c, options);
+    let mut history = history;
+    for (name, h) in history.iter_mut() {
+        if let Some(declared) = doc.history.get(name) {
+            h.reset_on_params_of = declared.reset_on_params_of.clone();
+            h.max_camera_degrees = declared.max_camera_degrees;
+        }
+    }
     Ok(Plan {
         name: doc.name.clone(),
         viewport: options.viewport,
@@ -374,6 +381,7 @@ fn build_resources(
                                 None => Binding::Unbound,
                             }
                         }
+                        Val::Input(n) if spec.kind == PortKind::VolumeVoxels => Binding::InputVoxels(n),
                         Val::Input(n) => Binding::Input(n),
                         Val::History(n) => Binding::History(n),
                         Val::Unbound => Binding::Unbound,
@@ -445,7 +453,15 @@ fn keep_results(
             resources[id].last_use = usize::MAX;
             persistent_roots.push(root_of(resources, id));
             // (one walk per history entry: few, however long the chain)
-            history.insert(name.clone(), History { source: id, initial: initial.clone() });
+            history.insert(
+                name.clone(),
+                History {
+                    source: id,
+                    initial: initial.clone(),
+                    reset_on_params_of: Vec::new(),
+                    max_camera_degrees: None,
+                },
+            );
         }
     }
     Kept { outputs, history, persistent_roots }

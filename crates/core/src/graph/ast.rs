@@ -48,6 +48,14 @@ pub struct HistoryDoc {
     /// The value on the first frame and after invalidation.
     #[serde(default)]
     pub initial: HistoryInitial,
+    /// Passes whose parameter edits make the kept value stale (an isovalue change: Klein et al.
+    /// 2005 §4.1); the history restarts from `initial` when one of them is rebuilt or updated.
+    #[serde(default)]
+    pub reset_on_params_of: Vec<String>,
+    /// The camera may turn at most this many degrees between two frames before the kept value
+    /// is thrown away (a camera jump: Klein et al. 2005 §4.1). Unbounded when absent.
+    #[serde(default)]
+    pub max_camera_degrees: Option<f64>,
 }
 
 /// What a history target holds when there is no previous frame.

@@ -118,6 +118,9 @@ pub struct FrameData {
     pub history_age: u64,
     /// The bound volume, if any.
     pub volume: Option<VolumeDesc>,
+    /// GPU memory a pass that streams data may hold (`--gpu-memory-mb`), in bytes; `None`: as
+    /// much as the adapter allows.
+    pub gpu_memory_budget: Option<u64>,
 }
 
 /// The pixel rays of a camera in texture space: pixel centre (x, y) (pixels, row 0 at the top)

@@ -1,15 +1,24 @@
 //! Graph inputs bound by the application, held by the runtime rather than by a plan: a volume
 //! and a transfer-function LUT are uploaded once and shared by every plan that reads them, and
 //! binding the same content again uploads nothing.
+//!
+//! A volume is kept on the CPU too and becomes a 3D texture only when a plan's pass reads it as
+//! one ([`InputStore::ensure_volume_texture`]): a pass that reads its voxels
+//! ([`crate::plugin::PortKind::VolumeVoxels`], the brick pool of Ruijters & Vilanova 2006)
+//! uploads what it needs itself, so a volume beyond the 3D texture limit or the memory budget
+//! still renders through it.
 
 use std::collections::BTreeMap;
 use std::hash::{Hash, Hasher};
+use std::sync::Arc;
 
 use volgraph_accel::volume::{Volume, VoxelData};
 
 use super::frame::VolumeDesc;
 use super::gpu::{Gpu, GpuFault};
-use super::upload::{UploadError, UploadedVolume, VolumeFormat, VolumeTexels, upload_lut, upload_volume};
+use super::upload::{
+    UploadError, UploadedVolume, VolumeFormat, VolumeTexels, upload_lut, upload_volume, volume_format_for,
+};
 
 /// One bound input texture.
 pub struct BoundInput {
@@ -21,10 +30,21 @@ pub struct BoundInput {
     content: u64,
 }
 
+/// A bound volume's voxels, kept on the CPU, and the hash of their content.
+struct BoundVoxels {
+    voxels: Arc<Volume>,
+    content: u64,
+}
+
 /// Inputs by graph input name, and the bound volume's description.
 #[derive(Default)]
 pub struct InputStore {
+    /// Textures: LUTs, application textures and volumes some pass read as a texture.
     inputs: BTreeMap<String, BoundInput>,
+    /// Bound volumes on the CPU (their texture, once made, is in `inputs`).
+    volumes: BTreeMap<String, BoundVoxels>,
+    /// Bound LUTs on the CPU (for passes that classify bricks with them).
+    tables: BTreeMap<String, Arc<Vec<[f32; 4]>>>,
     volume: Option<(VolumeDesc, VolumeFormat)>,
     uploads: u64,
 }
@@ -51,6 +71,52 @@ pub fn upload_volume_texture(gpu: &Gpu, volume: &Volume) -> Result<UploadedVolum
     }
 }
 
+/// The voxels `lo .. lo + dims` of `volume` (clamped to it per axis, so a box reaching past a
+/// face repeats the face: clamp-to-edge) as texels of `format`, x fastest, with the same
+/// normalisation as [`upload_volume_texture`]: what a brick pool uploads for one brick.
+pub fn volume_region_bytes(volume: &Volume, lo: glam::UVec3, dims: glam::UVec3, format: VolumeFormat) -> Vec<u8> {
+    let n = volume.dims;
+    let count = dims.x as usize * dims.y as usize * dims.z as usize;
+    let mut indices = Vec::with_capacity(count);
+    for z in 0..dims.z {
+        let zz = (lo.z + z).min(n.z - 1) as usize;
+        for y in 0..dims.y {
+            let yy = (lo.y + y).min(n.y - 1) as usize;
+            let row = (zz * n.y as usize + yy) * n.x as usize;
+            for x in 0..dims.x {
+                indices.push(row + (lo.x + x).min(n.x - 1) as usize);
+            }
+        }
+    }
+    match &volume.data {
+        VoxelData::U8(v) => {
+            let t: Vec<u8> = indices.iter().map(|i| v[*i]).collect();
+            super::upload::texel_bytes(&VolumeTexels::Unorm8(&t), format)
+        }
+        VoxelData::U16(v) => {
+            let t: Vec<u16> = indices.iter().map(|i| v[*i]).collect();
+            super::upload::texel_bytes(&VolumeTexels::Unorm16(&t), format)
+        }
+        VoxelData::I16(v) => {
+            let t: Vec<u16> = indices.iter().map(|i| (v[*i] as i32 + 32768) as u16).collect();
+            super::upload::texel_bytes(&VolumeTexels::Unorm16(&t), format)
+        }
+        VoxelData::F32(_) => {
+            let t: Vec<f32> = indices.iter().map(|i| volume.normalized(*i) as f32).collect();
+            super::upload::texel_bytes(&VolumeTexels::Float(&t), format)
+        }
+    }
+}
+
+/// The texture format [`upload_volume_texture`] gives `volume` on `gpu` (without uploading).
+pub fn volume_texture_format(gpu: &Gpu, volume: &Volume) -> VolumeFormat {
+    match &volume.data {
+        VoxelData::U8(_) => volume_format_for(gpu, &VolumeTexels::Unorm8(&[])),
+        VoxelData::U16(_) | VoxelData::I16(_) => volume_format_for(gpu, &VolumeTexels::Unorm16(&[])),
+        VoxelData::F32(_) => volume_format_for(gpu, &VolumeTexels::Float(&[])),
+    }
+}
+
 impl BoundInput {
     /// A version of the content: equal content, equal version (passes that run only when their
     /// inputs change compare it).
@@ -60,8 +126,8 @@ impl BoundInput {
 }
 
 impl InputStore {
-    /// Binds `volume` to input `name`; uploads only when its content differs from what is bound.
-    /// Returns whether it uploaded.
+    /// Binds `volume` to input `name`. Returns whether the content is new; the texture is made
+    /// by [`InputStore::ensure_volume_texture`] when a pass reads it as one.
     pub fn bind_volume(&mut self, gpu: &Gpu, name: &str, volume: &Volume) -> Result<bool, UploadError> {
         let content = content_hash(|h| {
             volume.dims.to_array().hash(h);
@@ -76,16 +142,52 @@ impl InputStore {
             }
         });
         let desc = VolumeDesc::of(volume);
-        if self.inputs.get(name).is_some_and(|i| i.content == content) {
-            if let Some((_, format)) = self.volume {
-                self.volume = Some((desc, format));
-            }
+        let format = volume_texture_format(gpu, volume);
+        if self.volumes.get(name).is_some_and(|v| v.content == content) {
+            self.volume = Some((desc, format));
             return Ok(false);
         }
-        let uploaded = upload_volume_texture(gpu, volume)?;
-        self.volume = Some((desc, uploaded.format));
+        let expected = volume.dims.x as u64 * volume.dims.y as u64 * volume.dims.z as u64;
+        if volume.data.len() as u64 != expected {
+            return Err(UploadError::Size { label: volume.name.clone(), given: volume.data.len(), expected });
+        }
+        self.inputs.remove(name);
+        self.volumes.insert(name.to_string(), BoundVoxels { voxels: Arc::new(volume.clone()), content });
+        self.volume = Some((desc, format));
+        Ok(true)
+    }
+
+    /// Makes the 3D texture of volume input `name` if it has none yet (a pass reads it as a
+    /// texture). Returns whether it uploaded.
+    pub fn ensure_volume_texture(&mut self, gpu: &Gpu, name: &str) -> Result<bool, UploadError> {
+        if self.inputs.contains_key(name) {
+            return Ok(false);
+        }
+        let Some(bound) = self.volumes.get(name) else { return Ok(false) };
+        let content = bound.content;
+        let uploaded = upload_volume_texture(gpu, &bound.voxels)?;
         self.insert(name, uploaded.texture, content);
         Ok(true)
+    }
+
+    /// The voxels bound to volume input `name`.
+    pub fn voxels(&self, name: &str) -> Option<&Arc<Volume>> {
+        self.volumes.get(name).map(|v| &v.voxels)
+    }
+
+    /// The LUT bound to input `name`, on the CPU.
+    pub fn table(&self, name: &str) -> Option<&Arc<Vec<[f32; 4]>>> {
+        self.tables.get(name)
+    }
+
+    /// The content version of input `name` (texture or CPU volume).
+    pub fn version(&self, name: &str) -> Option<u64> {
+        self.inputs.get(name).map(|i| i.content).or_else(|| self.volumes.get(name).map(|v| v.content))
+    }
+
+    /// Whether input `name` is bound (as a texture or as a volume on the CPU).
+    pub fn is_bound(&self, name: &str) -> bool {
+        self.inputs.contains_key(name) || self.volumes.contains_key(name)
     }
 
     /// Binds an RGBA LUT to input `name`; uploads only when it differs from what is bound.
@@ -96,6 +198,7 @@ impl InputStore {
         }
         let texture = upload_lut(gpu, "transfer function", lut)?;
         self.insert(name, texture, content);
+        self.tables.insert(name.to_string(), Arc::new(lut.to_vec()));
         Ok(true)
     }
 

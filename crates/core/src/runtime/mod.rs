@@ -38,7 +38,7 @@ pub use frame::{
 };
 pub use frames::{FrameStats, MAX_FRAMES_IN_FLIGHT};
 pub use gpu::{Gpu, GpuError, GpuFault, GpuFaultKind, GpuOptions};
-pub use inputs::upload_volume_texture;
+pub use inputs::{upload_volume_texture, volume_region_bytes, volume_texture_format};
 pub use present::PresentTarget;
 pub use readback::Image;
 pub use record::{RecordContext, SystemBindings};
@@ -116,6 +116,17 @@ pub struct MemoryInUse {
     pub bind_groups_created: u64,
 }
 
+/// How a graph's history was used (see [`Runtime::history_stats`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct HistoryStats {
+    /// Frames that read the previous frame's history instead of its initial value.
+    pub frames_from_history: u64,
+    /// Consecutive frames up to the last one that read the previous frame's history.
+    pub run: u64,
+    /// How often history started over after being used (resize, edit, new input, camera jump).
+    pub restarts: u64,
+}
+
 /// The long-lived runtime.
 pub struct Runtime {
     gpu: Arc<Gpu>,
@@ -132,9 +143,12 @@ pub struct Runtime {
     stale_modules: Vec<String>,
     frame_index: u64,
     history_age: u64,
+    history_stats: HistoryStats,
     last_camera: Option<(CameraData, (u32, u32))>,
     /// What the transfer function's opacity is per (a scene setting).
     opacity_reference: OpacityReference,
+    /// GPU memory passes that stream data may use (`--gpu-memory-mb`); `None`: the adapter's.
+    gpu_memory_budget: Option<u64>,
 }
 
 impl Runtime {
@@ -155,9 +169,34 @@ impl Runtime {
             stale_modules: Vec::new(),
             frame_index: 0,
             history_age: 0,
+            history_stats: HistoryStats::default(),
             last_camera: None,
             opacity_reference: OpacityReference::default(),
+            gpu_memory_budget: None,
         }
+    }
+
+    /// Bounds the GPU memory passes that stream data may hold (a brick pool), in bytes; `None`
+    /// leaves it to what the adapter allows. Takes effect with the next frame.
+    pub fn set_gpu_memory_budget(&mut self, bytes: Option<u64>) {
+        self.gpu_memory_budget = bytes;
+    }
+
+    /// Figures the applied plan's passes report about their last frame ([`crate::plugin::PassNode::counters`]),
+    /// as `(pass id, name, value)` in step order.
+    pub fn pass_counters(&self) -> Vec<(String, &'static str, f64)> {
+        let Some(schedule) = &self.schedule else { return Vec::new() };
+        let mut out = Vec::new();
+        let mut seen = std::collections::HashSet::new();
+        for step in &schedule.plan.steps {
+            if !seen.insert(step.pass_id.clone()) {
+                continue;
+            }
+            if let Some(entry) = schedule.nodes.get(&step.pass_id) {
+                out.extend(entry.node.counters().into_iter().map(|(name, v)| (step.pass_id.clone(), name, v)));
+            }
+        }
+        out
     }
 
     /// Sets what the transfer function's opacity is per (per voxel by default; per world unit
@@ -235,16 +274,18 @@ impl Runtime {
         volume: &volgraph_accel::volume::Volume,
         lut: &[[f32; 4]],
     ) -> Result<(), RuntimeError> {
+        let mut uploaded = false;
         for (name, kind) in inputs {
             match kind {
-                InputKind::Volume => {
-                    self.bind_volume(name, volume)?;
-                }
-                InputKind::TransferFunction => {
-                    self.bind_lut(name, lut)?;
-                }
+                InputKind::Volume => uploaded |= self.bind_volume(name, volume)?,
+                InputKind::TransferFunction => uploaded |= self.bind_lut(name, lut)?,
                 InputKind::Scalar(_) => {}
             }
+        }
+        // What history keeps was computed from the old inputs (Klein et al. 2005 §4.1: a new
+        // transfer function restarts from the box).
+        if uploaded {
+            self.invalidate_history();
         }
         Ok(())
     }
@@ -279,10 +320,16 @@ impl Runtime {
         };
         match schedule::build(resources, registry, plan, old, &self.stale_modules) {
             Ok((schedule, report)) => {
+                // Klein et al. 2005 §4.1: a resize starts from scratch, and so does a parameter
+                // edit of a pass a history entry declares it depends on (an isovalue change).
+                let stale = schedule
+                    .plan
+                    .history
+                    .values()
+                    .any(|h| h.reset_on_params_of.iter().any(|p| report.changed_passes.contains(p)));
                 self.schedule = Some(schedule);
                 self.stale_modules.clear();
-                if viewport_changed {
-                    // Klein et al. 2005 §4: a resize starts from scratch.
+                if viewport_changed || stale {
                     self.invalidate_history();
                 }
                 Ok(report)
@@ -306,8 +353,26 @@ impl Runtime {
     /// function or isovalue change, camera jump; Klein et al. 2005 §4).
     pub fn invalidate_history(&mut self) {
         self.history.invalidate();
+        if self.history_age > 0 {
+            self.history_stats.restarts += 1;
+        }
         self.history_age = 0;
         self.last_camera = None;
+    }
+
+    /// How the graph's history has been used: frames that read the previous frame's values
+    /// (Klein et al. 2005: frames that ran from reprojected starts) and how often it started
+    /// over. Zero for a graph without history.
+    pub fn history_stats(&self) -> HistoryStats {
+        self.history_stats
+    }
+
+    /// Whether `camera` turned further from the last frame's than some history entry allows
+    /// (`max_camera_degrees`): a camera jump starts that history over (Klein et al. 2005 §4.1).
+    fn camera_jumped(&self, camera: &CameraData) -> bool {
+        let (Some(plan), Some((last, _))) = (self.plan(), self.last_camera) else { return false };
+        let turned = last.forward.angle_between(camera.forward).to_degrees();
+        plan.history.values().any(|h| h.max_camera_degrees.is_some_and(|bound| turned > bound))
     }
 
     /// The frame data the next frame will see for `camera`.
@@ -321,6 +386,7 @@ impl Runtime {
             frame_index: self.frame_index,
             history_age: self.history_age,
             volume: self.inputs.volume().map(|(v, _)| v.with_opacity_reference(self.opacity_reference)),
+            gpu_memory_budget: self.gpu_memory_budget,
         })
     }
 
@@ -328,9 +394,19 @@ impl Runtime {
     /// window; returns the frame's index at once (at most [`MAX_FRAMES_IN_FLIGHT`] frames are
     /// queued: a further submit waits for the oldest).
     pub fn submit(&mut self, camera: CameraData, present: Option<&PresentTarget<'_>>) -> Result<u64, RuntimeError> {
+        if self.camera_jumped(&camera) {
+            self.invalidate_history();
+        }
         let frame = self.frame_data(camera)?;
         let Some(schedule) = self.schedule.as_mut() else { return Err(RuntimeError::NoPlan) };
         Self::check_inputs_of(&self.inputs, &schedule.plan)?;
+        for step in &schedule.plan.steps {
+            for bp in &step.ports {
+                if let Binding::Input(name) = &bp.binding {
+                    self.inputs.ensure_volume_texture(&self.gpu, name)?;
+                }
+            }
+        }
         let gpu = self.gpu.clone();
         self.gpu.queue.write_buffer(&self.system.frame, 0, bytemuck::bytes_of(&FrameUniforms::of(&frame)));
         let steps = schedule.plan.steps.len();
@@ -365,14 +441,20 @@ impl Runtime {
         schedule.bind_groups.borrow_mut().evict_older_than(frame.frame_index, 8);
         self.last_camera = Some((camera, frame.viewport));
         self.frame_index += 1;
+        if frame.history_age > 0 && !schedule.plan.history.is_empty() {
+            self.history_stats.frames_from_history += 1;
+        }
+        self.history_stats.run = frame.history_age;
         self.history_age += 1;
         Ok(frame.frame_index)
     }
 
     fn check_inputs_of(inputs: &inputs::InputStore, plan: &Plan) -> Result<(), RuntimeError> {
         for (name, kind) in &plan.inputs {
-            let used = plan.steps.iter().any(|s| s.ports.iter().any(|p| p.binding == Binding::Input(name.clone())));
-            if used && inputs.get(name).is_none() {
+            let used = plan.steps.iter().any(|s| {
+                s.ports.iter().any(|p| matches!(&p.binding, Binding::Input(n) | Binding::InputVoxels(n) if n == name))
+            });
+            if used && !inputs.is_bound(name) {
                 let (kind, hint) = match kind {
                     InputKind::Volume => ("Volume", "bind it with Runtime::bind_volume"),
                     InputKind::TransferFunction => ("TransferFunction", "bind the LUT with Runtime::bind_lut"),
@@ -566,8 +648,9 @@ fn record_steps(
         let mut ports = Vec::with_capacity(step.ports.len());
         for bp in &step.ports {
             let mut buffer = None;
+            let (mut voxels, mut table) = (None, None);
             let version = match &bp.binding {
-                Binding::Input(name) => inputs.get(name).map(|i| i.version()),
+                Binding::Input(name) | Binding::InputVoxels(name) => inputs.version(name),
                 Binding::Resource { id, .. } if matches!(plan.resources[*id].desc, ResourceDesc::Owned(_)) => {
                     owned_versions.get(&plan.resources[root_owned(plan, *id)].name).copied()
                 }
@@ -594,11 +677,27 @@ fn record_steps(
                     };
                     (view, extent)
                 }
-                Binding::Input(name) => (inputs.get(name).map(|t| &t.view), None),
+                Binding::Input(name) => {
+                    table = inputs.table(name);
+                    (inputs.get(name).map(|t| &t.view), None)
+                }
+                Binding::InputVoxels(name) => {
+                    voxels = inputs.voxels(name);
+                    (None, None)
+                }
                 Binding::History(name) => (history.get(name).map(|e| &e.previous().view), None),
                 Binding::Unbound => (None, None),
             };
-            ports.push(BoundPort { name: bp.port.clone(), access: bp.access, view, buffer, extent, version });
+            ports.push(BoundPort {
+                name: bp.port.clone(),
+                access: bp.access,
+                view,
+                buffer,
+                extent,
+                version,
+                voxels,
+                table,
+            });
         }
         let entry = nodes.get_mut(&step.pass_id).ok_or_else(|| ApplyError::UnknownKind(step.kind.clone()))?;
         let outputs_published = step.ports.iter().all(|bp| match &bp.binding {
@@ -666,7 +765,7 @@ fn input_versions(
     let mut versions = Vec::new();
     for bp in step.ports.iter().filter(|bp| bp.access != Access::Write) {
         versions.push(match &bp.binding {
-            Binding::Input(name) => inputs.get(name).map_or(0, |i| i.version()),
+            Binding::Input(name) | Binding::InputVoxels(name) => inputs.version(name).unwrap_or(0),
             Binding::Resource { id, .. } if matches!(plan.resources[*id].desc, ResourceDesc::Owned(_)) => {
                 owned_versions.get(&plan.resources[root_owned(plan, *id)].name).copied().unwrap_or(0)
             }

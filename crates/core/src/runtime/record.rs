@@ -20,6 +20,10 @@ pub(crate) struct BoundPort<'a> {
     /// Version of a graph input's content or of an Owned resource (equal content, equal
     /// version); `None` for targets, which change every frame.
     pub version: Option<u64>,
+    /// A volume input's voxels (ports of kind VolumeVoxels).
+    pub voxels: Option<&'a std::sync::Arc<volgraph_accel::volume::Volume>>,
+    /// A transfer-function input's LUT on the CPU.
+    pub table: Option<&'a std::sync::Arc<Vec<[f32; 4]>>>,
 }
 
 /// Samplers and the frame uniform buffer.
@@ -132,6 +136,21 @@ impl<'a> RecordContext<'a> {
             .ok_or_else(|| self.error(format!("port \"{port}\" is not bound to a texture")))
     }
 
+    /// The voxels of the volume bound to `port` (a port of kind
+    /// [`crate::plugin::PortKind::VolumeVoxels`]), on the CPU.
+    pub fn voxels(&self, port: &str) -> Result<&'a std::sync::Arc<volgraph_accel::volume::Volume>, PassError> {
+        self.port(port)
+            .and_then(|p| p.voxels)
+            .ok_or_else(|| self.error(format!("port \"{port}\" is not bound to a volume's voxels")))
+    }
+
+    /// The transfer-function LUT bound to `port`, on the CPU (classifying bricks).
+    pub fn table(&self, port: &str) -> Result<&'a std::sync::Arc<Vec<[f32; 4]>>, PassError> {
+        self.port(port)
+            .and_then(|p| p.table)
+            .ok_or_else(|| self.error(format!("port \"{port}\" is not bound to a transfer function")))
+    }
+
     /// The storage buffer bound to `port`.
     pub fn buffer(&self, port: &str) -> Result<&'a wgpu::Buffer, PassError> {
         self.port(port)
@@ -141,7 +160,7 @@ impl<'a> RecordContext<'a> {
 
     /// Whether an optional port is bound.
     pub fn is_bound(&self, port: &str) -> bool {
-        self.port(port).is_some_and(|p| p.view.is_some() || p.buffer.is_some())
+        self.port(port).is_some_and(|p| p.view.is_some() || p.buffer.is_some() || p.voxels.is_some())
     }
 
     /// Pixel size of the target bound to `port`.

@@ -113,6 +113,8 @@ pub struct ApplyReport {
     pub history_kept: Vec<String>,
     /// History entries that start over from their initial value.
     pub history_reset: Vec<String>,
+    /// Pass ids whose node was updated in place or built anew (their parameters changed).
+    pub changed_passes: Vec<String>,
 }
 
 /// Why a plan could not be applied.
@@ -310,6 +312,7 @@ pub(crate) fn build(
             }
             Decision::Update => {
                 report.nodes_updated += 1;
+                report.changed_passes.push(id.clone());
                 old_nodes.remove(&id).map(|mut e| {
                     e.node.update_params(r.gpu, &params);
                     e.params = params.clone();
@@ -319,6 +322,7 @@ pub(crate) fn build(
             }
             Decision::Create(node, modules) => {
                 report.nodes_created += 1;
+                report.changed_passes.push(id.clone());
                 let rerun = registry.get(&kind).map_or(Rerun::EveryFrame, |p| p.rerun());
                 Some(NodeEntry {
                     node,

@@ -32,7 +32,8 @@ impl VolumeFormat {
         }
     }
 
-    fn bytes(self) -> u32 {
+    /// Bytes per texel.
+    pub fn bytes(self) -> u32 {
         match self {
             VolumeFormat::R8Unorm => 1,
             VolumeFormat::R16Unorm | VolumeFormat::R16Float => 2,
@@ -111,8 +112,8 @@ pub fn volume_format_for(gpu: &Gpu, texels: &VolumeTexels<'_>) -> VolumeFormat {
     }
 }
 
-/// The bytes of `texels` in `format`.
-fn texel_bytes(texels: &VolumeTexels<'_>, format: VolumeFormat) -> Vec<u8> {
+/// The bytes of `texels` in `format` (x fastest, tightly packed).
+pub fn texel_bytes(texels: &VolumeTexels<'_>, format: VolumeFormat) -> Vec<u8> {
     let as_f32 = |t: &VolumeTexels<'_>| -> Vec<f32> {
         match t {
             VolumeTexels::Unorm8(v) => v.iter().map(|x| *x as f32 / 255.0).collect(),

@@ -43,6 +43,37 @@ impl Checker<'_> {
     pub(super) fn check_history(&mut self) -> BTreeMap<String, (Ref, HistoryInitial)> {
         let mut out = BTreeMap::new();
         for (name, h) in &self.doc.history.clone() {
+            for pass in &h.reset_on_params_of {
+                if !self.pass_by_id.contains_key(pass) {
+                    let mut ids: Vec<&str> = self.pass_by_id.keys().map(String::as_str).collect();
+                    ids.sort_unstable();
+                    let help = crate::suggest::guess_then(
+                        pass,
+                        ids.iter().copied(),
+                        "",
+                        format!("passes are: {}", comma_list(&ids)),
+                    );
+                    self.err(
+                        self.loc.top_entry_field("history", name, "reset_on_params_of"),
+                        format!(
+                            "history \"{name}\" resets when pass \"{pass}\" changes, but the graph has no such pass"
+                        ),
+                        Some(help),
+                    );
+                }
+            }
+            if let Some(d) = h.max_camera_degrees
+                && !(d.is_finite() && d > 0.0 && d <= 180.0)
+            {
+                self.err(
+                    self.loc.top_entry_field("history", name, "max_camera_degrees"),
+                    format!("history \"{name}\": max_camera_degrees {d} is not an angle the camera can turn"),
+                    Some(
+                        "write the largest turn between frames that still reuses the history, in degrees, 0 < d <= 180"
+                            .to_string(),
+                    ),
+                );
+            }
             let location = self.loc.top_entry_field("history", name, "of");
             let Some((head, tail)) = h.of.split_once('.') else {
                 self.err(

@@ -98,7 +98,7 @@ impl Checker<'_> {
                     ValueDesc::Buffer { bytes: *bytes, bytes_per_pixel: *bytes_per_pixel }
                 }
                 PortKind::Owned(t) => ValueDesc::Owned((*t).to_string()),
-                PortKind::Volume => ValueDesc::Volume,
+                PortKind::Volume | PortKind::VolumeVoxels => ValueDesc::Volume,
                 PortKind::TransferFunction => ValueDesc::TransferFunction,
             };
             out.insert(port.name.to_string(), desc);

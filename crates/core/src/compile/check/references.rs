@@ -427,7 +427,8 @@ impl Checker<'_> {
                 }
                 return;
             }
-            (PortKind::Volume, ValueDesc::Volume) | (PortKind::TransferFunction, ValueDesc::TransferFunction) => true,
+            (PortKind::Volume | PortKind::VolumeVoxels, ValueDesc::Volume)
+            | (PortKind::TransferFunction, ValueDesc::TransferFunction) => true,
             (PortKind::Owned(a), ValueDesc::Owned(b)) => a == b,
             (PortKind::Buffer { .. }, ValueDesc::Buffer { .. }) => true,
             _ => false,
@@ -442,7 +443,9 @@ impl Checker<'_> {
                     desc.describe()
                 ),
                 Some(match &spec.kind {
-                    PortKind::Volume => "declare inputs: {\"volume\": Volume} and read \"input.volume\"".to_string(),
+                    PortKind::Volume | PortKind::VolumeVoxels => {
+                        "declare inputs: {\"volume\": Volume} and read \"input.volume\"".to_string()
+                    }
                     PortKind::TransferFunction => {
                         "declare inputs: {\"tf\": TransferFunction} and read \"input.tf\"".to_string()
                     }

@@ -1,0 +1,159 @@
+//! `antialias`: Klein et al. 2005 §5's selective super-sampling. A pixel whose colour differs
+//! from a 4-neighbour by more than `contrast` is re-rendered from sub-pixel rays — `pattern` 2x
+//! (diagonal pair), 4x (regular grid) or rgss (4x rotated grid) — with directions interpolated
+//! from its own and its neighbours' ray directions (`directions`: linear from two neighbours as
+//! in the paper's Fig. 7 left, bilinear from three, or the camera's exact ones), each starting
+//! from the nearest leap hit of the pixel and its neighbours on its own step grid; the colour is
+//! their mean. `selection: "full"` re-renders every pixel: full-scene super-sampling, the
+//! baseline. Its raycast parameters (step, threshold, mode, isovalue, shading, step back) must
+//! be the raycaster's: share them through Scalar inputs. Shader: `shaders/antialias.wgsl`.
+
+use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::{CreateContext, Gpu, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
+use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+
+use crate::effects::jitter_defines;
+use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
+
+/// The plugin.
+pub struct Antialias;
+
+/// Rust twin of `AaParams` in `shaders/antialias.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct AaParamsGpu {
+    contrast: f32,
+    pattern: u32,
+    directions: u32,
+    full: u32,
+}
+
+const _: () = assert!(std::mem::size_of::<AaParamsGpu>() == 16);
+
+impl AaParamsGpu {
+    fn from_params(p: &Params) -> Self {
+        Self {
+            contrast: p.float("contrast") as f32,
+            pattern: match p.choice("pattern") {
+                "2x" => 2,
+                "rgss" => 5,
+                _ => 4,
+            },
+            directions: match p.choice("directions") {
+                "bilinear" => 1,
+                "exact" => 2,
+                _ => 0,
+            },
+            full: (p.choice("selection") == "full") as u32,
+        }
+    }
+}
+
+const FLOAT_TARGETS: [TargetFormat; 2] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float];
+
+impl PassPlugin for Antialias {
+    fn kind(&self) -> &'static str {
+        "antialias"
+    }
+
+    fn summary(&self) -> &'static str {
+        "selective super-sampling where a pixel differs from a 4-neighbour; 2x, 4x, rotated grid (Klein et al. 2005 §5)"
+    }
+
+    fn params(&self) -> Vec<ParamSpec> {
+        let mut p = raycast_param_specs();
+        p.push(ParamSpec::uint(
+            "step_back",
+            2,
+            0,
+            64,
+            "the raycaster's step back (sub-pixel rays start like its rays)",
+        ));
+        p.push(ParamSpec::float(
+            "contrast",
+            0.05,
+            0.0,
+            1.0,
+            "colour difference to a 4-neighbour (any channel) that flags a pixel",
+        ));
+        p.push(ParamSpec::choice(
+            "pattern",
+            "4x",
+            &["2x", "4x", "rgss"],
+            "sub-pixel pattern: 2 diagonal, 4 regular, 4 rotated grid",
+        ));
+        p.push(ParamSpec::choice(
+            "directions",
+            "linear",
+            &["linear", "bilinear", "exact"],
+            "sub-pixel directions from two neighbours (the paper), three, or the camera",
+        ));
+        p.push(ParamSpec::choice(
+            "selection",
+            "selective",
+            &["selective", "full"],
+            "re-render flagged pixels only, or every pixel (full-scene super-sampling)",
+        ));
+        p
+    }
+
+    fn ports(&self, _params: &Params) -> Vec<PortSpec> {
+        vec![
+            PortSpec::read("color", PortKind::target(&FLOAT_TARGETS)),
+            PortSpec::read("hits", PortKind::target(&[TargetFormat::Rgba32Float])),
+            PortSpec::read("volume", PortKind::Volume),
+            PortSpec::read("tf", PortKind::TransferFunction),
+            PortSpec::write("color_aa", PortKind::target(&[TargetFormat::Rgba16Float, TargetFormat::Rgba32Float])),
+        ]
+    }
+
+    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
+        jitter_defines(params)
+    }
+
+    fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
+        vec![ShaderUse { file: "antialias.wgsl", entry_point: if is_iso(params) { "fs_aa_iso" } else { "fs_aa_dvr" } }]
+    }
+
+    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
+        is_iso(old) == is_iso(new) && old.boolean("jitter") == new.boolean("jitter")
+    }
+
+    fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        let defines = self.shader_defines(ctx.params);
+        let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
+            shader: "antialias.wgsl",
+            vertex: "vs_fullscreen",
+            fragment: if is_iso(ctx.params) { "fs_aa_iso" } else { "fs_aa_dvr" },
+            extra_bindings: &["params", "aa"],
+            defines: &defines,
+            ..Default::default()
+        })?;
+        let params = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
+        let aa = ctx.uniform_with("aa", &AaParamsGpu::from_params(ctx.params));
+        Ok(Box::new(AntialiasNode { pipeline, params, aa }))
+    }
+}
+
+struct AntialiasNode {
+    pipeline: PassPipeline,
+    params: wgpu::Buffer,
+    aa: wgpu::Buffer,
+}
+
+impl PassNode for AntialiasNode {
+    fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
+        let bg = ctx.bind_group(
+            &self.pipeline,
+            &[("params", self.params.as_entire_binding()), ("aa", self.aa.as_entire_binding())],
+        )?;
+        let mut pass = ctx.begin_render_pass(&self.pipeline, None)?;
+        crate::draw(&mut pass, &self.pipeline, &bg, 0..3);
+        Ok(())
+    }
+
+    fn update_params(&mut self, gpu: &Gpu, params: &Params) {
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
+        gpu.queue.write_buffer(&self.aa, 0, bytemuck::bytes_of(&AaParamsGpu::from_params(params)));
+    }
+}

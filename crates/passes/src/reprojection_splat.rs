@@ -1,0 +1,158 @@
+//! `reprojection_splat`: Klein et al. 2005 §4.3–4.4's first hole-filling step. Last frame's leap
+//! hits (a history of the raycaster's `leap_hit`) are drawn with this frame's camera as k×k-pixel
+//! splats — instanced quads pulling their point from the texture, since WebGPU has no point
+//! size — depth-tested so the nearest start wins, only for the pixels of last frame's screen
+//! rectangle of the volume (computed here from the previous camera). Writes `start` (xyz: the
+//! texture-space start estimate, w = 1 where a splat landed) and its `depth`; `hole_fill`
+//! completes the rest. With `block` b > 1 one quad stands for the nearest of b×b hits, drawn
+//! over their projected bounding box grown by k/2: b² fewer quads (vertex work is most of a
+//! splat's cost where the vertex stage is slow, as on lavapipe), starts never farther than the
+//! hits they stand for. Shader: `shaders/reprojection_splat.wgsl`.
+
+use glam::{DVec3, DVec4};
+use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::{
+    CameraData, CreateContext, DepthSpec, Gpu, PassError, PassPipeline, PipelineKind, RecordContext, RenderPipelineSpec,
+};
+use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+
+/// The plugin.
+pub struct ReprojectionSplat;
+
+/// Rust twin of `SplatParams` in `shaders/reprojection_splat.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+struct SplatParamsGpu {
+    rect: [u32; 4],
+    size: f32,
+    block: u32,
+    _pad: [f32; 2],
+}
+
+const _: () = assert!(std::mem::size_of::<SplatParamsGpu>() == 32);
+
+impl PassPlugin for ReprojectionSplat {
+    fn kind(&self) -> &'static str {
+        "reprojection_splat"
+    }
+
+    fn summary(&self) -> &'static str {
+        "last frame's hit points reprojected as depth-tested k×k splats: ray start estimates (Klein et al. 2005 §4.3–4.4)"
+    }
+
+    fn params(&self) -> Vec<ParamSpec> {
+        vec![
+            ParamSpec::uint("splat_size", 2, 1, 16, "splat edge k in pixels (the paper: two or four closes the gaps)"),
+            ParamSpec::uint(
+                "block",
+                1,
+                1,
+                4,
+                "hits per splat side: one splat carries the nearest of a block×block of hits (block² fewer quads; the paper: 1)",
+            ),
+        ]
+    }
+
+    fn ports(&self, _params: &Params) -> Vec<PortSpec> {
+        vec![
+            PortSpec::read("hits", PortKind::target(&[TargetFormat::Rgba32Float])),
+            PortSpec::write("start", PortKind::target(&[TargetFormat::Rgba32Float])),
+            PortSpec::write("depth", PortKind::target(&[TargetFormat::Depth32Float])),
+        ]
+    }
+
+    fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
+        vec![
+            ShaderUse { file: "reprojection_splat.wgsl", entry_point: "vs_splat" },
+            ShaderUse { file: "reprojection_splat.wgsl", entry_point: "fs_splat" },
+        ]
+    }
+
+    fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
+        true
+    }
+
+    fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
+            shader: "reprojection_splat.wgsl",
+            vertex: "vs_splat",
+            fragment: "fs_splat",
+            extra_bindings: &["splat"],
+            depth: Some(DepthSpec { port: "depth", write: true, compare: wgpu::CompareFunction::Less }),
+            topology: wgpu::PrimitiveTopology::TriangleStrip,
+            ..Default::default()
+        })?;
+        let uniform = ctx.uniform_buffer("splat", std::mem::size_of::<SplatParamsGpu>() as u64);
+        let (size, block) = (ctx.params.uint("splat_size") as f32, ctx.params.uint("block") as u32);
+        Ok(Box::new(SplatNode { pipeline, uniform, size, block, written: None }))
+    }
+}
+
+struct SplatNode {
+    pipeline: PassPipeline,
+    uniform: wgpu::Buffer,
+    size: f32,
+    block: u32,
+    written: Option<SplatParamsGpu>,
+}
+
+/// The pixel rectangle `(x, y, w, h)` the volume box of half size `half` covers seen by
+/// `camera` in a `viewport`; the whole viewport when a corner is behind the eye.
+pub fn screen_rect(camera: &CameraData, half: DVec3, viewport: (u32, u32)) -> [u32; 4] {
+    let (w, h) = (viewport.0 as f64, viewport.1 as f64);
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for i in 0..8 {
+        let corner = DVec3::new(
+            if i & 1 != 0 { half.x } else { -half.x },
+            if i & 2 != 0 { half.y } else { -half.y },
+            if i & 4 != 0 { half.z } else { -half.z },
+        );
+        let c = camera.clip_from_world * DVec4::new(corner.x, corner.y, corner.z, 1.0);
+        if c.w <= 1e-9 {
+            return [0, 0, viewport.0, viewport.1];
+        }
+        let (px, py) = ((c.x / c.w + 1.0) * 0.5 * w, (1.0 - c.y / c.w) * 0.5 * h);
+        lo = [lo[0].min(px), lo[1].min(py)];
+        hi = [hi[0].max(px), hi[1].max(py)];
+    }
+    let x0 = lo[0].floor().clamp(0.0, w) as u32;
+    let y0 = lo[1].floor().clamp(0.0, h) as u32;
+    let x1 = hi[0].ceil().clamp(0.0, w) as u32;
+    let y1 = hi[1].ceil().clamp(0.0, h) as u32;
+    [x0, y0, x1.saturating_sub(x0), y1.saturating_sub(y0)]
+}
+
+impl PassNode for SplatNode {
+    fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
+        // Last frame's hits lie in last frame's rectangle; without a last frame history holds
+        // its initial value (no hits) and nothing is drawn.
+        let rect = match (&ctx.frame.previous_camera, &ctx.frame.volume) {
+            (Some(previous), Some(volume)) if ctx.frame.history_age > 0 => {
+                screen_rect(previous, volume.half_extent, ctx.frame.viewport)
+            }
+            _ => [0; 4],
+        };
+        let settings = SplatParamsGpu { rect, size: self.size, block: self.block, _pad: [0.0; 2] };
+        if self.written != Some(settings) {
+            ctx.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&settings));
+            self.written = Some(settings);
+        }
+        let bg = ctx.bind_group(&self.pipeline, &[("splat", self.uniform.as_entire_binding())])?;
+        let mut pass = ctx.begin_render_pass(&self.pipeline, Some(1.0))?;
+        let instances = rect[2].div_ceil(self.block) * rect[3].div_ceil(self.block);
+        if let PipelineKind::Render(p) = &self.pipeline.pipeline
+            && instances > 0
+        {
+            pass.set_pipeline(p);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.draw(0..4, 0..instances);
+        }
+        Ok(())
+    }
+
+    fn update_params(&mut self, _gpu: &Gpu, params: &Params) {
+        self.size = params.uint("splat_size") as f32;
+        self.block = params.uint("block") as u32;
+        self.written = None;
+    }
+}

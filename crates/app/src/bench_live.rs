@@ -247,6 +247,7 @@ pub fn run(args: &LiveArgs) -> anyhow::Result<()> {
                 viewport,
                 features: Vec::new(),
                 shaders: Some(dir.join("shaders")),
+                gpu_memory_mb: None,
             },
         )
         .map(|(s, _)| s)

@@ -80,6 +80,11 @@ enum Command {
         /// beside the graph's workspace, if there is one).
         #[arg(long)]
         shaders: Option<PathBuf>,
+        /// GPU memory, in MiB, passes that stream data may hold (the brick pool of
+        /// graphs/ruijters_vilanova_2006); a volume that does not fit streams through it
+        /// [default: what the adapter allows].
+        #[arg(long = "gpu-memory-mb", value_parser = clap::value_parser!(u64).range(1..=1 << 24))]
+        gpu_memory_mb: Option<u64>,
     },
     /// Show a graph live in a window, hot-reloading the graph, its shaders and its transfer
     /// function; an overlay shows per-pass GPU time, the plan and every parameter.
@@ -255,6 +260,7 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
             output,
             out,
             shaders,
+            gpu_memory_mb,
         } => {
             let args = crate::render::RenderArgs {
                 graph,
@@ -270,6 +276,7 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
                 output,
                 out,
                 shaders,
+                gpu_memory_mb,
             };
             Ok(Checked::Render(Box::new(crate::render::prepare(args)?)))
         }

@@ -33,6 +33,7 @@ pub struct RenderArgs {
     pub output: Option<String>,
     pub out: PathBuf,
     pub shaders: Option<PathBuf>,
+    pub gpu_memory_mb: Option<u64>,
 }
 
 /// Everything `render` needs, read and checked, before the GPU is opened.
@@ -156,6 +157,7 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
     let (sources, _) = crate::shader_dir::sources_for(&graph, args.shaders.as_deref());
     let mut runtime = Runtime::new(gpu, ShaderLibrary::new(sources));
     runtime.set_opacity_reference(opacity);
+    runtime.set_gpu_memory_budget(args.gpu_memory_mb.map(|mb| mb << 20));
     runtime.bind_scene(&plan.inputs, &volume, &lut).map_err(|e| anyhow!(e))?;
     if runtime.volume().is_some_and(|(_, f)| f == VolumeFormat::R16Float) && !matches!(volume.data, VoxelData::U8(_)) {
         eprintln!(
@@ -217,6 +219,47 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
             };
             eprintln!("  per pass (ms){caveat}: {}", list.join(", "));
         }
+        for line in crate::render::counter_lines(&runtime.pass_counters()) {
+            eprintln!("  {line}");
+        }
     }
     Ok(())
+}
+
+/// What passes reported about the last frame, one line per pass: the brick pool's uploads and
+/// occupancy (`march: uploaded 3.2 MiB (52 bricks) in 1 batch; pool 120/120 slots, 48.0 MiB;
+/// 118 of 512 bricks visible`), other counters as `name value`.
+pub fn counter_lines(counters: &[(String, &'static str, f64)]) -> Vec<String> {
+    let mut passes: Vec<&str> = counters.iter().map(|(p, _, _)| p.as_str()).collect();
+    passes.dedup();
+    passes
+        .into_iter()
+        .map(|pass| {
+            let get = |name: &str| counters.iter().find(|(p, n, _)| p == pass && *n == name).map(|c| c.2);
+            let mib = |b: f64| b / (1024.0 * 1024.0);
+            match (get("uploaded_bytes"), get("pool_slots")) {
+                (Some(up), Some(slots)) => format!(
+                    "{pass}: uploaded {:.1} MiB ({} bricks) in {} batch(es); pool {}/{} slots, {:.1} MiB; {} of {} bricks \
+                     visible; last TF classification {:.2} ms",
+                    mib(up),
+                    get("uploaded_bricks").unwrap_or(0.0),
+                    get("batches").unwrap_or(0.0),
+                    get("resident_bricks").unwrap_or(0.0),
+                    slots,
+                    mib(get("pool_bytes").unwrap_or(0.0)),
+                    get("visible_bricks").unwrap_or(0.0),
+                    get("bricks").unwrap_or(0.0),
+                    get("classify_ms").unwrap_or(0.0),
+                ),
+                _ => {
+                    let all: Vec<String> = counters
+                        .iter()
+                        .filter(|(p, _, _)| p == pass)
+                        .map(|(_, n, v)| format!("{n} {v}"))
+                        .collect();
+                    format!("{pass}: {}", all.join(", "))
+                }
+            }
+        })
+        .collect()
 }

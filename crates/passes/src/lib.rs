@@ -3,6 +3,7 @@
 //! same public [`volgraph_core::Registry`] API an external crate would use.
 
 pub mod antialias;
+pub mod brick_pool;
 pub mod effects;
 pub mod empty_distance;
 pub mod empty_space;
@@ -16,6 +17,7 @@ pub mod preintegration;
 pub mod present;
 pub mod ray_directions;
 pub mod raycast;
+pub mod raycast_bricks;
 pub mod raycast_compute;
 pub mod raycast_ess;
 pub mod raycast_fast;
@@ -57,6 +59,7 @@ pub fn register_builtin(registry: &mut Registry) {
         .register(reprojection_splat::ReprojectionSplat)
         .register(hole_fill::HoleFill)
         .register(antialias::Antialias)
+        .register(raycast_bricks::RaycastBricks)
         .register(present::Present);
 }
 

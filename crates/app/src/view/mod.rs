@@ -55,6 +55,10 @@ pub struct ViewArgs {
     /// else the shaders built into the binary).
     #[arg(long)]
     pub shaders: Option<PathBuf>,
+    /// GPU memory, in MiB, passes that stream data may hold (a brick pool) [default: what the
+    /// adapter allows].
+    #[arg(long = "gpu-memory-mb", value_parser = clap::value_parser!(u64).range(1..=1 << 24))]
+    pub gpu_memory_mb: Option<u64>,
     /// Exit after this many presented frames.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub frames: Option<u64>,
@@ -132,6 +136,7 @@ pub fn run(args: ViewArgs) -> Result<(), CliError> {
         viewport,
         features: args.features,
         shaders: args.shaders,
+        gpu_memory_mb: args.gpu_memory_mb,
     };
     let view = ViewOptions {
         camera,

@@ -134,6 +134,10 @@ pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapt
         if !plan.history.is_empty() {
             ui.label(history_line(&session.runtime.history_stats()));
         }
+        // What passes report about the last frame (a brick pool's uploads and occupancy).
+        for line in crate::render::counter_lines(&session.runtime.pass_counters()) {
+            ui.label(egui::RichText::new(line).small());
+        }
         ui.separator();
         let max = timings.per_pass.iter().map(|(_, ms)| *ms).fold(1e-6, f64::max);
         egui::Grid::new("passes").num_columns(3).show(ui, |ui| {

@@ -102,6 +102,8 @@ pub struct SessionArgs {
     pub features: Vec<String>,
     /// A shader folder to read (and watch) instead of the built-in shaders.
     pub shaders: Option<PathBuf>,
+    /// GPU memory (MiB) a brick pool may hold; None: what the adapter allows.
+    pub gpu_memory_mb: Option<u64>,
     /// A scene supplying the volume and transfer function where `volume` and `tf` are not
     /// given, and its precision and opacity reference.
     pub scene: Option<crate::scene::Scene>,
@@ -172,6 +174,7 @@ impl LiveSession {
         let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
         let (sources, shader_dir) = crate::shader_dir::sources_for(&args.graph, args.shaders.as_deref());
         let mut runtime = Runtime::new(gpu, ShaderLibrary::new(sources));
+        runtime.set_gpu_memory_budget(args.gpu_memory_mb.map(|mb| mb << 20));
         let mut options = CompileOptions::new(args.viewport.0, args.viewport.1)
             .with_features(args.features.iter().filter(|f| !f.is_empty()).cloned());
         if let Some(scene) = &args.scene {

@@ -71,20 +71,21 @@ pub fn upload_volume_texture(gpu: &Gpu, volume: &Volume) -> Result<UploadedVolum
     }
 }
 
-/// The voxels `lo .. lo + dims` of `volume` (clamped to it per axis, so a box reaching past a
-/// face repeats the face: clamp-to-edge) as texels of `format`, x fastest, with the same
-/// normalisation as [`upload_volume_texture`]: what a brick pool uploads for one brick.
-pub fn volume_region_bytes(volume: &Volume, lo: glam::UVec3, dims: glam::UVec3, format: VolumeFormat) -> Vec<u8> {
-    let n = volume.dims;
+/// The voxels `origin .. origin + dims` of `volume` (clamped to it per axis, so a box reaching
+/// past a face repeats the face: clamp-to-edge, as the sampler does) as texels of `format`, x
+/// fastest, with the same normalisation as [`upload_volume_texture`]: what a brick pool uploads
+/// for one brick.
+pub fn volume_region_bytes(volume: &Volume, origin: glam::IVec3, dims: glam::UVec3, format: VolumeFormat) -> Vec<u8> {
+    let n = volume.dims.as_ivec3();
     let count = dims.x as usize * dims.y as usize * dims.z as usize;
     let mut indices = Vec::with_capacity(count);
-    for z in 0..dims.z {
-        let zz = (lo.z + z).min(n.z - 1) as usize;
-        for y in 0..dims.y {
-            let yy = (lo.y + y).min(n.y - 1) as usize;
+    for z in 0..dims.z as i32 {
+        let zz = (origin.z + z).clamp(0, n.z - 1) as usize;
+        for y in 0..dims.y as i32 {
+            let yy = (origin.y + y).clamp(0, n.y - 1) as usize;
             let row = (zz * n.y as usize + yy) * n.x as usize;
-            for x in 0..dims.x {
-                indices.push(row + (lo.x + x).min(n.x - 1) as usize);
+            for x in 0..dims.x as i32 {
+                indices.push(row + (origin.x + x).clamp(0, n.x - 1) as usize);
             }
         }
     }

@@ -1,0 +1,608 @@
+//! `raycast_bricks`: DVR through a GPU brick pool with per-brick octrees, after Ruijters &
+//! Vilanova 2006, as one compute pass that walks the bricks itself.
+//!
+//! - §5 **bricks**: the volume is cut into bricks of `brick_cells`³ cells that keep the voxels
+//!   of their cells' corners (the one-voxel overlap trilinear samples inside a brick need) and
+//!   one more voxel on every side, so that a filter tap at a brick face blends exactly the
+//!   voxels the whole volume would and images have no seams. Non-empty bricks (for the current
+//!   TF) live in a 3D atlas texture, `brick_cells + 3` voxels per side per slot; empty bricks
+//!   are never uploaded. The pool is bounded by a memory budget (`pool_mb`, else the runtime's
+//!   `--gpu-memory-mb`, else what the adapter allows); a frame streams the bricks it needs
+//!   front to back and evicts the least recently used ([`crate::brick_pool`]). A volume larger
+//!   than the budget or the 3D texture limit renders in batches: the ray colour carries over.
+//! - §7 **octrees**: with `node_cells > 0`, each brick's octree (leaves of `node_cells`³ cells,
+//!   the paper's node-size limit) picks the boxes to draw by the ratio rule (`r = 0` skip,
+//!   `r ≥ ratio` draw whole, else descend); a ray leaves a leaf no box covers in one step.
+//! - **termination**: a ray stops at `threshold` and skips the bricks behind it (per-brick
+//!   early ray termination: with `threshold < 1` a saturated pixel costs nothing in later
+//!   batches either).
+//!
+//! Samples are those of `raycast_fast` (k + 0.5 steps from the analytic box entry, same
+//! compositing), so the image equals the single-texture raycast up to rounding
+//! (crates/passes/tests/ruijters_2006.rs). A TF change re-classifies bricks and octrees
+//! (CPU, [`volgraph_accel::octree`]) and uploads only bricks not yet resident.
+//! Shader: `shaders/raycast_bricks.wgsl`.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use glam::{DVec3, UVec3};
+use volgraph_accel::bricks::{BrickLayout, ViewPoint};
+use volgraph_accel::classify::OpacityClassifier;
+use volgraph_accel::octree::{DrawBox, OctreeHierarchy, OctreeVisibility};
+use volgraph_accel::volume::Volume;
+use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::upload::VolumeFormat;
+use volgraph_core::runtime::{
+    ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, PipelineKind, RecordContext, volume_region_bytes,
+    volume_texture_format,
+};
+use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use wgpu::util::DeviceExt;
+
+use crate::brick_pool::{Batch, BrickPool};
+use crate::raycast_params::{RaycastParamsGpu, raycast_param_specs};
+
+/// The plugin.
+pub struct RaycastBricks;
+
+/// The pool's budget when neither the pass nor the runtime sets one: 2 GiB, within what the
+/// atlas's 3D texture limit allows.
+const DEFAULT_BUDGET_BYTES: u64 = 2 << 30;
+
+/// Rust twin of `struct BrickParams` in `shaders/raycast_bricks.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+struct BrickParamsGpu {
+    grid: [u32; 4],
+    slots: [u32; 4],
+    leaves: [u32; 4],
+    atlas: [f32; 4],
+}
+
+const _: () = assert!(std::mem::size_of::<BrickParamsGpu>() == 64);
+
+impl PassPlugin for RaycastBricks {
+    fn kind(&self) -> &'static str {
+        "raycast_bricks"
+    }
+
+    fn summary(&self) -> &'static str {
+        "compute DVR through a GPU brick pool (LRU, memory budget, out of core) with per-brick octrees and early \
+         ray termination (Ruijters & Vilanova 2006 §5–7)"
+    }
+
+    fn params(&self) -> Vec<ParamSpec> {
+        let mut p: Vec<ParamSpec> = raycast_param_specs()
+            .into_iter()
+            .filter(|s| matches!(s.name, "step_voxels" | "threshold" | "max_steps" | "jitter"))
+            .collect();
+        p.push(ParamSpec::uint("brick_cells", 32, 2, 512, "cells per brick side (§5; the paper's best is 64)"));
+        p.push(ParamSpec::uint(
+            "node_cells",
+            8,
+            0,
+            512,
+            "octree node-size limit in cells (§7; 0: no octree, a brick is drawn whole when it is not empty)",
+        ));
+        p.push(ParamSpec::float(
+            "ratio",
+            0.5,
+            0.0,
+            1.0,
+            "octree ratio rule: a node whose visible-cell ratio reaches this is drawn whole, below it split (§7)",
+        ));
+        p.push(ParamSpec::uint(
+            "pool_mb",
+            0,
+            0,
+            1 << 20,
+            "brick pool budget in MiB (0: the runtime's --gpu-memory-mb, else what the adapter allows)",
+        ));
+        p.push(ParamSpec::uint("workgroup_x", 8, 1, 256, "workgroup width in pixels"));
+        p.push(ParamSpec::uint("workgroup_y", 8, 1, 256, "workgroup height in pixels"));
+        p
+    }
+
+    fn ports(&self, _params: &Params) -> Vec<PortSpec> {
+        vec![
+            PortSpec::read("volume", PortKind::VolumeVoxels),
+            PortSpec::read("tf", PortKind::TransferFunction),
+            PortSpec::write("color", PortKind::target(&[TargetFormat::Rgba16Float, TargetFormat::Rgba32Float])),
+        ]
+    }
+
+    fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
+        vec![ShaderUse { file: "raycast_bricks.wgsl", entry_point: "cs_main" }]
+    }
+
+    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
+        ["workgroup_x", "workgroup_y", "brick_cells", "node_cells", "pool_mb"]
+            .iter()
+            .all(|p| old.uint(p) == new.uint(p))
+            && old.float("ratio") == new.float("ratio")
+    }
+
+    fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        let wg = (ctx.params.uint("workgroup_x") as u32, ctx.params.uint("workgroup_y") as u32);
+        if wg.0 * wg.1 > ctx.gpu.limits.max_compute_invocations_per_workgroup {
+            return Err(PassError {
+                pass: ctx.pass_id.to_string(),
+                message: format!(
+                    "workgroup {}x{} is over this GPU's limit of {} invocations",
+                    wg.0, wg.1, ctx.gpu.limits.max_compute_invocations_per_workgroup
+                ),
+            });
+        }
+        let mut defines = Vec::new();
+        if crate::raycast_compute::color_is_f32(ctx) {
+            defines.push("COLOR_F32");
+        }
+        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
+            shader: "raycast_bricks.wgsl",
+            entry: "cs_main",
+            extra_bindings: &["params", "bricks", "table", "leaf_bits", "acc", "volume"],
+            defines: &defines,
+            constants: &[("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)],
+        })?;
+        let params = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
+        let uniform = ctx.uniform_buffer("bricks", std::mem::size_of::<BrickParamsGpu>() as u64);
+        let brick_cells = ctx.params.uint("brick_cells") as u32;
+        let node_cells = match ctx.params.uint("node_cells") as u32 {
+            0 => brick_cells,
+            n => n.min(brick_cells),
+        };
+        Ok(Box::new(RaycastBricksNode {
+            pipeline,
+            params,
+            uniform,
+            workgroup: wg,
+            brick_cells,
+            node_cells,
+            ratio: ctx.params.float("ratio") as f32,
+            pool_mb: ctx.params.uint("pool_mb"),
+            volume: None,
+            acc: None,
+            tables: None,
+            counters: FrameCounters::default(),
+        }))
+    }
+}
+
+/// What the last frame did, for [`PassNode::counters`].
+#[derive(Clone, Copy, Debug, Default)]
+struct FrameCounters {
+    uploaded_bytes: u64,
+    uploaded_bricks: u64,
+    batches: u64,
+    visible_bricks: u64,
+    bricks: u64,
+    slots: u64,
+    resident: u64,
+    pool_bytes: u64,
+    classify_ms: f64,
+}
+
+/// The atlas texture and how its slots are laid out.
+struct Atlas {
+    texture: wgpu::Texture,
+    view: wgpu::TextureView,
+    /// Slots per axis (x, y fixed for the volume; z grows).
+    slots: UVec3,
+}
+
+/// Everything derived from one bound volume.
+struct VolumeState {
+    version: u64,
+    voxels: Arc<Volume>,
+    layout: BrickLayout,
+    octree: OctreeHierarchy,
+    format: VolumeFormat,
+    /// Voxels per slot side.
+    side: u32,
+    /// Slots per atlas row and column (fixed), and the most layers the device allows.
+    slots_xy: (u32, u32),
+    max_layers: u32,
+    /// TF version last classified with.
+    tf_version: Option<u64>,
+    visibility: Option<OctreeVisibility>,
+    /// Per brick: visible under the TF.
+    visible: Vec<bool>,
+    leaf_words: u32,
+    leaves_per_axis: u32,
+    leaf_buffer: Option<wgpu::Buffer>,
+    atlas: Option<Atlas>,
+    pool: BrickPool,
+    /// Budget in bytes the pool was sized under.
+    budget: u64,
+}
+
+struct RaycastBricksNode {
+    pipeline: PassPipeline,
+    params: wgpu::Buffer,
+    uniform: wgpu::Buffer,
+    workgroup: (u32, u32),
+    brick_cells: u32,
+    node_cells: u32,
+    ratio: f32,
+    pool_mb: u64,
+    volume: Option<VolumeState>,
+    /// Per-pixel colour carried between batches, and the viewport it is sized for.
+    acc: Option<(wgpu::Buffer, (u32, u32))>,
+    /// Per-batch brick tables, and the stride and batch count they hold.
+    tables: Option<(wgpu::Buffer, u64, usize)>,
+    counters: FrameCounters,
+}
+
+fn pass_error(ctx: &RecordContext<'_>, message: String) -> PassError {
+    PassError { pass: ctx.label.to_string(), message }
+}
+
+impl VolumeState {
+    fn new(
+        ctx: &RecordContext<'_>,
+        voxels: Arc<Volume>,
+        version: u64,
+        brick_cells: u32,
+        node_cells: u32,
+    ) -> Result<Self, PassError> {
+        let layout = BrickLayout::new(voxels.dims, brick_cells, 1).map_err(|e| pass_error(ctx, e.to_string()))?;
+        let octree =
+            OctreeHierarchy::build(&voxels, &layout, node_cells).map_err(|e| pass_error(ctx, e.to_string()))?;
+        // The brick's voxels and one more on every side (clamped to the volume like the
+        // sampler): a filter tap at a brick face blends exactly what it would in the whole
+        // volume, even where the hardware's fixed-point weights give the next texel 1/256.
+        let side = brick_cells + 3;
+        let max_dim = ctx.gpu.limits.max_texture_dimension_3d;
+        let per_axis = (max_dim / side).max(1);
+        if side > max_dim {
+            return Err(pass_error(
+                ctx,
+                format!(
+                    "brick_cells {brick_cells} needs {side}³-voxel slots, over this GPU's 3D texture limit {max_dim}"
+                ),
+            ));
+        }
+        let cube = (layout.brick_count() as f64).cbrt().ceil() as u32;
+        let row = cube.clamp(1, per_axis);
+        let leaves_per_axis = brick_cells.div_ceil(node_cells);
+        let leaves = leaves_per_axis.pow(3);
+        Ok(Self {
+            version,
+            format: volume_texture_format(ctx.gpu, &voxels),
+            voxels,
+            pool: BrickPool::new(0, layout.brick_count()),
+            layout,
+            octree,
+            side,
+            slots_xy: (row, row),
+            max_layers: per_axis,
+            tf_version: None,
+            visibility: None,
+            visible: Vec::new(),
+            leaf_words: leaves.div_ceil(32),
+            leaves_per_axis,
+            leaf_buffer: None,
+            atlas: None,
+            budget: 0,
+        })
+    }
+
+    fn slot_bytes(&self) -> u64 {
+        (self.side as u64).pow(3) * self.format.bytes() as u64
+    }
+
+    /// Re-classifies bricks and octree leaves for a new TF (§7: only the TF-dependent part)
+    /// and uploads the leaf bits; returns the time it took in ms.
+    fn classify(&mut self, ctx: &RecordContext<'_>, lut: &[[f32; 4]], ratio: f32) -> Result<f64, PassError> {
+        let started = Instant::now();
+        let classifier = OpacityClassifier::new(lut).map_err(|e| pass_error(ctx, e.to_string()))?;
+        let visibility = match self.visibility.take() {
+            Some(mut v) => {
+                self.octree.classify_into(&classifier, &mut v);
+                v
+            }
+            None => self.octree.classify(&classifier),
+        };
+        let count = self.layout.brick_count();
+        self.visible = (0..count).map(|b| visibility.brick_visible_cells(b) > 0).collect();
+        let words = self.leaf_words as usize;
+        let mut bits = vec![0u32; count * words];
+        let mut boxes: Vec<DrawBox> = Vec::new();
+        let l = self.leaves_per_axis;
+        let leaf = self.octree.min_node_cells();
+        for b in (0..count).filter(|b| self.visible[*b]) {
+            boxes.clear();
+            self.octree.draw_boxes(&visibility, b, ratio, ViewPoint::Direction(DVec3::Z), &mut boxes);
+            let (brick_lo, _) = self.layout.brick_cells_box(self.layout.brick_coord(b));
+            for d in &boxes {
+                let lo = (d.cells_lo - brick_lo) / leaf;
+                let rel = d.cells_hi - brick_lo;
+                let hi =
+                    UVec3::new(rel.x.div_ceil(leaf), rel.y.div_ceil(leaf), rel.z.div_ceil(leaf)).min(UVec3::splat(l));
+                for z in lo.z..hi.z {
+                    for y in lo.y..hi.y {
+                        for x in lo.x..hi.x {
+                            let i = (x + l * (y + l * z)) as usize;
+                            bits[b * words + i / 32] |= 1 << (i % 32);
+                        }
+                    }
+                }
+            }
+        }
+        self.visibility = Some(visibility);
+        let bytes: &[u8] = bytemuck::cast_slice(&bits);
+        let size = (bytes.len() as u64).max(4);
+        if self.leaf_buffer.as_ref().is_none_or(|b| b.size() != size) {
+            self.leaf_buffer = Some(ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("brick leaf bits"),
+                size,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }));
+        }
+        if let Some(buffer) = &self.leaf_buffer
+            && !bytes.is_empty()
+        {
+            ctx.write_buffer(buffer, 0, bytes);
+        }
+        Ok(started.elapsed().as_secs_f64() * 1e3)
+    }
+
+    /// Sizes the pool for the visible bricks under `budget` bytes: grows the atlas (keeping
+    /// resident bricks where they are) or, when the budget changed, starts over.
+    fn size_pool(&mut self, ctx: &mut RecordContext<'_>, budget: u64) -> Result<(), PassError> {
+        if budget != self.budget {
+            self.pool = BrickPool::new(0, self.layout.brick_count());
+            self.atlas = None;
+            self.budget = budget;
+        }
+        let visible = self.visible.iter().filter(|v| **v).count() as u64;
+        let per_layer = self.slots_xy.0 * self.slots_xy.1;
+        let most = (budget / self.slot_bytes()).min((per_layer * self.max_layers) as u64);
+        if most == 0 {
+            return Err(pass_error(
+                ctx,
+                format!(
+                    "the brick pool's budget of {budget} bytes holds no {}-byte brick; raise --gpu-memory-mb (or \
+                     pool_mb) or lower brick_cells",
+                    self.slot_bytes()
+                ),
+            ));
+        }
+        let wanted = visible.min(most).max(1) as u32;
+        if wanted <= self.pool.slots() {
+            return Ok(());
+        }
+        let layers = wanted.div_ceil(per_layer);
+        let slots = UVec3::new(self.slots_xy.0, self.slots_xy.1, layers);
+        let size = slots * self.side;
+        let texture = ctx.gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("brick atlas"),
+            size: wgpu::Extent3d { width: size.x, height: size.y, depth_or_array_layers: size.z },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D3,
+            format: self.format.wgpu(),
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        if let Some(old) = &self.atlas {
+            let s = old.slots * self.side;
+            ctx.encoder.copy_texture_to_texture(
+                old.texture.as_image_copy(),
+                texture.as_image_copy(),
+                wgpu::Extent3d { width: s.x, height: s.y, depth_or_array_layers: s.z },
+            );
+        }
+        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let slot_count = (slots.x * slots.y * slots.z).min(most as u32);
+        self.pool.grow(slot_count - self.pool.slots());
+        self.atlas = Some(Atlas { texture, view, slots });
+        Ok(())
+    }
+
+    /// Records the copies of `uploads` into the atlas from one staging buffer.
+    fn upload(&self, ctx: &mut RecordContext<'_>, uploads: &[(u32, u32)]) -> u64 {
+        let Some(atlas) = &self.atlas else { return 0 };
+        if uploads.is_empty() {
+            return 0;
+        }
+        let side = self.side;
+        let texel = self.format.bytes();
+        let row = (side * texel).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let brick_bytes = row as usize * side as usize * side as usize;
+        let mut staging = vec![0u8; brick_bytes * uploads.len()];
+        for (i, (brick, _)) in uploads.iter().enumerate() {
+            let (lo, _) = self.layout.brick_cells_box(self.layout.brick_coord(*brick as usize));
+            let origin = lo.as_ivec3() - glam::IVec3::ONE;
+            let tight = volume_region_bytes(&self.voxels, origin, UVec3::splat(side), self.format);
+            let tight_row = (side * texel) as usize;
+            for (r, src) in tight.chunks_exact(tight_row).enumerate() {
+                let at = i * brick_bytes + r * row as usize;
+                staging[at..at + tight_row].copy_from_slice(src);
+            }
+        }
+        let buffer = ctx.gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("brick uploads"),
+            contents: &staging,
+            usage: wgpu::BufferUsages::COPY_SRC,
+        });
+        for (i, (_, slot)) in uploads.iter().enumerate() {
+            let s = atlas.slots;
+            let at = UVec3::new(slot % s.x, (slot / s.x) % s.y, slot / (s.x * s.y)) * side;
+            ctx.encoder.copy_buffer_to_texture(
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &buffer,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: (i * brick_bytes) as u64,
+                        bytes_per_row: Some(row),
+                        rows_per_image: Some(side),
+                    },
+                },
+                wgpu::TexelCopyTextureInfo {
+                    texture: &atlas.texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d { x: at.x, y: at.y, z: at.z },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                wgpu::Extent3d { width: side, height: side, depth_or_array_layers: side },
+            );
+        }
+        uploads.len() as u64 * (side as u64).pow(3) * texel as u64
+    }
+}
+
+impl RaycastBricksNode {
+    fn budget(&self, ctx: &RecordContext<'_>) -> u64 {
+        match self.pool_mb {
+            0 => ctx.frame.gpu_memory_budget.unwrap_or(DEFAULT_BUDGET_BYTES),
+            mb => mb << 20,
+        }
+    }
+
+    /// The per-batch tables (header word + slot + 1 per brick) in one buffer, one region per
+    /// batch at a stride the storage-offset alignment allows.
+    fn write_tables(&mut self, ctx: &RecordContext<'_>, batches: &[Batch], bricks: usize) -> u64 {
+        let align = ctx.gpu.limits.min_storage_buffer_offset_alignment as u64;
+        let stride = (4 * (1 + bricks as u64)).div_ceil(align) * align;
+        let count = batches.len().max(1);
+        if self.tables.as_ref().is_none_or(|(b, s, n)| *s != stride || *n < count || b.size() < stride * count as u64) {
+            let buffer = ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("brick tables"),
+                size: stride * count as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            self.tables = Some((buffer, stride, count));
+        }
+        let mut data = vec![0u32; (stride / 4) as usize * count];
+        data[0] = 1;
+        for (i, batch) in batches.iter().enumerate() {
+            let base = i * (stride / 4) as usize;
+            data[base] = u32::from(i == 0);
+            for (brick, slot) in &batch.bricks {
+                data[base + 1 + *brick as usize] = slot + 1;
+            }
+        }
+        if let Some((buffer, _, _)) = &self.tables {
+            ctx.write_buffer(buffer, 0, bytemuck::cast_slice(&data));
+        }
+        stride
+    }
+}
+
+impl PassNode for RaycastBricksNode {
+    fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
+        let voxels = ctx.voxels("volume")?.clone();
+        let version = ctx.input_version("volume").unwrap_or(0);
+        if self.volume.as_ref().is_none_or(|v| v.version != version) {
+            self.volume = Some(VolumeState::new(ctx, voxels, version, self.brick_cells, self.node_cells)?);
+        }
+        let tf_version = ctx.input_version("tf");
+        let lut = ctx.table("tf")?.clone();
+        let budget = self.budget(ctx);
+        let Some(state) = self.volume.as_mut() else { return Ok(()) };
+        let mut counters = FrameCounters { classify_ms: self.counters.classify_ms, ..Default::default() };
+        if state.tf_version != tf_version || state.visibility.is_none() {
+            counters.classify_ms = state.classify(ctx, &lut, self.ratio)?;
+            state.tf_version = tf_version;
+        }
+        state.size_pool(ctx, budget)?;
+
+        // Front to back from the eye (texture space), visible bricks only.
+        let camera = &ctx.frame.camera;
+        let half = ctx.frame.volume.map_or(DVec3::splat(0.5), |v| v.half_extent);
+        let eye = camera.eye / (2.0 * half) + DVec3::splat(0.5);
+        let order: Vec<u32> = state
+            .layout
+            .front_to_back(ViewPoint::Eye(eye))
+            .into_iter()
+            .filter(|b| state.visible[*b as usize])
+            .collect();
+        let batches = state.pool.plan_frame(&order);
+        let bricks = state.layout.brick_count();
+
+        let atlas_slots = state.atlas.as_ref().map_or(UVec3::ONE, |a| a.slots);
+        let atlas_size = (atlas_slots * state.side).as_vec3();
+        let grid = state.layout.grid_dims();
+        let uniform = BrickParamsGpu {
+            grid: [grid.x, grid.y, grid.z, self.brick_cells],
+            slots: [atlas_slots.x, atlas_slots.y, atlas_slots.z, state.side],
+            leaves: [state.octree.min_node_cells(), state.leaves_per_axis, state.leaf_words, 0],
+            atlas: [atlas_size.x, atlas_size.y, atlas_size.z, 0.0],
+        };
+        ctx.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+
+        let (w, h) = ctx.extent("color");
+        if self.acc.as_ref().is_none_or(|(_, size)| *size != (w, h)) {
+            let buffer = ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("brick ray colour"),
+                size: 16 * w.max(1) as u64 * h.max(1) as u64,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            });
+            self.acc = Some((buffer, (w, h)));
+        }
+        let stride = self.write_tables(ctx, &batches, bricks);
+        let state = self.volume.as_ref().expect("set above");
+        let (Some(atlas), Some(leaf_buffer), Some((acc, _)), Some((tables, _, _))) =
+            (&state.atlas, &state.leaf_buffer, &self.acc, &self.tables)
+        else {
+            return Err(pass_error(ctx, "brick pool not ready".to_string()));
+        };
+        for i in 0..batches.len().max(1) {
+            if let Some(batch) = batches.get(i) {
+                counters.uploaded_bytes += state.upload(ctx, &batch.uploads);
+                counters.uploaded_bricks += batch.uploads.len() as u64;
+            }
+            let table = wgpu::BufferBinding {
+                buffer: tables,
+                offset: i as u64 * stride,
+                size: std::num::NonZeroU64::new(stride),
+            };
+            let extra = [
+                ("params", self.params.as_entire_binding()),
+                ("bricks", self.uniform.as_entire_binding()),
+                ("table", wgpu::BindingResource::Buffer(table)),
+                ("leaf_bits", leaf_buffer.as_entire_binding()),
+                ("acc", acc.as_entire_binding()),
+                ("volume", wgpu::BindingResource::TextureView(&atlas.view)),
+            ];
+            let bg = ctx.bind_group(&self.pipeline, &extra)?;
+            let mut pass = ctx.begin_compute_pass();
+            if let PipelineKind::Compute(p) = &self.pipeline.pipeline {
+                pass.set_pipeline(p);
+            }
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups(w.div_ceil(self.workgroup.0), h.div_ceil(self.workgroup.1), 1);
+        }
+        counters.batches = batches.len() as u64;
+        counters.visible_bricks = order.len() as u64;
+        counters.bricks = bricks as u64;
+        counters.slots = state.pool.slots() as u64;
+        counters.resident = state.pool.resident() as u64;
+        counters.pool_bytes = state.pool.slots() as u64 * state.slot_bytes();
+        self.counters = counters;
+        Ok(())
+    }
+
+    fn update_params(&mut self, gpu: &Gpu, params: &Params) {
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
+    }
+
+    fn counters(&self) -> Vec<(&'static str, f64)> {
+        let c = &self.counters;
+        vec![
+            ("uploaded_bytes", c.uploaded_bytes as f64),
+            ("uploaded_bricks", c.uploaded_bricks as f64),
+            ("batches", c.batches as f64),
+            ("visible_bricks", c.visible_bricks as f64),
+            ("bricks", c.bricks as f64),
+            ("pool_slots", c.slots as f64),
+            ("resident_bricks", c.resident as f64),
+            ("pool_bytes", c.pool_bytes as f64),
+            ("classify_ms", c.classify_ms),
+        ]
+    }
+}

@@ -1,0 +1,140 @@
+// The bricked raycaster of Ruijters & Vilanova 2006 (crates/passes/src/raycast_bricks.rs): one
+// invocation per pixel marches the samples of the single-texture raycasters (common/
+// analytic_ray.wgsl: k + 0.5 steps from the box entry, the same compositing), but reads the
+// volume from a pool of bricks — an atlas of `brick_cells + 3` voxels per side per slot: the
+// brick's corner voxels (the overlap of §5) and one more on each side, so a filter tap at a
+// brick face blends what it would in the whole volume — and
+// skips what the transfer function leaves empty:
+// - a brick that is empty, or not in this dispatch's batch, is left in one step (§5, §7: bricks
+//   drawn front to back, one batch of resident bricks after another when the pool is smaller
+//   than the visible bricks);
+// - inside a brick, a leaf of its octree (`leaf_cells`³ cells, the node limit of §7) that no box
+//   chosen by the ratio rule covers is left in one step;
+// - the samples of a leaf worth drawing are a run with nothing but sampling in the loop.
+// The ray's colour survives between batches in `acc` (per pixel), so a frame drawn in several
+// batches composites exactly like one drawn in a single pass; a ray stops at `threshold` (early
+// ray termination: its remaining bricks cost nothing).
+
+#import "common/frame.wgsl"
+#import "common/raymarch.wgsl"
+#import "common/analytic_ray.wgsl"
+
+override WORKGROUP_X: u32 = 8u;
+override WORKGROUP_Y: u32 = 8u;
+
+struct BrickParams {
+    // Bricks per axis (xyz); w = cells per brick side.
+    grid: vec4<u32>,
+    // Slots per atlas axis (xyz); w = voxels per slot side (brick_cells + 3; voxel lo - 1 first).
+    slots: vec4<u32>,
+    // x = cells per leaf side, y = leaves per brick side, z = u32 words of leaf bits per brick.
+    leaves: vec4<u32>,
+    // Atlas size in texels (xyz).
+    atlas: vec4<f32>,
+}
+
+@group(0) @binding(9) var<uniform> bricks: BrickParams;
+// This batch: word 0 = 1 for the first batch of the frame (start from a clear ray); word 1 + b
+// = slot + 1 of brick b when it is drawn in this batch, 0 when it is not.
+@group(0) @binding(10) var<storage, read> table: array<u32>;
+// Per brick, `bricks.leaves.z` words: bit l set when leaf l is covered by a box to draw.
+@group(0) @binding(11) var<storage, read> leaf_bits: array<u32>;
+// Per pixel: the premultiplied colour composited so far this frame.
+@group(0) @binding(12) var<storage, read_write> acc: array<vec4<f32>>;
+#if COLOR_F32
+@group(0) @binding(13) var color: texture_storage_2d<rgba32float, write>;
+#else
+@group(0) @binding(13) var color: texture_storage_2d<rgba16float, write>;
+#endif
+
+// The first sample index after the box [lo, hi] (voxel coordinates, faces of the volume
+// extended to the texture box like common/box.wgsl's cells) that the sample k at `p` lies in.
+fn past_box(k: u32, p: vec3<f32>, delta: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> u32 {
+    let n = frame.volume_dims.xyz;
+    let lo_u = select((lo + 0.5) / n, vec3<f32>(0.0), lo <= vec3<f32>(0.0));
+    let hi_u = select((hi + 0.5) / n, vec3<f32>(1.0), hi >= n - vec3<f32>(1.0));
+    let bound = select(lo_u, hi_u, delta > vec3<f32>(0.0));
+    let t = (bound - p) / select(delta, vec3<f32>(1.0), delta == vec3<f32>(0.0));
+    let t_axis = select(t, vec3<f32>(3.0e38), delta == vec3<f32>(0.0));
+    let steps = min(t_axis.x, min(t_axis.y, t_axis.z));
+    return k + max(1u, u32(clamp(floor(steps) + 1.0, 0.0, f32(params.max_steps))));
+}
+
+// The samples of `ray` from colour `start` on, through this batch's bricks.
+fn march_bricks(ray: Ray, pixel: vec2<u32>, start: vec4<f32>) -> vec4<f32> {
+    var out = start;
+    let s = ray_samples(ray, pixel);
+    begin_ray(s.first, s.delta);
+    let n = frame.volume_dims.xyz;
+    let last_voxel = max(n - vec3<f32>(1.0), vec3<f32>(0.0));
+    let brick_cells = f32(bricks.grid.w);
+    let leaf_cells = f32(bricks.leaves.x);
+    let leaves = bricks.leaves.y;
+    let grid = bricks.grid.xyz;
+    var k = 0u;
+    loop {
+        if (k >= s.count || out.a >= params.threshold) {
+            break;
+        }
+        let p = s.first + f32(k) * s.delta;
+        let c = clamp(p * n - vec3<f32>(0.5), vec3<f32>(0.0), last_voxel);
+        let b = min(vec3<u32>(c / brick_cells), grid - vec3<u32>(1u));
+        let brick = b.x + grid.x * (b.y + grid.y * b.z);
+        let lo = vec3<f32>(b) * brick_cells;
+        let hi = min(lo + vec3<f32>(brick_cells), last_voxel);
+        let entry = table[1u + brick];
+        if (entry == 0u) {
+            k = past_box(k, p, s.delta, lo, hi);
+            continue;
+        }
+        let l = min(vec3<u32>((c - lo) / leaf_cells), vec3<u32>(leaves - 1u));
+        let leaf = l.x + leaves * (l.y + leaves * l.z);
+        let leaf_lo = lo + vec3<f32>(l) * leaf_cells;
+        let leaf_hi = min(leaf_lo + vec3<f32>(leaf_cells), hi);
+        let exit = past_box(k, p, s.delta, leaf_lo, leaf_hi);
+        let word = leaf_bits[brick * bricks.leaves.z + leaf / 32u];
+        if (((word >> (leaf % 32u)) & 1u) == 0u) {
+            k = exit;
+            resume_ray(p);
+            continue;
+        }
+        // A leaf to draw: its samples read the brick's slot, clamped to the brick's voxels
+        // (the volume's clamp-to-edge at its faces; rounding at the brick's own faces).
+        let slot = entry - 1u;
+        let slots = bricks.slots;
+        let origin = vec3<f32>(vec3<u32>(slot % slots.x, (slot / slots.x) % slots.y, slot / (slots.x * slots.y)) * slots.w);
+        let offset = origin + vec3<f32>(1.5) - lo;
+        let end = min(exit, s.count);
+        loop {
+            if (k >= end) {
+                break;
+            }
+            let ck = clamp((s.first + f32(k) * s.delta) * n - vec3<f32>(0.5), lo, hi);
+            out = composite_sample(out, (ck + offset) / bricks.atlas.xyz);
+            k += 1u;
+            if (out.a >= params.threshold) {
+                break;
+            }
+        }
+    }
+    return out;
+}
+
+@compute @workgroup_size(WORKGROUP_X, WORKGROUP_Y)
+fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let p = id.xy;
+    if (f32(p.x) >= frame.viewport.x || f32(p.y) >= frame.viewport.y) {
+        return;
+    }
+    let i = p.y * u32(frame.viewport.x) + p.x;
+    var c = vec4<f32>(0.0);
+    if (table[0] == 0u) {
+        c = acc[i];
+    }
+    let ray = analytic_ray(p);
+    if (ray.len > 0.0 && c.a < params.threshold && ray_is_valid(ray.u0, ray.d, ray.len)) {
+        c = march_bricks(ray, p, c);
+    }
+    acc[i] = c;
+    textureStore(color, vec2<i32>(p), c);
+}

@@ -5,11 +5,12 @@
 // brick's corner voxels (the overlap of §5) and one more on each side, so a filter tap at a
 // brick face blends what it would in the whole volume — and
 // skips what the transfer function leaves empty:
-// - a brick that is empty, or not in this dispatch's batch, is left in one step (§5, §7: bricks
-//   drawn front to back, one batch of resident bricks after another when the pool is smaller
-//   than the visible bricks);
-// - inside a brick, a leaf of its octree (`leaf_cells`³ cells, the node limit of §7) that no box
-//   chosen by the ratio rule covers is left in one step;
+// - in a leaf of the octrees (`leaf_cells`³ cells, the node limit of §7) that no box chosen by
+//   the ratio rule covers, the ray leaps out of the largest cube of such leaves around it
+//   (`leaf_distance`, Chebyshev distances: empty nodes and empty bricks alike);
+// - a brick not in this dispatch's batch is left in one step (§5, §7: bricks drawn front to
+//   back, one batch of resident bricks after another when the pool is smaller than the
+//   visible bricks);
 // - the samples of a leaf worth drawing are a run with nothing but sampling in the loop.
 // The ray's colour survives between batches in `acc` (per pixel), so a frame drawn in several
 // batches composites exactly like one drawn in a single pass; a ray stops at `threshold` (early
@@ -27,8 +28,10 @@ struct BrickParams {
     grid: vec4<u32>,
     // Slots per atlas axis (xyz); w = voxels per slot side (brick_cells + 3; voxel lo - 1 first).
     slots: vec4<u32>,
-    // x = cells per leaf side, y = leaves per brick side, z = u32 words of leaf bits per brick.
+    // x = cells per leaf side, y = leaves per brick side.
     leaves: vec4<u32>,
+    // Leaves per axis over the whole volume (xyz).
+    leaf_grid: vec4<u32>,
     // Atlas size in texels (xyz).
     atlas: vec4<f32>,
 }
@@ -37,8 +40,9 @@ struct BrickParams {
 // This batch: word 0 = 1 for the first batch of the frame (start from a clear ray); word 1 + b
 // = slot + 1 of brick b when it is drawn in this batch, 0 when it is not.
 @group(0) @binding(10) var<storage, read> table: array<u32>;
-// Per brick, `bricks.leaves.z` words: bit l set when leaf l is covered by a box to draw.
-@group(0) @binding(11) var<storage, read> leaf_bits: array<u32>;
+// Per leaf of the volume (x fastest): 0 where a box to draw covers it, else the Chebyshev
+// distance in leaves to the nearest such leaf (every leaf closer is empty too).
+@group(0) @binding(11) var<storage, read> leaf_distance: array<u32>;
 // Per pixel: the premultiplied colour composited so far this frame.
 @group(0) @binding(12) var<storage, read_write> acc: array<vec4<f32>>;
 #if COLOR_F32
@@ -69,35 +73,56 @@ fn march_bricks(ray: Ray, pixel: vec2<u32>, start: vec4<f32>) -> vec4<f32> {
     let last_voxel = max(n - vec3<f32>(1.0), vec3<f32>(0.0));
     let brick_cells = f32(bricks.grid.w);
     let leaf_cells = f32(bricks.leaves.x);
-    let leaves = bricks.leaves.y;
     let grid = bricks.grid.xyz;
+    let leaf_grid = bricks.leaf_grid.xyz;
     var k = 0u;
+    // In rounds, like raycast_fast: first every lane leaps until it stands in a leaf to draw
+    // (cheap iterations that all lanes take together), then every lane marches its leaf. A lane
+    // that leaps never waits for another's run of samples inside the same iteration.
     loop {
         if (k >= s.count || out.a >= params.threshold) {
             break;
         }
-        let p = s.first + f32(k) * s.delta;
-        let c = clamp(p * n - vec3<f32>(0.5), vec3<f32>(0.0), last_voxel);
-        let b = min(vec3<u32>(c / brick_cells), grid - vec3<u32>(1u));
-        let brick = b.x + grid.x * (b.y + grid.y * b.z);
-        let lo = vec3<f32>(b) * brick_cells;
-        let hi = min(lo + vec3<f32>(brick_cells), last_voxel);
-        let entry = table[1u + brick];
-        if (entry == 0u) {
-            k = past_box(k, p, s.delta, lo, hi);
-            continue;
+        var lo = vec3<f32>(0.0);
+        var hi = vec3<f32>(0.0);
+        var exit = k;
+        var entry = 0u;
+        loop {
+            if (k >= s.count) {
+                break;
+            }
+            let p = s.first + f32(k) * s.delta;
+            let c = clamp(p * n - vec3<f32>(0.5), vec3<f32>(0.0), last_voxel);
+            let l = min(vec3<u32>(c / leaf_cells), leaf_grid - vec3<u32>(1u));
+            let d = leaf_distance[l.x + leaf_grid.x * (l.y + leaf_grid.y * l.z)];
+            if (d > 0u) {
+                // Out of the cube of empty leaves around this one.
+                let reach = vec3<u32>(d - 1u);
+                let lo_leaf = l - min(l, reach);
+                let hi_leaf = min(l + reach, leaf_grid - vec3<u32>(1u));
+                let cube_hi = min(vec3<f32>(hi_leaf + vec3<u32>(1u)) * leaf_cells, last_voxel);
+                k = past_box(k, p, s.delta, vec3<f32>(lo_leaf) * leaf_cells, cube_hi);
+                continue;
+            }
+            let b = min(vec3<u32>(c / brick_cells), grid - vec3<u32>(1u));
+            lo = vec3<f32>(b) * brick_cells;
+            hi = min(lo + vec3<f32>(brick_cells), last_voxel);
+            entry = table[1u + b.x + grid.x * (b.y + grid.y * b.z)];
+            if (entry == 0u) {
+                // Drawn in another batch.
+                k = past_box(k, p, s.delta, lo, hi);
+                continue;
+            }
+            let leaf_lo = vec3<f32>(l) * leaf_cells;
+            exit = past_box(k, p, s.delta, leaf_lo, min(leaf_lo + vec3<f32>(leaf_cells), hi));
+            break;
         }
-        let l = min(vec3<u32>((c - lo) / leaf_cells), vec3<u32>(leaves - 1u));
-        let leaf = l.x + leaves * (l.y + leaves * l.z);
-        let leaf_lo = lo + vec3<f32>(l) * leaf_cells;
-        let leaf_hi = min(leaf_lo + vec3<f32>(leaf_cells), hi);
-        let exit = past_box(k, p, s.delta, leaf_lo, leaf_hi);
-        let word = leaf_bits[brick * bricks.leaves.z + leaf / 32u];
-        if (((word >> (leaf % 32u)) & 1u) == 0u) {
-            k = exit;
-            resume_ray(p);
-            continue;
+        if (k >= s.count) {
+            break;
         }
+#if PREINTEGRATION
+        resume_ray(s.first + (f32(k) - 1.0) * s.delta);
+#endif
         // A leaf to draw: its samples read the brick's slot, clamped to the brick's voxels
         // (the volume's clamp-to-edge at its faces; rounding at the brick's own faces).
         let slot = entry - 1u;

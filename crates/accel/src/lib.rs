@@ -6,6 +6,7 @@
 
 pub mod bricks;
 pub mod camera;
+pub mod chebyshev;
 pub mod classify;
 pub mod data_dir;
 pub mod generate;

@@ -12,7 +12,10 @@
 //!   than the budget or the 3D texture limit renders in batches: the ray colour carries over.
 //! - §7 **octrees**: with `node_cells > 0`, each brick's octree (leaves of `node_cells`³ cells,
 //!   the paper's node-size limit) picks the boxes to draw by the ratio rule (`r = 0` skip,
-//!   `r ≥ ratio` draw whole, else descend); a ray leaves a leaf no box covers in one step.
+//!   `r ≥ ratio` draw whole, else descend). The boxes are rasterized into the volume's grid of
+//!   leaves and its complement into Chebyshev leap distances ([`volgraph_accel::chebyshev`]):
+//!   a ray leaves the largest cube of leaves no box covers in one step — the octree's empty
+//!   nodes, and empty bricks, as one lookup (without an octree the leaves are the bricks).
 //! - **termination**: a ray stops at `threshold` and skips the bricks behind it (per-brick
 //!   early ray termination: with `threshold < 1` a saturated pixel costs nothing in later
 //!   batches either).
@@ -57,10 +60,14 @@ struct BrickParamsGpu {
     grid: [u32; 4],
     slots: [u32; 4],
     leaves: [u32; 4],
+    leaf_grid: [u32; 4],
     atlas: [f32; 4],
 }
 
-const _: () = assert!(std::mem::size_of::<BrickParamsGpu>() == 64);
+const _: () = assert!(std::mem::size_of::<BrickParamsGpu>() == 80);
+
+/// Leap distances are capped here (a cube of 2·255 − 1 leaves is wider than any volume).
+const MAX_LEAP: u32 = 255;
 
 impl PassPlugin for RaycastBricks {
     fn kind(&self) -> &'static str {
@@ -99,6 +106,15 @@ impl PassPlugin for RaycastBricks {
             1 << 20,
             "brick pool budget in MiB (0: the runtime's --gpu-memory-mb, else what the adapter allows)",
         ));
+        p.push(ParamSpec::uint(
+            "ranks",
+            1,
+            1,
+            4096,
+            "sort-last rendering (docs/scaling.md): the bricks are split into this many slabs of the brick grid \
+             along its longest axis, one per rank",
+        ));
+        p.push(ParamSpec::uint("rank", 0, 0, 4095, "with ranks > 1: the slab of bricks this pass draws (0-based)"));
         p.push(ParamSpec::uint("workgroup_x", 8, 1, 256, "workgroup width in pixels"));
         p.push(ParamSpec::uint("workgroup_y", 8, 1, 256, "workgroup height in pixels"));
         p
@@ -117,7 +133,7 @@ impl PassPlugin for RaycastBricks {
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        ["workgroup_x", "workgroup_y", "brick_cells", "node_cells", "pool_mb"]
+        ["workgroup_x", "workgroup_y", "brick_cells", "node_cells", "pool_mb", "ranks", "rank"]
             .iter()
             .all(|p| old.uint(p) == new.uint(p))
             && old.float("ratio") == new.float("ratio")
@@ -141,7 +157,7 @@ impl PassPlugin for RaycastBricks {
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
             shader: "raycast_bricks.wgsl",
             entry: "cs_main",
-            extra_bindings: &["params", "bricks", "table", "leaf_bits", "acc", "volume"],
+            extra_bindings: &["params", "bricks", "table", "leaf_distance", "acc", "volume"],
             defines: &defines,
             constants: &[("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)],
         })?;
@@ -152,7 +168,25 @@ impl PassPlugin for RaycastBricks {
             0 => brick_cells,
             n => n.min(brick_cells),
         };
+        if !brick_cells.is_multiple_of(node_cells) {
+            return Err(PassError {
+                pass: ctx.pass_id.to_string(),
+                message: format!(
+                    "node_cells {node_cells} does not divide brick_cells {brick_cells}: octree leaves must tile a \
+                     brick; use a power of two for both (e.g. 8 and 64)"
+                ),
+            });
+        }
+        let ranks = ctx.params.uint("ranks") as u32;
+        let rank = ctx.params.uint("rank") as u32;
+        if rank >= ranks {
+            return Err(PassError {
+                pass: ctx.pass_id.to_string(),
+                message: format!("rank {rank} is not below ranks {ranks}; ranks are numbered 0..ranks"),
+            });
+        }
         Ok(Box::new(RaycastBricksNode {
+            ranks: (rank, ranks),
             pipeline,
             params,
             uniform,
@@ -181,6 +215,8 @@ struct FrameCounters {
     resident: u64,
     pool_bytes: u64,
     classify_ms: f64,
+    /// Fraction of the visible bricks' octree leaves that a box to draw covers.
+    drawn_leaves: f64,
 }
 
 /// The atlas texture and how its slots are laid out.
@@ -208,9 +244,11 @@ struct VolumeState {
     visibility: Option<OctreeVisibility>,
     /// Per brick: visible under the TF.
     visible: Vec<bool>,
-    leaf_words: u32,
-    leaves_per_axis: u32,
+    /// Leaves per axis over the whole volume.
+    leaf_grid: UVec3,
     leaf_buffer: Option<wgpu::Buffer>,
+    /// Fraction of the visible bricks' leaves drawn (the last classification).
+    drawn_leaves: f64,
     atlas: Option<Atlas>,
     pool: BrickPool,
     /// Budget in bytes the pool was sized under.
@@ -226,6 +264,8 @@ struct RaycastBricksNode {
     node_cells: u32,
     ratio: f32,
     pool_mb: u64,
+    /// (this rank, ranks): the slab of the brick grid this pass draws (sort-last).
+    ranks: (u32, u32),
     volume: Option<VolumeState>,
     /// Per-pixel colour carried between batches, and the viewport it is sized for.
     acc: Option<(wgpu::Buffer, (u32, u32))>,
@@ -265,8 +305,9 @@ impl VolumeState {
         }
         let cube = (layout.brick_count() as f64).cbrt().ceil() as u32;
         let row = cube.clamp(1, per_axis);
-        let leaves_per_axis = brick_cells.div_ceil(node_cells);
-        let leaves = leaves_per_axis.pow(3);
+        let cells = volgraph_accel::bricks::cell_dims(voxels.dims);
+        let leaf_grid =
+            UVec3::new(cells.x.div_ceil(node_cells), cells.y.div_ceil(node_cells), cells.z.div_ceil(node_cells));
         Ok(Self {
             version,
             format: volume_texture_format(ctx.gpu, &voxels),
@@ -280,9 +321,9 @@ impl VolumeState {
             tf_version: None,
             visibility: None,
             visible: Vec::new(),
-            leaf_words: leaves.div_ceil(32),
-            leaves_per_axis,
+            leaf_grid,
             leaf_buffer: None,
+            drawn_leaves: 0.0,
             atlas: None,
             budget: 0,
         })
@@ -293,7 +334,7 @@ impl VolumeState {
     }
 
     /// Re-classifies bricks and octree leaves for a new TF (§7: only the TF-dependent part)
-    /// and uploads the leaf bits; returns the time it took in ms.
+    /// and uploads the leaves' leap distances; returns the time it took in ms.
     fn classify(&mut self, ctx: &RecordContext<'_>, lut: &[[f32; 4]], ratio: f32) -> Result<f64, PassError> {
         let started = Instant::now();
         let classifier = OpacityClassifier::new(lut).map_err(|e| pass_error(ctx, e.to_string()))?;
@@ -306,36 +347,36 @@ impl VolumeState {
         };
         let count = self.layout.brick_count();
         self.visible = (0..count).map(|b| visibility.brick_visible_cells(b) > 0).collect();
-        let words = self.leaf_words as usize;
-        let mut bits = vec![0u32; count * words];
+        // The boxes to draw, rasterized into the volume's grid of leaves.
+        let g = self.leaf_grid;
+        let mut drawn = vec![false; (g.x * g.y * g.z) as usize];
         let mut boxes: Vec<DrawBox> = Vec::new();
-        let l = self.leaves_per_axis;
         let leaf = self.octree.min_node_cells();
         for b in (0..count).filter(|b| self.visible[*b]) {
             boxes.clear();
             self.octree.draw_boxes(&visibility, b, ratio, ViewPoint::Direction(DVec3::Z), &mut boxes);
-            let (brick_lo, _) = self.layout.brick_cells_box(self.layout.brick_coord(b));
             for d in &boxes {
-                let lo = (d.cells_lo - brick_lo) / leaf;
-                let rel = d.cells_hi - brick_lo;
+                let lo = d.cells_lo / leaf;
                 let hi =
-                    UVec3::new(rel.x.div_ceil(leaf), rel.y.div_ceil(leaf), rel.z.div_ceil(leaf)).min(UVec3::splat(l));
+                    UVec3::new(d.cells_hi.x.div_ceil(leaf), d.cells_hi.y.div_ceil(leaf), d.cells_hi.z.div_ceil(leaf))
+                        .min(g);
                 for z in lo.z..hi.z {
                     for y in lo.y..hi.y {
                         for x in lo.x..hi.x {
-                            let i = (x + l * (y + l * z)) as usize;
-                            bits[b * words + i / 32] |= 1 << (i % 32);
+                            drawn[(x + g.x * (y + g.y * z)) as usize] = true;
                         }
                     }
                 }
             }
         }
         self.visibility = Some(visibility);
+        self.drawn_leaves = drawn.iter().filter(|d| **d).count() as f64 / drawn.len().max(1) as f64;
+        let bits = volgraph_accel::chebyshev::chebyshev_distance(&drawn, g, MAX_LEAP);
         let bytes: &[u8] = bytemuck::cast_slice(&bits);
         let size = (bytes.len() as u64).max(4);
         if self.leaf_buffer.as_ref().is_none_or(|b| b.size() != size) {
             self.leaf_buffer = Some(ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("brick leaf bits"),
+                label: Some("leaf leap distances"),
                 size,
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
@@ -453,6 +494,24 @@ impl VolumeState {
     }
 }
 
+/// Whether rank `ranks.0` of `ranks.1` draws brick `brick`: the brick grid is cut into
+/// `ranks.1` slabs along its longest axis (a one-level kd-tree; docs/scaling.md).
+pub fn owns(layout: &BrickLayout, brick: u32, (rank, ranks): (u32, u32)) -> bool {
+    if ranks <= 1 {
+        return true;
+    }
+    let grid = layout.grid_dims();
+    let axis = if grid.x >= grid.y && grid.x >= grid.z {
+        0
+    } else if grid.y >= grid.z {
+        1
+    } else {
+        2
+    };
+    let c = layout.brick_coord(brick as usize)[axis] as u64;
+    (c * ranks as u64 / grid[axis] as u64) as u32 == rank
+}
+
 impl RaycastBricksNode {
     fn budget(&self, ctx: &RecordContext<'_>) -> u64 {
         match self.pool_mb {
@@ -518,7 +577,7 @@ impl PassNode for RaycastBricksNode {
             .layout
             .front_to_back(ViewPoint::Eye(eye))
             .into_iter()
-            .filter(|b| state.visible[*b as usize])
+            .filter(|b| state.visible[*b as usize] && owns(&state.layout, *b, self.ranks))
             .collect();
         let batches = state.pool.plan_frame(&order);
         let bricks = state.layout.brick_count();
@@ -529,7 +588,8 @@ impl PassNode for RaycastBricksNode {
         let uniform = BrickParamsGpu {
             grid: [grid.x, grid.y, grid.z, self.brick_cells],
             slots: [atlas_slots.x, atlas_slots.y, atlas_slots.z, state.side],
-            leaves: [state.octree.min_node_cells(), state.leaves_per_axis, state.leaf_words, 0],
+            leaves: [state.octree.min_node_cells(), self.brick_cells / state.octree.min_node_cells(), 0, 0],
+            leaf_grid: [state.leaf_grid.x, state.leaf_grid.y, state.leaf_grid.z, 0],
             atlas: [atlas_size.x, atlas_size.y, atlas_size.z, 0.0],
         };
         ctx.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
@@ -565,7 +625,7 @@ impl PassNode for RaycastBricksNode {
                 ("params", self.params.as_entire_binding()),
                 ("bricks", self.uniform.as_entire_binding()),
                 ("table", wgpu::BindingResource::Buffer(table)),
-                ("leaf_bits", leaf_buffer.as_entire_binding()),
+                ("leaf_distance", leaf_buffer.as_entire_binding()),
                 ("acc", acc.as_entire_binding()),
                 ("volume", wgpu::BindingResource::TextureView(&atlas.view)),
             ];
@@ -583,6 +643,7 @@ impl PassNode for RaycastBricksNode {
         counters.slots = state.pool.slots() as u64;
         counters.resident = state.pool.resident() as u64;
         counters.pool_bytes = state.pool.slots() as u64 * state.slot_bytes();
+        counters.drawn_leaves = state.drawn_leaves;
         self.counters = counters;
         Ok(())
     }
@@ -603,6 +664,7 @@ impl PassNode for RaycastBricksNode {
             ("resident_bricks", c.resident as f64),
             ("pool_bytes", c.pool_bytes as f64),
             ("classify_ms", c.classify_ms),
+            ("drawn_leaves", c.drawn_leaves),
         ]
     }
 }

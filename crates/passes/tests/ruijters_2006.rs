@@ -333,3 +333,65 @@ fn a_volume_beyond_the_texture_limit_renders_through_the_brick_pool() {
     let got = live(&gpu, &registry, "bricks", &short, &lut, &options).frame(&cam);
     assert_same("rv_half", &got, &want, SAME);
 }
+
+/// Sort-last rendering simulated in one process (docs/scaling.md): the bricks split into N
+/// slabs (ranks), each rank renders only its own, and the N images composited front to back in
+/// the slabs' visibility order from the eye equal the single render. Each rank's image is an
+/// f16 target: 1.5/255 covers N roundings of premultiplied colours ≤ 1 (2⁻¹¹ relative each).
+#[test]
+fn sort_last_compositing_of_brick_slabs_equals_the_single_render() {
+    let gpu = support::gpu();
+    let registry = builtin_registry();
+    let volume = volgraph_accel::vessels::vessel_tree(64, 2);
+    let lut = TransferFunction::preset(Preset::Sparse, (0.0, 255.0)).to_lut_for(&volume, 256);
+    let base = CompileOptions::new(SIZE, SIZE).with_scalar("brick_cells", 16.0);
+    let layout = volgraph_accel::bricks::BrickLayout::new(volume.dims, 16, 1).expect("layout");
+    for azimuth in [20.0, 110.0, 250.0] {
+        let cam = camera(azimuth, 2.4);
+        let single = live(&gpu, &registry, "bricks_octree", &volume, &lut, &base).frame(&cam);
+        let viewport = (SIZE, SIZE);
+        let half = volgraph_core::runtime::VolumeDesc::of(&volume).half_extent;
+        let eye = CameraData::from_orbit(&cam, viewport).eye / (2.0 * half) + glam::DVec3::splat(0.5);
+        // Along x (the longest grid axis; ties go to x): the eye's voxel coordinate.
+        let eye_voxel = eye.x * volume.dims.x as f64 - 0.5;
+        for ranks in [2u32, 4] {
+            // Each rank's slab as a voxel range along x, and its image.
+            let mut slabs: Vec<(f64, Image)> = (0..ranks)
+                .map(|rank| {
+                    let xs: Vec<u32> = (0..layout.brick_count() as u32)
+                        .filter(|b| volgraph_passes::raycast_bricks::owns(&layout, *b, (rank, ranks)))
+                        .map(|b| layout.brick_coord(b as usize).x)
+                        .collect();
+                    let lo = *xs.iter().min().expect("every rank owns bricks") as f64 * 16.0;
+                    let hi = (*xs.iter().max().expect("bricks") as f64 + 1.0) * 16.0;
+                    let distance = if eye_voxel < lo { lo - eye_voxel } else { (eye_voxel - hi).max(0.0) };
+                    let options = base.clone().with_param("march", "ranks", ranks as u64).with_param(
+                        "march",
+                        "rank",
+                        rank as u64,
+                    );
+                    (distance, live(&gpu, &registry, "bricks_octree", &volume, &lut, &options).frame(&cam))
+                })
+                .collect();
+            // Visibility order: nearest slab first (a ray meets the slabs on its side of the eye
+            // in this order and no others).
+            slabs.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut composite = vec![[0.0f64; 4]; (SIZE * SIZE) as usize];
+            for (_, image) in &slabs {
+                for (i, acc) in composite.iter_mut().enumerate() {
+                    let c = image.rgba(i as u32 % SIZE, i as u32 / SIZE);
+                    let transmittance = 1.0 - acc[3];
+                    for ch in 0..4 {
+                        acc[ch] += transmittance * c[ch] as f64;
+                    }
+                }
+            }
+            let (max, _) = diff_reference(&single, &composite);
+            if max > 1.5 / 255.0 {
+                save_images(&format!("rv_sort_last_{ranks}_az{azimuth}"), &single, &composite);
+            }
+            assert!(coverage(&single) > 0.02, "the volume is in view");
+            assert!(max <= 1.5 / 255.0, "{ranks} ranks at {azimuth}°: max {:.3}/255", max * 255.0);
+        }
+    }
+}

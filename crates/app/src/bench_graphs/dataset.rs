@@ -1,5 +1,6 @@
 //! Benchmark datasets by name: real volumes found through `volgraph_accel::data_dir`
-//! (`$VOLGRAPH_DATA`), or volumes generated on the spot (`ml64`, `mlf64`, `sphere64`, `noise64`).
+//! (`$VOLGRAPH_DATA`), or volumes generated on the spot (`ml64`, `mlf64`, `sphere64`, `noise64`,
+//! `vessels256`: the sparse vessel tree of `volgraph_accel::vessels`).
 
 use anyhow::anyhow;
 use volgraph_accel::generate;
@@ -18,6 +19,8 @@ fn generated(name: &str) -> Option<anyhow::Result<Volume>> {
         (|n| generate::sphere(n, 0.6), d)
     } else if let Some(d) = name.strip_prefix("noise") {
         (|n| generate::noise(n, 1), d)
+    } else if let Some(d) = name.strip_prefix("vessels") {
+        (|n| volgraph_accel::vessels::vessel_tree(n, 1), d)
     } else {
         return None;
     };
@@ -34,7 +37,7 @@ fn generated(name: &str) -> Option<anyhow::Result<Volume>> {
 pub fn load_generated(name: &str) -> anyhow::Result<Volume> {
     generated(name).unwrap_or_else(|| {
         Err(anyhow!(
-            "Generated(\"{name}\") names no generated volume; use ml<N>, mlf<N>, sphere<N> or noise<N>, e.g. ml64"
+            "Generated(\"{name}\") names no generated volume; use ml<N>, mlf<N>, sphere<N>, noise<N> or vessels<N>, e.g. ml64"
         ))
     })
 }
@@ -46,7 +49,7 @@ pub fn load(name: &str) -> anyhow::Result<Volume> {
         return volume;
     }
     let loaded = volgraph_accel::data_dir::load_dataset(name).map_err(|e| {
-        anyhow!("--datasets {name}: {e} (generated volumes: ml<N>, mlf<N>, sphere<N>, noise<N>, e.g. ml64)")
+        anyhow!("--datasets {name}: {e} (generated volumes: ml<N>, mlf<N>, sphere<N>, noise<N>, vessels<N>, e.g. ml64)")
     })?;
     Ok(loaded.volume)
 }

@@ -121,6 +121,7 @@ pub fn run(
             error: None,
             error_viewport: None,
             pareto: None,
+            counters: Default::default(),
         })
         .collect();
     Ok(PeerResult { rows, ran: format!("VTK {} {}", parsed.vtk, parsed.mapper) })

@@ -198,6 +198,35 @@ pub const PRESETS: &[BenchPreset] = &[
         memory: &[("graphs/klein_2005/leap_iso_aa.ron", (1920, 1080))],
     },
     BenchPreset {
+        name: "ruijters2006",
+        about: "Ruijters & Vilanova 2006 Table 1: the same raycast over the whole volume in one texture \
+                (unoptimized) against bricks, bricks + per-brick octrees, and + early ray termination, at 800², \
+                1.5 samples per voxel (step 2/3 voxel), on the generated vessel tree (about 3 % visible under \
+                graphs/tf/vessels.ron, like the paper's angiography: optimized vs unoptimized 7.66× on a QuadroFX \
+                3400) and on the dense engine (the paper's ERT on a dense volume: 2.2 → 5.2 → 16.1 fps). Bricks \
+                64³, node limit 8³, ratio 1; uploads and pool occupancy from the brick pass",
+        graphs: &[
+            "graphs/ruijters_vilanova_2006/unoptimized.ron",
+            "graphs/ruijters_vilanova_2006/bricks.ron",
+            "graphs/ruijters_vilanova_2006/bricks_octree.ron",
+            "graphs/ruijters_vilanova_2006/bricks_octree_ert.ron",
+        ],
+        baseline: "unoptimized",
+        baselines: &[],
+        datasets: &[],
+        viewports: &[(800, 800)],
+        tfs: &[],
+        cases: &[("vessels256", "graphs/tf/vessels.ron"), ("engine_vollib", "default")],
+        params: &[("input.step_voxels", 0.6666666666666666)],
+        dataset_params: &[],
+        frames: 8,
+        camera: None,
+        full_turn: false,
+        peer: None,
+        antialias: None,
+        memory: &[],
+    },
+    BenchPreset {
         name: "effects-off",
         about: "A graph that offers every scene effect, with the effects off, against the same graph written by hand \
                 without them (graphs/bench/fastest_minimal.ron): the ratio should be 1 within noise",

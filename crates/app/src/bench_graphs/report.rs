@@ -131,6 +131,10 @@ pub struct Row {
     /// On the Pareto front of (ms/frame, mean abs error) among the sweep values of this
     /// graph × dataset × TF × viewport.
     pub pareto: Option<bool>,
+    /// What the passes reported about the last timed frame (`pass.counter`: a brick pool's
+    /// `march.uploaded_bytes`, `march.pool_bytes`, ...).
+    #[serde(default)]
+    pub counters: BTreeMap<String, f64>,
 }
 
 fn mib(bytes: u64) -> String {
@@ -171,6 +175,7 @@ impl GraphBenchReport {
         let sweeping = self.sweep.is_some();
         let errors = self.rows.iter().any(|r| r.error.is_some());
         let counted = self.rows.iter().any(|r| r.gpu_samples_per_pixel.is_some());
+        let pooled = self.rows.iter().any(|r| r.counters.keys().any(|k| k.ends_with(".uploaded_bytes")));
         let mut header = vec!["graph", "dataset", "TF", "viewport"];
         let sweep_key = self.sweep.clone().unwrap_or_default();
         if sweeping {
@@ -179,6 +184,9 @@ impl GraphBenchReport {
         header.extend(["ms/frame", "clock", "speed-up", "samples/px", "Msamples/s"]);
         if counted {
             header.extend(["GPU samples/px", "GPU Msamples/s", "of fetch ceiling"]);
+        }
+        if pooled {
+            header.extend(["uploaded MiB/frame", "batches", "pool MiB", "bricks drawn"]);
         }
         header.push("per pass (ms)");
         if errors {
@@ -213,6 +221,21 @@ impl GraphBenchReport {
                 cells.push(
                     r.fraction_of_fetch_ceiling.map_or_else(|| "n/a".to_string(), |f| format!("{:.0} %", f * 100.0)),
                 );
+            }
+            if pooled {
+                let sum = |name: &str| {
+                    let v: Vec<f64> =
+                        r.counters.iter().filter(|(k, _)| k.ends_with(&format!(".{name}"))).map(|(_, v)| *v).collect();
+                    (!v.is_empty()).then(|| v.iter().sum::<f64>())
+                };
+                let mib = |b: Option<f64>| b.map_or_else(|| "n/a".to_string(), |b| format!("{:.1}", b / 1048576.0));
+                cells.push(mib(sum("uploaded_bytes")));
+                cells.push(opt(sum("batches"), 0));
+                cells.push(mib(sum("pool_bytes")));
+                cells.push(match (sum("visible_bricks"), sum("bricks")) {
+                    (Some(v), Some(t)) => format!("{v:.0}/{t:.0}"),
+                    _ => "n/a".to_string(),
+                });
             }
             cells.push(if passes.is_empty() { "n/a".to_string() } else { passes });
             if errors {

@@ -414,6 +414,8 @@ fn run_case(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<Row> {
         }
     };
     let median_ms = median(&timing.frame_ms);
+    let counters =
+        ctx.runtime.pass_counters().into_iter().map(|(pass, name, v)| (format!("{pass}.{name}"), v)).collect();
     let counted = if config.gpu_count { count_on_gpu(ctx, case) } else { None };
     let step = settings.map_or(0.5, |s| s.step_voxels);
     let ceiling = counted.and_then(|_| fetch_ceiling(ctx, case, step));
@@ -455,6 +457,7 @@ fn run_case(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<Row> {
         error,
         error_viewport: error.map(|_| [error_viewport.0, error_viewport.1]),
         pareto: None,
+        counters,
     })
 }
 

@@ -93,7 +93,7 @@ fn bad_flags_name_the_flag_and_the_fix() {
     let graphs = vec![basic_graph("fragment_raycast.ron")];
     assert_eq!(
         error_of(GraphsArgs { preset: Some("kw".to_string()), scale: 1.0, ..GraphsArgs::default() }),
-        "--preset \"kw\": no such preset; choose one of: basic, kw2003-table1, thesis-tables, peer, klein2005, effects-off"
+        "--preset \"kw\": no such preset; choose one of: basic, kw2003-table1, thesis-tables, peer, klein2005, ruijters2006, effects-off"
     );
     assert_eq!(
         error_of(GraphsArgs {

@@ -34,6 +34,16 @@ enum Command {
         /// Scene values, NAME=VALUE (repeat counts, ...).
         #[arg(long = "scalar", value_parser = parse_scalar)]
         scalars: Vec<(String, f64)>,
+        /// Print the plan as a Graphviz DOT picture instead (passes, values with their slots,
+        /// culled passes greyed, repeat groups boxed, history edges dashed): `| dot -Tsvg`.
+        #[arg(long)]
+        dot: bool,
+    },
+    /// List every pass kind a graph can use (summary, paper section), or show one kind's ports,
+    /// parameters (type, default, range, doc), features and shaders.
+    Passes {
+        /// The kind to show in full.
+        kind: Option<String>,
     },
     /// Render a graph to an image (PNG: 8-bit sRGB; EXR: 32-bit float linear).
     Render {
@@ -238,13 +248,14 @@ pub enum Checked {
 /// break, without the GPU (the CLI fuzzer runs this). Other commands are not checked here.
 pub fn check(cli: Cli) -> Result<Checked, CliError> {
     match cli.command {
-        Command::Plan { graph, size, features, scalars } => {
+        Command::Plan { graph, size, features, scalars, dot } => {
             let source = inputs::read_graph(&graph)?;
             let options = compile_options(&size, &features, &scalars)?;
             let plan =
                 compile(&display_name(&graph), &source, &builtin_registry(), &options).map_err(CliError::Graph)?;
             check_user_names(&plan, &options)?;
-            Ok(Checked::Plan { text: plan.to_text(), notes: warning_lines(&plan) })
+            let text = if dot { plan.to_dot() } else { plan.to_text() };
+            Ok(Checked::Plan { text, notes: warning_lines(&plan) })
         }
         Command::Render {
             graph,
@@ -280,7 +291,7 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
             };
             Ok(Checked::Render(Box::new(crate::render::prepare(args)?)))
         }
-        Command::Bench { .. } | Command::View(_) | Command::Sweep(_) => {
+        Command::Bench { .. } | Command::View(_) | Command::Sweep(_) | Command::Passes { .. } => {
             Err(CliError::Other(anyhow!("only plan and render are checked ahead of running")))
         }
     }
@@ -305,6 +316,11 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             }
         },
         Command::View(args) => crate::view::run(args),
+        Command::Passes { kind } => {
+            let text = crate::passes_cmd::describe(&builtin_registry(), kind.as_deref())?;
+            crate::stdout::write_stdout(&text)?;
+            Ok(())
+        }
         Command::Sweep(args) => {
             crate::sweep::run(&args).context("sweep")?;
             Ok(())

@@ -11,6 +11,7 @@ mod cli;
 mod cli_fuzz;
 mod image_out;
 mod inputs;
+mod passes_cmd;
 mod render;
 mod scene;
 mod shader_dir;

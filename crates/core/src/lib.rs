@@ -11,6 +11,7 @@ pub mod format;
 pub mod graph;
 pub mod params;
 pub mod plan;
+mod plan_dot;
 pub mod plugin;
 pub mod runtime;
 pub mod shader_source;

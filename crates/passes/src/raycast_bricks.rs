@@ -345,33 +345,11 @@ impl VolumeState {
             }
             None => self.octree.classify(&classifier),
         };
-        let count = self.layout.brick_count();
-        self.visible = (0..count).map(|b| visibility.brick_visible_cells(b) > 0).collect();
-        // The boxes to draw, rasterized into the volume's grid of leaves.
-        let g = self.leaf_grid;
-        let mut drawn = vec![false; (g.x * g.y * g.z) as usize];
-        let mut boxes: Vec<DrawBox> = Vec::new();
-        let leaf = self.octree.min_node_cells();
-        for b in (0..count).filter(|b| self.visible[*b]) {
-            boxes.clear();
-            self.octree.draw_boxes(&visibility, b, ratio, ViewPoint::Direction(DVec3::Z), &mut boxes);
-            for d in &boxes {
-                let lo = d.cells_lo / leaf;
-                let hi =
-                    UVec3::new(d.cells_hi.x.div_ceil(leaf), d.cells_hi.y.div_ceil(leaf), d.cells_hi.z.div_ceil(leaf))
-                        .min(g);
-                for z in lo.z..hi.z {
-                    for y in lo.y..hi.y {
-                        for x in lo.x..hi.x {
-                            drawn[(x + g.x * (y + g.y * z)) as usize] = true;
-                        }
-                    }
-                }
-            }
-        }
+        let leaves = classify_leaves(&self.octree, &visibility, &self.layout, self.leaf_grid, ratio);
         self.visibility = Some(visibility);
-        self.drawn_leaves = drawn.iter().filter(|d| **d).count() as f64 / drawn.len().max(1) as f64;
-        let bits = volgraph_accel::chebyshev::chebyshev_distance(&drawn, g, MAX_LEAP);
+        self.visible = leaves.visible;
+        self.drawn_leaves = leaves.drawn_fraction;
+        let bits = leaves.distance;
         let bytes: &[u8] = bytemuck::cast_slice(&bits);
         let size = (bytes.len() as u64).max(4);
         if self.leaf_buffer.as_ref().is_none_or(|b| b.size() != size) {
@@ -492,6 +470,59 @@ impl VolumeState {
         }
         uploads.len() as u64 * (side as u64).pow(3) * texel as u64
     }
+}
+
+/// Leaves of `node_cells`³ cells per axis over a volume of `volume_dims` voxels.
+pub fn leaf_grid(volume_dims: UVec3, node_cells: u32) -> UVec3 {
+    let cells = volgraph_accel::bricks::cell_dims(volume_dims);
+    UVec3::new(cells.x.div_ceil(node_cells), cells.y.div_ceil(node_cells), cells.z.div_ceil(node_cells))
+}
+
+/// The CPU work of a TF change after the octrees' visible counts are rebuilt: which bricks are
+/// visible, and every leaf's leap distance.
+pub struct LeafClassification {
+    /// Per brick: visible under the TF.
+    pub visible: Vec<bool>,
+    /// Per leaf of the volume (x fastest): 0 where a box to draw covers it, else the Chebyshev
+    /// distance in leaves to the nearest such leaf (capped at 255).
+    pub distance: Vec<u32>,
+    /// Fraction of the leaves drawn.
+    pub drawn_fraction: f64,
+}
+
+/// Rasterizes every visible brick's boxes to draw (§7's ratio rule at `ratio`) into the leaf
+/// grid and turns the rest into leap distances ([`volgraph_accel::chebyshev`]).
+pub fn classify_leaves(
+    octree: &OctreeHierarchy,
+    visibility: &OctreeVisibility,
+    layout: &BrickLayout,
+    grid: UVec3,
+    ratio: f32,
+) -> LeafClassification {
+    let count = layout.brick_count();
+    let visible: Vec<bool> = (0..count).map(|b| visibility.brick_visible_cells(b) > 0).collect();
+    let mut drawn = vec![false; (grid.x * grid.y * grid.z) as usize];
+    let mut boxes: Vec<DrawBox> = Vec::new();
+    let leaf = octree.min_node_cells();
+    for b in (0..count).filter(|b| visible[*b]) {
+        boxes.clear();
+        octree.draw_boxes(visibility, b, ratio, ViewPoint::Direction(DVec3::Z), &mut boxes);
+        for d in &boxes {
+            let lo = d.cells_lo / leaf;
+            let hi = UVec3::new(d.cells_hi.x.div_ceil(leaf), d.cells_hi.y.div_ceil(leaf), d.cells_hi.z.div_ceil(leaf))
+                .min(grid);
+            for z in lo.z..hi.z {
+                for y in lo.y..hi.y {
+                    for x in lo.x..hi.x {
+                        drawn[(x + grid.x * (y + grid.y * z)) as usize] = true;
+                    }
+                }
+            }
+        }
+    }
+    let drawn_fraction = drawn.iter().filter(|d| **d).count() as f64 / drawn.len().max(1) as f64;
+    let distance = volgraph_accel::chebyshev::chebyshev_distance(&drawn, grid, MAX_LEAP);
+    LeafClassification { visible, distance, drawn_fraction }
 }
 
 /// Whether rank `ranks.0` of `ranks.1` draws brick `brick`: the brick grid is cut into

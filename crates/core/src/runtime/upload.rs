@@ -69,7 +69,8 @@ pub enum UploadError {
     /// A side is zero or beyond the device's 3D texture limit.
     #[error(
         "volume \"{label}\" is {}x{}x{}, but this GPU's 3D textures are limited to 1..={max} per side; \
-         bricking (Ruijters–Vilanova) lifts this limit", .dims[0], .dims[1], .dims[2]
+         render it with bricking, through the brick pool of graphs/ruijters_vilanova_2006/bricks_octree.ron, \
+         which has no such limit", .dims[0], .dims[1], .dims[2]
     )]
     TooLarge {
         /// The volume's name.

@@ -16,6 +16,7 @@ pub mod plugin;
 pub mod runtime;
 pub mod shader_source;
 pub mod suggest;
+pub mod wgsl_pass;
 
 pub use compile::{CompileOptions, compile};
 pub use diagnostic::{Diagnostic, Diagnostics, Location};

@@ -36,6 +36,9 @@ pub struct Plan {
     pub outputs: BTreeMap<String, ResourceId>,
     /// History entries: name → what they track.
     pub history: BTreeMap<String, History>,
+    /// Pass kinds the graph declares itself (WGSL-only passes): the runtime adds them to its
+    /// registry when it applies the plan ([`crate::wgsl_pass::with_graph_kinds`]).
+    pub kinds: BTreeMap<String, crate::graph::ast::WgslKindDoc>,
     /// Every scene feature some pass of the graph needs, on or off (what a viewer offers as
     /// toggles, and what `--features` may name).
     pub known_features: BTreeSet<String>,

@@ -63,6 +63,10 @@ pub struct GraphsArgs {
     /// parameter); by default one extra frame per case counts them.
     #[arg(long)]
     pub no_gpu_count: bool,
+    /// GPU memory, in MiB, a brick pool may hold (graphs/ruijters_vilanova_2006); volumes that do
+    /// not fit stream through it [default: what the adapter allows].
+    #[arg(long = "gpu-memory-mb", value_parser = clap::value_parser!(u64).range(1..=1 << 24))]
+    pub gpu_memory_mb: Option<u64>,
     /// Accuracy sweep PASS.PARAM=V1,V2,... (e.g. march.step_voxels=0.25,0.5,1,2), input.NAME=...
     /// for a Scalar graph input shared by several passes, feature.NAME=off,on for a scene effect,
     /// scene.precision=f16,f32; adds error against a converged CPU reference (of the same
@@ -142,6 +146,8 @@ pub struct BenchConfig {
     pub spp_size: u32,
     /// Count samples on the GPU where a pass can.
     pub gpu_count: bool,
+    /// The brick pool's budget in bytes (`--gpu-memory-mb`).
+    pub gpu_memory_budget: Option<u64>,
     /// Run the preset's peer.
     pub peer: bool,
     /// A shader folder read before the built-in shaders.
@@ -377,6 +383,7 @@ impl GraphsArgs {
             reference_step: self.reference_step,
             spp_size: self.spp_size,
             gpu_count: !self.no_gpu_count,
+            gpu_memory_budget: self.gpu_memory_mb.map(|mb| mb << 20),
             peer: !self.no_peer && preset.is_some_and(|p| p.peer.is_some()),
             shaders: self.shaders.clone(),
             json: self.json.clone(),

@@ -159,6 +159,7 @@ pub fn run(gpu: std::sync::Arc<Gpu>, config: &BenchConfig) -> anyhow::Result<Gra
         reference_cache: HashMap::new(),
         ceiling_cache: HashMap::new(),
     };
+    ctx.runtime.set_gpu_memory_budget(config.gpu_memory_budget);
     let graphs: Vec<GraphFile> = config
         .graphs
         .iter()

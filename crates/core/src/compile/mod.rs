@@ -89,6 +89,18 @@ pub fn compile(file: &str, source: &str, registry: &Registry, options: &CompileO
     let source = source.strip_prefix('\u{feff}').unwrap_or(source);
     let fail = |items| Diagnostics { file: file.to_string(), text: Arc::from(source), items };
     let doc = crate::graph::parse_graph(source).map_err(|d| fail(vec![d]))?;
+    // Pass kinds the graph declares itself join the registry for this graph only.
+    let extended;
+    let registry = if doc.kinds.is_empty() {
+        registry
+    } else {
+        let problems = crate::wgsl_pass::check_kinds(&doc.kinds, registry);
+        if !problems.is_empty() {
+            return Err(fail(problems));
+        }
+        extended = crate::wgsl_pass::with_graph_kinds(registry, &doc.kinds);
+        &extended
+    };
     let checked = check::check(&doc, source, registry, options).map_err(fail)?;
     let mut warnings = checked.warnings.clone();
     let mut plan = schedule::schedule(&doc, checked, options).map_err(fail)?;

@@ -89,6 +89,7 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
         slots,
         outputs,
         history,
+        kinds: doc.kinds.clone(),
         known_features: c
             .passes
             .iter()

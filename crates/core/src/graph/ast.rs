@@ -26,6 +26,77 @@ pub struct GraphDoc {
     pub passes: Vec<NodeDoc>,
     /// Named results: `{"image": "march.color"}`.
     pub outputs: BTreeMap<String, String>,
+    /// Pass kinds this graph declares itself, each implemented by a WGSL file alone:
+    /// `{"edge_enhance": WgslKind(shader: "edge_enhance.wgsl", ...)}` (see [`WgslKindDoc`]).
+    #[serde(default)]
+    pub kinds: BTreeMap<String, WgslKindDoc>,
+}
+
+/// A pass kind implemented by one WGSL compute shader, declared in the graph file: its ports and
+/// parameters are declared here, the parameter block is laid out from them (one `f32` per
+/// parameter, in the order given: `struct Params { a: f32, b: f32, ... }` bound as `params`),
+/// and it is validated, planned, culled, pooled, timed and hot-reloaded like a built-in.
+/// Bindings are by global name, as for every pass: an input port `color` is the shader's
+/// `color`, an output `out` its storage texture `out`.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, rename = "WgslKind")]
+pub struct WgslKindDoc {
+    /// The shader file, found like every shader (the graph's `shaders/` folders, then the
+    /// built-in ones).
+    pub shader: String,
+    /// One line saying what the pass does.
+    #[serde(default)]
+    pub summary: String,
+    /// The compute entry point.
+    #[serde(default = "default_wgsl_entry")]
+    pub entry: String,
+    /// The shader's `@workgroup_size(x, y)`: the dispatch covers the first output with it.
+    #[serde(default = "default_wgsl_workgroup")]
+    pub workgroup: (u32, u32),
+    /// Input ports: name → what they read.
+    #[serde(default)]
+    pub inputs: BTreeMap<String, WgslInput>,
+    /// Output ports: name → the storage texture format the shader writes.
+    pub outputs: BTreeMap<String, TargetFormat>,
+    /// Parameters, in the order of the shader's `Params` struct.
+    #[serde(default)]
+    pub params: Vec<WgslParamDoc>,
+}
+
+fn default_wgsl_entry() -> String {
+    "cs_main".to_string()
+}
+
+fn default_wgsl_workgroup() -> (u32, u32) {
+    (8, 8)
+}
+
+/// What an input port of a WGSL-only pass reads.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+pub enum WgslInput {
+    /// A viewport-sized float target (sampled with `textureLoad`).
+    Target,
+    /// The volume as a 3D texture.
+    Volume,
+    /// The transfer-function LUT.
+    TransferFunction,
+}
+
+/// A parameter of a WGSL-only pass: an `f32` in `[min, max]`.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct WgslParamDoc {
+    /// Name in the graph and in the shader's `Params` struct.
+    pub name: String,
+    /// Value when the graph does not set it.
+    pub default: f64,
+    /// Smallest valid value.
+    pub min: f64,
+    /// Largest valid value.
+    pub max: f64,
+    /// What it does.
+    #[serde(default)]
+    pub doc: String,
 }
 
 /// The kind of a graph input.

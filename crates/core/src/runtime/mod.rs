@@ -309,6 +309,14 @@ impl Runtime {
     /// Makes `plan` the running plan, reusing what did not change; on error the previous plan
     /// keeps running.
     pub fn apply(&mut self, plan: Plan, registry: &Registry) -> Result<ApplyReport, RuntimeError> {
+        // The graph's own WGSL-only kinds join the registry for this plan.
+        let extended;
+        let registry = if plan.kinds.is_empty() {
+            registry
+        } else {
+            extended = crate::wgsl_pass::with_graph_kinds(registry, &plan.kinds);
+            &extended
+        };
         let viewport_changed = self.plan().is_some_and(|p| p.viewport != plan.viewport);
         let old = self.schedule.take();
         let resources = schedule::Resources {

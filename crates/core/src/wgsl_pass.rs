@@ -1,0 +1,274 @@
+//! Pass kinds implemented by a WGSL file alone, declared in a graph's `kinds:` block
+//! ([`crate::graph::ast::WgslKindDoc`]). [`with_graph_kinds`] turns each declaration into a
+//! [`PassPlugin`] beside the registry's, so the compiler checks and schedules such a pass like a
+//! built-in and the runtime creates, times and hot-reloads it like one: its shader is read from
+//! the shader library, and an edit rebuilds the node.
+
+use std::collections::{BTreeMap, HashSet};
+use std::sync::{Mutex, OnceLock};
+
+use crate::diagnostic::{Diagnostic, Location};
+use crate::graph::ast::{WgslInput, WgslKindDoc};
+use crate::params::{ParamSpec, Params};
+use crate::plugin::{PassNode, PassPlugin, PortKind, PortSpec, Registry, ShaderUse};
+use crate::runtime::{ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, PipelineKind, RecordContext};
+
+/// A string that lives as long as the program. Plugin declarations are `&'static str`; names a
+/// graph declares are interned once each, so reloading a graph does not grow memory.
+fn intern(s: &str) -> &'static str {
+    static STRINGS: OnceLock<Mutex<HashSet<&'static str>>> = OnceLock::new();
+    let mut set = STRINGS.get_or_init(Default::default).lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(found) = set.get(s) {
+        return found;
+    }
+    let leaked: &'static str = Box::leak(s.to_string().into_boxed_str());
+    set.insert(leaked);
+    leaked
+}
+
+/// Problems with a graph's `kinds:` block, each naming the kind and field with the fix.
+pub fn check_kinds(kinds: &BTreeMap<String, WgslKindDoc>, registry: &Registry) -> Vec<Diagnostic> {
+    let mut out = Vec::new();
+    let mut err = |kind: &str, message: String, help: &str| {
+        out.push(Diagnostic::new(Location::File, format!("kind \"{kind}\": {message}")).with_help(help.to_string()));
+    };
+    for (name, k) in kinds {
+        if registry.get(name).is_some() {
+            err(name, "is already a registered pass kind".into(), "give the WGSL kind a name of its own");
+        }
+        if !k.shader.ends_with(".wgsl") {
+            err(
+                name,
+                format!("shader \"{}\" is not a .wgsl file", k.shader),
+                "name the WGSL file, e.g. \"my_pass.wgsl\"",
+            );
+        }
+        if k.outputs.is_empty() {
+            err(
+                name,
+                "declares no outputs".into(),
+                "add outputs: {\"out\": Rgba16Float} (the storage texture it writes)",
+            );
+        }
+        if k.workgroup.0 == 0 || k.workgroup.1 == 0 || k.workgroup.0 * k.workgroup.1 > 1024 {
+            err(
+                name,
+                format!("workgroup {:?} is not a valid workgroup size", k.workgroup),
+                "use the shader's @workgroup_size(x, y), e.g. (8, 8)",
+            );
+        }
+        let mut seen = HashSet::new();
+        for p in &k.params {
+            if !seen.insert(p.name.as_str()) {
+                err(name, format!("parameter \"{}\" is declared twice", p.name), "give each parameter its own name");
+            }
+            if !(p.min <= p.default && p.default <= p.max) {
+                err(
+                    name,
+                    format!("parameter \"{}\": default {} is outside [{}, {}]", p.name, p.default, p.min, p.max),
+                    "make min <= default <= max",
+                );
+            }
+            if k.inputs.contains_key(&p.name) || k.outputs.contains_key(&p.name) || p.name == "params" {
+                err(name, format!("parameter \"{}\" has the name of a port", p.name), "rename the parameter");
+            }
+        }
+        for port in k.inputs.keys().filter(|p| k.outputs.contains_key(*p)) {
+            err(name, format!("\"{port}\" is both an input and an output"), "name the output differently");
+        }
+    }
+    out
+}
+
+/// `registry` with a plugin for each WGSL-only kind of `kinds` added.
+pub fn with_graph_kinds(registry: &Registry, kinds: &BTreeMap<String, WgslKindDoc>) -> Registry {
+    let mut extended = registry.clone();
+    for (name, doc) in kinds {
+        extended.register(WgslPass { kind: intern(name), doc: doc.clone() });
+    }
+    extended
+}
+
+/// The plugin of one WGSL-only kind.
+struct WgslPass {
+    kind: &'static str,
+    doc: WgslKindDoc,
+}
+
+/// Float formats a target input may have.
+const READABLE: [crate::TargetFormat; 4] = [
+    crate::TargetFormat::Rgba16Float,
+    crate::TargetFormat::Rgba32Float,
+    crate::TargetFormat::Rgba8Unorm,
+    crate::TargetFormat::R32Float,
+];
+
+impl PassPlugin for WgslPass {
+    fn kind(&self) -> &'static str {
+        self.kind
+    }
+
+    fn summary(&self) -> &'static str {
+        if self.doc.summary.is_empty() {
+            intern(&format!("WGSL-only pass ({})", self.doc.shader))
+        } else {
+            intern(&self.doc.summary)
+        }
+    }
+
+    fn params(&self) -> Vec<ParamSpec> {
+        self.doc
+            .params
+            .iter()
+            .map(|p| ParamSpec::float(intern(&p.name), p.default, p.min, p.max, intern(&p.doc)))
+            .collect()
+    }
+
+    fn ports(&self, _params: &Params) -> Vec<PortSpec> {
+        let mut ports: Vec<PortSpec> = self
+            .doc
+            .inputs
+            .iter()
+            .map(|(name, input)| {
+                let kind = match input {
+                    WgslInput::Target => PortKind::target(&READABLE),
+                    WgslInput::Volume => PortKind::Volume,
+                    WgslInput::TransferFunction => PortKind::TransferFunction,
+                };
+                PortSpec::read(intern(name), kind)
+            })
+            .collect();
+        ports.extend(
+            self.doc.outputs.iter().map(|(name, format)| PortSpec::write(intern(name), PortKind::target(&[*format]))),
+        );
+        ports
+    }
+
+    fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
+        vec![ShaderUse { file: intern(&self.doc.shader), entry_point: intern(&self.doc.entry) }]
+    }
+
+    fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
+        true
+    }
+
+    fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        let extra: &[&str] = if self.doc.params.is_empty() { &[] } else { &["params"] };
+        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
+            shader: &self.doc.shader,
+            entry: &self.doc.entry,
+            extra_bindings: extra,
+            constants: &[],
+            defines: &[],
+        })?;
+        let uniform = (!self.doc.params.is_empty()).then(|| {
+            let buffer = ctx.uniform_buffer("params", param_block_size(self.doc.params.len()));
+            ctx.gpu.queue.write_buffer(&buffer, 0, &param_block(&self.doc, ctx.params));
+            buffer
+        });
+        let first_output = self.doc.outputs.keys().next().map(|n| intern(n)).unwrap_or("out");
+        Ok(Box::new(WgslPassNode { pipeline, uniform, doc: self.doc.clone(), first_output }))
+    }
+}
+
+/// Bytes of the uniform block of `n` f32 parameters (a multiple of 16).
+fn param_block_size(n: usize) -> u64 {
+    ((4 * n as u64).div_ceil(16) * 16).max(16)
+}
+
+/// The parameter values as the shader's `Params` struct: one f32 each, in declaration order.
+fn param_block(doc: &WgslKindDoc, params: &Params) -> Vec<u8> {
+    let mut bytes = vec![0u8; param_block_size(doc.params.len()) as usize];
+    for (i, p) in doc.params.iter().enumerate() {
+        bytes[4 * i..4 * i + 4].copy_from_slice(&(params.float(&p.name) as f32).to_le_bytes());
+    }
+    bytes
+}
+
+struct WgslPassNode {
+    pipeline: PassPipeline,
+    uniform: Option<wgpu::Buffer>,
+    doc: WgslKindDoc,
+    first_output: &'static str,
+}
+
+impl PassNode for WgslPassNode {
+    fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
+        let extra: Vec<(&str, wgpu::BindingResource<'_>)> =
+            self.uniform.iter().map(|b| ("params", b.as_entire_binding())).collect();
+        let bg = ctx.bind_group(&self.pipeline, &extra)?;
+        let (w, h) = ctx.extent(self.first_output);
+        let (wx, wy) = self.doc.workgroup;
+        let mut pass = ctx.begin_compute_pass();
+        if let PipelineKind::Compute(p) = &self.pipeline.pipeline {
+            pass.set_pipeline(p);
+        }
+        pass.set_bind_group(0, &bg, &[]);
+        pass.dispatch_workgroups(w.div_ceil(wx), h.div_ceil(wy), 1);
+        Ok(())
+    }
+
+    fn update_params(&mut self, gpu: &Gpu, params: &Params) {
+        if let Some(buffer) = &self.uniform {
+            gpu.queue.write_buffer(buffer, 0, &param_block(&self.doc, params));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn kinds(text: &str) -> BTreeMap<String, WgslKindDoc> {
+        ron::from_str(text).expect("parses")
+    }
+
+    /// Each mistake in a `kinds:` block is reported with the kind, the field and the fix.
+    #[test]
+    fn bad_declarations_name_the_kind_and_the_fix() {
+        let bad = kinds(
+            r#"{
+                "blur": WgslKind(shader: "blur.glsl", outputs: {}, workgroup: (0, 8),
+                    inputs: {"color": Target},
+                    params: [(name: "r", default: 9.0, min: 0.0, max: 4.0),
+                             (name: "r", default: 1.0, min: 0.0, max: 4.0),
+                             (name: "color", default: 1.0, min: 0.0, max: 4.0)]),
+            }"#,
+        );
+        let mut registry = Registry::new();
+        registry.register(WgslPass { kind: "present", doc: bad["blur"].clone() });
+        let clash = kinds(r#"{"present": WgslKind(shader: "p.wgsl", outputs: {"out": Rgba16Float})}"#);
+        let messages: Vec<String> = check_kinds(&bad, &registry)
+            .into_iter()
+            .chain(check_kinds(&clash, &registry))
+            .map(|d| format!("{} / {}", d.message, d.help.unwrap_or_default()))
+            .collect();
+        let all = messages.join("\n");
+        for expected in [
+            "kind \"blur\": shader \"blur.glsl\" is not a .wgsl file",
+            "kind \"blur\": declares no outputs",
+            "kind \"blur\": workgroup (0, 8) is not a valid workgroup size",
+            "kind \"blur\": parameter \"r\": default 9 is outside [0, 4]",
+            "kind \"blur\": parameter \"r\" is declared twice",
+            "kind \"blur\": parameter \"color\" has the name of a port",
+            "kind \"present\": is already a registered pass kind",
+        ] {
+            assert!(all.contains(expected), "missing {expected:?} in\n{all}");
+        }
+    }
+
+    /// The parameter block: one f32 per parameter in declaration order, padded to 16 bytes.
+    #[test]
+    fn the_parameter_block_follows_the_declaration_order() {
+        let doc = &kinds(
+            r#"{"k": WgslKind(shader: "k.wgsl", outputs: {"out": Rgba16Float},
+                params: [(name: "b", default: 2.0, min: 0.0, max: 9.0), (name: "a", default: 1.0, min: 0.0, max: 9.0)])}"#,
+        )["k"];
+        let plugin = WgslPass { kind: "k", doc: doc.clone() };
+        let params = Params::defaults(&plugin.params());
+        let block = param_block(doc, &params);
+        assert_eq!(block.len(), 16);
+        assert_eq!(&block[0..4], &2.0f32.to_le_bytes());
+        assert_eq!(&block[4..8], &1.0f32.to_le_bytes());
+    }
+}

@@ -6,6 +6,7 @@
 //! scheduling) → [`plan::Plan`] → [`runtime::Runtime::apply`] → frames submitted by the runtime.
 
 pub mod compile;
+pub mod declare;
 pub mod diagnostic;
 pub mod format;
 pub mod graph;

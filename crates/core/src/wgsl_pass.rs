@@ -11,7 +11,7 @@ use crate::diagnostic::{Diagnostic, Location};
 use crate::graph::ast::{WgslInput, WgslKindDoc};
 use crate::params::{ParamSpec, Params};
 use crate::plugin::{PassNode, PassPlugin, PortKind, PortSpec, Registry, ShaderUse};
-use crate::runtime::{ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, PipelineKind, RecordContext};
+use crate::runtime::{ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, RecordContext};
 
 /// A string that lives as long as the program. Plugin declarations are `&'static str`; names a
 /// graph declares are interned once each, so reloading a graph does not grow memory.
@@ -196,16 +196,7 @@ impl PassNode for WgslPassNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let extra: Vec<(&str, wgpu::BindingResource<'_>)> =
             self.uniform.iter().map(|b| ("params", b.as_entire_binding())).collect();
-        let bg = ctx.bind_group(&self.pipeline, &extra)?;
-        let (w, h) = ctx.extent(self.first_output);
-        let (wx, wy) = self.doc.workgroup;
-        let mut pass = ctx.begin_compute_pass();
-        if let PipelineKind::Compute(p) = &self.pipeline.pipeline {
-            pass.set_pipeline(p);
-        }
-        pass.set_bind_group(0, &bg, &[]);
-        pass.dispatch_workgroups(w.div_ceil(wx), h.div_ceil(wy), 1);
-        Ok(())
+        ctx.dispatch_over(&self.pipeline, &extra, self.first_output, self.doc.workgroup)
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {

@@ -5,23 +5,19 @@
 //! data-centre GPUs too). Shader: `shaders/present.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{
-    ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, PipelineKind, RecordContext,
-};
+use volgraph_core::runtime::{ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, RecordContext};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
 pub struct Present;
 
-/// Rust twin of `PresentParams` in `shaders/present.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct PresentParamsGpu {
-    background: f32,
-    _pad: [f32; 3],
+volgraph_core::pass_params! {
+    /// The parameters, declared once: the spec, typed values and `PresentParams` of
+    /// `shaders/present.wgsl` (checked against the shader by a test).
+    pub struct PresentParams {
+        background: f32 = 0.0, 0.0..=1.0, "linear grey level behind the volume";
+    }
 }
-
-const _: () = assert!(std::mem::size_of::<PresentParamsGpu>() == 16);
 
 impl PassPlugin for Present {
     fn kind(&self) -> &'static str {
@@ -33,7 +29,7 @@ impl PassPlugin for Present {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        vec![ParamSpec::float("background", 0.0, 0.0, 1.0, "linear grey level behind the volume")]
+        PresentParams::specs()
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -59,8 +55,7 @@ impl PassPlugin for Present {
             ..Default::default()
         })?;
         let params = ctx.uniform_buffer("params", 16);
-        let p = PresentParamsGpu { background: ctx.params.float("background") as f32, _pad: [0.0; 3] };
-        ctx.gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&p));
+        ctx.gpu.queue.write_buffer(&params, 0, &PresentParams::from_params(ctx.params).uniform_bytes());
         Ok(Box::new(PresentNode { pipeline, params }))
     }
 }
@@ -72,19 +67,25 @@ struct PresentNode {
 
 impl PassNode for PresentNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
-        let bg = ctx.bind_group(&self.pipeline, &[("params", self.params.as_entire_binding())])?;
-        let (w, h) = ctx.extent("display");
-        let mut pass = ctx.begin_compute_pass();
-        if let PipelineKind::Compute(p) = &self.pipeline.pipeline {
-            pass.set_pipeline(p);
-        }
-        pass.set_bind_group(0, &bg, &[]);
-        pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
-        Ok(())
+        ctx.dispatch_over(&self.pipeline, &[("params", self.params.as_entire_binding())], "display", (8, 8))
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
-        let p = PresentParamsGpu { background: params.float("background") as f32, _pad: [0.0; 3] };
-        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        gpu.queue.write_buffer(&self.params, 0, &PresentParams::from_params(params).uniform_bytes());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::PresentParams;
+
+    /// The shader's `PresentParams` is the struct `pass_params!` uploads.
+    #[test]
+    fn the_shader_struct_matches_the_declaration() {
+        let source =
+            volgraph_core::shader_source::assemble(&crate::builtin_shaders(), "present.wgsl").expect("assembles");
+        let fields: Vec<(&str, &str)> = PresentParams::specs().iter().map(|s| (s.name, "f32")).collect();
+        volgraph_core::declare::check_wgsl_struct(&source.text, "PresentParams", &fields).expect("same layout");
+        assert!(PresentParams::wgsl_struct().starts_with("struct PresentParams {\n    background: f32,"));
     }
 }

@@ -4,39 +4,35 @@
 //! windowed by `level` and `width` like a radiology viewer, alpha 1 where the ray hits the box.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{
-    ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, PipelineKind, RecordContext,
-};
+use volgraph_core::runtime::{ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, RecordContext};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 use volgraph_passes::raycast_params::RaycastParamsGpu;
 
 /// The plugin.
 pub struct Mip;
 
-/// Rust twin of `struct MipParams` in `shaders/mip.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct MipParams {
-    level: f32,
-    width: f32,
-    _pad: [f32; 2],
-}
-
-impl MipParams {
-    fn of(p: &Params) -> Self {
-        Self { level: p.float("level") as f32, width: p.float("width") as f32, _pad: [0.0; 2] }
+volgraph_core::pass_params! {
+    /// The window, declared once: spec, typed values and the shader's `MipParams` (a test
+    /// compares the two).
+    pub struct MipParams {
+        level: f32 = 0.5, 0.0..=1.0, "window centre, in normalized scalar units";
+        width: f32 = 1.0, 0.001..=2.0, "window width, in normalized scalar units";
     }
 }
 
-/// The shared raycasting parameters (`params` in volgraph's `common/raycast_params.wgsl`): the
-/// step and the bound on samples, so the samples are those of volgraph's raycasters.
+volgraph_core::pass_params! {
+    /// The sampling, declared once; it fills volgraph's shared raycasting block.
+    pub struct Sampling {
+        step_voxels: f32 = 0.5, 0.01..=16.0, "sample distance in units of the smallest voxel side";
+        max_steps: u32 = 4096, 1..=1048576, "upper bound on samples per ray";
+    }
+}
+
+/// The shared raycasting parameters (`params` in volgraph's `common/raycast_params.wgsl`), so the
+/// samples are those of volgraph's raycasters.
 fn ray_params(p: &Params) -> RaycastParamsGpu {
-    RaycastParamsGpu {
-        step_voxels: p.float("step_voxels") as f32,
-        max_steps: p.uint("max_steps") as u32,
-        threshold: 1.0,
-        ..Default::default()
-    }
+    let s = Sampling::from_params(p);
+    RaycastParamsGpu { step_voxels: s.step_voxels, max_steps: s.max_steps, threshold: 1.0, ..Default::default() }
 }
 
 impl PassPlugin for Mip {
@@ -49,12 +45,7 @@ impl PassPlugin for Mip {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        vec![
-            ParamSpec::float("step_voxels", 0.5, 0.01, 16.0, "sample distance in units of the smallest voxel side"),
-            ParamSpec::float("level", 0.5, 0.0, 1.0, "window centre, in normalized scalar units"),
-            ParamSpec::float("width", 1.0, 0.001, 2.0, "window width, in normalized scalar units"),
-            ParamSpec::uint("max_steps", 4096, 1, 1 << 20, "upper bound on samples per ray"),
-        ]
+        [MipParams::specs(), Sampling::specs()].concat()
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -80,7 +71,8 @@ impl PassPlugin for Mip {
             constants: &[],
             defines: &[],
         })?;
-        let uniform = ctx.uniform_with("mip", &MipParams::of(ctx.params));
+        let uniform = ctx.uniform_buffer("mip", 16);
+        ctx.gpu.queue.write_buffer(&uniform, 0, &MipParams::from_params(ctx.params).uniform_bytes());
         let rays = ctx.uniform_with("params", &ray_params(ctx.params));
         Ok(Box::new(MipNode { pipeline, uniform, rays }))
     }
@@ -95,19 +87,27 @@ struct MipNode {
 impl PassNode for MipNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let extra = [("mip", self.uniform.as_entire_binding()), ("params", self.rays.as_entire_binding())];
-        let bg = ctx.bind_group(&self.pipeline, &extra)?;
-        let (w, h) = ctx.extent("color");
-        let mut pass = ctx.begin_compute_pass();
-        if let PipelineKind::Compute(p) = &self.pipeline.pipeline {
-            pass.set_pipeline(p);
-        }
-        pass.set_bind_group(0, &bg, &[]);
-        pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
-        Ok(())
+        ctx.dispatch_over(&self.pipeline, &extra, "color", (8, 8))
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
-        gpu.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&MipParams::of(params)));
+        gpu.queue.write_buffer(&self.uniform, 0, &MipParams::from_params(params).uniform_bytes());
         gpu.queue.write_buffer(&self.rays, 0, bytemuck::bytes_of(&ray_params(params)));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::MipParams;
+
+    /// The shader's `MipParams` is the struct `pass_params!` uploads.
+    #[test]
+    fn the_shader_struct_matches_the_declaration() {
+        let source = include_str!("../shaders/mip.wgsl");
+        let fields: Vec<(&str, &str)> = MipParams::specs().iter().map(|s| (s.name, "f32")).collect();
+        // The shader imports volgraph's shared files; check the struct on its own text.
+        let start = source.find("struct MipParams").expect("declared");
+        let end = start + source[start..].find('}').expect("closed") + 1;
+        volgraph_core::declare::check_wgsl_struct(&source[start..end], "MipParams", &fields).expect("same layout");
     }
 }

@@ -299,6 +299,29 @@ impl<'a> RecordContext<'a> {
         Ok(pass.forget_lifetime())
     }
 
+    /// The common compute pass in one call: bind group 0 of `pipeline` (with `extra`), one
+    /// dispatch of `workgroup`-sized groups covering the target bound to `port`. A render
+    /// pipeline here is an error naming the pass, not a silently skipped dispatch.
+    pub fn dispatch_over(
+        &mut self,
+        pipeline: &PassPipeline,
+        extra: &[(&str, wgpu::BindingResource<'_>)],
+        port: &str,
+        workgroup: (u32, u32),
+    ) -> Result<(), PassError> {
+        let super::create::PipelineKind::Compute(compute) = &pipeline.pipeline else {
+            return Err(self
+                .error(format!("pipeline \"{}\" is a render pipeline; dispatch needs a compute one", pipeline.label)));
+        };
+        let bind_group = self.bind_group(pipeline, extra)?;
+        let (w, h) = self.extent(port);
+        let mut pass = self.begin_compute_pass();
+        pass.set_pipeline(compute);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.dispatch_workgroups(w.div_ceil(workgroup.0.max(1)), h.div_ceil(workgroup.1.max(1)), 1);
+        Ok(())
+    }
+
     /// Begins a compute pass, labelled and timed.
     pub fn begin_compute_pass(&mut self) -> wgpu::ComputePass<'static> {
         let ts = self.timestamp_indices();

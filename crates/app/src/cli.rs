@@ -254,6 +254,16 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
             let plan =
                 compile(&display_name(&graph), &source, &builtin_registry(), &options).map_err(CliError::Graph)?;
             check_user_names(&plan, &options)?;
+            // Shader bindings against ports, without a GPU: what node creation would reject.
+            let (sources, _) = crate::shader_dir::sources_for(&graph, None);
+            let problems = volgraph_core::check_plan_bindings(&plan, &builtin_registry(), &sources);
+            if !problems.is_empty() {
+                return Err(CliError::Graph(volgraph_core::Diagnostics {
+                    file: display_name(&graph),
+                    text: std::sync::Arc::from(source.as_str()),
+                    items: problems,
+                }));
+            }
             let text = if dot { plan.to_dot() } else { plan.to_text() };
             Ok(Checked::Plan { text, notes: warning_lines(&plan) })
         }

@@ -73,3 +73,42 @@ fn malformed_graph_is_reported_with_its_location() {
     assert!(err.contains(":1:47: pass \"a\" has unknown kind \"raycats\""), "{err}");
     assert!(err.contains("did you mean \"raycast\"?"), "{err}");
 }
+
+/// `volgraph plan` checks shader bindings without a GPU: a shader global renamed away from its
+/// port in a workspace's shader copy is an error naming the pass, the shader and the ports.
+#[test]
+fn plan_catches_a_shader_binding_that_matches_no_port() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let dir = std::env::temp_dir().join(format!("volgraph_plan_bindings_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    copy_dir(&root.join("shaders"), &dir.join("shaders"));
+    std::fs::copy(root.join("graphs/basic/compute_raycast.ron"), dir.join("compute_raycast.ron")).expect("copy");
+    let shader = dir.join("shaders/raycast_compute.wgsl");
+    let text = std::fs::read_to_string(&shader).expect("read");
+    let renamed = text
+        .replace("var dir: texture_2d<f32>;", "var dirs: texture_2d<f32>;")
+        .replace("textureLoad(dir, ", "textureLoad(dirs, ");
+    assert_ne!(renamed, text, "the shader has the global this test renames");
+    std::fs::write(&shader, renamed).expect("write");
+    let (code, err) = volgraph(&["plan", &dir.join("compute_raycast.ron").display().to_string()]);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("pass \"march\" (raycast_compute): raycast_compute.wgsl: global \"dirs\" is neither a port")
+            && err.contains("(ports: entry, dir, volume, tf, color)"),
+        "{err}"
+    );
+}
+
+fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
+    std::fs::create_dir_all(to).expect("mkdir");
+    for entry in std::fs::read_dir(from).expect("read_dir") {
+        let path = entry.expect("entry").path();
+        let target = to.join(path.file_name().expect("name"));
+        if path.is_dir() {
+            copy_dir(&path, &target);
+        } else {
+            std::fs::copy(&path, &target).expect("copy");
+        }
+    }
+}

@@ -19,7 +19,7 @@ pub mod shader_source;
 pub mod suggest;
 pub mod wgsl_pass;
 
-pub use compile::{CompileOptions, compile};
+pub use compile::{CompileOptions, check_plan_bindings, compile};
 pub use diagnostic::{Diagnostic, Diagnostics, Location};
 pub use format::{Precision, TargetFormat, TargetSize};
 pub use params::{ParamSpec, ParamValue, Params};

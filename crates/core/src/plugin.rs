@@ -177,6 +177,14 @@ pub trait PassPlugin: Send + Sync {
         Vec::new()
     }
 
+    /// As [`PassPlugin::shaders`], for a pass whose wired optional inputs choose its shader (a
+    /// leaping variant when the empty-block flags are wired): `wired` names the ports the graph
+    /// binds. What `volgraph plan` checks bindings with.
+    fn shaders_wired(&self, params: &Params, wired: &[&str]) -> Vec<ShaderUse> {
+        let _ = wired;
+        self.shaders(params)
+    }
+
     /// The `#if` names its shaders are assembled with for these parameters (the scene effects it
     /// specializes for), so tools that walk the shaders see exactly what the GPU compiles.
     fn shader_defines(&self, _params: &Params) -> Vec<&'static str> {
@@ -212,6 +220,10 @@ pub struct ShaderUse {
     pub file: &'static str,
     /// Entry point name.
     pub entry_point: &'static str,
+    /// Globals the node binds itself (its uniform buffers, tables it owns): with the ports and
+    /// the system bindings, every global the entry point uses must be one of these —
+    /// `volgraph plan` checks it without a GPU ([`crate::compile::check_plan_bindings`]).
+    pub extra: &'static [&'static str],
 }
 
 /// The per-graph instance of a pass kind: owns its pipelines, records each frame.

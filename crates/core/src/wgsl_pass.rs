@@ -145,7 +145,8 @@ impl PassPlugin for WgslPass {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: intern(&self.doc.shader), entry_point: intern(&self.doc.entry) }]
+        let extra: &'static [&'static str] = if self.doc.params.is_empty() { &[] } else { &["params"] };
+        vec![ShaderUse { file: intern(&self.doc.shader), entry_point: intern(&self.doc.entry), extra }]
     }
 
     fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {

@@ -112,7 +112,11 @@ impl PassPlugin for Antialias {
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "antialias.wgsl", entry_point: if is_iso(params) { "fs_aa_iso" } else { "fs_aa_dvr" } }]
+        vec![ShaderUse {
+            file: "antialias.wgsl",
+            entry_point: if is_iso(params) { "fs_aa_iso" } else { "fs_aa_dvr" },
+            extra: &["params", "aa"],
+        }]
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {

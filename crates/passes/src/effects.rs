@@ -31,6 +31,12 @@ pub fn effect_param_specs() -> Vec<ParamSpec> {
 /// The shading coefficients DVR shading reads (the isosurface's too).
 pub const SHADING_PARAMS: [&str; 4] = ["ambient", "diffuse", "specular", "shininess"];
 
+/// The shader uses the effects add to a raycaster's own: the pre-integration table's compute
+/// pipelines when `preintegration` is on (one of the two is built, by what the device filters).
+pub fn effect_shader_uses(params: &Params) -> Vec<volgraph_core::plugin::ShaderUse> {
+    if params.boolean("preintegration") { crate::preintegration::TABLE_SHADERS.to_vec() } else { Vec::new() }
+}
+
 /// The `#if` names of the effects `params` turn on (`jitter`, a raycast parameter, is JITTER).
 pub fn effect_defines(params: &Params) -> Vec<&'static str> {
     let mut defines: Vec<&'static str> =

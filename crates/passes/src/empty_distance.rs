@@ -50,7 +50,11 @@ impl PassPlugin for EmptyDistance {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "empty_distance.wgsl", entry_point: "cs_line" }]
+        vec![ShaderUse {
+            file: "empty_distance.wgsl",
+            entry_point: "cs_line",
+            extra: &["partial", "distance", "pass_params"],
+        }]
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {

@@ -90,7 +90,7 @@ impl PassPlugin for EmptySpace {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "empty_space.wgsl", entry_point: "cs_classify" }]
+        vec![ShaderUse { file: "empty_space.wgsl", entry_point: "cs_classify", extra: &[] }]
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {

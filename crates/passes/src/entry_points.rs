@@ -26,8 +26,8 @@ impl PassPlugin for EntryPoints {
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         vec![
-            ShaderUse { file: "entry_points.wgsl", entry_point: "fs_entry" },
-            ShaderUse { file: "entry_points.wgsl", entry_point: "fs_near_plane" },
+            ShaderUse { file: "entry_points.wgsl", entry_point: "fs_entry", extra: &[] },
+            ShaderUse { file: "entry_points.wgsl", entry_point: "fs_near_plane", extra: &[] },
         ]
     }
 

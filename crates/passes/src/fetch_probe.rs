@@ -52,7 +52,7 @@ impl PassPlugin for FetchProbe {
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
         let entry_point = if params.boolean("count_samples") { "cs_counted" } else { "cs_main" };
-        vec![ShaderUse { file: "fetch_probe.wgsl", entry_point }]
+        vec![ShaderUse { file: "fetch_probe.wgsl", entry_point, extra: &["params"] }]
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {

@@ -68,7 +68,7 @@ impl PassPlugin for HoleFill {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "hole_fill.wgsl", entry_point: "fs_hole" }]
+        vec![ShaderUse { file: "hole_fill.wgsl", entry_point: "fs_hole", extra: &["holes"] }]
     }
 
     fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {

@@ -128,7 +128,7 @@ impl PassPlugin for MinMaxGridPass {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "minmax_grid.wgsl", entry_point: "cs_minmax" }]
+        vec![ShaderUse { file: "minmax_grid.wgsl", entry_point: "cs_minmax", extra: &["minmax"] }]
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {

@@ -19,8 +19,8 @@ pub const TABLE_SIZE: u32 = 4096;
 
 /// The shader entry points that fill the table: Rgba32Float, Rgba16Float.
 pub const TABLE_SHADERS: [ShaderUse; 2] = [
-    ShaderUse { file: "opacity_lut.wgsl", entry_point: "cs_table32" },
-    ShaderUse { file: "opacity_lut.wgsl", entry_point: "cs_table16" },
+    ShaderUse { file: "opacity_lut.wgsl", entry_point: "cs_table32", extra: &["params", "table32"] },
+    ShaderUse { file: "opacity_lut.wgsl", entry_point: "cs_table16", extra: &["params", "table16"] },
 ];
 
 /// A corrected table and the pipeline that fills it.

@@ -15,8 +15,8 @@ pub const TABLE_SIZE: u32 = 256;
 
 /// The entry points that fill the table: Rgba32Float, Rgba16Float.
 pub const TABLE_SHADERS: [ShaderUse; 2] = [
-    ShaderUse { file: "preintegration.wgsl", entry_point: "cs_table32" },
-    ShaderUse { file: "preintegration.wgsl", entry_point: "cs_table16" },
+    ShaderUse { file: "preintegration.wgsl", entry_point: "cs_table32", extra: &["params", "table32"] },
+    ShaderUse { file: "preintegration.wgsl", entry_point: "cs_table16", extra: &["params", "table16"] },
 ];
 
 /// A raycaster's pre-integration table, its pipeline and what it was built for.

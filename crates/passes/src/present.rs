@@ -40,7 +40,7 @@ impl PassPlugin for Present {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "present.wgsl", entry_point: "cs_present" }]
+        vec![ShaderUse { file: "present.wgsl", entry_point: "cs_present", extra: &["params"] }]
     }
 
     fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {

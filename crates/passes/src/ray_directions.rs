@@ -28,7 +28,7 @@ impl PassPlugin for RayDirections {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "ray_directions.wgsl", entry_point: "fs_dir" }]
+        vec![ShaderUse { file: "ray_directions.wgsl", entry_point: "fs_dir", extra: &[] }]
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {

@@ -94,7 +94,12 @@ impl PassPlugin for Raycast {
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "raycast.wgsl", entry_point: fragment_entry(params) }]
+        let own = ShaderUse {
+            file: "raycast.wgsl",
+            entry_point: fragment_entry(params),
+            extra: &["params", "preintegrated"],
+        };
+        [vec![own], crate::effects::effect_shader_uses(params)].concat()
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {

@@ -129,7 +129,11 @@ impl PassPlugin for RaycastBricks {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "raycast_bricks.wgsl", entry_point: "cs_main" }]
+        vec![ShaderUse {
+            file: "raycast_bricks.wgsl",
+            entry_point: "cs_main",
+            extra: &["params", "bricks", "table", "leaf_distance", "acc", "volume"],
+        }]
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {

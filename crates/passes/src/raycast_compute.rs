@@ -45,7 +45,8 @@ impl PassPlugin for RaycastCompute {
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
         let entry = if is_iso(params) { "cs_iso" } else { "cs_dvr" };
-        vec![ShaderUse { file: "raycast_compute.wgsl", entry_point: entry }]
+        let own = ShaderUse { file: "raycast_compute.wgsl", entry_point: entry, extra: &["params", "preintegrated"] };
+        [vec![own], crate::effects::effect_shader_uses(params)].concat()
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {

@@ -71,8 +71,10 @@ impl PassPlugin for RaycastEss {
         ]
     }
 
-    fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "raycast_ess.wgsl", entry_point: "fs_dvr" }]
+    fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
+        let own =
+            ShaderUse { file: "raycast_ess.wgsl", entry_point: "fs_dvr", extra: &["params", "ess", "preintegrated"] };
+        [vec![own], crate::effects::effect_shader_uses(params)].concat()
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {

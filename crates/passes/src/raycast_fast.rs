@@ -135,10 +135,15 @@ impl PassPlugin for RaycastFast {
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
         let entry_point = if params.boolean("count_samples") { "cs_counted" } else { "cs_main" };
-        let mut uses = vec![ShaderUse { file: "raycast_fast.wgsl", entry_point }];
+        let mut uses = vec![ShaderUse {
+            file: "raycast_fast.wgsl",
+            entry_point,
+            extra: &["params", "fast", "corrected", "preintegrated"],
+        }];
         if params.choice("classify") == "table" {
             uses.extend(TABLE_SHADERS);
         }
+        uses.extend(crate::effects::effect_shader_uses(params));
         uses
     }
 

@@ -159,8 +159,16 @@ impl PassPlugin for RaycastSegment {
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        let (file, entry_point) = self.entry(params);
-        vec![ShaderUse { file, entry_point }]
+        self.shaders_wired(params, &[])
+    }
+
+    fn shaders_wired(&self, params: &Params, wired: &[&str]) -> Vec<ShaderUse> {
+        let (file, entry_point) = match self.entry(params) {
+            // §2.3 inside the segment: with the empty-block flags wired, the leaping variant.
+            ("raycast_segment.wgsl", "fs_dvr") if wired.contains(&"empty") => ("raycast_segment.wgsl", "fs_dvr_leap"),
+            other => other,
+        };
+        vec![ShaderUse { file, entry_point, extra: &["params", "segment", "invocations"] }]
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {

@@ -63,8 +63,8 @@ impl PassPlugin for ReprojectionSplat {
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         vec![
-            ShaderUse { file: "reprojection_splat.wgsl", entry_point: "vs_splat" },
-            ShaderUse { file: "reprojection_splat.wgsl", entry_point: "fs_splat" },
+            ShaderUse { file: "reprojection_splat.wgsl", entry_point: "vs_splat", extra: &["splat"] },
+            ShaderUse { file: "reprojection_splat.wgsl", entry_point: "fs_splat", extra: &["splat"] },
         ]
     }
 

@@ -49,7 +49,7 @@ impl PassPlugin for SegmentInit {
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "segment_init.wgsl", entry_point: fragment(params) }]
+        vec![ShaderUse { file: "segment_init.wgsl", entry_point: fragment(params), extra: &[] }]
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {

@@ -66,8 +66,12 @@ impl PassPlugin for TerminationTest {
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         vec![
-            ShaderUse { file: "termination_test.wgsl", entry_point: "fs_terminate" },
-            ShaderUse { file: "termination_test.wgsl", entry_point: "fs_terminate_empty" },
+            ShaderUse { file: "termination_test.wgsl", entry_point: "fs_terminate", extra: &["params", "segment"] },
+            ShaderUse {
+                file: "termination_test.wgsl",
+                entry_point: "fs_terminate_empty",
+                extra: &["params", "segment"],
+            },
         ]
     }
 

@@ -56,7 +56,7 @@ impl PassPlugin for Mip {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "mip.wgsl", entry_point: "cs_main" }]
+        vec![ShaderUse { file: "mip.wgsl", entry_point: "cs_main", extra: &["mip", "params"] }]
     }
 
     fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {

@@ -4,6 +4,7 @@
 //! [`schedule`] unrolls repeat groups, orders the passes, culls what no output needs and pools
 //! transient targets by descriptor across non-overlapping lifetimes.
 
+mod bindings;
 mod check;
 mod schedule;
 
@@ -82,6 +83,8 @@ impl CompileOptions {
         self
     }
 }
+
+pub use bindings::check_plan_bindings;
 
 /// Compiles graph text named `file` (used in messages) into a plan.
 pub fn compile(file: &str, source: &str, registry: &Registry, options: &CompileOptions) -> Result<Plan, Diagnostics> {

@@ -193,6 +193,8 @@ pub struct CreateContext<'a> {
     pub(crate) pipelines: &'a PipelineCache,
     /// Shader modules this node's pipelines came from (a shader edit rebuilds exactly these nodes).
     pub(crate) modules: RefCell<BTreeSet<String>>,
+    /// `(file, entry point)` of every pipeline built, vertex and fragment entries both.
+    built: RefCell<BTreeSet<(String, String)>>,
 }
 
 impl<'a> CreateContext<'a> {
@@ -205,7 +207,22 @@ impl<'a> CreateContext<'a> {
         params: &'a Params,
         ports: &'a [PortInfo],
     ) -> Self {
-        Self { gpu, shaders, pass_id, params, ports, pipelines, modules: RefCell::new(BTreeSet::new()) }
+        Self {
+            gpu,
+            shaders,
+            pass_id,
+            params,
+            ports,
+            pipelines,
+            modules: RefCell::new(BTreeSet::new()),
+            built: RefCell::new(BTreeSet::new()),
+        }
+    }
+
+    /// `(file, entry point)` of every pipeline this context built so far (tests compare it with
+    /// what the plugin declares in [`crate::plugin::PassPlugin::shaders`]).
+    pub fn built_entry_points(&self) -> BTreeSet<(String, String)> {
+        self.built.borrow().clone()
     }
 
     fn error(&self, message: String) -> PassError {
@@ -218,78 +235,7 @@ impl<'a> CreateContext<'a> {
     }
 
     fn check_bindings(&self, shader: &str, bindings: &[ReflectedBinding], extra: &[&str]) -> Result<(), PassError> {
-        for b in bindings {
-            if b.group != 0 {
-                return Err(self.error(format!(
-                    "{shader}: global \"{}\" is in @group({}); volgraph binds everything in @group(0)",
-                    b.name, b.group
-                )));
-            }
-            if SYSTEM_BINDINGS.contains(&b.name.as_str()) || extra.contains(&b.name.as_str()) {
-                continue;
-            }
-            let Some(p) = self.port(&b.name) else {
-                let ports: Vec<&str> = self.ports.iter().map(|p| p.name.as_str()).collect();
-                return Err(self.error(format!(
-                    "{shader}: global \"{}\" is neither a port of this pass (ports: {}) nor a system binding ({}) \
-                     nor one the pass binds itself ({}); rename it to the port it stands for",
-                    b.name,
-                    ports.join(", "),
-                    SYSTEM_BINDINGS.join(", "),
-                    if extra.is_empty() { "none".to_string() } else { extra.join(", ") }
-                )));
-            };
-            match &b.ty {
-                BindingKind::Storage { read_only } => {
-                    if !p.buffer {
-                        return Err(self.error(format!(
-                            "{shader}: global \"{}\" is a storage buffer but port \"{}\" is a texture",
-                            b.name, b.name
-                        )));
-                    }
-                    if !*read_only && p.access == Access::Read {
-                        return Err(self.error(format!(
-                            "{shader}: storage buffer \"{}\" is read_write but the port is an input; declare it \
-                             var<storage, read>",
-                            b.name
-                        )));
-                    }
-                }
-                _ if p.buffer => {
-                    return Err(self.error(format!(
-                        "{shader}: global \"{}\" is not a storage buffer but port \"{}\" is a buffer; declare it \
-                         var<storage, read> or var<storage, read_write>",
-                        b.name, b.name
-                    )));
-                }
-                BindingKind::StorageTexture { format, .. } => {
-                    if p.access == Access::Read {
-                        return Err(self.error(format!(
-                            "{shader}: storage texture \"{}\" is an input port; storage textures are outputs",
-                            b.name
-                        )));
-                    }
-                    if let Some(port_format) = p.format
-                        && *format != Some(port_format)
-                    {
-                        let declared = format.map_or("an unsupported format".to_string(), |f| format!("{f:?}"));
-                        return Err(self.error(format!(
-                            "{shader}: storage texture \"{}\" is declared {declared} but the port's target is \
-                             {port_format:?}; declare the output with the shader's format",
-                            b.name
-                        )));
-                    }
-                }
-                _ if p.access == Access::Write => {
-                    return Err(self.error(format!(
-                        "{shader}: global \"{}\" samples output port \"{}\"; outputs are written, not read",
-                        b.name, b.name
-                    )));
-                }
-                _ => {}
-            }
-        }
-        Ok(())
+        check_bindings(shader, bindings, extra, self.ports, true).map_err(|m| self.error(m))
     }
 
     fn layout_entries(
@@ -325,6 +271,10 @@ impl<'a> CreateContext<'a> {
     /// pass's output ports, named by the fragment output struct's members.
     pub fn render_pipeline(&self, spec: &RenderPipelineSpec<'_>) -> Result<PassPipeline, PassError> {
         let shader = self.shader(spec.shader, spec.defines)?;
+        let mut built = self.built.borrow_mut();
+        built.insert((spec.shader.to_string(), spec.vertex.to_string()));
+        built.insert((spec.shader.to_string(), spec.fragment.to_string()));
+        drop(built);
         let r = reflect(&shader.module, &shader.info, &[spec.vertex, spec.fragment])
             .map_err(|e| self.error(format!("{} {e}", spec.shader)))?;
         self.check_bindings(spec.shader, &r.bindings, spec.extra_bindings)?;
@@ -455,6 +405,7 @@ impl<'a> CreateContext<'a> {
     /// textures or buffers named after the ports.
     pub fn compute_pipeline(&self, spec: &ComputePipelineSpec<'_>) -> Result<PassPipeline, PassError> {
         let shader = self.shader(spec.shader, spec.defines)?;
+        self.built.borrow_mut().insert((spec.shader.to_string(), spec.entry.to_string()));
         let r = reflect(&shader.module, &shader.info, &[spec.entry])
             .map_err(|e| self.error(format!("{} {e}", spec.shader)))?;
         self.check_bindings(spec.shader, &r.bindings, spec.extra_bindings)?;
@@ -524,4 +475,91 @@ impl<'a> CreateContext<'a> {
         self.gpu.queue.write_buffer(&buffer, 0, bytemuck::bytes_of(value));
         buffer
     }
+}
+
+/// Checks the globals an entry point uses (`bindings`, reflected from `shader`) against a pass's
+/// ports, the system bindings and the names the node binds itself (`extra`): every global must
+/// be one of them, in `@group(0)`, a storage buffer exactly where the port is a buffer, a
+/// storage texture only for an output (of the port's format when `formats` is set), and no
+/// sampled output. Used when a node is created and by `volgraph plan` without a GPU.
+pub fn check_bindings(
+    shader: &str,
+    bindings: &[ReflectedBinding],
+    extra: &[&str],
+    ports: &[PortInfo],
+    formats: bool,
+) -> Result<(), String> {
+    for b in bindings {
+        if b.group != 0 {
+            return Err(format!(
+                "{shader}: global \"{}\" is in @group({}); volgraph binds everything in @group(0)",
+                b.name, b.group
+            ));
+        }
+        if SYSTEM_BINDINGS.contains(&b.name.as_str()) || extra.contains(&b.name.as_str()) {
+            continue;
+        }
+        let Some(p) = ports.iter().find(|p| p.name == b.name) else {
+            let ports: Vec<&str> = ports.iter().map(|p| p.name.as_str()).collect();
+            return Err(format!(
+                "{shader}: global \"{}\" is neither a port of this pass (ports: {}) nor a system binding ({}) \
+                 nor one the pass binds itself ({}); rename it to the port it stands for",
+                b.name,
+                ports.join(", "),
+                SYSTEM_BINDINGS.join(", "),
+                if extra.is_empty() { "none".to_string() } else { extra.join(", ") }
+            ));
+        };
+        match &b.ty {
+            BindingKind::Storage { read_only } => {
+                if !p.buffer {
+                    return Err(format!(
+                        "{shader}: global \"{}\" is a storage buffer but port \"{}\" is a texture",
+                        b.name, b.name
+                    ));
+                }
+                if !*read_only && p.access == Access::Read {
+                    return Err(format!(
+                        "{shader}: storage buffer \"{}\" is read_write but the port is an input; declare it \
+                         var<storage, read>",
+                        b.name
+                    ));
+                }
+            }
+            _ if p.buffer => {
+                return Err(format!(
+                    "{shader}: global \"{}\" is not a storage buffer but port \"{}\" is a buffer; declare it \
+                     var<storage, read> or var<storage, read_write>",
+                    b.name, b.name
+                ));
+            }
+            BindingKind::StorageTexture { format, .. } => {
+                if p.access == Access::Read {
+                    return Err(format!(
+                        "{shader}: storage texture \"{}\" is an input port; storage textures are outputs",
+                        b.name
+                    ));
+                }
+                if formats
+                    && let Some(port_format) = p.format
+                    && *format != Some(port_format)
+                {
+                    let declared = format.map_or("an unsupported format".to_string(), |f| format!("{f:?}"));
+                    return Err(format!(
+                        "{shader}: storage texture \"{}\" is declared {declared} but the port's target is \
+                         {port_format:?}; declare the output with the shader's format",
+                        b.name
+                    ));
+                }
+            }
+            _ if p.access == Access::Write => {
+                return Err(format!(
+                    "{shader}: global \"{}\" samples output port \"{}\"; outputs are written, not read",
+                    b.name, b.name
+                ));
+            }
+            _ => {}
+        }
+    }
+    Ok(())
 }

@@ -131,8 +131,9 @@ pub enum ApplyError {
     Gpu(#[from] GpuFault),
 }
 
-/// The ports of `step` as the runtime resolves them (formats from the plan's resources).
-fn port_infos(plan: &Plan, step: &crate::plan::Step, specs: &[crate::plugin::PortSpec]) -> Vec<PortInfo> {
+/// The ports of `step` as the runtime resolves them (formats from the plan's resources): what
+/// [`crate::plugin::PassPlugin::create`] sees, also for tools that create nodes outside a runtime.
+pub fn port_infos(plan: &Plan, step: &crate::plan::Step, specs: &[crate::plugin::PortSpec]) -> Vec<PortInfo> {
     step.ports
         .iter()
         .map(|bp| {

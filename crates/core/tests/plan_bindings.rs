@@ -1,0 +1,166 @@
+//! `volgraph plan` checks shader bindings without a GPU (`check_plan_bindings`): one test per
+//! class of binding error that used to surface only when the node was created at run time.
+//! The plugins and shaders here are test-local, registered through the public API.
+
+use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::{CreateContext, PassError, RecordContext};
+use volgraph_core::shader_source::ShaderSources;
+use volgraph_core::{
+    CompileOptions, Params, PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, check_plan_bindings,
+    compile,
+};
+
+/// A pass with a texture input `color`, a buffer input `counts`, an output `out`, and the shader
+/// entry point `entry` of `probe.wgsl`; binds `params` itself.
+struct Probe {
+    entry: &'static str,
+}
+
+struct Noop;
+
+impl PassNode for Noop {
+    fn record(&mut self, _ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
+        Ok(())
+    }
+}
+
+impl PassPlugin for Probe {
+    fn kind(&self) -> &'static str {
+        "probe"
+    }
+    fn summary(&self) -> &'static str {
+        "binding-check test pass"
+    }
+    fn ports(&self, _params: &Params) -> Vec<PortSpec> {
+        vec![
+            PortSpec::read("color", PortKind::target(&[TargetFormat::Rgba16Float])),
+            PortSpec::read("counts", PortKind::buffer(16)).optional(),
+            PortSpec::write("out", PortKind::target(&[TargetFormat::Rgba16Float])),
+        ]
+    }
+    fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
+        vec![ShaderUse { file: "probe.wgsl", entry_point: self.entry, extra: &["params"] }]
+    }
+    fn create(&self, _ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        Ok(Box::new(Noop))
+    }
+}
+
+struct Source;
+
+impl PassPlugin for Source {
+    fn kind(&self) -> &'static str {
+        "source"
+    }
+    fn summary(&self) -> &'static str {
+        "writes a target"
+    }
+    fn ports(&self, _params: &Params) -> Vec<PortSpec> {
+        vec![PortSpec::write("color", PortKind::target(&[TargetFormat::Rgba16Float]))]
+    }
+    fn create(&self, _ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        Ok(Box::new(Noop))
+    }
+}
+
+const SHADER: &str = r#"
+struct P { k: f32 }
+@group(0) @binding(0) var<uniform> params: P;
+@group(0) @binding(1) var color: texture_2d<f32>;
+@group(0) @binding(2) var out: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(3) var colour: texture_2d<f32>;
+@group(0) @binding(4) var<storage, read> color_buffer: array<u32>;
+@group(0) @binding(5) var counts: texture_2d<f32>;
+@group(0) @binding(6) var color_storage: texture_storage_2d<rgba16float, write>;
+@group(1) @binding(0) var<uniform> grouped: P;
+
+@compute @workgroup_size(8, 8)
+fn cs_ok(@builtin(global_invocation_id) id: vec3<u32>) {
+    textureStore(out, vec2<i32>(id.xy), textureLoad(color, vec2<i32>(id.xy), 0) * params.k);
+}
+// The port is `color`; the shader says `colour`.
+@compute @workgroup_size(8, 8)
+fn cs_misnamed(@builtin(global_invocation_id) id: vec3<u32>) {
+    textureStore(out, vec2<i32>(id.xy), textureLoad(colour, vec2<i32>(id.xy), 0));
+}
+// `counts` is a storage-buffer port read as a texture.
+@compute @workgroup_size(8, 8)
+fn cs_buffer_as_texture(@builtin(global_invocation_id) id: vec3<u32>) {
+    textureStore(out, vec2<i32>(id.xy), textureLoad(counts, vec2<i32>(id.xy), 0));
+}
+// Everything in @group(0).
+@compute @workgroup_size(8, 8)
+fn cs_group(@builtin(global_invocation_id) id: vec3<u32>) {
+    textureStore(out, vec2<i32>(id.xy), vec4<f32>(grouped.k));
+}
+"#;
+
+const OUT_AS_INPUT: &str = r#"
+@group(0) @binding(0) var color: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(1) var out: texture_2d<f32>;
+@compute @workgroup_size(8, 8)
+fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
+    textureStore(color, vec2<i32>(id.xy), textureLoad(out, vec2<i32>(id.xy), 0));
+}
+"#;
+
+const GRAPH: &str = r#"Graph(
+    name: "probe",
+    passes: [
+        Pass(id: "src", kind: "source"),
+        Pass(id: "p", kind: "probe", inputs: {"color": "src.color"}),
+    ],
+    outputs: {"image": "p.out"},
+)"#;
+
+fn problems(entry: &'static str, shader: &'static str) -> Vec<String> {
+    let mut registry = Registry::new();
+    registry.register(Source).register(Probe { entry });
+    let plan = compile("probe.ron", GRAPH, &registry, &CompileOptions::new(32, 32)).expect("compiles");
+    // Embedded shader tables are 'static; a test leaks its few bytes.
+    let table: &'static [(&'static str, &'static str)] = Box::leak(Box::new([("probe.wgsl", shader)]));
+    let sources = ShaderSources::new().with_embedded(table);
+    check_plan_bindings(&plan, &registry, &sources).into_iter().map(|d| d.message).collect()
+}
+
+#[test]
+fn a_correct_pass_has_no_problem() {
+    assert_eq!(problems("cs_ok", SHADER), Vec::<String>::new());
+}
+
+#[test]
+fn a_misnamed_port_is_caught_at_plan_time() {
+    let p = problems("cs_misnamed", SHADER);
+    assert!(
+        p.len() == 1 && p[0].contains("global \"colour\" is neither a port of this pass (ports: color, counts, out)"),
+        "{p:?}"
+    );
+    assert!(p[0].starts_with("pass \"p\" (probe): probe.wgsl"), "{p:?}");
+}
+
+#[test]
+fn a_buffer_port_read_as_a_texture_is_caught_at_plan_time() {
+    let p = problems("cs_buffer_as_texture", SHADER);
+    assert!(
+        p.len() == 1 && p[0].contains("\"counts\" is not a storage buffer but port \"counts\" is a buffer"),
+        "{p:?}"
+    );
+}
+
+#[test]
+fn a_group_other_than_zero_is_caught_at_plan_time() {
+    let p = problems("cs_group", SHADER);
+    assert!(p.len() == 1 && p[0].contains("global \"grouped\" is in @group(1)"), "{p:?}");
+}
+
+#[test]
+fn an_entry_point_the_shader_lacks_is_caught_at_plan_time() {
+    let p = problems("cs_missing", SHADER);
+    assert!(p.len() == 1 && p[0].contains("has no entry point \"cs_missing\""), "{p:?}");
+}
+
+#[test]
+fn a_storage_texture_on_an_input_and_a_sampled_output_are_caught_at_plan_time() {
+    let p = problems("cs_main", OUT_AS_INPUT);
+    assert!(p.len() == 1 && p[0].contains("storage texture \"color\" is an input port"), "{p:?}");
+}

@@ -11,7 +11,7 @@ use crate::diagnostic::{Diagnostic, Location};
 use crate::graph::ast::{WgslInput, WgslKindDoc};
 use crate::params::{ParamSpec, Params};
 use crate::plugin::{PassNode, PassPlugin, PortKind, PortSpec, Registry, ShaderUse};
-use crate::runtime::{ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, RecordContext};
+use crate::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
 
 /// A string that lives as long as the program. Plugin declarations are `&'static str`; names a
 /// graph declares are interned once each, so reloading a graph does not grow memory.
@@ -187,7 +187,7 @@ fn param_block(doc: &WgslKindDoc, params: &Params) -> Vec<u8> {
 }
 
 struct WgslPassNode {
-    pipeline: PassPipeline,
+    pipeline: ComputePassPipeline,
     uniform: Option<wgpu::Buffer>,
     doc: WgslKindDoc,
     first_output: &'static str,

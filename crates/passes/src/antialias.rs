@@ -9,7 +9,7 @@
 //! be the raycaster's: share them through Scalar inputs. Shader: `shaders/antialias.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{CreateContext, Gpu, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
+use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::effects::jitter_defines;
@@ -140,7 +140,7 @@ impl PassPlugin for Antialias {
 }
 
 struct AntialiasNode {
-    pipeline: PassPipeline,
+    pipeline: RenderPassPipeline,
     params: wgpu::Buffer,
     aa: wgpu::Buffer,
 }

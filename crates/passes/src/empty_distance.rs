@@ -6,9 +6,7 @@
 //! lies in an empty block. Shader: `shaders/empty_distance.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{
-    ComputePipelineSpec, CreateContext, PassError, PassPipeline, PipelineKind, RecordContext,
-};
+use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
 use volgraph_core::{Params, PassNode, PassPlugin, PortKind, PortSpec, Rerun};
 
 use crate::empty_space::EMPTY_BLOCKS;
@@ -71,7 +69,7 @@ impl PassPlugin for EmptyDistance {
 }
 
 struct EmptyDistanceNode {
-    pipeline: PassPipeline,
+    pipeline: ComputePassPipeline,
     axes: [wgpu::Buffer; 3],
     /// The published map and the scratch texture of the middle pass, with their size.
     textures: Option<(wgpu::TextureView, wgpu::TextureView, [u32; 3])>,
@@ -106,17 +104,15 @@ impl PassNode for EmptyDistanceNode {
             )?);
         }
         let mut pass = ctx.begin_compute_pass();
-        if let PipelineKind::Compute(p) = &self.pipeline.pipeline {
-            pass.set_pipeline(p);
-            for (axis, bg) in groups.iter().enumerate() {
-                let across = match axis {
-                    0 => (dims[1], dims[2]),
-                    1 => (dims[0], dims[2]),
-                    _ => (dims[0], dims[1]),
-                };
-                pass.set_bind_group(0, bg, &[]);
-                pass.dispatch_workgroups(across.0.div_ceil(8), across.1.div_ceil(8), 1);
-            }
+        pass.set_pipeline(&self.pipeline.pipeline);
+        for (axis, bg) in groups.iter().enumerate() {
+            let across = match axis {
+                0 => (dims[1], dims[2]),
+                1 => (dims[0], dims[2]),
+                _ => (dims[0], dims[1]),
+            };
+            pass.set_bind_group(0, bg, &[]);
+            pass.dispatch_workgroups(across.0.div_ceil(8), across.1.div_ceil(8), 1);
         }
         Ok(())
     }

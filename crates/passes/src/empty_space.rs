@@ -9,7 +9,7 @@
 //! `shaders/empty_space.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{ComputePipelineSpec, CreateContext, PassError, PassPipeline, RecordContext};
+use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, Rerun};
 
 use crate::grid_tap::GridTap;
@@ -106,7 +106,7 @@ impl PassPlugin for EmptySpace {
 }
 
 struct EmptySpaceNode {
-    pipeline: PassPipeline,
+    pipeline: ComputePassPipeline,
     flags: Option<(wgpu::Texture, wgpu::TextureView, [u32; 3])>,
     tap: Option<GridTap>,
 }

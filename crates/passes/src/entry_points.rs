@@ -5,7 +5,7 @@
 //! of the two writes, so both are always drawn). Shader: `shaders/entry_points.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{CreateContext, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
+use volgraph_core::runtime::{CreateContext, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
 use volgraph_core::{Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
@@ -50,8 +50,8 @@ impl PassPlugin for EntryPoints {
 }
 
 struct EntryPointsNode {
-    faces: PassPipeline,
-    near_plane: PassPipeline,
+    faces: RenderPassPipeline,
+    near_plane: RenderPassPipeline,
 }
 
 impl PassNode for EntryPointsNode {

@@ -8,9 +8,7 @@
 //! `samples`. Shader: `shaders/fetch_probe.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{
-    ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, PipelineKind, RecordContext,
-};
+use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::raycast_fast::SAMPLE_ROWS;
@@ -83,7 +81,7 @@ impl PassPlugin for FetchProbe {
 }
 
 struct FetchProbeNode {
-    pipeline: PassPipeline,
+    pipeline: ComputePassPipeline,
     params: wgpu::Buffer,
     workgroup: (u32, u32),
     counted: bool,
@@ -97,9 +95,7 @@ impl PassNode for FetchProbeNode {
         let bg = ctx.bind_group(&self.pipeline, &[("params", self.params.as_entire_binding())])?;
         let (w, h) = ctx.extent("color");
         let mut pass = ctx.begin_compute_pass();
-        if let PipelineKind::Compute(p) = &self.pipeline.pipeline {
-            pass.set_pipeline(p);
-        }
+        pass.set_pipeline(&self.pipeline.pipeline);
         pass.set_bind_group(0, &bg, &[]);
         pass.dispatch_workgroups(w.div_ceil(self.workgroup.0), h.div_ceil(self.workgroup.1), 1);
         Ok(())

@@ -9,7 +9,7 @@
 //! it). Reads the splats' `splats` start target, writes `start`. Shader: `shaders/hole_fill.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{CreateContext, Gpu, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
+use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
@@ -89,7 +89,7 @@ impl PassPlugin for HoleFill {
 }
 
 struct HoleFillNode {
-    pipeline: PassPipeline,
+    pipeline: RenderPassPipeline,
     uniform: wgpu::Buffer,
 }
 

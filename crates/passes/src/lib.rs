@@ -74,13 +74,11 @@ pub fn builtin_registry() -> Registry {
 /// render pass pulls its vertices from `vertex_index`).
 pub(crate) fn draw(
     pass: &mut wgpu::RenderPass<'_>,
-    pipeline: &volgraph_core::runtime::PassPipeline,
+    pipeline: &volgraph_core::runtime::RenderPassPipeline,
     bind_group: &wgpu::BindGroup,
     vertices: std::ops::Range<u32>,
 ) {
-    if let volgraph_core::runtime::PipelineKind::Render(p) = &pipeline.pipeline {
-        pass.set_pipeline(p);
-        pass.set_bind_group(0, bind_group, &[]);
-        pass.draw(vertices, 0..1);
-    }
+    pass.set_pipeline(&pipeline.pipeline);
+    pass.set_bind_group(0, bind_group, &[]);
+    pass.draw(vertices, 0..1);
 }

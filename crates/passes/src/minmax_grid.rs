@@ -7,9 +7,7 @@
 //! content changes (`Rerun::WhenInputsChange`). Shader: `shaders/minmax_grid.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{
-    ComputePipelineSpec, CreateContext, PassError, PassPipeline, PipelineKind, RecordContext,
-};
+use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, Rerun};
 
 use crate::grid_tap::GridTap;
@@ -79,20 +77,18 @@ pub(crate) fn bound_size(ctx: &RecordContext<'_>, port: &str) -> Result<[u32; 3]
 /// records an empty pass, which keeps the step's label and timestamps.
 pub(crate) fn dispatch_grid(
     ctx: &mut RecordContext<'_>,
-    pipeline: &PassPipeline,
+    pipeline: &ComputePassPipeline,
     bind_group: &wgpu::BindGroup,
     dims: [u32; 3],
 ) {
     let mut pass = ctx.begin_compute_pass();
-    if let PipelineKind::Compute(p) = &pipeline.pipeline {
-        pass.set_pipeline(p);
-        pass.set_bind_group(0, bind_group, &[]);
-        pass.dispatch_workgroups(
-            dims[0].div_ceil(GRID_WORKGROUP),
-            dims[1].div_ceil(GRID_WORKGROUP),
-            dims[2].div_ceil(GRID_WORKGROUP),
-        );
-    }
+    pass.set_pipeline(&pipeline.pipeline);
+    pass.set_bind_group(0, bind_group, &[]);
+    pass.dispatch_workgroups(
+        dims[0].div_ceil(GRID_WORKGROUP),
+        dims[1].div_ceil(GRID_WORKGROUP),
+        dims[2].div_ceil(GRID_WORKGROUP),
+    );
 }
 
 impl PassPlugin for MinMaxGridPass {
@@ -148,7 +144,7 @@ impl PassPlugin for MinMaxGridPass {
 }
 
 struct MinMaxGridNode {
-    pipeline: PassPipeline,
+    pipeline: ComputePassPipeline,
     params: wgpu::Buffer,
     block_size: u32,
     /// The grid, the volume size it was built for, and whether it has been built.

@@ -9,9 +9,7 @@
 //! device). Shader: `shaders/opacity_lut.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{
-    ComputePipelineSpec, CreateContext, PassError, PassPipeline, PipelineKind, RecordContext,
-};
+use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
 
 /// Texels of the table: 16× the 256-entry LUT, so the table's own linear interpolation adds
 /// < 0.1/255 to the image for the peer TFs (crates/passes/tests/fastest.rs).
@@ -25,7 +23,7 @@ pub const TABLE_SHADERS: [ShaderUse; 2] = [
 
 /// A corrected table and the pipeline that fills it.
 pub struct OpacityTable {
-    pipeline: PassPipeline,
+    pipeline: ComputePassPipeline,
     storage: wgpu::TextureView,
     /// The storage binding the pipeline writes (`table32` or `table16`).
     binding: &'static str,
@@ -71,11 +69,9 @@ impl OpacityTable {
             ],
         )?;
         let mut pass = ctx.begin_compute_pass();
-        if let PipelineKind::Compute(p) = &self.pipeline.pipeline {
-            pass.set_pipeline(p);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.dispatch_workgroups(TABLE_SIZE.div_ceil(64), 1, 1);
-        }
+        pass.set_pipeline(&self.pipeline.pipeline);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.dispatch_workgroups(TABLE_SIZE.div_ceil(64), 1, 1);
         Ok(())
     }
 }

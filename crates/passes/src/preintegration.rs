@@ -6,9 +6,7 @@
 //! the step changes, so table and march always agree. Shader: `shaders/preintegration.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{
-    ComputePipelineSpec, CreateContext, PassError, PassPipeline, PipelineKind, RecordContext,
-};
+use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
 
 /// Texels per side: one per scalar value of an 8-bit volume.
 pub const TABLE_SIZE: u32 = 256;
@@ -21,7 +19,7 @@ pub const TABLE_SHADERS: [ShaderUse; 2] = [
 
 /// A raycaster's pre-integration table, its pipeline and what it was built for.
 pub struct PreintegrationTable {
-    pipeline: PassPipeline,
+    pipeline: ComputePassPipeline,
     storage: wgpu::TextureView,
     binding: &'static str,
     /// The table, bound as `preintegrated`.
@@ -80,11 +78,9 @@ impl PreintegrationTable {
             ],
         )?;
         let mut pass = ctx.begin_compute_pass();
-        if let PipelineKind::Compute(p) = &self.pipeline.pipeline {
-            pass.set_pipeline(p);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.dispatch_workgroups(TABLE_SIZE.div_ceil(8), TABLE_SIZE.div_ceil(8), 1);
-        }
+        pass.set_pipeline(&self.pipeline.pipeline);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.dispatch_workgroups(TABLE_SIZE.div_ceil(8), TABLE_SIZE.div_ceil(8), 1);
         self.built_for = Some(key);
         self.builds += 1;
         Ok(())

@@ -5,7 +5,7 @@
 //! data-centre GPUs too). Shader: `shaders/present.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, RecordContext};
+use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
@@ -61,7 +61,7 @@ impl PassPlugin for Present {
 }
 
 struct PresentNode {
-    pipeline: PassPipeline,
+    pipeline: ComputePassPipeline,
     params: wgpu::Buffer,
 }
 

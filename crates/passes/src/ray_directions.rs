@@ -3,7 +3,7 @@
 //! direction and, in alpha, the ray length. Shader: `shaders/ray_directions.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{CreateContext, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
+use volgraph_core::runtime::{CreateContext, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
 use volgraph_core::{Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
@@ -44,7 +44,7 @@ impl PassPlugin for RayDirections {
 }
 
 struct RayDirectionsNode {
-    pipeline: PassPipeline,
+    pipeline: RenderPassPipeline,
 }
 
 impl PassNode for RayDirectionsNode {

@@ -15,7 +15,7 @@
 //! `shaders/raycast.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{CreateContext, Gpu, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
+use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::effects::{EffectState, effect_defines, effect_param_specs, same_effects, with_effect_bindings};
@@ -197,7 +197,7 @@ fn conservative_step_back(volume: &volgraph_core::runtime::VolumeDesc, step_voxe
 }
 
 struct RaycastNode {
-    pipeline: PassPipeline,
+    pipeline: RenderPassPipeline,
     params: wgpu::Buffer,
     effects: EffectState,
     /// What `params` holds (the conservative step back is filled in per volume).

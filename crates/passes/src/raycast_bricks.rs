@@ -37,7 +37,7 @@ use volgraph_accel::volume::Volume;
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::upload::VolumeFormat;
 use volgraph_core::runtime::{
-    ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, PipelineKind, RecordContext, volume_region_bytes,
+    ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, volume_region_bytes,
     volume_texture_format,
 };
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
@@ -260,7 +260,7 @@ struct VolumeState {
 }
 
 struct RaycastBricksNode {
-    pipeline: PassPipeline,
+    pipeline: ComputePassPipeline,
     params: wgpu::Buffer,
     uniform: wgpu::Buffer,
     workgroup: (u32, u32),
@@ -666,9 +666,7 @@ impl PassNode for RaycastBricksNode {
             ];
             let bg = ctx.bind_group(&self.pipeline, &extra)?;
             let mut pass = ctx.begin_compute_pass();
-            if let PipelineKind::Compute(p) = &self.pipeline.pipeline {
-                pass.set_pipeline(p);
-            }
+            pass.set_pipeline(&self.pipeline.pipeline);
             pass.set_bind_group(0, &bg, &[]);
             pass.dispatch_workgroups(w.div_ceil(self.workgroup.0), h.div_ceil(self.workgroup.1), 1);
         }

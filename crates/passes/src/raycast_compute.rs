@@ -4,9 +4,7 @@
 //! Shader: `shaders/raycast_compute.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{
-    ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, PipelineKind, RecordContext,
-};
+use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortSpec, TargetFormat};
 
 use crate::effects::{EffectState, effect_defines, effect_param_specs, same_effects, with_effect_bindings};
@@ -101,7 +99,7 @@ pub(crate) fn color_is_f32(ctx: &CreateContext<'_>) -> bool {
 }
 
 struct RaycastComputeNode {
-    pipeline: PassPipeline,
+    pipeline: ComputePassPipeline,
     params: wgpu::Buffer,
     workgroup: (u32, u32),
     effects: EffectState,
@@ -116,9 +114,7 @@ impl PassNode for RaycastComputeNode {
         let bg = ctx.bind_group(&self.pipeline, &extra)?;
         let (w, h) = ctx.extent("color");
         let mut pass = ctx.begin_compute_pass();
-        if let PipelineKind::Compute(p) = &self.pipeline.pipeline {
-            pass.set_pipeline(p);
-        }
+        pass.set_pipeline(&self.pipeline.pipeline);
         pass.set_bind_group(0, &bg, &[]);
         pass.dispatch_workgroups(w.div_ceil(self.workgroup.0), h.div_ceil(self.workgroup.1), 1);
         Ok(())

@@ -7,7 +7,7 @@
 //! at `threshold` as in `raycast`. Shader: `shaders/raycast_ess.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{CreateContext, Gpu, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
+use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::effects::{
@@ -104,7 +104,7 @@ impl PassPlugin for RaycastEss {
 }
 
 struct RaycastEssNode {
-    pipeline: PassPipeline,
+    pipeline: RenderPassPipeline,
     params: wgpu::Buffer,
     ess: wgpu::Buffer,
     block_size: u32,

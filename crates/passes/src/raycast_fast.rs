@@ -23,9 +23,7 @@
 //! Shader: `shaders/raycast_fast.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{
-    ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, PipelineKind, RecordContext,
-};
+use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::effects::{
@@ -247,9 +245,9 @@ impl PassPlugin for RaycastFast {
 }
 
 struct RaycastFastNode {
-    pipeline: PassPipeline,
+    pipeline: ComputePassPipeline,
     /// The HALF_STEP variant, when the step is 0.5 voxel.
-    half_step: Option<PassPipeline>,
+    half_step: Option<ComputePassPipeline>,
     params: wgpu::Buffer,
     fast: wgpu::Buffer,
     block_size: u32,
@@ -311,9 +309,7 @@ impl PassNode for RaycastFastNode {
         let bg = ctx.bind_group(pipeline, &extra)?;
         let (w, h) = ctx.extent("color");
         let mut pass = ctx.begin_compute_pass();
-        if let PipelineKind::Compute(p) = &pipeline.pipeline {
-            pass.set_pipeline(p);
-        }
+        pass.set_pipeline(&pipeline.pipeline);
         pass.set_bind_group(0, &bg, &[]);
         pass.dispatch_workgroups(w.div_ceil(self.workgroup.0), h.div_ceil(self.workgroup.1), 1);
         Ok(())

@@ -20,7 +20,7 @@ use std::sync::{Arc, Mutex};
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{
-    CreateContext, DepthSpec, Gpu, PassError, PassPipeline, RecordContext, RenderPipelineSpec,
+    CreateContext, DepthSpec, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
 };
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
@@ -257,9 +257,9 @@ impl RaycastSegment {
 
 struct RaycastSegmentNode {
     /// Without the depth test (RC: no termination pass wired).
-    free: PassPipeline,
+    free: RenderPassPipeline,
     /// With the early-z test against `depth`.
-    early_z: PassPipeline,
+    early_z: RenderPassPipeline,
     params: wgpu::Buffer,
     segment: wgpu::Buffer,
     invocations: Option<wgpu::Buffer>,
@@ -279,11 +279,9 @@ impl PassNode for RaycastSegmentNode {
         }
         let bg = ctx.bind_group(pipeline, &extra)?;
         let mut pass = ctx.begin_render_pass(pipeline, None)?;
-        if let volgraph_core::runtime::PipelineKind::Render(p) = &pipeline.pipeline {
-            pass.set_pipeline(p);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.draw(0..3, index..index + 1);
-        }
+        pass.set_pipeline(&pipeline.pipeline);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.draw(0..3, index..index + 1);
         Ok(())
     }
 }

@@ -12,7 +12,7 @@
 use glam::{DVec3, DVec4};
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{
-    CameraData, CreateContext, DepthSpec, Gpu, PassError, PassPipeline, PipelineKind, RecordContext, RenderPipelineSpec,
+    CameraData, CreateContext, DepthSpec, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
 };
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
@@ -89,7 +89,7 @@ impl PassPlugin for ReprojectionSplat {
 }
 
 struct SplatNode {
-    pipeline: PassPipeline,
+    pipeline: RenderPassPipeline,
     uniform: wgpu::Buffer,
     size: f32,
     block: u32,
@@ -140,10 +140,8 @@ impl PassNode for SplatNode {
         let bg = ctx.bind_group(&self.pipeline, &[("splat", self.uniform.as_entire_binding())])?;
         let mut pass = ctx.begin_render_pass(&self.pipeline, Some(1.0))?;
         let instances = rect[2].div_ceil(self.block) * rect[3].div_ceil(self.block);
-        if let PipelineKind::Render(p) = &self.pipeline.pipeline
-            && instances > 0
-        {
-            pass.set_pipeline(p);
+        if instances > 0 {
+            pass.set_pipeline(&self.pipeline.pipeline);
             pass.set_bind_group(0, &bg, &[]);
             pass.draw(0..4, 0..instances);
         }

@@ -5,7 +5,9 @@
 //! Shader: `shaders/segment_init.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{CreateContext, DepthSpec, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
+use volgraph_core::runtime::{
+    CreateContext, DepthSpec, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
+};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
@@ -65,7 +67,7 @@ impl PassPlugin for SegmentInit {
 }
 
 struct SegmentInitNode {
-    pipeline: PassPipeline,
+    pipeline: RenderPassPipeline,
 }
 
 impl PassNode for SegmentInitNode {

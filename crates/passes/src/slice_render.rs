@@ -7,7 +7,7 @@
 //! planes past the box draw nothing. Shader: `shaders/slice_render.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{CreateContext, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
+use volgraph_core::runtime::{CreateContext, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::raycast_segment::front_to_back_blend;
@@ -82,7 +82,7 @@ impl PassPlugin for SliceRender {
 }
 
 struct SliceRenderNode {
-    pipeline: PassPipeline,
+    pipeline: RenderPassPipeline,
     slices: wgpu::Buffer,
     max_slices: u32,
 }
@@ -91,11 +91,9 @@ impl PassNode for SliceRenderNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let bg = ctx.bind_group(&self.pipeline, &[("slices", self.slices.as_entire_binding())])?;
         let mut pass = ctx.begin_render_pass(&self.pipeline, None)?;
-        if let volgraph_core::runtime::PipelineKind::Render(p) = &self.pipeline.pipeline {
-            pass.set_pipeline(p);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.draw(0..12, 0..self.max_slices);
-        }
+        pass.set_pipeline(&self.pipeline.pipeline);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.draw(0..12, 0..self.max_slices);
         Ok(())
     }
 }

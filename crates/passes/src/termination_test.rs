@@ -15,7 +15,9 @@
 //! pass's. Shader: `shaders/termination_test.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{CreateContext, DepthSpec, PassError, PassPipeline, RecordContext, RenderPipelineSpec};
+use volgraph_core::runtime::{
+    CreateContext, DepthSpec, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
+};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::empty_space::{EMPTY_BLOCKS, block_size_spec};
@@ -106,8 +108,8 @@ impl PassPlugin for TerminationTest {
 }
 
 struct TerminationTestNode {
-    alpha_only: PassPipeline,
-    with_empty: PassPipeline,
+    alpha_only: RenderPassPipeline,
+    with_empty: RenderPassPipeline,
     params: wgpu::Buffer,
     segment: wgpu::Buffer,
 }
@@ -122,11 +124,9 @@ impl PassNode for TerminationTestNode {
             &[("params", self.params.as_entire_binding()), ("segment", self.segment.as_entire_binding())],
         )?;
         let mut pass = ctx.begin_render_pass(pipeline, None)?;
-        if let volgraph_core::runtime::PipelineKind::Render(p) = &pipeline.pipeline {
-            pass.set_pipeline(p);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.draw(0..3, next..next + 1);
-        }
+        pass.set_pipeline(&pipeline.pipeline);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.draw(0..3, next..next + 1);
         Ok(())
     }
 }

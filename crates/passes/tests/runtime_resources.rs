@@ -8,8 +8,8 @@ use std::sync::Arc;
 use volgraph_accel::camera::OrbitCamera;
 use volgraph_core::plugin::SizeRule;
 use volgraph_core::runtime::{
-    CameraData, ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, PipelineKind, RecordContext,
-    RenderPipelineSpec, Runtime, ShaderLibrary,
+    CameraData, ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext,
+    RenderPassPipeline, RenderPipelineSpec, Runtime, ShaderLibrary,
 };
 use volgraph_core::{
     CompileOptions, Params, PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile,
@@ -22,7 +22,7 @@ struct Splat;
 struct CountLit;
 
 struct Draw {
-    pipeline: PassPipeline,
+    pipeline: RenderPassPipeline,
     vertices: u32,
     /// Instances per frame: `None` draws one; `Some(port)` one per texel of that port's texture.
     instances_from: Option<&'static str>,
@@ -39,17 +39,15 @@ impl PassNode for Draw {
         };
         let bg = ctx.bind_group(&self.pipeline, &[])?;
         let mut pass = ctx.begin_render_pass(&self.pipeline, None)?;
-        if let PipelineKind::Render(p) = &self.pipeline.pipeline {
-            pass.set_pipeline(p);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.draw(0..self.vertices, 0..instances);
-        }
+        pass.set_pipeline(&self.pipeline.pipeline);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.draw(0..self.vertices, 0..instances);
         Ok(())
     }
 }
 
 struct Count {
-    pipeline: PassPipeline,
+    pipeline: ComputePassPipeline,
 }
 
 impl PassNode for Count {
@@ -58,11 +56,9 @@ impl PassNode for Count {
         let (w, h) = ctx.extent("image");
         let bg = ctx.bind_group(&self.pipeline, &[])?;
         let mut pass = ctx.begin_compute_pass();
-        if let PipelineKind::Compute(p) = &self.pipeline.pipeline {
-            pass.set_pipeline(p);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
-        }
+        pass.set_pipeline(&self.pipeline.pipeline);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
         Ok(())
     }
 }

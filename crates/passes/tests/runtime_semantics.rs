@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 use volgraph_accel::camera::OrbitCamera;
 use volgraph_core::runtime::{
-    CameraData, CreateContext, Gpu, PassError, PassPipeline, PipelineKind, RecordContext, RenderPipelineSpec, Runtime,
+    CameraData, CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec, Runtime,
     ShaderLibrary,
 };
 use volgraph_core::{
@@ -33,7 +33,7 @@ struct AddParams {
 }
 
 struct Node {
-    pipeline: PassPipeline,
+    pipeline: RenderPassPipeline,
     params: Option<wgpu::Buffer>,
 }
 
@@ -43,11 +43,9 @@ impl PassNode for Node {
             self.params.iter().map(|b| ("params", b.as_entire_binding())).collect();
         let bg = ctx.bind_group(&self.pipeline, &extra)?;
         let mut pass = ctx.begin_render_pass(&self.pipeline, None)?;
-        if let PipelineKind::Render(p) = &self.pipeline.pipeline {
-            pass.set_pipeline(p);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.draw(0..3, 0..1);
-        }
+        pass.set_pipeline(&self.pipeline.pipeline);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.draw(0..3, 0..1);
         Ok(())
     }
 

@@ -4,7 +4,7 @@
 //! windowed by `level` and `width` like a radiology viewer, alpha 1 where the ray hits the box.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{ComputePipelineSpec, CreateContext, Gpu, PassError, PassPipeline, RecordContext};
+use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 use volgraph_passes::raycast_params::RaycastParamsGpu;
 
@@ -79,7 +79,7 @@ impl PassPlugin for Mip {
 }
 
 struct MipNode {
-    pipeline: PassPipeline,
+    pipeline: ComputePassPipeline,
     uniform: wgpu::Buffer,
     rays: wgpu::Buffer,
 }

@@ -176,7 +176,7 @@ fn a_resize_rebuilds_no_pipeline() {
 struct BadDraw;
 
 struct BadDrawNode {
-    pipeline: volgraph_core::runtime::PassPipeline,
+    pipeline: volgraph_core::runtime::ComputePassPipeline,
 }
 
 impl volgraph_core::PassNode for BadDrawNode {

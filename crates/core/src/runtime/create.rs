@@ -100,13 +100,16 @@ pub struct ComputePipelineSpec<'a> {
     pub defines: &'a [&'a str],
 }
 
-/// The compiled pipeline of a pass with its reflected bindings; cheap to clone.
+/// The compiled pipeline of a pass with its reflected bindings; cheap to clone. Typed by what
+/// it is: [`RenderPassPipeline`] from [`CreateContext::render_pipeline`], [`ComputePassPipeline`]
+/// from [`CreateContext::compute_pipeline`], so a render pipeline cannot be dispatched (or a
+/// compute one drawn) by mistake; `PassPipeline` alone is the cache's either-kind form.
 #[derive(Clone, Debug)]
-pub struct PassPipeline {
+pub struct PassPipeline<K = PipelineKind> {
     /// Debug label (`pass/entry`).
     pub label: String,
-    /// Render or compute.
-    pub pipeline: PipelineKind,
+    /// The wgpu pipeline.
+    pub pipeline: K,
     /// Layout of bind group 0.
     pub layout: wgpu::BindGroupLayout,
     /// Bindings by name.
@@ -117,7 +120,21 @@ pub struct PassPipeline {
     pub depth_port: Option<String>,
 }
 
-/// A render or compute pipeline.
+/// A render pipeline of a pass.
+pub type RenderPassPipeline = PassPipeline<wgpu::RenderPipeline>;
+
+/// A compute pipeline of a pass.
+pub type ComputePassPipeline = PassPipeline<wgpu::ComputePipeline>;
+
+impl PassPipeline {
+    /// The typed form, if this is a `T` pipeline.
+    fn typed<T>(self, pick: impl FnOnce(PipelineKind) -> Option<T>) -> Option<PassPipeline<T>> {
+        let PassPipeline { label, pipeline, layout, bindings, color_ports, depth_port } = self;
+        pick(pipeline).map(|pipeline| PassPipeline { label, pipeline, layout, bindings, color_ports, depth_port })
+    }
+}
+
+/// A render or compute pipeline (the pipeline cache holds both).
 #[derive(Clone, Debug)]
 pub enum PipelineKind {
     /// Render.
@@ -269,7 +286,7 @@ impl<'a> CreateContext<'a> {
 
     /// Builds (or takes from the cache) a render pipeline drawing a fragment shader into this
     /// pass's output ports, named by the fragment output struct's members.
-    pub fn render_pipeline(&self, spec: &RenderPipelineSpec<'_>) -> Result<PassPipeline, PassError> {
+    pub fn render_pipeline(&self, spec: &RenderPipelineSpec<'_>) -> Result<RenderPassPipeline, PassError> {
         let shader = self.shader(spec.shader, spec.defines)?;
         let mut built = self.built.borrow_mut();
         built.insert((spec.shader.to_string(), spec.vertex.to_string()));
@@ -399,11 +416,18 @@ impl<'a> CreateContext<'a> {
                 p.label = label.clone();
                 p
             })
+            .and_then(|p| {
+                p.typed(|k| match k {
+                    PipelineKind::Render(r) => Some(r),
+                    PipelineKind::Compute(_) => None,
+                })
+                .ok_or_else(|| self.error("the pipeline cache returned a compute pipeline for a render key".into()))
+            })
     }
 
     /// Builds (or takes from the cache) a compute pipeline writing this pass's outputs as storage
     /// textures or buffers named after the ports.
-    pub fn compute_pipeline(&self, spec: &ComputePipelineSpec<'_>) -> Result<PassPipeline, PassError> {
+    pub fn compute_pipeline(&self, spec: &ComputePipelineSpec<'_>) -> Result<ComputePassPipeline, PassError> {
         let shader = self.shader(spec.shader, spec.defines)?;
         self.built.borrow_mut().insert((spec.shader.to_string(), spec.entry.to_string()));
         let r = reflect(&shader.module, &shader.info, &[spec.entry])
@@ -456,6 +480,13 @@ impl<'a> CreateContext<'a> {
             .map(|mut p| {
                 p.label = label.clone();
                 p
+            })
+            .and_then(|p| {
+                p.typed(|k| match k {
+                    PipelineKind::Compute(c) => Some(c),
+                    PipelineKind::Render(_) => None,
+                })
+                .ok_or_else(|| self.error("the pipeline cache returned a render pipeline for a compute key".into()))
             })
     }
 

@@ -30,8 +30,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 pub use create::{
-    ComputePipelineSpec, CreateContext, DepthSpec, PassError, PassPipeline, PipelineCache, PipelineKind, PortInfo,
-    RenderPipelineSpec,
+    ComputePassPipeline, ComputePipelineSpec, CreateContext, DepthSpec, PassError, PassPipeline, PipelineCache,
+    PipelineKind, PortInfo, RenderPassPipeline, RenderPipelineSpec,
 };
 pub use frame::{
     CameraData, FrameData, FrameUniforms, LONGEST_RAY_VOXELS, OpacityReference, PixelRays, VolumeDesc, scene_values_of,

@@ -5,7 +5,7 @@
 use std::cell::RefCell;
 use std::collections::HashMap;
 
-use super::create::{PassError, PassPipeline};
+use super::create::{ComputePassPipeline, PassError, PassPipeline, RenderPassPipeline};
 use super::frame::FrameData;
 use super::gpu::Gpu;
 use crate::plugin::Access;
@@ -183,9 +183,9 @@ impl<'a> RecordContext<'a> {
 
     /// Bind group 0 of `pipeline`, every binding resolved by name: system bindings, then `extra`
     /// (the pass's own buffers), then ports. Cached by the resources it holds.
-    pub fn bind_group(
+    pub fn bind_group<K>(
         &self,
-        pipeline: &PassPipeline,
+        pipeline: &PassPipeline<K>,
         extra: &[(&str, wgpu::BindingResource<'_>)],
     ) -> Result<wgpu::BindGroup, PassError> {
         let mut entries = Vec::with_capacity(pipeline.bindings.len());
@@ -249,7 +249,7 @@ impl<'a> RecordContext<'a> {
     /// labelled and timed.
     pub fn begin_render_pass(
         &mut self,
-        pipeline: &PassPipeline,
+        pipeline: &RenderPassPipeline,
         depth_clear: Option<f32>,
     ) -> Result<wgpu::RenderPass<'static>, PassError> {
         let mut colors = Vec::new();
@@ -300,23 +300,18 @@ impl<'a> RecordContext<'a> {
     }
 
     /// The common compute pass in one call: bind group 0 of `pipeline` (with `extra`), one
-    /// dispatch of `workgroup`-sized groups covering the target bound to `port`. A render
-    /// pipeline here is an error naming the pass, not a silently skipped dispatch.
+    /// dispatch of `workgroup`-sized groups covering the target bound to `port`.
     pub fn dispatch_over(
         &mut self,
-        pipeline: &PassPipeline,
+        pipeline: &ComputePassPipeline,
         extra: &[(&str, wgpu::BindingResource<'_>)],
         port: &str,
         workgroup: (u32, u32),
     ) -> Result<(), PassError> {
-        let super::create::PipelineKind::Compute(compute) = &pipeline.pipeline else {
-            return Err(self
-                .error(format!("pipeline \"{}\" is a render pipeline; dispatch needs a compute one", pipeline.label)));
-        };
         let bind_group = self.bind_group(pipeline, extra)?;
         let (w, h) = self.extent(port);
         let mut pass = self.begin_compute_pass();
-        pass.set_pipeline(compute);
+        pass.set_pipeline(&pipeline.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.dispatch_workgroups(w.div_ceil(workgroup.0.max(1)), h.div_ceil(workgroup.1.max(1)), 1);
         Ok(())

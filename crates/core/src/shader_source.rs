@@ -231,7 +231,45 @@ pub fn assemble_with(
     let mut included = BTreeSet::new();
     let mut stack = Vec::new();
     append(sources, relative, defines, &mut out, &mut included, &mut stack)?;
+    out.text = number_auto_bindings(&out.text);
     Ok(out)
+}
+
+/// Binding numbers assigned from declarations: every `@binding(auto)` of the assembled module
+/// (all files, imports included) gets the lowest `@group(0)` number no other declaration uses,
+/// in order of appearance. volgraph binds resources by global name, so the numbers only have to
+/// be distinct; a shader (or a WGSL-only pass) need not coordinate them across `#import`ed
+/// files. Line structure is unchanged, so error locations stay exact.
+pub fn number_auto_bindings(text: &str) -> String {
+    const AUTO: &str = "@binding(auto)";
+    if !text.contains(AUTO) {
+        return text.to_string();
+    }
+    let mut used = BTreeSet::new();
+    let mut rest = text;
+    while let Some(at) = rest.find("@binding(") {
+        let after = &rest[at + "@binding(".len()..];
+        if let Some(end) = after.find(')')
+            && let Ok(n) = after[..end].trim().parse::<u32>()
+        {
+            used.insert(n);
+        }
+        rest = after;
+    }
+    let mut out = String::with_capacity(text.len());
+    let mut next = 0u32;
+    let mut rest = text;
+    while let Some(at) = rest.find(AUTO) {
+        while used.contains(&next) {
+            next += 1;
+        }
+        out.push_str(&rest[..at]);
+        out.push_str(&format!("@binding({next})"));
+        used.insert(next);
+        rest = &rest[at + AUTO.len()..];
+    }
+    out.push_str(rest);
+    out
 }
 
 /// One open `#if`: whether its current branch is kept, whether the enclosing one is, and whether
@@ -346,6 +384,36 @@ mod tests {
         ("stray.wgsl", "a\n#endif\n"),
         ("twice.wgsl", "#if X\n#else\n#else\n#endif\n"),
     ];
+
+    /// `@binding(auto)` takes the lowest numbers nobody declares, across imported files, and
+    /// the result is valid WGSL naga accepts with distinct bindings.
+    #[test]
+    fn auto_bindings_get_distinct_numbers_across_imports() {
+        const FILES: EmbeddedShaders = &[
+            (
+                "pass.wgsl",
+                "#import \"lib.wgsl\"\n@group(0) @binding(auto) var<uniform> k: f32;\n@group(0) @binding(auto) var t: texture_2d<f32>;\n@compute @workgroup_size(1) fn main() { let a = k + f(); let b = textureLoad(t, vec2<i32>(0), 0); }\n",
+            ),
+            (
+                "lib.wgsl",
+                "@group(0) @binding(1) var<uniform> fixed: f32;\n@group(0) @binding(auto) var<uniform> shared_value: f32;\nfn f() -> f32 { return fixed + shared_value; }\n",
+            ),
+        ];
+        let s = assemble(&ShaderSources::new().with_embedded(FILES), "pass.wgsl").expect("assembles");
+        assert!(!s.text.contains("auto"), "{}", s.text);
+        let (module, _) = crate::runtime::shaders::parse_and_validate("pass.wgsl", &s.text).expect("valid WGSL");
+        let mut numbers: Vec<(String, u32)> = module
+            .global_variables
+            .iter()
+            .filter_map(|(_, g)| Some((g.name.clone()?, g.binding.as_ref()?.binding)))
+            .collect();
+        numbers.sort();
+        assert_eq!(
+            numbers,
+            [("fixed".to_string(), 1), ("k".to_string(), 2), ("shared_value".to_string(), 0), ("t".to_string(), 3)]
+        );
+        assert_eq!(s.text.lines().count(), s.line_origins.len(), "lines unchanged");
+    }
 
     fn lines(defines: &[&str]) -> Vec<String> {
         let sources = ShaderSources::new().with_embedded(TABLE);

@@ -164,3 +164,19 @@ fn a_storage_texture_on_an_input_and_a_sampled_output_are_caught_at_plan_time() 
     let p = problems("cs_main", OUT_AS_INPUT);
     assert!(p.len() == 1 && p[0].contains("storage texture \"color\" is an input port"), "{p:?}");
 }
+
+/// A WGSL error inside an `#import`ed file is reported at that file's own line, not at the line
+/// of the assembled text.
+#[test]
+fn a_shader_error_points_at_the_imported_file_and_line() {
+    let mut registry = Registry::new();
+    registry.register(Source).register(Probe { entry: "cs_ok" });
+    let plan = compile("probe.ron", GRAPH, &registry, &CompileOptions::new(32, 32)).expect("compiles");
+    let table: &'static [(&'static str, &'static str)] = Box::leak(Box::new([
+        ("probe.wgsl", "#import \"lib.wgsl\"\n@compute @workgroup_size(1) fn cs_ok() { }\n"),
+        ("lib.wgsl", "fn ok() -> f32 { return 1.0; }\nfn broken() -> f32 { return vec2<f32>(1.0); }\n"),
+    ]));
+    let sources = ShaderSources::new().with_embedded(table);
+    let p: Vec<String> = check_plan_bindings(&plan, &registry, &sources).into_iter().map(|d| d.message).collect();
+    assert!(p.len() == 1 && p[0].contains("lib.wgsl:2:"), "{p:?}");
+}

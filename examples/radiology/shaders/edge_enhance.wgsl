@@ -8,9 +8,9 @@ struct Params {
     radius: f32,
 }
 
-@group(0) @binding(0) var<uniform> params: Params;
-@group(0) @binding(1) var color: texture_2d<f32>;
-@group(0) @binding(2) var enhanced: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(auto) var<uniform> params: Params;
+@group(0) @binding(auto) var color: texture_2d<f32>;
+@group(0) @binding(auto) var enhanced: texture_storage_2d<rgba16float, write>;
 
 // The pixel at `p`, clamped to the image.
 fn at(p: vec2<i32>) -> vec4<f32> {

@@ -8,10 +8,13 @@ use std::collections::{BTreeMap, HashSet};
 use std::sync::{Mutex, OnceLock};
 
 use crate::diagnostic::{Diagnostic, Location};
-use crate::graph::ast::{WgslInput, WgslKindDoc};
+use crate::graph::ast::{WgslForm, WgslInput, WgslKindDoc};
 use crate::params::{ParamSpec, Params};
 use crate::plugin::{PassNode, PassPlugin, PortKind, PortSpec, Registry, ShaderUse};
-use crate::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
+use crate::runtime::{
+    ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline,
+    RenderPipelineSpec,
+};
 
 /// A string that lives as long as the program. Plugin declarations are `&'static str`; names a
 /// graph declares are interned once each, so reloading a graph does not grow memory.
@@ -49,6 +52,9 @@ pub fn check_kinds(kinds: &BTreeMap<String, WgslKindDoc>, registry: &Registry) -
                 "declares no outputs".into(),
                 "add outputs: {\"out\": Rgba16Float} (the storage texture it writes)",
             );
+        }
+        if k.form == WgslForm::Fragment && k.outputs.values().any(|f| matches!(f, crate::TargetFormat::Depth32Float)) {
+            err(name, "a fragment-form kind writes colour outputs only".into(), "declare colour formats");
         }
         if k.workgroup.0 == 0 || k.workgroup.1 == 0 || k.workgroup.0 * k.workgroup.1 > 1024 {
             err(
@@ -146,7 +152,7 @@ impl PassPlugin for WgslPass {
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         let extra: &'static [&'static str] = if self.doc.params.is_empty() { &[] } else { &["params"] };
-        vec![ShaderUse { file: intern(&self.doc.shader), entry_point: intern(&self.doc.entry), extra }]
+        vec![ShaderUse { file: intern(&self.doc.shader), entry_point: intern(self.doc.entry_point()), extra }]
     }
 
     fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
@@ -155,13 +161,22 @@ impl PassPlugin for WgslPass {
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let extra: &[&str] = if self.doc.params.is_empty() { &[] } else { &["params"] };
-        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
-            shader: &self.doc.shader,
-            entry: &self.doc.entry,
-            extra_bindings: extra,
-            constants: &[],
-            defines: &[],
-        })?;
+        let pipeline = match self.doc.form {
+            WgslForm::Compute => Pipeline::Compute(ctx.compute_pipeline(&ComputePipelineSpec {
+                shader: &self.doc.shader,
+                entry: self.doc.entry_point(),
+                extra_bindings: extra,
+                constants: &[],
+                defines: &[],
+            })?),
+            WgslForm::Fragment => Pipeline::Fragment(ctx.render_pipeline(&RenderPipelineSpec {
+                shader: &self.doc.shader,
+                vertex: "vs_fullscreen",
+                fragment: self.doc.entry_point(),
+                extra_bindings: extra,
+                ..Default::default()
+            })?),
+        };
         let uniform = (!self.doc.params.is_empty()).then(|| {
             let buffer = ctx.uniform_buffer("params", param_block_size(self.doc.params.len()));
             ctx.gpu.queue.write_buffer(&buffer, 0, &param_block(&self.doc, ctx.params));
@@ -186,8 +201,14 @@ fn param_block(doc: &WgslKindDoc, params: &Params) -> Vec<u8> {
     bytes
 }
 
+/// The pipeline of a WGSL-only pass, by form.
+enum Pipeline {
+    Compute(ComputePassPipeline),
+    Fragment(RenderPassPipeline),
+}
+
 struct WgslPassNode {
-    pipeline: ComputePassPipeline,
+    pipeline: Pipeline,
     uniform: Option<wgpu::Buffer>,
     doc: WgslKindDoc,
     first_output: &'static str,
@@ -197,7 +218,17 @@ impl PassNode for WgslPassNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let extra: Vec<(&str, wgpu::BindingResource<'_>)> =
             self.uniform.iter().map(|b| ("params", b.as_entire_binding())).collect();
-        ctx.dispatch_over(&self.pipeline, &extra, self.first_output, self.doc.workgroup)
+        match &self.pipeline {
+            Pipeline::Compute(p) => ctx.dispatch_over(p, &extra, self.first_output, self.doc.workgroup),
+            Pipeline::Fragment(p) => {
+                let bind_group = ctx.bind_group(p, &extra)?;
+                let mut pass = ctx.begin_render_pass(p, None)?;
+                pass.set_pipeline(&p.pipeline);
+                pass.set_bind_group(0, &bind_group, &[]);
+                pass.draw(0..3, 0..1);
+                Ok(())
+            }
+        }
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {

@@ -290,3 +290,83 @@ fn the_viewer_counts_frames_from_reprojected_starts_and_an_isovalue_edit_restart
     assert_eq!(session.runtime.history_stats().run, 1);
     let _ = std::fs::remove_dir_all(&s.dir);
 }
+
+/// WGSL-only passes of both forms, declared in the graph, run like built-ins and hot-reload: a
+/// fragment-form `tint` and a compute-form `invert` after the raycast equal their CPU arithmetic
+/// on the raycast's own image; an edit of the fragment shader file rebuilds its node and the new
+/// image follows; a parameter edit in the graph updates it in place.
+#[test]
+fn wgsl_only_passes_of_both_forms_render_and_hot_reload() {
+    let s = scratch("wgsl-only", "graphs/basic/compute_raycast.ron");
+    std::fs::write(
+        s.shaders.join("tint.wgsl"),
+        "#import \"common/fullscreen.wgsl\"\n\
+         struct Params { gain: f32 }\n\
+         @group(0) @binding(auto) var<uniform> params: Params;\n\
+         @group(0) @binding(auto) var color: texture_2d<f32>;\n\
+         struct Out { @location(0) tinted: vec4<f32> }\n\
+         @fragment fn fs_main(v: FullscreenVertex) -> Out {\n\
+             let c = textureLoad(color, vec2<i32>(v.clip.xy), 0);\n\
+             return Out(vec4<f32>(c.rgb * params.gain, c.a));\n\
+         }\n",
+    )
+    .expect("write");
+    std::fs::write(
+        s.shaders.join("invert.wgsl"),
+        "@group(0) @binding(auto) var color: texture_2d<f32>;\n\
+         @group(0) @binding(auto) var inverted: texture_storage_2d<rgba16float, write>;\n\
+         @compute @workgroup_size(8, 8) fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {\n\
+             let size = textureDimensions(color);\n\
+             if (id.x >= size.x || id.y >= size.y) { return; }\n\
+             let c = textureLoad(color, vec2<i32>(id.xy), 0);\n\
+             textureStore(inverted, vec2<i32>(id.xy), vec4<f32>(vec3<f32>(1.0) - c.rgb, c.a));\n\
+         }\n",
+    )
+    .expect("write");
+    edit(
+        &s.graph,
+        "    passes: [",
+        "    kinds: {\n\
+         \"tint\": WgslKind(shader: \"tint.wgsl\", form: Fragment, inputs: {\"color\": Target},\n\
+             outputs: {\"tinted\": Rgba16Float}, params: [(name: \"gain\", default: 1.0, min: 0.0, max: 4.0)]),\n\
+         \"invert\": WgslKind(shader: \"invert.wgsl\", inputs: {\"color\": Target}, outputs: {\"inverted\": Rgba16Float}),\n\
+         },\n    passes: [\n\
+         Pass(id: \"tint\", kind: \"tint\", params: {\"gain\": 0.5}, inputs: {\"color\": \"march.color\"}),\n\
+         Pass(id: \"inv\", kind: \"invert\", inputs: {\"color\": \"tint.tinted\"}),",
+    );
+    edit(&s.graph, "\"image\": \"march.color\",", "\"image\": \"inv.inverted\",\n        \"raw\": \"march.color\",");
+    let mut session = open(&s, None);
+    // The expected image from the raycast's own output: 1 - gain·rgb, alpha kept.
+    let check = |session: &mut LiveSession, gain: f32| {
+        let image = frame(session);
+        let raw = session.runtime.read_output("raw").expect("raw").data;
+        assert!(raw.chunks(4).any(|p| p[3] > 0.0), "the volume is in view");
+        let worst = image
+            .chunks(4)
+            .zip(raw.chunks(4))
+            .flat_map(|(i, r)| {
+                (0..4).map(move |c| {
+                    let want = if c == 3 { r[3] } else { 1.0 - gain * r[c] };
+                    (i[c] - want).abs()
+                })
+            })
+            .fold(0.0f32, f32::max);
+        // Two f16 roundings of values ≤ 1 (tint's target, then invert's).
+        assert!(worst <= 2e-3, "gain {gain}: largest difference {worst}");
+    };
+    check(&mut session, 0.5);
+    // A shader edit: the file is watched, the node rebuilt, the image follows.
+    let tint = s.shaders.join("tint.wgsl");
+    assert!(session.watched_files().iter().any(|f| f.ends_with("shaders/tint.wgsl")), "WGSL-only shaders are watched");
+    edit(&tint, "c.rgb * params.gain", "c.rgb * params.gain * 0.5");
+    let events = session.files_changed(std::slice::from_ref(&tint));
+    assert!(matches!(events.as_slice(), [Event::Reloaded { .. }]), "{events:?}");
+    check(&mut session, 0.25);
+    // A parameter edit in the graph: updated in place.
+    edit(&s.graph, "params: {\"gain\": 0.5}", "params: {\"gain\": 1.0}");
+    let events = session.files_changed(std::slice::from_ref(&s.graph));
+    let [Event::Reloaded { detail, .. }] = events.as_slice() else { panic!("{events:?}") };
+    assert!(detail.contains("1 updated in place"), "{detail}");
+    check(&mut session, 0.5);
+    let _ = std::fs::remove_dir_all(&s.dir);
+}

@@ -47,9 +47,14 @@ pub struct WgslKindDoc {
     /// One line saying what the pass does.
     #[serde(default)]
     pub summary: String,
-    /// The compute entry point.
-    #[serde(default = "default_wgsl_entry")]
-    pub entry: String,
+    /// A compute shader (the default) or a fullscreen fragment shader.
+    #[serde(default)]
+    pub form: WgslForm,
+    /// The entry point: the compute entry, or the fragment entry (whose output struct's members
+    /// are named after the outputs; the vertex stage is `vs_fullscreen` of
+    /// `common/fullscreen.wgsl`, which the shader imports). Default `cs_main` / `fs_main`.
+    #[serde(default)]
+    pub entry: Option<String>,
     /// The shader's `@workgroup_size(x, y)`: the dispatch covers the first output with it.
     #[serde(default = "default_wgsl_workgroup")]
     pub workgroup: (u32, u32),
@@ -63,8 +68,24 @@ pub struct WgslKindDoc {
     pub params: Vec<WgslParamDoc>,
 }
 
-fn default_wgsl_entry() -> String {
-    "cs_main".to_string()
+/// How a WGSL-only pass runs.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+pub enum WgslForm {
+    /// One invocation per pixel of the first output (storage textures).
+    #[default]
+    Compute,
+    /// One fullscreen triangle; the fragment shader returns the outputs.
+    Fragment,
+}
+
+impl WgslKindDoc {
+    /// The entry point, defaulted by form.
+    pub fn entry_point(&self) -> &str {
+        self.entry.as_deref().unwrap_or(match self.form {
+            WgslForm::Compute => "cs_main",
+            WgslForm::Fragment => "fs_main",
+        })
+    }
 }
 
 fn default_wgsl_workgroup() -> (u32, u32) {

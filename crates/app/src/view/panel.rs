@@ -187,13 +187,15 @@ pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapt
                 });
             }
             ui.collapsing("Parameters", |ui| {
+                // The graph's own WGSL-only kinds have parameters too.
+                let registry = volgraph_core::wgsl_pass::with_graph_kinds(session.registry(), &plan.kinds);
                 let mut seen = Vec::new();
                 for step in &plan.steps {
                     if seen.contains(&step.pass_id) {
                         continue;
                     }
                     seen.push(step.pass_id.clone());
-                    let Some(plugin) = session.registry().get(&step.kind) else { continue };
+                    let Some(plugin) = registry.get(&step.kind) else { continue };
                     let specs = plugin.params();
                     if specs.is_empty() {
                         continue;
@@ -207,6 +209,9 @@ pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapt
                         }
                     });
                 }
+            });
+            ui.collapsing("Graph", |ui| {
+                egui::ScrollArea::horizontal().id_salt("graph").show(ui, |ui| super::graph_picture::show(ui, plan));
             });
             ui.collapsing("Plan", |ui| {
                 ui.add(egui::Label::new(egui::RichText::new(plan.to_text()).monospace().small()).extend());

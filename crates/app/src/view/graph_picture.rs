@@ -1,0 +1,166 @@
+//! The plan as a picture in the viewer's panel — the same marks as `volgraph plan --dot`
+//! (`Plan::to_dot`): passes as boxes in columns by dependency depth, data edges solid, history
+//! edges (last frame's value) dashed, culled and gated passes greyed in a last column, repeat
+//! groups boxed. [`layout`] is pure (tested); [`show`] paints it with egui.
+
+use std::collections::BTreeMap;
+
+use volgraph_core::plan::{Binding, Plan};
+
+/// One box.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Node {
+    /// `label\nkind`.
+    pub text: String,
+    /// Column (dependency depth) and row.
+    pub at: (usize, usize),
+    /// Culled or switched off by a feature.
+    pub greyed: bool,
+    /// The repeat group it belongs to.
+    pub group: Option<String>,
+}
+
+/// One arrow between boxes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Edge {
+    /// Node indices.
+    pub from: usize,
+    /// Node indices.
+    pub to: usize,
+    /// A history edge (last frame's value).
+    pub dashed: bool,
+}
+
+/// The laid-out picture.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Picture {
+    /// Boxes: the plan's steps in order, then culled and gated passes.
+    pub nodes: Vec<Node>,
+    /// Arrows.
+    pub edges: Vec<Edge>,
+}
+
+/// Lays `plan` out: a step's column is one more than the deepest step it reads from.
+pub fn layout(plan: &Plan) -> Picture {
+    let mut depth = vec![0usize; plan.steps.len()];
+    let mut edges = Vec::new();
+    for (i, step) in plan.steps.iter().enumerate() {
+        for bp in step.ports.iter().filter(|p| p.access != volgraph_core::Access::Write) {
+            match &bp.binding {
+                Binding::Resource { id, .. } => {
+                    let from = plan.resources[*id].producer;
+                    if from < i {
+                        depth[i] = depth[i].max(depth[from] + 1);
+                        edges.push(Edge { from, to: i, dashed: false });
+                    }
+                }
+                Binding::History(name) => {
+                    if let Some(h) = plan.history.get(name) {
+                        edges.push(Edge { from: plan.resources[h.source].producer, to: i, dashed: true });
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    edges.dedup();
+    let mut rows: BTreeMap<usize, usize> = BTreeMap::new();
+    let mut nodes: Vec<Node> = plan
+        .steps
+        .iter()
+        .enumerate()
+        .map(|(i, step)| {
+            let row = rows.entry(depth[i]).or_default();
+            let at = (depth[i], *row);
+            *row += 1;
+            let group = step.iteration.and_then(|_| step.label.split_once('[').map(|(g, _)| g.to_string()));
+            Node { text: format!("{}\n{}", step.label, step.kind), at, greyed: false, group }
+        })
+        .collect();
+    let last = depth.iter().max().map_or(0, |d| d + 1);
+    let off = plan
+        .culled
+        .iter()
+        .map(|id| format!("{id}\nculled"))
+        .chain(plan.gated.iter().map(|(id, f)| format!("{id}\noff: {}", f.join(", "))));
+    for (row, text) in off.enumerate() {
+        nodes.push(Node { text, at: (last, row), greyed: true, group: None });
+    }
+    Picture { nodes, edges }
+}
+
+/// Paints `plan`'s picture into `ui`.
+pub fn show(ui: &mut egui::Ui, plan: &Plan) {
+    let picture = layout(plan);
+    let (w, h) = (118.0, 34.0);
+    let (gap_x, gap_y) = (30.0, 14.0);
+    let cols = picture.nodes.iter().map(|n| n.at.0 + 1).max().unwrap_or(1) as f32;
+    let rows = picture.nodes.iter().map(|n| n.at.1 + 1).max().unwrap_or(1) as f32;
+    let size = egui::vec2(cols * (w + gap_x), rows * (h + gap_y));
+    let (response, painter) = ui.allocate_painter(size, egui::Sense::hover());
+    let origin = response.rect.min;
+    let rect_of = |n: &Node| {
+        egui::Rect::from_min_size(
+            origin + egui::vec2(n.at.0 as f32 * (w + gap_x), n.at.1 as f32 * (h + gap_y)),
+            egui::vec2(w, h),
+        )
+    };
+    let text_color = ui.visuals().text_color();
+    // Repeat groups: one rounded box around their steps.
+    let mut groups: BTreeMap<&str, egui::Rect> = BTreeMap::new();
+    for n in &picture.nodes {
+        if let Some(g) = &n.group {
+            let r = rect_of(n).expand(4.0);
+            groups.entry(g).and_modify(|u| *u = u.union(r)).or_insert(r);
+        }
+    }
+    for r in groups.values() {
+        painter.rect_stroke(*r, 6.0, egui::Stroke::new(1.0, egui::Color32::GRAY), egui::StrokeKind::Outside);
+    }
+    for e in &picture.edges {
+        let (a, b) = (rect_of(&picture.nodes[e.from]), rect_of(&picture.nodes[e.to]));
+        let (p, q) = (a.right_center(), b.left_center());
+        let stroke = egui::Stroke::new(1.0, text_color);
+        if e.dashed {
+            painter.extend(egui::Shape::dashed_line(&[p, q], stroke, 4.0, 3.0));
+        } else {
+            painter.arrow(p, q - p, stroke);
+        }
+    }
+    for n in &picture.nodes {
+        let r = rect_of(n);
+        let (fill, color) = if n.greyed {
+            (egui::Color32::TRANSPARENT, egui::Color32::GRAY)
+        } else {
+            (ui.visuals().faint_bg_color, text_color)
+        };
+        painter.rect_filled(r, 3.0, fill);
+        painter.rect_stroke(r, 3.0, egui::Stroke::new(1.0, color), egui::StrokeKind::Inside);
+        painter.text(r.center(), egui::Align2::CENTER_CENTER, &n.text, egui::FontId::proportional(10.0), color);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use volgraph_core::{CompileOptions, compile};
+
+    fn plan(graph: &str) -> Plan {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../graphs").join(graph);
+        let source = std::fs::read_to_string(&path).expect("graph");
+        compile(graph, &source, &volgraph_passes::builtin_registry(), &CompileOptions::new(64, 64)).expect("compiles")
+    }
+
+    /// The marks of `--dot`: columns follow dependencies, history edges are dashed, repeat
+    /// groups are grouped.
+    #[test]
+    fn the_picture_has_the_marks_of_the_dot_output() {
+        let p = layout(&plan("klein_2005/leap_iso.ron"));
+        let march = p.nodes.iter().position(|n| n.text.starts_with("march\n")).expect("march");
+        let splat = p.nodes.iter().position(|n| n.text.starts_with("splat\n")).expect("splat");
+        assert!(p.nodes[march].at.0 > p.nodes[splat].at.0, "the raycast comes after the splats");
+        assert!(p.edges.iter().any(|e| e.dashed && e.from == march && e.to == splat), "last frame's hits: dashed");
+        let rc = layout(&plan("kruger_westermann_2003/rc.ron"));
+        assert!(rc.nodes.iter().any(|n| n.group.is_some()), "the segment loop is a group");
+    }
+}

@@ -14,6 +14,7 @@ use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec,
 
 use crate::effects::jitter_defines;
 use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
+use crate::shared::FLOAT_TARGETS;
 
 /// The plugin.
 pub struct Antialias;
@@ -48,8 +49,6 @@ impl AaParamsGpu {
         }
     }
 }
-
-const FLOAT_TARGETS: [TargetFormat; 2] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float];
 
 impl PassPlugin for Antialias {
     fn kind(&self) -> &'static str {

@@ -13,7 +13,6 @@ use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateCon
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, Rerun};
 
 use crate::grid_tap::GridTap;
-pub(crate) use crate::minmax_grid::block_size_spec;
 use crate::minmax_grid::{MINMAX_GRID, bound_size, create_grid_texture, dispatch_grid};
 
 /// The Owned type name of the empty-block flags.

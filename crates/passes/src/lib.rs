@@ -25,6 +25,7 @@ pub mod raycast_params;
 pub mod raycast_segment;
 pub mod reprojection_splat;
 pub mod segment_init;
+pub mod shared;
 pub mod slice_render;
 pub mod termination_test;
 

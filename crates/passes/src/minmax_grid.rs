@@ -11,6 +11,7 @@ use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateCon
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, Rerun};
 
 use crate::grid_tap::GridTap;
+use crate::shared::block_size_spec;
 
 /// The Owned type name of the grid.
 pub const MINMAX_GRID: &str = "minmax_grid";
@@ -40,11 +41,6 @@ const _: () = assert!(std::mem::size_of::<MinMaxParamsGpu>() == 16);
 
 /// Workgroup edge of `cs_minmax` and `cs_classify` (4³ blocks per workgroup).
 pub(crate) const GRID_WORKGROUP: u32 = 4;
-
-/// The `block_size` parameter (K-W 2003 §2.3 used 8).
-pub(crate) fn block_size_spec() -> ParamSpec {
-    ParamSpec::uint("block_size", 8, 1, 256, "edge of an empty-space block in voxels (Krüger–Westermann used 8)")
-}
 
 /// A 3D float texture usable as a storage output and a sampled input.
 pub(crate) fn create_grid_texture(

@@ -2,14 +2,13 @@
 //! ray's exit point; with the entry point from pass 1 this writes the normalized texture-space
 //! direction and, in alpha, the ray length. Shader: `shaders/ray_directions.wgsl`.
 
+use crate::shared::FLOAT_TARGETS;
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
-use volgraph_core::{Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{Params, PassNode, PassPlugin, PortKind, PortSpec};
 
 /// The plugin.
 pub struct RayDirections;
-
-const FLOAT_TARGETS: [TargetFormat; 2] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float];
 
 impl PassPlugin for RayDirections {
     fn kind(&self) -> &'static str {

@@ -20,11 +20,10 @@ use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec,
 
 use crate::effects::{EffectState, effect_defines, effect_param_specs, same_effects, with_effect_bindings};
 use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
+use crate::shared::FLOAT_TARGETS;
 
 /// The plugin.
 pub struct Raycast;
-
-const FLOAT_TARGETS: [TargetFormat; 2] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float];
 
 /// The ports shared by both raycasters; `color_formats` differ (compute writes a storage texture
 /// of one format).

@@ -155,7 +155,7 @@ impl PassPlugin for RaycastBricks {
             });
         }
         let mut defines = Vec::new();
-        if crate::raycast_compute::color_is_f32(ctx) {
+        if crate::shared::color_is_f32(ctx) {
             defines.push("COLOR_F32");
         }
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {

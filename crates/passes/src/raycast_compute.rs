@@ -10,6 +10,7 @@ use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortSpec, TargetFor
 use crate::effects::{EffectState, effect_defines, effect_param_specs, same_effects, with_effect_bindings};
 use crate::raycast::raycast_ports;
 use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
+use crate::shared::color_is_f32;
 
 /// The plugin.
 pub struct RaycastCompute;
@@ -91,11 +92,6 @@ impl PassPlugin for RaycastCompute {
             step_voxels: ctx.params.float("step_voxels"),
         }))
     }
-}
-
-/// Whether the graph (or the scene's precision) made `color` an Rgba32Float target.
-pub(crate) fn color_is_f32(ctx: &CreateContext<'_>) -> bool {
-    ctx.port("color").and_then(|p| p.format) == Some(wgpu::TextureFormat::Rgba32Float)
 }
 
 struct RaycastComputeNode {

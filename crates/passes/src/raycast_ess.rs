@@ -13,14 +13,13 @@ use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec,
 use crate::effects::{
     EffectState, SHADING_PARAMS, effect_defines, effect_param_specs, same_effects, with_effect_bindings,
 };
-use crate::empty_space::{EMPTY_BLOCKS, block_size_spec, check_block_grid};
+use crate::empty_space::{EMPTY_BLOCKS, check_block_grid};
 use crate::minmax_grid::bound_size;
 use crate::raycast_params::{RaycastParamsGpu, raycast_param_specs};
+use crate::shared::{FLOAT_TARGETS, block_size_spec};
 
 /// The plugin.
 pub struct RaycastEss;
-
-const FLOAT_TARGETS: [TargetFormat; 2] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float];
 
 /// Rust twin of `struct EssParams` in `shaders/raycast_ess.wgsl`.
 #[repr(C)]

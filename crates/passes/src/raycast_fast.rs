@@ -30,10 +30,10 @@ use crate::effects::{
     EffectState, SHADING_PARAMS, effect_defines, effect_param_specs, same_effects, with_effect_bindings,
 };
 use crate::empty_distance::EMPTY_DISTANCE;
-use crate::empty_space::block_size_spec;
 use crate::minmax_grid::bound_size;
 use crate::opacity_lut::{OpacityTable, TABLE_SHADERS};
 use crate::raycast_params::{RaycastParamsGpu, raycast_param_specs};
+use crate::shared::block_size_spec;
 
 /// The plugin.
 pub struct RaycastFast;
@@ -179,7 +179,7 @@ impl PassPlugin for RaycastFast {
         };
         let counted = ctx.params.boolean("count_samples");
         let mut defines = self.shader_defines(ctx.params);
-        if crate::raycast_compute::color_is_f32(ctx) {
+        if crate::shared::color_is_f32(ctx) {
             defines.push("COLOR_F32");
         }
         let variant = |half_step: bool| {

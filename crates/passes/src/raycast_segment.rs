@@ -24,11 +24,9 @@ use volgraph_core::runtime::{
 };
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
-use crate::empty_space::{EMPTY_BLOCKS, block_size_spec};
+use crate::empty_space::EMPTY_BLOCKS;
 use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
-use crate::segment_init::{ACCUM_FORMATS, HIT_FORMATS};
-
-const FLOAT_TARGETS: [TargetFormat; 2] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float];
+use crate::shared::{ACCUM_FORMATS, FLOAT_TARGETS, HIT_FORMATS, block_size_spec, front_to_back_blend};
 
 /// The plugin. [`Default`] is the production pass; [`RaycastSegment::counting`] adds the debug
 /// invocation counter.
@@ -106,16 +104,6 @@ pub(crate) fn segment_steps_spec() -> ParamSpec {
         4096,
         "M: samples per segment (Krüger–Westermann used 8); the repeat count divides by it",
     )
-}
-
-/// The segment's blend: `dst + (1 - dst.a)·src` for colour and alpha.
-pub(crate) fn front_to_back_blend() -> wgpu::BlendState {
-    let c = wgpu::BlendComponent {
-        src_factor: wgpu::BlendFactor::OneMinusDstAlpha,
-        dst_factor: wgpu::BlendFactor::One,
-        operation: wgpu::BlendOperation::Add,
-    };
-    wgpu::BlendState { color: c, alpha: c }
 }
 
 /// The segment index this record is for: the repeat iteration (0 outside a repeat group).

@@ -4,6 +4,7 @@
 //! into RES and test against the depth buffer through Modify/Read ports from the start.
 //! Shader: `shaders/segment_init.wgsl`.
 
+use crate::shared::{ACCUM_FORMATS, HIT_FORMATS};
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{
     CreateContext, DepthSpec, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
@@ -12,12 +13,6 @@ use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec,
 
 /// The plugin.
 pub struct SegmentInit;
-
-/// Formats an accumulation target may have (blendable float formats).
-pub(crate) const ACCUM_FORMATS: [TargetFormat; 2] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float];
-
-/// Formats a hit-position target may have (blendable float formats; f32 keeps positions exact).
-pub(crate) const HIT_FORMATS: [TargetFormat; 2] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float];
 
 fn fragment(params: &Params) -> &'static str {
     if params.boolean("with_hit") { "fs_init_hit" } else { "fs_init" }

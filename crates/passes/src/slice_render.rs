@@ -6,11 +6,10 @@
 //! same integral with a different sampling pattern. `max_slices` bounds the instance count;
 //! planes past the box draw nothing. Shader: `shaders/slice_render.wgsl`.
 
+use crate::shared::front_to_back_blend;
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
-
-use crate::raycast_segment::front_to_back_blend;
 
 /// The plugin.
 pub struct SliceRender;

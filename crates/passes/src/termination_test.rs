@@ -20,15 +20,13 @@ use volgraph_core::runtime::{
 };
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
-use crate::empty_space::{EMPTY_BLOCKS, block_size_spec};
+use crate::empty_space::EMPTY_BLOCKS;
 use crate::raycast_params::RaycastParamsGpu;
 use crate::raycast_segment::{SegmentParamsGpu, segment_index, segment_steps_spec};
-use crate::segment_init::ACCUM_FORMATS;
+use crate::shared::{ACCUM_FORMATS, FLOAT_TARGETS, block_size_spec};
 
 /// The plugin.
 pub struct TerminationTest;
-
-const FLOAT_TARGETS: [TargetFormat; 2] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float];
 
 impl PassPlugin for TerminationTest {
     fn kind(&self) -> &'static str {

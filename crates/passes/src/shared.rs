@@ -1,0 +1,39 @@
+//! Helpers several technique modules share, kept out of the modules themselves: the target
+//! format sets ports accept, the block-size rule of the empty-space passes, the front-to-back
+//! blend, and how a node tells which colour precision its graph picked.
+
+use volgraph_core::runtime::CreateContext;
+use volgraph_core::{ParamSpec, TargetFormat};
+
+/// Float RGBA targets a ray pass reads or writes (entry points, directions, hits); the first is
+/// the default for outputs.
+pub const FLOAT_TARGETS: [TargetFormat; 2] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float];
+
+/// Formats of an accumulation target blended into segment by segment (Krüger & Westermann 2003
+/// §2.1).
+pub const ACCUM_FORMATS: [TargetFormat; 2] = FLOAT_TARGETS;
+
+/// Formats of the isosurface hit target blended like the colour (§2.2).
+pub const HIT_FORMATS: [TargetFormat; 2] = FLOAT_TARGETS;
+
+/// The `block_size` parameter of the min/max grid and everything that reads it (Krüger &
+/// Westermann 2003 §2.3): one declaration, so the passes that must agree cannot drift.
+pub fn block_size_spec() -> ParamSpec {
+    ParamSpec::uint("block_size", 8, 1, 256, "edge of an empty-space block in voxels (Krüger–Westermann used 8)")
+}
+
+/// The front-to-back blend `dst + (1 - dst.a)·src` for colour and alpha.
+pub fn front_to_back_blend() -> wgpu::BlendState {
+    let c = wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::OneMinusDstAlpha,
+        dst_factor: wgpu::BlendFactor::One,
+        operation: wgpu::BlendOperation::Add,
+    };
+    wgpu::BlendState { color: c, alpha: c }
+}
+
+/// Whether the graph (or the scene's precision) made `color` an Rgba32Float target: the node
+/// then compiles its shader with `COLOR_F32`.
+pub fn color_is_f32(ctx: &CreateContext<'_>) -> bool {
+    ctx.port("color").and_then(|p| p.format) == Some(wgpu::TextureFormat::Rgba32Float)
+}

@@ -25,10 +25,10 @@ struct AaParams {
 }
 
 // The raycast colour.
-@group(0) @binding(5) var color: texture_2d<f32>;
+@group(0) @binding(auto) var color: texture_2d<f32>;
 // The raycast's leap hits (xyz texture space; w = 1 surface, 0.5 exit point, 0 no ray).
-@group(0) @binding(6) var hits: texture_2d<f32>;
-@group(0) @binding(8) var<uniform> aa: AaParams;
+@group(0) @binding(auto) var hits: texture_2d<f32>;
+@group(0) @binding(auto) var<uniform> aa: AaParams;
 
 fn texel_clamped(t: texture_2d<f32>, p: vec2<i32>) -> vec4<f32> {
     return textureLoad(t, clamp(p, vec2<i32>(0), vec2<i32>(textureDimensions(t)) - vec2<i32>(1)), 0);

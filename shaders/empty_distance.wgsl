@@ -18,11 +18,11 @@ struct DistanceParams {
 }
 
 // 1.0 = empty (empty_space.wgsl).
-@group(0) @binding(0) var empty: texture_3d<f32>;
+@group(0) @binding(auto) var empty: texture_3d<f32>;
 // The previous axis's distances (passes y and z).
-@group(0) @binding(1) var partial: texture_3d<f32>;
-@group(0) @binding(2) var distance: texture_storage_3d<r32float, write>;
-@group(0) @binding(3) var<uniform> pass_params: DistanceParams;
+@group(0) @binding(auto) var partial: texture_3d<f32>;
+@group(0) @binding(auto) var distance: texture_storage_3d<r32float, write>;
+@group(0) @binding(auto) var<uniform> pass_params: DistanceParams;
 
 // Cell `i` along `axis` of the line through `line` (the other two coordinates).
 fn cell(line: vec2<u32>, axis: u32, i: u32) -> vec3<i32> {

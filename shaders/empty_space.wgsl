@@ -11,8 +11,8 @@
 #import "common/volume.wgsl"
 
 // The min/max grid of minmax_grid.wgsl (r = min, g = max).
-@group(0) @binding(5) var grid: texture_3d<f32>;
-@group(0) @binding(6) var empty: texture_storage_3d<r32float, write>;
+@group(0) @binding(auto) var grid: texture_3d<f32>;
+@group(0) @binding(auto) var empty: texture_storage_3d<r32float, write>;
 
 // `volgraph_accel::classify::VALUE_MARGIN`: covers f32 rounding of interpolated values.
 const VALUE_MARGIN: f32 = 1e-6;

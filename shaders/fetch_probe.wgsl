@@ -12,9 +12,9 @@
 override WORKGROUP_X: u32 = 8u;
 override WORKGROUP_Y: u32 = 8u;
 
-@group(0) @binding(9) var color: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(auto) var color: texture_storage_2d<rgba16float, write>;
 // Samples taken per image row (as raycast_fast.wgsl's).
-@group(0) @binding(13) var<storage, read_write> samples: array<atomic<u32>>;
+@group(0) @binding(auto) var<storage, read_write> samples: array<atomic<u32>>;
 const SAMPLE_ROWS: u32 = 4096u;
 
 struct Fetched {

@@ -20,8 +20,8 @@ struct HoleParams {
 }
 
 // The reprojected starts (w = 1 where a splat landed).
-@group(0) @binding(6) var splats: texture_2d<f32>;
-@group(0) @binding(7) var<uniform> holes: HoleParams;
+@group(0) @binding(auto) var splats: texture_2d<f32>;
+@group(0) @binding(auto) var<uniform> holes: HoleParams;
 
 // (u0, 1) where pixel `p`'s ray enters the box, (0,0,0,0) where it misses.
 fn entry_of(p: vec2<i32>) -> vec4<f32> {

@@ -17,8 +17,8 @@ struct MinMaxParams {
     _pad2: u32,
 }
 
-@group(0) @binding(5) var grid: texture_storage_3d<rg32float, write>;
-@group(0) @binding(6) var<uniform> minmax: MinMaxParams;
+@group(0) @binding(auto) var grid: texture_storage_3d<rg32float, write>;
+@group(0) @binding(auto) var<uniform> minmax: MinMaxParams;
 
 // Workgroups of 4³ blocks.
 @compute @workgroup_size(4, 4, 4)

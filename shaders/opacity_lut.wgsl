@@ -10,8 +10,8 @@
 
 #import "common/raymarch.wgsl"
 
-@group(0) @binding(11) var table32: texture_storage_2d<rgba32float, write>;
-@group(0) @binding(12) var table16: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(auto) var table32: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(auto) var table16: texture_storage_2d<rgba16float, write>;
 
 // Texel i of an n-texel table.
 fn corrected_texel(i: u32, n: u32) -> vec4<f32> {

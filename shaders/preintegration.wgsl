@@ -9,8 +9,8 @@
 
 #import "common/raymarch.wgsl"
 
-@group(0) @binding(11) var table32: texture_storage_2d<rgba32float, write>;
-@group(0) @binding(12) var table16: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(auto) var table32: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(auto) var table16: texture_storage_2d<rgba16float, write>;
 
 fn segment(s_front: f32, s_back: f32) -> vec4<f32> {
     let texels = f32(textureDimensions(tf).x);

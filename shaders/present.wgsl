@@ -12,9 +12,9 @@ struct PresentParams {
     _pad2: f32,
 }
 
-@group(0) @binding(0) var color: texture_2d<f32>;
-@group(0) @binding(1) var<uniform> params: PresentParams;
-@group(0) @binding(2) var display: texture_storage_2d<rgba8unorm, write>;
+@group(0) @binding(auto) var color: texture_2d<f32>;
+@group(0) @binding(auto) var<uniform> params: PresentParams;
+@group(0) @binding(auto) var display: texture_storage_2d<rgba8unorm, write>;
 
 // The sRGB transfer function (IEC 61966-2-1).
 fn srgb_encode(linear: vec3<f32>) -> vec3<f32> {

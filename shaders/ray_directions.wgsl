@@ -8,7 +8,7 @@
 #import "common/box_vertex.wgsl"
 
 // Pass 1's output: (u0, 1) where the ray enters the box, (0,0,0,0) where it misses.
-@group(0) @binding(5) var entry: texture_2d<f32>;
+@group(0) @binding(auto) var entry: texture_2d<f32>;
 
 // Shorter segments count as "no ray" (t_out <= t0 in the model). 1e-6 texture units is far
 // below any sample spacing in use (0.01 voxel of a 4096³ volume is 2.4e-6), yet well above the

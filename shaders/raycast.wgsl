@@ -28,9 +28,9 @@ fn pixel_dir(pixel: vec2<u32>) -> vec4<f32> {
 }
 #else
 // (u0, 1) where the pixel's ray enters the box, (0,0,0,0) where it misses.
-@group(0) @binding(5) var entry: texture_2d<f32>;
+@group(0) @binding(auto) var entry: texture_2d<f32>;
 // (d_tex, len_tex); (0,0,0,0) for no ray.
-@group(0) @binding(6) var dir: texture_2d<f32>;
+@group(0) @binding(auto) var dir: texture_2d<f32>;
 
 fn pixel_entry(pixel: vec2<u32>) -> vec4<f32> {
     return textureLoad(entry, vec2<i32>(pixel), 0);
@@ -83,12 +83,12 @@ fn fs_iso(in: FullscreenVertex) -> IsoOut {
 
 #if START
 // xyz: texture-space start estimate, w = 1 where there is one (reprojection_splat, hole_fill).
-@group(0) @binding(10) var start: texture_2d<f32>;
+@group(0) @binding(auto) var start: texture_2d<f32>;
 #endif
 
 #if COUNT
 // Samples taken per image row (row y adds into samples[y % 4096]).
-@group(0) @binding(13) var<storage, read_write> samples: array<atomic<u32>>;
+@group(0) @binding(auto) var<storage, read_write> samples: array<atomic<u32>>;
 #endif
 
 struct LeapDvrOut {

@@ -36,19 +36,19 @@ struct BrickParams {
     atlas: vec4<f32>,
 }
 
-@group(0) @binding(9) var<uniform> bricks: BrickParams;
+@group(0) @binding(auto) var<uniform> bricks: BrickParams;
 // This batch: word 0 = 1 for the first batch of the frame (start from a clear ray); word 1 + b
 // = slot + 1 of brick b when it is drawn in this batch, 0 when it is not.
-@group(0) @binding(10) var<storage, read> table: array<u32>;
+@group(0) @binding(auto) var<storage, read> table: array<u32>;
 // Per leaf of the volume (x fastest): 0 where a box to draw covers it, else the Chebyshev
 // distance in leaves to the nearest such leaf (every leaf closer is empty too).
-@group(0) @binding(11) var<storage, read> leaf_distance: array<u32>;
+@group(0) @binding(auto) var<storage, read> leaf_distance: array<u32>;
 // Per pixel: the premultiplied colour composited so far this frame.
-@group(0) @binding(12) var<storage, read_write> acc: array<vec4<f32>>;
+@group(0) @binding(auto) var<storage, read_write> acc: array<vec4<f32>>;
 #if COLOR_F32
-@group(0) @binding(13) var color: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(auto) var color: texture_storage_2d<rgba32float, write>;
 #else
-@group(0) @binding(13) var color: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(auto) var color: texture_storage_2d<rgba16float, write>;
 #endif
 
 // The first sample index after the box [lo, hi] (voxel coordinates, faces of the volume

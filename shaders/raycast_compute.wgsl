@@ -14,17 +14,17 @@ override WORKGROUP_X: u32 = 8u;
 override WORKGROUP_Y: u32 = 8u;
 
 // (u0, 1) where the pixel's ray enters the box, (0,0,0,0) where it misses.
-@group(0) @binding(5) var entry: texture_2d<f32>;
+@group(0) @binding(auto) var entry: texture_2d<f32>;
 // (d_tex, len_tex); (0,0,0,0) for no ray.
-@group(0) @binding(6) var dir: texture_2d<f32>;
+@group(0) @binding(auto) var dir: texture_2d<f32>;
 // Premultiplied linear RGBA (Rgba32Float when the scene asks for f32 precision).
 #if COLOR_F32
-@group(0) @binding(7) var color: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(auto) var color: texture_storage_2d<rgba32float, write>;
 #else
-@group(0) @binding(7) var color: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(auto) var color: texture_storage_2d<rgba16float, write>;
 #endif
 // Texture-space hit position (w = 1), zero on a miss; only `cs_iso` writes it.
-@group(0) @binding(8) var hit: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(auto) var hit: texture_storage_2d<rgba32float, write>;
 
 // True when invocation `id` is a pixel of the viewport (the grid is rounded up).
 fn pixel_in_viewport(id: vec3<u32>) -> bool {

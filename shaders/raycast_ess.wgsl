@@ -14,8 +14,8 @@
 #import "common/raymarch.wgsl"
 #import "common/empty_blocks.wgsl"
 
-@group(0) @binding(5) var entry: texture_2d<f32>;
-@group(0) @binding(6) var dir: texture_2d<f32>;
+@group(0) @binding(auto) var entry: texture_2d<f32>;
+@group(0) @binding(auto) var dir: texture_2d<f32>;
 
 // Rust twin: `EssParamsGpu` in crates/passes/src/raycast_ess.rs.
 struct EssParams {
@@ -25,7 +25,7 @@ struct EssParams {
     _pad2: u32,
 }
 
-@group(0) @binding(7) var<uniform> ess: EssParams;
+@group(0) @binding(auto) var<uniform> ess: EssParams;
 
 struct RaycastOut {
     @location(0) color: vec4<f32>,

@@ -40,17 +40,17 @@ struct FastParams {
 }
 
 #if COLOR_F32
-@group(0) @binding(9) var color: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(auto) var color: texture_storage_2d<rgba32float, write>;
 #else
-@group(0) @binding(9) var color: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(auto) var color: texture_storage_2d<rgba16float, write>;
 #endif
-@group(0) @binding(10) var<uniform> fast: FastParams;
+@group(0) @binding(auto) var<uniform> fast: FastParams;
 // Chebyshev distance in blocks to the nearest block that may be visible (0: this one may be).
-@group(0) @binding(11) var distance: texture_3d<f32>;
+@group(0) @binding(auto) var distance: texture_3d<f32>;
 // (rgb·α', α') per scalar, α' corrected for the step (opacity_lut.wgsl).
-@group(0) @binding(12) var corrected: texture_2d<f32>;
+@group(0) @binding(auto) var corrected: texture_2d<f32>;
 // Samples taken per image row (row y adds into samples[y % SAMPLE_ROWS]; the benchmark sums them).
-@group(0) @binding(13) var<storage, read_write> samples: array<atomic<u32>>;
+@group(0) @binding(auto) var<storage, read_write> samples: array<atomic<u32>>;
 const SAMPLE_ROWS: u32 = 4096u;
 
 // One front-to-back step at `u` (common/raymarch.wgsl's composite_sample when !CORRECTED).

@@ -9,7 +9,7 @@
 #import "common/segment.wgsl"
 
 // Fragment invocations since the counter was last cleared (the node clears it every frame).
-@group(0) @binding(8) var<storage, read_write> invocations: atomic<u32>;
+@group(0) @binding(auto) var<storage, read_write> invocations: atomic<u32>;
 
 struct SegmentOut {
     @location(0) accum: vec4<f32>,

@@ -23,8 +23,8 @@ struct SplatParams {
 
 // Last frame's leap hits: xyz texture space, w = 1 (surface) or 0.5 (exit point); w = 0 where
 // there was no ray.
-@group(0) @binding(5) var hits: texture_2d<f32>;
-@group(0) @binding(6) var<uniform> splat: SplatParams;
+@group(0) @binding(auto) var hits: texture_2d<f32>;
+@group(0) @binding(auto) var<uniform> splat: SplatParams;
 
 struct SplatVertex {
     @builtin(position) clip: vec4<f32>,

@@ -25,7 +25,7 @@ struct SliceParams {
     _pad2: f32,
 }
 
-@group(0) @binding(4) var<uniform> slices: SliceParams;
+@group(0) @binding(auto) var<uniform> slices: SliceParams;
 
 struct SliceVertex {
     @builtin(position) clip: vec4<f32>,

@@ -19,7 +19,7 @@
 #import "common/empty_blocks.wgsl"
 
 // The accumulated colour RES after the segment just drawn.
-@group(0) @binding(9) var accum: texture_2d<f32>;
+@group(0) @binding(auto) var accum: texture_2d<f32>;
 
 struct DepthOut {
     @builtin(frag_depth) depth: f32,

@@ -8,7 +8,7 @@
 
 #import "common/frame.wgsl"
 
-@group(0) @binding(12) var empty: texture_3d<f32>;
+@group(0) @binding(auto) var empty: texture_3d<f32>;
 
 // The block holding texture-space position `u`: floor(u·n / B), clamped to the grid.
 fn block_of(u: vec3<f32>, block_size: u32) -> vec3<u32> {

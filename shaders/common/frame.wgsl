@@ -35,7 +35,7 @@ struct Frame {
     _pad1: u32,
 }
 
-@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(auto) var<uniform> frame: Frame;
 
 // World position -> texture-space position (docs/rendering_model.md "Volume and world space").
 fn texture_from_world(p: vec3<f32>) -> vec3<f32> {

@@ -24,4 +24,4 @@ struct RaycastParams {
     _pad2: f32,
 }
 
-@group(0) @binding(4) var<uniform> params: RaycastParams;
+@group(0) @binding(auto) var<uniform> params: RaycastParams;

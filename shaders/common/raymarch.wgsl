@@ -79,7 +79,7 @@ fn corrected_alpha(a_tf: f32) -> f32 {
 #if PREINTEGRATION
 // The pre-integration table (crates/passes/src/preintegration.rs): texel (i, j) holds the
 // premultiplied RGBA of a segment from scalar i/(N-1) to j/(N-1), N×N, filtered linearly.
-@group(0) @binding(14) var preintegrated: texture_2d<f32>;
+@group(0) @binding(auto) var preintegrated: texture_2d<f32>;
 
 fn lookup_preintegrated(s_front: f32, s_back: f32) -> vec4<f32> {
     let n = vec2<f32>(textureDimensions(preintegrated));

@@ -13,9 +13,9 @@
 #import "common/raymarch.wgsl"
 
 // (u0, 1) where the pixel's ray enters the box, (0,0,0,0) where it misses.
-@group(0) @binding(5) var entry: texture_2d<f32>;
+@group(0) @binding(auto) var entry: texture_2d<f32>;
 // (d_tex, len_tex); (0,0,0,0) for no ray.
-@group(0) @binding(6) var dir: texture_2d<f32>;
+@group(0) @binding(auto) var dir: texture_2d<f32>;
 
 // Rust twin: `SegmentParamsGpu` in crates/passes/src/raycast_segment.rs.
 struct SegmentParams {
@@ -28,7 +28,7 @@ struct SegmentParams {
     _pad0: u32,
 }
 
-@group(0) @binding(7) var<uniform> segment: SegmentParams;
+@group(0) @binding(auto) var<uniform> segment: SegmentParams;
 
 // The depth segments are drawn at. The early-z buffer holds 0 for live rays and 1 for
 // terminated ones; with depth compare Greater (the paper's GREATER) a segment fragment passes

@@ -2,11 +2,11 @@
 // Conventions: docs/rendering_model.md ("Volume and world space", "Classification").
 
 // Normalized scalar values, sampled trilinearly with clamp-to-edge: s(u) of the rendering model.
-@group(0) @binding(1) var volume: texture_3d<f32>;
+@group(0) @binding(auto) var volume: texture_3d<f32>;
 // Filtering sampler, clamp-to-edge on every axis (used for `volume` and `tf`).
-@group(0) @binding(2) var linear_clamp: sampler;
+@group(0) @binding(auto) var linear_clamp: sampler;
 // The transfer-function LUT as an N×1 RGBA texture (straight colour, alpha per unit step).
-@group(0) @binding(3) var tf: texture_2d<f32>;
+@group(0) @binding(auto) var tf: texture_2d<f32>;
 
 // s(u): the normalized scalar at texture-space position `u`, trilinear.
 fn sample_trilinear(u: vec3<f32>) -> f32 {

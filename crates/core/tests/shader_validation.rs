@@ -75,38 +75,32 @@ fn every_shader_validates() {
     assert!(failures.is_empty(), "{} shader(s) failed:\n\n{}", failures.len(), failures.join("\n\n"));
 }
 
-/// The executor binds by global name (naga reflection), so binding numbers are free per module,
-/// but everything is in @group(0), and a module that imports a shared common file keeps that
-/// file's globals at the slots it declares (binding numbers are unique within a module: naga's
-/// validator already rejects a clash).
+/// The executor binds by global name (naga reflection), so binding numbers only have to be
+/// distinct within a module: every built-in shader declares `@binding(auto)` and the assembler
+/// numbers them (`shader_source::number_auto_bindings`) across `#import`ed files — no file has
+/// to know another's numbers. Everything is in @group(0), and after assembly the numbers are
+/// distinct (naga's validator rejects a clash).
 #[test]
-fn bindings_are_in_group_zero_and_shared_globals_keep_their_slots() {
+fn bindings_are_in_group_zero_and_numbered_from_declarations() {
     let root = default_shader_root();
-    // (global, declaring file, binding)
-    let shared = [
-        ("frame", "common/frame.wgsl", 0),
-        ("volume", "common/volume.wgsl", 1),
-        ("linear_clamp", "common/volume.wgsl", 2),
-        ("tf", "common/volume.wgsl", 3),
-        ("params", "common/raycast_params.wgsl", 4),
-    ];
     let mut failures = Vec::new();
     for name in wgsl_files(&root, "") {
-        let Ok((module, files)) = validate(&root, &name) else {
+        let text = std::fs::read_to_string(root.join(&name)).unwrap_or_default();
+        for (i, line) in text.lines().enumerate() {
+            if line.contains("@binding(") && !line.contains("@binding(auto)") && !line.trim_start().starts_with("//") {
+                failures.push(format!("shaders/{name}:{}: a hand-numbered binding; write @binding(auto)", i + 1));
+            }
+        }
+        let Ok((module, _)) = validate(&root, &name) else {
             continue; // reported by `every_shader_validates`
         };
-        let imports = |common: &str| files.iter().any(|f| f.ends_with(common));
+        let mut seen = std::collections::BTreeSet::new();
         for (global, group, binding) in bindings(&module) {
             if group != 0 {
                 failures.push(format!("shaders/{name}: `{global}` is in @group({group}); everything is in @group(0)"));
             }
-            if let Some((_, file, want)) = shared.iter().find(|(n, _, _)| *n == global)
-                && imports(file)
-                && binding != *want
-            {
-                failures.push(format!(
-                    "shaders/{name}: `{global}` (from shaders/{file}) is at @binding({binding}), expected {want}"
-                ));
+            if !seen.insert(binding) {
+                failures.push(format!("shaders/{name}: binding {binding} used twice"));
             }
         }
     }

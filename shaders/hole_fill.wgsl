@@ -13,7 +13,7 @@
 
 // Rust twin: `HoleParamsGpu` in crates/passes/src/hole_fill.rs.
 struct HoleParams {
-    band: i32,
+    silhouette_band: i32,
     extend: i32,
     _pad1: i32,
     _pad2: i32,
@@ -35,7 +35,7 @@ fn entry_of(p: vec2<i32>) -> vec4<f32> {
 // do.
 fn near_silhouette(pixel: vec2<i32>) -> bool {
     let size = vec2<i32>(frame.viewport.xy);
-    let b = holes.band;
+    let b = holes.silhouette_band;
     let corners = array<vec2<i32>, 4>(vec2<i32>(-b, -b), vec2<i32>(b, -b), vec2<i32>(-b, b), vec2<i32>(b, b));
     for (var i = 0u; i < 4u; i += 1u) {
         let q = clamp(pixel + corners[i], vec2<i32>(0), size - vec2<i32>(1));

@@ -7,8 +7,9 @@
 //!   buffer (`uniform_bytes()`), and the WGSL struct text it must match (`wgsl_struct()`),
 //!   which [`check_wgsl_struct`] compares with a shader's struct through naga.
 //!
-//! Types are `f32` (a float parameter) and `u32` (an unsigned one); both are 4 bytes, so the
-//! struct has no padding inside and its layout is the declaration order.
+//! Types are `f32` (a float parameter), `u32` (an unsigned one) and `i32` (an unsigned parameter
+//! a shader uses in signed arithmetic); all are 4 bytes, so the struct has no padding inside and
+//! its layout is the declaration order.
 
 /// Declares a pass's parameters once (module docs). Example:
 ///
@@ -71,8 +72,14 @@ macro_rules! pass_params {
     (@spec u32, $n:expr, $d:expr, $lo:expr, $hi:expr, $doc:expr) => {
         $crate::ParamSpec::uint($n, $d as u64, $lo as u64, $hi as u64, $doc)
     };
+    // A count a shader uses in signed arithmetic (loop bounds around a pixel): declared and
+    // checked as an unsigned parameter, uploaded as i32.
+    (@spec i32, $n:expr, $d:expr, $lo:expr, $hi:expr, $doc:expr) => {
+        $crate::ParamSpec::uint($n, $d as u64, $lo as u64, $hi as u64, $doc)
+    };
     (@get f32, $p:expr, $n:expr) => { $p.float($n) as f32 };
     (@get u32, $p:expr, $n:expr) => { $p.uint($n) as u32 };
+    (@get i32, $p:expr, $n:expr) => { $p.uint($n) as i32 };
 }
 
 /// The WGSL text of a parameter struct: `struct NAME { a: f32, b: u32, _pad0: f32, ... }`,
@@ -108,6 +115,7 @@ pub fn check_wgsl_struct(source: &str, name: &str, fields: &[(&str, &str)]) -> R
         let got = match &module.types[m.ty].inner {
             naga::TypeInner::Scalar(naga::Scalar { kind: naga::ScalarKind::Float, width: 4 }) => "f32",
             naga::TypeInner::Scalar(naga::Scalar { kind: naga::ScalarKind::Uint, width: 4 }) => "u32",
+            naga::TypeInner::Scalar(naga::Scalar { kind: naga::ScalarKind::Sint, width: 4 }) => "i32",
             _ => "another type",
         };
         let member = m.name.as_deref().unwrap_or("?");

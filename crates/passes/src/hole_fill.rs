@@ -15,22 +15,15 @@ use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec,
 /// The plugin.
 pub struct HoleFill;
 
-/// Rust twin of `HoleParams` in `shaders/hole_fill.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct HoleParamsGpu {
-    band: i32,
-    extend: i32,
-    _pad: [i32; 2],
-}
-
-impl HoleParamsGpu {
-    fn from_params(params: &Params) -> Self {
-        Self { band: params.uint("silhouette_band") as i32, extend: params.uint("extend") as i32, _pad: [0; 2] }
+volgraph_core::pass_params! {
+    /// The parameters, declared once: spec, typed values and `HoleParams` of
+    /// `shaders/hole_fill.wgsl` (a test compares the two).
+    pub struct HoleParams {
+        silhouette_band: i32 = 2, 0..=8,
+            "pixels this close to the footprint's edge start at the box (at least the splat's half size)";
+        extend: i32 = 1, 0..=4, "a hole takes the nearest start among the splats this many pixels around it";
     }
 }
-
-const _: () = assert!(std::mem::size_of::<HoleParamsGpu>() == 16);
 
 impl PassPlugin for HoleFill {
     fn kind(&self) -> &'static str {
@@ -42,22 +35,7 @@ impl PassPlugin for HoleFill {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        vec![
-            ParamSpec::uint(
-                "silhouette_band",
-                2,
-                0,
-                8,
-                "pixels this close to the footprint's edge start at the box (at least the splat's half size)",
-            ),
-            ParamSpec::uint(
-                "extend",
-                1,
-                0,
-                4,
-                "a hole takes the nearest start among the splats this many pixels around it",
-            ),
-        ]
+        HoleParams::specs()
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -83,7 +61,8 @@ impl PassPlugin for HoleFill {
             extra_bindings: &["holes"],
             ..Default::default()
         })?;
-        let uniform = ctx.uniform_with("holes", &HoleParamsGpu::from_params(ctx.params));
+        let uniform = ctx.uniform_buffer("holes", 16);
+        ctx.gpu.queue.write_buffer(&uniform, 0, &HoleParams::from_params(ctx.params).uniform_bytes());
         Ok(Box::new(HoleFillNode { pipeline, uniform }))
     }
 }
@@ -102,6 +81,20 @@ impl PassNode for HoleFillNode {
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
-        gpu.queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&HoleParamsGpu::from_params(params)));
+        gpu.queue.write_buffer(&self.uniform, 0, &HoleParams::from_params(params).uniform_bytes());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::HoleParams;
+
+    /// The shader's `HoleParams` is the struct `pass_params!` uploads.
+    #[test]
+    fn the_shader_struct_matches_the_declaration() {
+        let source =
+            volgraph_core::shader_source::assemble(&crate::builtin_shaders(), "hole_fill.wgsl").expect("assembles");
+        let fields: Vec<(&str, &str)> = HoleParams::specs().iter().map(|s| (s.name, "i32")).collect();
+        volgraph_core::declare::check_wgsl_struct(&source.text, "HoleParams", &fields).expect("same layout");
     }
 }

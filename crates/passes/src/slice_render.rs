@@ -14,15 +14,21 @@ use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec,
 /// The plugin.
 pub struct SliceRender;
 
-/// Rust twin of `struct SliceParams` in `shaders/slice_render.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct SliceParamsGpu {
-    slice_voxels: f32,
-    _pad: [f32; 3],
+volgraph_core::pass_params! {
+    /// The plane spacing, declared once: spec, typed value and `SliceParams` of
+    /// `shaders/slice_render.wgsl` (a test compares the two).
+    pub struct SliceParams {
+        slice_voxels: f32 = 0.5, 0.01..=16.0, "distance between planes in units of the smallest voxel side";
+    }
 }
 
-const _: () = assert!(std::mem::size_of::<SliceParamsGpu>() == 16);
+volgraph_core::pass_params! {
+    /// What stays on the CPU: the instance count bound.
+    pub struct SliceLimits {
+        max_slices: u32 = 8192, 1..=1048576,
+            "upper bound on planes drawn; the default covers a 2048³ volume's diagonal at 0.5 voxel spacing";
+    }
+}
 
 impl PassPlugin for SliceRender {
     fn kind(&self) -> &'static str {
@@ -34,22 +40,7 @@ impl PassPlugin for SliceRender {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        vec![
-            ParamSpec::float(
-                "slice_voxels",
-                0.5,
-                0.01,
-                16.0,
-                "distance between planes in units of the smallest voxel side",
-            ),
-            ParamSpec::uint(
-                "max_slices",
-                8192,
-                1,
-                1 << 20,
-                "upper bound on planes drawn; the default covers a 2048³ volume's diagonal at 0.5 voxel spacing",
-            ),
-        ]
+        [SliceParams::specs(), SliceLimits::specs()].concat()
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -74,9 +65,8 @@ impl PassPlugin for SliceRender {
             ..Default::default()
         })?;
         let slices = ctx.uniform_buffer("slices", 16);
-        let p = SliceParamsGpu { slice_voxels: ctx.params.float("slice_voxels") as f32, _pad: [0.0; 3] };
-        ctx.gpu.queue.write_buffer(&slices, 0, bytemuck::bytes_of(&p));
-        Ok(Box::new(SliceRenderNode { pipeline, slices, max_slices: ctx.params.uint("max_slices") as u32 }))
+        ctx.gpu.queue.write_buffer(&slices, 0, &SliceParams::from_params(ctx.params).uniform_bytes());
+        Ok(Box::new(SliceRenderNode { pipeline, slices, max_slices: SliceLimits::from_params(ctx.params).max_slices }))
     }
 }
 
@@ -94,5 +84,19 @@ impl PassNode for SliceRenderNode {
         pass.set_bind_group(0, &bg, &[]);
         pass.draw(0..12, 0..self.max_slices);
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::SliceParams;
+
+    /// The shader's `SliceParams` is the struct `pass_params!` uploads.
+    #[test]
+    fn the_shader_struct_matches_the_declaration() {
+        let source =
+            volgraph_core::shader_source::assemble(&crate::builtin_shaders(), "slice_render.wgsl").expect("assembles");
+        let fields: Vec<(&str, &str)> = SliceParams::specs().iter().map(|s| (s.name, "f32")).collect();
+        volgraph_core::declare::check_wgsl_struct(&source.text, "SliceParams", &fields).expect("same layout");
     }
 }

@@ -51,15 +51,23 @@ struct BrickParams {
 @group(0) @binding(auto) var color: texture_storage_2d<rgba16float, write>;
 #endif
 
-// The first sample index after the box [lo, hi] (voxel coordinates, faces of the volume
-// extended to the texture box like common/box.wgsl's cells) that the sample k at `p` lies in.
-fn past_box(k: u32, p: vec3<f32>, delta: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> u32 {
-    let n = frame.volume_dims.xyz;
-    let lo_u = select((lo + 0.5) / n, vec3<f32>(0.0), lo <= vec3<f32>(0.0));
-    let hi_u = select((hi + 0.5) / n, vec3<f32>(1.0), hi >= n - vec3<f32>(1.0));
-    let bound = select(lo_u, hi_u, delta > vec3<f32>(0.0));
-    let t = (bound - p) / select(delta, vec3<f32>(1.0), delta == vec3<f32>(0.0));
-    let t_axis = select(t, vec3<f32>(3.0e38), delta == vec3<f32>(0.0));
+// A ray's samples in voxel coordinates (voxel centres at integers): sample k at
+// `first + k·delta`; `inv` = 1/delta per axis (0 where the ray runs parallel to an axis), so a
+// leap costs multiplications only.
+struct VoxelRay {
+    first: vec3<f32>,
+    delta: vec3<f32>,
+    inv: vec3<f32>,
+}
+
+// The first sample index after the box [lo, hi] (voxel coordinates; a box at a face of the
+// volume extends to the face, half a voxel beyond the last centre, like common/box.wgsl's
+// cells) that sample k at `v` lies in.
+fn past_box(k: u32, v: vec3<f32>, r: VoxelRay, lo: vec3<f32>, hi: vec3<f32>, last: vec3<f32>) -> u32 {
+    let lo_v = select(lo, vec3<f32>(-0.5), lo <= vec3<f32>(0.0));
+    let hi_v = select(hi, last + vec3<f32>(0.5), hi >= last);
+    let bound = select(lo_v, hi_v, r.delta > vec3<f32>(0.0));
+    let t_axis = select((bound - v) * r.inv, vec3<f32>(3.0e38), r.delta == vec3<f32>(0.0));
     let steps = min(t_axis.x, min(t_axis.y, t_axis.z));
     return k + max(1u, u32(clamp(floor(steps) + 1.0, 0.0, f32(params.max_steps))));
 }
@@ -71,6 +79,8 @@ fn march_bricks(ray: Ray, pixel: vec2<u32>, start: vec4<f32>) -> vec4<f32> {
     begin_ray(s.first, s.delta);
     let n = frame.volume_dims.xyz;
     let last_voxel = max(n - vec3<f32>(1.0), vec3<f32>(0.0));
+    let dv = s.delta * n;
+    let r = VoxelRay(s.first * n - vec3<f32>(0.5), dv, select(vec3<f32>(1.0) / dv, vec3<f32>(0.0), dv == vec3<f32>(0.0)));
     let brick_cells = f32(bricks.grid.w);
     let leaf_cells = f32(bricks.leaves.x);
     let grid = bricks.grid.xyz;
@@ -91,8 +101,8 @@ fn march_bricks(ray: Ray, pixel: vec2<u32>, start: vec4<f32>) -> vec4<f32> {
             if (k >= s.count) {
                 break;
             }
-            let p = s.first + f32(k) * s.delta;
-            let c = clamp(p * n - vec3<f32>(0.5), vec3<f32>(0.0), last_voxel);
+            let v = r.first + f32(k) * r.delta;
+            let c = clamp(v, vec3<f32>(0.0), last_voxel);
             let l = min(vec3<u32>(c / leaf_cells), leaf_grid - vec3<u32>(1u));
             let d = leaf_distance[l.x + leaf_grid.x * (l.y + leaf_grid.y * l.z)];
             if (d > 0u) {
@@ -101,7 +111,7 @@ fn march_bricks(ray: Ray, pixel: vec2<u32>, start: vec4<f32>) -> vec4<f32> {
                 let lo_leaf = l - min(l, reach);
                 let hi_leaf = min(l + reach, leaf_grid - vec3<u32>(1u));
                 let cube_hi = min(vec3<f32>(hi_leaf + vec3<u32>(1u)) * leaf_cells, last_voxel);
-                k = past_box(k, p, s.delta, vec3<f32>(lo_leaf) * leaf_cells, cube_hi);
+                k = past_box(k, v, r, vec3<f32>(lo_leaf) * leaf_cells, cube_hi, last_voxel);
                 continue;
             }
             let b = min(vec3<u32>(c / brick_cells), grid - vec3<u32>(1u));
@@ -110,11 +120,11 @@ fn march_bricks(ray: Ray, pixel: vec2<u32>, start: vec4<f32>) -> vec4<f32> {
             entry = table[1u + b.x + grid.x * (b.y + grid.y * b.z)];
             if (entry == 0u) {
                 // Drawn in another batch.
-                k = past_box(k, p, s.delta, lo, hi);
+                k = past_box(k, v, r, lo, hi, last_voxel);
                 continue;
             }
             let leaf_lo = vec3<f32>(l) * leaf_cells;
-            exit = past_box(k, p, s.delta, leaf_lo, min(leaf_lo + vec3<f32>(leaf_cells), hi));
+            exit = past_box(k, v, r, leaf_lo, min(leaf_lo + vec3<f32>(leaf_cells), hi), last_voxel);
             break;
         }
         if (k >= s.count) {
@@ -134,7 +144,7 @@ fn march_bricks(ray: Ray, pixel: vec2<u32>, start: vec4<f32>) -> vec4<f32> {
             if (k >= end) {
                 break;
             }
-            let ck = clamp((s.first + f32(k) * s.delta) * n - vec3<f32>(0.5), lo, hi);
+            let ck = clamp(r.first + f32(k) * r.delta, lo, hi);
             out = composite_sample(out, (ck + offset) / bricks.atlas.xyz);
             k += 1u;
             if (out.a >= params.threshold) {

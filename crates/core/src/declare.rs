@@ -7,9 +7,10 @@
 //!   buffer (`uniform_bytes()`), and the WGSL struct text it must match (`wgsl_struct()`),
 //!   which [`check_wgsl_struct`] compares with a shader's struct through naga.
 //!
-//! Types are `f32` (a float parameter), `u32` (an unsigned one) and `i32` (an unsigned parameter
-//! a shader uses in signed arithmetic); all are 4 bytes, so the struct has no padding inside and
-//! its layout is the declaration order.
+//! Types are `f32` (a float parameter), `u32` (an unsigned one), `i32` (an unsigned parameter a
+//! shader uses in signed arithmetic) and `bool` (a `u32` 0 or 1 on the GPU); all are 4 bytes
+//! there, so the struct has no padding inside and its layout is the declaration order. A bool
+//! is written `flag: bool = false, false..=true, "doc";` (the range is the type's).
 
 /// Declares a pass's parameters once (module docs). Example:
 ///
@@ -53,7 +54,7 @@ macro_rules! pass_params {
             /// The values as a uniform buffer's bytes, zero-padded to a multiple of 16.
             pub fn uniform_bytes(&self) -> Vec<u8> {
                 let mut bytes = Vec::with_capacity(16);
-                $( bytes.extend_from_slice(&self.$field.to_le_bytes()); )*
+                $( bytes.extend_from_slice(&$crate::pass_params!(@bytes $ty, self.$field)); )*
                 bytes.resize(bytes.len().div_ceil(16).max(1) * 16, 0);
                 bytes
             }
@@ -61,7 +62,7 @@ macro_rules! pass_params {
             /// The WGSL struct the shader declares for these parameters (same name, same
             /// fields in the same order, padded to 16 bytes).
             pub fn wgsl_struct() -> String {
-                let fields: &[(&str, &str)] = &[ $( (stringify!($field), stringify!($ty)), )* ];
+                let fields: &[(&str, &str)] = &[ $( (stringify!($field), $crate::pass_params!(@wgsl $ty)), )* ];
                 $crate::declare::wgsl_struct_text(stringify!($name), fields)
             }
         }
@@ -77,6 +78,14 @@ macro_rules! pass_params {
     (@spec i32, $n:expr, $d:expr, $lo:expr, $hi:expr, $doc:expr) => {
         $crate::ParamSpec::uint($n, $d as u64, $lo as u64, $hi as u64, $doc)
     };
+    (@spec bool, $n:expr, $d:expr, $lo:expr, $hi:expr, $doc:expr) => {
+        $crate::ParamSpec::boolean($n, $d, $doc)
+    };
+    (@get bool, $p:expr, $n:expr) => { $p.boolean($n) };
+    (@bytes bool, $e:expr) => { u32::from($e).to_le_bytes() };
+    (@bytes $ty:ident, $e:expr) => { $e.to_le_bytes() };
+    (@wgsl bool) => { "u32" };
+    (@wgsl $ty:ident) => { stringify!($ty) };
     (@get f32, $p:expr, $n:expr) => { $p.float($n) as f32 };
     (@get u32, $p:expr, $n:expr) => { $p.uint($n) as u32 };
     (@get i32, $p:expr, $n:expr) => { $p.uint($n) as i32 };
@@ -163,5 +172,26 @@ mod tests {
         let swapped = "struct Knobs { taps: u32, strength: f32 }";
         let err = super::check_wgsl_struct(swapped, "Knobs", &fields).expect_err("order differs");
         assert!(err.contains("member 0 is `taps: u32`"), "{err}");
+    }
+}
+
+#[cfg(test)]
+mod bool_tests {
+    crate::pass_params! {
+        /// With a flag.
+        pub struct Flags {
+            on: bool = true, false..=true, "a switch";
+            gain: f32 = 2.0, 0.0..=4.0, "a gain";
+        }
+    }
+
+    #[test]
+    fn a_bool_is_a_boolean_parameter_and_a_u32_on_the_gpu() {
+        let specs = Flags::specs();
+        assert!(matches!(specs[0].kind, crate::params::ParamKind::Bool { default: true }));
+        let f = Flags::from_params(&crate::Params::defaults(&specs));
+        assert_eq!(f, Flags { on: true, gain: 2.0 });
+        assert_eq!(&f.uniform_bytes()[0..4], &1u32.to_le_bytes());
+        assert!(Flags::wgsl_struct().contains("on: u32,"));
     }
 }

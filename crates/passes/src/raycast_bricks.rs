@@ -49,6 +49,25 @@ use crate::raycast_params::{RaycastParamsGpu, raycast_param_specs};
 /// The plugin.
 pub struct RaycastBricks;
 
+volgraph_core::pass_params! {
+    /// The brick pass's own parameters, declared once (the raycasting ones are shared with the
+    /// other raycasters: `raycast_param_specs`).
+    pub struct BrickSettings {
+        brick_cells: u32 = 32, 2..=512, "cells per brick side (§5; the paper's best is 64)";
+        node_cells: u32 = 8, 0..=512,
+            "octree node-size limit in cells (§7; 0: no octree, a brick is drawn whole when it is not empty)";
+        ratio: f32 = 0.5, 0.0..=1.0,
+            "octree ratio rule: a node whose visible-cell ratio reaches this is drawn whole, below it split (§7)";
+        pool_mb: u32 = 0, 0..=1048576,
+            "brick pool budget in MiB (0: the runtime's --gpu-memory-mb, else what the adapter allows)";
+        ranks: u32 = 1, 1..=4096,
+            "sort-last rendering (docs/scaling.md): the bricks are split into this many slabs of the brick grid along its longest axis, one per rank";
+        rank: u32 = 0, 0..=4095, "with ranks > 1: the slab of bricks this pass draws (0-based)";
+        workgroup_x: u32 = 8, 1..=256, "workgroup width in pixels";
+        workgroup_y: u32 = 8, 1..=256, "workgroup height in pixels";
+    }
+}
+
 /// The pool's budget when neither the pass nor the runtime sets one: 2 GiB, within what the
 /// atlas's 3D texture limit allows.
 const DEFAULT_BUDGET_BYTES: u64 = 2 << 30;
@@ -84,39 +103,7 @@ impl PassPlugin for RaycastBricks {
             .into_iter()
             .filter(|s| matches!(s.name, "step_voxels" | "threshold" | "max_steps" | "jitter"))
             .collect();
-        p.push(ParamSpec::uint("brick_cells", 32, 2, 512, "cells per brick side (§5; the paper's best is 64)"));
-        p.push(ParamSpec::uint(
-            "node_cells",
-            8,
-            0,
-            512,
-            "octree node-size limit in cells (§7; 0: no octree, a brick is drawn whole when it is not empty)",
-        ));
-        p.push(ParamSpec::float(
-            "ratio",
-            0.5,
-            0.0,
-            1.0,
-            "octree ratio rule: a node whose visible-cell ratio reaches this is drawn whole, below it split (§7)",
-        ));
-        p.push(ParamSpec::uint(
-            "pool_mb",
-            0,
-            0,
-            1 << 20,
-            "brick pool budget in MiB (0: the runtime's --gpu-memory-mb, else what the adapter allows)",
-        ));
-        p.push(ParamSpec::uint(
-            "ranks",
-            1,
-            1,
-            4096,
-            "sort-last rendering (docs/scaling.md): the bricks are split into this many slabs of the brick grid \
-             along its longest axis, one per rank",
-        ));
-        p.push(ParamSpec::uint("rank", 0, 0, 4095, "with ranks > 1: the slab of bricks this pass draws (0-based)"));
-        p.push(ParamSpec::uint("workgroup_x", 8, 1, 256, "workgroup width in pixels"));
-        p.push(ParamSpec::uint("workgroup_y", 8, 1, 256, "workgroup height in pixels"));
+        p.extend(BrickSettings::specs());
         p
     }
 
@@ -137,14 +124,14 @@ impl PassPlugin for RaycastBricks {
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        ["workgroup_x", "workgroup_y", "brick_cells", "node_cells", "pool_mb", "ranks", "rank"]
-            .iter()
-            .all(|p| old.uint(p) == new.uint(p))
-            && old.float("ratio") == new.float("ratio")
+        // Only the raycasting parameters (a uniform) change in place; the brick settings
+        // shape the pool and the leaves.
+        BrickSettings::from_params(old) == BrickSettings::from_params(new)
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let wg = (ctx.params.uint("workgroup_x") as u32, ctx.params.uint("workgroup_y") as u32);
+        let settings = BrickSettings::from_params(ctx.params);
+        let wg = (settings.workgroup_x, settings.workgroup_y);
         if wg.0 * wg.1 > ctx.gpu.limits.max_compute_invocations_per_workgroup {
             return Err(PassError {
                 pass: ctx.pass_id.to_string(),
@@ -167,8 +154,8 @@ impl PassPlugin for RaycastBricks {
         })?;
         let params = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
         let uniform = ctx.uniform_buffer("bricks", std::mem::size_of::<BrickParamsGpu>() as u64);
-        let brick_cells = ctx.params.uint("brick_cells") as u32;
-        let node_cells = match ctx.params.uint("node_cells") as u32 {
+        let brick_cells = settings.brick_cells;
+        let node_cells = match settings.node_cells {
             0 => brick_cells,
             n => n.min(brick_cells),
         };
@@ -181,8 +168,7 @@ impl PassPlugin for RaycastBricks {
                 ),
             });
         }
-        let ranks = ctx.params.uint("ranks") as u32;
-        let rank = ctx.params.uint("rank") as u32;
+        let (ranks, rank) = (settings.ranks, settings.rank);
         if rank >= ranks {
             return Err(PassError {
                 pass: ctx.pass_id.to_string(),
@@ -197,8 +183,8 @@ impl PassPlugin for RaycastBricks {
             workgroup: wg,
             brick_cells,
             node_cells,
-            ratio: ctx.params.float("ratio") as f32,
-            pool_mb: ctx.params.uint("pool_mb"),
+            ratio: settings.ratio,
+            pool_mb: settings.pool_mb as u64,
             volume: None,
             acc: None,
             tables: None,

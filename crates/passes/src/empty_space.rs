@@ -53,6 +53,14 @@ pub(crate) fn check_block_grid(
     Ok(())
 }
 
+volgraph_core::pass_params! {
+    /// The pass's parameters, declared once.
+    pub struct ClassifySettings {
+        segments: bool = false, false..=true,
+            "classify for pre-integrated segments: a block is empty only if its neighbours' values are invisible too (a segment spans two adjacent blocks; wire to feature.preintegration)";
+    }
+}
+
 impl PassPlugin for EmptySpace {
     fn kind(&self) -> &'static str {
         "empty_space"
@@ -76,16 +84,11 @@ impl PassPlugin for EmptySpace {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        vec![ParamSpec::boolean(
-            "segments",
-            false,
-            "classify for pre-integrated segments: a block is empty only if its neighbours' values are invisible \
-             too (a segment spans two adjacent blocks; wire to feature.preintegration)",
-        )]
+        ClassifySettings::specs()
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        if params.boolean("segments") { vec!["SEGMENTS"] } else { Vec::new() }
+        if ClassifySettings::from_params(params).segments { vec!["SEGMENTS"] } else { Vec::new() }
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {

@@ -31,6 +31,16 @@ struct SplatParamsGpu {
 
 const _: () = assert!(std::mem::size_of::<SplatParamsGpu>() == 32);
 
+volgraph_core::pass_params! {
+    /// The pass's parameters, declared once (the GPU block adds the screen rectangle the node
+    /// computes per frame, so it stays a struct of its own).
+    pub struct SplatSettings {
+        splat_size: u32 = 2, 1..=16, "splat edge k in pixels (the paper: two or four closes the gaps)";
+        block: u32 = 1, 1..=4,
+            "hits per splat side: one splat carries the nearest of a block×block of hits (block² fewer quads; the paper: 1)";
+    }
+}
+
 impl PassPlugin for ReprojectionSplat {
     fn kind(&self) -> &'static str {
         "reprojection_splat"
@@ -41,16 +51,7 @@ impl PassPlugin for ReprojectionSplat {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        vec![
-            ParamSpec::uint("splat_size", 2, 1, 16, "splat edge k in pixels (the paper: two or four closes the gaps)"),
-            ParamSpec::uint(
-                "block",
-                1,
-                1,
-                4,
-                "hits per splat side: one splat carries the nearest of a block×block of hits (block² fewer quads; the paper: 1)",
-            ),
-        ]
+        SplatSettings::specs()
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -83,7 +84,8 @@ impl PassPlugin for ReprojectionSplat {
             ..Default::default()
         })?;
         let uniform = ctx.uniform_buffer("splat", std::mem::size_of::<SplatParamsGpu>() as u64);
-        let (size, block) = (ctx.params.uint("splat_size") as f32, ctx.params.uint("block") as u32);
+        let settings = SplatSettings::from_params(ctx.params);
+        let (size, block) = (settings.splat_size as f32, settings.block);
         Ok(Box::new(SplatNode { pipeline, uniform, size, block, written: None }))
     }
 }
@@ -149,8 +151,9 @@ impl PassNode for SplatNode {
     }
 
     fn update_params(&mut self, _gpu: &Gpu, params: &Params) {
-        self.size = params.uint("splat_size") as f32;
-        self.block = params.uint("block") as u32;
+        let settings = SplatSettings::from_params(params);
+        self.size = settings.splat_size as f32;
+        self.block = settings.block;
         self.written = None;
     }
 }

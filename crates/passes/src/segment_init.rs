@@ -11,11 +11,18 @@ use volgraph_core::runtime::{
 };
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
+volgraph_core::pass_params! {
+    /// The pass's parameters, declared once.
+    pub struct InitSettings {
+        with_hit: bool = false, false..=true, "also clear a hit-position target for isosurface segments";
+    }
+}
+
 /// The plugin.
 pub struct SegmentInit;
 
 fn fragment(params: &Params) -> &'static str {
-    if params.boolean("with_hit") { "fs_init_hit" } else { "fs_init" }
+    if InitSettings::from_params(params).with_hit { "fs_init_hit" } else { "fs_init" }
 }
 
 /// The value the early-z buffer holds for a live ray (the paper's "z = 0").
@@ -31,7 +38,7 @@ impl PassPlugin for SegmentInit {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        vec![ParamSpec::boolean("with_hit", false, "also clear a hit-position target for isosurface segments")]
+        InitSettings::specs()
     }
 
     fn ports(&self, params: &Params) -> Vec<PortSpec> {
@@ -39,7 +46,7 @@ impl PassPlugin for SegmentInit {
             PortSpec::write("accum", PortKind::target(&ACCUM_FORMATS)),
             PortSpec::write("depth", PortKind::target(&[TargetFormat::Depth32Float])),
         ];
-        if params.boolean("with_hit") {
+        if InitSettings::from_params(params).with_hit {
             ports.push(PortSpec::write("hit", PortKind::target(&HIT_FORMATS)));
         }
         ports

@@ -180,3 +180,18 @@ fn a_shader_error_points_at_the_imported_file_and_line() {
     let p: Vec<String> = check_plan_bindings(&plan, &registry, &sources).into_iter().map(|d| d.message).collect();
     assert!(p.len() == 1 && p[0].contains("lib.wgsl:2:"), "{p:?}");
 }
+
+const SAMPLES_OUTPUT: &str = r#"
+@group(0) @binding(0) var color: texture_2d<f32>;
+@group(0) @binding(1) var out: texture_2d<f32>;
+@compute @workgroup_size(8, 8)
+fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let a = textureLoad(color, vec2<i32>(id.xy), 0) + textureLoad(out, vec2<i32>(id.xy), 0);
+}
+"#;
+
+#[test]
+fn a_sampled_output_is_caught_at_plan_time() {
+    let p = problems("cs_main", SAMPLES_OUTPUT);
+    assert!(p.len() == 1 && p[0].contains("global \"out\" samples output port \"out\""), "{p:?}");
+}

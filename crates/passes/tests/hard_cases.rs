@@ -196,9 +196,16 @@ fn sixteen_bit_ml(dtype: &str, endianness: volgraph_accel::load::Endianness) -> 
         })
         .collect();
     let order = if endianness == Endianness::Big { "be" } else { "le" };
-    let path = std::env::temp_dir().join(format!("volgraph_hard_ml{order}_24x24x24_{dtype}.raw"));
+    // A directory of its own per call: tests run in parallel and two of them write the same
+    // name (the name carries the dims and type the loader reads).
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("volgraph_hard_{}_{call}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join(format!("ml{order}_24x24x24_{dtype}.raw"));
     std::fs::write(&path, bytes).expect("temp file");
     let loaded = load_volume(&path, &RawOptions { endianness, ..RawOptions::default() }).expect("loads");
+    let _ = std::fs::remove_dir_all(&dir);
     loaded.volume
 }
 

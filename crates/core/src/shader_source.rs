@@ -22,7 +22,9 @@ use std::path::{Path, PathBuf};
 #[derive(Clone, Debug, thiserror::Error, PartialEq)]
 pub enum ShaderSourceError {
     /// No layer has the file.
-    #[error("{file}: no such shader (searched: {searched})")]
+    #[error(
+        "{file}: no such shader (searched: {searched}); a graph's own shaders (WGSL-only kinds) go in a shaders/ folder beside the graph file or its parent"
+    )]
     NotFound {
         /// The relative name.
         file: String,

@@ -147,35 +147,70 @@ impl Params {
         self.values.iter().map(|(k, v)| (k.as_str(), v))
     }
 
-    /// A float parameter; 0 if the plugin asks for one it did not declare (a plugin bug that
-    /// the plugin's own tests catch).
+    /// The value of a declared parameter. Asking for one the plugin never declared is a plugin
+    /// bug: debug builds (every test) panic naming it, so a misspelled name cannot silently read
+    /// as 0; release builds fall back to 0 / false / "". A plugin that reads a parameter some of
+    /// its variants do not declare says so with [`Self::float_or`] and friends.
+    fn declared(&self, name: &str, ty: &str) -> Option<&ParamValue> {
+        let v = self.values.get(name);
+        debug_assert!(
+            v.is_some(),
+            "parameter \"{name}\" ({ty}) was never declared by this pass (declared: {:?}); a misspelled name, \
+             or use {ty}_or for one some variants lack",
+            self.values.keys().collect::<Vec<_>>()
+        );
+        v
+    }
+
+    /// A float parameter (an integer one widens).
     pub fn float(&self, name: &str) -> f64 {
-        match self.values.get(name) {
+        match self.declared(name, "float") {
             Some(ParamValue::Float(v)) => *v,
             Some(ParamValue::UInt(v)) => *v as f64,
             _ => 0.0,
         }
     }
 
-    /// An integer parameter (0 if undeclared, as [`Self::float`]).
+    /// An integer parameter.
     pub fn uint(&self, name: &str) -> u64 {
-        match self.values.get(name) {
+        match self.declared(name, "uint") {
             Some(ParamValue::UInt(v)) => *v,
             _ => 0,
         }
     }
 
-    /// A boolean parameter (false if undeclared).
+    /// A boolean parameter.
     pub fn boolean(&self, name: &str) -> bool {
-        matches!(self.values.get(name), Some(ParamValue::Bool(true)))
+        matches!(self.declared(name, "boolean"), Some(ParamValue::Bool(true)))
     }
 
-    /// A choice parameter ("" if undeclared).
+    /// A choice parameter.
     pub fn choice(&self, name: &str) -> &str {
-        match self.values.get(name) {
+        match self.declared(name, "choice") {
             Some(ParamValue::Choice(v)) => v,
             _ => "",
         }
+    }
+
+    /// A float parameter the pass may not declare (a shared block filled for several pass
+    /// kinds): `default` when it is absent.
+    pub fn float_or(&self, name: &str, default: f64) -> f64 {
+        if self.values.contains_key(name) { self.float(name) } else { default }
+    }
+
+    /// An integer parameter the pass may not declare: `default` when it is absent.
+    pub fn uint_or(&self, name: &str, default: u64) -> u64 {
+        if self.values.contains_key(name) { self.uint(name) } else { default }
+    }
+
+    /// A boolean parameter the pass may not declare: `default` when it is absent.
+    pub fn boolean_or(&self, name: &str, default: bool) -> bool {
+        if self.values.contains_key(name) { self.boolean(name) } else { default }
+    }
+
+    /// A choice parameter the pass may not declare: `default` when it is absent.
+    pub fn choice_or<'a>(&'a self, name: &str, default: &'a str) -> &'a str {
+        if self.values.contains_key(name) { self.choice(name) } else { default }
     }
 }
 

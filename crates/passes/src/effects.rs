@@ -40,7 +40,7 @@ pub fn effect_shader_uses(params: &Params) -> Vec<volgraph_core::plugin::ShaderU
 /// The `#if` names of the effects `params` turn on (`jitter`, a raycast parameter, is JITTER).
 pub fn effect_defines(params: &Params) -> Vec<&'static str> {
     let mut defines: Vec<&'static str> =
-        EFFECTS.iter().filter(|(name, ..)| params.boolean(name)).map(|&(_, define, _)| define).collect();
+        EFFECTS.iter().filter(|(name, ..)| params.boolean_or(name, false)).map(|&(_, define, _)| define).collect();
     defines.extend(jitter_defines(params));
     defines
 }
@@ -48,7 +48,7 @@ pub fn effect_defines(params: &Params) -> Vec<&'static str> {
 /// `JITTER` when the `jitter` parameter is on: for passes that march the raycast samples
 /// without the other effects (the segment loop, its termination test, the fetch probe).
 pub fn jitter_defines(params: &Params) -> Vec<&'static str> {
-    match (params.boolean("jitter"), params.boolean("jitter_per_frame")) {
+    match (params.boolean_or("jitter", false), params.boolean_or("jitter_per_frame", false)) {
         (false, _) => Vec::new(),
         (true, false) => vec!["JITTER"],
         (true, true) => vec!["JITTER", "JITTER_PER_FRAME"],
@@ -61,7 +61,7 @@ pub fn same_effects(old: &Params, new: &Params) -> bool {
         .iter()
         .map(|(name, ..)| *name)
         .chain(["jitter", "jitter_per_frame"])
-        .all(|name| old.boolean(name) == new.boolean(name))
+        .all(|name| old.boolean_or(name, false) == new.boolean_or(name, false))
 }
 
 /// What a raycaster node keeps for its effects: the pre-integration table when that effect is on.

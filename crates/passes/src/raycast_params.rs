@@ -68,17 +68,19 @@ const _: () = assert!(std::mem::size_of::<RaycastParamsGpu>() == 48);
 impl RaycastParamsGpu {
     /// From checked pass parameters.
     pub fn from_params(p: &Params) -> Self {
+        // The raycasters share this block but declare only the parameters they use: what a
+        // kind does not declare is a value its shader never reads (0, as the block's padding).
         Self {
             step_voxels: p.float("step_voxels") as f32,
-            threshold: p.float("threshold") as f32,
+            threshold: p.float_or("threshold", 1.0) as f32,
             max_steps: p.uint("max_steps") as u32,
-            jitter: p.boolean("jitter") as u32,
-            iso_value: p.float("iso_value") as f32,
-            ambient: p.float("ambient") as f32,
-            diffuse: p.float("diffuse") as f32,
-            specular: p.float("specular") as f32,
-            shininess: p.float("shininess") as f32,
-            step_back: p.uint("step_back") as f32,
+            jitter: p.boolean_or("jitter", false) as u32,
+            iso_value: p.float_or("iso_value", 0.0) as f32,
+            ambient: p.float_or("ambient", 0.0) as f32,
+            diffuse: p.float_or("diffuse", 0.0) as f32,
+            specular: p.float_or("specular", 0.0) as f32,
+            shininess: p.float_or("shininess", 0.0) as f32,
+            step_back: p.uint_or("step_back", 0) as f32,
             _pad: [0.0; 2],
         }
     }
@@ -86,7 +88,7 @@ impl RaycastParamsGpu {
 
 /// Whether the parameters ask for the isosurface.
 pub fn is_iso(p: &Params) -> bool {
-    p.choice("mode") == "iso"
+    p.choice_or("mode", "dvr") == "iso"
 }
 
 /// The CPU reference settings equivalent to a raycast pass's parameters, so tests render the
@@ -94,29 +96,29 @@ pub fn is_iso(p: &Params) -> bool {
 pub fn reference_settings(p: &Params) -> RaycastSettings {
     RaycastSettings {
         step_voxels: p.float("step_voxels"),
-        threshold: p.float("threshold"),
+        threshold: p.float_or("threshold", 1.0),
         max_steps: p.uint("max_steps") as u32,
-        jitter: p.boolean("jitter"),
+        jitter: p.boolean_or("jitter", false),
         effects: volgraph_accel::reference::Effects {
-            shading: p.boolean("shading"),
-            preintegration: p.boolean("preintegration"),
-            tricubic: p.boolean("tricubic"),
+            shading: p.boolean_or("shading", false),
+            preintegration: p.boolean_or("preintegration", false),
+            tricubic: p.boolean_or("tricubic", false),
         },
         dvr_shading: Phong {
-            ambient: p.float("ambient"),
-            diffuse: p.float("diffuse"),
-            specular: p.float("specular"),
-            shininess: p.float("shininess"),
+            ambient: p.float_or("ambient", 0.0),
+            diffuse: p.float_or("diffuse", 0.0),
+            specular: p.float_or("specular", 0.0),
+            shininess: p.float_or("shininess", 0.0),
         },
         opacity_unit_voxels: 1.0,
         mode: if is_iso(p) {
             RenderMode::Isosurface {
-                iso: p.float("iso_value"),
+                iso: p.float_or("iso_value", 0.0),
                 shading: Phong {
-                    ambient: p.float("ambient"),
-                    diffuse: p.float("diffuse"),
-                    specular: p.float("specular"),
-                    shininess: p.float("shininess"),
+                    ambient: p.float_or("ambient", 0.0),
+                    diffuse: p.float_or("diffuse", 0.0),
+                    specular: p.float_or("specular", 0.0),
+                    shininess: p.float_or("shininess", 0.0),
                 },
             }
         } else {

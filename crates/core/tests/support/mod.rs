@@ -59,7 +59,7 @@ impl PassPlugin for TestPlugin {
 
     fn ports(&self, params: &volgraph_core::Params) -> Vec<PortSpec> {
         let mut ports = self.ports.clone();
-        if params.choice("mode") == "iso" {
+        if params.choice_or("mode", "dvr") == "iso" {
             ports.extend(self.iso_ports.iter().cloned());
         }
         ports

@@ -163,4 +163,17 @@ mod tests {
         let rc = layout(&plan("kruger_westermann_2003/rc.ron"));
         assert!(rc.nodes.iter().any(|n| n.group.is_some()), "the segment loop is a group");
     }
+
+    /// Painting every shipped kind of mark runs without a window (egui alone), and draws a box
+    /// per node.
+    #[test]
+    fn the_picture_paints_headless() {
+        for graph in ["klein_2005/leap_iso_aa.ron", "kruger_westermann_2003/rc.ron", "modern/fastest.ron"] {
+            let plan = plan(graph);
+            let ctx = egui::Context::default();
+            let output = ctx.run_ui(egui::RawInput::default(), |ui| show(ui, &plan));
+            let shapes = output.shapes.len();
+            assert!(shapes >= layout(&plan).nodes.len(), "{graph}: {shapes} shapes");
+        }
+    }
 }

@@ -44,6 +44,9 @@ enum Command {
     Passes {
         /// The kind to show in full.
         kind: Option<String>,
+        /// Also list the WGSL-only kinds this graph file declares (its `kinds:` block).
+        #[arg(long)]
+        graph: Option<PathBuf>,
     },
     /// Render a graph to an image (PNG: 8-bit sRGB; EXR: 32-bit float linear).
     Render {
@@ -326,8 +329,12 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             }
         },
         Command::View(args) => crate::view::run(args),
-        Command::Passes { kind } => {
-            let text = crate::passes_cmd::describe(&builtin_registry(), kind.as_deref())?;
+        Command::Passes { kind, graph } => {
+            let registry = match &graph {
+                Some(path) => crate::passes_cmd::with_graph_kinds(&builtin_registry(), path)?,
+                None => builtin_registry(),
+            };
+            let text = crate::passes_cmd::describe(&registry, kind.as_deref())?;
             crate::stdout::write_stdout(&text)?;
             Ok(())
         }

@@ -8,6 +8,13 @@ use anyhow::anyhow;
 use volgraph_core::params::ParamKind;
 use volgraph_core::{Access, Params, PassPlugin, PortKind, Registry};
 
+/// `registry` plus the WGSL-only kinds graph file `path` declares.
+pub fn with_graph_kinds(registry: &Registry, path: &std::path::Path) -> anyhow::Result<Registry> {
+    let source = crate::inputs::read_graph(path)?;
+    let doc = volgraph_core::graph::parse_graph(&source).map_err(|d| anyhow!("{}: {}", path.display(), d.message))?;
+    Ok(volgraph_core::wgsl_pass::with_graph_kinds(registry, &doc.kinds))
+}
+
 /// The listing of every kind (one line each), or the full description of `kind`.
 pub fn describe(registry: &Registry, kind: Option<&str>) -> anyhow::Result<String> {
     let Some(kind) = kind else {
@@ -107,6 +114,16 @@ mod tests {
             bricks.contains("brick_cells") && bricks.contains("default 32") && bricks.contains("voxels"),
             "{bricks}"
         );
+    }
+
+    /// `--graph` adds the graph's own WGSL-only kinds, with their declared ports and parameters.
+    #[test]
+    fn a_graphs_wgsl_only_kinds_are_listed_with_it() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/radiology/graphs/mip_enhanced.ron");
+        let registry = with_graph_kinds(&volgraph_passes::builtin_registry(), &path).expect("reads");
+        let one = describe(&registry, Some("edge_enhance")).expect("describes");
+        assert!(one.contains("unsharp masking") && one.contains("strength") && one.contains("enhanced"), "{one}");
     }
 
     #[test]

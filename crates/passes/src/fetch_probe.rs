@@ -92,13 +92,12 @@ impl PassNode for FetchProbeNode {
         if self.counted {
             ctx.clear_buffer("samples")?;
         }
-        let bg = ctx.bind_group(&self.pipeline, &[("params", self.params.as_entire_binding())])?;
-        let (w, h) = ctx.extent("color");
-        let mut pass = ctx.begin_compute_pass();
-        pass.set_pipeline(&self.pipeline.pipeline);
-        pass.set_bind_group(0, &bg, &[]);
-        pass.dispatch_workgroups(w.div_ceil(self.workgroup.0), h.div_ceil(self.workgroup.1), 1);
-        Ok(())
+        ctx.dispatch_over(
+            &self.pipeline,
+            &[("params", self.params.as_entire_binding())],
+            "color",
+            (self.workgroup.0, self.workgroup.1),
+        )
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {

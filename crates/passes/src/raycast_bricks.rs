@@ -650,11 +650,7 @@ impl PassNode for RaycastBricksNode {
                 ("acc", acc.as_entire_binding()),
                 ("volume", wgpu::BindingResource::TextureView(&atlas.view)),
             ];
-            let bg = ctx.bind_group(&self.pipeline, &extra)?;
-            let mut pass = ctx.begin_compute_pass();
-            pass.set_pipeline(&self.pipeline.pipeline);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.dispatch_workgroups(w.div_ceil(self.workgroup.0), h.div_ceil(self.workgroup.1), 1);
+            ctx.dispatch_over(&self.pipeline, &extra, "color", self.workgroup)?;
         }
         counters.batches = batches.len() as u64;
         counters.visible_bricks = order.len() as u64;

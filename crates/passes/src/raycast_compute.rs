@@ -107,13 +107,7 @@ impl PassNode for RaycastComputeNode {
         self.effects.update(ctx, &self.params, self.step_voxels)?;
         let mut extra = vec![("params", self.params.as_entire_binding())];
         extra.extend(self.effects.bindings());
-        let bg = ctx.bind_group(&self.pipeline, &extra)?;
-        let (w, h) = ctx.extent("color");
-        let mut pass = ctx.begin_compute_pass();
-        pass.set_pipeline(&self.pipeline.pipeline);
-        pass.set_bind_group(0, &bg, &[]);
-        pass.dispatch_workgroups(w.div_ceil(self.workgroup.0), h.div_ceil(self.workgroup.1), 1);
-        Ok(())
+        ctx.dispatch_over(&self.pipeline, &extra, "color", (self.workgroup.0, self.workgroup.1))
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {

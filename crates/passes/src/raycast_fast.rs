@@ -306,13 +306,7 @@ impl PassNode for RaycastFastNode {
             Some(half) if self.step_voxels / unit == 0.5 => half,
             _ => &self.pipeline,
         };
-        let bg = ctx.bind_group(pipeline, &extra)?;
-        let (w, h) = ctx.extent("color");
-        let mut pass = ctx.begin_compute_pass();
-        pass.set_pipeline(&pipeline.pipeline);
-        pass.set_bind_group(0, &bg, &[]);
-        pass.dispatch_workgroups(w.div_ceil(self.workgroup.0), h.div_ceil(self.workgroup.1), 1);
-        Ok(())
+        ctx.dispatch_over(pipeline, &extra, "color", (self.workgroup.0, self.workgroup.1))
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {

@@ -7,57 +7,19 @@
 //! transfer function, an isovalue edit or a camera jump starts again from the box. Failure
 //! images go to target/test-images.
 
-use std::sync::Arc;
-
 use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::reference::{Phong, RaycastSettings, RenderMode, render_supersampled};
 use volgraph_accel::transfer_function::{Preset, TransferFunction};
 use volgraph_accel::volume::Volume;
-use volgraph_core::runtime::{CameraData, Gpu, Image, Runtime};
-use volgraph_core::{CompileOptions, Registry};
+use volgraph_core::CompileOptions;
+use volgraph_core::runtime::Image;
 use volgraph_passes::builtin_registry;
 
 mod support;
 
-use support::{as_reference, graph_source, save_images};
+use support::{Live, as_reference, graph_source, save_images};
 
 const SIZE: u32 = 128;
-
-/// A graph applied on its own runtime, ready to render frames.
-struct Live {
-    runtime: Runtime,
-    viewport: (u32, u32),
-}
-
-fn live(
-    gpu: &Arc<Gpu>,
-    registry: &Registry,
-    graph: &str,
-    volume: &Volume,
-    lut: &[[f32; 4]],
-    options: &CompileOptions,
-) -> Live {
-    let mut runtime = support::runtime(gpu);
-    let source = graph_source(graph);
-    let plan = runtime.compile(graph, &source, registry, options).unwrap_or_else(|d| panic!("{graph}:\n{d}"));
-    runtime.bind_scene(&plan.inputs, volume, lut).expect("binds");
-    let viewport = plan.viewport;
-    runtime.apply(plan, registry).expect("applies");
-    Live { runtime, viewport }
-}
-
-impl Live {
-    fn frame(&mut self, camera: &OrbitCamera) -> Image {
-        self.runtime.render(CameraData::from_orbit(camera, self.viewport)).expect("renders");
-        self.runtime.read_output("image").expect("image")
-    }
-
-    /// A target of the last frame by resource name (`holes.start`, `entry.entry`).
-    fn resource(&mut self, name: &str) -> Image {
-        let rid = self.runtime.plan().expect("plan").resources.iter().position(|r| r.name == name).expect(name);
-        self.runtime.read_resource(rid).expect("reads")
-    }
-}
 
 /// The fraction of pixels with a channel more than 1/255 apart, and the largest difference.
 fn compare(a: &Image, b: &Image) -> (f64, f64) {
@@ -110,8 +72,9 @@ fn rotation_matches_the_baseline(mode: &str) {
         let options = CompileOptions::new(SIZE, SIZE).with_scalar("iso_value", iso);
         let lut = tf.to_lut_for(&volume, 256);
         for degrees in [1.0, 2.0, 5.0] {
-            let mut base = live(&gpu, &registry, &format!("klein_2005/baseline_{mode}.ron"), &volume, &lut, &options);
-            let mut leap = live(&gpu, &registry, &format!("klein_2005/leap_{mode}.ron"), &volume, &lut, &options);
+            let mut base =
+                Live::new(&gpu, &registry, &format!("klein_2005/baseline_{mode}.ron"), &volume, &lut, &options);
+            let mut leap = Live::new(&gpu, &registry, &format!("klein_2005/leap_{mode}.ron"), &volume, &lut, &options);
             let mut worst = (0.0, 0.0, 0);
             for f in 0..30 {
                 let cam = camera(10.0 + degrees * f as f64);
@@ -178,7 +141,7 @@ fn hole_filling_leaves_no_pixel_of_the_footprint_without_a_start() {
         let options = CompileOptions::new(SIZE, SIZE)
             .with_param("splat", "splat_size", 1u64)
             .with_param("holes", "extend", extend);
-        let mut leap = live(&gpu, &registry, "klein_2005/leap_iso.ron", &volume, &lut, &options);
+        let mut leap = Live::new(&gpu, &registry, "klein_2005/leap_iso.ron", &volume, &lut, &options);
         let mut holes_before_filling = 0;
         for f in 0..6 {
             let cam = camera(20.0 + 3.0 * f as f64);
@@ -214,7 +177,7 @@ fn a_new_transfer_function_an_isovalue_edit_and_a_camera_jump_start_from_the_box
     let (volume, tf, _) = datasets().remove(0);
     let lut = tf.to_lut_for(&volume, 256);
     let options = CompileOptions::new(SIZE, SIZE);
-    let mut leap = live(&gpu, &registry, "klein_2005/leap_iso.ron", &volume, &lut, &options);
+    let mut leap = Live::new(&gpu, &registry, "klein_2005/leap_iso.ron", &volume, &lut, &options);
     leap.frame(&camera(10.0));
     assert!(started_at_the_box(&mut leap), "the first frame starts at the box");
     leap.frame(&camera(11.0));
@@ -226,7 +189,7 @@ fn a_new_transfer_function_an_isovalue_edit_and_a_camera_jump_start_from_the_box
     leap.runtime.bind_scene(&inputs, &volume, &other).expect("binds");
     let after_tf = leap.frame(&camera(12.0));
     assert!(started_at_the_box(&mut leap), "a new TF leaves no stale start");
-    let mut base = live(&gpu, &registry, "klein_2005/baseline_iso.ron", &volume, &other, &options);
+    let mut base = Live::new(&gpu, &registry, "klein_2005/baseline_iso.ron", &volume, &other, &options);
     assert_eq!(after_tf.data, base.frame(&camera(12.0)).data, "the frame after a TF change is the plain raycast");
 
     // An isovalue edit (a parameter of "march"): from the box again.
@@ -279,8 +242,8 @@ fn selective_super_sampling_equals_full_super_sampling_on_the_flagged_pixels() {
                     .with_param("aa", "selection", selection)
             };
             let mut selective =
-                live(&gpu, &registry, "klein_2005/leap_iso_aa.ron", &volume, &lut, &options("selective"));
-            let mut full = live(&gpu, &registry, "klein_2005/leap_iso_aa.ron", &volume, &lut, &options("full"));
+                Live::new(&gpu, &registry, "klein_2005/leap_iso_aa.ron", &volume, &lut, &options("selective"));
+            let mut full = Live::new(&gpu, &registry, "klein_2005/leap_iso_aa.ron", &volume, &lut, &options("full"));
             // Three frames: the last starts its sub-pixel rays from reprojected leap hits.
             for f in 0..3 {
                 let cam = camera(30.0 + 2.0 * f as f64);
@@ -338,7 +301,7 @@ fn super_sampling_moves_the_image_towards_the_16x_reference() {
             .with_scalar("iso_value", iso)
             .with_param("aa", "pattern", pattern)
             .with_param("aa", "selection", selection);
-        let mut aa = live(&gpu, &registry, "klein_2005/leap_iso_aa.ron", &volume, &lut, &options);
+        let mut aa = Live::new(&gpu, &registry, "klein_2005/leap_iso_aa.ron", &volume, &lut, &options);
         let image = aa.frame(&cam);
         let raw = aa.runtime.read_output("raw").expect("raw");
         let (none, with) = (rms_255(&raw, &reference), rms_255(&image, &reference));

@@ -13,13 +13,13 @@ use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::reference::{RaycastSettings, render_reference};
 use volgraph_accel::transfer_function::{ControlPoint, Preset, TransferFunction};
 use volgraph_accel::volume::{Volume, VoxelData};
-use volgraph_core::runtime::{CameraData, Gpu, Image, Runtime};
+use volgraph_core::runtime::{CameraData, Gpu, Image};
 use volgraph_core::{CompileOptions, Registry};
 use volgraph_passes::builtin_registry;
 
 mod support;
 
-use support::{as_reference, diff_reference, graph_source, save_images};
+use support::{Live, as_reference, diff_reference, save_images};
 
 const SIZE: u32 = 96;
 
@@ -29,12 +29,7 @@ fn tf_points(domain: (f64, f64), points: &[(f64, [f64; 3], f64)]) -> TransferFun
     TransferFunction { domain, points }
 }
 
-/// A graph applied on its own runtime.
-struct Live {
-    runtime: Runtime,
-    viewport: (u32, u32),
-}
-
+/// `graphs/ruijters_vilanova_2006/<graph>.ron` applied with `volume` and `lut`.
 fn live(
     gpu: &Arc<Gpu>,
     registry: &Registry,
@@ -43,25 +38,7 @@ fn live(
     lut: &[[f32; 4]],
     options: &CompileOptions,
 ) -> Live {
-    let mut runtime = support::runtime(gpu);
-    let source = graph_source(&format!("ruijters_vilanova_2006/{graph}.ron"));
-    let plan = runtime.compile(graph, &source, registry, options).unwrap_or_else(|d| panic!("{graph}:\n{d}"));
-    runtime.bind_scene(&plan.inputs, volume, lut).expect("binds");
-    let viewport = plan.viewport;
-    runtime.apply(plan, registry).expect("applies");
-    Live { runtime, viewport }
-}
-
-impl Live {
-    fn frame(&mut self, camera: &OrbitCamera) -> Image {
-        self.runtime.render(CameraData::from_orbit(camera, self.viewport)).unwrap_or_else(|e| panic!("{e}"));
-        self.runtime.read_output("image").expect("image")
-    }
-
-    fn counter(&self, name: &str) -> f64 {
-        let counters = self.runtime.pass_counters();
-        counters.iter().find(|(_, n, _)| *n == name).unwrap_or_else(|| panic!("no counter {name}: {counters:?}")).2
-    }
+    Live::new(gpu, registry, &format!("ruijters_vilanova_2006/{graph}.ron"), volume, lut, options)
 }
 
 fn camera(azimuth: f64, distance: f64) -> OrbitCamera {

@@ -1,6 +1,6 @@
 //! The plan as a picture in the viewer's panel — the same marks as `volgraph plan --dot`
-//! (`Plan::to_dot`): passes as boxes in columns by dependency depth, data edges solid, history
-//! edges (last frame's value) dashed, culled and gated passes greyed in a last column, repeat
+//! (`Plan::to_dot`): passes as boxes in rows by dependency depth, data edges solid, history
+//! edges (last frame's value) dashed, culled and gated passes greyed in a last row, repeat
 //! groups boxed. [`layout`] is pure (tested); [`show`] paints it with egui.
 
 use std::collections::BTreeMap;
@@ -12,7 +12,7 @@ use volgraph_core::plan::{Binding, Plan};
 pub struct Node {
     /// `label\nkind`.
     pub text: String,
-    /// Column (dependency depth) and row.
+    /// Dependency depth (the row it is drawn in) and its place among the nodes of that depth.
     pub at: (usize, usize),
     /// Culled or switched off by a feature.
     pub greyed: bool,
@@ -89,23 +89,27 @@ pub fn layout(plan: &Plan) -> Picture {
     Picture { nodes, edges }
 }
 
-/// Paints `plan`'s picture into `ui`.
+/// Paints `plan`'s picture into `ui`, top to bottom (the panel is narrow): a node's depth is its
+/// row. Data edges run down between boxes; history edges (last frame's value, pointing back up)
+/// run dashed in a lane right of the boxes, so they never cross a label.
 pub fn show(ui: &mut egui::Ui, plan: &Plan) {
     let picture = layout(plan);
-    let (w, h) = (118.0, 34.0);
-    let (gap_x, gap_y) = (30.0, 14.0);
-    let cols = picture.nodes.iter().map(|n| n.at.0 + 1).max().unwrap_or(1) as f32;
-    let rows = picture.nodes.iter().map(|n| n.at.1 + 1).max().unwrap_or(1) as f32;
-    let size = egui::vec2(cols * (w + gap_x), rows * (h + gap_y));
+    let (w, h) = (132.0, 32.0);
+    let (gap_x, gap_y) = (12.0, 18.0);
+    let lane = 18.0;
+    let cols = picture.nodes.iter().map(|n| n.at.1 + 1).max().unwrap_or(1) as f32;
+    let rows = picture.nodes.iter().map(|n| n.at.0 + 1).max().unwrap_or(1) as f32;
+    let size = egui::vec2(cols * (w + gap_x) + lane, rows * (h + gap_y));
     let (response, painter) = ui.allocate_painter(size, egui::Sense::hover());
-    let origin = response.rect.min;
+    let origin = response.rect.min + egui::vec2(0.0, 4.0);
     let rect_of = |n: &Node| {
         egui::Rect::from_min_size(
-            origin + egui::vec2(n.at.0 as f32 * (w + gap_x), n.at.1 as f32 * (h + gap_y)),
+            origin + egui::vec2(n.at.1 as f32 * (w + gap_x), n.at.0 as f32 * (h + gap_y)),
             egui::vec2(w, h),
         )
     };
     let text_color = ui.visuals().text_color();
+    let stroke = egui::Stroke::new(1.0, text_color);
     // Repeat groups: one rounded box around their steps.
     let mut groups: BTreeMap<&str, egui::Rect> = BTreeMap::new();
     for n in &picture.nodes {
@@ -117,20 +121,26 @@ pub fn show(ui: &mut egui::Ui, plan: &Plan) {
     for r in groups.values() {
         painter.rect_stroke(*r, 6.0, egui::Stroke::new(1.0, egui::Color32::GRAY), egui::StrokeKind::Outside);
     }
+    let lane_x = origin.x + cols * (w + gap_x) + lane * 0.5;
     for e in &picture.edges {
         let (a, b) = (rect_of(&picture.nodes[e.from]), rect_of(&picture.nodes[e.to]));
-        let (p, q) = (a.right_center(), b.left_center());
-        let stroke = egui::Stroke::new(1.0, text_color);
         if e.dashed {
-            painter.extend(egui::Shape::dashed_line(&[p, q], stroke, 4.0, 3.0));
+            let path = [
+                a.right_center(),
+                egui::pos2(lane_x, a.center().y),
+                egui::pos2(lane_x, b.center().y),
+                b.right_center(),
+            ];
+            painter.extend(egui::Shape::dashed_line(&path, stroke, 4.0, 3.0));
         } else {
+            let (p, q) = (a.center_bottom(), b.center_top());
             painter.arrow(p, q - p, stroke);
         }
     }
     for n in &picture.nodes {
         let r = rect_of(n);
         let (fill, color) = if n.greyed {
-            (egui::Color32::TRANSPARENT, egui::Color32::GRAY)
+            (ui.visuals().extreme_bg_color, egui::Color32::GRAY)
         } else {
             (ui.visuals().faint_bg_color, text_color)
         };

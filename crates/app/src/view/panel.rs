@@ -210,8 +210,10 @@ pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapt
                     });
                 }
             });
-            ui.collapsing("Graph", |ui| {
-                egui::ScrollArea::horizontal().id_salt("graph").show(ui, |ui| super::graph_picture::show(ui, plan));
+            egui::CollapsingHeader::new("Graph").default_open(true).show(ui, |ui| {
+                egui::ScrollArea::both().id_salt("graph").max_height(320.0).show(ui, |ui| {
+                    super::graph_picture::show(ui, plan);
+                });
             });
             ui.collapsing("Plan", |ui| {
                 ui.add(egui::Label::new(egui::RichText::new(plan.to_text()).monospace().small()).extend());

@@ -110,3 +110,50 @@ pub fn save_images(name: &str, gpu: &Image, reference: &[[f64; 4]]) {
     let _ = r.save(dir.join(format!("{name}_reference.png")));
     let _ = d.save(dir.join(format!("{name}_diff_x10.png")));
 }
+
+/// A graph (`graphs/<name>`) applied on its own runtime with `volume` and `lut` bound, ready to
+/// render frames and read what its passes report (the Klein and Ruijters tests).
+pub struct Live {
+    /// The runtime holding the applied plan.
+    pub runtime: Runtime,
+    /// The plan's viewport.
+    pub viewport: (u32, u32),
+}
+
+impl Live {
+    /// Compiles, binds and applies `graph` on a fresh runtime.
+    pub fn new(
+        gpu: &Arc<Gpu>,
+        registry: &Registry,
+        graph: &str,
+        volume: &Volume,
+        lut: &[[f32; 4]],
+        options: &CompileOptions,
+    ) -> Self {
+        let mut runtime = runtime(gpu);
+        let source = graph_source(graph);
+        let plan = runtime.compile(graph, &source, registry, options).unwrap_or_else(|d| panic!("{graph}:\n{d}"));
+        runtime.bind_scene(&plan.inputs, volume, lut).expect("binds");
+        let viewport = plan.viewport;
+        runtime.apply(plan, registry).unwrap_or_else(|e| panic!("{graph}: {e}"));
+        Self { runtime, viewport }
+    }
+
+    /// Renders one frame from `camera` and reads the `image` output.
+    pub fn frame(&mut self, camera: &OrbitCamera) -> Image {
+        self.runtime.render(CameraData::from_orbit(camera, self.viewport)).unwrap_or_else(|e| panic!("{e}"));
+        self.runtime.read_output("image").expect("image")
+    }
+
+    /// A target of the last frame by resource name (`holes.start`, `entry.entry`).
+    pub fn resource(&mut self, name: &str) -> Image {
+        let rid = self.runtime.plan().expect("plan").resources.iter().position(|r| r.name == name).expect(name);
+        self.runtime.read_resource(rid).expect("reads")
+    }
+
+    /// A figure a pass reported about the last frame (`PassNode::counters`), by name.
+    pub fn counter(&self, name: &str) -> f64 {
+        let counters = self.runtime.pass_counters();
+        counters.iter().find(|(_, n, _)| *n == name).unwrap_or_else(|| panic!("no counter {name}: {counters:?}")).2
+    }
+}

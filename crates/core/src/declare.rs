@@ -7,10 +7,78 @@
 //!   buffer (`uniform_bytes()`), and the WGSL struct text it must match (`wgsl_struct()`),
 //!   which [`check_wgsl_struct`] compares with a shader's struct through naga.
 //!
-//! Types are `f32` (a float parameter), `u32` (an unsigned one), `i32` (an unsigned parameter a
-//! shader uses in signed arithmetic) and `bool` (a `u32` 0 or 1 on the GPU); all are 4 bytes
-//! there, so the struct has no padding inside and its layout is the declaration order. A bool
-//! is written `flag: bool = false, false..=true, "doc";` (the range is the type's).
+//! Field forms, one per line:
+//! - `name: f32 = 0.5, 0.0..=1.0, "doc";` — a float parameter (`f64`: kept exact on the host,
+//!   for a CPU reference, and an `f32` on the GPU; `u32` an unsigned one; `i32` an unsigned
+//!   parameter a shader uses in signed arithmetic);
+//! - `name: bool = false, "doc";` — a boolean parameter, a `u32` 0 or 1 on the GPU;
+//! - `name: Mode = Dvr, "doc";` — a choice between the variants of a [`param_choice!`](crate::param_choice)
+//!   enum (its names in the graph file), the variant's index as a `u32` on the GPU;
+//! - `name: f32 = computed, "doc";` — no parameter: a value the node computes (a count derived
+//!   from the volume) that still has its place in the uniform block; `from_params` sets 0.
+//!
+//! All are 4 bytes on the GPU, so the struct has no padding inside and its layout is the
+//! declaration order.
+//!
+//! A block several pass kinds share (the raycasters' sampling, shading, isosurface blocks) is
+//! declared once and listed whole by each kind that takes it (`[A::specs(), B::specs()].concat()`).
+//! Code serving several kinds reads it with `try_from_params`: `Some` exactly when the kind
+//! declares that block — a block is never declared in part, so no name is looked up by hand.
+
+/// A choice parameter's values, declared once (see [`param_choice!`](crate::param_choice)).
+pub trait ParamChoice: Copy + Sized + 'static {
+    /// The names a graph file writes, in declaration order.
+    const NAMES: &'static [&'static str];
+    /// The values, in the same order.
+    const VALUES: &'static [Self];
+    /// The value a name stands for (`None` for a name not in [`Self::NAMES`]).
+    fn from_name(name: &str) -> Option<Self>;
+    /// The value's position in [`Self::NAMES`].
+    fn index(self) -> usize;
+    /// The value's name in a graph file.
+    fn name(self) -> &'static str {
+        Self::NAMES[self.index()]
+    }
+}
+
+/// Declares the values of a choice parameter as an enum with their graph-file names, for a
+/// [`pass_params!`](crate::pass_params) field:
+///
+/// ```
+/// volgraph_core::param_choice! {
+///     /// What the raycaster computes.
+///     pub enum Mode { Dvr = "dvr", Iso = "iso" }
+/// }
+/// use volgraph_core::declare::ParamChoice;
+/// assert_eq!(Mode::NAMES, ["dvr", "iso"]);
+/// assert_eq!(Mode::from_name("iso"), Some(Mode::Iso));
+/// assert_eq!(Mode::Iso.index(), 1);
+/// ```
+#[macro_export]
+macro_rules! param_choice {
+    (
+        $(#[$meta:meta])*
+        $vis:vis enum $name:ident { $( $(#[$vmeta:meta])* $variant:ident = $text:literal ),+ $(,)? }
+    ) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        $vis enum $name { $( $(#[$vmeta])* #[doc = concat!("`\"", $text, "\"` in a graph file.")] $variant, )+ }
+
+        impl $crate::declare::ParamChoice for $name {
+            const NAMES: &'static [&'static str] = &[$($text),+];
+            const VALUES: &'static [Self] = &[$(Self::$variant),+];
+            fn from_name(name: &str) -> Option<Self> {
+                match name {
+                    $( $text => Some(Self::$variant), )+
+                    _ => None,
+                }
+            }
+            fn index(self) -> usize {
+                self as usize
+            }
+        }
+    };
+}
 
 /// Declares a pass's parameters once (module docs). Example:
 ///
@@ -30,65 +98,124 @@
 macro_rules! pass_params {
     (
         $(#[$meta:meta])*
-        $vis:vis struct $name:ident {
-            $( $field:ident : $ty:ident = $default:literal, $min:literal ..= $max:literal, $doc:literal; )*
-        }
+        $vis:vis struct $name:ident { $($body:tt)* }
     ) => {
-        $(#[$meta])*
+        $crate::pass_params!(@fields [$(#[$meta])*] [$vis] $name [] $($body)*);
+    };
+
+    // Each field line, normalized to `[field, type, form, (default), (range), doc]`.
+    (@fields $m:tt $v:tt $name:ident [$($done:tt)*]
+        $field:ident : bool = $d:literal, $doc:literal; $($rest:tt)*) => {
+        $crate::pass_params!(@fields $m $v $name [$($done)* [$field, bool, flag, ($d), (), $doc]] $($rest)*);
+    };
+    (@fields $m:tt $v:tt $name:ident [$($done:tt)*]
+        $field:ident : $ty:ident = computed, $doc:literal; $($rest:tt)*) => {
+        $crate::pass_params!(@fields $m $v $name [$($done)* [$field, $ty, computed, (), (), $doc]] $($rest)*);
+    };
+    (@fields $m:tt $v:tt $name:ident [$($done:tt)*]
+        $field:ident : $ty:ident = $d:literal, $lo:literal ..= $hi:literal, $doc:literal; $($rest:tt)*) => {
+        $crate::pass_params!(@fields $m $v $name [$($done)* [$field, $ty, number, ($d), ($lo, $hi), $doc]] $($rest)*);
+    };
+    (@fields $m:tt $v:tt $name:ident [$($done:tt)*]
+        $field:ident : $ty:ident = $d:ident, $doc:literal; $($rest:tt)*) => {
+        $crate::pass_params!(@fields $m $v $name [$($done)* [$field, $ty, choice, ($d), (), $doc]] $($rest)*);
+    };
+
+    (@fields [$($meta:tt)*] [$vis:vis] $name:ident
+        [$( [$field:ident, $ty:ident, $form:ident, $d:tt, $range:tt, $doc:literal] )*]) => {
+        $($meta)*
         #[derive(Clone, Copy, Debug, PartialEq)]
         $vis struct $name {
             $( #[doc = $doc] pub $field: $ty, )*
         }
 
+        #[allow(dead_code)] // generated API: a pass may not need every form
         impl $name {
             /// The declared parameters, for [`PassPlugin::params`]($crate::PassPlugin::params).
+            #[allow(clippy::vec_init_then_push)] // computed fields push nothing
             pub fn specs() -> Vec<$crate::ParamSpec> {
-                vec![ $( $crate::pass_params!(@spec $ty, stringify!($field), $default, $min, $max, $doc), )* ]
+                let mut specs = Vec::new();
+                $( $crate::pass_params!(@spec specs, $form, $ty, stringify!($field), $d, $range, $doc); )*
+                specs
             }
 
             /// The checked values of a compiled pass, typed.
             pub fn from_params(p: &$crate::Params) -> Self {
-                Self { $( $field: $crate::pass_params!(@get $ty, p, stringify!($field)), )* }
+                Self { $( $field: $crate::pass_params!(@get $form, $ty, p, stringify!($field)), )* }
+            }
+
+            /// The block's values when the pass declares it (a block shared by several kinds
+            /// is declared whole or not at all), else `None`.
+            pub fn try_from_params(p: &$crate::Params) -> Option<Self> {
+                Self::specs().iter().all(|s| p.declares(s.name)).then(|| Self::from_params(p))
             }
 
             /// The values as a uniform buffer's bytes, zero-padded to a multiple of 16.
             pub fn uniform_bytes(&self) -> Vec<u8> {
                 let mut bytes = Vec::with_capacity(16);
-                $( bytes.extend_from_slice(&$crate::pass_params!(@bytes $ty, self.$field)); )*
+                $( bytes.extend_from_slice(&$crate::pass_params!(@bytes $form, $ty, self.$field)); )*
                 bytes.resize(bytes.len().div_ceil(16).max(1) * 16, 0);
                 bytes
+            }
+
+            /// The `(name, WGSL type)` of each member, in order.
+            pub fn wgsl_fields() -> Vec<(&'static str, &'static str)> {
+                vec![ $( (stringify!($field), $crate::pass_params!(@wgsl $form, $ty)), )* ]
             }
 
             /// The WGSL struct the shader declares for these parameters (same name, same
             /// fields in the same order, padded to 16 bytes).
             pub fn wgsl_struct() -> String {
-                let fields: &[(&str, &str)] = &[ $( (stringify!($field), $crate::pass_params!(@wgsl $ty)), )* ];
-                $crate::declare::wgsl_struct_text(stringify!($name), fields)
+                $crate::declare::wgsl_struct_text(stringify!($name), &Self::wgsl_fields())
             }
         }
     };
-    (@spec f32, $n:expr, $d:expr, $lo:expr, $hi:expr, $doc:expr) => {
-        $crate::ParamSpec::float($n, $d as f64, $lo as f64, $hi as f64, $doc)
+
+    (@spec $v:ident, number, f32, $n:expr, ($d:literal), ($lo:literal, $hi:literal), $doc:expr) => {
+        $v.push($crate::ParamSpec::float($n, $d as f64, $lo as f64, $hi as f64, $doc))
     };
-    (@spec u32, $n:expr, $d:expr, $lo:expr, $hi:expr, $doc:expr) => {
-        $crate::ParamSpec::uint($n, $d as u64, $lo as u64, $hi as u64, $doc)
+    (@spec $v:ident, number, f64, $n:expr, ($d:literal), ($lo:literal, $hi:literal), $doc:expr) => {
+        $v.push($crate::ParamSpec::float($n, $d as f64, $lo as f64, $hi as f64, $doc))
     };
-    // A count a shader uses in signed arithmetic (loop bounds around a pixel): declared and
+    // A count a shader may use in signed arithmetic (loop bounds around a pixel): declared and
     // checked as an unsigned parameter, uploaded as i32.
-    (@spec i32, $n:expr, $d:expr, $lo:expr, $hi:expr, $doc:expr) => {
-        $crate::ParamSpec::uint($n, $d as u64, $lo as u64, $hi as u64, $doc)
+    (@spec $v:ident, number, $ty:ident, $n:expr, ($d:literal), ($lo:literal, $hi:literal), $doc:expr) => {
+        $v.push($crate::ParamSpec::uint($n, $d as u64, $lo as u64, $hi as u64, $doc))
     };
-    (@spec bool, $n:expr, $d:expr, $lo:expr, $hi:expr, $doc:expr) => {
-        $crate::ParamSpec::boolean($n, $d, $doc)
+    (@spec $v:ident, flag, bool, $n:expr, ($d:literal), (), $doc:expr) => {
+        $v.push($crate::ParamSpec::boolean($n, $d, $doc))
     };
-    (@get bool, $p:expr, $n:expr) => { $p.boolean($n) };
-    (@bytes bool, $e:expr) => { u32::from($e).to_le_bytes() };
-    (@bytes $ty:ident, $e:expr) => { $e.to_le_bytes() };
-    (@wgsl bool) => { "u32" };
-    (@wgsl $ty:ident) => { stringify!($ty) };
-    (@get f32, $p:expr, $n:expr) => { $p.float($n) as f32 };
-    (@get u32, $p:expr, $n:expr) => { $p.uint($n) as u32 };
-    (@get i32, $p:expr, $n:expr) => { $p.uint($n) as i32 };
+    (@spec $v:ident, choice, $ty:ident, $n:expr, ($d:ident), (), $doc:expr) => {
+        $v.push($crate::ParamSpec::choice(
+            $n,
+            $crate::declare::ParamChoice::name($ty::$d),
+            <$ty as $crate::declare::ParamChoice>::NAMES,
+            $doc,
+        ))
+    };
+    (@spec $v:ident, computed, $ty:ident, $n:expr, (), (), $doc:expr) => {};
+
+    (@get number, f32, $p:expr, $n:expr) => { $p.float($n) as f32 };
+    (@get number, f64, $p:expr, $n:expr) => { $p.float($n) };
+    (@get number, u32, $p:expr, $n:expr) => { $p.uint($n) as u32 };
+    (@get number, i32, $p:expr, $n:expr) => { $p.uint($n) as i32 };
+    (@get flag, bool, $p:expr, $n:expr) => { $p.boolean($n) };
+    (@get choice, $ty:ident, $p:expr, $n:expr) => {
+        // The compiler checked the name against NAMES; unchecked values read as the first.
+        <$ty as $crate::declare::ParamChoice>::from_name($p.choice($n))
+            .unwrap_or(<$ty as $crate::declare::ParamChoice>::VALUES[0])
+    };
+    (@get computed, $ty:ident, $p:expr, $n:expr) => { <$ty>::default() };
+
+    (@bytes flag, $ty:ident, $e:expr) => { u32::from($e).to_le_bytes() };
+    (@bytes choice, $ty:ident, $e:expr) => { ($crate::declare::ParamChoice::index($e) as u32).to_le_bytes() };
+    (@bytes $form:ident, f64, $e:expr) => { ($e as f32).to_le_bytes() };
+    (@bytes $form:ident, $ty:ident, $e:expr) => { $e.to_le_bytes() };
+
+    (@wgsl flag, $ty:ident) => { "u32" };
+    (@wgsl choice, $ty:ident) => { "u32" };
+    (@wgsl $form:ident, f64) => { "f32" };
+    (@wgsl $form:ident, $ty:ident) => { stringify!($ty) };
 }
 
 /// The WGSL text of a parameter struct: `struct NAME { a: f32, b: u32, _pad0: f32, ... }`,
@@ -180,7 +307,7 @@ mod bool_tests {
     crate::pass_params! {
         /// With a flag.
         pub struct Flags {
-            on: bool = true, false..=true, "a switch";
+            on: bool = true, "a switch";
             gain: f32 = 2.0, 0.0..=4.0, "a gain";
         }
     }
@@ -193,5 +320,61 @@ mod bool_tests {
         assert_eq!(f, Flags { on: true, gain: 2.0 });
         assert_eq!(&f.uniform_bytes()[0..4], &1u32.to_le_bytes());
         assert!(Flags::wgsl_struct().contains("on: u32,"));
+    }
+}
+
+#[cfg(test)]
+mod choice_tests {
+    use super::ParamChoice;
+
+    crate::param_choice! {
+        /// A test choice.
+        pub enum Shape { Round = "round", Square = "square" }
+    }
+
+    crate::pass_params! {
+        /// A choice, a computed value and a number.
+        pub struct Mixed {
+            shape: Shape = Square, "which shape";
+            derived: f32 = computed, "set by the node";
+            size: u32 = 3, 1..=9, "how big";
+        }
+    }
+
+    crate::pass_params! {
+        /// A block another kind might not declare.
+        pub struct Other {
+            gain: f32 = 1.0, 0.0..=2.0, "a gain";
+        }
+    }
+
+    #[test]
+    fn a_choice_is_a_typed_enum_and_its_index_on_the_gpu() {
+        let specs = Mixed::specs();
+        assert_eq!(specs.iter().map(|s| s.name).collect::<Vec<_>>(), ["shape", "size"], "computed is no parameter");
+        assert!(matches!(
+            specs[0].kind,
+            crate::params::ParamKind::Choice { default: "square", options: ["round", "square"] }
+        ));
+        let mut params = crate::Params::defaults(&specs);
+        let m = Mixed::from_params(&params);
+        assert_eq!(m, Mixed { shape: Shape::Square, derived: 0.0, size: 3 });
+        params.set("shape", crate::ParamValue::Choice("round".into()));
+        let m = Mixed { derived: 2.5, ..Mixed::from_params(&params) };
+        assert_eq!(m.shape, Shape::Round);
+        let bytes = m.uniform_bytes();
+        assert_eq!(&bytes[0..4], &0u32.to_le_bytes());
+        assert_eq!(&bytes[4..8], &2.5f32.to_le_bytes());
+        assert_eq!(Mixed::wgsl_fields(), [("shape", "u32"), ("derived", "f32"), ("size", "u32")]);
+        assert_eq!(Shape::Square.name(), "square");
+    }
+
+    #[test]
+    fn a_shared_block_is_read_only_where_it_is_declared() {
+        let params = crate::Params::defaults(&Mixed::specs());
+        assert!(Other::try_from_params(&params).is_none());
+        assert!(Mixed::try_from_params(&params).is_some());
+        let both = crate::Params::defaults(&[Mixed::specs(), Other::specs()].concat());
+        assert_eq!(Other::try_from_params(&both), Some(Other { gain: 1.0 }));
     }
 }

@@ -149,17 +149,22 @@ impl Params {
 
     /// The value of a declared parameter. Asking for one the plugin never declared is a plugin
     /// bug: debug builds (every test) panic naming it, so a misspelled name cannot silently read
-    /// as 0; release builds fall back to 0 / false / "". A plugin that reads a parameter some of
-    /// its variants do not declare says so with [`Self::float_or`] and friends.
+    /// as 0; release builds fall back to 0 / false / "". Code that serves several kinds reads a
+    /// shared block through its `pass_params!` struct's `try_from_params` instead.
     fn declared(&self, name: &str, ty: &str) -> Option<&ParamValue> {
         let v = self.values.get(name);
         debug_assert!(
             v.is_some(),
             "parameter \"{name}\" ({ty}) was never declared by this pass (declared: {:?}); a misspelled name, \
-             or use {ty}_or for one some variants lack",
+             or a shared block to read with its pass_params! struct's try_from_params",
             self.values.keys().collect::<Vec<_>>()
         );
         v
+    }
+
+    /// Whether the pass declares parameter `name` (a shared block's `try_from_params`).
+    pub fn declares(&self, name: &str) -> bool {
+        self.values.contains_key(name)
     }
 
     /// A float parameter (an integer one widens).
@@ -190,27 +195,6 @@ impl Params {
             Some(ParamValue::Choice(v)) => v,
             _ => "",
         }
-    }
-
-    /// A float parameter the pass may not declare (a shared block filled for several pass
-    /// kinds): `default` when it is absent.
-    pub fn float_or(&self, name: &str, default: f64) -> f64 {
-        if self.values.contains_key(name) { self.float(name) } else { default }
-    }
-
-    /// An integer parameter the pass may not declare: `default` when it is absent.
-    pub fn uint_or(&self, name: &str, default: u64) -> u64 {
-        if self.values.contains_key(name) { self.uint(name) } else { default }
-    }
-
-    /// A boolean parameter the pass may not declare: `default` when it is absent.
-    pub fn boolean_or(&self, name: &str, default: bool) -> bool {
-        if self.values.contains_key(name) { self.boolean(name) } else { default }
-    }
-
-    /// A choice parameter the pass may not declare: `default` when it is absent.
-    pub fn choice_or<'a>(&'a self, name: &str, default: &'a str) -> &'a str {
-        if self.values.contains_key(name) { self.choice(name) } else { default }
     }
 }
 

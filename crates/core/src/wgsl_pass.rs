@@ -160,12 +160,10 @@ impl PassPlugin for WgslPass {
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let extra: &[&str] = if self.doc.params.is_empty() { &[] } else { &["params"] };
         let pipeline = match self.doc.form {
             WgslForm::Compute => Pipeline::Compute(ctx.compute_pipeline(&ComputePipelineSpec {
                 shader: &self.doc.shader,
                 entry: self.doc.entry_point(),
-                extra_bindings: extra,
                 constants: &[],
                 defines: &[],
             })?),
@@ -173,7 +171,6 @@ impl PassPlugin for WgslPass {
                 shader: &self.doc.shader,
                 vertex: "vs_fullscreen",
                 fragment: self.doc.entry_point(),
-                extra_bindings: extra,
                 ..Default::default()
             })?),
         };

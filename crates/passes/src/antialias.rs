@@ -12,6 +12,8 @@ use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
+use volgraph_core::declare::ParamChoice;
+
 use crate::effects::jitter_defines;
 use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
 use crate::shared::FLOAT_TARGETS;
@@ -31,22 +33,60 @@ struct AaParamsGpu {
 
 const _: () = assert!(std::mem::size_of::<AaParamsGpu>() == 16);
 
+volgraph_core::param_choice! {
+    /// The sub-pixel pattern.
+    pub enum Pattern { Two = "2x", Four = "4x", RotatedGrid = "rgss" }
+}
+
+volgraph_core::param_choice! {
+    /// Where the sub-pixel rays' directions come from.
+    pub enum Directions { Linear = "linear", Bilinear = "bilinear", Exact = "exact" }
+}
+
+volgraph_core::param_choice! {
+    /// Which pixels are re-rendered.
+    pub enum Selection { Selective = "selective", Full = "full" }
+}
+
+volgraph_core::pass_params! {
+    /// The antialiasing pass's own parameters (Klein et al. 2005 §5).
+    pub struct AaOwn {
+        step_back: u32 = 2, 0..=64, "the raycaster's step back (sub-pixel rays start like its rays)";
+        contrast: f32 = 0.05, 0.0..=1.0, "colour difference to a 4-neighbour (any channel) that flags a pixel";
+        pattern: Pattern = Four, "sub-pixel pattern: 2 diagonal, 4 regular, 4 rotated grid";
+        directions: Directions = Linear, "sub-pixel directions from two neighbours (the paper), three, or the camera";
+        selection: Selection = Selective, "re-render flagged pixels only, or every pixel (full-scene super-sampling)";
+    }
+}
+
 impl AaParamsGpu {
     fn from_params(p: &Params) -> Self {
+        let own = AaOwn::from_params(p);
         Self {
-            contrast: p.float("contrast") as f32,
-            pattern: match p.choice("pattern") {
-                "2x" => 2,
-                "rgss" => 5,
-                _ => 4,
+            contrast: own.contrast,
+            // The shader's pattern code: its sample count, 5 for the rotated grid's 4.
+            pattern: match own.pattern {
+                Pattern::Two => 2,
+                Pattern::Four => 4,
+                Pattern::RotatedGrid => 5,
             },
-            directions: match p.choice("directions") {
-                "bilinear" => 1,
-                "exact" => 2,
-                _ => 0,
-            },
-            full: (p.choice("selection") == "full") as u32,
+            directions: own.directions.index() as u32,
+            full: (own.selection == Selection::Full) as u32,
         }
+    }
+}
+
+/// The raycaster's block with its step back, so sub-pixel rays start like its rays.
+fn ray_block(p: &Params) -> RaycastParamsGpu {
+    RaycastParamsGpu { step_back: AaOwn::from_params(p).step_back as f32, ..RaycastParamsGpu::from_params(p) }
+}
+
+/// Its pipeline for these parameters.
+fn shader(params: &Params) -> ShaderUse {
+    ShaderUse {
+        file: "antialias.wgsl",
+        entry_point: if is_iso(params) { "fs_aa_iso" } else { "fs_aa_dvr" },
+        extra: &["params", "aa"],
     }
 }
 
@@ -60,40 +100,7 @@ impl PassPlugin for Antialias {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        let mut p = raycast_param_specs();
-        p.push(ParamSpec::uint(
-            "step_back",
-            2,
-            0,
-            64,
-            "the raycaster's step back (sub-pixel rays start like its rays)",
-        ));
-        p.push(ParamSpec::float(
-            "contrast",
-            0.05,
-            0.0,
-            1.0,
-            "colour difference to a 4-neighbour (any channel) that flags a pixel",
-        ));
-        p.push(ParamSpec::choice(
-            "pattern",
-            "4x",
-            &["2x", "4x", "rgss"],
-            "sub-pixel pattern: 2 diagonal, 4 regular, 4 rotated grid",
-        ));
-        p.push(ParamSpec::choice(
-            "directions",
-            "linear",
-            &["linear", "bilinear", "exact"],
-            "sub-pixel directions from two neighbours (the paper), three, or the camera",
-        ));
-        p.push(ParamSpec::choice(
-            "selection",
-            "selective",
-            &["selective", "full"],
-            "re-render flagged pixels only, or every pixel (full-scene super-sampling)",
-        ));
-        p
+        [raycast_param_specs(), AaOwn::specs()].concat()
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -111,28 +118,20 @@ impl PassPlugin for Antialias {
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse {
-            file: "antialias.wgsl",
-            entry_point: if is_iso(params) { "fs_aa_iso" } else { "fs_aa_dvr" },
-            extra: &["params", "aa"],
-        }]
+        vec![shader(params)]
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        is_iso(old) == is_iso(new) && old.boolean("jitter") == new.boolean("jitter")
+        is_iso(old) == is_iso(new) && jitter_defines(old) == jitter_defines(new)
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let defines = self.shader_defines(ctx.params);
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
-            shader: "antialias.wgsl",
-            vertex: "vs_fullscreen",
-            fragment: if is_iso(ctx.params) { "fs_aa_iso" } else { "fs_aa_dvr" },
-            extra_bindings: &["params", "aa"],
             defines: &defines,
-            ..Default::default()
+            ..RenderPipelineSpec::fullscreen(&shader(ctx.params))
         })?;
-        let params = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
+        let params = ctx.uniform_with("params", &ray_block(ctx.params));
         let aa = ctx.uniform_with("aa", &AaParamsGpu::from_params(ctx.params));
         Ok(Box::new(AntialiasNode { pipeline, params, aa }))
     }
@@ -156,7 +155,7 @@ impl PassNode for AntialiasNode {
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
-        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&ray_block(params)));
         gpu.queue.write_buffer(&self.aa, 0, bytemuck::bytes_of(&AaParamsGpu::from_params(params)));
     }
 }

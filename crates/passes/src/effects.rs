@@ -7,40 +7,50 @@
 //! `jitter` parameter, wired the same way. The f64 reference computes the same effects
 //! (`volgraph_accel::reference::Effects`).
 
+use volgraph_core::Params;
 use volgraph_core::runtime::{CreateContext, PassError, RecordContext};
-use volgraph_core::{ParamSpec, Params};
 
 use crate::preintegration::PreintegrationTable;
+use crate::raycast_params::Sampling;
 
-/// (parameter and feature name, shader define, what it does).
-pub const EFFECTS: [(&str, &str, &str); 3] = [
-    ("shading", "SHADING", "Blinn–Phong headlight shading of every sample with the gradient (central differences)"),
-    (
-        "preintegration",
-        "PREINTEGRATION",
-        "pre-integrated classification of the segment between samples (Engel et al. 2001), table rebuilt when the TF changes",
-    ),
-    ("tricubic", "TRICUBIC", "tricubic B-spline reconstruction from 8 trilinear fetches instead of trilinear"),
-];
-
-/// The effect parameters (all off by default).
-pub fn effect_param_specs() -> Vec<ParamSpec> {
-    EFFECTS.iter().map(|&(name, _, doc)| ParamSpec::boolean(name, false, doc)).collect()
+volgraph_core::pass_params! {
+    /// The effect switches, declared once (all off by default); each is an `#if` of the same
+    /// name in capitals in the shaders ([`EffectFlags::defines`]).
+    pub struct EffectFlags {
+        shading: bool = false, "Blinn–Phong headlight shading of every sample with the gradient (central differences)";
+        preintegration: bool = false,
+            "pre-integrated classification of the segment between samples (Engel et al. 2001), table rebuilt when the TF changes";
+        tricubic: bool = false, "tricubic B-spline reconstruction from 8 trilinear fetches instead of trilinear";
+    }
 }
 
-/// The shading coefficients DVR shading reads (the isosurface's too).
-pub const SHADING_PARAMS: [&str; 4] = ["ambient", "diffuse", "specular", "shininess"];
+impl EffectFlags {
+    /// Every effect off (a kind that declares none).
+    pub const OFF: Self = Self { shading: false, preintegration: false, tricubic: false };
+
+    /// The effects of `params` (all off for a kind that does not declare them).
+    pub fn of(params: &Params) -> Self {
+        Self::try_from_params(params).unwrap_or(Self::OFF)
+    }
+
+    /// The `#if` names of the effects turned on.
+    pub fn defines(&self) -> Vec<&'static str> {
+        [(self.shading, "SHADING"), (self.preintegration, "PREINTEGRATION"), (self.tricubic, "TRICUBIC")]
+            .into_iter()
+            .filter_map(|(on, define)| on.then_some(define))
+            .collect()
+    }
+}
 
 /// The shader uses the effects add to a raycaster's own: the pre-integration table's compute
 /// pipelines when `preintegration` is on (one of the two is built, by what the device filters).
 pub fn effect_shader_uses(params: &Params) -> Vec<volgraph_core::plugin::ShaderUse> {
-    if params.boolean("preintegration") { crate::preintegration::TABLE_SHADERS.to_vec() } else { Vec::new() }
+    if EffectFlags::of(params).preintegration { crate::preintegration::TABLE_SHADERS.to_vec() } else { Vec::new() }
 }
 
-/// The `#if` names of the effects `params` turn on (`jitter`, a raycast parameter, is JITTER).
+/// The `#if` names of the effects `params` turn on (`jitter`, a sampling parameter, is JITTER).
 pub fn effect_defines(params: &Params) -> Vec<&'static str> {
-    let mut defines: Vec<&'static str> =
-        EFFECTS.iter().filter(|(name, ..)| params.boolean_or(name, false)).map(|&(_, define, _)| define).collect();
+    let mut defines = EffectFlags::of(params).defines();
     defines.extend(jitter_defines(params));
     defines
 }
@@ -48,20 +58,17 @@ pub fn effect_defines(params: &Params) -> Vec<&'static str> {
 /// `JITTER` when the `jitter` parameter is on: for passes that march the raycast samples
 /// without the other effects (the segment loop, its termination test, the fetch probe).
 pub fn jitter_defines(params: &Params) -> Vec<&'static str> {
-    match (params.boolean_or("jitter", false), params.boolean_or("jitter_per_frame", false)) {
-        (false, _) => Vec::new(),
-        (true, false) => vec!["JITTER"],
-        (true, true) => vec!["JITTER", "JITTER_PER_FRAME"],
+    let sampling = Sampling::try_from_params(params);
+    match sampling.map(|s| (s.jitter, s.jitter_per_frame)) {
+        None | Some((false, _)) => Vec::new(),
+        Some((true, false)) => vec!["JITTER"],
+        Some((true, true)) => vec!["JITTER", "JITTER_PER_FRAME"],
     }
 }
 
 /// Whether two parameter sets compile the same effects (else the node is rebuilt).
 pub fn same_effects(old: &Params, new: &Params) -> bool {
-    EFFECTS
-        .iter()
-        .map(|(name, ..)| *name)
-        .chain(["jitter", "jitter_per_frame"])
-        .all(|name| old.boolean_or(name, false) == new.boolean_or(name, false))
+    EffectFlags::of(old) == EffectFlags::of(new) && jitter_defines(old) == jitter_defines(new)
 }
 
 /// What a raycaster node keeps for its effects: the pre-integration table when that effect is on.
@@ -72,7 +79,7 @@ pub struct EffectState {
 impl EffectState {
     /// Builds what the effects in `ctx.params` need.
     pub fn new(ctx: &CreateContext<'_>) -> Result<Self, PassError> {
-        let table = ctx.params.boolean("preintegration").then(|| PreintegrationTable::new(ctx)).transpose()?;
+        let table = EffectFlags::of(ctx.params).preintegration.then(|| PreintegrationTable::new(ctx)).transpose()?;
         Ok(Self { table })
     }
 
@@ -92,7 +99,7 @@ impl EffectState {
 
     /// The bindings the effects add (`preintegrated`).
     pub fn bindings(&self) -> Vec<(&'static str, wgpu::BindingResource<'_>)> {
-        self.table.iter().map(|t| ("preintegrated", wgpu::BindingResource::TextureView(&t.view))).collect()
+        self.table.iter().map(|t| ("preintegrated", wgpu::BindingResource::TextureView(&t.table.view))).collect()
     }
 
     /// Table builds so far (0 without pre-integration).
@@ -106,11 +113,4 @@ impl EffectState {
             t.invalidate();
         }
     }
-}
-
-/// The extra binding names of a raycaster with effects, after its own.
-pub fn with_effect_bindings(own: &[&'static str]) -> Vec<&'static str> {
-    let mut names = own.to_vec();
-    names.push("preintegrated");
-    names
 }

@@ -59,7 +59,6 @@ impl PassPlugin for EmptyDistance {
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
             shader: "empty_distance.wgsl",
             entry: "cs_line",
-            extra_bindings: &["partial", "distance", "pass_params"],
             ..Default::default()
         })?;
         let axes = [0u32, 1, 2]

@@ -56,7 +56,7 @@ pub(crate) fn check_block_grid(
 volgraph_core::pass_params! {
     /// The pass's parameters, declared once.
     pub struct ClassifySettings {
-        segments: bool = false, false..=true,
+        segments: bool = false,
             "classify for pre-integrated segments: a block is empty only if its neighbours' values are invisible too (a segment spans two adjacent blocks; wire to feature.preintegration)";
     }
 }

@@ -12,10 +12,17 @@ use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateCon
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::raycast_fast::SAMPLE_ROWS;
-use crate::raycast_params::{RaycastParamsGpu, raycast_param_specs};
+use crate::raycast_params::{RaycastParamsGpu, Sampling, Workgroup};
 
 /// The plugin.
 pub struct FetchProbe;
+
+volgraph_core::pass_params! {
+    /// Whether the probe counts its samples.
+    pub struct Counting {
+        count_samples: bool = false, "write the number of samples taken to the `samples` buffer";
+    }
+}
 
 impl PassPlugin for FetchProbe {
     fn kind(&self) -> &'static str {
@@ -27,14 +34,7 @@ impl PassPlugin for FetchProbe {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        let mut p: Vec<ParamSpec> = raycast_param_specs()
-            .into_iter()
-            .filter(|s| matches!(s.name, "step_voxels" | "max_steps" | "jitter"))
-            .collect();
-        p.push(ParamSpec::boolean("count_samples", false, "write the number of samples taken to the `samples` buffer"));
-        p.push(ParamSpec::uint("workgroup_x", 8, 1, 256, "workgroup width in pixels"));
-        p.push(ParamSpec::uint("workgroup_y", 8, 1, 256, "workgroup height in pixels"));
-        p
+        [Sampling::specs(), Counting::specs(), Workgroup::specs()].concat()
     }
 
     fn ports(&self, params: &Params) -> Vec<PortSpec> {
@@ -42,36 +42,35 @@ impl PassPlugin for FetchProbe {
             PortSpec::read("volume", PortKind::Volume),
             PortSpec::write("color", PortKind::target(&[TargetFormat::Rgba16Float])),
         ];
-        if params.boolean("count_samples") {
+        if Counting::from_params(params).count_samples {
             ports.push(PortSpec::write("samples", PortKind::buffer(4 * SAMPLE_ROWS)));
         }
         ports
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        let entry_point = if params.boolean("count_samples") { "cs_counted" } else { "cs_main" };
+        let entry_point = if Counting::from_params(params).count_samples { "cs_counted" } else { "cs_main" };
         vec![ShaderUse { file: "fetch_probe.wgsl", entry_point, extra: &["params"] }]
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        ["workgroup_x", "workgroup_y"].iter().all(|p| old.uint(p) == new.uint(p))
-            && old.boolean("count_samples") == new.boolean("count_samples")
-            && old.boolean("jitter") == new.boolean("jitter")
+        Workgroup::from_params(old) == Workgroup::from_params(new)
+            && Counting::from_params(old) == Counting::from_params(new)
+            && crate::effects::jitter_defines(old) == crate::effects::jitter_defines(new)
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let wg = (ctx.params.uint("workgroup_x") as u32, ctx.params.uint("workgroup_y") as u32);
+        let wg = Workgroup::from_params(ctx.params).size();
         if wg.0 * wg.1 > ctx.gpu.limits.max_compute_invocations_per_workgroup {
             return Err(PassError {
                 pass: ctx.pass_id.to_string(),
                 message: format!("workgroup {}x{} is over this GPU's invocation limit", wg.0, wg.1),
             });
         }
-        let counted = ctx.params.boolean("count_samples");
+        let counted = Counting::from_params(ctx.params).count_samples;
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
             shader: "fetch_probe.wgsl",
             entry: if counted { "cs_counted" } else { "cs_main" },
-            extra_bindings: &["params"],
             constants: &[("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)],
             defines: &crate::effects::jitter_defines(ctx.params),
         })?;

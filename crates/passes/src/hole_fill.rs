@@ -58,7 +58,6 @@ impl PassPlugin for HoleFill {
             shader: "hole_fill.wgsl",
             vertex: "vs_fullscreen",
             fragment: "fs_hole",
-            extra_bindings: &["holes"],
             ..Default::default()
         })?;
         let uniform = ctx.uniform_buffer("holes", 16);

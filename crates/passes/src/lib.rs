@@ -28,6 +28,7 @@ pub mod segment_init;
 pub mod shared;
 pub mod slice_render;
 pub mod termination_test;
+pub mod tf_table;
 
 use volgraph_core::Registry;
 use volgraph_core::shader_source::ShaderSources;

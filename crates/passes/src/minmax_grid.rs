@@ -11,7 +11,15 @@ use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateCon
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, Rerun};
 
 use crate::grid_tap::GridTap;
-use crate::shared::block_size_spec;
+use crate::shared::BlockSize;
+
+volgraph_core::pass_params! {
+    /// Whether the grid covers what the tricubic effect reads.
+    pub struct GridApron {
+        tricubic: bool = false,
+            "widen each block's range by a two-voxel apron, what the tricubic B-spline reads (wire to feature.tricubic)";
+    }
+}
 
 /// The Owned type name of the grid.
 pub const MINMAX_GRID: &str = "minmax_grid";
@@ -101,18 +109,11 @@ impl PassPlugin for MinMaxGridPass {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        vec![
-            block_size_spec(),
-            ParamSpec::boolean(
-                "tricubic",
-                false,
-                "widen each block's range by a two-voxel apron, what the tricubic B-spline reads (wire to feature.tricubic)",
-            ),
-        ]
+        [BlockSize::specs(), GridApron::specs()].concat()
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        if params.boolean("tricubic") { vec!["TRICUBIC"] } else { Vec::new() }
+        if GridApron::from_params(params).tricubic { vec!["TRICUBIC"] } else { Vec::new() }
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -128,11 +129,10 @@ impl PassPlugin for MinMaxGridPass {
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
             shader: "minmax_grid.wgsl",
             entry: "cs_minmax",
-            extra_bindings: &["minmax"],
             defines: &defines,
             ..Default::default()
         })?;
-        let block_size = ctx.params.uint("block_size").max(1) as u32;
+        let block_size = BlockSize::of(ctx.params);
         let params = ctx.uniform_buffer("minmax", 16);
         ctx.gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&MinMaxParamsGpu { block_size, _pad: [0; 3] }));
         Ok(Box::new(MinMaxGridNode { pipeline, params, block_size, grid: None, tap: self.tap.clone() }))

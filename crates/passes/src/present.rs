@@ -19,6 +19,9 @@ volgraph_core::pass_params! {
     }
 }
 
+/// Its one pipeline, declared once: `volgraph plan` checks the bindings of what `create` builds.
+const SHADER: ShaderUse = ShaderUse { file: "present.wgsl", entry_point: "cs_present", extra: &["params"] };
+
 impl PassPlugin for Present {
     fn kind(&self) -> &'static str {
         "present"
@@ -40,7 +43,7 @@ impl PassPlugin for Present {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "present.wgsl", entry_point: "cs_present", extra: &["params"] }]
+        vec![SHADER]
     }
 
     fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
@@ -48,12 +51,7 @@ impl PassPlugin for Present {
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
-            shader: "present.wgsl",
-            entry: "cs_present",
-            extra_bindings: &["params"],
-            ..Default::default()
-        })?;
+        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec::of(&SHADER))?;
         let params = ctx.uniform_buffer("params", 16);
         ctx.gpu.queue.write_buffer(&params, 0, &PresentParams::from_params(ctx.params).uniform_bytes());
         Ok(Box::new(PresentNode { pipeline, params }))

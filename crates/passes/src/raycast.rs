@@ -18,7 +18,7 @@ use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
-use crate::effects::{EffectState, effect_defines, effect_param_specs, same_effects, with_effect_bindings};
+use crate::effects::{EffectFlags, EffectState, effect_defines, same_effects};
 use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
 use crate::shared::FLOAT_TARGETS;
 
@@ -51,42 +51,39 @@ impl PassPlugin for Raycast {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        let mut p = raycast_param_specs();
-        p.extend(effect_param_specs());
-        p.extend(leap_param_specs());
-        p
+        [raycast_param_specs(), EffectFlags::specs(), RaycastOwn::specs()].concat()
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
+        let own = RaycastOwn::from_params(params);
         let mut defines = effect_defines(params);
-        if params.boolean("count_samples") {
+        if own.count_samples {
             defines.push("COUNT");
         }
-        if analytic(params) {
+        if own.analytic() {
             defines.push("ANALYTIC");
         }
         defines
     }
 
     fn ports(&self, params: &Params) -> Vec<PortSpec> {
+        let own = RaycastOwn::from_params(params);
         let mut ports = raycast_ports(
             params,
             &[TargetFormat::Rgba16Float, TargetFormat::Rgba32Float],
             &[TargetFormat::Rgba32Float, TargetFormat::Rgba16Float],
         );
-        if analytic(params) {
+        if own.analytic() {
             ports.retain(|p| p.name != "entry" && p.name != "dir");
         }
-        if leaps(params) {
+        if own.leaps() {
             // The leap variant writes `leap_hit` instead of the exact isosurface `hit`.
             ports.retain(|p| p.name != "hit");
-        }
-        if leaps(params) {
             // Leave unwired to start every ray at the box (the first frame of Klein's loop).
             ports.push(PortSpec::read("start", PortKind::target(&[TargetFormat::Rgba32Float])).optional());
             ports.push(PortSpec::write("leap_hit", PortKind::target(&[TargetFormat::Rgba32Float])));
         }
-        if params.boolean("count_samples") {
+        if own.count_samples {
             ports.push(PortSpec::write("samples", PortKind::buffer(4 * crate::raycast_fast::SAMPLE_ROWS)));
         }
         ports
@@ -103,11 +100,12 @@ impl PassPlugin for Raycast {
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
         // Every parameter but the mode, the effects and the leap outputs is a uniform value.
+        let (a, b) = (RaycastOwn::from_params(old), RaycastOwn::from_params(new));
         is_iso(old) == is_iso(new)
             && same_effects(old, new)
-            && leaps(old) == leaps(new)
-            && analytic(old) == analytic(new)
-            && old.boolean("count_samples") == new.boolean("count_samples")
+            && a.leaps() == b.leaps()
+            && a.analytic() == b.analytic()
+            && a.count_samples == b.count_samples
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
@@ -120,72 +118,86 @@ impl PassPlugin for Raycast {
             shader: "raycast.wgsl",
             vertex: "vs_fullscreen",
             fragment,
-            extra_bindings: &with_effect_bindings(&["params"]),
             defines: &defines,
             ..Default::default()
         })?;
-        let params = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
+        let own = RaycastOwn::from_params(ctx.params);
+        let settings = gpu_block(ctx.params);
+        let params = ctx.uniform_with("params", &settings);
         let effects = EffectState::new(ctx)?;
         Ok(Box::new(RaycastNode {
             pipeline,
             params,
             effects,
-            settings: RaycastParamsGpu::from_params(ctx.params),
-            conservative: ctx.params.choice("step_back_rule") == "conservative",
-            counted: ctx.params.boolean("count_samples"),
+            settings,
+            conservative: own.step_back_rule == StepBackRule::Conservative,
+            counted: own.count_samples,
             written_step_back: None,
         }))
     }
 }
 
-/// The Klein et al. 2005 parameters of the raycaster.
-fn leap_param_specs() -> Vec<ParamSpec> {
-    vec![
-        ParamSpec::choice(
-            "rays",
-            "raster",
-            &["raster", "analytic"],
+volgraph_core::param_choice! {
+    /// Where a ray's entry and direction come from.
+    pub enum Rays {
+        /// The `entry` and `dir` inputs (K-W 2003 §2.1).
+        Raster = "raster",
+        /// Met with the box in the shader, no inputs needed.
+        Analytic = "analytic",
+    }
+}
+
+volgraph_core::param_choice! {
+    /// How far a leap hit is moved back along the ray (Klein et al. 2005 §4.2).
+    pub enum StepBackRule {
+        /// `step_back` samples.
+        Fixed = "fixed",
+        /// ⌈|voxel diagonal| / step⌉, never missing a voxel.
+        Conservative = "conservative",
+    }
+}
+
+volgraph_core::pass_params! {
+    /// The raycaster's own parameters: its rays and Klein et al. 2005's leap hits.
+    pub struct RaycastOwn {
+        rays: Rays = Raster,
             "raster: entry and direction from the `entry` and `dir` inputs (K-W 2003 §2.1); analytic: met with the box in \
-             the shader, no inputs needed",
-        ),
-        ParamSpec::boolean(
-            "leap_hits",
-            false,
-            "write `leap_hit` (where the next frame's ray starts) and read the optional `start` estimate (Klein et al. 2005 §4.2)",
-        ),
-        ParamSpec::uint(
-            "step_back",
-            2,
-            0,
-            64,
-            "samples a leap hit is moved back along the ray (the paper: one to three suffice)",
-        ),
-        ParamSpec::choice(
-            "step_back_rule",
-            "fixed",
-            &["fixed", "conservative"],
-            "fixed: step_back samples; conservative: ⌈|voxel diagonal| / step⌉, never missing a voxel (Klein et al. 2005 §4.2)",
-        ),
-        ParamSpec::boolean("count_samples", false, "add the samples taken to the `samples` buffer (benchmarks)"),
-    ]
+             the shader, no inputs needed";
+        leap_hits: bool = false,
+            "write `leap_hit` (where the next frame's ray starts) and read the optional `start` estimate (Klein et al. 2005 §4.2)";
+        step_back: u32 = 2, 0..=64, "samples a leap hit is moved back along the ray (the paper: one to three suffice)";
+        step_back_rule: StepBackRule = Fixed,
+            "fixed: step_back samples; conservative: ⌈|voxel diagonal| / step⌉, never missing a voxel (Klein et al. 2005 §4.2)";
+        count_samples: bool = false, "add the samples taken to the `samples` buffer (benchmarks)";
+    }
 }
 
-/// Whether the rays meet the box analytically (no `entry` / `dir` inputs).
-fn analytic(params: &Params) -> bool {
-    params.choice("rays") == "analytic"
-}
+impl RaycastOwn {
+    /// Whether the rays meet the box analytically (no `entry` / `dir` inputs).
+    fn analytic(&self) -> bool {
+        self.rays == Rays::Analytic
+    }
 
-/// Whether the pass runs Klein's variant (leap hits written, or samples counted).
-fn leaps(params: &Params) -> bool {
-    params.boolean("leap_hits") || params.boolean("count_samples")
+    /// Whether the pass runs Klein's variant (leap hits written, or samples counted).
+    fn leaps(&self) -> bool {
+        self.leap_hits || self.count_samples
+    }
 }
 
 fn fragment_entry(params: &Params) -> &'static str {
-    match (is_iso(params), leaps(params)) {
+    match (is_iso(params), RaycastOwn::from_params(params).leaps()) {
         (false, false) => "fs_dvr",
         (true, false) => "fs_iso",
         (false, true) => "fs_dvr_leap",
         (true, true) => "fs_iso_leap",
+    }
+}
+
+/// The shared block with the fixed step back (the conservative one is computed per volume).
+fn gpu_block(params: &Params) -> RaycastParamsGpu {
+    RaycastParamsGpu {
+        step_back: RaycastOwn::from_params(params).step_back as f32,
+        ..RaycastParamsGpu::from_params(params)
     }
 }
 
@@ -231,8 +243,8 @@ impl PassNode for RaycastNode {
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
-        self.settings = RaycastParamsGpu::from_params(params);
-        self.conservative = params.choice("step_back_rule") == "conservative";
+        self.settings = gpu_block(params);
+        self.conservative = RaycastOwn::from_params(params).step_back_rule == StepBackRule::Conservative;
         self.written_step_back = None;
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&self.settings));
         self.effects.invalidate();

@@ -7,7 +7,7 @@
 //!   voxels the whole volume would and images have no seams. Non-empty bricks (for the current
 //!   TF) live in a 3D atlas texture, `brick_cells + 3` voxels per side per slot; empty bricks
 //!   are never uploaded. The pool is bounded by a memory budget (`pool_mb`, else the runtime's
-//!   `--gpu-memory-mb`, else what the adapter allows); a frame streams the bricks it needs
+//!   `--gpu-memory-mb`, else 2 GiB bounded by the 3D texture limit); a frame streams the bricks it needs
 //!   front to back and evicts the least recently used ([`crate::brick_pool`]). A volume larger
 //!   than the budget or the 3D texture limit renders in batches: the ray colour carries over.
 //! - §7 **octrees**: with `node_cells > 0`, each brick's octree (leaves of `node_cells`³ cells,
@@ -44,14 +44,14 @@ use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec,
 use wgpu::util::DeviceExt;
 
 use crate::brick_pool::{Batch, BrickPool};
-use crate::raycast_params::{RaycastParamsGpu, raycast_param_specs};
+use crate::raycast_params::{RaycastParamsGpu, Sampling, Termination, Workgroup};
 
 /// The plugin.
 pub struct RaycastBricks;
 
 volgraph_core::pass_params! {
-    /// The brick pass's own parameters, declared once (the raycasting ones are shared with the
-    /// other raycasters: `raycast_param_specs`).
+    /// The brick pass's own parameters, declared once (the sampling, termination and workgroup
+    /// blocks are the other raycasters': `raycast_params`).
     pub struct BrickSettings {
         brick_cells: u32 = 32, 2..=512, "cells per brick side (§5; the paper's best is 64)";
         node_cells: u32 = 8, 0..=512,
@@ -59,12 +59,10 @@ volgraph_core::pass_params! {
         ratio: f32 = 0.5, 0.0..=1.0,
             "octree ratio rule: a node whose visible-cell ratio reaches this is drawn whole, below it split (§7)";
         pool_mb: u32 = 0, 0..=1048576,
-            "brick pool budget in MiB (0: the runtime's --gpu-memory-mb, else what the adapter allows)";
+            "brick pool budget in MiB (0: the runtime's --gpu-memory-mb, else 2 GiB bounded by the 3D texture limit)";
         ranks: u32 = 1, 1..=4096,
             "sort-last rendering (docs/scaling.md): the bricks are split into this many slabs of the brick grid along its longest axis, one per rank";
         rank: u32 = 0, 0..=4095, "with ranks > 1: the slab of bricks this pass draws (0-based)";
-        workgroup_x: u32 = 8, 1..=256, "workgroup width in pixels";
-        workgroup_y: u32 = 8, 1..=256, "workgroup height in pixels";
     }
 }
 
@@ -99,12 +97,11 @@ impl PassPlugin for RaycastBricks {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        let mut p: Vec<ParamSpec> = raycast_param_specs()
-            .into_iter()
-            .filter(|s| matches!(s.name, "step_voxels" | "threshold" | "max_steps" | "jitter"))
-            .collect();
-        p.extend(BrickSettings::specs());
-        p
+        [Sampling::specs(), Termination::specs(), BrickSettings::specs(), Workgroup::specs()].concat()
+    }
+
+    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
+        crate::effects::jitter_defines(params)
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -127,11 +124,13 @@ impl PassPlugin for RaycastBricks {
         // Only the raycasting parameters (a uniform) change in place; the brick settings
         // shape the pool and the leaves.
         BrickSettings::from_params(old) == BrickSettings::from_params(new)
+            && Workgroup::from_params(old) == Workgroup::from_params(new)
+            && self.shader_defines(old) == self.shader_defines(new)
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let settings = BrickSettings::from_params(ctx.params);
-        let wg = (settings.workgroup_x, settings.workgroup_y);
+        let wg = Workgroup::from_params(ctx.params).size();
         if wg.0 * wg.1 > ctx.gpu.limits.max_compute_invocations_per_workgroup {
             return Err(PassError {
                 pass: ctx.pass_id.to_string(),
@@ -141,14 +140,13 @@ impl PassPlugin for RaycastBricks {
                 ),
             });
         }
-        let mut defines = Vec::new();
+        let mut defines = self.shader_defines(ctx.params);
         if crate::shared::color_is_f32(ctx) {
             defines.push("COLOR_F32");
         }
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
             shader: "raycast_bricks.wgsl",
             entry: "cs_main",
-            extra_bindings: &["params", "bricks", "table", "leaf_distance", "acc", "volume"],
             defines: &defines,
             constants: &[("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)],
         })?;

@@ -7,9 +7,9 @@ use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortSpec, TargetFormat};
 
-use crate::effects::{EffectState, effect_defines, effect_param_specs, same_effects, with_effect_bindings};
+use crate::effects::{EffectFlags, EffectState, effect_defines, same_effects};
 use crate::raycast::raycast_ports;
-use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
+use crate::raycast_params::{RaycastParamsGpu, Sampling, Workgroup, is_iso, raycast_param_specs};
 use crate::shared::color_is_f32;
 
 /// The plugin.
@@ -25,11 +25,7 @@ impl PassPlugin for RaycastCompute {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        let mut p = raycast_param_specs();
-        p.extend(effect_param_specs());
-        p.push(ParamSpec::uint("workgroup_x", 8, 1, 256, "workgroup width in pixels"));
-        p.push(ParamSpec::uint("workgroup_y", 8, 1, 256, "workgroup height in pixels"));
-        p
+        [raycast_param_specs(), EffectFlags::specs(), Workgroup::specs()].concat()
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
@@ -52,12 +48,11 @@ impl PassPlugin for RaycastCompute {
         // The mode picks the entry point and the workgroup size is a pipeline constant.
         is_iso(old) == is_iso(new)
             && same_effects(old, new)
-            && old.uint("workgroup_x") == new.uint("workgroup_x")
-            && old.uint("workgroup_y") == new.uint("workgroup_y")
+            && Workgroup::from_params(old) == Workgroup::from_params(new)
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let wg = (ctx.params.uint("workgroup_x") as u32, ctx.params.uint("workgroup_y") as u32);
+        let wg = Workgroup::from_params(ctx.params).size();
         if wg.0 * wg.1 > ctx.gpu.limits.max_compute_invocations_per_workgroup {
             return Err(PassError {
                 pass: ctx.pass_id.to_string(),
@@ -78,7 +73,6 @@ impl PassPlugin for RaycastCompute {
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
             shader: "raycast_compute.wgsl",
             entry,
-            extra_bindings: &with_effect_bindings(&["params"]),
             constants: &[("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)],
             defines: &defines,
         })?;
@@ -89,7 +83,7 @@ impl PassPlugin for RaycastCompute {
             params,
             workgroup: wg,
             effects,
-            step_voxels: ctx.params.float("step_voxels"),
+            step_voxels: Sampling::from_params(ctx.params).step_voxels,
         }))
     }
 }
@@ -112,7 +106,7 @@ impl PassNode for RaycastComputeNode {
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
-        self.step_voxels = params.float("step_voxels");
+        self.step_voxels = Sampling::from_params(params).step_voxels;
         self.effects.invalidate();
     }
 }

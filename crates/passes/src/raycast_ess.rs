@@ -10,26 +10,19 @@ use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
-use crate::effects::{
-    EffectState, SHADING_PARAMS, effect_defines, effect_param_specs, same_effects, with_effect_bindings,
-};
+use crate::effects::{EffectState, effect_defines, same_effects};
 use crate::empty_space::{EMPTY_BLOCKS, check_block_grid};
 use crate::minmax_grid::bound_size;
-use crate::raycast_params::{RaycastParamsGpu, raycast_param_specs};
-use crate::shared::{FLOAT_TARGETS, block_size_spec};
+use crate::raycast_fast::dvr_leap_specs;
+use crate::raycast_params::{RaycastParamsGpu, Sampling};
+use crate::shared::{BlockSize, FLOAT_TARGETS};
 
 /// The plugin.
 pub struct RaycastEss;
 
-/// Rust twin of `struct EssParams` in `shaders/raycast_ess.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct EssParamsGpu {
-    block_size: u32,
-    _pad: [u32; 3],
-}
-
-const _: () = assert!(std::mem::size_of::<EssParamsGpu>() == 16);
+/// Its one pipeline.
+const SHADER: ShaderUse =
+    ShaderUse { file: "raycast_ess.wgsl", entry_point: "fs_dvr", extra: &["params", "ess", "preintegrated"] };
 
 impl PassPlugin for RaycastEss {
     fn kind(&self) -> &'static str {
@@ -43,16 +36,7 @@ impl PassPlugin for RaycastEss {
     fn params(&self) -> Vec<ParamSpec> {
         // DVR only: the isosurface parameters of `raycast` do not apply (its shading
         // coefficients do, for the shading effect).
-        let mut p: Vec<ParamSpec> = raycast_param_specs()
-            .into_iter()
-            .filter(|s| {
-                matches!(s.name, "step_voxels" | "threshold" | "max_steps" | "jitter" | "jitter_per_frame")
-                    || SHADING_PARAMS.contains(&s.name)
-            })
-            .collect();
-        p.push(block_size_spec());
-        p.extend(effect_param_specs());
-        p
+        dvr_leap_specs()
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
@@ -71,9 +55,7 @@ impl PassPlugin for RaycastEss {
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        let own =
-            ShaderUse { file: "raycast_ess.wgsl", entry_point: "fs_dvr", extra: &["params", "ess", "preintegrated"] };
-        [vec![own], crate::effects::effect_shader_uses(params)].concat()
+        [vec![SHADER], crate::effects::effect_shader_uses(params)].concat()
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
@@ -83,21 +65,16 @@ impl PassPlugin for RaycastEss {
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let defines = effect_defines(ctx.params);
-        let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
-            shader: "raycast_ess.wgsl",
-            vertex: "vs_fullscreen",
-            fragment: "fs_dvr",
-            extra_bindings: &with_effect_bindings(&["params", "ess"]),
-            defines: &defines,
-            ..Default::default()
-        })?;
+        let pipeline =
+            ctx.render_pipeline(&RenderPipelineSpec { defines: &defines, ..RenderPipelineSpec::fullscreen(&SHADER) })?;
         let params = ctx.uniform_buffer("params", std::mem::size_of::<RaycastParamsGpu>() as u64);
         ctx.gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(ctx.params)));
-        let block_size = ctx.params.uint("block_size").max(1) as u32;
+        let block_size = BlockSize::of(ctx.params);
+        // `EssParams` of the shader: the block edge, padded to 16 bytes.
         let ess = ctx.uniform_buffer("ess", 16);
-        ctx.gpu.queue.write_buffer(&ess, 0, bytemuck::bytes_of(&EssParamsGpu { block_size, _pad: [0; 3] }));
+        ctx.gpu.queue.write_buffer(&ess, 0, &BlockSize { block_size }.uniform_bytes());
         let effects = EffectState::new(ctx)?;
-        let step_voxels = ctx.params.float("step_voxels");
+        let step_voxels = Sampling::from_params(ctx.params).step_voxels;
         Ok(Box::new(RaycastEssNode { pipeline, params, ess, block_size, effects, step_voxels }))
     }
 }
@@ -126,10 +103,9 @@ impl PassNode for RaycastEssNode {
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
-        self.step_voxels = params.float("step_voxels");
+        self.step_voxels = Sampling::from_params(params).step_voxels;
         self.effects.invalidate();
-        self.block_size = params.uint("block_size").max(1) as u32;
-        let ess = EssParamsGpu { block_size: self.block_size, _pad: [0; 3] };
-        gpu.queue.write_buffer(&self.ess, 0, bytemuck::bytes_of(&ess));
+        self.block_size = BlockSize::of(params);
+        gpu.queue.write_buffer(&self.ess, 0, &BlockSize { block_size: self.block_size }.uniform_bytes());
     }
 }

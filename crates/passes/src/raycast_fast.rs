@@ -26,14 +26,13 @@ use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
-use crate::effects::{
-    EffectState, SHADING_PARAMS, effect_defines, effect_param_specs, same_effects, with_effect_bindings,
-};
+use crate::effects::{EffectFlags, EffectState, effect_defines, same_effects};
 use crate::empty_distance::EMPTY_DISTANCE;
 use crate::minmax_grid::bound_size;
-use crate::opacity_lut::{OpacityTable, TABLE_SHADERS};
-use crate::raycast_params::{RaycastParamsGpu, raycast_param_specs};
-use crate::shared::block_size_spec;
+use crate::opacity_lut::{TABLE_SHADERS, opacity_table};
+use crate::raycast_params::{RaycastParamsGpu, Sampling, Shading, Termination, Workgroup};
+use crate::shared::BlockSize;
+use crate::tf_table::TfTable;
 
 /// The plugin.
 pub struct RaycastFast;
@@ -42,19 +41,51 @@ pub struct RaycastFast;
 /// y mod SAMPLE_ROWS, so a word holds at most a row's samples.
 pub const SAMPLE_ROWS: u64 = 4096;
 
-/// Rust twin of `struct FastParams` in `shaders/raycast_fast.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct FastParamsGpu {
-    block_size: u32,
-    _pad: [u32; 3],
+volgraph_core::param_choice! {
+    /// What a run of samples leaps out of when the distance map says it may.
+    pub enum Leap {
+        /// The largest cube of empty blocks around the sample.
+        Cubes = "cubes",
+        /// The sample's own block.
+        Blocks = "blocks",
+        /// Nothing: every sample is taken.
+        None = "none",
+    }
 }
 
-const _: () = assert!(std::mem::size_of::<FastParamsGpu>() == 16);
+volgraph_core::param_choice! {
+    /// How a sample is classified.
+    pub enum Classify {
+        /// The TF and the exact per-sample opacity correction.
+        Exact = "exact",
+        /// One lookup in a table pre-corrected for the step.
+        Table = "table",
+    }
+}
 
-/// The parameters whose change needs a new pipeline (override constants, ports).
-const PIPELINE_UINTS: [&str; 3] = ["workgroup_x", "workgroup_y", "check_every"];
-const PIPELINE_CHOICES: [&str; 2] = ["leap", "classify"];
+volgraph_core::pass_params! {
+    /// `raycast_fast`'s own parameters; all of them choose the pipeline (override constants,
+    /// ports), so a change rebuilds the node.
+    pub struct FastOwn {
+        leap: Leap = Cubes,
+            "with `distance` wired: leap out of the largest cube of empty blocks, out of one block at a time, or \
+             take every sample (unwired: none)";
+        check_every: u32 = 16, 1..=1024,
+            "samples in a run between two looks at the distance map (all lanes look together)";
+        classify: Classify = Exact,
+            "exact: the TF and the exact per-sample opacity correction (sqrt at step 0.5, else pow); table: one \
+             lookup in a table pre-corrected for the step, rebuilt each frame (faster than pow, up to ~1/255 off \
+             where the TF reaches alpha 1)";
+        count_samples: bool = false,
+            "write the number of samples taken to the `samples` buffer (benchmarks; one atomic per pixel)";
+    }
+}
+
+/// The blocks `raycast_fast` and `raycast_ess` share: DVR sampling with termination, the
+/// shading coefficients (for the shading effect), the block grid and the effects.
+pub(crate) fn dvr_leap_specs() -> Vec<ParamSpec> {
+    [Sampling::specs(), Termination::specs(), Shading::specs(), BlockSize::specs(), EffectFlags::specs()].concat()
+}
 
 impl PassPlugin for RaycastFast {
     fn kind(&self) -> &'static str {
@@ -67,45 +98,7 @@ impl PassPlugin for RaycastFast {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        let mut p: Vec<ParamSpec> = raycast_param_specs()
-            .into_iter()
-            .filter(|s| {
-                matches!(s.name, "step_voxels" | "threshold" | "max_steps" | "jitter" | "jitter_per_frame")
-                    || SHADING_PARAMS.contains(&s.name)
-            })
-            .collect();
-        p.push(block_size_spec());
-        p.extend(effect_param_specs());
-        p.push(ParamSpec::choice(
-            "leap",
-            "cubes",
-            &["cubes", "blocks", "none"],
-            "with `distance` wired: leap out of the largest cube of empty blocks, out of one block at a time, or \
-             take every sample (unwired: none)",
-        ));
-        p.push(ParamSpec::uint(
-            "check_every",
-            16,
-            1,
-            1024,
-            "samples in a run between two looks at the distance map (all lanes look together)",
-        ));
-        p.push(ParamSpec::choice(
-            "classify",
-            "exact",
-            &["exact", "table"],
-            "exact: the TF and the exact per-sample opacity correction (sqrt at step 0.5, else pow); table: one \
-             lookup in a table pre-corrected for the step, rebuilt each frame (faster than pow, up to ~1/255 off \
-             where the TF reaches alpha 1)",
-        ));
-        p.push(ParamSpec::boolean(
-            "count_samples",
-            false,
-            "write the number of samples taken to the `samples` buffer (benchmarks; one atomic per pixel)",
-        ));
-        p.push(ParamSpec::uint("workgroup_x", 8, 1, 256, "workgroup width in pixels"));
-        p.push(ParamSpec::uint("workgroup_y", 8, 1, 256, "workgroup height in pixels"));
-        p
+        [dvr_leap_specs(), FastOwn::specs(), Workgroup::specs()].concat()
     }
 
     fn ports(&self, params: &Params) -> Vec<PortSpec> {
@@ -116,7 +109,7 @@ impl PassPlugin for RaycastFast {
             PortSpec::read("distance", PortKind::Owned(EMPTY_DISTANCE)).optional(),
             PortSpec::write("color", PortKind::target(&[TargetFormat::Rgba16Float, TargetFormat::Rgba32Float])),
         ];
-        if params.boolean("count_samples") {
+        if FastOwn::from_params(params).count_samples {
             // One u32 per image row (mod SAMPLE_ROWS): samples taken this frame.
             ports.push(PortSpec::write("samples", PortKind::buffer(4 * SAMPLE_ROWS)));
         }
@@ -125,20 +118,22 @@ impl PassPlugin for RaycastFast {
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
         let mut defines = effect_defines(params);
-        if params.boolean("shading") || params.boolean("preintegration") {
+        let effects = EffectFlags::of(params);
+        if effects.shading || effects.preintegration {
             defines.push("EFFECTS");
         }
         defines
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        let entry_point = if params.boolean("count_samples") { "cs_counted" } else { "cs_main" };
+        let own = FastOwn::from_params(params);
+        let entry_point = if own.count_samples { "cs_counted" } else { "cs_main" };
         let mut uses = vec![ShaderUse {
             file: "raycast_fast.wgsl",
             entry_point,
             extra: &["params", "fast", "corrected", "preintegrated"],
         }];
-        if params.choice("classify") == "table" {
+        if own.classify == Classify::Table {
             uses.extend(TABLE_SHADERS);
         }
         uses.extend(crate::effects::effect_shader_uses(params));
@@ -146,15 +141,17 @@ impl PassPlugin for RaycastFast {
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        PIPELINE_UINTS.iter().all(|p| old.uint(p) == new.uint(p))
-            && PIPELINE_CHOICES.iter().all(|p| old.choice(p) == new.choice(p))
-            && old.boolean("count_samples") == new.boolean("count_samples")
+        let half_step = |p: &Params| Sampling::from_params(p).step_voxels == 0.5;
+        FastOwn::from_params(old) == FastOwn::from_params(new)
+            && Workgroup::from_params(old) == Workgroup::from_params(new)
             && same_effects(old, new)
-            && (old.float("step_voxels") == 0.5) == (new.float("step_voxels") == 0.5)
+            && half_step(old) == half_step(new)
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let wg = (ctx.params.uint("workgroup_x") as u32, ctx.params.uint("workgroup_y") as u32);
+        let own = FastOwn::from_params(ctx.params);
+        let sampling = Sampling::from_params(ctx.params);
+        let wg = Workgroup::from_params(ctx.params).size();
         if wg.0 * wg.1 > ctx.gpu.limits.max_compute_invocations_per_workgroup {
             return Err(PassError {
                 pass: ctx.pass_id.to_string(),
@@ -168,16 +165,16 @@ impl PassPlugin for RaycastFast {
             });
         }
         let distance_wired = ctx.port("distance").is_some_and(|p| p.bound);
-        let leap = match (distance_wired, ctx.params.choice("leap")) {
-            (false, _) | (true, "none") => 0.0,
-            (true, "blocks") => 1.0,
-            (true, _) => 2.0,
+        let leap = match (distance_wired, own.leap) {
+            (false, _) | (true, Leap::None) => 0.0,
+            (true, Leap::Blocks) => 1.0,
+            (true, Leap::Cubes) => 2.0,
         };
-        let table = match ctx.params.choice("classify") {
-            "table" => Some(OpacityTable::new(ctx)?),
-            _ => None,
+        let table = match own.classify {
+            Classify::Table => Some(opacity_table(ctx)?),
+            Classify::Exact => None,
         };
-        let counted = ctx.params.boolean("count_samples");
+        let counted = own.count_samples;
         let mut defines = self.shader_defines(ctx.params);
         if crate::shared::color_is_f32(ctx) {
             defines.push("COLOR_F32");
@@ -186,14 +183,13 @@ impl PassPlugin for RaycastFast {
             ctx.compute_pipeline(&ComputePipelineSpec {
                 shader: "raycast_fast.wgsl",
                 entry: if counted { "cs_counted" } else { "cs_main" },
-                extra_bindings: &with_effect_bindings(&["params", "fast", "corrected"]),
                 defines: &defines,
                 constants: &[
                     ("WORKGROUP_X", wg.0 as f64),
                     ("WORKGROUP_Y", wg.1 as f64),
                     ("LEAP", leap),
                     ("CORRECTED", if table.is_some() { 1.0 } else { 0.0 }),
-                    ("CHECK_EVERY", ctx.params.uint("check_every").max(1) as f64),
+                    ("CHECK_EVERY", own.check_every.max(1) as f64),
                     ("HALF_STEP", if half_step { 1.0 } else { 0.0 }),
                 ],
             })
@@ -201,11 +197,14 @@ impl PassPlugin for RaycastFast {
         let pipeline = variant(false)?;
         // The square-root variant, for frames whose correction exponent is exactly 0.5 (step
         // 0.5 with opacity per voxel); only the exact classification without effects uses it.
-        let exact_plain = table.is_none() && !ctx.params.boolean("shading") && !ctx.params.boolean("preintegration");
-        let half_step = (exact_plain && ctx.params.float("step_voxels") == 0.5).then(|| variant(true)).transpose()?;
+        let effects = EffectFlags::of(ctx.params);
+        let exact_plain = table.is_none() && !effects.shading && !effects.preintegration;
+        let half_step = (exact_plain && sampling.step_voxels == 0.5).then(|| variant(true)).transpose()?;
         let params = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
-        let block_size = ctx.params.uint("block_size").max(1) as u32;
-        let fast = ctx.uniform_with("fast", &FastParamsGpu { block_size, _pad: [0; 3] });
+        let block_size = BlockSize::of(ctx.params);
+        // `FastParams` of the shader: the block edge, padded to 16 bytes.
+        let fast = ctx.uniform_buffer("fast", 16);
+        ctx.gpu.queue.write_buffer(&fast, 0, &BlockSize { block_size }.uniform_bytes());
         let stand_in = |dimension, format, label: &str| {
             ctx.gpu
                 .device
@@ -239,7 +238,7 @@ impl PassPlugin for RaycastFast {
             no_distance,
             no_table,
             effects,
-            step_voxels: ctx.params.float("step_voxels"),
+            step_voxels: sampling.step_voxels,
         }))
     }
 }
@@ -253,7 +252,7 @@ struct RaycastFastNode {
     block_size: u32,
     workgroup: (u32, u32),
     counted: bool,
-    table: Option<OpacityTable>,
+    table: Option<TfTable>,
     no_distance: Option<wgpu::TextureView>,
     no_table: Option<wgpu::TextureView>,
     effects: EffectState,
@@ -289,7 +288,7 @@ impl PassNode for RaycastFastNode {
             ctx.clear_buffer("samples")?;
         }
         if let Some(table) = &self.table {
-            table.record(ctx, &self.params)?;
+            table.fill(ctx, &self.params)?;
         }
         self.effects.update(ctx, &self.params, self.step_voxels)?;
         let corrected = self.table.as_ref().map_or(self.no_table.as_ref(), |t| Some(&t.view));
@@ -311,10 +310,9 @@ impl PassNode for RaycastFastNode {
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
-        self.step_voxels = params.float("step_voxels");
+        self.step_voxels = Sampling::from_params(params).step_voxels;
         self.effects.invalidate();
-        self.block_size = params.uint("block_size").max(1) as u32;
-        let fast = FastParamsGpu { block_size: self.block_size, _pad: [0; 3] };
-        gpu.queue.write_buffer(&self.fast, 0, bytemuck::bytes_of(&fast));
+        self.block_size = BlockSize::of(params);
+        gpu.queue.write_buffer(&self.fast, 0, &BlockSize { block_size: self.block_size }.uniform_bytes());
     }
 }

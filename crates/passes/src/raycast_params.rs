@@ -1,40 +1,92 @@
-//! Parameters shared by the fragment and compute raycasters, and their GPU twin.
+//! Parameters shared by the raycasters, declared once as blocks, and their GPU twin.
+//!
+//! Each block is a [`pass_params!`](volgraph_core::pass_params) declaration; a kind lists the
+//! blocks it takes whole (`[Sampling::specs(), Termination::specs()].concat()`), and code that
+//! serves several kinds reads a block with `try_from_params` (`Some` where the kind declares
+//! it). No parameter name is written anywhere else. docs/rendering_model.md gives their meaning.
 
 use volgraph_accel::reference::{Phong, RaycastSettings, RenderMode};
-use volgraph_core::{ParamSpec, Params};
+use volgraph_core::Params;
 
-/// The declared parameters (docs/rendering_model.md for their meaning).
-pub fn raycast_param_specs() -> Vec<ParamSpec> {
-    vec![
-        ParamSpec::float("step_voxels", 0.5, 0.01, 16.0, "sample distance in units of the smallest voxel side"),
-        ParamSpec::float(
-            "threshold",
-            1.0,
-            0.0,
-            1.0,
-            "early ray termination once accumulated alpha reaches this (1 = off, lossless)",
-        ),
-        ParamSpec::uint("max_steps", 4096, 1, 1 << 20, "upper bound on samples per ray"),
-        ParamSpec::boolean(
-            "jitter",
-            false,
-            "offset each ray's first sample by a per-pixel hash (trades banding for noise)",
-        ),
-        ParamSpec::boolean(
-            "jitter_per_frame",
-            false,
-            "with jitter: move the offsets every frame (frame 0 keeps the stable ones), for accumulation",
-        ),
-        ParamSpec::choice("mode", "dvr", &["dvr", "iso"], "direct volume rendering or first-hit isosurface"),
-        ParamSpec::float("iso_value", 0.5, 0.0, 1.0, "isovalue in normalized scalar units (mode \"iso\")"),
-        ParamSpec::float("ambient", 0.15, 0.0, 1.0, "Blinn–Phong ambient coefficient (mode \"iso\")"),
-        ParamSpec::float("diffuse", 0.75, 0.0, 1.0, "Blinn–Phong diffuse coefficient (mode \"iso\")"),
-        ParamSpec::float("specular", 0.25, 0.0, 1.0, "Blinn–Phong specular coefficient (mode \"iso\")"),
-        ParamSpec::float("shininess", 32.0, 1.0, 512.0, "Blinn–Phong exponent (mode \"iso\")"),
-    ]
+use crate::effects::EffectFlags;
+
+volgraph_core::param_choice! {
+    /// What a raycaster computes.
+    pub enum Mode {
+        /// Direct volume rendering: the emission–absorption integral.
+        Dvr = "dvr",
+        /// The first hit of the isosurface, Blinn–Phong shaded.
+        Iso = "iso",
+    }
 }
 
-/// Rust twin of `struct RaycastParams` in `shaders/common/raycast_params.wgsl`.
+volgraph_core::pass_params! {
+    /// How each ray is sampled: every raycaster.
+    pub struct Sampling {
+        step_voxels: f64 = 0.5, 0.01..=16.0, "sample distance in units of the smallest voxel side";
+        max_steps: u32 = 4096, 1..=1048576, "upper bound on samples per ray";
+        jitter: bool = false, "offset each ray's first sample by a per-pixel hash (trades banding for noise)";
+        jitter_per_frame: bool = false,
+            "with jitter: move the offsets every frame (frame 0 keeps the stable ones), for accumulation";
+    }
+}
+
+volgraph_core::pass_params! {
+    /// Early ray termination (Krüger–Westermann 2003 §2.2).
+    pub struct Termination {
+        threshold: f64 = 1.0, 0.0..=1.0,
+            "early ray termination once accumulated alpha reaches this (1 = off, lossless)";
+    }
+}
+
+volgraph_core::pass_params! {
+    /// What the raycaster computes: the integral or the first isosurface hit.
+    pub struct Surface {
+        mode: Mode = Dvr, "direct volume rendering or first-hit isosurface";
+        iso_value: f64 = 0.5, 0.0..=1.0, "isovalue in normalized scalar units (mode \"iso\")";
+    }
+}
+
+volgraph_core::pass_params! {
+    /// Blinn–Phong headlight coefficients: the isosurface's, and DVR's with the shading effect.
+    pub struct Shading {
+        ambient: f64 = 0.15, 0.0..=1.0, "Blinn–Phong ambient coefficient (mode \"iso\", or the shading effect)";
+        diffuse: f64 = 0.75, 0.0..=1.0, "Blinn–Phong diffuse coefficient (mode \"iso\", or the shading effect)";
+        specular: f64 = 0.25, 0.0..=1.0, "Blinn–Phong specular coefficient (mode \"iso\", or the shading effect)";
+        shininess: f64 = 32.0, 1.0..=512.0, "Blinn–Phong exponent (mode \"iso\", or the shading effect)";
+    }
+}
+
+volgraph_core::pass_params! {
+    /// The compute raycasters' workgroup.
+    pub struct Workgroup {
+        workgroup_x: u32 = 8, 1..=256, "workgroup width in pixels";
+        workgroup_y: u32 = 8, 1..=256, "workgroup height in pixels";
+    }
+}
+
+impl Shading {
+    /// The coefficients of a kind that declares them, else 0 (what its shader never reads).
+    pub fn of(p: &Params) -> Self {
+        Self::try_from_params(p).unwrap_or(Self { ambient: 0.0, diffuse: 0.0, specular: 0.0, shininess: 0.0 })
+    }
+}
+
+impl Workgroup {
+    /// `(x, y)`.
+    pub fn size(&self) -> (u32, u32) {
+        (self.workgroup_x, self.workgroup_y)
+    }
+}
+
+/// Every block of the full raycaster (`raycast`, `raycast_compute`, `raycast_segment`,
+/// `antialias`): sampling, termination, isosurface and shading.
+pub fn raycast_param_specs() -> Vec<volgraph_core::ParamSpec> {
+    [Sampling::specs(), Termination::specs(), Surface::specs(), Shading::specs()].concat()
+}
+
+/// Rust twin of `struct RaycastParams` in `shaders/common/raycast_params.wgsl` (a test compares
+/// the two through naga).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct RaycastParamsGpu {
@@ -56,8 +108,8 @@ pub struct RaycastParamsGpu {
     pub specular: f32,
     /// Phong exponent.
     pub shininess: f32,
-    /// Klein et al. 2005 §4.2: samples a leap hit is moved back (the `step_back` parameter, or
-    /// the conservative count the node computes for the bound volume).
+    /// Klein et al. 2005 §4.2: samples a leap hit is moved back (computed by `raycast`'s node
+    /// from its `step_back` parameter or the bound volume; 0 elsewhere).
     pub step_back: f32,
     /// Padding.
     pub _pad: [f32; 2],
@@ -66,63 +118,97 @@ pub struct RaycastParamsGpu {
 const _: () = assert!(std::mem::size_of::<RaycastParamsGpu>() == 48);
 
 impl RaycastParamsGpu {
-    /// From checked pass parameters.
+    /// The block of a raycaster's parameters: the sampling every raycaster declares, and the
+    /// termination, isosurface and shading blocks where its kind declares them (else what the
+    /// shader never reads: no termination, 0).
     pub fn from_params(p: &Params) -> Self {
-        // The raycasters share this block but declare only the parameters they use: what a
-        // kind does not declare is a value its shader never reads (0, as the block's padding).
+        let sampling = Sampling::from_params(p);
+        let threshold = Termination::try_from_params(p).map_or(1.0, |t| t.threshold);
+        let iso_value = Surface::try_from_params(p).map_or(0.0, |s| s.iso_value);
+        let shading = Shading::of(p);
         Self {
-            step_voxels: p.float("step_voxels") as f32,
-            threshold: p.float_or("threshold", 1.0) as f32,
-            max_steps: p.uint("max_steps") as u32,
-            jitter: p.boolean_or("jitter", false) as u32,
-            iso_value: p.float_or("iso_value", 0.0) as f32,
-            ambient: p.float_or("ambient", 0.0) as f32,
-            diffuse: p.float_or("diffuse", 0.0) as f32,
-            specular: p.float_or("specular", 0.0) as f32,
-            shininess: p.float_or("shininess", 0.0) as f32,
-            step_back: p.uint_or("step_back", 0) as f32,
+            step_voxels: sampling.step_voxels as f32,
+            threshold: threshold as f32,
+            max_steps: sampling.max_steps,
+            jitter: sampling.jitter as u32,
+            iso_value: iso_value as f32,
+            ambient: shading.ambient as f32,
+            diffuse: shading.diffuse as f32,
+            specular: shading.specular as f32,
+            shininess: shading.shininess as f32,
+            step_back: 0.0,
             _pad: [0.0; 2],
         }
     }
 }
 
-/// Whether the parameters ask for the isosurface.
+/// Whether the parameters ask for the isosurface (kinds without the [`Surface`] block are DVR).
 pub fn is_iso(p: &Params) -> bool {
-    p.choice_or("mode", "dvr") == "iso"
+    Surface::try_from_params(p).is_some_and(|s| s.mode == Mode::Iso)
 }
 
 /// The CPU reference settings equivalent to a raycast pass's parameters, so tests render the
 /// same integral on both sides.
 pub fn reference_settings(p: &Params) -> RaycastSettings {
+    let sampling = Sampling::from_params(p);
+    let effects = EffectFlags::of(p);
+    let shading = Shading::of(p);
+    let phong = Phong {
+        ambient: shading.ambient,
+        diffuse: shading.diffuse,
+        specular: shading.specular,
+        shininess: shading.shininess,
+    };
+    let iso = Surface::try_from_params(p).map_or(0.0, |s| s.iso_value);
     RaycastSettings {
-        step_voxels: p.float("step_voxels"),
-        threshold: p.float_or("threshold", 1.0),
-        max_steps: p.uint("max_steps") as u32,
-        jitter: p.boolean_or("jitter", false),
+        step_voxels: sampling.step_voxels,
+        threshold: Termination::try_from_params(p).map_or(1.0, |t| t.threshold),
+        max_steps: sampling.max_steps,
+        jitter: sampling.jitter,
         effects: volgraph_accel::reference::Effects {
-            shading: p.boolean_or("shading", false),
-            preintegration: p.boolean_or("preintegration", false),
-            tricubic: p.boolean_or("tricubic", false),
+            shading: effects.shading,
+            preintegration: effects.preintegration,
+            tricubic: effects.tricubic,
         },
-        dvr_shading: Phong {
-            ambient: p.float_or("ambient", 0.0),
-            diffuse: p.float_or("diffuse", 0.0),
-            specular: p.float_or("specular", 0.0),
-            shininess: p.float_or("shininess", 0.0),
-        },
+        dvr_shading: phong,
         opacity_unit_voxels: 1.0,
-        mode: if is_iso(p) {
-            RenderMode::Isosurface {
-                iso: p.float_or("iso_value", 0.0),
-                shading: Phong {
-                    ambient: p.float_or("ambient", 0.0),
-                    diffuse: p.float_or("diffuse", 0.0),
-                    specular: p.float_or("specular", 0.0),
-                    shininess: p.float_or("shininess", 0.0),
-                },
-            }
-        } else {
-            RenderMode::Dvr
-        },
+        mode: if is_iso(p) { RenderMode::Isosurface { iso, shading: phong } } else { RenderMode::Dvr },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The Rust block and the shader's `RaycastParams` have the same members in the same order.
+    #[test]
+    fn the_gpu_block_matches_the_shader_struct() {
+        // The struct alone: the file's binding uses `@binding(auto)`, numbered at assembly.
+        let file = include_str!("../../../shaders/common/raycast_params.wgsl");
+        let source: String = file.lines().filter(|l| !l.starts_with("@group")).collect::<Vec<_>>().join("\n");
+        let fields = [
+            ("step_voxels", "f32"),
+            ("threshold", "f32"),
+            ("max_steps", "u32"),
+            ("jitter", "u32"),
+            ("iso_value", "f32"),
+            ("ambient", "f32"),
+            ("diffuse", "f32"),
+            ("specular", "f32"),
+            ("shininess", "f32"),
+            ("step_back", "f32"),
+        ];
+        volgraph_core::declare::check_wgsl_struct(&source, "RaycastParams", &fields).expect("the layouts agree");
+        assert_eq!(std::mem::size_of::<RaycastParamsGpu>(), 4 * fields.len() + 8);
+    }
+
+    #[test]
+    fn blocks_a_kind_does_not_declare_read_as_what_the_shader_ignores() {
+        let params = Params::defaults(&Sampling::specs());
+        let gpu = RaycastParamsGpu::from_params(&params);
+        assert_eq!((gpu.threshold, gpu.iso_value, gpu.ambient), (1.0, 0.0, 0.0));
+        assert!(!is_iso(&params));
+        let full = Params::defaults(&raycast_param_specs());
+        assert_eq!(RaycastParamsGpu::from_params(&full).ambient, 0.15);
     }
 }

@@ -25,8 +25,8 @@ use volgraph_core::runtime::{
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::empty_space::EMPTY_BLOCKS;
-use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
-use crate::shared::{ACCUM_FORMATS, FLOAT_TARGETS, HIT_FORMATS, block_size_spec, front_to_back_blend};
+use crate::raycast_params::{RaycastParamsGpu, Termination, is_iso, raycast_param_specs};
+use crate::shared::{ACCUM_FORMATS, BlockSize, FLOAT_TARGETS, HIT_FORMATS, front_to_back_blend};
 
 /// The plugin. [`Default`] is the production pass; [`RaycastSegment::counting`] adds the debug
 /// invocation counter.
@@ -84,26 +84,24 @@ pub struct SegmentParamsGpu {
 const _: () = assert!(std::mem::size_of::<SegmentParamsGpu>() == 16);
 
 impl SegmentParamsGpu {
-    /// From checked parameters (`segment_steps`, `block_size`, `threshold`; absent ones are 0).
+    /// From the checked parameters of a kind that declares the [`SegmentSteps`], [`BlockSize`]
+    /// and [`Termination`] blocks (`raycast_segment`, `termination_test`).
     pub fn from_params(p: &Params) -> Self {
         Self {
-            steps: p.uint("segment_steps") as u32,
-            block_size: p.uint("block_size").max(1) as u32,
-            threshold: p.float("threshold") as f32,
+            steps: SegmentSteps::from_params(p).segment_steps,
+            block_size: BlockSize::of(p),
+            threshold: Termination::from_params(p).threshold as f32,
             _pad: 0,
         }
     }
 }
 
-/// The `segment_steps` parameter, shared with `termination_test` (both must agree).
-pub(crate) fn segment_steps_spec() -> ParamSpec {
-    ParamSpec::uint(
-        "segment_steps",
-        8,
-        1,
-        4096,
-        "M: samples per segment (Krüger–Westermann used 8); the repeat count divides by it",
-    )
+volgraph_core::pass_params! {
+    /// The segment length, shared with `termination_test` (both must agree).
+    pub struct SegmentSteps {
+        segment_steps: u32 = 8, 1..=4096,
+            "M: samples per segment (Krüger–Westermann used 8); the repeat count divides by it";
+    }
 }
 
 /// The segment index this record is for: the repeat iteration (0 outside a repeat group).
@@ -121,10 +119,7 @@ impl PassPlugin for RaycastSegment {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        let mut p = raycast_param_specs();
-        p.push(segment_steps_spec());
-        p.push(block_size_spec());
-        p
+        [raycast_param_specs(), SegmentSteps::specs(), BlockSize::specs()].concat()
     }
 
     fn ports(&self, params: &Params) -> Vec<PortSpec> {
@@ -156,7 +151,10 @@ impl PassPlugin for RaycastSegment {
             ("raycast_segment.wgsl", "fs_dvr") if wired.contains(&"empty") => ("raycast_segment.wgsl", "fs_dvr_leap"),
             other => other,
         };
-        vec![ShaderUse { file, entry_point, extra: &["params", "segment", "invocations"] }]
+        // The counting variant (a bench tool's) binds the invocation counter too.
+        let extra: &'static [&'static str] =
+            if self.counter.is_some() { &["params", "segment", "invocations"] } else { &["params", "segment"] };
+        vec![ShaderUse { file, entry_point, extra }]
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
@@ -190,14 +188,11 @@ impl PassPlugin for RaycastSegment {
             }
             (false, entry) => entry,
         };
-        let extra: &[&str] =
-            if self.counter.is_some() { &["params", "segment", "invocations"] } else { &["params", "segment"] };
         let defines = crate::effects::jitter_defines(ctx.params);
         let spec = |depth: Option<DepthSpec<'static>>| RenderPipelineSpec {
             shader,
             vertex: "vs_segment",
             fragment,
-            extra_bindings: extra,
             blend: Some(front_to_back_blend()),
             depth,
             defines: &defines,

@@ -78,7 +78,6 @@ impl PassPlugin for ReprojectionSplat {
             shader: "reprojection_splat.wgsl",
             vertex: "vs_splat",
             fragment: "fs_splat",
-            extra_bindings: &["splat"],
             depth: Some(DepthSpec { port: "depth", write: true, compare: wgpu::CompareFunction::Less }),
             topology: wgpu::PrimitiveTopology::TriangleStrip,
             ..Default::default()

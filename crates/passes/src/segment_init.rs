@@ -14,7 +14,7 @@ use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec,
 volgraph_core::pass_params! {
     /// The pass's parameters, declared once.
     pub struct InitSettings {
-        with_hit: bool = false, false..=true, "also clear a hit-position target for isosurface segments";
+        with_hit: bool = false, "also clear a hit-position target for isosurface segments";
     }
 }
 

@@ -2,8 +2,8 @@
 //! format sets ports accept, the block-size rule of the empty-space passes, the front-to-back
 //! blend, and how a node tells which colour precision its graph picked.
 
+use volgraph_core::TargetFormat;
 use volgraph_core::runtime::CreateContext;
-use volgraph_core::{ParamSpec, TargetFormat};
 
 /// Float RGBA targets a ray pass reads or writes (entry points, directions, hits); the first is
 /// the default for outputs.
@@ -16,10 +16,19 @@ pub const ACCUM_FORMATS: [TargetFormat; 2] = FLOAT_TARGETS;
 /// Formats of the isosurface hit target blended like the colour (§2.2).
 pub const HIT_FORMATS: [TargetFormat; 2] = FLOAT_TARGETS;
 
-/// The `block_size` parameter of the min/max grid and everything that reads it (Krüger &
-/// Westermann 2003 §2.3): one declaration, so the passes that must agree cannot drift.
-pub fn block_size_spec() -> ParamSpec {
-    ParamSpec::uint("block_size", 8, 1, 256, "edge of an empty-space block in voxels (Krüger–Westermann used 8)")
+volgraph_core::pass_params! {
+    /// The `block_size` parameter of the min/max grid and everything that reads it (Krüger &
+    /// Westermann 2003 §2.3): one declaration, so the passes that must agree cannot drift.
+    pub struct BlockSize {
+        block_size: u32 = 8, 1..=256, "edge of an empty-space block in voxels (Krüger–Westermann used 8)";
+    }
+}
+
+impl BlockSize {
+    /// The block edge of `params` (at least 1).
+    pub fn of(params: &volgraph_core::Params) -> u32 {
+        Self::from_params(params).block_size.max(1)
+    }
 }
 
 /// The front-to-back blend `dst + (1 - dst.a)·src` for colour and alpha.

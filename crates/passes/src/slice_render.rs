@@ -60,7 +60,6 @@ impl PassPlugin for SliceRender {
             shader: "slice_render.wgsl",
             vertex: "vs_slice",
             fragment: "fs_slice",
-            extra_bindings: &["slices"],
             blend: Some(front_to_back_blend()),
             ..Default::default()
         })?;

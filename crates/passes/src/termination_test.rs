@@ -21,12 +21,21 @@ use volgraph_core::runtime::{
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::empty_space::EMPTY_BLOCKS;
-use crate::raycast_params::RaycastParamsGpu;
-use crate::raycast_segment::{SegmentParamsGpu, segment_index, segment_steps_spec};
-use crate::shared::{ACCUM_FORMATS, FLOAT_TARGETS, block_size_spec};
+use crate::raycast_params::{RaycastParamsGpu, Sampling};
+use crate::raycast_segment::{SegmentParamsGpu, SegmentSteps, segment_index};
+use crate::shared::{ACCUM_FORMATS, BlockSize, FLOAT_TARGETS};
 
 /// The plugin.
 pub struct TerminationTest;
+
+volgraph_core::pass_params! {
+    /// The test's threshold: the `threshold` of the shared termination block (the segment
+    /// pass's), with the paper's T = 0.95 as its default.
+    pub struct TestThreshold {
+        threshold: f32 = 0.95, 0.0..=1.0,
+            "T: rays whose accumulated alpha is >= T stop (1 = only fully opaque rays, lossless)";
+    }
+}
 
 impl PassPlugin for TerminationTest {
     fn kind(&self) -> &'static str {
@@ -38,20 +47,9 @@ impl PassPlugin for TerminationTest {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        vec![
-            ParamSpec::float(
-                "threshold",
-                0.95,
-                0.0,
-                1.0,
-                "T: rays whose accumulated alpha is >= T stop (1 = only fully opaque rays, lossless)",
-            ),
-            ParamSpec::float("step_voxels", 0.5, 0.01, 16.0, "the segment pass's sample distance (must match it)"),
-            ParamSpec::uint("max_steps", 4096, 1, 1 << 20, "the segment pass's max_steps (must match it)"),
-            ParamSpec::boolean("jitter", false, "the segment pass's jitter (must match it)"),
-            segment_steps_spec(),
-            block_size_spec(),
-        ]
+        // The segment pass's sampling, segment length and block grid (they must match it; a
+        // graph shares them through Scalar inputs), and the test's own threshold.
+        [Sampling::specs(), TestThreshold::specs(), SegmentSteps::specs(), BlockSize::specs()].concat()
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -85,7 +83,6 @@ impl PassPlugin for TerminationTest {
             shader: "termination_test.wgsl",
             vertex: "vs_segment",
             fragment,
-            extra_bindings: &["params", "segment"],
             depth: Some(DepthSpec { port: "depth", write: true, compare: wgpu::CompareFunction::Always }),
             defines: &defines,
             ..Default::default()

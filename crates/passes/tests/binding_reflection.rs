@@ -3,6 +3,7 @@
 //! ports, never a wgpu panic or a silently unbound texture. The plugins here live outside
 //! crates/passes' registry on purpose: they register through the public API.
 
+use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{
     ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, RenderPipelineSpec, Runtime, ShaderLibrary,
 };
@@ -51,12 +52,20 @@ impl PassPlugin for Misnamed {
         ]
     }
 
+    fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
+        match (self.compute_color, self.kind) {
+            // Declares the fragment entry it does not build (`fs_iso`), not the one it does.
+            (_, "undeclared") => vec![ShaderUse { file: "raycast.wgsl", entry_point: "fs_iso", extra: &["params"] }],
+            (Some(_), _) => vec![ShaderUse { file: "raycast_compute.wgsl", entry_point: "cs_dvr", extra: &["params"] }],
+            (None, _) => vec![ShaderUse { file: "raycast.wgsl", entry_point: "fs_dvr", extra: &["params"] }],
+        }
+    }
+
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         if self.compute_color.is_some() {
             ctx.compute_pipeline(&ComputePipelineSpec {
                 shader: "raycast_compute.wgsl",
                 entry: "cs_dvr",
-                extra_bindings: &["params"],
                 constants: &[],
                 defines: &[],
             })?;
@@ -65,7 +74,6 @@ impl PassPlugin for Misnamed {
                 shader: "raycast.wgsl",
                 vertex: "vs_fullscreen",
                 fragment: "fs_dvr",
-                extra_bindings: &["params"],
                 ..Default::default()
             })?;
         }
@@ -116,6 +124,19 @@ fn shader_global_without_a_port_is_named() {
         "pass \"march\": raycast.wgsl: global \"dir\" is neither a port of this pass (ports: entry, direction, volume, tf, color) \
          nor a system binding (frame, linear_clamp, nearest_clamp) nor one the pass binds itself (params); \
          rename it to the port it stands for"
+    );
+}
+
+/// Node creation builds from the declared list: a pipeline `shaders()` does not declare (so
+/// `volgraph plan` never checked its bindings) is an error, not a silent extra.
+#[test]
+fn an_entry_point_the_plugin_does_not_declare_is_not_built() {
+    let msg = build_error(Misnamed { kind: "undeclared", dir_port: "dir", color_port: "color", compute_color: None });
+    assert_eq!(
+        msg,
+        "pass \"march\": it builds raycast.wgsl entry point `fs_dvr`, which its plugin's `shaders()` does not \
+         declare for these parameters (it declares raycast.wgsl:fs_iso); add `ShaderUse { file: \"raycast.wgsl\", \
+         entry_point: \"fs_dvr\", extra: &[...] }` there, so `volgraph plan` checks its bindings too"
     );
 }
 

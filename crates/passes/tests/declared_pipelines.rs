@@ -41,7 +41,15 @@ fn every_pass_builds_exactly_the_shaders_it_declares() {
             for step in plan.steps.iter().filter(|s| s.iteration.is_none_or(|(i, _)| i == 0)) {
                 let plugin = registry.get(&step.kind).expect("a built-in kind");
                 let ports = port_infos(&plan, step, &plugin.ports(&step.params));
-                let ctx = CreateContext::new(&gpu, &shaders, &pipelines, &step.pass_id, &step.params, &ports);
+                let ctx = CreateContext::new(
+                    &gpu,
+                    &shaders,
+                    &pipelines,
+                    &step.pass_id,
+                    &step.params,
+                    &ports,
+                    plugin.as_ref(),
+                );
                 if let Err(e) = plugin.create(&ctx) {
                     failures.push(format!("{}: {}: create failed: {e}", path.display(), step.pass_id));
                     continue;

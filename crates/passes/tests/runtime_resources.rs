@@ -6,7 +6,7 @@
 use std::sync::Arc;
 
 use volgraph_accel::camera::OrbitCamera;
-use volgraph_core::plugin::SizeRule;
+use volgraph_core::plugin::{ShaderUse, SizeRule};
 use volgraph_core::runtime::{
     CameraData, ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext,
     RenderPassPipeline, RenderPipelineSpec, Runtime, ShaderLibrary,
@@ -67,6 +67,9 @@ impl PassPlugin for PointList {
     fn kind(&self) -> &'static str {
         "point_list"
     }
+    fn shaders(&self, _p: &Params) -> Vec<ShaderUse> {
+        vec![ShaderUse { file: SHADER, entry_point: "fs_points", extra: &[] }]
+    }
     fn summary(&self) -> &'static str {
         "test: four NDC points in an N×1 target"
     }
@@ -90,6 +93,9 @@ impl PassPlugin for PointList {
 impl PassPlugin for Splat {
     fn kind(&self) -> &'static str {
         "splat"
+    }
+    fn shaders(&self, _p: &Params) -> Vec<ShaderUse> {
+        vec![ShaderUse { file: SHADER, entry_point: "fs_splat", extra: &[] }]
     }
     fn summary(&self) -> &'static str {
         "test: a 2×2-pixel quad per point, instanced, vertices pulled from the point texture"
@@ -118,6 +124,9 @@ impl PassPlugin for Splat {
 impl PassPlugin for CountLit {
     fn kind(&self) -> &'static str {
         "count_lit"
+    }
+    fn shaders(&self, _p: &Params) -> Vec<ShaderUse> {
+        vec![ShaderUse { file: SHADER, entry_point: "cs_count", extra: &[] }]
     }
     fn summary(&self) -> &'static str {
         "test: counts lit pixels into a storage buffer"

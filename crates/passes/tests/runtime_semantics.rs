@@ -10,6 +10,7 @@
 use std::sync::Arc;
 
 use volgraph_accel::camera::OrbitCamera;
+use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{
     CameraData, CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec, Runtime,
     ShaderLibrary,
@@ -57,6 +58,9 @@ impl PassNode for Node {
     }
 }
 
+const ADD_ONE: ShaderUse = ShaderUse { file: "add_one.wgsl", entry_point: "fs_add_one", extra: &["params"] };
+const FILL: ShaderUse = ShaderUse { file: "add_one.wgsl", entry_point: "fs_fill", extra: &[] };
+
 impl PassPlugin for AddOne {
     fn kind(&self) -> &'static str {
         "add_one"
@@ -76,14 +80,11 @@ impl PassPlugin for AddOne {
     fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
         true
     }
+    fn shaders(&self, _p: &Params) -> Vec<ShaderUse> {
+        vec![ADD_ONE]
+    }
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
-            shader: "add_one.wgsl",
-            vertex: "vs_fullscreen",
-            fragment: "fs_add_one",
-            extra_bindings: &["params"],
-            ..Default::default()
-        })?;
+        let pipeline = ctx.render_pipeline(&RenderPipelineSpec::fullscreen(&ADD_ONE))?;
         let params =
             ctx.uniform_with("params", &AddParams { amount: ctx.params.float("amount") as f32, _pad: [0.0; 3] });
         Ok(Box::new(Node { pipeline, params: Some(params) }))
@@ -100,13 +101,11 @@ impl PassPlugin for Fill {
     fn ports(&self, _p: &Params) -> Vec<PortSpec> {
         vec![PortSpec::write("filled", PortKind::target(&[TargetFormat::Rgba32Float]))]
     }
+    fn shaders(&self, _p: &Params) -> Vec<ShaderUse> {
+        vec![FILL]
+    }
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
-            shader: "add_one.wgsl",
-            vertex: "vs_fullscreen",
-            fragment: "fs_fill",
-            ..Default::default()
-        })?;
+        let pipeline = ctx.render_pipeline(&RenderPipelineSpec::fullscreen(&FILL))?;
         Ok(Box::new(Node { pipeline, params: None }))
     }
 }

@@ -35,6 +35,10 @@ fn ray_params(p: &Params) -> RaycastParamsGpu {
     RaycastParamsGpu { step_voxels: s.step_voxels, max_steps: s.max_steps, threshold: 1.0, ..Default::default() }
 }
 
+/// Its one pipeline, declared once: listed by `shaders()` (what `volgraph plan` checks) and
+/// built by `create`.
+const SHADER: ShaderUse = ShaderUse { file: "mip.wgsl", entry_point: "cs_main", extra: &["mip", "params"] };
+
 impl PassPlugin for Mip {
     fn kind(&self) -> &'static str {
         "mip"
@@ -56,7 +60,7 @@ impl PassPlugin for Mip {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "mip.wgsl", entry_point: "cs_main", extra: &["mip", "params"] }]
+        vec![SHADER]
     }
 
     fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
@@ -64,13 +68,7 @@ impl PassPlugin for Mip {
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
-            shader: "mip.wgsl",
-            entry: "cs_main",
-            extra_bindings: &["mip", "params"],
-            constants: &[],
-            defines: &[],
-        })?;
+        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec::of(&SHADER))?;
         let uniform = ctx.uniform_buffer("mip", 16);
         ctx.gpu.queue.write_buffer(&uniform, 0, &MipParams::from_params(ctx.params).uniform_bytes());
         let rays = ctx.uniform_with("params", &ray_params(ctx.params));

@@ -191,6 +191,9 @@ impl volgraph_core::PassNode for BadDrawNode {
     }
 }
 
+const BAD_DRAW: volgraph_core::plugin::ShaderUse =
+    volgraph_core::plugin::ShaderUse { file: "present.wgsl", entry_point: "cs_present", extra: &["params"] };
+
 impl volgraph_core::PassPlugin for BadDraw {
     fn kind(&self) -> &'static str {
         "bad_draw"
@@ -213,16 +216,14 @@ impl volgraph_core::PassPlugin for BadDraw {
             ),
         ]
     }
+    fn shaders(&self, _p: &volgraph_core::Params) -> Vec<volgraph_core::plugin::ShaderUse> {
+        vec![BAD_DRAW]
+    }
     fn create(
         &self,
         ctx: &volgraph_core::runtime::CreateContext<'_>,
     ) -> Result<Box<dyn volgraph_core::PassNode>, volgraph_core::runtime::PassError> {
-        let pipeline = ctx.compute_pipeline(&volgraph_core::runtime::ComputePipelineSpec {
-            shader: "present.wgsl",
-            entry: "cs_present",
-            extra_bindings: &["params"],
-            ..Default::default()
-        })?;
+        let pipeline = ctx.compute_pipeline(&volgraph_core::runtime::ComputePipelineSpec::of(&BAD_DRAW))?;
         Ok(Box::new(BadDrawNode { pipeline }))
     }
 }

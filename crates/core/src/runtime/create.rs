@@ -14,7 +14,7 @@ use super::gpu::Gpu;
 use super::reflect::{BindingKind, ReflectedBinding, layout_entry, reflect};
 use super::shaders::ShaderLibrary;
 use crate::params::Params;
-use crate::plugin::Access;
+use crate::plugin::{Access, PassPlugin, ShaderUse};
 
 /// Names the runtime binds itself, in every pass that declares them.
 pub const SYSTEM_BINDINGS: [&str; 3] = ["frame", "linear_clamp", "nearest_clamp"];
@@ -69,8 +69,6 @@ pub struct RenderPipelineSpec<'a> {
     pub vertex: &'a str,
     /// Fragment entry point.
     pub fragment: &'a str,
-    /// Names the pass binds itself (its `params` uniform, ...).
-    pub extra_bindings: &'a [&'a str],
     /// Face culling.
     pub cull: Option<wgpu::Face>,
     /// Blending for every colour target.
@@ -92,12 +90,32 @@ pub struct ComputePipelineSpec<'a> {
     pub shader: &'a str,
     /// Entry point.
     pub entry: &'a str,
-    /// Names the pass binds itself.
-    pub extra_bindings: &'a [&'a str],
     /// Pipeline-overridable constants (workgroup size, features).
     pub constants: &'a [(&'a str, f64)],
     /// `#if` names the module is assembled with (effects a scene turned on).
     pub defines: &'a [&'a str],
+}
+
+impl<'a> ComputePipelineSpec<'a> {
+    /// The pipeline of a declared entry point (a pass's `const` [`ShaderUse`], listed by its
+    /// `shaders()`), so the file and entry are named once.
+    pub fn of(declared: &ShaderUse) -> Self {
+        Self { shader: declared.file, entry: declared.entry_point, ..Default::default() }
+    }
+}
+
+impl<'a> RenderPipelineSpec<'a> {
+    /// The pipeline drawing a declared fragment entry point over the fullscreen triangle of
+    /// `shaders/common/fullscreen.wgsl` (`vs_fullscreen`); override `vertex` for other draws.
+    pub fn fullscreen(declared: &ShaderUse) -> Self {
+        Self {
+            shader: declared.file,
+            vertex: "vs_fullscreen",
+            fragment: declared.entry_point,
+            topology: wgpu::PrimitiveTopology::TriangleList,
+            ..Default::default()
+        }
+    }
 }
 
 /// The compiled pipeline of a pass with its reflected bindings; cheap to clone. Typed by what
@@ -212,10 +230,16 @@ pub struct CreateContext<'a> {
     pub(crate) modules: RefCell<BTreeSet<String>>,
     /// `(file, entry point)` of every pipeline built, vertex and fragment entries both.
     built: RefCell<BTreeSet<(String, String)>>,
+    /// What the plugin declares it builds for these parameters and wired ports
+    /// ([`PassPlugin::shaders_wired`]): the one list `volgraph plan` checks bindings with and
+    /// the pipelines below are built from — an entry point it lacks is an error, and the names a
+    /// node binds itself come from it.
+    declared: Vec<ShaderUse>,
 }
 
 impl<'a> CreateContext<'a> {
-    /// A context for building pass `pass_id` outside a runtime (tools, tests of plugins).
+    /// A context for building pass `pass_id` of `plugin` (the runtime's, and tools' or plugin
+    /// tests' outside one).
     pub fn new(
         gpu: &'a Gpu,
         shaders: &'a ShaderLibrary,
@@ -223,7 +247,10 @@ impl<'a> CreateContext<'a> {
         pass_id: &'a str,
         params: &'a Params,
         ports: &'a [PortInfo],
+        plugin: &dyn PassPlugin,
     ) -> Self {
+        let wired: Vec<&str> = ports.iter().filter(|p| p.bound).map(|p| p.name.as_str()).collect();
+        let declared = plugin.shaders_wired(params, &wired);
         Self {
             gpu,
             shaders,
@@ -233,7 +260,25 @@ impl<'a> CreateContext<'a> {
             pipelines,
             modules: RefCell::new(BTreeSet::new()),
             built: RefCell::new(BTreeSet::new()),
+            declared,
         }
+    }
+
+    /// The declared use of `file`'s `entry` ([`Self::declared`]), or an error saying how to
+    /// declare it.
+    fn declared_use(&self, file: &str, entry: &str) -> Result<&ShaderUse, PassError> {
+        self.declared.iter().find(|u| u.file == file && u.entry_point == entry).ok_or_else(|| {
+            self.error(format!(
+                "it builds {file} entry point `{entry}`, which its plugin's `shaders()` does not declare for these \
+                 parameters (it declares {}); add `ShaderUse {{ file: \"{file}\", entry_point: \"{entry}\", extra: \
+                 &[...] }}` there, so `volgraph plan` checks its bindings too",
+                if self.declared.is_empty() {
+                    "none".to_string()
+                } else {
+                    self.declared.iter().map(|u| format!("{}:{}", u.file, u.entry_point)).collect::<Vec<_>>().join(", ")
+                }
+            ))
+        })
     }
 
     /// `(file, entry point)` of every pipeline this context built so far (tests compare it with
@@ -287,6 +332,7 @@ impl<'a> CreateContext<'a> {
     /// Builds (or takes from the cache) a render pipeline drawing a fragment shader into this
     /// pass's output ports, named by the fragment output struct's members.
     pub fn render_pipeline(&self, spec: &RenderPipelineSpec<'_>) -> Result<RenderPassPipeline, PassError> {
+        let declared = self.declared_use(spec.shader, spec.fragment)?;
         let shader = self.shader(spec.shader, spec.defines)?;
         let mut built = self.built.borrow_mut();
         built.insert((spec.shader.to_string(), spec.vertex.to_string()));
@@ -294,7 +340,7 @@ impl<'a> CreateContext<'a> {
         drop(built);
         let r = reflect(&shader.module, &shader.info, &[spec.vertex, spec.fragment])
             .map_err(|e| self.error(format!("{} {e}", spec.shader)))?;
-        self.check_bindings(spec.shader, &r.bindings, spec.extra_bindings)?;
+        self.check_bindings(spec.shader, &r.bindings, declared.extra)?;
         let mut outputs = r.fragment_outputs.clone();
         outputs.sort_by_key(|(_, loc)| *loc);
         let mut targets = Vec::new();
@@ -428,11 +474,12 @@ impl<'a> CreateContext<'a> {
     /// Builds (or takes from the cache) a compute pipeline writing this pass's outputs as storage
     /// textures or buffers named after the ports.
     pub fn compute_pipeline(&self, spec: &ComputePipelineSpec<'_>) -> Result<ComputePassPipeline, PassError> {
+        let declared = self.declared_use(spec.shader, spec.entry)?;
         let shader = self.shader(spec.shader, spec.defines)?;
         self.built.borrow_mut().insert((spec.shader.to_string(), spec.entry.to_string()));
         let r = reflect(&shader.module, &shader.info, &[spec.entry])
             .map_err(|e| self.error(format!("{} {e}", spec.shader)))?;
-        self.check_bindings(spec.shader, &r.bindings, spec.extra_bindings)?;
+        self.check_bindings(spec.shader, &r.bindings, declared.extra)?;
         let entries = self.layout_entries(&r.bindings, wgpu::ShaderStages::COMPUTE);
         let key =
             format!("compute|{}|{:016x}|{}|{:?}|{:?}", spec.shader, shader.hash, spec.entry, spec.constants, entries);

@@ -177,7 +177,8 @@ impl Runtime {
     }
 
     /// Bounds the GPU memory passes that stream data may hold (a brick pool), in bytes; `None`
-    /// leaves it to what the adapter allows. Takes effect with the next frame.
+    /// leaves it to the pass (raycast_bricks: 2 GiB, bounded by the 3D texture limit). Takes
+    /// effect with the next frame.
     pub fn set_gpu_memory_budget(&mut self, bytes: Option<u64>) {
         self.gpu_memory_budget = bytes;
     }

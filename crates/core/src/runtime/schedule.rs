@@ -214,7 +214,15 @@ pub(crate) fn build(
             Some(e) if e.params == step.params => Decision::Keep,
             Some(e) if plugin.updates_in_place(&e.params, &step.params) => Decision::Update,
             _ => {
-                let ctx = CreateContext::new(r.gpu, r.shaders, r.pipelines, &step.pass_id, &step.params, &ports);
+                let ctx = CreateContext::new(
+                    r.gpu,
+                    r.shaders,
+                    r.pipelines,
+                    &step.pass_id,
+                    &step.params,
+                    &ports,
+                    plugin.as_ref(),
+                );
                 match plugin.create(&ctx) {
                     Ok(node) => Decision::Create(node, ctx.modules.into_inner()),
                     Err(e) => return Err((e.into(), old)),

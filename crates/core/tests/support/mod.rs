@@ -59,7 +59,7 @@ impl PassPlugin for TestPlugin {
 
     fn ports(&self, params: &volgraph_core::Params) -> Vec<PortSpec> {
         let mut ports = self.ports.clone();
-        if params.choice_or("mode", "dvr") == "iso" {
+        if params.declares("mode") && params.choice("mode") == "iso" {
             ports.extend(self.iso_ports.iter().cloned());
         }
         ports

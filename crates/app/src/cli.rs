@@ -36,8 +36,12 @@ enum Command {
         scalars: Vec<(String, f64)>,
         /// Print the plan as a Graphviz DOT picture instead (passes, values with their slots,
         /// culled passes greyed, repeat groups boxed, history edges dashed): `| dot -Tsvg`.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "svg")]
         dot: bool,
+        /// Print the plan as an SVG picture instead, drawn by volgraph itself (no Graphviz): the
+        /// viewer's picture, passes in rows by dependency, history edges dashed in a side lane.
+        #[arg(long)]
+        svg: bool,
     },
     /// List every pass kind a graph can use (summary, paper section), or show one kind's ports,
     /// parameters (type, default, range, doc), features and shaders.
@@ -49,56 +53,7 @@ enum Command {
         graph: Option<PathBuf>,
     },
     /// Render a graph to an image (PNG: 8-bit sRGB; EXR: 32-bit float linear).
-    Render {
-        /// The graph file (RON); default: the scene's graph.
-        graph: Option<PathBuf>,
-        /// A scene file (scenes/*.ron): volume, transfer function, camera or camera path,
-        /// viewport, graph, effects, precision; flags given as well win over it.
-        #[arg(long)]
-        scene: Option<PathBuf>,
-        /// Volume file (.raw named NAME_XxYxZ_TYPE.raw, .nrrd, .nhdr, .mhd, .mha); default: a
-        /// generated Marschner–Lobb 64³.
-        #[arg(long)]
-        volume: Option<PathBuf>,
-        #[command(flatten)]
-        raw: RawArgs,
-        /// Transfer function (RON, or ParaView color-map .json); default: one fitted to the data.
-        #[arg(long)]
-        tf: Option<PathBuf>,
-        /// The colour map to use from a ParaView .json holding several (its "Name"); default: the first.
-        #[arg(long = "tf-map")]
-        tf_map: Option<String>,
-        /// Viewport, WIDTHxHEIGHT [default: the scene's, else 512x512].
-        #[arg(long)]
-        size: Option<String>,
-        /// Orbit camera AZIMUTH,ELEVATION,DISTANCE (degrees, degrees, world units) [default: the
-        /// scene's, else 30,20,3.2].
-        #[arg(long)]
-        camera: Option<String>,
-        /// Frames to render (the last one is written); each rotates the volume 1° about y, or
-        /// follows the scene's camera path [default: the scene's, else 1].
-        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100_000))]
-        frames: Option<u32>,
-        /// Scene features (effects) that are on, comma separated: shading, preintegration,
-        /// jitter, tricubic (added to the scene's).
-        #[arg(long, value_delimiter = ',')]
-        features: Vec<String>,
-        /// The graph output to write; default: "display" for PNG when the graph has it, else "image".
-        #[arg(long)]
-        output: Option<String>,
-        /// Where to write the image (.png or .exr).
-        #[arg(short = 'o', long = "out")]
-        out: PathBuf,
-        /// A shader folder to read instead of the built-in shaders (default: a `shaders/` folder
-        /// beside the graph's workspace, if there is one).
-        #[arg(long)]
-        shaders: Option<PathBuf>,
-        /// GPU memory, in MiB, passes that stream data may hold (the brick pool of
-        /// graphs/ruijters_vilanova_2006); a volume that does not fit streams through it
-        /// [default: what the adapter allows].
-        #[arg(long = "gpu-memory-mb", value_parser = clap::value_parser!(u64).range(1..=1 << 24))]
-        gpu_memory_mb: Option<u64>,
-    },
+    Render(crate::render::RenderArgs),
     /// Show a graph live in a window, hot-reloading the graph, its shaders and its transfer
     /// function; an overlay shows per-pass GPU time, the plan and every parameter.
     View(crate::view::ViewArgs),
@@ -251,7 +206,7 @@ pub enum Checked {
 /// break, without the GPU (the CLI fuzzer runs this). Other commands are not checked here.
 pub fn check(cli: Cli) -> Result<Checked, CliError> {
     match cli.command {
-        Command::Plan { graph, size, features, scalars, dot } => {
+        Command::Plan { graph, size, features, scalars, dot, svg } => {
             let source = inputs::read_graph(&graph)?;
             let options = compile_options(&size, &features, &scalars)?;
             let plan =
@@ -267,43 +222,14 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
                     items: problems,
                 }));
             }
-            let text = if dot { plan.to_dot() } else { plan.to_text() };
+            let text = match (dot, svg) {
+                (true, _) => plan.to_dot(),
+                (_, true) => crate::plan_svg::plan_svg(&plan),
+                _ => plan.to_text(),
+            };
             Ok(Checked::Plan { text, notes: warning_lines(&plan) })
         }
-        Command::Render {
-            graph,
-            scene,
-            volume,
-            raw,
-            tf,
-            tf_map,
-            size,
-            camera,
-            frames,
-            features,
-            output,
-            out,
-            shaders,
-            gpu_memory_mb,
-        } => {
-            let args = crate::render::RenderArgs {
-                graph,
-                scene,
-                volume,
-                raw,
-                tf,
-                tf_map,
-                size,
-                camera,
-                frames,
-                features,
-                output,
-                out,
-                shaders,
-                gpu_memory_mb,
-            };
-            Ok(Checked::Render(Box::new(crate::render::prepare(args)?)))
-        }
+        Command::Render(args) => Ok(Checked::Render(Box::new(crate::render::prepare(args)?))),
         Command::Bench { .. } | Command::View(_) | Command::Sweep(_) | Command::Passes { .. } => {
             Err(CliError::Other(anyhow!("only plan and render are checked ahead of running")))
         }
@@ -313,7 +239,7 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
 /// Runs a parsed command line.
 pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
-        Command::Plan { .. } | Command::Render { .. } => match check(cli)? {
+        Command::Plan { .. } | Command::Render(_) => match check(cli)? {
             Checked::Plan { text, notes } => {
                 for note in notes {
                     eprintln!("{note}");

@@ -12,6 +12,7 @@ mod cli_fuzz;
 mod image_out;
 mod inputs;
 mod passes_cmd;
+mod plan_svg;
 mod render;
 mod scene;
 mod shader_dir;

@@ -18,21 +18,56 @@ use crate::inputs;
 use crate::scene::{CameraSpec, Scene};
 use volgraph_core::runtime::OpacityReference;
 
-/// The arguments of `volgraph render`.
+/// The arguments of `volgraph render` (its command line, flattened into the CLI).
+#[derive(clap::Args, Debug)]
 pub struct RenderArgs {
+    /// The graph file (RON); default: the scene's graph.
     pub graph: Option<PathBuf>,
+    /// A scene file (scenes/*.ron): volume, transfer function, camera or camera path,
+    /// viewport, graph, effects, precision; flags given as well win over it.
+    #[arg(long)]
     pub scene: Option<PathBuf>,
+    /// Volume file (.raw named NAME_XxYxZ_TYPE.raw, .nrrd, .nhdr, .mhd, .mha); default: a
+    /// generated Marschner–Lobb 64³.
+    #[arg(long)]
     pub volume: Option<PathBuf>,
+    #[command(flatten)]
     pub raw: RawArgs,
+    /// Transfer function (RON, or ParaView color-map .json); default: one fitted to the data.
+    #[arg(long)]
     pub tf: Option<PathBuf>,
+    /// The colour map to use from a ParaView .json holding several (its "Name"); default: the first.
+    #[arg(long = "tf-map")]
     pub tf_map: Option<String>,
+    /// Viewport, WIDTHxHEIGHT [default: the scene's, else 512x512].
+    #[arg(long)]
     pub size: Option<String>,
+    /// Orbit camera AZIMUTH,ELEVATION,DISTANCE (degrees, degrees, world units) [default: the
+    /// scene's, else 30,20,3.2].
+    #[arg(long)]
     pub camera: Option<String>,
+    /// Frames to render (the last one is written); each rotates the volume 1° about y, or
+    /// follows the scene's camera path [default: the scene's, else 1].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     pub frames: Option<u32>,
+    /// Scene features (effects) that are on, comma separated: shading, preintegration,
+    /// jitter, tricubic (added to the scene's).
+    #[arg(long, value_delimiter = ',')]
     pub features: Vec<String>,
+    /// The graph output to write; default: "display" for PNG when the graph has it, else "image".
+    #[arg(long)]
     pub output: Option<String>,
+    /// Where to write the image (.png or .exr).
+    #[arg(short = 'o', long = "out")]
     pub out: PathBuf,
+    /// A shader folder to read instead of the built-in shaders (default: a `shaders/` folder
+    /// beside the graph's workspace, if there is one).
+    #[arg(long)]
     pub shaders: Option<PathBuf>,
+    /// GPU memory, in MiB, passes that stream data may hold (the brick pool of
+    /// graphs/ruijters_vilanova_2006); a volume that does not fit streams through it
+    /// [default: 2048, bounded by the adapter's 3D texture limit].
+    #[arg(long = "gpu-memory-mb", value_parser = clap::value_parser!(u64).range(1..=1 << 24))]
     pub gpu_memory_mb: Option<u64>,
 }
 

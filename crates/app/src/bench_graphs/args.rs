@@ -64,7 +64,7 @@ pub struct GraphsArgs {
     #[arg(long)]
     pub no_gpu_count: bool,
     /// GPU memory, in MiB, a brick pool may hold (graphs/ruijters_vilanova_2006); volumes that do
-    /// not fit stream through it [default: what the adapter allows].
+    /// not fit stream through it [default: 2048, bounded by the adapter's 3D texture limit].
     #[arg(long = "gpu-memory-mb", value_parser = clap::value_parser!(u64).range(1..=1 << 24))]
     pub gpu_memory_mb: Option<u64>,
     /// Accuracy sweep PASS.PARAM=V1,V2,... (e.g. march.step_voxels=0.25,0.5,1,2), input.NAME=...

@@ -1,7 +1,8 @@
 //! The plan as a picture in the viewer's panel — the same marks as `volgraph plan --dot`
 //! (`Plan::to_dot`): passes as boxes in rows by dependency depth, data edges solid, history
 //! edges (last frame's value) dashed, culled and gated passes greyed in a last row, repeat
-//! groups boxed. [`layout`] is pure (tested); [`show`] paints it with egui.
+//! groups boxed. [`layout`] and the geometry are pure (tested); [`show`] paints it with egui,
+//! `crate::plan_svg` writes the same picture as SVG (`volgraph plan --svg`).
 
 use std::collections::BTreeMap;
 
@@ -38,6 +39,38 @@ pub struct Picture {
     pub nodes: Vec<Node>,
     /// Arrows.
     pub edges: Vec<Edge>,
+}
+
+/// Box width and height, in points (egui) or pixels (SVG).
+pub const BOX: (f32, f32) = (132.0, 32.0);
+/// Space between boxes across and down.
+pub const GAP: (f32, f32) = (12.0, 18.0);
+/// Width of the lane right of the boxes where history edges run.
+pub const LANE: f32 = 18.0;
+
+impl Picture {
+    /// Columns and rows of boxes.
+    fn grid(&self) -> (f32, f32) {
+        let cols = self.nodes.iter().map(|n| n.at.1 + 1).max().unwrap_or(1) as f32;
+        let rows = self.nodes.iter().map(|n| n.at.0 + 1).max().unwrap_or(1) as f32;
+        (cols, rows)
+    }
+
+    /// The drawing's width and height, lane included.
+    pub fn size(&self) -> (f32, f32) {
+        let (cols, rows) = self.grid();
+        (cols * (BOX.0 + GAP.0) + LANE, rows * (BOX.1 + GAP.1))
+    }
+
+    /// Top-left corner of a node's box: its depth is its row (top to bottom).
+    pub fn corner(&self, n: &Node) -> (f32, f32) {
+        (n.at.1 as f32 * (BOX.0 + GAP.0), n.at.0 as f32 * (BOX.1 + GAP.1))
+    }
+
+    /// The x of the history-edge lane.
+    pub fn lane_x(&self) -> f32 {
+        self.grid().0 * (BOX.0 + GAP.0) + LANE * 0.5
+    }
 }
 
 /// Lays `plan` out: a step's column is one more than the deepest step it reads from.
@@ -94,19 +127,12 @@ pub fn layout(plan: &Plan) -> Picture {
 /// run dashed in a lane right of the boxes, so they never cross a label.
 pub fn show(ui: &mut egui::Ui, plan: &Plan) {
     let picture = layout(plan);
-    let (w, h) = (132.0, 32.0);
-    let (gap_x, gap_y) = (12.0, 18.0);
-    let lane = 18.0;
-    let cols = picture.nodes.iter().map(|n| n.at.1 + 1).max().unwrap_or(1) as f32;
-    let rows = picture.nodes.iter().map(|n| n.at.0 + 1).max().unwrap_or(1) as f32;
-    let size = egui::vec2(cols * (w + gap_x) + lane, rows * (h + gap_y));
-    let (response, painter) = ui.allocate_painter(size, egui::Sense::hover());
+    let (width, height) = picture.size();
+    let (response, painter) = ui.allocate_painter(egui::vec2(width, height), egui::Sense::hover());
     let origin = response.rect.min + egui::vec2(0.0, 4.0);
     let rect_of = |n: &Node| {
-        egui::Rect::from_min_size(
-            origin + egui::vec2(n.at.1 as f32 * (w + gap_x), n.at.0 as f32 * (h + gap_y)),
-            egui::vec2(w, h),
-        )
+        let (x, y) = picture.corner(n);
+        egui::Rect::from_min_size(origin + egui::vec2(x, y), egui::vec2(BOX.0, BOX.1))
     };
     let text_color = ui.visuals().text_color();
     let stroke = egui::Stroke::new(1.0, text_color);
@@ -121,7 +147,7 @@ pub fn show(ui: &mut egui::Ui, plan: &Plan) {
     for r in groups.values() {
         painter.rect_stroke(*r, 6.0, egui::Stroke::new(1.0, egui::Color32::GRAY), egui::StrokeKind::Outside);
     }
-    let lane_x = origin.x + cols * (w + gap_x) + lane * 0.5;
+    let lane_x = origin.x + picture.lane_x();
     for e in &picture.edges {
         let (a, b) = (rect_of(&picture.nodes[e.from]), rect_of(&picture.nodes[e.to]));
         if e.dashed {

@@ -102,7 +102,7 @@ pub struct SessionArgs {
     pub features: Vec<String>,
     /// A shader folder to read (and watch) instead of the built-in shaders.
     pub shaders: Option<PathBuf>,
-    /// GPU memory (MiB) a brick pool may hold; None: what the adapter allows.
+    /// GPU memory (MiB) a brick pool may hold; None: 2 GiB, bounded by the adapter's 3D texture limit.
     pub gpu_memory_mb: Option<u64>,
     /// A scene supplying the volume and transfer function where `volume` and `tf` are not
     /// given, and its precision and opacity reference.

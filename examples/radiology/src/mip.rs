@@ -6,7 +6,8 @@
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
 use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
-use volgraph_passes::raycast_params::RaycastParamsGpu;
+// volgraph's shared sampling block: the same step, sample count and jitter as its raycasters.
+use volgraph_passes::raycast_params::{RaycastParamsGpu, Sampling};
 
 /// The plugin.
 pub struct Mip;
@@ -18,21 +19,6 @@ volgraph_core::pass_params! {
         level: f32 = 0.5, 0.0..=1.0, "window centre, in normalized scalar units";
         width: f32 = 1.0, 0.001..=2.0, "window width, in normalized scalar units";
     }
-}
-
-volgraph_core::pass_params! {
-    /// The sampling, declared once; it fills volgraph's shared raycasting block.
-    pub struct Sampling {
-        step_voxels: f32 = 0.5, 0.01..=16.0, "sample distance in units of the smallest voxel side";
-        max_steps: u32 = 4096, 1..=1048576, "upper bound on samples per ray";
-    }
-}
-
-/// The shared raycasting parameters (`params` in volgraph's `common/raycast_params.wgsl`), so the
-/// samples are those of volgraph's raycasters.
-fn ray_params(p: &Params) -> RaycastParamsGpu {
-    let s = Sampling::from_params(p);
-    RaycastParamsGpu { step_voxels: s.step_voxels, max_steps: s.max_steps, threshold: 1.0, ..Default::default() }
 }
 
 /// Its one pipeline, declared once: listed by `shaders()` (what `volgraph plan` checks) and
@@ -63,15 +49,22 @@ impl PassPlugin for Mip {
         vec![SHADER]
     }
 
-    fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
-        true
+    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
+        // `jitter` of the sampling block is an `#if` of the shared ray code.
+        volgraph_passes::effects::jitter_defines(params)
+    }
+
+    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
+        self.shader_defines(old) == self.shader_defines(new)
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec::of(&SHADER))?;
+        let defines = self.shader_defines(ctx.params);
+        let pipeline =
+            ctx.compute_pipeline(&ComputePipelineSpec { defines: &defines, ..ComputePipelineSpec::of(&SHADER) })?;
         let uniform = ctx.uniform_buffer("mip", 16);
         ctx.gpu.queue.write_buffer(&uniform, 0, &MipParams::from_params(ctx.params).uniform_bytes());
-        let rays = ctx.uniform_with("params", &ray_params(ctx.params));
+        let rays = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
         Ok(Box::new(MipNode { pipeline, uniform, rays }))
     }
 }
@@ -90,7 +83,7 @@ impl PassNode for MipNode {
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
         gpu.queue.write_buffer(&self.uniform, 0, &MipParams::from_params(params).uniform_bytes());
-        gpu.queue.write_buffer(&self.rays, 0, bytemuck::bytes_of(&ray_params(params)));
+        gpu.queue.write_buffer(&self.rays, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
     }
 }
 

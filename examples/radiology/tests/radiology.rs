@@ -6,7 +6,7 @@
 use std::sync::Arc;
 
 use volgraph_accel::camera::OrbitCamera;
-use volgraph_accel::reference::{ray_segment, step_tex};
+use volgraph_accel::reference::{pixel_jitter, ray_segment, step_tex};
 use volgraph_core::runtime::{CameraData, Gpu, Image, Runtime, ShaderLibrary};
 use volgraph_core::{CompileOptions, Registry};
 
@@ -19,11 +19,20 @@ fn registry() -> Registry {
 }
 
 fn render(volume: &volgraph_accel::volume::Volume, camera: &OrbitCamera) -> (Image, Image) {
+    render_with(volume, camera, |source| source)
+}
+
+/// Renders the example graph after `edit` changed its text.
+fn render_with(
+    volume: &volgraph_accel::volume::Volume,
+    camera: &OrbitCamera,
+    edit: impl Fn(String) -> String,
+) -> (Image, Image) {
     let gpu = Arc::new(Gpu::new_headless().expect("a Vulkan adapter (lavapipe without a GPU)"));
     let shaders = volgraph_passes::builtin_shaders().with_embedded(volgraph_example_radiology::SHADERS);
     let mut runtime = Runtime::new(gpu, ShaderLibrary::new(shaders));
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("graphs/mip_enhanced.ron");
-    let source = std::fs::read_to_string(&path).expect("graph");
+    let source = edit(std::fs::read_to_string(&path).expect("graph"));
     let registry = registry();
     let plan = runtime
         .compile("mip_enhanced.ron", &source, &registry, &CompileOptions::new(SIZE, SIZE))
@@ -36,25 +45,32 @@ fn render(volume: &volgraph_accel::volume::Volume, camera: &OrbitCamera) -> (Ima
 }
 
 /// The CPU MIP of pixel (x, y): the largest trilinear sample at volgraph's sample positions
-/// (k + 0.5 steps of 0.5 voxel from the entry), or None where the ray misses the box.
-fn cpu_mip(volume: &volgraph_accel::volume::Volume, camera: &OrbitCamera, x: u32, y: u32) -> Option<f64> {
+/// (k + 0.5 + jitter steps of 0.5 voxel from the entry, jitter 0 unless `jittered`), or None
+/// where the ray misses the box.
+fn cpu_mip(
+    volume: &volgraph_accel::volume::Volume,
+    camera: &OrbitCamera,
+    x: u32,
+    y: u32,
+    jittered: bool,
+) -> Option<f64> {
     let frame = camera.frame(SIZE, SIZE);
     let seg = ray_segment(volume, camera, &frame, x, y)?;
     let step = step_tex(volume, seg.d_tex, 0.5);
-    let count = (seg.len_tex / step - 0.5).ceil().max(0.0) as u32;
-    Some((0..count).map(|k| volume.sample_trilinear(seg.u0 + (k as f64 + 0.5) * step * seg.d_tex)).fold(0.0, f64::max))
+    let jitter = if jittered { pixel_jitter(x, y, SIZE) } else { 0.0 };
+    let count = (seg.len_tex / step - 0.5 - jitter).ceil().max(0.0) as u32;
+    let at = |k: u32| seg.u0 + (k as f64 + 0.5 + jitter) * step * seg.d_tex;
+    Some((0..count).map(|k| volume.sample_trilinear(at(k))).fold(0.0, f64::max))
 }
 
-#[test]
-fn mip_equals_a_cpu_maximum_intensity_projection() {
-    let volume = volgraph_accel::generate::marschner_lobb(40);
-    let camera = OrbitCamera { azimuth_deg: 35.0, elevation_deg: 20.0, distance: 2.6, ..OrbitCamera::default() };
-    let (mip, _) = render(&volume, &camera);
+/// Compares the GPU MIP with the CPU one; returns the largest difference over the pixels both
+/// hit, after checking that the volume fills the view and few silhouette pixels disagree.
+fn compare_with_cpu(mip: &Image, volume: &volgraph_accel::volume::Volume, camera: &OrbitCamera, jittered: bool) -> f64 {
     let (mut compared, mut edge, mut max) = (0, 0, 0.0f64);
     for y in 0..SIZE {
         for x in 0..SIZE {
             let gpu = mip.rgba(x, y);
-            match cpu_mip(&volume, &camera, x, y) {
+            match cpu_mip(volume, camera, x, y, jittered) {
                 Some(m) if gpu[3] == 1.0 => {
                     compared += 1;
                     max = max.max((gpu[0] as f64 - m).abs());
@@ -67,9 +83,33 @@ fn mip_equals_a_cpu_maximum_intensity_projection() {
     }
     assert!(compared > (SIZE * SIZE / 4) as usize, "the volume fills the view ({compared} pixels)");
     assert!(edge * 100 <= compared, "{edge} silhouette pixels disagree on hit/miss");
+    max
+}
+
+#[test]
+fn mip_equals_a_cpu_maximum_intensity_projection() {
+    let volume = volgraph_accel::generate::marschner_lobb(40);
+    let camera = OrbitCamera { azimuth_deg: 35.0, elevation_deg: 20.0, distance: 2.6, ..OrbitCamera::default() };
+    let (mip, _) = render(&volume, &camera);
+    let max = compare_with_cpu(&mip, &volume, &camera, false);
     // 2/255: 8-bit trilinear weights on u8 data and an f16 target against f64 (the tolerance of
     // volgraph's own GPU-vs-reference tests).
     assert!(max <= 2.0 / 255.0, "largest MIP difference {:.3}/255", max * 255.0);
+}
+
+/// `jitter` comes with volgraph's shared sampling block, and the pass honours it: the GPU MIP
+/// equals the CPU one at the jittered sample positions, and not the unjittered one.
+#[test]
+fn mip_takes_the_shared_jitter() {
+    let volume = volgraph_accel::generate::marschner_lobb(40);
+    let camera = OrbitCamera { azimuth_deg: 35.0, elevation_deg: 20.0, distance: 2.6, ..OrbitCamera::default() };
+    let jitter_on = |source: String| source.replacen(r#""width": 1.0}"#, r#""width": 1.0, "jitter": true}"#, 1);
+    let (mip, _) = render_with(&volume, &camera, jitter_on);
+    // 2/255 as above: the same samples, offset by the same per-pixel hash.
+    let jittered = compare_with_cpu(&mip, &volume, &camera, true);
+    assert!(jittered <= 2.0 / 255.0, "largest jittered MIP difference {:.3}/255", jittered * 255.0);
+    let plain = compare_with_cpu(&mip, &volume, &camera, false);
+    assert!(plain > jittered, "jitter moved the samples ({:.3} vs {:.3}/255)", plain * 255.0, jittered * 255.0);
 }
 
 #[test]

@@ -15,6 +15,7 @@ mod passes_cmd;
 mod plan_svg;
 mod render;
 mod scene;
+mod scene_args;
 mod shader_dir;
 mod stdout;
 mod sweep;

@@ -9,7 +9,7 @@ use std::fmt::Write;
 
 use volgraph_core::plan::Plan;
 
-use crate::view::graph_picture::{BOX, LANE, Node, layout};
+use crate::view::graph_picture::{BOX, Node, layout};
 
 /// Margin around the drawing.
 const MARGIN: f32 = 8.0;
@@ -22,7 +22,7 @@ pub fn plan_svg(plan: &Plan) -> String {
     let _ = writeln!(
         svg,
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="{x} {x} {w} {h}" font-family="sans-serif" font-size="10">"#,
-        w = width + 2.0 * MARGIN + LANE,
+        w = width + 2.0 * MARGIN,
         h = height + 2.0 * MARGIN,
         x = -MARGIN,
     );
@@ -53,11 +53,13 @@ pub fn plan_svg(plan: &Plan) -> String {
     for e in &picture.edges {
         let ((ax, ay), (bx, by)) = (rect_of(&picture.nodes[e.from]), rect_of(&picture.nodes[e.to]));
         if e.dashed {
+            // From the source box's right edge out to the lane, along it, back into the target's.
             let (ay, by) = (ay + BOX.1 / 2.0, by + BOX.1 / 2.0);
             let _ = writeln!(
                 svg,
-                r#"<polyline points="{a},{ay} {lane_x},{ay} {lane_x},{by} {a},{by}" fill="none" stroke="black" stroke-dasharray="4 3" marker-end="url(#arrow)"/>"#,
-                a = ax.max(bx) + BOX.0,
+                r#"<polyline points="{},{ay} {lane_x},{ay} {lane_x},{by} {},{by}" fill="none" stroke="black" stroke-dasharray="4 3" marker-end="url(#arrow)"/>"#,
+                ax + BOX.0,
+                bx + BOX.0,
             );
         } else {
             let _ = writeln!(
@@ -99,13 +101,7 @@ fn escape(text: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use volgraph_core::{CompileOptions, compile};
-
-    fn plan(graph: &str) -> Plan {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../graphs").join(graph);
-        let source = std::fs::read_to_string(&path).expect("graph");
-        compile(graph, &source, &volgraph_passes::builtin_registry(), &CompileOptions::new(64, 64)).expect("compiles")
-    }
+    use crate::view::graph_picture::tests::plan;
 
     /// The SVG is well-formed XML with a box per node, an arrow per data edge, a dashed path per
     /// history edge and a rounded box per repeat group.
@@ -121,6 +117,15 @@ mod tests {
             let history = picture.edges.iter().filter(|e| e.dashed).count();
             assert_eq!(svg.matches("<line ").count(), data, "{graph}");
             assert_eq!(svg.matches("stroke-dasharray").count(), history, "{graph}");
+            // Each history edge leaves its source box's right edge and ends at its target's.
+            for e in picture.edges.iter().filter(|e| e.dashed) {
+                let ((ax, ay), (bx, by)) =
+                    (picture.corner(&picture.nodes[e.from]), picture.corner(&picture.nodes[e.to]));
+                let (ay, by) = (ay + BOX.1 / 2.0, by + BOX.1 / 2.0);
+                let lane = picture.lane_x();
+                let points = format!(r#"points="{},{ay} {lane},{ay} {lane},{by} {},{by}""#, ax + BOX.0, bx + BOX.0);
+                assert!(svg.contains(&points), "{graph}: {points}");
+            }
             let groups: std::collections::BTreeSet<_> = picture.nodes.iter().filter_map(|n| n.group.clone()).collect();
             assert_eq!(svg.matches("<title>repeat group").count(), groups.len(), "{graph}");
             for n in &picture.nodes {

@@ -6,69 +6,33 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use anyhow::anyhow;
-use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::volume::VoxelData;
 use volgraph_core::compile;
 use volgraph_core::runtime::{CameraData, Gpu, Runtime, ShaderLibrary, VolumeDesc, VolumeFormat, scene_values_of};
 use volgraph_passes::builtin_registry;
 
-use crate::cli::{CliError, RawArgs, check_user_names, compile_options, display_name, warning_lines};
+use crate::cli::{CliError, check_user_names, compile_options, display_name, warning_lines};
 use crate::image_out::{self, ImageKind};
 use crate::inputs;
 use crate::scene::{CameraSpec, Scene};
+use crate::scene_args::{Resolved, SceneArgs};
 use volgraph_core::runtime::OpacityReference;
 
 /// The arguments of `volgraph render` (its command line, flattened into the CLI).
 #[derive(clap::Args, Debug)]
 pub struct RenderArgs {
-    /// The graph file (RON); default: the scene's graph.
-    pub graph: Option<PathBuf>,
-    /// A scene file (scenes/*.ron): volume, transfer function, camera or camera path,
-    /// viewport, graph, effects, precision; flags given as well win over it.
-    #[arg(long)]
-    pub scene: Option<PathBuf>,
-    /// Volume file (.raw named NAME_XxYxZ_TYPE.raw, .nrrd, .nhdr, .mhd, .mha); default: a
-    /// generated Marschner–Lobb 64³.
-    #[arg(long)]
-    pub volume: Option<PathBuf>,
     #[command(flatten)]
-    pub raw: RawArgs,
-    /// Transfer function (RON, or ParaView color-map .json); default: one fitted to the data.
-    #[arg(long)]
-    pub tf: Option<PathBuf>,
-    /// The colour map to use from a ParaView .json holding several (its "Name"); default: the first.
-    #[arg(long = "tf-map")]
-    pub tf_map: Option<String>,
-    /// Viewport, WIDTHxHEIGHT [default: the scene's, else 512x512].
-    #[arg(long)]
-    pub size: Option<String>,
-    /// Orbit camera AZIMUTH,ELEVATION,DISTANCE (degrees, degrees, world units) [default: the
-    /// scene's, else 30,20,3.2].
-    #[arg(long)]
-    pub camera: Option<String>,
+    pub inputs: SceneArgs,
     /// Frames to render (the last one is written); each rotates the volume 1° about y, or
     /// follows the scene's camera path [default: the scene's, else 1].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     pub frames: Option<u32>,
-    /// Scene features (effects) that are on, comma separated: shading, preintegration,
-    /// jitter, tricubic (added to the scene's).
-    #[arg(long, value_delimiter = ',')]
-    pub features: Vec<String>,
     /// The graph output to write; default: "display" for PNG when the graph has it, else "image".
     #[arg(long)]
     pub output: Option<String>,
     /// Where to write the image (.png or .exr).
     #[arg(short = 'o', long = "out")]
     pub out: PathBuf,
-    /// A shader folder to read instead of the built-in shaders (default: a `shaders/` folder
-    /// beside the graph's workspace, if there is one).
-    #[arg(long)]
-    pub shaders: Option<PathBuf>,
-    /// GPU memory, in MiB, passes that stream data may hold (the brick pool of
-    /// graphs/ruijters_vilanova_2006); a volume that does not fit streams through it
-    /// [default: 2048, bounded by the adapter's 3D texture limit].
-    #[arg(long = "gpu-memory-mb", value_parser = clap::value_parser!(u64).range(1..=1 << 24))]
-    pub gpu_memory_mb: Option<u64>,
 }
 
 /// Everything `render` needs, read and checked, before the GPU is opened.
@@ -90,44 +54,28 @@ pub struct Prepared {
 /// Reads and checks every input of `volgraph render`; touches no GPU, prints nothing.
 pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     let kind = ImageKind::from_path(&args.out)?;
-    let scene = args.scene.as_deref().map(Scene::load).transpose().map_err(|e| anyhow!(e))?;
-    let graph = match (&args.graph, scene.as_ref().and_then(|s| s.graph.clone())) {
-        (Some(g), _) => g.clone(),
-        (None, Some(g)) => g,
-        (None, None) => {
-            return Err(CliError::Other(anyhow!(
-                "no graph: give a graph file (volgraph render GRAPH -o out.png), or a --scene whose file names one \
-                 (graph: \"../graphs/modern/fastest.ron\")"
-            )));
-        }
-    };
+    let Resolved { scene, graph, size, camera } = args.inputs.resolve("volgraph render GRAPH -o out.png", "512x512")?;
     let source = inputs::read_graph(&graph)?;
-    let size = args.size.clone().or_else(|| scene.as_ref().and_then(|s| s.viewport).map(|(w, h)| format!("{w}x{h}")));
     let mut features = scene.as_ref().map(|s| s.effects.clone()).unwrap_or_default();
-    features.extend(args.features.iter().cloned());
-    let mut options = compile_options(size.as_deref().unwrap_or("512x512"), &features, &[])?;
+    features.extend(args.inputs.features.iter().cloned());
+    let mut options = compile_options(&size, &features, &[])?;
     options.precision = scene.as_ref().and_then(|s| s.precision);
-    let camera = match (&args.camera, scene.as_ref().and_then(|s| s.camera.clone())) {
-        (Some(text), _) => orbit_spec(&inputs::parse_camera(text)?),
-        (None, Some(spec)) => spec,
-        (None, None) => orbit_spec(&inputs::parse_camera("30,20,3.2")?),
-    };
     let frames = args.frames.or(scene.as_ref().map(Scene::frame_count)).unwrap_or(1);
-    let raw = inputs::raw_options(&args.raw)?;
-    let (volume, generated, mut notes) = match (&args.volume, &scene) {
+    let raw = inputs::raw_options(&args.inputs.raw)?;
+    let (volume, generated, mut notes) = match (&args.inputs.volume, &scene) {
         (None, Some(scene)) => crate::scene::load_volume(scene, &raw)?,
         (volume, _) => {
             let (v, notes) = inputs::volume(volume.as_ref(), &raw)?;
             (v, volume.is_none(), notes)
         }
     };
-    let (tf, tf_notes) = match (&args.tf, &scene) {
+    let (tf, tf_notes) = match (&args.inputs.tf, &scene) {
         (None, Some(scene)) => {
             let (tf, _, notes) =
-                crate::scene::load_transfer_function(scene, args.tf_map.as_deref(), &volume, generated)?;
+                crate::scene::load_transfer_function(scene, args.inputs.tf_map.as_deref(), &volume, generated)?;
             (tf, notes)
         }
-        (tf, _) => inputs::transfer_function(tf.as_ref(), args.tf_map.as_deref(), &volume, generated)?,
+        (tf, _) => inputs::transfer_function(tf.as_ref(), args.inputs.tf_map.as_deref(), &volume, generated)?,
     };
     notes.extend(tf_notes);
     let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
@@ -140,7 +88,7 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     // graph); a --features name it does not know is the user's typo: an error.
     let mut user = options.clone();
     user.features.retain(|f| {
-        let from_scene = scene.as_ref().is_some_and(|s| s.effects.contains(f)) && !args.features.contains(f);
+        let from_scene = scene.as_ref().is_some_and(|s| s.effects.contains(f)) && !args.inputs.features.contains(f);
         if from_scene && !plan.known_features.contains(f) {
             notes.push(format!(
                 "note: graph \"{}\" does not offer the scene's effect \"{f}\"; it is left out",
@@ -178,21 +126,16 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     Ok(Prepared { args, graph, kind, camera, frames, opacity, volume, lut, plan, output, notes })
 }
 
-/// The camera spec of one orbit camera (turning 1° per frame).
-fn orbit_spec(c: &OrbitCamera) -> CameraSpec {
-    CameraSpec::Orbit { azimuth: c.azimuth_deg, elevation: c.elevation_deg, distance: c.distance }
-}
-
 /// Opens the GPU, renders the frames and writes the image.
 pub fn execute(prepared: Prepared) -> Result<(), CliError> {
     let Prepared { args, graph, kind, camera, frames, opacity, volume, lut, plan, output, .. } = prepared;
     let registry = builtin_registry();
     let viewport = plan.viewport;
     let gpu = Arc::new(Gpu::new_headless().map_err(|e| anyhow!(e))?);
-    let (sources, _) = crate::shader_dir::sources_for(&graph, args.shaders.as_deref());
+    let (sources, _) = crate::shader_dir::sources_for(&graph, args.inputs.shaders.as_deref());
     let mut runtime = Runtime::new(gpu, ShaderLibrary::new(sources));
     runtime.set_opacity_reference(opacity);
-    runtime.set_gpu_memory_budget(args.gpu_memory_mb.map(|mb| mb << 20));
+    runtime.set_gpu_memory_budget(args.inputs.gpu_memory_mb.map(|mb| mb << 20));
     runtime.bind_scene(&plan.inputs, &volume, &lut).map_err(|e| anyhow!(e))?;
     if runtime.volume().is_some_and(|(_, f)| f == VolumeFormat::R16Float) && !matches!(volume.data, VoxelData::U8(_)) {
         eprintln!(

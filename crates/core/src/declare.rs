@@ -14,8 +14,9 @@
 //! - `name: bool = false, "doc";` — a boolean parameter, a `u32` 0 or 1 on the GPU;
 //! - `name: Mode = Dvr, "doc";` — a choice between the variants of a [`param_choice!`](crate::param_choice)
 //!   enum (its names in the graph file), the variant's index as a `u32` on the GPU;
-//! - `name: f32 = computed, "doc";` — no parameter: a value the node computes (a count derived
+//! - `name: f32 = computed, "doc";` — no parameter: a number the node computes (a count derived
 //!   from the volume) that still has its place in the uniform block; `from_params` sets 0.
+//!   Numbers only (`f32`, `u32`, `i32`): a computed flag or choice does not compile.
 //!
 //! All are 4 bytes on the GPU, so the struct has no padding inside and its layout is the
 //! declaration order.

@@ -43,7 +43,8 @@ impl PassPlugin for TerminationTest {
     }
 
     fn summary(&self) -> &'static str {
-        "early-z buffer for the next segment: saturated, finished or empty rays rejected (Krüger–Westermann 2003 §2.1, §2.3)"
+        "early-z buffer for the next segment: saturated, finished or empty rays rejected (Krüger–Westermann 2003 §2.1, \
+         §2.3); its sampling, segment_steps and block_size must be the segment pass's (share Scalar inputs)"
     }
 
     fn params(&self) -> Vec<ParamSpec> {

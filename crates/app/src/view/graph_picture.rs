@@ -177,11 +177,12 @@ pub fn show(ui: &mut egui::Ui, plan: &Plan) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use volgraph_core::{CompileOptions, compile};
 
-    fn plan(graph: &str) -> Plan {
+    /// The 64×64 plan of a shipped graph (`graphs/` relative path); also `plan_svg`'s tests'.
+    pub(crate) fn plan(graph: &str) -> Plan {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../graphs").join(graph);
         let source = std::fs::read_to_string(&path).expect("graph");
         compile(graph, &source, &volgraph_passes::builtin_registry(), &CompileOptions::new(64, 64)).expect("compiles")

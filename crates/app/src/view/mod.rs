@@ -19,47 +19,14 @@ use std::path::PathBuf;
 
 use volgraph_accel::camera::OrbitCamera;
 
-use crate::cli::{CliError, RawArgs};
+use crate::cli::CliError;
 use crate::inputs;
 
 /// The arguments of `volgraph view`.
 #[derive(clap::Args, Debug)]
 pub struct ViewArgs {
-    /// The graph file (RON); default: the scene's graph.
-    pub graph: Option<PathBuf>,
-    /// A scene file (scenes/*.ron): volume, transfer function, camera, viewport, graph, effects
-    /// (on at start; the panel toggles them), precision; flags given as well win over it.
-    #[arg(long)]
-    pub scene: Option<PathBuf>,
-    /// Volume file (.raw, .nrrd, .nhdr, .mhd, .mha); default: a generated Marschner–Lobb 64³.
-    #[arg(long)]
-    pub volume: Option<PathBuf>,
     #[command(flatten)]
-    pub raw: RawArgs,
-    /// Transfer function (RON, or ParaView color-map .json); watched for edits.
-    #[arg(long)]
-    pub tf: Option<PathBuf>,
-    /// The colour map to use from a ParaView .json holding several.
-    #[arg(long = "tf-map")]
-    pub tf_map: Option<String>,
-    /// Window size, WIDTHxHEIGHT [default: the scene's viewport, else 800x600].
-    #[arg(long)]
-    pub size: Option<String>,
-    /// Orbit camera AZIMUTH,ELEVATION,DISTANCE (degrees, degrees, world units) [default: the
-    /// scene's first camera, else 30,20,3.2].
-    #[arg(long)]
-    pub camera: Option<String>,
-    /// Scene features on at start, comma separated.
-    #[arg(long, value_delimiter = ',')]
-    pub features: Vec<String>,
-    /// A shader folder to read and watch (default: `shaders/` beside the graph's workspace, if any;
-    /// else the shaders built into the binary).
-    #[arg(long)]
-    pub shaders: Option<PathBuf>,
-    /// GPU memory, in MiB, passes that stream data may hold (a brick pool) [default: what the
-    /// adapter allows].
-    #[arg(long = "gpu-memory-mb", value_parser = clap::value_parser!(u64).range(1..=1 << 24))]
-    pub gpu_memory_mb: Option<u64>,
+    pub inputs: crate::scene_args::SceneArgs,
     /// Exit after this many presented frames.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub frames: Option<u64>,
@@ -101,23 +68,9 @@ pub fn emit(event: &session::Event) {
 
 /// Runs `volgraph view`.
 pub fn run(args: ViewArgs) -> Result<(), CliError> {
-    let scene = args.scene.as_deref().map(crate::scene::Scene::load).transpose().map_err(|e| anyhow::anyhow!(e))?;
-    let graph = match (&args.graph, scene.as_ref().and_then(|s| s.graph.clone())) {
-        (Some(g), _) => g.clone(),
-        (None, Some(g)) => g,
-        (None, None) => {
-            return Err(CliError::Other(anyhow::anyhow!(
-                "no graph: give a graph file (volgraph view GRAPH), or a --scene whose file names one"
-            )));
-        }
-    };
-    let size = args.size.clone().or_else(|| scene.as_ref().and_then(|s| s.viewport).map(|(w, h)| format!("{w}x{h}")));
-    let viewport = inputs::parse_size(size.as_deref().unwrap_or("800x600"))?;
-    let camera = match (&args.camera, scene.as_ref().and_then(|s| s.camera.as_ref())) {
-        (Some(text), _) => inputs::parse_camera(text)?,
-        (None, Some(spec)) => spec.at(0),
-        (None, None) => inputs::parse_camera("30,20,3.2")?,
-    };
+    let resolved = args.inputs.resolve("volgraph view GRAPH", "800x600")?;
+    let viewport = inputs::parse_size(&resolved.size)?;
+    let camera = resolved.camera.at(0);
     if let Some(path) = &args.screenshot {
         let kind = crate::image_out::ImageKind::from_path(path)?;
         if kind != crate::image_out::ImageKind::Png {
@@ -128,16 +81,16 @@ pub fn run(args: ViewArgs) -> Result<(), CliError> {
         }
     }
     let session_args = session::SessionArgs {
-        graph,
-        scene,
-        volume: args.volume,
-        raw: inputs::raw_options(&args.raw)?,
-        tf: args.tf,
-        tf_map: args.tf_map,
+        graph: resolved.graph,
+        scene: resolved.scene,
+        volume: args.inputs.volume,
+        raw: inputs::raw_options(&args.inputs.raw)?,
+        tf: args.inputs.tf,
+        tf_map: args.inputs.tf_map,
         viewport,
-        features: args.features,
-        shaders: args.shaders,
-        gpu_memory_mb: args.gpu_memory_mb,
+        features: args.inputs.features,
+        shaders: args.inputs.shaders,
+        gpu_memory_mb: args.inputs.gpu_memory_mb,
     };
     let view = ViewOptions {
         camera,

@@ -1,0 +1,104 @@
+//! The inputs `volgraph render` and `volgraph view` share, declared once for both command lines:
+//! the graph, a scene file, the volume, the transfer function, the viewport, the camera, the
+//! scene's effects, a shader folder and the GPU memory budget.
+
+use std::path::PathBuf;
+
+use anyhow::anyhow;
+
+use crate::cli::RawArgs;
+use crate::inputs;
+use crate::scene::{CameraSpec, Scene};
+
+/// What to draw and how to look at it (flags given as well as a scene win over it).
+#[derive(clap::Args, Debug)]
+pub struct SceneArgs {
+    /// The graph file (RON); default: the scene's graph.
+    pub graph: Option<PathBuf>,
+    /// A scene file (scenes/*.ron): volume, transfer function, camera or camera path,
+    /// viewport, graph, effects, precision; flags given as well win over it.
+    #[arg(long)]
+    pub scene: Option<PathBuf>,
+    /// Volume file (.raw named NAME_XxYxZ_TYPE.raw, .nrrd, .nhdr, .mhd, .mha); default: a
+    /// generated Marschner–Lobb 64³.
+    #[arg(long)]
+    pub volume: Option<PathBuf>,
+    #[command(flatten)]
+    pub raw: RawArgs,
+    /// Transfer function (RON, or ParaView color-map .json; the viewer watches it for edits);
+    /// default: one fitted to the data.
+    #[arg(long)]
+    pub tf: Option<PathBuf>,
+    /// The colour map to use from a ParaView .json holding several (its "Name"); default: the first.
+    #[arg(long = "tf-map")]
+    pub tf_map: Option<String>,
+    /// Viewport (the viewer's window), WIDTHxHEIGHT [default: the scene's, else 512x512 for
+    /// render and 800x600 for view].
+    #[arg(long)]
+    pub size: Option<String>,
+    /// Orbit camera AZIMUTH,ELEVATION,DISTANCE (degrees, degrees, world units) [default: the
+    /// scene's first camera, else 30,20,3.2].
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// Scene features (effects) that are on, comma separated: shading, preintegration,
+    /// jitter, tricubic (added to the scene's; the viewer's panel toggles them).
+    #[arg(long, value_delimiter = ',')]
+    pub features: Vec<String>,
+    /// A shader folder to read (and, in the viewer, watch) instead of the built-in shaders
+    /// (default: a `shaders/` folder beside the graph's workspace, if there is one).
+    #[arg(long)]
+    pub shaders: Option<PathBuf>,
+    /// GPU memory, in MiB, passes that stream data may hold (the brick pool of
+    /// graphs/ruijters_vilanova_2006); a volume that does not fit streams through it
+    /// [default: 2048, bounded by the adapter's 3D texture limit].
+    #[arg(long = "gpu-memory-mb", value_parser = clap::value_parser!(u64).range(1..=1 << 24))]
+    pub gpu_memory_mb: Option<u64>,
+}
+
+/// What the command line and the scene say together: flags win over the scene.
+pub struct Resolved {
+    /// The scene file, read and checked.
+    pub scene: Option<Scene>,
+    /// The graph file.
+    pub graph: PathBuf,
+    /// The viewport, WIDTHxHEIGHT.
+    pub size: String,
+    /// The camera (an orbit, or the scene's path).
+    pub camera: CameraSpec,
+}
+
+impl SceneArgs {
+    /// Reads the scene and picks the graph, viewport and camera: a flag, else the
+    /// scene's, else `default_size` and the 30,20,3.2 orbit. `usage` is the command line that
+    /// names a graph, for the error when neither says one.
+    pub fn resolve(&self, usage: &str, default_size: &str) -> anyhow::Result<Resolved> {
+        let scene = self.scene.as_deref().map(Scene::load).transpose().map_err(|e| anyhow!(e))?;
+        let graph = match (&self.graph, scene.as_ref().and_then(|s| s.graph.clone())) {
+            (Some(g), _) => g.clone(),
+            (None, Some(g)) => g,
+            (None, None) => {
+                return Err(anyhow!(
+                    "no graph: give a graph file ({usage}), or a --scene whose file names one \
+                     (graph: \"../graphs/modern/fastest.ron\")"
+                ));
+            }
+        };
+        let size = self
+            .size
+            .clone()
+            .or_else(|| scene.as_ref().and_then(|s| s.viewport).map(|(w, h)| format!("{w}x{h}")))
+            .unwrap_or_else(|| default_size.to_string());
+        let camera = match (&self.camera, scene.as_ref().and_then(|s| s.camera.clone())) {
+            (Some(text), _) => orbit(text)?,
+            (None, Some(spec)) => spec,
+            (None, None) => orbit("30,20,3.2")?,
+        };
+        Ok(Resolved { scene, graph, size, camera })
+    }
+}
+
+/// The orbit camera of `AZIMUTH,ELEVATION,DISTANCE`.
+fn orbit(text: &str) -> anyhow::Result<CameraSpec> {
+    let c = inputs::parse_camera(text)?;
+    Ok(CameraSpec::Orbit { azimuth: c.azimuth_deg, elevation: c.elevation_deg, distance: c.distance })
+}

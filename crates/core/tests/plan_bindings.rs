@@ -88,6 +88,11 @@ fn cs_misnamed(@builtin(global_invocation_id) id: vec3<u32>) {
 fn cs_buffer_as_texture(@builtin(global_invocation_id) id: vec3<u32>) {
     textureStore(out, vec2<i32>(id.xy), textureLoad(counts, vec2<i32>(id.xy), 0));
 }
+// A vertex stage (declared like any other, CreateContext requires it) that reads `colour`.
+@vertex
+fn vs_misnamed(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    return vec4<f32>(textureLoad(colour, vec2<i32>(0, 0), 0).x, 0.0, 0.0, 1.0);
+}
 // Everything in @group(0).
 @compute @workgroup_size(8, 8)
 fn cs_group(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -136,6 +141,14 @@ fn a_misnamed_port_is_caught_at_plan_time() {
         "{p:?}"
     );
     assert!(p[0].starts_with("pass \"p\" (probe): probe.wgsl"), "{p:?}");
+}
+
+/// Vertex stages that bind something are declared too (node creation refuses them otherwise),
+/// so their bindings are checked at plan time like the fragment and compute stages'.
+#[test]
+fn a_misnamed_global_in_a_vertex_stage_is_caught_at_plan_time() {
+    let p = problems("vs_misnamed", SHADER);
+    assert!(p.len() == 1 && p[0].contains("global \"colour\" is neither a port of this pass"), "{p:?}");
 }
 
 #[test]

@@ -26,6 +26,7 @@ impl PassPlugin for EntryPoints {
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         vec![
+            ShaderUse { file: "entry_points.wgsl", entry_point: "vs_box", extra: &[] },
             ShaderUse { file: "entry_points.wgsl", entry_point: "fs_entry", extra: &[] },
             ShaderUse { file: "entry_points.wgsl", entry_point: "fs_near_plane", extra: &[] },
         ]

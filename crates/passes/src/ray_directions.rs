@@ -27,7 +27,10 @@ impl PassPlugin for RayDirections {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "ray_directions.wgsl", entry_point: "fs_dir", extra: &[] }]
+        vec![
+            ShaderUse { file: "ray_directions.wgsl", entry_point: "vs_box", extra: &[] },
+            ShaderUse { file: "ray_directions.wgsl", entry_point: "fs_dir", extra: &[] },
+        ]
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {

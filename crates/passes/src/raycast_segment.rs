@@ -154,7 +154,7 @@ impl PassPlugin for RaycastSegment {
         // The counting variant (a bench tool's) binds the invocation counter too.
         let extra: &'static [&'static str] =
             if self.counter.is_some() { &["params", "segment", "invocations"] } else { &["params", "segment"] };
-        vec![ShaderUse { file, entry_point, extra }]
+        vec![ShaderUse { file, entry_point: "vs_segment", extra }, ShaderUse { file, entry_point, extra }]
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {

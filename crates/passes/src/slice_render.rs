@@ -52,7 +52,10 @@ impl PassPlugin for SliceRender {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "slice_render.wgsl", entry_point: "fs_slice", extra: &["slices"] }]
+        vec![
+            ShaderUse { file: "slice_render.wgsl", entry_point: "vs_slice", extra: &["slices"] },
+            ShaderUse { file: "slice_render.wgsl", entry_point: "fs_slice", extra: &["slices"] },
+        ]
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {

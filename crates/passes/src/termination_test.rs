@@ -65,6 +65,12 @@ impl PassPlugin for TerminationTest {
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         vec![
+            ShaderUse { file: "termination_test.wgsl", entry_point: "vs_segment", extra: &["params", "segment"] },
+            ShaderUse {
+                file: "termination_test.wgsl",
+                entry_point: "vs_terminate_alpha",
+                extra: &["params", "segment"],
+            },
             ShaderUse { file: "termination_test.wgsl", entry_point: "fs_terminate", extra: &["params", "segment"] },
             ShaderUse {
                 file: "termination_test.wgsl",

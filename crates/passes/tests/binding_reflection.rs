@@ -56,13 +56,24 @@ impl PassPlugin for Misnamed {
         match (self.compute_color, self.kind) {
             // Declares the fragment entry it does not build (`fs_iso`), not the one it does.
             (_, "undeclared") => vec![ShaderUse { file: "raycast.wgsl", entry_point: "fs_iso", extra: &["params"] }],
+            // Declares the fragment stage but not the vertex stage, which binds the frame.
+            (_, "undeclared_vertex") => {
+                vec![ShaderUse { file: "entry_points.wgsl", entry_point: "fs_entry", extra: &[] }]
+            }
             (Some(_), _) => vec![ShaderUse { file: "raycast_compute.wgsl", entry_point: "cs_dvr", extra: &["params"] }],
             (None, _) => vec![ShaderUse { file: "raycast.wgsl", entry_point: "fs_dvr", extra: &["params"] }],
         }
     }
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        if self.compute_color.is_some() {
+        if self.kind == "undeclared_vertex" {
+            ctx.render_pipeline(&RenderPipelineSpec {
+                shader: "entry_points.wgsl",
+                vertex: "vs_box",
+                fragment: "fs_entry",
+                ..Default::default()
+            })?;
+        } else if self.compute_color.is_some() {
             ctx.compute_pipeline(&ComputePipelineSpec {
                 shader: "raycast_compute.wgsl",
                 entry: "cs_dvr",
@@ -137,6 +148,19 @@ fn an_entry_point_the_plugin_does_not_declare_is_not_built() {
         "pass \"march\": it builds raycast.wgsl entry point `fs_dvr`, which its plugin's `shaders()` does not \
          declare for these parameters (it declares raycast.wgsl:fs_iso); add `ShaderUse { file: \"raycast.wgsl\", \
          entry_point: \"fs_dvr\", extra: &[...] }` there, so `volgraph plan` checks its bindings too"
+    );
+}
+
+/// A vertex stage that binds something (here the frame) is declared like the fragment stage.
+#[test]
+fn a_vertex_stage_that_binds_something_must_be_declared() {
+    let msg =
+        build_error(Misnamed { kind: "undeclared_vertex", dir_port: "dir", color_port: "color", compute_color: None });
+    assert!(
+        msg.contains(
+            "it builds entry_points.wgsl entry point `vs_box`, which its plugin's `shaders()` does not declare"
+        ),
+        "{msg}"
     );
 }
 

@@ -95,7 +95,10 @@ impl PassPlugin for Splat {
         "splat"
     }
     fn shaders(&self, _p: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: SHADER, entry_point: "fs_splat", extra: &[] }]
+        vec![
+            ShaderUse { file: SHADER, entry_point: "vs_splat", extra: &[] },
+            ShaderUse { file: SHADER, entry_point: "fs_splat", extra: &[] },
+        ]
     }
     fn summary(&self) -> &'static str {
         "test: a 2×2-pixel quad per point, instanced, vertices pulled from the point texture"

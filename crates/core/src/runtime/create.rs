@@ -340,7 +340,16 @@ impl<'a> CreateContext<'a> {
         drop(built);
         let r = reflect(&shader.module, &shader.info, &[spec.vertex, spec.fragment])
             .map_err(|e| self.error(format!("{} {e}", spec.shader)))?;
-        self.check_bindings(spec.shader, &r.bindings, declared.extra)?;
+        // A vertex stage that binds anything (the frame, a point texture) is declared like the
+        // fragment stage, so `volgraph plan` checks it too; one that binds nothing (the
+        // fullscreen triangle) needs no declaration.
+        let vertex = reflect(&shader.module, &shader.info, &[spec.vertex])
+            .map_err(|e| self.error(format!("{} {e}", spec.shader)))?;
+        let mut extra: Vec<&str> = declared.extra.to_vec();
+        if !vertex.bindings.is_empty() {
+            extra.extend(self.declared_use(spec.shader, spec.vertex)?.extra);
+        }
+        self.check_bindings(spec.shader, &r.bindings, &extra)?;
         let mut outputs = r.fragment_outputs.clone();
         outputs.sort_by_key(|(_, loc)| *loc);
         let mut targets = Vec::new();

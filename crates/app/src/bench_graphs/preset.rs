@@ -204,7 +204,8 @@ pub const PRESETS: &[BenchPreset] = &[
                 1.5 samples per voxel (step 2/3 voxel), on the generated vessel tree (about 3 % visible under \
                 graphs/tf/vessels.ron, like the paper's angiography: optimized vs unoptimized 7.66× on a QuadroFX \
                 3400) and on the dense engine (the paper's ERT on a dense volume: 2.2 → 5.2 → 16.1 fps). Bricks \
-                64³, node limit 8³, ratio 1; uploads and pool occupancy from the brick pass",
+                64³, node limit 4³ (the fastest of our Figure 6 sweep with 2³), ratio 1; uploads and pool occupancy \
+                from the brick pass",
         graphs: &[
             "graphs/ruijters_vilanova_2006/unoptimized.ron",
             "graphs/ruijters_vilanova_2006/bricks.ron",

@@ -78,7 +78,7 @@ impl AaParamsGpu {
 
 /// The raycaster's block with its step back, so sub-pixel rays start like its rays.
 fn ray_block(p: &Params) -> RaycastParamsGpu {
-    RaycastParamsGpu { step_back: AaOwn::from_params(p).step_back as f32, ..RaycastParamsGpu::from_params(p) }
+    RaycastParamsGpu { step_back: AaOwn::from_params(p).step_back as f32, ..RaycastParamsGpu::of(p) }
 }
 
 /// Its pipeline for these parameters.
@@ -131,7 +131,7 @@ impl PassPlugin for Antialias {
             defines: &defines,
             ..RenderPipelineSpec::fullscreen(&shader(ctx.params))
         })?;
-        let params = ctx.uniform_with("params", &ray_block(ctx.params));
+        let params = ctx.uniform_from_bytes("params", &ray_block(ctx.params).uniform_bytes());
         let aa = ctx.uniform_with("aa", &AaParamsGpu::from_params(ctx.params));
         Ok(Box::new(AntialiasNode { pipeline, params, aa }))
     }
@@ -155,7 +155,7 @@ impl PassNode for AntialiasNode {
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
-        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&ray_block(params)));
+        gpu.queue.write_buffer(&self.params, 0, &ray_block(params).uniform_bytes());
         gpu.queue.write_buffer(&self.aa, 0, bytemuck::bytes_of(&AaParamsGpu::from_params(params)));
     }
 }

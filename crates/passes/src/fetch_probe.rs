@@ -74,7 +74,7 @@ impl PassPlugin for FetchProbe {
             constants: &[("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)],
             defines: &crate::effects::jitter_defines(ctx.params),
         })?;
-        let params = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
+        let params = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());
         Ok(Box::new(FetchProbeNode { pipeline, params, workgroup: wg, counted }))
     }
 }
@@ -100,6 +100,6 @@ impl PassNode for FetchProbeNode {
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
-        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
+        gpu.queue.write_buffer(&self.params, 0, &RaycastParamsGpu::of(params).uniform_bytes());
     }
 }

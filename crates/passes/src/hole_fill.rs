@@ -60,8 +60,7 @@ impl PassPlugin for HoleFill {
             fragment: "fs_hole",
             ..Default::default()
         })?;
-        let uniform = ctx.uniform_buffer("holes", 16);
-        ctx.gpu.queue.write_buffer(&uniform, 0, &HoleParams::from_params(ctx.params).uniform_bytes());
+        let uniform = ctx.uniform_from_bytes("holes", &HoleParams::from_params(ctx.params).uniform_bytes());
         Ok(Box::new(HoleFillNode { pipeline, uniform }))
     }
 }

@@ -37,16 +37,6 @@ impl MinMaxGridPass {
     }
 }
 
-/// Rust twin of `struct MinMaxParams` in `shaders/minmax_grid.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct MinMaxParamsGpu {
-    block_size: u32,
-    _pad: [u32; 3],
-}
-
-const _: () = assert!(std::mem::size_of::<MinMaxParamsGpu>() == 16);
-
 /// Workgroup edge of `cs_minmax` and `cs_classify` (4³ blocks per workgroup).
 pub(crate) const GRID_WORKGROUP: u32 = 4;
 
@@ -133,8 +123,8 @@ impl PassPlugin for MinMaxGridPass {
             ..Default::default()
         })?;
         let block_size = BlockSize::of(ctx.params);
-        let params = ctx.uniform_buffer("minmax", 16);
-        ctx.gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&MinMaxParamsGpu { block_size, _pad: [0; 3] }));
+        // `MinMaxParams` of the shader: the block edge, padded to 16 bytes.
+        let params = ctx.uniform_from_bytes("minmax", &BlockSize { block_size }.uniform_bytes());
         Ok(Box::new(MinMaxGridNode { pipeline, params, block_size, grid: None, tap: self.tap.clone() }))
     }
 }

@@ -52,8 +52,7 @@ impl PassPlugin for Present {
 
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec::of(&SHADER))?;
-        let params = ctx.uniform_buffer("params", 16);
-        ctx.gpu.queue.write_buffer(&params, 0, &PresentParams::from_params(ctx.params).uniform_bytes());
+        let params = ctx.uniform_from_bytes("params", &PresentParams::from_params(ctx.params).uniform_bytes());
         Ok(Box::new(PresentNode { pipeline, params }))
     }
 }

@@ -123,7 +123,7 @@ impl PassPlugin for Raycast {
         })?;
         let own = RaycastOwn::from_params(ctx.params);
         let settings = gpu_block(ctx.params);
-        let params = ctx.uniform_with("params", &settings);
+        let params = ctx.uniform_from_bytes("params", &settings.uniform_bytes());
         let effects = EffectState::new(ctx)?;
         Ok(Box::new(RaycastNode {
             pipeline,
@@ -195,10 +195,7 @@ fn fragment_entry(params: &Params) -> &'static str {
 
 /// The shared block with the fixed step back (the conservative one is computed per volume).
 fn gpu_block(params: &Params) -> RaycastParamsGpu {
-    RaycastParamsGpu {
-        step_back: RaycastOwn::from_params(params).step_back as f32,
-        ..RaycastParamsGpu::from_params(params)
-    }
+    RaycastParamsGpu { step_back: RaycastOwn::from_params(params).step_back as f32, ..RaycastParamsGpu::of(params) }
 }
 
 /// ⌈|voxel diagonal| / h⌉ for the bound volume (Klein et al. 2005 §4.2's conservative bound).
@@ -226,7 +223,7 @@ impl PassNode for RaycastNode {
             let n = conservative_step_back(volume, self.settings.step_voxels as f64);
             if self.written_step_back != Some(n) {
                 self.settings.step_back = n;
-                ctx.write_buffer(&self.params, 0, bytemuck::bytes_of(&self.settings));
+                ctx.write_buffer(&self.params, 0, &self.settings.uniform_bytes());
                 self.written_step_back = Some(n);
             }
         }
@@ -246,7 +243,7 @@ impl PassNode for RaycastNode {
         self.settings = gpu_block(params);
         self.conservative = RaycastOwn::from_params(params).step_back_rule == StepBackRule::Conservative;
         self.written_step_back = None;
-        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&self.settings));
+        gpu.queue.write_buffer(&self.params, 0, &self.settings.uniform_bytes());
         self.effects.invalidate();
     }
 }

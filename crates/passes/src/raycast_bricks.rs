@@ -150,7 +150,7 @@ impl PassPlugin for RaycastBricks {
             defines: &defines,
             constants: &[("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)],
         })?;
-        let params = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
+        let params = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());
         let uniform = ctx.uniform_buffer("bricks", std::mem::size_of::<BrickParamsGpu>() as u64);
         let brick_cells = settings.brick_cells;
         let node_cells = match settings.node_cells {
@@ -662,7 +662,7 @@ impl PassNode for RaycastBricksNode {
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
-        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
+        gpu.queue.write_buffer(&self.params, 0, &RaycastParamsGpu::of(params).uniform_bytes());
     }
 
     fn counters(&self) -> Vec<(&'static str, f64)> {

@@ -76,7 +76,7 @@ impl PassPlugin for RaycastCompute {
             constants: &[("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)],
             defines: &defines,
         })?;
-        let params = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
+        let params = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());
         let effects = EffectState::new(ctx)?;
         Ok(Box::new(RaycastComputeNode {
             pipeline,
@@ -105,7 +105,7 @@ impl PassNode for RaycastComputeNode {
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
-        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
+        gpu.queue.write_buffer(&self.params, 0, &RaycastParamsGpu::of(params).uniform_bytes());
         self.step_voxels = Sampling::from_params(params).step_voxels;
         self.effects.invalidate();
     }

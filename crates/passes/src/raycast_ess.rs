@@ -67,12 +67,10 @@ impl PassPlugin for RaycastEss {
         let defines = effect_defines(ctx.params);
         let pipeline =
             ctx.render_pipeline(&RenderPipelineSpec { defines: &defines, ..RenderPipelineSpec::fullscreen(&SHADER) })?;
-        let params = ctx.uniform_buffer("params", std::mem::size_of::<RaycastParamsGpu>() as u64);
-        ctx.gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(ctx.params)));
+        let params = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());
         let block_size = BlockSize::of(ctx.params);
         // `EssParams` of the shader: the block edge, padded to 16 bytes.
-        let ess = ctx.uniform_buffer("ess", 16);
-        ctx.gpu.queue.write_buffer(&ess, 0, &BlockSize { block_size }.uniform_bytes());
+        let ess = ctx.uniform_from_bytes("ess", &BlockSize { block_size }.uniform_bytes());
         let effects = EffectState::new(ctx)?;
         let step_voxels = Sampling::from_params(ctx.params).step_voxels;
         Ok(Box::new(RaycastEssNode { pipeline, params, ess, block_size, effects, step_voxels }))
@@ -102,7 +100,7 @@ impl PassNode for RaycastEssNode {
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
-        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
+        gpu.queue.write_buffer(&self.params, 0, &RaycastParamsGpu::of(params).uniform_bytes());
         self.step_voxels = Sampling::from_params(params).step_voxels;
         self.effects.invalidate();
         self.block_size = BlockSize::of(params);

@@ -200,11 +200,10 @@ impl PassPlugin for RaycastFast {
         let effects = EffectFlags::of(ctx.params);
         let exact_plain = table.is_none() && !effects.shading && !effects.preintegration;
         let half_step = (exact_plain && sampling.step_voxels == 0.5).then(|| variant(true)).transpose()?;
-        let params = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
+        let params = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());
         let block_size = BlockSize::of(ctx.params);
         // `FastParams` of the shader: the block edge, padded to 16 bytes.
-        let fast = ctx.uniform_buffer("fast", 16);
-        ctx.gpu.queue.write_buffer(&fast, 0, &BlockSize { block_size }.uniform_bytes());
+        let fast = ctx.uniform_from_bytes("fast", &BlockSize { block_size }.uniform_bytes());
         let stand_in = |dimension, format, label: &str| {
             ctx.gpu
                 .device
@@ -309,7 +308,7 @@ impl PassNode for RaycastFastNode {
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
-        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
+        gpu.queue.write_buffer(&self.params, 0, &RaycastParamsGpu::of(params).uniform_bytes());
         self.step_voxels = Sampling::from_params(params).step_voxels;
         self.effects.invalidate();
         self.block_size = BlockSize::of(params);

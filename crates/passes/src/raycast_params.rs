@@ -85,43 +85,30 @@ pub fn raycast_param_specs() -> Vec<volgraph_core::ParamSpec> {
     [Sampling::specs(), Termination::specs(), Surface::specs(), Shading::specs()].concat()
 }
 
-/// Rust twin of `struct RaycastParams` in `shaders/common/raycast_params.wgsl` (a test compares
-/// the two through naga).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct RaycastParamsGpu {
-    /// Sample distance in voxels.
-    pub step_voxels: f32,
-    /// Termination threshold.
-    pub threshold: f32,
-    /// Max samples per ray.
-    pub max_steps: u32,
-    /// 1 = jitter.
-    pub jitter: u32,
-    /// Isovalue.
-    pub iso_value: f32,
-    /// Phong ambient.
-    pub ambient: f32,
-    /// Phong diffuse.
-    pub diffuse: f32,
-    /// Phong specular.
-    pub specular: f32,
-    /// Phong exponent.
-    pub shininess: f32,
-    /// Klein et al. 2005 §4.2: samples a leap hit is moved back (computed by `raycast`'s node
-    /// from its `step_back` parameter or the bound volume; 0 elsewhere).
-    pub step_back: f32,
-    /// Padding.
-    pub _pad: [f32; 2],
+volgraph_core::pass_params! {
+    /// The raycasters' shared uniform `params`: `struct RaycastParams` of
+    /// `shaders/common/raycast_params.wgsl` (a test compares the two through naga). It has no
+    /// parameters of its own; [`RaycastParamsGpu::of`] fills it from the blocks a kind declares.
+    pub struct RaycastParamsGpu {
+        step_voxels: f32 = computed, "sample distance in voxels";
+        threshold: f32 = computed, "early-termination threshold (1 where the kind has none)";
+        max_steps: u32 = computed, "upper bound on samples per ray";
+        jitter: u32 = computed, "1: jitter the first sample";
+        iso_value: f32 = computed, "isovalue (mode iso)";
+        ambient: f32 = computed, "Blinn–Phong ambient";
+        diffuse: f32 = computed, "Blinn–Phong diffuse";
+        specular: f32 = computed, "Blinn–Phong specular";
+        shininess: f32 = computed, "Blinn–Phong exponent";
+        step_back: f32 = computed,
+            "Klein et al. 2005 §4.2: samples a leap hit is moved back (set by `raycast` and `antialias` from their step back; 0 elsewhere)";
+    }
 }
-
-const _: () = assert!(std::mem::size_of::<RaycastParamsGpu>() == 48);
 
 impl RaycastParamsGpu {
     /// The block of a raycaster's parameters: the sampling every raycaster declares, and the
     /// termination, isosurface and shading blocks where its kind declares them (else what the
     /// shader never reads: no termination, 0).
-    pub fn from_params(p: &Params) -> Self {
+    pub fn of(p: &Params) -> Self {
         let sampling = Sampling::from_params(p);
         let threshold = Termination::try_from_params(p).map_or(1.0, |t| t.threshold);
         let iso_value = Surface::try_from_params(p).map_or(0.0, |s| s.iso_value);
@@ -137,7 +124,6 @@ impl RaycastParamsGpu {
             specular: shading.specular as f32,
             shininess: shading.shininess as f32,
             step_back: 0.0,
-            _pad: [0.0; 2],
         }
     }
 }
@@ -186,29 +172,18 @@ mod tests {
         // The struct alone: the file's binding uses `@binding(auto)`, numbered at assembly.
         let file = include_str!("../../../shaders/common/raycast_params.wgsl");
         let source: String = file.lines().filter(|l| !l.starts_with("@group")).collect::<Vec<_>>().join("\n");
-        let fields = [
-            ("step_voxels", "f32"),
-            ("threshold", "f32"),
-            ("max_steps", "u32"),
-            ("jitter", "u32"),
-            ("iso_value", "f32"),
-            ("ambient", "f32"),
-            ("diffuse", "f32"),
-            ("specular", "f32"),
-            ("shininess", "f32"),
-            ("step_back", "f32"),
-        ];
-        volgraph_core::declare::check_wgsl_struct(&source, "RaycastParams", &fields).expect("the layouts agree");
-        assert_eq!(std::mem::size_of::<RaycastParamsGpu>(), 4 * fields.len() + 8);
+        volgraph_core::declare::check_wgsl_struct(&source, "RaycastParams", &RaycastParamsGpu::wgsl_fields())
+            .expect("the layouts agree");
+        assert_eq!(RaycastParamsGpu::of(&Params::defaults(&raycast_param_specs())).uniform_bytes().len(), 48);
     }
 
     #[test]
     fn blocks_a_kind_does_not_declare_read_as_what_the_shader_ignores() {
         let params = Params::defaults(&Sampling::specs());
-        let gpu = RaycastParamsGpu::from_params(&params);
+        let gpu = RaycastParamsGpu::of(&params);
         assert_eq!((gpu.threshold, gpu.iso_value, gpu.ambient), (1.0, 0.0, 0.0));
         assert!(!is_iso(&params));
         let full = Params::defaults(&raycast_param_specs());
-        assert_eq!(RaycastParamsGpu::from_params(&full).ambient, 0.15);
+        assert_eq!(RaycastParamsGpu::of(&full).ambient, 0.15);
     }
 }

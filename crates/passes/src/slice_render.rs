@@ -66,8 +66,7 @@ impl PassPlugin for SliceRender {
             blend: Some(front_to_back_blend()),
             ..Default::default()
         })?;
-        let slices = ctx.uniform_buffer("slices", 16);
-        ctx.gpu.queue.write_buffer(&slices, 0, &SliceParams::from_params(ctx.params).uniform_bytes());
+        let slices = ctx.uniform_from_bytes("slices", &SliceParams::from_params(ctx.params).uniform_bytes());
         Ok(Box::new(SliceRenderNode { pipeline, slices, max_slices: SliceLimits::from_params(ctx.params).max_slices }))
     }
 }

@@ -101,8 +101,7 @@ impl PassPlugin for TerminationTest {
             ..spec("fs_terminate")
         })?;
         let with_empty = ctx.render_pipeline(&spec("fs_terminate_empty"))?;
-        let params = ctx.uniform_buffer("params", std::mem::size_of::<RaycastParamsGpu>() as u64);
-        ctx.gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(ctx.params)));
+        let params = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());
         let segment = ctx.uniform_buffer("segment", std::mem::size_of::<SegmentParamsGpu>() as u64);
         ctx.gpu.queue.write_buffer(&segment, 0, bytemuck::bytes_of(&SegmentParamsGpu::from_params(ctx.params)));
         Ok(Box::new(TerminationTestNode { alpha_only, with_empty, params, segment }))

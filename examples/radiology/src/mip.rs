@@ -62,9 +62,8 @@ impl PassPlugin for Mip {
         let defines = self.shader_defines(ctx.params);
         let pipeline =
             ctx.compute_pipeline(&ComputePipelineSpec { defines: &defines, ..ComputePipelineSpec::of(&SHADER) })?;
-        let uniform = ctx.uniform_buffer("mip", 16);
-        ctx.gpu.queue.write_buffer(&uniform, 0, &MipParams::from_params(ctx.params).uniform_bytes());
-        let rays = ctx.uniform_with("params", &RaycastParamsGpu::from_params(ctx.params));
+        let uniform = ctx.uniform_from_bytes("mip", &MipParams::from_params(ctx.params).uniform_bytes());
+        let rays = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());
         Ok(Box::new(MipNode { pipeline, uniform, rays }))
     }
 }
@@ -83,7 +82,7 @@ impl PassNode for MipNode {
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
         gpu.queue.write_buffer(&self.uniform, 0, &MipParams::from_params(params).uniform_bytes());
-        gpu.queue.write_buffer(&self.rays, 0, bytemuck::bytes_of(&RaycastParamsGpu::from_params(params)));
+        gpu.queue.write_buffer(&self.rays, 0, &RaycastParamsGpu::of(params).uniform_bytes());
     }
 }
 

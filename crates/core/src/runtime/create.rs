@@ -556,6 +556,13 @@ impl<'a> CreateContext<'a> {
         })
     }
 
+    /// A uniform buffer named `name` holding `bytes` (a `pass_params!` block's `uniform_bytes()`).
+    pub fn uniform_from_bytes(&self, name: &str, bytes: &[u8]) -> wgpu::Buffer {
+        let buffer = self.uniform_buffer(name, bytes.len() as u64);
+        self.gpu.queue.write_buffer(&buffer, 0, bytes);
+        buffer
+    }
+
     /// A uniform buffer holding `value` (a `#[repr(C)]` twin of a WGSL struct).
     pub fn uniform_with<T: bytemuck::Pod>(&self, name: &str, value: &T) -> wgpu::Buffer {
         let buffer = self.uniform_buffer(name, std::mem::size_of::<T>() as u64);

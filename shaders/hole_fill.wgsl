@@ -11,7 +11,7 @@
 #import "common/fullscreen.wgsl"
 #import "common/analytic_ray.wgsl"
 
-// Rust twin: `HoleParamsGpu` in crates/passes/src/hole_fill.rs.
+// Declared once: `HoleParams` (pass_params!) in crates/passes/src/hole_fill.rs.
 struct HoleParams {
     silhouette_band: i32,
     extend: i32,

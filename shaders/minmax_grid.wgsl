@@ -9,7 +9,7 @@
 
 #import "common/volume.wgsl"
 
-// Rust twin: `MinMaxParamsGpu` in crates/passes/src/minmax_grid.rs.
+// Declared once: `BlockSize` (pass_params!) in crates/passes/src/shared.rs.
 struct MinMaxParams {
     block_size: u32,
     _pad0: u32,

@@ -3,7 +3,7 @@
 // on llvmpipe it costs a third of the fullscreen-triangle draw it replaced, and on data-centre
 // GPUs compute is the fast path.
 
-// Rust twin: `PresentParamsGpu` in crates/passes/src/present.rs.
+// Declared once: `PresentParams` (pass_params!) in crates/passes/src/present.rs.
 struct PresentParams {
     // Linear grey level behind the volume.
     background: f32,

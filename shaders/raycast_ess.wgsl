@@ -17,7 +17,7 @@
 @group(0) @binding(auto) var entry: texture_2d<f32>;
 @group(0) @binding(auto) var dir: texture_2d<f32>;
 
-// Rust twin: `EssParamsGpu` in crates/passes/src/raycast_ess.rs.
+// Declared once: `BlockSize` (pass_params!) in crates/passes/src/shared.rs.
 struct EssParams {
     block_size: u32,
     _pad0: u32,

@@ -31,6 +31,7 @@ override HALF_STEP: bool = false;
 // Samples between two looks at the distance map (see `march`).
 override CHECK_EVERY: u32 = 16u;
 
+// Declared once: `BlockSize` (pass_params!) in crates/passes/src/shared.rs.
 struct FastParams {
     // Edge of an empty-space block in voxels (the distance map's).
     block_size: u32,

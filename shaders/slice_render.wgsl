@@ -16,7 +16,7 @@
 #import "common/frame.wgsl"
 #import "common/volume.wgsl"
 
-// Rust twin: `SliceParamsGpu` in crates/passes/src/slice_render.rs.
+// Declared once: `SliceParams` (pass_params!) in crates/passes/src/slice_render.rs.
 struct SliceParams {
     // Plane spacing in unit steps (voxels).
     slice_voxels: f32,

@@ -1,6 +1,7 @@
 // Raycasting settings, bound as `params`.
-// Rust twin: a `#[repr(C)]` 48-byte struct in crates/passes (mirrors
-// `volgraph_accel::reference::RaycastSettings`); keep both in step.
+// Declared once: `RaycastParamsGpu` (pass_params!, filled from the parameter blocks) in
+// crates/passes/src/raycast_params.rs, whose test compares the two; it mirrors
+// `volgraph_accel::reference::RaycastSettings`.
 
 struct RaycastParams {
     // Sample distance in units of the smallest voxel side (docs/rendering_model.md "Step").

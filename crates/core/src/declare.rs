@@ -140,8 +140,15 @@ macro_rules! pass_params {
                 specs
             }
 
-            /// The checked values of a compiled pass, typed.
+            /// The checked values of a compiled pass, typed (computed fields 0).
             pub fn from_params(p: &$crate::Params) -> Self {
+                // A block of computed fields only has no parameters to read: it has its own
+                // constructor, and reading it from parameters would upload zeros.
+                debug_assert!(
+                    !Self::specs().is_empty() || Self::wgsl_fields().is_empty(),
+                    "{} declares no parameters (every field is computed): build it with its own constructor",
+                    stringify!($name)
+                );
                 Self { $( $field: $crate::pass_params!(@get $form, $ty, p, stringify!($field)), )* }
             }
 

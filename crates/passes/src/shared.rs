@@ -46,3 +46,31 @@ pub fn front_to_back_blend() -> wgpu::BlendState {
 pub fn color_is_f32(ctx: &CreateContext<'_>) -> bool {
     ctx.port("color").and_then(|p| p.format) == Some(wgpu::TextureFormat::Rgba32Float)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::BlockSize;
+
+    /// The struct `name` of a shader file, alone (the files `#import` and number bindings at
+    /// assembly, so the whole file does not parse on its own).
+    fn struct_text(file: &str, name: &str) -> String {
+        let start = file.find(&format!("struct {name} {{")).expect("the struct");
+        let end = start + file[start..].find('}').expect("its end") + 1;
+        file[start..end].to_string()
+    }
+
+    /// `MinMaxParams`, `FastParams` and `EssParams` are `BlockSize`'s bytes.
+    #[test]
+    fn the_block_size_uniforms_match_their_shader_structs() {
+        for (file, name) in [
+            (include_str!("../../../shaders/minmax_grid.wgsl"), "MinMaxParams"),
+            (include_str!("../../../shaders/raycast_fast.wgsl"), "FastParams"),
+            (include_str!("../../../shaders/raycast_ess.wgsl"), "EssParams"),
+        ] {
+            let text = struct_text(file, name);
+            volgraph_core::declare::check_wgsl_struct(&text, name, &BlockSize::wgsl_fields())
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!(BlockSize { block_size: 8 }.uniform_bytes().len(), 16);
+        }
+    }
+}

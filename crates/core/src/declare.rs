@@ -171,6 +171,12 @@ macro_rules! pass_params {
                 vec![ $( (stringify!($field), $crate::pass_params!(@wgsl $form, $ty)), )* ]
             }
 
+            /// Checks that the struct `wgsl_name` of the assembled shader `source` has these
+            /// fields, in this order, at these offsets ([`check_wgsl_struct`]($crate::declare::check_wgsl_struct)).
+            pub fn check_shader(source: &str, wgsl_name: &str) -> Result<(), String> {
+                $crate::declare::check_wgsl_struct(source, wgsl_name, &Self::wgsl_fields())
+            }
+
             /// The WGSL struct the shader declares for these parameters (same name, same
             /// fields in the same order, padded to 16 bytes).
             pub fn wgsl_struct() -> String {

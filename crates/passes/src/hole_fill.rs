@@ -90,9 +90,6 @@ mod tests {
     /// The shader's `HoleParams` is the struct `pass_params!` uploads.
     #[test]
     fn the_shader_struct_matches_the_declaration() {
-        let source =
-            volgraph_core::shader_source::assemble(&crate::builtin_shaders(), "hole_fill.wgsl").expect("assembles");
-        let fields: Vec<(&str, &str)> = HoleParams::specs().iter().map(|s| (s.name, "i32")).collect();
-        volgraph_core::declare::check_wgsl_struct(&source.text, "HoleParams", &fields).expect("same layout");
+        HoleParams::check_shader(&crate::shared::assembled("hole_fill.wgsl"), "HoleParams").expect("same layout");
     }
 }

@@ -79,10 +79,7 @@ mod tests {
     /// The shader's `PresentParams` is the struct `pass_params!` uploads.
     #[test]
     fn the_shader_struct_matches_the_declaration() {
-        let source =
-            volgraph_core::shader_source::assemble(&crate::builtin_shaders(), "present.wgsl").expect("assembles");
-        let fields: Vec<(&str, &str)> = PresentParams::specs().iter().map(|s| (s.name, "f32")).collect();
-        volgraph_core::declare::check_wgsl_struct(&source.text, "PresentParams", &fields).expect("same layout");
+        PresentParams::check_shader(&crate::shared::assembled("present.wgsl"), "PresentParams").expect("same layout");
         assert!(PresentParams::wgsl_struct().starts_with("struct PresentParams {\n    background: f32,"));
     }
 }

@@ -169,10 +169,7 @@ mod tests {
     /// The Rust block and the shader's `RaycastParams` have the same members in the same order.
     #[test]
     fn the_gpu_block_matches_the_shader_struct() {
-        // The struct alone: the file's binding uses `@binding(auto)`, numbered at assembly.
-        let file = include_str!("../../../shaders/common/raycast_params.wgsl");
-        let source: String = file.lines().filter(|l| !l.starts_with("@group")).collect::<Vec<_>>().join("\n");
-        volgraph_core::declare::check_wgsl_struct(&source, "RaycastParams", &RaycastParamsGpu::wgsl_fields())
+        RaycastParamsGpu::check_shader(&crate::shared::assembled("raycast.wgsl"), "RaycastParams")
             .expect("the layouts agree");
         assert_eq!(RaycastParamsGpu::of(&Params::defaults(&raycast_param_specs())).uniform_bytes().len(), 48);
     }

@@ -47,30 +47,27 @@ pub fn color_is_f32(ctx: &CreateContext<'_>) -> bool {
     ctx.port("color").and_then(|p| p.format) == Some(wgpu::TextureFormat::Rgba32Float)
 }
 
+/// A built-in shader assembled as the GPU gets it (imports resolved, bindings numbered), for
+/// tests that compare a `pass_params!` declaration with its WGSL struct (`check_shader`).
+#[cfg(test)]
+pub(crate) fn assembled(file: &str) -> String {
+    volgraph_core::shader_source::assemble(&crate::builtin_shaders(), file).expect("assembles").text
+}
+
 #[cfg(test)]
 mod tests {
-    use super::BlockSize;
-
-    /// The struct `name` of a shader file, alone (the files `#import` and number bindings at
-    /// assembly, so the whole file does not parse on its own).
-    fn struct_text(file: &str, name: &str) -> String {
-        let start = file.find(&format!("struct {name} {{")).expect("the struct");
-        let end = start + file[start..].find('}').expect("its end") + 1;
-        file[start..end].to_string()
-    }
+    use super::{BlockSize, assembled};
 
     /// `MinMaxParams`, `FastParams` and `EssParams` are `BlockSize`'s bytes.
     #[test]
     fn the_block_size_uniforms_match_their_shader_structs() {
         for (file, name) in [
-            (include_str!("../../../shaders/minmax_grid.wgsl"), "MinMaxParams"),
-            (include_str!("../../../shaders/raycast_fast.wgsl"), "FastParams"),
-            (include_str!("../../../shaders/raycast_ess.wgsl"), "EssParams"),
+            ("minmax_grid.wgsl", "MinMaxParams"),
+            ("raycast_fast.wgsl", "FastParams"),
+            ("raycast_ess.wgsl", "EssParams"),
         ] {
-            let text = struct_text(file, name);
-            volgraph_core::declare::check_wgsl_struct(&text, name, &BlockSize::wgsl_fields())
-                .unwrap_or_else(|e| panic!("{name}: {e}"));
-            assert_eq!(BlockSize { block_size: 8 }.uniform_bytes().len(), 16);
+            BlockSize::check_shader(&assembled(file), name).unwrap_or_else(|e| panic!("{name}: {e}"));
         }
+        assert_eq!(BlockSize { block_size: 8 }.uniform_bytes().len(), 16);
     }
 }

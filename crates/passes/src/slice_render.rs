@@ -95,9 +95,6 @@ mod tests {
     /// The shader's `SliceParams` is the struct `pass_params!` uploads.
     #[test]
     fn the_shader_struct_matches_the_declaration() {
-        let source =
-            volgraph_core::shader_source::assemble(&crate::builtin_shaders(), "slice_render.wgsl").expect("assembles");
-        let fields: Vec<(&str, &str)> = SliceParams::specs().iter().map(|s| (s.name, "f32")).collect();
-        volgraph_core::declare::check_wgsl_struct(&source.text, "SliceParams", &fields).expect("same layout");
+        SliceParams::check_shader(&crate::shared::assembled("slice_render.wgsl"), "SliceParams").expect("same layout");
     }
 }

@@ -93,11 +93,9 @@ mod tests {
     /// The shader's `MipParams` is the struct `pass_params!` uploads.
     #[test]
     fn the_shader_struct_matches_the_declaration() {
-        let source = include_str!("../shaders/mip.wgsl");
-        let fields: Vec<(&str, &str)> = MipParams::specs().iter().map(|s| (s.name, "f32")).collect();
-        // The shader imports volgraph's shared files; check the struct on its own text.
-        let start = source.find("struct MipParams").expect("declared");
-        let end = start + source[start..].find('}').expect("closed") + 1;
-        volgraph_core::declare::check_wgsl_struct(&source[start..end], "MipParams", &fields).expect("same layout");
+        // Assembled as the GPU gets it: volgraph's shared files imported, bindings numbered.
+        let shaders = volgraph_passes::builtin_shaders().with_embedded(crate::SHADERS);
+        let source = volgraph_core::shader_source::assemble(&shaders, "mip.wgsl").expect("assembles");
+        MipParams::check_shader(&source.text, "MipParams").expect("same layout");
     }
 }

@@ -26,8 +26,11 @@ override WORKGROUP_Y: u32 = 8u;
 struct BrickParams {
     // Bricks per axis (xyz); w = cells per brick side.
     grid: vec4<u32>,
-    // Slots per atlas axis (xyz); w = voxels per slot side (brick_cells + 3; voxel lo - 1 first).
+    // Slots per atlas axis (xyz).
     slots: vec4<u32>,
+    // Voxels per slot and axis (xyz): brick_cells + 3 (voxel lo - 1 first), fewer on an axis
+    // thinner than a brick.
+    slot_side: vec4<u32>,
     // x = cells per leaf side, y = leaves per brick side.
     leaves: vec4<u32>,
     // Leaves per axis over the whole volume (xyz).
@@ -137,7 +140,7 @@ fn march_bricks(ray: Ray, pixel: vec2<u32>, start: vec4<f32>) -> vec4<f32> {
         // (the volume's clamp-to-edge at its faces; rounding at the brick's own faces).
         let slot = entry - 1u;
         let slots = bricks.slots;
-        let origin = vec3<f32>(vec3<u32>(slot % slots.x, (slot / slots.x) % slots.y, slot / (slots.x * slots.y)) * slots.w);
+        let origin = vec3<f32>(vec3<u32>(slot % slots.x, (slot / slots.x) % slots.y, slot / (slots.x * slots.y)) * bricks.slot_side.xyz);
         let offset = origin + vec3<f32>(1.5) - lo;
         let end = min(exit, s.count);
         loop {

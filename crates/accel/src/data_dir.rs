@@ -106,12 +106,26 @@ pub fn available_datasets() -> Result<Vec<(String, PathBuf)>, DataError> {
     Ok(found)
 }
 
-/// The file of dataset `name`: an exact dataset name, or else a unique prefix of one followed by
-/// `_` (`engine` finds `engine_vollib_256x256x256_uint8.raw`).
+/// The file of dataset `name`: a file's stem or name (`foo_16x16x16_uint8`), an exact dataset
+/// name held by one file, or else a unique prefix of one followed by `_` (`engine` finds
+/// `engine_vollib_256x256x256_uint8.raw`). Two files of one dataset name (`foo_8x8x8_uint8.raw`
+/// and `foo_16x16x16_uint8.raw`) make the name ambiguous; their stems choose one.
 pub fn dataset_path(name: &str) -> Result<PathBuf, DataError> {
     let all = available_datasets()?;
-    if let Some((_, path)) = all.iter().find(|(n, _)| n == name) {
+    let stem = |p: &Path| p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    if let Some((_, path)) = all.iter().find(|(_, p)| stem(p) == name || p.file_name().is_some_and(|f| f == name)) {
         return Ok(path.clone());
+    }
+    let exact: Vec<&(String, PathBuf)> = all.iter().filter(|(n, _)| n == name).collect();
+    match exact.as_slice() {
+        [(_, path)] => return Ok(path.clone()),
+        [] => {}
+        several => {
+            return Err(DataError::Ambiguous {
+                name: name.to_string(),
+                matches: several.iter().map(|(_, p)| stem(p)).collect(),
+            });
+        }
     }
     let prefix = format!("{name}_");
     let matches: Vec<&(String, PathBuf)> = all.iter().filter(|(n, _)| n.starts_with(&prefix)).collect();
@@ -167,8 +181,8 @@ pub struct ManifestEntry {
 /// `.raw` file name; the spacing and SHA-256 columns are found by header name.
 pub fn read_manifest() -> Result<Vec<ManifestEntry>, DataError> {
     let path = volumes_dir().join("MANIFEST.md");
-    let text = std::fs::read_to_string(&path)
-        .map_err(|e| DataError::Manifest { path: path.clone(), message: format!("cannot read the manifest: {e}") })?;
+    let text = crate::input_file::read_text(&path, "data-folder manifest")
+        .map_err(|e| DataError::Manifest { path: path.clone(), message: e.to_string() })?;
     parse_manifest(&path, &text)
 }
 
@@ -211,6 +225,9 @@ fn parse_manifest(path: &Path, text: &str) -> Result<Vec<ManifestEntry>, DataErr
         let &[sx, sy, sz] = spacing.as_slice() else {
             return Err(bad(format!("the spacing of {file} is not three numbers")));
         };
+        if ![sx, sy, sz].iter().all(|s| s.is_finite() && *s > 0.0) {
+            return Err(bad(format!("the spacing of {file} ({sx}, {sy}, {sz}) is not three positive numbers")));
+        }
         let sha256 = row
             .get(sha_col)
             .and_then(|c| between_backticks(c))
@@ -233,7 +250,12 @@ fn parse_manifest(path: &Path, text: &str) -> Result<Vec<ManifestEntry>, DataErr
 pub fn load_dataset(name: &str) -> Result<LoadedVolume, DataError> {
     let path = dataset_path(name)?;
     let file_name = path.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default();
-    let spacing =
-        read_manifest().ok().and_then(|rows| rows.into_iter().find(|r| r.file == file_name)).map(|r| r.spacing);
+    // No manifest: spacing (1, 1, 1). A manifest that is there but malformed is an error, not a
+    // silent fallback (it would render a 1 × 1 × 1.4 volume squashed).
+    let spacing = if volumes_dir().join("MANIFEST.md").exists() {
+        read_manifest()?.into_iter().find(|r| r.file == file_name).map(|r| r.spacing)
+    } else {
+        None
+    };
     Ok(load_volume(&path, &RawOptions { spacing, ..RawOptions::default() })?)
 }

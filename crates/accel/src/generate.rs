@@ -201,3 +201,54 @@ pub fn non_finite_f32(n: u32) -> (Volume, (usize, usize, usize)) {
     let volume = Volume::new(format!("non_finite_{n}"), UVec3::splat(n), DVec3::ONE, VoxelData::F32(data));
     (volume, (nan, pos, neg))
 }
+
+/// Largest edge of a generated volume named by [`by_name`] (512³ u8 is 128 MiB; more is surely
+/// a typo).
+pub const MAX_NAMED_EDGE: u32 = 512;
+
+/// The generated volumes [`by_name`] knows, for messages.
+pub const NAMED_GENERATORS: &str = "ml<N>, mlf<N>, sphere<N>, noise<N> or vessels<N> (N = edge in voxels), e.g. ml64";
+
+/// Why a generated-volume name makes no volume.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum NamedVolumeError {
+    /// The name is none of the generators.
+    #[error("\"{name}\" names no generated volume; use {NAMED_GENERATORS}")]
+    Unknown {
+        /// The name.
+        name: String,
+    },
+    /// The edge is out of range.
+    #[error("\"{name}\": a generated volume's edge must be 2..={MAX_NAMED_EDGE} voxels")]
+    Edge {
+        /// The name.
+        name: String,
+    },
+}
+
+/// The generated volume a name asks for: `ml64` (Marschner–Lobb, 64³ u8), `mlf64` (f32),
+/// `sphere64`, `noise64`, `vessels256` (the sparse vessel tree of [`crate::vessels`]). `Err(Unknown)`
+/// for a name that is none of these, so callers can fall back on a data-folder dataset.
+pub fn by_name(name: &str) -> Result<Volume, NamedVolumeError> {
+    let unknown = || NamedVolumeError::Unknown { name: name.to_string() };
+    let (make, digits): (fn(u32) -> Volume, &str) = if let Some(d) = name.strip_prefix("mlf") {
+        (marschner_lobb_f32, d)
+    } else if let Some(d) = name.strip_prefix("ml") {
+        (marschner_lobb, d)
+    } else if let Some(d) = name.strip_prefix("sphere") {
+        (|n| sphere(n, 0.6), d)
+    } else if let Some(d) = name.strip_prefix("noise") {
+        (|n| noise(n, 1), d)
+    } else if let Some(d) = name.strip_prefix("vessels") {
+        (|n| crate::vessels::vessel_tree(n, 1), d)
+    } else {
+        return Err(unknown());
+    };
+    if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+        return Err(unknown());
+    }
+    match digits.parse::<u32>() {
+        Ok(edge) if (2..=MAX_NAMED_EDGE).contains(&edge) => Ok(make(edge)),
+        _ => Err(NamedVolumeError::Edge { name: name.to_string() }),
+    }
+}

@@ -63,14 +63,9 @@ pub struct TransferFunction {
 /// and field, and say how to fix it.
 #[derive(Debug, thiserror::Error)]
 pub enum TfError {
-    /// The file cannot be read.
-    #[error("{}: cannot read the transfer function: {source}", .path.display())]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The OS error.
-        source: std::io::Error,
-    },
+    /// The file cannot be read (missing, not a regular file, too large, not text).
+    #[error(transparent)]
+    Read(#[from] crate::input_file::InputFileError),
     /// The RON text does not parse into a `TransferFunction`.
     #[error("{}:{line}:{col}: {message}; see graphs/tf/default.ron for the format", .path.display())]
     Ron {
@@ -296,7 +291,7 @@ impl TransferFunction {
 
     /// Reads and validates a RON transfer function file.
     pub fn load(path: &Path) -> Result<TransferFunction, TfError> {
-        let text = std::fs::read_to_string(path).map_err(|source| TfError::Io { path: path.to_path_buf(), source })?;
+        let text = crate::input_file::read_text(path, "transfer function")?;
         TransferFunction::from_ron_str(&text, path)
     }
 
@@ -314,8 +309,9 @@ impl TransferFunction {
 
     /// Imports a ParaView colour-map JSON file: an array whose first object has `RGBPoints`
     /// (`[x, r, g, b, …]`) and optionally `Points` (`[x, alpha, midpoint, sharpness, …]`).
-    /// ParaView colours are sRGB and are converted to linear RGB; the map is interpolated linearly
-    /// in linear RGB whatever its `ColorSpace`; midpoint and sharpness are ignored; without
+    /// ParaView colours are sRGB and are converted to linear RGB; a `"ColorSpace": "HSV"` map gets
+    /// points along its HSV path (other colour spaces than RGB and HSV are interpolated in RGB,
+    /// with a note); midpoint and sharpness are ignored (with a note); without
     /// `Points` the opacity ramps from 0 to 1 over the domain. The domain is the range of all x.
     pub fn load_paraview(path: &Path) -> Result<TransferFunction, TfError> {
         Self::load_paraview_map(path, None).map(|m| m.tf)
@@ -324,7 +320,7 @@ impl TransferFunction {
     /// Like [`Self::load_paraview`], choosing the colour map named `name` (its `"Name"`, or `#i`
     /// for the i-th) from a file that holds several, and saying which was used.
     pub fn load_paraview_map(path: &Path, name: Option<&str>) -> Result<ParaviewColorMap, TfError> {
-        let text = std::fs::read_to_string(path).map_err(|source| TfError::Io { path: path.to_path_buf(), source })?;
+        let text = crate::input_file::read_text(path, "transfer function")?;
         paraview::parse_map(&text, path, name)
     }
 

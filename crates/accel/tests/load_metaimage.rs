@@ -119,3 +119,21 @@ fn transform_matrix_flips_are_honoured_and_rotations_rejected() {
     assert!(err.to_string().contains("r.mhd:2: TransformMatrix"), "{err}");
     assert!(err.to_string().contains("are not along the volume's axes"), "{err}");
 }
+
+/// Issue 19: `ElementDataFile` before `DimSize` said "no DimSize field" (the field is there,
+/// after the line that ends the header), and a NaN TransformMatrix came out as spacing 0.
+#[test]
+fn fields_after_the_data_file_and_non_finite_matrices_are_named() {
+    let dir = common::temp_dir("mhd-order");
+    std::fs::write(dir.join("v.raw"), [0u8; 8]).expect("write");
+    let header = "NDims = 3\nElementType = MET_UCHAR\nElementDataFile = v.raw\nDimSize = 2 2 2\n";
+    std::fs::write(dir.join("late.mhd"), header).expect("write");
+    let err = load_volume(&dir.join("late.mhd"), &RawOptions::default()).expect_err("DimSize after the data file");
+    let text = err.to_string();
+    assert!(text.contains("late.mhd:3: ElementDataFile must be the last field"), "{text}");
+    assert!(text.contains("move DimSize above ElementDataFile"), "{text}");
+    let nan = "NDims = 3\nTransformMatrix = NaN 0 0 0 1 0 0 0 1\nDimSize = 2 2 2\nElementType = MET_UCHAR\nElementDataFile = v.raw\n";
+    std::fs::write(dir.join("nan.mhd"), nan).expect("write");
+    let err = load_volume(&dir.join("nan.mhd"), &RawOptions::default()).expect_err("NaN matrix").to_string();
+    assert!(err.contains("nan.mhd:2:") && err.contains("nine finite numbers"), "{err}");
+}

@@ -228,3 +228,23 @@ fn byte_skip_minus_one_reads_the_end_of_the_data_file() {
     let loaded = load_volume(&dir.join("w.nhdr"), &RawOptions::default()).expect("load");
     assert_eq!(loaded.volume.data, VoxelData::U8((0u8..8).collect()));
 }
+
+/// Issue 19: `kinds: RGB-color …` and `3-vector` files were read as scalar volumes (the
+/// components interleaved along an axis). Vector and colour axes are refused, naming the line.
+#[test]
+fn vector_and_colour_kinds_are_refused() {
+    let dir = common::temp_dir("nrrd-kinds");
+    for kinds in ["RGB-color domain domain", "domain 3-vector domain", "domain domain list"] {
+        let header = format!("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 3 2 2\nencoding: raw\nkinds: {kinds}\n\n");
+        let mut bytes = header.into_bytes();
+        bytes.extend(0u8..12);
+        std::fs::write(dir.join("v.nrrd"), bytes).expect("write");
+        let err = load_volume(&dir.join("v.nrrd"), &RawOptions::default()).expect_err(kinds).to_string();
+        assert!(err.contains("v.nrrd:6:") && err.contains("renders scalar volumes"), "{kinds}: {err}");
+    }
+    let header = "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: raw\nkinds: domain space ???\n\n";
+    let mut bytes = header.as_bytes().to_vec();
+    bytes.extend(0u8..8);
+    std::fs::write(dir.join("ok.nrrd"), bytes).expect("write");
+    load_volume(&dir.join("ok.nrrd"), &RawOptions::default()).expect("spatial kinds are scalar volumes");
+}

@@ -179,3 +179,14 @@ fn texture_limit_names_the_axis_and_bricking() {
         "volume \"tall\": z size 3000 exceeds the device's 3D texture limit of 2048; split it into bricks (volgraph_accel::bricks), which lifts this limit, or downsample it"
     );
 }
+
+/// Issue 19: `NAME_2x2x2_uint8.RAW` (upper case, as Windows tools write it) was loaded as a
+/// raw file but its name was not read, so it asked for --dims.
+#[test]
+fn an_upper_case_extension_is_read_like_a_lower_case_one() {
+    assert_eq!(parse_raw_name("ct_2x2x2_uint8.RAW"), Some(("ct".to_string(), [2, 2, 2], Some("uint8".to_string()))));
+    let dir = common::temp_dir("raw-upper");
+    let path = write(&dir, "ct_2x2x2_uint8.RAW", &[0, 1, 2, 3, 4, 5, 6, 7]);
+    let loaded = load_volume(&path, &RawOptions::default()).expect("the name gives the layout");
+    assert_eq!(loaded.volume.dims, UVec3::new(2, 2, 2));
+}

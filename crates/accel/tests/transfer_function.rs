@@ -300,3 +300,20 @@ fn a_byte_order_mark_before_ron_is_accepted() {
     );
     TransferFunction::from_ron_str(&text, Path::new("bom.ron")).expect("a BOM is not part of the RON");
 }
+
+/// Issue 19: `"ColorSpace": "HSV"` maps were interpolated in RGB. Red to blue the short way
+/// round the hue circle passes magenta: halfway the colour is (1, 0, 1), not the (½, 0, ½) of
+/// interpolating the end points (in linear RGB, as volgraph does for RGB maps).
+/// Tolerance 0.02 (linear): 32 points per segment make the LUT's linear pieces follow the
+/// HSV path that closely.
+#[test]
+fn an_hsv_paraview_map_follows_the_hue_circle() {
+    let json =
+        |space: &str| format!(r#"[{{"Name": "rb", "ColorSpace": "{space}", "RGBPoints": [0, 1, 0, 0, 1, 0, 0, 1]}}]"#);
+    let hsv = TransferFunction::from_paraview_json(&json("HSV"), Path::new("rb.json")).expect("parses");
+    let mid = hsv.eval(0.5);
+    assert!((mid[0] - 1.0).abs() < 0.02 && mid[1].abs() < 0.02 && (mid[2] - 1.0).abs() < 0.02, "{mid:?}");
+    let rgb = TransferFunction::from_paraview_json(&json("RGB"), Path::new("rb.json")).expect("parses");
+    let mid = rgb.eval(0.5);
+    assert!((mid[0] - 0.5).abs() < 0.01 && mid[1].abs() < 0.01 && (mid[2] - 0.5).abs() < 0.01, "{mid:?}");
+}

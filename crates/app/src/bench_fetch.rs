@@ -159,7 +159,7 @@ pub fn run(args: &FetchArgs) -> anyhow::Result<FetchReport> {
         let volume = match dataset::load(name) {
             Ok(v) => v,
             Err(e) => {
-                eprintln!("note: skipping dataset {name}: {e:#}");
+                crate::stdout::eprintln_escaped!("note: skipping dataset {name}: {e:#}");
                 skipped.push(format!("{name}: {e:#}"));
                 continue;
             }

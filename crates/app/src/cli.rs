@@ -242,14 +242,14 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Plan { .. } | Command::Render(_) => match check(cli)? {
             Checked::Plan { text, notes } => {
                 for note in notes {
-                    eprintln!("{note}");
+                    crate::stdout::eprintln_escaped!("{note}");
                 }
                 crate::stdout::write_stdout(&text)?;
                 Ok(())
             }
             Checked::Render(prepared) => {
                 for note in &prepared.notes {
-                    eprintln!("{note}");
+                    crate::stdout::eprintln_escaped!("{note}");
                 }
                 crate::render::execute(*prepared)
             }

@@ -15,19 +15,20 @@ pub enum ImageKind {
 }
 
 impl ImageKind {
-    /// The kind of `path`, checked before any GPU work so a typo costs nothing.
-    pub fn from_path(path: &Path) -> anyhow::Result<ImageKind> {
+    /// The kind of `path` (given with `flag`, for the message), checked before any GPU work
+    /// so a typo costs nothing.
+    pub fn from_path(flag: &str, path: &Path) -> anyhow::Result<ImageKind> {
         let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
         match extension.as_deref() {
             Some("png") => Ok(ImageKind::Png),
             Some("exr") => Ok(ImageKind::Exr),
             Some(other) => bail!(
-                "-o {}: volgraph writes .png (8-bit sRGB) or .exr (32-bit float, linear), not .{other}; \
+                "{flag} {}: volgraph writes .png (8-bit sRGB) or .exr (32-bit float, linear), not .{other}; \
                  change the extension",
                 path.display()
             ),
             None => bail!(
-                "-o {}: the file name has no extension; end it in .png (8-bit sRGB) or .exr (32-bit float, linear)",
+                "{flag} {}: the file name has no extension; end it in .png (8-bit sRGB) or .exr (32-bit float, linear)",
                 path.display()
             ),
         }
@@ -38,6 +39,28 @@ impl ImageKind {
 fn srgb_encode(c: f32) -> f32 {
     let c = c.clamp(0.0, 1.0);
     if c <= 0.003_130_8 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+}
+
+/// The inverse of [`srgb_encode`].
+fn srgb_decode(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.040_45 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+/// Writes `bytes` to `path` and waits until the file system has them: a full disk or a
+/// failing device is an error here, never a reported success (a buffered writer dropped
+/// without a flush, as image encoders use, loses that error).
+fn write_fully(path: &Path, bytes: &[u8], what: &str) -> anyhow::Result<()> {
+    use std::io::Write as _;
+    let context = || format!("{}: cannot write {what}", path.display());
+    let mut file = std::fs::File::create(path).with_context(context)?;
+    file.write_all(bytes).with_context(context)?;
+    file.flush().with_context(context)?;
+    // Regular files only: a device such as /dev/stdout cannot be synced, and needs not be.
+    if file.metadata().is_ok_and(|m| m.is_file()) {
+        file.sync_all().with_context(context)?;
+    }
+    Ok(())
 }
 
 /// Writes `image` as PNG. `already_srgb`: the values are display-encoded (a `present` output);
@@ -57,15 +80,26 @@ pub fn write_png(path: &Path, image: &Image, already_srgb: bool) -> anyhow::Resu
     let Some(buffer) = image::RgbaImage::from_raw(image.width, image.height, bytes) else {
         bail!("internal: image buffer size mismatch");
     };
-    buffer.save(path).with_context(|| format!("{}: cannot write PNG", path.display()))
+    let mut encoded = std::io::Cursor::new(Vec::new());
+    buffer.write_to(&mut encoded, image::ImageFormat::Png).context("internal: PNG encoding failed")?;
+    write_fully(path, encoded.get_ref(), "PNG")
 }
 
-/// Writes `image` as a 32-bit float RGBA EXR (linear, premultiplied).
-pub fn write_exr(path: &Path, image: &Image) -> anyhow::Result<()> {
+/// Writes `image` as a 32-bit float RGBA EXR (linear, premultiplied). EXR is linear by
+/// definition, so display-encoded values (`already_srgb`: the `display` output) are decoded
+/// back to linear first.
+pub fn write_exr(path: &Path, image: &Image, already_srgb: bool) -> anyhow::Result<()> {
+    use exr::prelude::{Image as ExrImage, SpecificChannels, Vec2, WritableImage};
     let (w, h) = (image.width as usize, image.height as usize);
-    exr::prelude::write_rgba_file(path, w, h, |x, y| {
+    let linear = |v: f32| if already_srgb { srgb_decode(v) } else { v };
+    let channels = SpecificChannels::rgba(|Vec2(x, y): Vec2<usize>| {
         let p = image.rgba(x as u32, y as u32);
-        (p[0], p[1], p[2], p[3])
-    })
-    .with_context(|| format!("{}: cannot write EXR", path.display()))
+        (linear(p[0]), linear(p[1]), linear(p[2]), p[3])
+    });
+    let mut encoded = std::io::Cursor::new(Vec::new());
+    ExrImage::from_channels((w, h), channels)
+        .write()
+        .to_buffered(&mut encoded)
+        .map_err(|e| anyhow::anyhow!("internal: EXR encoding failed: {e}"))?;
+    write_fully(path, encoded.get_ref(), "EXR")
 }

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, anyhow, bail};
+use anyhow::{anyhow, bail};
 use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::load::{RawOptions, load_volume};
 use volgraph_accel::transfer_function::TransferFunction;
@@ -14,7 +14,7 @@ pub const LUT_SIZE: usize = 256;
 
 /// Reads a graph file's text.
 pub fn read_graph(path: &Path) -> anyhow::Result<String> {
-    std::fs::read_to_string(path).with_context(|| format!("{}: cannot read graph file", path.display()))
+    Ok(volgraph_accel::input_file::read_text(path, "graph file")?)
 }
 
 /// Raw-file options from `--dims`, `--dtype`, `--spacing`, `--big-endian`.
@@ -123,7 +123,31 @@ pub fn transfer_function(
         }
         Some(p) => TransferFunction::load(p).map_err(|e| anyhow!("{e}"))?,
     };
+    if let Some(p) = path
+        && let Some(note) = domain_note(&tf, volume)
+    {
+        notes.push(format!("{}: {note}", p.display()));
+    }
     Ok((tf, notes))
+}
+
+/// A warning when the TF's domain and the volume's values do not overlap: every voxel then
+/// takes the colour of one end of the TF (clamp to edge), and the volume renders as a uniform
+/// box or not at all.
+pub fn domain_note(tf: &TransferFunction, volume: &Volume) -> Option<String> {
+    let (lo, hi) = volume.value_range;
+    let (d0, d1) = tf.domain;
+    if d1 < lo || d0 > hi {
+        let side = if d1 < lo { "below" } else { "above" };
+        Some(format!(
+            "warning: the transfer function's domain [{d0}, {d1}] lies wholly {side} the volume's values [{lo}, {hi}]; \
+             every voxel takes the TF's {} colour (a uniform box or nothing); write the control points in the \
+             volume's values",
+            if d1 < lo { "last" } else { "first" }
+        ))
+    } else {
+        None
+    }
 }
 
 /// A note when nothing of `volume` can be seen under `lut`: every LUT entry its values reach

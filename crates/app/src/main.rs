@@ -10,6 +10,8 @@ mod cli;
 #[cfg(test)]
 mod cli_fuzz;
 mod image_out;
+#[cfg(test)]
+mod input_fuzz;
 mod inputs;
 mod passes_cmd;
 mod plan_svg;
@@ -46,14 +48,20 @@ fn main() -> ExitCode {
     match cli::run(args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(cli::CliError::Graph(diagnostics)) => {
-            for report in diagnostics.to_miette_reports() {
-                eprintln!("{report:?}");
+            // Each problem once: drawn with its source excerpt on a terminal, as the
+            // compiler-style `file:line:col: message` lines when stderr is a file or a pipe.
+            use std::io::IsTerminal as _;
+            if std::io::stderr().is_terminal() {
+                for report in diagnostics.to_miette_reports() {
+                    eprintln!("{report:?}");
+                }
+            } else {
+                eprintln!("{}", volgraph_core::terminal::escape_controls(&diagnostics.to_string()));
             }
-            eprintln!("{}", diagnostics);
             ExitCode::from(1)
         }
         Err(cli::CliError::Other(e)) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", volgraph_core::terminal::escape_controls(&format!("{e:#}")));
             ExitCode::from(1)
         }
     }

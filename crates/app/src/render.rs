@@ -53,7 +53,7 @@ pub struct Prepared {
 
 /// Reads and checks every input of `volgraph render`; touches no GPU, prints nothing.
 pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
-    let kind = ImageKind::from_path(&args.out)?;
+    let kind = ImageKind::from_path("-o", &args.out)?;
     let Resolved { scene, graph, size, camera } = args.inputs.resolve("volgraph render GRAPH -o out.png", "512x512")?;
     let source = inputs::read_graph(&graph)?;
     let mut features = scene.as_ref().map(|s| s.effects.clone()).unwrap_or_default();
@@ -100,6 +100,7 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     });
     check_user_names(&plan, &user)?;
     notes.extend(warning_lines(&plan));
+    notes.extend(budget_note(&plan, &registry, args.inputs.gpu_memory_mb));
     let output = match &args.output {
         Some(name) => name.clone(),
         None if kind == ImageKind::Png && plan.outputs.contains_key("display") => "display".to_string(),
@@ -126,6 +127,20 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     Ok(Prepared { args, graph, kind, camera, frames, opacity, volume, lut, plan, output, notes })
 }
 
+/// A note when `--gpu-memory-mb` was given to a graph none of whose passes streams data within
+/// a budget (only the brick pool does): the flag changes nothing there.
+pub fn budget_note(plan: &volgraph_core::Plan, registry: &volgraph_core::Registry, mb: Option<u64>) -> Option<String> {
+    let mb = mb?;
+    let uses = plan.steps.iter().any(|s| registry.get(&s.kind).is_some_and(|p| p.uses_gpu_memory_budget()));
+    (!uses).then(|| {
+        format!(
+            "note: --gpu-memory-mb {mb}: graph \"{}\" has no pass that streams within a memory budget (the brick \
+             pool of graphs/ruijters_vilanova_2006 does); the flag changes nothing here",
+            plan.name
+        )
+    })
+}
+
 /// Opens the GPU, renders the frames and writes the image.
 pub fn execute(prepared: Prepared) -> Result<(), CliError> {
     let Prepared { args, graph, kind, camera, frames, opacity, volume, lut, plan, output, .. } = prepared;
@@ -138,7 +153,7 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
     runtime.set_gpu_memory_budget(args.inputs.gpu_memory_mb.map(|mb| mb << 20));
     runtime.bind_scene(&plan.inputs, &volume, &lut).map_err(|e| anyhow!(e))?;
     if runtime.volume().is_some_and(|(_, f)| f == VolumeFormat::R16Float) && !matches!(volume.data, VoxelData::U8(_)) {
-        eprintln!(
+        crate::stdout::eprintln_escaped!(
             "note: this GPU filters neither 16-bit normalized nor 32-bit float textures; the volume is sampled as \
              16-bit float (11 significant bits)"
         );
@@ -153,25 +168,21 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
     let last = stats.pop();
     let image = runtime.read_output(&output).map_err(|e| anyhow!(e))?;
     let plan = runtime.plan().ok_or_else(|| anyhow!("internal: no plan after rendering"))?;
+    // An Rgba8Unorm output (`present`'s display) holds sRGB-encoded values.
+    let srgb = image.channels == 4
+        && plan.outputs.get(&output).is_some_and(|&r| {
+            matches!(
+                plan.resources[r].desc,
+                volgraph_core::plan::ResourceDesc::Target { format: volgraph_core::TargetFormat::Rgba8Unorm, .. }
+            )
+        });
     match kind {
-        ImageKind::Exr => image_out::write_exr(&args.out, &image)?,
-        ImageKind::Png => {
-            let srgb = image.channels == 4
-                && plan.outputs.get(&output).is_some_and(|&r| {
-                    matches!(
-                        plan.resources[r].desc,
-                        volgraph_core::plan::ResourceDesc::Target {
-                            format: volgraph_core::TargetFormat::Rgba8Unorm,
-                            ..
-                        }
-                    )
-                });
-            image_out::write_png(&args.out, &image, srgb)?;
-        }
+        ImageKind::Exr => image_out::write_exr(&args.out, &image, srgb)?,
+        ImageKind::Png => image_out::write_png(&args.out, &image, srgb)?,
     }
     if let Some(stats) = last {
         let clock = if stats.wall_time_fallback { "wall time" } else { "GPU time" };
-        eprintln!(
+        crate::stdout::eprintln_escaped!(
             "{}: {}x{} on {}, last frame {:.2} ms {clock} → {}",
             graph.display(),
             viewport.0,
@@ -181,7 +192,7 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
             args.out.display()
         );
         if !warm.is_empty() {
-            eprintln!(
+            crate::stdout::eprintln_escaped!(
                 "  median of frames 2..{}: {:.2} ms {clock}",
                 warm.len() + 1,
                 crate::bench_graphs::measure::median(&warm)
@@ -195,10 +206,10 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
             } else {
                 " (timestamps of a CPU adapter: compute passes are not covered)"
             };
-            eprintln!("  per pass (ms){caveat}: {}", list.join(", "));
+            crate::stdout::eprintln_escaped!("  per pass (ms){caveat}: {}", list.join(", "));
         }
         for line in crate::render::counter_lines(&runtime.pass_counters()) {
-            eprintln!("  {line}");
+            crate::stdout::eprintln_escaped!("  {line}");
         }
     }
     Ok(())

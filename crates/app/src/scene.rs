@@ -25,9 +25,13 @@ use volgraph_accel::camera::OrbitCamera;
 use volgraph_core::Precision;
 use volgraph_core::runtime::OpacityReference;
 
+/// The most frames a scene renders, from `frames:` or a camera path's last keyframe (as
+/// `render --frames` is capped): a keyframe at frame 10⁹ is an error, not a day of rendering.
+pub const MAX_FRAMES: u32 = 100_000;
+
 /// The effects a scene may ask for (issue "effects a scene asks for"); graphs read them as
 /// `"feature.NAME"`.
-pub const EFFECTS: [&str; 4] = ["shading", "preintegration", "jitter", "tricubic"];
+pub const EFFECTS: [&str; 4] = volgraph_core::compile::SCENE_EFFECTS;
 
 /// Where a scene's volume comes from.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
@@ -135,14 +139,9 @@ pub struct Scene {
 /// Why a scene could not be read.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
-    /// The file cannot be read.
-    #[error("{}: cannot read the scene: {source}", .path.display())]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The OS error.
-        source: std::io::Error,
-    },
+    /// The file cannot be read (missing, not a regular file, too large, not text).
+    #[error(transparent)]
+    Read(#[from] volgraph_accel::input_file::InputFileError),
     /// The RON does not parse into a scene.
     #[error("{}:{line}:{col}: {message}; see scenes/README.md (or crates/app/src/scene.rs) for the format", .path.display())]
     Ron {
@@ -170,8 +169,7 @@ pub enum SceneError {
 impl Scene {
     /// Reads and checks the scene file `path`.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let text =
-            std::fs::read_to_string(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+        let text = volgraph_accel::input_file::read_text(path, "scene file")?;
         Scene::from_str(&text, path)
     }
 
@@ -208,12 +206,41 @@ impl Scene {
             return Err(field("viewport", format!("({w}, {h}): each side must be 1..=16384 pixels")));
         }
         if let Some(frames) = doc.frames
-            && !(1..=100_000).contains(&frames)
+            && !(1..=MAX_FRAMES).contains(&frames)
         {
-            return Err(field("frames", format!("{frames}: expected 1..=100000")));
+            return Err(field("frames", format!("{frames}: expected 1..={MAX_FRAMES}")));
         }
         if let Some(camera) = &doc.camera {
             check_camera(camera).map_err(|m| field("camera", m))?;
+        }
+        if doc.graph.as_deref().is_some_and(|g| g.trim().is_empty()) {
+            return Err(field(
+                "graph",
+                "is empty; name the graph file, e.g. graph: \"../graphs/modern/fastest.ron\"".into(),
+            ));
+        }
+        for (name, path) in [
+            (
+                "volume",
+                match &doc.volume {
+                    VolumeSource::File(p) => Some(p),
+                    _ => None,
+                },
+            ),
+            (
+                "transfer_function",
+                match &doc.transfer_function {
+                    Some(TfSource::File(p)) => Some(p),
+                    _ => None,
+                },
+            ),
+        ] {
+            if path.is_some_and(|p| p.trim().is_empty()) {
+                return Err(field(name, "File(\"\") names no file; give its path relative to the scene file".into()));
+            }
+        }
+        if let Some(TfSource::Data(name)) = &doc.transfer_function {
+            check_data_name(name).map_err(|m| field("transfer_function", m))?;
         }
         let volume = match doc.volume {
             VolumeSource::File(p) => VolumeSource::File(resolve(&p).display().to_string()),
@@ -241,27 +268,75 @@ impl Scene {
     pub fn frame_count(&self) -> u32 {
         match (&self.camera, self.frames) {
             (_, Some(f)) => f,
-            (Some(CameraSpec::Path { keyframes }), None) => keyframes.last().map_or(1, |k| k.frame + 1),
+            (Some(CameraSpec::Path { keyframes }), None) => {
+                keyframes.last().map_or(1, |k| k.frame.saturating_add(1).min(MAX_FRAMES))
+            }
             _ => 1,
         }
     }
 }
 
+/// A `Data("name")` transfer function names a file of `$VOLGRAPH_DATA/tf` by its stem: no
+/// folders, no `..`, so a scene cannot read a file outside that folder.
+fn check_data_name(name: &str) -> Result<(), String> {
+    let plain = !name.is_empty()
+        && name != "."
+        && name != ".."
+        && !name.contains(['/', '\\'])
+        && !name.chars().any(volgraph_core::terminal::is_unsafe);
+    if plain {
+        return Ok(());
+    }
+    Err(format!(
+        "Data(\"{name}\") must name a file of $VOLGRAPH_DATA/tf by its stem (e.g. Data(\"engine_opaque\")), \
+         without folders or \"..\"; for a file elsewhere write File(\"path.ron\")"
+    ))
+}
+
+/// The orbit values the CLI's `--camera` accepts: finite degrees, an elevation within ±90°
+/// (beyond it the orbit flips over the pole) and a positive distance at which a ray can still
+/// be set up (at 1e-300 world units the eye is inside the volume at a point, and the
+/// projection divides by it).
+fn check_orbit(azimuth: f64, elevation: f64, distance: f64) -> Result<(), String> {
+    if !(azimuth.is_finite() && elevation.is_finite() && distance.is_finite()) {
+        return Err("azimuth, elevation and distance must be finite numbers".into());
+    }
+    // 1e-300 as written, not as three hundred zeros.
+    let number = |x: f64| if x != 0.0 && !(1e-4..1e7).contains(&x.abs()) { format!("{x:e}") } else { format!("{x}") };
+    if elevation.abs() > 90.0 {
+        return Err(format!("elevation {} must be within -90..=90 degrees", number(elevation)));
+    }
+    if !(MIN_DISTANCE..=MAX_DISTANCE).contains(&distance) {
+        return Err(format!(
+            "distance {} must be within {MIN_DISTANCE}..={MAX_DISTANCE} world units (the volume's longest side is 1)",
+            number(distance)
+        ));
+    }
+    Ok(())
+}
+
+/// The nearest eye distance from the volume's centre (inside the volume is fine, the centre is
+/// not a camera).
+pub const MIN_DISTANCE: f64 = 1e-3;
+/// The farthest (beyond it the volume is under a pixel at any sensible field of view).
+pub const MAX_DISTANCE: f64 = 1e6;
+
 fn check_camera(camera: &CameraSpec) -> Result<(), String> {
-    let finite = |a: f64, e: f64, d: f64| a.is_finite() && e.is_finite() && d.is_finite() && d > 0.0;
     match camera {
-        CameraSpec::Orbit { azimuth, elevation, distance } => {
-            if !finite(*azimuth, *elevation, *distance) {
-                return Err("azimuth and elevation must be finite degrees and distance a positive length".into());
-            }
-        }
+        CameraSpec::Orbit { azimuth, elevation, distance } => check_orbit(*azimuth, *elevation, *distance)?,
         CameraSpec::Path { keyframes } => {
             if keyframes.is_empty() {
                 return Err("a Path needs at least one keyframe".into());
             }
             for (i, k) in keyframes.iter().enumerate() {
-                if !finite(k.azimuth, k.elevation, k.distance) {
-                    return Err(format!("keyframe {i}: finite degrees and a positive distance, please"));
+                check_orbit(k.azimuth, k.elevation, k.distance).map_err(|m| format!("keyframe {i}: {m}"))?;
+                if k.frame >= MAX_FRAMES {
+                    return Err(format!(
+                        "keyframe {i}: frame {} is beyond the last frame a scene renders ({}); a path holds at most \
+                         {MAX_FRAMES} frames",
+                        k.frame,
+                        MAX_FRAMES - 1
+                    ));
                 }
                 if i > 0 && k.frame <= keyframes[i - 1].frame {
                     return Err(format!(
@@ -322,7 +397,15 @@ pub fn load_volume(
             Ok((loaded.volume, false, Vec::new()))
         }
         VolumeSource::Generated(name) => {
-            let v = crate::bench_graphs::dataset::load_generated(name).map_err(at)?;
+            let v = volgraph_accel::generate::by_name(name).map_err(|e| {
+                at(match e {
+                    volgraph_accel::generate::NamedVolumeError::Unknown { .. } => anyhow::anyhow!(
+                        "Generated(\"{name}\") names no generated volume; use {}",
+                        volgraph_accel::generate::NAMED_GENERATORS
+                    ),
+                    other => anyhow::anyhow!("Generated(\"{name}\"): {other}"),
+                })
+            })?;
             Ok((v, true, Vec::new()))
         }
     }
@@ -417,5 +500,42 @@ mod tests {
         let err =
             parse("Scene(volume: Generated(\"ml32\"), camera: Path(keyframes: []))").expect_err("empty").to_string();
         assert!(err.contains("camera: a Path needs at least one keyframe"), "{err}");
+    }
+
+    /// Issue 19: a keyframe at frame 10⁹ rendered 10⁹ frames, one at 2³²−1 wrapped to 0 frames
+    /// (a black PNG); elevations beyond ±90° and distances like 1e-300 were accepted.
+    #[test]
+    fn camera_paths_and_orbits_are_bounded_like_the_cli() {
+        let path = |frame: u64| {
+            format!(
+                "Scene(volume: Generated(\"ml32\"), camera: Path(keyframes: [(frame: 0, azimuth: 0, elevation: 0, \
+                 distance: 3), (frame: {frame}, azimuth: 9, elevation: 0, distance: 3)]))"
+            )
+        };
+        for frame in [1_000_000_000u64, u64::from(u32::MAX)] {
+            let err = parse(&path(frame)).expect_err("too long").to_string();
+            assert!(err.contains(&format!("keyframe 1: frame {frame} is beyond the last frame")), "{err}");
+        }
+        assert_eq!(parse(&path(u64::from(MAX_FRAMES - 1))).expect("the longest path").frame_count(), MAX_FRAMES);
+        for (camera, expected) in [
+            ("Orbit(azimuth: 0, elevation: 91, distance: 3)", "elevation 91 must be within -90..=90"),
+            ("Orbit(azimuth: 0, elevation: -200, distance: 3)", "elevation -200 must be within"),
+            ("Orbit(azimuth: 0, elevation: 0, distance: 1e-300)", "distance 1e-300 must be within"),
+        ] {
+            let err =
+                parse(&format!("Scene(volume: Generated(\"ml32\"), camera: {camera})")).expect_err(camera).to_string();
+            assert!(err.contains(expected), "{camera}: {err}");
+        }
+    }
+
+    /// Issue 19: `Data("…")` climbed out of `$VOLGRAPH_DATA/tf`.
+    #[test]
+    fn a_data_transfer_function_stays_in_the_data_folder() {
+        for name in ["../../../etc/passwd", "/etc/passwd", "..", "a/b", ""] {
+            let text = format!("Scene(volume: Generated(\"ml32\"), transfer_function: Data(\"{name}\"))");
+            let err = parse(&text).expect_err(name).to_string();
+            assert!(err.contains("transfer_function: Data(") && err.contains("without folders"), "{name}: {err}");
+        }
+        parse("Scene(volume: Generated(\"ml32\"), transfer_function: Data(\"engine_opaque\"))").expect("a stem");
     }
 }

@@ -72,6 +72,16 @@ impl SceneArgs {
     /// scene's, else `default_size` and the 30,20,3.2 orbit. `usage` is the command line that
     /// names a graph, for the error when neither says one.
     pub fn resolve(&self, usage: &str, default_size: &str) -> anyhow::Result<Resolved> {
+        if let Some(dir) = &self.shaders
+            && !dir.is_dir()
+        {
+            let what = if dir.exists() { "is not a folder" } else { "does not exist" };
+            return Err(anyhow!(
+                "--shaders {}: {what}; give the folder that holds the .wgsl files (e.g. --shaders shaders), or leave \
+                 the flag out to use the built-in shaders",
+                dir.display()
+            ));
+        }
         let scene = self.scene.as_deref().map(Scene::load).transpose().map_err(|e| anyhow!(e))?;
         let graph = match (&self.graph, scene.as_ref().and_then(|s| s.graph.clone())) {
             (Some(g), _) => g.clone(),

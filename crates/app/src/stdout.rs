@@ -3,11 +3,30 @@
 
 use anyhow::Context as _;
 
-/// Writes `text` to stdout; a closed pipe is not an error.
+/// Writes `text` to stdout, control characters from the user's files escaped
+/// ([`volgraph_core::terminal`]); a closed pipe is not an error.
 pub fn write_stdout(text: &str) -> anyhow::Result<()> {
     use std::io::Write as _;
+    let text = volgraph_core::terminal::escape_controls(text);
     match std::io::stdout().lock().write_all(text.as_bytes()) {
         Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
         other => other.context("cannot write to standard output"),
     }
 }
+
+/// `eprintln!` with control characters from the user's files escaped
+/// ([`volgraph_core::terminal`]): every note, warning and error volgraph writes to stderr.
+macro_rules! eprintln_escaped {
+    ($($arg:tt)*) => {
+        eprintln!("{}", volgraph_core::terminal::escape_controls(&format!($($arg)*)))
+    };
+}
+pub(crate) use eprintln_escaped;
+
+/// `println!` with control characters escaped, like [`eprintln_escaped`].
+macro_rules! println_escaped {
+    ($($arg:tt)*) => {
+        println!("{}", volgraph_core::terminal::escape_controls(&format!($($arg)*)))
+    };
+}
+pub(crate) use println_escaped;

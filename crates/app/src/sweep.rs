@@ -230,7 +230,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<SweepReport> {
     let mut skipped = Vec::new();
     let reference_step = 0.1;
     for knob in &knobs {
-        eprintln!("sweep {}: {} on {}", knob.name, knob.sweep, args.datasets.join(", "));
+        crate::stdout::eprintln_escaped!("sweep {}: {} on {}", knob.name, knob.sweep, args.datasets.join(", "));
         let graphs_args = GraphsArgs {
             graphs: vec![workspace_root().join(knob.graph)],
             datasets: args.datasets.clone(),

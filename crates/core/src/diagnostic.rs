@@ -44,6 +44,7 @@ pub struct Diagnostic {
 const MAX_MESSAGE_CHARS: usize = 600;
 
 fn clip_message(text: String) -> String {
+    let text = crate::terminal::escape_controls(&text).into_owned();
     let count = text.chars().count();
     if count <= MAX_MESSAGE_CHARS {
         return text;
@@ -80,13 +81,17 @@ pub struct Diagnostics {
 impl Diagnostics {
     /// The `file:line:col` (or `file: pass "x", field y`) prefix of one item.
     pub fn position(&self, d: &Diagnostic) -> String {
+        let file = crate::terminal::escape_controls(&self.file);
         match &d.location {
             Location::Span(s) => {
                 let (line, col) = line_col(&self.text, s.start);
-                format!("{}:{line}:{col}", self.file)
+                format!("{file}:{line}:{col}")
             }
-            Location::Field { pass, field } => format!("{}: pass \"{pass}\", field {field}", self.file),
-            Location::File => self.file.clone(),
+            Location::Field { pass, field } => {
+                let (pass, field) = (crate::terminal::escape_controls(pass), crate::terminal::escape_controls(field));
+                format!("{file}: pass \"{pass}\", field {field}")
+            }
+            Location::File => file.into_owned(),
         }
     }
 }
@@ -164,14 +169,27 @@ impl Diagnostics {
                         (None, format!("line {line}, column {col}: {}", d.message))
                     }
                     Location::Span(s) => (Some(*s), d.message.clone()),
-                    Location::Field { pass, field } => (None, format!("pass \"{pass}\", field {field}: {}", d.message)),
+                    Location::Field { pass, field } => (
+                        None,
+                        format!(
+                            "pass \"{}\", field {}: {}",
+                            crate::terminal::escape_controls(pass),
+                            crate::terminal::escape_controls(field),
+                            d.message
+                        ),
+                    ),
                     Location::File => (None, d.message.clone()),
                 };
                 miette::Report::new(MietteItem {
                     message,
                     help: d.help.clone(),
                     span,
-                    source: miette::NamedSource::new(self.file.clone(), self.text.to_string()),
+                    // The excerpt shows the file with its control characters masked (same byte
+                    // length, so the span still fits): a name holding ESC cannot drive the terminal.
+                    source: miette::NamedSource::new(
+                        crate::terminal::escape_controls(&self.file),
+                        crate::terminal::mask_controls(&self.text).into_owned(),
+                    ),
                 })
             })
             .collect()

@@ -17,6 +17,7 @@ pub mod plugin;
 pub mod runtime;
 pub mod shader_source;
 pub mod suggest;
+pub mod terminal;
 pub mod wgsl_pass;
 
 pub use compile::{CompileOptions, check_plan_bindings, compile};

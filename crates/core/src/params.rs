@@ -233,6 +233,10 @@ pub fn check_param(spec: &ParamSpec, value: &ron::Value) -> Result<ParamValue, P
             if !x.is_finite() || x < *min || x > *max {
                 return Err(ParamProblem::OutOfRange { value: format!("{x}") });
             }
+            // Shaders read parameters as f32: beyond its range a value would arrive as inf.
+            if x.abs() > f32::MAX as f64 {
+                return Err(ParamProblem::OutOfRange { value: format!("{x} (beyond a 32-bit float's ±3.4e38)") });
+            }
             Ok(ParamValue::Float(x))
         }
         ParamKind::UInt { min, max, .. } => {

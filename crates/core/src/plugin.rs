@@ -191,6 +191,21 @@ pub trait PassPlugin: Send + Sync {
         Vec::new()
     }
 
+    /// Checks a module of one of its declared shader uses against what this kind declares
+    /// beyond bindings (a workgroup size, the layout of a uniform block), once naga has
+    /// validated it: `Err` says what disagrees and how to fix it. Called by `volgraph plan`
+    /// and before a pipeline is built, so a disagreement is never a silent wrong image.
+    fn check_module(&self, _params: &Params, _shader: &ShaderUse, _module: &naga::Module) -> Result<(), String> {
+        Ok(())
+    }
+
+    /// True for passes that hold what they stream within the runtime's GPU memory budget
+    /// (`--gpu-memory-mb`): a budget given to a graph without one changes nothing, and the CLI
+    /// says so.
+    fn uses_gpu_memory_budget(&self) -> bool {
+        false
+    }
+
     /// True for passes whose effect is outside the graph (writing a file): never culled.
     fn is_sink(&self) -> bool {
         false

@@ -57,6 +57,16 @@ pub enum ShaderSourceError {
         /// What is wrong.
         problem: String,
     },
+    /// A shader name that would reach outside the shader roots (absolute, `..`), or a file that
+    /// is not WGSL. Its text is never read, so a mistaken `#import "/etc/passwd"` shows nothing of
+    /// the file.
+    #[error("{file}: {reason}; shaders are named relative to a shader folder, e.g. \"common/frame.wgsl\"")]
+    OutsideRoots {
+        /// The name as written.
+        file: String,
+        /// What is wrong with it.
+        reason: &'static str,
+    },
     /// Files import each other in a cycle.
     #[error("{path}: import cycle: {chain}")]
     ImportCycle {
@@ -153,14 +163,27 @@ impl ShaderSources {
         if parts.is_empty() { "no layers".to_string() } else { parts.join(", ") }
     }
 
-    /// The text of `relative` from the first layer that has it.
+    /// The text of `relative` from the first layer that has it. The name must stay inside the
+    /// roots ([`check_shader_name`]); on disk, a link that leads out of its root is refused too.
     pub fn read(&self, relative: &str) -> Result<(SourceFile, String), ShaderSourceError> {
+        check_shader_name(relative)
+            .map_err(|reason| ShaderSourceError::OutsideRoots { file: relative.into(), reason })?;
         for layer in &self.layers {
             match layer {
                 SourceLayer::Disk(root) => {
                     let path = root.join(relative);
                     if path.is_file() {
-                        let text = std::fs::read_to_string(&path)
+                        let inside = match (root.canonicalize(), path.canonicalize()) {
+                            (Ok(r), Ok(p)) => p.starts_with(r),
+                            _ => false,
+                        };
+                        if !inside {
+                            return Err(ShaderSourceError::OutsideRoots {
+                                file: relative.into(),
+                                reason: "it is a link that leads out of its shader folder",
+                            });
+                        }
+                        let text = volgraph_accel::input_file::read_text(&path, "WGSL shader")
                             .map_err(|e| ShaderSourceError::Read { path: path.clone(), reason: e.to_string() })?;
                         return Ok((SourceFile { name: relative.to_string(), path: Some(path) }, text));
                     }
@@ -174,6 +197,37 @@ impl ShaderSources {
         }
         Err(ShaderSourceError::NotFound { file: relative.to_string(), searched: self.describe() })
     }
+}
+
+/// Whether `name` may name a shader: a relative path of plain components (no root, no drive,
+/// no `..` or `.`, no backslash) ending in `.wgsl` — resolved inside a shader root, as
+/// librashader and web servers resolve theirs. `Err` says what is wrong.
+pub fn check_shader_name(name: &str) -> Result<(), &'static str> {
+    use std::path::Component;
+    if name.chars().any(char::is_control) {
+        return Err("the name holds control characters");
+    }
+    if name.contains('\\') {
+        return Err("the name holds a backslash; separate folders with /");
+    }
+    let path = Path::new(name);
+    if path.is_absolute() || name.starts_with('/') {
+        return Err("an absolute path reaches outside the shader folders");
+    }
+    for component in path.components() {
+        match component {
+            Component::Normal(_) => {}
+            Component::ParentDir => return Err("\"..\" climbs out of the shader folders"),
+            Component::CurDir => return Err("write the name without \"./\""),
+            Component::RootDir | Component::Prefix(_) => {
+                return Err("an absolute path reaches outside the shader folders");
+            }
+        }
+    }
+    if !name.ends_with(".wgsl") {
+        return Err("only .wgsl files are shaders");
+    }
+    Ok(())
 }
 
 /// A shader module's assembled text and the files it came from.
@@ -443,5 +497,38 @@ mod tests {
             let err = assemble(&sources, file).expect_err("malformed").to_string();
             assert!(err.contains(&format!("{file}:{line}: {problem}")), "{err}");
         }
+    }
+
+    /// Issue 19: `#import` accepted absolute paths, `..` and non-WGSL files, and the error
+    /// printed the file's lines (`/etc/passwd` in the terminal). Names stay inside the roots
+    /// and a file is read only when it is a `.wgsl` file there.
+    #[test]
+    fn imports_stay_inside_the_shader_roots() {
+        let root = std::env::temp_dir().join(format!("volgraph-roots-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&root);
+        std::fs::create_dir_all(root.join("shaders")).expect("temp dir");
+        std::fs::write(root.join("secret.wgsl"), "SECRET LINE\n").expect("write");
+        std::fs::write(root.join("shaders/notes.txt"), "SECRET LINE\n").expect("write");
+        let sources = ShaderSources::new().with_disk(root.join("shaders"));
+        for (target, reason) in [
+            ("/etc/passwd", "an absolute path"),
+            ("../secret.wgsl", "climbs out of the shader folders"),
+            ("common/../../secret.wgsl", "climbs out of the shader folders"),
+            ("notes.txt", "only .wgsl files are shaders"),
+            ("./a.wgsl", "without \"./\""),
+        ] {
+            std::fs::write(root.join("shaders/main.wgsl"), format!("#import \"{target}\"\n")).expect("write");
+            let err = assemble(&sources, "main.wgsl").expect_err(target).to_string();
+            assert!(err.contains(reason), "{target}: {err}");
+            assert!(!err.contains("SECRET"), "{target}: the file's text is never shown: {err}");
+        }
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink(root.join("secret.wgsl"), root.join("shaders/link.wgsl")).expect("symlink");
+            std::fs::write(root.join("shaders/main.wgsl"), "#import \"link.wgsl\"\n").expect("write");
+            let err = assemble(&sources, "main.wgsl").expect_err("a link out of the root").to_string();
+            assert!(err.contains("leads out of its shader folder") && !err.contains("SECRET"), "{err}");
+        }
+        let _ = std::fs::remove_dir_all(&root);
     }
 }

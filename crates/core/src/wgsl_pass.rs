@@ -31,34 +31,59 @@ fn intern(s: &str) -> &'static str {
 
 /// Problems with a graph's `kinds:` block, each naming the kind and field with the fix.
 pub fn check_kinds(kinds: &BTreeMap<String, WgslKindDoc>, registry: &Registry) -> Vec<Diagnostic> {
+    check_kinds_in(kinds, registry, "")
+}
+
+/// [`check_kinds`] for the graph text `source`: each problem points at the field's line and
+/// column (the kind's name where no one field is to blame).
+pub fn check_kinds_in(kinds: &BTreeMap<String, WgslKindDoc>, registry: &Registry, source: &str) -> Vec<Diagnostic> {
+    let locator = crate::graph::locate::Locator::new(source);
     let mut out = Vec::new();
-    let mut err = |kind: &str, message: String, help: &str| {
-        out.push(Diagnostic::new(Location::File, format!("kind \"{kind}\": {message}")).with_help(help.to_string()));
+    let mut err = |kind: &str, field: &str, message: String, help: &str| {
+        let at = match field {
+            "" => locator.top_entry("kinds", kind, true),
+            f => locator.top_entry_field("kinds", kind, f),
+        };
+        let at = match at {
+            Location::Field { .. } => Location::File,
+            span => span,
+        };
+        out.push(Diagnostic::new(at, format!("kind \"{kind}\": {message}")).with_help(help.to_string()));
     };
     for (name, k) in kinds {
         if registry.get(name).is_some() {
-            err(name, "is already a registered pass kind".into(), "give the WGSL kind a name of its own");
+            err(name, "", "is already a registered pass kind".into(), "give the WGSL kind a name of its own");
         }
         if !k.shader.ends_with(".wgsl") {
             err(
                 name,
+                "shader",
                 format!("shader \"{}\" is not a .wgsl file", k.shader),
                 "name the WGSL file, e.g. \"my_pass.wgsl\"",
+            );
+        } else if let Err(reason) = crate::shader_source::check_shader_name(&k.shader) {
+            err(
+                name,
+                "shader",
+                format!("shader \"{}\": {reason}", k.shader),
+                "name the file relative to the graph's shaders/ folder, e.g. \"my_pass.wgsl\"",
             );
         }
         if k.outputs.is_empty() {
             err(
                 name,
+                "outputs",
                 "declares no outputs".into(),
                 "add outputs: {\"out\": Rgba16Float} (the storage texture it writes)",
             );
         }
         if k.form == WgslForm::Fragment && k.outputs.values().any(|f| matches!(f, crate::TargetFormat::Depth32Float)) {
-            err(name, "a fragment-form kind writes colour outputs only".into(), "declare colour formats");
+            err(name, "form", "a fragment-form kind writes colour outputs only".into(), "declare colour formats");
         }
-        if k.workgroup.0 == 0 || k.workgroup.1 == 0 || k.workgroup.0 * k.workgroup.1 > 1024 {
+        if k.workgroup.0 == 0 || k.workgroup.1 == 0 || u64::from(k.workgroup.0) * u64::from(k.workgroup.1) > 1024 {
             err(
                 name,
+                "workgroup",
                 format!("workgroup {:?} is not a valid workgroup size", k.workgroup),
                 "use the shader's @workgroup_size(x, y), e.g. (8, 8)",
             );
@@ -66,21 +91,34 @@ pub fn check_kinds(kinds: &BTreeMap<String, WgslKindDoc>, registry: &Registry) -
         let mut seen = HashSet::new();
         for p in &k.params {
             if !seen.insert(p.name.as_str()) {
-                err(name, format!("parameter \"{}\" is declared twice", p.name), "give each parameter its own name");
-            }
-            if !(p.min <= p.default && p.default <= p.max) {
                 err(
                     name,
+                    "params",
+                    format!("parameter \"{}\" is declared twice", p.name),
+                    "give each parameter its own name",
+                );
+            }
+            if [p.min, p.default, p.max].iter().any(|v| !v.is_finite() || v.abs() > f32::MAX as f64) {
+                err(
+                    name,
+                    "params",
+                    format!("parameter \"{}\": min, default and max must be finite 32-bit floats", p.name),
+                    "the shader reads them as f32 (at most ±3.4e38)",
+                );
+            } else if !(p.min <= p.default && p.default <= p.max) {
+                err(
+                    name,
+                    "params",
                     format!("parameter \"{}\": default {} is outside [{}, {}]", p.name, p.default, p.min, p.max),
                     "make min <= default <= max",
                 );
             }
             if k.inputs.contains_key(&p.name) || k.outputs.contains_key(&p.name) || p.name == "params" {
-                err(name, format!("parameter \"{}\" has the name of a port", p.name), "rename the parameter");
+                err(name, "params", format!("parameter \"{}\" has the name of a port", p.name), "rename the parameter");
             }
         }
         for port in k.inputs.keys().filter(|p| k.outputs.contains_key(*p)) {
-            err(name, format!("\"{port}\" is both an input and an output"), "name the output differently");
+            err(name, "outputs", format!("\"{port}\" is both an input and an output"), "name the output differently");
         }
     }
     out
@@ -159,7 +197,14 @@ impl PassPlugin for WgslPass {
         true
     }
 
+    fn check_module(&self, _params: &Params, _shader: &ShaderUse, module: &naga::Module) -> Result<(), String> {
+        check_module_against(&self.doc, module)
+    }
+
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        let module = ctx.shader_module(&self.doc.shader)?;
+        check_module_against(&self.doc, &module.module)
+            .map_err(|m| PassError { pass: ctx.pass_id.into(), message: m })?;
         let pipeline = match self.doc.form {
             WgslForm::Compute => Pipeline::Compute(ctx.compute_pipeline(&ComputePipelineSpec {
                 shader: &self.doc.shader,
@@ -181,6 +226,88 @@ impl PassPlugin for WgslPass {
         });
         let first_output = self.doc.outputs.keys().next().map(|n| intern(n)).unwrap_or("out");
         Ok(Box::new(WgslPassNode { pipeline, uniform, doc: self.doc.clone(), first_output }))
+    }
+}
+
+/// What a WGSL-only kind's declaration promises about its shader, checked against the module:
+/// a compute entry point's `@workgroup_size` is the declared `workgroup` (the dispatch is sized
+/// by it: a smaller one writes a fraction of the image), and the `params` uniform is a struct
+/// of one `f32` per declared parameter with the same names in the same order (the block is
+/// filled by position: a swapped or misnamed member would read another parameter's value).
+fn check_module_against(doc: &WgslKindDoc, module: &naga::Module) -> Result<(), String> {
+    let file = &doc.shader;
+    if doc.form == WgslForm::Compute
+        && let Some(entry) = module.entry_points.iter().find(|e| e.name == doc.entry_point())
+        && entry.workgroup_size_overrides.is_none()
+    {
+        let [x, y, z] = entry.workgroup_size;
+        if (x, y, z) != (doc.workgroup.0, doc.workgroup.1, 1) {
+            return Err(format!(
+                "{file}: {} has @workgroup_size({x}, {y}, {z}) but the kind declares workgroup: ({}, {}); \
+                 write workgroup: ({x}, {y}) (a 2D size, z = 1)",
+                doc.entry_point(),
+                doc.workgroup.0,
+                doc.workgroup.1
+            ));
+        }
+    }
+    let params = module.global_variables.iter().find(|(_, g)| g.name.as_deref() == Some("params"));
+    let Some((_, global)) = params else { return Ok(()) };
+    let declared: Vec<&str> = doc.params.iter().map(|p| p.name.as_str()).collect();
+    let naga::TypeInner::Struct { members, span } = &module.types[global.ty].inner else {
+        return Err(format!(
+            "{file}: global \"params\" is not a struct; declare struct Params {{ {} }}",
+            declared.iter().map(|n| format!("{n}: f32")).collect::<Vec<_>>().join(", ")
+        ));
+    };
+    let names: Vec<&str> = members.iter().map(|m| m.name.as_deref().unwrap_or("")).collect();
+    let all_f32 = members.iter().all(|m| {
+        matches!(
+            module.types[m.ty].inner,
+            naga::TypeInner::Scalar(naga::Scalar { kind: naga::ScalarKind::Float, width: 4 })
+        )
+    });
+    let padding = |n: &&str| n.starts_with('_');
+    let named: Vec<&str> = names.iter().copied().filter(|n| !padding(n)).collect();
+    if named != declared || !all_f32 || u64::from(*span) > param_block_size(doc.params.len()) {
+        return Err(format!(
+            "{file}: the \"params\" struct has members ({}) but the kind declares the parameters ({}); \
+             the block is filled by position, one f32 each: declare struct Params {{ {} }} (members \
+             named _pad… may follow as padding)",
+            members
+                .iter()
+                .map(|m| format!("{}: {}", m.name.as_deref().unwrap_or("?"), type_name(module, m.ty)))
+                .collect::<Vec<_>>()
+                .join(", "),
+            declared.join(", "),
+            declared.iter().map(|n| format!("{n}: f32")).collect::<Vec<_>>().join(", ")
+        ));
+    }
+    if names.iter().position(padding).is_some_and(|first| names[first..].iter().any(|n| !padding(n))) {
+        return Err(format!("{file}: the \"params\" struct's padding members (_…) must come after the parameters"));
+    }
+    Ok(())
+}
+
+/// A short WGSL-like name of a type, for messages.
+fn type_name(module: &naga::Module, ty: naga::Handle<naga::Type>) -> String {
+    let t = &module.types[ty];
+    if let Some(name) = &t.name {
+        return name.clone();
+    }
+    match &t.inner {
+        naga::TypeInner::Scalar(s) => match (s.kind, s.width) {
+            (naga::ScalarKind::Float, 4) => "f32".into(),
+            (naga::ScalarKind::Float, 2) => "f16".into(),
+            (naga::ScalarKind::Sint, 4) => "i32".into(),
+            (naga::ScalarKind::Uint, 4) => "u32".into(),
+            (naga::ScalarKind::Bool, _) => "bool".into(),
+            _ => "a scalar".into(),
+        },
+        naga::TypeInner::Vector { size, scalar } => {
+            format!("vec{}<{}>", *size as u8, if scalar.kind == naga::ScalarKind::Float { "f32" } else { "…" })
+        }
+        _ => "a compound type".into(),
     }
 }
 
@@ -290,5 +417,56 @@ mod tests {
         assert_eq!(block.len(), 16);
         assert_eq!(&block[0..4], &2.0f32.to_le_bytes());
         assert_eq!(&block[4..8], &1.0f32.to_le_bytes());
+    }
+
+    /// Issue 19: a WGSL-only kind's `shader:` could be absolute or climb out with `..`, a
+    /// workgroup of 65536 × 65536 overflowed u32, and a parameter beyond f32 became inf.
+    #[test]
+    fn shader_paths_workgroups_and_parameters_are_bounded() {
+        let registry = Registry::new();
+        let text = r#"{
+            "a": WgslKind(shader: "/etc/a.wgsl", outputs: {"out": Rgba16Float}),
+            "b": WgslKind(shader: "../../b.wgsl", outputs: {"out": Rgba16Float}, workgroup: (65536, 65536)),
+            "c": WgslKind(shader: "c.wgsl", outputs: {"out": Rgba16Float},
+                params: [(name: "k", default: 1e39, min: 0.0, max: 1e40)]),
+        }"#;
+        let all: Vec<String> = check_kinds(&kinds(text), &registry).into_iter().map(|d| d.message).collect();
+        let all = all.join("\n");
+        for expected in [
+            "kind \"a\": shader \"/etc/a.wgsl\": an absolute path reaches outside the shader folders",
+            "kind \"b\": shader \"../../b.wgsl\": \"..\" climbs out of the shader folders",
+            "kind \"b\": workgroup (65536, 65536) is not a valid workgroup size",
+            "kind \"c\": parameter \"k\": min, default and max must be finite 32-bit floats",
+        ] {
+            assert!(all.contains(expected), "missing {expected:?} in\n{all}");
+        }
+    }
+
+    /// Issue 19: a shader whose `@workgroup_size` differs from the declared `workgroup` wrote
+    /// part of the image; `params` members in another order than declared read each other's
+    /// values. Both are errors before anything runs.
+    #[test]
+    fn the_module_must_match_the_declaration() {
+        let doc = &kinds(
+            r#"{"k": WgslKind(shader: "k.wgsl", outputs: {"out": Rgba16Float}, workgroup: (8, 8),
+                params: [(name: "gain", default: 1.0, min: 0.0, max: 9.0), (name: "bias", default: 0.0, min: 0.0, max: 9.0)])}"#,
+        )["k"];
+        let module = |params: &str, size: &str| {
+            let text = format!(
+                "struct Params {{ {params} }}\n@group(0) @binding(0) var<uniform> params: Params;\n\
+                 @compute @workgroup_size({size}) fn cs_main() {{ let g = params; }}"
+            );
+            naga::front::wgsl::parse_str(&text).expect("parses")
+        };
+        check_module_against(doc, &module("gain: f32, bias: f32, _pad0: f32", "8, 8")).expect("as declared");
+        let err = check_module_against(doc, &module("gain: f32, bias: f32", "16, 16")).expect_err("size");
+        assert!(err.contains("@workgroup_size(16, 16, 1) but the kind declares workgroup: (8, 8)"), "{err}");
+        let err = check_module_against(doc, &module("bias: f32, gain: f32", "8, 8")).expect_err("order");
+        assert!(
+            err.contains("has members (bias: f32, gain: f32) but the kind declares the parameters (gain, bias)"),
+            "{err}"
+        );
+        let err = check_module_against(doc, &module("gain: f32, bias: vec4<f32>", "8, 8")).expect_err("types");
+        assert!(err.contains("bias: vec4<f32>"), "{err}");
     }
 }

@@ -76,12 +76,18 @@ const DEFAULT_BUDGET_BYTES: u64 = 2 << 30;
 struct BrickParamsGpu {
     grid: [u32; 4],
     slots: [u32; 4],
+    slot_side: [u32; 4],
     leaves: [u32; 4],
     leaf_grid: [u32; 4],
     atlas: [f32; 4],
 }
 
-const _: () = assert!(std::mem::size_of::<BrickParamsGpu>() == 80);
+const _: () = assert!(std::mem::size_of::<BrickParamsGpu>() == 96);
+
+/// The largest staging buffer one upload batch uses, whatever the adapter allows: a frame's
+/// uploads are split into chunks of at most this many bytes (and at most the device's
+/// `max_buffer_size`), so a 1024³ volume never needs a gigabyte of staging at once.
+const MAX_STAGING_BYTES: u64 = 64 << 20;
 
 /// Leap distances are capped here (a cube of 2·255 − 1 leaves is wider than any volume).
 const MAX_LEAP: u32 = 255;
@@ -102,6 +108,10 @@ impl PassPlugin for RaycastBricks {
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
         crate::effects::jitter_defines(params)
+    }
+
+    fn uses_gpu_memory_budget(&self) -> bool {
+        true
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -222,8 +232,9 @@ struct VolumeState {
     layout: BrickLayout,
     octree: OctreeHierarchy,
     format: VolumeFormat,
-    /// Voxels per slot side.
-    side: u32,
+    /// Voxels per slot and axis: `brick_cells + 3`, or fewer on an axis thinner than a brick
+    /// (a 1-voxel-thick slab stores 4 layers per brick, not 35).
+    side: UVec3,
     /// Slots per atlas row and column (fixed), and the most layers the device allows.
     slots_xy: (u32, u32),
     max_layers: u32,
@@ -280,20 +291,23 @@ impl VolumeState {
         // The brick's voxels and one more on every side (clamped to the volume like the
         // sampler): a filter tap at a brick face blends exactly what it would in the whole
         // volume, even where the hardware's fixed-point weights give the next texel 1/256.
-        let side = brick_cells + 3;
+        // An axis with fewer cells than a brick holds one brick of that many cells.
+        let cells = volgraph_accel::bricks::cell_dims(voxels.dims);
+        let side = cells.min(UVec3::splat(brick_cells)) + 3;
         let max_dim = ctx.gpu.limits.max_texture_dimension_3d;
-        let per_axis = (max_dim / side).max(1);
-        if side > max_dim {
+        if side.max_element() > max_dim {
             return Err(pass_error(
                 ctx,
                 format!(
-                    "brick_cells {brick_cells} needs {side}³-voxel slots, over this GPU's 3D texture limit {max_dim}"
+                    "brick_cells {brick_cells} needs slots of {}x{}x{} voxels, over this GPU's 3D texture limit \
+                     {max_dim}; lower brick_cells",
+                    side.x, side.y, side.z
                 ),
             ));
         }
+        let per_axis = UVec3::splat(max_dim) / side;
         let cube = (layout.brick_count() as f64).cbrt().ceil() as u32;
-        let row = cube.clamp(1, per_axis);
-        let cells = volgraph_accel::bricks::cell_dims(voxels.dims);
+        let row = (cube.clamp(1, per_axis.x), cube.clamp(1, per_axis.y));
         let leaf_grid =
             UVec3::new(cells.x.div_ceil(node_cells), cells.y.div_ceil(node_cells), cells.z.div_ceil(node_cells));
         Ok(Self {
@@ -304,8 +318,8 @@ impl VolumeState {
             layout,
             octree,
             side,
-            slots_xy: (row, row),
-            max_layers: per_axis,
+            slots_xy: row,
+            max_layers: per_axis.z,
             tf_version: None,
             visibility: None,
             visible: Vec::new(),
@@ -318,7 +332,7 @@ impl VolumeState {
     }
 
     fn slot_bytes(&self) -> u64 {
-        (self.side as u64).pow(3) * self.format.bytes() as u64
+        self.side.as_u64vec3().element_product() * self.format.bytes() as u64
     }
 
     /// Re-classifies bricks and octree leaves for a new TF (§7: only the TF-dependent part)
@@ -409,25 +423,46 @@ impl VolumeState {
         Ok(())
     }
 
-    /// Records the copies of `uploads` into the atlas from one staging buffer.
-    fn upload(&self, ctx: &mut RecordContext<'_>, uploads: &[(u32, u32)]) -> u64 {
-        let Some(atlas) = &self.atlas else { return 0 };
-        if uploads.is_empty() {
-            return 0;
+    /// Records the copies of `uploads` into the atlas, through staging buffers of at most
+    /// [`MAX_STAGING_BYTES`] and the device's `max_buffer_size` each; returns the voxel bytes
+    /// uploaded.
+    fn upload(&self, ctx: &mut RecordContext<'_>, uploads: &[(u32, u32)]) -> Result<u64, PassError> {
+        let Some(atlas) = &self.atlas else { return Ok(0) };
+        let texel = self.format.bytes() as u64;
+        let brick_row = self.side.x as u64 * texel;
+        let rows = self.side.y as u64 * self.side.z as u64;
+        let limit = MAX_STAGING_BYTES.min(ctx.gpu.limits.max_buffer_size);
+        let per_chunk = staging_bricks_per_chunk(brick_row, rows, limit);
+        if per_chunk == 0 {
+            return Err(pass_error(
+                ctx,
+                format!(
+                    "one brick of {}x{}x{} voxels needs more than this device's largest buffer ({limit} bytes) to \
+                     upload; lower brick_cells",
+                    self.side.x, self.side.y, self.side.z
+                ),
+            ));
         }
+        for chunk in uploads.chunks(per_chunk) {
+            self.upload_chunk(ctx, atlas, chunk, brick_row);
+        }
+        Ok(uploads.len() as u64 * self.slot_bytes())
+    }
+
+    /// One staging buffer for `chunk`: the bricks side by side along x (brick `i`'s row `r` at
+    /// `r · row + i · brick_row`), so rows share the 256-byte alignment a buffer-to-texture
+    /// copy needs instead of padding every brick's row to it.
+    fn upload_chunk(&self, ctx: &mut RecordContext<'_>, atlas: &Atlas, chunk: &[(u32, u32)], brick_row: u64) {
         let side = self.side;
-        let texel = self.format.bytes();
-        let row = (side * texel).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let brick_bytes = row as usize * side as usize * side as usize;
-        let mut staging = vec![0u8; brick_bytes * uploads.len()];
-        for (i, (brick, _)) in uploads.iter().enumerate() {
+        let row = staging_row_bytes(brick_row, chunk.len());
+        let mut staging = vec![0u8; (row * side.y as u64 * side.z as u64) as usize];
+        for (i, (brick, _)) in chunk.iter().enumerate() {
             let (lo, _) = self.layout.brick_cells_box(self.layout.brick_coord(*brick as usize));
             let origin = lo.as_ivec3() - glam::IVec3::ONE;
-            let tight = volume_region_bytes(&self.voxels, origin, UVec3::splat(side), self.format);
-            let tight_row = (side * texel) as usize;
-            for (r, src) in tight.chunks_exact(tight_row).enumerate() {
-                let at = i * brick_bytes + r * row as usize;
-                staging[at..at + tight_row].copy_from_slice(src);
+            let tight = volume_region_bytes(&self.voxels, origin, side, self.format);
+            for (r, src) in tight.chunks_exact(brick_row as usize).enumerate() {
+                let at = (r as u64 * row + i as u64 * brick_row) as usize;
+                staging[at..at + src.len()].copy_from_slice(src);
             }
         }
         let buffer = ctx.gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -435,16 +470,16 @@ impl VolumeState {
             contents: &staging,
             usage: wgpu::BufferUsages::COPY_SRC,
         });
-        for (i, (_, slot)) in uploads.iter().enumerate() {
+        for (i, (_, slot)) in chunk.iter().enumerate() {
             let s = atlas.slots;
             let at = UVec3::new(slot % s.x, (slot / s.x) % s.y, slot / (s.x * s.y)) * side;
             ctx.encoder.copy_buffer_to_texture(
                 wgpu::TexelCopyBufferInfo {
                     buffer: &buffer,
                     layout: wgpu::TexelCopyBufferLayout {
-                        offset: (i * brick_bytes) as u64,
-                        bytes_per_row: Some(row),
-                        rows_per_image: Some(side),
+                        offset: i as u64 * brick_row,
+                        bytes_per_row: Some(row as u32),
+                        rows_per_image: Some(side.y),
                     },
                 },
                 wgpu::TexelCopyTextureInfo {
@@ -453,11 +488,36 @@ impl VolumeState {
                     origin: wgpu::Origin3d { x: at.x, y: at.y, z: at.z },
                     aspect: wgpu::TextureAspect::All,
                 },
-                wgpu::Extent3d { width: side, height: side, depth_or_array_layers: side },
+                wgpu::Extent3d { width: side.x, height: side.y, depth_or_array_layers: side.z },
             );
         }
-        uploads.len() as u64 * (side as u64).pow(3) * texel as u64
     }
+}
+
+/// Bytes per staging row for `bricks` bricks of `brick_row` bytes side by side, padded to the
+/// copy alignment.
+fn staging_row_bytes(brick_row: u64, bricks: usize) -> u64 {
+    let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as u64;
+    (brick_row * bricks as u64).div_ceil(align) * align
+}
+
+/// How many bricks (`rows` rows of `brick_row` bytes each) one staging buffer of at most
+/// `limit` bytes holds (0: not even one). Row pitch stays within `u32`, as copies need.
+pub fn staging_bricks_per_chunk(brick_row: u64, rows: u64, limit: u64) -> usize {
+    let fits = |n: u64| {
+        let row = staging_row_bytes(brick_row, n as usize);
+        row <= u64::from(u32::MAX) && row * rows <= limit
+    };
+    if !fits(1) {
+        return 0;
+    }
+    // The largest n that fits: rows grow monotonically with n.
+    let (mut lo, mut hi) = (1u64, (limit / (brick_row * rows).max(1)).max(1) + 1);
+    while lo + 1 < hi {
+        let mid = lo + (hi - lo) / 2;
+        if fits(mid) { lo = mid } else { hi = mid }
+    }
+    lo as usize
 }
 
 /// Leaves of `node_cells`³ cells per axis over a volume of `volume_dims` voxels.
@@ -606,7 +666,8 @@ impl PassNode for RaycastBricksNode {
         let grid = state.layout.grid_dims();
         let uniform = BrickParamsGpu {
             grid: [grid.x, grid.y, grid.z, self.brick_cells],
-            slots: [atlas_slots.x, atlas_slots.y, atlas_slots.z, state.side],
+            slots: [atlas_slots.x, atlas_slots.y, atlas_slots.z, 0],
+            slot_side: [state.side.x, state.side.y, state.side.z, 0],
             leaves: [state.octree.min_node_cells(), self.brick_cells / state.octree.min_node_cells(), 0, 0],
             leaf_grid: [state.leaf_grid.x, state.leaf_grid.y, state.leaf_grid.z, 0],
             atlas: [atlas_size.x, atlas_size.y, atlas_size.z, 0.0],
@@ -632,7 +693,7 @@ impl PassNode for RaycastBricksNode {
         };
         for i in 0..batches.len().max(1) {
             if let Some(batch) = batches.get(i) {
-                counters.uploaded_bytes += state.upload(ctx, &batch.uploads);
+                counters.uploaded_bytes += state.upload(ctx, &batch.uploads)?;
                 counters.uploaded_bricks += batch.uploads.len() as u64;
             }
             let table = wgpu::BufferBinding {

@@ -134,7 +134,8 @@ fn shader_global_without_a_port_is_named() {
         msg,
         "pass \"march\": raycast.wgsl: global \"dir\" is neither a port of this pass (ports: entry, direction, volume, tf, color) \
          nor a system binding (frame, linear_clamp, nearest_clamp) nor one the pass binds itself (params); \
-         rename it to the port it stands for"
+         rename it to the port it stands for, or, when the node binds it itself, add \"dir\" to the `extra` \
+         names of the pass's ShaderUse"
     );
 }
 

@@ -13,6 +13,7 @@ use support::{gpu, graph_source, runtime};
 fn a_texture_the_device_cannot_make_is_a_fault_not_a_panic() {
     let gpu = volgraph_core::runtime::Gpu::new_headless_with(&GpuOptions {
         without_features: wgpu::Features::TEXTURE_FORMAT_16BIT_NORM,
+        ..Default::default()
     })
     .expect("a Vulkan adapter");
     let fault = gpu

@@ -229,8 +229,11 @@ fn sixteen_bit_volumes_in_both_byte_orders_match_the_reference() {
 fn sixteen_bit_volume_without_norm16_is_widened_to_float() {
     use volgraph_core::runtime::{Gpu, GpuOptions};
     let gpu = std::sync::Arc::new(
-        Gpu::new_headless_with(&GpuOptions { without_features: wgpu::Features::TEXTURE_FORMAT_16BIT_NORM })
-            .expect("a Vulkan adapter"),
+        Gpu::new_headless_with(&GpuOptions {
+            without_features: wgpu::Features::TEXTURE_FORMAT_16BIT_NORM,
+            ..Default::default()
+        })
+        .expect("a Vulkan adapter"),
     );
     assert!(!gpu.norm16);
     let v = sixteen_bit_ml("uint16", volgraph_accel::load::Endianness::Little);
@@ -251,7 +254,8 @@ fn sixteen_bit_volume_on_a_device_with_neither_format_uses_half_floats() {
     use volgraph_core::runtime::{Gpu, GpuOptions, VolumeFormat};
     let without = wgpu::Features::TEXTURE_FORMAT_16BIT_NORM | wgpu::Features::FLOAT32_FILTERABLE;
     let gpu = std::sync::Arc::new(
-        Gpu::new_headless_with(&GpuOptions { without_features: without }).expect("a Vulkan adapter"),
+        Gpu::new_headless_with(&GpuOptions { without_features: without, ..Default::default() })
+            .expect("a Vulkan adapter"),
     );
     let v = sixteen_bit_ml("int16", volgraph_accel::load::Endianness::Big);
     let uploaded = volgraph_core::runtime::upload_volume_texture(&gpu, &v).expect("uploads");

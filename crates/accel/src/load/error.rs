@@ -56,6 +56,18 @@ pub enum LoadError {
         what: &'static str,
     },
 
+    /// A MetaImage header sets a required field only after `ElementDataFile`, which ends the
+    /// header.
+    #[error(
+        "{at}: ElementDataFile must be the last field of a MetaImage header (what follows it is data), but {field} is not set before it; move {field} above ElementDataFile"
+    )]
+    FieldAfterDataFile {
+        /// The ElementDataFile line.
+        at: Location,
+        /// The field not set before it.
+        field: &'static str,
+    },
+
     /// A detached data file named in the header cannot be read.
     #[error("{at}: the header's {field} \"{name}\" points to {}, which cannot be read: {source}", .path.display())]
     DataFile {

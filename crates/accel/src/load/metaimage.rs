@@ -125,11 +125,18 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
             "transformmatrix" | "rotation" | "orientation" => {
                 let parsed: Option<Vec<f64>> = value.split_whitespace().map(|s| s.parse().ok()).collect();
                 match parsed.as_deref() {
-                    Some(&[a, b, c, d, e, f, g, h, i]) => {
+                    Some(m @ &[a, b, c, d, e, f, g, h, i])
+                        if m.iter().all(|v| v.is_finite())
+                            && [[a, b, c], [d, e, f], [g, h, i]].iter().all(|r| r.iter().any(|v| *v != 0.0)) =>
+                    {
                         // Row k is the world direction of file axis k (ITK's MetaImageIO).
                         directions = Some((number, [DVec3::new(a, b, c), DVec3::new(d, e, f), DVec3::new(g, h, i)]));
                     }
-                    _ => return Err(bad("nine numbers, e.g. `TransformMatrix = 1 0 0 0 1 0 0 0 1`")),
+                    _ => {
+                        return Err(bad(
+                            "nine finite numbers, each row of three not all zero, e.g. `TransformMatrix = 1 0 0 0 1 0 0 0 1`",
+                        ));
+                    }
                 }
             }
             "compresseddata" => {
@@ -168,7 +175,12 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
         }
     }
 
-    let missing = |field, example| LoadError::MissingField { path: path.to_path_buf(), field, example };
+    // ElementDataFile ends the header: a field written after it is data, not a field.
+    let data_file_line = data_file.as_ref().map(|(_, _, line)| *line);
+    let missing = |field, example| match data_file_line {
+        Some(line) => LoadError::FieldAfterDataFile { at: Location::line(path, line), field },
+        None => LoadError::MissingField { path: path.to_path_buf(), field, example },
+    };
     if !ndims_seen {
         return Err(missing("NDims", "NDims = 3"));
     }

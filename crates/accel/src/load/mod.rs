@@ -200,33 +200,11 @@ pub fn sanitize_volume(volume: &mut Volume) -> (usize, usize, usize) {
 /// Fails unless `path` is a regular file (or a link to one): a directory or a FIFO would
 /// otherwise surface as a puzzling size error, or block.
 fn check_is_file(path: &Path) -> Result<(), LoadError> {
-    let meta = std::fs::metadata(path).map_err(|source| LoadError::Io { path: path.to_path_buf(), source })?;
-    let kind = meta.file_type();
-    if kind.is_file() {
-        return Ok(());
+    match crate::input_file::special_kind(path) {
+        Ok(None) => Ok(()),
+        Ok(Some(what)) => Err(LoadError::NotAFile { path: path.to_path_buf(), what }),
+        Err(source) => Err(LoadError::Io { path: path.to_path_buf(), source }),
     }
-    let what = if kind.is_dir() {
-        "a directory"
-    } else {
-        #[cfg(unix)]
-        {
-            use std::os::unix::fs::FileTypeExt;
-            if kind.is_fifo() {
-                "a FIFO (named pipe)"
-            } else if kind.is_socket() {
-                "a socket"
-            } else if kind.is_block_device() || kind.is_char_device() {
-                "a device"
-            } else {
-                "not a regular file"
-            }
-        }
-        #[cfg(not(unix))]
-        {
-            "not a regular file"
-        }
-    };
-    Err(LoadError::NotAFile { path: path.to_path_buf(), what })
 }
 
 /// Reads a whole file, mapping the error to [`LoadError::Io`].

@@ -32,7 +32,6 @@ const IGNORED: &[&str] = &[
     "space origin",
     "space units",
     "space dimension",
-    "kinds",
     "labels",
     "units",
     "centers",
@@ -122,6 +121,19 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
             expected,
         };
         match field.as_str() {
+            // Each axis must be a spatial one: a colour or vector axis (RGB-color, 3-vector,
+            // list, ...) makes the voxels vectors, which read as a scalar volume would be the
+            // components interleaved along that axis.
+            "kinds" => {
+                let spatial = ["domain", "space", "time", "none", "???"];
+                if value.split_whitespace().any(|k| !spatial.contains(&k.to_ascii_lowercase().as_str())) {
+                    return Err(bad(
+                        "one spatial kind per axis (domain, space, time, none or ???); this file's voxels are \
+                         vectors or colours, and volgraph renders scalar volumes: extract one component first \
+                         (e.g. `unu slice -a 0 -p 0`)",
+                    ));
+                }
+            }
             "type" => {
                 let t = voxel_type(&value.to_ascii_lowercase()).ok_or_else(|| LoadError::UnsupportedType {
                     at: at.clone(),

@@ -17,7 +17,13 @@ const SUPPORTED: &str = "uint8, uint16, int16, float32 (or u8, u16, i16, f32)";
 /// the dimensions and the type token (not checked; see [`VoxelType::from_name`]). A name ending
 /// in `_XxYxZ` without a type gives `None` for the token. `None` when no `_XxYxZ` part is there.
 pub fn parse_raw_name(file_name: &str) -> Option<(String, [u64; 3], Option<String>)> {
-    let stem = file_name.strip_suffix(".raw").unwrap_or(file_name);
+    // The extension in any case (`.RAW` from Windows tools), as `load_volume` matches it.
+    let stem = match file_name.len().checked_sub(4) {
+        Some(cut) if file_name.is_char_boundary(cut) && file_name[cut..].eq_ignore_ascii_case(".raw") => {
+            &file_name[..cut]
+        }
+        _ => file_name,
+    };
     let parse_dims = |token: &str| -> Option<[u64; 3]> {
         let mut parts = token.split(['x', 'X']);
         let mut dims = [0u64; 3];

@@ -81,6 +81,71 @@ fn map_label(map: &Value, i: usize) -> String {
 
 /// Parses ParaView colour-map JSON and picks map `wanted` (its `"Name"`, or `#i`), the first
 /// when `None`.
+/// Points between each pair of `[x, r, g, b]` points (sRGB) along the HSV path between them.
+fn hsv_resampled(rgb: &[[f64; 4]]) -> Vec<[f64; 4]> {
+    const STEPS: usize = 32;
+    let mut out = Vec::with_capacity(rgb.len() * STEPS);
+    for pair in rgb.windows(2) {
+        let (a, b) = (pair[0], pair[1]);
+        let (ha, hb) = (rgb_to_hsv([a[1], a[2], a[3]]), rgb_to_hsv([b[1], b[2], b[3]]));
+        // The hue of a grey point is undefined: take the other end's.
+        let (ha, hb) = match (ha[1] == 0.0, hb[1] == 0.0) {
+            (true, false) => ([hb[0], ha[1], ha[2]], hb),
+            (false, true) => (ha, [ha[0], hb[1], hb[2]]),
+            _ => (ha, hb),
+        };
+        let mut dh = hb[0] - ha[0];
+        if dh > 0.5 {
+            dh -= 1.0;
+        } else if dh < -0.5 {
+            dh += 1.0;
+        }
+        for k in 0..STEPS {
+            let t = k as f64 / STEPS as f64;
+            let h = (ha[0] + t * dh).rem_euclid(1.0);
+            let c = hsv_to_rgb([h, ha[1] + t * (hb[1] - ha[1]), ha[2] + t * (hb[2] - ha[2])]);
+            out.push([a[0] + t * (b[0] - a[0]), c[0], c[1], c[2]]);
+        }
+    }
+    if let Some(last) = rgb.last() {
+        out.push(*last);
+    }
+    out
+}
+
+/// `[h, s, v]` in 0..1 of an RGB colour in 0..1.
+fn rgb_to_hsv([r, g, b]: [f64; 3]) -> [f64; 3] {
+    let max = r.max(g).max(b);
+    let min = r.min(g).min(b);
+    let d = max - min;
+    let h = if d == 0.0 {
+        0.0
+    } else if max == r {
+        ((g - b) / d).rem_euclid(6.0) / 6.0
+    } else if max == g {
+        ((b - r) / d + 2.0) / 6.0
+    } else {
+        ((r - g) / d + 4.0) / 6.0
+    };
+    [h, if max == 0.0 { 0.0 } else { d / max }, max]
+}
+
+/// The RGB colour of `[h, s, v]` in 0..1.
+fn hsv_to_rgb([h, s, v]: [f64; 3]) -> [f64; 3] {
+    let h6 = h.rem_euclid(1.0) * 6.0;
+    let i = h6.floor();
+    let f = h6 - i;
+    let (p, q, t) = (v * (1.0 - s), v * (1.0 - s * f), v * (1.0 - s * (1.0 - f)));
+    match i as u32 % 6 {
+        0 => [v, t, p],
+        1 => [q, v, p],
+        2 => [p, v, t],
+        3 => [p, q, v],
+        4 => [t, p, v],
+        _ => [v, p, q],
+    }
+}
+
 pub(super) fn parse_map(text: &str, path: &Path, wanted: Option<&str>) -> Result<ParaviewColorMap, TfError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let root: Value = serde_json::from_str(text).map_err(|e| {
@@ -150,6 +215,22 @@ pub(super) fn parse_map(text: &str, path: &Path, wanted: Option<&str>) -> Result
         }
     }
 
+    // ParaView interpolates colours in its `ColorSpace`: RGB (the default) is what the LUT's
+    // linear interpolation between points does; for HSV, points are added along each segment
+    // (hue the short way round, as ParaView's default HSVWrap does), so the piecewise-linear
+    // LUT follows the HSV path within 1/255.
+    let space = object.get("ColorSpace").and_then(Value::as_str).unwrap_or("RGB");
+    let rgb = match space.to_ascii_uppercase().as_str() {
+        "RGB" => rgb,
+        "HSV" => hsv_resampled(&rgb),
+        other => {
+            notes.push(format!(
+                "ColorSpace \"{space}\" is not supported ({other}); its colours are interpolated in RGB instead \
+                 (RGB and HSV are)"
+            ));
+            rgb
+        }
+    };
     let xs_rgb = rgb.iter().map(|q| q[0]);
     let xs_alpha = opacity.iter().flatten().map(|q| q[0]);
     let mut xs: Vec<f64> = xs_rgb.chain(xs_alpha).filter(|x| x.is_finite()).collect();

@@ -56,7 +56,7 @@ struct Context<'a> {
 impl Context<'_> {
     fn skip(&mut self, what: String, reason: String) {
         if self.skip_seen.insert((what.clone(), reason.clone())) {
-            self.progress.suspend(|| eprintln!("note: skipping {what}: {reason}"));
+            self.progress.suspend(|| crate::stdout::eprintln_escaped!("note: skipping {what}: {reason}"));
             self.skipped.push(Skipped { what, reason });
         }
     }
@@ -125,6 +125,33 @@ fn set_knob(options: &mut CompileOptions, key: &str, value: &ron::Value) {
     }
 }
 
+/// A `--sweep` over a Scalar input or a feature the graph does not have would measure the same
+/// graph at every "value": an error naming what the graph has instead. (A `pass.param` the graph
+/// lacks is already a compile error.)
+fn sweep_applies(plan: &Plan, key: &str) -> Result<(), String> {
+    let (what, name, known) = if let Some(name) = key.strip_prefix("input.") {
+        ("Scalar input", name, &plan.known_scalars)
+    } else if let Some(name) = key.strip_prefix("feature.") {
+        ("feature", name, &plan.known_features)
+    } else {
+        return Ok(());
+    };
+    if known.contains(name) {
+        return Ok(());
+    }
+    let list: Vec<&str> = known.iter().map(String::as_str).collect();
+    Err(format!(
+        "--sweep {key}: graph \"{}\" has no {what} \"{name}\", so every value would measure the same thing; {}",
+        plan.name,
+        volgraph_core::suggest::guess_then(
+            name,
+            list.iter().copied(),
+            if what == "feature" { "feature." } else { "input." },
+            format!("it has: {}", volgraph_core::suggest::comma_list(&list))
+        )
+    ))
+}
+
 /// Binds the case's volume and LUT (uploads only what changed) and compiles the case at
 /// `viewport` with the runtime's scene values (the volume's longest ray, which multipass graphs
 /// size their segment loop by).
@@ -139,6 +166,9 @@ fn compile_case(ctx: &mut Context<'_>, case: &Case<'_>, viewport: (u32, u32)) ->
         .runtime
         .compile(&file, &case.graph.source, &ctx.registry, &options)
         .map_err(|d: Diagnostics| d.to_string())?;
+    if let Some(sweep) = &ctx.config.sweep {
+        sweep_applies(&plan, &sweep.key)?;
+    }
     ctx.runtime.bind_scene(&plan.inputs, &case.dataset.volume, case.lut).map_err(|e| e.to_string())?;
     Ok(plan)
 }

@@ -7,6 +7,7 @@
 pub mod graph_picture;
 pub mod orbit;
 pub mod panel;
+pub mod script;
 pub mod session;
 pub mod watch;
 pub mod window;
@@ -33,8 +34,8 @@ pub struct ViewArgs {
     /// Write the last frame here on exit (PNG; the graph output as presented, without the overlay).
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
-    /// Turn the camera this many degrees per frame.
-    #[arg(long)]
+    /// Turn the camera this many degrees per frame (finite, -360..=360).
+    #[arg(long, value_parser = parse_turn)]
     pub turn: Option<f64>,
     /// Start without the overlay panel (F1 toggles it).
     #[arg(long)]
@@ -42,6 +43,15 @@ pub struct ViewArgs {
     /// Read script lines from stdin: `quit`, `screenshot PATH`, `param PASS.NAME VALUE`.
     #[arg(long)]
     pub script: bool,
+}
+
+/// `--turn DEGREES`: finite and at most a whole turn per frame (NaN would turn the camera
+/// into NaN and draw nothing).
+fn parse_turn(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v.abs() <= 360.0 => Ok(v),
+        _ => Err(format!("\"{text}\": expected finite degrees per frame within -360..=360, e.g. 1.5")),
+    }
 }
 
 /// What only the window needs.
@@ -62,7 +72,7 @@ pub struct ViewOptions {
 /// Writes one event line to stdout, flushed (tests read it as it happens).
 pub fn emit(event: &session::Event) {
     let mut out = std::io::stdout().lock();
-    let _ = writeln!(out, "{event}");
+    let _ = writeln!(out, "{}", volgraph_core::terminal::escape_controls(&event.to_string()));
     let _ = out.flush();
 }
 
@@ -72,7 +82,7 @@ pub fn run(args: ViewArgs) -> Result<(), CliError> {
     let viewport = inputs::parse_size(&resolved.size)?;
     let camera = resolved.camera.at(0);
     if let Some(path) = &args.screenshot {
-        let kind = crate::image_out::ImageKind::from_path(path)?;
+        let kind = crate::image_out::ImageKind::from_path("--screenshot", path)?;
         if kind != crate::image_out::ImageKind::Png {
             return Err(CliError::Other(anyhow::anyhow!(
                 "--screenshot {}: screenshots are PNG; end the name in .png",

@@ -118,9 +118,12 @@ pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapt
             plan.viewport.0,
             plan.viewport.1
         ));
-        match session.shader_dir() {
-            Some(dir) => ui.small(format!("shaders: {} (watched)", dir.display())),
-            None => ui.small("shaders: built into the binary"),
+        match session.shader_dirs() {
+            [] => ui.small("shaders: built into the binary"),
+            dirs => ui.small(format!(
+                "shaders: {} (watched)",
+                dirs.iter().map(|d| d.display().to_string()).collect::<Vec<_>>().join(", ")
+            )),
         };
         if let Some((what, message)) = session.error() {
             ui.colored_label(

@@ -124,12 +124,12 @@ pub struct LiveSession {
     lut: Vec<[f32; 4]>,
     generated: bool,
     options: CompileOptions,
-    shader_dir: Option<PathBuf>,
+    shader_dirs: Vec<PathBuf>,
     /// The last change's error, while it lasts.
     error: Option<(String, String)>,
     /// The graph text and options whose frames last rendered without a GPU error: what a frame
     /// failure falls back to.
-    validated: Option<(String, CompileOptions)>,
+    validated: Option<(String, CompileOptions, volgraph_core::runtime::shaders::ShaderSnapshot)>,
     /// True until a frame of the current plan has rendered.
     unproven: bool,
 }
@@ -157,7 +157,7 @@ impl LiveSession {
             }
         };
         for note in notes {
-            eprintln!("note: {note}");
+            crate::stdout::eprintln_escaped!("note: {note}");
         }
         let (tf, tf_path, tf_notes) = match (&args.tf, &args.scene) {
             (None, Some(scene)) => {
@@ -169,10 +169,13 @@ impl LiveSession {
             }
         };
         for note in tf_notes {
-            eprintln!("note: {note}");
+            crate::stdout::eprintln_escaped!("note: {note}");
         }
         let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
-        let (sources, shader_dir) = crate::shader_dir::sources_for(&args.graph, args.shaders.as_deref());
+        let (sources, _) = crate::shader_dir::sources_for(&args.graph, args.shaders.as_deref());
+        // Every folder read (and so watched), in search order: the start line and the panel name
+        // all of them, not just the first.
+        let shader_dirs: Vec<PathBuf> = sources.disk_roots().into_iter().map(Path::to_path_buf).collect();
         let mut runtime = Runtime::new(gpu, ShaderLibrary::new(sources));
         runtime.set_gpu_memory_budget(args.gpu_memory_mb.map(|mb| mb << 20));
         let mut options = CompileOptions::new(args.viewport.0, args.viewport.1)
@@ -190,7 +193,7 @@ impl LiveSession {
         if let Some(scene) = &args.scene {
             for effect in &scene.effects {
                 if !plan.known_features.contains(effect) && !args.features.contains(effect) {
-                    eprintln!(
+                    crate::stdout::eprintln_escaped!(
                         "note: graph \"{}\" does not offer the scene's effect \"{effect}\"; it is left out",
                         plan.name
                     );
@@ -199,9 +202,12 @@ impl LiveSession {
             }
         }
         crate::cli::check_user_names(&plan, &options)?;
-        let shaders = match &shader_dir {
-            Some(dir) => format!("shaders from {}", dir.display()),
-            None => "built-in shaders".to_string(),
+        let shaders = match shader_dirs.as_slice() {
+            [] => "built-in shaders".to_string(),
+            dirs => format!(
+                "shaders from {} (watched), then the built-in ones",
+                dirs.iter().map(|d| d.display().to_string()).collect::<Vec<_>>().join(", ")
+            ),
         };
         let loaded = format!("{}, {shaders}", summary(&plan));
         runtime.bind_scene(&plan.inputs, &volume, &lut).map_err(|e| crate::cli::CliError::Other(anyhow!(e)))?;
@@ -218,7 +224,7 @@ impl LiveSession {
             lut,
             generated,
             options,
-            shader_dir,
+            shader_dirs,
             error: None,
             validated: None,
             unproven: true,
@@ -247,9 +253,9 @@ impl LiveSession {
         self.error.as_ref()
     }
 
-    /// The shader folder read from disk, if any.
-    pub fn shader_dir(&self) -> Option<&Path> {
-        self.shader_dir.as_deref()
+    /// The shader folders read from disk (and watched), in search order.
+    pub fn shader_dirs(&self) -> &[PathBuf] {
+        &self.shader_dirs
     }
 
     /// Every file whose edit changes what is shown: the graph, the transfer function, and every
@@ -442,12 +448,17 @@ impl LiveSession {
             Ok(_) => {
                 if self.unproven {
                     self.unproven = false;
-                    self.validated = Some((self.source.clone(), self.options.clone()));
+                    self.validated = Some((self.source.clone(), self.options.clone(), self.runtime.shader_snapshot()));
                 }
                 Ok(Vec::new())
             }
             Err(e) => {
-                let Some((source, options)) = self.validated.clone().filter(|_| self.unproven) else { return Err(e) };
+                let Some((source, options, shaders)) = self.validated.clone().filter(|_| self.unproven) else {
+                    return Err(e);
+                };
+                // The compiled modules that rendered, not the files: after a shader edit the
+                // GPU rejected, the files hold that edit.
+                self.runtime.restore_shaders(&shaders);
                 let what = "frame".to_string();
                 let message =
                     format!("{e}\n(the GPU rejected the new graph's frame; the last graph that rendered is back)");

@@ -371,3 +371,37 @@ fn wgsl_only_passes_of_both_forms_render_and_hot_reload() {
     check(&mut session, 0.5);
     let _ = std::fs::remove_dir_all(&s.dir);
 }
+
+/// Issue 19: a hot-reloaded shader that naga accepts but the GPU rejects (a params struct
+/// larger than the uniform the pass binds) made the viewer quit: the rollback re-applied the
+/// last good graph, which read the bad shader from disk again. The last good *compiled*
+/// modules come back instead, and the window keeps rendering the last good image until the
+/// file is fixed.
+#[test]
+fn a_shader_edit_the_gpu_rejects_keeps_the_last_good_pipelines() {
+    let s = scratch("gpu-rejects-shader", "graphs/basic/fragment_raycast.ron");
+    let mut session = open(&s, None);
+    let camera = OrbitCamera::default();
+    assert!(session.frame(&camera, None).expect("a good frame").is_empty());
+    session.runtime.finish();
+    let good = session.runtime.read_output("image").expect("image").data;
+    let present = s.shaders.join("present.wgsl");
+    edit(&present, "    _pad2: f32,\n}", "    _pad2: f32,\n    larger_than_declared: vec4<f32>,\n}");
+    let events = session.files_changed(std::slice::from_ref(&present));
+    assert!(matches!(events.as_slice(), [Event::Reloaded { .. }]), "naga accepts the edit: {events:?}");
+    let events = session.frame(&camera, None).expect("recovers by itself");
+    let [Event::Error { what, message }] = events.as_slice() else { panic!("{events:?}") };
+    assert_eq!(what, "frame");
+    assert!(message.contains("the last graph that rendered is back"), "{message}");
+    for _ in 0..2 {
+        assert!(session.frame(&camera, None).expect("the last good pipelines render").is_empty());
+    }
+    session.runtime.finish();
+    assert_eq!(session.runtime.read_output("image").expect("image").data, good);
+    // Fixing the file reloads it like any edit.
+    edit(&present, "    larger_than_declared: vec4<f32>,\n", "");
+    let events = session.files_changed(std::slice::from_ref(&present));
+    assert!(events.iter().any(|e| matches!(e, Event::Reloaded { .. })), "{events:?}");
+    assert!(session.frame(&camera, None).expect("the fixed shader renders").is_empty());
+    let _ = std::fs::remove_dir_all(&s.dir);
+}

@@ -16,6 +16,7 @@ use winit::window::{Window, WindowId};
 
 use super::orbit::Orbit;
 use super::panel::{self, Action, Timings};
+use super::script::ScriptCommand;
 use super::session::{Event, LiveSession, SessionArgs};
 use super::watch::FileWatch;
 use super::{ViewOptions, emit};
@@ -133,7 +134,7 @@ impl Viewer {
         for e in &events {
             emit(e);
             if let Event::Error { message, .. } = e {
-                eprintln!("{message}");
+                crate::stdout::eprintln_escaped!("{message}");
             }
         }
         if !events.is_empty()
@@ -168,20 +169,14 @@ impl Viewer {
     fn run_script(&mut self) {
         let lines: Vec<String> = self.script.as_ref().map(|rx| rx.try_iter().collect()).unwrap_or_default();
         for line in lines {
-            let mut words = line.split_whitespace();
-            match (words.next(), words.next(), words.next()) {
-                (Some("quit"), _, _) => self.quit = true,
-                (Some("screenshot"), Some(path), _) => self.screenshot_now = Some(PathBuf::from(path)),
-                (Some("param"), Some(key), Some(value)) => {
-                    match (key.split_once('.'), ron::from_str::<ron::Value>(value)) {
-                        (Some((pass, name)), Ok(v)) => {
-                            self.apply_actions(vec![Action::Param(pass.to_string(), name.to_string(), v)])
-                        }
-                        _ => eprintln!("script: cannot read \"{line}\"; write param PASS.NAME VALUE"),
-                    }
+            match super::script::parse_line(&line) {
+                Ok(Some(ScriptCommand::Quit)) => self.quit = true,
+                Ok(Some(ScriptCommand::Screenshot(path))) => self.screenshot_now = Some(path),
+                Ok(Some(ScriptCommand::Param { pass, name, value })) => {
+                    self.apply_actions(vec![Action::Param(pass, name, value)])
                 }
-                _ if line.trim().is_empty() => {}
-                _ => eprintln!("script: unknown line \"{line}\"; known: quit, screenshot PATH, param PASS.NAME VALUE"),
+                Ok(None) => {}
+                Err(message) => crate::stdout::eprintln_escaped!("script: {message}"),
             }
         }
     }
@@ -203,7 +198,7 @@ impl Viewer {
         }
         let image = image::RgbaImage::from_raw(w, h, rgba).ok_or("screenshot size mismatch")?;
         image.save(path).map_err(|e| format!("{}: cannot write the screenshot: {e}", path.display()))?;
-        println!("screenshot {}", path.display());
+        crate::stdout::println_escaped!("screenshot {}", path.display());
         Ok(())
     }
 
@@ -289,7 +284,7 @@ impl Viewer {
         if let Some(path) = self.screenshot_now.take()
             && let Err(e) = self.save_screenshot(&path)
         {
-            eprintln!("error: {e}");
+            crate::stdout::eprintln_escaped!("error: {e}");
         }
         let done = self.view.frames.is_some_and(|n| self.timings.frames >= n);
         if done || self.quit {
@@ -299,7 +294,7 @@ impl Viewer {
                 self.fail(event_loop, e);
                 return;
             }
-            println!("presented {} frames", self.timings.frames);
+            crate::stdout::println_escaped!("presented {} frames", self.timings.frames);
             event_loop.exit();
         }
     }

@@ -69,6 +69,9 @@ pub fn check_plan_bindings(plan: &Plan, registry: &Registry, sources: &ShaderSou
             if let Err(e) = check_bindings(shader.file, &reflection.bindings, shader.extra, &ports, false) {
                 out.push(problem(e));
             }
+            if let Err(e) = plugin.check_module(&step.params, &shader, &module) {
+                out.push(problem(e));
+            }
         }
     }
     out

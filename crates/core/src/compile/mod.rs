@@ -86,6 +86,10 @@ impl CompileOptions {
 
 pub use bindings::check_plan_bindings;
 
+/// The effects a scene may ask for (`scenes/*.ron`'s `effects:`, `--features`); passes read
+/// them as `"feature.NAME"` and gate on them with `when: [NAME]`.
+pub const SCENE_EFFECTS: [&str; 4] = ["shading", "preintegration", "jitter", "tricubic"];
+
 /// Compiles graph text named `file` (used in messages) into a plan.
 pub fn compile(file: &str, source: &str, registry: &Registry, options: &CompileOptions) -> Result<Plan, Diagnostics> {
     // A UTF-8 byte-order mark (some Windows editors write one) is not part of the graph.
@@ -97,7 +101,7 @@ pub fn compile(file: &str, source: &str, registry: &Registry, options: &CompileO
     let registry = if doc.kinds.is_empty() {
         registry
     } else {
-        let problems = crate::wgsl_pass::check_kinds(&doc.kinds, registry);
+        let problems = crate::wgsl_pass::check_kinds_in(&doc.kinds, registry, source);
         if !problems.is_empty() {
             return Err(fail(problems));
         }

@@ -47,6 +47,21 @@ pub struct PortInfo {
     /// Whether the graph wires this port (optional inputs may be left unwired; a node binds a
     /// stand-in or picks a variant without it).
     pub bound: bool,
+    /// The texture dimension the port binds, where its kind fixes one (targets and the TF are
+    /// 2D, the volume 3D); `None` for owned resources and buffers.
+    pub dim: Option<wgpu::TextureViewDimension>,
+}
+
+/// Names a texture dimension as WGSL writes it.
+fn wgsl_dim(dim: wgpu::TextureViewDimension) -> &'static str {
+    match dim {
+        wgpu::TextureViewDimension::D1 => "texture_1d",
+        wgpu::TextureViewDimension::D2 => "texture_2d",
+        wgpu::TextureViewDimension::D2Array => "texture_2d_array",
+        wgpu::TextureViewDimension::Cube => "texture_cube",
+        wgpu::TextureViewDimension::CubeArray => "texture_cube_array",
+        wgpu::TextureViewDimension::D3 => "texture_3d",
+    }
 }
 
 /// Depth test of a render pipeline.
@@ -324,6 +339,12 @@ impl<'a> CreateContext<'a> {
             .collect()
     }
 
+    /// The validated module of `file` (no `#if` names), for a plugin that checks its shader
+    /// against its declaration before building ([`crate::plugin::PassPlugin::check_module`]).
+    pub fn shader_module(&self, file: &str) -> Result<std::sync::Arc<super::shaders::LoadedShader>, PassError> {
+        self.shader(file, &[])
+    }
+
     fn shader(&self, file: &str, defines: &[&str]) -> Result<std::sync::Arc<super::shaders::LoadedShader>, PassError> {
         self.modules.borrow_mut().insert(file.to_string());
         self.shaders.get_with(self.gpu, file, defines).map_err(|e| self.error(e))
@@ -597,13 +618,31 @@ pub fn check_bindings(
             let ports: Vec<&str> = ports.iter().map(|p| p.name.as_str()).collect();
             return Err(format!(
                 "{shader}: global \"{}\" is neither a port of this pass (ports: {}) nor a system binding ({}) \
-                 nor one the pass binds itself ({}); rename it to the port it stands for",
+                 nor one the pass binds itself ({}); rename it to the port it stands for, or, when the node \
+                 binds it itself, add \"{}\" to the `extra` names of the pass's ShaderUse",
                 b.name,
                 ports.join(", "),
                 SYSTEM_BINDINGS.join(", "),
-                if extra.is_empty() { "none".to_string() } else { extra.join(", ") }
+                if extra.is_empty() { "none".to_string() } else { extra.join(", ") },
+                b.name
             ));
         };
+        let shader_dim = match &b.ty {
+            BindingKind::Texture { dim, .. } | BindingKind::StorageTexture { dim, .. } => Some(*dim),
+            _ => None,
+        };
+        if let (Some(have), Some(want)) = (shader_dim, p.dim)
+            && have != want
+        {
+            return Err(format!(
+                "{shader}: global \"{}\" is a {} but port \"{}\" binds a {} texture; declare it {}",
+                b.name,
+                wgsl_dim(have),
+                b.name,
+                if want == wgpu::TextureViewDimension::D3 { "3D" } else { "2D" },
+                wgsl_dim(want),
+            ));
+        }
         match &b.ty {
             BindingKind::Storage { read_only } => {
                 if !p.buffer {

@@ -74,6 +74,10 @@ pub struct GpuOptions {
     /// Optional features not to request even where the adapter offers them (tests of fallback
     /// paths, e.g. a volume upload without `TEXTURE_FORMAT_16BIT_NORM`).
     pub without_features: wgpu::Features,
+    /// A `max_buffer_size` below the adapter's (tests of the paths that split work by the
+    /// device's buffer limit, with small data: a 1 MiB limit makes a 96³ volume "larger than the
+    /// largest buffer").
+    pub max_buffer_size: Option<u64>,
 }
 
 /// Device, queue and what the adapter can do.
@@ -140,7 +144,11 @@ impl Gpu {
             | wgpu::Features::TEXTURE_FORMAT_16BIT_NORM
             | wgpu::Features::SHADER_EARLY_DEPTH_TEST;
         let features = adapter.features() & wanted & !options.without_features;
-        let limits = adapter.limits();
+        let mut limits = adapter.limits();
+        if let Some(cap) = options.max_buffer_size {
+            limits.max_buffer_size = limits.max_buffer_size.min(cap);
+            limits.max_storage_buffer_binding_size = limits.max_storage_buffer_binding_size.min(cap);
+        }
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("volgraph"),
             required_features: features,

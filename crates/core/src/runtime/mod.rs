@@ -350,6 +350,20 @@ impl Runtime {
         }
     }
 
+    /// The compiled shader modules now in use ([`ShaderLibrary::snapshot`]): a viewer takes one
+    /// when a graph has rendered, to fall back on.
+    pub fn shader_snapshot(&self) -> shaders::ShaderSnapshot {
+        self.shaders.snapshot()
+    }
+
+    /// Puts back the modules of `snapshot` and marks those that differ stale, so the next
+    /// [`Self::apply`] rebuilds their nodes from the good modules instead of re-reading an edit
+    /// the GPU rejected.
+    pub fn restore_shaders(&mut self, snapshot: &shaders::ShaderSnapshot) {
+        let changed = self.shaders.restore(snapshot);
+        self.stale_modules.extend(changed);
+    }
+
     /// Forgets the cached modules built from `changed` files; the next [`Self::apply`] rebuilds
     /// exactly the nodes whose pipelines use them. Returns the modules affected.
     pub fn shaders_changed(&mut self, changed: &[std::path::PathBuf]) -> Vec<String> {

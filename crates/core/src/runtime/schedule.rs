@@ -159,7 +159,16 @@ pub fn port_infos(plan: &Plan, step: &crate::plan::Step, specs: &[crate::plugin:
                 || (matches!(bp.binding, Binding::Unbound)
                     && specs.iter().any(|s| s.name == bp.port && matches!(s.kind, PortKind::Buffer { .. })));
             let bound = !matches!(bp.binding, Binding::Unbound);
-            PortInfo { name: bp.port.clone(), access: bp.access, format, owned, buffer, bound }
+            let dim = match (desc, declared) {
+                (Some(ResourceDesc::Target { .. }), _) => Some(wgpu::TextureViewDimension::D2),
+                (Some(_), _) => None,
+                (None, Some(PortKind::Target { .. } | PortKind::TransferFunction)) => {
+                    Some(wgpu::TextureViewDimension::D2)
+                }
+                (None, Some(PortKind::Volume)) => Some(wgpu::TextureViewDimension::D3),
+                _ => None,
+            };
+            PortInfo { name: bp.port.clone(), access: bp.access, format, owned, buffer, bound, dim }
         })
         .collect()
 }

@@ -39,6 +39,10 @@ fn file_of_key(key: &str) -> &str {
     key.split_once('#').map_or(key, |(file, _)| file)
 }
 
+/// The compiled modules of a [`ShaderLibrary`] at one moment ([`ShaderLibrary::snapshot`]).
+#[derive(Clone, Default)]
+pub struct ShaderSnapshot(HashMap<String, Arc<LoadedShader>>);
+
 /// Loads and caches shader modules by relative name and defines.
 pub struct ShaderLibrary {
     sources: ShaderSources,
@@ -57,8 +61,22 @@ fn located(
     message: &str,
     report: String,
 ) -> String {
-    match location.and_then(|l| source.origin_of_line(l.line_number as usize).map(|o| (o, l.line_position))) {
-        Some(((path, line), col)) => format!("{}:{line}:{col}: {message}\n{report}", path.display()),
+    match location.and_then(|l| source.origin_of_line(l.line_number as usize).map(|o| (o, l))) {
+        // naga's own frame shows the assembled text (imports inlined) under the root file's
+        // name, so its line numbers match no file on disk: show the line where it came from.
+        Some(((path, line), l)) => {
+            let col = l.line_position;
+            let text = source.text.lines().nth((l.line_number as usize).saturating_sub(1)).unwrap_or("");
+            let caret = " ".repeat(text.chars().take(col.saturating_sub(1) as usize).count());
+            let width =
+                (l.length as usize).clamp(1, text.len().saturating_sub((col as usize).saturating_sub(1)).max(1));
+            format!(
+                "{}:{line}:{col}: {message}\n  --> {}:{line}:{col}\n   |\n   | {text}\n   | {caret}{}",
+                path.display(),
+                path.display(),
+                "^".repeat(width)
+            )
+        }
         None => format!("{file}: {message}\n{report}"),
     }
 }
@@ -103,6 +121,33 @@ impl ShaderLibrary {
     /// Where files come from.
     pub fn sources(&self) -> &ShaderSources {
         &self.sources
+    }
+
+    /// The compiled modules now loaded: what [`Self::restore`] puts back when a shader edit that
+    /// naga accepted is rejected by the GPU (the files on disk then hold the bad edit, so the
+    /// last good graph must not read them again).
+    pub fn snapshot(&self) -> ShaderSnapshot {
+        ShaderSnapshot(self.cache.lock().map(|c| c.clone()).unwrap_or_default())
+    }
+
+    /// Puts the modules of `snapshot` back in place of what is loaded now; returns the names of
+    /// the modules that differ (their pipelines must be rebuilt). The restored modules stay until
+    /// one of their files changes again.
+    pub fn restore(&self, snapshot: &ShaderSnapshot) -> Vec<String> {
+        let Ok(mut cache) = self.cache.lock() else { return Vec::new() };
+        let mut changed: Vec<String> = cache
+            .iter()
+            .filter(|(k, s)| snapshot.0.get(*k).is_none_or(|old| old.hash != s.hash))
+            .chain(snapshot.0.iter().filter(|(k, _)| !cache.contains_key(*k)))
+            .map(|(k, _)| file_of_key(k).to_string())
+            .collect();
+        *cache = snapshot.0.clone();
+        if let Ok(mut unloaded) = self.unloaded.lock() {
+            unloaded.retain(|name, _| !cache.keys().any(|k| file_of_key(k) == name));
+        }
+        changed.sort();
+        changed.dedup();
+        changed
     }
 
     /// Forgets every cached module (the next [`Self::get`] reads the files again).

@@ -1,5 +1,5 @@
 //! Test plugins for the core integration tests that compile graph files without the GPU
-//! (`malformed_graphs`, `fuzz_graphs`, `graph_format_doc`).
+//! (`malformed_graphs`, `fuzz_graphs`).
 //!
 //! Their ports mirror the built-in passes of `volgraph-passes` (`entry_points`,
 //! `ray_directions`, `raycast`, `present`) and the passes the papers' pipelines need

@@ -144,6 +144,7 @@ pub(crate) fn check(
         }
     }
     c.check_references();
+    c.check_when_names();
     let outputs = c.check_graph_outputs();
     let history = c.check_history();
     if c.diags.is_empty() {
@@ -178,6 +179,50 @@ pub(crate) fn check(
 }
 
 impl Checker<'_> {
+    /// A `when:` name one typo away from a scene effect or from a feature the graph uses
+    /// elsewhere (`"shadng"`) would gate its pass off for good, since nothing turns that name
+    /// on: an error with "did you mean". Names far from every known one are the graph's own
+    /// features (`"reprojection"`, turned on by `--features`).
+    fn check_when_names(&mut self) {
+        let mut known: std::collections::BTreeSet<&str> = crate::compile::SCENE_EFFECTS.into_iter().collect();
+        known.extend(self.features_read.iter().map(String::as_str));
+        let mut uses: HashMap<&str, usize> = HashMap::new();
+        for p in &self.passes {
+            for name in &p.needs {
+                *uses.entry(name.as_str()).or_default() += 1;
+            }
+        }
+        let mut found = Vec::new();
+        for p in &self.passes {
+            for (i, name) in p.needs.iter().enumerate() {
+                if known.contains(name.as_str()) {
+                    continue;
+                }
+                // Another name used more often than this one, or a known one, that it is a typo of.
+                let others = known
+                    .iter()
+                    .copied()
+                    .chain(
+                        uses.iter().filter(|(n, count)| **n != name && **count > uses[name.as_str()]).map(|(n, _)| *n),
+                    )
+                    .filter(|n| *n != name);
+                if let Some(best) = crate::suggest::closest(name, others) {
+                    found.push((
+                        self.loc.pass_list_item(p.path, &p.id, "when", i),
+                        format!("pass \"{}\" is gated on feature \"{name}\", which nothing turns on", p.id),
+                        format!(
+                            "did you mean \"{best}\"? the scene effects are: {}",
+                            comma_list(&crate::compile::SCENE_EFFECTS)
+                        ),
+                    ));
+                }
+            }
+        }
+        for (at, message, help) in found {
+            self.err(at, message, Some(help));
+        }
+    }
+
     fn err(&mut self, location: Location, message: String, help: Option<String>) {
         let mut d = Diagnostic::new(location, message);
         if let Some(h) = help {

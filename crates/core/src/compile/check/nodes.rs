@@ -158,11 +158,14 @@ impl Checker<'_> {
                     );
                     return 1;
                 };
-                if !divide_by.is_finite() || *divide_by <= 0.0 || !value.is_finite() {
+                if !divide_by.is_finite() || *divide_by <= 0.0 || !value.is_finite() || value < 0.0 {
                     self.err(
                         self.loc.pass_field(path, id, "count"),
                         format!("repeat group \"{id}\" divides \"{name}\" ({value}) by {divide_by}"),
-                        Some("divide_by must be a positive number and the scene value finite".to_string()),
+                        Some(format!(
+                            "divide_by must be a positive number and \"{name}\" a finite length of zero or more (a \
+                             negative ray length would silently run one iteration)"
+                        )),
                     );
                     return 1;
                 }

@@ -36,17 +36,17 @@ pub struct LiveArgs {
     /// Viewport, WIDTHxHEIGHT.
     #[arg(long, default_value = "256x256")]
     pub size: String,
-    /// Edits timed per kind (the median is reported).
-    #[arg(long, default_value_t = 15)]
+    /// Edits timed per kind (the median is reported; at least 1, or the tables would be NaN).
+    #[arg(long, default_value_t = 15, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=100_000))]
     pub edits: usize,
-    /// Frames per throughput run.
-    #[arg(long, default_value_t = 120)]
+    /// Frames per throughput run (at least 2: the first includes pipeline JIT).
+    #[arg(long, default_value_t = 120, value_parser = clap::value_parser!(u32).range(2..))]
     pub throughput_frames: u32,
-    /// Soak frames.
-    #[arg(long, default_value_t = 10_000)]
+    /// Soak frames (at least 1).
+    #[arg(long, default_value_t = 10_000, value_parser = clap::value_parser!(u32).range(1..))]
     pub soak_frames: u32,
-    /// Soak reloads (alternating a good and a broken graph).
-    #[arg(long, default_value_t = 1_000)]
+    /// Soak reloads (alternating a good and a broken graph; at least 1).
+    #[arg(long, default_value_t = 1_000, value_parser = clap::value_parser!(u32).range(1..))]
     pub soak_reloads: u32,
     /// Soak viewport, WIDTHxHEIGHT.
     #[arg(long, default_value = "64x64")]

@@ -154,6 +154,26 @@ impl GraphBenchReport {
         if let Some(about) = &self.about {
             let _ = writeln!(s, "{about}\n");
         }
+        // What this run measured, from its rows: a preset given other graphs, datasets or
+        // viewports on the command line is described by what ran, not by the preset's text.
+        let distinct = |f: &dyn Fn(&Row) -> String| {
+            let mut v: Vec<String> = Vec::new();
+            for r in &self.rows {
+                let x = f(r);
+                if !v.contains(&x) {
+                    v.push(x);
+                }
+            }
+            v.join(", ")
+        };
+        let _ = writeln!(
+            s,
+            "Measured: graphs {}; datasets {}; TFs {}; viewports {}.\n",
+            distinct(&|r| format!("`{}`", r.graph)),
+            distinct(&|r| format!("{} ({}×{}×{})", r.dataset, r.dims[0], r.dims[1], r.dims[2])),
+            distinct(&|r| r.tf.clone()),
+            distinct(&|r| format!("{}×{}", r.viewport[0], r.viewport[1])),
+        );
         let speedup = if self.baselines.is_empty() {
             format!("median of `{}` / median of the row", self.baseline)
         } else {

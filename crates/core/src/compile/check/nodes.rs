@@ -223,7 +223,12 @@ impl Checker<'_> {
         };
         let Some(plugin) = plugin else {
             let kinds = self.registry.kinds();
-            let mut help = format!("known kinds: {}", comma_list(&kinds));
+            let mut help = format!(
+                "known kinds: {}; a kind written in Rust by another crate (such as examples/radiology's \"mip\") \
+                 is known only to that crate's program, which registers it (docs/writing_a_pass.md), and a WGSL-only \
+                 kind is declared in the graph's kinds: block",
+                comma_list(&kinds)
+            );
             help = guess_then(&p.kind, kinds.iter().copied(), "", help);
             self.err(
                 self.loc.pass_field(path, &p.id, "kind"),

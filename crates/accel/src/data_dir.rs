@@ -259,3 +259,31 @@ pub fn load_dataset(name: &str) -> Result<LoadedVolume, DataError> {
     };
     Ok(load_volume(&path, &RawOptions { spacing, ..RawOptions::default() })?)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HEADER: &str = "| File | Voxel spacing | SHA-256 |\n|---|---|---|\n";
+    const SHA: &str = "0123456789abcdef0123456789abcdef0123456789abcdef0123456789abcdef";
+
+    /// Issue 19: a malformed manifest was ignored (`load_dataset` fell back on spacing 1, 1, 1).
+    /// Every malformed row is an error naming the file and what is wrong.
+    #[test]
+    fn malformed_manifest_rows_are_errors() {
+        let path = Path::new("volumes/MANIFEST.md");
+        let good = format!("{HEADER}| `lobster_301x324x56_uint8.raw` | 1, 1, 1.4 | `{SHA}` |\n");
+        let rows = parse_manifest(path, &good).expect("a good row");
+        assert_eq!(rows[0].spacing, DVec3::new(1.0, 1.0, 1.4));
+        for (row, expected) in [
+            (format!("| `a_2x2x2_uint8.raw` | 1, 1 | `{SHA}` |"), "the spacing of a_2x2x2_uint8.raw is not three numbers"),
+            (format!("| `a_2x2x2_uint8.raw` | 1, 0, -2 | `{SHA}` |"), "is not three positive numbers"),
+            ("| `a_2x2x2_uint8.raw` | 1, 1, 1 | `abc` |".to_string(), "the SHA-256 of a_2x2x2_uint8.raw is not 64 hex digits"),
+        ] {
+            let err = parse_manifest(path, &format!("{HEADER}{row}\n")).expect_err(&row).to_string();
+            assert!(err.starts_with("volumes/MANIFEST.md: ") && err.contains(expected), "{row}: {err}");
+        }
+        let err = parse_manifest(path, "no table here").expect_err("no table").to_string();
+        assert!(err.contains("no file table"), "{err}");
+    }
+}

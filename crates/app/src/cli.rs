@@ -28,7 +28,8 @@ enum Command {
         /// Viewport, WIDTHxHEIGHT.
         #[arg(long, default_value = "1920x1080")]
         size: String,
-        /// Scene features that are on, comma separated (e.g. shading,antialias).
+        /// Scene features that are on, comma separated: the scene effects shading, preintegration,
+        /// jitter, tricubic (e.g. shading,jitter), or a feature the graph gates passes on (`when:`).
         #[arg(long, value_delimiter = ',')]
         features: Vec<String>,
         /// Scene values, NAME=VALUE (repeat counts, ...).

@@ -253,3 +253,25 @@ fn a_wgsl_kind_unlike_its_shader_is_a_plan_error() {
     let run = volgraph(&["plan", &s(&graph)]);
     assert_fails_with(&run, 1, "@workgroup_size(16, 16, 1) but the kind declares workgroup: (8, 8)", "workgroup");
 }
+
+/// Class 6: `--gpu-memory-mb` given to a graph without a brick pool was ignored in silence.
+#[test]
+fn a_memory_budget_for_a_graph_without_a_pool_is_named() {
+    let dir = temp_dir();
+    let run =
+        volgraph(&["render", GRAPH, "--size", "16x16", "--gpu-memory-mb", "64", "-o", &s(&dir.join("budget.png"))]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(
+        run.stderr.contains("--gpu-memory-mb 64: graph \"fragment_raycast\" has no pass that streams"),
+        "{}",
+        run.stderr
+    );
+}
+
+/// Class 7: an OS error was printed twice (in the message and again as its source).
+#[test]
+fn an_os_error_is_printed_once() {
+    let run = volgraph(&["plan", "graphs/no_such_graph.ron"]);
+    assert_fails_with(&run, 1, "graphs/no_such_graph.ron: cannot read the graph file", "missing graph");
+    assert_eq!(run.stderr.matches("No such file or directory").count(), 1, "{}", run.stderr);
+}

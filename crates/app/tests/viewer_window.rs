@@ -1,6 +1,7 @@
 //! `volgraph view` in a real window under Xvfb: start on a scratch graph, edit a parameter,
-//! break the graph, break a shader, fix both, and check the event lines; then compare the
-//! screenshot with the headless render of the same graph.
+//! break the graph, break a shader, fix both, make a shader edit the GPU rejects, swap a FIFO in
+//! for the graph, and check the event lines; then compare the screenshot with the headless
+//! render of the same graph.
 //!
 //! Xvfb is started by the test (`.ci/run` installs it). Without it the test is skipped with a
 //! note, except under CI (`CI` set), where that is a failure.
@@ -164,6 +165,36 @@ fn hot_reload_in_a_window_keeps_the_last_good_graph_and_matches_the_headless_ren
     edit(&present, "fn cs_present(((", "fn cs_present");
     expect_line(&lines, "reloaded shader present.wgsl", &mut log);
     expect_line(&lines, "recovered", &mut log);
+    // 6. Issue 19: a shader edit naga accepts but the GPU rejects (a params struct larger than
+    // the uniform bound) made the viewer quit; the last good compiled modules come back and the
+    // window keeps running.
+    edit(&present, "    _pad2: f32,\n}", "    _pad2: f32,\n    larger_than_declared: vec4<f32>,\n}");
+    expect_line(&lines, "reloaded shader present.wgsl", &mut log);
+    let line = expect_line(&lines, "error in frame", &mut log);
+    assert!(line.ends_with("keeping the last good graph"), "{line}");
+    edit(&present, "    larger_than_declared: vec4<f32>,\n", "");
+    expect_line(&lines, "reloaded shader present.wgsl", &mut log);
+    // 7. Issue 19: a FIFO swapped in for the graph froze the viewer (reading it blocked, quit
+    // was ignored); it is refused at once and the last good graph keeps rendering.
+    #[cfg(unix)]
+    {
+        let saved = dir.join("graph.ron.saved");
+        std::fs::rename(&graph, &saved).expect("move the graph aside");
+        let made = Command::new("mkfifo").arg(&graph).status().expect("mkfifo runs");
+        assert!(made.success(), "mkfifo");
+        // (A "no such file" error for the moment the graph was gone may come first.)
+        let deadline = Instant::now() + Duration::from_secs(120);
+        loop {
+            let line = expect_line(&lines, "error in graph", &mut log);
+            if line.contains("is a FIFO (named pipe), not a graph file") {
+                break;
+            }
+            assert!(Instant::now() < deadline, "no FIFO error; seen:\n{}", log.join("\n"));
+        }
+        std::fs::remove_file(&graph).expect("remove the FIFO");
+        std::fs::rename(&saved, &graph).expect("put the graph back");
+        expect_line(&lines, "reloaded graph", &mut log);
+    }
 
     let mut stdin = viewer.stdin.take().expect("stdin");
     writeln!(stdin, "quit").expect("script line");

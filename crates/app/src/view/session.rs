@@ -202,6 +202,9 @@ impl LiveSession {
             }
         }
         crate::cli::check_user_names(&plan, &options)?;
+        if let Some(note) = crate::render::budget_note(&plan, &registry, args.gpu_memory_mb) {
+            crate::stdout::eprintln_escaped!("{note}");
+        }
         let shaders = match shader_dirs.as_slice() {
             [] => "built-in shaders".to_string(),
             dirs => format!(
@@ -460,8 +463,7 @@ impl LiveSession {
                 // GPU rejected, the files hold that edit.
                 self.runtime.restore_shaders(&shaders);
                 let what = "frame".to_string();
-                let message =
-                    format!("{e}\n(the GPU rejected the new graph's frame; the last graph that rendered is back)");
+                let message = format!("{e}\n(the new graph's frame failed; the last graph that rendered is back)");
                 self.error = Some((what.clone(), message.clone()));
                 if let Err(revert) = self.compile_and_apply(&source, &options) {
                     return Err(volgraph_core::runtime::RuntimeError::Readback(format!(

@@ -393,6 +393,11 @@ fn a_shader_edit_the_gpu_rejects_keeps_the_last_good_pipelines() {
     let [Event::Error { what, message }] = events.as_slice() else { panic!("{events:?}") };
     assert_eq!(what, "frame");
     assert!(message.contains("the last graph that rendered is back"), "{message}");
+    // The failure names the pass and the binding, not wgpu's "binding index 1".
+    assert!(
+        message.contains("pass \"present\": present/cs_present: uniform \"params\" (@binding(1)) is 32 bytes in the shader but the buffer the pass binds holds 16"),
+        "{message}"
+    );
     for _ in 0..2 {
         assert!(session.frame(&camera, None).expect("the last good pipelines render").is_empty());
     }

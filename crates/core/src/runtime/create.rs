@@ -199,6 +199,24 @@ impl PipelineCache {
         self.len() == 0
     }
 
+    /// For each pipeline whose label (`pass/entry`) a wgpu message quotes, one line naming its
+    /// bindings by number: wgpu reports `binding 3`, the graph author thinks in port names.
+    pub fn binding_names_in(&self, message: &str) -> Vec<String> {
+        let Ok(pipelines) = self.pipelines.lock() else { return Vec::new() };
+        let mut seen = BTreeSet::new();
+        let mut lines: Vec<String> = pipelines
+            .values()
+            .filter(|p| message.contains(&format!("'{}'", p.label)) && seen.insert(p.label.clone()))
+            .map(|p| {
+                let names: Vec<String> =
+                    p.bindings.iter().map(|b| format!("@binding({}) = \"{}\"", b.binding, b.name)).collect();
+                format!("pipeline '{}' binds {}", p.label, names.join(", "))
+            })
+            .collect();
+        lines.sort();
+        lines
+    }
+
     /// Drops the pipelines built from a module whose source hash is no longer current.
     pub fn retain(&self, keep: impl Fn(&str) -> bool) {
         if let Ok(mut p) = self.pipelines.lock() {

@@ -440,24 +440,34 @@ impl Runtime {
         let system = &self.system;
         let frames = &self.frames;
         let blitter = &mut self.blitter;
-        let commands = gpu.checked(
-            || what.clone(),
-            || -> Result<wgpu::CommandBuffer, RuntimeError> {
-                let mut encoder = gpu
-                    .device
-                    .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(&schedule.plan.name) });
-                history.begin_frame(&mut encoder);
-                record_steps(&gpu, schedule, history, inputs, system, &frame, &mut encoder, timestamps.as_ref())?;
-                if let Some(target) = present {
-                    let (view, encoded) = output_view(schedule, history, target.output)?;
-                    blitter.record(&gpu, &mut encoder, &view, encoded, target)?;
-                }
-                frames.resolve(&mut encoder, steps);
-                Ok(encoder.finish())
-            },
-        )??;
+        let pipelines = &self.pipelines;
+        // A validation error names bindings by number; say which port each number is.
+        let named = |mut fault: GpuFault| {
+            for line in pipelines.binding_names_in(&fault.message) {
+                fault.message.push_str(&format!("\n  {line}"));
+            }
+            fault
+        };
+        let commands = gpu
+            .checked(
+                || what.clone(),
+                || -> Result<wgpu::CommandBuffer, RuntimeError> {
+                    let mut encoder = gpu
+                        .device
+                        .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(&schedule.plan.name) });
+                    history.begin_frame(&mut encoder);
+                    record_steps(&gpu, schedule, history, inputs, system, &frame, &mut encoder, timestamps.as_ref())?;
+                    if let Some(target) = present {
+                        let (view, encoded) = output_view(schedule, history, target.output)?;
+                        blitter.record(&gpu, &mut encoder, &view, encoded, target)?;
+                    }
+                    frames.resolve(&mut encoder, steps);
+                    Ok(encoder.finish())
+                },
+            )
+            .map_err(named)??;
         let submitted = Instant::now();
-        let submission = gpu.checked(|| what.clone(), || gpu.queue.submit([commands]))?;
+        let submission = gpu.checked(|| what.clone(), || gpu.queue.submit([commands])).map_err(named)?;
         self.history.end_frame();
         let pass_ids = schedule.pass_ids.clone();
         self.frames.submitted(&gpu, submission, frame.frame_index, pass_ids, submitted);

@@ -203,6 +203,22 @@ impl<'a> RecordContext<'a> {
                     },
                 },
             };
+            // A uniform buffer smaller than the shader's struct is rejected by the GPU when the
+            // pass runs, as "binding index N"; say which binding and what disagrees.
+            if let (Some(want), wgpu::BindingResource::Buffer(bb)) = (b.uniform_size, &resource) {
+                let have = bb.size.map_or_else(|| bb.buffer.size().saturating_sub(bb.offset), |s| s.get());
+                if have < want {
+                    return Err(PassError {
+                        pass: self.label.to_string(),
+                        message: format!(
+                            "{}: uniform \"{}\" (@binding({})) is {want} bytes in the shader but the buffer the pass \
+                             binds holds {have}; the shader's struct and the pass's parameter block disagree (check \
+                             the struct against its pass_params! declaration)",
+                            pipeline.label, b.name, b.binding
+                        ),
+                    });
+                }
+            }
             let resource_key = match &resource {
                 wgpu::BindingResource::TextureView(v) => Some(ResourceKey::View((*v).clone())),
                 wgpu::BindingResource::Sampler(s) => Some(ResourceKey::Sampler((*s).clone())),

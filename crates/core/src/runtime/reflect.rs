@@ -16,6 +16,8 @@ pub struct ReflectedBinding {
     pub binding: u32,
     /// What it is.
     pub ty: BindingKind,
+    /// Bytes the shader reads through it: a uniform's type size (`None` for everything else).
+    pub uniform_size: Option<u64>,
 }
 
 /// The kinds of bindings volgraph shaders use.
@@ -86,7 +88,15 @@ pub fn reflect(
                 continue;
             }
             let ty = binding_kind(module, var)?;
-            out.bindings.push(ReflectedBinding { name: var_name, group: rb.group, binding: rb.binding, ty });
+            let uniform_size = (var.space == AddressSpace::Uniform)
+                .then(|| u64::from(module.types[var.ty].inner.size(module.to_ctx())));
+            out.bindings.push(ReflectedBinding {
+                name: var_name,
+                group: rb.group,
+                binding: rb.binding,
+                ty,
+                uniform_size,
+            });
         }
         if ep.stage == naga::ShaderStage::Fragment
             && let Some(result) = &ep.function.result

@@ -276,9 +276,15 @@ mod tests {
         let rows = parse_manifest(path, &good).expect("a good row");
         assert_eq!(rows[0].spacing, DVec3::new(1.0, 1.0, 1.4));
         for (row, expected) in [
-            (format!("| `a_2x2x2_uint8.raw` | 1, 1 | `{SHA}` |"), "the spacing of a_2x2x2_uint8.raw is not three numbers"),
+            (
+                format!("| `a_2x2x2_uint8.raw` | 1, 1 | `{SHA}` |"),
+                "the spacing of a_2x2x2_uint8.raw is not three numbers",
+            ),
             (format!("| `a_2x2x2_uint8.raw` | 1, 0, -2 | `{SHA}` |"), "is not three positive numbers"),
-            ("| `a_2x2x2_uint8.raw` | 1, 1, 1 | `abc` |".to_string(), "the SHA-256 of a_2x2x2_uint8.raw is not 64 hex digits"),
+            (
+                "| `a_2x2x2_uint8.raw` | 1, 1, 1 | `abc` |".to_string(),
+                "the SHA-256 of a_2x2x2_uint8.raw is not 64 hex digits",
+            ),
         ] {
             let err = parse_manifest(path, &format!("{HEADER}{row}\n")).expect_err(&row).to_string();
             assert!(err.starts_with("volumes/MANIFEST.md: ") && err.contains(expected), "{row}: {err}");

@@ -10,11 +10,9 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
-use std::time::{Duration, Instant};
 
 use clap::Parser;
 use proptest::prelude::*;
-use proptest::test_runner::{Config, TestCaseError, TestRunner};
 
 use crate::cli::{Cli, CliError, check};
 
@@ -280,35 +278,21 @@ fn run_line(argv: &[String]) -> Result<Outcome, String> {
 
 #[test]
 fn random_command_lines_never_panic_hang_or_exit_wrongly() {
-    let mut runner = TestRunner::new(Config { cases: cases(), failure_persistence: None, ..Config::default() });
-    let counts = std::sync::Mutex::new(std::collections::BTreeMap::<Outcome, u64>::new());
-    let slowest = std::sync::Mutex::new(Duration::ZERO);
-    let result = runner.run(&command_line(), |argv| {
-        let start = Instant::now();
-        let outcome = std::panic::catch_unwind(|| run_line(&argv))
-            .map_err(|_| TestCaseError::fail(format!("panicked on {argv:?}")))?
-            .map_err(|e| TestCaseError::fail(format!("{e} for {argv:?}")))?;
-        let took = start.elapsed();
-        if took.as_secs_f64() > HANG_SECONDS {
-            return Err(TestCaseError::fail(format!("took {took:?} (a hang) on {argv:?}")));
-        }
-        if let Ok(mut s) = slowest.lock() {
-            *s = (*s).max(took);
-        }
-        if let Ok(mut c) = counts.lock() {
-            *c.entry(outcome).or_default() += 1;
-        }
-        Ok(())
-    });
-    let counts = counts.into_inner().unwrap_or_default();
-    let total: u64 = counts.values().sum();
+    let run = crate::fuzz_runner::fuzz(
+        &command_line(),
+        cases(),
+        HANG_SECONDS,
+        |argv| format!("{argv:?}"),
+        |argv| run_line(argv),
+    );
+    if let Some(failure) = run.failure {
+        panic!("{failure}");
+    }
+    let (total, counts) = (run.total(), &run.counts);
     eprintln!(
         "cli fuzz: {total} command lines, 0 panics, 0 hangs (slowest {:.1} ms), 0 wrong exit codes; outcomes {counts:?}",
-        slowest.into_inner().unwrap_or_default().as_secs_f64() * 1e3
+        run.slowest.as_secs_f64() * 1e3
     );
-    if let Err(e) = result {
-        panic!("{e}");
-    }
     // The fuzzer is not vacuous: it reaches both accepted and rejected inputs.
     assert!(
         total < 64 || (counts.contains_key(&Outcome::Accepted) && counts.contains_key(&Outcome::Rejected)),

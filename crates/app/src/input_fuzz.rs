@@ -10,10 +10,8 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
-use std::time::{Duration, Instant};
 
 use proptest::prelude::*;
-use proptest::test_runner::{Config, TestCaseError, TestRunner};
 use volgraph_core::shader_source::ShaderSources;
 use volgraph_core::{CompileOptions, Registry, check_plan_bindings, compile};
 
@@ -321,39 +319,33 @@ fn run_case(kind: Kind, text: &str) -> Result<Outcome, String> {
 fn mutated_graphs_with_wgsl_kinds_and_scenes_never_panic_hang_or_fail_unlocated() {
     let count = seeds().texts.len();
     assert!(count >= 8, "the seeds: the WGSL-kind graph, shipped graphs and scenes ({count})");
-    let mut runner = TestRunner::new(Config { cases: cases(), failure_persistence: None, ..Config::default() });
-    let counts = std::sync::Mutex::new(std::collections::BTreeMap::<(String, Outcome), u64>::new());
-    let slowest = std::sync::Mutex::new(Duration::ZERO);
     let strategy = (0..count, proptest::collection::vec(edit(), 0..4));
-    let result = runner.run(&strategy, |(seed, edits)| {
-        let (kind, text) = &seeds().texts[seed];
-        let mutated = apply(text, &edits);
-        let start = Instant::now();
-        let outcome = std::panic::catch_unwind(|| run_case(*kind, &mutated))
-            .map_err(|_| TestCaseError::fail(format!("panicked on {kind:?}:\n{mutated}")))?
-            .map_err(|e| TestCaseError::fail(format!("{e}\nfor {kind:?}:\n{mutated}")))?;
-        let took = start.elapsed();
-        if took.as_secs_f64() > HANG_SECONDS {
-            return Err(TestCaseError::fail(format!("took {took:?} (a hang) on {kind:?}:\n{mutated}")));
-        }
-        if let Ok(mut s) = slowest.lock() {
-            *s = (*s).max(took);
-        }
-        if let Ok(mut c) = counts.lock() {
-            *c.entry((format!("{kind:?}"), outcome)).or_default() += 1;
-        }
-        Ok(())
-    });
-    let counts = counts.into_inner().unwrap_or_default();
-    let total: u64 = counts.values().sum();
+    let mutated = |(seed, edits): &(usize, Vec<Edit>)| {
+        let (kind, text) = &seeds().texts[*seed];
+        (*kind, apply(text, edits))
+    };
+    let run = crate::fuzz_runner::fuzz(
+        &strategy,
+        cases(),
+        HANG_SECONDS,
+        |v| {
+            let (kind, text) = mutated(v);
+            format!("{kind:?}:\n{text}")
+        },
+        |v| {
+            let (kind, text) = mutated(v);
+            run_case(kind, &text).map(|o| (format!("{kind:?}"), o))
+        },
+    );
+    if let Some(failure) = run.failure {
+        panic!("{failure}");
+    }
+    let (total, counts) = (run.total(), &run.counts);
     eprintln!(
         "input fuzz: {total} graph and scene files, 0 panics, 0 hangs (slowest {:.1} ms), 0 unlocated or wrong \
          outcomes; outcomes {counts:?}",
-        slowest.into_inner().unwrap_or_default().as_secs_f64() * 1e3
+        run.slowest.as_secs_f64() * 1e3
     );
-    if let Err(e) = result {
-        panic!("{e}");
-    }
     // Not vacuous: graphs and scenes are both accepted and rejected.
     if total >= 256 {
         for kind in ["Graph", "Scene"] {

@@ -9,6 +9,8 @@ mod bench_live;
 mod cli;
 #[cfg(test)]
 mod cli_fuzz;
+#[cfg(test)]
+mod fuzz_runner;
 mod image_out;
 #[cfg(test)]
 mod input_fuzz;

@@ -58,6 +58,9 @@ enum Command {
     /// Show a graph live in a window, hot-reloading the graph, its shaders and its transfer
     /// function; an overlay shows per-pass GPU time, the plan and every parameter.
     View(crate::view::ViewArgs),
+    /// List the graphs built into the binary (name, paper, description): every one can be given
+    /// by name where a graph file is asked for (`volgraph render klein_2005/leap_iso -o x.png`).
+    Graphs,
     /// What accuracy costs in time: every knob (step, threshold, precision, block size, shading,
     /// pre-integration, jitter, filter) swept on several datasets, error against the converged
     /// f64 reference beside ms per frame; a table, JSON rows and one plot per knob.
@@ -231,7 +234,7 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
             Ok(Checked::Plan { text, notes: warning_lines(&plan) })
         }
         Command::Render(args) => Ok(Checked::Render(Box::new(crate::render::prepare(args)?))),
-        Command::Bench { .. } | Command::View(_) | Command::Sweep(_) | Command::Passes { .. } => {
+        Command::Bench { .. } | Command::View(_) | Command::Sweep(_) | Command::Passes { .. } | Command::Graphs => {
             Err(CliError::Other(anyhow!("only plan and render are checked ahead of running")))
         }
     }
@@ -256,6 +259,10 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             }
         },
         Command::View(args) => crate::view::run(args),
+        Command::Graphs => {
+            crate::stdout::write_stdout(&crate::builtin_graphs::listing())?;
+            Ok(())
+        }
         Command::Passes { kind, graph } => {
             let registry = match &graph {
                 Some(path) => crate::passes_cmd::with_graph_kinds(&builtin_registry(), path)?,

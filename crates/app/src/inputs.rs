@@ -12,9 +12,29 @@ use volgraph_accel::volume::Volume;
 /// The LUT resolution uploaded for every transfer function.
 pub const LUT_SIZE: usize = 256;
 
-/// Reads a graph file's text.
+/// Reads a graph file's text; a path that is no file but names a built-in graph
+/// (`kruger_westermann_2003/rc_b`, [`crate::builtin_graphs`]) gives that graph's text.
 pub fn read_graph(path: &Path) -> anyhow::Result<String> {
-    Ok(volgraph_accel::input_file::read_text(path, "graph file")?)
+    if !path.exists()
+        && let Some((_, text)) = crate::builtin_graphs::find(path)
+    {
+        return Ok(text.to_string());
+    }
+    match volgraph_accel::input_file::read_text(path, "graph file") {
+        Err(volgraph_accel::input_file::InputFileError::Io { reason, .. })
+            if reason.kind() == std::io::ErrorKind::NotFound =>
+        {
+            let names: Vec<&str> = crate::builtin_graphs::EMBEDDED_GRAPHS.iter().map(|(n, _)| *n).collect();
+            let guess = volgraph_core::suggest::closest(&path.to_string_lossy(), names.iter().copied())
+                .map_or(String::new(), |g| format!("did you mean the built-in graph \"{g}\"? "));
+            bail!(
+                "{}: cannot read the graph file: no such file, nor a built-in graph of that name; {guess}`volgraph \
+                 graphs` lists the built-in ones",
+                path.display()
+            )
+        }
+        other => Ok(other?),
+    }
 }
 
 /// Raw-file options from `--dims`, `--dtype`, `--spacing`, `--big-endian`.

@@ -6,6 +6,7 @@ mod bench_compile;
 mod bench_fetch;
 mod bench_graphs;
 mod bench_live;
+mod builtin_graphs;
 mod cli;
 #[cfg(test)]
 mod cli_fuzz;

@@ -271,7 +271,9 @@ fn a_memory_budget_for_a_graph_without_a_pool_is_named() {
 /// Class 7: an OS error was printed twice (in the message and again as its source).
 #[test]
 fn an_os_error_is_printed_once() {
-    let run = volgraph(&["plan", "graphs/no_such_graph.ron"]);
-    assert_fails_with(&run, 1, "graphs/no_such_graph.ron: cannot read the graph file", "missing graph");
+    let dir = temp_dir();
+    let scene = s(&dir.join("no_such_scene.ron"));
+    let run = volgraph(&["render", "--scene", &scene, "-o", &s(&dir.join("x.png"))]);
+    assert_fails_with(&run, 1, "no_such_scene.ron: cannot read the scene file: No such file or directory", "scene");
     assert_eq!(run.stderr.matches("No such file or directory").count(), 1, "{}", run.stderr);
 }

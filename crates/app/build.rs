@@ -1,0 +1,43 @@
+//! Compiles every graph of the workspace's `graphs/` folder (not the transfer functions of
+//! `graphs/tf/`) into the binary (`crate::builtin_graphs::EMBEDDED_GRAPHS`), so an installed
+//! `volgraph` renders them by name from any folder: `volgraph render kruger_westermann_2003/rc_b`.
+
+use std::path::{Path, PathBuf};
+
+fn collect(dir: &Path, root: &Path, out: &mut Vec<(String, PathBuf)>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
+    paths.sort();
+    for path in paths {
+        let relative = path.strip_prefix(root).unwrap_or(&path).to_string_lossy().replace('\\', "/");
+        if path.is_dir() {
+            if relative != "tf" {
+                collect(&path, root, out);
+            }
+        } else if let Some(name) = relative.strip_suffix(".ron") {
+            out.push((name.to_string(), path));
+        }
+    }
+}
+
+fn main() {
+    let manifest = std::env::var("CARGO_MANIFEST_DIR").unwrap_or_else(|_| ".".to_string());
+    let root = Path::new(&manifest).join("../../graphs");
+    println!("cargo:rerun-if-changed={}", root.display());
+    let mut files = Vec::new();
+    collect(&root, &root, &mut files);
+    let mut code = String::from(
+        "/// Every graph of the workspace's `graphs/` folder: `(name, text)`, the name its path there \
+         without `.ron`.\npub static EMBEDDED_GRAPHS: &[(&str, &str)] = &[\n",
+    );
+    for (name, path) in &files {
+        println!("cargo:rerun-if-changed={}", path.display());
+        let absolute = path.canonicalize().unwrap_or_else(|_| path.clone());
+        code.push_str(&format!("    ({name:?}, include_str!({:?})),\n", absolute.display().to_string()));
+    }
+    code.push_str("];\n");
+    let out = PathBuf::from(std::env::var("OUT_DIR").unwrap_or_else(|_| ".".to_string())).join("embedded_graphs.rs");
+    if let Err(e) = std::fs::write(&out, code) {
+        panic!("cannot write {}: {e}", out.display());
+    }
+}

@@ -96,7 +96,7 @@ pub fn read_text_limited(path: &Path, what: &'static str, limit: u64) -> Result<
     }
     let file = std::fs::File::open(path).map_err(io)?;
     let mut bytes = Vec::new();
-    file.take(limit + 1).read_to_end(&mut bytes).map_err(io)?;
+    file.take(limit.saturating_add(1)).read_to_end(&mut bytes).map_err(io)?;
     if bytes.len() as u64 > limit {
         return Err(InputFileError::TooLarge { path: path.to_path_buf(), what, limit });
     }

@@ -50,11 +50,17 @@ pub fn all() -> Vec<BuiltinGraph> {
 /// The built-in graph a command-line graph argument names: `folder/stem`, optionally with
 /// `.ron` and a leading `graphs/` (as the source tree spells it).
 pub fn find(argument: &Path) -> Option<(&'static str, &'static str)> {
-    let text = argument.to_str()?.replace('\\', "/");
+    let name = normalized(argument);
+    EMBEDDED_GRAPHS.iter().find(|(n, _)| *n == name).copied()
+}
+
+/// A graph argument as a built-in name would be spelled: `/` separators, without `./`,
+/// `graphs/` or `.ron`.
+pub fn normalized(argument: &Path) -> String {
+    let text = argument.to_string_lossy().replace('\\', "/");
     let name = text.strip_prefix("./").unwrap_or(&text);
     let name = name.strip_prefix("graphs/").unwrap_or(name);
-    let name = name.strip_suffix(".ron").unwrap_or(name);
-    EMBEDDED_GRAPHS.iter().find(|(n, _)| *n == name).copied()
+    name.strip_suffix(".ron").unwrap_or(name).to_string()
 }
 
 /// The text of `volgraph graphs`: one line per graph (name, paper, description).

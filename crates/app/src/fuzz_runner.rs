@@ -28,7 +28,8 @@ impl<O> FuzzSummary<O> {
 
 /// Runs `cases` cases of `strategy`: `case` maps one value to its outcome or to what is wrong,
 /// `describe` names the value in a failure. A panic, a case over `hang_seconds` or an `Err` fails
-/// the run.
+/// the run. A case that never returns (a real hang) is caught by a watchdog thread, which names
+/// it and ends the process with exit status 1 after ten times the limit.
 pub fn fuzz<S, O>(
     strategy: &S,
     cases: u32,
@@ -44,7 +45,29 @@ where
     let mut runner = TestRunner::new(Config { cases, failure_persistence: None, ..Config::default() });
     let counts = Mutex::new(BTreeMap::<O, u64>::new());
     let slowest = Mutex::new(Duration::ZERO);
+    // The case running now: when it started and what it is.
+    let current = std::sync::Arc::new(Mutex::new(None::<(Instant, String)>));
+    let done = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let watchdog = {
+        let (current, done) = (current.clone(), done.clone());
+        let limit = Duration::from_secs_f64(hang_seconds * 10.0);
+        std::thread::spawn(move || {
+            while !done.load(std::sync::atomic::Ordering::Relaxed) {
+                std::thread::sleep(Duration::from_millis(100));
+                if let Ok(c) = current.lock()
+                    && let Some((start, what)) = c.as_ref()
+                    && start.elapsed() > limit
+                {
+                    eprintln!("fuzz: a case hung for over {limit:?}: {what}");
+                    std::process::exit(1);
+                }
+            }
+        })
+    };
     let result = runner.run(strategy, |value| {
+        if let Ok(mut c) = current.lock() {
+            *c = Some((Instant::now(), describe(&value)));
+        }
         let start = Instant::now();
         let outcome = std::panic::catch_unwind(|| case(&value))
             .map_err(|_| TestCaseError::fail(format!("panicked on {}", describe(&value))))?
@@ -59,8 +82,13 @@ where
         if let Ok(mut c) = counts.lock() {
             *c.entry(outcome).or_default() += 1;
         }
+        if let Ok(mut c) = current.lock() {
+            *c = None;
+        }
         Ok(())
     });
+    done.store(true, std::sync::atomic::Ordering::Relaxed);
+    let _ = watchdog.join();
     FuzzSummary {
         counts: counts.into_inner().unwrap_or_default(),
         slowest: slowest.into_inner().unwrap_or_default(),

@@ -15,7 +15,8 @@ pub const LUT_SIZE: usize = 256;
 /// Reads a graph file's text; a path that is no file but names a built-in graph
 /// (`kruger_westermann_2003/rc_b`, [`crate::builtin_graphs`]) gives that graph's text.
 pub fn read_graph(path: &Path) -> anyhow::Result<String> {
-    if !path.exists()
+    // `symlink_metadata`: a dangling link or an unreadable file is the user's file, not a name.
+    if path.symlink_metadata().is_err()
         && let Some((_, text)) = crate::builtin_graphs::find(path)
     {
         return Ok(text.to_string());
@@ -25,8 +26,9 @@ pub fn read_graph(path: &Path) -> anyhow::Result<String> {
             if reason.kind() == std::io::ErrorKind::NotFound =>
         {
             let names: Vec<&str> = crate::builtin_graphs::EMBEDDED_GRAPHS.iter().map(|(n, _)| *n).collect();
-            let guess = volgraph_core::suggest::closest(&path.to_string_lossy(), names.iter().copied())
-                .map_or(String::new(), |g| format!("did you mean the built-in graph \"{g}\"? "));
+            let guess =
+                volgraph_core::suggest::closest(&crate::builtin_graphs::normalized(path), names.iter().copied())
+                    .map_or(String::new(), |g| format!("did you mean the built-in graph \"{g}\"? "));
             bail!(
                 "{}: cannot read the graph file: no such file, nor a built-in graph of that name; {guess}`volgraph \
                  graphs` lists the built-in ones",

@@ -168,8 +168,11 @@ fn a_misspelled_when_feature_is_an_error_with_a_suggestion() {
     let path = dir.join("when.ron");
     std::fs::write(&path, gated).expect("write");
     let run = volgraph(&["plan", &s(&path)]);
-    assert_fails_with(&run, 1, "pass \"present\" is gated on feature \"shadng\", which nothing turns on", "when");
+    assert_fails_with(&run, 1, "pass \"present\" is gated on feature \"shadng\", which no scene effect", "when");
     assert!(run.stderr.contains("did you mean \"shading\"?"), "{}", run.stderr);
+    // With --features shadng the user means it: no error about the name.
+    let run = volgraph(&["plan", &s(&path), "--features", "shadng"]);
+    assert!(!run.stderr.contains("is gated on feature"), "{}", run.stderr);
 }
 
 /// Class 6: `--shaders` naming a missing folder or a file was ignored (the built-in shaders

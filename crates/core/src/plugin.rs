@@ -193,8 +193,10 @@ pub trait PassPlugin: Send + Sync {
 
     /// Checks a module of one of its declared shader uses against what this kind declares
     /// beyond bindings (a workgroup size, the layout of a uniform block), once naga has
-    /// validated it: `Err` says what disagrees and how to fix it. Called by `volgraph plan`
-    /// and before a pipeline is built, so a disagreement is never a silent wrong image.
+    /// validated it: `Err` says what disagrees and how to fix it. `volgraph plan` calls it
+    /// ([`crate::compile::check_plan_bindings`]); a plugin calls it from `create` too where a
+    /// hot-reloaded shader could disagree (the WGSL-only kinds do), so a disagreement is never
+    /// a silent wrong image.
     fn check_module(&self, _params: &Params, _shader: &ShaderUse, _module: &naga::Module) -> Result<(), String> {
         Ok(())
     }

@@ -214,6 +214,16 @@ pub fn check_shader_name(name: &str) -> Result<(), &'static str> {
     if path.is_absolute() || name.starts_with('/') {
         return Err("an absolute path reaches outside the shader folders");
     }
+    // `Path::components` drops inner `.` and empty segments; the name itself is the import's
+    // identity (each file is inlined once), so it must be written one way only.
+    for segment in name.split('/') {
+        match segment {
+            ".." => return Err("\"..\" climbs out of the shader folders"),
+            "." => return Err("write the name without \"./\""),
+            "" => return Err("the name has an empty folder (\"//\")"),
+            _ => {}
+        }
+    }
     for component in path.components() {
         match component {
             Component::Normal(_) => {}
@@ -516,6 +526,8 @@ mod tests {
             ("common/../../secret.wgsl", "climbs out of the shader folders"),
             ("notes.txt", "only .wgsl files are shaders"),
             ("./a.wgsl", "without \"./\""),
+            ("common/./a.wgsl", "without \"./\""),
+            ("common//a.wgsl", "an empty folder"),
         ] {
             std::fs::write(root.join("shaders/main.wgsl"), format!("#import \"{target}\"\n")).expect("write");
             let err = assemble(&sources, "main.wgsl").expect_err(target).to_string();

@@ -34,11 +34,20 @@ pub fn escape_controls(text: &str) -> Cow<'_, str> {
 
 /// `text` with every [unsafe](is_unsafe) character replaced by `?`s of the same UTF-8 length,
 /// so byte spans into it still point at the same places (the source excerpt of a diagnostic).
+/// A CR before LF (a Windows line end) is kept.
 pub fn mask_controls(text: &str) -> Cow<'_, str> {
-    if !text.chars().any(is_unsafe) {
-        return Cow::Borrowed(text);
+    let mut chars = text.chars().peekable();
+    let mut masked = String::new();
+    let mut changed = false;
+    while let Some(c) = chars.next() {
+        if is_unsafe(c) && !(c == '\r' && chars.peek() == Some(&'\n')) {
+            masked.push_str(&"?".repeat(c.len_utf8()));
+            changed = true;
+        } else {
+            masked.push(c);
+        }
     }
-    Cow::Owned(text.chars().map(|c| if is_unsafe(c) { "?".repeat(c.len_utf8()) } else { c.to_string() }).collect())
+    if changed { Cow::Owned(masked) } else { Cow::Borrowed(text) }
 }
 
 #[cfg(test)]
@@ -59,5 +68,7 @@ mod tests {
         let masked = mask_controls(text);
         assert_eq!(masked.len(), text.len());
         assert_eq!(masked, "a?b??c");
+        assert!(matches!(mask_controls("a\r\nb\r\n"), Cow::Borrowed(_)), "CRLF line ends stay");
+        assert_eq!(mask_controls("a\rb"), "a?b", "a lone CR would overwrite the line");
     }
 }

@@ -267,9 +267,12 @@ fn check_module_against(doc: &WgslKindDoc, module: &naga::Module) -> Result<(), 
             naga::TypeInner::Scalar(naga::Scalar { kind: naga::ScalarKind::Float, width: 4 })
         )
     });
+    // The declared parameters first, in order; after them only padding members (`_pad…`).
     let padding = |n: &&str| n.starts_with('_');
-    let named: Vec<&str> = names.iter().copied().filter(|n| !padding(n)).collect();
-    if named != declared || !all_f32 || u64::from(*span) > param_block_size(doc.params.len()) {
+    let named_ok = names.len() >= declared.len()
+        && names[..declared.len()] == declared[..]
+        && names[declared.len()..].iter().all(padding);
+    if !named_ok || !all_f32 {
         return Err(format!(
             "{file}: the \"params\" struct has members ({}) but the kind declares the parameters ({}); \
              the block is filled by position, one f32 each: declare struct Params {{ {} }} (members \
@@ -283,8 +286,13 @@ fn check_module_against(doc: &WgslKindDoc, module: &naga::Module) -> Result<(), 
             declared.iter().map(|n| format!("{n}: f32")).collect::<Vec<_>>().join(", ")
         ));
     }
-    if names.iter().position(padding).is_some_and(|first| names[first..].iter().any(|n| !padding(n))) {
-        return Err(format!("{file}: the \"params\" struct's padding members (_…) must come after the parameters"));
+    let block = param_block_size(doc.params.len());
+    if u64::from(*span) > block {
+        return Err(format!(
+            "{file}: the \"params\" struct is {span} bytes but the block volgraph fills for {} parameters is {block}; \
+             remove padding members past {block} bytes",
+            doc.params.len()
+        ));
     }
     Ok(())
 }

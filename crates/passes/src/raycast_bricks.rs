@@ -431,14 +431,17 @@ impl VolumeState {
         let texel = self.format.bytes() as u64;
         let brick_row = self.side.x as u64 * texel;
         let rows = self.side.y as u64 * self.side.z as u64;
-        let limit = MAX_STAGING_BYTES.min(ctx.gpu.limits.max_buffer_size);
-        let per_chunk = staging_bricks_per_chunk(brick_row, rows, limit);
+        // Chunks of MAX_STAGING_BYTES, or one brick where a brick is larger; never more than
+        // the device's largest buffer.
+        let one_brick = staging_row_bytes(brick_row, 1) * rows;
+        let device = ctx.gpu.limits.max_buffer_size;
+        let per_chunk = staging_bricks_per_chunk(brick_row, rows, MAX_STAGING_BYTES.max(one_brick).min(device));
         if per_chunk == 0 {
             return Err(pass_error(
                 ctx,
                 format!(
-                    "one brick of {}x{}x{} voxels needs more than this device's largest buffer ({limit} bytes) to \
-                     upload; lower brick_cells",
+                    "one brick of {}x{}x{} voxels needs {one_brick} bytes of staging, more than this device's \
+                     largest buffer ({device} bytes); lower brick_cells",
                     self.side.x, self.side.y, self.side.z
                 ),
             ));
@@ -518,6 +521,28 @@ pub fn staging_bricks_per_chunk(brick_row: u64, rows: u64, limit: u64) -> usize 
         if fits(mid) { lo = mid } else { hi = mid }
     }
     lo as usize
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Chunks fill the limit without passing it; rows are padded to the copy alignment once per
+    /// chunk, not once per brick.
+    #[test]
+    fn staging_chunks_fit_the_limit() {
+        // 35-voxel u8 rows, 35·35 rows per brick.
+        let (brick_row, rows) = (35u64, 35 * 35u64);
+        for limit in [64 << 20, 512 << 10, 400_000, 256 * rows] {
+            let n = staging_bricks_per_chunk(brick_row, rows, limit);
+            assert!(n >= 1, "{limit}");
+            assert!(staging_row_bytes(brick_row, n) * rows <= limit, "{limit}: {n} bricks");
+            assert!(staging_row_bytes(brick_row, n + 1) * rows > limit, "{limit}: {n} is the most");
+        }
+        // Padding: 64 MiB holds ~1561 bricks of 42875 bytes, not the 214 a 256-byte row each allows.
+        assert!(staging_bricks_per_chunk(brick_row, rows, 64 << 20) > 1500);
+        assert_eq!(staging_bricks_per_chunk(brick_row, rows, 1000), 0, "not even one brick");
+    }
 }
 
 /// Leaves of `node_cells`³ cells per axis over a volume of `volume_dims` voxels.

@@ -53,7 +53,8 @@ pub struct ShaderLibrary {
 }
 
 /// `path:line:col: message` for a naga error at `location` of the assembled text, pointing at
-/// the original file through the import map, followed by naga's report.
+/// the original file through the import map and showing that file's line; naga's own report
+/// (whose frame shows the assembled text) only where no location is known.
 fn located(
     source: &ShaderSource,
     file: &str,
@@ -65,11 +66,13 @@ fn located(
         // naga's own frame shows the assembled text (imports inlined) under the root file's
         // name, so its line numbers match no file on disk: show the line where it came from.
         Some(((path, line), l)) => {
+            // naga's column is in bytes; the caret line copies tabs so it lines up.
             let col = l.line_position;
             let text = source.text.lines().nth((l.line_number as usize).saturating_sub(1)).unwrap_or("");
-            let caret = " ".repeat(text.chars().take(col.saturating_sub(1) as usize).count());
-            let width =
-                (l.length as usize).clamp(1, text.len().saturating_sub((col as usize).saturating_sub(1)).max(1));
+            let before = text.get(..(col as usize).saturating_sub(1)).unwrap_or("");
+            let caret: String = before.chars().map(|c| if c == '\t' { '\t' } else { ' ' }).collect();
+            let rest = text.get(before.len()..).unwrap_or("");
+            let width = rest.get(..(l.length as usize).min(rest.len())).map_or(1, |s| s.chars().count().max(1));
             format!(
                 "{}:{line}:{col}: {message}\n  --> {}:{line}:{col}\n   |\n   | {text}\n   | {caret}{}",
                 path.display(),
@@ -93,7 +96,14 @@ pub fn parse_and_validate_source(
     let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
         .validate(&module)
         .map_err(|e| {
-            located(source, file, e.location(text), &e.as_inner().to_string(), e.emit_to_string_with_path(text, file))
+            // The whole chain: the top level alone ("Function 'fs_main' is invalid") hides the cause.
+            let mut message = e.as_inner().to_string();
+            let mut cause = std::error::Error::source(e.as_inner());
+            while let Some(c) = cause {
+                message.push_str(&format!(": {c}"));
+                cause = c.source();
+            }
+            located(source, file, e.location(text), &message, e.emit_to_string_with_path(text, file))
         })?;
     Ok((module, info))
 }

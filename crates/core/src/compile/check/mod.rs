@@ -64,6 +64,8 @@ pub(crate) struct PassInfo {
     pub inputs: BTreeMap<String, Ref>,
     pub enabled: bool,
     pub needs: Vec<String>,
+    /// How many of `needs` the graph's `when:` list wrote (the rest the plugin declares).
+    pub when_count: usize,
     pub otherwise: BTreeMap<String, Ref>,
 }
 
@@ -194,8 +196,9 @@ impl Checker<'_> {
         }
         let mut found = Vec::new();
         for p in &self.passes {
-            for (i, name) in p.needs.iter().enumerate() {
-                if known.contains(name.as_str()) {
+            // Only what the graph wrote; a name the user turns on (`--features`) is meant.
+            for (i, name) in p.needs.iter().enumerate().take(p.when_count) {
+                if known.contains(name.as_str()) || self.options.features.contains(name) {
                     continue;
                 }
                 // Another name used more often than this one, or a known one, that it is a typo of.
@@ -209,9 +212,14 @@ impl Checker<'_> {
                 if let Some(best) = crate::suggest::closest(name, others) {
                     found.push((
                         self.loc.pass_list_item(p.path, &p.id, "when", i),
-                        format!("pass \"{}\" is gated on feature \"{name}\", which nothing turns on", p.id),
                         format!(
-                            "did you mean \"{best}\"? the scene effects are: {}",
+                            "pass \"{}\" is gated on feature \"{name}\", which no scene effect or other pass of \
+                             the graph uses",
+                            p.id
+                        ),
+                        format!(
+                            "did you mean \"{best}\"? (a feature of the graph's own is turned on with --features \
+                             {name}) the scene effects are: {}",
                             comma_list(&crate::compile::SCENE_EFFECTS)
                         ),
                     ));

@@ -219,6 +219,7 @@ impl Checker<'_> {
             inputs: BTreeMap::new(),
             enabled: true,
             needs: p.when.clone(),
+            when_count: p.when.len(),
             otherwise: BTreeMap::new(),
         };
         let Some(plugin) = plugin else {

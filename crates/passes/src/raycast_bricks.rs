@@ -523,28 +523,6 @@ pub fn staging_bricks_per_chunk(brick_row: u64, rows: u64, limit: u64) -> usize 
     lo as usize
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Chunks fill the limit without passing it; rows are padded to the copy alignment once per
-    /// chunk, not once per brick.
-    #[test]
-    fn staging_chunks_fit_the_limit() {
-        // 35-voxel u8 rows, 35·35 rows per brick.
-        let (brick_row, rows) = (35u64, 35 * 35u64);
-        for limit in [64 << 20, 512 << 10, 400_000, 256 * rows] {
-            let n = staging_bricks_per_chunk(brick_row, rows, limit);
-            assert!(n >= 1, "{limit}");
-            assert!(staging_row_bytes(brick_row, n) * rows <= limit, "{limit}: {n} bricks");
-            assert!(staging_row_bytes(brick_row, n + 1) * rows > limit, "{limit}: {n} is the most");
-        }
-        // Padding: 64 MiB holds ~1561 bricks of 42875 bytes, not the 214 a 256-byte row each allows.
-        assert!(staging_bricks_per_chunk(brick_row, rows, 64 << 20) > 1500);
-        assert_eq!(staging_bricks_per_chunk(brick_row, rows, 1000), 0, "not even one brick");
-    }
-}
-
 /// Leaves of `node_cells`³ cells per axis over a volume of `volume_dims` voxels.
 pub fn leaf_grid(volume_dims: UVec3, node_cells: u32) -> UVec3 {
     let cells = volgraph_accel::bricks::cell_dims(volume_dims);
@@ -765,5 +743,27 @@ impl PassNode for RaycastBricksNode {
             ("classify_ms", c.classify_ms),
             ("drawn_leaves", c.drawn_leaves),
         ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Chunks fill the limit without passing it; rows are padded to the copy alignment once per
+    /// chunk, not once per brick.
+    #[test]
+    fn staging_chunks_fit_the_limit() {
+        // 35-voxel u8 rows, 35·35 rows per brick.
+        let (brick_row, rows) = (35u64, 35 * 35u64);
+        for limit in [64 << 20, 512 << 10, 400_000, 256 * rows] {
+            let n = staging_bricks_per_chunk(brick_row, rows, limit);
+            assert!(n >= 1, "{limit}");
+            assert!(staging_row_bytes(brick_row, n) * rows <= limit, "{limit}: {n} bricks");
+            assert!(staging_row_bytes(brick_row, n + 1) * rows > limit, "{limit}: {n} is the most");
+        }
+        // Padding: 64 MiB holds ~1561 bricks of 42875 bytes, not the 214 a 256-byte row each allows.
+        assert!(staging_bricks_per_chunk(brick_row, rows, 64 << 20) > 1500);
+        assert_eq!(staging_bricks_per_chunk(brick_row, rows, 1000), 0, "not even one brick");
     }
 }

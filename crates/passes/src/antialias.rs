@@ -10,7 +10,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
-use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use volgraph_core::declare::ParamChoice;
 
@@ -90,7 +90,7 @@ fn shader(params: &Params) -> ShaderUse {
     }
 }
 
-impl PassPlugin for Antialias {
+impl PassDecl for Antialias {
     fn kind(&self) -> &'static str {
         "antialias"
     }
@@ -124,7 +124,9 @@ impl PassPlugin for Antialias {
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
         is_iso(old) == is_iso(new) && jitter_defines(old) == jitter_defines(new)
     }
+}
 
+impl PassPlugin for Antialias {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let defines = self.shader_defines(ctx.params);
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {

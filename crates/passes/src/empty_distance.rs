@@ -7,7 +7,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
-use volgraph_core::{Params, PassNode, PassPlugin, PortKind, PortSpec, Rerun};
+use volgraph_core::{Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, Rerun};
 
 use crate::empty_space::EMPTY_BLOCKS;
 use crate::minmax_grid::{bound_size, create_grid_texture};
@@ -25,7 +25,7 @@ struct DistanceParamsGpu {
     _pad: [u32; 3],
 }
 
-impl PassPlugin for EmptyDistance {
+impl PassDecl for EmptyDistance {
     fn kind(&self) -> &'static str {
         "empty_distance"
     }
@@ -54,7 +54,9 @@ impl PassPlugin for EmptyDistance {
             extra: &["partial", "distance", "pass_params"],
         }]
     }
+}
 
+impl PassPlugin for EmptyDistance {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
             shader: "empty_distance.wgsl",

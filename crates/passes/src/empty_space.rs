@@ -10,7 +10,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
-use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, Rerun};
+use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, Rerun};
 
 use crate::grid_tap::GridTap;
 use crate::minmax_grid::{MINMAX_GRID, bound_size, create_grid_texture, dispatch_grid};
@@ -61,7 +61,7 @@ volgraph_core::pass_params! {
     }
 }
 
-impl PassPlugin for EmptySpace {
+impl PassDecl for EmptySpace {
     fn kind(&self) -> &'static str {
         "empty_space"
     }
@@ -94,7 +94,9 @@ impl PassPlugin for EmptySpace {
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         vec![ShaderUse { file: "empty_space.wgsl", entry_point: "cs_classify", extra: &[] }]
     }
+}
 
+impl PassPlugin for EmptySpace {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let defines = self.shader_defines(ctx.params);
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {

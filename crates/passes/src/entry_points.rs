@@ -6,12 +6,12 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
-use volgraph_core::{Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
 pub struct EntryPoints;
 
-impl PassPlugin for EntryPoints {
+impl PassDecl for EntryPoints {
     fn kind(&self) -> &'static str {
         "entry_points"
     }
@@ -31,7 +31,9 @@ impl PassPlugin for EntryPoints {
             ShaderUse { file: "entry_points.wgsl", entry_point: "fs_near_plane", extra: &[] },
         ]
     }
+}
 
+impl PassPlugin for EntryPoints {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let faces = ctx.render_pipeline(&RenderPipelineSpec {
             shader: "entry_points.wgsl",

@@ -9,7 +9,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
-use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::raycast_fast::SAMPLE_ROWS;
 use crate::raycast_params::{RaycastParamsGpu, Sampling, Workgroup};
@@ -24,7 +24,7 @@ volgraph_core::pass_params! {
     }
 }
 
-impl PassPlugin for FetchProbe {
+impl PassDecl for FetchProbe {
     fn kind(&self) -> &'static str {
         "fetch_probe"
     }
@@ -58,7 +58,9 @@ impl PassPlugin for FetchProbe {
             && Counting::from_params(old) == Counting::from_params(new)
             && crate::effects::jitter_defines(old) == crate::effects::jitter_defines(new)
     }
+}
 
+impl PassPlugin for FetchProbe {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let wg = Workgroup::from_params(ctx.params).size();
         if wg.0 * wg.1 > ctx.gpu.limits.max_compute_invocations_per_workgroup {

@@ -10,7 +10,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
-use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
 pub struct HoleFill;
@@ -25,7 +25,7 @@ volgraph_core::pass_params! {
     }
 }
 
-impl PassPlugin for HoleFill {
+impl PassDecl for HoleFill {
     fn kind(&self) -> &'static str {
         "hole_fill"
     }
@@ -52,7 +52,9 @@ impl PassPlugin for HoleFill {
     fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
         true
     }
+}
 
+impl PassPlugin for HoleFill {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
             shader: "hole_fill.wgsl",

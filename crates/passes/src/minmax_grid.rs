@@ -8,7 +8,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
-use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, Rerun};
+use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, Rerun};
 
 use crate::grid_tap::GridTap;
 use crate::shared::BlockSize;
@@ -85,7 +85,7 @@ pub(crate) fn dispatch_grid(
     );
 }
 
-impl PassPlugin for MinMaxGridPass {
+impl PassDecl for MinMaxGridPass {
     fn kind(&self) -> &'static str {
         "minmax_grid"
     }
@@ -113,7 +113,9 @@ impl PassPlugin for MinMaxGridPass {
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         vec![ShaderUse { file: "minmax_grid.wgsl", entry_point: "cs_minmax", extra: &["minmax"] }]
     }
+}
 
+impl PassPlugin for MinMaxGridPass {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let defines = self.shader_defines(ctx.params);
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {

@@ -6,7 +6,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
-use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
 pub struct Present;
@@ -22,7 +22,7 @@ volgraph_core::pass_params! {
 /// Its one pipeline, declared once: `volgraph plan` checks the bindings of what `create` builds.
 const SHADER: ShaderUse = ShaderUse { file: "present.wgsl", entry_point: "cs_present", extra: &["params"] };
 
-impl PassPlugin for Present {
+impl PassDecl for Present {
     fn kind(&self) -> &'static str {
         "present"
     }
@@ -49,7 +49,9 @@ impl PassPlugin for Present {
     fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
         true
     }
+}
 
+impl PassPlugin for Present {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec::of(&SHADER))?;
         let params = ctx.uniform_from_bytes("params", &PresentParams::from_params(ctx.params).uniform_bytes());

@@ -5,12 +5,12 @@
 use crate::shared::FLOAT_TARGETS;
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
-use volgraph_core::{Params, PassNode, PassPlugin, PortKind, PortSpec};
+use volgraph_core::{Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec};
 
 /// The plugin.
 pub struct RayDirections;
 
-impl PassPlugin for RayDirections {
+impl PassDecl for RayDirections {
     fn kind(&self) -> &'static str {
         "ray_directions"
     }
@@ -32,7 +32,9 @@ impl PassPlugin for RayDirections {
             ShaderUse { file: "ray_directions.wgsl", entry_point: "fs_dir", extra: &[] },
         ]
     }
+}
 
+impl PassPlugin for RayDirections {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
             shader: "ray_directions.wgsl",

@@ -16,7 +16,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
-use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::effects::{EffectFlags, EffectState, effect_defines, same_effects};
 use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
@@ -41,7 +41,7 @@ pub(crate) fn raycast_ports(params: &Params, color: &[TargetFormat], hit: &[Targ
     ports
 }
 
-impl PassPlugin for Raycast {
+impl PassDecl for Raycast {
     fn kind(&self) -> &'static str {
         "raycast"
     }
@@ -107,7 +107,9 @@ impl PassPlugin for Raycast {
             && a.analytic() == b.analytic()
             && a.count_samples == b.count_samples
     }
+}
 
+impl PassPlugin for Raycast {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let fragment = fragment_entry(ctx.params);
         let mut defines = self.shader_defines(ctx.params);

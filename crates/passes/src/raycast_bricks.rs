@@ -40,7 +40,7 @@ use volgraph_core::runtime::{
     ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, volume_region_bytes,
     volume_texture_format,
 };
-use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
 use wgpu::util::DeviceExt;
 
 use crate::brick_pool::{Batch, BrickPool};
@@ -92,7 +92,7 @@ const MAX_STAGING_BYTES: u64 = 64 << 20;
 /// Leap distances are capped here (a cube of 2·255 − 1 leaves is wider than any volume).
 const MAX_LEAP: u32 = 255;
 
-impl PassPlugin for RaycastBricks {
+impl PassDecl for RaycastBricks {
     fn kind(&self) -> &'static str {
         "raycast_bricks"
     }
@@ -137,7 +137,9 @@ impl PassPlugin for RaycastBricks {
             && Workgroup::from_params(old) == Workgroup::from_params(new)
             && self.shader_defines(old) == self.shader_defines(new)
     }
+}
 
+impl PassPlugin for RaycastBricks {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let settings = BrickSettings::from_params(ctx.params);
         let wg = Workgroup::from_params(ctx.params).size();

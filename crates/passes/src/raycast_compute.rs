@@ -5,7 +5,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
-use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortSpec, TargetFormat};
 
 use crate::effects::{EffectFlags, EffectState, effect_defines, same_effects};
 use crate::raycast::raycast_ports;
@@ -15,7 +15,7 @@ use crate::shared::color_is_f32;
 /// The plugin.
 pub struct RaycastCompute;
 
-impl PassPlugin for RaycastCompute {
+impl PassDecl for RaycastCompute {
     fn kind(&self) -> &'static str {
         "raycast_compute"
     }
@@ -50,7 +50,9 @@ impl PassPlugin for RaycastCompute {
             && same_effects(old, new)
             && Workgroup::from_params(old) == Workgroup::from_params(new)
     }
+}
 
+impl PassPlugin for RaycastCompute {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let wg = Workgroup::from_params(ctx.params).size();
         if wg.0 * wg.1 > ctx.gpu.limits.max_compute_invocations_per_workgroup {

@@ -8,7 +8,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
-use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::effects::{EffectState, effect_defines, same_effects};
 use crate::empty_space::{EMPTY_BLOCKS, check_block_grid};
@@ -24,7 +24,7 @@ pub struct RaycastEss;
 const SHADER: ShaderUse =
     ShaderUse { file: "raycast_ess.wgsl", entry_point: "fs_dvr", extra: &["params", "ess", "preintegrated"] };
 
-impl PassPlugin for RaycastEss {
+impl PassDecl for RaycastEss {
     fn kind(&self) -> &'static str {
         "raycast_ess"
     }
@@ -62,7 +62,9 @@ impl PassPlugin for RaycastEss {
         // Every parameter but the effects is a uniform value (the block size too).
         same_effects(old, new)
     }
+}
 
+impl PassPlugin for RaycastEss {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let defines = effect_defines(ctx.params);
         let pipeline =

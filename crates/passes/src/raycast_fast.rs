@@ -24,7 +24,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
-use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::effects::{EffectFlags, EffectState, effect_defines, same_effects};
 use crate::empty_distance::EMPTY_DISTANCE;
@@ -87,7 +87,7 @@ pub(crate) fn dvr_leap_specs() -> Vec<ParamSpec> {
     [Sampling::specs(), Termination::specs(), Shading::specs(), BlockSize::specs(), EffectFlags::specs()].concat()
 }
 
-impl PassPlugin for RaycastFast {
+impl PassDecl for RaycastFast {
     fn kind(&self) -> &'static str {
         "raycast_fast"
     }
@@ -147,7 +147,9 @@ impl PassPlugin for RaycastFast {
             && same_effects(old, new)
             && half_step(old) == half_step(new)
     }
+}
 
+impl PassPlugin for RaycastFast {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let own = FastOwn::from_params(ctx.params);
         let sampling = Sampling::from_params(ctx.params);

@@ -22,7 +22,7 @@ use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{
     CreateContext, DepthSpec, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
 };
-use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::empty_space::EMPTY_BLOCKS;
 use crate::raycast_params::{RaycastParamsGpu, Termination, is_iso, raycast_param_specs};
@@ -109,7 +109,7 @@ pub(crate) fn segment_index(ctx: &RecordContext<'_>) -> u32 {
     ctx.iteration.map_or(0, |(i, _)| i)
 }
 
-impl PassPlugin for RaycastSegment {
+impl PassDecl for RaycastSegment {
     fn kind(&self) -> &'static str {
         "raycast_segment"
     }
@@ -160,7 +160,9 @@ impl PassPlugin for RaycastSegment {
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
         crate::effects::jitter_defines(params)
     }
+}
 
+impl PassPlugin for RaycastSegment {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let error = |message: String| PassError { pass: ctx.pass_id.to_string(), message };
         let accum_format = ctx.ports.iter().find(|p| p.name == "accum").and_then(|p| p.format);

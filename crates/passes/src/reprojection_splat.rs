@@ -14,7 +14,7 @@ use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{
     CameraData, CreateContext, DepthSpec, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
 };
-use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
 pub struct ReprojectionSplat;
@@ -41,7 +41,7 @@ volgraph_core::pass_params! {
     }
 }
 
-impl PassPlugin for ReprojectionSplat {
+impl PassDecl for ReprojectionSplat {
     fn kind(&self) -> &'static str {
         "reprojection_splat"
     }
@@ -72,7 +72,9 @@ impl PassPlugin for ReprojectionSplat {
     fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
         true
     }
+}
 
+impl PassPlugin for ReprojectionSplat {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
             shader: "reprojection_splat.wgsl",

@@ -9,7 +9,7 @@ use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{
     CreateContext, DepthSpec, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
 };
-use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 volgraph_core::pass_params! {
     /// The pass's parameters, declared once.
@@ -28,7 +28,7 @@ fn fragment(params: &Params) -> &'static str {
 /// The value the early-z buffer holds for a live ray (the paper's "z = 0").
 pub(crate) const DEPTH_LIVE: f32 = 0.0;
 
-impl PassPlugin for SegmentInit {
+impl PassDecl for SegmentInit {
     fn kind(&self) -> &'static str {
         "segment_init"
     }
@@ -55,7 +55,9 @@ impl PassPlugin for SegmentInit {
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
         vec![ShaderUse { file: "segment_init.wgsl", entry_point: fragment(params), extra: &[] }]
     }
+}
 
+impl PassPlugin for SegmentInit {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
             shader: "segment_init.wgsl",

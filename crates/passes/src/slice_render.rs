@@ -9,7 +9,7 @@
 use crate::shared::front_to_back_blend;
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
-use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
 pub struct SliceRender;
@@ -30,7 +30,7 @@ volgraph_core::pass_params! {
     }
 }
 
-impl PassPlugin for SliceRender {
+impl PassDecl for SliceRender {
     fn kind(&self) -> &'static str {
         "slice_render"
     }
@@ -57,7 +57,9 @@ impl PassPlugin for SliceRender {
             ShaderUse { file: "slice_render.wgsl", entry_point: "fs_slice", extra: &["slices"] },
         ]
     }
+}
 
+impl PassPlugin for SliceRender {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
             shader: "slice_render.wgsl",

@@ -18,7 +18,7 @@ use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{
     CreateContext, DepthSpec, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
 };
-use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::empty_space::EMPTY_BLOCKS;
 use crate::raycast_params::{RaycastParamsGpu, Sampling};
@@ -37,7 +37,7 @@ volgraph_core::pass_params! {
     }
 }
 
-impl PassPlugin for TerminationTest {
+impl PassDecl for TerminationTest {
     fn kind(&self) -> &'static str {
         "termination_test"
     }
@@ -83,7 +83,9 @@ impl PassPlugin for TerminationTest {
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
         crate::effects::jitter_defines(params)
     }
+}
 
+impl PassPlugin for TerminationTest {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let defines = crate::effects::jitter_defines(ctx.params);
         let spec = |fragment| RenderPipelineSpec {

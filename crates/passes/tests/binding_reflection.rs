@@ -8,7 +8,7 @@ use volgraph_core::runtime::{
     ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, RenderPipelineSpec, Runtime, ShaderLibrary,
 };
 use volgraph_core::{
-    CompileOptions, Params, PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile,
+    CompileOptions, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile,
 };
 
 const FLOATS: [TargetFormat; 3] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float, TargetFormat::Rgba8Unorm];
@@ -29,7 +29,7 @@ impl PassNode for NoOp {
     }
 }
 
-impl PassPlugin for Misnamed {
+impl PassDecl for Misnamed {
     fn kind(&self) -> &'static str {
         self.kind
     }
@@ -64,7 +64,9 @@ impl PassPlugin for Misnamed {
             (None, _) => vec![ShaderUse { file: "raycast.wgsl", entry_point: "fs_dvr", extra: &["params"] }],
         }
     }
+}
 
+impl PassPlugin for Misnamed {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         if self.kind == "undeclared_vertex" {
             ctx.render_pipeline(&RenderPipelineSpec {

@@ -12,7 +12,7 @@ use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::transfer_function::{Preset, TransferFunction};
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CameraData, CreateContext, Gpu, PassError, RecordContext, Runtime};
-use volgraph_core::{CompileOptions, ParamSpec, Params, PassNode, PassPlugin, PortSpec, Registry, Rerun};
+use volgraph_core::{CompileOptions, ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortSpec, Registry, Rerun};
 use volgraph_passes::builtin_registry;
 
 mod support;
@@ -41,7 +41,7 @@ impl PassNode for CountingNode {
     }
 }
 
-impl PassPlugin for Counting {
+impl PassDecl for Counting {
     fn kind(&self) -> &'static str {
         self.inner.kind()
     }
@@ -63,6 +63,9 @@ impl PassPlugin for Counting {
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
         self.inner.updates_in_place(old, new)
     }
+}
+
+impl PassPlugin for Counting {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         Ok(Box::new(CountingNode { inner: self.inner.create(ctx)?, records: self.records.clone() }))
     }

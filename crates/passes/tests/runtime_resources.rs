@@ -12,7 +12,7 @@ use volgraph_core::runtime::{
     RenderPassPipeline, RenderPipelineSpec, Runtime, ShaderLibrary,
 };
 use volgraph_core::{
-    CompileOptions, Params, PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile,
+    CompileOptions, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile,
 };
 
 const SHADER: &str = "splat_count.wgsl";
@@ -63,7 +63,7 @@ impl PassNode for Count {
     }
 }
 
-impl PassPlugin for PointList {
+impl PassDecl for PointList {
     fn kind(&self) -> &'static str {
         "point_list"
     }
@@ -79,6 +79,9 @@ impl PassPlugin for PointList {
             PortKind::Target { formats: vec![TargetFormat::Rgba32Float], size: SizeRule::Any },
         )]
     }
+}
+
+impl PassPlugin for PointList {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
             shader: SHADER,
@@ -90,7 +93,7 @@ impl PassPlugin for PointList {
     }
 }
 
-impl PassPlugin for Splat {
+impl PassDecl for Splat {
     fn kind(&self) -> &'static str {
         "splat"
     }
@@ -112,6 +115,9 @@ impl PassPlugin for Splat {
             PortSpec::write("image", PortKind::target(&[TargetFormat::Rgba32Float])),
         ]
     }
+}
+
+impl PassPlugin for Splat {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
             shader: SHADER,
@@ -124,7 +130,7 @@ impl PassPlugin for Splat {
     }
 }
 
-impl PassPlugin for CountLit {
+impl PassDecl for CountLit {
     fn kind(&self) -> &'static str {
         "count_lit"
     }
@@ -140,6 +146,9 @@ impl PassPlugin for CountLit {
             PortSpec::write("counts", PortKind::buffer(16)),
         ]
     }
+}
+
+impl PassPlugin for CountLit {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline =
             ctx.compute_pipeline(&ComputePipelineSpec { shader: SHADER, entry: "cs_count", ..Default::default() })?;

@@ -16,7 +16,7 @@ use volgraph_core::runtime::{
     ShaderLibrary,
 };
 use volgraph_core::{
-    CompileOptions, ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile,
+    CompileOptions, ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile,
 };
 
 /// `next = value + (amount, 0, 0, 0)`.
@@ -61,7 +61,7 @@ impl PassNode for Node {
 const ADD_ONE: ShaderUse = ShaderUse { file: "add_one.wgsl", entry_point: "fs_add_one", extra: &["params"] };
 const FILL: ShaderUse = ShaderUse { file: "add_one.wgsl", entry_point: "fs_fill", extra: &[] };
 
-impl PassPlugin for AddOne {
+impl PassDecl for AddOne {
     fn kind(&self) -> &'static str {
         "add_one"
     }
@@ -83,6 +83,9 @@ impl PassPlugin for AddOne {
     fn shaders(&self, _p: &Params) -> Vec<ShaderUse> {
         vec![ADD_ONE]
     }
+}
+
+impl PassPlugin for AddOne {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec::fullscreen(&ADD_ONE))?;
         let params =
@@ -91,7 +94,7 @@ impl PassPlugin for AddOne {
     }
 }
 
-impl PassPlugin for Fill {
+impl PassDecl for Fill {
     fn kind(&self) -> &'static str {
         "fill"
     }
@@ -104,13 +107,16 @@ impl PassPlugin for Fill {
     fn shaders(&self, _p: &Params) -> Vec<ShaderUse> {
         vec![FILL]
     }
+}
+
+impl PassPlugin for Fill {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec::fullscreen(&FILL))?;
         Ok(Box::new(Node { pipeline, params: None }))
     }
 }
 
-impl PassPlugin for Broken {
+impl PassDecl for Broken {
     fn kind(&self) -> &'static str {
         "broken"
     }
@@ -120,6 +126,9 @@ impl PassPlugin for Broken {
     fn ports(&self, _p: &Params) -> Vec<PortSpec> {
         vec![PortSpec::write("filled", PortKind::target(&[TargetFormat::Rgba32Float]))]
     }
+}
+
+impl PassPlugin for Broken {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         Err(PassError { pass: ctx.pass_id.to_string(), message: "this kind never builds".to_string() })
     }

@@ -5,7 +5,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
-use volgraph_core::{ParamSpec, Params, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
 // volgraph's shared sampling block: the same step, sample count and jitter as its raycasters.
 use volgraph_passes::raycast_params::{RaycastParamsGpu, Sampling};
 
@@ -25,7 +25,7 @@ volgraph_core::pass_params! {
 /// built by `create`.
 const SHADER: ShaderUse = ShaderUse { file: "mip.wgsl", entry_point: "cs_main", extra: &["mip", "params"] };
 
-impl PassPlugin for Mip {
+impl PassDecl for Mip {
     fn kind(&self) -> &'static str {
         "mip"
     }
@@ -57,7 +57,9 @@ impl PassPlugin for Mip {
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
         self.shader_defines(old) == self.shader_defines(new)
     }
+}
 
+impl PassPlugin for Mip {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let defines = self.shader_defines(ctx.params);
         let pipeline =

@@ -194,7 +194,7 @@ impl volgraph_core::PassNode for BadDrawNode {
 const BAD_DRAW: volgraph_core::plugin::ShaderUse =
     volgraph_core::plugin::ShaderUse { file: "present.wgsl", entry_point: "cs_present", extra: &["params"] };
 
-impl volgraph_core::PassPlugin for BadDraw {
+impl volgraph_core::PassDecl for BadDraw {
     fn kind(&self) -> &'static str {
         "bad_draw"
     }
@@ -219,6 +219,9 @@ impl volgraph_core::PassPlugin for BadDraw {
     fn shaders(&self, _p: &volgraph_core::Params) -> Vec<volgraph_core::plugin::ShaderUse> {
         vec![BAD_DRAW]
     }
+}
+
+impl volgraph_core::PassPlugin for BadDraw {
     fn create(
         &self,
         ctx: &volgraph_core::runtime::CreateContext<'_>,

@@ -15,9 +15,7 @@ use super::reflect::{BindingKind, ReflectedBinding, layout_entry, reflect};
 use super::shaders::ShaderLibrary;
 use crate::params::Params;
 use crate::plugin::{Access, PassPlugin, ShaderUse};
-
-/// Names the runtime binds itself, in every pass that declares them.
-pub const SYSTEM_BINDINGS: [&str; 3] = ["frame", "linear_clamp", "nearest_clamp"];
+pub use volgraph_compiler::binding_rules::{PortInfo, SYSTEM_BINDINGS, check_bindings};
 
 /// A pass failed to build or record.
 #[derive(Clone, Debug, thiserror::Error, PartialEq, Eq)]
@@ -29,40 +27,6 @@ pub struct PassError {
     pub message: String,
 }
 
-/// What a port of a pass is, as the runtime resolved it.
-#[derive(Clone, Debug, PartialEq, Eq, Hash)]
-pub struct PortInfo {
-    /// Port name.
-    pub name: String,
-    /// Read, write or modify.
-    pub access: Access,
-    /// Texture format, when known at build time (targets; graph inputs are filterable formats).
-    pub format: Option<wgpu::TextureFormat>,
-    /// A texture another pass owns (a min/max grid): bound as unfilterable float, read with
-    /// `textureLoad`, so 32-bit float grids need no FLOAT32_FILTERABLE. True for an Owned port
-    /// whether or not it is wired (see `bound`).
-    pub owned: bool,
-    /// A storage buffer (counters, point lists) rather than a texture.
-    pub buffer: bool,
-    /// Whether the graph wires this port (optional inputs may be left unwired; a node binds a
-    /// stand-in or picks a variant without it).
-    pub bound: bool,
-    /// The texture dimension the port binds, where its kind fixes one (targets and the TF are
-    /// 2D, the volume 3D); `None` for owned resources and buffers.
-    pub dim: Option<wgpu::TextureViewDimension>,
-}
-
-/// Names a texture dimension as WGSL writes it.
-fn wgsl_dim(dim: wgpu::TextureViewDimension) -> &'static str {
-    match dim {
-        wgpu::TextureViewDimension::D1 => "texture_1d",
-        wgpu::TextureViewDimension::D2 => "texture_2d",
-        wgpu::TextureViewDimension::D2Array => "texture_2d_array",
-        wgpu::TextureViewDimension::Cube => "texture_cube",
-        wgpu::TextureViewDimension::CubeArray => "texture_cube_array",
-        wgpu::TextureViewDimension::D3 => "texture_3d",
-    }
-}
 
 /// Depth test of a render pipeline.
 #[derive(Clone, Copy, Debug)]
@@ -610,107 +574,3 @@ impl<'a> CreateContext<'a> {
     }
 }
 
-/// Checks the globals an entry point uses (`bindings`, reflected from `shader`) against a pass's
-/// ports, the system bindings and the names the node binds itself (`extra`): every global must
-/// be one of them, in `@group(0)`, a storage buffer exactly where the port is a buffer, a
-/// storage texture only for an output (of the port's format when `formats` is set), and no
-/// sampled output. Used when a node is created and by `volgraph plan` without a GPU.
-pub fn check_bindings(
-    shader: &str,
-    bindings: &[ReflectedBinding],
-    extra: &[&str],
-    ports: &[PortInfo],
-    formats: bool,
-) -> Result<(), String> {
-    for b in bindings {
-        if b.group != 0 {
-            return Err(format!(
-                "{shader}: global \"{}\" is in @group({}); volgraph binds everything in @group(0)",
-                b.name, b.group
-            ));
-        }
-        if SYSTEM_BINDINGS.contains(&b.name.as_str()) || extra.contains(&b.name.as_str()) {
-            continue;
-        }
-        let Some(p) = ports.iter().find(|p| p.name == b.name) else {
-            let ports: Vec<&str> = ports.iter().map(|p| p.name.as_str()).collect();
-            return Err(format!(
-                "{shader}: global \"{}\" is neither a port of this pass (ports: {}) nor a system binding ({}) \
-                 nor one the pass binds itself ({}); rename it to the port it stands for, or, when the node \
-                 binds it itself, add \"{}\" to the `extra` names of the pass's ShaderUse",
-                b.name,
-                ports.join(", "),
-                SYSTEM_BINDINGS.join(", "),
-                if extra.is_empty() { "none".to_string() } else { extra.join(", ") },
-                b.name
-            ));
-        };
-        let shader_dim = match &b.ty {
-            BindingKind::Texture { dim, .. } | BindingKind::StorageTexture { dim, .. } => Some(*dim),
-            _ => None,
-        };
-        if let (Some(have), Some(want)) = (shader_dim, p.dim)
-            && have != want
-        {
-            return Err(format!(
-                "{shader}: global \"{}\" is a {} but port \"{}\" binds a {} texture; declare it {}",
-                b.name,
-                wgsl_dim(have),
-                b.name,
-                if want == wgpu::TextureViewDimension::D3 { "3D" } else { "2D" },
-                wgsl_dim(want),
-            ));
-        }
-        match &b.ty {
-            BindingKind::Storage { read_only } => {
-                if !p.buffer {
-                    return Err(format!(
-                        "{shader}: global \"{}\" is a storage buffer but port \"{}\" is a texture",
-                        b.name, b.name
-                    ));
-                }
-                if !*read_only && p.access == Access::Read {
-                    return Err(format!(
-                        "{shader}: storage buffer \"{}\" is read_write but the port is an input; declare it \
-                         var<storage, read>",
-                        b.name
-                    ));
-                }
-            }
-            _ if p.buffer => {
-                return Err(format!(
-                    "{shader}: global \"{}\" is not a storage buffer but port \"{}\" is a buffer; declare it \
-                     var<storage, read> or var<storage, read_write>",
-                    b.name, b.name
-                ));
-            }
-            BindingKind::StorageTexture { format, .. } => {
-                if p.access == Access::Read {
-                    return Err(format!(
-                        "{shader}: storage texture \"{}\" is an input port; storage textures are outputs",
-                        b.name
-                    ));
-                }
-                if formats
-                    && let Some(port_format) = p.format
-                    && *format != Some(port_format)
-                {
-                    let declared = format.map_or("an unsupported format".to_string(), |f| format!("{f:?}"));
-                    return Err(format!(
-                        "{shader}: storage texture \"{}\" is declared {declared} but the port's target is \
-                         {port_format:?}; declare the output with the shader's format",
-                        b.name
-                    ));
-                }
-            }
-            _ if p.access == Access::Write => {
-                return Err(format!(
-                    "{shader}: global \"{}\" samples output port \"{}\"; outputs are written, not read",
-                    b.name, b.name
-                ));
-            }
-            _ => {}
-        }
-    }
-    Ok(())
-}

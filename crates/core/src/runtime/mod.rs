@@ -11,6 +11,7 @@
 //! [`Runtime::read_output`] (readback).
 
 pub mod create;
+pub use volgraph_compiler::reflect;
 pub mod frame;
 pub mod frames;
 pub mod gpu;
@@ -19,7 +20,6 @@ pub mod inputs;
 pub mod present;
 pub mod readback;
 pub mod record;
-pub mod reflect;
 pub mod schedule;
 pub mod shaders;
 pub mod textures;

@@ -16,7 +16,8 @@ use super::shaders::ShaderLibrary;
 use super::textures::{PooledBuffer, PooledTexture, TextureKey, TexturePool};
 use crate::params::Params;
 use crate::plan::{Binding, Plan, ResourceDesc, ResourceId, SlotDesc};
-use crate::plugin::{Access, PassNode, PortKind, Registry, Rerun};
+use crate::plugin::{Access, PassNode, Registry, Rerun};
+pub use volgraph_compiler::binding_rules::port_infos;
 
 /// A node with what it was built from.
 pub(crate) struct NodeEntry {
@@ -131,47 +132,6 @@ pub enum ApplyError {
     Gpu(#[from] GpuFault),
 }
 
-/// The ports of `step` as the runtime resolves them (formats from the plan's resources): what
-/// [`crate::plugin::PassPlugin::create`] sees, also for tools that create nodes outside a runtime.
-pub fn port_infos(plan: &Plan, step: &crate::plan::Step, specs: &[crate::plugin::PortSpec]) -> Vec<PortInfo> {
-    step.ports
-        .iter()
-        .map(|bp| {
-            let desc_format = |rid: ResourceId| match &plan.resources[rid].desc {
-                ResourceDesc::Target { format, .. } => Some(format.wgpu()),
-                ResourceDesc::Buffer { .. } | ResourceDesc::Owned(_) => None,
-            };
-            let format = match &bp.binding {
-                Binding::Resource { id, .. } => desc_format(*id),
-                Binding::History(name) => plan.history.get(name).and_then(|h| desc_format(h.source)),
-                _ => specs.iter().find(|s| s.name == bp.port).and_then(|s| match &s.kind {
-                    PortKind::Target { formats, .. } => formats.first().map(|f| f.wgpu()),
-                    _ => None,
-                }),
-            };
-            let desc = match &bp.binding {
-                Binding::Resource { id, .. } => Some(&plan.resources[*id].desc),
-                _ => None,
-            };
-            let declared = specs.iter().find(|s| s.name == bp.port).map(|s| &s.kind);
-            let owned = matches!(desc, Some(ResourceDesc::Owned(_))) || matches!(declared, Some(PortKind::Owned(_)));
-            let buffer = matches!(desc, Some(ResourceDesc::Buffer { .. }))
-                || (matches!(bp.binding, Binding::Unbound)
-                    && specs.iter().any(|s| s.name == bp.port && matches!(s.kind, PortKind::Buffer { .. })));
-            let bound = !matches!(bp.binding, Binding::Unbound);
-            let dim = match (desc, declared) {
-                (Some(ResourceDesc::Target { .. }), _) => Some(wgpu::TextureViewDimension::D2),
-                (Some(_), _) => None,
-                (None, Some(PortKind::Target { .. } | PortKind::TransferFunction)) => {
-                    Some(wgpu::TextureViewDimension::D2)
-                }
-                (None, Some(PortKind::Volume)) => Some(wgpu::TextureViewDimension::D3),
-                _ => None,
-            };
-            PortInfo { name: bp.port.clone(), access: bp.access, format, owned, buffer, bound, dim }
-        })
-        .collect()
-}
 
 /// The slot's history entry name, if it is the current-frame texture of one.
 fn history_of_slot(plan: &Plan, slot: usize) -> Option<&str> {

@@ -2,11 +2,10 @@
 //! class of binding error that used to surface only when the node was created at run time.
 //! The plugins and shaders here are test-local, registered through the public API.
 
-use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{CreateContext, PassError, RecordContext};
-use volgraph_core::shader_source::ShaderSources;
-use volgraph_core::{
-    CompileOptions, Params, PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, check_plan_bindings,
+use volgraph_compiler::decl::ShaderUse;
+use volgraph_compiler::shader_source::ShaderSources;
+use volgraph_compiler::{
+    CompileOptions, Params, PassDecl, PortKind, PortSpec, Kinds, TargetFormat, check_plan_bindings,
     compile,
 };
 
@@ -16,15 +15,8 @@ struct Probe {
     entry: &'static str,
 }
 
-struct Noop;
 
-impl PassNode for Noop {
-    fn record(&mut self, _ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
-        Ok(())
-    }
-}
-
-impl PassPlugin for Probe {
+impl PassDecl for Probe {
     fn kind(&self) -> &'static str {
         "probe"
     }
@@ -41,14 +33,12 @@ impl PassPlugin for Probe {
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         vec![ShaderUse { file: "probe.wgsl", entry_point: self.entry, extra: &["params"] }]
     }
-    fn create(&self, _ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        Ok(Box::new(Noop))
-    }
 }
+
 
 struct Source;
 
-impl PassPlugin for Source {
+impl PassDecl for Source {
     fn kind(&self) -> &'static str {
         "source"
     }
@@ -58,10 +48,8 @@ impl PassPlugin for Source {
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
         vec![PortSpec::write("color", PortKind::target(&[TargetFormat::Rgba16Float]))]
     }
-    fn create(&self, _ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        Ok(Box::new(Noop))
-    }
 }
+
 
 const SHADER: &str = r#"
 struct P { k: f32 }
@@ -119,7 +107,7 @@ const GRAPH: &str = r#"Graph(
 )"#;
 
 fn problems(entry: &'static str, shader: &'static str) -> Vec<String> {
-    let mut registry = Registry::new();
+    let mut registry = Kinds::new();
     registry.register(Source).register(Probe { entry });
     let plan = compile("probe.ron", GRAPH, &registry, &CompileOptions::new(32, 32)).expect("compiles");
     // Embedded shader tables are 'static; a test leaks its few bytes.
@@ -182,7 +170,7 @@ fn a_storage_texture_on_an_input_and_a_sampled_output_are_caught_at_plan_time() 
 /// of the assembled text.
 #[test]
 fn a_shader_error_points_at_the_imported_file_and_line() {
-    let mut registry = Registry::new();
+    let mut registry = Kinds::new();
     registry.register(Source).register(Probe { entry: "cs_ok" });
     let plan = compile("probe.ron", GRAPH, &registry, &CompileOptions::new(32, 32)).expect("compiles");
     let table: &'static [(&'static str, &'static str)] = Box::leak(Box::new([

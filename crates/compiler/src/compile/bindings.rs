@@ -1,9 +1,9 @@
 //! Shader bindings checked at plan time, without a GPU: every scheduled pass's declared shader
-//! uses ([`crate::plugin::PassPlugin::shaders`]) are assembled with the pass's `#if` names,
+//! uses ([`crate::decl::PassDecl::shaders`]) are assembled with the pass's `#if` names,
 //! parsed and validated with naga, and each entry point's globals are checked against the
 //! pass's ports, the system bindings and the names the node binds itself
-//! ([`crate::plugin::ShaderUse::extra`]) — the same rules node creation enforces
-//! ([`crate::runtime::create::check_bindings`]), except storage texture formats, which depend
+//! ([`crate::decl::ShaderUse::extra`]) — the same rules node creation enforces
+//! ([`crate::binding_rules::check_bindings`]), except storage texture formats, which depend
 //! on the target formats a node picks its shader variant by. A misnamed port, a buffer bound
 //! as a texture, a sampled output or an entry point the shader does not have is reported by
 //! `volgraph plan` instead of at the first frame.
@@ -12,16 +12,16 @@ use std::collections::{BTreeSet, HashSet};
 
 use crate::diagnostic::{Diagnostic, Location};
 use crate::plan::Plan;
-use crate::plugin::Registry;
-use crate::runtime::create::{PortInfo, check_bindings};
-use crate::runtime::reflect::reflect;
-use crate::runtime::schedule::port_infos;
-use crate::runtime::shaders::parse_and_validate_source;
+use crate::decl::KindLookup;
+use crate::binding_rules::{PortInfo, check_bindings};
+use crate::reflect::reflect;
+use crate::binding_rules::port_infos;
+use crate::shader_check::parse_and_validate_source;
 use crate::shader_source::{ShaderSources, assemble_with};
 
 /// The binding problems of `plan`'s passes, one per pass and shader use, each naming them.
-pub fn check_plan_bindings(plan: &Plan, registry: &Registry, sources: &ShaderSources) -> Vec<Diagnostic> {
-    let registry = crate::wgsl_pass::with_graph_kinds(registry, &plan.kinds);
+pub fn check_plan_bindings(plan: &Plan, registry: &dyn KindLookup, sources: &ShaderSources) -> Vec<Diagnostic> {
+    let registry = crate::wgsl_kind::with_graph_kinds(registry, &plan.kinds);
     let mut out = Vec::new();
     let mut seen = HashSet::new();
     for step in &plan.steps {
@@ -29,7 +29,7 @@ pub fn check_plan_bindings(plan: &Plan, registry: &Registry, sources: &ShaderSou
         if !seen.insert(step.pass_id.clone()) {
             continue;
         }
-        let Some(plugin) = registry.get(&step.kind) else { continue };
+        let Some(plugin) = registry.decl(&step.kind) else { continue };
         let defines: BTreeSet<String> = plugin.shader_defines(&step.params).into_iter().map(str::to_string).collect();
         let ports: Vec<PortInfo> = port_infos(plan, step, &plugin.ports(&step.params));
         let wired: Vec<&str> = step

@@ -17,7 +17,7 @@ use super::{CompileOptions, MAX_PLAN_STEPS};
 use crate::diagnostic::{Diagnostic, Location};
 use crate::graph::ast::{GraphDoc, HistoryInitial};
 use crate::plan::{Binding, BoundPort, History, Plan, Resource, ResourceDesc, ResourceId, Slot, Step};
-use crate::plugin::{Access, PortKind};
+use crate::decl::{Access, PortKind};
 
 #[derive(Clone, Debug, PartialEq)]
 enum Val {

@@ -13,7 +13,7 @@ use std::sync::Arc;
 
 use crate::diagnostic::Diagnostics;
 use crate::plan::Plan;
-use crate::plugin::Registry;
+use crate::decl::KindLookup;
 
 /// The most iterations one repeat group may have: a bound, so that a typo such as
 /// `Fixed(1000000)` is a located error rather than a hang. Krüger–Westermann's loop on a 4096-voxel
@@ -91,21 +91,21 @@ pub use bindings::check_plan_bindings;
 pub const SCENE_EFFECTS: [&str; 4] = ["shading", "preintegration", "jitter", "tricubic"];
 
 /// Compiles graph text named `file` (used in messages) into a plan.
-pub fn compile(file: &str, source: &str, registry: &Registry, options: &CompileOptions) -> Result<Plan, Diagnostics> {
+pub fn compile(file: &str, source: &str, registry: &dyn KindLookup, options: &CompileOptions) -> Result<Plan, Diagnostics> {
     // A UTF-8 byte-order mark (some Windows editors write one) is not part of the graph.
     let source = source.strip_prefix('\u{feff}').unwrap_or(source);
     let fail = |items| Diagnostics { file: file.to_string(), text: Arc::from(source), items };
     let doc = crate::graph::parse_graph(source).map_err(|d| fail(vec![d]))?;
     // Pass kinds the graph declares itself join the registry for this graph only.
     let extended;
-    let registry = if doc.kinds.is_empty() {
+    let registry: &dyn KindLookup = if doc.kinds.is_empty() {
         registry
     } else {
-        let problems = crate::wgsl_pass::check_kinds_in(&doc.kinds, registry, source);
+        let problems = crate::wgsl_kind::check_kinds_in(&doc.kinds, registry, source);
         if !problems.is_empty() {
             return Err(fail(problems));
         }
-        extended = crate::wgsl_pass::with_graph_kinds(registry, &doc.kinds);
+        extended = crate::wgsl_kind::with_graph_kinds(registry, &doc.kinds);
         &extended
     };
     let checked = check::check(&doc, source, registry, options).map_err(fail)?;

@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use super::{Checker, Ref, ValueDesc};
 use crate::diagnostic::Location;
 use crate::graph::ast::HistoryInitial;
-use crate::plugin::PortKind;
+use crate::decl::PortKind;
 use crate::suggest::comma_list;
 
 impl Checker<'_> {

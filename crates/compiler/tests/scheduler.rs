@@ -2,13 +2,12 @@
 //! ping-pong, Modify chains, history, feature gating and scene-derived repeat counts.
 //!
 //! The pass kinds are defined here, outside `volgraph-passes`, through the public
-//! [`PassPlugin`] API: this is also the proof that a crate other than the built-in one can add
+//! [`PassDecl`] API: this is also the proof that a crate other than the built-in one can add
 //! pass kinds and have them scheduled. Their nodes record nothing; these tests never touch a GPU.
 
-use volgraph_core::plan::{Binding, ResourceDesc};
-use volgraph_core::runtime::{CreateContext, PassError, RecordContext};
-use volgraph_core::{
-    Access, CompileOptions, ParamSpec, Params, PassNode, PassPlugin, Plan, PortKind, PortSpec, Registry, TargetFormat,
+use volgraph_compiler::plan::{Binding, ResourceDesc};
+use volgraph_compiler::{
+    Access, CompileOptions, ParamSpec, Params, PassDecl, Plan, PortKind, PortSpec, Kinds, TargetFormat,
     compile,
 };
 
@@ -52,15 +51,8 @@ impl Kind {
 }
 
 /// Records nothing: scheduling tests never run a frame.
-struct Noop;
 
-impl PassNode for Noop {
-    fn record(&mut self, _ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
-        Ok(())
-    }
-}
-
-impl PassPlugin for Kind {
+impl PassDecl for Kind {
     fn kind(&self) -> &'static str {
         self.name
     }
@@ -80,18 +72,15 @@ impl PassPlugin for Kind {
     fn features(&self) -> Vec<&'static str> {
         self.features.clone()
     }
-
-    fn create(&self, _ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        Ok(Box::new(Noop))
-    }
 }
+
 
 const RGBA32: TargetFormat = TargetFormat::Rgba32Float;
 const RGBA16: TargetFormat = TargetFormat::Rgba16Float;
 const DEPTH: TargetFormat = TargetFormat::Depth32Float;
 
-fn registry() -> Registry {
-    let mut r = Registry::new();
+fn registry() -> Kinds {
+    let mut r = Kinds::new();
     r.register(Kind::new("source").write("out", RGBA32));
     r.register(Kind::new("source16").write("out", RGBA16));
     r.register(Kind::new("filter").read("src", RGBA32).write("out", RGBA32));

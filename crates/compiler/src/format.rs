@@ -81,15 +81,15 @@ impl TargetFormat {
     }
 
     /// The wgpu format.
-    pub fn wgpu(self) -> wgpu::TextureFormat {
+    pub fn wgpu(self) -> wgpu_types::TextureFormat {
         match self {
-            TargetFormat::R32Float => wgpu::TextureFormat::R32Float,
-            TargetFormat::Rg32Float => wgpu::TextureFormat::Rg32Float,
-            TargetFormat::Rgba16Float => wgpu::TextureFormat::Rgba16Float,
-            TargetFormat::Rgba32Float => wgpu::TextureFormat::Rgba32Float,
-            TargetFormat::Depth32Float => wgpu::TextureFormat::Depth32Float,
-            TargetFormat::Rgba8Unorm => wgpu::TextureFormat::Rgba8Unorm,
-            TargetFormat::R8Unorm => wgpu::TextureFormat::R8Unorm,
+            TargetFormat::R32Float => wgpu_types::TextureFormat::R32Float,
+            TargetFormat::Rg32Float => wgpu_types::TextureFormat::Rg32Float,
+            TargetFormat::Rgba16Float => wgpu_types::TextureFormat::Rgba16Float,
+            TargetFormat::Rgba32Float => wgpu_types::TextureFormat::Rgba32Float,
+            TargetFormat::Depth32Float => wgpu_types::TextureFormat::Depth32Float,
+            TargetFormat::Rgba8Unorm => wgpu_types::TextureFormat::Rgba8Unorm,
+            TargetFormat::R8Unorm => wgpu_types::TextureFormat::R8Unorm,
         }
     }
 

@@ -16,7 +16,7 @@ use crate::format::{TargetFormat, TargetSize};
 use crate::graph::ast::{GraphDoc, HistoryInitial, InputKind, NodeDoc, RepeatCount};
 use crate::graph::locate::{Locator, PassPath};
 use crate::params::Params;
-use crate::plugin::{PassPlugin, PortSpec, Registry};
+use crate::decl::{KindLookup, PassDecl, PortSpec};
 use crate::suggest::comma_list;
 
 /// A resolved reference to a value.
@@ -57,7 +57,7 @@ pub(crate) struct PassInfo {
     pub kind: String,
     pub path: PassPath,
     pub group: Option<usize>,
-    pub plugin: Option<Arc<dyn PassPlugin>>,
+    pub plugin: Option<Arc<dyn PassDecl>>,
     pub params: Params,
     pub ports: Vec<PortSpec>,
     pub outputs: BTreeMap<String, ValueDesc>,
@@ -102,7 +102,7 @@ struct Checker<'a> {
     doc: &'a GraphDoc,
     source: &'a str,
     loc: Locator,
-    registry: &'a Registry,
+    registry: &'a dyn KindLookup,
     options: &'a CompileOptions,
     diags: Vec<Diagnostic>,
     warnings: Vec<Diagnostic>,
@@ -116,7 +116,7 @@ struct Checker<'a> {
 pub(crate) fn check(
     doc: &GraphDoc,
     source: &str,
-    registry: &Registry,
+    registry: &dyn KindLookup,
     options: &CompileOptions,
 ) -> Result<Checked, Vec<Diagnostic>> {
     let mut c = Checker {

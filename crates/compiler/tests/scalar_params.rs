@@ -5,7 +5,7 @@
 
 mod support;
 
-use volgraph_core::{CompileOptions, compile};
+use volgraph_compiler::{CompileOptions, compile};
 
 const GRAPH: &str = r#"Graph(
     name: "shared scalars",

@@ -96,7 +96,7 @@ impl Checker<'_> {
                     ),
                     Some(format!(
                         "use at most Fixed({MAX_REPEAT_ITERATIONS}) and do more work per iteration \
-                         (volgraph_core::compile::MAX_REPEAT_ITERATIONS)"
+                         (volgraph_compiler::compile::MAX_REPEAT_ITERATIONS)"
                     )),
                 );
                 1
@@ -206,7 +206,7 @@ impl Checker<'_> {
         if self.claim_id(&p.id, self.loc.pass_field(path, &p.id, "id"), first) {
             self.pass_by_id.insert(p.id.clone(), idx);
         }
-        let plugin = self.registry.get(&p.kind).cloned();
+        let plugin = self.registry.decl(&p.kind);
         let mut info = PassInfo {
             id: p.id.clone(),
             kind: p.kind.clone(),
@@ -223,7 +223,7 @@ impl Checker<'_> {
             otherwise: BTreeMap::new(),
         };
         let Some(plugin) = plugin else {
-            let kinds = self.registry.kinds();
+            let kinds = self.registry.kind_names();
             let mut help = format!(
                 "known kinds: {}; a kind written in Rust by another crate (such as examples/radiology's \"mip\") \
                  is known only to that crate's program, which registers it (docs/writing_a_pass.md), and a WGSL-only \

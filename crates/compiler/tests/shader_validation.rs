@@ -7,7 +7,7 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 use naga::valid::{Capabilities, ValidationFlags, Validator};
-use volgraph_core::shader_source::{default_shader_root, load_shader};
+use volgraph_compiler::shader_source::{default_shader_root, load_shader};
 
 /// `.wgsl` files directly in `dir`, as paths relative to the shader root (`prefix` + name).
 fn wgsl_files(dir: &Path, prefix: &str) -> Vec<String> {

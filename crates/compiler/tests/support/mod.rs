@@ -9,9 +9,8 @@
 
 #![allow(dead_code, reason = "each test file uses a different subset of the helpers")]
 
-use volgraph_core::params::ParamSpec;
-use volgraph_core::runtime::{CreateContext, PassError, RecordContext};
-use volgraph_core::{PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat};
+use volgraph_compiler::params::ParamSpec;
+use volgraph_compiler::{PassDecl, PortKind, PortSpec, Kinds, TargetFormat};
 
 /// Float targets the ray passes accept (first is the default for outputs).
 pub const FLOAT_TARGETS: [TargetFormat; 2] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float];
@@ -36,15 +35,8 @@ impl TestPlugin {
     }
 }
 
-struct NoopNode;
 
-impl PassNode for NoopNode {
-    fn record(&mut self, _ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
-        Ok(())
-    }
-}
-
-impl PassPlugin for TestPlugin {
+impl PassDecl for TestPlugin {
     fn kind(&self) -> &'static str {
         self.kind
     }
@@ -57,7 +49,7 @@ impl PassPlugin for TestPlugin {
         self.params.clone()
     }
 
-    fn ports(&self, params: &volgraph_core::Params) -> Vec<PortSpec> {
+    fn ports(&self, params: &volgraph_compiler::Params) -> Vec<PortSpec> {
         let mut ports = self.ports.clone();
         if params.declares("mode") && params.choice("mode") == "iso" {
             ports.extend(self.iso_ports.iter().cloned());
@@ -68,11 +60,8 @@ impl PassPlugin for TestPlugin {
     fn features(&self) -> Vec<&'static str> {
         self.features.clone()
     }
-
-    fn create(&self, _ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        Ok(Box::new(NoopNode))
-    }
 }
+
 
 fn raycast_params() -> Vec<ParamSpec> {
     vec![
@@ -90,9 +79,9 @@ fn raycast_params() -> Vec<ParamSpec> {
 }
 
 /// The test registry: built-in look-alikes plus the papers' passes.
-pub fn registry() -> Registry {
+pub fn registry() -> Kinds {
     let t = PortKind::target;
-    let mut r = Registry::new();
+    let mut r = Kinds::new();
     r.register(TestPlugin::new("entry_points", vec![PortSpec::write("entry", t(&FLOAT_TARGETS))]));
     r.register(TestPlugin::new(
         "ray_directions",

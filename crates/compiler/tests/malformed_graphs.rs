@@ -10,7 +10,7 @@ mod support;
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use volgraph_core::{CompileOptions, compile};
+use volgraph_compiler::{CompileOptions, compile};
 
 fn malformed_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tests/graphs/malformed")

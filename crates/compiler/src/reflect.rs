@@ -4,6 +4,7 @@
 //! and checks at graph load that every binding has a meaning.
 
 use naga::{AddressSpace, ImageClass, ImageDimension, TypeInner};
+use wgpu_types as wgpu;
 
 /// One resource binding an entry point uses.
 #[derive(Clone, Debug, PartialEq)]

@@ -6,7 +6,7 @@ use super::{Checker, PassInfo, ValueDesc};
 use crate::format::{TargetFormat, TargetSize};
 use crate::graph::ast::PassDoc;
 use crate::graph::locate::PassPath;
-use crate::plugin::{Access, PortKind};
+use crate::decl::{Access, PortKind};
 use crate::suggest::{closest, comma_list, guess_then};
 
 impl Checker<'_> {

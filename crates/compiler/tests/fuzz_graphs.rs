@@ -13,7 +13,7 @@ mod support;
 use std::path::Path;
 
 use proptest::prelude::*;
-use volgraph_core::{CompileOptions, Location, compile};
+use volgraph_compiler::{CompileOptions, Location, compile};
 
 const FILE: &str = "fuzz.ron";
 

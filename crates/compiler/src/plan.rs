@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 use crate::format::{TargetFormat, TargetSize};
 use crate::graph::ast::{HistoryInitial, InputKind};
 use crate::params::Params;
-use crate::plugin::Access;
+use crate::decl::Access;
 
 /// Index into [`Plan::resources`].
 pub type ResourceId = usize;
@@ -37,7 +37,7 @@ pub struct Plan {
     /// History entries: name → what they track.
     pub history: BTreeMap<String, History>,
     /// Pass kinds the graph declares itself (WGSL-only passes): the runtime adds them to its
-    /// registry when it applies the plan ([`crate::wgsl_pass::with_graph_kinds`]).
+    /// registry when it applies the plan ([`crate::wgsl_kind::with_graph_kinds`]).
     pub kinds: BTreeMap<String, crate::graph::ast::WgslKindDoc>,
     /// Every scene feature some pass of the graph needs, on or off (what a viewer offers as
     /// toggles, and what `--features` may name).
@@ -90,7 +90,7 @@ pub enum Binding {
     },
     /// A graph input bound by the application.
     Input(String),
-    /// A volume input the pass reads as voxels on the CPU ([`crate::plugin::PortKind::VolumeVoxels`]):
+    /// A volume input the pass reads as voxels on the CPU ([`crate::decl::PortKind::VolumeVoxels`]):
     /// no texture is made for it.
     InputVoxels(String),
     /// The previous frame's value of a history entry.

@@ -3,8 +3,8 @@
 
 mod support;
 
-use volgraph_core::compile::{MAX_PLAN_STEPS, MAX_REPEAT_ITERATIONS};
-use volgraph_core::{CompileOptions, compile};
+use volgraph_compiler::compile::{MAX_PLAN_STEPS, MAX_REPEAT_ITERATIONS};
+use volgraph_compiler::{CompileOptions, compile};
 
 /// A Krüger–Westermann style loop with `body_passes` passes per iteration (a segment, then
 /// termination tests chained on its depth); `count` is spliced in as written.

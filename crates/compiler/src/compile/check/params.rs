@@ -5,11 +5,11 @@ use super::Checker;
 use crate::graph::ast::PassDoc;
 use crate::graph::locate::PassPath;
 use crate::params::{ParamKind, ParamProblem, Params, check_param};
-use crate::plugin::PassPlugin;
+use crate::decl::PassDecl;
 use crate::suggest::{comma_list, guess_then, quoted_list};
 
 impl Checker<'_> {
-    pub(super) fn check_params(&mut self, p: &PassDoc, path: PassPath, plugin: &dyn PassPlugin) -> Params {
+    pub(super) fn check_params(&mut self, p: &PassDoc, path: PassPath, plugin: &dyn PassDecl) -> Params {
         let specs = plugin.params();
         let mut params = Params::defaults(&specs);
         let mut values: Vec<(String, ron::Value)> = p.params.iter().map(|(k, v)| (k.clone(), v.clone())).collect();

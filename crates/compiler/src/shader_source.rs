@@ -129,6 +129,12 @@ impl ShaderSources {
         self
     }
 
+    /// Searches `table` before every layer already added (a plugin program's own shaders).
+    pub fn prepend_embedded(mut self, table: EmbeddedShaders) -> Self {
+        self.layers.insert(0, SourceLayer::Embedded(table));
+        self
+    }
+
     /// Searches `dir` before every layer already added.
     pub fn prepend_disk(mut self, dir: impl Into<PathBuf>) -> Self {
         self.layers.insert(0, SourceLayer::Disk(dir.into()));
@@ -467,7 +473,7 @@ mod tests {
         ];
         let s = assemble(&ShaderSources::new().with_embedded(FILES), "pass.wgsl").expect("assembles");
         assert!(!s.text.contains("auto"), "{}", s.text);
-        let (module, _) = crate::runtime::shaders::parse_and_validate("pass.wgsl", &s.text).expect("valid WGSL");
+        let (module, _) = crate::shader_check::parse_and_validate("pass.wgsl", &s.text).expect("valid WGSL");
         let mut numbers: Vec<(String, u32)> = module
             .global_variables
             .iter()

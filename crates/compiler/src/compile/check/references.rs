@@ -6,7 +6,7 @@ use crate::diagnostic::Location;
 use crate::format::{TargetFormat, TargetSize};
 use crate::graph::ast::{InputKind, NodeDoc, PassDoc};
 use crate::graph::locate::PassPath;
-use crate::plugin::{Access, PortKind, PortSpec, SizeRule};
+use crate::decl::{Access, PortKind, PortSpec, SizeRule};
 use crate::suggest::{closest, comma_list, guess_then, quoted_list};
 
 impl Checker<'_> {

@@ -46,11 +46,11 @@ pub trait ParamChoice: Copy + Sized + 'static {
 /// [`pass_params!`](crate::pass_params) field:
 ///
 /// ```
-/// volgraph_core::param_choice! {
+/// volgraph_compiler::param_choice! {
 ///     /// What the raycaster computes.
 ///     pub enum Mode { Dvr = "dvr", Iso = "iso" }
 /// }
-/// use volgraph_core::declare::ParamChoice;
+/// use volgraph_compiler::declare::ParamChoice;
 /// assert_eq!(Mode::NAMES, ["dvr", "iso"]);
 /// assert_eq!(Mode::from_name("iso"), Some(Mode::Iso));
 /// assert_eq!(Mode::Iso.index(), 1);
@@ -84,7 +84,7 @@ macro_rules! param_choice {
 /// Declares a pass's parameters once (module docs). Example:
 ///
 /// ```
-/// volgraph_core::pass_params! {
+/// volgraph_compiler::pass_params! {
 ///     /// `present`'s parameters; WGSL twin `PresentParams` in shaders/present.wgsl.
 ///     pub struct PresentParams {
 ///         background: f32 = 0.0, 0.0..=1.0, "linear grey level behind the volume";
@@ -92,7 +92,7 @@ macro_rules! param_choice {
 /// }
 /// let specs = PresentParams::specs();
 /// assert_eq!(specs[0].name, "background");
-/// assert_eq!(PresentParams::from_params(&volgraph_core::Params::defaults(&specs)).background, 0.0);
+/// assert_eq!(PresentParams::from_params(&volgraph_compiler::Params::defaults(&specs)).background, 0.0);
 /// assert_eq!(PresentParams { background: 0.5 }.uniform_bytes().len(), 16);
 /// ```
 #[macro_export]
@@ -132,7 +132,7 @@ macro_rules! pass_params {
 
         #[allow(dead_code)] // generated API: a pass may not need every form
         impl $name {
-            /// The declared parameters, for [`PassPlugin::params`]($crate::PassPlugin::params).
+            /// The declared parameters, for [`PassDecl::params`]($crate::PassDecl::params).
             #[allow(clippy::vec_init_then_push)] // computed fields push nothing
             pub fn specs() -> Vec<$crate::ParamSpec> {
                 let mut specs = Vec::new();

@@ -78,7 +78,7 @@ impl Plan {
             let _ = writeln!(s, "  {} -> {};", q(&format!("step{}", r.producer)), q(&format!("r{rid}")));
         }
         for (i, step) in self.steps.iter().enumerate() {
-            for bp in step.ports.iter().filter(|p| p.access != crate::plugin::Access::Write) {
+            for bp in step.ports.iter().filter(|p| p.access != crate::decl::Access::Write) {
                 let from = match &bp.binding {
                     Binding::Resource { id, .. } => format!("r{id}"),
                     Binding::Input(n) | Binding::InputVoxels(n) => format!("input.{n}"),

@@ -36,6 +36,22 @@ fn main() {
         code.push_str(&format!("    ({name:?}, include_str!({:?})),\n", absolute.display().to_string()));
     }
     code.push_str("];\n");
+    // The transfer functions of `graphs/tf/`, which presets and scenes name.
+    code.push_str(
+        "/// Every transfer function of the workspace's `graphs/tf/` folder: `(stem, text)`.\n\
+         pub static EMBEDDED_TFS: &[(&str, &str)] = &[\n",
+    );
+    let mut tfs: Vec<PathBuf> = std::fs::read_dir(root.join("tf"))
+        .map(|entries| entries.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    tfs.sort();
+    for path in tfs.iter().filter(|p| p.extension().is_some_and(|e| e == "ron")) {
+        println!("cargo:rerun-if-changed={}", path.display());
+        let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let absolute = path.canonicalize().unwrap_or_else(|_| path.clone());
+        code.push_str(&format!("    ({stem:?}, include_str!({:?})),\n", absolute.display().to_string()));
+    }
+    code.push_str("];\n");
     let out = PathBuf::from(std::env::var("OUT_DIR").unwrap_or_else(|_| ".".to_string())).join("embedded_graphs.rs");
     if let Err(e) = std::fs::write(&out, code) {
         panic!("cannot write {}: {e}", out.display());

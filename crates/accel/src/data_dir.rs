@@ -1,6 +1,10 @@
-//! Where tests and benchmarks find real data: the one setting is the `VOLGRAPH_DATA`
-//! environment variable (a folder holding `volumes/` and its `MANIFEST.md`); unset or empty, it
-//! defaults to `<workspace root>/../shared/data`.
+//! Where tests and benchmarks find real data: a folder holding `volumes/` (with its
+//! `MANIFEST.md`) and `tf/`. In order: the folder a program was given (`--data DIR`,
+//! [`set_data_dir`]), the `VOLGRAPH_DATA` environment variable, `../shared/data` from the
+//! current folder (the README's layout, commands run from the checkout), and — for tests and
+//! `cargo run` only — `<workspace root>/../shared/data` as the source tree was built. Installed
+//! programs call [`forget_build_path`] first: a binary never reads data from the build
+//! machine's source path.
 //!
 //! Datasets are named by the part of the file name before `_XxYxZ_dtype.raw`
 //! (`hydrogen_atom` → `volumes/hydrogen_atom_128x128x128_uint8.raw`). Under CI (the `CI`
@@ -21,8 +25,8 @@ pub const DATA_ENV: &str = "VOLGRAPH_DATA";
 pub enum DataError {
     /// The volumes folder cannot be listed.
     #[error(
-        "cannot list the volumes folder {}: {source}; set {DATA_ENV} to the folder that holds volumes/ \
-         (default: <workspace>/../shared/data)",
+        "cannot list the volumes folder {}: {source}; give --data DIR or set {DATA_ENV} to the folder that \
+         holds volumes/ (default: ../shared/data)",
         .dir.display()
     )]
     NoVolumesDir {
@@ -65,10 +69,33 @@ pub enum DataError {
     Load(#[from] LoadError),
 }
 
-/// The data folder: `$VOLGRAPH_DATA`, or `<workspace root>/../shared/data`.
+/// The folder `--data DIR` gave, which wins over everything else.
+static GIVEN: std::sync::RwLock<Option<PathBuf>> = std::sync::RwLock::new(None);
+/// Set by [`forget_build_path`].
+static NO_BUILD_PATH: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Makes `dir` the data folder of this process (a program's `--data DIR`).
+pub fn set_data_dir(dir: PathBuf) {
+    *GIVEN.write().unwrap_or_else(|e| e.into_inner()) = Some(dir);
+}
+
+/// Stops [`data_dir`] from falling back on the source tree this crate was built in: what a
+/// program calls at start, so an installed binary finds data only where its user says (or in
+/// `../shared/data` beside the folder it runs in).
+pub fn forget_build_path() {
+    NO_BUILD_PATH.store(true, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// The data folder (module docs give the order).
 pub fn data_dir() -> PathBuf {
+    if let Some(dir) = GIVEN.read().unwrap_or_else(|e| e.into_inner()).clone() {
+        return dir;
+    }
+    let beside = Path::new("../shared/data");
     match std::env::var_os(DATA_ENV) {
         Some(dir) if !dir.is_empty() => PathBuf::from(dir),
+        _ if beside.join("volumes").is_dir() => beside.to_path_buf(),
+        _ if NO_BUILD_PATH.load(std::sync::atomic::Ordering::Relaxed) => beside.to_path_buf(),
         _ => {
             let crate_dir = Path::new(env!("CARGO_MANIFEST_DIR"));
             // crates/accel → workspace root → its parent; fall back to `..` joins if the path is

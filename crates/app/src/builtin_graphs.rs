@@ -54,6 +54,14 @@ pub fn find(argument: &Path) -> Option<(&'static str, &'static str)> {
     EMBEDDED_GRAPHS.iter().find(|(n, _)| *n == name).copied()
 }
 
+/// The built-in transfer function a path names when no such file exists:
+/// `graphs/tf/vessels.ron`, `tf/vessels.ron` or `tf/vessels` → `("vessels", text)`.
+pub fn find_tf(argument: &Path) -> Option<(&'static str, &'static str)> {
+    let name = normalized(argument);
+    let stem = name.strip_prefix("tf/")?;
+    EMBEDDED_TFS.iter().find(|(n, _)| *n == stem).copied()
+}
+
 /// A graph argument as a built-in name would be spelled: `/` separators, without `./`,
 /// `graphs/` or `.ron`.
 pub fn normalized(argument: &Path) -> String {

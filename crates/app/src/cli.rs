@@ -3,21 +3,25 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, anyhow};
+use anyhow::anyhow;
 use clap::{Parser, Subcommand};
 use volgraph_core::{CompileOptions, Diagnostics, compile};
-use volgraph_passes::builtin_registry;
 
 use crate::inputs;
 
 /// volgraph: GPU volume rendering assembled from a declarative render graph.
 #[derive(Parser, Debug)]
-#[command(name = "volgraph", version, about)]
+#[command(name = "volgraph", version)]
 pub struct Cli {
+    /// The data folder: volumes/ (with MANIFEST.md) and tf/ (default: $VOLGRAPH_DATA, else
+    /// ../shared/data).
+    #[arg(long, global = true, value_name = "DIR")]
+    data: Option<PathBuf>,
     #[command(subcommand)]
     command: Command,
 }
 
+/// The subcommands every volgraph program has (a plugin's binary too, `crate::main_with`).
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Compile a graph and print its schedule: ordered passes, culled passes, targets → slots,
@@ -61,16 +65,6 @@ enum Command {
     /// List the graphs built into the binary (name, paper, description): every one can be given
     /// by name where a graph file is asked for (`volgraph render klein_2005/leap_iso -o x.png`).
     Graphs,
-    /// What accuracy costs in time: every knob (step, threshold, precision, block size, shading,
-    /// pre-integration, jitter, filter) swept on several datasets, error against the converged
-    /// f64 reference beside ms per frame; a table, JSON rows and one plot per knob.
-    Sweep(crate::sweep::SweepArgs),
-    /// Measure: graphs (speed, samples, accuracy), fetch (the device's sampling ceiling), live
-    /// (reload latency, soak), compile, accel (CPU acceleration structures).
-    Bench {
-        #[command(subcommand)]
-        which: BenchCommand,
-    },
 }
 
 /// How to read a headerless `.raw` volume whose name does not say (or to override the name).
@@ -90,37 +84,6 @@ pub struct RawArgs {
     pub big_endian: bool,
 }
 
-#[derive(Subcommand, Debug)]
-#[allow(clippy::large_enum_variant, reason = "parsed once per process; boxing would only obscure the clap derive")]
-enum BenchCommand {
-    /// Min/max grid + classification of the engine volume; octree rebuild after a TF change.
-    Accel {
-        /// Repetitions per figure (the median is reported).
-        #[arg(long, default_value_t = 7)]
-        repeats: usize,
-        /// Write the figures as JSON here.
-        #[arg(long)]
-        json: Option<PathBuf>,
-    },
-    /// Time render graphs over datasets, transfer functions and viewports (presets: basic,
-    /// kw2003-table1, thesis-tables, peer); speed-ups vs a baseline, samples counted on the GPU
-    /// as a fraction of the fetch ceiling, accuracy sweeps.
-    Graphs(crate::bench_graphs::GraphsArgs),
-    /// The fetch ceiling: trilinear samples per second of a pass that only samples the volume
-    /// along the raycaster's rays (no classification, no compositing).
-    Fetch(crate::bench_fetch::FetchArgs),
-    /// The live runtime: reload latency (parameter, graph and shader edits), frames in flight vs
-    /// blocking, and a soak of frames and reloads with memory at start and end.
-    Live(crate::bench_live::LiveArgs),
-    /// Compile time of a generated 30-pass graph; pooled vs unpooled transient memory of every
-    /// graph in graphs/ at 1920x1080.
-    Compile {
-        /// Write the figures as JSON here.
-        #[arg(long)]
-        json: Option<PathBuf>,
-    },
-}
-
 fn parse_scalar(text: &str) -> Result<(String, f64), String> {
     let (name, value) = text.split_once('=').ok_or_else(|| format!("\"{text}\": expected NAME=VALUE"))?;
     let value: f64 = value.parse().map_err(|_| format!("\"{text}\": \"{value}\" is not a number"))?;
@@ -128,6 +91,7 @@ fn parse_scalar(text: &str) -> Result<(String, f64), String> {
 }
 
 /// What went wrong, split so graph diagnostics can be drawn with their source excerpts.
+#[derive(Debug)]
 pub enum CliError {
     /// Problems in a graph file.
     Graph(Diagnostics),
@@ -141,6 +105,7 @@ impl From<anyhow::Error> for CliError {
     }
 }
 
+/// Compile options from `--size`, `--features` and `--scalar`.
 pub fn compile_options(size: &str, features: &[String], scalars: &[(String, f64)]) -> anyhow::Result<CompileOptions> {
     let (w, h) = inputs::parse_size(size)?;
     let mut o = CompileOptions::new(w, h).with_features(features.iter().filter(|f| !f.is_empty()).cloned());
@@ -148,6 +113,7 @@ pub fn compile_options(size: &str, features: &[String], scalars: &[(String, f64)
     Ok(o)
 }
 
+/// How a graph path is named in messages.
 pub fn display_name(path: &Path) -> String {
     path.display().to_string()
 }
@@ -214,11 +180,11 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
             let source = inputs::read_graph(&graph)?;
             let options = compile_options(&size, &features, &scalars)?;
             let plan =
-                compile(&display_name(&graph), &source, &builtin_registry(), &options).map_err(CliError::Graph)?;
+                compile(&display_name(&graph), &source, &crate::program::registry(), &options).map_err(CliError::Graph)?;
             check_user_names(&plan, &options)?;
             // Shader bindings against ports, without a GPU: what node creation would reject.
             let (sources, _) = crate::shader_dir::sources_for(&graph, None);
-            let problems = volgraph_core::check_plan_bindings(&plan, &builtin_registry(), &sources);
+            let problems = volgraph_core::check_plan_bindings(&plan, &crate::program::registry(), &sources);
             if !problems.is_empty() {
                 return Err(CliError::Graph(volgraph_core::Diagnostics {
                     file: display_name(&graph),
@@ -234,7 +200,7 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
             Ok(Checked::Plan { text, notes: warning_lines(&plan) })
         }
         Command::Render(args) => Ok(Checked::Render(Box::new(crate::render::prepare(args)?))),
-        Command::Bench { .. } | Command::View(_) | Command::Sweep(_) | Command::Passes { .. } | Command::Graphs => {
+        Command::View(_) | Command::Passes { .. } | Command::Graphs => {
             Err(CliError::Other(anyhow!("only plan and render are checked ahead of running")))
         }
     }
@@ -265,40 +231,11 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         }
         Command::Passes { kind, graph } => {
             let registry = match &graph {
-                Some(path) => crate::passes_cmd::with_graph_kinds(&builtin_registry(), path)?,
-                None => builtin_registry(),
+                Some(path) => crate::passes_cmd::with_graph_kinds(&crate::program::registry(), path)?,
+                None => crate::program::registry(),
             };
             let text = crate::passes_cmd::describe(&registry, kind.as_deref())?;
             crate::stdout::write_stdout(&text)?;
-            Ok(())
-        }
-        Command::Sweep(args) => {
-            crate::sweep::run(&args).context("sweep")?;
-            Ok(())
-        }
-        Command::Bench { which: BenchCommand::Accel { repeats, json } } => {
-            let opts = crate::bench_accel::AccelBenchOptions {
-                data_dir: volgraph_accel::data_dir::data_dir(),
-                repeats,
-                json_out: json,
-            };
-            crate::bench_accel::run(&opts).context("bench accel")?;
-            Ok(())
-        }
-        Command::Bench { which: BenchCommand::Compile { json } } => {
-            crate::bench_compile::run(json.as_deref()).context("bench compile")?;
-            Ok(())
-        }
-        Command::Bench { which: BenchCommand::Live(args) } => {
-            crate::bench_live::run(&args).context("bench live")?;
-            Ok(())
-        }
-        Command::Bench { which: BenchCommand::Graphs(args) } => {
-            crate::bench_graphs::run_cli(&args).context("bench graphs")?;
-            Ok(())
-        }
-        Command::Bench { which: BenchCommand::Fetch(args) } => {
-            crate::bench_fetch::run(&args).context("bench fetch")?;
             Ok(())
         }
     }

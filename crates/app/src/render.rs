@@ -9,7 +9,6 @@ use anyhow::anyhow;
 use volgraph_accel::volume::VoxelData;
 use volgraph_core::compile;
 use volgraph_core::runtime::{CameraData, Gpu, Runtime, ShaderLibrary, VolumeDesc, VolumeFormat, scene_values_of};
-use volgraph_passes::builtin_registry;
 
 use crate::cli::{CliError, check_user_names, compile_options, display_name, warning_lines};
 use crate::image_out::{self, ImageKind};
@@ -21,6 +20,7 @@ use volgraph_core::runtime::OpacityReference;
 /// The arguments of `volgraph render` (its command line, flattened into the CLI).
 #[derive(clap::Args, Debug)]
 pub struct RenderArgs {
+    /// What to render: graph, scene, volume, TF, camera, viewport.
     #[command(flatten)]
     pub inputs: SceneArgs,
     /// Frames to render (the last one is written); each rotates the volume 1° about y, or
@@ -79,7 +79,7 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     };
     notes.extend(tf_notes);
     let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
-    let registry = builtin_registry();
+    let registry = crate::program::registry();
     let file = display_name(&graph);
     let opacity = scene.as_ref().map(|s| s.opacity_reference).unwrap_or_default();
     options.scene = scene_values_of(&VolumeDesc::of(&volume));
@@ -144,7 +144,7 @@ pub fn budget_note(plan: &volgraph_core::Plan, registry: &volgraph_core::Registr
 /// Opens the GPU, renders the frames and writes the image.
 pub fn execute(prepared: Prepared) -> Result<(), CliError> {
     let Prepared { args, graph, kind, camera, frames, opacity, volume, lut, plan, output, .. } = prepared;
-    let registry = builtin_registry();
+    let registry = crate::program::registry();
     let viewport = plan.viewport;
     let gpu = Arc::new(Gpu::new_headless().map_err(|e| anyhow!(e))?);
     let (sources, _) = crate::shader_dir::sources_for(&graph, args.inputs.shaders.as_deref());
@@ -195,7 +195,7 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
             crate::stdout::eprintln_escaped!(
                 "  median of frames 2..{}: {:.2} ms {clock}",
                 warm.len() + 1,
-                crate::bench_graphs::measure::median(&warm)
+                volgraph_accel::stats::median(&warm)
             );
         }
         if stats.step_gpu_ms.is_some() {

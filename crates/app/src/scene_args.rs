@@ -23,6 +23,7 @@ pub struct SceneArgs {
     /// generated Marschner–Lobb 64³.
     #[arg(long)]
     pub volume: Option<PathBuf>,
+    /// How to read a headerless raw volume.
     #[command(flatten)]
     pub raw: RawArgs,
     /// Transfer function (RON, or ParaView color-map .json; the viewer watches it for edits);

@@ -41,7 +41,7 @@ pub fn graph_local(graph: &Path) -> Vec<PathBuf> {
 /// if any.
 pub fn sources_for(graph: &Path, explicit: Option<&Path>) -> (ShaderSources, Option<PathBuf>) {
     let disk = explicit.map(Path::to_path_buf).or_else(|| find_beside(graph));
-    let mut sources = volgraph_passes::builtin_shaders();
+    let mut sources = crate::program::shaders();
     let mut local = graph_local(graph);
     local.retain(|d| {
         Some(d) != disk.as_ref() && d.canonicalize().ok() != disk.as_ref().and_then(|x| x.canonicalize().ok())

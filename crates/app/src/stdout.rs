@@ -2,6 +2,7 @@
 //! output quietly instead of panicking as `print!` would.
 
 use anyhow::Context as _;
+pub use volgraph_core::terminal::escape_controls;
 
 /// Writes `text` to stdout, control characters from the user's files escaped
 /// ([`volgraph_core::terminal`]); a closed pipe is not an error.
@@ -16,17 +17,19 @@ pub fn write_stdout(text: &str) -> anyhow::Result<()> {
 
 /// `eprintln!` with control characters from the user's files escaped
 /// ([`volgraph_core::terminal`]): every note, warning and error volgraph writes to stderr.
+#[macro_export]
 macro_rules! eprintln_escaped {
     ($($arg:tt)*) => {
-        eprintln!("{}", volgraph_core::terminal::escape_controls(&format!($($arg)*)))
+        eprintln!("{}", $crate::stdout::escape_controls(&format!($($arg)*)))
     };
 }
-pub(crate) use eprintln_escaped;
+pub use crate::eprintln_escaped;
 
 /// `println!` with control characters escaped, like [`eprintln_escaped`].
+#[macro_export]
 macro_rules! println_escaped {
     ($($arg:tt)*) => {
-        println!("{}", volgraph_core::terminal::escape_controls(&format!($($arg)*)))
+        println!("{}", $crate::stdout::escape_controls(&format!($($arg)*)))
     };
 }
-pub(crate) use println_escaped;
+pub use crate::println_escaped;

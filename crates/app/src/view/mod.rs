@@ -26,6 +26,7 @@ use crate::inputs;
 /// The arguments of `volgraph view`.
 #[derive(clap::Args, Debug)]
 pub struct ViewArgs {
+    /// What to show: graph, scene, volume, TF, camera, viewport.
     #[command(flatten)]
     pub inputs: crate::scene_args::SceneArgs,
     /// Exit after this many presented frames.

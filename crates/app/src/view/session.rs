@@ -138,7 +138,7 @@ impl LiveSession {
     /// Loads the scene and the graph on `gpu`; fails (with located diagnostics) when the graph
     /// does not compile or build at all.
     pub fn open(gpu: Arc<Gpu>, args: &SessionArgs) -> Result<(Self, Event), crate::cli::CliError> {
-        Self::open_with(gpu, args, volgraph_passes::builtin_registry())
+        Self::open_with(gpu, args, crate::program::registry())
     }
 
     /// [`Self::open`] with another registry (built-ins plus a plugin crate's kinds).

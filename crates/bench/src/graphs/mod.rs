@@ -39,7 +39,7 @@ pub fn run_cli(args: &GraphsArgs) -> anyhow::Result<GraphBenchReport> {
     let gpu = std::sync::Arc::new(Gpu::new_headless().map_err(|e| anyhow!(e))?);
     let report = run::run(gpu, &config)?;
     let markdown = report.to_markdown();
-    crate::stdout::write_stdout(&markdown)?;
+    volgraph_app::stdout::write_stdout(&markdown)?;
     write_outputs(&config, &report, &markdown)?;
     Ok(report)
 }

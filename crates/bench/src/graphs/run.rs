@@ -12,7 +12,6 @@ use volgraph_accel::reference::render_reference;
 use volgraph_accel::volume::Volume;
 use volgraph_core::runtime::{CameraData, Gpu, Runtime, ShaderLibrary};
 use volgraph_core::{CompileOptions, Diagnostics, Plan, Registry};
-use volgraph_passes::builtin_registry;
 
 use super::accuracy::{self, ImageError};
 use super::args::{BenchConfig, graph_label, reduced_viewport};
@@ -50,13 +49,13 @@ struct Context<'a> {
     /// converged reference colour by (dataset, tf, size, settings).
     reference_cache: HashMap<String, Vec<[f64; 4]>>,
     /// fetch ceiling by (dataset, size, step); `None` when it could not be measured.
-    ceiling_cache: HashMap<String, Option<crate::bench_fetch::Ceiling>>,
+    ceiling_cache: HashMap<String, Option<crate::fetch::Ceiling>>,
 }
 
 impl Context<'_> {
     fn skip(&mut self, what: String, reason: String) {
         if self.skip_seen.insert((what.clone(), reason.clone())) {
-            self.progress.suspend(|| crate::stdout::eprintln_escaped!("note: skipping {what}: {reason}"));
+            self.progress.suspend(|| volgraph_app::stdout::eprintln_escaped!("note: skipping {what}: {reason}"));
             self.skipped.push(Skipped { what, reason });
         }
     }
@@ -177,10 +176,10 @@ fn compile_case(ctx: &mut Context<'_>, case: &Case<'_>, viewport: (u32, u32)) ->
 pub fn run(gpu: std::sync::Arc<Gpu>, config: &BenchConfig) -> anyhow::Result<GraphBenchReport> {
     let adapter = gpu.adapter_name.clone();
     let first_graph = config.graphs.first().cloned().unwrap_or_default();
-    let (sources, _) = crate::shader_dir::sources_for(&first_graph, config.shaders.as_deref());
+    let (sources, _) = volgraph_app::shader_dir::sources_for(&first_graph, config.shaders.as_deref());
     let mut ctx = Context {
         runtime: Runtime::new(gpu, ShaderLibrary::new(sources)),
-        registry: builtin_registry(),
+        registry: volgraph_app::registry(),
         config,
         progress: ProgressBar::hidden(),
         skipped: Vec::new(),
@@ -193,7 +192,7 @@ pub fn run(gpu: std::sync::Arc<Gpu>, config: &BenchConfig) -> anyhow::Result<Gra
     let graphs: Vec<GraphFile> = config
         .graphs
         .iter()
-        .filter_map(|path| match std::fs::read_to_string(path) {
+        .filter_map(|path| match volgraph_app::inputs::read_graph(path) {
             Ok(source) => Some(GraphFile { label: graph_label(path), path: path.clone(), source }),
             Err(e) => {
                 ctx.skip(
@@ -330,7 +329,7 @@ fn memory_figure(
     graph: &std::path::Path,
     size: (u32, u32),
 ) -> Result<MemoryFigure, String> {
-    let source = std::fs::read_to_string(graph).map_err(|e| e.to_string())?;
+    let source = volgraph_app::inputs::read_graph(graph).map_err(|e| format!("{e:#}"))?;
     let file = graph.display().to_string();
     let plan = runtime
         .compile(&file, &source, registry, &CompileOptions::new(size.0, size.1))
@@ -343,7 +342,7 @@ fn memory_figure(
         .map(|s| s.holds.iter().map(|&r| plan.resources[r].name.clone()).collect())
         .collect();
     Ok(MemoryFigure {
-        graph: graph.strip_prefix(super::args::workspace_root()).unwrap_or(graph).display().to_string(),
+        graph: graph.display().to_string(),
         viewport: [size.0, size.1],
         pooled_bytes: memory.pooled_bytes,
         unpooled_bytes: memory.unpooled_bytes,
@@ -370,7 +369,6 @@ fn run_peer(config: &BenchConfig, spec: &peer::PeerSpec, rows: &[Row]) -> Result
     for &viewport in &config.viewports {
         let r = peer::run(
             spec,
-            &super::args::workspace_root(),
             &volgraph_accel::data_dir::data_dir(),
             &cases,
             viewport,
@@ -534,13 +532,13 @@ fn count_on_gpu(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<gpu_count::Cou
 
 /// The fetch ceiling of the case's dataset and viewport at `step` (measured once per run, with
 /// the case's views; see `volgraph bench fetch`).
-fn fetch_ceiling(ctx: &mut Context<'_>, case: &Case<'_>, step: f64) -> Option<crate::bench_fetch::Ceiling> {
+fn fetch_ceiling(ctx: &mut Context<'_>, case: &Case<'_>, step: f64) -> Option<crate::fetch::Ceiling> {
     let config = ctx.config;
     let k = format!("{}|{}x{}|{step}", case.dataset.name, case.viewport.0, case.viewport.1);
     if let Some(c) = ctx.ceiling_cache.get(&k) {
         return *c;
     }
-    let measured = crate::bench_fetch::measure_ceiling(
+    let measured = crate::fetch::measure_ceiling(
         &mut ctx.runtime,
         &ctx.registry,
         &case.dataset.volume,

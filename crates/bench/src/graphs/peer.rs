@@ -19,8 +19,11 @@ pub struct PeerSpec {
     pub label: &'static str,
     /// What it is, for the notes.
     pub about: &'static str,
-    /// The script, relative to the workspace root, run with `python3`.
+    /// The script's name in reports (its path in the source tree).
     pub script: &'static str,
+    /// The script's text, compiled in and written to a temporary file to run with `python3`, so
+    /// the peer runs from any folder.
+    pub script_text: &'static str,
     /// How to make it runnable, for the note when it is not.
     pub install: &'static str,
 }
@@ -63,14 +66,17 @@ pub struct PeerResult {
 /// `step_voxels`; an error says why it could not (and how to fix that).
 pub fn run(
     spec: &PeerSpec,
-    workspace: &Path,
     data_dir: &Path,
     cases: &[PeerCase],
     viewport: (u32, u32),
     frames: u32,
     step_voxels: f64,
 ) -> Result<PeerResult, String> {
-    let script = workspace.join(spec.script);
+    let dir = std::env::temp_dir().join(format!("volgraph-peer-{}", std::process::id()));
+    let script = dir.join(Path::new(spec.script).file_name().unwrap_or_default());
+    std::fs::create_dir_all(&dir)
+        .and_then(|()| std::fs::write(&script, spec.script_text))
+        .map_err(|e| format!("cannot write the peer script to {}: {e}", script.display()))?;
     let pairs: Vec<String> = cases.iter().map(|c| format!("{}:{}", c.dataset, c.tf)).collect();
     let output = Command::new("python3")
         .arg(&script)

@@ -13,8 +13,7 @@ use std::path::PathBuf;
 use anyhow::{Context as _, anyhow, bail};
 use serde::Serialize;
 
-use crate::bench_graphs::GraphsArgs;
-use crate::bench_graphs::args::workspace_root;
+use crate::graphs::GraphsArgs;
 
 /// One knob: what it sweeps, on which graph, and why there.
 #[derive(Clone, Copy, Debug)]
@@ -160,15 +159,15 @@ pub fn measure_table_rebuild(
 ) -> anyhow::Result<TableRebuild> {
     use volgraph_accel::transfer_function::{Preset, TransferFunction};
     use volgraph_core::runtime::{CameraData, Runtime, ShaderLibrary};
-    let path = workspace_root().join("graphs/modern/fastest.ron");
-    let source = std::fs::read_to_string(&path).with_context(|| format!("{}", path.display()))?;
-    let registry = volgraph_passes::builtin_registry();
-    let (sources, _) = crate::shader_dir::sources_for(&path, None);
+    let path = PathBuf::from("graphs/modern/fastest.ron");
+    let source = volgraph_app::inputs::read_graph(&path)?;
+    let registry = volgraph_app::registry();
+    let (sources, _) = volgraph_app::shader_dir::sources_for(&path, None);
     let mut runtime = Runtime::new(gpu, ShaderLibrary::new(sources));
     let volume = volgraph_accel::generate::marschner_lobb(64);
     let luts: Vec<Vec<[f32; 4]>> = [Preset::Default, Preset::Sparse]
         .into_iter()
-        .map(|p| TransferFunction::preset(p, volume.value_range).to_lut_for(&volume, crate::inputs::LUT_SIZE))
+        .map(|p| TransferFunction::preset(p, volume.value_range).to_lut_for(&volume, volgraph_app::inputs::LUT_SIZE))
         .collect();
     let options = volgraph_core::CompileOptions::new(viewport.0, viewport.1).with_features(["preintegration"]);
     let plan = runtime.compile("fastest.ron", &source, &registry, &options).map_err(|d| anyhow!("{d}"))?;
@@ -188,7 +187,7 @@ pub fn measure_table_rebuild(
         steady.push(frame(&mut runtime)?);
     }
     let (changed_ms, steady_ms) =
-        (crate::bench_graphs::measure::median(&changed), crate::bench_graphs::measure::median(&steady));
+        (crate::graphs::measure::median(&changed), crate::graphs::measure::median(&steady));
     Ok(TableRebuild { viewport: [viewport.0, viewport.1], changed_ms, steady_ms, rebuild_ms: changed_ms - steady_ms })
 }
 
@@ -221,7 +220,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<SweepReport> {
     if args.frames == 0 {
         bail!("--frames 0: at least one timed frame is needed");
     }
-    let viewport = crate::inputs::parse_size(&args.size)?;
+    let viewport = volgraph_app::inputs::parse_size(&args.size)?;
     if let Some(dir) = &args.plots {
         std::fs::create_dir_all(dir).with_context(|| format!("--plots {}: cannot create the folder", dir.display()))?;
     }
@@ -230,9 +229,9 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<SweepReport> {
     let mut skipped = Vec::new();
     let reference_step = 0.1;
     for knob in &knobs {
-        crate::stdout::eprintln_escaped!("sweep {}: {} on {}", knob.name, knob.sweep, args.datasets.join(", "));
+        volgraph_app::stdout::eprintln_escaped!("sweep {}: {} on {}", knob.name, knob.sweep, args.datasets.join(", "));
         let graphs_args = GraphsArgs {
-            graphs: vec![workspace_root().join(knob.graph)],
+            graphs: vec![PathBuf::from(knob.graph)],
             datasets: args.datasets.clone(),
             size: vec![args.size.clone()],
             scale: 1.0,
@@ -246,9 +245,9 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<SweepReport> {
             ..GraphsArgs::default()
         };
         let config = graphs_args.resolve()?;
-        let report = crate::bench_graphs::run::run(gpu.clone(), &config)?;
+        let report = crate::graphs::run::run(gpu.clone(), &config)?;
         if let Some(plot) = &config.plot {
-            crate::bench_graphs::plot::write_plot(plot, &report)?;
+            crate::graphs::plot::write_plot(plot, &report)?;
         }
         skipped.extend(report.skipped.iter().map(|s| format!("{}: {}: {}", knob.name, s.what, s.reason)));
         for r in report.rows {
@@ -290,7 +289,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<SweepReport> {
         skipped,
     };
     let markdown = to_markdown(&report, &knobs);
-    crate::stdout::write_stdout(&markdown)?;
+    volgraph_app::stdout::write_stdout(&markdown)?;
     if let Some(path) = &args.json {
         std::fs::write(path, serde_json::to_string_pretty(&report)? + "\n")
             .with_context(|| format!("--json {}: cannot write the file", path.display()))?;
@@ -392,8 +391,8 @@ mod tests {
     #[test]
     fn every_knob_has_a_valid_sweep_and_a_graph() {
         for k in KNOBS {
-            crate::bench_graphs::args::parse_sweep(k.sweep).unwrap_or_else(|e| panic!("{}: {e}", k.name));
-            assert!(workspace_root().join(k.graph).is_file(), "{}: {}", k.name, k.graph);
+            crate::graphs::args::parse_sweep(k.sweep).unwrap_or_else(|e| panic!("{}: {e}", k.name));
+            assert!(volgraph_app::builtin_graphs::find(std::path::Path::new(k.graph)).is_some(), "{}: {}", k.name, k.graph);
         }
         let err = chosen(&SweepArgs {
             knobs: vec!["stepp".into()],

@@ -12,7 +12,6 @@ use volgraph_core::runtime::{CameraData, Image, Runtime};
 use volgraph_core::{CompileOptions, Diagnostics, Registry};
 
 use super::accuracy::{self, ImageError};
-use super::args::workspace_root;
 use super::measure::{self, frame_camera, median};
 use super::tf_choice::TfChoice;
 use super::{dataset, gpu_count};
@@ -134,8 +133,7 @@ pub fn run(
     let mut reference: Option<Vec<[f64; 4]>> = None;
     let mut rows = Vec::new();
     for variant in &VARIANTS {
-        let path = workspace_root().join(variant.graph);
-        let source = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let source = volgraph_app::inputs::read_graph(std::path::Path::new(variant.graph)).map_err(|e| format!("{e:#}"))?;
         let mut options = CompileOptions::new(viewport.0, viewport.1)
             .with_scalar("iso_value", spec.iso_value)
             .with_scalar("step_voxels", 0.5);
@@ -143,7 +141,7 @@ pub fn run(
             options = options.with_param("aa", "pattern", pattern).with_param("aa", "selection", selection);
         }
         runtime.bind_scene(&gpu_count::scene_inputs(), &volume, &lut).map_err(|e| e.to_string())?;
-        let file = path.display().to_string();
+        let file = variant.graph.to_string();
         let plan = runtime.compile(&file, &source, registry, &options).map_err(|d: Diagnostics| d.to_string())?;
         let settings = accuracy::raycast_settings(&plan).ok_or("the graph has no raycast step")?;
         let contrast = plan.steps.iter().find(|s| s.pass_id == "aa").map(|s| s.params.float("contrast") as f32);

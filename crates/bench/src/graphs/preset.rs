@@ -144,6 +144,7 @@ pub const PRESETS: &[BenchPreset] = &[
             about: "vtk_fixed_point: VTK's vtkFixedPointVolumeRayCastMapper on this machine's CPU cores, offscreen, \
                     timed per Render() by bench/peer/vtk_cpu_raycast.py in this run",
             script: "bench/peer/vtk_cpu_raycast.py",
+            script_text: include_str!("../../../../bench/peer/vtk_cpu_raycast.py"),
             install: "install the peer with `pip install vtk==9.7.2`, or pass --no-peer",
         }),
         baselines: &[],

@@ -9,7 +9,7 @@ use volgraph_accel::camera::OrbitCamera;
 
 use super::preset::{self, BenchPreset};
 use super::tf_choice::TfChoice;
-use crate::inputs;
+use volgraph_app::inputs;
 
 /// Flags of `volgraph bench graphs`. A `--preset` fills in graphs, datasets, sizes, transfer
 /// functions, baseline and frames; any flag given as well replaces the preset's value.
@@ -172,10 +172,6 @@ pub struct BenchConfig {
     pub memory: Vec<(PathBuf, (u32, u32))>,
 }
 
-/// The workspace root, against which preset graph paths are written.
-pub fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
 
 /// The label of a graph file in tables: its file stem.
 pub fn graph_label(path: &Path) -> String {
@@ -287,7 +283,7 @@ impl GraphsArgs {
         let graphs: Vec<PathBuf> = if !self.graphs.is_empty() {
             self.graphs.clone()
         } else if let Some(p) = preset {
-            p.graphs.iter().map(|g| workspace_root().join(g)).collect()
+            p.graphs.iter().map(PathBuf::from).collect()
         } else {
             bail!("no graphs: give --graphs a.ron,b.ron or a --preset ({})", preset::names());
         };
@@ -363,7 +359,7 @@ impl GraphsArgs {
             .unwrap_or_default();
         let antialias = own.and_then(|p| p.antialias).map(|study| (study, scale_viewport(study.size, self.scale)));
         let memory = own
-            .map(|p| p.memory.iter().map(|(g, size)| (workspace_root().join(g), *size)).collect())
+            .map(|p| p.memory.iter().map(|(g, size)| (PathBuf::from(g), *size)).collect())
             .unwrap_or_default();
         Ok(BenchConfig {
             preset,

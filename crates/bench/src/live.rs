@@ -23,9 +23,9 @@ use serde::Serialize;
 use volgraph_accel::camera::OrbitCamera;
 use volgraph_core::runtime::{CameraData, Gpu};
 
-use crate::bench_graphs::measure::median;
-use crate::view::session::{Event, LiveSession, SessionArgs};
-use crate::view::watch::{FileWatch, QUIET};
+use crate::graphs::measure::median;
+use volgraph_app::view::session::{Event, LiveSession, SessionArgs};
+use volgraph_app::view::watch::{FileWatch, QUIET};
 
 /// The options of `volgraph bench live`.
 #[derive(clap::Args, Debug, Clone)]
@@ -223,11 +223,11 @@ fn latency_of(
 
 /// Runs the benchmark.
 pub fn run(args: &LiveArgs) -> anyhow::Result<()> {
-    let viewport = crate::inputs::parse_size(&args.size)?;
-    let soak_viewport = crate::inputs::parse_size(&args.soak_size)?;
+    let viewport = volgraph_app::inputs::parse_size(&args.size)?;
+    let soak_viewport = volgraph_app::inputs::parse_size(&args.soak_size)?;
     let dir = std::env::temp_dir().join(format!("volgraph-bench-live-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let shaders_root = crate::shader_dir::find_beside(&args.graph)
+    let shaders_root = volgraph_app::shader_dir::find_beside(&args.graph)
         .ok_or_else(|| anyhow!("{}: no shaders/ folder beside the graph to copy", args.graph.display()))?;
     copy_dir(&shaders_root, &dir.join("shaders"))?;
     let graph = dir.join("graph.ron");
@@ -252,8 +252,8 @@ pub fn run(args: &LiveArgs) -> anyhow::Result<()> {
         )
         .map(|(s, _)| s)
         .map_err(|e| match e {
-            crate::cli::CliError::Graph(d) => anyhow!("{d}"),
-            crate::cli::CliError::Other(e) => e,
+            volgraph_app::cli::CliError::Graph(d) => anyhow!("{d}"),
+            volgraph_app::cli::CliError::Other(e) => e,
         })
     };
 
@@ -374,11 +374,11 @@ pub fn run(args: &LiveArgs) -> anyhow::Result<()> {
         soak_errors: errors,
         soak_recoveries: recoveries,
     };
-    crate::stdout::write_stdout(&to_markdown(&report))?;
+    volgraph_app::stdout::write_stdout(&to_markdown(&report))?;
     if let Some(path) = &args.json {
         std::fs::write(path, serde_json::to_string_pretty(&report)?)
             .with_context(|| format!("writing {}", path.display()))?;
-        crate::stdout::write_stdout(&format!("\nJSON written to {}\n", path.display()))?;
+        volgraph_app::stdout::write_stdout(&format!("\nJSON written to {}\n", path.display()))?;
     }
     Ok(())
 }

@@ -16,13 +16,12 @@
 //! Prints markdown tables; writes the same figures as JSON when asked. Never asserts a timing.
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use anyhow::Context;
 use serde::Serialize;
 use volgraph_core::{CompileOptions, compile};
-use volgraph_passes::builtin_registry;
 
 /// Warm-up compilations before timing (caches, allocator).
 const WARMUP: usize = 50;
@@ -99,11 +98,11 @@ pub struct CompileBenchReport {
 /// `json_out` when given.
 pub fn run(json_out: Option<&Path>) -> anyhow::Result<()> {
     let report = measure()?;
-    crate::stdout::write_stdout(&to_markdown(&report))?;
+    volgraph_app::stdout::write_stdout(&to_markdown(&report))?;
     if let Some(path) = json_out {
         let json = serde_json::to_string_pretty(&report).context("serializing the report")?;
         std::fs::write(path, json).with_context(|| format!("writing {}", path.display()))?;
-        crate::stdout::write_stdout(&format!("\nJSON written to {}\n", path.display()))?;
+        volgraph_app::stdout::write_stdout(&format!("\nJSON written to {}\n", path.display()))?;
     }
     Ok(())
 }
@@ -113,21 +112,21 @@ pub fn measure() -> anyhow::Result<CompileBenchReport> {
     let timing = time_generated_graph()?;
     let viewport = (1920, 1080);
     let mut graphs = vec![memory_of("(generated bench_30)", &thirty_pass_graph(), viewport)];
-    graphs.extend(graph_files()?.iter().map(|(path, name)| graph_memory(path, name, viewport)));
+    graphs.extend(graph_files()?.iter().map(|(text, name)| memory_of(name, text, viewport)));
     Ok(CompileBenchReport { viewport, timing, scaling: time_scaling()?, graphs })
 }
 
 /// (c): RC-a with `Fixed(n)` segments, n = 256 … 4096.
 fn time_scaling() -> anyhow::Result<Vec<ScalingRow>> {
-    let path = graphs_dir().join("kruger_westermann_2003/rc_a.ron");
-    let source = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let path = Path::new("kruger_westermann_2003/rc_a");
+    let source = volgraph_app::inputs::read_graph(path)?;
     let count = "count: Scene(name: \"longest_ray_voxels\", divide_by_inputs: [\"step_voxels\", \"segment_steps\"])";
     anyhow::ensure!(
         source.contains(count),
         "{} no longer has the segment count this benchmark replaces",
         path.display()
     );
-    let registry = builtin_registry();
+    let registry = volgraph_app::registry();
     let options = CompileOptions::new(512, 512);
     let mut rows = Vec::new();
     for n in [256u32, 512, 1024, 2048, 4096] {
@@ -201,7 +200,7 @@ pub fn thirty_pass_graph() -> String {
 
 fn time_generated_graph() -> anyhow::Result<CompileTiming> {
     let text = thirty_pass_graph();
-    let registry = builtin_registry();
+    let registry = volgraph_app::registry();
     let options = CompileOptions::new(1920, 1080);
     let plan = compile("bench_30.ron", &text, &registry, &options)
         .map_err(|d| anyhow::anyhow!("the generated benchmark graph does not compile:\n{d}"))?;
@@ -229,49 +228,10 @@ fn time_generated_graph() -> anyhow::Result<CompileTiming> {
     })
 }
 
-/// The graphs folder: `./graphs` when run from the repository root, else the one next to this
-/// crate's sources.
-fn graphs_dir() -> PathBuf {
-    let here = PathBuf::from("graphs");
-    if here.is_dir() { here } else { Path::new(env!("CARGO_MANIFEST_DIR")).join("../../graphs") }
-}
-
-/// `(path, display name)` of every graph file, sorted, skipping `graphs/tf/`.
-fn graph_files() -> anyhow::Result<Vec<(PathBuf, String)>> {
-    let root = graphs_dir();
-    let mut files = Vec::new();
-    let mut stack = vec![root.clone()];
-    while let Some(dir) = stack.pop() {
-        for entry in std::fs::read_dir(&dir).with_context(|| format!("reading {}", dir.display()))? {
-            let path = entry?.path();
-            if path.is_dir() {
-                if path.file_name().is_some_and(|n| n != "tf") || dir != root {
-                    stack.push(path);
-                }
-            } else if path.extension().is_some_and(|e| e == "ron") {
-                let rel = path.strip_prefix(&root).unwrap_or(&path).to_string_lossy().replace('\\', "/");
-                files.push((path.clone(), format!("graphs/{rel}")));
-            }
-        }
-    }
-    files.sort();
-    Ok(files)
-}
-
-fn graph_memory(path: &Path, name: &str, viewport: (u32, u32)) -> GraphMemory {
-    let failed = |error: String| GraphMemory {
-        file: name.to_string(),
-        steps: None,
-        slots: None,
-        pooled_bytes: None,
-        unpooled_bytes: None,
-        history_bytes: None,
-        error: Some(error),
-    };
-    match std::fs::read_to_string(path) {
-        Ok(source) => memory_of(name, &source, viewport),
-        Err(e) => failed(format!("cannot read: {e}")),
-    }
+/// `(text, display name)` of every graph built into the program (the graphs of `graphs/`
+/// without the transfer functions), in name order: the figures need no source tree.
+fn graph_files() -> anyhow::Result<Vec<(&'static str, String)>> {
+    Ok(volgraph_app::builtin_graphs::all().into_iter().map(|g| (g.text, format!("graphs/{}.ron", g.name))).collect())
 }
 
 /// Compiles `source` and reads its memory figures; the generated graph comes through here too
@@ -286,7 +246,7 @@ fn memory_of(name: &str, source: &str, viewport: (u32, u32)) -> GraphMemory {
         history_bytes: None,
         error: Some(error),
     };
-    match compile(name, source, &builtin_registry(), &CompileOptions::new(viewport.0, viewport.1)) {
+    match compile(name, source, &volgraph_app::registry(), &CompileOptions::new(viewport.0, viewport.1)) {
         Ok(plan) => {
             let m = plan.memory();
             GraphMemory {
@@ -374,7 +334,7 @@ mod tests {
     fn generated_graph_has_thirty_passes_and_culls_two() {
         let text = thirty_pass_graph();
         assert_eq!(text.matches("Pass(").count(), 30);
-        let plan = compile("bench_30.ron", &text, &builtin_registry(), &CompileOptions::new(1920, 1080))
+        let plan = compile("bench_30.ron", &text, &volgraph_app::registry(), &CompileOptions::new(1920, 1080))
             .unwrap_or_else(|d| panic!("{d}\n{text}"));
         assert_eq!(plan.culled, ["x1", "x2"]);
         // 28 live passes, the 2-pass body run 4 times instead of once.
@@ -389,7 +349,7 @@ mod tests {
     }
 
     /// The benchmark itself, for a run without the CLI:
-    /// `cargo test --release -p volgraph-app bench_compile -- --ignored --nocapture`.
+    /// `cargo test --release -p volgraph-bench compile_time -- --ignored --nocapture`.
     #[test]
     #[ignore = "a measurement, not a test"]
     fn print_the_benchmark() {

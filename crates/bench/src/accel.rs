@@ -359,5 +359,5 @@ fn print_table(r: &AccelBenchReport) -> anyhow::Result<()> {
         o.tf_change_ms,
         o.tf_change_ms / o.paper_ms
     );
-    crate::stdout::write_stdout(&out)
+    volgraph_app::stdout::write_stdout(&out)
 }

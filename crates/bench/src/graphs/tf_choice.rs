@@ -10,13 +10,21 @@ use volgraph_accel::data_dir::data_dir;
 use volgraph_accel::transfer_function::{Preset, TransferFunction};
 use volgraph_accel::volume::Volume;
 
-use crate::inputs::LUT_SIZE;
+use volgraph_app::inputs::LUT_SIZE;
 
 /// One `--tf` value.
 #[derive(Clone, Debug, PartialEq)]
 pub enum TfChoice {
     /// Stretched over the volume's value range.
     Preset(Preset),
+    /// One of `graphs/tf/`, compiled into the program (`graphs/tf/vessels.ron` where no such
+    /// file exists): the presets name these, and they work from any folder.
+    Builtin {
+        /// The file stem, for tables.
+        name: &'static str,
+        /// The RON text.
+        text: &'static str,
+    },
     /// Read from a file when the case runs (a missing file skips its cases with a note).
     File {
         /// The file stem, for tables.
@@ -46,6 +54,11 @@ impl TfChoice {
         let stem = |p: &Path| p.file_stem().map_or_else(|| text.to_string(), |s| s.to_string_lossy().into_owned());
         if is_tf_file(text) {
             let path = PathBuf::from(text);
+            if path.symlink_metadata().is_err()
+                && let Some((name, text)) = volgraph_app::builtin_graphs::find_tf(&path)
+            {
+                return Ok(TfChoice::Builtin { name, text });
+            }
             return Ok(TfChoice::File { name: stem(&path), path });
         }
         let named = tf_dir().join(format!("{text}.ron"));
@@ -63,6 +76,7 @@ impl TfChoice {
     pub fn name(&self) -> String {
         match self {
             TfChoice::Preset(p) => p.name().to_string(),
+            TfChoice::Builtin { name, .. } => name.to_string(),
             TfChoice::File { name, .. } => name.clone(),
         }
     }
@@ -73,6 +87,10 @@ impl TfChoice {
             TfChoice::Preset(p) => {
                 let (lo, hi) = volume.value_range;
                 TransferFunction::preset(*p, (lo, if hi > lo { hi } else { lo + 1.0 }))
+            }
+            TfChoice::Builtin { name, text } => {
+                TransferFunction::from_ron_str(text, Path::new(&format!("graphs/tf/{name}.ron")))
+                    .map_err(|e| anyhow!("{e}"))?
             }
             TfChoice::File { path, .. } => {
                 let json = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
@@ -103,5 +121,17 @@ mod tests {
         let volume = volgraph_accel::generate::marschner_lobb(8);
         let err = choice.lut_for(&volume).expect_err("the file is missing").to_string();
         assert!(err.contains("/nonexistent/tf.ron"), "{err}");
+    }
+
+    /// The presets' `graphs/tf/…` files are compiled in: a run from any folder finds them.
+    /// (Tests run in `crates/bench`, where no `graphs/` folder is.)
+    #[test]
+    fn graphs_tf_files_are_built_in() {
+        assert!(!std::path::Path::new("graphs/tf/vessels.ron").exists(), "run from a folder without graphs/");
+        let choice = TfChoice::parse("graphs/tf/vessels.ron").expect("built in");
+        assert!(matches!(choice, TfChoice::Builtin { name: "vessels", .. }), "{choice:?}");
+        let volume = volgraph_accel::generate::marschner_lobb(8);
+        assert_eq!(choice.lut_for(&volume).expect("parses").len(), LUT_SIZE);
+        assert!(matches!(TfChoice::parse("graphs/tf/nope.ron"), Ok(TfChoice::File { .. })));
     }
 }

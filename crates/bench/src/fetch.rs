@@ -15,12 +15,11 @@ use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::volume::Volume;
 use volgraph_core::runtime::{Gpu, Runtime, ShaderLibrary};
 use volgraph_core::{CompileOptions, Diagnostics, Registry};
-use volgraph_passes::builtin_registry;
 
-use crate::bench_graphs::gpu_count;
-use crate::bench_graphs::measure::{self, frame_camera, median};
-use crate::bench_graphs::{args::workspace_root, dataset};
-use crate::inputs;
+use crate::graphs::gpu_count;
+use crate::graphs::measure::{self, frame_camera, median};
+use crate::graphs::dataset;
+use volgraph_app::inputs;
 
 /// The probe graph, compiled in so the command works from any directory.
 pub const FETCH_GRAPH: &str = include_str!("../../../graphs/bench/fetch_ceiling.ron");
@@ -149,8 +148,8 @@ pub fn run(args: &FetchArgs) -> anyhow::Result<FetchReport> {
     let camera = inputs::parse_camera(&args.camera)?;
     let gpu = std::sync::Arc::new(Gpu::new_headless().map_err(|e| anyhow!(e))?);
     let adapter = gpu.adapter_name.clone();
-    let registry = builtin_registry();
-    let (sources, _) = crate::shader_dir::sources_for(&workspace_root().join(FETCH_GRAPH_FILE), None);
+    let registry = volgraph_app::registry();
+    let (sources, _) = volgraph_app::shader_dir::sources_for(std::path::Path::new(FETCH_GRAPH_FILE), None);
     let mut runtime = Runtime::new(gpu, ShaderLibrary::new(sources));
     let degrees = 360.0 / args.frames as f64;
     let mut rows = Vec::new();
@@ -159,7 +158,7 @@ pub fn run(args: &FetchArgs) -> anyhow::Result<FetchReport> {
         let volume = match dataset::load(name) {
             Ok(v) => v,
             Err(e) => {
-                crate::stdout::eprintln_escaped!("note: skipping dataset {name}: {e:#}");
+                volgraph_app::stdout::eprintln_escaped!("note: skipping dataset {name}: {e:#}");
                 skipped.push(format!("{name}: {e:#}"));
                 continue;
             }
@@ -191,7 +190,7 @@ pub fn run(args: &FetchArgs) -> anyhow::Result<FetchReport> {
         skipped,
     };
     let markdown = to_markdown(&report);
-    crate::stdout::write_stdout(&markdown)?;
+    volgraph_app::stdout::write_stdout(&markdown)?;
     write_file(args.json.as_deref(), &(serde_json::to_string_pretty(&report)? + "\n"), "--json")?;
     write_file(args.markdown.as_deref(), &markdown, "--markdown")?;
     Ok(report)
@@ -255,7 +254,7 @@ mod tests {
             panic!("no GPU adapter (install mesa-vulkan-drivers for lavapipe)");
         };
         let gpu = std::sync::Arc::new(gpu);
-        let registry = builtin_registry();
+        let registry = volgraph_app::registry();
         let mut runtime = Runtime::new(gpu, ShaderLibrary::new(volgraph_passes::builtin_shaders()));
         let volume = volgraph_accel::generate::marschner_lobb(32);
         let camera = OrbitCamera { azimuth_deg: 0.0, elevation_deg: 0.0, distance: 3.2, ..OrbitCamera::default() };

@@ -1,0 +1,29 @@
+//! The `volgraph` program as a library: every subcommand a user runs — `render`, `plan`,
+//! `passes`, `graphs`, `view` with hot reload — and [`main_with`], which gives a plugin crate's
+//! own binary all of them with its pass kinds and shaders added ([`Extension`]). The benchmarks
+//! and the sweep are `volgraph-bench` (`crates/bench`), which builds on this library; the stock
+//! binary hands `bench` and `sweep` to it ([`forward`]). This crate is the one that talks to a
+//! user: inputs are read and checked here, before any GPU work.
+
+pub mod builtin_graphs;
+pub mod cli;
+#[cfg(test)]
+mod cli_fuzz;
+pub mod forward;
+#[cfg(test)]
+mod fuzz_runner;
+pub mod image_out;
+#[cfg(test)]
+mod input_fuzz;
+pub mod inputs;
+pub mod passes_cmd;
+pub mod plan_svg;
+pub mod program;
+pub mod render;
+pub mod scene;
+pub mod scene_args;
+pub mod shader_dir;
+pub mod stdout;
+pub mod view;
+
+pub use program::{Commands, Extension, main_with, registry, shaders};

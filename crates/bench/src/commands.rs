@@ -1,0 +1,95 @@
+//! The `bench` and `sweep` subcommands, added to a volgraph program's command line.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Context as _;
+use clap::{FromArgMatches as _, Subcommand};
+use volgraph_app::cli::CliError;
+
+/// What `volgraph-bench` adds.
+#[derive(Subcommand, Debug)]
+#[allow(clippy::large_enum_variant, reason = "parsed once per process; boxing would only obscure the clap derive")]
+enum BenchCli {
+    /// What accuracy costs in time: every knob (step, threshold, precision, block size, shading,
+    /// pre-integration, jitter, filter) swept on several datasets, error against the converged
+    /// f64 reference beside ms per frame; a table, JSON rows and one plot per knob.
+    Sweep(crate::sweep::SweepArgs),
+    /// Measure: graphs (speed, samples, accuracy), fetch (the device's sampling ceiling), live
+    /// (reload latency, soak), compile, accel (CPU acceleration structures).
+    Bench {
+        #[command(subcommand)]
+        which: BenchCommand,
+    },
+}
+
+#[derive(Subcommand, Debug)]
+#[allow(clippy::large_enum_variant, reason = "parsed once per process; boxing would only obscure the clap derive")]
+enum BenchCommand {
+    /// Min/max grid + classification of the engine volume; octree rebuild after a TF change.
+    Accel {
+        /// Repetitions per figure (the median is reported).
+        #[arg(long, default_value_t = 7)]
+        repeats: usize,
+        /// Write the figures as JSON here.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
+    /// Time render graphs over datasets, transfer functions and viewports (presets: basic,
+    /// kw2003-table1, thesis-tables, peer, …); speed-ups vs a baseline, samples counted on the
+    /// GPU as a fraction of the fetch ceiling, accuracy sweeps.
+    Graphs(crate::graphs::GraphsArgs),
+    /// The fetch ceiling: trilinear samples per second of a pass that only samples the volume
+    /// along the raycaster's rays (no classification, no compositing).
+    Fetch(crate::fetch::FetchArgs),
+    /// The live runtime: reload latency (parameter, graph and shader edits), frames in flight vs
+    /// blocking, and a soak of frames and reloads with memory at start and end.
+    Live(crate::live::LiveArgs),
+    /// Compile time of a generated 30-pass graph; pooled vs unpooled transient memory of every
+    /// built-in graph at 1920x1080.
+    Compile {
+        /// Write the figures as JSON here.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
+}
+
+/// `bench` and `sweep` as [`volgraph_app::Commands`].
+pub struct BenchCommands;
+
+impl volgraph_app::Commands for BenchCommands {
+    fn augment(&self, command: clap::Command) -> clap::Command {
+        BenchCli::augment_subcommands(command)
+    }
+
+    fn handles(&self, name: &str) -> bool {
+        BenchCli::has_subcommand(name)
+    }
+
+    fn run(&self, matches: &clap::ArgMatches) -> Result<ExitCode, CliError> {
+        let cli = BenchCli::from_arg_matches(matches).unwrap_or_else(|e| e.exit());
+        run(cli)?;
+        Ok(ExitCode::SUCCESS)
+    }
+}
+
+fn run(cli: BenchCli) -> anyhow::Result<()> {
+    match cli {
+        BenchCli::Sweep(args) => crate::sweep::run(&args).context("sweep").map(drop),
+        BenchCli::Bench { which: BenchCommand::Accel { repeats, json } } => {
+            let opts =
+                crate::accel::AccelBenchOptions { data_dir: volgraph_accel::data_dir::data_dir(), repeats, json_out: json };
+            crate::accel::run(&opts).context("bench accel").map(drop)
+        }
+        BenchCli::Bench { which: BenchCommand::Compile { json } } => {
+            crate::compile_time::run(json.as_deref()).context("bench compile").map(drop)
+        }
+        BenchCli::Bench { which: BenchCommand::Live(args) } => crate::live::run(&args).context("bench live").map(drop),
+        BenchCli::Bench { which: BenchCommand::Graphs(args) } => {
+            crate::graphs::run_cli(&args).context("bench graphs").map(drop)
+        }
+        BenchCli::Bench { which: BenchCommand::Fetch(args) } => {
+            crate::fetch::run(&args).context("bench fetch").map(drop)
+        }
+    }
+}

@@ -18,7 +18,14 @@ fn every_graph_binds_its_shaders_at_plan_time() {
         let source = std::fs::read_to_string(&path).expect("readable");
         for features in [vec![], vec!["shading", "preintegration", "jitter", "tricubic"]] {
             let options = CompileOptions::new(320, 240).with_features(features.clone());
-            let Ok(plan) = compile(&name, &source, &registry, &options) else { continue };
+            // A graph that stops compiling is a failure, never a graph left unchecked.
+            let plan = match compile(&name, &source, &registry, &options) {
+                Ok(plan) => plan,
+                Err(d) => {
+                    failures.push(format!("{name} {features:?} does not compile:\n{d}"));
+                    continue;
+                }
+            };
             checked += 1;
             for d in check_plan_bindings(&plan, &registry, &sources) {
                 failures.push(format!("{name} {features:?}: {}", d.message));

@@ -12,6 +12,7 @@
 #import "common/frame.wgsl"
 #import "common/volume.wgsl"
 #import "common/raycast_params.wgsl"
+#import "common/ray_box.wgsl"
 
 // O'Neill's PCG hash (state = v*747796405 + 2891336453, then the RXS-M-XS output permutation).
 fn pcg_hash(v: u32) -> u32 {
@@ -37,10 +38,9 @@ fn ray_jitter(pixel: vec2<u32>) -> f32 {
 #endif
 }
 
-// step_tex = step_voxels * unit_world / |d_tex * 2*half| for a unit texture-space direction.
+// The step of this pass's `step_voxels` along unit texture-space direction `d_tex`.
 fn ray_step_tex(d_tex: vec3<f32>) -> f32 {
-    let world_per_tex = length(d_tex * 2.0 * frame.half_extent.xyz);
-    return params.step_voxels * frame.half_extent.w / world_per_tex;
+    return step_tex_for(params.step_voxels, d_tex);
 }
 
 // True when the ray (u0, d_tex, len_tex) can be marched: positive finite length, a unit

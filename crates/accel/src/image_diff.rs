@@ -28,6 +28,16 @@ impl ImageDiff {
     pub fn within(&self, tolerance: f64) -> bool {
         self.non_finite == 0 && self.max_abs <= tolerance
     }
+
+    /// The PSNR as a table shows it: dB to one decimal, `∞` for identical images, and the
+    /// count of non-finite channels where there are any.
+    pub fn psnr_label(&self) -> String {
+        match (self.non_finite, self.psnr_db) {
+            (0, None) => "∞".to_string(),
+            (0, Some(db)) => format!("{db:.1}"),
+            (n, _) => format!("{n} non-finite"),
+        }
+    }
 }
 
 /// Why two images cannot be compared.

@@ -14,6 +14,7 @@ pub mod image_diff;
 pub mod input_file;
 pub mod load;
 pub mod minmax;
+pub mod mip;
 pub mod octree;
 pub mod reference;
 pub mod stats;

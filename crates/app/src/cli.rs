@@ -179,8 +179,8 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
         Command::Plan { graph, size, features, scalars, dot, svg } => {
             let source = inputs::read_graph(&graph)?;
             let options = compile_options(&size, &features, &scalars)?;
-            let plan =
-                compile(&display_name(&graph), &source, &crate::program::registry(), &options).map_err(CliError::Graph)?;
+            let plan = compile(&display_name(&graph), &source, &crate::program::registry(), &options)
+                .map_err(CliError::Graph)?;
             check_user_names(&plan, &options)?;
             // Shader bindings against ports, without a GPU: what node creation would reject.
             let (sources, _) = crate::shader_dir::sources_for(&graph, None);

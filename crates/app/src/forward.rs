@@ -28,16 +28,13 @@ impl Commands for ToBenchProgram {
     fn augment(&self, mut command: clap::Command) -> clap::Command {
         for (name, about) in FORWARDED {
             command = command.subcommand(
-                clap::Command::new(name)
-                    .about(about)
-                    .disable_help_flag(true)
-                    .arg(
-                        clap::Arg::new("args")
-                            .num_args(0..)
-                            .trailing_var_arg(true)
-                            .allow_hyphen_values(true)
-                            .value_parser(clap::value_parser!(OsString)),
-                    ),
+                clap::Command::new(name).about(about).disable_help_flag(true).arg(
+                    clap::Arg::new("args")
+                        .num_args(0..)
+                        .trailing_var_arg(true)
+                        .allow_hyphen_values(true)
+                        .value_parser(clap::value_parser!(OsString)),
+                ),
             );
         }
         command

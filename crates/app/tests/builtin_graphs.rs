@@ -68,3 +68,42 @@ fn a_file_of_the_same_name_wins_over_the_built_in_graph() {
     assert!(out.starts_with("plan \"compute_raycast\""), "the file on disk, not the built-in graph:\n{out}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 20, item 5: a stock graph declares a WGSL-only pass kind (`basic/mip`); the stock
+/// binary lists its kind with `passes --graph` and renders it by name from any folder (its
+/// shader is compiled in with the built-in ones).
+#[test]
+fn the_stock_wgsl_only_kind_is_listed_and_renders() {
+    let dir = empty_folder("wgsl-kind");
+    let (code, out, err) = volgraph(&dir, &["passes", "--graph", "basic/mip", "mip_projection"]);
+    assert_eq!(code, 0, "{err}");
+    for expected in ["mip_projection", "level", "width", "step_voxels", "graph_kinds/mip_projection.wgsl"] {
+        assert!(out.contains(expected), "missing {expected:?} in\n{out}");
+    }
+    let png = dir.join("mip.png");
+    let (code, _, err) =
+        volgraph(&dir, &["render", "basic/mip", "--size", "32x32", "-o", png.to_str().expect("utf-8")]);
+    assert_eq!(code, 0, "{err}");
+    let image = std::fs::read(&png).expect("the image was written");
+    assert!(image.starts_with(b"\x89PNG"), "a PNG");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue 20, item 2: the stock binary hands `bench` and `sweep` to `volgraph-bench`; where that
+/// program is neither beside it nor on PATH, the message says how to get it.
+#[test]
+fn bench_without_the_bench_program_says_how_to_install_it() {
+    let dir = empty_folder("no-bench");
+    let copied = dir.join("volgraph");
+    std::fs::copy(env!("CARGO_BIN_EXE_volgraph"), &copied).expect("copy the binary");
+    let out = Command::new(&copied)
+        .args(["sweep", "--knobs", "step"])
+        .current_dir(&dir)
+        .env("PATH", &dir.join("no-such-folder"))
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("volgraph-bench") && err.contains("cargo install --path crates/bench"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

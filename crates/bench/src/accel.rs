@@ -110,16 +110,8 @@ pub struct OctreeBench {
     pub tf_change_ms: f64,
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(|a, b| a.total_cmp(b));
-    let n = v.len();
-    if n == 0 {
-        f64::NAN
-    } else if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
+fn median(v: Vec<f64>) -> f64 {
+    volgraph_accel::stats::median(&v)
 }
 
 fn time_ms<T>(f: impl FnOnce() -> T) -> (T, f64) {

@@ -77,8 +77,11 @@ fn run(cli: BenchCli) -> anyhow::Result<()> {
     match cli {
         BenchCli::Sweep(args) => crate::sweep::run(&args).context("sweep").map(drop),
         BenchCli::Bench { which: BenchCommand::Accel { repeats, json } } => {
-            let opts =
-                crate::accel::AccelBenchOptions { data_dir: volgraph_accel::data_dir::data_dir(), repeats, json_out: json };
+            let opts = crate::accel::AccelBenchOptions {
+                data_dir: volgraph_accel::data_dir::data_dir(),
+                repeats,
+                json_out: json,
+            };
             crate::accel::run(&opts).context("bench accel").map(drop)
         }
         BenchCli::Bench { which: BenchCommand::Compile { json } } => {

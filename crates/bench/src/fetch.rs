@@ -16,9 +16,9 @@ use volgraph_accel::volume::Volume;
 use volgraph_core::runtime::{Gpu, Runtime, ShaderLibrary};
 use volgraph_core::{CompileOptions, Diagnostics, Registry};
 
+use crate::graphs::dataset;
 use crate::graphs::gpu_count;
 use crate::graphs::measure::{self, frame_camera, median};
-use crate::graphs::dataset;
 use volgraph_app::inputs;
 
 /// The probe graph, compiled in so the command works from any directory.

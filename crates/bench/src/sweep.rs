@@ -186,8 +186,7 @@ pub fn measure_table_rebuild(
         changed.push(frame(&mut runtime)?);
         steady.push(frame(&mut runtime)?);
     }
-    let (changed_ms, steady_ms) =
-        (crate::graphs::measure::median(&changed), crate::graphs::measure::median(&steady));
+    let (changed_ms, steady_ms) = (crate::graphs::measure::median(&changed), crate::graphs::measure::median(&steady));
     Ok(TableRebuild { viewport: [viewport.0, viewport.1], changed_ms, steady_ms, rebuild_ms: changed_ms - steady_ms })
 }
 
@@ -392,7 +391,12 @@ mod tests {
     fn every_knob_has_a_valid_sweep_and_a_graph() {
         for k in KNOBS {
             crate::graphs::args::parse_sweep(k.sweep).unwrap_or_else(|e| panic!("{}: {e}", k.name));
-            assert!(volgraph_app::builtin_graphs::find(std::path::Path::new(k.graph)).is_some(), "{}: {}", k.name, k.graph);
+            assert!(
+                volgraph_app::builtin_graphs::find(std::path::Path::new(k.graph)).is_some(),
+                "{}: {}",
+                k.name,
+                k.graph
+            );
         }
         let err = chosen(&SweepArgs {
             knobs: vec!["stepp".into()],

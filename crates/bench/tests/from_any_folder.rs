@@ -85,19 +85,26 @@ fn graphs_and_render_by_name() {
 fn a_preset_runs_on_the_built_in_graphs() {
     let s = sandbox("preset");
     let args = [
-        "bench", "graphs", "--preset", "basic", "--datasets", "ml64", "--size", "32x32", "--frames", "2", "--quiet",
-        "--json", "basic.json",
+        "bench",
+        "graphs",
+        "--preset",
+        "basic",
+        "--datasets",
+        "ml64",
+        "--size",
+        "32x32",
+        "--frames",
+        "2",
+        "--quiet",
+        "--json",
+        "basic.json",
     ];
     let out = s.run(&s.bench, &args);
     let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
     assert!(!text.contains("left out of this run"), "a preset graph was left out:\n{text}");
     let report = json(&s.work.join("basic.json"));
-    let graphs: Vec<&str> = report["rows"]
-        .as_array()
-        .expect("rows")
-        .iter()
-        .map(|r| r["graph"].as_str().expect("a graph label"))
-        .collect();
+    let graphs: Vec<&str> =
+        report["rows"].as_array().expect("rows").iter().map(|r| r["graph"].as_str().expect("a graph label")).collect();
     for expected in ["fragment_raycast", "compute_raycast"] {
         assert!(graphs.contains(&expected), "{expected} measured: {graphs:?}");
     }
@@ -107,8 +114,19 @@ fn a_preset_runs_on_the_built_in_graphs() {
 fn a_tiny_sweep_runs_on_the_built_in_graphs() {
     let s = sandbox("sweep");
     let args = [
-        "sweep", "--knobs", "step", "--datasets", "ml64", "--size", "32x32", "--frames", "1", "--accuracy-size", "16",
-        "--json", "sweep.json",
+        "sweep",
+        "--knobs",
+        "step",
+        "--datasets",
+        "ml64",
+        "--size",
+        "32x32",
+        "--frames",
+        "1",
+        "--accuracy-size",
+        "16",
+        "--json",
+        "sweep.json",
     ];
     let mut programs = vec![s.bench.clone()];
     programs.extend(s.stock.clone());

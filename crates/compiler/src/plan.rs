@@ -3,10 +3,10 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 
+use crate::decl::Access;
 use crate::format::{TargetFormat, TargetSize};
 use crate::graph::ast::{HistoryInitial, InputKind};
 use crate::params::Params;
-use crate::decl::Access;
 
 /// Index into [`Plan::resources`].
 pub type ResourceId = usize;

@@ -68,4 +68,3 @@ pub fn parse_and_validate(file: &str, text: &str) -> Result<(naga::Module, naga:
         .map_err(|e| e.emit_to_string_with_path(text, file))?;
     Ok((module, info))
 }
-

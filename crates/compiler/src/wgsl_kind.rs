@@ -6,10 +6,10 @@
 use std::collections::{BTreeMap, HashSet};
 use std::sync::{Arc, Mutex, OnceLock};
 
+use crate::decl::{KindLookup, PassDecl, PortKind, PortSpec, ShaderUse};
 use crate::diagnostic::{Diagnostic, Location};
 use crate::graph::ast::{WgslForm, WgslInput, WgslKindDoc};
 use crate::params::{ParamSpec, Params};
-use crate::decl::{KindLookup, PassDecl, PortKind, PortSpec, ShaderUse};
 
 /// A string that lives as long as the program. Plugin declarations are `&'static str`; names a
 /// graph declares are interned once each, so reloading a graph does not grow memory.
@@ -31,7 +31,11 @@ pub fn check_kinds(kinds: &BTreeMap<String, WgslKindDoc>, registry: &dyn KindLoo
 
 /// [`check_kinds`] for the graph text `source`: each problem points at the field's line and
 /// column (the kind's name where no one field is to blame).
-pub fn check_kinds_in(kinds: &BTreeMap<String, WgslKindDoc>, registry: &dyn KindLookup, source: &str) -> Vec<Diagnostic> {
+pub fn check_kinds_in(
+    kinds: &BTreeMap<String, WgslKindDoc>,
+    registry: &dyn KindLookup,
+    source: &str,
+) -> Vec<Diagnostic> {
     let locator = crate::graph::locate::Locator::new(source);
     let mut out = Vec::new();
     let mut err = |kind: &str, field: &str, message: String, help: &str| {

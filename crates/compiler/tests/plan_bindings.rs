@@ -5,8 +5,7 @@
 use volgraph_compiler::decl::ShaderUse;
 use volgraph_compiler::shader_source::ShaderSources;
 use volgraph_compiler::{
-    CompileOptions, Params, PassDecl, PortKind, PortSpec, Kinds, TargetFormat, check_plan_bindings,
-    compile,
+    CompileOptions, Kinds, Params, PassDecl, PortKind, PortSpec, TargetFormat, check_plan_bindings, compile,
 };
 
 /// A pass with a texture input `color`, a buffer input `counts`, an output `out`, and the shader
@@ -14,7 +13,6 @@ use volgraph_compiler::{
 struct Probe {
     entry: &'static str,
 }
-
 
 impl PassDecl for Probe {
     fn kind(&self) -> &'static str {
@@ -35,7 +33,6 @@ impl PassDecl for Probe {
     }
 }
 
-
 struct Source;
 
 impl PassDecl for Source {
@@ -49,7 +46,6 @@ impl PassDecl for Source {
         vec![PortSpec::write("color", PortKind::target(&[TargetFormat::Rgba16Float]))]
     }
 }
-
 
 const SHADER: &str = r#"
 struct P { k: f32 }

@@ -7,8 +7,7 @@
 
 use volgraph_compiler::plan::{Binding, ResourceDesc};
 use volgraph_compiler::{
-    Access, CompileOptions, ParamSpec, Params, PassDecl, Plan, PortKind, PortSpec, Kinds, TargetFormat,
-    compile,
+    Access, CompileOptions, Kinds, ParamSpec, Params, PassDecl, Plan, PortKind, PortSpec, TargetFormat, compile,
 };
 
 /// A pass kind described as data: a name, ports, parameters and features.
@@ -73,7 +72,6 @@ impl PassDecl for Kind {
         self.features.clone()
     }
 }
-
 
 const RGBA32: TargetFormat = TargetFormat::Rgba32Float;
 const RGBA16: TargetFormat = TargetFormat::Rgba16Float;

@@ -28,8 +28,7 @@ pub fn with_graph_kinds(registry: &Registry, kinds: &BTreeMap<String, WgslKindDo
 impl PassPlugin for WgslKind {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let module = ctx.shader_module(&self.doc().shader)?;
-        self.check_module_against(&module.module)
-            .map_err(|m| PassError { pass: ctx.pass_id.into(), message: m })?;
+        self.check_module_against(&module.module).map_err(|m| PassError { pass: ctx.pass_id.into(), message: m })?;
         let pipeline = match self.doc().form {
             WgslForm::Compute => Pipeline::Compute(ctx.compute_pipeline(&ComputePipelineSpec {
                 shader: &self.doc().shader,
@@ -88,4 +87,3 @@ impl PassNode for WgslPassNode {
         }
     }
 }
-

@@ -7,7 +7,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
-use volgraph_core::{Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, Rerun};
+use volgraph_core::{Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, Rerun};
 
 use crate::empty_space::EMPTY_BLOCKS;
 use crate::minmax_grid::{bound_size, create_grid_texture};

@@ -6,7 +6,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
-use volgraph_core::{Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
 pub struct EntryPoints;

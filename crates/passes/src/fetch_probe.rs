@@ -9,7 +9,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
-use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::raycast_fast::SAMPLE_ROWS;
 use crate::raycast_params::{RaycastParamsGpu, Sampling, Workgroup};
@@ -62,13 +62,7 @@ impl PassDecl for FetchProbe {
 
 impl PassPlugin for FetchProbe {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let wg = Workgroup::from_params(ctx.params).size();
-        if wg.0 * wg.1 > ctx.gpu.limits.max_compute_invocations_per_workgroup {
-            return Err(PassError {
-                pass: ctx.pass_id.to_string(),
-                message: format!("workgroup {}x{} is over this GPU's invocation limit", wg.0, wg.1),
-            });
-        }
+        let wg = Workgroup::checked_size(ctx)?;
         let counted = Counting::from_params(ctx.params).count_samples;
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
             shader: "fetch_probe.wgsl",

@@ -6,7 +6,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
-use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
 pub struct Present;

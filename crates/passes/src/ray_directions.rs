@@ -5,7 +5,7 @@
 use crate::shared::FLOAT_TARGETS;
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
-use volgraph_core::{Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec};
+use volgraph_core::{Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec};
 
 /// The plugin.
 pub struct RayDirections;

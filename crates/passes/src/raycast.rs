@@ -16,7 +16,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
-use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::effects::{EffectFlags, EffectState, effect_defines, same_effects};
 use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};

@@ -40,7 +40,7 @@ use volgraph_core::runtime::{
     ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, volume_region_bytes,
     volume_texture_format,
 };
-use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 use wgpu::util::DeviceExt;
 
 use crate::brick_pool::{Batch, BrickPool};
@@ -142,16 +142,7 @@ impl PassDecl for RaycastBricks {
 impl PassPlugin for RaycastBricks {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let settings = BrickSettings::from_params(ctx.params);
-        let wg = Workgroup::from_params(ctx.params).size();
-        if wg.0 * wg.1 > ctx.gpu.limits.max_compute_invocations_per_workgroup {
-            return Err(PassError {
-                pass: ctx.pass_id.to_string(),
-                message: format!(
-                    "workgroup {}x{} is over this GPU's limit of {} invocations",
-                    wg.0, wg.1, ctx.gpu.limits.max_compute_invocations_per_workgroup
-                ),
-            });
-        }
+        let wg = Workgroup::checked_size(ctx)?;
         let mut defines = self.shader_defines(ctx.params);
         if crate::shared::color_is_f32(ctx) {
             defines.push("COLOR_F32");

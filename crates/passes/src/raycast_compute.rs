@@ -5,7 +5,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
-use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortSpec, TargetFormat};
 
 use crate::effects::{EffectFlags, EffectState, effect_defines, same_effects};
 use crate::raycast::raycast_ports;
@@ -54,19 +54,7 @@ impl PassDecl for RaycastCompute {
 
 impl PassPlugin for RaycastCompute {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let wg = Workgroup::from_params(ctx.params).size();
-        if wg.0 * wg.1 > ctx.gpu.limits.max_compute_invocations_per_workgroup {
-            return Err(PassError {
-                pass: ctx.pass_id.to_string(),
-                message: format!(
-                    "workgroup {}x{} has {} invocations, over this GPU's limit of {}",
-                    wg.0,
-                    wg.1,
-                    wg.0 * wg.1,
-                    ctx.gpu.limits.max_compute_invocations_per_workgroup
-                ),
-            });
-        }
+        let wg = Workgroup::checked_size(ctx)?;
         let entry = if is_iso(ctx.params) { "cs_iso" } else { "cs_dvr" };
         let mut defines = effect_defines(ctx.params);
         if color_is_f32(ctx) {

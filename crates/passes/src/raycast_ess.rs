@@ -8,7 +8,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
-use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::effects::{EffectState, effect_defines, same_effects};
 use crate::empty_space::{EMPTY_BLOCKS, check_block_grid};

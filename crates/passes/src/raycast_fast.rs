@@ -24,7 +24,7 @@
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
-use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::effects::{EffectFlags, EffectState, effect_defines, same_effects};
 use crate::empty_distance::EMPTY_DISTANCE;
@@ -153,19 +153,7 @@ impl PassPlugin for RaycastFast {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let own = FastOwn::from_params(ctx.params);
         let sampling = Sampling::from_params(ctx.params);
-        let wg = Workgroup::from_params(ctx.params).size();
-        if wg.0 * wg.1 > ctx.gpu.limits.max_compute_invocations_per_workgroup {
-            return Err(PassError {
-                pass: ctx.pass_id.to_string(),
-                message: format!(
-                    "workgroup {}x{} has {} invocations, over this GPU's limit of {}",
-                    wg.0,
-                    wg.1,
-                    wg.0 * wg.1,
-                    ctx.gpu.limits.max_compute_invocations_per_workgroup
-                ),
-            });
-        }
+        let wg = Workgroup::checked_size(ctx)?;
         let distance_wired = ctx.port("distance").is_some_and(|p| p.bound);
         let leap = match (distance_wired, own.leap) {
             (false, _) | (true, Leap::None) => 0.0,

@@ -77,6 +77,26 @@ impl Workgroup {
     pub fn size(&self) -> (u32, u32) {
         (self.workgroup_x, self.workgroup_y)
     }
+
+    /// The size a compute pass is created with, checked against the device's invocation limit:
+    /// the one check every compute pass with a workgroup parameter makes in `create`.
+    pub fn checked_size(
+        ctx: &volgraph_core::runtime::CreateContext<'_>,
+    ) -> Result<(u32, u32), volgraph_core::runtime::PassError> {
+        let (x, y) = Self::from_params(ctx.params).size();
+        let limit = ctx.gpu.limits.max_compute_invocations_per_workgroup;
+        let invocations = u64::from(x) * u64::from(y);
+        if invocations > u64::from(limit) {
+            return Err(volgraph_core::runtime::PassError {
+                pass: ctx.pass_id.to_string(),
+                message: format!(
+                    "workgroup {x}x{y} has {invocations} invocations, over this GPU's limit of {limit}; choose \
+                     workgroup_x × workgroup_y ≤ {limit}"
+                ),
+            });
+        }
+        Ok((x, y))
+    }
 }
 
 /// Every block of the full raycaster (`raycast`, `raycast_compute`, `raycast_segment`,

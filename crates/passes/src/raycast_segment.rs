@@ -22,7 +22,7 @@ use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{
     CreateContext, DepthSpec, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
 };
-use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::empty_space::EMPTY_BLOCKS;
 use crate::raycast_params::{RaycastParamsGpu, Termination, is_iso, raycast_param_specs};

@@ -14,7 +14,7 @@ use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{
     CameraData, CreateContext, DepthSpec, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
 };
-use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
 pub struct ReprojectionSplat;

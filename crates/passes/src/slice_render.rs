@@ -9,7 +9,7 @@
 use crate::shared::front_to_back_blend;
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CreateContext, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
-use volgraph_core::{ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
 pub struct SliceRender;

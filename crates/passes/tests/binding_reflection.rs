@@ -8,7 +8,7 @@ use volgraph_core::runtime::{
     ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, RenderPipelineSpec, Runtime, ShaderLibrary,
 };
 use volgraph_core::{
-    CompileOptions, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile,
+    CompileOptions, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile,
 };
 
 const FLOATS: [TargetFormat; 3] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float, TargetFormat::Rgba8Unorm];

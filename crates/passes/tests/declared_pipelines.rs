@@ -37,7 +37,14 @@ fn every_pass_builds_exactly_the_shaders_it_declares() {
         for features in [vec![], vec!["shading", "preintegration", "jitter", "tricubic"]] {
             let mut options = CompileOptions::new(64, 64).with_features(features.clone());
             options.scene = volgraph_core::runtime::scene_values_of(&volgraph_core::runtime::VolumeDesc::of(&volume));
-            let Ok(plan) = compile(&path.display().to_string(), &source, &registry, &options) else { continue };
+            // A graph that stops compiling is a failure, never a graph left unchecked.
+            let plan = match compile(&path.display().to_string(), &source, &registry, &options) {
+                Ok(plan) => plan,
+                Err(d) => {
+                    failures.push(format!("{} {features:?} does not compile:\n{d}", path.display()));
+                    continue;
+                }
+            };
             for step in plan.steps.iter().filter(|s| s.iteration.is_none_or(|(i, _)| i == 0)) {
                 let plugin = registry.get(&step.kind).expect("a built-in kind");
                 let ports = port_infos(&plan, step, &plugin.ports(&step.params));

@@ -71,3 +71,23 @@ fn a_viewport_over_the_texture_limit_is_an_error_naming_the_target() {
     assert!(fault.what.starts_with("creating target slot0") && fault.what.contains("entry.entry"), "{}", fault.what);
     assert!(runtime.plan().is_none(), "nothing half-applied");
 }
+
+/// Issue 20: the four compute passes with a workgroup parameter share one check against the
+/// device's invocation limit; 256×256 (within the parameter's range) is over every device's.
+#[test]
+fn a_workgroup_over_the_device_limit_names_both_sizes() {
+    let gpu = gpu();
+    let limit = gpu.limits.max_compute_invocations_per_workgroup;
+    let registry = builtin_registry();
+    for (graph, pass) in [("basic/compute_raycast.ron", "march"), ("modern/fastest.ron", "march")] {
+        let options =
+            CompileOptions::new(16, 16).with_param(pass, "workgroup_x", 256u64).with_param(pass, "workgroup_y", 256u64);
+        let plan = compile(graph, &graph_source(graph), &registry, &options).unwrap_or_else(|d| panic!("{d}"));
+        let mut runtime = runtime(&gpu);
+        let err = runtime.apply(plan, &registry).expect_err("over the invocation limit").to_string();
+        assert!(
+            err.contains(&format!("workgroup 256x256 has 65536 invocations, over this GPU's limit of {limit}")),
+            "{graph}: {err}"
+        );
+    }
+}

@@ -12,7 +12,7 @@ use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::transfer_function::{Preset, TransferFunction};
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{CameraData, CreateContext, Gpu, PassError, RecordContext, Runtime};
-use volgraph_core::{CompileOptions, ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortSpec, Registry, Rerun};
+use volgraph_core::{CompileOptions, ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortSpec, Registry, Rerun};
 use volgraph_passes::builtin_registry;
 
 mod support;

@@ -12,7 +12,7 @@ use volgraph_core::runtime::{
     RenderPassPipeline, RenderPipelineSpec, Runtime, ShaderLibrary,
 };
 use volgraph_core::{
-    CompileOptions, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile,
+    CompileOptions, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile,
 };
 
 const SHADER: &str = "splat_count.wgsl";

@@ -16,7 +16,8 @@ use volgraph_core::runtime::{
     ShaderLibrary,
 };
 use volgraph_core::{
-    CompileOptions, ParamSpec, Params, PassNode, PassDecl, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile,
+    CompileOptions, ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat,
+    compile,
 };
 
 /// `next = value + (amount, 0, 0, 0)`.

@@ -6,7 +6,6 @@
 use std::sync::Arc;
 
 use volgraph_accel::camera::OrbitCamera;
-use volgraph_accel::reference::{pixel_jitter, ray_segment, step_tex};
 use volgraph_core::runtime::{CameraData, Gpu, Image, Runtime, ShaderLibrary};
 use volgraph_core::{CompileOptions, Registry};
 
@@ -44,9 +43,8 @@ fn render_with(
     (runtime.read_output("mip").expect("mip"), runtime.read_output("image").expect("image"))
 }
 
-/// The CPU MIP of pixel (x, y): the largest trilinear sample at volgraph's sample positions
-/// (k + 0.5 + jitter steps of 0.5 voxel from the entry, jitter 0 unless `jittered`), or None
-/// where the ray misses the box.
+/// The CPU MIP of pixel (x, y) at volgraph's sample positions, step 0.5 voxel
+/// ([`volgraph_accel::mip::mip_pixel`]), or None where the ray misses the box.
 fn cpu_mip(
     volume: &volgraph_accel::volume::Volume,
     camera: &OrbitCamera,
@@ -54,13 +52,7 @@ fn cpu_mip(
     y: u32,
     jittered: bool,
 ) -> Option<f64> {
-    let frame = camera.frame(SIZE, SIZE);
-    let seg = ray_segment(volume, camera, &frame, x, y)?;
-    let step = step_tex(volume, seg.d_tex, 0.5);
-    let jitter = if jittered { pixel_jitter(x, y, SIZE) } else { 0.0 };
-    let count = (seg.len_tex / step - 0.5 - jitter).ceil().max(0.0) as u32;
-    let at = |k: u32| seg.u0 + (k as f64 + 0.5 + jitter) * step * seg.d_tex;
-    Some((0..count).map(|k| volume.sample_trilinear(at(k))).fold(0.0, f64::max))
+    volgraph_accel::mip::mip_pixel(volume, camera, &camera.frame(SIZE, SIZE), (x, y, SIZE), 0.5, jittered)
 }
 
 /// Compares the GPU MIP with the CPU one; returns the largest difference over the pixels both

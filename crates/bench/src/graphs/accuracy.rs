@@ -6,7 +6,6 @@
 
 use std::collections::BTreeSet;
 
-use serde::Serialize;
 use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::reference::{RaycastSettings, render_reference};
 use volgraph_accel::volume::Volume;
@@ -51,40 +50,17 @@ pub fn samples_per_pixel(
     image.samples as f64 / (size.0 as f64 * size.1 as f64)
 }
 
-/// Error of a GPU image against a reference image (premultiplied linear RGBA, all four channels).
-#[derive(Clone, Copy, Debug, Serialize)]
-pub struct ImageError {
-    /// Largest absolute channel difference.
-    pub max_abs: f64,
-    /// Mean absolute channel difference.
-    pub mean_abs: f64,
-    /// PSNR in dB for a peak of 1; `None` when the images are identical.
-    pub psnr_db: Option<f64>,
-}
+/// Error of a GPU image against a reference image: the project's one metric
+/// ([`volgraph_accel::image_diff`], a NaN is an infinite error, never a small one).
+pub type ImageError = volgraph_accel::image_diff::ImageDiff;
 
-/// Compares `gpu` with `reference` (same size, row 0 at the top in both).
+/// Compares `gpu` with `reference` (same size, row 0 at the top in both); `None` when the sizes
+/// differ or the image is empty.
 pub fn image_error(gpu: &Image, reference: &[[f64; 4]]) -> Option<ImageError> {
-    let pixels = gpu.width as usize * gpu.height as usize;
-    if reference.len() != pixels || pixels == 0 {
+    if reference.is_empty() {
         return None;
     }
-    let (mut max_abs, mut sum_abs, mut sum_sq) = (0.0f64, 0.0, 0.0);
-    for y in 0..gpu.height {
-        for x in 0..gpu.width {
-            let g = gpu.rgba(x, y);
-            let r = reference[(y * gpu.width + x) as usize];
-            for c in 0..4 {
-                let d = (g[c] as f64 - r[c]).abs();
-                max_abs = max_abs.max(d);
-                sum_abs += d;
-                sum_sq += d * d;
-            }
-        }
-    }
-    let n = 4.0 * pixels as f64;
-    let mse = sum_sq / n;
-    let psnr_db = (mse > 0.0).then(|| 10.0 * (1.0 / mse).log10());
-    Some(ImageError { max_abs, mean_abs: sum_abs / n, psnr_db })
+    volgraph_accel::image_diff::image_diff(&gpu.to_rgba_f64(), reference).ok()
 }
 
 /// Which points `(ms, error)` are on the Pareto front: no other point is at least as fast and at
@@ -108,12 +84,12 @@ mod tests {
         assert_eq!(front, vec![true, true, false, false, false]);
     }
 
+    /// The bench's error is the tests' metric: a NaN pixel is an infinite error.
     #[test]
-    fn identical_images_have_zero_error_and_no_psnr() {
-        let image = Image { width: 2, height: 1, channels: 4, data: vec![0.5; 8] };
+    fn a_nan_pixel_is_an_infinite_error() {
+        let image = Image { width: 2, height: 1, channels: 4, data: vec![0.5, 0.5, 0.5, f32::NAN, 0.5, 0.5, 0.5, 0.5] };
         let e = image_error(&image, &[[0.5; 4]; 2]).expect("same size");
-        assert_eq!((e.max_abs, e.mean_abs, e.psnr_db), (0.0, 0.0, None));
-        let e = image_error(&image, &[[0.4; 4]; 2]).expect("same size");
-        assert!((e.psnr_db.expect("differs") - 20.0).abs() < 1e-4);
+        assert!(e.max_abs.is_infinite() && e.non_finite == 1 && e.psnr_db.is_none(), "{e:?}");
+        assert!(image_error(&image, &[[0.5; 4]; 3]).is_none(), "sizes differ");
     }
 }

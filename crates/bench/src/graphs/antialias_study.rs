@@ -133,7 +133,8 @@ pub fn run(
     let mut reference: Option<Vec<[f64; 4]>> = None;
     let mut rows = Vec::new();
     for variant in &VARIANTS {
-        let source = volgraph_app::inputs::read_graph(std::path::Path::new(variant.graph)).map_err(|e| format!("{e:#}"))?;
+        let source =
+            volgraph_app::inputs::read_graph(std::path::Path::new(variant.graph)).map_err(|e| format!("{e:#}"))?;
         let mut options = CompileOptions::new(viewport.0, viewport.1)
             .with_scalar("iso_value", spec.iso_value)
             .with_scalar("step_voxels", 0.5);
@@ -174,7 +175,7 @@ pub fn run(
             refined_fraction: refined,
             rays_per_pixel: 1.0 + refined * sub_rays,
             error,
-            rms_255: error.and_then(|e| e.psnr_db.map(|db| 255.0 * 10f64.powf(-db / 20.0))),
+            rms_255: error.map(|e| if e.non_finite > 0 { f64::INFINITY } else { 255.0 * e.rms }),
             pareto: false,
         });
     }
@@ -237,7 +238,7 @@ impl AntialiasReport {
                 e.map_or_else(|| "n/a".into(), |e| format!("{:.2e}", e.mean_abs)),
                 r.rms_255.map_or_else(|| "n/a".into(), |x| format!("{x:.2}")),
                 e.map_or_else(|| "n/a".into(), |e| format!("{:.3}", e.max_abs)),
-                e.and_then(|e| e.psnr_db).map_or_else(|| "∞".into(), |x| format!("{x:.1}")),
+                e.map_or_else(|| "n/a".into(), |e| e.psnr_label()),
                 if r.pareto { "★" } else { "" }
             );
         }

@@ -172,7 +172,6 @@ pub struct BenchConfig {
     pub memory: Vec<(PathBuf, (u32, u32))>,
 }
 
-
 /// The label of a graph file in tables: its file stem.
 pub fn graph_label(path: &Path) -> String {
     path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| path.display().to_string())
@@ -358,9 +357,8 @@ impl GraphsArgs {
             .map(|p| p.dataset_params.iter().map(|(d, k, v)| (d.to_string(), k.to_string(), *v)).collect())
             .unwrap_or_default();
         let antialias = own.and_then(|p| p.antialias).map(|study| (study, scale_viewport(study.size, self.scale)));
-        let memory = own
-            .map(|p| p.memory.iter().map(|(g, size)| (PathBuf::from(g), *size)).collect())
-            .unwrap_or_default();
+        let memory =
+            own.map(|p| p.memory.iter().map(|(g, size)| (PathBuf::from(g), *size)).collect()).unwrap_or_default();
         Ok(BenchConfig {
             preset,
             graphs,

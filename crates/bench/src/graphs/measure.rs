@@ -8,17 +8,7 @@ use std::time::Instant;
 use volgraph_accel::camera::OrbitCamera;
 use volgraph_core::runtime::{CameraData, Runtime, RuntimeError};
 
-/// Median of `values` (NaN when empty).
-pub fn median(values: &[f64]) -> f64 {
-    let mut v = values.to_vec();
-    v.sort_by(|a, b| a.total_cmp(b));
-    let n = v.len();
-    match n {
-        0 => f64::NAN,
-        _ if n % 2 == 1 => v[n / 2],
-        _ => 0.5 * (v[n / 2 - 1] + v[n / 2]),
-    }
-}
+pub use volgraph_accel::stats::median;
 
 /// What the timed frames of one case gave.
 #[derive(Clone, Debug)]
@@ -70,16 +60,4 @@ pub fn time_frames(
         timing.pass_ms = per_pass.into_iter().map(|(pass, v)| (pass, median(&v))).collect();
     }
     Ok(timing)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn median_of_odd_even_and_empty() {
-        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
-        assert!(median(&[]).is_nan());
-    }
 }

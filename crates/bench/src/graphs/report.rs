@@ -261,10 +261,7 @@ impl GraphBenchReport {
             if errors {
                 cells.push(opt(r.error.map(|e| e.max_abs), 4));
                 cells.push(r.error.map_or_else(|| "n/a".to_string(), |e| format!("{:.2e}", e.mean_abs)));
-                cells.push(match r.error {
-                    Some(ImageError { psnr_db: None, .. }) => "∞".to_string(),
-                    e => opt(e.and_then(|e| e.psnr_db), 1),
-                });
+                cells.push(r.error.map_or_else(|| "n/a".to_string(), |e| e.psnr_label()));
             }
             if sweeping {
                 cells.push(if r.pareto == Some(true) { "★".to_string() } else { String::new() });

@@ -367,14 +367,7 @@ fn run_peer(config: &BenchConfig, spec: &peer::PeerSpec, rows: &[Row]) -> Result
     let step = config.params.iter().find(|(k, _)| k.ends_with("step_voxels")).map_or(0.5, |(_, v)| *v);
     let mut result = peer::PeerResult { rows: Vec::new(), ran: String::new() };
     for &viewport in &config.viewports {
-        let r = peer::run(
-            spec,
-            &volgraph_accel::data_dir::data_dir(),
-            &cases,
-            viewport,
-            config.frames,
-            step,
-        )?;
+        let r = peer::run(spec, &volgraph_accel::data_dir::data_dir(), &cases, viewport, config.frames, step)?;
         result.rows.extend(r.rows);
         result.ran = r.ran;
     }

@@ -10,12 +10,12 @@
 
 use std::collections::{BTreeSet, HashSet};
 
+use crate::binding_rules::port_infos;
+use crate::binding_rules::{PortInfo, check_bindings};
+use crate::decl::KindLookup;
 use crate::diagnostic::{Diagnostic, Location};
 use crate::plan::Plan;
-use crate::decl::KindLookup;
-use crate::binding_rules::{PortInfo, check_bindings};
 use crate::reflect::reflect;
-use crate::binding_rules::port_infos;
 use crate::shader_check::parse_and_validate_source;
 use crate::shader_source::{ShaderSources, assemble_with};
 

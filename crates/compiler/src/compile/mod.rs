@@ -11,9 +11,9 @@ mod schedule;
 use std::collections::{BTreeMap, BTreeSet};
 use std::sync::Arc;
 
+use crate::decl::KindLookup;
 use crate::diagnostic::Diagnostics;
 use crate::plan::Plan;
-use crate::decl::KindLookup;
 
 /// The most iterations one repeat group may have: a bound, so that a typo such as
 /// `Fixed(1000000)` is a located error rather than a hang. Krüger–Westermann's loop on a 4096-voxel
@@ -91,7 +91,12 @@ pub use bindings::check_plan_bindings;
 pub const SCENE_EFFECTS: [&str; 4] = ["shading", "preintegration", "jitter", "tricubic"];
 
 /// Compiles graph text named `file` (used in messages) into a plan.
-pub fn compile(file: &str, source: &str, registry: &dyn KindLookup, options: &CompileOptions) -> Result<Plan, Diagnostics> {
+pub fn compile(
+    file: &str,
+    source: &str,
+    registry: &dyn KindLookup,
+    options: &CompileOptions,
+) -> Result<Plan, Diagnostics> {
     // A UTF-8 byte-order mark (some Windows editors write one) is not part of the graph.
     let source = source.strip_prefix('\u{feff}').unwrap_or(source);
     let fail = |items| Diagnostics { file: file.to_string(), text: Arc::from(source), items };

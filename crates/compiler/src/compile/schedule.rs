@@ -14,10 +14,10 @@ use std::collections::{BTreeMap, BinaryHeap, HashMap};
 
 use super::check::{Checked, Item, Ref, ValueDesc};
 use super::{CompileOptions, MAX_PLAN_STEPS};
+use crate::decl::{Access, PortKind};
 use crate::diagnostic::{Diagnostic, Location};
 use crate::graph::ast::{GraphDoc, HistoryInitial};
 use crate::plan::{Binding, BoundPort, History, Plan, Resource, ResourceDesc, ResourceId, Slot, Step};
-use crate::decl::{Access, PortKind};
 
 #[derive(Clone, Debug, PartialEq)]
 enum Val {

@@ -10,7 +10,7 @@
 #![allow(dead_code, reason = "each test file uses a different subset of the helpers")]
 
 use volgraph_compiler::params::ParamSpec;
-use volgraph_compiler::{PassDecl, PortKind, PortSpec, Kinds, TargetFormat};
+use volgraph_compiler::{Kinds, PassDecl, PortKind, PortSpec, TargetFormat};
 
 /// Float targets the ray passes accept (first is the default for outputs).
 pub const FLOAT_TARGETS: [TargetFormat; 2] = [TargetFormat::Rgba32Float, TargetFormat::Rgba16Float];
@@ -34,7 +34,6 @@ impl TestPlugin {
         Self { kind, ports, iso_ports: Vec::new(), params: Vec::new(), features: Vec::new() }
     }
 }
-
 
 impl PassDecl for TestPlugin {
     fn kind(&self) -> &'static str {
@@ -61,7 +60,6 @@ impl PassDecl for TestPlugin {
         self.features.clone()
     }
 }
-
 
 fn raycast_params() -> Vec<ParamSpec> {
     vec![

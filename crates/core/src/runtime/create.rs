@@ -27,7 +27,6 @@ pub struct PassError {
     pub message: String,
 }
 
-
 /// Depth test of a render pipeline.
 #[derive(Clone, Copy, Debug)]
 pub struct DepthSpec<'a> {
@@ -573,4 +572,3 @@ impl<'a> CreateContext<'a> {
         buffer
     }
 }
-

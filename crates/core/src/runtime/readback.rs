@@ -26,6 +26,15 @@ impl Image {
         out[..n].copy_from_slice(&self.data[i..i + n]);
         out
     }
+
+    /// Every pixel as f64 RGBA, row by row from the top: what
+    /// [`volgraph_accel::image_diff::image_diff`] compares with a reference.
+    pub fn to_rgba_f64(&self) -> Vec<[f64; 4]> {
+        (0..self.height)
+            .flat_map(|y| (0..self.width).map(move |x| (x, y)))
+            .map(|(x, y)| self.rgba(x, y).map(f64::from))
+            .collect()
+    }
 }
 
 fn channels(format: TargetFormat) -> u32 {

@@ -132,7 +132,6 @@ pub enum ApplyError {
     Gpu(#[from] GpuFault),
 }
 
-
 /// The slot's history entry name, if it is the current-frame texture of one.
 fn history_of_slot(plan: &Plan, slot: usize) -> Option<&str> {
     plan.history.iter().find(|(_, h)| plan.resources[h.source].slot == Some(slot)).map(|(n, _)| n.as_str())

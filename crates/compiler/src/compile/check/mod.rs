@@ -11,12 +11,12 @@ use std::collections::{BTreeMap, HashMap};
 use std::sync::Arc;
 
 use super::CompileOptions;
+use crate::decl::{KindLookup, PassDecl, PortSpec};
 use crate::diagnostic::{Diagnostic, Location};
 use crate::format::{TargetFormat, TargetSize};
 use crate::graph::ast::{GraphDoc, HistoryInitial, InputKind, NodeDoc, RepeatCount};
 use crate::graph::locate::{Locator, PassPath};
 use crate::params::Params;
-use crate::decl::{KindLookup, PassDecl, PortSpec};
 use crate::suggest::comma_list;
 
 /// A resolved reference to a value.

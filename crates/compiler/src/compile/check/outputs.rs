@@ -3,9 +3,9 @@
 use std::collections::BTreeMap;
 
 use super::{Checker, Ref, ValueDesc};
+use crate::decl::PortKind;
 use crate::diagnostic::Location;
 use crate::graph::ast::HistoryInitial;
-use crate::decl::PortKind;
 use crate::suggest::comma_list;
 
 impl Checker<'_> {

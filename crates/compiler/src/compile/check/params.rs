@@ -2,10 +2,10 @@
 //! against the plugin's parameter specs.
 
 use super::Checker;
+use crate::decl::PassDecl;
 use crate::graph::ast::PassDoc;
 use crate::graph::locate::PassPath;
 use crate::params::{ParamKind, ParamProblem, Params, check_param};
-use crate::decl::PassDecl;
 use crate::suggest::{comma_list, guess_then, quoted_list};
 
 impl Checker<'_> {

@@ -3,10 +3,10 @@
 use std::collections::BTreeMap;
 
 use super::{Checker, PassInfo, ValueDesc};
+use crate::decl::{Access, PortKind};
 use crate::format::{TargetFormat, TargetSize};
 use crate::graph::ast::PassDoc;
 use crate::graph::locate::PassPath;
-use crate::decl::{Access, PortKind};
 use crate::suggest::{closest, comma_list, guess_then};
 
 impl Checker<'_> {

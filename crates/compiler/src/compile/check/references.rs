@@ -2,11 +2,11 @@
 //! sizes and stand-ins for gated-off passes.
 
 use super::{Checker, PassInfo, Ref, ValueDesc};
+use crate::decl::{Access, PortKind, PortSpec, SizeRule};
 use crate::diagnostic::Location;
 use crate::format::{TargetFormat, TargetSize};
 use crate::graph::ast::{InputKind, NodeDoc, PassDoc};
 use crate::graph::locate::PassPath;
-use crate::decl::{Access, PortKind, PortSpec, SizeRule};
 use crate::suggest::{closest, comma_list, guess_then, quoted_list};
 
 impl Checker<'_> {

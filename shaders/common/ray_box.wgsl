@@ -1,0 +1,64 @@
+// A pixel's ray met analytically with the volume box, in texture space: the same segment as
+// `volgraph_accel::reference::ray_segment` and docs/rendering_model.md ("Ray segment inside the
+// box"). Needs only the frame, so any pass can import it — the compute raycasters through
+// common/analytic_ray.wgsl, a WGSL-only pass directly (graph_kinds/mip_projection.wgsl).
+
+#import "common/frame.wgsl"
+
+// A pixel's ray in texture space; `len = 0` for no ray.
+struct Ray {
+    u0: vec3<f32>,
+    d: vec3<f32>,
+    len: f32,
+}
+
+// The ray of pixel centre `pixel` clipped to the box and the near plane, as
+// `volgraph_accel::reference::ray_segment` clips it (slab test; start at max(t_in, t_near); the
+// ends clamped to [0,1]³; rays shorter than 1e-6 dropped), computed in texture space from the
+// frame's per-pixel ray (FrameUniforms::ray_*_texture): the box is [0,1]³ and, the direction
+// being scaled to unit forward distance, the near plane is at t = near. No loop, no early
+// return: the lanes of a SIMD group stay together.
+fn analytic_ray(pixel: vec2<u32>) -> Ray {
+    return analytic_ray_at(vec2<f32>(pixel) + vec2<f32>(0.5));
+}
+
+// The texture-space direction of the ray through image position `at` (pixels; pixel centres at
+// +0.5), scaled to unit forward distance.
+fn pixel_ray_texture(at: vec2<f32>) -> vec3<f32> {
+    return frame.ray_base_texture.xyz + at.x * frame.ray_dx_texture.xyz + at.y * frame.ray_dy_texture.xyz;
+}
+
+// The ray through image position `at` (any sub-pixel position), clipped like `analytic_ray`.
+fn analytic_ray_at(at: vec2<f32>) -> Ray {
+    return analytic_ray_along(pixel_ray_texture(at));
+}
+
+// The ray from the eye along texture-space direction `dir` (scaled to unit forward distance),
+// clipped to the box and the near plane like `analytic_ray`.
+fn analytic_ray_along(dir: vec3<f32>) -> Ray {
+    let eye = frame.eye_texture.xyz;
+    let far = vec3<f32>(3.0e38);
+    let parallel = dir == vec3<f32>(0.0);
+    let inv = 1.0 / select(dir, vec3<f32>(1.0), parallel);
+    let ta = -eye * inv;
+    let tb = (vec3<f32>(1.0) - eye) * inv;
+    // An axis the ray runs parallel to: no constraint when the eye is within the slab, else no ray.
+    let inside = (eye >= vec3<f32>(0.0)) & (eye <= vec3<f32>(1.0));
+    let lo = select(min(ta, tb), select(far, -far, inside), parallel);
+    let hi = select(max(ta, tb), select(-far, far, inside), parallel);
+    let t_in = max(lo.x, max(lo.y, lo.z));
+    let t_out = min(hi.x, min(hi.y, hi.z));
+    let t0 = max(t_in, frame.camera_forward.w);
+    let u0 = clamp(eye + t0 * dir, vec3<f32>(0.0), vec3<f32>(1.0));
+    let u1 = clamp(eye + t_out * dir, vec3<f32>(0.0), vec3<f32>(1.0));
+    let len = length(u1 - u0);
+    let hit = t_in <= t_out && t0 < t_out && len >= 1e-6;
+    return Ray(u0, select(vec3<f32>(0.0, 0.0, 1.0), (u1 - u0) / len, hit), select(0.0, len, hit));
+}
+
+// The texture-space length of a step of `step_voxels` voxels along unit texture-space direction
+// `d_tex`: step_voxels * unit_world / |d_tex * 2*half| (`volgraph_accel::reference::step_tex`).
+fn step_tex_for(step_voxels: f32, d_tex: vec3<f32>) -> f32 {
+    let world_per_tex = length(d_tex * 2.0 * frame.half_extent.xyz);
+    return step_voxels * frame.half_extent.w / world_per_tex;
+}

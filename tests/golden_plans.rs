@@ -3,7 +3,9 @@
 //! it as `NAME.plan.txt`, so a change in ordering, culling or pooling shows up in review.
 //! `VOLGRAPH_BLESS=1 cargo test -p volgraph-tests --test golden_plans` rewrites them.
 
-use volgraph_core::{CompileOptions, compile};
+// The compiler alone (`volgraph_compiler`, no GPU stack) turns each graph into its plan; the
+// built-in passes only contribute their declarations (`KindLookup`).
+use volgraph_compiler::{CompileOptions, KindLookup, compile};
 use volgraph_passes::builtin_registry;
 use volgraph_tests::{check_golden, graph_files, relative_name};
 
@@ -12,6 +14,7 @@ fn every_graph_matches_its_golden_plan() {
     let files = graph_files().expect("graphs/ is readable");
     assert!(files.len() >= 3, "expected the graphs/basic files, found {files:?}");
     let registry = builtin_registry();
+    let kinds: &dyn KindLookup = &registry;
     let options = CompileOptions::new(1920, 1080);
     let mut failures = Vec::new();
     for path in &files {
@@ -23,7 +26,7 @@ fn every_graph_matches_its_golden_plan() {
                 continue;
             }
         };
-        match compile(&name, &source, &registry, &options) {
+        match compile(&name, &source, kinds, &options) {
             Ok(plan) => {
                 let golden = path.with_extension("plan.txt");
                 if let Err(e) = check_golden(&golden, &plan.to_text()) {

@@ -48,7 +48,7 @@ pub struct CameraFrame {
     pub eye: DVec3,
     /// `view` transform (world → eye), right-handed.
     pub view_from_world: DMat4,
-    /// Projection (eye → clip), WebGPU depth range [0,1].
+    /// Projection (eye → clip), WebGPU depth range \[0,1\].
     pub clip_from_view: DMat4,
     /// `clip_from_view * view_from_world`.
     pub clip_from_world: DMat4,

@@ -45,7 +45,7 @@ pub enum RenderMode {
     Dvr,
     /// First-hit isosurface, shaded with a headlight (Krüger & Westermann 2003 §2.2).
     Isosurface {
-        /// The iso value, a normalized scalar in [0,1].
+        /// The iso value, a normalized scalar in \[0,1\].
         iso: f64,
         /// Shading coefficients.
         #[serde(default)]
@@ -234,7 +234,7 @@ pub fn pixel_jitter(x: u32, y: u32, width: u32) -> f64 {
 }
 
 /// Opacity correction of the LUT's per-unit-step alpha to a step of `step_voxels`:
-/// `1 - (1 - a)^step_voxels`, with `a` clamped to [0,1].
+/// `1 - (1 - a)^step_voxels`, with `a` clamped to \[0,1\].
 pub fn corrected_alpha(a_tf: f64, step_voxels: f64) -> f64 {
     let a = a_tf.clamp(0.0, 1.0);
     if a >= 1.0 {

@@ -54,7 +54,7 @@ pub struct Volume {
     pub data: VoxelData,
     /// A human-readable name (file stem or generator), used in messages and benchmarks.
     pub name: String,
-    /// For float data: the (min, max) of the finite values, used to normalize to [0,1].
+    /// For float data: the (min, max) of the finite values, used to normalize to \[0,1\].
     pub value_range: (f64, f64),
 }
 
@@ -70,7 +70,7 @@ impl Volume {
         x as usize + self.dims.x as usize * (y as usize + self.dims.y as usize * z as usize)
     }
 
-    /// The normalized value in [0,1] of voxel `i`, exactly as the GPU texture holds it
+    /// The normalized value in \[0,1\] of voxel `i`, exactly as the GPU texture holds it
     /// (u8 → v/255, u16 → v/65535, i16 → (v+32768)/65535, f32 → (v-min)/(max-min)).
     #[inline]
     pub fn normalized(&self, i: usize) -> f64 {
@@ -85,7 +85,7 @@ impl Volume {
         }
     }
 
-    /// All voxels normalized to [0,1] as f32 (what an R32Float texture upload wants).
+    /// All voxels normalized to \[0,1\] as f32 (what an R32Float texture upload wants).
     pub fn normalized_f32(&self) -> Vec<f32> {
         (0..self.voxel_count()).map(|i| self.normalized(i) as f32).collect()
     }

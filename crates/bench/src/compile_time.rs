@@ -4,7 +4,7 @@
 //! (a) Compile time: a generated 30-pass graph (a chain of ray-direction passes, eight raycast
 //! branches with presents, a 4-iteration repeat group with carried feedback, and two passes
 //! nothing reads, which are culled) built from the built-in kinds, compiled by
-//! [`volgraph_core::compile`] many times; the median must stay under 1 ms so a hot-reloading
+//! [`volgraph_core::compile()`] many times; the median must stay under 1 ms so a hot-reloading
 //! viewer can recompile on every keystroke.
 //! (b) Memory: every graph under `graphs/` (except `graphs/tf/`, transfer functions) compiled at
 //! 1920x1080 with no features; [`volgraph_core::Plan::memory`] gives the pooled and unpooled peak

@@ -45,8 +45,10 @@ fn every_pass_builds_exactly_the_shaders_it_declares() {
                     continue;
                 }
             };
+            // A graph's own WGSL-only kinds (`graphs/basic/mip.ron`) join the built-in ones.
+            let kinds = volgraph_core::wgsl_pass::with_graph_kinds(&registry, &plan.kinds);
             for step in plan.steps.iter().filter(|s| s.iteration.is_none_or(|(i, _)| i == 0)) {
-                let plugin = registry.get(&step.kind).expect("a built-in kind");
+                let plugin = kinds.get(&step.kind).expect("a built-in kind or one the graph declares");
                 let ports = port_infos(&plan, step, &plugin.ports(&step.params));
                 let ctx = CreateContext::new(
                     &gpu,

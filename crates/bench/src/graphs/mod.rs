@@ -2,8 +2,8 @@
 //! sweep), each timed over frames that turn the volume about y, as the papers did. Prints a
 //! markdown table of median ms/frame, speed-up against a baseline graph measured in the same run,
 //! per-pass GPU time, samples per pixel and million samples per second; with a sweep, error
-//! against a converged CPU reference and the Pareto front ("Accuracy costs time",
-//! PIPELINES.md). JSON and a PNG plot on request; progress on stderr.
+//! against a converged CPU reference and the Pareto front (what accuracy costs in time:
+//! `docs/accuracy.md`). JSON and a PNG plot on request; progress on stderr.
 //!
 //! Layout: [`args`] (flags → configuration), [`preset`] (the papers' comparisons as data),
 //! [`dataset`], [`measure`] (frames and clocks), [`accuracy`] (CPU reference side), [`run`]

@@ -1,7 +1,7 @@
 //! Compiling a graph: a pure function of (graph text, registry, viewport, scene features,
 //! scene values) → [`Plan`], cheap enough to rerun on every keystroke of a hot-reloading
-//! viewer. [`check`] validates and resolves every reference, reporting all problems at once;
-//! [`schedule`] unrolls repeat groups, orders the passes, culls what no output needs and pools
+//! viewer. `check` validates and resolves every reference, reporting all problems at once;
+//! `schedule` unrolls repeat groups, orders the passes, culls what no output needs and pools
 //! transient targets by descriptor across non-overlapping lifetimes.
 
 mod bindings;

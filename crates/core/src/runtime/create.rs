@@ -278,7 +278,7 @@ impl<'a> CreateContext<'a> {
     }
 
     /// `(file, entry point)` of every pipeline this context built so far (tests compare it with
-    /// what the plugin declares in [`crate::plugin::PassPlugin::shaders`]).
+    /// what the plugin declares in [`crate::plugin::PassDecl::shaders`]).
     pub fn built_entry_points(&self) -> BTreeSet<(String, String)> {
         self.built.borrow().clone()
     }
@@ -321,7 +321,7 @@ impl<'a> CreateContext<'a> {
     }
 
     /// The validated module of `file` (no `#if` names), for a plugin that checks its shader
-    /// against its declaration before building ([`crate::plugin::PassPlugin::check_module`]).
+    /// against its declaration before building ([`crate::plugin::PassDecl::check_module`]).
     pub fn shader_module(&self, file: &str) -> Result<std::sync::Arc<super::shaders::LoadedShader>, PassError> {
         self.shader(file, &[])
     }

@@ -1,7 +1,7 @@
 //! Frames in flight: each submitted frame gets a slot of a small ring with its own timestamp
 //! queries and readback buffer. Submitting returns at once; a new frame waits only when the ring
 //! is full (for the oldest frame), and timings are read back asynchronously when the GPU reports
-//! the frame done ([`FrameRing::poll`]).
+//! the frame done (`FrameRing::poll`).
 
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, Ordering};

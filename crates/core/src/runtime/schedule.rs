@@ -1,5 +1,5 @@
 //! A plan made live: one node per pass, a texture per slot, the owned resources nodes publish and
-//! a bind-group cache. [`build`] makes one from a plan and the previous schedule, reusing what did
+//! a bind-group cache. `build` makes one from a plan and the previous schedule, reusing what did
 //! not change: a node whose kind, ports and shaders are unchanged is kept (its parameters updated
 //! in place where the plugin can), everything else is created with pipelines from the runtime's
 //! cache. Building is all-or-nothing: on any error the previous schedule is untouched.

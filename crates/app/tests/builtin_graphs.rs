@@ -99,7 +99,7 @@ fn bench_without_the_bench_program_says_how_to_install_it() {
     let out = Command::new(&copied)
         .args(["sweep", "--knobs", "step"])
         .current_dir(&dir)
-        .env("PATH", &dir.join("no-such-folder"))
+        .env("PATH", dir.join("no-such-folder"))
         .output()
         .expect("runs");
     let err = String::from_utf8_lossy(&out.stderr);

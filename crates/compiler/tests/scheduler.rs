@@ -3,7 +3,7 @@
 //!
 //! The pass kinds are defined here, outside `volgraph-passes`, through the public
 //! [`PassDecl`] API: this is also the proof that a crate other than the built-in one can add
-//! pass kinds and have them scheduled. Their nodes record nothing; these tests never touch a GPU.
+//! pass kinds and have them scheduled. They are declarations only: this test links no GPU stack.
 
 use volgraph_compiler::plan::{Binding, ResourceDesc};
 use volgraph_compiler::{
@@ -49,8 +49,7 @@ impl Kind {
     }
 }
 
-/// Records nothing: scheduling tests never run a frame.
-
+/// A declaration only: scheduling tests never run a frame.
 impl PassDecl for Kind {
     fn kind(&self) -> &'static str {
         self.name

@@ -1,11 +1,11 @@
-//! Test plugins for the core integration tests that compile graph files without the GPU
-//! (`malformed_graphs`, `fuzz_graphs`).
+//! Pass declarations for the compiler's integration tests, which compile graph files with no GPU
+//! stack at all (`malformed_graphs`, `fuzz_graphs`, ...).
 //!
 //! Their ports mirror the built-in passes of `volgraph-passes` (`entry_points`,
 //! `ray_directions`, `raycast`, `present`) and the passes the papers' pipelines need
 //! (`raycast_segment`, `termination_test` for Krüger–Westermann's multipass loop;
 //! `reprojection_splat`, `hole_fill`, `antialias` for Klein et al.), so error messages read as
-//! they would for real graphs. Their nodes record nothing: these tests never run a frame.
+//! they would for real graphs. They are declarations only (`PassDecl`): nothing is ever created.
 
 #![allow(dead_code, reason = "each test file uses a different subset of the helpers")]
 

@@ -3,8 +3,9 @@
 //! it as `NAME.plan.txt`, so a change in ordering, culling or pooling shows up in review.
 //! `VOLGRAPH_BLESS=1 cargo test -p volgraph-tests --test golden_plans` rewrites them.
 
-// The compiler alone (`volgraph_compiler`, no GPU stack) turns each graph into its plan; the
-// built-in passes only contribute their declarations (`KindLookup`).
+// The compiler's `compile` (`volgraph_compiler`) turns each graph into its plan; the built-in
+// passes contribute only their declarations (`KindLookup`). This test binary still links wgpu:
+// volgraph-passes keeps each kind's declaration and GPU code in one module.
 use volgraph_compiler::{CompileOptions, KindLookup, compile};
 use volgraph_passes::builtin_registry;
 use volgraph_tests::{check_golden, graph_files, relative_name};

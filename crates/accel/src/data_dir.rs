@@ -1,10 +1,10 @@
 //! Where tests and benchmarks find real data: a folder holding `volumes/` (with its
 //! `MANIFEST.md`) and `tf/`. In order: the folder a program was given (`--data DIR`,
 //! [`set_data_dir`]), the `VOLGRAPH_DATA` environment variable, `../shared/data` from the
-//! current folder (the README's layout, commands run from the checkout), and — for tests and
-//! `cargo run` only — `<workspace root>/../shared/data` as the source tree was built. Installed
-//! programs call [`forget_build_path`] first: a binary never reads data from the build
-//! machine's source path.
+//! current folder (the README's layout, commands run from the checkout), and — for tests only —
+//! `<workspace root>/../shared/data` as the source tree was built. Every volgraph program calls
+//! [`forget_build_path`] first (`volgraph_app::main_with`): a binary never reads data from the
+//! build machine's source path.
 //!
 //! Datasets are named by the part of the file name before `_XxYxZ_dtype.raw`
 //! (`hydrogen_atom` → `volumes/hydrogen_atom_128x128x128_uint8.raw`). Under CI (the `CI`
@@ -37,7 +37,7 @@ pub enum DataError {
     },
     /// No dataset has that name.
     #[error(
-        "dataset \"{name}\" not found in {}; available: {}. Set {DATA_ENV} to another data folder if it lives elsewhere",
+        "dataset \"{name}\" not found in {}; available: {}. Give --data DIR or set {DATA_ENV} to another data folder if it lives elsewhere",
         .dir.display(), if .available.is_empty() { "none".to_string() } else { .available.join(", ") }
     )]
     NotFound {

@@ -12,9 +12,9 @@ use serde::Serialize;
 pub struct ImageDiff {
     /// Largest absolute channel difference (infinite when a channel is not finite).
     pub max_abs: f64,
-    /// Mean absolute channel difference over the finite channels.
+    /// Mean absolute channel difference (infinite when a channel is not finite).
     pub mean_abs: f64,
-    /// Root-mean-square channel difference over the finite channels.
+    /// Root-mean-square channel difference (infinite when a channel is not finite).
     pub rms: f64,
     /// PSNR in dB for a peak of 1; `None` when the images are identical or a channel is not
     /// finite.
@@ -70,10 +70,28 @@ pub fn image_diff(image: &[[f64; 4]], reference: &[[f64; 4]]) -> Result<ImageDif
             finite += 1;
         }
     }
+    if non_finite > 0 {
+        // Every summary says it: a reader of the mean alone (a Pareto front, a test of the
+        // mean) must not see a NaN image as a small error.
+        let inf = f64::INFINITY;
+        return Ok(ImageDiff { max_abs: inf, mean_abs: inf, rms: inf, psnr_db: None, non_finite });
+    }
     let n = finite.max(1) as f64;
     let mse = sum_sq / n;
-    let psnr_db = (mse > 0.0 && non_finite == 0).then(|| 10.0 * (1.0 / mse).log10());
+    let psnr_db = (mse > 0.0).then(|| 10.0 * (1.0 / mse).log10());
     Ok(ImageDiff { max_abs, mean_abs: sum_abs / n, rms: mse.sqrt(), psnr_db, non_finite })
+}
+
+/// The share of pixels with a channel more than `threshold` from the reference; a pixel with a
+/// non-finite channel counts as off. (How much of an image is wrong, where [`image_diff`] says
+/// by how much.)
+pub fn fraction_over(image: &[[f64; 4]], reference: &[[f64; 4]], threshold: f64) -> Result<f64, SizeMismatch> {
+    if image.len() != reference.len() {
+        return Err(SizeMismatch { image: image.len(), reference: reference.len() });
+    }
+    // `!(d <= threshold)` is true for NaN.
+    let off = image.iter().zip(reference).filter(|(a, b)| (0..4).any(|c| !((a[c] - b[c]).abs() <= threshold))).count();
+    Ok(off as f64 / image.len().max(1) as f64)
 }
 
 #[cfg(test)]
@@ -96,9 +114,15 @@ mod tests {
     fn nan_fails_every_tolerance() {
         let d = image_diff(&[[f64::NAN, 0.0, 0.0, 0.0]], &[[0.0; 4]]).expect("same size");
         assert_eq!(d.non_finite, 1);
-        assert!(d.max_abs.is_infinite());
+        assert!(d.max_abs.is_infinite() && d.mean_abs.is_infinite() && d.rms.is_infinite());
         assert!(!d.within(1e9));
         assert_eq!(d.psnr_db, None);
+    }
+
+    #[test]
+    fn fraction_over_counts_pixels_and_nan() {
+        let image = [[0.0; 4], [0.5, 0.0, 0.0, 0.0], [f64::NAN, 0.0, 0.0, 0.0], [0.1, 0.0, 0.0, 0.0]];
+        assert_eq!(fraction_over(&image, &[[0.0; 4]; 4], 0.2), Ok(0.5));
     }
 
     #[test]

@@ -59,11 +59,22 @@ impl Commands for ToBenchProgram {
         }
         child.arg(name).args(sub.get_many::<OsString>("args").into_iter().flatten());
         let status = child.status().map_err(|e| anyhow!("cannot run {}: {e}", program.display()))?;
-        Ok(match status.code() {
-            Some(0) => ExitCode::SUCCESS,
-            Some(code) => ExitCode::from(u8::try_from(code).unwrap_or(1)),
-            None => ExitCode::from(1),
-        })
+        match status.code() {
+            Some(0) => Ok(ExitCode::SUCCESS),
+            Some(code) => Ok(ExitCode::from(u8::try_from(code).unwrap_or(1))),
+            // Killed by a signal: say so rather than exit 1 in silence.
+            None => {
+                #[cfg(unix)]
+                let signal = std::os::unix::process::ExitStatusExt::signal(&status);
+                #[cfg(not(unix))]
+                let signal: Option<i32> = None;
+                Err(CliError::Other(anyhow!(
+                    "{} was stopped by signal {}",
+                    program.display(),
+                    signal.map_or_else(|| "?".to_string(), |s| s.to_string())
+                )))
+            }
+        }
     }
 }
 

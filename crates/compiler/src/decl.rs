@@ -152,7 +152,7 @@ pub enum Rerun {
 }
 
 /// What a pass kind declares: everything the compiler checks and schedules a graph with. The
-/// runtime's `PassDecl` extends it with `create`, which builds the per-graph node on a device.
+/// runtime's `PassPlugin` extends it with `create`, which builds the per-graph node on a device.
 pub trait PassDecl: Send + Sync {
     /// The name graph files use in `kind:`.
     fn kind(&self) -> &'static str;

@@ -14,6 +14,7 @@
 //!   bound, because the GPU filters unorm8 textures with 8-bit weights (reason beside the test).
 
 use volgraph_accel::camera::OrbitCamera;
+use volgraph_accel::image_diff::{fraction_over, image_diff};
 use volgraph_accel::reference::render_reference;
 use volgraph_accel::transfer_function::TransferFunction;
 use volgraph_accel::volume::Volume;
@@ -35,32 +36,18 @@ struct Comparison {
     frac_over_16: f64,
 }
 
+/// The GPU image against the reference by the project's one metric
+/// (`volgraph_accel::image_diff`: a NaN is an infinite error and a pixel over every threshold).
 fn compare(gpu: &Image, reference: &[[f64; 4]]) -> Comparison {
-    let mut max_abs: f64 = 0.0;
-    let mut sum = 0.0;
-    let mut over = 0usize;
-    let mut over16 = 0usize;
-    for y in 0..gpu.height {
-        for x in 0..gpu.width {
-            let g = gpu.rgba(x, y);
-            let r = reference[(y * gpu.width + x) as usize];
-            let mut pixel_max: f64 = 0.0;
-            for c in 0..4 {
-                let d = (g[c] as f64 - r[c]).abs();
-                pixel_max = pixel_max.max(d);
-                sum += d;
-            }
-            max_abs = max_abs.max(pixel_max);
-            if pixel_max > 2.0 / 255.0 {
-                over += 1;
-            }
-            if pixel_max > 16.0 / 255.0 {
-                over16 += 1;
-            }
-        }
+    let image = gpu.to_rgba_f64();
+    let diff = image_diff(&image, reference).expect("same size");
+    let over = |threshold: f64| fraction_over(&image, reference, threshold).expect("same size");
+    Comparison {
+        max_abs: diff.max_abs,
+        mean_abs: diff.mean_abs,
+        frac_over_2: over(2.0 / 255.0),
+        frac_over_16: over(16.0 / 255.0),
     }
-    let n = (gpu.width * gpu.height) as f64;
-    Comparison { max_abs, mean_abs: sum / (4.0 * n), frac_over_2: over as f64 / n, frac_over_16: over16 as f64 / n }
 }
 
 fn render_both(

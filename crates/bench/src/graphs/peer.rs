@@ -6,7 +6,7 @@
 //! install it.
 
 use std::path::Path;
-use std::process::Command;
+use std::process::{Command, Stdio};
 
 use serde::Deserialize;
 
@@ -21,8 +21,8 @@ pub struct PeerSpec {
     pub about: &'static str,
     /// The script's name in reports (its path in the source tree).
     pub script: &'static str,
-    /// The script's text, compiled in and written to a temporary file to run with `python3`, so
-    /// the peer runs from any folder.
+    /// The script's text, compiled in and handed to `python3` on its standard input, so the peer
+    /// runs from any folder.
     pub script_text: &'static str,
     /// How to make it runnable, for the note when it is not.
     pub install: &'static str,
@@ -72,14 +72,10 @@ pub fn run(
     frames: u32,
     step_voxels: f64,
 ) -> Result<PeerResult, String> {
-    let dir = std::env::temp_dir().join(format!("volgraph-peer-{}", std::process::id()));
-    let script = dir.join(Path::new(spec.script).file_name().unwrap_or_default());
-    std::fs::create_dir_all(&dir)
-        .and_then(|()| std::fs::write(&script, spec.script_text))
-        .map_err(|e| format!("cannot write the peer script to {}: {e}", script.display()))?;
     let pairs: Vec<String> = cases.iter().map(|c| format!("{}:{}", c.dataset, c.tf)).collect();
-    let output = Command::new("python3")
-        .arg(&script)
+    // The script goes to python3 on its standard input: nothing is written to disk.
+    let mut child = Command::new("python3")
+        .arg("-")
         .arg("--data")
         .arg(data_dir)
         .arg("--cases")
@@ -90,15 +86,25 @@ pub fn run(
         .arg(frames.to_string())
         .arg("--step")
         .arg(step_voxels.to_string())
-        .output()
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
         .map_err(|e| format!("cannot start python3 ({e}); {}", spec.install))?;
+    if let Some(mut stdin) = child.stdin.take() {
+        use std::io::Write as _;
+        stdin
+            .write_all(spec.script_text.as_bytes())
+            .map_err(|e| format!("cannot hand {} to python3: {e}", spec.script))?;
+    }
+    let output = child.wait_with_output().map_err(|e| format!("{}: {e}", spec.script))?;
     if !output.status.success() {
         let stderr = String::from_utf8_lossy(&output.stderr);
         let last = stderr.lines().rev().find(|l| !l.trim().is_empty()).unwrap_or("no message");
-        return Err(format!("{} failed: {last}; {}", script.display(), spec.install));
+        return Err(format!("{} failed: {last}; {}", spec.script, spec.install));
     }
     let parsed: PeerOutput = serde_json::from_slice(&output.stdout)
-        .map_err(|e| format!("{} printed no report it understands: {e}", script.display()))?;
+        .map_err(|e| format!("{} printed no report it understands: {e}", spec.script))?;
     let rows = parsed
         .rows
         .into_iter()

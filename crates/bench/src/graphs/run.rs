@@ -30,7 +30,10 @@ struct GraphFile {
 
 /// A dataset with its volume.
 struct Dataset {
+    /// The `--datasets` name the cases refer to.
     name: String,
+    /// Its name in tables (`NAME→ml64` for a generated stand-in).
+    label: String,
     volume: Volume,
 }
 
@@ -203,11 +206,28 @@ pub fn run(gpu: std::sync::Arc<Gpu>, config: &BenchConfig) -> anyhow::Result<Gra
             }
         })
         .collect();
+    let mut stand_in_notes = Vec::new();
+    let mut stand_in_taken = config.datasets.iter().any(|d| d == dataset::STAND_IN);
     let datasets: Vec<Dataset> = config
         .datasets
         .iter()
-        .filter_map(|name| match dataset::load(name) {
-            Ok(volume) => Some(Dataset { name: name.clone(), volume }),
+        .filter_map(|name| match dataset::load_or_stand_in(name) {
+            // One stand-in at most, and none beside the generated volume itself: the same
+            // volume measured twice under two names says nothing new.
+            Ok(loaded) if loaded.stand_in_note.is_some() && std::mem::replace(&mut stand_in_taken, true) => {
+                ctx.skip(
+                    format!("dataset {name}"),
+                    format!("not in the data folder, and the generated {} is measured already", dataset::STAND_IN),
+                );
+                None
+            }
+            Ok(loaded) => {
+                if let Some(note) = loaded.stand_in_note {
+                    ctx.progress.suspend(|| volgraph_app::stdout::eprintln_escaped!("note: {note}"));
+                    stand_in_notes.push(note);
+                }
+                Some(Dataset { name: name.clone(), label: loaded.label, volume: loaded.volume })
+            }
             Err(e) => {
                 ctx.skip(format!("dataset {name}"), format!("{e:#}"));
                 None
@@ -251,6 +271,7 @@ pub fn run(gpu: std::sync::Arc<Gpu>, config: &BenchConfig) -> anyhow::Result<Gra
     }
     ctx.progress.finish_and_clear();
     let mut notes = notes(config);
+    notes.extend(stand_in_notes);
     if config.peer
         && let Some(spec) = config.preset.and_then(|p| p.peer)
     {
@@ -455,7 +476,7 @@ fn run_case(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<Row> {
     Some(Row {
         graph: case.graph.label.clone(),
         graph_file: file,
-        dataset: case.dataset.name.clone(),
+        dataset: case.dataset.label.clone(),
         dims: case.dataset.volume.dims.to_array(),
         tf: case.tf_name.clone(),
         viewport: [case.viewport.0, case.viewport.1],

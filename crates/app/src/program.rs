@@ -103,8 +103,13 @@ pub fn main_with(extension: Extension) -> ExitCode {
     let Extension { name, register, shaders, commands } = extension;
     let _ = PROGRAM.set(Program { register, shaders });
     let mut command = Cli::command().name(name).bin_name(name);
+    let about = command.get_about().cloned();
     for c in &commands {
         command = c.augment(command);
+    }
+    // An extension's derive may set the program's about line; volgraph's stays.
+    if let Some(about) = about {
+        command = command.about(about);
     }
     let matches = command.get_matches();
     report(run(&matches, &commands))

@@ -7,7 +7,7 @@ use anyhow::Context as _;
 use clap::{FromArgMatches as _, Subcommand};
 use volgraph_app::cli::CliError;
 
-/// What `volgraph-bench` adds.
+// What `volgraph-bench` adds (no doc comment: clap would make it the program's about line).
 #[derive(Subcommand, Debug)]
 #[allow(clippy::large_enum_variant, reason = "parsed once per process; boxing would only obscure the clap derive")]
 enum BenchCli {

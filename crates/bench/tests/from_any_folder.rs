@@ -74,6 +74,10 @@ fn json(path: &Path) -> serde_json::Value {
 #[test]
 fn graphs_and_render_by_name() {
     let s = sandbox("render");
+    // The program says what it is: volgraph's about line, not a subcommand group's.
+    let help = String::from_utf8_lossy(&s.run(&s.bench, &["--help"]).stdout).into_owned();
+    assert!(help.starts_with("volgraph: GPU volume rendering"), "{help}");
+    assert!(help.contains("sweep") && help.contains("bench") && help.contains("render"), "{help}");
     let listing = String::from_utf8_lossy(&s.run(&s.bench, &["graphs"]).stdout).into_owned();
     assert!(listing.contains("kruger_westermann_2003/rc_b") && listing.contains("modern/fastest"), "{listing}");
     s.run(&s.bench, &["render", "kruger_westermann_2003/rc_b", "--size", "32x32", "-o", "rc_b.png"]);

@@ -217,7 +217,11 @@ pub fn run(gpu: std::sync::Arc<Gpu>, config: &BenchConfig) -> anyhow::Result<Gra
             Ok(loaded) if loaded.stand_in_note.is_some() && std::mem::replace(&mut stand_in_taken, true) => {
                 ctx.skip(
                     format!("dataset {name}"),
-                    format!("not in the data folder, and the generated {} is measured already", dataset::STAND_IN),
+                    format!(
+                        "not in the data folder {} (give --data DIR), and the generated {} is measured already",
+                        volgraph_accel::data_dir::data_dir().display(),
+                        dataset::STAND_IN
+                    ),
                 );
                 None
             }

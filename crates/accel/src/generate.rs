@@ -159,6 +159,19 @@ pub fn noise(n: u32, seed: u64) -> Volume {
     Volume::new(format!("noise_{n}_seed{seed}"), UVec3::splat(n), DVec3::ONE, VoxelData::U8(data))
 }
 
+/// A scanned object in its noise floor, named `scanned_sphere_<n>`: a sphere of radius 0.5 (box
+/// units) at 200 inside a background of 70..=80 — 0.27–0.31 of the range, where a CT's air and
+/// noise often sit — so a default transfer function must find the background to show the object
+/// rather than a box of noise.
+pub fn scanned_sphere(n: u32) -> Volume {
+    let data = fill(n, |v| {
+        let index = u64::from(v.x) + u64::from(n) * (u64::from(v.y) + u64::from(n) * u64::from(v.z));
+        let noise = 70 + (SplitMix64(index).next_u64() % 11) as u8;
+        if voxel_centre(n, v.x, v.y, v.z).length() <= 0.5 { 200 } else { noise }
+    });
+    Volume::new(format!("scanned_sphere_{n}"), UVec3::splat(n), DVec3::ONE, VoxelData::U8(data))
+}
+
 /// All zeros (`uint8`), named `zeros_<n>`: nothing to see, every skip structure is empty.
 pub fn zeros(n: u32) -> Volume {
     binary(format!("zeros_{n}"), n, |_| false)

@@ -10,6 +10,7 @@ pub mod chebyshev;
 pub mod classify;
 pub mod data_dir;
 pub mod generate;
+pub mod histogram;
 pub mod image_diff;
 pub mod input_file;
 pub mod load;

@@ -234,13 +234,38 @@ impl TransferFunction {
         TransferFunction { domain, points }
     }
 
-    /// The [`Preset::Default`] ramp over the volume's `value_range` (for `uint8`, 0..255), so
-    /// that [`Self::to_lut`] and [`Self::to_lut_for`] agree for it. A volume whose range is empty
-    /// (a constant float volume) gets the domain (lo, lo + 1).
+    /// The transfer function fitted to `volume`: the [`Preset::Default`] ramp over its
+    /// `value_range` (for `uint8`, 0..255), made transparent up to the top of its background —
+    /// the histogram's low peak of air or scanner noise
+    /// ([`crate::histogram::Histogram::background`]) — so the object shows instead of a box of
+    /// noise. Where the ramp is transparent there anyway (a background below a tenth of the
+    /// range), it is the plain ramp. Its domain is the volume's range, so [`Self::to_lut`] and
+    /// [`Self::to_lut_for`] agree for it. A volume whose range is empty (a constant float
+    /// volume) gets the domain (lo, lo + 1).
     pub fn default_for(volume: &Volume) -> TransferFunction {
         let (lo, hi) = volume.value_range;
         let hi = if hi > lo { hi } else { lo + 1.0 };
-        TransferFunction::preset(Preset::Default, (lo, hi))
+        let ramp = TransferFunction::preset(Preset::Default, (lo, hi));
+        let Some(background) = crate::histogram::Histogram::of(volume, 256).background() else { return ramp };
+        ramp.hidden_below(lo + background.ceiling * (hi - lo))
+    }
+
+    /// This transfer function with every value below `cut` transparent: a step at `cut` from
+    /// nothing to what it was there, unchanged above.
+    pub fn hidden_below(&self, cut: f64) -> TransferFunction {
+        let at = self.eval(cut);
+        if !(cut > self.domain.0 && cut < self.domain.1) || at[3] == 0.0 {
+            let mut all = self.clone();
+            all.points.iter_mut().filter(|p| p.value < cut).for_each(|p| p.alpha = 0.0);
+            return all;
+        }
+        let color = [at[0], at[1], at[2]];
+        let mut points: Vec<ControlPoint> =
+            self.points.iter().filter(|p| p.value < cut).map(|p| ControlPoint { alpha: 0.0, ..p.clone() }).collect();
+        points.push(ControlPoint { value: cut, color, alpha: 0.0 });
+        points.push(ControlPoint { value: cut, color, alpha: at[3] });
+        points.extend(self.points.iter().filter(|p| p.value > cut).cloned());
+        TransferFunction { domain: self.domain, points }
     }
 
     /// Checks the rules of the file format; `path` names the source in messages.

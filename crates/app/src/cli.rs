@@ -62,6 +62,16 @@ enum Command {
     /// Show a graph live in a window, hot-reloading the graph, its shaders and its transfer
     /// function; an overlay shows per-pass GPU time, the plan and every parameter.
     View(crate::view::ViewArgs),
+    /// What a volume holds: dimensions, voxel type, spacing, value range, histogram percentiles,
+    /// its background (air or the scanner's noise floor) and where the fitted default transfer
+    /// function starts.
+    Info {
+        /// The volume file (.raw named NAME_XxYxZ_TYPE.raw, .nrrd, .nhdr, .mhd, .mha).
+        volume: PathBuf,
+        /// How to read a headerless raw volume.
+        #[command(flatten)]
+        raw: RawArgs,
+    },
     /// List the graphs built into the binary (name, paper, description): every one can be given
     /// by name where a graph file is asked for (`volgraph render klein_2005/leap_iso -o x.png`).
     Graphs,
@@ -200,7 +210,7 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
             Ok(Checked::Plan { text, notes: warning_lines(&plan) })
         }
         Command::Render(args) => Ok(Checked::Render(Box::new(crate::render::prepare(args)?))),
-        Command::View(_) | Command::Passes { .. } | Command::Graphs => {
+        Command::View(_) | Command::Passes { .. } | Command::Graphs | Command::Info { .. } => {
             Err(CliError::Other(anyhow!("only plan and render are checked ahead of running")))
         }
     }
@@ -227,6 +237,14 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::View(args) => crate::view::run(args),
         Command::Graphs => {
             crate::stdout::write_stdout(&crate::builtin_graphs::listing())?;
+            Ok(())
+        }
+        Command::Info { volume, raw } => {
+            let (loaded, notes) = inputs::volume(Some(&volume), &inputs::raw_options(&raw)?)?;
+            for note in notes {
+                crate::stdout::eprintln_escaped!("note: {note}");
+            }
+            crate::stdout::write_stdout(&crate::info_cmd::describe(&volume, &loaded))?;
             Ok(())
         }
         Command::Passes { kind, graph } => {

@@ -13,6 +13,7 @@ pub mod forward;
 #[cfg(test)]
 mod fuzz_runner;
 pub mod image_out;
+pub mod info_cmd;
 #[cfg(test)]
 mod input_fuzz;
 pub mod inputs;

@@ -27,7 +27,8 @@ pub struct SceneArgs {
     #[command(flatten)]
     pub raw: RawArgs,
     /// Transfer function (RON, or ParaView color-map .json; the viewer watches it for edits);
-    /// default: one fitted to the data.
+    /// default: one fitted to the data (transparent up to its background of air or noise; see
+    /// `volgraph info`).
     #[arg(long)]
     pub tf: Option<PathBuf>,
     /// The colour map to use from a ParaView .json holding several (its "Name"); default: the first.

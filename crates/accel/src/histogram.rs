@@ -1,0 +1,125 @@
+//! The histogram of a volume's normalized values, and the background it shows: the peak that
+//! air, or a scanner's noise floor, makes at the low end. A default transfer function that
+//! starts above it shows the object instead of a box of noise (3D Slicer's and ParaView's
+//! presets do the same by starting their ramps above air), and `volgraph info` reports it.
+
+use crate::volume::Volume;
+
+/// Counts of normalized values in `bins` equal bins over \[0,1\].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Histogram {
+    /// Voxels per bin.
+    pub counts: Vec<u64>,
+    /// All voxels counted.
+    pub total: u64,
+}
+
+/// The background peak of a histogram ([`Histogram::background`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Background {
+    /// The normalized value of the peak (the histogram's mode).
+    pub mode: f64,
+    /// The normalized value where the peak's upper flank has fallen to 1% of its height: what
+    /// lies below is background.
+    pub ceiling: f64,
+    /// The share of voxels at or below the ceiling.
+    pub fraction: f64,
+}
+
+/// A mode holding less than this share of the voxels is not a background.
+const MIN_BACKGROUND_SHARE: f64 = 0.1;
+/// The peak ends where the counts fall below this share of its height.
+const FLANK: f64 = 0.01;
+
+impl Histogram {
+    /// The histogram of `volume`'s normalized values (what the GPU samples) in `bins` bins.
+    pub fn of(volume: &Volume, bins: usize) -> Histogram {
+        let bins = bins.max(1);
+        let mut counts = vec![0u64; bins];
+        for i in 0..volume.voxel_count() {
+            let v = volume.normalized(i);
+            let b = if v.is_finite() { ((v * bins as f64) as usize).min(bins - 1) } else { 0 };
+            counts[b] += 1;
+        }
+        Histogram { total: counts.iter().sum(), counts }
+    }
+
+    /// The normalized value at the centre of bin `i`.
+    pub fn bin_centre(&self, i: usize) -> f64 {
+        (i as f64 + 0.5) / self.counts.len() as f64
+    }
+
+    /// The normalized value below which a share `p` (0..=1) of the voxels lie (bin resolution).
+    pub fn percentile(&self, p: f64) -> f64 {
+        let want = (p.clamp(0.0, 1.0) * self.total as f64).ceil() as u64;
+        let mut seen = 0;
+        for (i, &c) in self.counts.iter().enumerate() {
+            seen += c;
+            if seen >= want.max(1) {
+                return (i + 1) as f64 / self.counts.len() as f64;
+            }
+        }
+        1.0
+    }
+
+    /// The background: the histogram's mode — the densest window of 5 bins, so noise spread
+    /// over neighbouring values counts as one peak — when it lies in the lower half of the
+    /// values and holds at least a tenth of the voxels, up to where the counts fall below 1%
+    /// of the peak's highest bin. `None` for a volume without one (a peak in the upper half, a
+    /// flat histogram, or a peak with nothing above it).
+    pub fn background(&self) -> Option<Background> {
+        let n = self.counts.len();
+        let around = |i: usize| i.saturating_sub(2)..(i + 3).min(n);
+        let window = |i: usize| self.counts[around(i)].iter().sum::<u64>();
+        let densest = (0..n).max_by_key(|&i| (window(i), std::cmp::Reverse(i)))?;
+        if self.total == 0 || (window(densest) as f64) < MIN_BACKGROUND_SHARE * self.total as f64 {
+            return None;
+        }
+        // The peak is the window's highest bin; the background ends where the counts above it
+        // fall below 1% of its height.
+        let mode = around(densest).max_by_key(|&i| (self.counts[i], std::cmp::Reverse(i)))?;
+        if self.bin_centre(mode) >= 0.5 {
+            return None;
+        }
+        let floor = (self.counts[mode] as f64 * FLANK).max(1.0);
+        let end = (mode..n).find(|&i| (self.counts[i] as f64) < floor)?;
+        let below: u64 = self.counts[..end].iter().sum();
+        if below == self.total || below == 0 {
+            return None;
+        }
+        Some(Background {
+            mode: self.bin_centre(mode),
+            ceiling: end as f64 / n as f64,
+            fraction: below as f64 / self.total as f64,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DVec3, UVec3};
+
+    use super::*;
+    use crate::volume::VoxelData;
+
+    #[test]
+    fn the_noise_floor_is_the_background() {
+        let h = Histogram::of(&crate::generate::scanned_sphere(32), 256);
+        let b = h.background().expect("a background");
+        assert!((70.0 / 255.0..=81.0 / 255.0).contains(&b.mode), "{b:?}");
+        assert!((80.0 / 255.0..=90.0 / 255.0).contains(&b.ceiling), "the floor ends after 80: {b:?}");
+        assert!(b.fraction > 0.8 && b.fraction < 1.0, "{b:?}");
+        assert!(h.percentile(0.5) < b.ceiling && h.percentile(1.0) > 0.78, "{}", h.percentile(1.0));
+    }
+
+    #[test]
+    fn a_volume_without_a_low_peak_has_no_background() {
+        // A ramp: every value equally common.
+        let ramp: Vec<u8> = (0..4096u32).map(|i| (i % 256) as u8).collect();
+        let v = Volume::new("ramp", UVec3::new(16, 16, 16), DVec3::ONE, VoxelData::U8(ramp));
+        assert_eq!(Histogram::of(&v, 256).background(), None);
+        // A constant volume: nothing above the peak.
+        let flat = Volume::new("flat", UVec3::splat(4), DVec3::ONE, VoxelData::U8(vec![30; 64]));
+        assert_eq!(Histogram::of(&flat, 256).background(), None);
+    }
+}

@@ -89,8 +89,8 @@ pub fn fraction_over(image: &[[f64; 4]], reference: &[[f64; 4]], threshold: f64)
     if image.len() != reference.len() {
         return Err(SizeMismatch { image: image.len(), reference: reference.len() });
     }
-    // `!(d <= threshold)` is true for NaN.
-    let off = image.iter().zip(reference).filter(|(a, b)| (0..4).any(|c| !((a[c] - b[c]).abs() <= threshold))).count();
+    let off_by = |d: f64| d.is_nan() || d > threshold;
+    let off = image.iter().zip(reference).filter(|(a, b)| (0..4).any(|c| off_by((a[c] - b[c]).abs()))).count();
     Ok(off as f64 / image.len().max(1) as f64)
 }
 

@@ -16,8 +16,10 @@ fn fresh(name: &str) -> PathBuf {
     dir
 }
 
-/// The binaries copied into `bin/`, the working folder `work/` and the data folder `data/`.
+/// The binaries copied into `bin/`, the working folder `work/` and the data folder `data/`;
+/// removed when dropped (the copies are hundreds of MB).
 struct Sandbox {
+    root: PathBuf,
     bench: PathBuf,
     stock: Option<PathBuf>,
     work: PathBuf,
@@ -42,7 +44,13 @@ fn sandbox(name: &str) -> Sandbox {
     if stock.is_none() && std::env::var_os("CI").is_some() {
         panic!("{} was not built beside volgraph-bench; CI runs cargo test --workspace", stock_built.display());
     }
-    Sandbox { bench, stock, work, data }
+    Sandbox { root, bench, stock, work, data }
+}
+
+impl Drop for Sandbox {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.root);
+    }
 }
 
 impl Sandbox {

@@ -62,3 +62,20 @@ fn step_tex_for(step_voxels: f32, d_tex: vec3<f32>) -> f32 {
     let world_per_tex = length(d_tex * 2.0 * frame.half_extent.xyz);
     return step_voxels * frame.half_extent.w / world_per_tex;
 }
+
+// Sample k of a ray lies at `first + k · delta` (texture space): `first` the first sample,
+// `delta` one step. The hot loop keeps only these, the colour and two counters in registers.
+struct Samples {
+    first: vec3<f32>,
+    delta: vec3<f32>,
+    count: u32,
+}
+
+// The samples of `ray` a step of `step_tex` apart: k = 0.. with (k + 0.5 + jitter) · step_tex <
+// len, at most `max_count` — the positions of every raycaster
+// (`volgraph_accel::reference`, docs/rendering_model.md).
+fn samples_along(ray: Ray, step_tex: f32, jitter: f32, max_count: u32) -> Samples {
+    let delta = ray.d * step_tex;
+    let count = u32(clamp(ceil(ray.len / step_tex - 0.5 - jitter), 0.0, f32(max_count)));
+    return Samples(ray.u0 + (0.5 + jitter) * delta, delta, count);
+}

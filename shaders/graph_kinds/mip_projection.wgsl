@@ -8,7 +8,7 @@
 // parameters below; volgraph fills `params` from that list, one f32 each, in order.
 
 #import "common/ray_box.wgsl"
-#import "common/volume.wgsl"
+#import "common/mip.wgsl"
 
 struct Params {
     level: f32,
@@ -31,13 +31,8 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
     let ray = analytic_ray(p);
     var out = vec4<f32>(0.0);
     if (ray.len > 0.0) {
-        let step = step_tex_for(params.step_voxels, ray.d);
-        let count = min(u32(max(ceil(ray.len / step - 0.5), 0.0)), MAX_SAMPLES);
-        var brightest = 0.0;
-        for (var k = 0u; k < count; k += 1u) {
-            brightest = max(brightest, sample_volume(ray.u0 + (f32(k) + 0.5) * step * ray.d));
-        }
-        let g = clamp((brightest - (params.level - 0.5 * params.width)) / params.width, 0.0, 1.0);
+        let s = samples_along(ray, step_tex_for(params.step_voxels, ray.d), 0.0, MAX_SAMPLES);
+        let g = mip_window(brightest_sample(s), params.level, params.width);
         out = vec4<f32>(g, g, g, 1.0);
     }
     textureStore(color, vec2<i32>(p), out);

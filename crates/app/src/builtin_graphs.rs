@@ -54,9 +54,13 @@ pub fn find(argument: &Path) -> Option<(&'static str, &'static str)> {
     EMBEDDED_GRAPHS.iter().find(|(n, _)| *n == name).copied()
 }
 
-/// The built-in transfer function a path names when no such file exists:
-/// `graphs/tf/vessels.ron`, `tf/vessels.ron` or `tf/vessels` → `("vessels", text)`.
+/// The built-in transfer function a path names when nothing exists at that path (a file, even
+/// a dangling link, always wins): `graphs/tf/vessels.ron`, `tf/vessels.ron` or `tf/vessels` →
+/// `("vessels", text)`.
 pub fn find_tf(argument: &Path) -> Option<(&'static str, &'static str)> {
+    if argument.symlink_metadata().is_ok() {
+        return None;
+    }
     let name = normalized(argument);
     let stem = name.strip_prefix("tf/")?;
     EMBEDDED_TFS.iter().find(|(n, _)| *n == stem).copied()
@@ -126,6 +130,12 @@ mod tests {
             assert_eq!(find(Path::new(spelling)).map(|(n, _)| n), Some("kruger_westermann_2003/rc_b"), "{spelling}");
         }
         assert_eq!(find(Path::new("tf/default")), None, "transfer functions are not graphs");
+        // Transfer functions by name, where nothing of that name is on disk (tests run in
+        // crates/app, which has no graphs/); a file on disk is the user's.
+        assert_eq!(find_tf(Path::new("graphs/tf/vessels.ron")).map(|(n, _)| n), Some("vessels"));
+        assert_eq!(find_tf(Path::new("tf/nope.ron")), None);
+        assert_eq!(find_tf(Path::new("Cargo.toml")), None);
+        assert_eq!(find_tf(Path::new("graphs/tf/../../etc/passwd.ron")), None, "no climbing out");
         let registry = volgraph_passes::builtin_registry();
         for g in all() {
             volgraph_core::compile(g.name, g.text, &registry, &volgraph_core::CompileOptions::new(64, 64))

@@ -39,6 +39,9 @@ pub fn read_graph(path: &Path) -> anyhow::Result<String> {
     }
 }
 
+/// The largest ratio of voxel sides `--spacing` accepts.
+const MAX_SPACING_RATIO: f64 = 1e4;
+
 /// Raw-file options from `--dims`, `--dtype`, `--spacing`, `--big-endian`.
 pub fn raw_options(raw: &crate::cli::RawArgs) -> anyhow::Result<RawOptions> {
     let mut o = RawOptions::default();
@@ -67,6 +70,16 @@ pub fn raw_options(raw: &crate::cli::RawArgs) -> anyhow::Result<RawOptions> {
             s.split(',').map(|p| p.trim().parse::<f64>().map_err(|_| fail())).collect::<Result<_, _>>()?;
         if v.len() != 3 || v.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
             return Err(fail());
+        }
+        // The box is scaled to its longest side in f32: beyond this ratio the shortest side is
+        // below f32's resolution and the volume renders as nothing.
+        let (lo, hi) = (v.iter().copied().fold(f64::INFINITY, f64::min), v.iter().copied().fold(0.0, f64::max));
+        if hi / lo > MAX_SPACING_RATIO {
+            bail!(
+                "--spacing \"{s}\": the longest voxel side is {:.1e} times the shortest; at most {MAX_SPACING_RATIO:.0e} \
+                 (give the spacing in one unit, e.g. mm for every axis)",
+                hi / lo
+            );
         }
         o.spacing = Some(glam::DVec3::new(v[0], v[1], v[2]));
     }
@@ -144,11 +157,10 @@ pub fn transfer_function(
             chosen.tf
         }
         // `graphs/tf/NAME.ron` where no such file exists: the copy compiled into the program.
-        Some(p) if p.symlink_metadata().is_err() && crate::builtin_graphs::find_tf(p).is_some() => {
-            let (_, text) = crate::builtin_graphs::find_tf(p).unwrap_or_default();
-            TransferFunction::from_ron_str(text, p).map_err(|e| anyhow!("{e}"))?
-        }
-        Some(p) => TransferFunction::load(p).map_err(|e| anyhow!("{e}"))?,
+        Some(p) => match crate::builtin_graphs::find_tf(p) {
+            Some((_, text)) => TransferFunction::from_ron_str(text, p).map_err(|e| anyhow!("{e}"))?,
+            None => TransferFunction::load(p).map_err(|e| anyhow!("{e}"))?,
+        },
     };
     if let Some(p) = path
         && let Some(note) = domain_note(&tf, volume)

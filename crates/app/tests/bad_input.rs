@@ -122,6 +122,21 @@ fn an_unwritable_image_kind_is_refused_before_any_gpu_work() {
     }
 }
 
+/// A spacing so anisotropic that the shortest side vanishes in f32 (1e39 against 1) is refused
+/// with the ratio, for `info` as for `render`; NaN, 0 and a negative value were already.
+#[test]
+fn a_spacing_beyond_f32_resolution_is_refused() {
+    let raw = temp("ratio_4x4x4_uint8.raw");
+    std::fs::write(&raw, [0u8; 64]).expect("write");
+    for spacing in ["1e39,1,1", "1,1,0.00000001"] {
+        let run = volgraph(&["info", &s(&raw), "--spacing", spacing]);
+        assert_eq!(run.code, 1, "{spacing}: {}", run.stderr);
+        assert!(run.stderr.contains("times the shortest; at most 1e4"), "{}", run.stderr);
+    }
+    let run = volgraph(&["info", &s(&raw), "--spacing", "1,1,1.4"]);
+    assert_eq!(run.code, 0, "an anisotropic but representable spacing is fine: {}", run.stderr);
+}
+
 #[test]
 fn a_directory_given_as_a_volume_is_named_as_one() {
     let dir = temp("folder_4x4x4_uint8.raw");

@@ -6,6 +6,7 @@
 #import "common/frame.wgsl"
 #import "common/raymarch.wgsl"
 #import "common/analytic_ray.wgsl"
+#import "common/mip.wgsl"
 
 struct MipParams {
     // Window centre and width, normalized scalar units.
@@ -28,11 +29,7 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
     var out = vec4<f32>(0.0);
     if (ray.len > 0.0 && ray_is_valid(ray.u0, ray.d, ray.len)) {
         let s = ray_samples(ray, p);
-        var brightest = 0.0;
-        for (var k = 0u; k < s.count; k += 1u) {
-            brightest = max(brightest, sample_volume(s.first + f32(k) * s.delta));
-        }
-        let g = clamp((brightest - (mip.level - 0.5 * mip.width)) / mip.width, 0.0, 1.0);
+        let g = mip_window(brightest_sample(s), mip.level, mip.width);
         out = vec4<f32>(g, g, g, 1.0);
     }
     textureStore(color, vec2<i32>(p), out);

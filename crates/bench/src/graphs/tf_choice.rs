@@ -54,9 +54,7 @@ impl TfChoice {
         let stem = |p: &Path| p.file_stem().map_or_else(|| text.to_string(), |s| s.to_string_lossy().into_owned());
         if is_tf_file(text) {
             let path = PathBuf::from(text);
-            if path.symlink_metadata().is_err()
-                && let Some((name, text)) = volgraph_app::builtin_graphs::find_tf(&path)
-            {
+            if let Some((name, text)) = volgraph_app::builtin_graphs::find_tf(&path) {
                 return Ok(TfChoice::Builtin { name, text });
             }
             return Ok(TfChoice::File { name: stem(&path), path });

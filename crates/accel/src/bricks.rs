@@ -282,7 +282,14 @@ impl BrickSet {
         for b in &self.bricks {
             paste_box(&mut data, n, b.origin, b.dims, &b.data);
         }
-        Volume { dims: n, spacing: self.spacing, data, name: self.name.clone(), value_range: self.value_range }
+        Volume {
+            dims: n,
+            spacing: self.spacing,
+            data,
+            name: self.name.clone(),
+            value_range: self.value_range,
+            meta: Default::default(),
+        }
     }
 }
 

@@ -22,3 +22,4 @@ pub mod stats;
 pub mod transfer_function;
 pub mod vessels;
 pub mod volume;
+pub mod volume_meta;

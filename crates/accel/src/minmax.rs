@@ -127,25 +127,25 @@ fn raw_box_minmax<T: Copy + PartialOrd>(data: &[T], dims: UVec3, lo: UVec3, hi: 
 /// monotone for every voxel type, so the raw min/max map to the normalized min/max.
 pub(crate) fn voxel_box_range(volume: &Volume, lo: UVec3, hi: UVec3) -> [f32; 2] {
     let dims = volume.dims;
-    let (mn, mx) = match &volume.data {
+    let (a, b) = match &volume.data {
         VoxelData::U8(v) => {
             let (a, b) = raw_box_minmax(v, dims, lo, hi);
-            (a as f64 / 255.0, b as f64 / 255.0)
+            (a as f64, b as f64)
         }
         VoxelData::U16(v) => {
             let (a, b) = raw_box_minmax(v, dims, lo, hi);
-            (a as f64 / 65535.0, b as f64 / 65535.0)
+            (a as f64, b as f64)
         }
         VoxelData::I16(v) => {
             let (a, b) = raw_box_minmax(v, dims, lo, hi);
-            ((a as f64 + 32768.0) / 65535.0, (b as f64 + 32768.0) / 65535.0)
+            (a as f64, b as f64)
         }
         VoxelData::F32(v) => {
             let (a, b) = raw_box_minmax(v, dims, lo, hi);
-            let (vlo, vhi) = volume.value_range;
-            if vhi > vlo { ((a as f64 - vlo) / (vhi - vlo), (b as f64 - vlo) / (vhi - vlo)) } else { (0.0, 0.0) }
+            (a as f64, b as f64)
         }
     };
+    let (mn, mx) = (volume.normalize_value(a), volume.normalize_value(b));
     [f32_down(mn), f32_up(mx)]
 }
 

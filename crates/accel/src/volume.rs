@@ -54,8 +54,12 @@ pub struct Volume {
     pub data: VoxelData,
     /// A human-readable name (file stem or generator), used in messages and benchmarks.
     pub name: String,
-    /// For float data: the (min, max) of the finite values, used to normalize to \[0,1\].
+    /// The data values that normalize to 0 and 1 (see [`Volume::normalized`]): the type range
+    /// for integer data from [`Volume::new`], the finite (min, max) for float data, and for
+    /// scanner data the values the file holds ([`Volume::fit_range_to_data`]).
     pub value_range: (f64, f64),
+    /// Modality, units, window and patient frame, as far as the file says.
+    pub meta: crate::volume_meta::VolumeMeta,
 }
 
 impl Volume {
@@ -70,19 +74,76 @@ impl Volume {
         x as usize + self.dims.x as usize * (y as usize + self.dims.y as usize * z as usize)
     }
 
-    /// The normalized value in \[0,1\] of voxel `i`, exactly as the GPU texture holds it
-    /// (u8 → v/255, u16 → v/65535, i16 → (v+32768)/65535, f32 → (v-min)/(max-min)).
+    /// The normalized value in \[0,1\] of voxel `i`, exactly as the GPU texture holds it:
+    /// `(v - lo)/(hi - lo)` over [`Volume::value_range`] — with the type range of
+    /// [`Volume::new`], u8 → v/255, u16 → v/65535, i16 → (v+32768)/65535; f32 →
+    /// (v-min)/(max-min). An empty range gives 0.
     #[inline]
     pub fn normalized(&self, i: usize) -> f64 {
+        self.normalize_value(self.raw_value(i))
+    }
+
+    /// The data value of voxel `i` (the stored value, as f64).
+    #[inline]
+    pub fn raw_value(&self, i: usize) -> f64 {
         match &self.data {
-            VoxelData::U8(v) => v[i] as f64 / 255.0,
-            VoxelData::U16(v) => v[i] as f64 / 65535.0,
-            VoxelData::I16(v) => (v[i] as f64 + 32768.0) / 65535.0,
-            VoxelData::F32(v) => {
-                let (lo, hi) = self.value_range;
-                if hi > lo { (v[i] as f64 - lo) / (hi - lo) } else { 0.0 }
+            VoxelData::U8(v) => v[i] as f64,
+            VoxelData::U16(v) => v[i] as f64,
+            VoxelData::I16(v) => v[i] as f64,
+            VoxelData::F32(v) => v[i] as f64,
+        }
+    }
+
+    /// Where data value `v` lies in the normalized values: `(v - lo)/(hi - lo)`, 0 for an empty
+    /// range.
+    #[inline]
+    pub fn normalize_value(&self, v: f64) -> f64 {
+        let (lo, hi) = self.value_range;
+        if hi > lo { (v - lo) / (hi - lo) } else { 0.0 }
+    }
+
+    /// The data value at normalized value `s` (the inverse of [`Self::normalize_value`]).
+    pub fn data_value(&self, s: f64) -> f64 {
+        let (lo, hi) = self.value_range;
+        lo + s * (hi - lo)
+    }
+
+    /// The (min, max) of the stored values ((0, 0) for an empty volume).
+    pub fn data_min_max(&self) -> (f64, f64) {
+        fn fold<T: Copy + Into<f64>>(v: &[T]) -> (f64, f64) {
+            v.iter().fold(None, |acc: Option<(f64, f64)>, &x| {
+                let x: f64 = x.into();
+                Some(acc.map_or((x, x), |(lo, hi)| (lo.min(x), hi.max(x))))
+            })
+            .unwrap_or((0.0, 0.0))
+        }
+        match &self.data {
+            VoxelData::U8(v) => fold(v),
+            VoxelData::U16(v) => fold(v),
+            VoxelData::I16(v) => fold(v),
+            VoxelData::F32(v) => finite_range(v).unwrap_or((0.0, 0.0)),
+        }
+    }
+
+    /// Narrows [`Volume::value_range`] of 16-bit data to the values it holds, so that a
+    /// transfer function over them (CT's −1024…3071 HU in int16) gets the whole LUT rather
+    /// than the sixteenth of it the type range would leave. Scanner loaders call it; other
+    /// volumes keep the type range. 8-bit and float data are unchanged; a constant volume keeps
+    /// its range.
+    pub fn fit_range_to_data(&mut self) {
+        if matches!(self.data, VoxelData::U16(_) | VoxelData::I16(_)) {
+            let (lo, hi) = self.data_min_max();
+            if hi > lo {
+                self.value_range = (lo, hi);
             }
         }
+    }
+
+    /// Voxel `i` as the 16-bit normalized texel the GPU samples: `round(normalized · 65535)`,
+    /// exact for the type range (`v` for u16, `v + 32768` for i16).
+    #[inline]
+    pub fn unorm16(&self, i: usize) -> u16 {
+        (self.normalized(i).clamp(0.0, 1.0) * 65535.0).round() as u16
     }
 
     /// All voxels normalized to \[0,1\] as f32 (what an R32Float texture upload wants).
@@ -275,7 +336,7 @@ impl Volume {
             VoxelData::F32(v) => finite_range(v).unwrap_or((0.0, 0.0)),
             other => other.voxel_type().integer_range().unwrap_or((0.0, 1.0)),
         };
-        Volume { dims, spacing, data, name: name.into(), value_range }
+        Volume { dims, spacing, data, name: name.into(), value_range, meta: Default::default() }
     }
 }
 
@@ -289,6 +350,7 @@ impl Volume {
             data: VoxelData::U8(Vec::new()),
             name: self.name.clone(),
             value_range: self.value_range,
+            meta: self.meta.clone(),
         }
     }
 }

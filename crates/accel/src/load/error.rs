@@ -48,7 +48,7 @@ pub enum LoadError {
     },
 
     /// The path is a directory, a FIFO, a socket or a device rather than a file.
-    #[error("{}: is {what}, not a volume file; give the path of a .raw, .nrrd, .nhdr, .mhd or .mha file", .path.display())]
+    #[error("{}: is {what}, not a volume file; give the path of a .raw, .nrrd, .nhdr, .mhd, .mha, .nii or .nii.gz file, or a folder of DICOM slices", .path.display())]
     NotAFile {
         /// The path.
         path: PathBuf,
@@ -124,7 +124,7 @@ pub enum LoadError {
 
     /// The extension is not one of the supported formats.
     #[error(
-        "{}: unknown volume format \"{extension}\"; use .raw, .nrrd, .nhdr, .mhd or .mha",
+        "{}: unknown volume format \"{extension}\"; use .raw, .nrrd, .nhdr, .mhd, .mha, .nii, .nii.gz, or DICOM (a folder of slices, .dcm files)",
         .path.display()
     )]
     UnknownFormat {
@@ -303,6 +303,122 @@ pub enum LoadError {
         codec: &'static str,
         /// The decoder's error.
         source: std::io::Error,
+    },
+
+    /// A DICOM file that cannot be parsed (corrupt or truncated).
+    #[error("{}: cannot read the DICOM file: {reason}; the file is corrupt or truncated (remove it, or copy it again)", .path.display())]
+    DicomRead {
+        /// The file.
+        path: PathBuf,
+        /// dicom-rs's message.
+        reason: String,
+    },
+
+    /// No DICOM image where one was expected.
+    #[error(
+        "{place}: no DICOM images found ({files} file(s): {not_dicom} not DICOM, {dicomdirs} DICOMDIR index); \
+         give the folder holding the slices, a slice file, or a volume file (.raw, .nrrd, .nhdr, .mhd, .mha, .nii, .nii.gz)"
+    )]
+    NoDicomImages {
+        /// The paths given.
+        place: String,
+        /// Files looked at.
+        files: usize,
+        /// Files without the DICOM magic.
+        not_dicom: usize,
+        /// DICOMDIR files.
+        dicomdirs: usize,
+    },
+
+    /// Several series where one was expected.
+    #[error("{place}: holds {count} DICOM series; choose one with --series N, --series UID or --series DESCRIPTION:\n{list}")]
+    SeveralSeries {
+        /// The paths given.
+        place: String,
+        /// How many.
+        count: usize,
+        /// One line per series.
+        list: String,
+    },
+
+    /// `--series` names no series that is there.
+    #[error("{place}: no DICOM series \"{wanted}\"; give its number in this list, its UID or its description:\n{list}")]
+    NoSuchSeries {
+        /// The paths given.
+        place: String,
+        /// What was asked for.
+        wanted: String,
+        /// One line per series.
+        list: String,
+    },
+
+    /// Slices that do not make a regular grid.
+    #[error("DICOM {series}: {message}")]
+    DicomGeometry {
+        /// The series (description or number).
+        series: String,
+        /// What is wrong, naming slices and positions, and what to do.
+        message: String,
+    },
+
+    /// Pixel data this build cannot decode.
+    #[error(
+        "{}: pixel data in {name} (transfer syntax {uid}) cannot be decoded; supported: {supported}; convert the series \
+         (e.g. `gdcmconv --raw` or `dcmdjpeg`) to one of them",
+        .path.display()
+    )]
+    DicomTransferSyntax {
+        /// The file.
+        path: PathBuf,
+        /// The transfer syntax UID.
+        uid: String,
+        /// Its name.
+        name: String,
+        /// The decodable ones.
+        supported: String,
+    },
+
+    /// Pixel data that is not a scalar image or fails to decode.
+    #[error("{}: {message}", .path.display())]
+    DicomPixels {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+
+    /// A NIfTI file that cannot be read.
+    #[error("{}: cannot read the NIfTI file: {reason}", .path.display())]
+    NiftiRead {
+        /// The file.
+        path: PathBuf,
+        /// What failed.
+        reason: String,
+    },
+
+    /// A 4D NIfTI file without `--frame`, or a frame past its end.
+    #[error(
+        "{}: holds {frames} volumes (a 4D series); {what}: pick one with --frame N (0..={last})",
+        .path.display(), last = .frames.saturating_sub(1)
+    )]
+    NiftiFrame {
+        /// The file.
+        path: PathBuf,
+        /// Volumes in the file.
+        frames: u64,
+        /// `no --frame was given` or `--frame 9 is past the end`.
+        what: String,
+    },
+
+    /// An option that does not apply to the file given.
+    #[error("{}: {option} {reason}; remove {option}", .path.display())]
+    OptionDoesNotApply {
+        /// The file.
+        path: PathBuf,
+        /// `--series`, `--frame`.
+        option: &'static str,
+        /// Why.
+        reason: &'static str,
     },
 
     /// A dimension exceeds the device's 3D texture limit (see [`super::check_texture_limit`]).

@@ -1,8 +1,11 @@
 //! Volume loading: headerless `.raw` (layout from the file name or [`RawOptions`]), NRRD
-//! (`.nrrd` attached, `.nhdr` detached; raw or gzip encoding) and MetaImage (`.mhd` detached,
-//! `.mha` with `ElementDataFile = LOCAL`; optionally zlib-compressed).
+//! (`.nrrd` attached, `.nhdr` detached; raw or gzip encoding), MetaImage (`.mhd` detached,
+//! `.mha` with `ElementDataFile = LOCAL`; optionally zlib-compressed), NIfTI-1/2 (`.nii`,
+//! `.nii.gz`) and DICOM series (a folder of slices, a multi-frame file, a list of files).
 //!
-//! [`load_volume`] is the one entry point; it picks the format from the extension. Every loader
+//! [`load_volumes`] is the one entry point ([`load_volume`] for one file with raw options); it
+//! picks the format from the extension, or DICOM for folders and `.dcm` files. Scanner formats
+//! put the box in the LPS patient frame and fill [`crate::volume_meta::VolumeMeta`]. Every loader
 //! returns the volume in native byte order with `value_range` set as [`Volume::new`] documents,
 //! and a [`LoadReport`] saying what was repaired:
 //!
@@ -12,8 +15,10 @@
 //!
 //! Parsers never panic on any input (`tests/load_fuzz.rs` checks it with proptest).
 
+pub mod dicom;
 mod error;
 mod metaimage;
+pub mod nifti;
 mod nrrd;
 mod orientation;
 mod raw;
@@ -63,6 +68,100 @@ pub enum VolumeFormat {
     Nrrd,
     /// MetaImage, `.mhd` or `.mha`.
     MetaImage,
+    /// NIfTI-1 or NIfTI-2, `.nii` or `.nii.gz`.
+    Nifti,
+    /// A DICOM series.
+    Dicom,
+}
+
+/// Everything that says how to read a volume: raw layout, the DICOM series, the NIfTI frame,
+/// and who hears of progress.
+#[derive(Clone, Default)]
+pub struct LoadOptions<'a> {
+    /// Layout of headerless raw files; `spacing` overrides any header.
+    pub raw: RawOptions,
+    /// The series to read from a folder holding several (`N`, UID or description).
+    pub series: Option<String>,
+    /// The volume of a 4D NIfTI file.
+    pub frame: Option<u64>,
+    /// Told `(done, total)` as a DICOM series' files are read.
+    pub progress: Option<dicom::Progress<'a>>,
+}
+
+/// True when `path` names a NIfTI file (`.nii`, `.nii.gz`, any case).
+pub fn is_nifti(path: &Path) -> bool {
+    let name = path.file_name().map(|n| n.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+    name.ends_with(".nii") || name.ends_with(".nii.gz")
+}
+
+/// Loads the volume at `paths`: one volume file, or DICOM (folders, `.dcm` files, a list of
+/// slice files). See [`LoadOptions`].
+pub fn load_volumes(paths: &[PathBuf], options: &LoadOptions<'_>) -> Result<LoadedVolume, LoadError> {
+    let first = paths.first().cloned().unwrap_or_default();
+    let mut loaded = if dicom::is_dicom_input(paths) && !paths.is_empty() {
+        if options.frame.is_some() {
+            return Err(LoadError::OptionDoesNotApply {
+                path: first,
+                option: "--frame",
+                reason: "picks a volume of a 4D NIfTI file; a DICOM series is chosen with --series",
+            });
+        }
+        check_no_raw_layout(&first, &options.raw)?;
+        dicom::load(paths, &dicom::DicomOptions { series: options.series.clone() }, options.progress)?
+    } else if paths.len() > 1 {
+        return Err(LoadError::NotAFile {
+            path: paths[1].clone(),
+            what: "a second volume file (only DICOM slices come as a list)",
+        });
+    } else {
+        if options.series.is_some() {
+            return Err(LoadError::OptionDoesNotApply {
+                path: first,
+                option: "--series",
+                reason: "picks a series of DICOM slices, but this is not DICOM",
+            });
+        }
+        if is_nifti(&first) {
+            if first.exists() {
+                check_is_file(&first)?;
+            }
+            check_no_raw_layout(&first, &options.raw)?;
+            nifti::load(&first, options.frame)?
+        } else {
+            if options.frame.is_some() {
+                return Err(LoadError::OptionDoesNotApply {
+                    path: first,
+                    option: "--frame",
+                    reason: "picks a volume of a 4D NIfTI file, but this is not NIfTI",
+                });
+            }
+            return load_file(&first, &options.raw);
+        }
+    };
+    if let Some(spacing) = options.raw.spacing {
+        check_spacing(&Location::file(&first), spacing)?;
+        loaded.volume.spacing = spacing;
+    }
+    Ok(loaded)
+}
+
+/// Raw layout options on a file with a header are an error.
+fn check_no_raw_layout(path: &Path, opts: &RawOptions) -> Result<(), LoadError> {
+    let mut given = Vec::new();
+    if opts.dims.is_some() {
+        given.push("--dims");
+    }
+    if opts.dtype.is_some() {
+        given.push("--dtype");
+    }
+    if opts.endianness != Endianness::Little {
+        given.push("--big-endian");
+    }
+    if given.is_empty() {
+        Ok(())
+    } else {
+        Err(LoadError::RawOptionsOnHeader { path: path.to_path_buf(), options: given.join(", ") })
+    }
 }
 
 /// What a loader did besides reading: repairs and ignored header content.
@@ -109,34 +208,30 @@ pub struct LoadedVolume {
     pub report: LoadReport,
 }
 
-/// Loads a volume, choosing the format by extension (case-insensitive): `.raw`, `.nrrd`,
-/// `.nhdr`, `.mhd`, `.mha`. `opts` describes raw files; see [`RawOptions`].
+/// Loads one volume file, choosing the format by extension (case-insensitive): `.raw`, `.nrrd`,
+/// `.nhdr`, `.mhd`, `.mha`, `.nii`, `.nii.gz`. `opts` describes raw files; see [`RawOptions`].
+/// A folder or a `.dcm` file is read as DICOM ([`load_volumes`] also takes a list of slices,
+/// a series choice and a NIfTI frame).
 pub fn load_volume(path: &Path, opts: &RawOptions) -> Result<LoadedVolume, LoadError> {
+    load_volumes(&[path.to_path_buf()], &LoadOptions { raw: opts.clone(), ..LoadOptions::default() })
+}
+
+/// One volume file by extension.
+fn load_file(path: &Path, opts: &RawOptions) -> Result<LoadedVolume, LoadError> {
     // A directory or FIFO is named as such before its (missing) extension is; a path that does
     // not exist gets the extension check first and the read error after.
     if path.exists() {
         check_is_file(path)?;
     }
     let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
-    if matches!(extension.as_str(), "nrrd" | "nhdr" | "mhd" | "mha") {
-        let mut given = Vec::new();
-        if opts.dims.is_some() {
-            given.push("--dims");
-        }
-        if opts.dtype.is_some() {
-            given.push("--dtype");
-        }
-        if opts.endianness != Endianness::Little {
-            given.push("--big-endian");
-        }
-        if !given.is_empty() {
-            return Err(LoadError::RawOptionsOnHeader { path: path.to_path_buf(), options: given.join(", ") });
-        }
+    if matches!(extension.as_str(), "nrrd" | "nhdr" | "mhd" | "mha") || is_nifti(path) {
+        check_no_raw_layout(path, opts)?;
     }
     let mut loaded = match extension.as_str() {
         "raw" => raw::load(path, opts)?,
         "nrrd" | "nhdr" => nrrd::load(path)?,
         "mhd" | "mha" => metaimage::load(path)?,
+        _ if is_nifti(path) => nifti::load(path, None)?,
         _ => {
             return Err(LoadError::UnknownFormat { path: path.to_path_buf(), extension });
         }

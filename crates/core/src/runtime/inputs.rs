@@ -56,16 +56,19 @@ fn content_hash(parts: impl FnOnce(&mut std::collections::hash_map::DefaultHashe
 }
 
 /// Uploads a volume as the 3D texture the shaders sample (normalized values,
-/// `docs/rendering_model.md`): u8 → `v / 255`, u16 → `v / 65535`, i16 → `(v + 32768) / 65535`,
-/// f32 → normalized by the value range, in the device's best format for the data.
+/// `docs/rendering_model.md`): u8 → `v / 255`; 16-bit data as [`Volume::unorm16`] (with the
+/// type range u16 → `v / 65535`, i16 → `(v + 32768) / 65535`; scanner data over the values it
+/// holds); f32 → normalized by the value range; in the device's best format for the data.
 pub fn upload_volume_texture(gpu: &Gpu, volume: &Volume) -> Result<UploadedVolume, UploadError> {
     let dims = [volume.dims.x, volume.dims.y, volume.dims.z];
     match &volume.data {
         VoxelData::U8(v) => upload_volume(gpu, &volume.name, dims, &VolumeTexels::Unorm8(v)),
-        VoxelData::U16(v) => upload_volume(gpu, &volume.name, dims, &VolumeTexels::Unorm16(v)),
-        VoxelData::I16(v) => {
-            let shifted: Vec<u16> = v.iter().map(|x| (*x as i32 + 32768) as u16).collect();
-            upload_volume(gpu, &volume.name, dims, &VolumeTexels::Unorm16(&shifted))
+        VoxelData::U16(v) if volume.value_range == (0.0, 65535.0) => {
+            upload_volume(gpu, &volume.name, dims, &VolumeTexels::Unorm16(v))
+        }
+        VoxelData::U16(_) | VoxelData::I16(_) => {
+            let texels: Vec<u16> = (0..volume.voxel_count()).map(|i| volume.unorm16(i)).collect();
+            upload_volume(gpu, &volume.name, dims, &VolumeTexels::Unorm16(&texels))
         }
         VoxelData::F32(_) => upload_volume(gpu, &volume.name, dims, &VolumeTexels::Float(&volume.normalized_f32())),
     }
@@ -94,12 +97,8 @@ pub fn volume_region_bytes(volume: &Volume, origin: glam::IVec3, dims: glam::UVe
             let t: Vec<u8> = indices.iter().map(|i| v[*i]).collect();
             super::upload::texel_bytes(&VolumeTexels::Unorm8(&t), format)
         }
-        VoxelData::U16(v) => {
-            let t: Vec<u16> = indices.iter().map(|i| v[*i]).collect();
-            super::upload::texel_bytes(&VolumeTexels::Unorm16(&t), format)
-        }
-        VoxelData::I16(v) => {
-            let t: Vec<u16> = indices.iter().map(|i| (v[*i] as i32 + 32768) as u16).collect();
+        VoxelData::U16(_) | VoxelData::I16(_) => {
+            let t: Vec<u16> = indices.iter().map(|i| volume.unorm16(*i)).collect();
             super::upload::texel_bytes(&VolumeTexels::Unorm16(&t), format)
         }
         VoxelData::F32(_) => {

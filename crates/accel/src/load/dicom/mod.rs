@@ -1,0 +1,270 @@
+//! DICOM series: a folder of slices (searched recursively), one multi-frame file, or a list of
+//! files, read with dicom-rs (`dicom-object`, `dicom-pixeldata`). Slices are grouped by
+//! SeriesInstanceUID; several series are an error listing them unless
+//! [`DicomOptions::series`] picks one. Geometry ([`geometry`]): slices sorted by
+//! ImagePositionPatient along the normal, flips and axis swaps honoured in the LPS patient
+//! frame, oblique stacks rejected. Values: RescaleSlope/Intercept applied (CT in HU), kept as
+//! int16/uint16/uint8 where the rescaled values are integers that fit, float32 otherwise.
+
+mod geometry;
+mod header;
+mod pixels;
+
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+
+use self::header::{FileHeader, Probe};
+use super::{AxisOrientation, LoadError, LoadReport, LoadedVolume, Location, VolumeFormat};
+use crate::volume::Volume;
+use crate::volume_meta::{VolumeMeta, Window, WorldFrame};
+
+/// Progress of a long load: `(done, total)` files; called from worker threads.
+pub type Progress<'a> = &'a (dyn Fn(usize, usize) + Sync);
+
+/// Which series to load when a folder holds several.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct DicomOptions {
+    /// `N` (the position in the listing, from 1), a SeriesInstanceUID, or a SeriesDescription.
+    pub series: Option<String>,
+}
+
+/// One series found, as listed in errors and by `volgraph info`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SeriesSummary {
+    /// SeriesInstanceUID.
+    pub uid: String,
+    /// SeriesNumber.
+    pub number: Option<i64>,
+    /// SeriesDescription.
+    pub description: String,
+    /// Modality.
+    pub modality: String,
+    /// Slices (frames) in the series.
+    pub slices: usize,
+    /// Columns × rows of the first slice.
+    pub size: (u32, u32),
+}
+
+impl SeriesSummary {
+    fn line(&self, position: usize) -> String {
+        format!(
+            "  {position}. series {} \"{}\" {}: {} slice(s) of {}x{} (UID {})",
+            self.number.map_or("-".to_string(), |n| n.to_string()),
+            self.description,
+            self.modality,
+            self.slices,
+            self.size.0,
+            self.size.1,
+            self.uid
+        )
+    }
+}
+
+/// The lines listing `series`, one per series.
+pub fn series_list(series: &[SeriesSummary]) -> String {
+    series.iter().enumerate().map(|(i, s)| s.line(i + 1)).collect::<Vec<_>>().join("\n")
+}
+
+/// True when `paths` should be read as DICOM: a directory, or files ending in `.dcm`/`.dicom`/
+/// `.ima`, or without an extension (scanners often write bare numbers), holding the DICM magic.
+pub fn is_dicom_input(paths: &[PathBuf]) -> bool {
+    paths.iter().all(|p| {
+        p.is_dir() || {
+            let ext = p.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+            matches!(ext.as_deref(), Some("dcm" | "dicom" | "ima")) || (ext.is_none() && header::looks_like_dicom(p))
+        }
+    })
+}
+
+/// Every file under `paths` (folders searched recursively, in name order).
+fn collect_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, LoadError> {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) -> Result<(), LoadError> {
+        let entries = std::fs::read_dir(dir).map_err(|source| LoadError::Io { path: dir.to_path_buf(), source })?;
+        let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
+        paths.sort();
+        for p in paths {
+            if p.is_dir() {
+                walk(&p, out)?;
+            } else if p.is_file() {
+                out.push(p);
+            }
+        }
+        Ok(())
+    }
+    let mut files = Vec::new();
+    for p in paths {
+        if p.is_dir() {
+            walk(p, &mut files)?;
+        } else {
+            files.push(p.clone());
+        }
+    }
+    Ok(files)
+}
+
+/// The headers of the images among `paths`, grouped into series (in SeriesNumber, then UID,
+/// order), with a note on what was skipped.
+pub fn scan(paths: &[PathBuf]) -> Result<(Vec<Vec<FileHeader>>, Vec<String>), LoadError> {
+    let files = collect_files(paths)?;
+    let probes: Vec<Result<Probe, LoadError>> = files.par_iter().map(|f| header::probe(f)).collect();
+    let (mut images, mut not_dicom, mut dicomdirs) = (Vec::new(), 0usize, 0usize);
+    for probe in probes {
+        match probe? {
+            Probe::NotDicom => not_dicom += 1,
+            Probe::Dicomdir => dicomdirs += 1,
+            Probe::Image(h) => images.push(*h),
+        }
+    }
+    let place = paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
+    if images.is_empty() {
+        return Err(LoadError::NoDicomImages { place, files: files.len(), not_dicom, dicomdirs });
+    }
+    let mut notes = Vec::new();
+    if not_dicom > 0 {
+        notes.push(format!("skipped {not_dicom} file(s) that are not DICOM"));
+    }
+    if dicomdirs > 0 {
+        notes.push(format!(
+            "skipped {dicomdirs} DICOMDIR index file(s); the images were read from the folder itself"
+        ));
+    }
+    let mut groups: Vec<Vec<FileHeader>> = Vec::new();
+    for h in images {
+        match groups.iter_mut().find(|g| g[0].series_uid == h.series_uid) {
+            Some(g) => g.push(h),
+            None => groups.push(vec![h]),
+        }
+    }
+    groups.sort_by(|a, b| (a[0].series_number, &a[0].series_uid).cmp(&(b[0].series_number, &b[0].series_uid)));
+    Ok((groups, notes))
+}
+
+/// A summary of each series in `groups`.
+pub fn summaries(groups: &[Vec<FileHeader>]) -> Vec<SeriesSummary> {
+    groups
+        .iter()
+        .map(|g| {
+            let first = &g[0];
+            let geometry = &first.frame_geometry[0];
+            SeriesSummary {
+                uid: first.series_uid.clone(),
+                number: first.series_number,
+                description: first.description.clone(),
+                modality: first.modality.clone(),
+                slices: g.iter().map(|h| h.frame_geometry.len()).sum(),
+                size: (geometry.columns, geometry.rows),
+            }
+        })
+        .collect()
+}
+
+/// Lists the series under `paths` (what `volgraph info DIR` shows).
+pub fn list_series(paths: &[PathBuf]) -> Result<Vec<SeriesSummary>, LoadError> {
+    Ok(summaries(&scan(paths)?.0))
+}
+
+/// Picks the series `wanted` names (position from 1, UID or description), or the only one.
+fn choose(place: &str, groups: Vec<Vec<FileHeader>>, wanted: Option<&str>) -> Result<Vec<FileHeader>, LoadError> {
+    let list = series_list(&summaries(&groups));
+    let Some(wanted) = wanted else {
+        if groups.len() == 1 {
+            return Ok(groups.into_iter().next().unwrap_or_default());
+        }
+        return Err(LoadError::SeveralSeries { place: place.to_string(), count: groups.len(), list });
+    };
+    let index = match wanted.parse::<usize>() {
+        Ok(n) if (1..=groups.len()).contains(&n) => Some(n - 1),
+        _ => groups
+            .iter()
+            .position(|g| g[0].series_uid == wanted)
+            .or_else(|| groups.iter().position(|g| g[0].description.eq_ignore_ascii_case(wanted))),
+    };
+    match index {
+        Some(i) => Ok(groups.into_iter().nth(i).unwrap_or_default()),
+        None => Err(LoadError::NoSuchSeries { place: place.to_string(), wanted: wanted.to_string(), list }),
+    }
+}
+
+/// Loads one DICOM series from `paths` (folders, files). `progress` hears of each slice file
+/// read.
+pub fn load(paths: &[PathBuf], options: &DicomOptions, progress: Option<Progress<'_>>) -> Result<LoadedVolume, LoadError> {
+    let place = paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
+    let (groups, mut notes) = scan(paths)?;
+    let series = choose(&place, groups, options.series.as_deref())?;
+    let first = series[0].clone();
+    let series_name = if first.description.is_empty() {
+        format!("series {}", first.series_number.map_or(first.series_uid.clone(), |n| n.to_string()))
+    } else {
+        format!("series \"{}\"", first.description)
+    };
+    for h in &series {
+        if h.samples_per_pixel != 1 {
+            return Err(LoadError::DicomPixels {
+                path: h.path.clone(),
+                message: format!(
+                    "has {} samples per pixel (a colour image); volgraph renders scalar volumes: use a greyscale \
+                     series (SamplesPerPixel 1)",
+                    h.samples_per_pixel
+                ),
+            });
+        }
+        pixels::check_transfer_syntax(&h.path, &h.transfer_syntax)?;
+    }
+    // Every frame of every file, with where its pixels come from.
+    let mut slices = Vec::new();
+    let mut sources = Vec::new();
+    for (file, h) in series.iter().enumerate() {
+        for (frame, g) in h.frame_geometry.iter().enumerate() {
+            slices.push(g.clone());
+            sources.push((file, frame));
+        }
+    }
+    let stack = geometry::stack(&series_name, &slices, first.slice_thickness.or(first.spacing_between_slices))?;
+    notes.extend(stack.notes.iter().cloned());
+    let ordered: Vec<(usize, usize)> = stack.order.iter().map(|&i| sources[i]).collect();
+    let (rows, columns) = (first.frame_geometry[0].rows, first.frame_geometry[0].columns);
+    let file_dims = glam::UVec3::new(columns, rows, ordered.len() as u32);
+    let voxels = pixels::read(&series, &ordered, file_dims, progress)?;
+
+    let at = Location::file(&first.path);
+    let (orientation, spacing) = AxisOrientation::from_directions(stack.directions, &at, "ImageOrientationPatient")?;
+    let mut report = LoadReport::new(VolumeFormat::Dicom, &first.path);
+    report.notes = notes;
+    if !orientation.is_identity() {
+        report.notes.push(format!(
+            "voxels reordered to the LPS patient frame ({}): the series' orientation is honoured",
+            orientation.describe()
+        ));
+    }
+    // The corner of the box nearest −∞ on every world axis: voxel (0,0,0) after reordering.
+    let origin = (0..3).fold(stack.origin, |o, i| {
+        if orientation.flipped[i] { o + stack.directions[i] * (file_dims[i] as f64 - 1.0) } else { o }
+    });
+    let data = orientation.reorder(file_dims, voxels);
+    let name = if first.description.is_empty() { dicom_name(paths) } else { first.description.clone() };
+    let mut volume = Volume::new(name, orientation.world_dims(file_dims), spacing, data);
+    volume.fit_range_to_data();
+    let units = match (first.modality.as_str(), first.rescale_type.as_deref()) {
+        (_, Some(t)) if !t.eq_ignore_ascii_case("US") => Some(t.to_string()),
+        ("CT", _) => Some("HU".to_string()),
+        _ => None,
+    };
+    volume.meta = VolumeMeta {
+        modality: (!first.modality.is_empty()).then(|| first.modality.clone()),
+        units,
+        window: first.window.map(|(center, width)| Window { center, width }),
+        frame: WorldFrame::Lps,
+        origin: Some(origin),
+        description: (!first.description.is_empty()).then(|| first.description.clone()),
+    };
+    Ok(LoadedVolume { volume, report })
+}
+
+/// A name for a series without a description: the folder's (or first file's) name.
+fn dicom_name(paths: &[PathBuf]) -> String {
+    paths
+        .first()
+        .and_then(|p| p.file_stem().or_else(|| p.file_name()))
+        .map_or_else(|| "dicom".to_string(), |s| s.to_string_lossy().into_owned())
+}

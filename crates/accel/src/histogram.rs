@@ -95,6 +95,66 @@ impl Histogram {
     }
 }
 
+impl Histogram {
+    /// Like [`Histogram::percentile`] over only the voxels at or above normalized value `cut`
+    /// (the foreground above a background ceiling).
+    pub fn percentile_above(&self, cut: f64, p: f64) -> f64 {
+        let n = self.counts.len();
+        let first = ((cut.clamp(0.0, 1.0) * n as f64) as usize).min(n - 1);
+        let total: u64 = self.counts[first..].iter().sum();
+        let want = (p.clamp(0.0, 1.0) * total as f64).ceil() as u64;
+        let mut seen = 0;
+        for (i, &c) in self.counts.iter().enumerate().skip(first) {
+            seen += c;
+            if seen >= want.max(1) {
+                return (i + 1) as f64 / n as f64;
+            }
+        }
+        1.0
+    }
+
+    /// Otsu's threshold (Otsu 1979): the normalized value that splits the histogram into the two
+    /// classes of least within-class variance — for a scan, background from object. `None` for
+    /// an empty or constant histogram.
+    pub fn otsu(&self) -> Option<f64> {
+        let n = self.counts.len();
+        let total = self.total as f64;
+        let sum: f64 = self.counts.iter().enumerate().map(|(i, &c)| i as f64 * c as f64).sum();
+        let (mut below, mut below_sum, mut best) = (0.0, 0.0, None::<(f64, usize)>);
+        for (i, &c) in self.counts.iter().enumerate().take(n.saturating_sub(1)) {
+            below += c as f64;
+            below_sum += i as f64 * c as f64;
+            let above = total - below;
+            if below == 0.0 || above == 0.0 {
+                continue;
+            }
+            let (m0, m1) = (below_sum / below, (sum - below_sum) / above);
+            let between = below * above * (m0 - m1) * (m0 - m1);
+            if best.is_none_or(|(b, _)| between > b) {
+                best = Some((between, i));
+            }
+        }
+        best.map(|(_, i)| (i + 1) as f64 / n as f64)
+    }
+}
+
+/// The iso value a graph gets for `iso_value: Auto` (normalized): the surface between the
+/// background and the object — Otsu's threshold, never below the top of the background peak
+/// (air, the noise floor), so the surface is the object's and not the box of noise. 0.5 for a
+/// volume without contrast.
+pub fn auto_iso(volume: &Volume) -> f64 {
+    let h = Histogram::of(volume, 256);
+    let otsu = h.otsu().unwrap_or(0.5);
+    h.background().map_or(otsu, |b| otsu.max(b.ceiling))
+}
+
+/// The data range and automatic iso value of `volume` as `(low, high, auto_iso)`: what a
+/// graph's `Data(...)` inputs are resolved with (the compiler's `DATA_LOW`, `DATA_HIGH`,
+/// `DATA_AUTO_ISO` scene values).
+pub fn data_scale(volume: &Volume) -> (f64, f64, f64) {
+    (volume.value_range.0, volume.value_range.1, auto_iso(volume))
+}
+
 #[cfg(test)]
 mod tests {
     use glam::{DVec3, UVec3};
@@ -110,6 +170,13 @@ mod tests {
         assert!((80.0 / 255.0..=90.0 / 255.0).contains(&b.ceiling), "the floor ends after 80: {b:?}");
         assert!(b.fraction > 0.8 && b.fraction < 1.0, "{b:?}");
         assert!(h.percentile(0.5) < b.ceiling && h.percentile(1.0) > 0.78, "{}", h.percentile(1.0));
+    }
+
+    #[test]
+    fn the_auto_iso_value_lies_between_the_noise_floor_and_the_object() {
+        // scanned_sphere: noise floor near 75/255, the object at 200/255.
+        let iso = auto_iso(&crate::generate::scanned_sphere(32));
+        assert!((85.0 / 255.0..200.0 / 255.0).contains(&iso), "{}", iso * 255.0);
     }
 
     #[test]

@@ -23,8 +23,10 @@
 //! (0, 255); [`TransferFunction::normalized_domain_for`] says where the domain falls in `s`.
 
 mod paraview;
+mod scanner_presets;
 
 pub use paraview::ParaviewColorMap;
+pub use scanner_presets::ScannerPreset;
 
 use std::path::{Path, PathBuf};
 

@@ -111,11 +111,12 @@ impl Volume {
     /// The (min, max) of the stored values ((0, 0) for an empty volume).
     pub fn data_min_max(&self) -> (f64, f64) {
         fn fold<T: Copy + Into<f64>>(v: &[T]) -> (f64, f64) {
-            v.iter().fold(None, |acc: Option<(f64, f64)>, &x| {
-                let x: f64 = x.into();
-                Some(acc.map_or((x, x), |(lo, hi)| (lo.min(x), hi.max(x))))
-            })
-            .unwrap_or((0.0, 0.0))
+            v.iter()
+                .fold(None, |acc: Option<(f64, f64)>, &x| {
+                    let x: f64 = x.into();
+                    Some(acc.map_or((x, x), |(lo, hi)| (lo.min(x), hi.max(x))))
+                })
+                .unwrap_or((0.0, 0.0))
         }
         match &self.data {
             VoxelData::U8(v) => fold(v),

@@ -282,6 +282,7 @@ fn one_voxel_volume() {
         data: VoxelData::F32(vec![3.5]),
         name: "one".into(),
         value_range: (3.5, 3.5),
+        meta: Default::default(),
     };
     let set = BrickSet::build(&volume, 64, 2).expect("valid");
     assert_eq!(set.bricks().len(), 1);

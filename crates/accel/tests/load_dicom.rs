@@ -30,7 +30,12 @@ fn load_series(paths: &[PathBuf], series: &str) -> Result<volgraph_accel::load::
 /// precision) and every value.
 fn assert_twin(loaded: &Volume, phantom: &Volume) {
     assert_eq!(loaded.dims, phantom.dims, "dims");
-    assert!((loaded.spacing - phantom.spacing).abs().max_element() < 1e-9, "spacing {} vs {}", loaded.spacing, phantom.spacing);
+    assert!(
+        (loaded.spacing - phantom.spacing).abs().max_element() < 1e-9,
+        "spacing {} vs {}",
+        loaded.spacing,
+        phantom.spacing
+    );
     let values: Vec<f64> = (0..loaded.voxel_count()).map(|i| loaded.raw_value(i)).collect();
     let want: Vec<f64> = (0..phantom.voxel_count()).map(|i| phantom.raw_value(i)).collect();
     let wrong = values.iter().zip(&want).filter(|(a, b)| (*a - *b).abs() > 1e-3).count();
@@ -75,7 +80,9 @@ fn shuffled_names_and_descending_positions_are_sorted_by_position() {
 fn flips_and_axis_swaps_are_honoured() {
     let phantom = phantom();
     for (i, (row, column)) in
-        [(-IVec3::X, IVec3::Y), (IVec3::Y, IVec3::X), (IVec3::Z, -IVec3::X), (-IVec3::Y, IVec3::Z)].into_iter().enumerate()
+        [(-IVec3::X, IVec3::Y), (IVec3::Y, IVec3::X), (IVec3::Z, -IVec3::X), (-IVec3::Y, IVec3::Z)]
+            .into_iter()
+            .enumerate()
     {
         let dir = scratch(&format!("orient_{i}"));
         write_series(&dir, &phantom, &SeriesSpec { row, column, ..SeriesSpec::default() });
@@ -94,7 +101,11 @@ fn a_list_of_files_is_a_series() {
     assert_twin(&loaded.volume, &phantom);
     // The folder itself: the text file is skipped with a count.
     let loaded = load(&[dir]).expect("loads");
-    assert!(loaded.report.notes.iter().any(|n| n.contains("skipped 1 file(s) that are not DICOM")), "{:?}", loaded.report.notes);
+    assert!(
+        loaded.report.notes.iter().any(|n| n.contains("skipped 1 file(s) that are not DICOM")),
+        "{:?}",
+        loaded.report.notes
+    );
 }
 
 #[test]
@@ -132,7 +143,10 @@ fn two_series_are_listed_and_picked_by_number_uid_or_description() {
     assert!(e.contains("1. series 1 \"AX test\" CT: 8 slice(s) of 12x10"), "{e}");
     assert!(e.contains("2. series 2 \"COR small\" CT: 4 slice(s) of 6x5"), "{e}");
     assert_twin(&load_series(std::slice::from_ref(&dir), "2").expect("by number").volume, &other);
-    assert_twin(&load_series(std::slice::from_ref(&dir), "1.2.826.0.1.3680043.8.498.1").expect("by UID").volume, &phantom);
+    assert_twin(
+        &load_series(std::slice::from_ref(&dir), "1.2.826.0.1.3680043.8.498.1").expect("by UID").volume,
+        &phantom,
+    );
     assert_twin(&load_series(std::slice::from_ref(&dir), "cor small").expect("by description").volume, &other);
     let e = load_series(&[dir], "sagittal").expect_err("no such series");
     assert!(e.contains("no DICOM series \"sagittal\"") && e.contains("2. series 2"), "{e}");
@@ -150,9 +164,16 @@ fn a_gap_names_the_positions_around_it() {
 fn an_oblique_series_is_rejected_with_what_to_do() {
     let dir = scratch("oblique");
     let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
-    write_series(&dir, &phantom(), &SeriesSpec { orientation_override: Some([c, s, 0.0, -s, c, 0.0]), ..SeriesSpec::default() });
+    write_series(
+        &dir,
+        &phantom(),
+        &SeriesSpec { orientation_override: Some([c, s, 0.0, -s, c, 0.0]), ..SeriesSpec::default() },
+    );
     let e = load(&[dir]).expect_err("oblique");
-    assert!(e.contains("ImageOrientationPatient") && e.contains("not along the volume's axes") && e.contains("resample"), "{e}");
+    assert!(
+        e.contains("ImageOrientationPatient") && e.contains("not along the volume's axes") && e.contains("resample"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -189,7 +210,8 @@ fn bad_files_are_named_never_a_panic() {
     write_series(&dir, &phantom, &SeriesSpec::default());
     let small = ct_phantom(UVec3::new(6, 5, 1), DVec3::new(0.7, 0.6, 2.5));
     let odd = scratch("sizes_odd");
-    let files = write_series(&odd, &small, &SeriesSpec { origin: DVec3::new(-40.0, -30.0, 40.0), ..SeriesSpec::default() });
+    let files =
+        write_series(&odd, &small, &SeriesSpec { origin: DVec3::new(-40.0, -30.0, 40.0), ..SeriesSpec::default() });
     std::fs::copy(&files[0], dir.join("IM0050")).expect("copy");
     let e = load(std::slice::from_ref(&dir)).expect_err("sizes");
     assert!(e.contains("slices of different sizes") && e.contains("IM0050"), "{e}");

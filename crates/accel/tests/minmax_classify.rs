@@ -131,6 +131,7 @@ fn one_voxel_volume() {
         data: VoxelData::U8(vec![100]),
         name: "one".into(),
         value_range: (0.0, 255.0),
+        meta: Default::default(),
     };
     let grid = MinMaxGrid::build(&volume, 8).expect("valid");
     assert_eq!(grid.dims(), UVec3::ONE);
@@ -174,6 +175,7 @@ fn apron_makes_a_neighbouring_voxel_count() {
         data: VoxelData::U8(data),
         name: "spike".into(),
         value_range: (0.0, 255.0),
+        meta: Default::default(),
     };
     let grid = MinMaxGrid::build(&volume, 8).expect("valid");
     assert_eq!(grid.range(UVec3::ZERO), [0.0, 1.0]);

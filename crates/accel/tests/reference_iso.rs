@@ -29,6 +29,7 @@ fn radial_volume() -> (Volume, f64, f64) {
         data: VoxelData::F32(data),
         name: "radial".into(),
         value_range: (lo, hi),
+        meta: Default::default(),
     };
     (volume, lo, hi)
 }
@@ -125,6 +126,7 @@ fn a_constant_field_above_iso_hits_at_the_first_sample_with_a_headlight_normal()
         data: VoxelData::U8(vec![200]),
         name: "one".into(),
         value_range: (0.0, 255.0),
+        meta: Default::default(),
     };
     let settings = RaycastSettings {
         mode: RenderMode::Isosurface { iso: 0.5, shading: Phong { specular: 0.0, ..Default::default() } },
@@ -167,8 +169,14 @@ fn normals_are_world_space_on_anisotropic_volumes() {
     // white LUT the colour is |a·d|.
     let dims = UVec3::new(24, 16, 12);
     let spacing = DVec3::new(1.0, 1.5, 3.0);
-    let mut volume =
-        Volume { dims, spacing, data: VoxelData::F32(vec![]), name: "plane".into(), value_range: (0.0, 1.0) };
+    let mut volume = Volume {
+        dims,
+        spacing,
+        data: VoxelData::F32(vec![]),
+        name: "plane".into(),
+        value_range: (0.0, 1.0),
+        meta: Default::default(),
+    };
     let half = volume.half_extent_world();
     let a = DVec3::new(1.0, 2.0, 3.0).normalize();
     let mut data = Vec::new();

@@ -17,6 +17,7 @@ fn constant_volume(dims: UVec3, value: u8) -> Volume {
         data: VoxelData::U8(vec![value; n]),
         name: "constant".into(),
         value_range: (0.0, 255.0),
+        meta: Default::default(),
     }
 }
 
@@ -165,6 +166,7 @@ fn degenerate_inputs_give_transparent_images_without_panicking() {
         data: VoxelData::U8(vec![]),
         name: "empty".into(),
         value_range: (0.0, 255.0),
+        meta: Default::default(),
     };
     let image = render_reference(&empty, &LUT, &camera, 4, 3, &settings);
     assert_eq!((image.color.len(), image.samples), (12, 0));

@@ -66,8 +66,10 @@ enum Command {
     /// its background (air or the scanner's noise floor) and where the fitted default transfer
     /// function starts.
     Info {
-        /// The volume file (.raw named NAME_XxYxZ_TYPE.raw, .nrrd, .nhdr, .mhd, .mha).
-        volume: PathBuf,
+        /// The volume: a file (.raw named NAME_XxYxZ_TYPE.raw, .nrrd, .nhdr, .mhd, .mha, .nii,
+        /// .nii.gz), a folder of DICOM slices (its series are listed), or DICOM slice files.
+        #[arg(required = true, num_args = 1..)]
+        volume: Vec<PathBuf>,
         /// How to read a headerless raw volume.
         #[command(flatten)]
         raw: RawArgs,
@@ -77,9 +79,17 @@ enum Command {
     Graphs,
 }
 
-/// How to read a headerless `.raw` volume whose name does not say (or to override the name).
+/// How to read the volume: a headerless `.raw` whose name does not say (or to override the
+/// name), the series of a DICOM folder, the frame of a 4D NIfTI file.
 #[derive(clap::Args, Debug, Default, Clone)]
 pub struct RawArgs {
+    /// The DICOM series to read from a folder holding several: its number in the listing
+    /// (`volgraph info DIR`), its SeriesInstanceUID or its SeriesDescription.
+    #[arg(long)]
+    pub series: Option<String>,
+    /// The volume to read from a 4D NIfTI file (0-based).
+    #[arg(long)]
+    pub frame: Option<u64>,
     /// Raw volume dimensions, XxYxZ (default: from the file name NAME_XxYxZ_TYPE.raw).
     #[arg(long)]
     pub dims: Option<String>,
@@ -240,11 +250,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             Ok(())
         }
         Command::Info { volume, raw } => {
-            let (loaded, notes) = inputs::volume(Some(&volume), &inputs::raw_options(&raw)?)?;
-            for note in notes {
-                crate::stdout::eprintln_escaped!("note: {note}");
-            }
-            crate::stdout::write_stdout(&crate::info_cmd::describe(&volume, &loaded))?;
+            crate::stdout::write_stdout(&crate::info_cmd::run(&volume, &inputs::raw_options(&raw)?)?)?;
             Ok(())
         }
         Command::Passes { kind, graph } => {

@@ -1,14 +1,42 @@
-//! `volgraph info FILE`: what a user checks first about a volume — dimensions, voxel type,
-//! spacing and physical extent, the value range, the histogram's percentiles and its background
-//! (the low peak of air or scanner noise that the fitted default transfer function starts
-//! above), and where that transfer function starts.
+//! `volgraph info FILE|DIR`: what a user checks first about a volume — dimensions, voxel type,
+//! spacing and physical extent, orientation (patient frame), modality and units, the value
+//! range, the histogram's percentiles and its background (the low peak of air or scanner noise
+//! that the fitted default transfer function starts above), where that transfer function
+//! starts, the automatic iso value, and for a DICOM folder the series it holds.
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
+use anyhow::anyhow;
 use volgraph_accel::histogram::Histogram;
+use volgraph_accel::load::LoadOptions;
+use volgraph_accel::load::dicom;
 use volgraph_accel::transfer_function::TransferFunction;
 use volgraph_accel::volume::Volume;
+
+/// The report for `paths`: the series list of a DICOM folder holding several (and the first
+/// series, or the one `--series` picks), else the one volume.
+pub fn run(paths: &[PathBuf], options: &LoadOptions<'static>) -> anyhow::Result<String> {
+    let mut out = String::new();
+    if dicom::is_dicom_input(paths) {
+        let series = dicom::list_series(paths).map_err(|e| anyhow!("{e}"))?;
+        let _ = writeln!(out, "DICOM series ({}):\n{}", series.len(), dicom::series_list(&series));
+        if series.len() > 1 && options.series.is_none() {
+            let _ = writeln!(out, "describing series 1; choose another with --series N");
+        }
+    }
+    let mut chosen = options.clone();
+    if dicom::is_dicom_input(paths) && chosen.series.is_none() {
+        chosen.series = Some("1".to_string());
+    }
+    let (volume, notes) = crate::inputs::volume(paths, &chosen)?;
+    for note in notes {
+        crate::stdout::eprintln_escaped!("note: {note}");
+    }
+    let name = paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(" ");
+    out.push_str(&describe(Path::new(&name), &volume));
+    Ok(out)
+}
 
 /// The report on `volume`, read from `path`.
 pub fn describe(path: &Path, volume: &Volume) -> String {
@@ -16,15 +44,33 @@ pub fn describe(path: &Path, volume: &Volume) -> String {
     let data = |normalized: f64| lo + normalized * (hi - lo);
     let d = volume.dims;
     let e = volume.extent();
+    let meta = &volume.meta;
+    let units = meta.units.as_deref().map_or(String::new(), |u| format!(" {u}"));
     let mut out = String::new();
     let _ = writeln!(out, "{}", path.display());
+    if let Some(description) = &meta.description {
+        let _ = writeln!(out, "  description  {description}");
+    }
+    let _ = writeln!(
+        out,
+        "  modality     {}, values in {}",
+        meta.modality.as_deref().unwrap_or("unknown"),
+        meta.units.as_deref().unwrap_or("file units (no physical unit given)")
+    );
     let _ = writeln!(out, "  dimensions   {} × {} × {} voxels, {}", d.x, d.y, d.z, volume.data.type_name());
     let _ = writeln!(
         out,
         "  spacing      {} × {} × {} (extent {:.4} × {:.4} × {:.4})",
         volume.spacing.x, volume.spacing.y, volume.spacing.z, e.x, e.y, e.z
     );
-    let _ = writeln!(out, "  value range  {lo} … {hi} (normalized to 0 … 1 on the GPU)");
+    let _ = writeln!(out, "  orientation  {}", meta.frame.describe());
+    if let Some(o) = meta.origin {
+        let _ = writeln!(out, "  origin       ({:.3}, {:.3}, {:.3}) mm, the centre of voxel (0, 0, 0)", o.x, o.y, o.z);
+    }
+    let _ = writeln!(out, "  value range  {lo} … {hi}{units} (normalized to 0 … 1 on the GPU)");
+    if let Some(w) = meta.window {
+        let _ = writeln!(out, "  window       centre {} width {}{units} (from the file)", w.center, w.width);
+    }
     let h = Histogram::of(volume, 256);
     let _ = writeln!(
         out,
@@ -56,6 +102,12 @@ pub fn describe(path: &Path, volume: &Volume) -> String {
     let _ = writeln!(
         out,
         "  default TF   the default ramp over {lo} … {hi}, transparent up to {clear_to:.4} (see the background)"
+    );
+    let _ = writeln!(
+        out,
+        "  auto iso     {:.4}{units} (iso_value: Auto; normalized {:.4})",
+        data(volgraph_accel::histogram::auto_iso(volume)),
+        volgraph_accel::histogram::auto_iso(volume)
     );
     out
 }

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail};
 use volgraph_accel::camera::OrbitCamera;
-use volgraph_accel::load::{RawOptions, load_volume};
-use volgraph_accel::transfer_function::TransferFunction;
+use volgraph_accel::load::{LoadOptions, RawOptions};
+use volgraph_accel::transfer_function::{ScannerPreset, TransferFunction};
 use volgraph_accel::volume::Volume;
 
 /// The LUT resolution uploaded for every transfer function.
@@ -42,8 +42,14 @@ pub fn read_graph(path: &Path) -> anyhow::Result<String> {
 /// The largest ratio of voxel sides `--spacing` accepts.
 const MAX_SPACING_RATIO: f64 = 1e4;
 
+/// How to read the volume: `--dims`, `--dtype`, `--spacing`, `--big-endian` for raw files,
+/// `--series`, `--frame` for scanner data.
+pub fn raw_options(raw: &crate::cli::RawArgs) -> anyhow::Result<LoadOptions<'static>> {
+    Ok(LoadOptions { raw: raw_layout(raw)?, series: raw.series.clone(), frame: raw.frame, progress: None })
+}
+
 /// Raw-file options from `--dims`, `--dtype`, `--spacing`, `--big-endian`.
-pub fn raw_options(raw: &crate::cli::RawArgs) -> anyhow::Result<RawOptions> {
+fn raw_layout(raw: &crate::cli::RawArgs) -> anyhow::Result<RawOptions> {
     let mut o = RawOptions::default();
     if let Some(d) = &raw.dims {
         let parts: Vec<&str> = d.split(['x', 'X']).collect();
@@ -89,13 +95,15 @@ pub fn raw_options(raw: &crate::cli::RawArgs) -> anyhow::Result<RawOptions> {
     Ok(o)
 }
 
-/// Loads `--volume`, or generates the default (Marschner–Lobb 64³) when none is given. What the
-/// loader repaired or reordered comes back as notes for stderr.
-pub fn volume(path: Option<&PathBuf>, raw: &RawOptions) -> anyhow::Result<(Volume, Vec<String>)> {
-    match path {
-        None => Ok((default_volume().clone(), Vec::new())),
-        Some(p) => {
-            let loaded = load_volume(p, raw).map_err(|e| anyhow!("{e}"))?;
+/// Loads `--volume` (a file, a DICOM folder or slice files), or generates the default
+/// (Marschner–Lobb 64³) when none is given. What the loader repaired or reordered comes back as
+/// notes for stderr. A DICOM series shows a progress bar on a terminal while it loads.
+pub fn volume(paths: &[PathBuf], options: &LoadOptions<'_>) -> anyhow::Result<(Volume, Vec<String>)> {
+    match paths {
+        [] => Ok((default_volume().clone(), Vec::new())),
+        paths => {
+            let p = &paths[0];
+            let loaded = crate::load_progress::load_with_progress(paths, options).map_err(|e| anyhow!("{e}"))?;
             let mut notes: Vec<String> = loaded.report.notes.iter().map(|n| format!("{}: {n}", p.display())).collect();
             if loaded.report.non_finite_replaced() > 0 {
                 notes.push(format!("{}: replaced {} NaN/Inf voxels", p.display(), loaded.report.non_finite_replaced()));
@@ -156,6 +164,18 @@ pub fn transfer_function(
             notes.extend(chosen.notes.iter().map(|n| format!("{}: {n}", p.display())));
             chosen.tf
         }
+        // `--tf ct-bone`: a built-in scanner preset (a file of that name wins).
+        Some(p) if !p.exists() && let Some(preset) = p.to_str().and_then(ScannerPreset::from_name) => {
+            if preset.is_ct() && !volume.meta.is_ct_hu() {
+                notes.push(format!(
+                    "warning: --tf {} is written in Hounsfield units, but the volume's values are {}; the preset \
+                     fits CT data (DICOM CT, or NIfTI/NRRD holding HU)",
+                    preset.name(),
+                    volume.meta.units.as_deref().map_or("in no known unit".to_string(), |u| format!("in {u}"))
+                ));
+            }
+            preset.for_volume(volume)
+        }
         // `graphs/tf/NAME.ron` where no such file exists: the copy compiled into the program.
         Some(p) => match crate::builtin_graphs::find_tf(p) {
             Some((_, text)) => TransferFunction::from_ron_str(text, p).map_err(|e| anyhow!("{e}"))?,
@@ -174,7 +194,9 @@ pub fn transfer_function(
 /// takes the colour of one end of the TF (clamp to edge), and the volume renders as a uniform
 /// box or not at all.
 pub fn domain_note(tf: &TransferFunction, volume: &Volume) -> Option<String> {
-    let (lo, hi) = volume.value_range;
+    // The values the volume holds, not its type's range: a CT in int16 spans −1024…3071, not
+    // −32768…32767.
+    let (lo, hi) = volume.data_min_max();
     let (d0, d1) = tf.domain;
     if d1 < lo || d0 > hi {
         let side = if d1 < lo { "below" } else { "above" };
@@ -249,4 +271,12 @@ pub fn parse_camera(text: &str) -> anyhow::Result<OrbitCamera> {
         bail!("--camera \"{text}\": elevation must be within -90..=90 degrees");
     }
     Ok(OrbitCamera { azimuth_deg: v[0], elevation_deg: v[1], distance: v[2], ..OrbitCamera::default() })
+}
+
+/// The scene values a graph's `Data(...)` inputs (`iso_value: Data(Auto)`, values in HU) are
+/// resolved with: the volume's data range and automatic iso value.
+pub fn data_scene_values(volume: &Volume) -> Vec<(String, f64)> {
+    use volgraph_core::graph::ast::{DATA_AUTO_ISO, DATA_HIGH, DATA_LOW};
+    let (lo, hi, auto) = volgraph_accel::histogram::data_scale(volume);
+    vec![(DATA_LOW.to_string(), lo), (DATA_HIGH.to_string(), hi), (DATA_AUTO_ISO.to_string(), auto)]
 }

@@ -17,6 +17,7 @@ pub mod info_cmd;
 #[cfg(test)]
 mod input_fuzz;
 pub mod inputs;
+pub mod load_progress;
 pub mod passes_cmd;
 pub mod plan_svg;
 pub mod program;

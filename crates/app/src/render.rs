@@ -62,11 +62,11 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     options.precision = scene.as_ref().and_then(|s| s.precision);
     let frames = args.frames.or(scene.as_ref().map(Scene::frame_count)).unwrap_or(1);
     let raw = inputs::raw_options(&args.inputs.raw)?;
-    let (volume, generated, mut notes) = match (&args.inputs.volume, &scene) {
-        (None, Some(scene)) => crate::scene::load_volume(scene, &raw)?,
+    let (volume, generated, mut notes) = match (args.inputs.volume.as_slice(), &scene) {
+        ([], Some(scene)) => crate::scene::load_volume(scene, &raw)?,
         (volume, _) => {
-            let (v, notes) = inputs::volume(volume.as_ref(), &raw)?;
-            (v, volume.is_none(), notes)
+            let (v, notes) = inputs::volume(volume, &raw)?;
+            (v, volume.is_empty(), notes)
         }
     };
     let (tf, tf_notes) = match (&args.inputs.tf, &scene) {
@@ -83,6 +83,7 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     let file = display_name(&graph);
     let opacity = scene.as_ref().map(|s| s.opacity_reference).unwrap_or_default();
     options.scene = scene_values_of(&VolumeDesc::of(&volume));
+    options.scene.extend(crate::inputs::data_scene_values(&volume));
     let plan = compile(&file, &source, &registry, &options).map_err(CliError::Graph)?;
     // A scene's effect the graph does not offer is a note (the scene may be shown with another
     // graph); a --features name it does not know is the user's typo: an error.

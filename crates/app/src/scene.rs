@@ -384,12 +384,12 @@ impl CameraSpec {
 /// names the scene file and field.
 pub fn load_volume(
     scene: &Scene,
-    raw: &volgraph_accel::load::RawOptions,
+    raw: &volgraph_accel::load::LoadOptions<'static>,
 ) -> anyhow::Result<(volgraph_accel::volume::Volume, bool, Vec<String>)> {
     let at = |e: anyhow::Error| anyhow::anyhow!("{}: volume: {e:#}", scene.path.display());
     match &scene.volume {
         VolumeSource::File(p) => {
-            let (v, notes) = crate::inputs::volume(Some(&PathBuf::from(p)), raw).map_err(at)?;
+            let (v, notes) = crate::inputs::volume(&[PathBuf::from(p)], raw).map_err(at)?;
             Ok((v, false, notes))
         }
         VolumeSource::Dataset(name) => {

@@ -19,16 +19,18 @@ pub struct SceneArgs {
     /// viewport, graph, effects, precision; flags given as well win over it.
     #[arg(long)]
     pub scene: Option<PathBuf>,
-    /// Volume file (.raw named NAME_XxYxZ_TYPE.raw, .nrrd, .nhdr, .mhd, .mha); default: a
-    /// generated Marschner–Lobb 64³.
-    #[arg(long)]
-    pub volume: Option<PathBuf>,
+    /// The volume: a file (.raw named NAME_XxYxZ_TYPE.raw, .nrrd, .nhdr, .mhd, .mha, .nii,
+    /// .nii.gz), a folder of DICOM slices, or DICOM slice files (`--volume dir/*.dcm`); default:
+    /// a generated Marschner–Lobb 64³.
+    #[arg(long, num_args = 1..)]
+    pub volume: Vec<PathBuf>,
     /// How to read a headerless raw volume.
     #[command(flatten)]
     pub raw: RawArgs,
-    /// Transfer function (RON, or ParaView color-map .json; the viewer watches it for edits);
-    /// default: one fitted to the data (transparent up to its background of air or noise; see
-    /// `volgraph info`).
+    /// Transfer function (RON, or ParaView color-map .json; the viewer watches it for edits), or
+    /// a built-in preset for scanner data: ct-bone, ct-soft-tissue, ct-lung, ct-angio (in HU),
+    /// mr-default (percentiles); default: one fitted to the data (transparent up to its
+    /// background of air or noise; see `volgraph info`).
     #[arg(long)]
     pub tf: Option<PathBuf>,
     /// The colour map to use from a ParaView .json holding several (its "Name"); default: the first.

@@ -168,6 +168,7 @@ fn bench_minmax(opts: &AccelBenchOptions, repeats: usize) -> anyhow::Result<MinM
         data: VoxelData::U8(bytes),
         name: "engine".into(),
         value_range: (0.0, 255.0),
+        meta: Default::default(),
     };
     let block_size = 8;
     let classifier = OpacityClassifier::new(&window_lut(0.3, 1.0))?;
@@ -238,6 +239,7 @@ fn generate_blobs(n: u32) -> Volume {
         data: VoxelData::U16(data),
         name: format!("blobs-{n}"),
         value_range: (0.0, 65535.0),
+        meta: Default::default(),
     }
 }
 

@@ -16,7 +16,7 @@ enum BenchCli {
     /// f64 reference beside ms per frame; a table, JSON rows and one plot per knob.
     Sweep(crate::sweep::SweepArgs),
     /// Measure: graphs (speed, samples, accuracy), fetch (the device's sampling ceiling), live
-    /// (reload latency, soak), compile, accel (CPU acceleration structures).
+    /// (reload latency, soak), compile, accel (CPU acceleration structures), load (DICOM vs raw).
     Bench {
         #[command(subcommand)]
         which: BenchCommand,
@@ -45,6 +45,9 @@ enum BenchCommand {
     /// The live runtime: reload latency (parameter, graph and shader edits), frames in flight vs
     /// blocking, and a soak of frames and reloads with memory at start and end.
     Live(crate::live::LiveArgs),
+    /// Loading a DICOM series (512 slices of 512² int16 by default) against reading the same
+    /// voxels as one raw file.
+    Load(crate::load::LoadArgs),
     /// Compile time of a generated 30-pass graph; pooled vs unpooled transient memory of every
     /// built-in graph at 1920x1080.
     Compile {
@@ -91,6 +94,7 @@ fn run(cli: BenchCli) -> anyhow::Result<()> {
         BenchCli::Bench { which: BenchCommand::Graphs(args) } => {
             crate::graphs::run_cli(&args).context("bench graphs").map(drop)
         }
+        BenchCli::Bench { which: BenchCommand::Load(args) } => crate::load::run(&args).context("bench load").map(drop),
         BenchCli::Bench { which: BenchCommand::Fetch(args) } => {
             crate::fetch::run(&args).context("bench fetch").map(drop)
         }

@@ -17,6 +17,7 @@ pub mod compile_time;
 pub mod fetch;
 pub mod graphs;
 pub mod live;
+pub mod load;
 pub mod sweep;
 
 pub use commands::BenchCommands;

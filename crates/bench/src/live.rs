@@ -240,7 +240,7 @@ pub fn run(args: &LiveArgs) -> anyhow::Result<()> {
             &SessionArgs {
                 scene: None,
                 graph: graph.clone(),
-                volume: None,
+                volume: Vec::new(),
                 raw: Default::default(),
                 tf: None,
                 tf_map: None,

@@ -66,3 +66,44 @@ fn a_scalar_reference_is_checked_like_a_written_value() {
         "{text}"
     );
 }
+
+/// Issue 21, item 4–5: an isovalue in the data's units, or `Auto`, resolved against the bound
+/// volume's range and automatic iso value (the scene values the application supplies).
+const DATA_GRAPH: &str = r#"Graph(
+    name: "data units",
+    inputs: {"volume": Volume, "tf": TransferFunction, "iso": Data(Auto), "hu": Data(Value(300.0))},
+    passes: [
+        Pass(id: "entry", kind: "entry_points"),
+        Pass(id: "dirs", kind: "ray_directions", inputs: {"entry": "entry.entry"}),
+        Pass(id: "auto", kind: "raycast", params: {"mode": "iso", "iso_value": "input.iso"}, inputs: {
+            "entry": "entry.entry", "dir": "dirs.dir", "volume": "input.volume", "tf": "input.tf",
+        }),
+        Pass(id: "fixed", kind: "raycast", params: {"mode": "iso", "iso_value": "input.hu"}, inputs: {
+            "entry": "entry.entry", "dir": "dirs.dir", "volume": "input.volume", "tf": "input.tf",
+        }),
+    ],
+    outputs: {"a": "auto.color", "b": "fixed.color"},
+)"#;
+
+fn iso_values(options: &CompileOptions) -> (f64, f64) {
+    let plan = compile("data.ron", DATA_GRAPH, &support::registry(), options).expect("compiles");
+    let iso = |id: &str| plan.steps.iter().find(|s| s.pass_id == id).expect("pass").params.float("iso_value");
+    (iso("auto"), iso("fixed"))
+}
+
+#[test]
+fn data_inputs_take_the_volumes_units_and_its_automatic_value() {
+    use volgraph_compiler::graph::ast::{DATA_AUTO_ISO, DATA_HIGH, DATA_LOW};
+    // A CT in HU: −1024 … 3071.
+    let mut ct = CompileOptions::new(8, 8);
+    ct.scene.extend([(DATA_LOW.to_string(), -1024.0), (DATA_HIGH.to_string(), 3071.0), (DATA_AUTO_ISO.to_string(), 0.17)]);
+    let (auto, fixed) = iso_values(&ct);
+    assert_eq!(auto, 0.17);
+    assert!((fixed - (300.0 + 1024.0) / 4095.0).abs() < 1e-12, "{fixed}");
+    // A user value is in data units too.
+    let (_, fixed) = iso_values(&ct.clone().with_scalar("hu", -1024.0));
+    assert_eq!(fixed, 0.0);
+    // Without a volume (planning only): Auto is 0.5, values are taken as normalized.
+    let out_of_range = compile("data.ron", DATA_GRAPH, &support::registry(), &CompileOptions::new(8, 8));
+    assert!(out_of_range.is_err(), "300 as a normalized value is outside 0..=1");
+}

@@ -331,7 +331,9 @@ pub enum LoadError {
     },
 
     /// Several series where one was expected.
-    #[error("{place}: holds {count} DICOM series; choose one with --series N, --series UID or --series DESCRIPTION:\n{list}")]
+    #[error(
+        "{place}: holds {count} DICOM series; choose one with --series N, --series UID or --series DESCRIPTION:\n{list}"
+    )]
     SeveralSeries {
         /// The paths given.
         place: String,

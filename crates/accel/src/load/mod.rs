@@ -88,6 +88,17 @@ pub struct LoadOptions<'a> {
     pub progress: Option<dicom::Progress<'a>>,
 }
 
+impl std::fmt::Debug for LoadOptions<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LoadOptions")
+            .field("raw", &self.raw)
+            .field("series", &self.series)
+            .field("frame", &self.frame)
+            .field("progress", &self.progress.is_some())
+            .finish()
+    }
+}
+
 /// True when `path` names a NIfTI file (`.nii`, `.nii.gz`, any case).
 pub fn is_nifti(path: &Path) -> bool {
     let name = path.file_name().map(|n| n.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();

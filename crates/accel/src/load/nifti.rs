@@ -59,7 +59,10 @@ pub fn parse(path: &Path, bytes: &[u8], frame: Option<u64>) -> Result<LoadedVolu
         Some((348, _)) => from_nifti1(path, bytes)?,
         Some((_, order)) => Nifti2Header::parse(path, bytes, order)?,
         None => {
-            return Err(read_error(path, "not a NIfTI file: the header size is neither 348 (NIfTI-1) nor 540 (NIfTI-2)"));
+            return Err(read_error(
+                path,
+                "not a NIfTI file: the header size is neither 348 (NIfTI-1) nor 540 (NIfTI-2)",
+            ));
         }
     };
     build(path, bytes, &g, frame)
@@ -112,7 +115,8 @@ impl Nifti2Header {
             let r = [b[o], b[o + 1], b[o + 2], b[o + 3]];
             if big { i32::from_be_bytes(r) } else { i32::from_le_bytes(r) }
         };
-        let i16_at = |o: usize| if big { i16::from_be_bytes([b[o], b[o + 1]]) } else { i16::from_le_bytes([b[o], b[o + 1]]) };
+        let i16_at =
+            |o: usize| if big { i16::from_be_bytes([b[o], b[o + 1]]) } else { i16::from_le_bytes([b[o], b[o + 1]]) };
         Ok(Geometry {
             version: 2,
             datatype: i16_at(12),
@@ -198,17 +202,28 @@ fn build(path: &Path, bytes: &[u8], g: &Geometry, frame: Option<u64>) -> Result<
     if (5..=7).any(|i| axis(i) > 1) {
         return Err(read_error(
             path,
-            format!("dim {:?}: vector or higher-dimensional data; volgraph reads scalar 3D or 4D files", &g.dim[1..=ndim as usize]),
+            format!(
+                "dim {:?}: vector or higher-dimensional data; volgraph reads scalar 3D or 4D files",
+                &g.dim[1..=ndim as usize]
+            ),
         ));
     }
     let frames = axis(4) as u64;
     let frame = match frame {
         None if frames > 1 => {
-            return Err(LoadError::NiftiFrame { path: path.to_path_buf(), frames, what: "no --frame was given".into() });
+            return Err(LoadError::NiftiFrame {
+                path: path.to_path_buf(),
+                frames,
+                what: "no --frame was given".into(),
+            });
         }
         None => 0,
         Some(f) if f >= frames => {
-            return Err(LoadError::NiftiFrame { path: path.to_path_buf(), frames, what: format!("--frame {f} is past the end") });
+            return Err(LoadError::NiftiFrame {
+                path: path.to_path_buf(),
+                frames,
+                what: format!("--frame {f} is past the end"),
+            });
         }
         Some(f) => f,
     };
@@ -235,7 +250,8 @@ fn build(path: &Path, bytes: &[u8], g: &Geometry, frame: Option<u64>) -> Result<
     let data = &bytes[start as usize..end as usize];
     let big = g.order == Endianness::Big;
     let values: Vec<f64> = data.chunks_exact(size).map(|c| read(c, big)).collect();
-    let (slope, inter) = if g.scl_slope == 0.0 || !g.scl_slope.is_finite() { (1.0, 0.0) } else { (g.scl_slope, g.scl_inter) };
+    let (slope, inter) =
+        if g.scl_slope == 0.0 || !g.scl_slope.is_finite() { (1.0, 0.0) } else { (g.scl_slope, g.scl_inter) };
     let mut report = LoadReport::new(VolumeFormat::Nifti, path);
     let voxels = scaled(values, slope, inter, g.datatype);
 
@@ -248,9 +264,8 @@ fn build(path: &Path, bytes: &[u8], g: &Geometry, frame: Option<u64>) -> Result<
             orientation.describe()
         ));
     }
-    let origin = (0..3).fold(origin, |o, i| {
-        if orientation.flipped[i] { o + directions[i] * (file_dims[i] as f64 - 1.0) } else { o }
-    });
+    let origin = (0..3)
+        .fold(origin, |o, i| if orientation.flipped[i] { o + directions[i] * (file_dims[i] as f64 - 1.0) } else { o });
     let data = orientation.reorder(file_dims, voxels);
     let mut volume = Volume::new(nifti_stem(path), orientation.world_dims(file_dims), spacing, data);
     let (nan, pos, neg) = super::sanitize_volume(&mut volume);
@@ -325,7 +340,9 @@ mod tests {
         };
         let (d, _, oriented) = g.directions_lps();
         assert!(oriented);
-        for (got, want) in d.iter().zip([DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.0, 2.0, 0.0), DVec3::new(0.0, 0.0, 3.0)]) {
+        for (got, want) in
+            d.iter().zip([DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.0, 2.0, 0.0), DVec3::new(0.0, 0.0, 3.0)])
+        {
             assert!((*got - want).length() < 1e-12, "{d:?}");
         }
     }

@@ -64,7 +64,7 @@ pub fn random_volume(dims: UVec3, float: bool, seed: u64) -> Volume {
     } else {
         (VoxelData::U8(values.iter().map(|v| (v * 255.0).round() as u8).collect()), (0.0, 255.0))
     };
-    Volume { dims, spacing: DVec3::ONE, data, name: format!("random-{seed}"), value_range }
+    Volume { dims, spacing: DVec3::ONE, data, name: format!("random-{seed}"), value_range, meta: Default::default() }
 }
 
 /// A LUT of 1..=64 texels whose alpha is zero in runs, so classification has gaps.

@@ -171,6 +171,8 @@ pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapt
                     InputKind::Scalar(default) => {
                         Some((n, session.options().scalars.get(n).copied().unwrap_or(*default)))
                     }
+                    // A value in data units: the panel edits it only once the user set one.
+                    InputKind::Data(_) => session.options().scalars.get(n).map(|v| (n, *v)),
                     _ => None,
                 })
                 .collect();

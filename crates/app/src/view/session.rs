@@ -88,10 +88,10 @@ fn summary(plan: &Plan) -> String {
 pub struct SessionArgs {
     /// The graph file.
     pub graph: PathBuf,
-    /// The volume file (None: the generated default).
-    pub volume: Option<PathBuf>,
+    /// The volume (a file, a DICOM folder or slices; empty: the generated default).
+    pub volume: Vec<PathBuf>,
     /// Raw layout options.
-    pub raw: volgraph_accel::load::RawOptions,
+    pub raw: volgraph_accel::load::LoadOptions<'static>,
     /// The transfer-function file.
     pub tf: Option<PathBuf>,
     /// A ParaView colour map's name.
@@ -149,11 +149,11 @@ impl LiveSession {
     ) -> Result<(Self, Event), crate::cli::CliError> {
         let start = Instant::now();
         let source = inputs::read_graph(&args.graph)?;
-        let (volume, generated, notes) = match (&args.volume, &args.scene) {
-            (None, Some(scene)) => crate::scene::load_volume(scene, &args.raw)?,
+        let (volume, generated, notes) = match (args.volume.as_slice(), &args.scene) {
+            ([], Some(scene)) => crate::scene::load_volume(scene, &args.raw)?,
             (volume, _) => {
-                let (v, notes) = inputs::volume(volume.as_ref(), &args.raw)?;
-                (v, volume.is_none(), notes)
+                let (v, notes) = inputs::volume(volume, &args.raw)?;
+                (v, volume.is_empty(), notes)
             }
         };
         for note in notes {
@@ -498,5 +498,6 @@ fn compile_for(
 ) -> Result<Plan, volgraph_core::Diagnostics> {
     let mut options = options.clone();
     options.scene = volgraph_core::runtime::scene_values_of(&volgraph_core::runtime::VolumeDesc::of(volume));
+    options.scene.extend(crate::inputs::data_scene_values(volume));
     volgraph_core::compile(file, source, registry, &options)
 }

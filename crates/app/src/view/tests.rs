@@ -46,7 +46,7 @@ fn open(s: &Scratch, tf: Option<PathBuf>) -> LiveSession {
     let args = SessionArgs {
         scene: None,
         graph: s.graph.clone(),
-        volume: None,
+        volume: Vec::new(),
         raw: Default::default(),
         tf,
         tf_map: None,
@@ -240,7 +240,7 @@ fn a_frame_the_gpu_rejects_puts_the_last_good_graph_back() {
     let args = SessionArgs {
         scene: None,
         graph: s.graph.clone(),
-        volume: None,
+        volume: Vec::new(),
         raw: Default::default(),
         tf: None,
         tf_map: None,

@@ -129,7 +129,30 @@ pub enum InputKind {
     TransferFunction,
     /// A scene scalar with its default value (repeat counts, thresholds).
     Scalar(f64),
+    /// A value in the data's units (HU for CT), or `Auto`: what the data suggests — for an
+    /// isovalue, the surface between the background and the object. Bound to parameters as a
+    /// normalized scalar once a volume is known (the scene values [`DATA_LOW`], [`DATA_HIGH`],
+    /// [`DATA_AUTO_ISO`]); without a volume, data units are taken as normalized and `Auto` is
+    /// 0.5. Written `Data(Auto)` or `Data(Value(300.0))`; a user value set for it (`--set`) is
+    /// in data units too.
+    Data(DataValue),
 }
+
+/// The default of a [`InputKind::Data`] input.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+pub enum DataValue {
+    /// What the data suggests.
+    Auto,
+    /// A value in the data's units.
+    Value(f64),
+}
+
+/// Scene value: the data value that normalizes to 0.
+pub const DATA_LOW: &str = "data_low";
+/// Scene value: the data value that normalizes to 1.
+pub const DATA_HIGH: &str = "data_high";
+/// Scene value: the normalized value `Data(Auto)` takes.
+pub const DATA_AUTO_ISO: &str = "data_auto_iso";
 
 /// A history entry: the previous frame's value of a target.
 #[derive(Clone, Debug, Deserialize)]

@@ -280,7 +280,7 @@ impl Runtime {
             match kind {
                 InputKind::Volume => uploaded |= self.bind_volume(name, volume)?,
                 InputKind::TransferFunction => uploaded |= self.bind_lut(name, lut)?,
-                InputKind::Scalar(_) => {}
+                InputKind::Scalar(_) | InputKind::Data(_) => {}
             }
         }
         // What history keeps was computed from the old inputs (Klein et al. 2005 §4.1: a new
@@ -491,7 +491,7 @@ impl Runtime {
                 let (kind, hint) = match kind {
                     InputKind::Volume => ("Volume", "bind it with Runtime::bind_volume"),
                     InputKind::TransferFunction => ("TransferFunction", "bind the LUT with Runtime::bind_lut"),
-                    InputKind::Scalar(_) => ("Scalar", "scalars are compile-time scene values"),
+                    InputKind::Scalar(_) | InputKind::Data(_) => ("Scalar", "scalars are compile-time scene values"),
                 };
                 return Err(RuntimeError::UnboundInput {
                     name: name.clone(),

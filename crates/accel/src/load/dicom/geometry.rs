@@ -103,11 +103,7 @@ pub fn stack(series: &str, slices: &[SliceGeometry], slice_thickness: Option<f64
     if !(row.length() > 0.5 && column.length() > 0.5 && normal.length() > 0.5) {
         return Err(geometry_error(
             series,
-            format!(
-                "{}: ImageOrientationPatient {:?} is not two perpendicular unit vectors",
-                name(first),
-                orientation
-            ),
+            format!("{}: ImageOrientationPatient {:?} is not two perpendicular unit vectors", name(first), orientation),
         ));
     }
     let (row, column, normal) = (row.normalize(), column.normalize(), normal.normalize());
@@ -252,7 +248,10 @@ mod tests {
     fn a_gap_names_the_slices_around_it() {
         let slices: Vec<_> = [0.0, 2.0, 4.0, 8.0, 10.0].iter().enumerate().map(|(i, &z)| slice(i, z)).collect();
         let e = stack("s", &slices, None).expect_err("a gap").to_string();
-        assert!(e.contains("between s2.dcm at 4.000 mm and s3.dcm at 8.000 mm") && e.contains("1 slice(s) missing"), "{e}");
+        assert!(
+            e.contains("between s2.dcm at 4.000 mm and s3.dcm at 8.000 mm") && e.contains("1 slice(s) missing"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -155,8 +155,7 @@ impl FileHeader {
                 .and_then(|s| nested(s, 0, tags::PLANE_ORIENTATION_SEQUENCE))
                 .and_then(|o| six(o.get(tags::IMAGE_ORIENTATION_PATIENT)?.to_multi_float64().ok()));
             let measures = shared.and_then(|s| nested(s, 0, tags::PIXEL_MEASURES_SEQUENCE));
-            let shared_spacing =
-                measures.and_then(|m| two(m.get(tags::PIXEL_SPACING)?.to_multi_float64().ok()));
+            let shared_spacing = measures.and_then(|m| two(m.get(tags::PIXEL_SPACING)?.to_multi_float64().ok()));
             if let Some(t) = measures.and_then(|m| m.get(tags::SLICE_THICKNESS)?.to_float64().ok()) {
                 slice_thickness = Some(t);
             }

@@ -9,6 +9,9 @@
 mod geometry;
 mod header;
 mod pixels;
+mod write;
+
+pub use write::write_ct_series;
 
 use std::path::{Path, PathBuf};
 
@@ -125,9 +128,7 @@ pub fn scan(paths: &[PathBuf]) -> Result<(Vec<Vec<FileHeader>>, Vec<String>), Lo
         notes.push(format!("skipped {not_dicom} file(s) that are not DICOM"));
     }
     if dicomdirs > 0 {
-        notes.push(format!(
-            "skipped {dicomdirs} DICOMDIR index file(s); the images were read from the folder itself"
-        ));
+        notes.push(format!("skipped {dicomdirs} DICOMDIR index file(s); the images were read from the folder itself"));
     }
     let mut groups: Vec<Vec<FileHeader>> = Vec::new();
     for h in images {
@@ -188,7 +189,11 @@ fn choose(place: &str, groups: Vec<Vec<FileHeader>>, wanted: Option<&str>) -> Re
 
 /// Loads one DICOM series from `paths` (folders, files). `progress` hears of each slice file
 /// read.
-pub fn load(paths: &[PathBuf], options: &DicomOptions, progress: Option<Progress<'_>>) -> Result<LoadedVolume, LoadError> {
+pub fn load(
+    paths: &[PathBuf],
+    options: &DicomOptions,
+    progress: Option<Progress<'_>>,
+) -> Result<LoadedVolume, LoadError> {
     let place = paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
     let (groups, mut notes) = scan(paths)?;
     let series = choose(&place, groups, options.series.as_deref())?;

@@ -69,7 +69,23 @@ impl Checker<'_> {
     pub(super) fn scalar_value(&self, name: &str) -> Option<f64> {
         match self.doc.inputs.get(name) {
             Some(InputKind::Scalar(default)) => Some(self.option_value(name).unwrap_or(*default)),
+            Some(InputKind::Data(default)) => Some(self.data_value(name, *default)),
             _ => None,
+        }
+    }
+
+    /// A `Data` input, normalized: the user's value or the default in data units over the
+    /// scene's data range, or the scene's automatic value.
+    fn data_value(&self, name: &str, default: crate::graph::ast::DataValue) -> f64 {
+        use crate::graph::ast::{DATA_AUTO_ISO, DATA_HIGH, DATA_LOW, DataValue};
+        let scene = |key: &str| self.options.scene.get(key).copied();
+        let normalize = |v: f64| match (scene(DATA_LOW), scene(DATA_HIGH)) {
+            (Some(lo), Some(hi)) if hi > lo => (v - lo) / (hi - lo),
+            _ => v,
+        };
+        match (self.options.scalars.get(name).copied(), default) {
+            (Some(v), _) | (None, DataValue::Value(v)) => normalize(v),
+            (None, DataValue::Auto) => scene(DATA_AUTO_ISO).unwrap_or(0.5),
         }
     }
 

@@ -156,7 +156,7 @@ impl Checker<'_> {
             Ref::Input(n) => match self.doc.inputs.get(n)? {
                 InputKind::Volume => Some(ValueDesc::Volume),
                 InputKind::TransferFunction => Some(ValueDesc::TransferFunction),
-                InputKind::Scalar(_) => Some(ValueDesc::Scalar),
+                InputKind::Scalar(_) | InputKind::Data(_) => Some(ValueDesc::Scalar),
             },
             Ref::History(n) => {
                 let of = &self.doc.history.get(n)?.of;

@@ -138,14 +138,36 @@ impl Histogram {
     }
 }
 
-/// The iso value a graph gets for `iso_value: Auto` (normalized): the surface between the
-/// background and the object — Otsu's threshold, never below the top of the background peak
-/// (air, the noise floor), so the surface is the object's and not the box of noise. 0.5 for a
-/// volume without contrast.
+/// Air lies below this in HU (−1000 HU, a scanner's air with noise and partial volume up to
+/// about −700); a CT peak above it is tissue, not background.
+const CT_AIR_BELOW_HU: f64 = -500.0;
+
+/// The background of `volume` ([`Histogram::background`] of its 256-bin histogram), where the
+/// data's units allow it: in CT (values in HU) only a peak of air counts — a field of view
+/// filled with soft tissue has no background, however common its values.
+pub fn background_of(volume: &Volume) -> Option<Background> {
+    let b = Histogram::of(volume, 256).background()?;
+    if volume.meta.is_ct_hu() && volume.data_value(b.mode) > CT_AIR_BELOW_HU {
+        return None;
+    }
+    Some(b)
+}
+
+/// The iso value a graph gets for `Data(Auto)` (normalized): halfway between the background
+/// peak (air, the noise floor) and the median of what lies above it — the half-maximum of a
+/// blurred step, where an edge between background and object is; for CT, between air and soft
+/// tissue, the skin. Never below the top of the background peak, so the surface is the
+/// object's and not the box of noise. A volume without a background gets Otsu's threshold
+/// (0.5 without contrast).
 pub fn auto_iso(volume: &Volume) -> f64 {
     let h = Histogram::of(volume, 256);
-    let otsu = h.otsu().unwrap_or(0.5);
-    h.background().map_or(otsu, |b| otsu.max(b.ceiling))
+    match background_of(volume) {
+        Some(b) => {
+            let foreground = h.percentile_above(b.ceiling, 0.5);
+            (0.5 * (b.mode + foreground)).max(b.ceiling)
+        }
+        None => h.otsu().unwrap_or(0.5),
+    }
 }
 
 /// The data range and automatic iso value of `volume` as `(low, high, auto_iso)`: what a
@@ -174,9 +196,9 @@ mod tests {
 
     #[test]
     fn the_auto_iso_value_lies_between_the_noise_floor_and_the_object() {
-        // scanned_sphere: noise floor near 75/255, the object at 200/255.
+        // scanned_sphere: noise floor near 75/255, the object at 200/255: halfway, ~137.
         let iso = auto_iso(&crate::generate::scanned_sphere(32));
-        assert!((85.0 / 255.0..200.0 / 255.0).contains(&iso), "{}", iso * 255.0);
+        assert!((120.0 / 255.0..160.0 / 255.0).contains(&iso), "{}", iso * 255.0);
     }
 
     #[test]

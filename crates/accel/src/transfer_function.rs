@@ -248,7 +248,7 @@ impl TransferFunction {
         let (lo, hi) = volume.value_range;
         let hi = if hi > lo { hi } else { lo + 1.0 };
         let ramp = TransferFunction::preset(Preset::Default, (lo, hi));
-        let Some(background) = crate::histogram::Histogram::of(volume, 256).background() else { return ramp };
+        let Some(background) = crate::histogram::background_of(volume) else { return ramp };
         ramp.hidden_below(lo + background.ceiling * (hi - lo))
     }
 

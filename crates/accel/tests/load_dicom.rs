@@ -220,7 +220,7 @@ fn bad_files_are_named_never_a_panic() {
     let dir = scratch("empty");
     std::fs::write(dir.join("readme.txt"), "hello").expect("write");
     let e = load(std::slice::from_ref(&dir)).expect_err("nothing");
-    assert!(e.contains("no DICOM images found (1 file(s): 1 not DICOM"), "{e}");
+    assert!(e.contains("is a folder with no DICOM images (1 file(s): 1 not DICOM"), "{e}");
 }
 
 #[test]

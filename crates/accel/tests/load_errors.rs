@@ -141,10 +141,13 @@ fn a_directory_or_fifo_is_named_for_what_it_is() {
     use volgraph_accel::load::{RawOptions, load_volume};
     let dir = std::env::temp_dir().join("volgraph-not-a-file_4x4x4_uint8.raw");
     std::fs::create_dir_all(&dir).expect("temp dir");
+    // A folder is read as DICOM slices; an empty one says so and what else to give.
     let err = load_volume(&dir, &RawOptions::default()).expect_err("a directory");
     assert!(
-        err.to_string()
-            .ends_with("is a directory, not a volume file; give the path of a .raw, .nrrd, .nhdr, .mhd or .mha file"),
+        err.to_string().ends_with(
+            "is a folder with no DICOM images (0 file(s): 0 not DICOM, 0 DICOMDIR index); give the folder holding the slices, \
+             a slice file, or a volume file (.raw, .nrrd, .nhdr, .mhd, .mha, .nii, .nii.gz)"
+        ),
         "{err}"
     );
     #[cfg(unix)]

@@ -248,3 +248,30 @@ fn vector_and_colour_kinds_are_refused() {
     std::fs::write(dir.join("ok.nrrd"), bytes).expect("write");
     load_volume(&dir.join("ok.nrrd"), &RawOptions::default()).expect("spatial kinds are scalar volumes");
 }
+
+/// Issue 21, item 3: NRRD's `space` is honoured. A RAS file (what 3D Slicer writes) whose
+/// directions are the identity runs along −x and −y in LPS: it loads as the LPS file whose
+/// directions flip those axes, and as an LPS volume.
+#[test]
+fn an_ras_space_is_turned_into_lps() {
+    use volgraph_accel::load::parse_nrrd;
+    use volgraph_accel::volume_meta::WorldFrame;
+    let data: Vec<u8> = (0..24).collect();
+    let header = |space: &str, dirs: &str| {
+        let mut bytes = format!(
+            "NRRD0004\ntype: uint8\ndimension: 3\nspace: {space}\nsizes: 2 3 4\nspace directions: {dirs}\nencoding: raw\n\n"
+        )
+        .into_bytes();
+        bytes.extend_from_slice(&data);
+        bytes
+    };
+    let path = std::path::Path::new("twin.nrrd");
+    let ras = parse_nrrd(path, &header("right-anterior-superior", "(1,0,0) (0,1,0) (0,0,1)")).expect("RAS");
+    let lps = parse_nrrd(path, &header("left-posterior-superior", "(-1,0,0) (0,-1,0) (0,0,1)")).expect("LPS");
+    assert_eq!(ras.volume.data, lps.volume.data);
+    assert_eq!(ras.volume.meta.frame, WorldFrame::Lps);
+    assert_ne!(ras.volume.data, volgraph_accel::volume::VoxelData::U8(data.clone()), "the axes were flipped");
+    let scanner = parse_nrrd(path, &header("scanner-xyz", "(1,0,0) (0,1,0) (0,0,1)")).expect("scanner");
+    assert_eq!(scanner.volume.data, volgraph_accel::volume::VoxelData::U8(data));
+    assert_eq!(scanner.volume.meta.frame, WorldFrame::Named("scanner-xyz".into()));
+}

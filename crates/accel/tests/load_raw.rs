@@ -166,7 +166,10 @@ fn unknown_layout_unsupported_type_and_zero_dims_are_errors() {
     let unknown = dir.join("volume.vtk");
     assert_eq!(
         load_volume(&unknown, &RawOptions::default()).expect_err("vtk").to_string(),
-        format!("{}: unknown volume format \"vtk\"; use .raw, .nrrd, .nhdr, .mhd or .mha", unknown.display())
+        format!(
+            "{}: unknown volume format \"vtk\"; use .raw, .nrrd, .nhdr, .mhd, .mha, .nii, .nii.gz, or DICOM (a folder of slices, .dcm files)",
+            unknown.display()
+        )
     );
 }
 

@@ -15,7 +15,14 @@ use volgraph_accel::volume::{Volume, VoxelData};
 
 fn constant_volume(dims: UVec3, spacing: DVec3, value: u8) -> Volume {
     let n = (dims.x * dims.y * dims.z) as usize;
-    Volume { dims, spacing, data: VoxelData::U8(vec![value; n]), name: "constant".into(), value_range: (0.0, 255.0), meta: Default::default() }
+    Volume {
+        dims,
+        spacing,
+        data: VoxelData::U8(vec![value; n]),
+        name: "constant".into(),
+        value_range: (0.0, 255.0),
+        meta: Default::default(),
+    }
 }
 
 /// A camera looking down -z through the box centre (azimuth 0, elevation 0).

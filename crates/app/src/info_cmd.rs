@@ -79,7 +79,7 @@ pub fn describe(path: &Path, volume: &Volume) -> String {
         data(h.percentile(0.5)),
         data(h.percentile(0.99))
     );
-    match h.background() {
+    match volgraph_accel::histogram::background_of(volume) {
         Some(b) => {
             let _ = writeln!(
                 out,

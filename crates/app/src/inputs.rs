@@ -165,7 +165,10 @@ pub fn transfer_function(
             chosen.tf
         }
         // `--tf ct-bone`: a built-in scanner preset (a file of that name wins).
-        Some(p) if !p.exists() && let Some(preset) = p.to_str().and_then(ScannerPreset::from_name) => {
+        Some(p)
+            if !p.exists()
+                && let Some(preset) = p.to_str().and_then(ScannerPreset::from_name) =>
+        {
             if preset.is_ct() && !volume.meta.is_ct_hu() {
                 notes.push(format!(
                     "warning: --tf {} is written in Hounsfield units, but the volume's values are {}; the preset \

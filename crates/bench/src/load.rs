@@ -38,7 +38,13 @@ fn phantom(size: u32, slices: u32) -> Volume {
             let (x, y) = ((i % n) as f64 / n as f64 - 0.5, (i / n) as f64 / n as f64 - 0.5);
             let r = (x * x + y * y * 1.4).sqrt();
             let noise = ((i * 7919 + z * 104729) % 41) as i16 - 20;
-            *v = if r < 0.12 { 900 } else if r < 0.4 { 40 } else { -1000 } + noise;
+            *v = if r < 0.12 {
+                900
+            } else if r < 0.4 {
+                40
+            } else {
+                -1000
+            } + noise;
         }
     });
     Volume::new("bench_ct", UVec3::new(size, size, slices), DVec3::new(0.7, 0.7, 1.0), VoxelData::I16(values))
@@ -78,7 +84,13 @@ pub fn run(args: &LoadArgs) -> anyhow::Result<serde_json::Value> {
     let (r, d) = (median_ms(raw_ms), median_ms(dicom_ms));
     let bytes = volume.voxel_count() * 2;
     let threads = rayon::current_num_threads();
-    println!("load {} slices of {}² int16 ({:.0} MB), median of {}, {threads} threads", args.slices, args.size, bytes as f64 / 1e6, args.repeats);
+    println!(
+        "load {} slices of {}² int16 ({:.0} MB), median of {}, {threads} threads",
+        args.slices,
+        args.size,
+        bytes as f64 / 1e6,
+        args.repeats
+    );
     println!("| input | ms | MB/s | vs raw |");
     println!("|---|---:|---:|---:|");
     println!("| raw file | {r:.1} | {:.0} | 1.00× |", bytes as f64 / 1e3 / r);

@@ -96,7 +96,11 @@ fn data_inputs_take_the_volumes_units_and_its_automatic_value() {
     use volgraph_compiler::graph::ast::{DATA_AUTO_ISO, DATA_HIGH, DATA_LOW};
     // A CT in HU: −1024 … 3071.
     let mut ct = CompileOptions::new(8, 8);
-    ct.scene.extend([(DATA_LOW.to_string(), -1024.0), (DATA_HIGH.to_string(), 3071.0), (DATA_AUTO_ISO.to_string(), 0.17)]);
+    ct.scene.extend([
+        (DATA_LOW.to_string(), -1024.0),
+        (DATA_HIGH.to_string(), 3071.0),
+        (DATA_AUTO_ISO.to_string(), 0.17),
+    ]);
     let (auto, fixed) = iso_values(&ct);
     assert_eq!(auto, 0.17);
     assert!((fixed - (300.0 + 1024.0) / 4095.0).abs() < 1e-12, "{fixed}");

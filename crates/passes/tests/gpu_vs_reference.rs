@@ -190,3 +190,24 @@ fn isosurface_matches_reference_on_marschner_lobb_and_hydrogen() {
         }
     }
 }
+
+/// Issue 21: scanner data in Hounsfield units — int16 whose value range is narrowed to the
+/// values it holds (`Volume::fit_range_to_data`, as the DICOM and NIfTI loaders do), uploaded as
+/// `round(normalized · 65535)` — under a CT preset written in HU. Same DVR tolerance as above:
+/// the texels' rounding (≤ 0.5/65535) is far below it.
+#[test]
+fn a_ct_in_hounsfield_units_matches_reference_under_a_hu_preset() {
+    use volgraph_accel::transfer_function::ScannerPreset;
+    use volgraph_accel::volume::VoxelData;
+    let ml = volgraph_accel::generate::marschner_lobb(64);
+    let VoxelData::U8(bytes) = &ml.data else { panic!("ML is uint8") };
+    // 0..255 → −1000 … 1000 HU: air, soft tissue, bone-like rings.
+    let hu: Vec<i16> = bytes.iter().map(|&b| (-1000 + (b as i32 * 2000) / 255) as i16).collect();
+    let mut ct = Volume::new("ct-ml", ml.dims, ml.spacing, VoxelData::I16(hu));
+    ct.fit_range_to_data();
+    ct.meta.units = Some("HU".to_string());
+    assert!(ct.value_range.1 - ct.value_range.0 < 2001.0, "narrowed: {:?}", ct.value_range);
+    let tf = ScannerPreset::CtSoftTissue.for_volume(&ct);
+    let (c, _, cov) = render_both(&gpu(), "basic/fragment_raycast.ron", &ct, &tf, &CAMERA);
+    assert_dvr("fragment/CT in HU", &c, cov);
+}

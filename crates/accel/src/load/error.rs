@@ -316,12 +316,14 @@ pub enum LoadError {
 
     /// No DICOM image where one was expected.
     #[error(
-        "{place}: no DICOM images found ({files} file(s): {not_dicom} not DICOM, {dicomdirs} DICOMDIR index); \
+        "{place}: {what} no DICOM images ({files} file(s): {not_dicom} not DICOM, {dicomdirs} DICOMDIR index); \
          give the folder holding the slices, a slice file, or a volume file (.raw, .nrrd, .nhdr, .mhd, .mha, .nii, .nii.gz)"
     )]
     NoDicomImages {
         /// The paths given.
         place: String,
+        /// `is a folder with` or `holds`.
+        what: &'static str,
         /// Files looked at.
         files: usize,
         /// Files without the DICOM magic.

@@ -5,7 +5,10 @@
 //! direction vector; flips and axis swaps are honoured by reordering the voxels, rotated or oblique
 //! directions are rejected: see [`super::AxisOrientation`]), `endian` (little when missing, noted in the report), `encoding`,
 //! `data file`, `byte skip` (≥ 0, or -1 with raw encoding: data at the end of the file) and
-//! `line skip: 0`. Ignored as harmless: comments, `key:=value` pairs, `content`, `space`,
+//! `line skip: 0`, and `space`: an anatomical space (`right-anterior-superior`/`RAS`,
+//! `left-anterior-superior`, `left-posterior-superior`, …) turns the directions into the LPS
+//! patient frame as ITK does (`docs/rendering_model.md`, "Patient frame"); another space keeps
+//! its own axes. Ignored as harmless: comments, `key:=value` pairs, `content`,
 //! `space origin`, `kinds`, `labels`, `units`, `centers` and the other per-axis or range
 //! annotations. Any other field is an error rather than a silent misreading.
 
@@ -19,6 +22,7 @@ use super::{
     check_spacing, finish, header_lines, inflate, read_data_file, read_file, stem,
 };
 use crate::volume::VoxelType;
+use crate::volume_meta::WorldFrame;
 
 const SUPPORTED_TYPES: &str = "uchar/uint8, ushort/uint16, short/int16, float";
 const SUPPORTED_ENCODINGS: &str = "raw, gzip";
@@ -28,7 +32,6 @@ const HINT: &str =
 /// Fields that do not change how the voxels are read.
 const IGNORED: &[&str] = &[
     "content",
-    "space",
     "space origin",
     "space units",
     "space dimension",
@@ -86,7 +89,8 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
     let mut dimension_seen = false;
     let mut sizes: Option<(usize, [u64; 3], String)> = None;
     let mut spacing: Option<(usize, DVec3)> = None;
-    let mut orientation = super::AxisOrientation::default();
+    let mut directions: Option<(Location, [DVec3; 3])> = None;
+    let mut space: Option<String> = None;
     let mut order = None;
     let mut encoding = None;
     let mut data_file: Option<(String, usize)> = None;
@@ -163,10 +167,11 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
                 }
             }
             "space directions" => {
-                let directions = parse_directions(value)
+                let parsed = parse_directions(value)
                     .ok_or_else(|| bad("three vectors, e.g. `space directions: (1,0,0) (0,1,0) (0,0,1.5)`"))?;
-                let (o, lengths) = super::AxisOrientation::from_directions(directions, &at, "space directions")?;
-                orientation = o;
+                // Checked here so a bad vector names its line; oriented once `space` is known.
+                let (_, lengths) = super::AxisOrientation::from_directions(parsed, &at, "space directions")?;
+                directions = Some((at.clone(), parsed));
                 spacing = Some((number, lengths));
             }
             "endian" => {
@@ -218,6 +223,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
                 }
             }
             "block size" | "blocksize" => {}
+            "space" => space = Some(value.to_string()),
             f if IGNORED.contains(&f) => {}
             _ => {
                 return Err(LoadError::UnsupportedField {
@@ -288,8 +294,49 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
     };
     let mut report = LoadReport::new(VolumeFormat::Nrrd, &data_path);
     report.notes = notes;
+    let (frame, lps) = space.as_deref().map_or((WorldFrame::IndexAxes, None), anatomical_space);
+    let oriented = directions.is_some();
+    let orientation = match directions {
+        Some((at, d)) => {
+            let d = match lps {
+                Some(flip) => d.map(|v| v * flip),
+                None => d,
+            };
+            super::AxisOrientation::from_directions(d, &at, "space directions")?.0
+        }
+        None => super::AxisOrientation::default(),
+    };
     let layout = Layout { name: stem(path), dims, dtype, order, spacing, orientation };
-    finish(layout, data, &data_path, report, HINT)
+    let mut loaded = finish(layout, data, &data_path, report, HINT)?;
+    loaded.volume.meta.frame = if oriented { frame } else { WorldFrame::IndexAxes };
+    Ok(loaded)
+}
+
+/// The frame of NRRD `space` value `name`, and for an anatomical space the per-axis signs that
+/// take its coordinates to LPS (`right-anterior-superior` → (−1, −1, 1)).
+fn anatomical_space(name: &str) -> (WorldFrame, Option<DVec3>) {
+    let lower = name.trim().to_ascii_lowercase();
+    let words: Vec<&str> = match lower.as_str() {
+        "ras" => vec!["right", "anterior", "superior"],
+        "las" => vec!["left", "anterior", "superior"],
+        "lps" => vec!["left", "posterior", "superior"],
+        "rps" => vec!["right", "posterior", "superior"],
+        other => other.split('-').collect(),
+    };
+    let sign = |word: &str, towards: &str, away: &str| match word {
+        w if w == towards => Some(1.0),
+        w if w == away => Some(-1.0),
+        _ => None,
+    };
+    match words.as_slice() {
+        [x, y, z] => {
+            match (sign(x, "left", "right"), sign(y, "posterior", "anterior"), sign(z, "superior", "inferior")) {
+                (Some(a), Some(b), Some(c)) => (WorldFrame::Lps, Some(DVec3::new(a, b, c))),
+                _ => (WorldFrame::Named(name.trim().to_string()), None),
+            }
+        }
+        _ => (WorldFrame::Named(name.trim().to_string()), None),
+    }
 }
 
 /// The three vectors of a `space directions` value such as `(1,0,0) (0,1,0) (0,0,2)`.

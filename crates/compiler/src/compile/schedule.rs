@@ -99,7 +99,9 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
         known_scalars: c
             .inputs
             .iter()
-            .filter(|(_, k)| matches!(k, crate::graph::ast::InputKind::Scalar(_) | crate::graph::ast::InputKind::Data(_)))
+            .filter(|(_, k)| {
+                matches!(k, crate::graph::ast::InputKind::Scalar(_) | crate::graph::ast::InputKind::Data(_))
+            })
             .map(|(n, _)| n.clone())
             .chain(c.scene_values.iter().cloned())
             .collect(),

@@ -144,7 +144,10 @@ impl FileHeader {
             rows,
             columns,
         };
-        let frame_geometry = if frames <= 1 {
+        let enhanced = object.get(tags::PER_FRAME_FUNCTIONAL_GROUPS_SEQUENCE).is_some();
+        // RT Dose and other multi-frame grids: frame offsets along the normal (PS3.3 C.8.8.3.2).
+        let grid_offsets = numbers(object, tags::GRID_FRAME_OFFSET_VECTOR).filter(|v| v.len() == frames as usize);
+        let frame_geometry = if frames <= 1 && !enhanced {
             vec![top]
         } else {
             // Enhanced multi-frame objects keep geometry in functional groups (PS3.3 C.7.6.16):
@@ -167,12 +170,16 @@ impl FileHeader {
                         .and_then(|p| nested(p, f, tags::PLANE_POSITION_SEQUENCE))
                         .and_then(|p| vec3(p.get(tags::IMAGE_POSITION_PATIENT)?.to_multi_float64().ok()))
                         .or_else(|| {
-                            // A legacy multi-frame file: frames stepped along the normal.
+                            // A legacy multi-frame file: frames stepped along the normal, by
+                            // the grid's offsets or the slice spacing.
                             let (p0, o) = (top.position?, orientation?);
-                            let step = spacing_between_slices.or(slice_thickness)?;
                             let normal =
                                 DVec3::new(o[0], o[1], o[2]).cross(DVec3::new(o[3], o[4], o[5])).normalize_or_zero();
-                            Some(p0 + normal * step * f as f64)
+                            let offset = match &grid_offsets {
+                                Some(offsets) => offsets[f],
+                                None => spacing_between_slices.or(slice_thickness)? * f as f64,
+                            };
+                            Some(p0 + normal * offset)
                         });
                     SliceGeometry {
                         path: PathBuf::from(format!("{} frame {f}", path.display())),
@@ -199,11 +206,12 @@ impl FileHeader {
             samples_per_pixel: number(object, tags::SAMPLES_PER_PIXEL).map_or(1, |n| n as u16),
             bits_allocated: number(object, tags::BITS_ALLOCATED).map_or(16, |n| n as u16),
             frames,
+            // RT Dose scales by DoseGridScaling (PS3.3 C.8.8.3) instead of a rescale.
             rescale: (
-                number(object, tags::RESCALE_SLOPE).unwrap_or(1.0),
+                number(object, tags::RESCALE_SLOPE).or(number(object, tags::DOSE_GRID_SCALING)).unwrap_or(1.0),
                 number(object, tags::RESCALE_INTERCEPT).unwrap_or(0.0),
             ),
-            rescale_type: text(object, tags::RESCALE_TYPE),
+            rescale_type: text(object, tags::RESCALE_TYPE).or_else(|| text(object, tags::DOSE_UNITS)),
             window,
             slice_thickness,
             spacing_between_slices,

@@ -51,10 +51,14 @@ pub struct SeriesSummary {
 
 impl SeriesSummary {
     fn line(&self, position: usize) -> String {
+        let description = if self.description.is_empty() {
+            "(no description)".to_string()
+        } else {
+            format!("\"{}\"", self.description)
+        };
         format!(
-            "  {position}. series {} \"{}\" {}: {} slice(s) of {}x{} (UID {})",
+            "  {position}. series {} {description} {}: {} slice(s) of {}x{} (UID {})",
             self.number.map_or("-".to_string(), |n| n.to_string()),
-            self.description,
             self.modality,
             self.slices,
             self.size.0,
@@ -121,7 +125,8 @@ pub fn scan(paths: &[PathBuf]) -> Result<(Vec<Vec<FileHeader>>, Vec<String>), Lo
     }
     let place = paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
     if images.is_empty() {
-        return Err(LoadError::NoDicomImages { place, files: files.len(), not_dicom, dicomdirs });
+        let what = if paths.len() == 1 && paths[0].is_dir() { "is a folder with" } else { "holds" };
+        return Err(LoadError::NoDicomImages { place, what, files: files.len(), not_dicom, dicomdirs });
     }
     let mut notes = Vec::new();
     if not_dicom > 0 {
@@ -224,6 +229,13 @@ pub fn load(
             slices.push(g.clone());
             sources.push((file, frame));
         }
+    }
+    // One image alone needs no position to be ordered by: it is placed at the origin.
+    if let [only] = slices.as_mut_slice()
+        && only.position.is_none()
+    {
+        only.position = Some(glam::DVec3::ZERO);
+        notes.push("the image has no ImagePositionPatient; placed at the origin".to_string());
     }
     let stack = geometry::stack(&series_name, &slices, first.slice_thickness.or(first.spacing_between_slices))?;
     notes.extend(stack.notes.iter().cloned());

@@ -6,7 +6,7 @@ use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use dicom_encoding::transfer_syntax::TransferSyntaxIndex;
-use dicom_pixeldata::{ConvertOptions, ModalityLutOption, PixelDecoder};
+use dicom_pixeldata::PixelDecoder;
 use dicom_transfer_syntax_registry::TransferSyntaxRegistry;
 use glam::UVec3;
 use rayon::prelude::*;
@@ -113,6 +113,29 @@ fn convert<T: Send + Copy>(slices: &[&Slice], cast: impl Fn(i64) -> T + Sync) ->
     per.concat()
 }
 
+/// The stored values of one frame's native little-endian pixel bytes: `bits_allocated` per
+/// sample (1-bit data comes one byte per pixel from the decoder), the low `bits_stored` of
+/// them, sign-extended when `signed` (PS3.5 §8.1.1). 32-bit values beyond `i32` are clamped.
+fn stored_values(bytes: &[u8], bits_allocated: u16, bits_stored: u16, signed: bool) -> Option<Vec<i32>> {
+    let stored = u32::from(bits_stored.clamp(1, bits_allocated.max(1)));
+    let extend = |v: u32| -> i32 {
+        let v = if stored < 32 { v & ((1u32 << stored) - 1) } else { v };
+        if signed && stored < 32 && v >> (stored - 1) & 1 == 1 {
+            (v | !((1u32 << stored) - 1)) as i32
+        } else if signed {
+            v as i32
+        } else {
+            v.min(i32::MAX as u32) as i32
+        }
+    };
+    Some(match bits_allocated {
+        1 | 8 => bytes.iter().map(|&b| extend(u32::from(b))).collect(),
+        16 => bytes.chunks_exact(2).map(|c| extend(u32::from(u16::from_le_bytes([c[0], c[1]])))).collect(),
+        32 => bytes.chunks_exact(4).map(|c| extend(u32::from_le_bytes([c[0], c[1], c[2], c[3]]))).collect(),
+        _ => return None,
+    })
+}
+
 fn read_file(h: &FileHeader, per_slice: usize) -> Result<Vec<Slice>, LoadError> {
     let pixels_error = |message: String| LoadError::DicomPixels { path: h.path.clone(), message };
     let object = dicom_object::open_file(&h.path)
@@ -124,12 +147,16 @@ fn read_file(h: &FileHeader, per_slice: usize) -> Result<Vec<Slice>, LoadError> 
             decoded.samples_per_pixel()
         )));
     }
-    let raw_only = ConvertOptions::new().with_modality_lut(ModalityLutOption::None);
+    let (bits, stored) = (decoded.bits_allocated(), decoded.bits_stored());
+    let signed = decoded.pixel_representation() == dicom_pixeldata::PixelRepresentation::Signed;
     (0..h.frames)
         .map(|frame| {
-            let raw: Vec<i32> = decoded
-                .to_vec_frame_with_options(frame, &raw_only)
-                .map_err(|e| pixels_error(format!("frame {frame}: {e}")))?;
+            let bytes = decoded.frame_data(frame).map_err(|e| pixels_error(format!("frame {frame}: {e}")))?;
+            let raw = stored_values(bytes, bits, stored, signed).ok_or_else(|| {
+                pixels_error(format!(
+                    "BitsAllocated {bits} is not supported; volgraph reads 1-, 8-, 16- and 32-bit greyscale pixels"
+                ))
+            })?;
             if raw.len() != per_slice {
                 return Err(pixels_error(format!(
                     "frame {frame} holds {} pixels, but Rows × Columns is {per_slice}; the file is truncated or corrupt",

@@ -1,0 +1,138 @@
+//! Issue 21 through the real binary: a DICOM folder (written with dicom-rs by
+//! `volgraph_accel::load::dicom::write_ct_series`) is described by `volgraph info` in HU and
+//! rendered with a CT preset; a folder of two series lists them and `--series` picks one;
+//! options that do not apply are refused by name.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use glam::{DVec3, UVec3};
+use volgraph_accel::volume::{Volume, VoxelData};
+
+struct Run {
+    code: i32,
+    stdout: String,
+    stderr: String,
+}
+
+fn volgraph(args: &[&str]) -> Run {
+    let out = Command::new(env!("CARGO_BIN_EXE_volgraph"))
+        .args(args)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .expect("the volgraph binary runs");
+    let run = Run {
+        code: out.status.code().unwrap_or(-1),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    };
+    assert_ne!(run.code, 101, "{args:?} panicked:\n{}", run.stderr);
+    run
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("scanner_data").join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch");
+    dir
+}
+
+/// A CT in HU: air around a soft-tissue ellipsoid with a bone core.
+fn ct(n: u32, name: &str) -> Volume {
+    let dims = UVec3::new(n, n - 4, n - 8);
+    let mut values = Vec::new();
+    for z in 0..dims.z {
+        for y in 0..dims.y {
+            for x in 0..dims.x {
+                let p = (DVec3::new(x as f64, y as f64, z as f64) + 0.5) / dims.as_dvec3() - 0.5;
+                let r = (p * DVec3::new(1.0, 1.2, 1.1)).length();
+                values.push(if r < 0.15 {
+                    900
+                } else if r < 0.4 {
+                    40
+                } else {
+                    -1000
+                } as i16);
+            }
+        }
+    }
+    Volume::new(name, dims, DVec3::new(0.8, 0.8, 1.5), VoxelData::I16(values))
+}
+
+fn write(dir: &Path, volume: &Volume) {
+    volgraph_accel::load::dicom::write_ct_series(dir, volume).expect("series written");
+}
+
+#[test]
+fn a_dicom_folder_is_described_in_hounsfield_units_and_renders_with_a_ct_preset() {
+    let dir = scratch("one");
+    write(&dir.join("series"), &ct(40, "phantom"));
+    let series = dir.join("series").display().to_string();
+    let info = volgraph(&["info", &series]);
+    assert_eq!(info.code, 0, "{}", info.stderr);
+    for expected in [
+        "DICOM series (1)",
+        "modality     CT, values in HU",
+        "40 × 36 × 32 voxels, int16",
+        "orientation  LPS",
+        "value range  -1000 … 900 HU",
+        "auto iso",
+    ] {
+        assert!(info.stdout.contains(expected), "missing {expected:?} in\n{}", info.stdout);
+    }
+    let png = dir.join("bone.png").display().to_string();
+    let run = volgraph(&[
+        "render",
+        "basic/fragment_raycast",
+        "--volume",
+        &series,
+        "--tf",
+        "ct-bone",
+        "--size",
+        "48x48",
+        "-o",
+        &png,
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let image = image::open(&png).expect("png").to_rgba8();
+    let lit = image.pixels().filter(|p| p.0[0] > 40).count();
+    // The bone core shows; the air around it does not.
+    assert!(lit > 20 && lit < 48 * 48 / 2, "{lit} lit pixels");
+    assert!(!run.stderr.contains("warning"), "a CT preset on CT data needs no warning: {}", run.stderr);
+}
+
+#[test]
+fn two_series_are_listed_and_picked() {
+    let dir = scratch("two");
+    write(&dir.join("a"), &ct(24, "first"));
+    let mut second = ct(32, "second");
+    second.name = "second".into();
+    // A second series: another SeriesInstanceUID.
+    volgraph_accel::load::dicom::write_ct_series(&dir.join("b"), &second).expect("written");
+    for f in std::fs::read_dir(dir.join("b")).expect("dir").flatten() {
+        let mut o = dicom_object::open_file(f.path()).expect("slice");
+        o.put(dicom_core::DataElement::new(
+            dicom_dictionary_std::tags::SERIES_INSTANCE_UID,
+            dicom_core::VR::UI,
+            dicom_core::value::PrimitiveValue::from("2.25.99"),
+        ));
+        o.put(dicom_core::DataElement::new(
+            dicom_dictionary_std::tags::SERIES_NUMBER,
+            dicom_core::VR::IS,
+            dicom_core::value::PrimitiveValue::from("2"),
+        ));
+        o.write_to_file(f.path()).expect("rewritten");
+    }
+    let folder = dir.display().to_string();
+    let out = dir.join("x.png").display().to_string();
+    let run = volgraph(&["render", "basic/fragment_raycast", "--volume", &folder, "--size", "16x16", "-o", &out]);
+    assert_eq!(run.code, 1);
+    assert!(run.stderr.contains("holds 2 DICOM series; choose one with --series"), "{}", run.stderr);
+    assert!(run.stderr.contains("2. series 2 \"second\" CT: 24 slice(s) of 32x28"), "{}", run.stderr);
+    let info = volgraph(&["info", &folder, "--series", "second"]);
+    assert_eq!(info.code, 0, "{}", info.stderr);
+    assert!(info.stdout.contains("32 × 28 × 24 voxels"), "{}", info.stdout);
+    let frame = volgraph(&["info", &folder, "--frame", "1"]);
+    assert_eq!(frame.code, 1);
+    assert!(frame.stderr.contains("--frame picks a volume of a 4D NIfTI file"), "{}", frame.stderr);
+}

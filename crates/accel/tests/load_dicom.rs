@@ -249,3 +249,64 @@ fn a_dicomdir_beside_the_slices_is_skipped() {
     let e = load(&[dir.join("DICOMDIR")]).expect_err("an index only");
     assert!(e.contains("1 DICOMDIR index"), "{e}");
 }
+
+/// Rewrites every element of `path` through `edit` (a test's way to make odd files from good
+/// ones).
+fn rewrite(path: &std::path::Path, edit: impl FnOnce(&mut dicom_object::DefaultDicomObject)) {
+    let mut object = dicom_object::open_file(path).expect("slice");
+    edit(&mut object);
+    object.write_to_file(path).expect("rewrite");
+}
+
+fn element(
+    tag: dicom_core::Tag,
+    vr: dicom_core::VR,
+    value: dicom_core::value::PrimitiveValue,
+) -> dicom_object::mem::InMemElement {
+    dicom_core::DataElement::new(tag, vr, value)
+}
+
+#[test]
+fn a_colour_slice_is_refused_by_name() {
+    use dicom_core::VR;
+    use dicom_core::value::PrimitiveValue;
+    use dicom_dictionary_std::tags;
+    let dir = scratch("rgb");
+    let files = write_series(&dir, &phantom(), &SeriesSpec::default());
+    rewrite(&files[1], |o| {
+        o.put(element(tags::SAMPLES_PER_PIXEL, VR::US, PrimitiveValue::from(3u16)));
+        o.put(element(tags::PHOTOMETRIC_INTERPRETATION, VR::CS, PrimitiveValue::from("RGB")));
+        o.put(element(tags::BITS_ALLOCATED, VR::US, PrimitiveValue::from(8u16)));
+        o.put(element(tags::BITS_STORED, VR::US, PrimitiveValue::from(8u16)));
+        o.put(element(tags::HIGH_BIT, VR::US, PrimitiveValue::from(7u16)));
+        o.put(element(tags::PLANAR_CONFIGURATION, VR::US, PrimitiveValue::from(0u16)));
+        o.put(element(tags::PIXEL_DATA, VR::OB, PrimitiveValue::U8(vec![128u8; 12 * 10 * 3].into())));
+    });
+    let e = load(&[dir]).expect_err("RGB");
+    assert!(e.contains(&format!("{}: has 3 samples per pixel (a colour image)", files[1].display())), "{e}");
+}
+
+#[test]
+fn a_single_multi_frame_file_is_a_volume() {
+    use dicom_core::VR;
+    use dicom_core::value::PrimitiveValue;
+    use dicom_dictionary_std::tags;
+    let phantom = phantom();
+    let dir = scratch("multiframe");
+    let files = write_series(&dir, &phantom, &SeriesSpec::default());
+    // Every slice's pixels, in order, in the first file; frames stepped by SpacingBetweenSlices.
+    let mut pixels: Vec<u16> = Vec::new();
+    for f in &files {
+        let o = dicom_object::open_file(f).expect("slice");
+        pixels.extend(o.element(tags::PIXEL_DATA).expect("pixels").to_multi_int::<u16>().expect("words"));
+    }
+    let single = scratch("multiframe_one").join("volume.dcm");
+    std::fs::copy(&files[0], &single).expect("copy");
+    rewrite(&single, |o| {
+        o.put(element(tags::NUMBER_OF_FRAMES, VR::IS, PrimitiveValue::from(files.len().to_string())));
+        o.put(element(tags::SPACING_BETWEEN_SLICES, VR::DS, PrimitiveValue::from("2.5")));
+        o.put(element(tags::PIXEL_DATA, VR::OW, PrimitiveValue::U16(pixels.into())));
+    });
+    let loaded = load(&[single]).expect("a multi-frame file");
+    assert_twin(&loaded.volume, &phantom);
+}

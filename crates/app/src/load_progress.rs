@@ -11,16 +11,22 @@ const MIN_FILES_FOR_A_BAR: usize = 32;
 
 /// Loads `paths` as [`load_volumes`] does, with a progress bar for long DICOM series.
 pub fn load_with_progress(paths: &[PathBuf], options: &LoadOptions<'_>) -> Result<LoadedVolume, LoadError> {
-    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    // Hidden until a series large enough reports: a raw file or a short series shows nothing.
+    let bar = ProgressBar::with_draw_target(Some(0), ProgressDrawTarget::hidden());
+    let shown = std::sync::Once::new();
     bar.set_style(
         ProgressStyle::with_template("reading {msg} {bar:40} {pos}/{len} slices ({eta} left)")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     bar.set_message(paths.first().map(|p| p.display().to_string()).unwrap_or_default());
-    let tick = |done: usize, total: usize| {
+    // Worker threads report out of order: count the reports rather than trusting `done`.
+    let tick = |_done: usize, total: usize| {
         if total >= MIN_FILES_FOR_A_BAR {
-            bar.set_length(total as u64);
-            bar.set_position(done as u64);
+            shown.call_once(|| {
+                bar.set_length(total as u64);
+                bar.set_draw_target(ProgressDrawTarget::stderr());
+            });
+            bar.inc(1);
         }
     };
     let with_bar = LoadOptions { progress: Some(&tick), ..options.clone() };

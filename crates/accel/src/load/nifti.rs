@@ -235,8 +235,13 @@ fn build(path: &Path, bytes: &[u8], g: &Geometry, frame: Option<u64>) -> Result<
     )?;
     let (size, read) = element(path, g.datatype)?;
     let voxels = file_dims.x as u64 * file_dims.y as u64 * file_dims.z as u64;
-    let start = g.vox_offset.max(if g.version == 1 { 352 } else { 544 }) + frame * voxels * size as u64;
-    let end = start + voxels * size as u64;
+    // Checked: a header's offset or sizes may be anything (1e39 saturates to u64::MAX).
+    let frame_bytes = voxels.checked_mul(size as u64);
+    let start = frame_bytes
+        .and_then(|b| b.checked_mul(frame))
+        .and_then(|b| b.checked_add(g.vox_offset.max(if g.version == 1 { 352 } else { 544 })));
+    let end = start.zip(frame_bytes).and_then(|(s, b)| s.checked_add(b)).unwrap_or(u64::MAX);
+    let start = start.unwrap_or(u64::MAX);
     if (bytes.len() as u64) < end {
         return Err(LoadError::DataSize {
             path: path.to_path_buf(),

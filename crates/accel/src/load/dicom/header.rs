@@ -63,6 +63,12 @@ pub struct FileHeader {
 /// Reads `path`'s header. `Ok(Probe::NotDicom)` for a file without the `DICM` magic; an error
 /// for a DICOM file that cannot be parsed (a corrupt or truncated slice).
 pub fn probe(path: &Path) -> Result<Probe, LoadError> {
+    // A FIFO or a device would block the read of the magic: refuse it by name.
+    match crate::input_file::special_kind(path) {
+        Ok(None) => {}
+        Ok(Some(what)) => return Err(LoadError::NotAFile { path: path.to_path_buf(), what }),
+        Err(source) => return Err(LoadError::Io { path: path.to_path_buf(), source }),
+    }
     if !has_dicom_magic(path)? {
         return Ok(Probe::NotDicom);
     }

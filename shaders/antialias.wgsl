@@ -10,7 +10,6 @@
 #import "common/frame.wgsl"
 #import "common/fullscreen.wgsl"
 #import "common/leap.wgsl"
-#import "common/analytic_ray.wgsl"
 
 // Rust twin: `AaParamsGpu` in crates/passes/src/antialias.rs.
 struct AaParams {
@@ -98,7 +97,7 @@ fn subpixel_direction(p: vec2<i32>, o: vec2<f32>) -> vec3<f32> {
 // four neighbours' rays reported (surface hits, or exit points of rays that met nothing,
 // projected onto this ray), less the step back; at its entry when one of them had no ray (the
 // footprint's edge runs through the pixel).
-fn subray_start(p: vec2<i32>, ray: Ray, pixel: vec2<u32>) -> u32 {
+fn subray_start(p: vec2<i32>, ray: Ray, s: Samples) -> u32 {
     let offsets = array<vec2<i32>, 5>(vec2<i32>(0, 0), vec2<i32>(1, 0), vec2<i32>(-1, 0), vec2<i32>(0, 1), vec2<i32>(0, -1));
     var k0 = 0xffffffffu;
     for (var i = 0u; i < 5u; i += 1u) {
@@ -106,7 +105,7 @@ fn subray_start(p: vec2<i32>, ray: Ray, pixel: vec2<u32>) -> u32 {
         if (hit.w == 0.0) {
             return 0u;
         }
-        k0 = min(k0, start_sample(hit, ray.u0, ray.d, pixel));
+        k0 = min(k0, start_sample(hit, ray, s));
     }
     return k0;
 }
@@ -125,11 +124,13 @@ fn resolve(in: FullscreenVertex, iso: bool) -> AaOut {
     let n = pattern_count();
     for (var i = 0u; i < n; i += 1u) {
         let ray = analytic_ray_along(subpixel_direction(p, pattern_offset(i)));
-        let k0 = subray_start(p, ray, pixel);
+        let s = pixel_samples(ray, pixel);
+        let k0 = subray_start(p, ray, s);
         if (iso) {
-            sum += leap_iso(ray.u0, ray.d, ray.len, pixel, k0).color;
+            sum += march_iso(s, k0, s.count).color;
         } else {
-            sum += leap_dvr(ray.u0, ray.d, ray.len, pixel, k0).color;
+            begin_ray(s, k0);
+            sum += march_dvr(s, k0, s.count, vec4<f32>(0.0)).color;
         }
     }
     return AaOut(sum / f32(n));

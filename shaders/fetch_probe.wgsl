@@ -1,5 +1,5 @@
 // The fetch ceiling (`volgraph bench fetch`): every sample a raycaster with this step would take
-// along the pixel's ray through the box — common/analytic_ray.wgsl's rays and samples, no
+// along the pixel's ray through the box — common/ray_box.wgsl's rays and samples, no
 // leaping, no termination — and nothing else: no classification, no compositing. What it
 // writes (the mean scalar along the ray, an average-intensity projection) only keeps the
 // samples from being optimised away. Its samples per second bound those of any raycaster on this
@@ -7,13 +7,12 @@
 
 #import "common/frame.wgsl"
 #import "common/raymarch.wgsl"
-#import "common/analytic_ray.wgsl"
 
 override WORKGROUP_X: u32 = 8u;
 override WORKGROUP_Y: u32 = 8u;
 
 @group(0) @binding(auto) var color: texture_storage_2d<rgba16float, write>;
-// Samples taken per image row (as raycast_fast.wgsl's).
+// Samples taken per image row (as common/pixel_march.wgsl's).
 @group(0) @binding(auto) var<storage, read_write> samples: array<atomic<u32>>;
 const SAMPLE_ROWS: u32 = 4096u;
 
@@ -23,20 +22,12 @@ struct Fetched {
 }
 
 fn fetch_ray(p: vec2<u32>) -> Fetched {
-    let ray = analytic_ray(p);
-    if (!ray_is_valid(ray.u0, ray.d, ray.len)) {
-        return Fetched(0.0, 0u);
-    }
-    let s = ray_samples(ray, p);
+    let s = pixel_samples(analytic_ray(p), p);
     var sum = 0.0;
     for (var k = 0u; k < s.count; k += 1u) {
-        sum += sample_volume(s.first + f32(k) * s.delta);
+        sum += sample_volume(sample_at(s, k));
     }
     return Fetched(sum / f32(max(s.count, 1u)), s.count);
-}
-
-fn in_viewport(p: vec2<u32>) -> bool {
-    return f32(p.x) < frame.viewport.x && f32(p.y) < frame.viewport.y;
 }
 
 @compute @workgroup_size(WORKGROUP_X, WORKGROUP_Y)

@@ -1,7 +1,7 @@
 // Klein et al. 2005 §4.4's two hole-filling steps. First, extended splats: a pixel no splat
 // reached takes the start nearest the eye among the splats within `extend` pixels — a larger
 // splat drawn only into holes. Then every pixel still without a start begins at the volume
-// box's front face — met analytically here (common/analytic_ray.wgsl), the raycaster's
+// box's front face — met analytically here (common/ray_box.wgsl), the raycaster's
 // `rays: "analytic"` entry. One more rule keeps the image exact while the volume turns: a pixel
 // within `band` pixels of the footprint's silhouette also starts at the box — a splat can carry
 // a neighbour's hit across the silhouette into a pixel whose ray, newly in view, meets the box
@@ -9,15 +9,11 @@
 
 #import "common/frame.wgsl"
 #import "common/fullscreen.wgsl"
-#import "common/analytic_ray.wgsl"
+#import "common/ray_box.wgsl"
 
-// Declared once: `HoleParams` (pass_params!) in crates/passes/src/hole_fill.rs.
-struct HoleParams {
-    silhouette_band: i32,
-    extend: i32,
-    _pad1: i32,
-    _pad2: i32,
-}
+// Declared once: `HoleParams` (pass_params!) in crates/passes/src/hole_fill.rs,
+// which generates the struct imported here.
+#import "params/HoleParams.wgsl"
 
 // The reprojected starts (w = 1 where a splat landed).
 @group(0) @binding(auto) var splats: texture_2d<f32>;

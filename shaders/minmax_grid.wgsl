@@ -9,16 +9,12 @@
 
 #import "common/volume.wgsl"
 
-// Declared once: `BlockSize` (pass_params!) in crates/passes/src/shared.rs.
-struct MinMaxParams {
-    block_size: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-}
+// Declared once: `BlockSize` (pass_params!) in crates/passes/src/shared.rs,
+// which generates the struct imported here.
+#import "params/BlockSize.wgsl"
 
 @group(0) @binding(auto) var grid: texture_storage_3d<rg32float, write>;
-@group(0) @binding(auto) var<uniform> minmax: MinMaxParams;
+@group(0) @binding(auto) var<uniform> minmax: BlockSize;
 
 // Workgroups of 4³ blocks.
 @compute @workgroup_size(4, 4, 4)

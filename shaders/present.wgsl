@@ -3,14 +3,9 @@
 // on llvmpipe it costs a third of the fullscreen-triangle draw it replaced, and on data-centre
 // GPUs compute is the fast path.
 
-// Declared once: `PresentParams` (pass_params!) in crates/passes/src/present.rs.
-struct PresentParams {
-    // Linear grey level behind the volume.
-    background: f32,
-    _pad0: f32,
-    _pad1: f32,
-    _pad2: f32,
-}
+// Declared once: `PresentParams` (pass_params!) in crates/passes/src/present.rs,
+// which generates the struct imported here.
+#import "params/PresentParams.wgsl"
 
 @group(0) @binding(auto) var color: texture_2d<f32>;
 @group(0) @binding(auto) var<uniform> params: PresentParams;

@@ -1,6 +1,6 @@
 // The bricked raycaster of Ruijters & Vilanova 2006 (crates/passes/src/raycast_bricks.rs): one
-// invocation per pixel marches the samples of the single-texture raycasters (common/
-// analytic_ray.wgsl: k + 0.5 steps from the box entry, the same compositing), but reads the
+// invocation per pixel marches the samples of the single-texture raycasters (common/ray_box.wgsl:
+// k + 0.5 steps from the box entry; common/raymarch.wgsl's loop and compositing), but reads the
 // volume from a pool of bricks — an atlas of `brick_cells + 3` voxels per side per slot: the
 // brick's corner voxels (the overlap of §5) and one more on each side, so a filter tap at a
 // brick face blends what it would in the whole volume — and
@@ -18,7 +18,7 @@
 
 #import "common/frame.wgsl"
 #import "common/raymarch.wgsl"
-#import "common/analytic_ray.wgsl"
+#import "common/leap_empty.wgsl"
 
 override WORKGROUP_X: u32 = 8u;
 override WORKGROUP_Y: u32 = 8u;
@@ -54,106 +54,94 @@ struct BrickParams {
 @group(0) @binding(auto) var color: texture_storage_2d<rgba16float, write>;
 #endif
 
-// A ray's samples in voxel coordinates (voxel centres at integers): sample k at
-// `first + k·delta`; `inv` = 1/delta per axis (0 where the ray runs parallel to an axis), so a
-// leap costs multiplications only.
-struct VoxelRay {
-    first: vec3<f32>,
-    delta: vec3<f32>,
-    inv: vec3<f32>,
-}
-
-// The first sample index after the box [lo, hi] (voxel coordinates; a box at a face of the
-// volume extends to the face, half a voxel beyond the last centre, like common/box.wgsl's
-// cells) that sample k at `v` lies in.
-fn past_box(k: u32, v: vec3<f32>, r: VoxelRay, lo: vec3<f32>, hi: vec3<f32>, last: vec3<f32>) -> u32 {
-    let lo_v = select(lo, vec3<f32>(-0.5), lo <= vec3<f32>(0.0));
-    let hi_v = select(hi, last + vec3<f32>(0.5), hi >= last);
-    let bound = select(lo_v, hi_v, r.delta > vec3<f32>(0.0));
-    let t_axis = select((bound - v) * r.inv, vec3<f32>(3.0e38), r.delta == vec3<f32>(0.0));
-    let steps = min(t_axis.x, min(t_axis.y, t_axis.z));
-    return k + max(1u, u32(clamp(floor(steps) + 1.0, 0.0, f32(params.max_steps))));
-}
-
-// The samples of `ray` from colour `start` on, through this batch's bricks.
-fn march_bricks(ray: Ray, pixel: vec2<u32>, start: vec4<f32>) -> vec4<f32> {
-    var out = start;
-    let s = ray_samples(ray, pixel);
-    begin_ray(s.first, s.delta);
+// Voxel coordinates (voxel centres at integers) of texture-space `p`, clamped to the voxels.
+fn voxel_of(p: vec3<f32>) -> vec3<f32> {
     let n = frame.volume_dims.xyz;
-    let last_voxel = max(n - vec3<f32>(1.0), vec3<f32>(0.0));
-    let dv = s.delta * n;
-    let r = VoxelRay(s.first * n - vec3<f32>(0.5), dv, select(vec3<f32>(1.0) / dv, vec3<f32>(0.0), dv == vec3<f32>(0.0)));
+    return clamp(p * n - vec3<f32>(0.5), vec3<f32>(0.0), max(n - vec3<f32>(1.0), vec3<f32>(0.0)));
+}
+
+// The texture-space box of voxel box [lo, hi]; a box at a face of the volume extends to the
+// face, half a voxel beyond the last centre (like common/box.wgsl's cells).
+fn voxel_box_lo(lo: vec3<f32>) -> vec3<f32> {
+    return select((lo + vec3<f32>(0.5)) / frame.volume_dims.xyz, vec3<f32>(0.0), lo <= vec3<f32>(0.0));
+}
+
+fn voxel_box_hi(hi: vec3<f32>) -> vec3<f32> {
+    let last = max(frame.volume_dims.xyz - vec3<f32>(1.0), vec3<f32>(0.0));
+    return select((hi + vec3<f32>(0.5)) / frame.volume_dims.xyz, vec3<f32>(1.0), hi >= last);
+}
+
+fn brick_index(b: vec3<u32>) -> u32 {
+    let grid = bricks.grid.xyz;
+    return b.x + grid.x * (b.y + grid.y * b.z);
+}
+
+// The brick holding voxel position `c`, and the leaf.
+fn brick_of(c: vec3<f32>) -> vec3<u32> {
+    return min(vec3<u32>(c / f32(bricks.grid.w)), bricks.grid.xyz - vec3<u32>(1u));
+}
+
+fn leaf_of(c: vec3<f32>) -> vec3<u32> {
+    return min(vec3<u32>(c / f32(bricks.leaves.x)), bricks.leaf_grid.xyz - vec3<u32>(1u));
+}
+
+// What this dispatch leaps over (common/leap_empty.wgsl): the largest cube of leaves no box to
+// draw covers, and a brick drawn in another batch.
+fn empty_region_at(p: vec3<f32>) -> EmptyRegion {
+    let c = voxel_of(p);
+    let last = max(frame.volume_dims.xyz - vec3<f32>(1.0), vec3<f32>(0.0));
+    let leaf_cells = f32(bricks.leaves.x);
+    let leaf_grid = bricks.leaf_grid.xyz;
+    let l = leaf_of(c);
+    let d = leaf_distance[l.x + leaf_grid.x * (l.y + leaf_grid.y * l.z)];
+    if (d > 0u) {
+        let reach = vec3<u32>(d - 1u);
+        let lo_leaf = l - min(l, reach);
+        let hi_leaf = min(l + reach, leaf_grid - vec3<u32>(1u));
+        let hi = min(vec3<f32>(hi_leaf + vec3<u32>(1u)) * leaf_cells, last);
+        return EmptyRegion(true, voxel_box_lo(vec3<f32>(lo_leaf) * leaf_cells), voxel_box_hi(hi));
+    }
+    let b = brick_of(c);
+    let lo = vec3<f32>(b) * f32(bricks.grid.w);
+    let hi = min(lo + vec3<f32>(f32(bricks.grid.w)), last);
+    return EmptyRegion(table[1u + brick_index(b)] == 0u, voxel_box_lo(lo), voxel_box_hi(hi));
+}
+
+// The samples of `ray` from colour `start` on, through this batch's bricks: in rounds, like
+// every leaping march (common/raymarch.wgsl): every lane leaps until it stands in a leaf to
+// draw, then marches that leaf's samples — the same samples, read from the brick's slot.
+fn march_bricks(s: Samples, start: vec4<f32>) -> vec4<f32> {
+    var out = start;
+    begin_ray(s, 0u);
+    let n = frame.volume_dims.xyz;
+    let last = max(n - vec3<f32>(1.0), vec3<f32>(0.0));
     let brick_cells = f32(bricks.grid.w);
     let leaf_cells = f32(bricks.leaves.x);
-    let grid = bricks.grid.xyz;
-    let leaf_grid = bricks.leaf_grid.xyz;
     var k = 0u;
-    // In rounds, like raycast_fast: first every lane leaps until it stands in a leaf to draw
-    // (cheap iterations that all lanes take together), then every lane marches its leaf. A lane
-    // that leaps never waits for another's run of samples inside the same iteration.
     loop {
+        k = leap(k, s, s.count);
         if (k >= s.count || out.a >= params.threshold) {
             break;
         }
-        var lo = vec3<f32>(0.0);
-        var hi = vec3<f32>(0.0);
-        var exit = k;
-        var entry = 0u;
-        loop {
-            if (k >= s.count) {
-                break;
-            }
-            let v = r.first + f32(k) * r.delta;
-            let c = clamp(v, vec3<f32>(0.0), last_voxel);
-            let l = min(vec3<u32>(c / leaf_cells), leaf_grid - vec3<u32>(1u));
-            let d = leaf_distance[l.x + leaf_grid.x * (l.y + leaf_grid.y * l.z)];
-            if (d > 0u) {
-                // Out of the cube of empty leaves around this one.
-                let reach = vec3<u32>(d - 1u);
-                let lo_leaf = l - min(l, reach);
-                let hi_leaf = min(l + reach, leaf_grid - vec3<u32>(1u));
-                let cube_hi = min(vec3<f32>(hi_leaf + vec3<u32>(1u)) * leaf_cells, last_voxel);
-                k = past_box(k, v, r, vec3<f32>(lo_leaf) * leaf_cells, cube_hi, last_voxel);
-                continue;
-            }
-            let b = min(vec3<u32>(c / brick_cells), grid - vec3<u32>(1u));
-            lo = vec3<f32>(b) * brick_cells;
-            hi = min(lo + vec3<f32>(brick_cells), last_voxel);
-            entry = table[1u + b.x + grid.x * (b.y + grid.y * b.z)];
-            if (entry == 0u) {
-                // Drawn in another batch.
-                k = past_box(k, v, r, lo, hi, last_voxel);
-                continue;
-            }
-            let leaf_lo = vec3<f32>(l) * leaf_cells;
-            exit = past_box(k, v, r, leaf_lo, min(leaf_lo + vec3<f32>(leaf_cells), hi), last_voxel);
-            break;
-        }
-        if (k >= s.count) {
-            break;
-        }
-#if PREINTEGRATION
-        resume_ray(s.first + (f32(k) - 1.0) * s.delta);
-#endif
-        // A leaf to draw: its samples read the brick's slot, clamped to the brick's voxels
-        // (the volume's clamp-to-edge at its faces; rounding at the brick's own faces).
-        let slot = entry - 1u;
+        // A leaf to draw, up to where the ray leaves it (or its brick).
+        let p = sample_at(s, k);
+        let c = voxel_of(p);
+        let b = brick_of(c);
+        let lo = vec3<f32>(b) * brick_cells;
+        let hi = min(lo + vec3<f32>(brick_cells), last);
+        let leaf_lo = vec3<f32>(leaf_of(c)) * leaf_cells;
+        let leaf_hi = min(leaf_lo + vec3<f32>(leaf_cells), hi);
+        let exit = min(past_box(k, p, s.delta, voxel_box_lo(leaf_lo), voxel_box_hi(leaf_hi)), s.count);
+        // Its samples in the atlas: voxel v of the brick lies at texel origin + 1.5 + (v - lo).
+        let slot = table[1u + brick_index(b)] - 1u;
         let slots = bricks.slots;
         let origin = vec3<f32>(vec3<u32>(slot % slots.x, (slot / slots.x) % slots.y, slot / (slots.x * slots.y)) * bricks.slot_side.xyz);
-        let offset = origin + vec3<f32>(1.5) - lo;
-        let end = min(exit, s.count);
-        loop {
-            if (k >= end) {
-                break;
-            }
-            let ck = clamp(r.first + f32(k) * r.delta, lo, hi);
-            out = composite_sample(out, (ck + offset) / bricks.atlas.xyz);
-            k += 1u;
-            if (out.a >= params.threshold) {
-                break;
-            }
-        }
+        let shift = origin + vec3<f32>(1.5) - lo - vec3<f32>(0.5);
+        let atlas = Samples((s.first * n + shift) / bricks.atlas.xyz, s.delta * n / bricks.atlas.xyz, s.count, s.step, s.offset);
+        resume_ray(sample_at(atlas, k) - atlas.delta);
+        let m = march_dvr(atlas, k, exit, out);
+        out = m.color;
+        k = m.end;
     }
     return out;
 }
@@ -161,7 +149,7 @@ fn march_bricks(ray: Ray, pixel: vec2<u32>, start: vec4<f32>) -> vec4<f32> {
 @compute @workgroup_size(WORKGROUP_X, WORKGROUP_Y)
 fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
     let p = id.xy;
-    if (f32(p.x) >= frame.viewport.x || f32(p.y) >= frame.viewport.y) {
+    if (!in_viewport(p)) {
         return;
     }
     let i = p.y * u32(frame.viewport.x) + p.x;
@@ -169,9 +157,9 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (table[0] == 0u) {
         c = acc[i];
     }
-    let ray = analytic_ray(p);
-    if (ray.len > 0.0 && c.a < params.threshold && ray_is_valid(ray.u0, ray.d, ray.len)) {
-        c = march_bricks(ray, p, c);
+    let s = pixel_samples(analytic_ray(p), p);
+    if (s.count > 0u && c.a < params.threshold) {
+        c = march_bricks(s, c);
     }
     acc[i] = c;
     textureStore(color, vec2<i32>(p), c);

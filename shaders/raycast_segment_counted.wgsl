@@ -19,7 +19,7 @@ struct SegmentOut {
 @early_depth_test(force)
 fn fs_dvr_counted(in: SegmentVertex) -> SegmentOut {
     atomicAdd(&invocations, 1u);
-    return SegmentOut(segment_dvr(pixel_ray(vec2<u32>(in.clip.xy)), in.index));
+    return SegmentOut(segment_dvr(pixel_ray_samples(vec2<u32>(in.clip.xy)), in.index));
 }
 
 struct SegmentIsoOut {
@@ -31,6 +31,6 @@ struct SegmentIsoOut {
 @early_depth_test(force)
 fn fs_iso_counted(in: SegmentVertex) -> SegmentIsoOut {
     atomicAdd(&invocations, 1u);
-    let r = segment_iso(pixel_ray(vec2<u32>(in.clip.xy)), in.index);
+    let r = segment_iso(pixel_ray_samples(vec2<u32>(in.clip.xy)), in.index);
     return SegmentIsoOut(r.color, r.hit);
 }

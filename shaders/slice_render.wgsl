@@ -16,14 +16,9 @@
 #import "common/frame.wgsl"
 #import "common/volume.wgsl"
 
-// Declared once: `SliceParams` (pass_params!) in crates/passes/src/slice_render.rs.
-struct SliceParams {
-    // Plane spacing in unit steps (voxels).
-    slice_voxels: f32,
-    _pad0: f32,
-    _pad1: f32,
-    _pad2: f32,
-}
+// Declared once: `SliceParams` (pass_params!) in crates/passes/src/slice_render.rs,
+// which generates the struct imported here.
+#import "params/SliceParams.wgsl"
 
 @group(0) @binding(auto) var<uniform> slices: SliceParams;
 

@@ -29,34 +29,17 @@ const TERMINATED: f32 = 1.0;
 const LIVE: f32 = 0.0;
 
 // Saturated, or no sample left for segment `index`.
-fn ray_is_done(pixel: vec2<u32>, ray: PixelRay, index: u32) -> bool {
+fn ray_is_done(pixel: vec2<u32>, s: Samples, index: u32) -> bool {
     let a = textureLoad(accum, vec2<i32>(pixel), 0).a;
-    return !(a < segment.threshold) || segment_is_outside(ray, index);
+    return !(a < segment.threshold) || segment_is_outside(s, index);
 }
 
-// True when every sample of segment `index` lies in an empty block. Walks the segment block by
-// block: after an empty block it leaps to the first sample past that block's exit (the samples
-// it leaps over lie inside the block's closed box, which its conservative range covers), so a
-// segment costs one look-up per block it crosses rather than one per sample.
-fn segment_is_empty(ray: PixelRay, index: u32) -> bool {
-    let end = segment_end(index);
-    var k = index * segment.steps;
-    loop {
-        if (k >= end) {
-            break;
-        }
-        let t = sample_t(ray, k);
-        if (!(t < ray.len_tex)) {
-            break;
-        }
-        let b = block_of(ray.u0 + t * ray.d_tex, segment.block_size);
-        if (!block_is_empty(b)) {
-            return false;
-        }
-        let next = first_sample_past_block(b, segment.block_size, ray.u0, ray.d_tex, ray.step_tex, ray.jitter);
-        k = max(k + 1u, u32(clamp(next, 0.0, f32(end))));
-    }
-    return true;
+// True when every sample of segment `index` lies in an empty block: the shared leap
+// (common/leap_empty.wgsl) walks the segment block by block and runs off its end, one look-up
+// per block it crosses rather than one per sample.
+fn segment_is_empty(s: Samples, index: u32) -> bool {
+    let r = segment_range(s, index);
+    return leap(r.x, s, r.y) >= r.y;
 }
 
 // RC-a: early ray termination only. A ray never comes back once terminated, so this test can
@@ -74,8 +57,8 @@ fn vs_terminate_alpha(@builtin(vertex_index) vertex_index: u32, @builtin(instanc
 @fragment
 fn fs_terminate(in: SegmentVertex) {
     let pixel = vec2<u32>(in.clip.xy);
-    let ray = pixel_ray(pixel);
-    if (!ray_is_done(pixel, ray, in.index)) {
+    let s = pixel_ray_samples(pixel);
+    if (!ray_is_done(pixel, s, in.index)) {
         discard;
     }
 }
@@ -84,7 +67,7 @@ fn fs_terminate(in: SegmentVertex) {
 @fragment
 fn fs_terminate_empty(in: SegmentVertex) -> DepthOut {
     let pixel = vec2<u32>(in.clip.xy);
-    let ray = pixel_ray(pixel);
-    let done = ray_is_done(pixel, ray, in.index) || segment_is_empty(ray, in.index);
+    let s = pixel_ray_samples(pixel);
+    let done = ray_is_done(pixel, s, in.index) || segment_is_empty(s, in.index);
     return DepthOut(select(LIVE, TERMINATED, done));
 }

@@ -23,7 +23,7 @@ struct Frame {
     eye_texture: vec4<f32>,
     // The texture-space pixel ray: pixel centre (x, y) looks along ray_base + x·ray_dx + y·ray_dy,
     // scaled to advance one world unit along camera_forward per unit of the ray parameter (the
-    // near plane is at parameter camera_forward.w). See common/analytic_ray.wgsl.
+    // near plane is at parameter camera_forward.w). See common/ray_box.wgsl.
     ray_base_texture: vec4<f32>,
     ray_dx_texture: vec4<f32>,
     ray_dy_texture: vec4<f32>,
@@ -53,4 +53,10 @@ fn pixel_ray_dir(pixel: vec2<f32>) -> vec3<f32> {
     let a = frame.world_from_clip * vec4<f32>(ndc, 0.0, 1.0);
     let b = frame.world_from_clip * vec4<f32>(ndc, 1.0, 1.0);
     return normalize(b.xyz / b.w - a.xyz / a.w);
+}
+
+// True when pixel (or compute invocation) `p` lies in the viewport; compute grids are rounded up
+// to whole workgroups.
+fn in_viewport(p: vec2<u32>) -> bool {
+    return f32(p.x) < frame.viewport.x && f32(p.y) < frame.viewport.y;
 }

@@ -1,7 +1,7 @@
 // A pixel's ray met analytically with the volume box, in texture space: the same segment as
 // `volgraph_accel::reference::ray_segment` and docs/rendering_model.md ("Ray segment inside the
 // box"). Needs only the frame, so any pass can import it — the compute raycasters through
-// common/analytic_ray.wgsl, a WGSL-only pass directly (graph_kinds/mip_projection.wgsl).
+// common/pixel_ray.wgsl, a WGSL-only pass directly (graph_kinds/mip_projection.wgsl).
 
 #import "common/frame.wgsl"
 
@@ -63,19 +63,50 @@ fn step_tex_for(step_voxels: f32, d_tex: vec3<f32>) -> f32 {
     return step_voxels * frame.half_extent.w / world_per_tex;
 }
 
-// Sample k of a ray lies at `first + k · delta` (texture space): `first` the first sample,
-// `delta` one step. The hot loop keeps only these, the colour and two counters in registers.
+// The samples of a ray, the one rule every raycaster, the probe and the f64 reference
+// (`volgraph_accel::reference`, docs/rendering_model.md "Samples") share: sample k lies at
+// t_k = (k + offset) · step from the entry (offset = 0.5 + jitter, in steps), that is at
+// `first + k · delta` in texture space, for k < count. The hot loops keep only `first`,
+// `delta`, the colour and two counters in registers.
 struct Samples {
     first: vec3<f32>,
     delta: vec3<f32>,
     count: u32,
+    // Texture-space length of one step.
+    step: f32,
+    // 0.5 + jitter: where sample 0 lies, in steps from the entry.
+    offset: f32,
 }
 
 // The samples of `ray` a step of `step_tex` apart: k = 0.. with (k + 0.5 + jitter) · step_tex <
-// len, at most `max_count` — the positions of every raycaster
-// (`volgraph_accel::reference`, docs/rendering_model.md).
+// len, at most `max_count`.
 fn samples_along(ray: Ray, step_tex: f32, jitter: f32, max_count: u32) -> Samples {
     let delta = ray.d * step_tex;
-    let count = u32(clamp(ceil(ray.len / step_tex - 0.5 - jitter), 0.0, f32(max_count)));
-    return Samples(ray.u0 + (0.5 + jitter) * delta, delta, count);
+    let offset = 0.5 + jitter;
+    let count = u32(clamp(ceil(ray.len / step_tex - offset), 0.0, f32(max_count)));
+    return Samples(ray.u0 + offset * delta, delta, count, step_tex, offset);
+}
+
+// Sample k's texture-space position.
+fn sample_at(s: Samples, k: u32) -> vec3<f32> {
+    return s.first + f32(k) * s.delta;
+}
+
+// The first sample index at or past distance `t` from the entry (capped at `count`): a ray that
+// starts late (Klein et al. 2005 §4.2) keeps every sample on the grid of the full march.
+fn first_sample_at(s: Samples, t: f32) -> u32 {
+    return u32(clamp(ceil(t / s.step - s.offset), 0.0, f32(s.count)));
+}
+
+// The one box exit: the first sample index after sample k (at `p`) whose position lies past
+// where the ray p + x·delta leaves the box [lo, hi] (any coordinates `p` and `delta` share:
+// texture space for blocks and cubes of blocks, voxels for bricks and leaves); at least k + 1.
+// Axes the ray runs parallel to never bound it. Every empty-space leap and every brick exit is
+// this function: the samples it passes over lie in the closed box.
+fn past_box(k: u32, p: vec3<f32>, delta: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> u32 {
+    let bound = select(lo, hi, delta > vec3<f32>(0.0));
+    let parallel = delta == vec3<f32>(0.0);
+    let x = select((bound - p) / select(delta, vec3<f32>(1.0), parallel), vec3<f32>(3.0e38), parallel);
+    let steps = min(x.x, min(x.y, x.z));
+    return k + max(1u, u32(clamp(floor(steps) + 1.0, 0.0, 16777216.0)));
 }

@@ -1,18 +1,34 @@
-// The volume-rendering integral shared by every raycaster (fragment and compute), implementing
-// docs/rendering_model.md ("Ray segment inside the box" from `u0` on, "Classification and
-// compositing", "Effects", "First-hit isosurface") exactly like `volgraph_accel::reference`.
-// Krüger & Westermann 2003 §2.1 (DVR, early ray termination) and §2.2 (first-hit isosurface).
+// The one sampling core of every raycaster — fragment (`raycast`), compute (`raycast_compute`),
+// multipass segments (`raycast_segment`, `termination_test`), bricks (`raycast_bricks`) and
+// `antialias`'s sub-pixel rays — implementing docs/rendering_model.md ("Samples", "Ray segment
+// inside the box", "Classification and compositing", "Effects", "First-hit isosurface") exactly
+// like `volgraph_accel::reference`. Krüger & Westermann 2003 §2.1 (DVR, early ray termination),
+// §2.2 (first-hit isosurface), §2.3 (empty-space skipping, through `leap`).
 //
-// Effects a scene turns on are compiled in with `#if` (crates/core/src/shader_source.rs):
+// One rule for where samples lie (`Samples` in common/ray_box.wgsl, jitter here), one box exit
+// (`past_box`), one compositing step (`classify_sample`), one leap over empty space
+// (`leap`, common/leap_empty.wgsl), one DVR loop (`march_dvr`) and one isosurface loop
+// (`march_iso`) over any range of samples [k0, end): a whole ray, a ray started late from a
+// reprojected estimate (Klein et al. 2005), a segment of M samples, a run inside a brick.
+//
+// Effects a scene turns on are compiled in with `#if` (crates/compiler/src/shader_source.rs):
 // SHADING (Blinn–Phong of every DVR sample with the gradient), PREINTEGRATION (Engel et al.
 // 2001: each sample composites the segment from the previous one through a 2D table), TRICUBIC
-// (common/volume.wgsl). A loop that uses them calls `begin_ray` before its first sample and
-// `resume_ray` after skipping samples.
+// (common/volume.wgsl), JITTER; and the pass's choices: CORRECTED_TABLE (classify through a
+// table pre-corrected for the step, opacity_lut.wgsl), LEAP (`march_dvr` leaps in rounds),
+// FIRST_VISIBLE (`march_dvr` records its first visible sample for Klein's leap hits).
 
 #import "common/frame.wgsl"
 #import "common/volume.wgsl"
 #import "common/raycast_params.wgsl"
 #import "common/ray_box.wgsl"
+
+// The correction exponent (step over opacity unit) is exactly 0.5: the exact correction is a
+// square root, no pow. A compute raycaster picks this pipeline per frame (the opacity unit is
+// frame data): no branch on it may sit in the sample loop, which on llvmpipe slows every sample.
+override HALF_STEP: bool = false;
+// With LEAP: samples in a run between two looks at the empty-space structure (`march_dvr`).
+override CHECK_EVERY: u32 = 16u;
 
 // O'Neill's PCG hash (state = v*747796405 + 2891336453, then the RXS-M-XS output permutation).
 fn pcg_hash(v: u32) -> u32 {
@@ -73,6 +89,9 @@ fn corrected_alpha(a_tf: f32) -> f32 {
     if (a <= 0.0) {
         return 0.0;
     }
+    if (HALF_STEP) {
+        return 1.0 - sqrt(1.0 - a);
+    }
     return 1.0 - pow(1.0 - a, step_exponent());
 }
 
@@ -88,18 +107,22 @@ fn lookup_preintegrated(s_front: f32, s_back: f32) -> vec4<f32> {
 }
 #endif
 
+#if CORRECTED_TABLE
+// (rgb·α', α') per scalar, α' corrected for the step (opacity_lut.wgsl): one filtered lookup
+// instead of the TF and a pow.
+@group(0) @binding(auto) var corrected: texture_2d<f32>;
+#endif
+
 // Per-ray state of the effects: the unit world view direction (SHADING) and the scalar of the
 // previous sample, the front of the next segment (PREINTEGRATION).
 var<private> ray_view_world: vec3<f32>;
 var<private> ray_prev_scalar: f32;
 
-// Starts a ray whose sample k lies at first + k·delta: the view direction, and the front value
-// of sample 0's segment (the field one step before it).
-fn begin_ray(first: vec3<f32>, delta: vec3<f32>) {
-    ray_view_world = normalize(delta * 2.0 * frame.half_extent.xyz);
-#if PREINTEGRATION
-    ray_prev_scalar = sample_volume(first - delta);
-#endif
+// Starts marching `s` at sample k0: the view direction, and the front value of sample k0's
+// segment (the field one step before it).
+fn begin_ray(s: Samples, k0: u32) {
+    ray_view_world = normalize(s.delta * 2.0 * frame.half_extent.xyz);
+    resume_ray(sample_at(s, k0) - s.delta);
 }
 
 // After skipping samples: `before` is the position of the sample just before the next one
@@ -118,9 +141,13 @@ fn classify_sample(u: vec3<f32>) -> vec4<f32> {
     var p = lookup_preintegrated(ray_prev_scalar, s);
     ray_prev_scalar = s;
 #else
+#if CORRECTED_TABLE
+    var p = textureSampleLevel(corrected, linear_clamp, vec2<f32>(s, 0.5), 0.0);
+#else
     let c = sample_tf(s);
     let a = corrected_alpha(c.a);
     var p = vec4<f32>(c.rgb * a, a);
+#endif
 #endif
 #if SHADING
     if (p.a > 0.0) {
@@ -131,42 +158,82 @@ fn classify_sample(u: vec3<f32>) -> vec4<f32> {
     return p;
 }
 
-// One front-to-back compositing step (docs/rendering_model.md): the sample at texture-space
-// `u` classified, added behind the premultiplied `acc`. Every DVR loop (single pass, segments,
-// empty-space leaping) composites through this function.
-fn composite_sample(acc: vec4<f32>, u: vec3<f32>) -> vec4<f32> {
-    return acc + (1.0 - acc.a) * classify_sample(u);
+// The samples of a pixel's ray (`count` 0 when there is no ray to march): step and jitter of
+// this pass.
+fn pixel_samples(ray: Ray, pixel: vec2<u32>) -> Samples {
+    if (!(ray.len > 0.0) || !ray_is_valid(ray.u0, ray.d, ray.len)) {
+        return Samples(ray.u0, vec3<f32>(0.0), 0u, 1.0, 0.5);
+    }
+    return samples_along(ray, ray_step_tex(ray.d), ray_jitter(pixel), params.max_steps);
 }
 
-// Direct volume rendering along u0 + t·d_tex, t in [0, len_tex): premultiplied linear RGBA,
-// front to back, stopping after the sample that makes A >= threshold or after max_steps samples.
-fn march_dvr(u0: vec3<f32>, d_tex: vec3<f32>, len_tex: f32, pixel: vec2<u32>) -> vec4<f32> {
-    var acc = vec4<f32>(0.0);
-    if (!ray_is_valid(u0, d_tex, len_tex)) {
-        return acc;
-    }
-    let step_tex = ray_step_tex(d_tex);
-    let jitter = ray_jitter(pixel);
-    begin_ray(u0 + (0.5 + jitter) * step_tex * d_tex, step_tex * d_tex);
-    for (var k = 0u; k < params.max_steps; k += 1u) {
-        let t = (f32(k) + 0.5 + jitter) * step_tex;
-        if (!(t < len_tex)) {
-            break;
-        }
-        acc = composite_sample(acc, u0 + t * d_tex);
-        if (acc.a >= params.threshold) {
-            break;
-        }
-    }
-    return acc;
-}
+// No such sample (`Marched::first`).
+const NO_SAMPLE: u32 = 0xffffffffu;
 
-// First-hit isosurface result: shaded premultiplied colour (alpha 1) and texture-space hit
-// position (w = 1); both (0,0,0,0) when the ray misses.
-struct IsoResult {
+// What a DVR march did: the premultiplied colour, its first visible sample (with FIRST_VISIBLE;
+// NO_SAMPLE when none), the samples it took and where it stopped.
+struct Marched {
     color: vec4<f32>,
-    hit: vec4<f32>,
+    first: u32,
+    samples: u32,
+    end: u32,
 }
+
+// Direct volume rendering of samples [k0, end) of `s` behind the premultiplied `start`, front to
+// back (docs/rendering_model.md), stopping after the sample that makes A >= threshold. Call
+// `begin_ray` (or `resume_ray`) first. With LEAP it goes in rounds: leap while the sample lies
+// in empty space (`leap`), then a run of up to CHECK_EVERY samples with nothing else in the
+// loop. The lanes of a SIMD group go through the rounds together, so they look at the
+// empty-space structure at the same time; a sample taken in an empty block adds nothing (its
+// classified alpha is 0), so a lane entering empty space during a run loses time, never
+// accuracy. (On llvmpipe, a leap check inside the sample loop — even one never taken — makes
+// every sample ~1.7× slower: bench/peer.md.)
+fn march_dvr(s: Samples, k0: u32, end: u32, start: vec4<f32>) -> Marched {
+    var out = Marched(start, NO_SAMPLE, 0u, k0);
+    var k = k0;
+    // Termination is tested after a sample, never before the first (T = 0 takes one sample, as
+    // the reference does).
+    loop {
+        if (k >= end) {
+            break;
+        }
+#if LEAP
+        let before = k;
+        k = leap(k, s, end);
+        if (k >= end) {
+            break;
+        }
+        if (k != before) {
+            resume_ray(sample_at(s, k) - s.delta);
+        }
+        let run_end = min(k + CHECK_EVERY, end);
+#else
+        let run_end = end;
+#endif
+        let run_start = k;
+        loop {
+            if (k >= run_end) {
+                break;
+            }
+            let p = classify_sample(sample_at(s, k));
+#if FIRST_VISIBLE
+            out.first = select(out.first, k, out.first == NO_SAMPLE && p.a > 0.0);
+#endif
+            out.color = out.color + (1.0 - out.color.a) * p;
+            k += 1u;
+            if (out.color.a >= params.threshold) {
+                break;
+            }
+        }
+        out.samples += k - run_start;
+        if (out.color.a >= params.threshold) {
+            break;
+        }
+    }
+    out.end = k;
+    return out;
+}
+
 
 // Blinn–Phong headlight at texture-space point `u` seen along the unit world direction `d_world`
 // (docs/rendering_model.md "First-hit isosurface", "Effects"): (ambient + diffuse·|n·l|, the
@@ -202,37 +269,50 @@ fn shade_iso(u: vec3<f32>, d_world: vec3<f32>) -> vec3<f32> {
     return clamp(base * light.x + vec3<f32>(light.y), vec3<f32>(0.0), vec3<f32>(1.0));
 }
 
-// First-hit isosurface along u0 + t·d_tex: the first sample k with s >= iso, refined linearly
-// between samples k-1 and k (t_0 itself when k = 0), shaded with the headlight.
-fn march_iso(u0: vec3<f32>, d_tex: vec3<f32>, len_tex: f32, pixel: vec2<u32>) -> IsoResult {
-    var result = IsoResult(vec4<f32>(0.0), vec4<f32>(0.0));
-    if (!ray_is_valid(u0, d_tex, len_tex)) {
-        return result;
-    }
-    let step_tex = ray_step_tex(d_tex);
-    let jitter = ray_jitter(pixel);
+// What an isosurface march found: shaded colour (alpha 1) and texture-space hit (w = 1), zero
+// on a miss; the samples it took.
+struct IsoMarch {
+    color: vec4<f32>,
+    hit: vec4<f32>,
+    samples: u32,
+}
+
+// First-hit isosurface over samples [k0, end) of `s`: the first sample k with value >= iso,
+// refined linearly against sample k - 1 (read again when k0 > 0, so a segment or a late start
+// refines like the whole ray; a start already past the surface reports the sample before it,
+// unrefined), shaded with the headlight.
+fn march_iso(s: Samples, k0: u32, end: u32) -> IsoMarch {
+    var out = IsoMarch(vec4<f32>(0.0), vec4<f32>(0.0), 0u);
     let iso = params.iso_value;
-    var t_prev = 0.0;
+    var k = k0;
     var s_prev = 0.0;
-    for (var k = 0u; k < params.max_steps; k += 1u) {
-        let t = (f32(k) + 0.5 + jitter) * step_tex;
-        if (!(t < len_tex)) {
-            break;
+    var has_prev = false;
+    if (k0 > 0u && k0 <= s.count) {
+        s_prev = sample_volume(sample_at(s, k0 - 1u));
+        out.samples = 1u;
+        has_prev = true;
+        if (s_prev >= iso) {
+            // The start was past the surface: take the sample that saw it again.
+            k = k0 - 1u;
+            has_prev = false;
         }
-        let s = sample_volume(u0 + t * d_tex);
-        if (s >= iso) {
-            var t_hit = t;
-            if (k > 0u) {
-                t_hit = t_prev + (t - t_prev) * (iso - s_prev) / (s - s_prev);
-            }
-            let u = u0 + t_hit * d_tex;
-            let d_world = normalize(d_tex * 2.0 * frame.half_extent.xyz);
-            result.color = vec4<f32>(shade_iso(u, d_world), 1.0);
-            result.hit = vec4<f32>(u, 1.0);
-            return result;
-        }
-        t_prev = t;
-        s_prev = s;
     }
-    return result;
+    for (; k < end; k += 1u) {
+        let v = sample_volume(sample_at(s, k));
+        out.samples += 1u;
+        if (v >= iso) {
+            var x = f32(k);
+            if (has_prev) {
+                x = x - 1.0 + (iso - s_prev) / (v - s_prev);
+            }
+            let u = s.first + x * s.delta;
+            let d_world = normalize(s.delta * 2.0 * frame.half_extent.xyz);
+            out.color = vec4<f32>(shade_iso(u, d_world), 1.0);
+            out.hit = vec4<f32>(u, 1.0);
+            return out;
+        }
+        s_prev = v;
+        has_prev = true;
+    }
+    return out;
 }

@@ -44,13 +44,16 @@ pub struct Extension {
     pub register: fn(&mut Registry),
     /// The program's own shaders, searched before volgraph's (whose `common/` they may import).
     pub shaders: EmbeddedShaders,
+    /// The WGSL structs of the program's `pass_params!` uniform blocks (`Name::wgsl_import()`),
+    /// which its shaders import as `params/NAME.wgsl`.
+    pub params_structs: fn() -> Vec<(String, String)>,
     /// Subcommands beyond volgraph's own.
     pub commands: Vec<Box<dyn Commands>>,
 }
 
 impl Default for Extension {
     fn default() -> Self {
-        Self { name: "volgraph", register: |_| {}, shaders: &[], commands: Vec::new() }
+        Self { name: "volgraph", register: |_| {}, shaders: &[], params_structs: Vec::new, commands: Vec::new() }
     }
 }
 
@@ -58,6 +61,7 @@ impl Default for Extension {
 struct Program {
     register: fn(&mut Registry),
     shaders: EmbeddedShaders,
+    params_structs: fn() -> Vec<(String, String)>,
 }
 
 static PROGRAM: OnceLock<Program> = OnceLock::new();
@@ -75,8 +79,8 @@ pub fn registry() -> Registry {
 pub fn shaders() -> ShaderSources {
     let builtin = volgraph_passes::builtin_shaders();
     match PROGRAM.get() {
-        Some(p) if !p.shaders.is_empty() => builtin.prepend_embedded(p.shaders),
-        _ => builtin,
+        Some(p) => builtin.prepend_embedded(p.shaders).with_generated((p.params_structs)()),
+        None => builtin,
     }
 }
 
@@ -100,8 +104,8 @@ pub fn main_with(extension: Extension) -> ExitCode {
     }));
     // An installed binary finds data where its user says, never in the build machine's tree.
     volgraph_accel::data_dir::forget_build_path();
-    let Extension { name, register, shaders, commands } = extension;
-    let _ = PROGRAM.set(Program { register, shaders });
+    let Extension { name, register, shaders, params_structs, commands } = extension;
+    let _ = PROGRAM.set(Program { register, shaders, params_structs });
     let mut command = Cli::command().name(name).bin_name(name);
     let about = command.get_about().cloned();
     for c in &commands {

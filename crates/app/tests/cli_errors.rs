@@ -87,7 +87,8 @@ fn plan_catches_a_shader_binding_that_matches_no_port() {
     let _ = std::fs::remove_dir_all(&dir);
     copy_dir(&root.join("shaders"), &dir.join("shaders"));
     std::fs::copy(root.join("graphs/basic/compute_raycast.ron"), dir.join("compute_raycast.ron")).expect("copy");
-    let shader = dir.join("shaders/raycast_compute.wgsl");
+    // The compute raycaster's `dir` is declared by the shared pixel ray it imports.
+    let shader = dir.join("shaders/common/pixel_ray.wgsl");
     let text = std::fs::read_to_string(&shader).expect("read");
     let renamed = text
         .replace("var dir: texture_2d<f32>;", "var dirs: texture_2d<f32>;")
@@ -99,7 +100,7 @@ fn plan_catches_a_shader_binding_that_matches_no_port() {
     assert_eq!(code, 1, "{err}");
     assert!(
         err.contains("pass \"march\" (raycast_compute): raycast_compute.wgsl: global \"dirs\" is neither a port")
-            && err.contains("(ports: entry, dir, volume, tf, color)"),
+            && err.contains("(ports: entry, dir, empty, distance, volume, tf, color)"),
         "{err}"
     );
 }

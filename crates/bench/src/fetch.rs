@@ -1,6 +1,6 @@
 //! `volgraph bench fetch`: the fetch ceiling of this device — trilinear volume samples per
 //! second of a pass that takes every sample a raycaster would (the analytic rays of
-//! `raycast_fast`, same step, same volume texture format) and does nothing else with them
+//! `raycast_compute` with `rays: "analytic"`, same step, same volume texture format) and does nothing else with them
 //! (`graphs/bench/fetch_ceiling.ron`, pass `fetch_probe`). Samples are counted on the GPU; time
 //! is the median frame over views turning about y. `volgraph bench graphs` measures the same
 //! ceiling for each dataset and viewport it times and reports every graph's counted samples per

@@ -116,7 +116,8 @@ pub fn check_bindings(
             return Err(format!(
                 "{shader}: global \"{}\" is neither a port of this pass (ports: {}) nor a system binding ({}) \
                  nor one the pass binds itself ({}); rename it to the port it stands for, or, when the node \
-                 binds it itself, add \"{}\" to the `extra` names of the pass's ShaderUse",
+                 binds it itself, declare it in the pass's ShaderUse (`.uniform(..)` for a uniform block, else \
+                 `.binds(&[\"{}\"])`)",
                 b.name,
                 ports.join(", "),
                 SYSTEM_BINDINGS.join(", "),

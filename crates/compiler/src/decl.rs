@@ -229,17 +229,70 @@ pub trait PassDecl: Send + Sync {
     }
 }
 
-/// One shader entry point a pass uses.
+/// One shader entry point a pass uses, declared once: the file, the entry point, the globals the
+/// node binds itself and the layout of each uniform block it uploads. `volgraph plan` checks
+/// the bindings and the uniform layouts against the shader without a GPU
+/// ([`crate::compile::check_plan_bindings`]); node creation checks them again (a hot-reloaded
+/// shader can change) and builds pipelines only for declared uses.
+///
+/// ```
+/// # use volgraph_compiler::ShaderUse;
+/// volgraph_compiler::pass_params! {
+///     /// Parameters of a pass; the shader imports the WGSL struct this generates.
+///     pub struct GlowParams { gain: f32 = 1.0, 0.0..=4.0, "how bright"; }
+/// }
+/// let shader = ShaderUse::new("glow.wgsl", "cs_glow").uniform(GlowParams::bound_as("glow"));
+/// assert_eq!(shader.node_bindings(), ["glow"]);
+/// ```
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ShaderUse {
     /// File under `shaders/`, e.g. `raycast.wgsl`.
     pub file: &'static str,
     /// Entry point name.
     pub entry_point: &'static str,
-    /// Globals the node binds itself (its uniform buffers, tables it owns): with the ports and
-    /// the system bindings, every global the entry point uses must be one of these —
-    /// `volgraph plan` checks it without a GPU ([`crate::compile::check_plan_bindings`]).
+    /// Globals the node binds itself besides its uniform blocks (tables it owns, storage it
+    /// keeps): with the ports, the system bindings and [`Self::uniforms`], every global the entry
+    /// point uses must be one of these.
     pub extra: &'static [&'static str],
+    /// The uniform blocks the node uploads, by global name, with their layout: the shader's
+    /// struct for each must have these members in this order (a swapped struct is an error, not
+    /// an image of zeros).
+    pub uniforms: Vec<UniformLayout>,
+}
+
+impl ShaderUse {
+    /// Entry point `entry_point` of `file`, binding nothing of its own yet.
+    pub const fn new(file: &'static str, entry_point: &'static str) -> Self {
+        Self { file, entry_point, extra: &[], uniforms: Vec::new() }
+    }
+
+    /// With `names` bound by the node that are not uniform blocks (tables, storage it owns).
+    pub const fn binds(mut self, names: &'static [&'static str]) -> Self {
+        self.extra = names;
+        self
+    }
+
+    /// With the uniform block `layout` (from a `pass_params!` struct's `bound_as`).
+    pub fn uniform(mut self, layout: UniformLayout) -> Self {
+        self.uniforms.push(layout);
+        self
+    }
+
+    /// Every global the node binds itself: [`Self::extra`] and the uniform blocks.
+    pub fn node_bindings(&self) -> Vec<&'static str> {
+        self.extra.iter().copied().chain(self.uniforms.iter().map(|u| u.global)).collect()
+    }
+}
+
+/// A uniform block as a node uploads it: the global it is bound to and its members, `(name,
+/// WGSL scalar type)` at 4-byte offsets in order — what a `pass_params!` struct lays out
+/// (`Name::bound_as(global)`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct UniformLayout {
+    /// The WGSL global, e.g. `params`.
+    pub global: &'static str,
+    /// The members, in order.
+    pub fields: Vec<(&'static str, &'static str)>,
 }
 
 /// Where the compiler looks pass kinds up: the runtime's `Registry` (every plugin is a

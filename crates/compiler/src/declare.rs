@@ -182,6 +182,19 @@ macro_rules! pass_params {
             pub fn wgsl_struct() -> String {
                 $crate::declare::wgsl_struct_text(stringify!($name), &Self::wgsl_fields())
             }
+
+            /// This block as the uniform `global` of a [`ShaderUse`]($crate::ShaderUse): the
+            /// layout `volgraph plan` and node creation check the shader's struct against.
+            pub fn bound_as(global: &'static str) -> $crate::decl::UniformLayout {
+                $crate::decl::UniformLayout { global, fields: Self::wgsl_fields() }
+            }
+
+            /// `(path, text)` of [`Self::wgsl_struct`] as a generated shader file, which shaders
+            /// import as `#import "params/NAME.wgsl"` once it is in their sources
+            /// ([`ShaderSources::with_generated`]($crate::shader_source::ShaderSources::with_generated)).
+            pub fn wgsl_import() -> (String, String) {
+                (format!("params/{}.wgsl", stringify!($name)), Self::wgsl_struct())
+            }
         }
     };
 
@@ -252,16 +265,55 @@ pub fn wgsl_struct_text(name: &str, fields: &[(&str, &str)]) -> String {
 /// struct uploads. Members after them may only be padding (`_pad*`).
 pub fn check_wgsl_struct(source: &str, name: &str, fields: &[(&str, &str)]) -> Result<(), String> {
     let module = naga::front::wgsl::parse_str(source).map_err(|e| format!("the shader does not parse: {e}"))?;
-    let (_, ty) = module
+    let (handle, _) = module
         .types
         .iter()
         .find(|(_, t)| t.name.as_deref() == Some(name))
         .ok_or_else(|| format!("the shader declares no struct {name}"))?;
+    check_struct_members(&module, handle, fields)
+}
+
+/// Checks the uniform blocks a shader use declares against the module: each global that the
+/// module declares under a [`UniformLayout::global`] name must be a `var<uniform>` of a struct
+/// with the declared members (a global the module lacks is the binding check's business: an
+/// entry point that does not use it needs no buffer).
+pub fn check_uniform_layouts(module: &naga::Module, uniforms: &[crate::decl::UniformLayout]) -> Result<(), String> {
+    for uniform in uniforms {
+        let Some((_, var)) = module.global_variables.iter().find(|(_, v)| v.name.as_deref() == Some(uniform.global))
+        else {
+            continue;
+        };
+        if var.space != naga::AddressSpace::Uniform {
+            return Err(format!(
+                "global \"{}\" is declared as a uniform block by the pass but the shader declares it in {:?}; \
+                 declare it `var<uniform> {}: ...`",
+                uniform.global, var.space, uniform.global
+            ));
+        }
+        check_struct_members(module, var.ty, &uniform.fields)
+            .map_err(|e| format!("uniform \"{}\": {e}", uniform.global))?;
+    }
+    Ok(())
+}
+
+/// The members of struct type `ty` of `module` against `fields` (see [`check_wgsl_struct`]).
+fn check_struct_members(
+    module: &naga::Module,
+    ty: naga::Handle<naga::Type>,
+    fields: &[(&str, &str)],
+) -> Result<(), String> {
+    let ty = &module.types[ty];
+    let name = ty.name.as_deref().unwrap_or("the block");
     let naga::TypeInner::Struct { members, .. } = &ty.inner else {
         return Err(format!("{name} is not a struct"));
     };
     for (i, (field, want)) in fields.iter().enumerate() {
-        let m = members.get(i).ok_or_else(|| format!("{name} has no member {i} ({field}: {want})"))?;
+        let m = members.get(i).ok_or_else(|| {
+            format!(
+                "{name} has no member {i} ({field}: {want}); declare the WGSL struct as `pass_params!` lays it out \
+                 (#import \"params/<Struct>.wgsl\", or wgsl_struct())"
+            )
+        })?;
         let got = match &module.types[m.ty].inner {
             naga::TypeInner::Scalar(naga::Scalar { kind: naga::ScalarKind::Float, width: 4 }) => "f32",
             naga::TypeInner::Scalar(naga::Scalar { kind: naga::ScalarKind::Uint, width: 4 }) => "u32",
@@ -272,7 +324,8 @@ pub fn check_wgsl_struct(source: &str, name: &str, fields: &[(&str, &str)]) -> R
         if member != *field || got != *want || m.offset != 4 * i as u32 {
             return Err(format!(
                 "{name} member {i} is `{member}: {got}` at offset {}, but the pass declares `{field}: {want}` at {}; \
-                 declare the WGSL struct as `pass_params!` lays it out (wgsl_struct())",
+                 declare the WGSL struct as `pass_params!` lays it out (#import \"params/<Struct>.wgsl\", or \
+                 wgsl_struct())",
                 m.offset,
                 4 * i
             ));

@@ -87,6 +87,10 @@ pub enum SourceLayer {
     Disk(PathBuf),
     /// Files compiled into the binary.
     Embedded(EmbeddedShaders),
+    /// Files generated from Rust declarations: the WGSL struct of each `pass_params!` block,
+    /// under `params/NAME.wgsl` ([`crate::declare`]), so a shader imports the struct its pass
+    /// uploads instead of restating it.
+    Generated(std::sync::Arc<Vec<(String, String)>>),
 }
 
 /// Where shader files come from, searched in order.
@@ -135,6 +139,13 @@ impl ShaderSources {
         self
     }
 
+    /// Searches the generated files `files` (`(relative name, text)`; the `wgsl_import()` of
+    /// `pass_params!` blocks) after the layers already added.
+    pub fn with_generated(mut self, files: Vec<(String, String)>) -> Self {
+        self.layers.push(SourceLayer::Generated(std::sync::Arc::new(files)));
+        self
+    }
+
     /// Searches `dir` before every layer already added.
     pub fn prepend_disk(mut self, dir: impl Into<PathBuf>) -> Self {
         self.layers.insert(0, SourceLayer::Disk(dir.into()));
@@ -152,7 +163,7 @@ impl ShaderSources {
             .iter()
             .filter_map(|l| match l {
                 SourceLayer::Disk(p) => Some(p.as_path()),
-                SourceLayer::Embedded(_) => None,
+                SourceLayer::Embedded(_) | SourceLayer::Generated(_) => None,
             })
             .collect()
     }
@@ -164,6 +175,7 @@ impl ShaderSources {
             .map(|l| match l {
                 SourceLayer::Disk(p) => p.display().to_string(),
                 SourceLayer::Embedded(t) => format!("{} embedded files", t.len()),
+                SourceLayer::Generated(t) => format!("{} generated files", t.len()),
             })
             .collect();
         if parts.is_empty() { "no layers".to_string() } else { parts.join(", ") }
@@ -197,6 +209,11 @@ impl ShaderSources {
                 SourceLayer::Embedded(table) => {
                     if let Some((_, text)) = table.iter().find(|(name, _)| *name == relative) {
                         return Ok((SourceFile { name: relative.to_string(), path: None }, text.to_string()));
+                    }
+                }
+                SourceLayer::Generated(files) => {
+                    if let Some((_, text)) = files.iter().find(|(name, _)| name == relative) {
+                        return Ok((SourceFile { name: relative.to_string(), path: None }, text.clone()));
                     }
                 }
             }

@@ -243,7 +243,7 @@ impl PassDecl for WgslKind {
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         let extra: &'static [&'static str] = if self.doc.params.is_empty() { &[] } else { &["params"] };
-        vec![ShaderUse { file: intern(&self.doc.shader), entry_point: intern(self.doc.entry_point()), extra }]
+        vec![ShaderUse::new(intern(&self.doc.shader), intern(self.doc.entry_point())).binds(extra)]
     }
 
     fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {

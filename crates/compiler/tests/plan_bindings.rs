@@ -8,8 +8,15 @@ use volgraph_compiler::{
     CompileOptions, Kinds, Params, PassDecl, PortKind, PortSpec, TargetFormat, check_plan_bindings, compile,
 };
 
+volgraph_compiler::pass_params! {
+    /// The probe's uniform block: one float, `struct P { k: f32 }` in the shader.
+    pub struct ProbeParams {
+        k: f32 = 1.0, 0.0..=2.0, "a knob";
+    }
+}
+
 /// A pass with a texture input `color`, a buffer input `counts`, an output `out`, and the shader
-/// entry point `entry` of `probe.wgsl`; binds `params` itself.
+/// entry point `entry` of `probe.wgsl`; binds the uniform block `params` itself.
 struct Probe {
     entry: &'static str,
 }
@@ -29,7 +36,7 @@ impl PassDecl for Probe {
         ]
     }
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "probe.wgsl", entry_point: self.entry, extra: &["params"] }]
+        vec![ShaderUse::new("probe.wgsl", self.entry).uniform(ProbeParams::bound_as("params"))]
     }
 }
 
@@ -115,6 +122,24 @@ fn problems(entry: &'static str, shader: &'static str) -> Vec<String> {
 #[test]
 fn a_correct_pass_has_no_problem() {
     assert_eq!(problems("cs_ok", SHADER), Vec::<String>::new());
+}
+
+/// A uniform struct that disagrees with the block the pass uploads (a member added in front, the
+/// rest shifted) would read its values from the wrong bytes — an image of zeros with exit status
+/// 0 at run time; at plan time it is an error naming the member, its offset and the fix.
+#[test]
+fn a_uniform_struct_that_disagrees_with_the_declaration_is_caught_at_plan_time() {
+    let shifted: &'static str =
+        Box::leak(SHADER.replace("struct P { k: f32 }", "struct P { j: u32, k: f32 }").into_boxed_str());
+    let p = problems("cs_ok", shifted);
+    assert!(
+        p.len() == 1
+            && p[0].contains(
+                "uniform \"params\": P member 0 is `j: u32` at offset 0, but the pass declares `k: f32` at 0"
+            )
+            && p[0].contains("#import \"params/<Struct>.wgsl\""),
+        "{p:?}"
+    );
 }
 
 #[test]

@@ -83,11 +83,9 @@ fn ray_block(p: &Params) -> RaycastParamsGpu {
 
 /// Its pipeline for these parameters.
 fn shader(params: &Params) -> ShaderUse {
-    ShaderUse {
-        file: "antialias.wgsl",
-        entry_point: if is_iso(params) { "fs_aa_iso" } else { "fs_aa_dvr" },
-        extra: &["params", "aa"],
-    }
+    ShaderUse::new("antialias.wgsl", if is_iso(params) { "fs_aa_iso" } else { "fs_aa_dvr" })
+        .binds(&["aa"])
+        .uniform(RaycastParamsGpu::bound_as("params"))
 }
 
 impl PassDecl for Antialias {

@@ -45,7 +45,11 @@ impl EffectFlags {
 /// The shader uses the effects add to a raycaster's own: the pre-integration table's compute
 /// pipelines when `preintegration` is on (one of the two is built, by what the device filters).
 pub fn effect_shader_uses(params: &Params) -> Vec<volgraph_core::plugin::ShaderUse> {
-    if EffectFlags::of(params).preintegration { crate::preintegration::TABLE_SHADERS.to_vec() } else { Vec::new() }
+    if EffectFlags::of(params).preintegration {
+        crate::preintegration::table_shader_uses().to_vec()
+    } else {
+        Vec::new()
+    }
 }
 
 /// The `#if` names of the effects `params` turn on (`jitter`, a sampling parameter, is JITTER).

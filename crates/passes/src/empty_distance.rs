@@ -1,6 +1,6 @@
 //! `empty_distance`: the Chebyshev distance, in blocks, from each block of `empty_space`'s grid
 //! to the nearest block that may be visible — the distance map with which a raycaster leaps over
-//! many empty blocks at once instead of one at a time (`raycast_fast` wired to `distance`). A
+//! many empty blocks at once instead of one at a time (`raycast_compute` wired to `distance`). A
 //! separable L∞ distance transform, one compute dispatch per axis, rebuilt every frame with the
 //! flags (it costs a few thousand line scans). The leap stays lossless: every sample it skips
 //! lies in an empty block. Shader: `shaders/empty_distance.wgsl`.
@@ -48,11 +48,7 @@ impl PassDecl for EmptyDistance {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse {
-            file: "empty_distance.wgsl",
-            entry_point: "cs_line",
-            extra: &["partial", "distance", "pass_params"],
-        }]
+        vec![ShaderUse::new("empty_distance.wgsl", "cs_line").binds(&["partial", "distance", "pass_params"])]
     }
 }
 

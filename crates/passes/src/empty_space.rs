@@ -3,9 +3,9 @@
 //! on `[min, max]` has non-zero alpha, mirroring `volgraph_accel::classify::OpacityClassifier`
 //! (the paper's "CT" texture, evaluated per block instead of looked up). Output: an Owned
 //! `R32Float` 3D texture of empty flags (1 = skip), consumed by `termination_test` (the paper's
-//! way) and `raycast_ess` (single-pass empty-block leaping). Runs (one invocation per block)
-//! only when the grid or the transfer function changed, so a new TF takes effect in the next
-//! frame and a steady one costs nothing. Shader:
+//! way) and `raycast` / `raycast_compute` (single-pass empty-block leaping, `empty` wired).
+//! Runs (one invocation per block) only when the grid or the transfer function changed, so a
+//! new TF takes effect in the next frame and a steady one costs nothing. Shader:
 //! `shaders/empty_space.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
@@ -92,7 +92,7 @@ impl PassDecl for EmptySpace {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "empty_space.wgsl", entry_point: "cs_classify", extra: &[] }]
+        vec![ShaderUse::new("empty_space.wgsl", "cs_classify")]
     }
 }
 

@@ -26,9 +26,9 @@ impl PassDecl for EntryPoints {
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         vec![
-            ShaderUse { file: "entry_points.wgsl", entry_point: "vs_box", extra: &[] },
-            ShaderUse { file: "entry_points.wgsl", entry_point: "fs_entry", extra: &[] },
-            ShaderUse { file: "entry_points.wgsl", entry_point: "fs_near_plane", extra: &[] },
+            ShaderUse::new("entry_points.wgsl", "vs_box"),
+            ShaderUse::new("entry_points.wgsl", "fs_entry"),
+            ShaderUse::new("entry_points.wgsl", "fs_near_plane"),
         ]
     }
 }

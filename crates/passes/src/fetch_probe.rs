@@ -1,6 +1,6 @@
 //! `fetch_probe`: the fetch ceiling of `volgraph bench fetch` — a compute pass that takes every
 //! sample a raycaster with the same step would take along each pixel's ray (the analytic ray of
-//! `raycast_fast`, no leaping, no termination) and does nothing else with them (no
+//! `raycast_compute` with `rays: "analytic"`, no leaping, no termination) and does nothing else with them (no
 //! classification, no compositing). Its trilinear samples per second bound any raycaster's on
 //! the same device, volume and texture format, so `volgraph bench graphs` reports each graph's
 //! counted samples per second as a fraction of it. Writes the mean scalar along the ray (an
@@ -11,7 +11,7 @@ use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
 use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
-use crate::raycast_fast::SAMPLE_ROWS;
+use crate::march::SAMPLE_ROWS;
 use crate::raycast_params::{RaycastParamsGpu, Sampling, Workgroup};
 
 /// The plugin.
@@ -50,7 +50,7 @@ impl PassDecl for FetchProbe {
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
         let entry_point = if Counting::from_params(params).count_samples { "cs_counted" } else { "cs_main" };
-        vec![ShaderUse { file: "fetch_probe.wgsl", entry_point, extra: &["params"] }]
+        vec![ShaderUse::new("fetch_probe.wgsl", entry_point).uniform(RaycastParamsGpu::bound_as("params"))]
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {

@@ -46,7 +46,7 @@ impl PassDecl for HoleFill {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "hole_fill.wgsl", entry_point: "fs_hole", extra: &["holes"] }]
+        vec![ShaderUse::new("hole_fill.wgsl", "fs_hole").uniform(HoleParams::bound_as("holes"))]
     }
 
     fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {

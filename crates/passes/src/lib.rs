@@ -11,6 +11,7 @@ pub mod entry_points;
 pub mod fetch_probe;
 pub mod grid_tap;
 pub mod hole_fill;
+pub mod march;
 pub mod minmax_grid;
 pub mod opacity_lut;
 pub mod preintegration;
@@ -19,8 +20,6 @@ pub mod ray_directions;
 pub mod raycast;
 pub mod raycast_bricks;
 pub mod raycast_compute;
-pub mod raycast_ess;
-pub mod raycast_fast;
 pub mod raycast_params;
 pub mod raycast_segment;
 pub mod reprojection_splat;
@@ -38,7 +37,19 @@ include!(concat!(env!("OUT_DIR"), "/embedded_shaders.rs"));
 /// The built-in shaders as a source layer, compiled into the binary. Put a folder on disk in
 /// front of it ([`ShaderSources::prepend_disk`]) to read (and hot-reload) a working copy.
 pub fn builtin_shaders() -> ShaderSources {
-    ShaderSources::new().with_embedded(EMBEDDED_SHADERS)
+    ShaderSources::new().with_embedded(EMBEDDED_SHADERS).with_generated(params_structs())
+}
+
+/// The WGSL struct of every built-in `pass_params!` block a shader binds as a uniform, as the
+/// generated files `params/NAME.wgsl` the shaders import: the struct is written once, in Rust.
+pub fn params_structs() -> Vec<(String, String)> {
+    vec![
+        raycast_params::RaycastParamsGpu::wgsl_import(),
+        shared::BlockSize::wgsl_import(),
+        present::PresentParams::wgsl_import(),
+        hole_fill::HoleParams::wgsl_import(),
+        slice_render::SliceParams::wgsl_import(),
+    ]
 }
 
 /// Adds every built-in pass kind to `registry`.
@@ -54,8 +65,6 @@ pub fn register_builtin(registry: &mut Registry) {
         .register(minmax_grid::MinMaxGridPass::default())
         .register(empty_space::EmptySpace::default())
         .register(empty_distance::EmptyDistance)
-        .register(raycast_ess::RaycastEss)
-        .register(raycast_fast::RaycastFast)
         .register(fetch_probe::FetchProbe)
         .register(slice_render::SliceRender)
         .register(reprojection_splat::ReprojectionSplat)

@@ -111,7 +111,7 @@ impl PassDecl for MinMaxGridPass {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "minmax_grid.wgsl", entry_point: "cs_minmax", extra: &["minmax"] }]
+        vec![ShaderUse::new("minmax_grid.wgsl", "cs_minmax").uniform(BlockSize::bound_as("minmax"))]
     }
 }
 

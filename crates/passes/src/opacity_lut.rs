@@ -1,7 +1,7 @@
 //! The transfer function pre-multiplied and opacity-corrected for the step, as a table denser
 //! than the LUT, so a raycaster pays one filtered lookup and no `pow` per sample (the correction
 //! depends only on the TF and the step: Engel et al. 2001). Not a pass of its own: a raycaster
-//! that classifies through it (`raycast_fast`, `classify: "table"`) builds it in its own
+//! that classifies through it (`raycast_compute`, `classify: "table"`) builds it in its own
 //! compute pass from its own `step_voxels`, so table and march can never disagree on the step.
 //! Rebuilding costs one dispatch of [`TABLE_SIZE`] invocations per frame. Read with a linear
 //! sampler it equals the exact per-sample correction to second order in the table spacing;
@@ -18,10 +18,12 @@ use crate::tf_table::{TfTable, table_shaders};
 pub const TABLE_SIZE: u32 = 4096;
 
 /// The shader entry points that fill the table: Rgba32Float, Rgba16Float.
-pub const TABLE_SHADERS: [ShaderUse; 2] = table_shaders("opacity_lut.wgsl");
+pub fn table_shader_uses() -> [ShaderUse; 2] {
+    table_shaders("opacity_lut.wgsl")
+}
 
 /// The corrected table of a raycaster (binding `corrected`), filled from its `tf` port with the
 /// step in its uniform `params` ([`TfTable::fill`], every frame).
 pub fn opacity_table(ctx: &CreateContext<'_>) -> Result<TfTable, PassError> {
-    TfTable::new(ctx, &TABLE_SHADERS, (TABLE_SIZE, 1), (64, 1), "opacity-corrected table")
+    TfTable::new(ctx, &table_shader_uses(), (TABLE_SIZE, 1), (64, 1), "opacity-corrected table")
 }

@@ -14,7 +14,9 @@ use crate::tf_table::{TfTable, table_shaders};
 pub const TABLE_SIZE: u32 = 256;
 
 /// The entry points that fill the table: Rgba32Float, Rgba16Float.
-pub const TABLE_SHADERS: [ShaderUse; 2] = table_shaders("preintegration.wgsl");
+pub fn table_shader_uses() -> [ShaderUse; 2] {
+    table_shaders("preintegration.wgsl")
+}
 
 /// A raycaster's pre-integration table and what it was built for.
 pub struct PreintegrationTable {
@@ -29,7 +31,7 @@ pub struct PreintegrationTable {
 impl PreintegrationTable {
     /// The pipeline (binding `params`: the raycaster's uniform) and the table texture.
     pub fn new(ctx: &CreateContext<'_>) -> Result<Self, PassError> {
-        let table = TfTable::new(ctx, &TABLE_SHADERS, (TABLE_SIZE, TABLE_SIZE), (8, 8), "pre-integration table")?;
+        let table = TfTable::new(ctx, &table_shader_uses(), (TABLE_SIZE, TABLE_SIZE), (8, 8), "pre-integration table")?;
         Ok(Self { table, built_for: None, builds: 0 })
     }
 

@@ -20,7 +20,9 @@ volgraph_core::pass_params! {
 }
 
 /// Its one pipeline, declared once: `volgraph plan` checks the bindings of what `create` builds.
-const SHADER: ShaderUse = ShaderUse { file: "present.wgsl", entry_point: "cs_present", extra: &["params"] };
+fn shader() -> ShaderUse {
+    ShaderUse::new("present.wgsl", "cs_present").uniform(PresentParams::bound_as("params"))
+}
 
 impl PassDecl for Present {
     fn kind(&self) -> &'static str {
@@ -43,7 +45,7 @@ impl PassDecl for Present {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![SHADER]
+        vec![shader()]
     }
 
     fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
@@ -53,7 +55,7 @@ impl PassDecl for Present {
 
 impl PassPlugin for Present {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec::of(&SHADER))?;
+        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec::of(&shader()))?;
         let params = ctx.uniform_from_bytes("params", &PresentParams::from_params(ctx.params).uniform_bytes());
         Ok(Box::new(PresentNode { pipeline, params }))
     }

@@ -27,10 +27,7 @@ impl PassDecl for RayDirections {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![
-            ShaderUse { file: "ray_directions.wgsl", entry_point: "vs_box", extra: &[] },
-            ShaderUse { file: "ray_directions.wgsl", entry_point: "fs_dir", extra: &[] },
-        ]
+        vec![ShaderUse::new("ray_directions.wgsl", "vs_box"), ShaderUse::new("ray_directions.wgsl", "fs_dir")]
     }
 }
 

@@ -20,7 +20,7 @@
 //!   early ray termination: with `threshold < 1` a saturated pixel costs nothing in later
 //!   batches either).
 //!
-//! Samples are those of `raycast_fast` (k + 0.5 steps from the analytic box entry, same
+//! Samples are those of every raycaster (`common/ray_box.wgsl`: k + 0.5 steps from the analytic box entry, same
 //! compositing), so the image equals the single-texture raycast up to rounding
 //! (crates/passes/tests/ruijters_2006.rs). A TF change re-classifies bricks and octrees
 //! (CPU, [`volgraph_accel::octree`]) and uploads only bricks not yet resident.
@@ -123,11 +123,11 @@ impl PassDecl for RaycastBricks {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse {
-            file: "raycast_bricks.wgsl",
-            entry_point: "cs_main",
-            extra: &["params", "bricks", "table", "leaf_distance", "acc", "volume"],
-        }]
+        vec![
+            ShaderUse::new("raycast_bricks.wgsl", "cs_main")
+                .binds(&["bricks", "table", "leaf_distance", "acc", "volume"])
+                .uniform(RaycastParamsGpu::bound_as("params")),
+        ]
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {

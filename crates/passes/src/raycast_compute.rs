@@ -1,19 +1,65 @@
-//! `raycast_compute`: the same integral as `raycast` in a compute shader writing a storage
-//! texture, one invocation per pixel — the DirectCompute thesis's compute raycaster
-//! (`RAYCASTSIMPLE_CS`). The workgroup size is a parameter (pipeline-overridable constants).
-//! Shader: `shaders/raycast_compute.wgsl`.
+//! `raycast_compute`: the single-pass raycaster in a compute shader writing storage textures,
+//! one invocation per pixel — the DirectCompute thesis's compute raycaster (`RAYCASTSIMPLE_CS`)
+//! and, with its settings turned up, the fastest DVR path volgraph has (`graphs/modern/fastest.ron`):
+//! - rays met with the box analytically (`rays: "analytic"`: no entry/direction raster passes);
+//! - leaping over empty space with a wired `distance` map (`empty_distance`: out of the largest
+//!   cube of empty blocks around the sample) or `empty` flags, looking at it once per run of
+//!   `check_every` samples so the lanes of a SIMD group stay together;
+//! - classification through the TF with the exact per-sample opacity correction (`classify:
+//!   "exact"`; a square root, not a `pow`, at the common half-voxel step) or through a
+//!   pre-multiplied, corrected table it builds itself from its own step (`"table"`,
+//!   [`crate::opacity_lut`]: one filtered lookup, no `pow`; the correction 1 - (1 - α)^step is
+//!   singular at α = 1, so a TF that reaches full opacity is off by up to ~1/255 there —
+//!   bench/peer-ablation.md, tests/fastest.rs);
+//! - early ray termination at `threshold` (§2.1) and sample counting (`count_samples`).
+//!
+//! The march is the fragment raycaster's (`shaders/common/pixel_march.wgsl`; settings in
+//! [`crate::march`]), so the two differ only in how pixels are scheduled. The workgroup size is
+//! a parameter (pipeline-overridable constants). Shader: `shaders/raycast_compute.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
 use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortSpec, TargetFormat};
 
 use crate::effects::{EffectFlags, EffectState, effect_defines, same_effects};
+use crate::march::{Leaping, MarchSettings, march_defines, march_specs, same_march};
+use crate::opacity_lut::{opacity_table, table_shader_uses};
 use crate::raycast::raycast_ports;
 use crate::raycast_params::{RaycastParamsGpu, Sampling, Workgroup, is_iso, raycast_param_specs};
-use crate::shared::color_is_f32;
+use crate::shared::{BlockSize, color_is_f32};
+use crate::tf_table::TfTable;
 
 /// The plugin.
 pub struct RaycastCompute;
+
+volgraph_core::param_choice! {
+    /// How a sample is classified.
+    pub enum Classify {
+        /// The TF and the exact per-sample opacity correction.
+        Exact = "exact",
+        /// One lookup in a table pre-corrected for the step.
+        Table = "table",
+    }
+}
+
+volgraph_core::pass_params! {
+    /// The compute raycaster's own parameter; it chooses the pipeline.
+    pub struct ComputeOwn {
+        classify: Classify = Exact,
+            "exact: the TF and the exact per-sample opacity correction (sqrt at step 0.5, else pow); table: one \
+             lookup in a table pre-corrected for the step, rebuilt each frame (faster than pow, up to ~1/255 off \
+             where the TF reaches alpha 1)";
+    }
+}
+
+fn entry(params: &Params) -> &'static str {
+    if is_iso(params) { "cs_iso" } else { "cs_dvr" }
+}
+
+/// Whether the pass classifies through the corrected table (pre-integration has its own).
+fn uses_table(params: &Params) -> bool {
+    ComputeOwn::from_params(params).classify == Classify::Table && !EffectFlags::of(params).preintegration
+}
 
 impl PassDecl for RaycastCompute {
     fn kind(&self) -> &'static str {
@@ -21,15 +67,20 @@ impl PassDecl for RaycastCompute {
     }
 
     fn summary(&self) -> &'static str {
-        "compute-shader raycaster writing a storage texture (DirectCompute thesis, RAYCASTSIMPLE_CS)"
+        "compute-shader raycaster, DVR or first-hit isosurface, optionally analytic rays, empty-space leaping, \
+         pre-corrected TF table, sample counting (DirectCompute thesis RAYCASTSIMPLE_CS; Krüger–Westermann 2003 §2.1–2.3)"
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        [raycast_param_specs(), EffectFlags::specs(), Workgroup::specs()].concat()
+        [raycast_param_specs(), EffectFlags::specs(), march_specs(), ComputeOwn::specs(), Workgroup::specs()].concat()
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        effect_defines(params)
+        let mut defines = [effect_defines(params), march_defines(params)].concat();
+        if uses_table(params) {
+            defines.push("CORRECTED_TABLE");
+        }
+        defines
     }
 
     fn ports(&self, params: &Params) -> Vec<PortSpec> {
@@ -39,64 +90,117 @@ impl PassDecl for RaycastCompute {
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        let entry = if is_iso(params) { "cs_iso" } else { "cs_dvr" };
-        let own = ShaderUse { file: "raycast_compute.wgsl", entry_point: entry, extra: &["params", "preintegrated"] };
-        [vec![own], crate::effects::effect_shader_uses(params)].concat()
+        let own = ShaderUse::new("raycast_compute.wgsl", entry(params))
+            .binds(&["corrected", "preintegrated"])
+            .uniform(RaycastParamsGpu::bound_as("params"))
+            .uniform(BlockSize::bound_as("blocks"));
+        let mut uses = vec![own];
+        if uses_table(params) {
+            uses.extend(table_shader_uses());
+        }
+        uses.extend(crate::effects::effect_shader_uses(params));
+        uses
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        // The mode picks the entry point and the workgroup size is a pipeline constant.
+        // The mode picks the entry point; the workgroup size, the march settings, the
+        // classification and a half-voxel step choose the pipeline.
+        let half_step = |p: &Params| Sampling::from_params(p).step_voxels == 0.5;
         is_iso(old) == is_iso(new)
             && same_effects(old, new)
+            && same_march(old, new)
+            && ComputeOwn::from_params(old) == ComputeOwn::from_params(new)
             && Workgroup::from_params(old) == Workgroup::from_params(new)
+            && half_step(old) == half_step(new)
     }
 }
 
 impl PassPlugin for RaycastCompute {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let wg = Workgroup::checked_size(ctx)?;
-        let entry = if is_iso(ctx.params) { "cs_iso" } else { "cs_dvr" };
-        let mut defines = effect_defines(ctx.params);
+        let sampling = Sampling::from_params(ctx.params);
+        let leaping = Leaping::new(ctx)?;
+        let table = uses_table(ctx.params).then(|| opacity_table(ctx)).transpose()?;
+        let mut defines = self.shader_defines(ctx.params);
+        defines.extend(leaping.defines());
         if color_is_f32(ctx) {
             defines.push("COLOR_F32");
         }
-        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
-            shader: "raycast_compute.wgsl",
-            entry,
-            constants: &[("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)],
-            defines: &defines,
-        })?;
+        let variant = |half_step: bool| {
+            let mut constants = vec![("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)];
+            constants.extend(leaping.constants());
+            if half_step {
+                constants.push(("HALF_STEP", 1.0));
+            }
+            ctx.compute_pipeline(&ComputePipelineSpec {
+                shader: "raycast_compute.wgsl",
+                entry: entry(ctx.params),
+                constants: &constants,
+                defines: &defines,
+            })
+        };
+        let pipeline = variant(false)?;
+        // The square-root variant, for frames whose correction exponent is exactly 0.5 (step
+        // 0.5 with opacity per voxel): DVR through the exact correction only.
+        let exact = table.is_none() && !EffectFlags::of(ctx.params).preintegration && !is_iso(ctx.params);
+        let half_step = (exact && sampling.step_voxels == 0.5).then(|| variant(true)).transpose()?;
         let params = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());
         let effects = EffectState::new(ctx)?;
         Ok(Box::new(RaycastComputeNode {
             pipeline,
+            half_step,
             params,
             workgroup: wg,
+            counted: MarchSettings::from_params(ctx.params).count_samples,
+            table,
+            leaping,
             effects,
-            step_voxels: Sampling::from_params(ctx.params).step_voxels,
+            step_voxels: sampling.step_voxels,
         }))
     }
 }
 
 struct RaycastComputeNode {
     pipeline: ComputePassPipeline,
+    /// The HALF_STEP variant, when the step is 0.5 voxel.
+    half_step: Option<ComputePassPipeline>,
     params: wgpu::Buffer,
     workgroup: (u32, u32),
+    counted: bool,
+    table: Option<TfTable>,
+    leaping: Leaping,
     effects: EffectState,
     step_voxels: f64,
 }
 
 impl PassNode for RaycastComputeNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
+        self.leaping.check(ctx)?;
+        if self.counted {
+            ctx.clear_buffer("samples")?;
+        }
+        if let Some(table) = &self.table {
+            table.fill(ctx, &self.params)?;
+        }
         self.effects.update(ctx, &self.params, self.step_voxels)?;
         let mut extra = vec![("params", self.params.as_entire_binding())];
+        if let Some(t) = &self.table {
+            extra.push(("corrected", wgpu::BindingResource::TextureView(&t.view)));
+        }
+        extra.extend(self.leaping.bindings());
         extra.extend(self.effects.bindings());
-        ctx.dispatch_over(&self.pipeline, &extra, "color", (self.workgroup.0, self.workgroup.1))
+        let unit = ctx.frame.volume.map_or(1.0, |v| v.opacity_unit_voxels);
+        let pipeline = match &self.half_step {
+            Some(half) if self.step_voxels / unit == 0.5 => half,
+            _ => &self.pipeline,
+        };
+        ctx.dispatch_over(pipeline, &extra, "color", (self.workgroup.0, self.workgroup.1))
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
         gpu.queue.write_buffer(&self.params, 0, &RaycastParamsGpu::of(params).uniform_bytes());
         self.step_voxels = Sampling::from_params(params).step_voxels;
+        self.leaping.update(gpu, params);
         self.effects.invalidate();
     }
 }

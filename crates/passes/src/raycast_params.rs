@@ -106,8 +106,8 @@ pub fn raycast_param_specs() -> Vec<volgraph_core::ParamSpec> {
 }
 
 volgraph_core::pass_params! {
-    /// The raycasters' shared uniform `params`: `struct RaycastParams` of
-    /// `shaders/common/raycast_params.wgsl` (a test compares the two through naga). It has no
+    /// The raycasters' shared uniform `params`, imported by `shaders/common/raycast_params.wgsl`
+    /// as the generated `params/RaycastParamsGpu.wgsl`. It has no
     /// parameters of its own; [`RaycastParamsGpu::of`] fills it from the blocks a kind declares.
     pub struct RaycastParamsGpu {
         step_voxels: f32 = computed, "sample distance in voxels";
@@ -189,7 +189,7 @@ mod tests {
     /// The Rust block and the shader's `RaycastParams` have the same members in the same order.
     #[test]
     fn the_gpu_block_matches_the_shader_struct() {
-        RaycastParamsGpu::check_shader(&crate::shared::assembled("raycast.wgsl"), "RaycastParams")
+        RaycastParamsGpu::check_shader(&crate::shared::assembled("raycast.wgsl"), "RaycastParamsGpu")
             .expect("the layouts agree");
         assert_eq!(RaycastParamsGpu::of(&Params::defaults(&raycast_param_specs())).uniform_bytes().len(), 48);
     }

@@ -142,19 +142,13 @@ impl PassDecl for RaycastSegment {
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        self.shaders_wired(params, &[])
-    }
-
-    fn shaders_wired(&self, params: &Params, wired: &[&str]) -> Vec<ShaderUse> {
-        let (file, entry_point) = match self.entry(params) {
-            // §2.3 inside the segment: with the empty-block flags wired, the leaping variant.
-            ("raycast_segment.wgsl", "fs_dvr") if wired.contains(&"empty") => ("raycast_segment.wgsl", "fs_dvr_leap"),
-            other => other,
-        };
+        let (file, entry_point) = self.entry(params);
         // The counting variant (a bench tool's) binds the invocation counter too.
         let extra: &'static [&'static str] =
-            if self.counter.is_some() { &["params", "segment", "invocations"] } else { &["params", "segment"] };
-        vec![ShaderUse { file, entry_point: "vs_segment", extra }, ShaderUse { file, entry_point, extra }]
+            if self.counter.is_some() { &["segment", "invocations"] } else { &["segment"] };
+        [ShaderUse::new(file, "vs_segment"), ShaderUse::new(file, entry_point)]
+            .map(|u| u.binds(extra).uniform(RaycastParamsGpu::bound_as("params")))
+            .to_vec()
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
@@ -181,7 +175,8 @@ impl PassPlugin for RaycastSegment {
         }
         let leap = ctx.ports.iter().any(|p| p.name == "empty" && p.bound);
         let (shader, fragment) = match (leap, self.entry(ctx.params)) {
-            (true, ("raycast_segment.wgsl", "fs_dvr")) => ("raycast_segment.wgsl", "fs_dvr_leap"),
+            // §2.3 inside the segment: with the empty-block flags wired, the shared march leaps.
+            (true, ("raycast_segment.wgsl", "fs_dvr")) => ("raycast_segment.wgsl", "fs_dvr"),
             (true, (_, entry)) => {
                 return Err(error(format!(
                     "empty-block leaping is implemented for the DVR segment shader only, not {entry}; \
@@ -190,7 +185,10 @@ impl PassPlugin for RaycastSegment {
             }
             (false, entry) => entry,
         };
-        let defines = crate::effects::jitter_defines(ctx.params);
+        let mut defines = crate::effects::jitter_defines(ctx.params);
+        if leap {
+            defines.extend(["LEAP", "LEAP_BLOCKS"]);
+        }
         let spec = |depth: Option<DepthSpec<'static>>| RenderPipelineSpec {
             shader,
             vertex: "vs_segment",

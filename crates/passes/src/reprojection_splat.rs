@@ -64,8 +64,8 @@ impl PassDecl for ReprojectionSplat {
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         vec![
-            ShaderUse { file: "reprojection_splat.wgsl", entry_point: "vs_splat", extra: &["splat"] },
-            ShaderUse { file: "reprojection_splat.wgsl", entry_point: "fs_splat", extra: &["splat"] },
+            ShaderUse::new("reprojection_splat.wgsl", "vs_splat").binds(&["splat"]),
+            ShaderUse::new("reprojection_splat.wgsl", "fs_splat").binds(&["splat"]),
         ]
     }
 

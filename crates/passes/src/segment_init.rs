@@ -53,7 +53,7 @@ impl PassDecl for SegmentInit {
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: "segment_init.wgsl", entry_point: fragment(params), extra: &[] }]
+        vec![ShaderUse::new("segment_init.wgsl", fragment(params))]
     }
 }
 

@@ -51,22 +51,28 @@ pub fn color_is_f32(ctx: &CreateContext<'_>) -> bool {
 /// tests that compare a `pass_params!` declaration with its WGSL struct (`check_shader`).
 #[cfg(test)]
 pub(crate) fn assembled(file: &str) -> String {
-    volgraph_core::shader_source::assemble(&crate::builtin_shaders(), file).expect("assembles").text
+    assembled_with(file, &[])
+}
+
+/// [`assembled`] with `defines` on.
+#[cfg(test)]
+pub(crate) fn assembled_with(file: &str, defines: &[&str]) -> String {
+    let defines = defines.iter().map(|d| d.to_string()).collect();
+    volgraph_core::shader_source::assemble_with(&crate::builtin_shaders(), file, &defines).expect("assembles").text
 }
 
 #[cfg(test)]
 mod tests {
-    use super::{BlockSize, assembled};
+    use super::{BlockSize, assembled, assembled_with};
 
-    /// `MinMaxParams`, `FastParams` and `EssParams` are `BlockSize`'s bytes.
+    /// The min/max grid's and the leaping raycasters' block-edge uniforms are `BlockSize`'s
+    /// bytes (the generated struct).
     #[test]
     fn the_block_size_uniforms_match_their_shader_structs() {
-        for (file, name) in [
-            ("minmax_grid.wgsl", "MinMaxParams"),
-            ("raycast_fast.wgsl", "FastParams"),
-            ("raycast_ess.wgsl", "EssParams"),
-        ] {
-            BlockSize::check_shader(&assembled(file), name).unwrap_or_else(|e| panic!("{name}: {e}"));
+        BlockSize::check_shader(&assembled("minmax_grid.wgsl"), "BlockSize").unwrap_or_else(|e| panic!("{e}"));
+        for file in ["raycast.wgsl", "raycast_compute.wgsl"] {
+            let text = assembled_with(file, &["LEAP", "LEAP_CUBES"]);
+            BlockSize::check_shader(&text, "BlockSize").unwrap_or_else(|e| panic!("{file}: {e}"));
         }
         assert_eq!(BlockSize { block_size: 8 }.uniform_bytes().len(), 16);
     }

@@ -53,8 +53,8 @@ impl PassDecl for SliceRender {
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         vec![
-            ShaderUse { file: "slice_render.wgsl", entry_point: "vs_slice", extra: &["slices"] },
-            ShaderUse { file: "slice_render.wgsl", entry_point: "fs_slice", extra: &["slices"] },
+            ShaderUse::new("slice_render.wgsl", "vs_slice").uniform(SliceParams::bound_as("slices")),
+            ShaderUse::new("slice_render.wgsl", "fs_slice").uniform(SliceParams::bound_as("slices")),
         ]
     }
 }

@@ -64,20 +64,13 @@ impl PassDecl for TerminationTest {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![
-            ShaderUse { file: "termination_test.wgsl", entry_point: "vs_segment", extra: &["params", "segment"] },
-            ShaderUse {
-                file: "termination_test.wgsl",
-                entry_point: "vs_terminate_alpha",
-                extra: &["params", "segment"],
-            },
-            ShaderUse { file: "termination_test.wgsl", entry_point: "fs_terminate", extra: &["params", "segment"] },
-            ShaderUse {
-                file: "termination_test.wgsl",
-                entry_point: "fs_terminate_empty",
-                extra: &["params", "segment"],
-            },
-        ]
+        ["vs_segment", "vs_terminate_alpha", "fs_terminate", "fs_terminate_empty"]
+            .map(|entry| {
+                ShaderUse::new("termination_test.wgsl", entry)
+                    .binds(&["segment"])
+                    .uniform(RaycastParamsGpu::bound_as("params"))
+            })
+            .to_vec()
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {

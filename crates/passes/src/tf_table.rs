@@ -21,10 +21,11 @@ pub struct TfTable {
 }
 
 /// The two entry points that fill a table of `file`: `cs_table32` and `cs_table16`.
-pub const fn table_shaders(file: &'static str) -> [ShaderUse; 2] {
+pub fn table_shaders(file: &'static str) -> [ShaderUse; 2] {
+    let step = || crate::raycast_params::RaycastParamsGpu::bound_as("params");
     [
-        ShaderUse { file, entry_point: "cs_table32", extra: &["params", "table32"] },
-        ShaderUse { file, entry_point: "cs_table16", extra: &["params", "table16"] },
+        ShaderUse::new(file, "cs_table32").binds(&["table32"]).uniform(step()),
+        ShaderUse::new(file, "cs_table16").binds(&["table16"]).uniform(step()),
     ]
 }
 

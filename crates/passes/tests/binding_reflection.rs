@@ -55,13 +55,13 @@ impl PassDecl for Misnamed {
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         match (self.compute_color, self.kind) {
             // Declares the fragment entry it does not build (`fs_iso`), not the one it does.
-            (_, "undeclared") => vec![ShaderUse { file: "raycast.wgsl", entry_point: "fs_iso", extra: &["params"] }],
+            (_, "undeclared") => vec![ShaderUse::new("raycast.wgsl", "fs_iso").binds(&["params"])],
             // Declares the fragment stage but not the vertex stage, which binds the frame.
             (_, "undeclared_vertex") => {
-                vec![ShaderUse { file: "entry_points.wgsl", entry_point: "fs_entry", extra: &[] }]
+                vec![ShaderUse::new("entry_points.wgsl", "fs_entry")]
             }
-            (Some(_), _) => vec![ShaderUse { file: "raycast_compute.wgsl", entry_point: "cs_dvr", extra: &["params"] }],
-            (None, _) => vec![ShaderUse { file: "raycast.wgsl", entry_point: "fs_dvr", extra: &["params"] }],
+            (Some(_), _) => vec![ShaderUse::new("raycast_compute.wgsl", "cs_dvr").binds(&["params"])],
+            (None, _) => vec![ShaderUse::new("raycast.wgsl", "fs_dvr").binds(&["params"])],
         }
     }
 }
@@ -136,8 +136,8 @@ fn shader_global_without_a_port_is_named() {
         msg,
         "pass \"march\": raycast.wgsl: global \"dir\" is neither a port of this pass (ports: entry, direction, volume, tf, color) \
          nor a system binding (frame, linear_clamp, nearest_clamp) nor one the pass binds itself (params); \
-         rename it to the port it stands for, or, when the node binds it itself, add \"dir\" to the `extra` \
-         names of the pass's ShaderUse"
+         rename it to the port it stands for, or, when the node binds it itself, declare it in the pass's \
+         ShaderUse (`.uniform(..)` for a uniform block, else `.binds(&[\"dir\"])`)"
     );
 }
 
@@ -149,8 +149,9 @@ fn an_entry_point_the_plugin_does_not_declare_is_not_built() {
     assert_eq!(
         msg,
         "pass \"march\": it builds raycast.wgsl entry point `fs_dvr`, which its plugin's `shaders()` does not \
-         declare for these parameters (it declares raycast.wgsl:fs_iso); add `ShaderUse { file: \"raycast.wgsl\", \
-         entry_point: \"fs_dvr\", extra: &[...] }` there, so `volgraph plan` checks its bindings too"
+         declare for these parameters (it declares raycast.wgsl:fs_iso); add `ShaderUse::new(\"raycast.wgsl\", \
+         \"fs_dvr\")` (with `.uniform(..)` / `.binds(..)` for what the node binds) there, so `volgraph plan` checks \
+         its bindings too"
     );
 }
 

@@ -21,7 +21,8 @@ fn reachable(file: &str, entry: &str) -> BTreeSet<String> {
 
 /// Names of the functions reachable from entry point `entry` of `file` assembled with `defines`.
 fn reachable_with(file: &str, entry: &str, defines: &[&str]) -> BTreeSet<String> {
-    let sources = ShaderSources::new().with_disk(default_shader_root());
+    let sources =
+        ShaderSources::new().with_disk(default_shader_root()).with_generated(volgraph_passes::params_structs());
     let defines: BTreeSet<String> = defines.iter().map(|d| d.to_string()).collect();
     let source = assemble_with(&sources, file, &defines).expect("shader loads");
     let (module, _) = parse_and_validate(file, &source.text).expect("shader validates");
@@ -131,10 +132,12 @@ fn switching_the_effect_by_a_parameter_override_switches_the_code() {
 }
 
 #[test]
-fn only_the_leaping_segment_entry_point_compiles_empty_space_code() {
-    // raycast_segment picks fs_dvr_leap only when its `empty` port is wired (rc_b_leap.ron).
+fn only_the_leaping_segment_loop_compiles_empty_space_code() {
+    // raycast_segment compiles LEAP + LEAP_BLOCKS only when its `empty` port is wired
+    // (rc_b_leap.ron): the shared core's leap over the block flags.
     let plain = reachable("raycast_segment.wgsl", "fs_dvr");
-    let leaping = reachable("raycast_segment.wgsl", "fs_dvr_leap");
-    assert!(!plain.iter().any(|f| f.starts_with("block_")), "{plain:?}");
-    assert!(leaping.contains("block_is_empty") && leaping.contains("block_exit_t"), "{leaping:?}");
+    let leaping = reachable_with("raycast_segment.wgsl", "fs_dvr", &["LEAP", "LEAP_BLOCKS"]);
+    let empty_space = |f: &String| f == "leap" || f == "empty_region_at" || f == "block_of";
+    assert!(!plain.iter().any(empty_space), "{plain:?}");
+    assert!(leaping.contains("leap") && leaping.contains("empty_region_at"), "{leaping:?}");
 }

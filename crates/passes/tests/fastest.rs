@@ -1,5 +1,5 @@
 //! `graphs/modern/fastest.ron` is lossless: leaping over empty cubes, the pre-corrected table and
-//! the run structure of `raycast_fast` change no pixel by more than rounding.
+//! the run structure of `raycast_compute` change no pixel by more than rounding.
 //!
 //! Tolerances (per channel of premultiplied linear RGBA):
 //! - against the same pass with leaping off (`leap: "none"`: every sample — the plain raycast

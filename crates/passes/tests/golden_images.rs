@@ -53,8 +53,8 @@ fn shipped_graphs() -> Vec<(String, PathBuf)> {
         for file in files.into_iter().filter(|f| f.extension().is_some_and(|e| e == "ron")) {
             let name = format!(
                 "{}/{}",
-                folder.file_name().unwrap().to_string_lossy(),
-                file.file_stem().unwrap().to_string_lossy()
+                folder.file_name().expect("a folder name").to_string_lossy(),
+                file.file_stem().expect("a file name").to_string_lossy()
             );
             graphs.push((name, file));
         }

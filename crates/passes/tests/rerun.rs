@@ -76,7 +76,7 @@ fn counting_registry() -> (Registry, BTreeMap<&'static str, Arc<AtomicUsize>>) {
     let builtin = builtin_registry();
     let mut registry = builtin.clone();
     let mut counters = BTreeMap::new();
-    for kind in ["minmax_grid", "empty_space", "empty_distance", "raycast_fast", "present"] {
+    for kind in ["minmax_grid", "empty_space", "empty_distance", "raycast_compute", "present"] {
         let records = Arc::new(AtomicUsize::new(0));
         let inner = builtin.get(kind).expect("a built-in kind").clone();
         registry.register(Counting { inner, records: records.clone() });
@@ -86,7 +86,7 @@ fn counting_registry() -> (Registry, BTreeMap<&'static str, Arc<AtomicUsize>>) {
 }
 
 fn counts(counters: &BTreeMap<&'static str, Arc<AtomicUsize>>) -> [usize; 4] {
-    ["minmax_grid", "empty_space", "empty_distance", "raycast_fast"].map(|k| counters[k].load(Ordering::SeqCst))
+    ["minmax_grid", "empty_space", "empty_distance", "raycast_compute"].map(|k| counters[k].load(Ordering::SeqCst))
 }
 
 #[test]

@@ -68,7 +68,7 @@ impl PassDecl for PointList {
         "point_list"
     }
     fn shaders(&self, _p: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: SHADER, entry_point: "fs_points", extra: &[] }]
+        vec![ShaderUse::new(SHADER, "fs_points")]
     }
     fn summary(&self) -> &'static str {
         "test: four NDC points in an N×1 target"
@@ -98,10 +98,7 @@ impl PassDecl for Splat {
         "splat"
     }
     fn shaders(&self, _p: &Params) -> Vec<ShaderUse> {
-        vec![
-            ShaderUse { file: SHADER, entry_point: "vs_splat", extra: &[] },
-            ShaderUse { file: SHADER, entry_point: "fs_splat", extra: &[] },
-        ]
+        vec![ShaderUse::new(SHADER, "vs_splat"), ShaderUse::new(SHADER, "fs_splat")]
     }
     fn summary(&self) -> &'static str {
         "test: a 2×2-pixel quad per point, instanced, vertices pulled from the point texture"
@@ -135,7 +132,7 @@ impl PassDecl for CountLit {
         "count_lit"
     }
     fn shaders(&self, _p: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse { file: SHADER, entry_point: "cs_count", extra: &[] }]
+        vec![ShaderUse::new(SHADER, "cs_count")]
     }
     fn summary(&self) -> &'static str {
         "test: counts lit pixels into a storage buffer"

@@ -59,8 +59,8 @@ impl PassNode for Node {
     }
 }
 
-const ADD_ONE: ShaderUse = ShaderUse { file: "add_one.wgsl", entry_point: "fs_add_one", extra: &["params"] };
-const FILL: ShaderUse = ShaderUse { file: "add_one.wgsl", entry_point: "fs_fill", extra: &[] };
+const ADD_ONE: ShaderUse = ShaderUse::new("add_one.wgsl", "fs_add_one").binds(&["params"]);
+const FILL: ShaderUse = ShaderUse::new("add_one.wgsl", "fs_fill");
 
 impl PassDecl for AddOne {
     fn kind(&self) -> &'static str {

@@ -1,5 +1,5 @@
 //! `mip`: maximum-intensity projection. Each pixel's ray meets the volume box analytically
-//! (volgraph's `common/analytic_ray.wgsl`) and keeps the largest normalized scalar of its
+//! (volgraph's `common/ray_box.wgsl`) and keeps the largest normalized scalar of its
 //! samples (the same samples as volgraph's raycasters); the output is that value as grey,
 //! windowed by `level` and `width` like a radiology viewer, alpha 1 where the ray hits the box.
 
@@ -21,9 +21,15 @@ volgraph_core::pass_params! {
     }
 }
 
-/// Its one pipeline, declared once: listed by `shaders()` (what `volgraph plan` checks) and
-/// built by `create`.
-const SHADER: ShaderUse = ShaderUse { file: "mip.wgsl", entry_point: "cs_main", extra: &["mip", "params"] };
+/// Its one pipeline, declared once: the file, the entry point and the uniform blocks it binds
+/// by name with their layouts (`volgraph plan` checks the shader's structs against them; the
+/// shader imports `MipParams` as generated, `params/MipParams.wgsl`). Listed by `shaders()`
+/// and built by `create`.
+fn shader() -> ShaderUse {
+    ShaderUse::new("mip.wgsl", "cs_main")
+        .uniform(MipParams::bound_as("mip"))
+        .uniform(RaycastParamsGpu::bound_as("params"))
+}
 
 impl PassDecl for Mip {
     fn kind(&self) -> &'static str {
@@ -46,7 +52,7 @@ impl PassDecl for Mip {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![SHADER]
+        vec![shader()]
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
@@ -63,7 +69,7 @@ impl PassPlugin for Mip {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let defines = self.shader_defines(ctx.params);
         let pipeline =
-            ctx.compute_pipeline(&ComputePipelineSpec { defines: &defines, ..ComputePipelineSpec::of(&SHADER) })?;
+            ctx.compute_pipeline(&ComputePipelineSpec { defines: &defines, ..ComputePipelineSpec::of(&shader()) })?;
         let uniform = ctx.uniform_from_bytes("mip", &MipParams::from_params(ctx.params).uniform_bytes());
         let rays = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());
         Ok(Box::new(MipNode { pipeline, uniform, rays }))
@@ -92,12 +98,13 @@ impl PassNode for MipNode {
 mod tests {
     use super::MipParams;
 
-    /// The shader's `MipParams` is the struct `pass_params!` uploads.
+    /// The shader's `MipParams` is the struct `pass_params!` generates (imported, not restated).
     #[test]
-    fn the_shader_struct_matches_the_declaration() {
-        // Assembled as the GPU gets it: volgraph's shared files imported, bindings numbered.
-        let shaders = volgraph_passes::builtin_shaders().with_embedded(crate::SHADERS);
-        let source = volgraph_core::shader_source::assemble(&shaders, "mip.wgsl").expect("assembles");
+    fn the_shader_struct_is_the_generated_one() {
+        // Assembled as the GPU gets it: volgraph's shared files and the generated structs
+        // imported, bindings numbered.
+        let source = volgraph_core::shader_source::assemble(&crate::shader_sources(), "mip.wgsl").expect("assembles");
         MipParams::check_shader(&source.text, "MipParams").expect("same layout");
+        assert!(source.text.contains(&MipParams::wgsl_struct()));
     }
 }

@@ -28,7 +28,7 @@ fn render_with(
     edit: impl Fn(String) -> String,
 ) -> (Image, Image) {
     let gpu = Arc::new(Gpu::new_headless().expect("a Vulkan adapter (lavapipe without a GPU)"));
-    let shaders = volgraph_passes::builtin_shaders().with_embedded(volgraph_example_radiology::SHADERS);
+    let shaders = volgraph_example_radiology::shader_sources();
     let mut runtime = Runtime::new(gpu, ShaderLibrary::new(shaders));
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("graphs/mip_enhanced.ron");
     let source = edit(std::fs::read_to_string(&path).expect("graph"));

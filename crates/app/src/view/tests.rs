@@ -191,8 +191,9 @@ impl volgraph_core::PassNode for BadDrawNode {
     }
 }
 
-const BAD_DRAW: volgraph_core::plugin::ShaderUse =
-    volgraph_core::plugin::ShaderUse { file: "present.wgsl", entry_point: "cs_present", extra: &["params"] };
+fn bad_draw() -> volgraph_core::plugin::ShaderUse {
+    volgraph_core::plugin::ShaderUse::new("present.wgsl", "cs_present").binds(&["params"])
+}
 
 impl volgraph_core::PassDecl for BadDraw {
     fn kind(&self) -> &'static str {
@@ -217,7 +218,7 @@ impl volgraph_core::PassDecl for BadDraw {
         ]
     }
     fn shaders(&self, _p: &volgraph_core::Params) -> Vec<volgraph_core::plugin::ShaderUse> {
-        vec![BAD_DRAW]
+        vec![bad_draw()]
     }
 }
 
@@ -226,7 +227,7 @@ impl volgraph_core::PassPlugin for BadDraw {
         &self,
         ctx: &volgraph_core::runtime::CreateContext<'_>,
     ) -> Result<Box<dyn volgraph_core::PassNode>, volgraph_core::runtime::PassError> {
-        let pipeline = ctx.compute_pipeline(&volgraph_core::runtime::ComputePipelineSpec::of(&BAD_DRAW))?;
+        let pipeline = ctx.compute_pipeline(&volgraph_core::runtime::ComputePipelineSpec::of(&bad_draw()))?;
         Ok(Box::new(BadDrawNode { pipeline }))
     }
 }
@@ -389,7 +390,13 @@ fn a_shader_edit_the_gpu_rejects_keeps_the_last_good_pipelines() {
     session.runtime.finish();
     let good = session.runtime.read_output("image").expect("image").data;
     let present = s.shaders.join("present.wgsl");
-    edit(&present, "    _pad2: f32,\n}", "    _pad2: f32,\n    larger_than_declared: vec4<f32>,\n}");
+    // The struct written out in full with trailing padding: the members the pass declares are
+    // all there (the layout check accepts it), but the block outgrows the buffer.
+    edit(
+        &present,
+        "#import \"params/PresentParams.wgsl\"",
+        "struct PresentParams {\n    background: f32,\n    _pad0: f32,\n    _pad1: f32,\n    _pad2: f32,\n    _pad_larger_than_declared: vec4<f32>,\n}",
+    );
     let events = session.files_changed(std::slice::from_ref(&present));
     assert!(matches!(events.as_slice(), [Event::Reloaded { .. }]), "naga accepts the edit: {events:?}");
     let events = session.frame(&camera, None).expect("recovers by itself");
@@ -407,7 +414,7 @@ fn a_shader_edit_the_gpu_rejects_keeps_the_last_good_pipelines() {
     session.runtime.finish();
     assert_eq!(session.runtime.read_output("image").expect("image").data, good);
     // Fixing the file reloads it like any edit.
-    edit(&present, "    larger_than_declared: vec4<f32>,\n", "");
+    edit(&present, "    _pad_larger_than_declared: vec4<f32>,\n", "");
     let events = session.files_changed(std::slice::from_ref(&present));
     assert!(events.iter().any(|e| matches!(e, Event::Reloaded { .. })), "{events:?}");
     assert!(session.frame(&camera, None).expect("the fixed shader renders").is_empty());

@@ -1,5 +1,5 @@
 //! Samples counted on the GPU, not estimated on the CPU: a pass whose plugin has a
-//! `count_samples` parameter (e.g. `raycast_fast`, `fetch_probe`) writes, when it is on, the
+//! `count_samples` parameter (e.g. `raycast_compute`, `fetch_probe`) writes, when it is on, the
 //! samples it took to its `samples` buffer — one u32 per image row, so that no word can overflow
 //! (a row of 4096 pixels × 2²⁰ samples would; the shaders' row sums stay far below) — and the
 //! benchmark renders one extra, untimed frame with it on and adds the rows up.

@@ -6,13 +6,15 @@
 //! ([`crate::binding_rules::check_bindings`]), except storage texture formats, which depend
 //! on the target formats a node picks its shader variant by. A misnamed port, a buffer bound
 //! as a texture, a sampled output or an entry point the shader does not have is reported by
-//! `volgraph plan` instead of at the first frame.
+//! `volgraph plan` instead of at the first frame. So is a uniform block whose WGSL struct
+//! disagrees with the layout the pass uploads ([`crate::decl::ShaderUse::uniforms`]).
 
 use std::collections::{BTreeSet, HashSet};
 
 use crate::binding_rules::port_infos;
 use crate::binding_rules::{PortInfo, check_bindings};
 use crate::decl::KindLookup;
+use crate::declare::check_uniform_layouts;
 use crate::diagnostic::{Diagnostic, Location};
 use crate::plan::Plan;
 use crate::reflect::reflect;
@@ -66,8 +68,11 @@ pub fn check_plan_bindings(plan: &Plan, registry: &dyn KindLookup, sources: &Sha
                     continue;
                 }
             };
-            if let Err(e) = check_bindings(shader.file, &reflection.bindings, shader.extra, &ports, false) {
+            if let Err(e) = check_bindings(shader.file, &reflection.bindings, &shader.node_bindings(), &ports, false) {
                 out.push(problem(e));
+            }
+            if let Err(e) = check_uniform_layouts(&module, &shader.uniforms) {
+                out.push(problem(format!("{}: {e}", shader.file)));
             }
             if let Err(e) = plugin.check_module(&step.params, &shader, &module) {
                 out.push(problem(e));

@@ -266,8 +266,8 @@ impl<'a> CreateContext<'a> {
         self.declared.iter().find(|u| u.file == file && u.entry_point == entry).ok_or_else(|| {
             self.error(format!(
                 "it builds {file} entry point `{entry}`, which its plugin's `shaders()` does not declare for these \
-                 parameters (it declares {}); add `ShaderUse {{ file: \"{file}\", entry_point: \"{entry}\", extra: \
-                 &[...] }}` there, so `volgraph plan` checks its bindings too",
+                 parameters (it declares {}); add `ShaderUse::new(\"{file}\", \"{entry}\")` (with \
+                 `.uniform(..)` / `.binds(..)` for what the node binds) there, so `volgraph plan` checks its bindings too",
                 if self.declared.is_empty() {
                     "none".to_string()
                 } else {
@@ -294,6 +294,13 @@ impl<'a> CreateContext<'a> {
 
     fn check_bindings(&self, shader: &str, bindings: &[ReflectedBinding], extra: &[&str]) -> Result<(), PassError> {
         check_bindings(shader, bindings, extra, self.ports, true).map_err(|m| self.error(m))
+    }
+
+    /// The declared uniform blocks of `declared` against the module (a hot reload may have
+    /// changed a struct): a disagreement is an error, never a buffer read as zeros.
+    fn check_uniforms(&self, file: &str, module: &naga::Module, declared: &ShaderUse) -> Result<(), PassError> {
+        volgraph_compiler::declare::check_uniform_layouts(module, &declared.uniforms)
+            .map_err(|e| self.error(format!("{file}: {e}")))
     }
 
     fn layout_entries(
@@ -347,9 +354,12 @@ impl<'a> CreateContext<'a> {
         // fullscreen triangle) needs no declaration.
         let vertex = reflect(&shader.module, &shader.info, &[spec.vertex])
             .map_err(|e| self.error(format!("{} {e}", spec.shader)))?;
-        let mut extra: Vec<&str> = declared.extra.to_vec();
+        let mut extra: Vec<&str> = declared.node_bindings();
+        self.check_uniforms(spec.shader, &shader.module, declared)?;
         if !vertex.bindings.is_empty() {
-            extra.extend(self.declared_use(spec.shader, spec.vertex)?.extra);
+            let vertex_use = self.declared_use(spec.shader, spec.vertex)?;
+            extra.extend(vertex_use.node_bindings());
+            self.check_uniforms(spec.shader, &shader.module, vertex_use)?;
         }
         self.check_bindings(spec.shader, &r.bindings, &extra)?;
         let mut outputs = r.fragment_outputs.clone();
@@ -490,7 +500,8 @@ impl<'a> CreateContext<'a> {
         self.built.borrow_mut().insert((spec.shader.to_string(), spec.entry.to_string()));
         let r = reflect(&shader.module, &shader.info, &[spec.entry])
             .map_err(|e| self.error(format!("{} {e}", spec.shader)))?;
-        self.check_bindings(spec.shader, &r.bindings, declared.extra)?;
+        self.check_bindings(spec.shader, &r.bindings, &declared.node_bindings())?;
+        self.check_uniforms(spec.shader, &shader.module, declared)?;
         let entries = self.layout_entries(&r.bindings, wgpu::ShaderStages::COMPUTE);
         let key =
             format!("compute|{}|{:016x}|{}|{:?}|{:?}", spec.shader, shader.hash, spec.entry, spec.constants, entries);

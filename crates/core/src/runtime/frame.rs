@@ -179,7 +179,7 @@ pub struct FrameUniforms {
     /// The texture-space pixel ray: pixel centre (x, y) looks along
     /// `ray_base + x·ray_dx + y·ray_dy` (xyz), scaled so that its world direction advances one
     /// world unit along `camera_forward` per unit of the ray parameter — the near plane is at
-    /// parameter `near` (`shaders/common/analytic_ray.wgsl`).
+    /// parameter `near` (`shaders/common/ray_box.wgsl`).
     pub ray_base_texture: [f32; 4],
     /// See `ray_base_texture`.
     pub ray_dx_texture: [f32; 4],

@@ -7,7 +7,7 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 use naga::valid::{Capabilities, ValidationFlags, Validator};
-use volgraph_compiler::shader_source::{default_shader_root, load_shader};
+use volgraph_core::shader_source::{assemble_with, default_shader_root};
 
 /// `.wgsl` files directly in `dir`, as paths relative to the shader root (`prefix` + name).
 fn wgsl_files(dir: &Path, prefix: &str) -> Vec<String> {
@@ -23,8 +23,19 @@ fn wgsl_files(dir: &Path, prefix: &str) -> Vec<String> {
 }
 
 /// Assembles and validates `relative`; the module on success, naga's full diagnostic otherwise.
+/// Files come from the folder on disk, then the generated `pass_params!` structs
+/// (`params/NAME.wgsl`), as the runtime reads them with `--shaders`.
 fn validate(root: &Path, relative: &str) -> Result<(naga::Module, Vec<PathBuf>), String> {
-    let source = load_shader(root, relative).map_err(|e| e.to_string())?;
+    validate_with(root, relative, &[])
+}
+
+/// [`validate`] with the `#if` names `defines` on.
+fn validate_with(root: &Path, relative: &str, defines: &[&str]) -> Result<(naga::Module, Vec<PathBuf>), String> {
+    let sources = volgraph_core::shader_source::ShaderSources::new()
+        .with_disk(root)
+        .with_generated(volgraph_passes::params_structs());
+    let defines = defines.iter().map(|d| d.to_string()).collect();
+    let source = assemble_with(&sources, relative, &defines).map_err(|e| e.to_string())?;
     let module = naga::front::wgsl::parse_str(&source.text)
         .map_err(|e| format!("parse error:\n{}", e.emit_to_string(&source.text)))?;
     Validator::new(ValidationFlags::all(), Capabilities::all())
@@ -45,6 +56,11 @@ fn bindings(module: &naga::Module) -> Vec<(String, u32, u32)> {
         .collect()
 }
 
+/// `#if` combinations the raycasters compile (crates/passes/src/march.rs): leaping over block
+/// flags or the distance map, start estimates with leap hits.
+const SETTINGS: &[&[&str]] =
+    &[&["LEAP", "LEAP_BLOCKS"], &["LEAP", "LEAP_CUBES"], &["START", "LEAP_HITS", "FIRST_VISIBLE"]];
+
 #[test]
 fn every_shader_validates() {
     let root = default_shader_root();
@@ -61,6 +77,14 @@ fn every_shader_validates() {
         match validate(&root, name) {
             Ok((_, files)) => imported.extend(files.into_iter().filter_map(|f| f.canonicalize().ok())),
             Err(e) => failures.push(format!("shaders/{name}: {e}")),
+        }
+        // Files a module imports only under an `#if` (the empty-space providers of the shared
+        // march need the importer's `block_edge()`) are checked through it with the settings
+        // the passes compile; a combination a module does not take may fail to assemble.
+        for defines in SETTINGS {
+            if let Ok((_, files)) = validate_with(&root, name, defines) {
+                imported.extend(files.into_iter().filter_map(|f| f.canonicalize().ok()));
+            }
         }
     }
     for name in &common {

@@ -1,0 +1,193 @@
+//! The Rust side of the one sampling core (`shaders/common/raymarch.wgsl`,
+//! `common/pixel_march.wgsl`): the settings the single-pass raycasters (`raycast`, fragment;
+//! `raycast_compute`, compute) share and what each compiles in — where rays come from, empty-space
+//! leaping from an optional `empty` (Krüger & Westermann 2003 §2.3's block flags) or `distance`
+//! (`empty_distance`'s Chebyshev map) input, and sample counting. Declared once here, so the two
+//! kinds cannot drift and a paper comparison between them is a comparison of settings.
+
+use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext};
+use volgraph_core::{Params, PortKind, PortSpec};
+
+use crate::empty_distance::EMPTY_DISTANCE;
+use crate::empty_space::{EMPTY_BLOCKS, check_block_grid};
+use crate::minmax_grid::bound_size;
+use crate::shared::{BlockSize, FLOAT_TARGETS};
+
+/// Rows of the `samples` buffer (`SAMPLE_ROWS` in the shaders): image row y counts into word
+/// y mod SAMPLE_ROWS, so a word holds at most a row's samples.
+pub const SAMPLE_ROWS: u64 = 4096;
+
+volgraph_core::param_choice! {
+    /// Where a ray's entry and direction come from.
+    pub enum Rays {
+        /// The `entry` and `dir` inputs (K-W 2003 §2.1).
+        Raster = "raster",
+        /// Met with the box in the shader, no inputs needed.
+        Analytic = "analytic",
+    }
+}
+
+volgraph_core::param_choice! {
+    /// What a ray leaps out of when the empty-space input says it may.
+    pub enum Leap {
+        /// The largest cube of empty blocks around the sample (`distance` input).
+        Cubes = "cubes",
+        /// The sample's own block.
+        Blocks = "blocks",
+        /// Nothing: every sample is taken.
+        None = "none",
+    }
+}
+
+volgraph_core::pass_params! {
+    /// The single-pass raycasters' rays, leaping and counting.
+    pub struct MarchSettings {
+        rays: Rays = Raster,
+            "raster: entry and direction from the `entry` and `dir` inputs (K-W 2003 §2.1); analytic: met with the box in \
+             the shader, no inputs needed";
+        leap: Leap = Cubes,
+            "with `empty` (block flags) or `distance` (distance map) wired: leap out of the largest cube of empty blocks \
+             (distance map only), out of one block at a time, or take every sample (unwired: none)";
+        check_every: u32 = 16, 1..=1024,
+            "with leaping: samples in a run between two looks at the empty-space input (all lanes look together)";
+        count_samples: bool = false, "add the samples taken to the `samples` buffer (benchmarks; one atomic per pixel)";
+    }
+}
+
+impl MarchSettings {
+    /// Whether the rays meet the box analytically (no `entry` / `dir` inputs).
+    pub fn analytic(&self) -> bool {
+        self.rays == Rays::Analytic
+    }
+}
+
+/// The parameter blocks of the shared march: its settings and the block edge of the empty-space
+/// inputs.
+pub fn march_specs() -> Vec<volgraph_core::ParamSpec> {
+    [MarchSettings::specs(), BlockSize::specs()].concat()
+}
+
+/// The ports the shared march adds: `entry`/`dir` for raster rays, the optional empty-space
+/// inputs, and `samples` when counting.
+pub fn march_ports(params: &Params) -> Vec<PortSpec> {
+    let settings = MarchSettings::from_params(params);
+    let mut ports = Vec::new();
+    if !settings.analytic() {
+        ports.push(PortSpec::read("entry", PortKind::target(&FLOAT_TARGETS)));
+        ports.push(PortSpec::read("dir", PortKind::target(&FLOAT_TARGETS)));
+    }
+    // Leave both unwired to take every sample; wire one.
+    ports.push(PortSpec::read("empty", PortKind::Owned(EMPTY_BLOCKS)).optional());
+    ports.push(PortSpec::read("distance", PortKind::Owned(EMPTY_DISTANCE)).optional());
+    if settings.count_samples {
+        ports.push(PortSpec::write("samples", PortKind::buffer(4 * SAMPLE_ROWS)));
+    }
+    ports
+}
+
+/// The `#if` names of `params`' march that a plan can know (the empty-space ones depend on the
+/// wiring and come from [`Leaping::defines`]).
+pub fn march_defines(params: &Params) -> Vec<&'static str> {
+    let settings = MarchSettings::from_params(params);
+    let mut defines = Vec::new();
+    if settings.analytic() {
+        defines.push("ANALYTIC");
+    }
+    if settings.count_samples {
+        defines.push("COUNT");
+    }
+    defines
+}
+
+/// Whether an edit from `old` to `new` keeps the march's pipeline (only the block edge, a
+/// uniform, may change).
+pub fn same_march(old: &Params, new: &Params) -> bool {
+    MarchSettings::from_params(old) == MarchSettings::from_params(new)
+}
+
+/// Which empty-space input a node leaps with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Source {
+    None,
+    /// `empty`: per-block flags.
+    Blocks,
+    /// `distance`: the Chebyshev map; `cubes` leaps out of cubes of blocks.
+    Distance {
+        cubes: bool,
+    },
+}
+
+/// A node's empty-space leaping: the input it reads, the block-edge uniform `blocks`, the
+/// defines and constants its pipeline is built with, and the grid check every frame.
+pub struct Leaping {
+    source: Source,
+    check_every: u32,
+    block_size: u32,
+    blocks: Option<wgpu::Buffer>,
+}
+
+impl Leaping {
+    /// From the node's wiring and settings; both inputs wired is an error.
+    pub fn new(ctx: &CreateContext<'_>) -> Result<Self, PassError> {
+        let settings = MarchSettings::from_params(ctx.params);
+        let wired = |port: &str| ctx.port(port).is_some_and(|p| p.bound);
+        let source = match (wired("empty"), wired("distance"), settings.leap) {
+            (true, true, _) => {
+                return Err(PassError {
+                    pass: ctx.pass_id.to_string(),
+                    message: "both \"empty\" and \"distance\" are wired; wire one empty-space input".into(),
+                });
+            }
+            (_, _, Leap::None) | (false, false, _) => Source::None,
+            (true, false, _) => Source::Blocks,
+            (false, true, leap) => Source::Distance { cubes: leap == Leap::Cubes },
+        };
+        let block_size = BlockSize::of(ctx.params);
+        let blocks = (source != Source::None)
+            .then(|| ctx.uniform_from_bytes("blocks", &BlockSize { block_size }.uniform_bytes()));
+        Ok(Self { source, check_every: settings.check_every.max(1), block_size, blocks })
+    }
+
+    /// The `#if` names of the leap (LEAP and the input's provider).
+    pub fn defines(&self) -> Vec<&'static str> {
+        match self.source {
+            Source::None => vec![],
+            Source::Blocks => vec!["LEAP", "LEAP_BLOCKS"],
+            Source::Distance { .. } => vec!["LEAP", "LEAP_CUBES"],
+        }
+    }
+
+    /// The pipeline constants of the leap.
+    pub fn constants(&self) -> Vec<(&'static str, f64)> {
+        match self.source {
+            Source::None => vec![],
+            Source::Blocks => vec![("CHECK_EVERY", self.check_every as f64)],
+            Source::Distance { cubes } => {
+                vec![("CHECK_EVERY", self.check_every as f64), ("LEAP_CUBES", if cubes { 1.0 } else { 0.0 })]
+            }
+        }
+    }
+
+    /// The node's own bindings (the block-edge uniform).
+    pub fn bindings(&self) -> Vec<(&'static str, wgpu::BindingResource<'_>)> {
+        self.blocks.iter().map(|b| ("blocks", b.as_entire_binding())).collect()
+    }
+
+    /// The empty-space input must be `block_size`'s grid of the bound volume.
+    pub fn check(&self, ctx: &RecordContext<'_>) -> Result<(), PassError> {
+        let port = match self.source {
+            Source::None => return Ok(()),
+            Source::Blocks => "empty",
+            Source::Distance { .. } => "distance",
+        };
+        check_block_grid(ctx, port, self.block_size, bound_size(ctx, "volume")?)
+    }
+
+    /// A parameter edit that kept the pipeline: the block edge may have changed.
+    pub fn update(&mut self, gpu: &Gpu, params: &Params) {
+        self.block_size = BlockSize::of(params);
+        if let Some(b) = &self.blocks {
+            gpu.queue.write_buffer(b, 0, &BlockSize { block_size: self.block_size }.uniform_bytes());
+        }
+    }
+}

@@ -1,0 +1,35 @@
+// Empty-space leaping, the one rule (Krüger & Westermann 2003 §2.3; the modern single-pass
+// form): from sample k, while it lies in a region the importing shader's empty-space structure
+// says is fully transparent, jump to the first sample past that region's box (`past_box`). The
+// structure provides `fn empty_region_at(p: vec3<f32>) -> EmptyRegion` for texture-space `p`:
+// common/empty_blocks.wgsl (per-block flags), common/empty_cubes.wgsl (Chebyshev distance map:
+// the largest cube of empty blocks), raycast_bricks.wgsl (empty leaves, bricks of other batches).
+// Lossless: every sample leapt over lies in the closed box of an empty region, whose
+// conservative range (a one-voxel apron) also covers the f32 rounding of the box exit.
+
+#import "common/ray_box.wgsl"
+
+// A box in texture space around a sample and whether it is empty (then every sample in the
+// closed box classifies to alpha 0).
+struct EmptyRegion {
+    empty: bool,
+    lo: vec3<f32>,
+    hi: vec3<f32>,
+}
+
+// The first sample at or after k (before `end`) that may be visible, or `end`.
+fn leap(k_from: u32, s: Samples, end: u32) -> u32 {
+    var k = k_from;
+    loop {
+        if (k >= end) {
+            break;
+        }
+        let p = sample_at(s, k);
+        let region = empty_region_at(p);
+        if (!region.empty) {
+            break;
+        }
+        k = past_box(k, p, s.delta, region.lo, region.hi);
+    }
+    return min(k, end);
+}

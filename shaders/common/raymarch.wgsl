@@ -280,39 +280,51 @@ struct IsoMarch {
 // First-hit isosurface over samples [k0, end) of `s`: the first sample k with value >= iso,
 // refined linearly against sample k - 1 (read again when k0 > 0, so a segment or a late start
 // refines like the whole ray; a start already past the surface reports the sample before it,
-// unrefined), shaded with the headlight.
+// unrefined), shaded with the headlight. The loop only finds k — one fetch and one compare per
+// sample, like the DVR run's body — and the refinement and shading (six more fetches) run once
+// after it: inside the loop, every lane of a SIMD group would wait through the shading of each
+// other lane's hit.
 fn march_iso(s: Samples, k0: u32, end: u32) -> IsoMarch {
     var out = IsoMarch(vec4<f32>(0.0), vec4<f32>(0.0), 0u);
     let iso = params.iso_value;
     var k = k0;
-    var s_prev = 0.0;
+    var prev = 0.0;
     var has_prev = false;
     if (k0 > 0u && k0 <= s.count) {
-        s_prev = sample_volume(sample_at(s, k0 - 1u));
+        prev = sample_volume(sample_at(s, k0 - 1u));
         out.samples = 1u;
         has_prev = true;
-        if (s_prev >= iso) {
+        if (prev >= iso) {
             // The start was past the surface: take the sample that saw it again.
             k = k0 - 1u;
             has_prev = false;
         }
     }
-    for (; k < end; k += 1u) {
-        let v = sample_volume(sample_at(s, k));
-        out.samples += 1u;
-        if (v >= iso) {
-            var x = f32(k);
-            if (has_prev) {
-                x = x - 1.0 + (iso - s_prev) / (v - s_prev);
-            }
-            let u = s.first + x * s.delta;
-            let d_world = normalize(s.delta * 2.0 * frame.half_extent.xyz);
-            out.color = vec4<f32>(shade_iso(u, d_world), 1.0);
-            out.hit = vec4<f32>(u, 1.0);
-            return out;
+    let first = k;
+    var v = 0.0;
+    loop {
+        if (k >= end) {
+            break;
         }
-        s_prev = v;
-        has_prev = true;
+        v = sample_volume(sample_at(s, k));
+        if (v >= iso) {
+            break;
+        }
+        prev = v;
+        k += 1u;
     }
+    if (k >= end) {
+        out.samples += k - first;
+        return out;
+    }
+    out.samples += k - first + 1u;
+    var x = f32(k);
+    if (has_prev || k > first) {
+        x = x - 1.0 + (iso - prev) / (v - prev);
+    }
+    let u = s.first + x * s.delta;
+    let d_world = normalize(s.delta * 2.0 * frame.half_extent.xyz);
+    out.color = vec4<f32>(shade_iso(u, d_world), 1.0);
+    out.hit = vec4<f32>(u, 1.0);
     return out;
 }

@@ -221,6 +221,24 @@ pub trait PassDecl: Send + Sync {
         Rerun::EveryFrame
     }
 
+    /// Whether the edit from `old` to `new` only changes values the declared uniform blocks carry:
+    /// the same shader uses (files, entry points, uniform layouts), `#if` names and ports, and
+    /// every parameter that differs is one a declared uniform block is made of
+    /// ([`UniformLayout::params`]). A pass whose node keeps its uniforms in
+    /// `volgraph_core::runtime::UniformBlocks` answers [`PassDecl::updates_in_place`] with it and
+    /// rewrites them in `update_params`, so neither is written by hand.
+    fn only_uniforms_change(&self, old: &Params, new: &Params) -> bool {
+        let uses = self.shaders(old);
+        if uses != self.shaders(new)
+            || self.shader_defines(old) != self.shader_defines(new)
+            || self.ports(old) != self.ports(new)
+        {
+            return false;
+        }
+        let carried = |name: &str| uses.iter().flat_map(|u| &u.uniforms).any(|u| u.params.contains(&name));
+        old.iter().zip(new.iter()).all(|((name, a), (_, b))| a == b || carried(name))
+    }
+
     /// Whether a node built with `old` parameters can take `new` ones through
     /// the node's `update_params` (uniform values) instead of being rebuilt (pipeline changes:
     /// a mode switch, a workgroup size). A parameter edit in the viewer then rebuilds nothing.
@@ -284,16 +302,32 @@ impl ShaderUse {
     }
 }
 
-/// A uniform block as a node uploads it: the global it is bound to and its members, `(name,
-/// WGSL scalar type)` at 4-byte offsets in order — what a `pass_params!` struct lays out
-/// (`Name::bound_as(global)`).
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// A uniform block as a node uploads it: the global it is bound to, its members `(name, WGSL
+/// scalar type)` at 4-byte offsets in order, the parameters it is made of and how its bytes
+/// are made from them — what a `pass_params!` struct declares (`Name::bound_as(global)`).
+/// Enough for the runtime to create, fill and rewrite the buffer
+/// (`volgraph_core::runtime::UniformBlocks`) and to tell an edit that only changes uniform
+/// values ([`PassDecl::only_uniforms_change`]).
+#[derive(Clone, Debug)]
 pub struct UniformLayout {
     /// The WGSL global, e.g. `params`.
     pub global: &'static str,
     /// The members, in order.
     pub fields: Vec<(&'static str, &'static str)>,
+    /// The parameters the bytes are made of.
+    pub params: Vec<&'static str>,
+    /// The block's bytes for a pass's parameters (padded to 16).
+    pub bytes: fn(&Params) -> Vec<u8>,
 }
+
+impl PartialEq for UniformLayout {
+    /// The same global, members and parameters (the byte function is the declaration's).
+    fn eq(&self, other: &Self) -> bool {
+        self.global == other.global && self.fields == other.fields && self.params == other.params
+    }
+}
+
+impl Eq for UniformLayout {}
 
 /// Where the compiler looks pass kinds up: the runtime's `Registry` (every plugin is a
 /// declaration too) or [`Kinds`], declarations alone.

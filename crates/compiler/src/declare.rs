@@ -186,7 +186,22 @@ macro_rules! pass_params {
             /// This block as the uniform `global` of a [`ShaderUse`]($crate::ShaderUse): the
             /// layout `volgraph plan` and node creation check the shader's struct against.
             pub fn bound_as(global: &'static str) -> $crate::decl::UniformLayout {
-                $crate::decl::UniformLayout { global, fields: Self::wgsl_fields() }
+                Self::bound_as_with(
+                    global,
+                    Self::specs().iter().map(|s| s.name).collect(),
+                    |p| Self::from_params(p).uniform_bytes(),
+                )
+            }
+
+            /// [`Self::bound_as`] for a block whose values are computed from parameters it
+            /// does not declare itself (a block of `computed` fields): `params` are the
+            /// parameters `bytes` reads.
+            pub fn bound_as_with(
+                global: &'static str,
+                params: Vec<&'static str>,
+                bytes: fn(&$crate::Params) -> Vec<u8>,
+            ) -> $crate::decl::UniformLayout {
+                $crate::decl::UniformLayout { global, fields: Self::wgsl_fields(), params, bytes }
             }
 
             /// `(path, text)` of [`Self::wgsl_struct`] as a generated shader file, which shaders

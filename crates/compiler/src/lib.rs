@@ -26,7 +26,7 @@ pub mod terminal;
 pub mod wgsl_kind;
 
 pub use compile::{CompileOptions, check_plan_bindings, compile};
-pub use decl::{Access, KindLookup, Kinds, PassDecl, PortKind, PortSpec, Rerun, ShaderUse};
+pub use decl::{Access, KindLookup, Kinds, PassDecl, PortKind, PortSpec, Rerun, ShaderUse, UniformLayout};
 pub use diagnostic::{Diagnostic, Diagnostics, Location};
 pub use format::{Precision, TargetFormat, TargetSize};
 pub use params::{ParamSpec, ParamValue, Params};

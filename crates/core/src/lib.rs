@@ -20,4 +20,6 @@ pub use diagnostic::{Diagnostic, Diagnostics, Location};
 pub use format::{Precision, TargetFormat, TargetSize};
 pub use params::{ParamSpec, ParamValue, Params};
 pub use plan::Plan;
-pub use plugin::{Access, KindLookup, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, Registry, Rerun};
+pub use plugin::{
+    Access, KindLookup, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, Registry, Rerun, UniformLayout,
+};

@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 pub use volgraph_compiler::decl::{
-    Access, KindLookup, Kinds, PassDecl, PortKind, PortSpec, Rerun, ShaderUse, SizeRule,
+    Access, KindLookup, Kinds, PassDecl, PortKind, PortSpec, Rerun, ShaderUse, SizeRule, UniformLayout,
 };
 
 use crate::params::Params;

@@ -85,7 +85,7 @@ fn ray_block(p: &Params) -> RaycastParamsGpu {
 fn shader(params: &Params) -> ShaderUse {
     ShaderUse::new("antialias.wgsl", if is_iso(params) { "fs_aa_iso" } else { "fs_aa_dvr" })
         .binds(&["aa"])
-        .uniform(RaycastParamsGpu::bound_as("params"))
+        .uniform(RaycastParamsGpu::bound("params"))
 }
 
 impl PassDecl for Antialias {

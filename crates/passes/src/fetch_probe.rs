@@ -50,7 +50,7 @@ impl PassDecl for FetchProbe {
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
         let entry_point = if Counting::from_params(params).count_samples { "cs_counted" } else { "cs_main" };
-        vec![ShaderUse::new("fetch_probe.wgsl", entry_point).uniform(RaycastParamsGpu::bound_as("params"))]
+        vec![ShaderUse::new("fetch_probe.wgsl", entry_point).uniform(RaycastParamsGpu::bound("params"))]
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {

@@ -9,7 +9,9 @@
 //! it). Reads the splats' `splats` start target, writes `start`. Shader: `shaders/hole_fill.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
+use volgraph_core::runtime::{
+    CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec, UniformBlocks,
+};
 use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
@@ -23,6 +25,11 @@ volgraph_core::pass_params! {
             "pixels this close to the footprint's edge start at the box (at least the splat's half size)";
         extend: i32 = 1, 0..=4, "a hole takes the nearest start among the splats this many pixels around it";
     }
+}
+
+/// Its one pipeline, declared once (file, entry point, the uniform block `holes`).
+fn shader() -> ShaderUse {
+    ShaderUse::new("hole_fill.wgsl", "fs_hole").uniform(HoleParams::bound_as("holes"))
 }
 
 impl PassDecl for HoleFill {
@@ -46,52 +53,36 @@ impl PassDecl for HoleFill {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse::new("hole_fill.wgsl", "fs_hole").uniform(HoleParams::bound_as("holes"))]
+        vec![shader()]
     }
 
-    fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
-        true
+    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
+        self.only_uniforms_change(old, new)
     }
 }
 
 impl PassPlugin for HoleFill {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
-            shader: "hole_fill.wgsl",
-            vertex: "vs_fullscreen",
-            fragment: "fs_hole",
-            ..Default::default()
-        })?;
-        let uniform = ctx.uniform_from_bytes("holes", &HoleParams::from_params(ctx.params).uniform_bytes());
-        Ok(Box::new(HoleFillNode { pipeline, uniform }))
+        let shader = shader();
+        let pipeline = ctx.render_pipeline(&RenderPipelineSpec::fullscreen(&shader))?;
+        Ok(Box::new(HoleFillNode { pipeline, uniforms: UniformBlocks::create(ctx, &[shader]) }))
     }
 }
 
 struct HoleFillNode {
     pipeline: RenderPassPipeline,
-    uniform: wgpu::Buffer,
+    uniforms: UniformBlocks,
 }
 
 impl PassNode for HoleFillNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
-        let bg = ctx.bind_group(&self.pipeline, &[("holes", self.uniform.as_entire_binding())])?;
+        let bg = ctx.bind_group(&self.pipeline, &self.uniforms.bindings())?;
         let mut pass = ctx.begin_render_pass(&self.pipeline, None)?;
         crate::draw(&mut pass, &self.pipeline, &bg, 0..3);
         Ok(())
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
-        gpu.queue.write_buffer(&self.uniform, 0, &HoleParams::from_params(params).uniform_bytes());
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::HoleParams;
-
-    /// The shader's `HoleParams` is the struct `pass_params!` uploads.
-    #[test]
-    fn the_shader_struct_matches_the_declaration() {
-        HoleParams::check_shader(&crate::shared::assembled("hole_fill.wgsl"), "HoleParams").expect("same layout");
+        self.uniforms.write(gpu, params);
     }
 }

@@ -5,15 +5,17 @@
 //! data-centre GPUs too). Shader: `shaders/present.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
+use volgraph_core::runtime::{
+    ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, UniformBlocks,
+};
 use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
 pub struct Present;
 
 volgraph_core::pass_params! {
-    /// The parameters, declared once: the spec, typed values and `PresentParams` of
-    /// `shaders/present.wgsl` (checked against the shader by a test).
+    /// The parameters, declared once: the spec, typed values, the uniform bytes and the struct
+    /// `shaders/present.wgsl` imports (`params/PresentParams.wgsl`).
     pub struct PresentParams {
         background: f32 = 0.0, 0.0..=1.0, "linear grey level behind the volume";
     }
@@ -48,42 +50,30 @@ impl PassDecl for Present {
         vec![shader()]
     }
 
-    fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
-        true
+    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
+        self.only_uniforms_change(old, new)
     }
 }
 
 impl PassPlugin for Present {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec::of(&shader()))?;
-        let params = ctx.uniform_from_bytes("params", &PresentParams::from_params(ctx.params).uniform_bytes());
-        Ok(Box::new(PresentNode { pipeline, params }))
+        let shader = shader();
+        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec::of(&shader))?;
+        Ok(Box::new(PresentNode { pipeline, uniforms: UniformBlocks::create(ctx, &[shader]) }))
     }
 }
 
 struct PresentNode {
     pipeline: ComputePassPipeline,
-    params: wgpu::Buffer,
+    uniforms: UniformBlocks,
 }
 
 impl PassNode for PresentNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
-        ctx.dispatch_over(&self.pipeline, &[("params", self.params.as_entire_binding())], "display", (8, 8))
+        ctx.dispatch_over(&self.pipeline, &self.uniforms.bindings(), "display", (8, 8))
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
-        gpu.queue.write_buffer(&self.params, 0, &PresentParams::from_params(params).uniform_bytes());
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::PresentParams;
-
-    /// The shader's `PresentParams` is the struct `pass_params!` uploads.
-    #[test]
-    fn the_shader_struct_matches_the_declaration() {
-        PresentParams::check_shader(&crate::shared::assembled("present.wgsl"), "PresentParams").expect("same layout");
-        assert!(PresentParams::wgsl_struct().starts_with("struct PresentParams {\n    background: f32,"));
+        self.uniforms.write(gpu, params);
     }
 }

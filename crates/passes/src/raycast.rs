@@ -83,7 +83,7 @@ impl PassDecl for Raycast {
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
         let own = ShaderUse::new("raycast.wgsl", fragment_entry(params))
             .binds(&["preintegrated"])
-            .uniform(RaycastParamsGpu::bound_as("params"))
+            .uniform(RaycastParamsGpu::bound("params"))
             .uniform(BlockSize::bound_as("blocks"));
         [vec![own], crate::effects::effect_shader_uses(params)].concat()
     }

@@ -126,7 +126,7 @@ impl PassDecl for RaycastBricks {
         vec![
             ShaderUse::new("raycast_bricks.wgsl", "cs_main")
                 .binds(&["bricks", "table", "leaf_distance", "acc", "volume"])
-                .uniform(RaycastParamsGpu::bound_as("params")),
+                .uniform(RaycastParamsGpu::bound("params")),
         ]
     }
 

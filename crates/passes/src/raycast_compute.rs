@@ -92,7 +92,7 @@ impl PassDecl for RaycastCompute {
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
         let own = ShaderUse::new("raycast_compute.wgsl", entry(params))
             .binds(&["corrected", "preintegrated"])
-            .uniform(RaycastParamsGpu::bound_as("params"))
+            .uniform(RaycastParamsGpu::bound("params"))
             .uniform(BlockSize::bound_as("blocks"));
         let mut uses = vec![own];
         if uses_table(params) {

@@ -125,6 +125,13 @@ volgraph_core::pass_params! {
 }
 
 impl RaycastParamsGpu {
+    /// This block as the uniform `global` of a shader use: its bytes are [`Self::of`] the
+    /// blocks a kind declares, so every parameter of those blocks is carried by it.
+    pub fn bound(global: &'static str) -> volgraph_core::UniformLayout {
+        let params = raycast_param_specs().iter().map(|s| s.name).collect();
+        Self::bound_as_with(global, params, |p| Self::of(p).uniform_bytes())
+    }
+
     /// The block of a raycaster's parameters: the sampling every raycaster declares, and the
     /// termination, isosurface and shading blocks where its kind declares them (else what the
     /// shader never reads: no termination, 0).

@@ -147,7 +147,7 @@ impl PassDecl for RaycastSegment {
         let extra: &'static [&'static str] =
             if self.counter.is_some() { &["segment", "invocations"] } else { &["segment"] };
         [ShaderUse::new(file, "vs_segment"), ShaderUse::new(file, entry_point)]
-            .map(|u| u.binds(extra).uniform(RaycastParamsGpu::bound_as("params")))
+            .map(|u| u.binds(extra).uniform(RaycastParamsGpu::bound("params")))
             .to_vec()
     }
 

@@ -8,7 +8,9 @@
 
 use crate::shared::front_to_back_blend;
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{CreateContext, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
+use volgraph_core::runtime::{
+    CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec, UniformBlocks,
+};
 use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
@@ -52,10 +54,14 @@ impl PassDecl for SliceRender {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![
-            ShaderUse::new("slice_render.wgsl", "vs_slice").uniform(SliceParams::bound_as("slices")),
-            ShaderUse::new("slice_render.wgsl", "fs_slice").uniform(SliceParams::bound_as("slices")),
-        ]
+        ["vs_slice", "fs_slice"]
+            .map(|entry| ShaderUse::new("slice_render.wgsl", entry).uniform(SliceParams::bound_as("slices")))
+            .to_vec()
+    }
+
+    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
+        // The plane spacing is a uniform value; the slice count sizes the draw (a rebuild).
+        self.only_uniforms_change(old, new)
     }
 }
 
@@ -68,35 +74,32 @@ impl PassPlugin for SliceRender {
             blend: Some(front_to_back_blend()),
             ..Default::default()
         })?;
-        let slices = ctx.uniform_from_bytes("slices", &SliceParams::from_params(ctx.params).uniform_bytes());
-        Ok(Box::new(SliceRenderNode { pipeline, slices, max_slices: SliceLimits::from_params(ctx.params).max_slices }))
+        let uniforms = UniformBlocks::create(ctx, &self.shaders(ctx.params));
+        Ok(Box::new(SliceRenderNode {
+            pipeline,
+            uniforms,
+            max_slices: SliceLimits::from_params(ctx.params).max_slices,
+        }))
     }
 }
 
 struct SliceRenderNode {
     pipeline: RenderPassPipeline,
-    slices: wgpu::Buffer,
+    uniforms: UniformBlocks,
     max_slices: u32,
 }
 
 impl PassNode for SliceRenderNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
-        let bg = ctx.bind_group(&self.pipeline, &[("slices", self.slices.as_entire_binding())])?;
+        let bg = ctx.bind_group(&self.pipeline, &self.uniforms.bindings())?;
         let mut pass = ctx.begin_render_pass(&self.pipeline, None)?;
         pass.set_pipeline(&self.pipeline.pipeline);
         pass.set_bind_group(0, &bg, &[]);
         pass.draw(0..12, 0..self.max_slices);
         Ok(())
     }
-}
 
-#[cfg(test)]
-mod tests {
-    use super::SliceParams;
-
-    /// The shader's `SliceParams` is the struct `pass_params!` uploads.
-    #[test]
-    fn the_shader_struct_matches_the_declaration() {
-        SliceParams::check_shader(&crate::shared::assembled("slice_render.wgsl"), "SliceParams").expect("same layout");
+    fn update_params(&mut self, gpu: &Gpu, params: &Params) {
+        self.uniforms.write(gpu, params);
     }
 }

@@ -68,7 +68,7 @@ impl PassDecl for TerminationTest {
             .map(|entry| {
                 ShaderUse::new("termination_test.wgsl", entry)
                     .binds(&["segment"])
-                    .uniform(RaycastParamsGpu::bound_as("params"))
+                    .uniform(RaycastParamsGpu::bound("params"))
             })
             .to_vec()
     }

@@ -22,7 +22,7 @@ pub struct TfTable {
 
 /// The two entry points that fill a table of `file`: `cs_table32` and `cs_table16`.
 pub fn table_shaders(file: &'static str) -> [ShaderUse; 2] {
-    let step = || crate::raycast_params::RaycastParamsGpu::bound_as("params");
+    let step = || crate::raycast_params::RaycastParamsGpu::bound("params");
     [
         ShaderUse::new(file, "cs_table32").binds(&["table32"]).uniform(step()),
         ShaderUse::new(file, "cs_table16").binds(&["table16"]).uniform(step()),

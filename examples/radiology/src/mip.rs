@@ -4,7 +4,9 @@
 //! windowed by `level` and `width` like a radiology viewer, alpha 1 where the ray hits the box.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
+use volgraph_core::runtime::{
+    ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, UniformBlocks,
+};
 use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 // volgraph's shared sampling block: the same step, sample count and jitter as its raycasters.
 use volgraph_passes::raycast_params::{RaycastParamsGpu, Sampling};
@@ -26,9 +28,7 @@ volgraph_core::pass_params! {
 /// shader imports `MipParams` as generated, `params/MipParams.wgsl`). Listed by `shaders()`
 /// and built by `create`.
 fn shader() -> ShaderUse {
-    ShaderUse::new("mip.wgsl", "cs_main")
-        .uniform(MipParams::bound_as("mip"))
-        .uniform(RaycastParamsGpu::bound_as("params"))
+    ShaderUse::new("mip.wgsl", "cs_main").uniform(MipParams::bound_as("mip")).uniform(RaycastParamsGpu::bound("params"))
 }
 
 impl PassDecl for Mip {
@@ -61,36 +61,32 @@ impl PassDecl for Mip {
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        self.shader_defines(old) == self.shader_defines(new)
+        self.only_uniforms_change(old, new)
     }
 }
 
 impl PassPlugin for Mip {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let defines = self.shader_defines(ctx.params);
+        let shader = shader();
         let pipeline =
-            ctx.compute_pipeline(&ComputePipelineSpec { defines: &defines, ..ComputePipelineSpec::of(&shader()) })?;
-        let uniform = ctx.uniform_from_bytes("mip", &MipParams::from_params(ctx.params).uniform_bytes());
-        let rays = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());
-        Ok(Box::new(MipNode { pipeline, uniform, rays }))
+            ctx.compute_pipeline(&ComputePipelineSpec { defines: &defines, ..ComputePipelineSpec::of(&shader) })?;
+        Ok(Box::new(MipNode { pipeline, uniforms: UniformBlocks::create(ctx, &[shader]) }))
     }
 }
 
 struct MipNode {
     pipeline: ComputePassPipeline,
-    uniform: wgpu::Buffer,
-    rays: wgpu::Buffer,
+    uniforms: UniformBlocks,
 }
 
 impl PassNode for MipNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
-        let extra = [("mip", self.uniform.as_entire_binding()), ("params", self.rays.as_entire_binding())];
-        ctx.dispatch_over(&self.pipeline, &extra, "color", (8, 8))
+        ctx.dispatch_over(&self.pipeline, &self.uniforms.bindings(), "color", (8, 8))
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
-        gpu.queue.write_buffer(&self.uniform, 0, &MipParams::from_params(params).uniform_bytes());
-        gpu.queue.write_buffer(&self.rays, 0, &RaycastParamsGpu::of(params).uniform_bytes());
+        self.uniforms.write(gpu, params);
     }
 }
 

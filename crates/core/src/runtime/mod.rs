@@ -23,6 +23,7 @@ pub mod record;
 pub mod schedule;
 pub mod shaders;
 pub mod textures;
+pub mod uniforms;
 pub mod upload;
 
 use std::collections::{BTreeMap, HashMap};
@@ -44,6 +45,7 @@ pub use readback::Image;
 pub use record::{RecordContext, SystemBindings};
 pub use schedule::{ApplyError, ApplyReport};
 pub use shaders::ShaderLibrary;
+pub use uniforms::UniformBlocks;
 pub use upload::{
     UploadError, UploadedVolume, VolumeFormat, VolumeTexels, upload_lut, upload_volume, volume_format_for,
 };

@@ -86,7 +86,8 @@ fn leaf_of(c: vec3<f32>) -> vec3<u32> {
 }
 
 // What this dispatch leaps over (common/leap_empty.wgsl): the largest cube of leaves no box to
-// draw covers, and a brick drawn in another batch.
+// draw covers, and a brick drawn in another batch; a leaf to draw reports its box (within its
+// brick), which the march runs to.
 fn empty_region_at(p: vec3<f32>) -> EmptyRegion {
     let c = voxel_of(p);
     let last = max(frame.volume_dims.xyz - vec3<f32>(1.0), vec3<f32>(0.0));
@@ -104,7 +105,11 @@ fn empty_region_at(p: vec3<f32>) -> EmptyRegion {
     let b = brick_of(c);
     let lo = vec3<f32>(b) * f32(bricks.grid.w);
     let hi = min(lo + vec3<f32>(f32(bricks.grid.w)), last);
-    return EmptyRegion(table[1u + brick_index(b)] == 0u, voxel_box_lo(lo), voxel_box_hi(hi));
+    if (table[1u + brick_index(b)] == 0u) {
+        return EmptyRegion(true, voxel_box_lo(lo), voxel_box_hi(hi));
+    }
+    let leaf_lo = vec3<f32>(l) * leaf_cells;
+    return EmptyRegion(false, voxel_box_lo(leaf_lo), voxel_box_hi(min(leaf_lo + vec3<f32>(leaf_cells), hi)));
 }
 
 // The samples of `ray` from colour `start` on, through this batch's bricks: in rounds, like
@@ -114,30 +119,27 @@ fn march_bricks(s: Samples, start: vec4<f32>) -> vec4<f32> {
     var out = start;
     begin_ray(s, 0u);
     let n = frame.volume_dims.xyz;
-    let last = max(n - vec3<f32>(1.0), vec3<f32>(0.0));
     let brick_cells = f32(bricks.grid.w);
-    let leaf_cells = f32(bricks.leaves.x);
+    let inv_atlas = vec3<f32>(1.0) / bricks.atlas.xyz;
+    let delta_atlas = s.delta * n * inv_atlas;
     var k = 0u;
     loop {
-        k = leap(k, s, s.count);
+        let stop = leap_stop(k, s, s.count);
+        k = stop.k;
         if (k >= s.count || out.a >= params.threshold) {
             break;
         }
-        // A leaf to draw, up to where the ray leaves it (or its brick).
+        // A leaf to draw, up to where the ray leaves it (within its brick).
         let p = sample_at(s, k);
-        let c = voxel_of(p);
-        let b = brick_of(c);
-        let lo = vec3<f32>(b) * brick_cells;
-        let hi = min(lo + vec3<f32>(brick_cells), last);
-        let leaf_lo = vec3<f32>(leaf_of(c)) * leaf_cells;
-        let leaf_hi = min(leaf_lo + vec3<f32>(leaf_cells), hi);
-        let exit = min(past_box(k, p, s.delta, voxel_box_lo(leaf_lo), voxel_box_hi(leaf_hi)), s.count);
+        let exit = min(past_box(k, p, s.delta, stop.region.lo, stop.region.hi), s.count);
         // Its samples in the atlas: voxel v of the brick lies at texel origin + 1.5 + (v - lo).
+        let b = brick_of(voxel_of(p));
+        let lo = vec3<f32>(b) * brick_cells;
         let slot = table[1u + brick_index(b)] - 1u;
         let slots = bricks.slots;
         let origin = vec3<f32>(vec3<u32>(slot % slots.x, (slot / slots.x) % slots.y, slot / (slots.x * slots.y)) * bricks.slot_side.xyz);
         let shift = origin + vec3<f32>(1.5) - lo - vec3<f32>(0.5);
-        let atlas = Samples((s.first * n + shift) / bricks.atlas.xyz, s.delta * n / bricks.atlas.xyz, s.count, s.step, s.offset);
+        let atlas = Samples((s.first * n + shift) * inv_atlas, delta_atlas, s.count, s.step, s.offset);
         resume_ray(sample_at(atlas, k) - atlas.delta);
         let m = march_dvr(atlas, k, exit, out);
         out = m.color;

@@ -17,19 +17,32 @@ struct EmptyRegion {
     hi: vec3<f32>,
 }
 
-// The first sample at or after k (before `end`) that may be visible, or `end`.
-fn leap(k_from: u32, s: Samples, end: u32) -> u32 {
+// Where a leap stopped: the first sample at or after the start (before `end`) that may be
+// visible, or `end`, and the region around it the importer reported (not empty), whose box a
+// march over that region can run to (a brick's leaf).
+struct LeapStop {
+    k: u32,
+    region: EmptyRegion,
+}
+
+fn leap_stop(k_from: u32, s: Samples, end: u32) -> LeapStop {
     var k = k_from;
+    var region = EmptyRegion(false, vec3<f32>(0.0), vec3<f32>(0.0));
     loop {
         if (k >= end) {
             break;
         }
         let p = sample_at(s, k);
-        let region = empty_region_at(p);
+        region = empty_region_at(p);
         if (!region.empty) {
             break;
         }
         k = past_box(k, p, s.delta, region.lo, region.hi);
     }
-    return min(k, end);
+    return LeapStop(min(k, end), region);
+}
+
+// The first sample at or after k (before `end`) that may be visible, or `end`.
+fn leap(k_from: u32, s: Samples, end: u32) -> u32 {
+    return leap_stop(k_from, s, end).k;
 }

@@ -48,7 +48,8 @@ impl PassDecl for Raycast {
     }
 
     fn summary(&self) -> &'static str {
-        "single-pass fragment raycaster, DVR or first-hit isosurface (Krüger–Westermann 2003 §2.1–2.2)"
+        "single-pass fragment raycaster, DVR or first-hit isosurface, optionally analytic rays, empty-space leaping, \
+         Klein's start estimates and leap hits, sample counting (Krüger–Westermann 2003 §2.1–2.3; Klein et al. 2005 §4.2)"
     }
 
     fn params(&self) -> Vec<ParamSpec> {

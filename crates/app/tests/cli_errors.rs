@@ -105,6 +105,29 @@ fn plan_catches_a_shader_binding_that_matches_no_port() {
     );
 }
 
+/// Code a wired input compiles in is checked at plan time too: the single-pass renderer with
+/// `empty` wired leaps (`#if LEAP`), so a misnamed global inside the leap code is a plan error,
+/// not a failure at the first frame.
+#[test]
+fn plan_checks_the_code_a_wired_input_compiles_in() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let dir = std::env::temp_dir().join(format!("volgraph_plan_wired_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    copy_dir(&root.join("shaders"), &dir.join("shaders"));
+    std::fs::copy(root.join("graphs/modern/single_pass_ess_ert.ron"), dir.join("ess.ron")).expect("copy");
+    let shader = dir.join("shaders/common/pixel_march.wgsl");
+    let text = std::fs::read_to_string(&shader).expect("read");
+    let renamed = text
+        .replace("var<uniform> blocks: BlockSize;", "var<uniform> block_edges: BlockSize;")
+        .replace("return blocks.block_size;", "return block_edges.block_size;");
+    assert_ne!(renamed, text, "the shader has the global this test renames");
+    std::fs::write(&shader, renamed).expect("write");
+    let (code, err) = volgraph(&["plan", &dir.join("ess.ron").display().to_string()]);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("pass \"march\" (raycast): raycast.wgsl: global \"block_edges\" is neither a port"), "{err}");
+}
+
 fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
     std::fs::create_dir_all(to).expect("mkdir");
     for entry in std::fs::read_dir(from).expect("read_dir") {

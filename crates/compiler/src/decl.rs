@@ -276,12 +276,17 @@ pub struct ShaderUse {
     /// struct for each must have these members in this order (a swapped struct is an error, not
     /// an image of zeros).
     pub uniforms: Vec<UniformLayout>,
+    /// `#if` names this use is assembled with beyond the pass's
+    /// [`PassDecl::shader_defines`]: code a wired input compiles into this entry point alone
+    /// (the raycasters' leap over a wired `empty` or `distance`, Klein's `start`), declared in
+    /// `shaders_wired` so `volgraph plan` checks the code the node builds.
+    pub defines: Vec<&'static str>,
 }
 
 impl ShaderUse {
     /// Entry point `entry_point` of `file`, binding nothing of its own yet.
     pub const fn new(file: &'static str, entry_point: &'static str) -> Self {
-        Self { file, entry_point, extra: &[], uniforms: Vec::new() }
+        Self { file, entry_point, extra: &[], uniforms: Vec::new(), defines: Vec::new() }
     }
 
     /// With `names` bound by the node that are not uniform blocks (tables, storage it owns).
@@ -293,6 +298,12 @@ impl ShaderUse {
     /// With the uniform block `layout` (from a `pass_params!` struct's `bound_as`).
     pub fn uniform(mut self, layout: UniformLayout) -> Self {
         self.uniforms.push(layout);
+        self
+    }
+
+    /// With the `#if` names `defines` on for this use ([`Self::defines`]).
+    pub fn defines(mut self, defines: Vec<&'static str>) -> Self {
+        self.defines = defines;
         self
     }
 

@@ -85,8 +85,8 @@ pub fn march_ports(params: &Params) -> Vec<PortSpec> {
     ports
 }
 
-/// The `#if` names of `params`' march that a plan can know (the empty-space ones depend on the
-/// wiring and come from [`Leaping::defines`]).
+/// The `#if` names of `params`' march that do not depend on the wiring (those that do:
+/// [`wired_defines`]).
 pub fn march_defines(params: &Params) -> Vec<&'static str> {
     let settings = MarchSettings::from_params(params);
     let mut defines = Vec::new();
@@ -117,6 +117,39 @@ enum Source {
     },
 }
 
+impl Source {
+    /// From the settings and the wired ports; `None` when both inputs are wired.
+    fn of(params: &Params, wired: &[&str]) -> Option<Self> {
+        let leap = MarchSettings::from_params(params).leap;
+        Some(match (wired.contains(&"empty"), wired.contains(&"distance"), leap) {
+            (true, true, _) => return None,
+            (_, _, Leap::None) | (false, false, _) => Source::None,
+            (true, false, _) => Source::Blocks,
+            (false, true, leap) => Source::Distance { cubes: leap == Leap::Cubes },
+        })
+    }
+
+    /// The `#if` names of the leap (LEAP and the input's provider).
+    fn defines(self) -> Vec<&'static str> {
+        match self {
+            Source::None => vec![],
+            Source::Blocks => vec!["LEAP", "LEAP_BLOCKS"],
+            Source::Distance { .. } => vec!["LEAP", "LEAP_CUBES"],
+        }
+    }
+}
+
+/// The `#if` names the wiring adds to the shared march: the leap over the wired empty-space
+/// input, START for a wired `start` estimate (both empty-space inputs wired: no leap; node
+/// creation reports it).
+pub fn wired_defines(params: &Params, wired: &[&str]) -> Vec<&'static str> {
+    let mut defines = Source::of(params, wired).map(Source::defines).unwrap_or_default();
+    if wired.contains(&"start") {
+        defines.push("START");
+    }
+    defines
+}
+
 /// A node's empty-space leaping: the input it reads, the block-edge uniform `blocks`, the
 /// defines and constants its pipeline is built with, and the grid check every frame.
 pub struct Leaping {
@@ -130,31 +163,14 @@ impl Leaping {
     /// From the node's wiring and settings; both inputs wired is an error.
     pub fn new(ctx: &CreateContext<'_>) -> Result<Self, PassError> {
         let settings = MarchSettings::from_params(ctx.params);
-        let wired = |port: &str| ctx.port(port).is_some_and(|p| p.bound);
-        let source = match (wired("empty"), wired("distance"), settings.leap) {
-            (true, true, _) => {
-                return Err(PassError {
-                    pass: ctx.pass_id.to_string(),
-                    message: "both \"empty\" and \"distance\" are wired; wire one empty-space input".into(),
-                });
-            }
-            (_, _, Leap::None) | (false, false, _) => Source::None,
-            (true, false, _) => Source::Blocks,
-            (false, true, leap) => Source::Distance { cubes: leap == Leap::Cubes },
-        };
+        let source = Source::of(ctx.params, &ctx.wired()).ok_or_else(|| PassError {
+            pass: ctx.pass_id.to_string(),
+            message: "both \"empty\" and \"distance\" are wired; wire one empty-space input".into(),
+        })?;
         let block_size = BlockSize::of(ctx.params);
         let blocks = (source != Source::None)
             .then(|| ctx.uniform_from_bytes("blocks", &BlockSize { block_size }.uniform_bytes()));
         Ok(Self { source, check_every: settings.check_every.max(1), block_size, blocks })
-    }
-
-    /// The `#if` names of the leap (LEAP and the input's provider).
-    pub fn defines(&self) -> Vec<&'static str> {
-        match self.source {
-            Source::None => vec![],
-            Source::Blocks => vec!["LEAP", "LEAP_BLOCKS"],
-            Source::Distance { .. } => vec!["LEAP", "LEAP_CUBES"],
-        }
     }
 
     /// The pipeline constants of the leap.

@@ -22,7 +22,7 @@ use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, Rende
 use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::effects::{EffectFlags, EffectState, effect_defines, same_effects};
-use crate::march::{Leaping, MarchSettings, march_defines, march_ports, march_specs, same_march};
+use crate::march::{Leaping, MarchSettings, march_defines, march_ports, march_specs, same_march, wired_defines};
 use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
 use crate::shared::BlockSize;
 
@@ -64,6 +64,12 @@ impl PassDecl for Raycast {
         defines
     }
 
+    fn shaders_wired(&self, params: &Params, wired: &[&str]) -> Vec<ShaderUse> {
+        let mut uses = self.shaders(params);
+        uses[0] = uses[0].clone().defines(wired_defines(params, wired));
+        uses
+    }
+
     fn ports(&self, params: &Params) -> Vec<PortSpec> {
         let own = RaycastOwn::from_params(params);
         let mut ports = raycast_ports(
@@ -100,12 +106,8 @@ impl PassDecl for Raycast {
 impl PassPlugin for Raycast {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let fragment = fragment_entry(ctx.params);
-        let mut defines = self.shader_defines(ctx.params);
-        if ctx.port("start").is_some_and(|p| p.bound) {
-            defines.push("START");
-        }
+        let defines = [self.shader_defines(ctx.params), wired_defines(ctx.params, &ctx.wired())].concat();
         let leaping = Leaping::new(ctx)?;
-        defines.extend(leaping.defines());
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
             shader: "raycast.wgsl",
             vertex: "vs_fullscreen",

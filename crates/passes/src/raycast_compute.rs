@@ -22,7 +22,7 @@ use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateCon
 use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortSpec, TargetFormat};
 
 use crate::effects::{EffectFlags, EffectState, effect_defines, same_effects};
-use crate::march::{Leaping, MarchSettings, march_defines, march_specs, same_march};
+use crate::march::{Leaping, MarchSettings, march_defines, march_specs, same_march, wired_defines};
 use crate::opacity_lut::{opacity_table, table_shader_uses};
 use crate::raycast::raycast_ports;
 use crate::raycast_params::{RaycastParamsGpu, Sampling, Workgroup, is_iso, raycast_param_specs};
@@ -83,6 +83,13 @@ impl PassDecl for RaycastCompute {
         defines
     }
 
+    fn shaders_wired(&self, params: &Params, wired: &[&str]) -> Vec<ShaderUse> {
+        // The march's own use gets the wired leap; the table shaders do not march.
+        let mut uses = self.shaders(params);
+        uses[0] = uses[0].clone().defines(wired_defines(params, wired));
+        uses
+    }
+
     fn ports(&self, params: &Params) -> Vec<PortSpec> {
         // Storage formats: rgba16float or (a scene's f32 precision) rgba32float colour, chosen by
         // a shader define; rgba32float hits.
@@ -121,8 +128,7 @@ impl PassPlugin for RaycastCompute {
         let sampling = Sampling::from_params(ctx.params);
         let leaping = Leaping::new(ctx)?;
         let table = uses_table(ctx.params).then(|| opacity_table(ctx)).transpose()?;
-        let mut defines = self.shader_defines(ctx.params);
-        defines.extend(leaping.defines());
+        let mut defines = [self.shader_defines(ctx.params), wired_defines(ctx.params, &ctx.wired())].concat();
         if color_is_f32(ctx) {
             defines.push("COLOR_F32");
         }

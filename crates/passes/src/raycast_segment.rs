@@ -154,6 +154,12 @@ impl PassDecl for RaycastSegment {
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
         crate::effects::jitter_defines(params)
     }
+
+    fn shaders_wired(&self, params: &Params, wired: &[&str]) -> Vec<ShaderUse> {
+        // §2.3 inside the segment: the shared march leaps over the wired block flags.
+        let leap: Vec<&'static str> = if wired.contains(&"empty") { vec!["LEAP", "LEAP_BLOCKS"] } else { vec![] };
+        self.shaders(params).into_iter().map(|u| u.defines(leap.clone())).collect()
+    }
 }
 
 impl PassPlugin for RaycastSegment {
@@ -185,7 +191,7 @@ impl PassPlugin for RaycastSegment {
             }
             (false, entry) => entry,
         };
-        let mut defines = crate::effects::jitter_defines(ctx.params);
+        let mut defines = self.shader_defines(ctx.params);
         if leap {
             defines.extend(["LEAP", "LEAP_BLOCKS"]);
         }

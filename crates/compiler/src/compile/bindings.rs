@@ -32,7 +32,6 @@ pub fn check_plan_bindings(plan: &Plan, registry: &dyn KindLookup, sources: &Sha
             continue;
         }
         let Some(plugin) = registry.decl(&step.kind) else { continue };
-        let defines: BTreeSet<String> = plugin.shader_defines(&step.params).into_iter().map(str::to_string).collect();
         let ports: Vec<PortInfo> = port_infos(plan, step, &plugin.ports(&step.params));
         let wired: Vec<&str> = step
             .ports
@@ -40,10 +39,13 @@ pub fn check_plan_bindings(plan: &Plan, registry: &dyn KindLookup, sources: &Sha
             .filter(|bp| bp.binding != crate::plan::Binding::Unbound)
             .map(|bp| bp.port.as_str())
             .collect();
+        let defines: BTreeSet<String> = plugin.shader_defines(&step.params).into_iter().map(str::to_string).collect();
         for shader in plugin.shaders_wired(&step.params, &wired) {
             let problem = |message: String| {
                 Diagnostic::new(Location::File, format!("pass \"{}\" ({}): {message}", step.pass_id, step.kind))
             };
+            let mut defines = defines.clone();
+            defines.extend(shader.defines.iter().map(|d| d.to_string()));
             let source = match assemble_with(sources, shader.file, &defines) {
                 Ok(s) => s,
                 Err(e) => {

@@ -287,6 +287,12 @@ impl<'a> CreateContext<'a> {
         PassError { pass: self.pass_id.to_string(), message }
     }
 
+    /// The names of the ports the graph wires (what `shaders_wired` / `shader_defines_wired`
+    /// take).
+    pub fn wired(&self) -> Vec<&str> {
+        self.ports.iter().filter(|p| p.bound).map(|p| p.name.as_str()).collect()
+    }
+
     /// The port named `name`.
     pub fn port(&self, name: &str) -> Option<&PortInfo> {
         self.ports.iter().find(|p| p.name == name)

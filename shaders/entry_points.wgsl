@@ -23,7 +23,7 @@ struct EntryOut {
 // Front faces: the entry point (u, 1).
 @fragment
 fn fs_entry(in: BoxVertex) -> EntryOut {
-    return EntryOut(vec4<f32>(clamp(in.u, vec3<f32>(0.0), vec3<f32>(1.0)), 1.0));
+    return EntryOut(vec4<f32>(clamp(in.u, grid_box_lo(), grid_box_hi()), 1.0));
 }
 
 // The near-plane point of the ray through this pixel's centre, (u, 1), or discard when it lies
@@ -34,7 +34,7 @@ fn fs_near_plane(in: FullscreenVertex) -> EntryOut {
     let ndc = vec2<f32>(2.0 * in.clip.x * frame.viewport.z - 1.0, 1.0 - 2.0 * in.clip.y * frame.viewport.w);
     let p = frame.world_from_clip * vec4<f32>(ndc, 0.0, 1.0);
     let u = texture_from_world(p.xyz / p.w);
-    if (any(u < vec3<f32>(0.0)) || any(u > vec3<f32>(1.0))) {
+    if (any(u < grid_box_lo()) || any(u > grid_box_hi())) {
         discard;
     }
     return EntryOut(vec4<f32>(u, 1.0));

@@ -23,7 +23,7 @@ struct DirOut {
 @fragment
 fn fs_dir(in: BoxVertex) -> DirOut {
     let e = textureLoad(entry, vec2<i32>(in.clip.xy), 0);
-    let exit = clamp(in.u, vec3<f32>(0.0), vec3<f32>(1.0));
+    let exit = clamp(in.u, grid_box_lo(), grid_box_hi());
     let delta = exit - e.xyz;
     let len = length(delta);
     if (e.w == 0.0 || !(len >= MIN_RAY_LENGTH_TEX)) {

@@ -33,9 +33,21 @@ struct Frame {
     history_age: u32,
     _pad0: u32,
     _pad1: u32,
+    // Sort-last windows (docs/scaling.md): the box rays are met with, whose entry anchors the
+    // step grid, and the box whose samples this frame takes, both in texture space. grid_lo.w =
+    // 1 when the bound volume is a window of a larger one; otherwise both boxes are [0,1]³.
+    grid_lo: vec4<f32>,
+    grid_hi: vec4<f32>,
+    own_lo: vec4<f32>,
+    own_hi: vec4<f32>,
 }
 
 @group(0) @binding(auto) var<uniform> frame: Frame;
+
+// True when the bound volume is a window of a larger one (sort-last rendering).
+fn is_window() -> bool {
+    return frame.grid_lo.w != 0.0;
+}
 
 // World position -> texture-space position (docs/rendering_model.md "Volume and world space").
 fn texture_from_world(p: vec3<f32>) -> vec3<f32> {

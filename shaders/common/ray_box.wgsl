@@ -5,11 +5,43 @@
 
 #import "common/frame.wgsl"
 
-// A pixel's ray in texture space; `len = 0` for no ray.
+// A pixel's ray in texture space; `len = 0` for no ray. `u0` is where it enters the box (the
+// step grid's anchor); its samples lie between `begin` and `len` from there: `begin` is 0 but in
+// a sort-last window (frame.grid_lo.w), where the ray is met with the whole volume's box and
+// this process takes only the samples in its own box (`own_segment`).
 struct Ray {
     u0: vec3<f32>,
     d: vec3<f32>,
     len: f32,
+    begin: f32,
+}
+
+// The part [t_in, t_out] of the line eye + t·dir (any parameter) inside the box [lo, hi]; empty
+// when t_in > t_out. An axis the line runs parallel to bounds it only when the eye is outside
+// that slab.
+fn box_span(eye: vec3<f32>, dir: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> vec2<f32> {
+    let far = vec3<f32>(3.0e38);
+    let parallel = dir == vec3<f32>(0.0);
+    let inv = 1.0 / select(dir, vec3<f32>(1.0), parallel);
+    let ta = (lo - eye) * inv;
+    let tb = (hi - eye) * inv;
+    let inside = (eye >= lo) & (eye <= hi);
+    let t_lo = select(min(ta, tb), select(far, -far, inside), parallel);
+    let t_hi = select(max(ta, tb), select(-far, far, inside), parallel);
+    return vec2<f32>(max(t_lo.x, max(t_lo.y, t_lo.z)), min(t_hi.x, min(t_hi.y, t_hi.z)));
+}
+
+// `ray` (met with the grid box) cut to this frame's own box: samples from `begin` to `len`. The
+// identity outside a sort-last window. A cut ray keeps its entry `u0`, so every process's
+// samples lie on the one step grid and each sample belongs to the one box that holds it.
+fn own_segment(ray: Ray) -> Ray {
+    if (!is_window() || !(ray.len > 0.0)) {
+        return ray;
+    }
+    let span = box_span(ray.u0, ray.d, frame.own_lo.xyz, frame.own_hi.xyz);
+    let begin = max(span.x, 0.0);
+    let end = min(span.y, ray.len);
+    return Ray(ray.u0, ray.d, select(0.0, end, begin < end), begin);
 }
 
 // The ray of pixel centre `pixel` clipped to the box and the near plane, as
@@ -37,23 +69,17 @@ fn analytic_ray_at(at: vec2<f32>) -> Ray {
 // clipped to the box and the near plane like `analytic_ray`.
 fn analytic_ray_along(dir: vec3<f32>) -> Ray {
     let eye = frame.eye_texture.xyz;
-    let far = vec3<f32>(3.0e38);
-    let parallel = dir == vec3<f32>(0.0);
-    let inv = 1.0 / select(dir, vec3<f32>(1.0), parallel);
-    let ta = -eye * inv;
-    let tb = (vec3<f32>(1.0) - eye) * inv;
-    // An axis the ray runs parallel to: no constraint when the eye is within the slab, else no ray.
-    let inside = (eye >= vec3<f32>(0.0)) & (eye <= vec3<f32>(1.0));
-    let lo = select(min(ta, tb), select(far, -far, inside), parallel);
-    let hi = select(max(ta, tb), select(-far, far, inside), parallel);
-    let t_in = max(lo.x, max(lo.y, lo.z));
-    let t_out = min(hi.x, min(hi.y, hi.z));
+    let lo = select(vec3<f32>(0.0), frame.grid_lo.xyz, is_window());
+    let hi = select(vec3<f32>(1.0), frame.grid_hi.xyz, is_window());
+    let span = box_span(eye, dir, lo, hi);
+    let t_in = span.x;
+    let t_out = span.y;
     let t0 = max(t_in, frame.camera_forward.w);
-    let u0 = clamp(eye + t0 * dir, vec3<f32>(0.0), vec3<f32>(1.0));
-    let u1 = clamp(eye + t_out * dir, vec3<f32>(0.0), vec3<f32>(1.0));
+    let u0 = clamp(eye + t0 * dir, lo, hi);
+    let u1 = clamp(eye + t_out * dir, lo, hi);
     let len = length(u1 - u0);
     let hit = t_in <= t_out && t0 < t_out && len >= 1e-6;
-    return Ray(u0, select(vec3<f32>(0.0, 0.0, 1.0), (u1 - u0) / len, hit), select(0.0, len, hit));
+    return own_segment(Ray(u0, select(vec3<f32>(0.0, 0.0, 1.0), (u1 - u0) / len, hit), select(0.0, len, hit), 0.0));
 }
 
 // The texture-space length of a step of `step_voxels` voxels along unit texture-space direction
@@ -78,13 +104,17 @@ struct Samples {
     offset: f32,
 }
 
-// The samples of `ray` a step of `step_tex` apart: k = 0.. with (k + 0.5 + jitter) · step_tex <
-// len, at most `max_count`.
+// The samples of `ray` a step of `step_tex` apart: those of the grid k = 0.. with
+// (k + 0.5 + jitter) · step_tex in [begin, len), k below `max_count`; sample 0 of the result is
+// the first of them (`offset` counts the grid steps before it, so distances from the entry keep
+// their meaning).
 fn samples_along(ray: Ray, step_tex: f32, jitter: f32, max_count: u32) -> Samples {
     let delta = ray.d * step_tex;
-    let offset = 0.5 + jitter;
-    let count = u32(clamp(ceil(ray.len / step_tex - offset), 0.0, f32(max_count)));
-    return Samples(ray.u0 + offset * delta, delta, count, step_tex, offset);
+    let grid_offset = 0.5 + jitter;
+    let end = clamp(ceil(ray.len / step_tex - grid_offset), 0.0, f32(max_count));
+    let skipped = clamp(ceil(ray.begin / step_tex - grid_offset), 0.0, end);
+    let offset = grid_offset + skipped;
+    return Samples(ray.u0 + offset * delta, delta, u32(end - skipped), step_tex, offset);
 }
 
 // Sample k's texture-space position.

@@ -13,6 +13,7 @@ pub mod generate;
 pub mod histogram;
 pub mod image_diff;
 pub mod input_file;
+pub mod kd_split;
 pub mod load;
 pub mod minmax;
 pub mod mip;

@@ -21,6 +21,16 @@ pub struct Cli {
     command: Command,
 }
 
+impl Cli {
+    /// The arguments of a `render` command line (`None` for another command).
+    pub fn into_render_args(self) -> Option<crate::render::RenderArgs> {
+        match self.command {
+            Command::Render(args) => Some(args),
+            _ => None,
+        }
+    }
+}
+
 /// The subcommands every volgraph program has (a plugin's binary too, `crate::main_with`).
 #[derive(Subcommand, Debug)]
 enum Command {
@@ -122,6 +132,14 @@ pub enum CliError {
 impl From<anyhow::Error> for CliError {
     fn from(e: anyhow::Error) -> Self {
         CliError::Other(e)
+    }
+}
+
+/// The text of an error as the CLI prints it (graph diagnostics as `file:line:col: message`).
+pub fn error_text(e: &CliError) -> String {
+    match e {
+        CliError::Graph(diagnostics) => diagnostics.to_string(),
+        CliError::Other(e) => format!("{e:#}"),
     }
 }
 
@@ -229,6 +247,7 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
 /// Runs a parsed command line.
 pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
+        Command::Render(args) if args.distributed => crate::distributed::launch(),
         Command::Plan { .. } | Command::Render(_) => match check(cli)? {
             Checked::Plan { text, notes } => {
                 for note in notes {

@@ -9,6 +9,7 @@ pub mod builtin_graphs;
 pub mod cli;
 #[cfg(test)]
 mod cli_fuzz;
+pub mod distributed;
 pub mod forward;
 #[cfg(test)]
 mod fuzz_runner;

@@ -33,6 +33,17 @@ pub struct RenderArgs {
     /// Where to write the image (.png or .exr).
     #[arg(short = 'o', long = "out")]
     pub out: PathBuf,
+    /// Sort-last rendering over MPI: run under `mpirun -n N` (a build with `--features mpi`);
+    /// each rank reads and renders its box of `--volume` (a .raw file) and rank 0 writes the
+    /// composited image. See docs/scaling.md.
+    #[arg(long)]
+    pub distributed: bool,
+    /// How --distributed ranks composite their images.
+    #[arg(long, value_enum, default_value = "radix-k", requires = "distributed")]
+    pub composite: crate::distributed::CompositeAlgorithm,
+    /// The largest group of a radix-k round (IceT's default: 8; 2 is binary swap).
+    #[arg(long = "radix-k", default_value_t = 8, value_parser = clap::value_parser!(u32).range(2..=64), requires = "distributed")]
+    pub radix_k: u32,
 }
 
 /// Everything `render` needs, read and checked, before the GPU is opened.

@@ -47,6 +47,16 @@ pub enum LoadError {
         source: std::io::Error,
     },
 
+    /// A format whose boxes cannot be read on their own (sort-last rendering reads each
+    /// process's box of the file).
+    #[error("{}: {format} files cannot be read a box at a time yet; `render --distributed` reads headerless .raw files: write the voxels out as name_XxYxZ_dtype.raw", .path.display())]
+    NoBoxRead {
+        /// The file.
+        path: PathBuf,
+        /// Its format.
+        format: &'static str,
+    },
+
     /// The path is a directory, a FIFO, a socket or a device rather than a file.
     #[error("{}: is {what}, not a volume file; give the path of a .raw, .nrrd, .nhdr, .mhd, .mha, .nii or .nii.gz file, or a folder of DICOM slices", .path.display())]
     NotAFile {

@@ -22,6 +22,7 @@ pub mod nifti;
 mod nrrd;
 mod orientation;
 mod raw;
+mod region;
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -31,6 +32,7 @@ use glam::{DVec3, UVec3};
 pub use error::{LoadError, Location};
 pub use orientation::AxisOrientation;
 pub use raw::parse_raw_name;
+pub use region::VolumeHeader;
 
 use crate::volume::{Volume, VoxelData, VoxelType, finite_range};
 

@@ -46,6 +46,17 @@ pub fn parse_raw_name(file_name: &str) -> Option<(String, [u64; 3], Option<Strin
 }
 
 pub(super) fn load(path: &Path, opts: &RawOptions) -> Result<LoadedVolume, LoadError> {
+    let layout = layout(path, opts)?;
+    let bytes = read_file(path)?;
+    finish(layout, &bytes, path, LoadReport::new(VolumeFormat::Raw, path), HINT)
+}
+
+const HINT: &str = "check the dimensions and type in the file name (name_XxYxZ_dtype.raw), or give them with \
+                    --dims XxYxZ --dtype TYPE (RawOptions::dims and ::dtype in code)";
+
+/// The layout of raw file `path` from its name or `opts`, its size checked against it; reads
+/// no voxels.
+pub(super) fn layout(path: &Path, opts: &RawOptions) -> Result<Layout, LoadError> {
     let at = Location::file(path);
     let file_name = path.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     let parsed = parse_raw_name(&file_name);
@@ -69,8 +80,7 @@ pub(super) fn load(path: &Path, opts: &RawOptions) -> Result<LoadedVolume, LoadE
         };
     let dims = check_dims(&at, "dims", &format!("{}x{}x{}", dims[0], dims[1], dims[2]), dims)?;
     let expected = byte_count(dims, dtype).unwrap_or(u64::MAX);
-    let hint = "check the dimensions and type in the file name (name_XxYxZ_dtype.raw), or give them with \
-                --dims XxYxZ --dtype TYPE (RawOptions::dims and ::dtype in code)";
+    let hint = HINT;
     // Compare sizes before reading, so a wrong name never makes us read a huge file for nothing.
     let actual = std::fs::metadata(path).map_err(|source| LoadError::Io { path: path.to_path_buf(), source })?.len();
     if actual != expected {
@@ -83,8 +93,5 @@ pub(super) fn load(path: &Path, opts: &RawOptions) -> Result<LoadedVolume, LoadE
             hint,
         });
     }
-    let bytes = read_file(path)?;
-    let layout =
-        Layout { name, dims, dtype, order: opts.endianness, spacing: DVec3::ONE, orientation: Default::default() };
-    finish(layout, &bytes, path, LoadReport::new(VolumeFormat::Raw, path), hint)
+    Ok(Layout { name, dims, dtype, order: opts.endianness, spacing: DVec3::ONE, orientation: Default::default() })
 }

@@ -37,6 +37,20 @@ impl CameraData {
     }
 }
 
+impl CameraData {
+    /// The same camera in a world moved by `offset` (every point p becomes p + offset): what a
+    /// process holding a window of the volume sees, its box centred at its own origin.
+    pub fn translated(&self, offset: DVec3) -> Self {
+        let moved_from = DMat4::from_translation(-offset);
+        Self {
+            clip_from_world: self.clip_from_world * moved_from,
+            world_from_clip: DMat4::from_translation(offset) * self.world_from_clip,
+            eye: self.eye + offset,
+            ..*self
+        }
+    }
+}
+
 /// What the frame contract knows of the bound volume.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct VolumeDesc {
@@ -49,6 +63,53 @@ pub struct VolumeDesc {
     /// The transfer function's opacity is per this many voxel units of distance (the scene's
     /// opacity reference length): 1 for "per voxel", `1 / unit_step` for "per world unit".
     pub opacity_unit_voxels: f64,
+    /// Where the bound voxels sit in a larger volume ([`VolumeWindow`]); `None` for a whole
+    /// volume.
+    pub window: Option<WindowBoxes>,
+}
+
+/// The bound voxels are a sub-box of a larger volume: sort-last rendering (`docs/scaling.md`),
+/// where each process holds its box of the volume plus the apron its filters reach into.
+/// Voxel coordinates of the whole volume; boxes are half-open `[lo, hi)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct VolumeWindow {
+    /// The whole volume's voxels per axis.
+    pub whole_dims: UVec3,
+    /// The whole volume's voxel spacing per axis (its world size follows from it).
+    pub whole_spacing: [u64; 3],
+    /// The first voxel the bound texture holds (its dims are the bound volume's).
+    pub origin: UVec3,
+    /// The box whose samples this process takes: every sample of a ray belongs to exactly one
+    /// process's box, so the images composite to the single-process one.
+    pub own_lo: UVec3,
+    /// See `own_lo`.
+    pub own_hi: UVec3,
+}
+
+impl VolumeWindow {
+    /// The whole volume's spacing.
+    pub fn spacing(&self) -> DVec3 {
+        DVec3::from_array(self.whole_spacing.map(f64::from_bits))
+    }
+
+    /// A window over `whole_dims` voxels of `spacing`.
+    pub fn new(whole_dims: UVec3, spacing: DVec3, origin: UVec3, own_lo: UVec3, own_hi: UVec3) -> Self {
+        Self { whole_dims, whole_spacing: spacing.to_array().map(f64::to_bits), origin, own_lo, own_hi }
+    }
+}
+
+/// A window's boxes in the bound texture's coordinates (`[0,1]³` is the bound texture) and the
+/// world offset of the bound box's centre from the whole volume's.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WindowBoxes {
+    /// The whole volume's box: rays are met with it, so every process's samples lie on the
+    /// step grid of the single-process march.
+    pub grid: (DVec3, DVec3),
+    /// The box whose samples this process takes.
+    pub own: (DVec3, DVec3),
+    /// World position of the bound box's centre in the whole volume's world (whose centre is
+    /// the origin); cameras are moved by minus this.
+    pub centre_world: DVec3,
 }
 
 /// What a transfer function's opacity is per (a scene setting).
@@ -71,6 +132,33 @@ impl VolumeDesc {
             half_extent: volume.half_extent_world(),
             unit_step: volume.unit_step_world(),
             opacity_unit_voxels: 1.0,
+            window: None,
+        }
+    }
+
+    /// The description of `dims` bound voxels that are `window` of a larger volume: world sizes
+    /// are the whole volume's (its longest side 1), the boxes are in the bound texture's
+    /// coordinates.
+    pub fn of_window(dims: UVec3, window: &VolumeWindow) -> Self {
+        let whole = window.whole_dims.as_dvec3();
+        let extent = whole * window.spacing();
+        let scale = 1.0 / extent.max_element();
+        let whole_half = extent * scale / 2.0;
+        let voxel_world = window.spacing() * scale;
+        let n = dims.as_dvec3().max(DVec3::ONE);
+        let origin = window.origin.as_dvec3();
+        let local = |v: DVec3| (v - origin) / n;
+        let centre = (origin + 0.5 * dims.as_dvec3()) * voxel_world - whole_half;
+        Self {
+            dims,
+            half_extent: dims.as_dvec3() * voxel_world / 2.0,
+            unit_step: voxel_world.min_element(),
+            opacity_unit_voxels: 1.0,
+            window: Some(WindowBoxes {
+                grid: (local(DVec3::ZERO), local(whole)),
+                own: (local(window.own_lo.as_dvec3()), local(window.own_hi.as_dvec3())),
+                centre_world: centre,
+            }),
         }
     }
 
@@ -88,7 +176,9 @@ impl VolumeDesc {
     /// it as the scene value [`LONGEST_RAY_VOXELS`] (K of Krüger & Westermann 2003 §3 is this
     /// over the step); 0 for a degenerate volume.
     pub fn longest_ray_voxels(&self) -> f64 {
-        let k = 2.0 * self.half_extent.length() / self.unit_step;
+        // A window's rays cross the whole volume's box.
+        let box_size = self.window.map_or(DVec3::ONE, |w| w.grid.1 - w.grid.0);
+        let k = 2.0 * (self.half_extent * box_size).length() / self.unit_step;
         if k.is_finite() && k > 0.0 { k } else { 0.0 }
     }
 }
@@ -191,9 +281,19 @@ pub struct FrameUniforms {
     pub history_age: u32,
     /// Padding to 16 bytes.
     pub _pad: [u32; 2],
+    /// The box rays are met with, whose entry anchors the step grid (xyz, texture space); w = 1
+    /// when the bound voxels are a window of a larger volume ([`VolumeWindow`]), else 0 and
+    /// the boxes are `[0,1]³`.
+    pub grid_lo: [f32; 4],
+    /// See `grid_lo`.
+    pub grid_hi: [f32; 4],
+    /// The box whose samples this frame takes (xyz, texture space).
+    pub own_lo: [f32; 4],
+    /// See `own_lo`.
+    pub own_hi: [f32; 4],
 }
 
-const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 352);
+const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 416);
 
 fn mat(m: DMat4) -> [[f32; 4]; 4] {
     m.as_mat4().to_cols_array_2d()
@@ -207,7 +307,10 @@ impl FrameUniforms {
             Some(v) => (v.half_extent, v.unit_step, v.dims.as_dvec3(), v.opacity_unit_voxels),
             None => (DVec3::splat(0.5), 1.0, DVec3::ONE, 1.0),
         };
-        let eye_inside = c.eye.abs().cmple(half).all();
+        let window = frame.volume.and_then(|v| v.window);
+        let (grid, own) = window.map_or(((DVec3::ZERO, DVec3::ONE), (DVec3::ZERO, DVec3::ONE)), |w| (w.grid, w.own));
+        let eye_texture = c.eye / (2.0 * half) + DVec3::splat(0.5);
+        let eye_inside = eye_texture.cmpge(grid.0).all() && eye_texture.cmple(grid.1).all();
         let (w, h) = (frame.viewport.0.max(1) as f32, frame.viewport.1.max(1) as f32);
         let ray = PixelRays::of(c, frame.viewport, half);
         let v4 = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32, 0.0];
@@ -220,15 +323,23 @@ impl FrameUniforms {
             volume_dims: [dims.x as f32, dims.y as f32, dims.z as f32, opacity_unit as f32],
             viewport: [w, h, 1.0 / w, 1.0 / h],
             camera_forward: [c.forward.x as f32, c.forward.y as f32, c.forward.z as f32, c.near as f32],
-            eye_texture: v4(c.eye / (2.0 * half) + DVec3::splat(0.5)),
+            eye_texture: v4(eye_texture),
             ray_base_texture: v4(ray.base),
             ray_dx_texture: v4(ray.dx),
             ray_dy_texture: v4(ray.dy),
             frame_index: frame.frame_index as u32,
             history_age: frame.history_age.min(u32::MAX as u64) as u32,
             _pad: [0; 2],
+            grid_lo: with_w(grid.0, if window.is_some() { 1.0 } else { 0.0 }),
+            grid_hi: with_w(grid.1, 0.0),
+            own_lo: with_w(own.0, 0.0),
+            own_hi: with_w(own.1, 0.0),
         }
     }
+}
+
+fn with_w(v: DVec3, w: f32) -> [f32; 4] {
+    [v.x as f32, v.y as f32, v.z as f32, w]
 }
 
 #[cfg(test)]

@@ -35,7 +35,8 @@ pub use create::{
     PipelineKind, PortInfo, RenderPassPipeline, RenderPipelineSpec,
 };
 pub use frame::{
-    CameraData, FrameData, FrameUniforms, LONGEST_RAY_VOXELS, OpacityReference, PixelRays, VolumeDesc, scene_values_of,
+    CameraData, FrameData, FrameUniforms, LONGEST_RAY_VOXELS, OpacityReference, PixelRays, VolumeDesc, VolumeWindow,
+    WindowBoxes, scene_values_of,
 };
 pub use frames::{FrameStats, MAX_FRAMES_IN_FLIGHT};
 pub use gpu::{Gpu, GpuError, GpuFault, GpuFaultKind, GpuOptions};
@@ -149,6 +150,7 @@ pub struct Runtime {
     last_camera: Option<(CameraData, (u32, u32))>,
     /// What the transfer function's opacity is per (a scene setting).
     opacity_reference: OpacityReference,
+    window: Option<VolumeWindow>,
     /// GPU memory passes that stream data may use (`--gpu-memory-mb`); `None`: the adapter's.
     gpu_memory_budget: Option<u64>,
 }
@@ -174,6 +176,7 @@ impl Runtime {
             history_stats: HistoryStats::default(),
             last_camera: None,
             opacity_reference: OpacityReference::default(),
+            window: None,
             gpu_memory_budget: None,
         }
     }
@@ -266,7 +269,7 @@ impl Runtime {
     /// Scene values of what is bound, for compiling: the bound volume's
     /// [`LONGEST_RAY_VOXELS`]. Computed in this one place.
     pub fn scene_values(&self) -> BTreeMap<String, f64> {
-        self.inputs.volume().map(|(v, _)| frame::scene_values_of(&v)).unwrap_or_default()
+        self.volume_desc().map(|v| frame::scene_values_of(&v)).unwrap_or_default()
     }
 
     /// Binds `volume` and `lut` to every graph input of kind Volume and TransferFunction in
@@ -400,17 +403,46 @@ impl Runtime {
         plan.history.values().any(|h| h.max_camera_degrees.is_some_and(|bound| turned > bound))
     }
 
+    /// Declares the bound volume a window of a larger one (sort-last rendering,
+    /// `docs/scaling.md`): rays meet the whole volume's box, samples are taken in the window's
+    /// own box only, and cameras given in the whole volume's world are moved to the window's.
+    /// `None`: the bound volume is the whole volume.
+    pub fn set_volume_window(&mut self, window: Option<VolumeWindow>) {
+        if self.window != window {
+            self.window = window;
+            self.invalidate_history();
+        }
+    }
+
+    /// The bound volume as the frame contract describes it (windowed when a window is set).
+    fn volume_desc(&self) -> Option<VolumeDesc> {
+        let (desc, _) = self.inputs.volume()?;
+        let desc = match &self.window {
+            Some(window) => VolumeDesc::of_window(desc.dims, window),
+            None => desc,
+        };
+        Some(desc.with_opacity_reference(self.opacity_reference))
+    }
+
+    /// `camera` (in the whole volume's world) in the bound box's world.
+    fn local_camera(&self, camera: CameraData) -> CameraData {
+        match self.volume_desc().and_then(|v| v.window) {
+            Some(w) => camera.translated(-w.centre_world),
+            None => camera,
+        }
+    }
+
     /// The frame data the next frame will see for `camera`.
     pub fn frame_data(&self, camera: CameraData) -> Result<FrameData, RuntimeError> {
         let plan = self.plan().ok_or(RuntimeError::NoPlan)?;
         let previous = self.last_camera.filter(|(_, vp)| *vp == plan.viewport).map(|(c, _)| c);
         Ok(FrameData {
             viewport: plan.viewport,
-            camera,
-            previous_camera: previous,
+            camera: self.local_camera(camera),
+            previous_camera: previous.map(|c| self.local_camera(c)),
             frame_index: self.frame_index,
             history_age: self.history_age,
-            volume: self.inputs.volume().map(|(v, _)| v.with_opacity_reference(self.opacity_reference)),
+            volume: self.volume_desc(),
             gpu_memory_budget: self.gpu_memory_budget,
         })
     }

@@ -1,0 +1,154 @@
+//! Reading a box of a volume file without reading the rest: what each process of a sort-last
+//! render does (`docs/scaling.md`): it seeks to every row of its box (plus apron) and reads only
+//! those bytes, so no process ever holds the whole volume.
+
+use std::io::{Read, Seek, SeekFrom};
+use std::path::{Path, PathBuf};
+
+use glam::{DVec3, UVec3};
+
+use super::{Endianness, Layout, LoadError, RawOptions, decode, raw};
+use crate::kd_split::VoxelBox;
+use crate::volume::{Volume, VoxelData, VoxelType};
+
+/// What a volume file holds, from its name or header, with where its voxels start: enough to
+/// read any box of it.
+#[derive(Clone, Debug)]
+pub struct VolumeHeader {
+    /// Dataset name.
+    pub name: String,
+    /// Voxels per axis.
+    pub dims: UVec3,
+    /// Voxel type.
+    pub dtype: VoxelType,
+    /// Byte order.
+    pub order: Endianness,
+    /// Physical voxel size.
+    pub spacing: DVec3,
+    data_path: PathBuf,
+    data_offset: u64,
+}
+
+impl VolumeHeader {
+    /// The header of volume file `path` (reads no voxels). Headerless `.raw` files for now;
+    /// another format is a [`LoadError::NoBoxRead`].
+    pub fn read(path: &Path, opts: &RawOptions) -> Result<Self, LoadError> {
+        let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+        let format = match extension.as_str() {
+            "raw" => None,
+            "nrrd" | "nhdr" => Some("NRRD"),
+            "mhd" | "mha" => Some("MetaImage"),
+            _ if super::is_nifti(path) => Some("NIfTI"),
+            _ if path.is_dir() || extension == "dcm" => Some("DICOM"),
+            _ => return Err(LoadError::UnknownFormat { path: path.to_path_buf(), extension }),
+        };
+        if let Some(format) = format {
+            return Err(LoadError::NoBoxRead { path: path.to_path_buf(), format });
+        }
+        let Layout { name, dims, dtype, order, spacing, .. } = raw::layout(path, opts)?;
+        Ok(Self {
+            name,
+            dims,
+            dtype,
+            order,
+            spacing: opts.spacing.unwrap_or(spacing),
+            data_path: path.to_path_buf(),
+            data_offset: 0,
+        })
+    }
+
+    /// The normalization range of the whole volume for integer data (the type range, as
+    /// [`Volume::new`] gives it); `None` for float data, whose range is the data's own.
+    pub fn type_range(&self) -> Option<(f64, f64)> {
+        self.dtype.integer_range()
+    }
+
+    /// The voxels of `bx` as a volume of `bx.size()` voxels, normalized over `value_range` (the
+    /// whole volume's, so every box maps values alike); non-finite floats are replaced as the
+    /// loaders do (NaN and −∞ by the range's low end, +∞ by its high end). Reads only the rows
+    /// of the box.
+    pub fn read_box(&self, bx: VoxelBox, value_range: (f64, f64)) -> Result<Volume, LoadError> {
+        let io = |source| LoadError::Io { path: self.data_path.clone(), source };
+        let size = bx.size();
+        let voxel = self.dtype.size_bytes() as u64;
+        let mut file = std::fs::File::open(&self.data_path).map_err(io)?;
+        let row = size.x as usize * voxel as usize;
+        let mut bytes = vec![0u8; row * size.y as usize * size.z as usize];
+        let mut at = 0;
+        for z in bx.lo.z..bx.hi.z {
+            for y in bx.lo.y..bx.hi.y {
+                let index = bx.lo.x as u64 + self.dims.x as u64 * (y as u64 + self.dims.y as u64 * z as u64);
+                file.seek(SeekFrom::Start(self.data_offset + index * voxel)).map_err(io)?;
+                file.read_exact(&mut bytes[at..at + row]).map_err(io)?;
+                at += row;
+            }
+        }
+        let mut data = decode(&bytes, self.dtype, self.order);
+        if let VoxelData::F32(values) = &mut data {
+            for v in values.iter_mut() {
+                if v.is_nan() || *v == f32::NEG_INFINITY {
+                    *v = value_range.0 as f32;
+                } else if *v == f32::INFINITY {
+                    *v = value_range.1 as f32;
+                }
+            }
+        }
+        let mut volume = Volume::new(self.name.clone(), size, self.spacing, data);
+        volume.value_range = value_range;
+        Ok(volume)
+    }
+
+    /// Reads the slabs of whole z slices `z.start..z.end`, `slices` at a time, and gives each to
+    /// `visit` with its first z: streaming over a part of the file in bounded memory.
+    pub fn for_each_slab(
+        &self,
+        z: std::ops::Range<u32>,
+        slices: u32,
+        value_range: (f64, f64),
+        mut visit: impl FnMut(u32, &Volume),
+    ) -> Result<(), LoadError> {
+        let mut z0 = z.start;
+        while z0 < z.end {
+            let z1 = (z0 + slices.max(1)).min(z.end);
+            let slab = VoxelBox::new(UVec3::new(0, 0, z0), UVec3::new(self.dims.x, self.dims.y, z1));
+            visit(z0, &self.read_box(slab, value_range)?);
+            z0 = z1;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A box read by seeking equals the same box cut from the whole volume.
+    #[test]
+    fn a_box_read_by_seeking_equals_the_box_of_the_whole_volume() {
+        let dir = std::env::temp_dir().join(format!("volgraph-region-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let path = dir.join("ramp_13x7x5_uint16.raw");
+        let values: Vec<u16> = (0..13 * 7 * 5).map(|i| (i * 37 % 65536) as u16).collect();
+        std::fs::write(&path, values.iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>()).expect("write");
+        let header = VolumeHeader::read(&path, &RawOptions::default()).expect("header");
+        let whole = super::super::load_volume(&path, &RawOptions::default()).expect("whole").volume;
+        let bx = VoxelBox::new(UVec3::new(2, 1, 3), UVec3::new(11, 7, 5));
+        let part = header.read_box(bx, header.type_range().expect("integer")).expect("box");
+        assert_eq!(part.dims, bx.size());
+        for z in 0..part.dims.z {
+            for y in 0..part.dims.y {
+                for x in 0..part.dims.x {
+                    let w = whole.index(x + bx.lo.x, y + bx.lo.y, z + bx.lo.z);
+                    assert_eq!(part.normalized(part.index(x, y, z)), whole.normalized(w));
+                }
+            }
+        }
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn formats_without_box_reads_say_so() {
+        let e = VolumeHeader::read(Path::new("brain.nii.gz"), &RawOptions::default()).expect_err("nifti");
+        assert!(e.to_string().contains("NIfTI files cannot be read a box at a time"), "{e}");
+    }
+}

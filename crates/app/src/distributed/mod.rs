@@ -1,0 +1,351 @@
+//! `volgraph render --distributed`: sort-last rendering over MPI (`docs/scaling.md`).
+//!
+//! Rank 0's command line is the job (it is broadcast, so ranks cannot disagree). Then:
+//! 1. every rank reads the file's header, and the file is surveyed once in total, a z-slab per
+//!    rank ([`survey`]): value range, a preview for the default transfer function, per-brick
+//!    histograms;
+//! 2. every rank builds the same kd-tree over the bricks, balanced by voxels visible under the
+//!    transfer function (`volgraph_accel::kd_split`), and reads only its box plus an apron of
+//!    [`APRON`] voxels;
+//! 3. every rank renders its box with the same graph and camera into premultiplied RGBA f32 —
+//!    rays meet the whole volume's box, so samples lie on the single-process step grid, and
+//!    each rank takes only the samples in its own box (`Runtime::set_volume_window`);
+//! 4. the images are composited in the kd-tree's visibility order for the camera, by radix-k
+//!    or direct-send (`volgraph_composite`), and rank 0 writes the image.
+//!
+//! After every step that can fail on one rank, the ranks agree on the outcome, so an error on
+//! one rank ends every rank with that rank's message and a non-zero exit, never a hang.
+
+pub mod survey;
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::anyhow;
+use glam::{DVec3, DVec4, UVec3};
+use volgraph_accel::kd_split::{KdTree, VoxelBox, radix_factors};
+use volgraph_accel::load::VolumeHeader;
+use volgraph_composite::{CompositeStats, Exchange, ExchangeError, Layer, agree, direct_send, gather, radix_k};
+use volgraph_core::runtime::{CameraData, Gpu, Runtime, ShaderLibrary, VolumeDesc, VolumeWindow, scene_values_of};
+use volgraph_core::{TargetFormat, compile};
+
+use crate::cli::{CliError, compile_options, display_name};
+use crate::image_out::{self, ImageKind};
+use crate::inputs;
+use crate::render::RenderArgs;
+
+/// Voxels each rank holds beyond its box on every side: trilinear filtering reaches 1, central
+/// differences for shading 1 more, the tricubic B-spline 2 — 4 covers them all.
+pub const APRON: u32 = 4;
+
+/// How ranks composite their images.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
+pub enum CompositeAlgorithm {
+    /// Every rank owns a tile and receives every other rank's pixels in it (one round).
+    DirectSend,
+    /// Rounds of k-way exchanges (Peterka et al. 2009), k per round chosen as IceT does.
+    RadixK,
+}
+
+/// What one rank did, for its line and the benchmarks.
+#[derive(Clone, Debug, Default)]
+pub struct RankReport {
+    /// This rank.
+    pub rank: usize,
+    /// The number of ranks.
+    pub ranks: usize,
+    /// Bytes of voxels this rank holds (its box and apron).
+    pub voxel_bytes: u64,
+    /// The box it owns.
+    pub own: Option<VoxelBox>,
+    /// The last frame's render and readback, ms.
+    pub render_ms: f64,
+    /// The last frame's compositing and gather, ms.
+    pub composite_ms: f64,
+    /// What compositing sent.
+    pub composite: CompositeStats,
+}
+
+impl RankReport {
+    /// `rank R of N holds B bytes of voxels, rendered in X ms, composited in Y ms`.
+    pub fn line(&self) -> String {
+        format!(
+            "rank {} of {} holds {} bytes of voxels, rendered in {:.2} ms, composited in {:.2} ms",
+            self.rank, self.ranks, self.voxel_bytes, self.render_ms, self.composite_ms
+        )
+    }
+}
+
+/// Runs `volgraph render --distributed` under MPI: initializes it, takes rank 0's command
+/// line, renders and composites. Each rank prints its line; rank 0 writes the image.
+#[cfg(feature = "mpi")]
+pub fn launch() -> Result<(), CliError> {
+    use clap::Parser;
+    let mut ex = volgraph_composite::mpi_exchange::MpiExchange::initialize()
+        .ok_or_else(|| CliError::Other(anyhow!("internal: MPI was initialized twice")))?;
+    let argv: Vec<String> = std::env::args().collect();
+    let job = volgraph_composite::broadcast_from_root(&mut ex, argv.join("\0").into_bytes()).map_err(other)?;
+    let argv: Vec<String> = String::from_utf8_lossy(&job).split('\0').map(str::to_string).collect();
+    let parsed = crate::cli::Cli::try_parse_from(&argv).map_err(|e| CliError::Other(anyhow!("{e}")));
+    let args = agree(&mut ex, parsed.map_err(|e| e.to_string()))
+        .map_err(other)?
+        .into_render_args()
+        .ok_or_else(|| CliError::Other(anyhow!("internal: rank 0's command is not render")))?;
+    let report = run(&mut ex, &args)?;
+    crate::stdout::eprintln_escaped!("{}", report.line());
+    Ok(())
+}
+
+/// Without MPI: says how to get a build with it.
+#[cfg(not(feature = "mpi"))]
+pub fn launch() -> Result<(), CliError> {
+    Err(CliError::Other(anyhow!(
+        "--distributed: this volgraph was built without MPI; build it with `cargo build --release -p volgraph-app \
+         --features mpi` (needs openmpi-bin, libopenmpi-dev and libclang-dev) and run it under `mpirun -n N`"
+    )))
+}
+
+fn other(e: ExchangeError) -> CliError {
+    CliError::Other(anyhow!("{e}"))
+}
+
+/// Agrees on a step's outcome: every rank gets the first failing rank's message.
+fn step<E: Exchange + ?Sized, T>(ex: &mut E, outcome: anyhow::Result<T>) -> Result<T, CliError> {
+    agree(ex, outcome.map_err(|e| format!("{e:#}"))).map_err(other)
+}
+
+/// Renders the job `args` as rank `ex.rank()` of `ex.size()`: the whole of `--distributed`
+/// over any transport (MPI, or threads in a test).
+pub fn run<E: Exchange + ?Sized>(ex: &mut E, args: &RenderArgs) -> Result<RankReport, CliError> {
+    let (rank, ranks) = (ex.rank(), ex.size());
+    let job = step(ex, Job::read(args))?;
+    let surveyed = survey::survey(ex, &job.header).map_err(|e| anyhow!(e));
+    let survey = step(ex, surveyed)?;
+    let (lut, plan) = step(ex, job.compile(&survey))?;
+    let weights = survey.weights(job.header.dims, &lut);
+    let factors = radix_factors(ranks, args.radix_k.max(2) as usize);
+    let tree = step(ex, KdTree::balanced(&weights, &factors).map_err(|e| anyhow!("{e}")))?;
+    let own = tree.boxes[rank];
+    let held = own.with_apron(APRON, job.header.dims);
+    let volume = step(ex, job.header.read_box(held, survey.value_range).map_err(|e| anyhow!("{e}")))?;
+    let mut report = RankReport {
+        rank,
+        ranks,
+        voxel_bytes: volume.voxel_count() as u64 * job.header.dtype.size_bytes() as u64,
+        own: Some(own),
+        ..Default::default()
+    };
+    let window = VolumeWindow::new(job.header.dims, job.header.spacing, held.lo, own.lo, own.hi);
+    let runtime = step(ex, job.runtime(&volume, &lut, window, plan))?;
+    let mut runtime = runtime;
+    let viewport = job.viewport;
+    let whole = VolumeDesc::of_window(
+        job.header.dims,
+        &VolumeWindow::new(job.header.dims, job.header.spacing, UVec3::ZERO, UVec3::ZERO, job.header.dims),
+    );
+    let mut last = None;
+    for frame in 0..job.frames {
+        let orbit = job.camera.at(frame);
+        let camera = CameraData::from_orbit(&orbit, viewport);
+        let started = Instant::now();
+        let rendered = runtime.render(camera).and_then(|_| runtime.read_output("image")).map_err(|e| anyhow!(e));
+        let image = step(ex, rendered)?;
+        report.render_ms = started.elapsed().as_secs_f64() * 1e3;
+        let layer = Layer {
+            width: image.width,
+            height: image.height,
+            pixels: image.data.chunks_exact(4).map(|p| [p[0], p[1], p[2], p[3]]).collect(),
+        };
+        let eye_voxels = (camera.eye / (2.0 * whole.half_extent) + DVec3::splat(0.5)) * job.header.dims.as_dvec3();
+        let rows = screen_rows(&camera, viewport, &whole, job.header.dims, &own);
+        let started = Instant::now();
+        let (piece, stats) = match job.algorithm {
+            CompositeAlgorithm::DirectSend => direct_send(ex, &layer, rows, &tree.visibility_order(eye_voxels)),
+            CompositeAlgorithm::RadixK => {
+                let rounds: Vec<usize> = tree.factors.iter().rev().copied().collect();
+                let orders: Vec<Vec<usize>> =
+                    (0..rounds.len()).map(|round| tree.children_order(rank, round, eye_voxels)).collect();
+                radix_k(ex, &layer, &rounds, &orders)
+            }
+        }
+        .map_err(other)?;
+        let gathered = gather(ex, &piece, viewport.0, viewport.1).map_err(other)?;
+        report.composite_ms = started.elapsed().as_secs_f64() * 1e3;
+        report.composite = stats;
+        last = gathered;
+    }
+    let written = match (&last, rank) {
+        (Some(image), 0) => job.write(image),
+        _ => Ok(()),
+    };
+    step(ex, written)?;
+    Ok(report)
+}
+
+/// The image rows the box `own` may cover for `camera`: its corners projected, or every row
+/// when a corner lies behind the near plane (the eye inside or beside the box).
+pub fn screen_rows(
+    camera: &CameraData,
+    viewport: (u32, u32),
+    whole: &VolumeDesc,
+    dims: UVec3,
+    own: &VoxelBox,
+) -> std::ops::Range<u32> {
+    let h = viewport.1;
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for i in 0..8 {
+        let corner = UVec3::new(
+            if i & 1 == 0 { own.lo.x } else { own.hi.x },
+            if i & 2 == 0 { own.lo.y } else { own.hi.y },
+            if i & 4 == 0 { own.lo.z } else { own.hi.z },
+        );
+        let world = (corner.as_dvec3() / dims.as_dvec3() - DVec3::splat(0.5)) * 2.0 * whole.half_extent;
+        let clip = camera.clip_from_world * DVec4::new(world.x, world.y, world.z, 1.0);
+        if clip.w <= camera.near * 0.5 {
+            return 0..h;
+        }
+        let y = (1.0 - clip.y / clip.w) * 0.5 * h as f64;
+        lo = lo.min(y);
+        hi = hi.max(y);
+    }
+    let lo = (lo.floor() - 1.0).clamp(0.0, h as f64) as u32;
+    let hi = (hi.ceil() + 1.0).clamp(0.0, h as f64) as u32;
+    lo..hi.max(lo)
+}
+
+/// The job every rank runs: what `render` reads, without the voxels.
+struct Job {
+    header: VolumeHeader,
+    graph: std::path::PathBuf,
+    shaders: Option<std::path::PathBuf>,
+    source: String,
+    options: volgraph_core::CompileOptions,
+    tf: Option<std::path::PathBuf>,
+    tf_map: Option<String>,
+    camera: crate::scene::CameraSpec,
+    viewport: (u32, u32),
+    frames: u32,
+    kind: ImageKind,
+    out: std::path::PathBuf,
+    algorithm: CompositeAlgorithm,
+}
+
+impl Job {
+    fn read(args: &RenderArgs) -> anyhow::Result<Job> {
+        let kind = ImageKind::from_path("-o", &args.out)?;
+        let resolved =
+            args.inputs.resolve("volgraph render GRAPH --distributed --volume FILE.raw -o out.png", "512x512")?;
+        if resolved.scene.is_some() {
+            return Err(anyhow!(
+                "--distributed takes its inputs from flags (--volume, --tf, --camera); --scene is not supported yet"
+            ));
+        }
+        let path = match args.inputs.volume.as_slice() {
+            [path] => path,
+            [] => return Err(anyhow!("--distributed needs --volume FILE.raw: each rank reads its box of the file")),
+            _ => return Err(anyhow!("--distributed reads one volume file; give one --volume")),
+        };
+        let raw = inputs::raw_options(&args.inputs.raw)?;
+        let header = VolumeHeader::read(path, &raw.raw).map_err(|e| anyhow!("{e}"))?;
+        let source = inputs::read_graph(&resolved.graph)?;
+        let options = compile_options(&resolved.size, &args.inputs.features, &[])?;
+        Ok(Job {
+            header,
+            graph: resolved.graph,
+            shaders: args.inputs.shaders.clone(),
+            source,
+            viewport: options.viewport,
+            options,
+            tf: args.inputs.tf.clone(),
+            tf_map: args.inputs.tf_map.clone(),
+            camera: resolved.camera,
+            frames: args.frames.unwrap_or(1),
+            kind,
+            out: args.out.clone(),
+            algorithm: args.composite,
+        })
+    }
+
+    /// The LUT (fitted to the preview when no --tf is given) and the plan, compiled with the
+    /// whole volume's scene values.
+    fn compile(&self, survey: &survey::Survey) -> anyhow::Result<(Vec<[f32; 4]>, volgraph_core::Plan)> {
+        let (tf, _) = inputs::transfer_function(self.tf.as_ref(), self.tf_map.as_deref(), &survey.preview, false)?;
+        let lut = tf.to_lut_for(&survey.preview, inputs::LUT_SIZE);
+        let mut options = self.options.clone();
+        let whole =
+            VolumeWindow::new(self.header.dims, self.header.spacing, UVec3::ZERO, UVec3::ZERO, self.header.dims);
+        options.scene = scene_values_of(&VolumeDesc::of_window(self.header.dims, &whole));
+        options.scene.extend(inputs::data_scene_values(&survey.preview));
+        let registry = crate::program::registry();
+        let plan = compile(&display_name(&self.graph), &self.source, &registry, &options)
+            .map_err(|e| anyhow!("{}", crate::cli::error_text(&CliError::Graph(e))))?;
+        let image = plan.outputs.get("image").map(|&r| &plan.resources[r].desc);
+        let float = matches!(
+            image,
+            Some(volgraph_core::plan::ResourceDesc::Target {
+                format: TargetFormat::Rgba32Float | TargetFormat::Rgba16Float,
+                ..
+            })
+        );
+        if !float {
+            return Err(anyhow!(
+                "graph \"{}\": --distributed composites the graph's output \"image\", which must be a premultiplied \
+                 Rgba32Float or Rgba16Float target (the raycasters' colour); this graph has none",
+                plan.name
+            ));
+        }
+        Ok((lut, plan))
+    }
+
+    fn runtime(
+        &self,
+        volume: &volgraph_accel::volume::Volume,
+        lut: &[[f32; 4]],
+        window: VolumeWindow,
+        plan: volgraph_core::Plan,
+    ) -> anyhow::Result<Runtime> {
+        let gpu = Arc::new(Gpu::new_headless().map_err(|e| anyhow!(e))?);
+        let (sources, _) = crate::shader_dir::sources_for(&self.graph, self.shaders.as_deref());
+        let mut runtime = Runtime::new(gpu, ShaderLibrary::new(sources));
+        runtime.set_volume_window(Some(window));
+        runtime.bind_scene(&plan.inputs, volume, lut).map_err(|e| anyhow!(e))?;
+        runtime.apply(plan, &crate::program::registry()).map_err(|e| anyhow!(e))?;
+        Ok(runtime)
+    }
+
+    /// Rank 0's output: EXR holds the composited premultiplied colour; PNG shows it over the
+    /// graph's `present` background in sRGB, as the single-process display output does.
+    fn write(&self, image: &Layer) -> anyhow::Result<()> {
+        let background = self.background();
+        let data: Vec<f32> = match self.kind {
+            ImageKind::Exr => image.pixels.iter().flatten().copied().collect(),
+            ImageKind::Png => image
+                .pixels
+                .iter()
+                .flat_map(|p| {
+                    let t = 1.0 - p[3];
+                    [p[0] + t * background, p[1] + t * background, p[2] + t * background, 1.0]
+                })
+                .collect(),
+        };
+        let out = volgraph_core::runtime::Image { width: image.width, height: image.height, channels: 4, data };
+        match self.kind {
+            ImageKind::Exr => image_out::write_exr(&self.out, &out, false),
+            ImageKind::Png => image_out::write_png(&self.out, &out, false),
+        }
+    }
+
+    /// The `present` pass's background grey of the graph (0 when it has none).
+    fn background(&self) -> f32 {
+        let registry = crate::program::registry();
+        compile(&display_name(&self.graph), &self.source, &registry, &self.options)
+            .ok()
+            .and_then(|plan| {
+                plan.steps
+                    .iter()
+                    .find(|s| s.kind == "present" && s.params.declares("background"))
+                    .map(|s| s.params.float("background"))
+            })
+            .unwrap_or(0.0) as f32
+    }
+}

@@ -1,0 +1,168 @@
+//! The first pass of a sort-last render: the file is read once in total, split in z-slabs
+//! between the processes, for what every process must agree on before it knows its box — the
+//! value range of float data, a subsampled preview (what the default transfer function and the
+//! data's automatic values are fitted to), and per-brick histograms (what the kd-tree balances:
+//! the voxels visible under the transfer function).
+
+use glam::UVec3;
+use volgraph_accel::kd_split::BrickWeights;
+use volgraph_accel::load::VolumeHeader;
+use volgraph_accel::volume::{Volume, VoxelData, VoxelType};
+use volgraph_composite::{Exchange, agree, all_gather};
+
+/// Histogram bins per brick: one per LUT texel (`inputs::LUT_SIZE`).
+pub const BINS: usize = crate::inputs::LUT_SIZE;
+/// The brick edge of the decomposition, in voxels: where split planes may lie.
+pub const BRICK: u32 = 16;
+/// The preview's longest side, in voxels.
+const PREVIEW: u32 = 64;
+
+/// What every process knows of the whole volume after the survey.
+pub struct Survey {
+    /// The range values normalize over (the type range, or the finite min/max of float data).
+    pub value_range: (f64, f64),
+    /// The volume subsampled every `stride` voxels (its spacing scaled to match).
+    pub preview: Volume,
+    /// Voxels per brick per normalized-value bin, brick-major.
+    pub bins: Vec<u64>,
+    /// Voxels this process read.
+    pub bytes_read: u64,
+}
+
+impl Survey {
+    /// The per-brick weights under `lut`: the voxels whose bin (or a neighbour, which linear
+    /// filtering blends in) has non-zero opacity.
+    pub fn weights(&self, dims: UVec3, lut: &[[f32; 4]]) -> BrickWeights {
+        let mut weights = BrickWeights::zeros(dims, BRICK);
+        let visible: Vec<bool> = (0..BINS)
+            .map(|b| {
+                let texel = |i: usize| lut.get(i * lut.len() / BINS).is_some_and(|t| t[3] > 0.0);
+                texel(b) || (b > 0 && texel(b - 1)) || texel(b + 1)
+            })
+            .collect();
+        for (brick, w) in weights.weight.iter_mut().enumerate() {
+            let counts = &self.bins[brick * BINS..(brick + 1) * BINS];
+            *w = counts.iter().zip(&visible).filter(|(_, v)| **v).map(|(c, _)| *c).sum();
+        }
+        weights
+    }
+}
+
+fn stride_of(dims: UVec3) -> u32 {
+    dims.max_element().div_ceil(PREVIEW).max(1)
+}
+
+/// This process's z-slab: whole preview slices (multiples of the stride), an equal share.
+fn slab(dims: UVec3, stride: u32, rank: usize, size: usize) -> std::ops::Range<u32> {
+    let slices = dims.z.div_ceil(stride) as usize;
+    let (j0, j1) = (slices * rank / size, slices * (rank + 1) / size);
+    (j0 as u32 * stride).min(dims.z)..(j1 as u32 * stride).min(dims.z)
+}
+
+/// Surveys `header`'s file with every process of `ex`.
+pub fn survey<E: Exchange + ?Sized>(ex: &mut E, header: &VolumeHeader) -> Result<Survey, String> {
+    let (rank, size) = (ex.rank(), ex.size());
+    let dims = header.dims;
+    let stride = stride_of(dims);
+    let z = slab(dims, stride, rank, size);
+    let fail = |e: volgraph_composite::ExchangeError| e.to_string();
+    // Float data normalizes over its finite range: agree on it first.
+    let value_range = match header.type_range() {
+        Some(range) => range,
+        None => {
+            let mut lo_hi = (f64::INFINITY, f64::NEG_INFINITY);
+            let read = header.for_each_slab(z.clone(), 8, (0.0, 1.0), |_, v| {
+                if let VoxelData::F32(values) = &v.data {
+                    for x in values.iter().filter(|x| x.is_finite()) {
+                        lo_hi = (lo_hi.0.min(*x as f64), lo_hi.1.max(*x as f64));
+                    }
+                }
+            });
+            agree(ex, read.map_err(|e| e.to_string())).map_err(fail)?;
+            let mine = [lo_hi.0, lo_hi.1].iter().flat_map(|v| v.to_le_bytes()).collect();
+            let all = all_gather(ex, mine).map_err(fail)?;
+            let (lo, hi) = all.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), m| {
+                let v = |i: usize| {
+                    m.get(8 * i..8 * i + 8).map_or(f64::NAN, |b| f64::from_le_bytes(b.try_into().unwrap_or([0; 8])))
+                };
+                (lo.min(v(0)), hi.max(v(1)))
+            });
+            if lo <= hi { (lo, hi) } else { (0.0, 0.0) }
+        }
+    };
+    let n_bricks = BrickWeights::zeros(dims, BRICK).weight.len();
+    let mut bins = vec![0u64; n_bricks * BINS];
+    let preview_dims = UVec3::new(dims.x.div_ceil(stride), dims.y.div_ceil(stride), dims.z.div_ceil(stride));
+    let mut preview_part: Vec<f32> = Vec::new();
+    let weights = BrickWeights::zeros(dims, BRICK);
+    let mut bytes_read = 0u64;
+    let read = header.for_each_slab(z.clone(), stride, value_range, |z0, v| {
+        bytes_read += v.voxel_count() as u64 * header.dtype.size_bytes() as u64;
+        for lz in 0..v.dims.z {
+            for y in 0..v.dims.y {
+                for x in 0..v.dims.x {
+                    let i = v.index(x, y, lz);
+                    let bin = ((v.normalized(i) * BINS as f64) as usize).min(BINS - 1);
+                    bins[weights.brick_of(UVec3::new(x, y, z0 + lz)) * BINS + bin] += 1;
+                }
+            }
+        }
+        // The preview slice at z0 (a multiple of the stride).
+        for y in (0..v.dims.y).step_by(stride as usize) {
+            for x in (0..v.dims.x).step_by(stride as usize) {
+                preview_part.push(v.raw_value(v.index(x, y, 0)) as f32);
+            }
+        }
+    });
+    agree(ex, read.map_err(|e| e.to_string())).map_err(fail)?;
+    // Everyone gets the histograms (summed) and the preview slices (in rank order = z order).
+    let all_bins = all_gather(ex, bytemuck_u64(&bins)).map_err(fail)?;
+    let mut summed = vec![0u64; bins.len()];
+    for m in &all_bins {
+        for (s, c) in summed.iter_mut().zip(m.chunks_exact(8)) {
+            *s += u64::from_le_bytes(c.try_into().unwrap_or([0; 8]));
+        }
+    }
+    let all_preview = all_gather(ex, preview_part.iter().flat_map(|v| v.to_le_bytes()).collect()).map_err(fail)?;
+    let values: Vec<f32> = all_preview
+        .iter()
+        .flat_map(|m| m.chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap_or([0; 4]))))
+        .collect();
+    if values.len() != (preview_dims.x * preview_dims.y * preview_dims.z) as usize {
+        return Err(format!("internal: the preview has {} voxels, expected {preview_dims}", values.len()));
+    }
+    let data = match header.dtype {
+        VoxelType::U8 => VoxelData::U8(values.iter().map(|v| *v as u8).collect()),
+        VoxelType::U16 => VoxelData::U16(values.iter().map(|v| *v as u16).collect()),
+        VoxelType::I16 => VoxelData::I16(values.iter().map(|v| *v as i16).collect()),
+        VoxelType::F32 => VoxelData::F32(values),
+    };
+    let mut preview = Volume::new(header.name.clone(), preview_dims, header.spacing * stride as f64, data);
+    preview.value_range = value_range;
+    Ok(Survey { value_range, preview, bins: summed, bytes_read })
+}
+
+fn bytemuck_u64(v: &[u64]) -> Vec<u8> {
+    v.iter().flat_map(|x| x.to_le_bytes()).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slabs_cover_the_volume_once() {
+        let dims = UVec3::new(10, 10, 130);
+        let stride = stride_of(dims);
+        for size in 1..6 {
+            let mut next = 0;
+            for rank in 0..size {
+                let z = slab(dims, stride, rank, size);
+                assert_eq!(z.start, next);
+                assert_eq!(z.start % stride, 0);
+                next = z.end;
+            }
+            assert_eq!(next, dims.z);
+        }
+    }
+}

@@ -1,0 +1,154 @@
+//! The transport compositing runs over, and the collectives the distributed renderer builds on
+//! it: broadcasting the job, agreeing on success (so an error on one process ends every
+//! process with that process's message instead of a hang).
+
+use std::sync::mpsc::{Receiver, Sender, channel};
+
+/// Why an exchange failed.
+#[derive(Debug, thiserror::Error, Clone, PartialEq, Eq)]
+pub enum ExchangeError {
+    /// A peer went away (its process ended, its channel closed).
+    #[error("rank {0} stopped answering")]
+    PeerGone(usize),
+    /// A message that does not decode.
+    #[error("a malformed message: {0}")]
+    Malformed(String),
+    /// Another process failed; its message.
+    #[error("rank {rank}: {message}")]
+    Remote {
+        /// The process that failed.
+        rank: usize,
+        /// Its error.
+        message: String,
+    },
+}
+
+/// Point-to-point messages between the processes of one job.
+pub trait Exchange {
+    /// This process's rank, `0..size`.
+    fn rank(&self) -> usize;
+    /// The number of processes.
+    fn size(&self) -> usize;
+    /// Sends each `(to, bytes)` of `outgoing` and receives one message from each rank of
+    /// `from`, returned in that order. Every process of a round must call it with matching
+    /// sends and receives; sends never wait for the matching receive to start.
+    fn exchange(&mut self, outgoing: Vec<(usize, Vec<u8>)>, from: &[usize]) -> Result<Vec<Vec<u8>>, ExchangeError>;
+}
+
+/// Every process's `mine`, by rank.
+pub fn all_gather<E: Exchange + ?Sized>(ex: &mut E, mine: Vec<u8>) -> Result<Vec<Vec<u8>>, ExchangeError> {
+    let (rank, size) = (ex.rank(), ex.size());
+    let others: Vec<usize> = (0..size).filter(|&r| r != rank).collect();
+    let outgoing = others.iter().map(|&r| (r, mine.clone())).collect();
+    let mut received = ex.exchange(outgoing, &others)?.into_iter();
+    Ok((0..size).map(|r| if r == rank { mine.clone() } else { received.next().unwrap_or_default() }).collect())
+}
+
+/// Rank 0's `message` on every process (the others pass anything, e.g. an empty vector).
+pub fn broadcast_from_root<E: Exchange + ?Sized>(ex: &mut E, message: Vec<u8>) -> Result<Vec<u8>, ExchangeError> {
+    if ex.rank() == 0 {
+        let outgoing = (1..ex.size()).map(|r| (r, message.clone())).collect();
+        ex.exchange(outgoing, &[])?;
+        Ok(message)
+    } else {
+        Ok(ex.exchange(Vec::new(), &[0])?.pop().unwrap_or_default())
+    }
+}
+
+/// Every process's outcome of a step, agreed: `Ok` on every process when every process
+/// succeeded, else the lowest failing rank's message on every process. Call it after every step
+/// that can fail on one process only (reading its box, opening its GPU, rendering), so that no
+/// process waits forever for one that gave up.
+pub fn agree<E: Exchange + ?Sized, T>(ex: &mut E, outcome: Result<T, String>) -> Result<T, ExchangeError> {
+    let mine = match &outcome {
+        Ok(_) => Vec::new(),
+        Err(message) => {
+            let mut m = vec![1u8];
+            m.extend(message.as_bytes());
+            m
+        }
+    };
+    let all = all_gather(ex, mine)?;
+    if let Some((rank, failed)) = all.iter().enumerate().find(|(_, m)| !m.is_empty()) {
+        return Err(ExchangeError::Remote { rank, message: String::from_utf8_lossy(&failed[1..]).into_owned() });
+    }
+    outcome.map_err(|message| ExchangeError::Remote { rank: ex.rank(), message })
+}
+
+/// Processes simulated by threads of one process: an [`Exchange`] per thread, over channels.
+pub struct LocalGroup {
+    rank: usize,
+    size: usize,
+    to: Vec<Sender<Vec<u8>>>,
+    from: Vec<Receiver<Vec<u8>>>,
+}
+
+impl LocalGroup {
+    /// `size` connected endpoints; give endpoint r to the thread of rank r.
+    pub fn new(size: usize) -> Vec<LocalGroup> {
+        // channels[src][dst]
+        let mut senders: Vec<Vec<Option<Sender<Vec<u8>>>>> =
+            (0..size).map(|_| (0..size).map(|_| None).collect()).collect();
+        let mut receivers: Vec<Vec<Option<Receiver<Vec<u8>>>>> =
+            (0..size).map(|_| (0..size).map(|_| None).collect()).collect();
+        for (src, row) in senders.iter_mut().enumerate() {
+            for (dst, slot) in row.iter_mut().enumerate() {
+                let (tx, rx) = channel();
+                *slot = Some(tx);
+                receivers[dst][src] = Some(rx);
+            }
+        }
+        senders
+            .into_iter()
+            .zip(receivers)
+            .enumerate()
+            .map(|(rank, (to, from))| LocalGroup {
+                rank,
+                size,
+                to: to.into_iter().flatten().collect(),
+                from: from.into_iter().flatten().collect(),
+            })
+            .collect()
+    }
+}
+
+impl Exchange for LocalGroup {
+    fn rank(&self) -> usize {
+        self.rank
+    }
+
+    fn size(&self) -> usize {
+        self.size
+    }
+
+    fn exchange(&mut self, outgoing: Vec<(usize, Vec<u8>)>, from: &[usize]) -> Result<Vec<Vec<u8>>, ExchangeError> {
+        for (to, bytes) in outgoing {
+            self.to[to].send(bytes).map_err(|_| ExchangeError::PeerGone(to))?;
+        }
+        from.iter().map(|&r| self.from[r].recv().map_err(|_| ExchangeError::PeerGone(r))).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_failure_reaches_every_rank() {
+        let results: Vec<Result<(), ExchangeError>> = std::thread::scope(|s| {
+            let handles: Vec<_> = LocalGroup::new(3)
+                .into_iter()
+                .map(|mut ex| {
+                    s.spawn(move || {
+                        let outcome = if ex.rank() == 2 { Err("cannot read box".to_string()) } else { Ok(()) };
+                        agree(&mut ex, outcome)
+                    })
+                })
+                .collect();
+            handles.into_iter().map(|h| h.join().expect("thread")).collect()
+        });
+        for r in results {
+            assert_eq!(r, Err(ExchangeError::Remote { rank: 2, message: "cannot read box".into() }));
+        }
+    }
+}

@@ -86,8 +86,8 @@ pub fn launch() -> Result<(), CliError> {
     let argv: Vec<String> = std::env::args().collect();
     let job = volgraph_composite::broadcast_from_root(&mut ex, argv.join("\0").into_bytes()).map_err(other)?;
     let argv: Vec<String> = String::from_utf8_lossy(&job).split('\0').map(str::to_string).collect();
-    let parsed = crate::cli::Cli::try_parse_from(&argv).map_err(|e| CliError::Other(anyhow!("{e}")));
-    let args = agree(&mut ex, parsed.map_err(|e| e.to_string()))
+    let parsed = crate::cli::Cli::try_parse_from(&argv).map_err(|e| e.to_string());
+    let args = agree(&mut ex, parsed)
         .map_err(other)?
         .into_render_args()
         .ok_or_else(|| CliError::Other(anyhow!("internal: rank 0's command is not render")))?;

@@ -139,7 +139,7 @@ fn march_bricks(s: Samples, start: vec4<f32>) -> vec4<f32> {
         let slots = bricks.slots;
         let origin = vec3<f32>(vec3<u32>(slot % slots.x, (slot / slots.x) % slots.y, slot / (slots.x * slots.y)) * bricks.slot_side.xyz);
         let shift = origin + vec3<f32>(1.5) - lo - vec3<f32>(0.5);
-        let atlas = Samples((s.first * n + shift) * inv_atlas, delta_atlas, s.count, s.step, s.offset);
+        let atlas = Samples((s.first * n + shift) * inv_atlas, delta_atlas, s.count, s.step, s.offset, s.cut);
         resume_ray(sample_at(atlas, k) - atlas.delta);
         let m = march_dvr(atlas, k, exit, out);
         out = m.color;

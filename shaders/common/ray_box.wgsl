@@ -100,8 +100,12 @@ struct Samples {
     count: u32,
     // Texture-space length of one step.
     step: f32,
-    // 0.5 + jitter: where sample 0 lies, in steps from the entry.
+    // 0.5 + jitter (+ the samples a window's own box cut off): where sample 0 lies, in steps
+    // from the entry.
     offset: f32,
+    // True when the grid has samples before sample 0 that another rank takes (a sort-last
+    // window cut the ray): a first-hit search still knows the field one step back.
+    cut: bool,
 }
 
 // The samples of `ray` a step of `step_tex` apart: those of the grid k = 0.. with
@@ -114,7 +118,7 @@ fn samples_along(ray: Ray, step_tex: f32, jitter: f32, max_count: u32) -> Sample
     let end = clamp(ceil(ray.len / step_tex - grid_offset), 0.0, f32(max_count));
     let skipped = clamp(ceil(ray.begin / step_tex - grid_offset), 0.0, end);
     let offset = grid_offset + skipped;
-    return Samples(ray.u0 + offset * delta, delta, u32(end - skipped), step_tex, offset);
+    return Samples(ray.u0 + offset * delta, delta, u32(end - skipped), step_tex, offset, skipped > 0.0);
 }
 
 // Sample k's texture-space position.

@@ -165,7 +165,7 @@ fn classify_sample(u: vec3<f32>) -> vec4<f32> {
 // this pass.
 fn pixel_samples(ray: Ray, pixel: vec2<u32>) -> Samples {
     if (!(ray.len > 0.0) || !ray_is_valid(ray.u0, ray.d, ray.len)) {
-        return Samples(ray.u0, vec3<f32>(0.0), 0u, 1.0, 0.5);
+        return Samples(ray.u0, vec3<f32>(0.0), 0u, 1.0, 0.5, false);
     }
     return samples_along(ray, ray_step_tex(ray.d), ray_jitter(pixel), params.max_steps);
 }
@@ -302,6 +302,15 @@ fn march_iso(s: Samples, k0: u32, end: u32) -> IsoMarch {
             k = k0 - 1u;
             has_prev = false;
         }
+    } else if (s.cut && k0 == 0u && s.count > 0u) {
+        // A sort-last window cut the ray: the sample before is another rank's. Where it already
+        // saw the surface, the hit is that rank's; otherwise it brackets a hit here.
+        prev = sample_volume(s.first - s.delta);
+        out.samples = 1u;
+        if (prev >= iso) {
+            return out;
+        }
+        has_prev = true;
     }
     let first = k;
     var v = 0.0;

@@ -87,6 +87,10 @@ enum Command {
     /// List the graphs built into the binary (name, paper, description): every one can be given
     /// by name where a graph file is asked for (`volgraph render klein_2005/leap_iso -o x.png`).
     Graphs,
+    /// Times sort-last compositing alone under mpirun (synthetic rank images); what
+    /// `volgraph bench distributed` runs. Rank 0 prints one JSON line.
+    #[command(hide = true)]
+    CompositeBench(crate::distributed::bench::CompositeBenchArgs),
 }
 
 /// How to read the volume: a headerless `.raw` whose name does not say (or to override the
@@ -238,7 +242,11 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
             Ok(Checked::Plan { text, notes: warning_lines(&plan) })
         }
         Command::Render(args) => Ok(Checked::Render(Box::new(crate::render::prepare(args)?))),
-        Command::View(_) | Command::Passes { .. } | Command::Graphs | Command::Info { .. } => {
+        Command::View(_)
+        | Command::Passes { .. }
+        | Command::Graphs
+        | Command::Info { .. }
+        | Command::CompositeBench(_) => {
             Err(CliError::Other(anyhow!("only plan and render are checked ahead of running")))
         }
     }
@@ -248,6 +256,7 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
 pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Render(args) if args.distributed => crate::distributed::launch(),
+        Command::CompositeBench(args) => crate::distributed::bench::launch(&args),
         Command::Plan { .. } | Command::Render(_) => match check(cli)? {
             Checked::Plan { text, notes } => {
                 for note in notes {

@@ -54,6 +54,11 @@ fn scratch(name: &str) -> PathBuf {
 /// early termination stops each rank's rays at its own α ≥ 1 − 1/255, so the rank behind still
 /// adds up to 1/255 where the single render had stopped.
 fn compare(label: &str, args: &[&str], ranks: usize, algorithm: &str) {
+    compare_within(label, args, ranks, algorithm, 2.0 / 255.0, 8);
+}
+
+/// `compare` with a bound on the worst pixel and on the pixels over 1/255.
+fn compare_within(label: &str, args: &[&str], ranks: usize, algorithm: &str, worst_bound: f32, over_bound: usize) {
     let single = scratch(&format!("{label}_single.exr"));
     let mut single_args = args.to_vec();
     single_args.extend(["--output", "image", "-o", single.to_str().expect("utf-8")]);
@@ -105,8 +110,8 @@ fn compare(label: &str, args: &[&str], ranks: usize, algorithm: &str) {
         eprintln!("  {}", r.line());
     }
     assert!(visible > w * h / 20, "{label}: the image shows the volume");
-    assert!(worst <= 2.0 / 255.0, "{label}: worst difference {:.2}/255", worst * 255.0);
-    assert!(over_one <= 8, "{label}: {over_one} pixels differ by more than 1/255");
+    assert!(worst <= worst_bound, "{label}: worst difference {:.2}/255", worst * 255.0);
+    assert!(over_one <= over_bound, "{label}: {over_one} pixels differ by more than 1/255");
     // No rank holds the whole volume.
     let whole = reports.iter().map(|r| r.own.map_or(0, |b| b.voxels())).sum::<u64>();
     assert!(reports.iter().all(|r| r.voxel_bytes < whole), "{label}: a rank held the whole volume");
@@ -147,4 +152,55 @@ fn rasterised_rays_and_shading_on_the_engine_equal_the_single_render() {
         "shading",
     ];
     compare("fragment_engine", &args, 4, "radix-k");
+}
+
+/// First-hit isosurfaces: a ray whose crossing straddles two ranks' boxes is refined by the rank
+/// behind with the sample before its box (`Samples::cut`), so hits stay where the single render
+/// puts them. Why not 1/255 everywhere: the refinement divides by the field's change between
+/// two samples, which at grazing hits amplifies the last bits of the sample positions — each
+/// rank computes them in its own texture coordinates, and the GPU quantizes sub-texel weights —
+/// into a visibly different hit at a few silhouette pixels (measured: 2 of 9216, up to 9/255).
+#[test]
+fn isosurface_hits_across_rank_boxes_equal_the_single_render_but_at_a_few_grazing_pixels() {
+    let Some(volume) = dataset("neghip") else { return };
+    let v = volume.to_str().expect("utf-8");
+    let args = ["basic/isosurface", "--volume", v, "--size", "96x96"];
+    compare_within("isosurface_neghip", &args, 2, "radix-k", 12.0 / 255.0, 4);
+    compare_within("isosurface_neghip", &args, 4, "direct-send", 12.0 / 255.0, 6);
+}
+
+/// Graphs whose passes do not take a ray's samples box by box (slice-based rendering, a
+/// maximum-intensity projection) are refused by name on every rank, not composited wrongly.
+#[test]
+fn graphs_that_cannot_be_split_are_refused_on_every_rank() {
+    let Some(volume) = dataset("neghip") else { return };
+    let out = scratch("refused.png");
+    for (graph, pass) in
+        [("basic/mip", "\"mip\" (mip_projection)"), ("kruger_westermann_2003/sbvr", "\"slices\" (slice_render)")]
+    {
+        let job = render_args(&[
+            graph,
+            "--volume",
+            volume.to_str().expect("utf-8"),
+            "--distributed",
+            "-o",
+            out.to_str().expect("utf-8"),
+        ]);
+        let errors: Vec<String> = std::thread::scope(|s| {
+            let handles: Vec<_> = LocalGroup::new(2)
+                .into_iter()
+                .map(|mut ex| {
+                    let job = &job;
+                    s.spawn(move || match distributed::run(&mut ex, job) {
+                        Ok(_) => String::new(),
+                        Err(e) => volgraph_app::cli::error_text(&e),
+                    })
+                })
+                .collect();
+            handles.into_iter().map(|h| h.join().expect("rank thread")).collect()
+        });
+        for e in &errors {
+            assert!(e.contains(&format!("cannot split pass {pass}")), "{graph}: {e}");
+        }
+    }
 }

@@ -56,7 +56,8 @@ fn xdg() -> PathBuf {
 }
 
 fn volgraph(args: &[&str]) -> Run {
-    let out = Command::new(env!("CARGO_BIN_EXE_volgraph")).args(args).env("XDG_RUNTIME_DIR", xdg()).output().expect("runs");
+    let out =
+        Command::new(env!("CARGO_BIN_EXE_volgraph")).args(args).env("XDG_RUNTIME_DIR", xdg()).output().expect("runs");
     Run { code: out.status.code().unwrap_or(-1), stderr: String::from_utf8_lossy(&out.stderr).into_owned() }
 }
 
@@ -82,7 +83,9 @@ fn read_exr(path: &Path) -> Vec<[f32; 4]> {
     let image = read_first_rgba_layer_from_file(
         path,
         |resolution, _| (resolution.width(), vec![[0.0f32; 4]; resolution.width() * resolution.height()]),
-        |(w, pixels), position, (r, g, b, a): (f32, f32, f32, f32)| pixels[position.y() * *w + position.x()] = [r, g, b, a],
+        |(w, pixels), position, (r, g, b, a): (f32, f32, f32, f32)| {
+            pixels[position.y() * *w + position.x()] = [r, g, b, a]
+        },
     )
     .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     image.layer_data.channel_data.pixels.1
@@ -91,7 +94,8 @@ fn read_exr(path: &Path) -> Vec<[f32; 4]> {
 /// The largest channel difference, and the pixels over 1/255.
 fn difference(a: &[[f32; 4]], b: &[[f32; 4]]) -> (f32, usize) {
     assert_eq!(a.len(), b.len());
-    let per_pixel: Vec<f32> = a.iter().zip(b).map(|(p, q)| (0..4).map(|c| (p[c] - q[c]).abs()).fold(0.0, f32::max)).collect();
+    let per_pixel: Vec<f32> =
+        a.iter().zip(b).map(|(p, q)| (0..4).map(|c| (p[c] - q[c]).abs()).fold(0.0, f32::max)).collect();
     (per_pixel.iter().copied().fold(0.0, f32::max), per_pixel.iter().filter(|d| **d > 1.0 / 255.0).count())
 }
 
@@ -106,9 +110,12 @@ fn mpirun_with_2_3_4_ranks_equals_the_single_render() {
     }
     let Some(volume) = dataset("hydrogen_atom") else { return };
     let tf = volgraph_accel::data_dir::data_dir().join("tf/hydrogen.ron").to_string_lossy().into_owned();
-    for (camera, ranks, algorithm) in
-        [("30,20,3.2", 2, "radix-k"), ("30,20,3.2", 3, "direct-send"), ("110,-30,2.4", 4, "radix-k"), ("40,25,0.3", 4, "direct-send")]
-    {
+    for (camera, ranks, algorithm) in [
+        ("30,20,3.2", 2, "radix-k"),
+        ("30,20,3.2", 3, "direct-send"),
+        ("110,-30,2.4", 4, "radix-k"),
+        ("40,25,0.3", 4, "direct-send"),
+    ] {
         let base = ["modern/fastest", "--volume", &volume, "--tf", &tf, "--size", "128x96", "--camera", camera];
         let single = scratch(&format!("single_{camera}.exr"));
         let s = single.to_string_lossy().into_owned();
@@ -116,15 +123,26 @@ fn mpirun_with_2_3_4_ranks_equals_the_single_render() {
         assert_eq!(run.code, 0, "{}", run.stderr);
         let split = scratch(&format!("split_{camera}_{ranks}_{algorithm}.exr"));
         let d = split.to_string_lossy().into_owned();
-        let run = mpirun(ranks, &[&base[..], &["--distributed", "--composite", algorithm, "--radix-k", "2", "-o", &d]].concat(), &[]);
+        let run = mpirun(
+            ranks,
+            &[&base[..], &["--distributed", "--composite", algorithm, "--radix-k", "2", "-o", &d]].concat(),
+            &[],
+        );
         assert_eq!(run.code, 0, "mpirun -n {ranks}: {}", run.stderr);
         for r in 0..ranks {
             let line = format!("rank {r} of {ranks} holds ");
             assert!(run.stderr.contains(&line), "no \"{line}…\" line:\n{}", run.stderr);
         }
         let (worst, over) = difference(&read_exr(&single), &read_exr(&split));
-        eprintln!("camera {camera}, {ranks} ranks, {algorithm}: worst {:.2}/255, {over} pixels over 1/255", worst * 255.0);
-        assert!(worst <= 2.0 / 255.0 && over <= 8, "camera {camera}, {ranks} ranks: worst {:.2}/255, {over} over 1/255", worst * 255.0);
+        eprintln!(
+            "camera {camera}, {ranks} ranks, {algorithm}: worst {:.2}/255, {over} pixels over 1/255",
+            worst * 255.0
+        );
+        assert!(
+            worst <= 2.0 / 255.0 && over <= 8,
+            "camera {camera}, {ranks} ranks: worst {:.2}/255, {over} over 1/255",
+            worst * 255.0
+        );
     }
 }
 
@@ -141,7 +159,18 @@ fn rank_zero_command_line_is_the_job() {
     let base = ["basic/fragment_raycast", "--volume", &volume, "--size", "64x64", "--camera", "10,10,2.8"];
     let run = volgraph(&[&["render"][..], &base, &["--output", "image", "-o", &single]].concat());
     assert_eq!(run.code, 0, "{}", run.stderr);
-    let other = ["basic/fragment_raycast", "--volume", &volume, "--size", "32x32", "--camera", "90,0,2", "--distributed", "-o", "ignored.exr"];
+    let other = [
+        "basic/fragment_raycast",
+        "--volume",
+        &volume,
+        "--size",
+        "32x32",
+        "--camera",
+        "90,0,2",
+        "--distributed",
+        "-o",
+        "ignored.exr",
+    ];
     let run = mpirun(1, &[&base[..], &["--distributed", "-o", &split]].concat(), &[("VOLGRAPH_UNUSED=1", &other)]);
     assert_eq!(run.code, 0, "{}", run.stderr);
     assert!(run.stderr.contains("rank 1 of 2 holds"), "{}", run.stderr);
@@ -165,7 +194,8 @@ fn an_error_on_one_rank_ends_every_rank_with_its_message() {
     let reports = run.stderr.matches("rank 1: no GPU adapter found").count();
     assert_eq!(reports, 2, "both ranks report rank 1's error:\n{}", run.stderr);
     // A file no rank can read: the loader's message, from every rank.
-    let missing = ["basic/fragment_raycast", "--volume", "/nonexistent/gone_8x8x8_uint8.raw", "--distributed", "-o", &out];
+    let missing =
+        ["basic/fragment_raycast", "--volume", "/nonexistent/gone_8x8x8_uint8.raw", "--distributed", "-o", &out];
     let run = mpirun(3, &missing, &[]);
     assert_ne!(run.code, 0);
     assert!(run.stderr.contains("gone_8x8x8_uint8.raw"), "{}", run.stderr);

@@ -48,6 +48,9 @@ enum BenchCommand {
     /// Loading a DICOM series (512 slices of 512² int16 by default) against reading the same
     /// voxels as one raw file.
     Load(crate::load::LoadArgs),
+    /// Sort-last rendering under mpirun: compositing alone (direct-send vs radix-k, 256² …
+    /// 2048², beside the memory-copy bound) and whole frames with 1, 2, 4 ranks.
+    Distributed(crate::distributed::DistributedArgs),
     /// Compile time of a generated 30-pass graph; pooled vs unpooled transient memory of every
     /// built-in graph at 1920x1080.
     Compile {
@@ -93,6 +96,9 @@ fn run(cli: BenchCli) -> anyhow::Result<()> {
         BenchCli::Bench { which: BenchCommand::Live(args) } => crate::live::run(&args).context("bench live").map(drop),
         BenchCli::Bench { which: BenchCommand::Graphs(args) } => {
             crate::graphs::run_cli(&args).context("bench graphs").map(drop)
+        }
+        BenchCli::Bench { which: BenchCommand::Distributed(args) } => {
+            crate::distributed::run(&args).context("bench distributed")
         }
         BenchCli::Bench { which: BenchCommand::Load(args) } => crate::load::run(&args).context("bench load").map(drop),
         BenchCli::Bench { which: BenchCommand::Fetch(args) } => {

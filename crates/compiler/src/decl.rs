@@ -203,6 +203,17 @@ pub trait PassDecl: Send + Sync {
         Ok(())
     }
 
+    /// True when the pass is right in a sort-last volume window (`Runtime::set_volume_window`,
+    /// docs/scaling.md): it takes no volume samples into its outputs (rays, grids, tables,
+    /// display), or exactly the samples of the single-process march that lie in the window's
+    /// own box (the raycasters, through the shared sampling core of `shaders/common`), so the
+    /// ranks' images composite to the single-process one. `render --distributed` refuses a graph
+    /// with any other pass (slice-based rendering, a maximum-intensity projection) rather than
+    /// composite a wrong image. Default: false.
+    fn honours_volume_window(&self) -> bool {
+        false
+    }
+
     /// True for passes that hold what they stream within the runtime's GPU memory budget
     /// (`--gpu-memory-mb`): a budget given to a graph without one changes nothing, and the CLI
     /// says so.

@@ -33,9 +33,9 @@ pub fn direct_send<E: Exchange + ?Sized>(
     let others: Vec<usize> = (0..size).filter(|&r| r != rank).collect();
     let received = ex.exchange(outgoing, &others)?;
     let tile = whole.part(rank, size);
-    // Fragments front to back, each a full-tile layer (empty where the rank sent nothing).
+    // Front to back: each fragment goes under what is there, on its spans only (elsewhere it
+    // is transparent and changes nothing).
     let mut acc = vec![[0.0f32; 4]; tile.len()];
-    let mut fragment = vec![[0.0f32; 4]; image.len()];
     for &r in order {
         if r == rank {
             for (a, p) in acc.iter_mut().zip(&image.pixels[tile.start..tile.end]) {
@@ -44,11 +44,7 @@ pub fn direct_send<E: Exchange + ?Sized>(
             continue;
         }
         let Some(i) = others.iter().position(|&o| o == r) else { continue };
-        spans::decode_into(&received[i], &mut fragment, |dst, src| *dst = src)?;
-        for (a, p) in acc.iter_mut().zip(&mut fragment[tile.start..tile.end]) {
-            *a = over_front_to_back(*a, *p);
-            *p = [0.0; 4];
-        }
+        spans::decode_into(&received[i], &mut acc, tile.start, |a, p| *a = over_front_to_back(*a, p))?;
     }
     Ok((Piece { range: tile, pixels: acc }, stats))
 }

@@ -93,7 +93,7 @@ pub fn gather<E: Exchange + ?Sized>(
     let mut image = Layer::transparent(width, height);
     image.pixels[piece.range.start..piece.range.end].copy_from_slice(&piece.pixels);
     for message in &received {
-        spans::decode_into(message, &mut image.pixels, |dst, src| *dst = src)?;
+        spans::decode_into(message, &mut image.pixels, 0, |dst, src| *dst = src)?;
     }
     Ok(Some(image))
 }

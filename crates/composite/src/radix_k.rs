@@ -25,22 +25,24 @@ pub fn radix_k<E: Exchange + ?Sized>(
     orders: &[Vec<usize>],
 ) -> Result<(Piece, CompositeStats), ExchangeError> {
     let rank = ex.rank();
-    let mut pixels = image.pixels.clone();
+    // What this process holds of the image: all of it at first, then its piece of each round.
     let mut range = PixelRange { start: 0, end: image.len() };
+    let mut held: Option<Vec<[f32; 4]>> = None;
     let mut stats = CompositeStats::default();
     let mut stride = 1;
-    let mut scratch = vec![[0.0f32; 4]; image.len()];
     for (round, &k) in factors.iter().enumerate() {
         if k == 1 {
             continue;
         }
+        let current: &[[f32; 4]] = held.as_deref().unwrap_or(&image.pixels);
+        let local = |p: PixelRange| (p.start - range.start)..(p.end - range.start);
         let digit = (rank / stride) % k;
         let base = rank - digit * stride;
         let member = |c: usize| base + c * stride;
         let mut outgoing = Vec::with_capacity(k - 1);
         for c in (0..k).filter(|&c| c != digit) {
             let piece = range.part(c, k);
-            let message = spans::encode(&pixels[piece.start..piece.end], piece.start);
+            let message = spans::encode(&current[local(piece)], piece.start);
             stats.bytes_sent += message.len() as u64;
             stats.messages += 1;
             outgoing.push((member(c), message));
@@ -51,24 +53,21 @@ pub fn radix_k<E: Exchange + ?Sized>(
         let mut acc = vec![[0.0f32; 4]; mine.len()];
         for &c in &orders[round] {
             if c == digit {
-                for (a, p) in acc.iter_mut().zip(&pixels[mine.start..mine.end]) {
+                for (a, p) in acc.iter_mut().zip(&current[local(mine)]) {
                     *a = over_front_to_back(*a, *p);
                 }
                 continue;
             }
             let i = if c < digit { c } else { c - 1 };
-            spans::decode_into(&received[i], &mut scratch, |dst, src| *dst = src)?;
-            for (a, p) in acc.iter_mut().zip(&mut scratch[mine.start..mine.end]) {
-                *a = over_front_to_back(*a, *p);
-                *p = [0.0; 4];
-            }
+            spans::decode_into(&received[i], &mut acc, mine.start, |a, p| *a = over_front_to_back(*a, p))?;
         }
-        pixels[mine.start..mine.end].copy_from_slice(&acc);
+        held = Some(acc);
         range = mine;
         stride *= k;
         stats.rounds += 1;
     }
-    Ok((Piece { range, pixels: pixels[range.start..range.end].to_vec() }, stats))
+    let pixels = held.unwrap_or_else(|| image.pixels.clone());
+    Ok((Piece { range, pixels }, stats))
 }
 
 #[cfg(test)]

@@ -1,7 +1,8 @@
 //! Non-empty pixel spans: what travels between processes. A process's image is mostly empty
 //! (its box covers a part of the screen, and rays that miss its box leave zeros), so each
 //! message holds only runs of pixels with any non-zero channel:
-//! `[run count, (start, length)…]` as u32 words, then the runs' pixels as f32.
+//! `[run count, (start, length)…]` as u32 words, then the runs' pixels as f32, in the hosts'
+//! byte order (the processes of one job share it).
 
 use crate::exchange::ExchangeError;
 
@@ -25,45 +26,49 @@ pub fn encode(pixels: &[[f32; 4]], first: usize) -> Vec<u8> {
         runs.push(((first + start) as u32, (i - start) as u32));
     }
     let count: usize = runs.iter().map(|r| r.1 as usize).sum();
-    let mut words: Vec<u32> = Vec::with_capacity(1 + 2 * runs.len() + 4 * count);
-    words.push(runs.len() as u32);
+    let mut bytes: Vec<u8> = Vec::with_capacity(4 * (1 + 2 * runs.len()) + 16 * count);
+    bytes.extend_from_slice(&(runs.len() as u32).to_ne_bytes());
     for &(start, len) in &runs {
-        words.extend([start, len]);
+        bytes.extend_from_slice(&start.to_ne_bytes());
+        bytes.extend_from_slice(&len.to_ne_bytes());
     }
     for &(start, len) in &runs {
         let from = start as usize - first;
-        for p in &pixels[from..from + len as usize] {
-            words.extend(p.map(f32::to_bits));
-        }
+        bytes.extend_from_slice(bytemuck::cast_slice(&pixels[from..from + len as usize]));
     }
-    bytemuck::cast_slice(&words).to_vec()
+    bytes
 }
 
-/// Applies every pixel of an encoded message to `image` (indexed by image pixel) with `apply`.
+/// Applies every pixel of an encoded message to `image` (indexed by image pixel minus
+/// `offset`, so a tile can be its own slice) with `apply`. Reads the message in place.
 pub fn decode_into(
     message: &[u8],
     image: &mut [[f32; 4]],
+    offset: usize,
     mut apply: impl FnMut(&mut [f32; 4], [f32; 4]),
 ) -> Result<(), ExchangeError> {
     let bad = |what: &str| ExchangeError::Malformed(what.to_string());
     if message.len() % 4 != 0 || message.len() < 4 {
         return Err(bad("not a whole number of words"));
     }
-    let words: Vec<u32> = message.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
-    let runs = words[0] as usize;
+    let word =
+        |i: usize| u32::from_ne_bytes([message[4 * i], message[4 * i + 1], message[4 * i + 2], message[4 * i + 3]]);
+    let words = message.len() / 4;
+    let runs = word(0) as usize;
     let header = 1 + 2 * runs;
-    if words.len() < header {
+    if words < header {
         return Err(bad("runs past the end"));
     }
     let mut at = header;
     for r in 0..runs {
-        let (start, len) = (words[1 + 2 * r] as usize, words[2 + 2 * r] as usize);
-        if start + len > image.len() || at + 4 * len > words.len() {
+        let (start, len) = (word(1 + 2 * r) as usize, word(2 + 2 * r) as usize);
+        if start < offset || start - offset + len > image.len() || at + 4 * len > words {
             return Err(bad("a run outside the image"));
         }
-        for (i, dst) in image[start..start + len].iter_mut().enumerate() {
-            let w = &words[at + 4 * i..at + 4 * i + 4];
-            apply(dst, [f32::from_bits(w[0]), f32::from_bits(w[1]), f32::from_bits(w[2]), f32::from_bits(w[3])]);
+        let bytes = &message[4 * at..4 * (at + 4 * len)];
+        for (dst, px) in image[start - offset..start - offset + len].iter_mut().zip(bytes.chunks_exact(16)) {
+            let f = |c: usize| f32::from_ne_bytes([px[4 * c], px[4 * c + 1], px[4 * c + 2], px[4 * c + 3]]);
+            apply(dst, [f(0), f(1), f(2), f(3)]);
         }
         at += 4 * len;
     }
@@ -83,8 +88,11 @@ mod tests {
         let message = encode(&pixels, 100);
         assert_eq!(message.len(), 4 * (1 + 4 + 12), "two runs, three pixels");
         let mut image = vec![[0.0f32; 4]; 120];
-        decode_into(&message, &mut image, |d, s| *d = s).expect("decodes");
+        decode_into(&message, &mut image, 0, |d, s| *d = s).expect("decodes");
         assert_eq!(&image[100..120], &pixels[..]);
-        assert!(decode_into(&message[..8], &mut image, |d, s| *d = s).is_err());
+        assert!(decode_into(&message[..8], &mut image, 0, |d, s| *d = s).is_err());
+        let mut tile = vec![[0.0f32; 4]; 20];
+        decode_into(&message, &mut tile, 100, |d, s| *d = s).expect("decodes into a tile");
+        assert_eq!(tile, pixels);
     }
 }

@@ -89,6 +89,10 @@ fn shader(params: &Params) -> ShaderUse {
 }
 
 impl PassDecl for Antialias {
+    fn honours_volume_window(&self) -> bool {
+        true
+    }
+
     fn kind(&self) -> &'static str {
         "antialias"
     }

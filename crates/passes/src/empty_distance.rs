@@ -26,6 +26,10 @@ struct DistanceParamsGpu {
 }
 
 impl PassDecl for EmptyDistance {
+    fn honours_volume_window(&self) -> bool {
+        true
+    }
+
     fn kind(&self) -> &'static str {
         "empty_distance"
     }

@@ -62,6 +62,10 @@ volgraph_core::pass_params! {
 }
 
 impl PassDecl for EmptySpace {
+    fn honours_volume_window(&self) -> bool {
+        true
+    }
+
     fn kind(&self) -> &'static str {
         "empty_space"
     }

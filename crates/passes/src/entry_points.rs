@@ -12,6 +12,10 @@ use volgraph_core::{Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, 
 pub struct EntryPoints;
 
 impl PassDecl for EntryPoints {
+    fn honours_volume_window(&self) -> bool {
+        true
+    }
+
     fn kind(&self) -> &'static str {
         "entry_points"
     }

@@ -33,6 +33,10 @@ fn shader() -> ShaderUse {
 }
 
 impl PassDecl for HoleFill {
+    fn honours_volume_window(&self) -> bool {
+        true
+    }
+
     fn kind(&self) -> &'static str {
         "hole_fill"
     }

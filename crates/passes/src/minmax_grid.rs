@@ -86,6 +86,10 @@ pub(crate) fn dispatch_grid(
 }
 
 impl PassDecl for MinMaxGridPass {
+    fn honours_volume_window(&self) -> bool {
+        true
+    }
+
     fn kind(&self) -> &'static str {
         "minmax_grid"
     }

@@ -27,6 +27,10 @@ fn shader() -> ShaderUse {
 }
 
 impl PassDecl for Present {
+    fn honours_volume_window(&self) -> bool {
+        true
+    }
+
     fn kind(&self) -> &'static str {
         "present"
     }

@@ -11,6 +11,10 @@ use volgraph_core::{Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec};
 pub struct RayDirections;
 
 impl PassDecl for RayDirections {
+    fn honours_volume_window(&self) -> bool {
+        true
+    }
+
     fn kind(&self) -> &'static str {
         "ray_directions"
     }

@@ -43,6 +43,10 @@ pub(crate) fn raycast_ports(params: &Params, color: &[TargetFormat], hit: &[Targ
 }
 
 impl PassDecl for Raycast {
+    fn honours_volume_window(&self) -> bool {
+        true
+    }
+
     fn kind(&self) -> &'static str {
         "raycast"
     }

@@ -93,6 +93,10 @@ const MAX_STAGING_BYTES: u64 = 64 << 20;
 const MAX_LEAP: u32 = 255;
 
 impl PassDecl for RaycastBricks {
+    fn honours_volume_window(&self) -> bool {
+        true
+    }
+
     fn kind(&self) -> &'static str {
         "raycast_bricks"
     }

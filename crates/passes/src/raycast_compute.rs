@@ -62,6 +62,10 @@ fn uses_table(params: &Params) -> bool {
 }
 
 impl PassDecl for RaycastCompute {
+    fn honours_volume_window(&self) -> bool {
+        true
+    }
+
     fn kind(&self) -> &'static str {
         "raycast_compute"
     }

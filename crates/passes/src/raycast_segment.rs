@@ -110,6 +110,10 @@ pub(crate) fn segment_index(ctx: &RecordContext<'_>) -> u32 {
 }
 
 impl PassDecl for RaycastSegment {
+    fn honours_volume_window(&self) -> bool {
+        true
+    }
+
     fn kind(&self) -> &'static str {
         "raycast_segment"
     }

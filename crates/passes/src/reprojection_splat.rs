@@ -42,6 +42,10 @@ volgraph_core::pass_params! {
 }
 
 impl PassDecl for ReprojectionSplat {
+    fn honours_volume_window(&self) -> bool {
+        true
+    }
+
     fn kind(&self) -> &'static str {
         "reprojection_splat"
     }

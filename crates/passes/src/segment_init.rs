@@ -29,6 +29,10 @@ fn fragment(params: &Params) -> &'static str {
 pub(crate) const DEPTH_LIVE: f32 = 0.0;
 
 impl PassDecl for SegmentInit {
+    fn honours_volume_window(&self) -> bool {
+        true
+    }
+
     fn kind(&self) -> &'static str {
         "segment_init"
     }

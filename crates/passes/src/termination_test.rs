@@ -38,6 +38,10 @@ volgraph_core::pass_params! {
 }
 
 impl PassDecl for TerminationTest {
+    fn honours_volume_window(&self) -> bool {
+        true
+    }
+
     fn kind(&self) -> &'static str {
         "termination_test"
     }

@@ -16,6 +16,7 @@
 //! After every step that can fail on one rank, the ranks agree on the outcome, so an error on
 //! one rank ends every rank with that rank's message and a non-zero exit, never a hang.
 
+pub mod bench;
 pub mod survey;
 
 use std::sync::Arc;
@@ -92,7 +93,9 @@ pub fn launch() -> Result<(), CliError> {
         .into_render_args()
         .ok_or_else(|| CliError::Other(anyhow!("internal: rank 0's command is not render")))?;
     let report = run(&mut ex, &args)?;
-    crate::stdout::eprintln_escaped!("{}", report.line());
+    // One write of the whole line: lines of ranks sharing a stderr pipe never interleave.
+    use std::io::Write as _;
+    let _ = std::io::stderr().write_all(format!("{}\n", report.line()).as_bytes());
     Ok(())
 }
 
@@ -122,6 +125,16 @@ pub fn run<E: Exchange + ?Sized>(ex: &mut E, args: &RenderArgs) -> Result<RankRe
     let surveyed = survey::survey(ex, &job.header).map_err(|e| anyhow!(e));
     let survey = step(ex, surveyed)?;
     let (lut, plan) = step(ex, job.compile(&survey))?;
+    if rank == 0
+        && let Some(threshold) = early_termination_below_one(&plan)
+    {
+        crate::stdout::eprintln_escaped!(
+            "note: this graph stops rays at opacity {threshold}; each rank stops only its own part of a ray, and the \
+             ranks behind still add their light, so the image may differ from the single-process one by up to \
+             {:.3} where rays saturate (it is nearer the converged image); a threshold of 1 makes them equal",
+            1.0 - threshold
+        );
+    }
     let weights = survey.weights(job.header.dims, &lut);
     let factors = radix_factors(ranks, args.radix_k.max(2) as usize);
     let tree = step(ex, KdTree::balanced(&weights, &factors).map_err(|e| anyhow!("{e}")))?;
@@ -180,6 +193,17 @@ pub fn run<E: Exchange + ?Sized>(ex: &mut E, args: &RenderArgs) -> Result<RankRe
     };
     step(ex, written)?;
     Ok(report)
+}
+
+/// The lowest early-termination threshold of `plan`'s passes below 1 − 1/255 (where one rank's
+/// rays stop before the single-process ones would), if any.
+fn early_termination_below_one(plan: &volgraph_core::Plan) -> Option<f64> {
+    plan.steps
+        .iter()
+        .filter(|s| s.params.declares("threshold"))
+        .map(|s| s.params.float("threshold"))
+        .filter(|t| *t < 1.0 - 1.0 / 255.0)
+        .reduce(f64::min)
 }
 
 /// The image rows the box `own` may cover for `camera`: its corners projected, or every row
@@ -279,6 +303,22 @@ impl Job {
         let registry = crate::program::registry();
         let plan = compile(&display_name(&self.graph), &self.source, &registry, &options)
             .map_err(|e| anyhow!("{}", crate::cli::error_text(&CliError::Graph(e))))?;
+        let unsplittable: Vec<String> = plan
+            .steps
+            .iter()
+            .filter(|s| !registry.get(&s.kind).is_some_and(|p| p.honours_volume_window()))
+            .map(|s| format!("\"{}\" ({})", s.pass_id, s.kind))
+            .collect();
+        if !unsplittable.is_empty() {
+            return Err(anyhow!(
+                "graph \"{}\": --distributed cannot split pass {} between ranks: only passes that take the samples of \
+                 a ray in a rank's own box composite with the over operator (the raycasters: e.g. basic/fragment_raycast, \
+                 modern/fastest, kruger_westermann_2003/rc_b, ruijters_vilanova_2006/bricks_octree_ert); render this \
+                 graph without --distributed",
+                plan.name,
+                unsplittable.join(", ")
+            ));
+        }
         let image = plan.outputs.get("image").map(|&r| &plan.resources[r].desc);
         let float = matches!(
             image,

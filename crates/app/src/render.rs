@@ -34,7 +34,7 @@ pub struct RenderArgs {
     #[arg(short = 'o', long = "out")]
     pub out: PathBuf,
     /// Sort-last rendering over MPI: run under `mpirun -n N` (a build with `--features mpi`);
-    /// each rank reads and renders its box of `--volume` (a .raw file) and rank 0 writes the
+    /// each rank reads and renders its box of `--volume` (.raw, .nrrd, .mha) and rank 0 writes the
     /// composited image. See docs/scaling.md.
     #[arg(long)]
     pub distributed: bool,

@@ -208,3 +208,30 @@ fn composite_flags_need_distributed() {
     assert_ne!(run.code, 0);
     assert!(run.stderr.contains("--distributed"), "{}", run.stderr);
 }
+
+/// A detached NRRD header over a raw file: every rank seeks in the data file for its box, and
+/// the image equals the single render of the same header.
+#[test]
+fn a_detached_nrrd_is_read_box_by_box() {
+    if !mpi_ready() {
+        return;
+    }
+    let Some(volume) = dataset("hydrogen_atom") else { return };
+    let nhdr = scratch("hydrogen.nhdr");
+    std::fs::write(
+        &nhdr,
+        format!("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 128 128 128\nspacings: 1 1 1.25\nencoding: raw\ndata file: {volume}\n\n"),
+    )
+    .expect("write the header");
+    let tf = volgraph_accel::data_dir::data_dir().join("tf/hydrogen.ron").to_string_lossy().into_owned();
+    let n = nhdr.to_string_lossy().into_owned();
+    let base = ["basic/compute_raycast", "--volume", &n, "--tf", &tf, "--size", "96x96", "--camera", "60,10,2.8"];
+    let single = scratch("nrrd_single.exr").to_string_lossy().into_owned();
+    let split = scratch("nrrd_split.exr").to_string_lossy().into_owned();
+    let run = volgraph(&[&["render"][..], &base, &["--output", "image", "-o", &single]].concat());
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let run = mpirun(2, &[&base[..], &["--distributed", "-o", &split]].concat(), &[]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let (worst, over) = difference(&read_exr(Path::new(&single)), &read_exr(Path::new(&split)));
+    assert!(worst <= 2.0 / 255.0 && over <= 8, "worst {:.2}/255, {over} over 1/255", worst * 255.0);
+}

@@ -40,7 +40,83 @@ pub(super) fn load(path: &Path) -> Result<LoadedVolume, LoadError> {
     parse(path, &bytes)
 }
 
+/// What a MetaImage header says: the layout and where and how the voxels are stored.
+struct Header {
+    layout: Layout,
+    compressed: bool,
+    header_size: i64,
+    /// `ElementDataFile`: its value, where attached data starts, its line.
+    data_name: String,
+    data_start: usize,
+    data_line: usize,
+    notes: Vec<String>,
+}
+
 pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError> {
+    let Header { layout, compressed, header_size, data_name, data_start, data_line, mut notes } =
+        parse_header(path, bytes)?;
+    let (dims, dtype) = (layout.dims, layout.dtype);
+    let local = data_name.eq_ignore_ascii_case("LOCAL");
+    let (data_path, stored) = if local {
+        if header_size != 0 {
+            notes.push(format!("HeaderSize = {header_size} ignored for LOCAL data"));
+        }
+        (path.to_path_buf(), bytes.get(data_start..).unwrap_or(&[]).to_vec())
+    } else {
+        read_data_file(path, Location::line(path, data_line), "ElementDataFile", &data_name)?
+    };
+    let expected = byte_count(dims, dtype).unwrap_or(u64::MAX);
+    let data = if compressed {
+        inflate(&data_path, &stored, true, expected.saturating_add(1))?
+    } else if local || header_size == 0 {
+        stored
+    } else if header_size == -1 {
+        let start = (stored.len() as u64).saturating_sub(expected) as usize;
+        stored[start..].to_vec()
+    } else {
+        let skip = (header_size as u64).min(stored.len() as u64) as usize;
+        stored[skip..].to_vec()
+    };
+    let mut report = LoadReport::new(VolumeFormat::MetaImage, &data_path);
+    report.notes = notes;
+    finish(layout, &data, &data_path, report, HINT)
+}
+
+/// Where the voxels of MetaImage `path` lie when a box of them can be read by seeking: the
+/// layout, the data file and the offset of the first voxel. `bytes` holds at least the header.
+/// Uncompressed data along the world's axes only; anything else is [`LoadError::NoBoxRead`].
+pub(super) fn raw_data(path: &Path, bytes: &[u8]) -> Result<(Layout, std::path::PathBuf, u64), LoadError> {
+    let h = parse_header(path, bytes)?;
+    let refuse = |format| LoadError::NoBoxRead { path: path.to_path_buf(), format };
+    if h.compressed {
+        return Err(refuse("compressed MetaImage"));
+    }
+    if !h.layout.orientation.is_identity() {
+        return Err(refuse("MetaImage with flipped or swapped axes"));
+    }
+    let expected = byte_count(h.layout.dims, h.layout.dtype).unwrap_or(u64::MAX);
+    let local = h.data_name.eq_ignore_ascii_case("LOCAL");
+    let data_path = if local { path.to_path_buf() } else { super::sibling(path, &h.data_name) };
+    let size = std::fs::metadata(&data_path).map_err(|source| LoadError::Io { path: data_path.clone(), source })?.len();
+    let offset = match (local, h.header_size) {
+        (true, _) => h.data_start as u64,
+        (false, -1) => size.saturating_sub(expected),
+        (false, skip) => skip.max(0) as u64,
+    };
+    if size < offset.saturating_add(expected) {
+        return Err(LoadError::DataSize {
+            path: data_path,
+            dims: super::dims_text(h.layout.dims),
+            dtype: h.layout.dtype,
+            expected,
+            actual: size.saturating_sub(offset),
+            hint: HINT,
+        });
+    }
+    Ok((h.layout, data_path, offset))
+}
+
+fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, LoadError> {
     let mut ndims_seen = false;
     let mut sizes: Option<(usize, [u64; 3], String)> = None;
     let mut spacing: Option<(usize, DVec3)> = None;
@@ -51,7 +127,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
     let mut compressed = false;
     let mut data_file: Option<(String, usize, usize)> = None;
     let mut directions: Option<(usize, [DVec3; 3])> = None;
-    let mut notes = Vec::new();
+    let notes = Vec::new();
 
     for (number, text, end) in header_lines(bytes) {
         if text.trim().is_empty() {
@@ -210,29 +286,6 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
         None => (super::AxisOrientation::default(), file_spacing),
     };
 
-    let local = data_name.eq_ignore_ascii_case("LOCAL");
-    let (data_path, stored) = if local {
-        if header_size != 0 {
-            notes.push(format!("HeaderSize = {header_size} ignored for LOCAL data"));
-        }
-        (path.to_path_buf(), bytes.get(data_start..).unwrap_or(&[]).to_vec())
-    } else {
-        read_data_file(path, Location::line(path, data_line), "ElementDataFile", &data_name)?
-    };
-    let expected = byte_count(dims, dtype).unwrap_or(u64::MAX);
-    let data = if compressed {
-        inflate(&data_path, &stored, true, expected.saturating_add(1))?
-    } else if local || header_size == 0 {
-        stored
-    } else if header_size == -1 {
-        let start = (stored.len() as u64).saturating_sub(expected) as usize;
-        stored[start..].to_vec()
-    } else {
-        let skip = (header_size as u64).min(stored.len() as u64) as usize;
-        stored[skip..].to_vec()
-    };
-    let mut report = LoadReport::new(VolumeFormat::MetaImage, &data_path);
-    report.notes = notes;
     let layout = Layout { name: stem(path), dims, dtype, order, spacing, orientation };
-    finish(layout, &data, &data_path, report, HINT)
+    Ok(Header { layout, compressed, header_size, data_name, data_start, data_line, notes })
 }

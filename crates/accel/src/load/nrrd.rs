@@ -77,7 +77,91 @@ pub(super) fn load(path: &Path) -> Result<LoadedVolume, LoadError> {
     parse(path, &bytes)
 }
 
+/// What a NRRD header says: the layout and where and how the voxels are stored.
+pub(super) struct Header {
+    layout: Layout,
+    encoding: Encoding,
+    data_file: Option<(String, usize)>,
+    byte_skip: i64,
+    /// Where attached data starts (after the blank line), when the header ends in `bytes`.
+    data_start: Option<usize>,
+    notes: Vec<String>,
+    frame: WorldFrame,
+    oriented: bool,
+}
+
 pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError> {
+    let Header { layout, encoding, data_file, byte_skip, data_start, notes, frame, oriented } =
+        parse_header(path, bytes)?;
+    let (dims, dtype) = (layout.dims, layout.dtype);
+    let missing = |field, example| LoadError::MissingField { path: path.to_path_buf(), field, example };
+    let (data_path, stored) = match &data_file {
+        Some((name, line)) => read_data_file(path, Location::line(path, *line), "data file", name)?,
+        None => match data_start {
+            Some(start) => (path.to_path_buf(), bytes.get(start..).unwrap_or(&[]).to_vec()),
+            None if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("nhdr")) => {
+                return Err(missing("data file", "data file: volume.raw"));
+            }
+            None => {
+                return Err(LoadError::UnterminatedHeader { path: path.to_path_buf() });
+            }
+        },
+    };
+    let expected = byte_count(dims, dtype).unwrap_or(u64::MAX);
+    let skip = byte_skip.max(0) as u64;
+    let decoded = match encoding {
+        Encoding::Raw => stored,
+        Encoding::Gzip => inflate(&data_path, &stored, false, expected.saturating_add(skip).saturating_add(1))?,
+    };
+    let data: &[u8] = if byte_skip == -1 {
+        // Data at the end of the file: the last `expected` bytes (too few bytes fall through to
+        // the size error below).
+        let start = (decoded.len() as u64).saturating_sub(expected) as usize;
+        &decoded[start..]
+    } else {
+        decoded.get(skip.min(decoded.len() as u64) as usize..).unwrap_or(&[])
+    };
+    let mut report = LoadReport::new(VolumeFormat::Nrrd, &data_path);
+    report.notes = notes;
+    let mut loaded = finish(layout, data, &data_path, report, HINT)?;
+    loaded.volume.meta.frame = if oriented { frame } else { WorldFrame::IndexAxes };
+    Ok(loaded)
+}
+
+/// Where the voxels of NRRD `path` lie when a box of them can be read by seeking: the layout,
+/// the data file and the offset of the first voxel. `bytes` holds at least the header. Raw
+/// encoding and file axes along the world's only; anything else is [`LoadError::NoBoxRead`].
+pub(super) fn raw_data(path: &Path, bytes: &[u8]) -> Result<(Layout, std::path::PathBuf, u64), LoadError> {
+    let header = parse_header(path, bytes)?;
+    let refuse = |format| LoadError::NoBoxRead { path: path.to_path_buf(), format };
+    if header.encoding != Encoding::Raw {
+        return Err(refuse("gzip-encoded NRRD"));
+    }
+    if !header.layout.orientation.is_identity() {
+        return Err(refuse("NRRD with flipped or swapped axes"));
+    }
+    let expected = byte_count(header.layout.dims, header.layout.dtype).unwrap_or(u64::MAX);
+    let (data_path, start) = match (&header.data_file, header.data_start) {
+        (Some((name, _)), _) => (super::sibling(path, name), 0),
+        (None, Some(start)) => (path.to_path_buf(), start as u64),
+        (None, None) => return Err(LoadError::UnterminatedHeader { path: path.to_path_buf() }),
+    };
+    let size = std::fs::metadata(&data_path).map_err(|source| LoadError::Io { path: data_path.clone(), source })?.len();
+    let offset = if header.byte_skip == -1 { size.saturating_sub(expected) } else { start + header.byte_skip as u64 };
+    if size < offset.saturating_add(expected) {
+        return Err(LoadError::DataSize {
+            path: data_path,
+            dims: super::dims_text(header.layout.dims),
+            dtype: header.layout.dtype,
+            expected,
+            actual: size.saturating_sub(offset),
+            hint: HINT,
+        });
+    }
+    Ok((header.layout, data_path, offset))
+}
+
+fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, LoadError> {
     let mut lines = header_lines(bytes);
     let magic = lines.next().map(|(_, text, _)| text).unwrap_or_default();
     let version_ok = magic.len() == 8 && magic.starts_with("NRRD000") && matches!(magic.as_bytes()[7], b'1'..=b'5');
@@ -266,34 +350,6 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
         });
     }
 
-    let (data_path, stored) = match &data_file {
-        Some((name, line)) => read_data_file(path, Location::line(path, *line), "data file", name)?,
-        None => match data_start {
-            Some(start) => (path.to_path_buf(), bytes.get(start..).unwrap_or(&[]).to_vec()),
-            None if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("nhdr")) => {
-                return Err(missing("data file", "data file: volume.raw"));
-            }
-            None => {
-                return Err(LoadError::UnterminatedHeader { path: path.to_path_buf() });
-            }
-        },
-    };
-    let expected = byte_count(dims, dtype).unwrap_or(u64::MAX);
-    let skip = byte_skip.max(0) as u64;
-    let decoded = match encoding {
-        Encoding::Raw => stored,
-        Encoding::Gzip => inflate(&data_path, &stored, false, expected.saturating_add(skip).saturating_add(1))?,
-    };
-    let data: &[u8] = if byte_skip == -1 {
-        // Data at the end of the file: the last `expected` bytes (too few bytes fall through to
-        // the size error below).
-        let start = (decoded.len() as u64).saturating_sub(expected) as usize;
-        &decoded[start..]
-    } else {
-        decoded.get(skip.min(decoded.len() as u64) as usize..).unwrap_or(&[])
-    };
-    let mut report = LoadReport::new(VolumeFormat::Nrrd, &data_path);
-    report.notes = notes;
     let (frame, lps) = space.as_deref().map_or((WorldFrame::IndexAxes, None), anatomical_space);
     let oriented = directions.is_some();
     let orientation = match directions {
@@ -307,9 +363,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
         None => super::AxisOrientation::default(),
     };
     let layout = Layout { name: stem(path), dims, dtype, order, spacing, orientation };
-    let mut loaded = finish(layout, data, &data_path, report, HINT)?;
-    loaded.volume.meta.frame = if oriented { frame } else { WorldFrame::IndexAxes };
-    Ok(loaded)
+    Ok(Header { layout, encoding, data_file, byte_skip, data_start, notes, frame, oriented })
 }
 
 /// The frame of NRRD `space` value `name`, and for an anatomical space the per-axis signs that

@@ -30,13 +30,33 @@ pub struct VolumeHeader {
 }
 
 impl VolumeHeader {
-    /// The header of volume file `path` (reads no voxels). Headerless `.raw` files for now;
-    /// another format is a [`LoadError::NoBoxRead`].
+    /// The header of volume file `path` (reads no voxels): headerless `.raw` files, raw-encoded
+    /// NRRD (`.nrrd`, `.nhdr`) and uncompressed MetaImage (`.mha`, `.mhd`), attached or detached,
+    /// whose axes are the world's; anything else (NIfTI, DICOM, compressed or reoriented data)
+    /// is a [`LoadError::NoBoxRead`].
     pub fn read(path: &Path, opts: &RawOptions) -> Result<Self, LoadError> {
         let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+        if matches!(extension.as_str(), "nrrd" | "nhdr" | "mhd" | "mha") {
+            super::check_no_raw_layout(path, opts)?;
+            let head = read_head(path)?;
+            let (Layout { name, dims, dtype, order, spacing, .. }, data_path, data_offset) =
+                if extension.starts_with('n') {
+                    super::nrrd::raw_data(path, &head)?
+                } else {
+                    super::metaimage::raw_data(path, &head)?
+                };
+            return Ok(Self {
+                name,
+                dims,
+                dtype,
+                order,
+                spacing: opts.spacing.unwrap_or(spacing),
+                data_path,
+                data_offset,
+            });
+        }
         let format = match extension.as_str() {
             "raw" => None,
-            "nrrd" | "nhdr" => Some("NRRD"),
             "mhd" | "mha" => Some("MetaImage"),
             _ if super::is_nifti(path) => Some("NIfTI"),
             _ if path.is_dir() || extension == "dcm" => Some("DICOM"),
@@ -55,6 +75,11 @@ impl VolumeHeader {
             data_path: path.to_path_buf(),
             data_offset: 0,
         })
+    }
+
+    /// The file the voxels are read from.
+    pub fn data_path(&self) -> &Path {
+        &self.data_path
     }
 
     /// The normalization range of the whole volume for integer data (the type range, as
@@ -118,6 +143,14 @@ impl VolumeHeader {
     }
 }
 
+/// The first MiB of `path`: enough for any header volgraph reads.
+fn read_head(path: &Path) -> Result<Vec<u8>, LoadError> {
+    let io = |source| LoadError::Io { path: path.to_path_buf(), source };
+    let mut head = Vec::new();
+    std::fs::File::open(path).map_err(io)?.take(1 << 20).read_to_end(&mut head).map_err(io)?;
+    Ok(head)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -143,6 +176,58 @@ mod tests {
                 }
             }
         }
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// NRRD, attached and detached: the box read by seeking equals the box of the loaded volume.
+    #[test]
+    fn a_box_of_a_nrrd_file_equals_the_box_of_the_whole_volume() {
+        let dir = std::env::temp_dir().join(format!("volgraph-region-nrrd-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let values: Vec<u8> = (0..9 * 8 * 7).map(|i| (i * 31 % 251) as u8).collect();
+        let header = "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 9 8 7\nspacings: 1 1 2\nencoding: raw\n";
+        let attached = dir.join("attached.nrrd");
+        std::fs::write(&attached, [format!("{header}\n").as_bytes(), &values].concat()).expect("write");
+        std::fs::write(dir.join("voxels.raw"), &values).expect("write");
+        let detached = dir.join("detached.nhdr");
+        std::fs::write(&detached, format!("{header}data file: voxels.raw\n\n")).expect("write");
+        let bx = VoxelBox::new(UVec3::new(1, 2, 3), UVec3::new(8, 8, 6));
+        for path in [attached, detached] {
+            let whole = super::super::load_volume(&path, &RawOptions::default()).expect("whole").volume;
+            let header = VolumeHeader::read(&path, &RawOptions::default()).expect("header");
+            assert_eq!(header.spacing, DVec3::new(1.0, 1.0, 2.0));
+            let part = header.read_box(bx, whole.value_range).expect("box");
+            for z in 0..part.dims.z {
+                for y in 0..part.dims.y {
+                    for x in 0..part.dims.x {
+                        let w = whole.index(x + bx.lo.x, y + bx.lo.y, z + bx.lo.z);
+                        assert_eq!(part.raw_value(part.index(x, y, z)), whole.raw_value(w), "{}", path.display());
+                    }
+                }
+            }
+        }
+        // MetaImage, attached and detached.
+        let mha = dir.join("attached.mha");
+        let fields = "NDims = 3\nDimSize = 9 8 7\nElementSpacing = 1 1 2\nElementType = MET_UCHAR\n";
+        std::fs::write(&mha, [format!("{fields}ElementDataFile = LOCAL\n").as_bytes(), &values].concat())
+            .expect("write");
+        let mhd = dir.join("detached.mhd");
+        std::fs::write(&mhd, format!("{fields}ElementDataFile = voxels.raw\n")).expect("write");
+        for path in [mha, mhd] {
+            let whole = super::super::load_volume(&path, &RawOptions::default()).expect("whole").volume;
+            let header = VolumeHeader::read(&path, &RawOptions::default()).expect("header");
+            let part = header.read_box(bx, whole.value_range).expect("box");
+            let w = whole.index(bx.lo.x + 2, bx.lo.y + 1, bx.lo.z + 1);
+            assert_eq!(part.raw_value(part.index(2, 1, 1)), whole.raw_value(w), "{}", path.display());
+            assert_eq!(
+                part.raw_value(part.voxel_count() - 1),
+                whole.raw_value(whole.index(bx.hi.x - 1, bx.hi.y - 1, bx.hi.z - 1))
+            );
+        }
+        let gz = dir.join("packed.nrrd");
+        std::fs::write(&gz, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: gzip\n\n").expect("write");
+        let e = VolumeHeader::read(&gz, &RawOptions::default()).expect_err("gzip");
+        assert!(e.to_string().contains("gzip-encoded NRRD files cannot be read a box at a time"), "{e}");
         std::fs::remove_dir_all(&dir).ok();
     }
 

@@ -266,7 +266,11 @@ impl Job {
         }
         let path = match args.inputs.volume.as_slice() {
             [path] => path,
-            [] => return Err(anyhow!("--distributed needs --volume FILE.raw: each rank reads its box of the file")),
+            [] => {
+                return Err(anyhow!(
+                    "--distributed needs --volume FILE (.raw, .nrrd, .nhdr, .mha or .mhd): each rank reads its box of the file"
+                ));
+            }
             _ => return Err(anyhow!("--distributed reads one volume file; give one --volume")),
         };
         let raw = inputs::raw_options(&args.inputs.raw)?;

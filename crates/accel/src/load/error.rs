@@ -49,7 +49,7 @@ pub enum LoadError {
 
     /// A format whose boxes cannot be read on their own (sort-last rendering reads each
     /// process's box of the file).
-    #[error("{}: {format} files cannot be read a box at a time yet; `render --distributed` reads raw files (name_XxYxZ_dtype.raw), raw-encoded NRRD and uncompressed MetaImage along the world's axes: write the voxels out as one of those", .path.display())]
+    #[error("{}: {format} files cannot be read a box at a time yet; `render --distributed` reads raw files (name_XxYxZ_dtype.raw), raw-encoded NRRD, uncompressed MetaImage and DICOM series along the world's axes: write the voxels out as one of those", .path.display())]
     NoBoxRead {
         /// The file.
         path: PathBuf,

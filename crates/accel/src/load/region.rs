@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 
 use glam::{DVec3, UVec3};
 
-use super::{Endianness, Layout, LoadError, RawOptions, decode, raw};
+use super::dicom::SeriesSlices;
+use super::{Endianness, Layout, LoadError, LoadOptions, decode, raw};
 use crate::kd_split::VoxelBox;
 use crate::volume::{Volume, VoxelData, VoxelType};
 
@@ -25,41 +26,52 @@ pub struct VolumeHeader {
     pub order: Endianness,
     /// Physical voxel size.
     pub spacing: DVec3,
-    data_path: PathBuf,
-    data_offset: u64,
+    source: Source,
+}
+
+/// Where the voxels are.
+#[derive(Clone, Debug)]
+enum Source {
+    /// In one file from `offset`, x fastest.
+    File { path: PathBuf, offset: u64 },
+    /// In the slices of a DICOM series (read as rescaled f32).
+    Dicom { slices: Box<SeriesSlices>, path: PathBuf },
 }
 
 impl VolumeHeader {
-    /// The header of volume file `path` (reads no voxels): headerless `.raw` files, raw-encoded
-    /// NRRD (`.nrrd`, `.nhdr`) and uncompressed MetaImage (`.mha`, `.mhd`), attached or detached,
-    /// whose axes are the world's; anything else (NIfTI, DICOM, compressed or reoriented data)
-    /// is a [`LoadError::NoBoxRead`].
-    pub fn read(path: &Path, opts: &RawOptions) -> Result<Self, LoadError> {
+    /// The header of volume `path` (reads no voxels): headerless `.raw` files, raw-encoded NRRD
+    /// (`.nrrd`, `.nhdr`) and uncompressed MetaImage (`.mha`, `.mhd`), attached or detached, and
+    /// DICOM series (a folder or a `.dcm` file; `options.series` picks one), whose axes are the
+    /// world's; anything else (NIfTI, compressed or reoriented data) is a
+    /// [`LoadError::NoBoxRead`].
+    pub fn read(path: &Path, options: &LoadOptions<'_>) -> Result<Self, LoadError> {
+        let opts = &options.raw;
         let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
         if matches!(extension.as_str(), "nrrd" | "nhdr" | "mhd" | "mha") {
             super::check_no_raw_layout(path, opts)?;
             let head = read_head(path)?;
-            let (Layout { name, dims, dtype, order, spacing, .. }, data_path, data_offset) =
-                if extension.starts_with('n') {
-                    super::nrrd::raw_data(path, &head)?
-                } else {
-                    super::metaimage::raw_data(path, &head)?
-                };
+            let (Layout { name, dims, dtype, order, spacing, .. }, data_path, offset) = if extension.starts_with('n') {
+                super::nrrd::raw_data(path, &head)?
+            } else {
+                super::metaimage::raw_data(path, &head)?
+            };
+            let source = Source::File { path: data_path, offset };
+            return Ok(Self { name, dims, dtype, order, spacing: opts.spacing.unwrap_or(spacing), source });
+        }
+        if path.is_dir() || extension == "dcm" {
+            let slices = SeriesSlices::open(&[path.to_path_buf()], options.series.as_deref())?;
             return Ok(Self {
-                name,
-                dims,
-                dtype,
-                order,
-                spacing: opts.spacing.unwrap_or(spacing),
-                data_path,
-                data_offset,
+                name: slices.name.clone(),
+                dims: slices.dims,
+                dtype: VoxelType::F32,
+                order: Endianness::Little,
+                spacing: opts.spacing.unwrap_or(slices.spacing),
+                source: Source::Dicom { slices: Box::new(slices), path: path.to_path_buf() },
             });
         }
         let format = match extension.as_str() {
             "raw" => None,
-            "mhd" | "mha" => Some("MetaImage"),
             _ if super::is_nifti(path) => Some("NIfTI"),
-            _ if path.is_dir() || extension == "dcm" => Some("DICOM"),
             _ => return Err(LoadError::UnknownFormat { path: path.to_path_buf(), extension }),
         };
         if let Some(format) = format {
@@ -72,20 +84,26 @@ impl VolumeHeader {
             dtype,
             order,
             spacing: opts.spacing.unwrap_or(spacing),
-            data_path: path.to_path_buf(),
-            data_offset: 0,
+            source: Source::File { path: path.to_path_buf(), offset: 0 },
         })
     }
 
-    /// The file the voxels are read from.
+    /// The file the voxels are read from (a DICOM series: the path it was opened by).
     pub fn data_path(&self) -> &Path {
-        &self.data_path
+        match &self.source {
+            Source::File { path, .. } | Source::Dicom { path, .. } => path,
+        }
     }
 
-    /// The normalization range of the whole volume for integer data (the type range, as
-    /// [`Volume::new`] gives it); `None` for float data, whose range is the data's own.
+    /// The normalization range of the whole volume when its type fixes it (integer files: the
+    /// type range, as [`Volume::new`] gives it; 8-bit DICOM: 0..=255); `None` when the range is
+    /// the data's own (float data; 16-bit DICOM, whose range the loader fits to the data) and
+    /// must be surveyed.
     pub fn type_range(&self) -> Option<(f64, f64)> {
-        self.dtype.integer_range()
+        match &self.source {
+            Source::Dicom { slices, .. } => slices.eight_bit.then_some((0.0, 255.0)),
+            Source::File { .. } => self.dtype.integer_range(),
+        }
     }
 
     /// The voxels of `bx` as a volume of `bx.size()` voxels, normalized over `value_range` (the
@@ -93,17 +111,35 @@ impl VolumeHeader {
     /// loaders do (NaN and −∞ by the range's low end, +∞ by its high end). Reads only the rows
     /// of the box.
     pub fn read_box(&self, bx: VoxelBox, value_range: (f64, f64)) -> Result<Volume, LoadError> {
-        let io = |source| LoadError::Io { path: self.data_path.clone(), source };
+        let (data_path, data_offset) = match &self.source {
+            Source::File { path, offset } => (path, *offset),
+            Source::Dicom { slices, .. } => {
+                // Whole slices of the box's z-range, then its rows and columns.
+                let all = slices.read_slices(bx.lo.z..bx.hi.z)?;
+                let size = bx.size();
+                let mut values = Vec::with_capacity(bx.voxels() as usize);
+                for z in 0..size.z as usize {
+                    for y in bx.lo.y as usize..bx.hi.y as usize {
+                        let row = (z * self.dims.y as usize + y) * self.dims.x as usize;
+                        values.extend_from_slice(&all[row + bx.lo.x as usize..row + bx.hi.x as usize]);
+                    }
+                }
+                let mut volume = Volume::new(self.name.clone(), size, self.spacing, VoxelData::F32(values));
+                volume.value_range = value_range;
+                return Ok(volume);
+            }
+        };
+        let io = |source| LoadError::Io { path: data_path.clone(), source };
         let size = bx.size();
         let voxel = self.dtype.size_bytes() as u64;
-        let mut file = std::fs::File::open(&self.data_path).map_err(io)?;
+        let mut file = std::fs::File::open(data_path).map_err(io)?;
         let row = size.x as usize * voxel as usize;
         let mut bytes = vec![0u8; row * size.y as usize * size.z as usize];
         let mut at = 0;
         for z in bx.lo.z..bx.hi.z {
             for y in bx.lo.y..bx.hi.y {
                 let index = bx.lo.x as u64 + self.dims.x as u64 * (y as u64 + self.dims.y as u64 * z as u64);
-                file.seek(SeekFrom::Start(self.data_offset + index * voxel)).map_err(io)?;
+                file.seek(SeekFrom::Start(data_offset + index * voxel)).map_err(io)?;
                 file.read_exact(&mut bytes[at..at + row]).map_err(io)?;
                 at += row;
             }
@@ -153,6 +189,7 @@ fn read_head(path: &Path) -> Result<Vec<u8>, LoadError> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::RawOptions;
     use super::*;
 
     /// A box read by seeking equals the same box cut from the whole volume.
@@ -163,7 +200,7 @@ mod tests {
         let path = dir.join("ramp_13x7x5_uint16.raw");
         let values: Vec<u16> = (0..13 * 7 * 5).map(|i| (i * 37 % 65536) as u16).collect();
         std::fs::write(&path, values.iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>()).expect("write");
-        let header = VolumeHeader::read(&path, &RawOptions::default()).expect("header");
+        let header = VolumeHeader::read(&path, &LoadOptions::default()).expect("header");
         let whole = super::super::load_volume(&path, &RawOptions::default()).expect("whole").volume;
         let bx = VoxelBox::new(UVec3::new(2, 1, 3), UVec3::new(11, 7, 5));
         let part = header.read_box(bx, header.type_range().expect("integer")).expect("box");
@@ -194,7 +231,7 @@ mod tests {
         let bx = VoxelBox::new(UVec3::new(1, 2, 3), UVec3::new(8, 8, 6));
         for path in [attached, detached] {
             let whole = super::super::load_volume(&path, &RawOptions::default()).expect("whole").volume;
-            let header = VolumeHeader::read(&path, &RawOptions::default()).expect("header");
+            let header = VolumeHeader::read(&path, &LoadOptions::default()).expect("header");
             assert_eq!(header.spacing, DVec3::new(1.0, 1.0, 2.0));
             let part = header.read_box(bx, whole.value_range).expect("box");
             for z in 0..part.dims.z {
@@ -215,7 +252,7 @@ mod tests {
         std::fs::write(&mhd, format!("{fields}ElementDataFile = voxels.raw\n")).expect("write");
         for path in [mha, mhd] {
             let whole = super::super::load_volume(&path, &RawOptions::default()).expect("whole").volume;
-            let header = VolumeHeader::read(&path, &RawOptions::default()).expect("header");
+            let header = VolumeHeader::read(&path, &LoadOptions::default()).expect("header");
             let part = header.read_box(bx, whole.value_range).expect("box");
             let w = whole.index(bx.lo.x + 2, bx.lo.y + 1, bx.lo.z + 1);
             assert_eq!(part.raw_value(part.index(2, 1, 1)), whole.raw_value(w), "{}", path.display());
@@ -226,14 +263,41 @@ mod tests {
         }
         let gz = dir.join("packed.nrrd");
         std::fs::write(&gz, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: gzip\n\n").expect("write");
-        let e = VolumeHeader::read(&gz, &RawOptions::default()).expect_err("gzip");
+        let e = VolumeHeader::read(&gz, &LoadOptions::default()).expect_err("gzip");
         assert!(e.to_string().contains("gzip-encoded NRRD files cannot be read a box at a time"), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// A DICOM series: a box read from only the slices it spans equals the box of the loaded
+    /// series (rescaled values, as f32).
+    #[test]
+    fn a_box_of_a_dicom_series_equals_the_box_of_the_loaded_series() {
+        let dir = std::env::temp_dir().join(format!("volgraph-region-dicom-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let dims = UVec3::new(12, 10, 9);
+        let values: Vec<i16> = (0..dims.x * dims.y * dims.z).map(|i| ((i * 37 % 2000) as i16) - 1000).collect();
+        let ct = Volume::new("ct", dims, DVec3::new(0.5, 0.5, 1.5), VoxelData::I16(values));
+        super::super::dicom::write_ct_series(&dir, &ct).expect("series written");
+        let whole = super::super::load_volumes(&[dir.clone()], &LoadOptions::default()).expect("whole").volume;
+        let header = VolumeHeader::read(&dir, &LoadOptions::default()).expect("header");
+        assert_eq!(header.dims, whole.dims);
+        assert_eq!(header.type_range(), None, "16-bit DICOM: the range is surveyed");
+        let bx = VoxelBox::new(UVec3::new(2, 3, 4), UVec3::new(11, 10, 7));
+        let part = header.read_box(bx, whole.value_range).expect("box");
+        for z in 0..part.dims.z {
+            for y in 0..part.dims.y {
+                for x in 0..part.dims.x {
+                    let w = whole.index(x + bx.lo.x, y + bx.lo.y, z + bx.lo.z);
+                    assert_eq!(part.raw_value(part.index(x, y, z)), whole.raw_value(w));
+                }
+            }
+        }
         std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]
     fn formats_without_box_reads_say_so() {
-        let e = VolumeHeader::read(Path::new("brain.nii.gz"), &RawOptions::default()).expect_err("nifti");
+        let e = VolumeHeader::read(Path::new("brain.nii.gz"), &LoadOptions::default()).expect_err("nifti");
         assert!(e.to_string().contains("NIfTI files cannot be read a box at a time"), "{e}");
     }
 }

@@ -59,6 +59,8 @@ pub struct RankReport {
     pub voxel_bytes: u64,
     /// The box it owns.
     pub own: Option<VoxelBox>,
+    /// The box it holds: its own and the apron.
+    pub held: Option<VoxelBox>,
     /// The last frame's render and readback, ms.
     pub render_ms: f64,
     /// The last frame's compositing and gather, ms.
@@ -146,6 +148,7 @@ pub fn run<E: Exchange + ?Sized>(ex: &mut E, args: &RenderArgs) -> Result<RankRe
         ranks,
         voxel_bytes: volume.voxel_count() as u64 * job.header.dtype.size_bytes() as u64,
         own: Some(own),
+        held: Some(held),
         ..Default::default()
     };
     let window = VolumeWindow::new(job.header.dims, job.header.spacing, held.lo, own.lo, own.hi);
@@ -268,13 +271,13 @@ impl Job {
             [path] => path,
             [] => {
                 return Err(anyhow!(
-                    "--distributed needs --volume FILE (.raw, .nrrd, .nhdr, .mha or .mhd): each rank reads its box of the file"
+                    "--distributed needs --volume: a .raw, .nrrd, .nhdr, .mha or .mhd file or a DICOM folder; each rank reads its box of it"
                 ));
             }
-            _ => return Err(anyhow!("--distributed reads one volume file; give one --volume")),
+            _ => return Err(anyhow!("--distributed reads one volume file or DICOM folder; give one --volume")),
         };
         let raw = inputs::raw_options(&args.inputs.raw)?;
-        let header = VolumeHeader::read(path, &raw.raw).map_err(|e| anyhow!("{e}"))?;
+        let header = VolumeHeader::read(path, &raw).map_err(|e| anyhow!("{e}"))?;
         let source = inputs::read_graph(&resolved.graph)?;
         let options = compile_options(&resolved.size, &args.inputs.features, &[])?;
         Ok(Job {

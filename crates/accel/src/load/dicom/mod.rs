@@ -199,9 +199,62 @@ pub fn load(
     options: &DicomOptions,
     progress: Option<Progress<'_>>,
 ) -> Result<LoadedVolume, LoadError> {
+    let Stacked { series, ordered, stack, file_dims, mut notes } = stack_series(paths, options.series.as_deref())?;
+    notes.extend(stack.notes.iter().cloned());
+    let first = series[0].clone();
+    let voxels = pixels::read(&series, &ordered, file_dims, progress)?;
+
+    let at = Location::file(&first.path);
+    let (orientation, spacing) = AxisOrientation::from_directions(stack.directions, &at, "ImageOrientationPatient")?;
+    let mut report = LoadReport::new(VolumeFormat::Dicom, &first.path);
+    report.notes = notes;
+    if !orientation.is_identity() {
+        report.notes.push(format!(
+            "voxels reordered to the LPS patient frame ({}): the series' orientation is honoured",
+            orientation.describe()
+        ));
+    }
+    // The corner of the box nearest −∞ on every world axis: voxel (0,0,0) after reordering.
+    let origin = (0..3).fold(stack.origin, |o, i| {
+        if orientation.flipped[i] { o + stack.directions[i] * (file_dims[i] as f64 - 1.0) } else { o }
+    });
+    let data = orientation.reorder(file_dims, voxels);
+    let name = if first.description.is_empty() { dicom_name(paths) } else { first.description.clone() };
+    let mut volume = Volume::new(name, orientation.world_dims(file_dims), spacing, data);
+    volume.fit_range_to_data();
+    let units = match (first.modality.as_str(), first.rescale_type.as_deref()) {
+        (_, Some(t)) if !t.eq_ignore_ascii_case("US") => Some(t.to_string()),
+        ("CT", _) => Some("HU".to_string()),
+        _ => None,
+    };
+    volume.meta = VolumeMeta {
+        modality: (!first.modality.is_empty()).then(|| first.modality.clone()),
+        units,
+        window: first.window.map(|(center, width)| Window { center, width }),
+        frame: WorldFrame::Lps,
+        origin: Some(origin),
+        description: (!first.description.is_empty()).then(|| first.description.clone()),
+    };
+    Ok(LoadedVolume { volume, report })
+}
+
+/// A series' frames in stack order.
+struct Stacked {
+    series: Vec<FileHeader>,
+    /// (file, frame) per slice, in increasing position along the slice normal.
+    ordered: Vec<(usize, usize)>,
+    stack: geometry::Stack,
+    /// Columns, rows, slices.
+    file_dims: glam::UVec3,
+    notes: Vec<String>,
+}
+
+/// Scans `paths`, picks the series (`wanted`, or the only one), checks its pixels can be read
+/// and orders its frames along the slice normal.
+fn stack_series(paths: &[PathBuf], wanted: Option<&str>) -> Result<Stacked, LoadError> {
     let place = paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
     let (groups, mut notes) = scan(paths)?;
-    let series = choose(&place, groups, options.series.as_deref())?;
+    let series = choose(&place, groups, wanted)?;
     let first = series[0].clone();
     let series_name = if first.description.is_empty() {
         format!("series {}", first.series_number.map_or(first.series_uid.clone(), |n| n.to_string()))
@@ -238,44 +291,66 @@ pub fn load(
         notes.push("the image has no ImagePositionPatient; placed at the origin".to_string());
     }
     let stack = geometry::stack(&series_name, &slices, first.slice_thickness.or(first.spacing_between_slices))?;
-    notes.extend(stack.notes.iter().cloned());
     let ordered: Vec<(usize, usize)> = stack.order.iter().map(|&i| sources[i]).collect();
     let (rows, columns) = (first.frame_geometry[0].rows, first.frame_geometry[0].columns);
     let file_dims = glam::UVec3::new(columns, rows, ordered.len() as u32);
-    let voxels = pixels::read(&series, &ordered, file_dims, progress)?;
+    Ok(Stacked { series, ordered, stack, file_dims, notes })
+}
 
-    let at = Location::file(&first.path);
-    let (orientation, spacing) = AxisOrientation::from_directions(stack.directions, &at, "ImageOrientationPatient")?;
-    let mut report = LoadReport::new(VolumeFormat::Dicom, &first.path);
-    report.notes = notes;
-    if !orientation.is_identity() {
-        report.notes.push(format!(
-            "voxels reordered to the LPS patient frame ({}): the series' orientation is honoured",
-            orientation.describe()
-        ));
+/// One DICOM series whose slices can be read a z-range at a time (sort-last rendering,
+/// `load::VolumeHeader`): only the files holding those slices are opened.
+#[derive(Clone, Debug)]
+pub struct SeriesSlices {
+    series: Vec<FileHeader>,
+    ordered: Vec<(usize, usize)>,
+    /// Voxels per axis (columns, rows, slices).
+    pub dims: glam::UVec3,
+    /// Voxel spacing (mm).
+    pub spacing: glam::DVec3,
+    /// The series' name.
+    pub name: String,
+    /// True when every file stores 8 bits per pixel (the whole volume normalizes over 0..=255
+    /// then, as [`load`] gives it).
+    pub eight_bit: bool,
+}
+
+impl SeriesSlices {
+    /// The series in `paths` (`wanted`, or the only one; its slices along the patient axes).
+    pub fn open(paths: &[PathBuf], wanted: Option<&str>) -> Result<Self, LoadError> {
+        let Stacked { series, ordered, stack, file_dims, .. } = stack_series(paths, wanted)?;
+        let first = &series[0];
+        let at = Location::file(&first.path);
+        let (orientation, spacing) =
+            AxisOrientation::from_directions(stack.directions, &at, "ImageOrientationPatient")?;
+        if !orientation.is_identity() {
+            return Err(LoadError::NoBoxRead {
+                path: first.path.clone(),
+                format: "DICOM series with flipped or swapped axes",
+            });
+        }
+        let name = if first.description.is_empty() { dicom_name(paths) } else { first.description.clone() };
+        let eight_bit = series.iter().all(|h| h.bits_allocated == 8 && h.rescale == (1.0, 0.0));
+        Ok(Self { series, ordered, dims: file_dims, spacing, name, eight_bit })
     }
-    // The corner of the box nearest −∞ on every world axis: voxel (0,0,0) after reordering.
-    let origin = (0..3).fold(stack.origin, |o, i| {
-        if orientation.flipped[i] { o + stack.directions[i] * (file_dims[i] as f64 - 1.0) } else { o }
-    });
-    let data = orientation.reorder(file_dims, voxels);
-    let name = if first.description.is_empty() { dicom_name(paths) } else { first.description.clone() };
-    let mut volume = Volume::new(name, orientation.world_dims(file_dims), spacing, data);
-    volume.fit_range_to_data();
-    let units = match (first.modality.as_str(), first.rescale_type.as_deref()) {
-        (_, Some(t)) if !t.eq_ignore_ascii_case("US") => Some(t.to_string()),
-        ("CT", _) => Some("HU".to_string()),
-        _ => None,
-    };
-    volume.meta = VolumeMeta {
-        modality: (!first.modality.is_empty()).then(|| first.modality.clone()),
-        units,
-        window: first.window.map(|(center, width)| Window { center, width }),
-        frame: WorldFrame::Lps,
-        origin: Some(origin),
-        description: (!first.description.is_empty()).then(|| first.description.clone()),
-    };
-    Ok(LoadedVolume { volume, report })
+
+    /// The rescaled values of slices `z` (whole slices, x fastest), reading only their files.
+    pub fn read_slices(&self, z: std::ops::Range<u32>) -> Result<Vec<f32>, LoadError> {
+        let wanted = &self.ordered[z.start as usize..z.end as usize];
+        let mut files: Vec<usize> = wanted.iter().map(|&(f, _)| f).collect();
+        files.sort_unstable();
+        files.dedup();
+        let subset: Vec<FileHeader> = files.iter().map(|&f| self.series[f].clone()).collect();
+        let reindexed: Vec<(usize, usize)> =
+            wanted.iter().map(|&(f, frame)| (files.binary_search(&f).unwrap_or(0), frame)).collect();
+        let dims = glam::UVec3::new(self.dims.x, self.dims.y, wanted.len() as u32);
+        let voxels = pixels::read(&subset, &reindexed, dims, None)?;
+        Ok(match voxels {
+            crate::volume::VoxelData::U8(v) => v.into_iter().map(f32::from).collect(),
+            crate::volume::VoxelData::U16(v) => v.into_iter().map(f32::from).collect(),
+            crate::volume::VoxelData::I16(v) => v.into_iter().map(f32::from).collect(),
+            crate::volume::VoxelData::F32(v) => v,
+        })
+    }
 }
 
 /// A name for a series without a description: the folder's (or first file's) name.

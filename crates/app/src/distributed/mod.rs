@@ -152,8 +152,8 @@ pub fn run<E: Exchange + ?Sized>(ex: &mut E, args: &RenderArgs) -> Result<RankRe
         ..Default::default()
     };
     let window = VolumeWindow::new(job.header.dims, job.header.spacing, held.lo, own.lo, own.hi);
-    let runtime = step(ex, job.runtime(&volume, &lut, window, plan))?;
-    let mut runtime = runtime;
+    let background = present_background(&plan);
+    let mut runtime = step(ex, job.runtime(&volume, &lut, window, plan))?;
     let viewport = job.viewport;
     let whole = VolumeDesc::of_window(
         job.header.dims,
@@ -191,11 +191,20 @@ pub fn run<E: Exchange + ?Sized>(ex: &mut E, args: &RenderArgs) -> Result<RankRe
         last = gathered;
     }
     let written = match (&last, rank) {
-        (Some(image), 0) => job.write(image),
+        (Some(image), 0) => job.write(image, background),
         _ => Ok(()),
     };
     step(ex, written)?;
     Ok(report)
+}
+
+/// The `present` pass's background grey of `plan` (0 when it has none): what PNG output shows
+/// behind the composited colour, as the single render's display does.
+fn present_background(plan: &volgraph_core::Plan) -> f32 {
+    plan.steps
+        .iter()
+        .find(|s| s.kind == "present" && s.params.declares("background"))
+        .map_or(0.0, |s| s.params.float("background")) as f32
 }
 
 /// The lowest early-termination threshold of `plan`'s passes below 1 − 1/255 (where one rank's
@@ -362,8 +371,7 @@ impl Job {
 
     /// Rank 0's output: EXR holds the composited premultiplied colour; PNG shows it over the
     /// graph's `present` background in sRGB, as the single-process display output does.
-    fn write(&self, image: &Layer) -> anyhow::Result<()> {
-        let background = self.background();
+    fn write(&self, image: &Layer, background: f32) -> anyhow::Result<()> {
         let data: Vec<f32> = match self.kind {
             ImageKind::Exr => image.pixels.iter().flatten().copied().collect(),
             ImageKind::Png => image
@@ -380,19 +388,5 @@ impl Job {
             ImageKind::Exr => image_out::write_exr(&self.out, &out, false),
             ImageKind::Png => image_out::write_png(&self.out, &out, false),
         }
-    }
-
-    /// The `present` pass's background grey of the graph (0 when it has none).
-    fn background(&self) -> f32 {
-        let registry = crate::program::registry();
-        compile(&display_name(&self.graph), &self.source, &registry, &self.options)
-            .ok()
-            .and_then(|plan| {
-                plan.steps
-                    .iter()
-                    .find(|s| s.kind == "present" && s.params.declares("background"))
-                    .map(|s| s.params.float("background"))
-            })
-            .unwrap_or(0.0) as f32
     }
 }

@@ -116,7 +116,7 @@ pub fn survey<E: Exchange + ?Sized>(ex: &mut E, header: &VolumeHeader) -> Result
     });
     agree(ex, read.map_err(|e| e.to_string())).map_err(fail)?;
     // Everyone gets the histograms (summed) and the preview slices (in rank order = z order).
-    let all_bins = all_gather(ex, bytemuck_u64(&bins)).map_err(fail)?;
+    let all_bins = all_gather(ex, u64_bytes(&bins)).map_err(fail)?;
     let mut summed = vec![0u64; bins.len()];
     for m in &all_bins {
         for (s, c) in summed.iter_mut().zip(m.chunks_exact(8)) {
@@ -142,7 +142,7 @@ pub fn survey<E: Exchange + ?Sized>(ex: &mut E, header: &VolumeHeader) -> Result
     Ok(Survey { value_range, preview, bins: summed, bytes_read })
 }
 
-fn bytemuck_u64(v: &[u64]) -> Vec<u8> {
+fn u64_bytes(v: &[u64]) -> Vec<u8> {
     v.iter().flat_map(|x| x.to_le_bytes()).collect()
 }
 

@@ -314,7 +314,7 @@ pub fn prime_factors(n: usize) -> Vec<usize> {
     let mut m = n.max(1);
     let mut p = 2;
     while p * p <= m {
-        while m % p == 0 {
+        while m.is_multiple_of(p) {
             factors.push(p);
             m /= p;
         }

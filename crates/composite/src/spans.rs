@@ -48,7 +48,7 @@ pub fn decode_into(
     mut apply: impl FnMut(&mut [f32; 4], [f32; 4]),
 ) -> Result<(), ExchangeError> {
     let bad = |what: &str| ExchangeError::Malformed(what.to_string());
-    if message.len() % 4 != 0 || message.len() < 4 {
+    if !message.len().is_multiple_of(4) || message.len() < 4 {
         return Err(bad("not a whole number of words"));
     }
     let word =

@@ -278,7 +278,8 @@ mod tests {
         let values: Vec<i16> = (0..dims.x * dims.y * dims.z).map(|i| ((i * 37 % 2000) as i16) - 1000).collect();
         let ct = Volume::new("ct", dims, DVec3::new(0.5, 0.5, 1.5), VoxelData::I16(values));
         super::super::dicom::write_ct_series(&dir, &ct).expect("series written");
-        let whole = super::super::load_volumes(&[dir.clone()], &LoadOptions::default()).expect("whole").volume;
+        let whole =
+            super::super::load_volumes(std::slice::from_ref(&dir), &LoadOptions::default()).expect("whole").volume;
         let header = VolumeHeader::read(&dir, &LoadOptions::default()).expect("header");
         assert_eq!(header.dims, whole.dims);
         assert_eq!(header.type_range(), None, "16-bit DICOM: the range is surveyed");

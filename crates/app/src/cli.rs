@@ -87,6 +87,16 @@ enum Command {
     /// List the graphs built into the binary (name, paper, description): every one can be given
     /// by name where a graph file is asked for (`volgraph render klein_2005/leap_iso -o x.png`).
     Graphs,
+    /// Write values into a graph file at their place (only the values' text changes; comments,
+    /// order and layout stay): `volgraph set graph.ron march.step_voxels=0.25 input.threshold=0.99`.
+    /// The edited graph is compiled first; a bad value or unknown name leaves the file untouched.
+    Set {
+        /// The graph file (RON).
+        graph: PathBuf,
+        /// PASS.PARAM=VALUE or input.NAME=VALUE (RON values: 0.25, true, "feature.shading").
+        #[arg(required = true, num_args = 1..)]
+        assignments: Vec<String>,
+    },
     /// Times sort-last compositing alone under mpirun (synthetic rank images); what
     /// `volgraph bench distributed` runs. Rank 0 prints one JSON line.
     #[command(hide = true)]
@@ -246,6 +256,7 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
         | Command::Passes { .. }
         | Command::Graphs
         | Command::Info { .. }
+        | Command::Set { .. }
         | Command::CompositeBench(_) => {
             Err(CliError::Other(anyhow!("only plan and render are checked ahead of running")))
         }
@@ -273,6 +284,10 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             }
         },
         Command::View(args) => crate::view::run(args),
+        Command::Set { graph, assignments } => {
+            crate::stdout::write_stdout(&crate::set_cmd::run(&graph, &assignments)?)?;
+            Ok(())
+        }
         Command::Graphs => {
             crate::stdout::write_stdout(&crate::builtin_graphs::listing())?;
             Ok(())

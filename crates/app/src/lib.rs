@@ -25,6 +25,7 @@ pub mod program;
 pub mod render;
 pub mod scene;
 pub mod scene_args;
+pub mod set_cmd;
 pub mod shader_dir;
 pub mod stdout;
 pub mod view;

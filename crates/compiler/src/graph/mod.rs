@@ -2,6 +2,7 @@
 //! ([`spans`]).
 
 pub mod ast;
+pub mod edit;
 pub mod locate;
 pub mod spans;
 

@@ -22,6 +22,8 @@ pub enum Action {
     Screenshot,
     /// Reset the camera.
     ResetCamera,
+    /// Write the parameters and inputs changed here into the graph file.
+    WriteBack,
 }
 
 /// Exponentially smoothed per-pass milliseconds.
@@ -231,6 +233,13 @@ pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapt
             }
             if ui.button("reset camera").clicked() {
                 actions.push(Action::ResetCamera);
+            }
+            if ui
+                .button("write to graph file")
+                .on_hover_text("the values changed here, written at their place")
+                .clicked()
+            {
+                actions.push(Action::WriteBack);
             }
         });
         ui.small(HELP);

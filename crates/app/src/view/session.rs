@@ -348,12 +348,42 @@ impl LiveSession {
         Ok(())
     }
 
-    /// Files changed on disk: the events of reloading what they affect.
+    /// Writes the parameters and graph inputs changed in the panel into the graph file at their
+    /// place (`volgraph set`'s code: only the values' text changes), then runs from the file:
+    /// the panel's overrides are cleared, as the file now says what they said. Returns one line
+    /// per value written; an error (a built-in graph, an unwritable file) changes nothing.
+    pub fn write_back(&mut self) -> anyhow::Result<Vec<String>> {
+        let mut assignments: Vec<String> = Vec::new();
+        for (key, value) in &self.options.param_overrides {
+            let text = ron::to_string(value).map_err(|e| anyhow!("{key}: {e}"))?;
+            assignments.push(format!("{key}={text}"));
+        }
+        let plan_inputs = self.plan().map(|p| p.inputs.clone()).unwrap_or_default();
+        for (name, value) in &self.options.scalars {
+            if plan_inputs.contains_key(name) {
+                assignments.push(format!("input.{name}={value:?}"));
+            }
+        }
+        if assignments.is_empty() {
+            return Ok(Vec::new());
+        }
+        let lines =
+            crate::set_cmd::run(&self.graph, &assignments).map_err(|e| anyhow!("{}", crate::cli::error_text(&e)))?;
+        self.source = inputs::read_graph(&self.graph)?;
+        self.options.param_overrides.clear();
+        self.options.scalars.retain(|name, _| !plan_inputs.contains_key(name));
+        Ok(lines.lines().map(str::to_string).collect())
+    }
+
+    /// Files changed on disk: the events of reloading what they affect. A graph file whose text
+    /// is the running one (the viewer's own write-back) is not reloaded.
     pub fn files_changed(&mut self, changed: &[PathBuf]) -> Vec<Event> {
         let same =
             |a: &Path, b: &Path| a == b || matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y);
         let mut events = Vec::new();
-        if changed.iter().any(|c| same(c, &self.graph)) {
+        if changed.iter().any(|c| same(c, &self.graph))
+            && std::fs::read_to_string(&self.graph).map_or(true, |text| text != self.source)
+        {
             events.extend(self.reload_graph());
         }
         if let Some(tf) = self.tf_path.clone()

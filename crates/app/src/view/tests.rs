@@ -86,6 +86,28 @@ fn a_parameter_edit_is_written_in_place_and_changes_the_image() {
     let _ = std::fs::remove_dir_all(&s.dir);
 }
 
+/// The panel's "write to graph file": the slider's value lands in the file at its place (a
+/// one-line diff), the session runs from the file with the same image, and the watcher does not
+/// reload the viewer's own write.
+#[test]
+fn a_parameter_moved_in_the_panel_is_written_back_into_the_graph_file() {
+    let s = scratch("write_back", "graphs/basic/fragment_raycast.ron");
+    let original = std::fs::read_to_string(&s.graph).expect("readable");
+    let mut session = open(&s, None);
+    session.set_param("march", "step_voxels", ron::Value::from(1.5));
+    let moved = frame(&mut session);
+    let lines = session.write_back().expect("written");
+    assert_eq!(lines.len(), 1, "{lines:?}");
+    assert!(lines[0].contains("march.step_voxels = 1.5 (was 0.5)"), "{lines:?}");
+    let written = std::fs::read_to_string(&s.graph).expect("readable");
+    let diff: Vec<(&str, &str)> = original.lines().zip(written.lines()).filter(|(a, b)| a != b).collect();
+    assert_eq!(diff, vec![("                \"step_voxels\": 0.5,", "                \"step_voxels\": 1.5,")]);
+    assert!(session.files_changed(std::slice::from_ref(&s.graph)).is_empty(), "its own write is not reloaded");
+    assert_eq!(frame(&mut session), moved, "the file now says what the slider said");
+    assert!(session.write_back().expect("nothing left").is_empty());
+    let _ = std::fs::remove_dir_all(&s.dir);
+}
+
 #[test]
 fn a_broken_graph_keeps_the_last_good_one_and_a_fix_recovers() {
     let s = scratch("graph", "graphs/basic/fragment_raycast.ron");

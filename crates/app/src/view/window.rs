@@ -160,6 +160,18 @@ impl Viewer {
                     self.orbit.reset();
                     Vec::new()
                 }
+                Action::WriteBack => match session.write_back() {
+                    Ok(lines) => {
+                        for line in lines {
+                            crate::stdout::eprintln_escaped!("wrote {line}");
+                        }
+                        Vec::new()
+                    }
+                    Err(e) => vec![super::session::Event::Error {
+                        what: "write to graph file".to_string(),
+                        message: format!("{e:#}"),
+                    }],
+                },
             };
             self.handle(events);
         }

@@ -376,13 +376,14 @@ impl LiveSession {
     }
 
     /// Files changed on disk: the events of reloading what they affect. A graph file whose text
-    /// is the running one (the viewer's own write-back) is not reloaded.
+    /// is the running one (the viewer's own write-back) is not reloaded, unless the last change
+    /// failed (then the same text is the fix, and reloading it recovers).
     pub fn files_changed(&mut self, changed: &[PathBuf]) -> Vec<Event> {
         let same =
             |a: &Path, b: &Path| a == b || matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y);
         let mut events = Vec::new();
         if changed.iter().any(|c| same(c, &self.graph))
-            && std::fs::read_to_string(&self.graph).map_or(true, |text| text != self.source)
+            && (self.error().is_some() || std::fs::read_to_string(&self.graph).map_or(true, |text| text != self.source))
         {
             events.extend(self.reload_graph());
         }

@@ -94,10 +94,22 @@ pub fn launch() -> Result<(), CliError> {
         .map_err(other)?
         .into_render_args()
         .ok_or_else(|| CliError::Other(anyhow!("internal: rank 0's command is not render")))?;
-    let report = run(&mut ex, &args)?;
+    let outcome = run(&mut ex, &args);
     // One write of the whole line: lines of ranks sharing a stderr pipe never interleave.
     use std::io::Write as _;
-    let _ = std::io::stderr().write_all(format!("{}\n", report.line()).as_bytes());
+    let line = match &outcome {
+        Ok(report) => format!("{}\n", report.line()),
+        Err(e) => format!("error: {}\n", volgraph_core::terminal::escape_controls(&crate::cli::error_text(e))),
+    };
+    let _ = std::io::stderr().write_all(line.as_bytes());
+    if outcome.is_err() {
+        // Every rank has its error (the ranks agreed on it): wait until every rank has printed
+        // it, since mpirun ends the job as soon as one rank exits non-zero; then leave MPI and
+        // exit without printing it again.
+        let _ = agree(&mut ex, Ok(()));
+        drop(ex);
+        std::process::exit(1);
+    }
     Ok(())
 }
 

@@ -383,7 +383,9 @@ impl LiveSession {
             |a: &Path, b: &Path| a == b || matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y);
         let mut events = Vec::new();
         if changed.iter().any(|c| same(c, &self.graph))
-            && (self.error().is_some() || std::fs::read_to_string(&self.graph).map_or(true, |text| text != self.source))
+            // (Read without blocking: a FIFO swapped in for the graph must not freeze the viewer.)
+            && (self.error().is_some()
+                || volgraph_accel::input_file::read_text(&self.graph, "graph file").map_or(true, |text| text != self.source))
         {
             events.extend(self.reload_graph());
         }

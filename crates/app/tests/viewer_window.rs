@@ -202,9 +202,27 @@ fn hot_reload_in_a_window_keeps_the_last_good_graph_and_matches_the_headless_ren
     }
 
     let mut stdin = viewer.stdin.take().expect("stdin");
+    // 8. A parameter moved in the viewer, written into the graph file ("write to graph file"):
+    // exactly its line changes, and the viewer does not reload its own write.
+    let before_write = std::fs::read_to_string(&graph).expect("readable");
+    writeln!(stdin, "param march.step_voxels 0.625").expect("script line");
+    expect_line(&lines, "reloaded parameter march.step_voxels", &mut log);
+    writeln!(stdin, "write").expect("script line");
+    let line = expect_line(&lines, "wrote ", &mut log);
+    assert!(line.contains("march.step_voxels = 0.625 (was 0.75)"), "{line}");
+    let written = std::fs::read_to_string(&graph).expect("readable");
+    let diff: Vec<(&str, &str)> = before_write.lines().zip(written.lines()).filter(|(a, b)| a != b).collect();
+    assert_eq!(diff.len(), 1, "{diff:?}");
+    assert!(diff[0].1.contains("\"step_voxels\": 0.625"), "{diff:?}");
     writeln!(stdin, "quit").expect("script line");
     drop(stdin);
     expect_line(&lines, "screenshot ", &mut log);
+    assert!(
+        !log.iter().any(|l| l.starts_with("wrote "))
+            || !log.iter().skip_while(|l| !l.starts_with("wrote ")).any(|l| l.starts_with("reloaded graph")),
+        "the viewer reloaded its own write:\n{}",
+        log.join("\n")
+    );
     let status = viewer.wait().expect("the viewer exits");
     let stderr = errors.join().unwrap_or_default();
     assert!(status.success(), "viewer exited with {status}:\n{stderr}");

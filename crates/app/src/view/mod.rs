@@ -2,7 +2,7 @@
 //! plan, every parameter, scalars, feature toggles) and hot reload of the graph, its shaders and
 //! its transfer function. Failures show located diagnostics and keep the last good graph.
 //! Scriptable for tests: `--frames N`, `--screenshot PATH`, and `--script` (lines on stdin:
-//! `quit`, `screenshot PATH`, `param PASS.NAME VALUE`); one line per event on stdout.
+//! `quit`, `screenshot PATH`, `param PASS.NAME VALUE`, `write`); one line per event on stdout.
 
 pub mod graph_picture;
 pub mod orbit;
@@ -41,7 +41,8 @@ pub struct ViewArgs {
     /// Start without the overlay panel (F1 toggles it).
     #[arg(long)]
     pub no_panel: bool,
-    /// Read script lines from stdin: `quit`, `screenshot PATH`, `param PASS.NAME VALUE`.
+    /// Read script lines from stdin: `quit`, `screenshot PATH`, `param PASS.NAME VALUE`, `write` (the
+    /// panel's "write to graph file").
     #[arg(long)]
     pub script: bool,
 }

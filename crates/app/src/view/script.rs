@@ -19,10 +19,12 @@ pub enum ScriptCommand {
         /// The value.
         value: ron::Value,
     },
+    /// `write`: the panel's "write to graph file" (the values changed here, into the graph).
+    Write,
 }
 
 /// What the script accepts, for messages.
-pub const USAGE: &str = "quit, screenshot PATH, param PASS.NAME VALUE";
+pub const USAGE: &str = "quit, screenshot PATH, param PASS.NAME VALUE, write";
 
 /// Parses one line: `Ok(None)` for a blank line, `Err` naming what is wrong.
 pub fn parse_line(line: &str) -> Result<Option<ScriptCommand>, String> {
@@ -34,6 +36,8 @@ pub fn parse_line(line: &str) -> Result<Option<ScriptCommand>, String> {
     match command {
         "quit" if rest.is_empty() => Ok(Some(ScriptCommand::Quit)),
         "quit" => Err(format!("\"{line}\": quit takes nothing after it (found \"{rest}\")")),
+        "write" if rest.is_empty() => Ok(Some(ScriptCommand::Write)),
+        "write" => Err(format!("\"{line}\": write takes nothing after it (found \"{rest}\")")),
         "screenshot" if rest.is_empty() => Err(format!("\"{line}\": write screenshot PATH")),
         "screenshot" => Ok(Some(ScriptCommand::Screenshot(PathBuf::from(rest)))),
         "param" => {
@@ -57,6 +61,8 @@ mod tests {
     fn commands_parse_whole() {
         assert_eq!(parse_line("  quit "), Ok(Some(ScriptCommand::Quit)));
         assert_eq!(parse_line(""), Ok(None));
+        assert_eq!(parse_line("write"), Ok(Some(ScriptCommand::Write)));
+        assert!(parse_line("write now").is_err());
         assert_eq!(
             parse_line("screenshot my shots/a.png"),
             Ok(Some(ScriptCommand::Screenshot(PathBuf::from("my shots/a.png"))))

@@ -163,7 +163,7 @@ impl Viewer {
                 Action::WriteBack => match session.write_back() {
                     Ok(lines) => {
                         for line in lines {
-                            crate::stdout::eprintln_escaped!("wrote {line}");
+                            crate::stdout::println_escaped!("wrote {line}");
                         }
                         Vec::new()
                     }
@@ -177,7 +177,7 @@ impl Viewer {
         }
     }
 
-    /// Script lines from stdin: `quit`, `screenshot PATH`, `param PASS.NAME VALUE`.
+    /// Script lines from stdin: `quit`, `screenshot PATH`, `param PASS.NAME VALUE`, `write`.
     fn run_script(&mut self) {
         let lines: Vec<String> = self.script.as_ref().map(|rx| rx.try_iter().collect()).unwrap_or_default();
         for line in lines {
@@ -187,6 +187,7 @@ impl Viewer {
                 Ok(Some(ScriptCommand::Param { pass, name, value })) => {
                     self.apply_actions(vec![Action::Param(pass, name, value)])
                 }
+                Ok(Some(ScriptCommand::Write)) => self.apply_actions(vec![Action::WriteBack]),
                 Ok(None) => {}
                 Err(message) => crate::stdout::eprintln_escaped!("script: {message}"),
             }

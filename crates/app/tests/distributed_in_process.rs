@@ -11,6 +11,8 @@ use volgraph_app::cli::Cli;
 use volgraph_app::distributed;
 use volgraph_composite::LocalGroup;
 
+mod support;
+
 fn dataset(name: &str) -> Option<PathBuf> {
     match volgraph_accel::data_dir::dataset_path(name) {
         Ok(p) => Some(p),
@@ -209,29 +211,10 @@ fn graphs_that_cannot_be_split_are_refused_on_every_rank() {
 /// image with a CT preset equals the single render (which loads the whole series).
 #[test]
 fn a_dicom_series_is_read_slices_by_box() {
-    use glam::{DVec3, UVec3};
-    use volgraph_accel::volume::{Volume, VoxelData};
     let dir = scratch("ct_series");
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("scratch");
-    let dims = UVec3::new(48, 44, 40);
-    let mut values = Vec::new();
-    for z in 0..dims.z {
-        for y in 0..dims.y {
-            for x in 0..dims.x {
-                let p = (DVec3::new(x as f64, y as f64, z as f64) + 0.5) / dims.as_dvec3() - 0.5;
-                let r = (p * DVec3::new(1.0, 1.2, 1.1)).length();
-                values.push(if r < 0.15 {
-                    900
-                } else if r < 0.4 {
-                    40
-                } else {
-                    -1000
-                } as i16);
-            }
-        }
-    }
-    let ct = Volume::new("ct", dims, DVec3::new(0.8, 0.8, 1.5), VoxelData::I16(values));
+    let ct = support::ct(48, "ct");
     volgraph_accel::load::dicom::write_ct_series(&dir, &ct).expect("series written");
     let d = dir.to_str().expect("utf-8");
     let args = ["basic/compute_raycast", "--volume", d, "--tf", "ct-bone", "--size", "80x80", "--camera", "20,30,2.6"];

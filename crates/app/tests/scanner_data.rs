@@ -6,8 +6,10 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use glam::{DVec3, UVec3};
-use volgraph_accel::volume::{Volume, VoxelData};
+mod support;
+use support::ct;
+
+use volgraph_accel::volume::Volume;
 
 struct Run {
     code: i32,
@@ -35,28 +37,6 @@ fn scratch(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("scratch");
     dir
-}
-
-/// A CT in HU: air around a soft-tissue ellipsoid with a bone core.
-fn ct(n: u32, name: &str) -> Volume {
-    let dims = UVec3::new(n, n - 4, n - 8);
-    let mut values = Vec::new();
-    for z in 0..dims.z {
-        for y in 0..dims.y {
-            for x in 0..dims.x {
-                let p = (DVec3::new(x as f64, y as f64, z as f64) + 0.5) / dims.as_dvec3() - 0.5;
-                let r = (p * DVec3::new(1.0, 1.2, 1.1)).length();
-                values.push(if r < 0.15 {
-                    900
-                } else if r < 0.4 {
-                    40
-                } else {
-                    -1000
-                } as i16);
-            }
-        }
-    }
-    Volume::new(name, dims, DVec3::new(0.8, 0.8, 1.5), VoxelData::I16(values))
 }
 
 fn write(dir: &Path, volume: &Volume) {

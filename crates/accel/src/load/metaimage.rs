@@ -97,22 +97,14 @@ pub(super) fn raw_data(path: &Path, bytes: &[u8]) -> Result<(Layout, std::path::
     let expected = byte_count(h.layout.dims, h.layout.dtype).unwrap_or(u64::MAX);
     let local = h.data_name.eq_ignore_ascii_case("LOCAL");
     let data_path = if local { path.to_path_buf() } else { super::sibling(path, &h.data_name) };
+    super::check_is_file(&data_path)?;
     let size = std::fs::metadata(&data_path).map_err(|source| LoadError::Io { path: data_path.clone(), source })?.len();
     let offset = match (local, h.header_size) {
         (true, _) => h.data_start as u64,
         (false, -1) => size.saturating_sub(expected),
         (false, skip) => skip.max(0) as u64,
     };
-    if size < offset.saturating_add(expected) {
-        return Err(LoadError::DataSize {
-            path: data_path,
-            dims: super::dims_text(h.layout.dims),
-            dtype: h.layout.dtype,
-            expected,
-            actual: size.saturating_sub(offset),
-            hint: HINT,
-        });
-    }
+    super::check_data_extent(&data_path, offset, &h.layout, HINT)?;
     Ok((h.layout, data_path, offset))
 }
 

@@ -307,6 +307,26 @@ pub fn sanitize_volume(volume: &mut Volume) -> (usize, usize, usize) {
 
 /// Fails unless `path` is a regular file (or a link to one): a directory or a FIFO would
 /// otherwise surface as a puzzling size error, or block.
+/// Checks that `data_path` holds the voxels of `layout` from byte `offset` (a box read seeks
+/// there), and that it is a regular file (a FIFO or device would block or never end).
+fn check_data_extent(data_path: &Path, offset: u64, layout: &Layout, hint: &'static str) -> Result<(), LoadError> {
+    check_is_file(data_path)?;
+    let size =
+        std::fs::metadata(data_path).map_err(|source| LoadError::Io { path: data_path.to_path_buf(), source })?.len();
+    let expected = byte_count(layout.dims, layout.dtype).unwrap_or(u64::MAX);
+    if size < offset.saturating_add(expected) {
+        return Err(LoadError::DataSize {
+            path: data_path.to_path_buf(),
+            dims: dims_text(layout.dims),
+            dtype: layout.dtype,
+            expected,
+            actual: size.saturating_sub(offset),
+            hint,
+        });
+    }
+    Ok(())
+}
+
 fn check_is_file(path: &Path) -> Result<(), LoadError> {
     match crate::input_file::special_kind(path) {
         Ok(None) => Ok(()),

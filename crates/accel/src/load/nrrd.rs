@@ -146,18 +146,10 @@ pub(super) fn raw_data(path: &Path, bytes: &[u8]) -> Result<(Layout, std::path::
         (None, Some(start)) => (path.to_path_buf(), start as u64),
         (None, None) => return Err(LoadError::UnterminatedHeader { path: path.to_path_buf() }),
     };
+    super::check_is_file(&data_path)?;
     let size = std::fs::metadata(&data_path).map_err(|source| LoadError::Io { path: data_path.clone(), source })?.len();
     let offset = if header.byte_skip == -1 { size.saturating_sub(expected) } else { start + header.byte_skip as u64 };
-    if size < offset.saturating_add(expected) {
-        return Err(LoadError::DataSize {
-            path: data_path,
-            dims: super::dims_text(header.layout.dims),
-            dtype: header.layout.dtype,
-            expected,
-            actual: size.saturating_sub(offset),
-            hint: HINT,
-        });
-    }
+    super::check_data_extent(&data_path, offset, &header.layout, HINT)?;
     Ok((header.layout, data_path, offset))
 }
 

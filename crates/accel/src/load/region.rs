@@ -181,6 +181,8 @@ impl VolumeHeader {
 
 /// The first MiB of `path`: enough for any header volgraph reads.
 fn read_head(path: &Path) -> Result<Vec<u8>, LoadError> {
+    // A FIFO or device would block the open or never end: refused by name first.
+    super::check_is_file(path)?;
     let io = |source| LoadError::Io { path: path.to_path_buf(), source };
     let mut head = Vec::new();
     std::fs::File::open(path).map_err(io)?.take(1 << 20).read_to_end(&mut head).map_err(io)?;
@@ -191,6 +193,19 @@ fn read_head(path: &Path) -> Result<Vec<u8>, LoadError> {
 mod tests {
     use super::super::RawOptions;
     use super::*;
+
+    /// `part` holds box `bx` of `whole`, voxel for voxel (stored values).
+    fn assert_is_box_of(part: &Volume, whole: &Volume, bx: VoxelBox, what: &str) {
+        assert_eq!(part.dims, bx.size(), "{what}");
+        for z in 0..part.dims.z {
+            for y in 0..part.dims.y {
+                for x in 0..part.dims.x {
+                    let w = whole.index(x + bx.lo.x, y + bx.lo.y, z + bx.lo.z);
+                    assert_eq!(part.raw_value(part.index(x, y, z)), whole.raw_value(w), "{what} at ({x}, {y}, {z})");
+                }
+            }
+        }
+    }
 
     /// A box read by seeking equals the same box cut from the whole volume.
     #[test]
@@ -204,15 +219,8 @@ mod tests {
         let whole = super::super::load_volume(&path, &RawOptions::default()).expect("whole").volume;
         let bx = VoxelBox::new(UVec3::new(2, 1, 3), UVec3::new(11, 7, 5));
         let part = header.read_box(bx, header.type_range().expect("integer")).expect("box");
-        assert_eq!(part.dims, bx.size());
-        for z in 0..part.dims.z {
-            for y in 0..part.dims.y {
-                for x in 0..part.dims.x {
-                    let w = whole.index(x + bx.lo.x, y + bx.lo.y, z + bx.lo.z);
-                    assert_eq!(part.normalized(part.index(x, y, z)), whole.normalized(w));
-                }
-            }
-        }
+        assert_is_box_of(&part, &whole, bx, "raw");
+        assert_eq!(part.value_range, whole.value_range, "normalized alike");
         std::fs::remove_dir_all(&dir).ok();
     }
 
@@ -234,14 +242,7 @@ mod tests {
             let header = VolumeHeader::read(&path, &LoadOptions::default()).expect("header");
             assert_eq!(header.spacing, DVec3::new(1.0, 1.0, 2.0));
             let part = header.read_box(bx, whole.value_range).expect("box");
-            for z in 0..part.dims.z {
-                for y in 0..part.dims.y {
-                    for x in 0..part.dims.x {
-                        let w = whole.index(x + bx.lo.x, y + bx.lo.y, z + bx.lo.z);
-                        assert_eq!(part.raw_value(part.index(x, y, z)), whole.raw_value(w), "{}", path.display());
-                    }
-                }
-            }
+            assert_is_box_of(&part, &whole, bx, &path.display().to_string());
         }
         // MetaImage, attached and detached.
         let mha = dir.join("attached.mha");
@@ -254,12 +255,7 @@ mod tests {
             let whole = super::super::load_volume(&path, &RawOptions::default()).expect("whole").volume;
             let header = VolumeHeader::read(&path, &LoadOptions::default()).expect("header");
             let part = header.read_box(bx, whole.value_range).expect("box");
-            let w = whole.index(bx.lo.x + 2, bx.lo.y + 1, bx.lo.z + 1);
-            assert_eq!(part.raw_value(part.index(2, 1, 1)), whole.raw_value(w), "{}", path.display());
-            assert_eq!(
-                part.raw_value(part.voxel_count() - 1),
-                whole.raw_value(whole.index(bx.hi.x - 1, bx.hi.y - 1, bx.hi.z - 1))
-            );
+            assert_is_box_of(&part, &whole, bx, &path.display().to_string());
         }
         let gz = dir.join("packed.nrrd");
         std::fs::write(&gz, "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: gzip\n\n").expect("write");
@@ -285,14 +281,21 @@ mod tests {
         assert_eq!(header.type_range(), None, "16-bit DICOM: the range is surveyed");
         let bx = VoxelBox::new(UVec3::new(2, 3, 4), UVec3::new(11, 10, 7));
         let part = header.read_box(bx, whole.value_range).expect("box");
-        for z in 0..part.dims.z {
-            for y in 0..part.dims.y {
-                for x in 0..part.dims.x {
-                    let w = whole.index(x + bx.lo.x, y + bx.lo.y, z + bx.lo.z);
-                    assert_eq!(part.raw_value(part.index(x, y, z)), whole.raw_value(w));
-                }
-            }
-        }
+        assert_is_box_of(&part, &whole, bx, "box");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// A FIFO named like a header is refused by name, never opened (opening it would block).
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_header_is_refused_without_blocking() {
+        let dir = std::env::temp_dir().join(format!("volgraph-region-fifo-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let fifo = dir.join("pipe.nrrd");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status().expect("mkfifo runs");
+        assert!(made.success());
+        let e = VolumeHeader::read(&fifo, &LoadOptions::default()).expect_err("a FIFO");
+        assert!(e.to_string().contains("FIFO"), "{e}");
         std::fs::remove_dir_all(&dir).ok();
     }
 

@@ -40,6 +40,12 @@ struct Frame {
     grid_hi: vec4<f32>,
     own_lo: vec4<f32>,
     own_hi: vec4<f32>,
+    // A scene's crop box (read under #if CROP) and clip planes (#if CLIP: keep u with
+    // dot(xyz, u) >= w; unused planes (0, 0, 0, -1)), in the bound texture's coordinates
+    // (common/ray_box.wgsl `cut_segment`).
+    crop_lo: vec4<f32>,
+    crop_hi: vec4<f32>,
+    clip_planes: array<vec4<f32>, 6>,
 }
 
 @group(0) @binding(auto) var<uniform> frame: Frame;

@@ -16,6 +16,6 @@ fn pixel_ray(pixel: vec2<u32>) -> Ray {
 fn pixel_ray(pixel: vec2<u32>) -> Ray {
     let e = textureLoad(entry, vec2<i32>(pixel), 0);
     let d = textureLoad(dir, vec2<i32>(pixel), 0);
-    return own_segment(Ray(e.xyz, d.xyz, select(0.0, d.w, e.w != 0.0), 0.0));
+    return own_segment(Ray(e.xyz, d.xyz, select(0.0, d.w, e.w != 0.0), 0.0, false));
 }
 #endif

@@ -6,14 +6,18 @@
 #import "common/frame.wgsl"
 
 // A pixel's ray in texture space; `len = 0` for no ray. `u0` is where it enters the box (the
-// step grid's anchor); its samples lie between `begin` and `len` from there: `begin` is 0 but in
-// a sort-last window (frame.grid_lo.w), where the ray is met with the whole volume's box and
-// this process takes only the samples in its own box (`own_segment`).
+// step grid's anchor); its samples lie between `begin` and `len` from there: `begin` is 0 but
+// where something cuts the ray's front (`own_segment`): a sort-last window (frame.grid_lo.w),
+// where the ray is met with the whole volume's box and this process takes only the samples in
+// its own box, or a scene's crop box and clip planes (#if CROP, #if CLIP).
 struct Ray {
     u0: vec3<f32>,
     d: vec3<f32>,
     len: f32,
     begin: f32,
+    // True when the samples before `begin` are another rank's (a window's own box cut the
+    // ray, not a crop or clip): a first-hit search still reads the one before.
+    looks_back: bool,
 }
 
 // The part [t_in, t_out] of the line eye + t·dir (any parameter) inside the box [lo, hi]; empty
@@ -31,18 +35,69 @@ fn box_span(eye: vec3<f32>, dir: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> vec
     return vec2<f32>(max(t_lo.x, max(t_lo.y, t_lo.z)), min(t_hi.x, min(t_hi.y, t_hi.z)));
 }
 
-// `ray` (met with the grid box) cut to this frame's own box: samples from `begin` to `len`. The
-// identity outside a sort-last window. A cut ray keeps its entry `u0`, so every process's
-// samples lie on the one step grid and each sample belongs to the one box that holds it.
+// `ray` (met with the grid box) cut to this frame's own box and to what the scene's cuts keep:
+// samples from `begin` to `len`. The identity without a sort-last window or cuts. A cut ray
+// keeps its entry `u0`, so every sample lies on the one step grid: each sample belongs to the
+// one box that holds it, and a crop drops samples without moving the others.
 fn own_segment(ray: Ray) -> Ray {
-    if (!is_window() || !(ray.len > 0.0)) {
-        return ray;
+    var begin = ray.begin;
+    var end = ray.len;
+    var looks_back = false;
+    if (is_window() && ray.len > 0.0) {
+        let span = box_span(ray.u0, ray.d, frame.own_lo.xyz, frame.own_hi.xyz);
+        begin = max(span.x, 0.0);
+        end = min(span.y, ray.len);
+        looks_back = begin > 0.0;
     }
-    let span = box_span(ray.u0, ray.d, frame.own_lo.xyz, frame.own_hi.xyz);
-    let begin = max(span.x, 0.0);
-    let end = min(span.y, ray.len);
-    return Ray(ray.u0, ray.d, select(0.0, end, begin < end), begin);
+    let kept = cut_segment(ray.u0, ray.d, begin, end);
+    // A crop face is a cap: nothing lies in front of it to look back at.
+    looks_back = looks_back && kept.x <= begin;
+    return Ray(ray.u0, ray.d, select(0.0, kept.y, kept.x < kept.y), kept.x, looks_back);
 }
+
+// The part [begin, end) of the ray u0 + t·d the scene's crop box (#if CROP) and clip planes
+// (#if CLIP) keep; the identity when a scene uses neither (nothing of this is compiled then).
+// The box and planes come in the bound texture's coordinates (FrameUniforms maps them from
+// volume fractions); an unused plane is (0, 0, 0, -1), which keeps everything. The f64 twin is
+// `volgraph_accel::cuts::Cuts::keeps_interval`.
+fn cut_segment(u0: vec3<f32>, d: vec3<f32>, begin: f32, end: f32) -> vec2<f32> {
+    var kept = vec2<f32>(begin, end);
+#if CROP
+    kept = crop_segment(u0, d, kept);
+#endif
+#if CLIP
+    kept = clip_segment(u0, d, kept);
+#endif
+    return kept;
+}
+
+#if CROP
+// `kept` cut to the crop box.
+fn crop_segment(u0: vec3<f32>, d: vec3<f32>, kept: vec2<f32>) -> vec2<f32> {
+    let span = box_span(u0, d, frame.crop_lo.xyz, frame.crop_hi.xyz);
+    return vec2<f32>(max(kept.x, span.x), min(kept.y, span.y));
+}
+#endif
+
+#if CLIP
+// `kept` cut to the half-spaces of the clip planes.
+fn clip_segment(u0: vec3<f32>, d: vec3<f32>, kept_in: vec2<f32>) -> vec2<f32> {
+    var kept = kept_in;
+    for (var i = 0u; i < 6u; i += 1u) {
+        let plane = frame.clip_planes[i];
+        let along = dot(plane.xyz, d);
+        let at = dot(plane.xyz, u0);
+        if (along > 0.0) {
+            kept.x = max(kept.x, (plane.w - at) / along);
+        } else if (along < 0.0) {
+            kept.y = min(kept.y, (plane.w - at) / along);
+        } else if (at < plane.w) {
+            kept.y = -3.0e38;
+        }
+    }
+    return kept;
+}
+#endif
 
 // The ray of pixel centre `pixel` clipped to the box and the near plane, as
 // `volgraph_accel::reference::ray_segment` clips it (slab test; start at max(t_in, t_near); the
@@ -79,7 +134,7 @@ fn analytic_ray_along(dir: vec3<f32>) -> Ray {
     let u1 = clamp(eye + t_out * dir, lo, hi);
     let len = length(u1 - u0);
     let hit = t_in <= t_out && t0 < t_out && len >= 1e-6;
-    return own_segment(Ray(u0, select(vec3<f32>(0.0, 0.0, 1.0), (u1 - u0) / len, hit), select(0.0, len, hit), 0.0));
+    return own_segment(Ray(u0, select(vec3<f32>(0.0, 0.0, 1.0), (u1 - u0) / len, hit), select(0.0, len, hit), 0.0, false));
 }
 
 // The texture-space length of a step of `step_voxels` voxels along unit texture-space direction
@@ -104,7 +159,8 @@ struct Samples {
     // from the entry.
     offset: f32,
     // True when the grid has samples before sample 0 that another rank takes (a sort-last
-    // window cut the ray): a first-hit search still knows the field one step back.
+    // window cut the ray; `Ray::looks_back`): a first-hit search still knows the field one
+    // step back.
     cut: bool,
 }
 
@@ -118,7 +174,7 @@ fn samples_along(ray: Ray, step_tex: f32, jitter: f32, max_count: u32) -> Sample
     let end = clamp(ceil(ray.len / step_tex - grid_offset), 0.0, f32(max_count));
     let skipped = clamp(ceil(ray.begin / step_tex - grid_offset), 0.0, end);
     let offset = grid_offset + skipped;
-    return Samples(ray.u0 + offset * delta, delta, u32(end - skipped), step_tex, offset, skipped > 0.0);
+    return Samples(ray.u0 + offset * delta, delta, u32(end - skipped), step_tex, offset, skipped > 0.0 && ray.looks_back);
 }
 
 // Sample k's texture-space position.

@@ -8,6 +8,7 @@ pub mod bricks;
 pub mod camera;
 pub mod chebyshev;
 pub mod classify;
+pub mod cuts;
 pub mod data_dir;
 pub mod generate;
 pub mod histogram;

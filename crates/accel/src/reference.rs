@@ -11,6 +11,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::camera::{CameraFrame, OrbitCamera};
+use crate::cuts::Cuts;
 use crate::volume::Volume;
 
 /// Blinn–Phong headlight coefficients for the isosurface (`docs/rendering_model.md`,
@@ -93,6 +94,10 @@ pub struct RaycastSettings {
     /// default), `1 / unit_world` for "per world unit" (a scene's opacity reference length).
     /// The correction exponent is `step_voxels / opacity_unit_voxels`.
     pub opacity_unit_voxels: f64,
+    /// Crop box and clip planes: samples outside what they keep are dropped, the step grid
+    /// stays the uncut ray's ([`crate::cuts`], `docs/rendering_model.md` "Cuts").
+    #[serde(skip)]
+    pub cuts: Cuts,
 }
 
 impl Default for RaycastSettings {
@@ -106,6 +111,7 @@ impl Default for RaycastSettings {
             effects: Effects::default(),
             dvr_shading: Phong::default(),
             opacity_unit_voxels: 1.0,
+            cuts: Cuts::NONE,
         }
     }
 }
@@ -254,9 +260,31 @@ struct March<'a> {
     seg: RaySegment,
     step_tex: f64,
     jitter: f64,
+    /// The first sample the cuts keep (0 without cuts): the grid is the uncut ray's.
+    k0: u32,
+    /// Where the cuts end the ray (texture-space distance from `seg.u0`; `seg.len_tex` uncut).
+    end_tex: f64,
 }
 
-impl March<'_> {
+impl<'a> March<'a> {
+    /// The march of `seg`, cut to what `settings.cuts` keep (`crate::cuts`): samples stay on
+    /// the uncut grid `(k + 0.5 + jitter)·step` and only those in the kept interval are taken,
+    /// as `samples_along` in `shaders/common/ray_box.wgsl` takes them.
+    fn new(
+        volume: &'a Volume,
+        lut: &'a [[f32; 4]],
+        settings: &'a RaycastSettings,
+        seg: RaySegment,
+        step_tex: f64,
+        jitter: f64,
+    ) -> Self {
+        let (begin, end) = settings.cuts.keeps_interval(seg.u0, seg.d_tex, 0.0, seg.len_tex);
+        let offset = 0.5 + jitter;
+        let k0 = if begin < end { ((begin / step_tex - offset).ceil()).clamp(0.0, u32::MAX as f64) as u32 } else { 0 };
+        let end_tex = if begin < end { end } else { 0.0 };
+        Self { volume, lut, settings, seg, step_tex, jitter, k0, end_tex }
+    }
+
     fn t(&self, k: u32) -> f64 {
         (k as f64 + 0.5 + self.jitter) * self.step_tex
     }
@@ -297,13 +325,14 @@ impl March<'_> {
     /// Front-to-back emission–absorption; returns the colour and the number of samples.
     fn dvr(&self) -> ([f64; 4], u64) {
         let mut acc = [0.0f64; 4];
-        let mut k = 0;
-        // Pre-integration: the front value of sample 0's segment is the field one step before it.
+        let mut k = self.k0;
+        // Pre-integration: the front value of the first sample's segment is the field one step
+        // before it.
         let mut s_prev =
-            if self.settings.effects.preintegration { self.sample(self.t(0) - self.step_tex) } else { 0.0 };
+            if self.settings.effects.preintegration { self.sample(self.t(k) - self.step_tex) } else { 0.0 };
         while k < self.settings.max_steps {
             let t = self.t(k);
-            if t >= self.seg.len_tex {
+            if t >= self.end_tex {
                 break;
             }
             let s = self.sample(t);
@@ -318,7 +347,7 @@ impl March<'_> {
                 break;
             }
         }
-        (acc, k as u64)
+        (acc, (k - self.k0.min(k)) as u64)
     }
 
     /// The headlight's factors at `u`: `ambient + diffuse·|n·l|` and the white specular term,
@@ -342,24 +371,26 @@ impl March<'_> {
     /// First hit of `s >= iso`, refined linearly; returns colour, hit and samples taken.
     fn iso(&self, iso: f64, shading: &Phong) -> ([f64; 4], [f64; 4], u64) {
         let (mut t_prev, mut s_prev) = (0.0, 0.0);
-        let mut k = 0;
+        // A cut face is a cap: the first kept sample at or over the iso value is the hit, not
+        // refined against the cut-away field (zeroed voxels there would be below it).
+        let mut k = self.k0;
         while k < self.settings.max_steps {
             let t = self.t(k);
-            if t >= self.seg.len_tex {
+            if t >= self.end_tex {
                 break;
             }
             let s = self.sample(t);
             if s >= iso {
-                let t_hit = if k > 0 { t_prev + (t - t_prev) * (iso - s_prev) / (s - s_prev) } else { t };
+                let t_hit = if k > self.k0 { t_prev + (t - t_prev) * (iso - s_prev) / (s - s_prev) } else { t };
                 let u = self.seg.u0 + t_hit * self.seg.d_tex;
                 let rgb = self.shade(u, iso, shading);
-                return ([rgb.x, rgb.y, rgb.z, 1.0], [u.x, u.y, u.z, 1.0], k as u64 + 1);
+                return ([rgb.x, rgb.y, rgb.z, 1.0], [u.x, u.y, u.z, 1.0], (k - self.k0) as u64 + 1);
             }
             t_prev = t;
             s_prev = s;
             k += 1;
         }
-        ([0.0; 4], [0.0; 4], k as u64)
+        ([0.0; 4], [0.0; 4], (k - self.k0.min(k)) as u64)
     }
 
     /// Headlight Blinn–Phong at texture-space `u` (`docs/rendering_model.md`): the gradient
@@ -448,7 +479,7 @@ pub fn render_reference(
                     continue;
                 }
                 let jitter = if settings.jitter { pixel_jitter(x, y, width) } else { 0.0 };
-                let march = March { volume, lut, settings, seg, step_tex, jitter };
+                let march = March::new(volume, lut, settings, seg, step_tex, jitter);
                 match settings.mode {
                     RenderMode::Dvr => {
                         let (c, n) = march.dvr();

@@ -54,6 +54,7 @@ pub struct Prepared {
     camera: CameraSpec,
     frames: u32,
     opacity: OpacityReference,
+    cuts: volgraph_accel::cuts::Cuts,
     volume: volgraph_accel::volume::Volume,
     lut: Vec<[f32; 4]>,
     plan: volgraph_core::Plan,
@@ -65,10 +66,13 @@ pub struct Prepared {
 /// Reads and checks every input of `volgraph render`; touches no GPU, prints nothing.
 pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     let kind = ImageKind::from_path("-o", &args.out)?;
-    let Resolved { scene, graph, size, camera } = args.inputs.resolve("volgraph render GRAPH -o out.png", "512x512")?;
+    let Resolved { scene, graph, size, camera, cuts } =
+        args.inputs.resolve("volgraph render GRAPH -o out.png", "512x512")?;
     let source = inputs::read_graph(&graph)?;
     let mut features = scene.as_ref().map(|s| s.effects.clone()).unwrap_or_default();
     features.extend(args.inputs.features.iter().cloned());
+    // A crop or clip is compiled in only when the scene (or --crop/--clip) asks for it.
+    features.extend(volgraph_core::cut_effects::features_of(&cuts));
     let mut options = compile_options(&size, &features, &[])?;
     options.precision = scene.as_ref().and_then(|s| s.precision);
     let frames = args.frames.or(scene.as_ref().map(Scene::frame_count)).unwrap_or(1);
@@ -136,7 +140,7 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     {
         notes.push(note);
     }
-    Ok(Prepared { args, graph, kind, camera, frames, opacity, volume, lut, plan, output, notes })
+    Ok(Prepared { args, graph, kind, camera, frames, opacity, cuts, volume, lut, plan, output, notes })
 }
 
 /// A note when `--gpu-memory-mb` was given to a graph none of whose passes streams data within
@@ -155,13 +159,14 @@ pub fn budget_note(plan: &volgraph_core::Plan, registry: &volgraph_core::Registr
 
 /// Opens the GPU, renders the frames and writes the image.
 pub fn execute(prepared: Prepared) -> Result<(), CliError> {
-    let Prepared { args, graph, kind, camera, frames, opacity, volume, lut, plan, output, .. } = prepared;
+    let Prepared { args, graph, kind, camera, frames, opacity, cuts, volume, lut, plan, output, .. } = prepared;
     let registry = crate::program::registry();
     let viewport = plan.viewport;
     let gpu = Arc::new(Gpu::new_headless().map_err(|e| anyhow!(e))?);
     let (sources, _) = crate::shader_dir::sources_for(&graph, args.inputs.shaders.as_deref());
     let mut runtime = Runtime::new(gpu, ShaderLibrary::new(sources));
     runtime.set_opacity_reference(opacity);
+    runtime.set_cuts(cuts);
     runtime.set_gpu_memory_budget(args.inputs.gpu_memory_mb.map(|mb| mb << 20));
     runtime.bind_scene(&plan.inputs, &volume, &lut).map_err(|e| anyhow!(e))?;
     if runtime.volume().is_some_and(|(_, f)| f == VolumeFormat::R16Float) && !matches!(volume.data, VoxelData::U8(_)) {

@@ -15,13 +15,17 @@
 //!     effects: ["shading", "jitter"],
 //!     precision: F32,                             // optional: F16 or F32 float targets
 //!     opacity_reference: Voxel,                   // or World
+//!     crop: (0, 0, 0, 0.5, 1, 1),                 // optional: X0,Y0,Z0,X1,Y1,Z1 in volume fractions
+//!     clip: [(0, 1, 1, 0.8)],                     // optional: planes NX,NY,NZ,D keeping n·f >= D
 //! )
 //! ```
 
 use std::path::{Path, PathBuf};
 
+use glam::DVec3;
 use serde::Deserialize;
 use volgraph_accel::camera::OrbitCamera;
+use volgraph_accel::cuts::{ClipPlane, CropBox, Cuts};
 use volgraph_core::Precision;
 use volgraph_core::runtime::OpacityReference;
 
@@ -109,6 +113,10 @@ struct SceneDoc {
     opacity_reference: OpacityReference,
     #[serde(default)]
     frames: Option<u32>,
+    #[serde(default)]
+    crop: Option<(f64, f64, f64, f64, f64, f64)>,
+    #[serde(default)]
+    clip: Vec<(f64, f64, f64, f64)>,
 }
 
 /// A scene read and checked, its paths resolved against the scene file's folder.
@@ -134,6 +142,8 @@ pub struct Scene {
     pub opacity_reference: OpacityReference,
     /// Frames of a camera path (default: the last keyframe's frame + 1, or 1).
     pub frames: Option<u32>,
+    /// The crop box and clip planes (volume fractions).
+    pub cuts: Cuts,
 }
 
 /// Why a scene could not be read.
@@ -239,6 +249,21 @@ impl Scene {
                 return Err(field(name, "File(\"\") names no file; give its path relative to the scene file".into()));
             }
         }
+        let crop = doc
+            .crop
+            .map(|(x0, y0, z0, x1, y1, z1)| CropBox::new(DVec3::new(x0, y0, z0), DVec3::new(x1, y1, z1)))
+            .transpose()
+            .map_err(|e| field("crop", format!("{e} (write crop: (X0, Y0, Z0, X1, Y1, Z1))")))?;
+        let planes = doc
+            .clip
+            .iter()
+            .enumerate()
+            .map(|(i, &(x, y, z, d))| {
+                ClipPlane::new(DVec3::new(x, y, z), d)
+                    .map_err(|e| field("clip", format!("plane {}: {e} (write clip: [(NX, NY, NZ, D)])", i + 1)))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let cuts = Cuts::new(crop, &planes).map_err(|e| field("clip", e.to_string()))?;
         if let Some(TfSource::Data(name)) = &doc.transfer_function {
             check_data_name(name).map_err(|m| field("transfer_function", m))?;
         }
@@ -261,6 +286,7 @@ impl Scene {
             precision: doc.precision,
             opacity_reference: doc.opacity_reference,
             frames: doc.frames,
+            cuts,
         })
     }
 

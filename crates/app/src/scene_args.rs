@@ -6,6 +6,8 @@ use std::path::PathBuf;
 
 use anyhow::anyhow;
 
+use volgraph_accel::cuts::{ClipPlane, CropBox, Cuts};
+
 use crate::cli::RawArgs;
 use crate::inputs;
 use crate::scene::{CameraSpec, Scene};
@@ -57,6 +59,15 @@ pub struct SceneArgs {
     /// [default: 2048, bounded by the adapter's 3D texture limit].
     #[arg(long = "gpu-memory-mb", value_parser = clap::value_parser!(u64).range(1..=1 << 24))]
     pub gpu_memory_mb: Option<u64>,
+    /// Crop box X0,Y0,Z0,X1,Y1,Z1 in fractions of the volume (0..1 per axis): only what lies
+    /// inside is drawn [default: the scene's crop, else none].
+    #[arg(long, value_parser = CropBox::parse, allow_hyphen_values = true)]
+    pub crop: Option<CropBox>,
+    /// A clip plane NX,NY,NZ,D in volume fractions, keeping the side its normal points to
+    /// (n·f >= D): 1,0,0,0.5 keeps x >= 0.5. Repeat for more (at most 6) [default: the scene's
+    /// planes].
+    #[arg(long, value_parser = ClipPlane::parse, allow_hyphen_values = true)]
+    pub clip: Vec<ClipPlane>,
 }
 
 /// What the command line and the scene say together: flags win over the scene.
@@ -69,6 +80,8 @@ pub struct Resolved {
     pub size: String,
     /// The camera (an orbit, or the scene's path).
     pub camera: CameraSpec,
+    /// The crop box and clip planes: `--crop` and `--clip` win over the scene's.
+    pub cuts: Cuts,
 }
 
 impl SceneArgs {
@@ -107,7 +120,12 @@ impl SceneArgs {
             (None, Some(spec)) => spec,
             (None, None) => orbit("30,20,3.2")?,
         };
-        Ok(Resolved { scene, graph, size, camera })
+        let scene_cuts = scene.as_ref().map_or(Cuts::NONE, |s| s.cuts);
+        let crop = self.crop.or(scene_cuts.crop());
+        let planes: Vec<ClipPlane> =
+            if self.clip.is_empty() { scene_cuts.planes().copied().collect() } else { self.clip.clone() };
+        let cuts = Cuts::new(crop, &planes).map_err(|e| anyhow!("--clip: {e}"))?;
+        Ok(Resolved { scene, graph, size, camera, cuts })
     }
 }
 

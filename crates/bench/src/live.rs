@@ -248,6 +248,7 @@ pub fn run(args: &LiveArgs) -> anyhow::Result<()> {
                 features: Vec::new(),
                 shaders: Some(dir.join("shaders")),
                 gpu_memory_mb: None,
+                cuts: Default::default(),
             },
         )
         .map(|(s, _)| s)

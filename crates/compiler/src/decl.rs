@@ -209,7 +209,10 @@ pub trait PassDecl: Send + Sync {
     /// own box (the raycasters, through the shared sampling core of `shaders/common`), so the
     /// ranks' images composite to the single-process one. `render --distributed` refuses a graph
     /// with any other pass (slice-based rendering, a maximum-intensity projection) rather than
-    /// composite a wrong image. Default: false.
+    /// composite a wrong image. The same property makes a scene's crop box and clip planes
+    /// right (`crate::cut_effects`: samples are dropped through the same `own_segment`): such a
+    /// pass's modules are compiled with `#if CROP`/`#if CLIP` when the scene cuts, and a graph
+    /// with a pass that is not is refused with a cut. Default: false.
     fn honours_volume_window(&self) -> bool {
         false
     }

@@ -10,6 +10,7 @@
 
 pub mod binding_rules;
 pub mod compile;
+pub mod cut_effects;
 pub mod decl;
 pub mod declare;
 pub mod diagnostic;

@@ -101,6 +101,56 @@ fn every_scene_effect_is_compiled_only_when_the_scene_turns_it_on() {
     }
 }
 
+/// The functions the pass `pass` of `graph` compiles, with the `#if` names the runtime adds for
+/// the scene's cuts (`volgraph_compiler::cut_effects`, given to every pass that honours them).
+fn pass_code_with_cuts(graph: &str, pass: &str, options: CompileOptions) -> BTreeSet<String> {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../graphs").join(graph);
+    let source = std::fs::read_to_string(path).expect("graph");
+    let registry = builtin_registry();
+    let plan = compile(graph, &source, &registry, &options).expect("compiles");
+    let step = plan.steps.iter().find(|s| s.pass_id == pass).expect("the step");
+    let plugin = registry.get(&step.kind).expect("registered");
+    assert!(plugin.honours_volume_window(), "{}: the raycasters take cuts", step.kind);
+    let mut defines = plugin.shader_defines(&step.params);
+    defines.extend(volgraph_core::cut_effects::defines_of(&plan.features));
+    let wired: Vec<&str> = step
+        .ports
+        .iter()
+        .filter(|p| p.binding != volgraph_core::plan::Binding::Unbound)
+        .map(|p| p.port.as_str())
+        .collect();
+    plugin
+        .shaders_wired(&step.params, &wired)
+        .iter()
+        .flat_map(|u| {
+            let mut d = defines.clone();
+            d.extend(u.defines.iter().copied());
+            reachable_with(u.file, u.entry_point, &d)
+        })
+        .collect()
+}
+
+/// Crop and clip (issue 24 §3) are frame effects: a scene that cuts nothing compiles no cut code
+/// into any raycaster, and each cut compiles only its own.
+#[test]
+fn a_cut_is_compiled_only_when_the_scene_cuts() {
+    for (graph, pass) in [
+        ("basic/fragment_raycast.ron", "march"),
+        ("modern/fastest.ron", "march"),
+        ("kruger_westermann_2003/rc_b_leap.ron", "march"),
+        ("ruijters_vilanova_2006/bricks_octree_ert.ron", "march"),
+        ("klein_2005/leap_iso.ron", "march"),
+    ] {
+        let none = pass_code_with_cuts(graph, pass, CompileOptions::new(64, 64));
+        assert!(none.contains("own_segment"), "{graph}: the window cut is always there: {none:?}");
+        assert!(!none.contains("crop_segment") && !none.contains("clip_segment"), "{graph}: no cut code: {none:?}");
+        let crop = pass_code_with_cuts(graph, pass, CompileOptions::new(64, 64).with_features(["crop"]));
+        assert!(crop.contains("crop_segment") && !crop.contains("clip_segment"), "{graph} with a crop: {crop:?}");
+        let clip = pass_code_with_cuts(graph, pass, CompileOptions::new(64, 64).with_features(["clip"]));
+        assert!(clip.contains("clip_segment") && !clip.contains("crop_segment"), "{graph} with a clip: {clip:?}");
+    }
+}
+
 #[test]
 fn the_isosurface_takes_tricubic_and_jitter() {
     let plain = march_code("basic/isosurface.ron", CompileOptions::new(64, 64));

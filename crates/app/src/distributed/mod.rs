@@ -276,6 +276,8 @@ struct Job {
     kind: ImageKind,
     out: std::path::PathBuf,
     algorithm: CompositeAlgorithm,
+    /// `--crop` and `--clip`: each rank takes the samples its own box and the cuts keep.
+    cuts: volgraph_accel::cuts::Cuts,
 }
 
 impl Job {
@@ -300,7 +302,8 @@ impl Job {
         let raw = inputs::raw_options(&args.inputs.raw)?;
         let header = VolumeHeader::read(path, &raw).map_err(|e| anyhow!("{e}"))?;
         let source = inputs::read_graph(&resolved.graph)?;
-        let options = compile_options(&resolved.size, &args.inputs.features, &[])?;
+        let mut options = compile_options(&resolved.size, &args.inputs.features, &[])?;
+        options.features.extend(volgraph_core::cut_effects::features_of(&resolved.cuts));
         Ok(Job {
             header,
             graph: resolved.graph,
@@ -315,6 +318,7 @@ impl Job {
             kind,
             out: args.out.clone(),
             algorithm: args.composite,
+            cuts: resolved.cuts,
         })
     }
 
@@ -376,6 +380,7 @@ impl Job {
         let (sources, _) = crate::shader_dir::sources_for(&self.graph, self.shaders.as_deref());
         let mut runtime = Runtime::new(gpu, ShaderLibrary::new(sources));
         runtime.set_volume_window(Some(window));
+        runtime.set_cuts(self.cuts);
         runtime.bind_scene(&plan.inputs, volume, lut).map_err(|e| anyhow!(e))?;
         runtime.apply(plan, &crate::program::registry()).map_err(|e| anyhow!(e))?;
         Ok(runtime)

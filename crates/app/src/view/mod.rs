@@ -103,6 +103,7 @@ pub fn run(args: ViewArgs) -> Result<(), CliError> {
         features: args.inputs.features,
         shaders: args.inputs.shaders,
         gpu_memory_mb: args.inputs.gpu_memory_mb,
+        cuts: resolved.cuts,
     };
     let view = ViewOptions {
         camera,

@@ -5,6 +5,7 @@
 
 use std::collections::BTreeMap;
 
+use volgraph_accel::cuts::{ClipPlane, CropBox, Cuts};
 use volgraph_core::graph::ast::InputKind;
 use volgraph_core::params::{ParamKind, ParamValue};
 
@@ -24,6 +25,8 @@ pub enum Action {
     ResetCamera,
     /// Write the parameters and inputs changed here into the graph file.
     WriteBack,
+    /// Set the crop box and clip planes.
+    Cuts(Cuts),
 }
 
 /// Exponentially smoothed per-pass milliseconds.
@@ -155,7 +158,9 @@ pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapt
         });
         ui.separator();
         egui::ScrollArea::vertical().show(ui, |ui| {
-            let known = &plan.known_features;
+            // Crop and clip have their own section below.
+            let known: Vec<&String> =
+                plan.known_features.iter().filter(|f| !volgraph_core::cut_effects::is_cut_feature(f)).collect();
             if !known.is_empty() {
                 ui.collapsing("Features", |ui| {
                     for f in known {
@@ -165,6 +170,9 @@ pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapt
                         }
                     }
                 });
+            }
+            if let Some(cuts) = cuts_section(ui, session.runtime.cuts()) {
+                actions.push(Action::Cuts(cuts));
             }
             let scalars: BTreeMap<&String, f64> = plan
                 .inputs
@@ -245,4 +253,53 @@ pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapt
         ui.small(HELP);
     });
     actions
+}
+
+/// The crop box (a checkbox and a low/high slider per axis) and the first clip plane (normal and
+/// offset); planes after the first (from `--clip`) are kept and listed. Returns new cuts when a
+/// control changed them.
+fn cuts_section(ui: &mut egui::Ui, cuts: Cuts) -> Option<Cuts> {
+    let mut crop = cuts.crop();
+    let mut planes: Vec<ClipPlane> = cuts.planes().copied().collect();
+    let mut changed = false;
+    ui.collapsing("Crop and clip", |ui| {
+        let mut on = crop.is_some();
+        if ui.checkbox(&mut on, "crop box (volume fractions)").changed() {
+            crop = on.then_some(CropBox::WHOLE);
+            changed = true;
+        }
+        if let Some(c) = crop.as_mut() {
+            for (axis, name) in ["x", "y", "z"].into_iter().enumerate() {
+                let (mut lo, mut hi) = (c.lo[axis], c.hi[axis]);
+                changed |= ui.add(egui::Slider::new(&mut lo, 0.0..=0.99).text(format!("{name} from"))).changed();
+                changed |= ui.add(egui::Slider::new(&mut hi, 0.01..=1.0).text(format!("{name} to"))).changed();
+                // The box stays a box: the high end at least a hundredth past the low one.
+                c.lo[axis] = lo.min(0.99);
+                c.hi[axis] = hi.max(c.lo[axis] + 0.01).min(1.0);
+            }
+        }
+        let mut on = !planes.is_empty();
+        if ui.checkbox(&mut on, "clip plane (keeps n·f >= d)").changed() {
+            planes = if on { vec![ClipPlane { normal: glam::DVec3::X, offset: 0.5 }] } else { Vec::new() };
+            changed = true;
+        }
+        if let Some(p) = planes.first_mut() {
+            let mut n = p.normal;
+            for (axis, name) in ["n.x", "n.y", "n.z"].into_iter().enumerate() {
+                changed |= ui.add(egui::Slider::new(&mut n[axis], -1.0..=1.0).text(name)).changed();
+            }
+            changed |= ui.add(egui::Slider::new(&mut p.offset, -1.0..=2.0).text("d")).changed();
+            // A zero normal keeps nothing meaningful: the slider cannot leave one.
+            if n != glam::DVec3::ZERO {
+                p.normal = n;
+            }
+        }
+        for p in planes.iter().skip(1) {
+            ui.small(format!("plane ({:.2}, {:.2}, {:.2}) · f >= {:.2}", p.normal.x, p.normal.y, p.normal.z, p.offset));
+        }
+    });
+    if !changed {
+        return None;
+    }
+    Cuts::new(crop, &planes).ok()
 }

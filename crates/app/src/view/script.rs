@@ -3,6 +3,8 @@
 
 use std::path::PathBuf;
 
+use volgraph_accel::cuts::{ClipPlane, CropBox};
+
 /// One script command.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ScriptCommand {
@@ -21,10 +23,15 @@ pub enum ScriptCommand {
     },
     /// `write`: the panel's "write to graph file" (the values changed here, into the graph).
     Write,
+    /// `crop X0,Y0,Z0,X1,Y1,Z1` or `crop off`: the panel's crop box.
+    Crop(Option<CropBox>),
+    /// `clip NX,NY,NZ,D` (one plane, replacing any) or `clip off`.
+    Clip(Option<ClipPlane>),
 }
 
 /// What the script accepts, for messages.
-pub const USAGE: &str = "quit, screenshot PATH, param PASS.NAME VALUE, write";
+pub const USAGE: &str =
+    "quit, screenshot PATH, param PASS.NAME VALUE, write, crop X0,Y0,Z0,X1,Y1,Z1|off, clip NX,NY,NZ,D|off";
 
 /// Parses one line: `Ok(None)` for a blank line, `Err` naming what is wrong.
 pub fn parse_line(line: &str) -> Result<Option<ScriptCommand>, String> {
@@ -49,6 +56,14 @@ pub fn parse_line(line: &str) -> Result<Option<ScriptCommand>, String> {
                 .map_err(|e| format!("\"{line}\": the value \"{}\" is not one RON value ({})", value.trim(), e.code))?;
             Ok(Some(ScriptCommand::Param { pass: pass.to_string(), name: name.to_string(), value }))
         }
+        "crop" if rest == "off" => Ok(Some(ScriptCommand::Crop(None))),
+        "crop" => {
+            CropBox::parse(rest).map(|c| Some(ScriptCommand::Crop(Some(c)))).map_err(|e| format!("\"{line}\": {e}"))
+        }
+        "clip" if rest == "off" => Ok(Some(ScriptCommand::Clip(None))),
+        "clip" => {
+            ClipPlane::parse(rest).map(|p| Some(ScriptCommand::Clip(Some(p)))).map_err(|e| format!("\"{line}\": {e}"))
+        }
         other => Err(format!("\"{line}\": unknown command \"{other}\"; known: {USAGE}")),
     }
 }
@@ -62,6 +77,8 @@ mod tests {
         assert_eq!(parse_line("  quit "), Ok(Some(ScriptCommand::Quit)));
         assert_eq!(parse_line(""), Ok(None));
         assert_eq!(parse_line("write"), Ok(Some(ScriptCommand::Write)));
+        assert_eq!(parse_line("crop off"), Ok(Some(ScriptCommand::Crop(None))));
+        assert!(matches!(parse_line("clip 1,0,0,0.5"), Ok(Some(ScriptCommand::Clip(Some(_))))));
         assert!(parse_line("write now").is_err());
         assert_eq!(
             parse_line("screenshot my shots/a.png"),
@@ -86,6 +103,8 @@ mod tests {
             ("param march 0.5", "\"march\" is not PASS.NAME"),
             ("screenshot", "write screenshot PATH"),
             ("qiut", "unknown command \"qiut\""),
+            ("crop 0,0,0,1,1", "got 5"),
+            ("clip 0,0,0,1", "no direction"),
         ] {
             let err = parse_line(line).expect_err(line);
             assert!(err.contains(expected), "{line}: {err}");

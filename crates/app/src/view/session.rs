@@ -11,10 +11,11 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::anyhow;
+use volgraph_accel::cuts::Cuts;
 use volgraph_accel::transfer_function::TransferFunction;
 use volgraph_accel::volume::Volume;
 use volgraph_core::runtime::{ApplyReport, CameraData, Gpu, PresentTarget, Runtime, ShaderLibrary};
-use volgraph_core::{CompileOptions, Plan, Registry};
+use volgraph_core::{CompileOptions, Plan, Registry, cut_effects};
 
 use crate::inputs;
 
@@ -107,6 +108,8 @@ pub struct SessionArgs {
     /// A scene supplying the volume and transfer function where `volume` and `tf` are not
     /// given, and its precision and opacity reference.
     pub scene: Option<crate::scene::Scene>,
+    /// The crop box and clip planes at start (`--crop`/`--clip` over the scene's).
+    pub cuts: Cuts,
 }
 
 /// A graph running on a runtime, with everything that can change it.
@@ -180,6 +183,8 @@ impl LiveSession {
         runtime.set_gpu_memory_budget(args.gpu_memory_mb.map(|mb| mb << 20));
         let mut options = CompileOptions::new(args.viewport.0, args.viewport.1)
             .with_features(args.features.iter().filter(|f| !f.is_empty()).cloned());
+        options.features.extend(cut_effects::features_of(&args.cuts));
+        runtime.set_cuts(args.cuts);
         if let Some(scene) = &args.scene {
             options.features.extend(scene.effects.iter().cloned());
             options.precision = scene.precision;
@@ -443,6 +448,33 @@ impl LiveSession {
             self.options = options;
         }
         self.outcome(format!("feature {name} {}", if on { "on" } else { "off" }), start, result)
+    }
+
+    /// Sets the crop box and clip planes (the panel's sliders, `--crop`/`--clip`, a scene's
+    /// `crop:`/`clip:`). Moving a box or plane writes the frame uniforms only; turning a kind of
+    /// cut on or off recompiles the raycasters with or without its code.
+    pub fn set_cuts(&mut self, cuts: Cuts) -> Vec<Event> {
+        let old = self.runtime.cuts();
+        if cuts == old {
+            return Vec::new();
+        }
+        let mut options = self.options.clone();
+        options.features.retain(|f| !cut_effects::is_cut_feature(f));
+        options.features.extend(cut_effects::features_of(&cuts));
+        self.runtime.set_cuts(cuts);
+        if options.features == self.options.features {
+            return Vec::new();
+        }
+        let start = Instant::now();
+        let source = self.source.clone();
+        let result = self.compile_and_apply(&source, &options).map(|r| describe(&r));
+        if result.is_ok() {
+            self.options = options;
+        } else {
+            self.runtime.set_cuts(old);
+        }
+        let what: Vec<String> = cut_effects::features_of(&cuts).into_iter().collect();
+        self.outcome(if what.is_empty() { "cuts off".to_string() } else { what.join(" and ") }, start, result)
     }
 
     /// The window was resized: only viewport-sized targets are reallocated.

@@ -54,6 +54,7 @@ fn open(s: &Scratch, tf: Option<PathBuf>) -> LiveSession {
         features: Vec::new(),
         shaders: Some(s.shaders.clone()),
         gpu_memory_mb: None,
+        cuts: Default::default(),
     };
     let (session, loaded) = LiveSession::open(gpu, &args).unwrap_or_else(|_| panic!("the scratch graph loads"));
     assert!(matches!(loaded, Event::Loaded { .. }), "{loaded}");
@@ -271,6 +272,7 @@ fn a_frame_the_gpu_rejects_puts_the_last_good_graph_back() {
         features: Vec::new(),
         shaders: Some(s.shaders.clone()),
         gpu_memory_mb: None,
+        cuts: Default::default(),
     };
     let (mut session, _) = LiveSession::open_with(gpu, &args, registry).unwrap_or_else(|_| panic!("loads"));
     let camera = OrbitCamera::default();

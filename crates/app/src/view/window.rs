@@ -151,6 +151,7 @@ impl Viewer {
                 Action::Param(pass, param, value) => session.set_param(&pass, &param, value),
                 Action::Scalar(name, value) => session.set_scalar(&name, value),
                 Action::Feature(name, on) => session.set_feature(&name, on),
+                Action::Cuts(cuts) => session.set_cuts(cuts),
                 Action::Screenshot => {
                     self.screenshot_now =
                         Some(self.view.screenshot.clone().unwrap_or_else(|| PathBuf::from("volgraph.png")));
@@ -188,6 +189,20 @@ impl Viewer {
                     self.apply_actions(vec![Action::Param(pass, name, value)])
                 }
                 Ok(Some(ScriptCommand::Write)) => self.apply_actions(vec![Action::WriteBack]),
+                Ok(Some(ScriptCommand::Crop(crop))) => {
+                    let Some(session) = self.session.as_ref() else { continue };
+                    let planes: Vec<_> = session.runtime.cuts().planes().copied().collect();
+                    if let Ok(cuts) = volgraph_accel::cuts::Cuts::new(crop, &planes) {
+                        self.apply_actions(vec![Action::Cuts(cuts)]);
+                    }
+                }
+                Ok(Some(ScriptCommand::Clip(plane))) => {
+                    let Some(session) = self.session.as_ref() else { continue };
+                    let crop = session.runtime.cuts().crop();
+                    if let Ok(cuts) = volgraph_accel::cuts::Cuts::new(crop, plane.as_slice()) {
+                        self.apply_actions(vec![Action::Cuts(cuts)]);
+                    }
+                }
                 Ok(None) => {}
                 Err(message) => crate::stdout::eprintln_escaped!("script: {message}"),
             }

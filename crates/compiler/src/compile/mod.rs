@@ -116,9 +116,41 @@ pub fn compile(
     let checked = check::check(&doc, source, registry, options).map_err(fail)?;
     let mut warnings = checked.warnings.clone();
     let mut plan = schedule::schedule(&doc, checked, options).map_err(fail)?;
+    let cut_problems = passes_that_cannot_cut(&plan, registry);
+    if !cut_problems.is_empty() {
+        return Err(fail(cut_problems));
+    }
     warnings.extend(unused_option_warnings(&plan, options));
     plan.warnings = fail(warnings);
     Ok(plan)
+}
+
+/// A scene that crops or clips (`crate::cut_effects`) needs every pass to take only the samples
+/// the cuts keep: a pass that does not (`PassDecl::honours_volume_window`) would draw the
+/// cut-away part — a silent wrong image — so it is an error naming the pass.
+fn passes_that_cannot_cut(plan: &Plan, registry: &dyn KindLookup) -> Vec<crate::diagnostic::Diagnostic> {
+    use crate::diagnostic::{Diagnostic, Location};
+    let cuts: Vec<&String> = plan.features.iter().filter(|f| crate::cut_effects::is_cut_feature(f)).collect();
+    if cuts.is_empty() {
+        return Vec::new();
+    }
+    let mut seen = std::collections::BTreeSet::new();
+    plan.steps
+        .iter()
+        .filter(|s| seen.insert(s.pass_id.clone()))
+        .filter(|s| registry.decl(&s.kind).is_some_and(|d| !d.honours_volume_window()))
+        .map(|s| {
+            let names: Vec<&str> = cuts.iter().map(|f| f.as_str()).collect();
+            Diagnostic::new(
+                Location::File,
+                format!("pass \"{}\" ({}) cannot {}: it samples the volume its own way", s.pass_id, s.kind, names.join(" or ")),
+            )
+            .with_help(
+                "crop boxes and clip planes work with the raycasters (raycast, raycast_compute, raycast_segment, raycast_bricks); render this graph without --crop/--clip"
+                    .to_string(),
+            )
+        })
+        .collect()
 }
 
 /// Scene features and values the options set that this graph never reads: named, with a

@@ -95,6 +95,8 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
             .iter()
             .flat_map(|p| p.needs.iter().cloned())
             .chain(c.features_read.iter().cloned())
+            // Crop and clip belong to the frame: every graph takes them.
+            .chain([crate::cut_effects::CROP, crate::cut_effects::CLIP].map(String::from))
             .collect(),
         known_scalars: c
             .inputs

@@ -231,6 +231,9 @@ pub struct CreateContext<'a> {
     /// the pipelines below are built from — an entry point it lacks is an error, and the names a
     /// node binds itself come from it.
     declared: Vec<ShaderUse>,
+    /// `#if` names the frame turns on in every module this node builds (a scene's crop box and
+    /// clip planes: [`volgraph_compiler::cut_effects`]), whatever its parameters say.
+    frame_defines: Vec<&'static str>,
 }
 
 impl<'a> CreateContext<'a> {
@@ -257,7 +260,15 @@ impl<'a> CreateContext<'a> {
             modules: RefCell::new(BTreeSet::new()),
             built: RefCell::new(BTreeSet::new()),
             declared,
+            frame_defines: Vec::new(),
         }
+    }
+
+    /// The same context with `defines` turned on in every module it builds (the runtime gives
+    /// the cut effects to passes that honour them, [`crate::plugin::PassDecl::honours_volume_window`]).
+    pub fn with_frame_defines(mut self, defines: Vec<&'static str>) -> Self {
+        self.frame_defines = defines;
+        self
     }
 
     /// The declared use of `file`'s `entry` ([`Self::declared`]), or an error saying how to
@@ -341,7 +352,8 @@ impl<'a> CreateContext<'a> {
 
     fn shader(&self, file: &str, defines: &[&str]) -> Result<std::sync::Arc<super::shaders::LoadedShader>, PassError> {
         self.modules.borrow_mut().insert(file.to_string());
-        self.shaders.get_with(self.gpu, file, defines).map_err(|e| self.error(e))
+        let defines = [defines, &self.frame_defines].concat();
+        self.shaders.get_with(self.gpu, file, &defines).map_err(|e| self.error(e))
     }
 
     /// Builds (or takes from the cache) a render pipeline drawing a fragment shader into this

@@ -5,6 +5,7 @@
 
 use glam::{DMat4, DVec3, UVec3};
 use volgraph_accel::camera::OrbitCamera;
+use volgraph_accel::cuts::{Cuts, MAX_CLIP_PLANES};
 use volgraph_accel::volume::Volume;
 
 /// One frame's camera, as both the GPU passes and the f64 reference use it
@@ -211,6 +212,8 @@ pub struct FrameData {
     /// GPU memory a pass that streams data may hold (`--gpu-memory-mb`), in bytes; `None`: as
     /// much as the adapter allows.
     pub gpu_memory_budget: Option<u64>,
+    /// The scene's crop box and clip planes (volume fractions of the whole volume).
+    pub cuts: Cuts,
 }
 
 /// The pixel rays of a camera in texture space: pixel centre (x, y) (pixels, row 0 at the top)
@@ -291,9 +294,19 @@ pub struct FrameUniforms {
     pub own_lo: [f32; 4],
     /// See `own_lo`.
     pub own_hi: [f32; 4],
+    /// The scene's crop box in the bound texture's coordinates (xyz); read under `#if CROP`.
+    pub crop_lo: [f32; 4],
+    /// See `crop_lo`.
+    pub crop_hi: [f32; 4],
+    /// The scene's clip planes in the bound texture's coordinates: keep `u` with
+    /// `dot(xyz, u) >= w`; unused planes are `(0, 0, 0, -1)`. Read under `#if CLIP`.
+    pub clip_planes: [[f32; 4]; MAX_CLIP_PLANES],
 }
 
-const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 416);
+const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 544);
+
+/// A plane that keeps every point (fills the unused clip-plane slots).
+const KEEP_ALL: [f32; 4] = [0.0, 0.0, 0.0, -1.0];
 
 fn mat(m: DMat4) -> [[f32; 4]; 4] {
     m.as_mat4().to_cols_array_2d()
@@ -334,7 +347,27 @@ impl FrameUniforms {
             grid_hi: with_w(grid.1, 0.0),
             own_lo: with_w(own.0, 0.0),
             own_hi: with_w(own.1, 0.0),
+            crop_lo: with_w(grid.0, 0.0),
+            crop_hi: with_w(grid.1, 0.0),
+            clip_planes: [KEEP_ALL; MAX_CLIP_PLANES],
         }
+        .with_cuts(&frame.cuts, grid)
+    }
+
+    /// The cuts (volume fractions of the whole volume) in the bound texture's coordinates, where
+    /// the whole volume is the box `grid`: `u = lo + f·size`.
+    fn with_cuts(mut self, cuts: &Cuts, grid: (DVec3, DVec3)) -> Self {
+        let (lo, size) = (grid.0, grid.1 - grid.0);
+        if let Some(c) = cuts.crop() {
+            self.crop_lo = with_w(lo + c.lo * size, 0.0);
+            self.crop_hi = with_w(lo + c.hi * size, 0.0);
+        }
+        for (slot, p) in self.clip_planes.iter_mut().zip(cuts.planes()) {
+            // n·f >= d with f = (u - lo)/size  <=>  (n/size)·u >= d + (n/size)·lo.
+            let n = p.normal / size;
+            *slot = with_w(n, (p.offset + n.dot(lo)) as f32);
+        }
+        self
     }
 }
 

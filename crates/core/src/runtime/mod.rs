@@ -55,9 +55,10 @@ use crate::diagnostic::Diagnostics;
 use crate::graph::ast::InputKind;
 use crate::plan::{Binding, Plan, ResourceDesc};
 use crate::plugin::{Access, Registry};
-use crate::{CompileOptions, compile};
+use crate::{CompileOptions, compile, cut_effects};
 use record::BoundPort;
 use schedule::{Schedule, SlotTexture};
+use volgraph_accel::cuts::Cuts;
 
 /// Why the runtime could not do what was asked.
 #[derive(Debug, thiserror::Error)]
@@ -98,6 +99,14 @@ pub enum RuntimeError {
     /// Reading a result back failed.
     #[error("{0}")]
     Readback(String),
+    /// Cuts were set that the applied plan was not compiled with.
+    #[error(
+        "the scene now cuts the volume ({wanted}) but the plan was applied without it; apply the plan again after Runtime::set_cuts"
+    )]
+    CutsNotApplied {
+        /// The cut features set.
+        wanted: String,
+    },
 }
 
 /// Memory the runtime holds, for reports and soak tests.
@@ -151,6 +160,8 @@ pub struct Runtime {
     /// What the transfer function's opacity is per (a scene setting).
     opacity_reference: OpacityReference,
     window: Option<VolumeWindow>,
+    /// The scene's crop box and clip planes.
+    cuts: Cuts,
     /// GPU memory passes that stream data may use (`--gpu-memory-mb`); `None`: the adapter's.
     gpu_memory_budget: Option<u64>,
 }
@@ -177,6 +188,7 @@ impl Runtime {
             last_camera: None,
             opacity_reference: OpacityReference::default(),
             window: None,
+            cuts: Cuts::NONE,
             gpu_memory_budget: None,
         }
     }
@@ -324,6 +336,7 @@ impl Runtime {
             &extended
         };
         let viewport_changed = self.plan().is_some_and(|p| p.viewport != plan.viewport);
+        let cut_defines = self.cut_defines_for(&plan.features);
         let old = self.schedule.take();
         let resources = schedule::Resources {
             gpu: &self.gpu,
@@ -332,7 +345,7 @@ impl Runtime {
             textures: &mut self.textures,
             history: &mut self.history,
         };
-        match schedule::build(resources, registry, plan, old, &self.stale_modules) {
+        match schedule::build(resources, registry, plan, old, &self.stale_modules, &cut_defines) {
             Ok((schedule, report)) => {
                 // Klein et al. 2005 §4.1: a resize starts from scratch, and so does a parameter
                 // edit of a pass a history entry declares it depends on (an isovalue change).
@@ -414,6 +427,29 @@ impl Runtime {
         }
     }
 
+    /// Sets the scene's crop box and clip planes (volume fractions of the whole volume,
+    /// `volgraph_accel::cuts`). Moving a box or plane takes effect with the next frame; turning
+    /// a kind of cut on needs a plan applied after this call (the cut's code is compiled in only
+    /// then: `volgraph_compiler::cut_effects`), else the next frame is refused.
+    pub fn set_cuts(&mut self, cuts: Cuts) {
+        if self.cuts != cuts {
+            self.cuts = cuts;
+            self.invalidate_history();
+        }
+    }
+
+    /// The scene's cuts.
+    pub fn cuts(&self) -> Cuts {
+        self.cuts
+    }
+
+    /// The cut `#if` names a plan with `features` is built with: the plan's and the set cuts'.
+    fn cut_defines_for(&self, features: &std::collections::BTreeSet<String>) -> Vec<&'static str> {
+        let mut all = cut_effects::features_of(&self.cuts);
+        all.extend(features.iter().cloned());
+        cut_effects::defines_of(&all)
+    }
+
     /// The bound volume as the frame contract describes it (windowed when a window is set).
     fn volume_desc(&self) -> Option<VolumeDesc> {
         let (desc, _) = self.inputs.volume()?;
@@ -444,6 +480,7 @@ impl Runtime {
             history_age: self.history_age,
             volume: self.volume_desc(),
             gpu_memory_budget: self.gpu_memory_budget,
+            cuts: self.cuts,
         })
     }
 
@@ -456,6 +493,11 @@ impl Runtime {
         }
         let frame = self.frame_data(camera)?;
         let Some(schedule) = self.schedule.as_mut() else { return Err(RuntimeError::NoPlan) };
+        let wanted = cut_effects::defines_of(&cut_effects::features_of(&self.cuts));
+        if !wanted.iter().all(|d| schedule.cut_defines.contains(d)) {
+            let wanted = cut_effects::features_of(&self.cuts).into_iter().collect::<Vec<_>>().join(", ");
+            return Err(RuntimeError::CutsNotApplied { wanted });
+        }
         Self::check_inputs_of(&self.inputs, &schedule.plan)?;
         for step in &schedule.plan.steps {
             for bp in &step.ports {

@@ -32,6 +32,8 @@ pub(crate) struct NodeEntry {
     ports: Vec<PortInfo>,
     /// Shader modules its pipelines came from.
     modules: BTreeSet<String>,
+    /// The frame's `#if` names its modules were compiled with (the scene's cuts).
+    frame_defines: Vec<&'static str>,
 }
 
 /// The texture or buffer behind one plan slot.
@@ -68,6 +70,8 @@ pub(crate) struct Schedule {
     pub owned: HashMap<ResourceId, wgpu::TextureView>,
     pub bind_groups: RefCell<BindGroupCache>,
     pub pass_ids: Arc<Vec<String>>,
+    /// The cut `#if` names the nodes were built with (`volgraph_compiler::cut_effects`).
+    pub cut_defines: Vec<&'static str>,
     /// Per step: whether it may be skipped when its inputs are unchanged (its node says
     /// [`Rerun::WhenInputsChange`] and the plan lets it: see [`skippable`]).
     pub skippable: Vec<bool>,
@@ -130,6 +134,16 @@ pub enum ApplyError {
     /// The GPU refused a texture.
     #[error(transparent)]
     Gpu(#[from] GpuFault),
+    /// The scene cuts the volume and a pass cannot take only the samples the cuts keep.
+    #[error(
+        "pass \"{pass}\" ({kind}) cannot crop or clip: it samples the volume its own way; render this graph without cuts"
+    )]
+    CannotCut {
+        /// The pass id.
+        pass: String,
+        /// Its kind.
+        kind: String,
+    },
 }
 
 /// The slot's history entry name, if it is the current-frame texture of one.
@@ -161,11 +175,12 @@ pub(crate) fn build(
     plan: Plan,
     old: Option<Schedule>,
     stale_modules: &[String],
+    cut_defines: &[&'static str],
 ) -> Result<(Schedule, ApplyReport), (ApplyError, Option<Schedule>)> {
     let (hits0, misses0) = r.pipelines.counts();
     let created0 = r.textures.created();
     // 1. Decide per pass; build new nodes (fallible, no side effects on `old`).
-    let mut decisions: Vec<(String, Decision, String, Params, Vec<PortInfo>)> = Vec::new();
+    let mut decisions: Vec<(String, Decision, String, Params, Vec<PortInfo>, Vec<&'static str>)> = Vec::new();
     for step in &plan.steps {
         if decisions.iter().any(|(id, ..)| *id == step.pass_id) {
             continue;
@@ -174,9 +189,18 @@ pub(crate) fn build(
             return Err((ApplyError::UnknownKind(step.kind.clone()), old));
         };
         let ports = port_infos(&plan, step, &plugin.ports(&step.params));
+        // The scene's cuts compile into the passes that take only the samples they keep (the
+        // compiler refused a plan with a cut and any other pass).
+        let frame_defines = if plugin.honours_volume_window() { cut_defines.to_vec() } else { Vec::new() };
+        if !cut_defines.is_empty() && !plugin.honours_volume_window() {
+            return Err((ApplyError::CannotCut { pass: step.pass_id.clone(), kind: step.kind.clone() }, old));
+        }
         let previous = old.as_ref().and_then(|o| o.nodes.get(&step.pass_id));
         let reusable = previous.filter(|e| {
-            e.kind == step.kind && e.ports == ports && !e.modules.iter().any(|m| stale_modules.contains(m))
+            e.kind == step.kind
+                && e.ports == ports
+                && e.frame_defines == frame_defines
+                && !e.modules.iter().any(|m| stale_modules.contains(m))
         });
         let decision = match reusable {
             Some(e) if e.params == step.params => Decision::Keep,
@@ -190,14 +214,15 @@ pub(crate) fn build(
                     &step.params,
                     &ports,
                     plugin.as_ref(),
-                );
+                )
+                .with_frame_defines(frame_defines.clone());
                 match plugin.create(&ctx) {
                     Ok(node) => Decision::Create(node, ctx.modules.into_inner()),
                     Err(e) => return Err((e.into(), old)),
                 }
             }
         };
-        decisions.push((step.pass_id.clone(), decision, step.kind.clone(), step.params.clone(), ports));
+        decisions.push((step.pass_id.clone(), decision, step.kind.clone(), step.params.clone(), ports, frame_defines));
     }
     // 2. Textures and buffers for the transient slots: the old schedule's of the same descriptor
     //    (shared, handed over on commit), else one from the pool (given back on failure).
@@ -281,7 +306,7 @@ pub(crate) fn build(
         }
     }
     let mut nodes = HashMap::new();
-    for (id, decision, kind, params, ports) in decisions {
+    for (id, decision, kind, params, ports, frame_defines) in decisions {
         let entry = match decision {
             Decision::Keep => {
                 report.nodes_kept += 1;
@@ -309,6 +334,7 @@ pub(crate) fn build(
                     params: params.clone(),
                     ports: ports.clone(),
                     modules,
+                    frame_defines,
                 })
             }
         };
@@ -359,6 +385,7 @@ pub(crate) fn build(
         owned,
         bind_groups: RefCell::new(BindGroupCache::default()),
         pass_ids,
+        cut_defines: cut_defines.to_vec(),
         skippable,
         owned_versions,
         next_version,

@@ -114,3 +114,79 @@ fn a_broken_scene_names_the_file_and_the_line_or_field() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 24 §3: `--crop`/`--clip` and a scene's `crop:`/`clip:` are the same cut: the flags
+/// render the scene's picture byte for byte, and the cut changes the picture.
+#[test]
+fn crop_and_clip_flags_equal_the_scenes_and_cut_the_image() {
+    let dir = std::env::temp_dir().join(format!("volgraph-scene-cuts-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let scene = dir.join("cut.ron");
+    std::fs::write(
+        &scene,
+        format!(
+            "Scene(graph: \"{}\", volume: Generated(\"ml64\"), crop: (0, 0.1, 0, 0.6, 1, 1), clip: [(0, 1, 1, 0.7)])",
+            root().join("graphs/modern/fastest.ron").display()
+        ),
+    )
+    .expect("scene");
+    let render = |extra: &[&str], name: &str| {
+        let out = dir.join(name);
+        let mut args = vec!["render", "--size", "48x48", "-o", out.to_str().expect("utf-8")];
+        args.extend_from_slice(extra);
+        let o = volgraph(&args);
+        assert!(o.status.success(), "{extra:?}: {}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read(&out).expect("written")
+    };
+    let from_scene = render(&["--scene", scene.to_str().expect("utf-8")], "scene.png");
+    let from_flags =
+        render(&["graphs/modern/fastest.ron", "--crop", "0,0.1,0,0.6,1,1", "--clip", "0,1,1,0.7"], "flags.png");
+    let uncut = render(&["graphs/modern/fastest.ron"], "uncut.png");
+    assert_eq!(from_scene, from_flags, "the scene's cuts and the flags render the same image");
+    assert_ne!(from_scene, uncut, "the cut changes the image");
+}
+
+/// A bad crop or clip is an error naming the flag or field and the rule; a graph that cannot
+/// cut is refused by pass name.
+#[test]
+fn bad_crops_and_clips_are_named() {
+    let dir = std::env::temp_dir().join(format!("volgraph-scene-bad-cuts-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let out = dir.join("x.png");
+    let out = out.to_str().expect("utf-8");
+    for (args, expected) in [
+        (vec!["--crop", "0,0,0,1,1"], "6 comma-separated numbers"),
+        (vec!["--crop", "0.6,0,0,0.5,1,1"], "x axis"),
+        (vec!["--clip", "0,0,0,1"], "no direction"),
+        (vec!["--clip", "1,0,0,nan"], "not a finite number"),
+    ] {
+        let mut all = vec!["render", "graphs/modern/fastest.ron", "--size", "16x16", "-o", out];
+        all.extend(args.iter().copied());
+        let o = volgraph(&all);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{args:?} is refused");
+        assert!(stderr.contains(expected) && stderr.contains(args[0]), "{args:?}: {stderr}");
+    }
+    let seven: Vec<&str> = (0..7).flat_map(|_| ["--clip", "1,0,0,0.1"]).collect();
+    let mut all = vec!["render", "graphs/modern/fastest.ron", "--size", "16x16", "-o", out];
+    all.extend(seven);
+    let stderr = String::from_utf8_lossy(&volgraph(&all).stderr).to_string();
+    assert!(stderr.contains("at most 6"), "{stderr}");
+    let o = volgraph(&[
+        "render",
+        "graphs/kruger_westermann_2003/sbvr.ron",
+        "--size",
+        "16x16",
+        "--crop",
+        "0,0,0,0.5,1,1",
+        "-o",
+        out,
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && stderr.contains("cannot crop") && stderr.contains("slices"), "{stderr}");
+    let scene = dir.join("bad.ron");
+    std::fs::write(&scene, "Scene(volume: Generated(\"ml64\"),\n  crop: (0, 0, 0, 1, 1, 2))").expect("scene");
+    let o = volgraph(&["render", "graphs/modern/fastest.ron", "--scene", scene.to_str().expect("utf-8"), "-o", out]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.contains("bad.ron") && stderr.contains("crop:") && stderr.contains("z axis"), "{stderr}");
+}

@@ -51,6 +51,9 @@ enum BenchCommand {
     /// Sort-last rendering under mpirun: compositing alone (direct-send vs radix-k, 256² …
     /// 2048², beside the memory-copy bound) and whole frames with 1, 2, 4 ranks.
     Distributed(crate::distributed::DistributedArgs),
+    /// Crop boxes and clip planes: ms/frame of crops to an eighth and a half and of a clip
+    /// plane beside the whole volume (the engine with modern/fastest by default).
+    Cuts(crate::cuts::CutsArgs),
     /// Compile time of a generated 30-pass graph; pooled vs unpooled transient memory of every
     /// built-in graph at 1920x1080.
     Compile {
@@ -101,6 +104,7 @@ fn run(cli: BenchCli) -> anyhow::Result<()> {
             crate::distributed::run(&args).context("bench distributed")
         }
         BenchCli::Bench { which: BenchCommand::Load(args) } => crate::load::run(&args).context("bench load").map(drop),
+        BenchCli::Bench { which: BenchCommand::Cuts(args) } => crate::cuts::run(&args).context("bench cuts").map(drop),
         BenchCli::Bench { which: BenchCommand::Fetch(args) } => {
             crate::fetch::run(&args).context("bench fetch").map(drop)
         }

@@ -14,6 +14,7 @@
 pub mod accel;
 mod commands;
 pub mod compile_time;
+pub mod cuts;
 pub mod distributed;
 pub mod fetch;
 pub mod graphs;

@@ -214,6 +214,12 @@ fn hot_reload_in_a_window_keeps_the_last_good_graph_and_matches_the_headless_ren
     let diff: Vec<(&str, &str)> = before_write.lines().zip(written.lines()).filter(|(a, b)| a != b).collect();
     assert_eq!(diff.len(), 1, "{diff:?}");
     assert!(diff[0].1.contains("\"step_voxels\": 0.625"), "{diff:?}");
+    // 9. Issue 24 §3: a crop box and a clip plane set in the viewer recompile the raycaster with
+    // their code; the screenshot below must equal `render --crop … --clip …`.
+    writeln!(stdin, "crop 0,0,0,0.6,1,1").expect("script line");
+    expect_line(&lines, "reloaded crop in", &mut log);
+    writeln!(stdin, "clip 0,1,1,0.9").expect("script line");
+    expect_line(&lines, "reloaded crop and clip in", &mut log);
     writeln!(stdin, "quit").expect("script line");
     drop(stdin);
     expect_line(&lines, "screenshot ", &mut log);
@@ -231,7 +237,8 @@ fn hot_reload_in_a_window_keeps_the_last_good_graph_and_matches_the_headless_ren
     // The same graph rendered headless.
     let headless = dir.join("headless.png");
     let out = Command::new(env!("CARGO_BIN_EXE_volgraph"))
-        .args(["render", &graph.display().to_string(), "--size", "96x96", "-o"])
+        .args(["render", &graph.display().to_string(), "--size", "96x96", "--crop", "0,0,0,0.6,1,1", "--clip"])
+        .args(["0,1,1,0.9", "-o"])
         .arg(&headless)
         .arg("--shaders")
         .arg(dir.join("shaders"))

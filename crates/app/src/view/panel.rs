@@ -288,7 +288,7 @@ fn cuts_section(ui: &mut egui::Ui, cuts: Cuts) -> Option<Cuts> {
             for (axis, name) in ["n.x", "n.y", "n.z"].into_iter().enumerate() {
                 changed |= ui.add(egui::Slider::new(&mut n[axis], -1.0..=1.0).text(name)).changed();
             }
-            changed |= ui.add(egui::Slider::new(&mut p.offset, -1.0..=2.0).text("d")).changed();
+            changed |= ui.add(egui::Slider::new(&mut p.offset, -3.0..=3.0).text("d")).changed();
             // A zero normal keeps nothing meaningful: the slider cannot leave one.
             if n != glam::DVec3::ZERO {
                 p.normal = n;

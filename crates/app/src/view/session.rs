@@ -473,8 +473,13 @@ impl LiveSession {
         } else {
             self.runtime.set_cuts(old);
         }
-        let what: Vec<String> = cut_effects::features_of(&cuts).into_iter().collect();
-        self.outcome(if what.is_empty() { "cuts off".to_string() } else { what.join(" and ") }, start, result)
+        let what = match (cuts.crop().is_some(), cuts.planes().next().is_some()) {
+            (false, false) => "cuts off",
+            (true, false) => "crop",
+            (false, true) => "clip",
+            (true, true) => "crop and clip",
+        };
+        self.outcome(what.to_string(), start, result)
     }
 
     /// The window was resized: only viewport-sized targets are reallocated.

@@ -84,6 +84,9 @@ pub enum CameraSpec {
         elevation: f64,
         /// Distance, world units.
         distance: f64,
+        /// The point it orbits (world units; default the volume's centre): a viewer's pan.
+        #[serde(default)]
+        target: Option<(f64, f64, f64)>,
     },
     /// Keyframes, interpolated linearly in azimuth, elevation and distance.
     Path {
@@ -349,7 +352,12 @@ pub const MAX_DISTANCE: f64 = 1e6;
 
 fn check_camera(camera: &CameraSpec) -> Result<(), String> {
     match camera {
-        CameraSpec::Orbit { azimuth, elevation, distance } => check_orbit(*azimuth, *elevation, *distance)?,
+        CameraSpec::Orbit { azimuth, elevation, distance, target } => {
+            check_orbit(*azimuth, *elevation, *distance)?;
+            if target.is_some_and(|(x, y, z)| !(x.is_finite() && y.is_finite() && z.is_finite())) {
+                return Err("target must be three finite numbers (world units)".into());
+            }
+        }
         CameraSpec::Path { keyframes } => {
             if keyframes.is_empty() {
                 return Err("a Path needs at least one keyframe".into());
@@ -382,10 +390,11 @@ impl CameraSpec {
     /// --frames`); a path interpolates its keyframes linearly and holds the ends.
     pub fn at(&self, index: u32) -> OrbitCamera {
         match self {
-            CameraSpec::Orbit { azimuth, elevation, distance } => OrbitCamera {
+            CameraSpec::Orbit { azimuth, elevation, distance, target } => OrbitCamera {
                 azimuth_deg: azimuth + index as f64,
                 elevation_deg: *elevation,
                 distance: *distance,
+                target: target.map_or([0.0; 3], |(x, y, z)| [x, y, z]),
                 ..OrbitCamera::default()
             },
             CameraSpec::Path { keyframes } => {
@@ -563,5 +572,138 @@ mod tests {
             assert!(err.contains("transfer_function: Data(") && err.contains("without folders"), "{name}: {err}");
         }
         parse("Scene(volume: Generated(\"ml32\"), transfer_function: Data(\"engine_opaque\"))").expect("a stem");
+    }
+}
+
+/// What the viewer's "save view" keeps: everything `render --scene` needs to draw the view on
+/// screen again, pixel for pixel.
+#[derive(Clone, Debug)]
+pub struct SavedView {
+    /// The graph file.
+    pub graph: PathBuf,
+    /// The volume.
+    pub volume: VolumeSource,
+    /// The transfer function file; `None`: fitted to the data (as it was).
+    pub transfer_function: Option<PathBuf>,
+    /// The camera on screen.
+    pub camera: OrbitCamera,
+    /// The viewport.
+    pub viewport: (u32, u32),
+    /// Effects that are on.
+    pub effects: Vec<String>,
+    /// Float target precision.
+    pub precision: Option<Precision>,
+    /// What the TF's opacity is per.
+    pub opacity_reference: OpacityReference,
+    /// The crop box and clip planes.
+    pub cuts: Cuts,
+}
+
+impl SavedView {
+    /// The scene file's text. Paths are written absolute, so the file may be moved.
+    pub fn to_ron(&self) -> String {
+        let quote = |p: &Path| {
+            let p = std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
+            format!("{:?}", p.display().to_string())
+        };
+        let mut out = String::from(
+            "// Saved by volgraph view (\"save view\"): `volgraph render --scene FILE` draws this view.\nScene(\n",
+        );
+        out += &format!("    graph: {},\n", quote(&self.graph));
+        out += &format!(
+            "    volume: {},\n",
+            match &self.volume {
+                VolumeSource::File(p) => format!("File({})", quote(Path::new(p))),
+                VolumeSource::Dataset(n) => format!("Dataset({n:?})"),
+                VolumeSource::Generated(n) => format!("Generated({n:?})"),
+            }
+        );
+        if let Some(tf) = &self.transfer_function {
+            out += &format!("    transfer_function: File({}),\n", quote(tf));
+        }
+        let c = &self.camera;
+        // Rust's shortest round-trip formatting: the file reads back the same f64.
+        out += &format!(
+            "    camera: Orbit(azimuth: {:?}, elevation: {:?}, distance: {:?}, target: ({:?}, {:?}, {:?})),\n",
+            c.azimuth_deg, c.elevation_deg, c.distance, c.target[0], c.target[1], c.target[2]
+        );
+        out += &format!("    viewport: ({}, {}),\n", self.viewport.0, self.viewport.1);
+        out += &format!("    effects: {:?},\n", self.effects);
+        if let Some(p) = self.precision {
+            out += &format!("    precision: {p:?},\n");
+        }
+        out += &format!("    opacity_reference: {:?},\n", self.opacity_reference);
+        if let Some(b) = self.cuts.crop() {
+            out += &format!(
+                "    crop: ({:?}, {:?}, {:?}, {:?}, {:?}, {:?}),\n",
+                b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z
+            );
+        }
+        let planes: Vec<String> = self
+            .cuts
+            .planes()
+            .map(|p| format!("({:?}, {:?}, {:?}, {:?})", p.normal.x, p.normal.y, p.normal.z, p.offset))
+            .collect();
+        if !planes.is_empty() {
+            out += &format!("    clip: [{}],\n", planes.join(", "));
+        }
+        out += ")\n";
+        out
+    }
+
+    /// Writes the scene to `path` (through a temporary file and a rename, so a reader never
+    /// sees half a file) and reads it back as a check.
+    pub fn save(&self, path: &Path) -> anyhow::Result<()> {
+        let text = self.to_ron();
+        let tmp = path.with_extension("ron.tmp");
+        std::fs::write(&tmp, &text).map_err(|e| anyhow::anyhow!("{}: {e}", tmp.display()))?;
+        std::fs::rename(&tmp, path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        Scene::load(path).map_err(|e| anyhow::anyhow!("the saved scene does not read back: {e}"))?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod saved_view_tests {
+    use super::*;
+
+    /// "Save view" writes a scene that reads back to the same camera, cuts and effects, to the
+    /// last bit of every f64.
+    #[test]
+    fn a_saved_view_reads_back_exactly() {
+        let cuts = Cuts::new(
+            Some(CropBox::new(DVec3::new(0.1, 0.0, 1.0 / 3.0), DVec3::new(0.9, 0.5, 1.0)).expect("box")),
+            &[ClipPlane::new(DVec3::new(-1.0, 0.25, 0.0), -0.3).expect("plane")],
+        )
+        .expect("cuts");
+        let camera = OrbitCamera {
+            azimuth_deg: 37.123456789,
+            elevation_deg: -12.5,
+            distance: 2.0 / 3.0,
+            target: [0.1, -0.2, 0.3],
+            ..OrbitCamera::default()
+        };
+        let view = SavedView {
+            graph: PathBuf::from("/nonexistent/graph.ron"),
+            volume: VolumeSource::Generated("ml64".into()),
+            transfer_function: None,
+            camera,
+            viewport: (320, 200),
+            effects: vec!["shading".into()],
+            precision: Some(Precision::F16),
+            opacity_reference: OpacityReference::World,
+            cuts,
+        };
+        let scene = Scene::from_str(&view.to_ron(), Path::new("/tmp/x.scene.ron")).expect("reads back");
+        assert_eq!(scene.cuts, cuts);
+        assert_eq!(scene.viewport, Some((320, 200)));
+        assert_eq!(scene.effects, vec!["shading".to_string()]);
+        assert_eq!(scene.precision, Some(Precision::F16));
+        assert_eq!(scene.opacity_reference, OpacityReference::World);
+        let back = scene.camera.expect("a camera").at(0);
+        assert_eq!(
+            (back.azimuth_deg, back.elevation_deg, back.distance, back.target),
+            (37.123456789, -12.5, 2.0 / 3.0, [0.1, -0.2, 0.3])
+        );
     }
 }

@@ -132,5 +132,5 @@ impl SceneArgs {
 /// The orbit camera of `AZIMUTH,ELEVATION,DISTANCE`.
 fn orbit(text: &str) -> anyhow::Result<CameraSpec> {
     let c = inputs::parse_camera(text)?;
-    Ok(CameraSpec::Orbit { azimuth: c.azimuth_deg, elevation: c.elevation_deg, distance: c.distance })
+    Ok(CameraSpec::Orbit { azimuth: c.azimuth_deg, elevation: c.elevation_deg, distance: c.distance, target: None })
 }

@@ -220,6 +220,11 @@ fn hot_reload_in_a_window_keeps_the_last_good_graph_and_matches_the_headless_ren
     expect_line(&lines, "reloaded crop in", &mut log);
     writeln!(stdin, "clip 0,1,1,0.9").expect("script line");
     expect_line(&lines, "reloaded crop and clip in", &mut log);
+    // 10. "Save view": the camera, crop, clip and effects to a scene file, which `render
+    // --scene` must draw as the window shows it (checked below).
+    let saved = dir.join("saved view.scene.ron");
+    writeln!(stdin, "save-scene {}", saved.display()).expect("script line");
+    expect_line(&lines, "saved scene ", &mut log);
     writeln!(stdin, "quit").expect("script line");
     drop(stdin);
     expect_line(&lines, "screenshot ", &mut log);
@@ -256,5 +261,20 @@ fn hot_reload_in_a_window_keeps_the_last_good_graph_and_matches_the_headless_ren
     let lit = b.pixels().filter(|p| p[0] > 20 || p[1] > 20 || p[2] > 20).count();
     assert!(lit > 96 * 96 / 10, "the headless render shows the volume ({lit} lit pixels)");
     assert!(max <= 2, "screenshot vs headless render: max channel difference {max}/255");
+    // The saved scene draws the same view (the shaders folder is a flag, not part of a scene).
+    let from_scene = dir.join("from_scene.png");
+    let out = Command::new(env!("CARGO_BIN_EXE_volgraph"))
+        .args(["render", "--scene", &saved.display().to_string(), "-o"])
+        .arg(&from_scene)
+        .arg("--shaders")
+        .arg(dir.join("shaders"))
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .expect("render runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let c = read_rgba(&from_scene);
+    assert_eq!(a.dimensions(), c.dimensions(), "the scene keeps the viewport");
+    let max = a.pixels().zip(c.pixels()).flat_map(|(p, q)| (0..3).map(move |c| p[c].abs_diff(q[c]))).max().unwrap_or(0);
+    assert!(max <= 2, "screenshot vs render --scene of the saved view: max channel difference {max}/255");
     let _ = std::fs::remove_dir_all(&dir);
 }

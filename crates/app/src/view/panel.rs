@@ -27,6 +27,8 @@ pub enum Action {
     WriteBack,
     /// Set the crop box and clip planes.
     Cuts(Cuts),
+    /// Save the view (camera, crop, clip, TF, effects) to a scene file.
+    SaveScene(std::path::PathBuf),
 }
 
 /// Exponentially smoothed per-pass milliseconds.
@@ -249,11 +251,23 @@ pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapt
             {
                 actions.push(Action::WriteBack);
             }
+            if ui
+                .button("save view")
+                .on_hover_text(format!(
+                    "camera, crop, clip, TF and effects to {SAVED_SCENE}: render --scene draws it again"
+                ))
+                .clicked()
+            {
+                actions.push(Action::SaveScene(SAVED_SCENE.into()));
+            }
         });
         ui.small(HELP);
     });
     actions
 }
+
+/// Where the panel's "save view" writes (the current folder).
+pub const SAVED_SCENE: &str = "view.scene.ron";
 
 /// The crop box (a checkbox and a low/high slider per axis) and the first clip plane (normal and
 /// offset); planes after the first (from `--clip`) are kept and listed. Returns new cuts when a

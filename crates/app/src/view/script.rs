@@ -27,11 +27,12 @@ pub enum ScriptCommand {
     Crop(Option<CropBox>),
     /// `clip NX,NY,NZ,D` (one plane, replacing any) or `clip off`.
     Clip(Option<ClipPlane>),
+    /// `save-scene PATH`: the panel's "save view" (camera, crop, clip, TF, effects) to a scene file.
+    SaveScene(PathBuf),
 }
 
 /// What the script accepts, for messages.
-pub const USAGE: &str =
-    "quit, screenshot PATH, param PASS.NAME VALUE, write, crop X0,Y0,Z0,X1,Y1,Z1|off, clip NX,NY,NZ,D|off";
+pub const USAGE: &str = "quit, screenshot PATH, param PASS.NAME VALUE, write, crop X0,Y0,Z0,X1,Y1,Z1|off, clip NX,NY,NZ,D|off, save-scene PATH";
 
 /// Parses one line: `Ok(None)` for a blank line, `Err` naming what is wrong.
 pub fn parse_line(line: &str) -> Result<Option<ScriptCommand>, String> {
@@ -56,6 +57,8 @@ pub fn parse_line(line: &str) -> Result<Option<ScriptCommand>, String> {
                 .map_err(|e| format!("\"{line}\": the value \"{}\" is not one RON value ({})", value.trim(), e.code))?;
             Ok(Some(ScriptCommand::Param { pass: pass.to_string(), name: name.to_string(), value }))
         }
+        "save-scene" if rest.is_empty() => Err(format!("\"{line}\": write save-scene PATH")),
+        "save-scene" => Ok(Some(ScriptCommand::SaveScene(PathBuf::from(rest)))),
         "crop" if rest == "off" => Ok(Some(ScriptCommand::Crop(None))),
         "crop" => {
             CropBox::parse(rest).map(|c| Some(ScriptCommand::Crop(Some(c)))).map_err(|e| format!("\"{line}\": {e}"))

@@ -135,6 +135,10 @@ pub struct LiveSession {
     validated: Option<(String, CompileOptions, volgraph_core::runtime::shaders::ShaderSnapshot)>,
     /// True until a frame of the current plan has rendered.
     unproven: bool,
+    /// Where the volume came from, for "save view".
+    volume_source: crate::scene::VolumeSource,
+    /// What the TF's opacity is per (the scene's).
+    opacity_reference: volgraph_core::runtime::OpacityReference,
 }
 
 impl LiveSession {
@@ -236,6 +240,8 @@ impl LiveSession {
             error: None,
             validated: None,
             unproven: true,
+            volume_source: volume_source_of(args),
+            opacity_reference: args.scene.as_ref().map(|s| s.opacity_reference).unwrap_or_default(),
         };
         let ms = start.elapsed().as_secs_f64() * 1e3;
         Ok((session, Event::Loaded { graph: graph_name, ms, summary: loaded }))
@@ -450,6 +456,21 @@ impl LiveSession {
         self.outcome(format!("feature {name} {}", if on { "on" } else { "off" }), start, result)
     }
 
+    /// What "save view" writes: this graph, volume, TF, effects and cuts seen by `camera`.
+    pub fn saved_view(&self, camera: &volgraph_accel::camera::OrbitCamera) -> crate::scene::SavedView {
+        crate::scene::SavedView {
+            graph: self.graph.clone(),
+            volume: self.volume_source.clone(),
+            transfer_function: self.tf_path.clone(),
+            camera: *camera,
+            viewport: self.options.viewport,
+            effects: self.options.features.iter().filter(|f| !cut_effects::is_cut_feature(f)).cloned().collect(),
+            precision: self.options.precision,
+            opacity_reference: self.opacity_reference,
+            cuts: self.runtime.cuts(),
+        }
+    }
+
     /// Sets the crop box and clip planes (the panel's sliders, `--crop`/`--clip`, a scene's
     /// `crop:`/`clip:`). Moving a box or plane writes the frame uniforms only; turning a kind of
     /// cut on or off recompiles the raycasters with or without its code.
@@ -570,4 +591,16 @@ fn compile_for(
     options.scene = volgraph_core::runtime::scene_values_of(&volgraph_core::runtime::VolumeDesc::of(volume));
     options.scene.extend(crate::inputs::data_scene_values(volume));
     volgraph_core::compile(file, source, registry, &options)
+}
+
+/// Where the session's volume came from: the one `--volume` file (or the folder of a DICOM
+/// series given as files), else the scene's, else the generated Marschner–Lobb 64³.
+fn volume_source_of(args: &SessionArgs) -> crate::scene::VolumeSource {
+    use crate::scene::VolumeSource;
+    match (args.volume.as_slice(), &args.scene) {
+        ([one], _) => VolumeSource::File(one.display().to_string()),
+        ([first, ..], _) => VolumeSource::File(first.parent().unwrap_or(Path::new(".")).display().to_string()),
+        ([], Some(scene)) => scene.volume.clone(),
+        ([], None) => VolumeSource::Generated("ml64".to_string()),
+    }
 }

@@ -152,6 +152,15 @@ impl Viewer {
                 Action::Scalar(name, value) => session.set_scalar(&name, value),
                 Action::Feature(name, on) => session.set_feature(&name, on),
                 Action::Cuts(cuts) => session.set_cuts(cuts),
+                Action::SaveScene(path) => match session.saved_view(&self.orbit.camera).save(&path) {
+                    Ok(()) => {
+                        crate::stdout::println_escaped!("saved scene {}", path.display());
+                        Vec::new()
+                    }
+                    Err(e) => {
+                        vec![super::session::Event::Error { what: "save view".to_string(), message: format!("{e:#}") }]
+                    }
+                },
                 Action::Screenshot => {
                     self.screenshot_now =
                         Some(self.view.screenshot.clone().unwrap_or_else(|| PathBuf::from("volgraph.png")));
@@ -189,6 +198,7 @@ impl Viewer {
                     self.apply_actions(vec![Action::Param(pass, name, value)])
                 }
                 Ok(Some(ScriptCommand::Write)) => self.apply_actions(vec![Action::WriteBack]),
+                Ok(Some(ScriptCommand::SaveScene(path))) => self.apply_actions(vec![Action::SaveScene(path)]),
                 Ok(Some(ScriptCommand::Crop(crop))) => {
                     let Some(session) = self.session.as_ref() else { continue };
                     let planes: Vec<_> = session.runtime.cuts().planes().copied().collect();

@@ -329,6 +329,13 @@ impl TransferFunction {
         ron::ser::to_string_pretty(self, config).unwrap_or_default()
     }
 
+    /// This transfer function as ParaView colour-map JSON written into `original` (the file's
+    /// text, when it had one: map `index` is replaced, every other map and key kept), else as a
+    /// fresh one-map file; [`Self::from_paraview_json`] reads it back to the same function.
+    pub fn to_paraview_json(&self, original: Option<&str>, index: usize) -> String {
+        paraview::write_map(self, original, index)
+    }
+
     /// Imports a ParaView colour-map JSON text (see [`Self::load_paraview`]).
     pub fn from_paraview_json(text: &str, path: &Path) -> Result<TransferFunction, TfError> {
         paraview::parse_map(text, path, None).map(|m| m.tf)
@@ -349,6 +356,15 @@ impl TransferFunction {
     pub fn load_paraview_map(path: &Path, name: Option<&str>) -> Result<ParaviewColorMap, TfError> {
         let text = crate::input_file::read_text(path, "transfer function")?;
         paraview::parse_map(&text, path, name)
+    }
+
+    /// Map `name` (the first when `None`) of ParaView JSON `text`; `path` names it in messages.
+    pub fn load_paraview_map_from_str(
+        text: &str,
+        path: &Path,
+        name: Option<&str>,
+    ) -> Result<TransferFunction, TfError> {
+        paraview::parse_map(text, path, name).map(|m| m.tf)
     }
 
     /// RGBA at data value `v`: linear between the control points around it, the end points'

@@ -317,3 +317,35 @@ fn an_hsv_paraview_map_follows_the_hue_circle() {
     let mid = rgb.eval(0.5);
     assert!((mid[0] - 0.5).abs() < 0.01 && mid[1].abs() < 0.01 && (mid[2] - 0.5).abs() < 0.01, "{mid:?}");
 }
+
+/// Issue 24: the viewer saves an edited TF "as it came": RON reads back equal, and ParaView JSON
+/// reads back to the same function (to sRGB rounding) with the file's other maps and keys kept.
+#[test]
+fn an_edited_tf_saves_as_it_came_and_reads_back() {
+    use volgraph_accel::transfer_function::{ControlPoint, TransferFunction};
+    let path = std::path::Path::new("edited.json");
+    let tf = TransferFunction {
+        domain: (0.0, 255.0),
+        points: vec![
+            ControlPoint { value: 20.0, color: [0.1, 0.2, 0.9], alpha: 0.0 },
+            ControlPoint { value: 90.0, color: [1.0, 0.5, 0.0], alpha: 0.35 },
+            ControlPoint { value: 200.0, color: [1.0, 1.0, 1.0], alpha: 0.8 },
+        ],
+    };
+    let ron = TransferFunction::from_ron_str(&tf.to_ron_string(), path).expect("RON reads back");
+    assert_eq!(ron, tf);
+    let original = r#"[{"Name": "first", "Creator": "someone", "RGBPoints": [0, 0, 0, 0, 1, 1, 1, 1]},
+                       {"Name": "second", "RGBPoints": [0, 1, 0, 0, 1, 0, 0, 1]}]"#;
+    let written = tf.to_paraview_json(Some(original), 1);
+    let value: serde_json::Value = serde_json::from_str(&written).expect("JSON");
+    assert_eq!(value[0]["Creator"], "someone", "the other map is kept: {written}");
+    assert_eq!(value[0]["RGBPoints"].as_array().map(Vec::len), Some(8));
+    assert_eq!(value[1]["Name"], "second");
+    let back = TransferFunction::load_paraview_map_from_str(&written, path, Some("second")).expect("reads back");
+    for v in [0.0, 10.0, 20.0, 55.0, 90.0, 150.0, 200.0, 255.0] {
+        let (a, b) = (tf.eval(v), back.eval(v));
+        for c in 0..4 {
+            assert!((a[c] - b[c]).abs() < 1e-9, "at {v}: {a:?} vs {b:?}");
+        }
+    }
+}

@@ -117,10 +117,14 @@ fn hot_reload_in_a_window_keeps_the_last_good_graph_and_matches_the_headless_ren
     copy_dir(&root().join("shaders"), &dir.join("shaders"));
     let graph = dir.join("graph.ron");
     std::fs::copy(root().join("graphs/basic/fragment_raycast.ron"), &graph).expect("graph");
+    let tf = dir.join("tf.ron");
+    std::fs::copy(root().join("graphs/tf/marschner_lobb.ron"), &tf).expect("tf");
     let shots = dir.join("window.png");
     let mut viewer = Command::new(env!("CARGO_BIN_EXE_volgraph"))
         .args(["view", &graph.display().to_string(), "--size", "96x96", "--no-panel", "--script", "--screenshot"])
         .arg(&shots)
+        .arg("--tf")
+        .arg(&tf)
         .arg("--shaders")
         .arg(dir.join("shaders"))
         .env("DISPLAY", &x.display)
@@ -220,7 +224,17 @@ fn hot_reload_in_a_window_keeps_the_last_good_graph_and_matches_the_headless_ren
     expect_line(&lines, "reloaded crop in", &mut log);
     writeln!(stdin, "clip 0,1,1,0.9").expect("script line");
     expect_line(&lines, "reloaded crop and clip in", &mut log);
-    // 10. "Save view": the camera, crop, clip and effects to a scene file, which `render
+    // 10. The TF editor: a point added and the TF saved (RON, as it came); the viewer does not
+    // reload its own save, and the renders below read the saved file.
+    let tf_before = std::fs::read_to_string(&tf).expect("tf");
+    writeln!(stdin, "tf-point 150 1,0.2,0.1,0.9").expect("script line");
+    expect_line(&lines, "reloaded transfer function edit in", &mut log);
+    writeln!(stdin, "tf-save").expect("script line");
+    expect_line(&lines, "saved transfer function ", &mut log);
+    let tf_after = std::fs::read_to_string(&tf).expect("tf");
+    assert_ne!(tf_before, tf_after, "the edit was saved");
+    assert!(tf_after.contains("150.0"), "{tf_after}");
+    // 11. "Save view": the camera, crop, clip, TF and effects to a scene file, which `render
     // --scene` must draw as the window shows it (checked below).
     let saved = dir.join("saved view.scene.ron");
     writeln!(stdin, "save-scene {}", saved.display()).expect("script line");
@@ -228,6 +242,13 @@ fn hot_reload_in_a_window_keeps_the_last_good_graph_and_matches_the_headless_ren
     writeln!(stdin, "quit").expect("script line");
     drop(stdin);
     expect_line(&lines, "screenshot ", &mut log);
+    assert!(
+        !log.iter()
+            .skip_while(|l| !l.starts_with("saved transfer function"))
+            .any(|l| l.contains("reloaded transfer function in")),
+        "the viewer reloaded its own TF save:\n{}",
+        log.join("\n")
+    );
     assert!(
         !log.iter().any(|l| l.starts_with("wrote "))
             || !log.iter().skip_while(|l| !l.starts_with("wrote ")).any(|l| l.starts_with("reloaded graph")),
@@ -243,7 +264,7 @@ fn hot_reload_in_a_window_keeps_the_last_good_graph_and_matches_the_headless_ren
     let headless = dir.join("headless.png");
     let out = Command::new(env!("CARGO_BIN_EXE_volgraph"))
         .args(["render", &graph.display().to_string(), "--size", "96x96", "--crop", "0,0,0,0.6,1,1", "--clip"])
-        .args(["0,1,1,0.9", "-o"])
+        .args(["0,1,1,0.9", "--tf", &tf.display().to_string(), "-o"])
         .arg(&headless)
         .arg("--shaders")
         .arg(dir.join("shaders"))

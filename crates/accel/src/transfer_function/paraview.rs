@@ -261,3 +261,46 @@ pub(super) fn parse_map(text: &str, path: &Path, wanted: Option<&str>) -> Result
     let name = map.get("Name").and_then(Value::as_str).map(str::to_string);
     Ok(ParaviewColorMap { tf, name, index, all, notes })
 }
+
+/// Linear channel → sRGB-encoded (IEC 61966-2-1), the inverse of `srgb_to_linear`.
+fn linear_to_srgb(c: f64) -> f64 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.0031308 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+}
+
+/// `tf` as ParaView colour-map JSON, written into `original` (the file it came from) when that
+/// parses: map `index` of it takes the new `RGBPoints` (sRGB), `Points` (linear opacity,
+/// midpoint 0.5, sharpness 0) and `ColorSpace` "RGB", and every other map and key is kept; a
+/// fresh single map otherwise. The domain's ends are written as points, so reading it back
+/// gives the same function.
+pub(super) fn write_map(tf: &TransferFunction, original: Option<&str>, index: usize) -> String {
+    let mut points = tf.points.clone();
+    for (end, at_start) in [(tf.domain.0, true), (tf.domain.1, false)] {
+        let present = points.iter().any(|p| p.value == end);
+        if !present {
+            let [r, g, b, a] = tf.eval(end);
+            let point = ControlPoint { value: end, color: [r, g, b], alpha: a };
+            if at_start { points.insert(0, point) } else { points.push(point) }
+        }
+    }
+    let rgb: Vec<Value> = points
+        .iter()
+        .flat_map(|p| [p.value, linear_to_srgb(p.color[0]), linear_to_srgb(p.color[1]), linear_to_srgb(p.color[2])])
+        .map(Value::from)
+        .collect();
+    let alpha: Vec<Value> = points.iter().flat_map(|p| [p.value, p.alpha, 0.5, 0.0]).map(Value::from).collect();
+    let mut root: Value = original
+        .and_then(|t| serde_json::from_str(t.strip_prefix('\u{feff}').unwrap_or(t)).ok())
+        .unwrap_or_else(|| serde_json::json!([{ "Name": "volgraph" }]));
+    let map = match &mut root {
+        Value::Array(items) if index < items.len() => &mut items[index],
+        Value::Array(_) => return write_map(tf, None, 0),
+        single => single,
+    };
+    if let Value::Object(object) = map {
+        object.insert("ColorSpace".into(), Value::from("RGB"));
+        object.insert("RGBPoints".into(), Value::Array(rgb));
+        object.insert("Points".into(), Value::Array(alpha));
+    }
+    serde_json::to_string_pretty(&root).unwrap_or_default()
+}

@@ -9,6 +9,7 @@ pub mod orbit;
 pub mod panel;
 pub mod script;
 pub mod session;
+pub mod tf_editor;
 pub mod watch;
 pub mod window;
 

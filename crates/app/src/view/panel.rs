@@ -29,6 +29,8 @@ pub enum Action {
     Cuts(Cuts),
     /// Save the view (camera, crop, clip, TF, effects) to a scene file.
     SaveScene(std::path::PathBuf),
+    /// The TF editor's action.
+    TransferFunction(super::tf_editor::TfAction),
 }
 
 /// Exponentially smoothed per-pass milliseconds.
@@ -170,6 +172,15 @@ pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapt
                         if ui.checkbox(&mut on, f.as_str()).changed() {
                             actions.push(Action::Feature(f.clone(), on));
                         }
+                    }
+                });
+            }
+            if plan.inputs.values().any(|k| *k == InputKind::TransferFunction) {
+                egui::CollapsingHeader::new("Transfer function").default_open(true).show(ui, |ui| {
+                    let (histogram, range) = session.histogram();
+                    let tf = session.transfer_function();
+                    if let Some(a) = super::tf_editor::show(ui, tf, histogram, range, session.save_tf_on_change) {
+                        actions.push(Action::TransferFunction(a));
                     }
                 });
             }

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 
 use volgraph_accel::cuts::{ClipPlane, CropBox};
+use volgraph_accel::transfer_function::ControlPoint;
 
 /// One script command.
 #[derive(Clone, Debug, PartialEq)]
@@ -29,10 +30,15 @@ pub enum ScriptCommand {
     Clip(Option<ClipPlane>),
     /// `save-scene PATH`: the panel's "save view" (camera, crop, clip, TF, effects) to a scene file.
     SaveScene(PathBuf),
+    /// `tf-point VALUE R,G,B,A`: the TF editor's point at data value VALUE (linear colour,
+    /// opacity), replacing one at the same value.
+    TfPoint(ControlPoint),
+    /// `tf-save`: the TF editor's "save TF".
+    TfSave,
 }
 
 /// What the script accepts, for messages.
-pub const USAGE: &str = "quit, screenshot PATH, param PASS.NAME VALUE, write, crop X0,Y0,Z0,X1,Y1,Z1|off, clip NX,NY,NZ,D|off, save-scene PATH";
+pub const USAGE: &str = "quit, screenshot PATH, param PASS.NAME VALUE, write, crop X0,Y0,Z0,X1,Y1,Z1|off, clip NX,NY,NZ,D|off, save-scene PATH, tf-point VALUE R,G,B,A, tf-save";
 
 /// Parses one line: `Ok(None)` for a blank line, `Err` naming what is wrong.
 pub fn parse_line(line: &str) -> Result<Option<ScriptCommand>, String> {
@@ -56,6 +62,22 @@ pub fn parse_line(line: &str) -> Result<Option<ScriptCommand>, String> {
             let value = ron::from_str::<ron::Value>(value.trim())
                 .map_err(|e| format!("\"{line}\": the value \"{}\" is not one RON value ({})", value.trim(), e.code))?;
             Ok(Some(ScriptCommand::Param { pass: pass.to_string(), name: name.to_string(), value }))
+        }
+        "tf-save" if rest.is_empty() => Ok(Some(ScriptCommand::TfSave)),
+        "tf-save" => Err(format!("\"{line}\": tf-save takes nothing after it (found \"{rest}\")")),
+        "tf-point" => {
+            let bad =
+                || format!("\"{line}\": write tf-point VALUE R,G,B,A (data value; linear colour and opacity in 0..1)");
+            let (value, rgba) = rest.split_once(char::is_whitespace).ok_or_else(bad)?;
+            let value: f64 = value.parse().ok().filter(|v: &f64| v.is_finite()).ok_or_else(bad)?;
+            let parts: Vec<f64> =
+                rgba.trim().split(',').map(|p| p.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| bad())?;
+            match parts.as_slice() {
+                [r, g, b, a] if [*r, *g, *b, *a].iter().all(|c| (0.0..=1.0).contains(c)) => {
+                    Ok(Some(ScriptCommand::TfPoint(ControlPoint { value, color: [*r, *g, *b], alpha: *a })))
+                }
+                _ => Err(bad()),
+            }
         }
         "save-scene" if rest.is_empty() => Err(format!("\"{line}\": write save-scene PATH")),
         "save-scene" => Ok(Some(ScriptCommand::SaveScene(PathBuf::from(rest)))),
@@ -107,6 +129,8 @@ mod tests {
             ("screenshot", "write screenshot PATH"),
             ("qiut", "unknown command \"qiut\""),
             ("crop 0,0,0,1,1", "got 5"),
+            ("tf-point 40 1,0,0", "write tf-point VALUE R,G,B,A"),
+            ("tf-point 40 1,0,0,2", "write tf-point VALUE R,G,B,A"),
             ("clip 0,0,0,1", "no direction"),
         ] {
             let err = parse_line(line).expect_err(line);

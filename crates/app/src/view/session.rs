@@ -52,6 +52,13 @@ pub enum Event {
         /// What changed.
         what: String,
     },
+    /// The viewer wrote a file (a TF edit saved).
+    Saved {
+        /// What was saved.
+        what: String,
+        /// Where.
+        path: PathBuf,
+    },
 }
 
 impl fmt::Display for Event {
@@ -64,6 +71,7 @@ impl fmt::Display for Event {
                 write!(f, "error in {what}: {first}; keeping the last good graph")
             }
             Event::Recovered { what } => write!(f, "recovered: {what} is good again"),
+            Event::Saved { what, path } => write!(f, "saved {what} {}", path.display()),
         }
     }
 }
@@ -139,6 +147,15 @@ pub struct LiveSession {
     volume_source: crate::scene::VolumeSource,
     /// What the TF's opacity is per (the scene's).
     opacity_reference: volgraph_core::runtime::OpacityReference,
+    /// The transfer function on screen (the TF editor's).
+    tf: TransferFunction,
+    /// Voxels per bin of the volume's normalized values (the TF editor's histogram).
+    histogram: Vec<u64>,
+    /// The text this viewer last wrote to the TF file: the watcher's event for it is not a
+    /// reload.
+    tf_written: Option<String>,
+    /// Save the TF file after every edit (the panel's toggle).
+    pub save_tf_on_change: bool,
 }
 
 impl LiveSession {
@@ -179,6 +196,7 @@ impl LiveSession {
             crate::stdout::eprintln_escaped!("note: {note}");
         }
         let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
+        let histogram = volgraph_accel::histogram::Histogram::of(&volume, HISTOGRAM_BINS).counts;
         let (sources, _) = crate::shader_dir::sources_for(&args.graph, args.shaders.as_deref());
         // Every folder read (and so watched), in search order: the start line and the panel name
         // all of them, not just the first.
@@ -241,6 +259,10 @@ impl LiveSession {
             validated: None,
             unproven: true,
             volume_source: volume_source_of(args),
+            tf,
+            histogram,
+            tf_written: None,
+            save_tf_on_change: false,
             opacity_reference: args.scene.as_ref().map(|s| s.opacity_reference).unwrap_or_default(),
         };
         let ms = start.elapsed().as_secs_f64() * 1e3;
@@ -345,9 +367,79 @@ impl LiveSession {
         let result =
             inputs::transfer_function(self.tf_path.as_ref(), self.tf_map.as_deref(), &self.volume, self.generated)
                 .map_err(|e| format!("{e:#}"))
-                .and_then(|(tf, _)| self.set_transfer_function(&tf).map_err(|e| format!("{e:#}")))
+                .and_then(|(tf, _)| {
+                    self.set_transfer_function(&tf).map_err(|e| format!("{e:#}"))?;
+                    self.tf = tf;
+                    Ok(())
+                })
                 .map(|_| "LUT uploaded, history restarted".to_string());
         self.outcome("transfer function".to_string(), start, result)
+    }
+
+    /// The transfer function on screen.
+    pub fn transfer_function(&self) -> &TransferFunction {
+        &self.tf
+    }
+
+    /// The volume's histogram (voxels per bin of normalized value) and the data values its
+    /// ends stand for: the TF editor's backdrop, in the data's units.
+    pub fn histogram(&self) -> (&[u64], (f64, f64)) {
+        (&self.histogram, self.volume.value_range)
+    }
+
+    /// The TF editor's edit: checked, uploaded at once (only what reads the TF reruns: the
+    /// classification, distance map and pre-integration table, by input version), and saved
+    /// when "save on change" is on.
+    pub fn edit_transfer_function(&mut self, tf: TransferFunction) -> Vec<Event> {
+        let start = Instant::now();
+        let path = self.tf_path.clone().unwrap_or_else(|| PathBuf::from(SAVED_TF));
+        let result = tf
+            .validate(&path)
+            .map_err(|e| e.to_string())
+            .and_then(|()| self.set_transfer_function(&tf).map_err(|e| format!("{e:#}")))
+            .map(|()| {
+                self.tf = tf;
+                "LUT uploaded".to_string()
+            });
+        let mut events = self.outcome("transfer function edit".to_string(), start, result);
+        if self.save_tf_on_change && self.error.is_none() {
+            events.extend(self.save_transfer_function_events());
+        }
+        events
+    }
+
+    /// Saves the TF to its file as it came (RON, or ParaView JSON with the file's other maps
+    /// kept), or to `view.tf.ron` for a fitted TF (which the viewer then watches); atomic.
+    pub fn save_transfer_function(&mut self) -> anyhow::Result<PathBuf> {
+        let path = self.tf_path.clone().unwrap_or_else(|| PathBuf::from(SAVED_TF));
+        let is_json = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
+        let text = if is_json {
+            let original = volgraph_accel::input_file::read_text(&path, "transfer function").ok();
+            let index = match (&original, self.tf_map.as_deref()) {
+                (Some(text), Some(name)) => serde_json::from_str::<serde_json::Value>(text)
+                    .ok()
+                    .and_then(|v| v.as_array().and_then(|maps| maps.iter().position(|m| m["Name"] == name)))
+                    .unwrap_or(0),
+                _ => 0,
+            };
+            self.tf.to_paraview_json(original.as_deref(), index)
+        } else {
+            self.tf.to_ron_string()
+        };
+        let tmp = path.with_extension("tmp~");
+        std::fs::write(&tmp, &text).map_err(|e| anyhow!("{}: {e}", tmp.display()))?;
+        std::fs::rename(&tmp, &path).map_err(|e| anyhow!("{}: {e}", path.display()))?;
+        self.tf_written = Some(text);
+        self.tf_path = Some(path.clone());
+        Ok(path)
+    }
+
+    /// [`Self::save_transfer_function`] as events.
+    pub fn save_transfer_function_events(&mut self) -> Vec<Event> {
+        match self.save_transfer_function() {
+            Ok(path) => vec![Event::Saved { what: "transfer function".to_string(), path }],
+            Err(e) => vec![Event::Error { what: "save transfer function".to_string(), message: format!("{e:#}") }],
+        }
     }
 
     /// Uploads `tf` as the LUT of every transfer-function input.
@@ -402,6 +494,9 @@ impl LiveSession {
         }
         if let Some(tf) = self.tf_path.clone()
             && changed.iter().any(|c| same(c, &tf))
+            // The viewer's own save is not an edit to reload.
+            && (self.tf_written.is_none()
+                || volgraph_accel::input_file::read_text(&tf, "transfer function").ok() != self.tf_written)
         {
             events.extend(self.reload_transfer_function());
         }
@@ -604,3 +699,9 @@ fn volume_source_of(args: &SessionArgs) -> crate::scene::VolumeSource {
         ([], None) => VolumeSource::Generated("ml64".to_string()),
     }
 }
+
+/// Bins of the TF editor's histogram.
+const HISTOGRAM_BINS: usize = 256;
+
+/// Where "save TF" writes a TF that came from no file (fitted to the data).
+pub const SAVED_TF: &str = "view.tf.ron";

@@ -176,6 +176,44 @@ fn a_transfer_function_edit_uploads_the_lut_and_a_bad_one_is_kept_out() {
     let _ = std::fs::remove_dir_all(&s.dir);
 }
 
+/// Issue 24 §1: the TF editor's edit is applied at once (one LUT upload, the image changes),
+/// "save on change" writes the file as it came (RON here) and the watcher does not reload the
+/// viewer's own write; a later edit by someone else still reloads.
+#[test]
+fn a_tf_editor_edit_applies_at_once_and_saves_without_reloading_itself() {
+    let s = scratch("tf-editor", "graphs/basic/fragment_raycast.ron");
+    let tf_path = s.dir.join("tf.ron");
+    std::fs::copy(root().join("graphs/tf/default.ron"), &tf_path).expect("tf copy");
+    let mut session = open(&s, Some(tf_path.clone()));
+    let before = frame(&mut session);
+    let uploads = session.runtime.uploads();
+    let mut tf = session.transfer_function().clone();
+    let (lo, hi) = tf.domain;
+    tf.points.push(volgraph_accel::transfer_function::ControlPoint {
+        value: lo + 0.55 * (hi - lo),
+        color: [1.0, 0.1, 0.1],
+        alpha: 0.9,
+    });
+    tf.points.sort_by(|a, b| a.value.total_cmp(&b.value));
+    session.save_tf_on_change = true;
+    let events = session.edit_transfer_function(tf.clone());
+    assert!(matches!(events.as_slice(), [Event::Reloaded { .. }, Event::Saved { .. }]), "{events:?}");
+    assert_eq!(session.runtime.uploads(), uploads + 1, "one LUT upload, no volume upload");
+    assert_ne!(frame(&mut session), before, "the edit shows at once");
+    let saved = volgraph_accel::transfer_function::TransferFunction::load(&tf_path).expect("the saved TF reads");
+    assert_eq!(saved, tf, "saved as edited");
+    assert!(session.files_changed(std::slice::from_ref(&tf_path)).is_empty(), "its own write is no reload");
+    std::fs::copy(root().join("graphs/tf/opaque.ron"), &tf_path).expect("someone else's edit");
+    let events = session.files_changed(std::slice::from_ref(&tf_path));
+    assert!(matches!(events.as_slice(), [Event::Reloaded { .. }]), "{events:?}");
+    // A bad edit (a colour out of range) is refused with its message; the last TF stays.
+    let mut bad = session.transfer_function().clone();
+    bad.points[0].color = [2.0, 0.0, 0.0];
+    let events = session.edit_transfer_function(bad);
+    assert!(matches!(events.as_slice(), [Event::Error { .. }]), "{events:?}");
+    let _ = std::fs::remove_dir_all(&s.dir);
+}
+
 #[test]
 fn a_resize_rebuilds_no_pipeline() {
     let s = scratch("resize", "graphs/basic/fragment_raycast.ron");

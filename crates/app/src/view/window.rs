@@ -18,6 +18,7 @@ use super::orbit::Orbit;
 use super::panel::{self, Action, Timings};
 use super::script::ScriptCommand;
 use super::session::{Event, LiveSession, SessionArgs};
+use super::tf_editor::TfAction;
 use super::watch::FileWatch;
 use super::{ViewOptions, emit};
 
@@ -152,6 +153,12 @@ impl Viewer {
                 Action::Scalar(name, value) => session.set_scalar(&name, value),
                 Action::Feature(name, on) => session.set_feature(&name, on),
                 Action::Cuts(cuts) => session.set_cuts(cuts),
+                Action::TransferFunction(TfAction::Edit(tf)) => session.edit_transfer_function(tf),
+                Action::TransferFunction(TfAction::Save) => session.save_transfer_function_events(),
+                Action::TransferFunction(TfAction::SaveOnChange(on)) => {
+                    session.save_tf_on_change = on;
+                    Vec::new()
+                }
                 Action::SaveScene(path) => match session.saved_view(&self.orbit.camera).save(&path) {
                     Ok(()) => {
                         crate::stdout::println_escaped!("saved scene {}", path.display());
@@ -199,6 +206,17 @@ impl Viewer {
                 }
                 Ok(Some(ScriptCommand::Write)) => self.apply_actions(vec![Action::WriteBack]),
                 Ok(Some(ScriptCommand::SaveScene(path))) => self.apply_actions(vec![Action::SaveScene(path)]),
+                Ok(Some(ScriptCommand::TfPoint(point))) => {
+                    let Some(session) = self.session.as_ref() else { continue };
+                    let mut tf = session.transfer_function().clone();
+                    tf.points.retain(|p| p.value != point.value);
+                    let at = tf.points.partition_point(|p| p.value <= point.value);
+                    tf.points.insert(at, point);
+                    tf.domain =
+                        (tf.domain.0.min(tf.points[0].value), tf.domain.1.max(tf.points[tf.points.len() - 1].value));
+                    self.apply_actions(vec![Action::TransferFunction(TfAction::Edit(tf))]);
+                }
+                Ok(Some(ScriptCommand::TfSave)) => self.apply_actions(vec![Action::TransferFunction(TfAction::Save)]),
                 Ok(Some(ScriptCommand::Crop(crop))) => {
                     let Some(session) = self.session.as_ref() else { continue };
                     let planes: Vec<_> = session.runtime.cuts().planes().copied().collect();

@@ -1,0 +1,202 @@
+//! The viewer's transfer-function editor (issue 24 §1; what ParaView's colour-map editor,
+//! Slicer's volume-rendering module and Inviwo's TF property offer): the volume's histogram on a
+//! log scale in the data's units, the TF's opacity curve and control points over it. Click empty
+//! space to add a point, drag a point to move it (value and opacity), right-click to delete it;
+//! the selected point's colour, opacity and value are edited below, and the built-in presets
+//! replace the whole function. Every change comes back as a new [`TransferFunction`] for the
+//! session to upload at once.
+
+use egui::{Color32, Pos2, Rect, Sense, Stroke, Vec2};
+use volgraph_accel::transfer_function::{ControlPoint, Preset, TransferFunction};
+
+/// Height of the editing area in points.
+const HEIGHT: f32 = 130.0;
+/// How near (in points) the pointer must be to grab a control point.
+const GRAB: f32 = 8.0;
+
+/// What the editor asks of the session.
+pub enum TfAction {
+    /// Use this function.
+    Edit(TransferFunction),
+    /// Save the TF to its file.
+    Save,
+    /// Turn "save on change" on or off.
+    SaveOnChange(bool),
+}
+
+/// Linear → sRGB for display (the points hold linear RGB).
+fn display_color(c: [f64; 3], alpha: f64) -> Color32 {
+    let s = |x: f64| {
+        let x = x.clamp(0.0, 1.0);
+        let e = if x <= 0.0031308 { x * 12.92 } else { 1.055 * x.powf(1.0 / 2.4) - 0.055 };
+        (e * 255.0).round() as u8
+    };
+    Color32::from_rgba_unmultiplied(s(c[0]), s(c[1]), s(c[2]), (alpha.clamp(0.0, 1.0) * 255.0) as u8)
+}
+
+/// The editor. `histogram` counts normalized values; `range` is the data values its ends stand
+/// for. Returns at most one action per frame.
+pub fn show(
+    ui: &mut egui::Ui,
+    tf: &TransferFunction,
+    histogram: &[u64],
+    range: (f64, f64),
+    save_on_change: bool,
+) -> Option<TfAction> {
+    let mut action = None;
+    let (lo, hi) = if range.1 > range.0 { range } else { tf.domain };
+    let selected_id = ui.make_persistent_id("tf_selected");
+    let mut selected: Option<usize> = ui.data(|d| d.get_temp(selected_id)).filter(|&i| i < tf.points.len());
+    let (response, painter) = ui.allocate_painter(Vec2::new(ui.available_width(), HEIGHT), Sense::click_and_drag());
+    let rect = response.rect;
+    let to_screen = |value: f64, alpha: f64| {
+        let x = ((value - lo) / (hi - lo)).clamp(0.0, 1.0) as f32;
+        Pos2::new(rect.left() + x * rect.width(), rect.bottom() - alpha.clamp(0.0, 1.0) as f32 * rect.height())
+    };
+    let from_screen = |p: Pos2| {
+        let x = ((p.x - rect.left()) / rect.width()).clamp(0.0, 1.0) as f64;
+        let a = ((rect.bottom() - p.y) / rect.height()).clamp(0.0, 1.0) as f64;
+        (lo + x * (hi - lo), a)
+    };
+    painter.rect_filled(rect, 2.0, Color32::from_gray(24));
+    // The histogram, log scale: air or a scanner's noise floor would flatten everything else.
+    let peak = histogram.iter().copied().max().unwrap_or(0).max(1) as f64;
+    let bar = rect.width() / histogram.len().max(1) as f32;
+    for (i, &count) in histogram.iter().enumerate() {
+        if count == 0 {
+            continue;
+        }
+        let h = ((1.0 + count as f64).ln() / (1.0 + peak).ln()) as f32 * rect.height();
+        let x = rect.left() + i as f32 * bar;
+        painter.rect_filled(
+            Rect::from_min_max(Pos2::new(x, rect.bottom() - h), Pos2::new(x + bar.max(1.0), rect.bottom())),
+            0.0,
+            Color32::from_gray(70),
+        );
+    }
+    // The opacity curve, each segment in its colour.
+    let n = 96;
+    for k in 0..n {
+        let (v0, v1) = (lo + (hi - lo) * k as f64 / n as f64, lo + (hi - lo) * (k + 1) as f64 / n as f64);
+        let (c0, c1) = (tf.eval(v0), tf.eval(v1));
+        painter.line_segment(
+            [to_screen(v0, c0[3]), to_screen(v1, c1[3])],
+            Stroke::new(2.0, display_color([c0[0], c0[1], c0[2]], 1.0)),
+        );
+    }
+    for (i, p) in tf.points.iter().enumerate() {
+        let at = to_screen(p.value, p.alpha);
+        painter.circle_filled(at, 5.0, display_color(p.color, 1.0));
+        let ring = if selected == Some(i) { Color32::WHITE } else { Color32::from_gray(140) };
+        painter.circle_stroke(at, 5.0, Stroke::new(1.5, ring));
+    }
+    let nearest = |pos: Pos2| {
+        tf.points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (i, to_screen(p.value, p.alpha).distance(pos)))
+            .filter(|(_, d)| *d <= GRAB)
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(i, _)| i)
+    };
+    let dragging_id = ui.make_persistent_id("tf_dragging");
+    if response.drag_started()
+        && let Some(pos) = response.interact_pointer_pos()
+    {
+        let grabbed = nearest(pos);
+        ui.data_mut(|d| d.insert_temp(dragging_id, grabbed));
+        selected = grabbed.or(selected);
+    }
+    let dragging: Option<usize> = ui.data(|d| d.get_temp::<Option<usize>>(dragging_id)).flatten();
+    if response.dragged()
+        && let (Some(i), Some(pos)) = (dragging, response.interact_pointer_pos())
+        && i < tf.points.len()
+    {
+        let (value, alpha) = from_screen(pos);
+        let mut next = tf.clone();
+        next.points[i].value = value;
+        next.points[i].alpha = alpha;
+        // Keep the order (and the selection on the dragged point).
+        let moved = next.points[i].clone();
+        next.points.sort_by(|a, b| a.value.total_cmp(&b.value));
+        let new_index = next.points.iter().position(|p| *p == moved).unwrap_or(i);
+        ui.data_mut(|d| d.insert_temp(dragging_id, Some(new_index)));
+        selected = Some(new_index);
+        action = Some(TfAction::Edit(widen(next)));
+    }
+    if response.drag_stopped() {
+        ui.data_mut(|d| d.insert_temp::<Option<usize>>(dragging_id, None));
+    }
+    if response.clicked()
+        && let Some(pos) = response.interact_pointer_pos()
+    {
+        match nearest(pos) {
+            Some(i) => selected = Some(i),
+            None => {
+                let (value, alpha) = from_screen(pos);
+                let [r, g, b, _] = tf.eval(value);
+                let mut next = tf.clone();
+                let point = ControlPoint { value, color: [r, g, b], alpha };
+                let at = next.points.partition_point(|p| p.value <= value);
+                next.points.insert(at, point);
+                selected = Some(at);
+                action = Some(TfAction::Edit(widen(next)));
+            }
+        }
+    }
+    if response.secondary_clicked()
+        && let Some(pos) = response.interact_pointer_pos()
+        && let Some(i) = nearest(pos)
+        && tf.points.len() > 1
+    {
+        let mut next = tf.clone();
+        next.points.remove(i);
+        selected = None;
+        action = Some(TfAction::Edit(next));
+    }
+    ui.small("click: add a point · drag: move · right-click: delete · histogram: log scale, data units");
+    if let Some(i) = selected.filter(|&i| i < tf.points.len()) {
+        let p = &tf.points[i];
+        let (mut value, mut alpha) = (p.value, p.alpha);
+        let mut color = p.color.map(|c| c as f32);
+        let mut changed = false;
+        ui.horizontal(|ui| {
+            ui.label(format!("point {}", i + 1));
+            changed |= ui.color_edit_button_rgb(&mut color).changed();
+            changed |= ui.add(egui::DragValue::new(&mut value).speed((hi - lo) / 500.0).prefix("value ")).changed();
+            changed |= ui.add(egui::DragValue::new(&mut alpha).speed(0.005).range(0.0..=1.0).prefix("α ")).changed();
+        });
+        if changed && action.is_none() {
+            let mut next = tf.clone();
+            next.points[i] = ControlPoint { value, color: color.map(f64::from), alpha };
+            next.points.sort_by(|a, b| a.value.total_cmp(&b.value));
+            action = Some(TfAction::Edit(widen(next)));
+        }
+    }
+    ui.horizontal(|ui| {
+        egui::ComboBox::from_id_salt("tf_preset").selected_text("preset…").show_ui(ui, |ui| {
+            for preset in [Preset::Default, Preset::Opaque, Preset::Sparse] {
+                if ui.selectable_label(false, preset.name()).clicked() {
+                    action = Some(TfAction::Edit(TransferFunction::preset(preset, (lo, hi))));
+                }
+            }
+        });
+        if ui.button("save TF").on_hover_text("to its file, RON or ParaView JSON as it came").clicked() {
+            action = Some(TfAction::Save);
+        }
+        let mut on = save_on_change;
+        if ui.checkbox(&mut on, "save on change").changed() {
+            action = Some(TfAction::SaveOnChange(on));
+        }
+    });
+    ui.data_mut(|d| d.insert_temp(selected_id, selected));
+    action
+}
+
+/// The domain stretched over every point (a point dragged past an end takes the domain along).
+fn widen(mut tf: TransferFunction) -> TransferFunction {
+    for p in &tf.points {
+        tf.domain = (tf.domain.0.min(p.value), tf.domain.1.max(p.value));
+    }
+    tf
+}

@@ -54,6 +54,9 @@ enum BenchCommand {
     /// Crop boxes and clip planes: ms/frame of crops to an eighth and a half and of a clip
     /// plane beside the whole volume (the engine with modern/fastest by default).
     Cuts(crate::cuts::CutsArgs),
+    /// The viewer as a workbench: TF edit → frame on a 256³ volume at 800x600, and the frame
+    /// time while the camera moves for every shipped graph.
+    Workbench(crate::workbench::WorkbenchArgs),
     /// Compile time of a generated 30-pass graph; pooled vs unpooled transient memory of every
     /// built-in graph at 1920x1080.
     Compile {
@@ -104,6 +107,9 @@ fn run(cli: BenchCli) -> anyhow::Result<()> {
             crate::distributed::run(&args).context("bench distributed")
         }
         BenchCli::Bench { which: BenchCommand::Load(args) } => crate::load::run(&args).context("bench load").map(drop),
+        BenchCli::Bench { which: BenchCommand::Workbench(args) } => {
+            crate::workbench::run(&args).context("bench workbench").map(drop)
+        }
         BenchCli::Bench { which: BenchCommand::Cuts(args) } => crate::cuts::run(&args).context("bench cuts").map(drop),
         BenchCli::Bench { which: BenchCommand::Fetch(args) } => {
             crate::fetch::run(&args).context("bench fetch").map(drop)

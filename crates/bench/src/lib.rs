@@ -21,6 +21,7 @@ pub mod graphs;
 pub mod live;
 pub mod load;
 pub mod sweep;
+pub mod workbench;
 
 pub use commands::BenchCommands;
 

@@ -1,0 +1,162 @@
+//! `volgraph bench workbench`: the viewer-as-a-workbench figures of issue 24, measured through
+//! the viewer's own session (`volgraph_app::view::session::LiveSession`, no window):
+//! - from a TF edit (a control point moved, as a drag in the editor does) to the first frame
+//!   that shows it finished on the GPU, on a 256³ volume at 800×600 (goal ≤ 50 ms): the LUT
+//!   upload, the passes that read the TF rerunning (classification, distance map), the frame;
+//!   beside the steady frame of the same view, so the edit's own cost shows;
+//! - the frame time while the camera moves (a new camera every frame, as a drag gives) for every
+//!   shipped graph (goal ≤ 100 ms at 800×600 on lavapipe).
+//!
+//! All cases run side by side in one process on one device; medians of `frames` frames after
+//! a warm-up frame (pipeline JIT).
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{Context as _, anyhow};
+use volgraph_accel::camera::OrbitCamera;
+use volgraph_app::view::session::{LiveSession, SessionArgs};
+use volgraph_core::runtime::Gpu;
+
+use crate::graphs::measure::median;
+
+/// `bench workbench` arguments.
+#[derive(clap::Args, Debug)]
+pub struct WorkbenchArgs {
+    /// The volume file (a 256³ dataset by default).
+    #[arg(long)]
+    pub volume: Option<PathBuf>,
+    /// The graph the TF edits are timed with (a file or a built-in name).
+    #[arg(long, default_value = "modern/fastest")]
+    pub graph: PathBuf,
+    /// Viewport, WIDTHxHEIGHT.
+    #[arg(long, default_value = "800x600")]
+    pub size: String,
+    /// Timed edits and frames per case (the median is reported).
+    #[arg(long, default_value_t = 8)]
+    pub frames: u32,
+    /// Skip the per-graph drag frame times (only the TF edit).
+    #[arg(long)]
+    pub no_drag: bool,
+    /// Write the figures as JSON here.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Write the tables as Markdown here.
+    #[arg(long)]
+    pub markdown: Option<PathBuf>,
+}
+
+fn open(gpu: &Arc<Gpu>, graph: PathBuf, volume: &std::path::Path, viewport: (u32, u32)) -> anyhow::Result<LiveSession> {
+    let args = SessionArgs {
+        graph,
+        volume: vec![volume.to_path_buf()],
+        raw: Default::default(),
+        tf: None,
+        tf_map: None,
+        viewport,
+        features: Vec::new(),
+        shaders: None,
+        gpu_memory_mb: None,
+        scene: None,
+        cuts: Default::default(),
+    };
+    LiveSession::open(gpu.clone(), &args).map(|(s, _)| s).map_err(|e| anyhow!("{}", volgraph_app::cli::error_text(&e)))
+}
+
+/// Submits a frame of `camera` and waits for it: wall ms.
+fn timed_frame(session: &mut LiveSession, camera: &OrbitCamera) -> anyhow::Result<f64> {
+    let t0 = Instant::now();
+    session.frame(camera, None).map_err(|e| anyhow!(e))?;
+    session.runtime.finish();
+    Ok(t0.elapsed().as_secs_f64() * 1e3)
+}
+
+/// Runs the benchmark, prints the tables and returns the JSON.
+pub fn run(args: &WorkbenchArgs) -> anyhow::Result<serde_json::Value> {
+    let viewport = volgraph_app::inputs::parse_size(&args.size)?;
+    let volume = match &args.volume {
+        Some(v) => v.clone(),
+        None => {
+            volgraph_accel::data_dir::dataset_path("engine_vollib").context("the engine dataset (set VOLGRAPH_DATA)")?
+        }
+    };
+    let gpu = Arc::new(Gpu::new_headless().map_err(|e| anyhow!(e))?);
+    let adapter = gpu.adapter_name.clone();
+    let camera = OrbitCamera { azimuth_deg: 30.0, elevation_deg: 20.0, distance: 3.2, ..OrbitCamera::default() };
+
+    // (a) TF edit → frame.
+    let mut session = open(&gpu, args.graph.clone(), &volume, viewport)?;
+    timed_frame(&mut session, &camera)?;
+    let steady: Vec<f64> =
+        (0..args.frames).map(|_| timed_frame(&mut session, &camera)).collect::<anyhow::Result<_>>()?;
+    let mut edits = Vec::new();
+    let mut uploads = Vec::new();
+    for i in 0..args.frames {
+        let mut tf = session.transfer_function().clone();
+        // Move the middle point's opacity, as a drag in the editor does.
+        let k = tf.points.len() / 2;
+        tf.points[k].alpha = (0.2 + 0.05 * (i % 8) as f64).min(1.0);
+        let t0 = Instant::now();
+        let events = session.edit_transfer_function(tf);
+        if let Some(e) = events.iter().find(|e| matches!(e, volgraph_app::view::session::Event::Error { .. })) {
+            return Err(anyhow!("TF edit: {e}"));
+        }
+        uploads.push(t0.elapsed().as_secs_f64() * 1e3);
+        session.frame(&camera, None).map_err(|e| anyhow!(e))?;
+        session.runtime.finish();
+        edits.push(t0.elapsed().as_secs_f64() * 1e3);
+    }
+    let (steady_ms, edit_ms, upload_ms) = (median(&steady), median(&edits), median(&uploads));
+    let dims = session.histogram().0.len();
+    drop(session);
+    let mut md = format!(
+        "# The viewer as a workbench (issue 24)\n\nMeasured through the viewer's session (no window) on {adapter}, \
+         {} at {}, medians of {} in one run.\n\n## From a TF edit to the first frame showing it (goal ≤ 50 ms)\n\n\
+         | | ms |\n|---|---:|\n| steady frame (same view, no edit) | {steady_ms:.1} |\n| TF edit: check + LUT upload | {upload_ms:.2} |\n\
+         | TF edit → frame finished | {edit_ms:.1} |\n\n",
+        volume.file_name().map(|f| f.to_string_lossy().to_string()).unwrap_or_default(),
+        args.size,
+        args.frames
+    );
+    let _ = dims;
+    let mut drag_rows = Vec::new();
+    if !args.no_drag {
+        md.push_str("## Frame time while the camera moves (goal ≤ 100 ms)\n\n| graph | ms/frame | within 100 ms |\n|---|---:|:---:|\n");
+        for (name, _) in volgraph_app::builtin_graphs::EMBEDDED_GRAPHS {
+            let mut session = match open(&gpu, PathBuf::from(name), &volume, viewport) {
+                Ok(s) => s,
+                Err(e) => {
+                    md.push_str(&format!(
+                        "| {name} | (does not open: {}) | |\n",
+                        e.to_string().lines().next().unwrap_or("")
+                    ));
+                    continue;
+                }
+            };
+            timed_frame(&mut session, &camera)?;
+            let ms: Vec<f64> = (0..args.frames.min(4))
+                .map(|i| {
+                    let moved = OrbitCamera { azimuth_deg: camera.azimuth_deg + 3.0 * (i + 1) as f64, ..camera };
+                    timed_frame(&mut session, &moved)
+                })
+                .collect::<anyhow::Result<_>>()?;
+            let m = median(&ms);
+            md.push_str(&format!("| {name} | {m:.1} | {} |\n", if m <= 100.0 { "yes" } else { "no" }));
+            drag_rows.push(serde_json::json!({ "graph": name, "ms_per_frame": m }));
+        }
+    }
+    println!("{md}");
+    let value = serde_json::json!({
+        "adapter": adapter, "size": args.size, "volume": volume.display().to_string(),
+        "steady_frame_ms": steady_ms, "tf_upload_ms": upload_ms, "tf_edit_to_frame_ms": edit_ms, "drag": drag_rows,
+    });
+    if let Some(path) = &args.markdown {
+        std::fs::write(path, &md).with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(path) = &args.json {
+        std::fs::write(path, serde_json::to_string_pretty(&value)?)
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    Ok(value)
+}

@@ -328,3 +328,42 @@ fn cuts_section(ui: &mut egui::Ui, cuts: Cuts) -> Option<Cuts> {
     }
     Cuts::new(crop, &planes).ok()
 }
+
+/// The "Crop and clip" section driven with egui's test harness: the crop checkbox and a slider
+/// moved through AccessKit, as assistive technology (or a user) would.
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use egui_kittest::Harness;
+    use egui_kittest::kittest::Queryable as _;
+
+    #[test]
+    fn the_crop_checkbox_and_sliders_set_the_cuts() {
+        let mut h = Harness::builder().with_size(egui::Vec2::new(360.0, 420.0)).build_ui_state(
+            |ui, cuts: &mut Cuts| {
+                if let Some(next) = cuts_section(ui, *cuts) {
+                    *cuts = next;
+                }
+            },
+            Cuts::NONE,
+        );
+        h.run();
+        h.get_by_label("Crop and clip").click();
+        h.run();
+        h.get_by_label("crop box (volume fractions)").click();
+        h.run();
+        assert_eq!(h.state().crop(), Some(CropBox::WHOLE), "the box starts as the whole volume");
+        h.get_by_role_and_label(egui::accesskit::Role::Slider, "x to").set_value_accesskit(0.4);
+        h.run();
+        let crop = h.state().crop().expect("a crop");
+        assert!((crop.hi.x - 0.4).abs() < 1e-9 && crop.lo.x == 0.0, "{crop:?}");
+        // The high end cannot pass below the low one: the box stays a box.
+        h.get_by_role_and_label(egui::accesskit::Role::Slider, "x from").set_value_accesskit(0.6);
+        h.run();
+        let crop = h.state().crop().expect("a crop");
+        assert!(crop.hi.x > crop.lo.x, "{crop:?}");
+        h.get_by_label("clip plane (keeps n·f >= d)").click();
+        h.run();
+        assert_eq!(h.state().planes().count(), 1);
+    }
+}

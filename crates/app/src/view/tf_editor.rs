@@ -100,8 +100,10 @@ pub fn show(
             .map(|(i, _)| i)
     };
     let dragging_id = ui.make_persistent_id("tf_dragging");
+    // Grab what was under the pointer when the button went down: a drag starts only once the
+    // pointer has moved a few points, by when a fast hand is already off the point.
     if response.drag_started()
-        && let Some(pos) = response.interact_pointer_pos()
+        && let Some(pos) = ui.input(|i| i.pointer.press_origin()).or(response.interact_pointer_pos())
     {
         let grabbed = nearest(pos);
         ui.data_mut(|d| d.insert_temp(dragging_id, grabbed));
@@ -174,7 +176,7 @@ pub fn show(
         }
     }
     ui.horizontal(|ui| {
-        egui::ComboBox::from_id_salt("tf_preset").selected_text("preset…").show_ui(ui, |ui| {
+        egui::ComboBox::from_label("preset").selected_text("replace with…").show_ui(ui, |ui| {
             for preset in [Preset::Default, Preset::Opaque, Preset::Sparse] {
                 if ui.selectable_label(false, preset.name()).clicked() {
                     action = Some(TfAction::Edit(TransferFunction::preset(preset, (lo, hi))));
@@ -199,4 +201,107 @@ fn widen(mut tf: TransferFunction) -> TransferFunction {
         tf.domain = (tf.domain.0.min(p.value), tf.domain.1.max(p.value));
     }
     tf
+}
+
+/// The editor driven with egui's own test harness (`egui_kittest`): synthetic pointer events on
+/// the canvas, the function the editor hands back checked.
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use egui_kittest::Harness;
+
+    struct State {
+        tf: TransferFunction,
+        /// The canvas: top-left corner and width, read where the editor is placed.
+        origin: Pos2,
+        width: f32,
+        edits: usize,
+        last: Option<TfAction>,
+    }
+
+    fn start() -> TransferFunction {
+        let point = |value, color, alpha| ControlPoint { value, color, alpha };
+        TransferFunction {
+            domain: (0.0, 100.0),
+            points: vec![point(0.0, [0.0; 3], 0.0), point(50.0, [1.0, 0.0, 0.0], 0.5), point(100.0, [1.0; 3], 1.0)],
+        }
+    }
+
+    fn harness() -> Harness<'static, State> {
+        let state = State { tf: start(), origin: Pos2::ZERO, width: 0.0, edits: 0, last: None };
+        let mut h = Harness::builder().with_size(Vec2::new(420.0, 320.0)).build_ui_state(
+            |ui, s: &mut State| {
+                s.origin = ui.cursor().min;
+                s.width = ui.available_width();
+                if let Some(action) = show(ui, &s.tf, &[5, 50, 500, 50, 5], (0.0, 100.0), false) {
+                    if let TfAction::Edit(tf) = &action {
+                        s.tf = tf.clone();
+                        s.edits += 1;
+                    }
+                    s.last = Some(action);
+                }
+            },
+            state,
+        );
+        h.run();
+        h
+    }
+
+    /// Where data value `v` at opacity `a` is on the canvas.
+    fn at(h: &Harness<'_, State>, v: f64, a: f64) -> Pos2 {
+        let s = h.state();
+        Pos2::new(s.origin.x + (v / 100.0) as f32 * s.width, s.origin.y + HEIGHT - a as f32 * HEIGHT)
+    }
+
+    #[test]
+    fn dragging_a_point_moves_its_value_and_opacity() {
+        let mut h = harness();
+        let (from, to) = (at(&h, 50.0, 0.5), at(&h, 30.0, 0.8));
+        h.hover_at(from);
+        h.step();
+        h.drag_at(from);
+        h.step();
+        for k in 1..=6 {
+            h.hover_at(from + (to - from) * (k as f32 / 6.0));
+            h.step();
+        }
+        h.drop_at(to);
+        h.step();
+        let p = &h.state().tf.points[1];
+        assert!((p.value - 30.0).abs() < 1.0 && (p.alpha - 0.8).abs() < 0.02, "moved to {p:?}");
+        assert_eq!(p.color, [1.0, 0.0, 0.0], "the colour stays with the point");
+        assert!(h.state().edits >= 1);
+    }
+
+    #[test]
+    fn a_click_adds_a_point_and_a_right_click_deletes_it() {
+        let mut h = harness();
+        let empty = at(&h, 75.0, 0.1);
+        h.hover_at(empty);
+        h.step();
+        h.drag_at(empty);
+        h.step();
+        h.drop_at(empty);
+        h.run();
+        let points = &h.state().tf.points;
+        assert_eq!(points.len(), 4, "{points:?}");
+        let added = &points[2];
+        assert!((added.value - 75.0).abs() < 1.0 && (added.alpha - 0.1).abs() < 0.02, "{added:?}");
+        // Its colour is the function's there: between red and white.
+        assert!(added.color[0] == 1.0 && added.color[1] > 0.0 && added.color[1] < 1.0, "{added:?}");
+        let on_it = at(&h, added.value, added.alpha);
+        h.hover_at(on_it);
+        h.step();
+        for pressed in [true, false] {
+            h.event(egui::Event::PointerButton {
+                pos: on_it,
+                button: egui::PointerButton::Secondary,
+                pressed,
+                modifiers: egui::Modifiers::NONE,
+            });
+            h.step();
+        }
+        h.run();
+        assert_eq!(h.state().tf.points, start().points, "deleted again");
+    }
 }

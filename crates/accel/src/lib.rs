@@ -19,6 +19,7 @@ pub mod load;
 pub mod minmax;
 pub mod mip;
 pub mod octree;
+pub mod probe;
 pub mod reference;
 pub mod stats;
 pub mod transfer_function;

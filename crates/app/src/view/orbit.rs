@@ -20,6 +20,11 @@ pub struct Orbit {
 }
 
 impl Orbit {
+    /// Whether a button is held (the camera is turning or panning).
+    pub fn is_dragging(&self) -> bool {
+        self.rotating || self.panning
+    }
+
     /// Control of `camera`; R returns to it.
     pub fn new(camera: OrbitCamera) -> Self {
         Self { camera, start: camera, rotating: false, panning: false, last: None }

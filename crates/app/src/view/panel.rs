@@ -114,7 +114,13 @@ pub fn history_line(stats: &volgraph_core::runtime::HistoryStats) -> String {
 }
 
 /// Draws the panel; returns what the user changed.
-pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapter: &str) -> Vec<Action> {
+pub fn show(
+    root: &mut egui::Ui,
+    session: &LiveSession,
+    timings: &Timings,
+    adapter: &str,
+    under_cursor: Option<&str>,
+) -> Vec<Action> {
     let mut actions = Vec::new();
     egui::Panel::right("volgraph").default_size(320.0).show(root, |ui| {
         let Some(plan) = session.plan() else { return };
@@ -146,6 +152,7 @@ pub fn show(root: &mut egui::Ui, session: &LiveSession, timings: &Timings, adapt
         if !plan.history.is_empty() {
             ui.label(history_line(&session.runtime.history_stats()));
         }
+        ui.small(under_cursor.unwrap_or("under the cursor: nothing visible"));
         // What passes report about the last frame (a brick pool's uploads and occupancy).
         for line in crate::render::counter_lines(&session.runtime.pass_counters()) {
             ui.label(egui::RichText::new(line).small());

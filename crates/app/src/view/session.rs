@@ -376,6 +376,24 @@ impl LiveSession {
         self.outcome("transfer function".to_string(), start, result)
     }
 
+    /// What lies under window pixel `cursor` (physical pixels) seen by `camera`: the first
+    /// visible point along its ray (the TF, the crop and clip planes as drawn) and the data value
+    /// there, as a line for the panel in the data's units; `None` off the volume.
+    pub fn probe_line(&self, camera: &volgraph_accel::camera::OrbitCamera, cursor: (f64, f64)) -> Option<String> {
+        let (w, h) = self.options.viewport;
+        if !(cursor.0 >= 0.0 && cursor.1 >= 0.0) {
+            return None;
+        }
+        let pixel = (cursor.0 as u32, cursor.1 as u32);
+        let cuts = self.runtime.cuts();
+        let p = volgraph_accel::probe::first_visible(&self.volume, &self.lut, camera, (w, h), pixel, 0.5, &cuts)?;
+        let units = self.volume.meta.units.as_deref().map_or(String::new(), |u| format!(" {u}"));
+        Some(format!(
+            "under the cursor: {:.4}{units} at voxel ({:.1}, {:.1}, {:.1}), α {:.2}",
+            p.value, p.voxel.x, p.voxel.y, p.voxel.z, p.alpha
+        ))
+    }
+
     /// The transfer function on screen.
     pub fn transfer_function(&self) -> &TransferFunction {
         &self.tf

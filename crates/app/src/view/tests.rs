@@ -214,6 +214,32 @@ fn a_tf_editor_edit_applies_at_once_and_saves_without_reloading_itself() {
     let _ = std::fs::remove_dir_all(&s.dir);
 }
 
+/// Issue 24 §4: the value under the cursor, where its ray first becomes visible, in the data's
+/// units; nothing off the volume; a crop moves it to the crop face.
+#[test]
+fn the_value_under_the_cursor_is_where_the_ray_first_becomes_visible() {
+    let s = scratch("probe", "graphs/basic/fragment_raycast.ron");
+    let mut session = open(&s, None);
+    let camera = volgraph_accel::camera::OrbitCamera {
+        azimuth_deg: 0.0,
+        elevation_deg: 0.0,
+        distance: 3.2,
+        ..Default::default()
+    };
+    let centre = session.probe_line(&camera, (24.0, 24.0)).expect("the volume is under the centre");
+    assert!(centre.starts_with("under the cursor: ") && centre.contains("at voxel ("), "{centre}");
+    assert_eq!(session.probe_line(&camera, (0.5, 0.5)), None, "the corner's ray misses the volume");
+    let cut = volgraph_accel::cuts::Cuts::new(
+        Some(volgraph_accel::cuts::CropBox::new(glam::DVec3::ZERO, glam::DVec3::new(1.0, 1.0, 0.5)).expect("box")),
+        &[],
+    )
+    .expect("cuts");
+    session.set_cuts(cut);
+    let cropped = session.probe_line(&camera, (24.0, 24.0));
+    assert_ne!(cropped, Some(centre), "the crop moves (or removes) what is under the cursor");
+    let _ = std::fs::remove_dir_all(&s.dir);
+}
+
 #[test]
 fn a_resize_rebuilds_no_pipeline() {
     let s = scratch("resize", "graphs/basic/fragment_raycast.ron");

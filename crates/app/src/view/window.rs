@@ -43,6 +43,8 @@ pub struct Viewer {
     timings: Timings,
     modifiers: ModifiersState,
     panel_open: bool,
+    /// The pointer's last position in the window (physical pixels), for "under the cursor".
+    cursor: Option<(f64, f64)>,
     screenshot_now: Option<PathBuf>,
     quit: bool,
     /// The outcome: an error ends the program with status 1.
@@ -63,6 +65,7 @@ impl Viewer {
             watch: None,
             timings: Timings::default(),
             modifiers: ModifiersState::empty(),
+            cursor: None,
             screenshot_now: None,
             quit: false,
             failure: None,
@@ -299,8 +302,13 @@ impl Viewer {
             let raw = gfx.egui.take_egui_input(&gfx.window);
             let ctx = gfx.egui.egui_ctx().clone();
             let adapter = gfx.gpu.adapter_name.clone();
+            // One ray on the CPU, only while the pointer is still (a drag turns the camera).
+            let probe = self
+                .cursor
+                .filter(|_| !self.orbit.is_dragging())
+                .and_then(|c| session.probe_line(&self.orbit.camera, c));
             let output = ctx.run_ui(raw, |ui| {
-                actions = panel::show(ui, session, &self.timings, &adapter);
+                actions = panel::show(ui, session, &self.timings, &adapter, probe.as_deref());
             });
             let egui::FullOutput { platform_output, mut textures_delta, shapes, pixels_per_point, .. } = output;
             gfx.egui.handle_platform_output(&gfx.window, platform_output);
@@ -406,6 +414,7 @@ impl ApplicationHandler for Viewer {
                 }
             }
             WindowEvent::CursorMoved { position, .. } => {
+                self.cursor = Some((position.x, position.y));
                 let height = self.gfx.as_ref().map_or(1.0, |g| g.config.height as f64);
                 self.orbit.moved(position.x, position.y, height);
             }

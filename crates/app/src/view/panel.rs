@@ -186,7 +186,10 @@ pub fn show(
                 egui::CollapsingHeader::new("Transfer function").default_open(true).show(ui, |ui| {
                     let (histogram, range) = session.histogram();
                     let tf = session.transfer_function();
-                    if let Some(a) = super::tf_editor::show(ui, tf, histogram, range, session.save_tf_on_change) {
+                    let presets = session.tf_presets();
+                    if let Some(a) =
+                        super::tf_editor::show(ui, tf, histogram, range, presets, session.save_tf_on_change)
+                    {
                         actions.push(Action::TransferFunction(a));
                     }
                 });

@@ -156,6 +156,8 @@ pub struct LiveSession {
     tf_written: Option<String>,
     /// Save the TF file after every edit (the panel's toggle).
     pub save_tf_on_change: bool,
+    /// The TF editor's presets for this volume (computed once: MR's reads percentiles).
+    tf_presets: Vec<(&'static str, TransferFunction)>,
 }
 
 impl LiveSession {
@@ -197,6 +199,7 @@ impl LiveSession {
         }
         let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
         let histogram = volgraph_accel::histogram::Histogram::of(&volume, HISTOGRAM_BINS).counts;
+        let tf_presets = tf_presets_for(&volume);
         let (sources, _) = crate::shader_dir::sources_for(&args.graph, args.shaders.as_deref());
         // Every folder read (and so watched), in search order: the start line and the panel name
         // all of them, not just the first.
@@ -263,6 +266,7 @@ impl LiveSession {
             histogram,
             tf_written: None,
             save_tf_on_change: false,
+            tf_presets,
             opacity_reference: args.scene.as_ref().map(|s| s.opacity_reference).unwrap_or_default(),
         };
         let ms = start.elapsed().as_secs_f64() * 1e3;
@@ -392,6 +396,12 @@ impl LiveSession {
             "under the cursor: {:.4}{units} at voxel ({:.1}, {:.1}, {:.1}), α {:.2}",
             p.value, p.voxel.x, p.voxel.y, p.voxel.z, p.alpha
         ))
+    }
+
+    /// The presets the TF editor offers for this volume: the general ones over its values, and
+    /// the scanner presets of its modality (the CT ones in HU, MR's percentile ramp).
+    pub fn tf_presets(&self) -> &[(&'static str, TransferFunction)] {
+        &self.tf_presets
     }
 
     /// The transfer function on screen.
@@ -723,3 +733,19 @@ const HISTOGRAM_BINS: usize = 256;
 
 /// Where "save TF" writes a TF that came from no file (fitted to the data).
 pub const SAVED_TF: &str = "view.tf.ron";
+
+/// The general presets over `volume`'s values and the scanner presets of its modality.
+fn tf_presets_for(volume: &Volume) -> Vec<(&'static str, TransferFunction)> {
+    use volgraph_accel::transfer_function::{Preset, ScannerPreset};
+    let mut out: Vec<(&'static str, TransferFunction)> =
+        Preset::ALL.iter().map(|p| (p.name(), TransferFunction::preset(*p, volume.value_range))).collect();
+    let modality = volume.meta.modality.as_deref().unwrap_or("");
+    for preset in ScannerPreset::ALL {
+        let fits =
+            if preset.is_ct() { modality.eq_ignore_ascii_case("CT") } else { modality.eq_ignore_ascii_case("MR") };
+        if fits {
+            out.push((preset.name(), preset.for_volume(volume)));
+        }
+    }
+    out
+}

@@ -7,7 +7,7 @@
 //! session to upload at once.
 
 use egui::{Color32, Pos2, Rect, Sense, Stroke, Vec2};
-use volgraph_accel::transfer_function::{ControlPoint, Preset, TransferFunction};
+use volgraph_accel::transfer_function::{ControlPoint, TransferFunction};
 
 /// Height of the editing area in points.
 const HEIGHT: f32 = 130.0;
@@ -41,6 +41,7 @@ pub fn show(
     tf: &TransferFunction,
     histogram: &[u64],
     range: (f64, f64),
+    presets: &[(&'static str, TransferFunction)],
     save_on_change: bool,
 ) -> Option<TfAction> {
     let mut action = None;
@@ -177,9 +178,9 @@ pub fn show(
     }
     ui.horizontal(|ui| {
         egui::ComboBox::from_label("preset").selected_text("replace with…").show_ui(ui, |ui| {
-            for preset in [Preset::Default, Preset::Opaque, Preset::Sparse] {
-                if ui.selectable_label(false, preset.name()).clicked() {
-                    action = Some(TfAction::Edit(TransferFunction::preset(preset, (lo, hi))));
+            for (name, preset) in presets {
+                if ui.selectable_label(false, *name).clicked() {
+                    action = Some(TfAction::Edit(preset.clone()));
                 }
             }
         });
@@ -233,7 +234,7 @@ mod tests {
             |ui, s: &mut State| {
                 s.origin = ui.cursor().min;
                 s.width = ui.available_width();
-                if let Some(action) = show(ui, &s.tf, &[5, 50, 500, 50, 5], (0.0, 100.0), false) {
+                if let Some(action) = show(ui, &s.tf, &[5, 50, 500, 50, 5], (0.0, 100.0), &[], false) {
                     if let TfAction::Edit(tf) = &action {
                         s.tf = tf.clone();
                         s.edits += 1;

@@ -5,6 +5,7 @@
 //! `quit`, `screenshot PATH`, `param PASS.NAME VALUE`, `write`); one line per event on stdout.
 
 pub mod graph_picture;
+pub mod lod;
 pub mod orbit;
 pub mod panel;
 pub mod script;

@@ -31,6 +31,13 @@ pub enum Action {
     SaveScene(std::path::PathBuf),
     /// The TF editor's action.
     TransferFunction(super::tf_editor::TfAction),
+    /// Level of detail while moving: on or off, and the frame rate to hold.
+    Lod {
+        /// Render coarser while moving.
+        enabled: bool,
+        /// The frame rate to hold.
+        target_fps: f64,
+    },
 }
 
 /// Exponentially smoothed per-pass milliseconds.
@@ -120,6 +127,7 @@ pub fn show(
     timings: &Timings,
     adapter: &str,
     under_cursor: Option<&str>,
+    lod: &super::lod::Lod,
 ) -> Vec<Action> {
     let mut actions = Vec::new();
     egui::Panel::right("volgraph").default_size(320.0).show(root, |ui| {
@@ -153,6 +161,15 @@ pub fn show(
             ui.label(history_line(&session.runtime.history_stats()));
         }
         ui.small(under_cursor.unwrap_or("under the cursor: nothing visible"));
+        ui.horizontal(|ui| {
+            let (mut enabled, mut fps) = (lod.enabled, 1000.0 / lod.target_ms);
+            let toggled = ui.checkbox(&mut enabled, "coarser while moving, target").changed();
+            let moved = ui.add(egui::DragValue::new(&mut fps).range(1.0..=120.0).speed(0.5).suffix(" fps")).changed();
+            if toggled || moved {
+                actions.push(Action::Lod { enabled, target_fps: fps });
+            }
+        });
+        ui.small(lod.line());
         // What passes report about the last frame (a brick pool's uploads and occupancy).
         for line in crate::render::counter_lines(&session.runtime.pass_counters()) {
             ui.label(egui::RichText::new(line).small());

@@ -45,6 +45,8 @@ pub struct Viewer {
     panel_open: bool,
     /// The pointer's last position in the window (physical pixels), for "under the cursor".
     cursor: Option<(f64, f64)>,
+    /// Coarser frames while the camera moves.
+    lod: super::lod::Lod,
     screenshot_now: Option<PathBuf>,
     quit: bool,
     /// The outcome: an error ends the program with status 1.
@@ -66,6 +68,7 @@ impl Viewer {
             timings: Timings::default(),
             modifiers: ModifiersState::empty(),
             cursor: None,
+            lod: super::lod::Lod::default(),
             screenshot_now: None,
             quit: false,
             failure: None,
@@ -156,6 +159,11 @@ impl Viewer {
                 Action::Scalar(name, value) => session.set_scalar(&name, value),
                 Action::Feature(name, on) => session.set_feature(&name, on),
                 Action::Cuts(cuts) => session.set_cuts(cuts),
+                Action::Lod { enabled, target_fps } => {
+                    self.lod.enabled = enabled;
+                    self.lod.target_ms = 1000.0 / target_fps.max(1.0);
+                    Vec::new()
+                }
                 Action::TransferFunction(TfAction::Edit(tf)) => session.edit_transfer_function(tf),
                 Action::TransferFunction(TfAction::Save) => session.save_transfer_function_events(),
                 Action::TransferFunction(TfAction::SaveOnChange(on)) => {
@@ -262,9 +270,19 @@ impl Viewer {
     }
 
     fn redraw(&mut self, event_loop: &ActiveEventLoop) {
+        // Level of detail: fewer pixels while the camera moves, the full image once it rests.
+        let mut lod_events = Vec::new();
+        if let (Some(session), Some(gfx)) = (self.session.as_mut(), self.gfx.as_ref()) {
+            let want = self.lod.viewport((gfx.config.width, gfx.config.height));
+            if want != session.options().viewport {
+                lod_events = session.resize(want.0, want.1);
+            }
+        }
+        self.handle(lod_events);
         let Some(session) = self.session.as_mut() else { return };
         for stats in session.runtime.poll() {
             self.timings.add(&stats);
+            self.lod.observe(stats.frame_ms);
         }
         let Some(gfx) = self.gfx.as_mut() else { return };
         let frame = match gfx.surface.get_current_texture() {
@@ -308,7 +326,7 @@ impl Viewer {
                 .filter(|_| !self.orbit.is_dragging())
                 .and_then(|c| session.probe_line(&self.orbit.camera, c));
             let output = ctx.run_ui(raw, |ui| {
-                actions = panel::show(ui, session, &self.timings, &adapter, probe.as_deref());
+                actions = panel::show(ui, session, &self.timings, &adapter, probe.as_deref(), &self.lod);
             });
             let egui::FullOutput { platform_output, mut textures_delta, shapes, pixels_per_point, .. } = output;
             gfx.egui.handle_platform_output(&gfx.window, platform_output);
@@ -415,6 +433,9 @@ impl ApplicationHandler for Viewer {
             }
             WindowEvent::CursorMoved { position, .. } => {
                 self.cursor = Some((position.x, position.y));
+                if self.orbit.is_dragging() {
+                    self.lod.moved();
+                }
                 let height = self.gfx.as_ref().map_or(1.0, |g| g.config.height as f64);
                 self.orbit.moved(position.x, position.y, height);
             }
@@ -424,6 +445,7 @@ impl ApplicationHandler for Viewer {
                     MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
                 };
                 self.orbit.wheel(lines);
+                self.lod.moved();
             }
             _ => {}
         }

@@ -1,0 +1,110 @@
+//! Interactive while moving (issue 24 §6; VTK's AutoAdjustSampleDistances and ParaView's LOD
+//! do the same): while the camera is dragged or zoomed, the viewer renders fewer pixels so a
+//! frame fits a target time, and returns to the full image once input has rested. The window's
+//! blit scales the coarse image up (nearest), the panel says which image is on screen.
+//!
+//! The scale is `sqrt(target / full)` (ray-cast frames cost in proportion to pixels), snapped to
+//! a few steps so a drag does not reallocate targets every frame, and never below a quarter.
+
+use std::time::{Duration, Instant};
+
+/// How long input must rest before the full image comes back.
+const REST: Duration = Duration::from_millis(300);
+/// The coarsest scale (per axis).
+const MIN_SCALE: f64 = 0.25;
+/// The scales a drag may take (per axis).
+const STEPS: [f64; 5] = [1.0, 0.75, 0.5, 0.35, 0.25];
+
+/// The level-of-detail state of one window.
+#[derive(Clone, Debug)]
+pub struct Lod {
+    /// Render coarser while moving.
+    pub enabled: bool,
+    /// The frame time to hold while moving, ms (default: 15 fps).
+    pub target_ms: f64,
+    last_motion: Option<Instant>,
+    /// Smoothed frame time at full resolution, ms (0 until measured).
+    full_ms: f64,
+    /// The scale of the image on screen (1 = full).
+    scale: f64,
+}
+
+impl Default for Lod {
+    fn default() -> Self {
+        Self { enabled: true, target_ms: 1000.0 / 15.0, last_motion: None, full_ms: 0.0, scale: 1.0 }
+    }
+}
+
+impl Lod {
+    /// The camera moved (a drag step, a wheel turn).
+    pub fn moved(&mut self) {
+        self.last_motion = Some(Instant::now());
+    }
+
+    /// A finished frame's time; it counts toward the full-resolution figure only when the full
+    /// image was on screen and nothing moved.
+    pub fn observe(&mut self, frame_ms: f64) {
+        if self.scale == 1.0 && !self.moving() && frame_ms.is_finite() && frame_ms > 0.0 {
+            self.full_ms = if self.full_ms == 0.0 { frame_ms } else { self.full_ms + 0.2 * (frame_ms - self.full_ms) };
+        }
+    }
+
+    fn moving(&self) -> bool {
+        self.last_motion.is_some_and(|t| t.elapsed() < REST)
+    }
+
+    /// The viewport to render now for a window of `window` pixels.
+    pub fn viewport(&mut self, window: (u32, u32)) -> (u32, u32) {
+        self.scale = if self.enabled && self.moving() && self.full_ms > self.target_ms {
+            let wanted = (self.target_ms / self.full_ms).sqrt().clamp(MIN_SCALE, 1.0);
+            // The largest step that still fits the target.
+            STEPS.iter().copied().find(|s| *s <= wanted + 1e-9).unwrap_or(MIN_SCALE)
+        } else {
+            1.0
+        };
+        let scaled = |n: u32| ((n as f64 * self.scale).round() as u32).max(1);
+        (scaled(window.0), scaled(window.1))
+    }
+
+    /// What the panel says about the image on screen.
+    pub fn line(&self) -> String {
+        if self.scale < 1.0 {
+            format!(
+                "image: coarse, {:.0}% per axis while moving (full: {:.0} ms, target {:.0} ms)",
+                self.scale * 100.0,
+                self.full_ms,
+                self.target_ms
+            )
+        } else {
+            "image: full resolution".to_string()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn moving_renders_coarser_to_hold_the_target_and_resting_restores_the_full_image() {
+        let mut lod = Lod::default();
+        lod.observe(400.0);
+        assert_eq!(lod.viewport((800, 600)), (800, 600), "at rest: the full image");
+        lod.moved();
+        // sqrt(66.7 / 400) = 0.41 → the 0.35 step.
+        assert_eq!(lod.viewport((800, 600)), (280, 210));
+        assert!(lod.line().contains("coarse, 35%"), "{}", lod.line());
+        // A frame observed while moving does not count as a full-resolution time.
+        lod.observe(30.0);
+        assert_eq!(lod.viewport((800, 600)), (280, 210));
+        lod.last_motion = Some(Instant::now() - REST - Duration::from_millis(1));
+        assert_eq!(lod.viewport((800, 600)), (800, 600), "rested: full again");
+        // A view that already fits the target is never coarsened.
+        let mut fast = Lod::default();
+        fast.observe(20.0);
+        fast.moved();
+        assert_eq!(fast.viewport((800, 600)), (800, 600));
+        fast.enabled = false;
+        assert_eq!(fast.viewport((800, 600)), (800, 600));
+    }
+}

@@ -12,6 +12,8 @@ use std::time::{Duration, Instant};
 const REST: Duration = Duration::from_millis(300);
 /// The coarsest scale (per axis).
 const MIN_SCALE: f64 = 0.25;
+/// The step factor of a coarse image.
+const STEP_FACTOR: f64 = 2.0;
 /// The scales a drag may take (per axis).
 const STEPS: [f64; 5] = [1.0, 0.75, 0.5, 0.35, 0.25];
 
@@ -27,11 +29,20 @@ pub struct Lod {
     full_ms: f64,
     /// The scale of the image on screen (1 = full).
     scale: f64,
+    /// The graph refused a wider step (a parameter range): only the resolution drops.
+    pub step_refused: bool,
 }
 
 impl Default for Lod {
     fn default() -> Self {
-        Self { enabled: true, target_ms: 1000.0 / 15.0, last_motion: None, full_ms: 0.0, scale: 1.0 }
+        Self {
+            enabled: true,
+            target_ms: 1000.0 / 15.0,
+            last_motion: None,
+            full_ms: 0.0,
+            scale: 1.0,
+            step_refused: false,
+        }
     }
 }
 
@@ -66,12 +77,19 @@ impl Lod {
         (scaled(window.0), scaled(window.1))
     }
 
+    /// The factor on every raycaster's step: twice as far apart while the image is coarse (the
+    /// samples per ray halve, as VTK's AutoAdjustSampleDistances does), 1 for the full image.
+    pub fn step_factor(&self) -> f64 {
+        if self.scale < 1.0 && !self.step_refused { STEP_FACTOR } else { 1.0 }
+    }
+
     /// What the panel says about the image on screen.
     pub fn line(&self) -> String {
         if self.scale < 1.0 {
             format!(
-                "image: coarse, {:.0}% per axis while moving (full: {:.0} ms, target {:.0} ms)",
+                "image: coarse, {:.0}% per axis{} while moving (full: {:.0} ms, target {:.0} ms)",
                 self.scale * 100.0,
+                if self.step_factor() > 1.0 { format!(", step ×{STEP_FACTOR}") } else { String::new() },
                 self.full_ms,
                 self.target_ms
             )
@@ -93,12 +111,14 @@ mod tests {
         lod.moved();
         // sqrt(66.7 / 400) = 0.41 → the 0.35 step.
         assert_eq!(lod.viewport((800, 600)), (280, 210));
-        assert!(lod.line().contains("coarse, 35%"), "{}", lod.line());
+        assert!(lod.line().contains("coarse, 35% per axis, step ×2"), "{}", lod.line());
+        assert_eq!(lod.step_factor(), 2.0);
         // A frame observed while moving does not count as a full-resolution time.
         lod.observe(30.0);
         assert_eq!(lod.viewport((800, 600)), (280, 210));
         lod.last_motion = Some(Instant::now() - REST - Duration::from_millis(1));
         assert_eq!(lod.viewport((800, 600)), (800, 600), "rested: full again");
+        assert_eq!(lod.step_factor(), 1.0);
         // A view that already fits the target is never coarsened.
         let mut fast = Lod::default();
         fast.observe(20.0);

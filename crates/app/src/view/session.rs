@@ -158,6 +158,9 @@ pub struct LiveSession {
     pub save_tf_on_change: bool,
     /// The TF editor's presets for this volume (computed once: MR's reads percentiles).
     tf_presets: Vec<(&'static str, TransferFunction)>,
+    /// While the level of detail widens the step: the factor and the parameter overrides from
+    /// before it (restored when it ends).
+    coarse_step: Option<(f64, std::collections::BTreeMap<String, ron::Value>)>,
 }
 
 impl LiveSession {
@@ -267,6 +270,7 @@ impl LiveSession {
             tf_written: None,
             save_tf_on_change: false,
             tf_presets,
+            coarse_step: None,
             opacity_reference: args.scene.as_ref().map(|s| s.opacity_reference).unwrap_or_default(),
         };
         let ms = start.elapsed().as_secs_f64() * 1e3;
@@ -484,6 +488,8 @@ impl LiveSession {
     /// the panel's overrides are cleared, as the file now says what they said. Returns one line
     /// per value written; an error (a built-in graph, an unwritable file) changes nothing.
     pub fn write_back(&mut self) -> anyhow::Result<Vec<String>> {
+        // The level of detail's wider step is not the user's: the graph's own values are written.
+        self.set_step_factor(1.0);
         let mut assignments: Vec<String> = Vec::new();
         for (key, value) in &self.options.param_overrides {
             let text = ron::to_string(value).map_err(|e| anyhow!("{key}: {e}"))?;
@@ -624,6 +630,49 @@ impl LiveSession {
             (true, true) => "crop and clip",
         };
         self.outcome(what.to_string(), start, result)
+    }
+
+    /// The level of detail's step: every pass with a `step_voxels` samples `factor` times further
+    /// apart while the camera moves (1: the graph's own steps again, with the overrides from
+    /// before). A graph that refuses the wider step (a range) just keeps its own; no error is
+    /// shown for it. Returns whether the step is now `factor`.
+    pub fn set_step_factor(&mut self, factor: f64) -> bool {
+        let current = self.coarse_step.as_ref().map_or(1.0, |(f, _)| *f);
+        if factor == current {
+            return true;
+        }
+        let base = self.coarse_step.as_ref().map_or_else(|| self.options.param_overrides.clone(), |(_, b)| b.clone());
+        let mut options = self.options.clone();
+        options.param_overrides = base.clone();
+        if factor != 1.0 {
+            // The graph's own step of each pass: its plan at factor 1 (the current one).
+            let Some(plan) = self.plan() else { return false };
+            let steps: Vec<(String, f64)> = plan
+                .steps
+                .iter()
+                .filter(|s| s.params.declares("step_voxels"))
+                .map(|s| (s.pass_id.clone(), s.params.float("step_voxels")))
+                .collect();
+            let base_step = |pass: &str, planned: f64| match base.get(&format!("{pass}.step_voxels")) {
+                Some(ron::Value::Number(n)) => n.into_f64(),
+                _ => planned,
+            };
+            for (pass, planned) in steps {
+                let wide = base_step(&pass, planned) * factor;
+                options
+                    .param_overrides
+                    .insert(format!("{pass}.step_voxels"), ron::Value::Number(ron::value::Number::F64(wide.into())));
+            }
+        }
+        let source = self.source.clone();
+        match self.compile_and_apply(&source, &options) {
+            Ok(_) => {
+                self.options = options;
+                self.coarse_step = (factor != 1.0).then_some((factor, base));
+                true
+            }
+            Err(_) => false,
+        }
     }
 
     /// The window was resized: only viewport-sized targets are reallocated.

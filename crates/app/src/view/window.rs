@@ -277,6 +277,9 @@ impl Viewer {
             if want != session.options().viewport {
                 lod_events = session.resize(want.0, want.1);
             }
+            if !session.set_step_factor(self.lod.step_factor()) {
+                self.lod.step_refused = true;
+            }
         }
         self.handle(lod_events);
         let Some(session) = self.session.as_mut() else { return };

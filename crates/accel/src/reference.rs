@@ -468,36 +468,46 @@ pub fn render_reference(
         .zip(hit.par_chunks_mut(row_len))
         .enumerate()
         .map(|(y, (color_row, hit_row))| {
-            let y = y as u32;
             let mut row_samples = 0;
             for x in 0..width {
-                let Some(seg) = ray_segment(volume, camera, &frame, x, y) else {
-                    continue;
-                };
-                let step_tex = step_tex(volume, seg.d_tex, settings.step_voxels);
-                if !(step_tex > 0.0 && step_tex < 1e30) {
-                    continue;
-                }
-                let jitter = if settings.jitter { pixel_jitter(x, y, width) } else { 0.0 };
-                let march = March::new(volume, lut, settings, seg, step_tex, jitter);
-                match settings.mode {
-                    RenderMode::Dvr => {
-                        let (c, n) = march.dvr();
-                        color_row[x as usize] = c;
-                        row_samples += n;
-                    }
-                    RenderMode::Isosurface { iso, shading } => {
-                        let (c, h, n) = march.iso(iso, &shading);
-                        color_row[x as usize] = c;
-                        hit_row[x as usize] = h;
-                        row_samples += n;
-                    }
-                }
+                let (c, h, n) = reference_pixel(volume, lut, camera, &frame, (x, y as u32), settings);
+                color_row[x as usize] = c;
+                hit_row[x as usize] = h;
+                row_samples += n;
             }
             row_samples
         })
         .sum();
     ReferenceImage { width, height, color, hit, samples }
+}
+
+/// One pixel of [`render_reference`]: premultiplied colour, the isosurface hit (zero for DVR or
+/// no hit) and the samples taken. `frame` is `camera.frame(width, height)`; the volume must be
+/// usable (as `render_reference` checks). For sparse checks (the viewer's live error).
+pub fn reference_pixel(
+    volume: &Volume,
+    lut: &[[f32; 4]],
+    camera: &OrbitCamera,
+    frame: &CameraFrame,
+    (x, y): (u32, u32),
+    settings: &RaycastSettings,
+) -> ([f64; 4], [f64; 4], u64) {
+    let Some(seg) = ray_segment(volume, camera, frame, x, y) else {
+        return ([0.0; 4], [0.0; 4], 0);
+    };
+    let step_tex = step_tex(volume, seg.d_tex, settings.step_voxels);
+    if !(step_tex > 0.0 && step_tex < 1e30) {
+        return ([0.0; 4], [0.0; 4], 0);
+    }
+    let jitter = if settings.jitter { pixel_jitter(x, y, frame.width) } else { 0.0 };
+    let march = March::new(volume, lut, settings, seg, step_tex, jitter);
+    match settings.mode {
+        RenderMode::Dvr => {
+            let (c, n) = march.dvr();
+            (c, [0.0; 4], n)
+        }
+        RenderMode::Isosurface { iso, shading } => march.iso(iso, &shading),
+    }
 }
 
 /// The `width × height` image with `n × n` rays per pixel on a regular sub-pixel grid, averaged:

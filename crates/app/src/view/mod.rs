@@ -4,6 +4,7 @@
 //! Scriptable for tests: `--frames N`, `--screenshot PATH`, and `--script` (lines on stdin:
 //! `quit`, `screenshot PATH`, `param PASS.NAME VALUE`, `write`); one line per event on stdout.
 
+pub mod accuracy;
 pub mod graph_picture;
 pub mod lod;
 pub mod orbit;

@@ -128,6 +128,7 @@ pub fn show(
     adapter: &str,
     under_cursor: Option<&str>,
     lod: &super::lod::Lod,
+    accuracy: &str,
 ) -> Vec<Action> {
     let mut actions = Vec::new();
     egui::Panel::right("volgraph").default_size(320.0).show(root, |ui| {
@@ -170,6 +171,7 @@ pub fn show(
             }
         });
         ui.small(lod.line());
+        ui.small(accuracy);
         // What passes report about the last frame (a brick pool's uploads and occupancy).
         for line in crate::render::counter_lines(&session.runtime.pass_counters()) {
             ui.label(egui::RichText::new(line).small());

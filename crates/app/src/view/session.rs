@@ -402,6 +402,33 @@ impl LiveSession {
         ))
     }
 
+    /// A comparison of the view on screen (the last frame's `image`) with the converged
+    /// reference, for a worker thread; `None` for a graph without a float `image` output or a
+    /// raycaster (`march`) to take the settings from.
+    pub fn accuracy_job(&mut self, camera: &volgraph_accel::camera::OrbitCamera) -> Option<super::accuracy::Job> {
+        let plan = self.plan()?;
+        let march = plan.steps.iter().find(|s| s.pass_id == "march" && s.params.declares("step_voxels"))?;
+        let mut settings = volgraph_passes::raycast_params::reference_settings(&march.params);
+        settings.opacity_unit_voxels = match self.opacity_reference {
+            volgraph_core::runtime::OpacityReference::World => 1.0 / self.volume.unit_step_world(),
+            volgraph_core::runtime::OpacityReference::Voxel => 1.0,
+        };
+        let size = plan.viewport;
+        let image = self.runtime.read_output("image").ok()?;
+        if (image.width, image.height) != size || image.channels != 4 {
+            return None;
+        }
+        Some(super::accuracy::Job {
+            image: image.to_rgba_f64(),
+            size,
+            volume: self.volume.clone(),
+            lut: self.lut.clone(),
+            camera: *camera,
+            settings,
+            cuts: self.runtime.cuts(),
+        })
+    }
+
     /// The presets the TF editor offers for this volume: the general ones over its values, and
     /// the scanner presets of its modality (the CT ones in HU, MR's percentile ramp).
     pub fn tf_presets(&self) -> &[(&'static str, TransferFunction)] {

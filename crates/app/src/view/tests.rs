@@ -240,6 +240,31 @@ fn the_value_under_the_cursor_is_where_the_ray_first_becomes_visible() {
     let _ = std::fs::remove_dir_all(&s.dir);
 }
 
+/// Issue 24 §5: the view's error against the converged reference, as the panel shows it: a
+/// coarser step costs accuracy, a finer one gains it back.
+#[test]
+fn the_live_error_follows_the_step() {
+    let s = scratch("accuracy", "graphs/basic/fragment_raycast.ron");
+    let mut session = open(&s, None);
+    let camera = volgraph_accel::camera::OrbitCamera::default();
+    let mut error_at = |session: &mut LiveSession, step: f64| {
+        let events =
+            session.set_param("march", "step_voxels", ron::Value::Number(ron::value::Number::F64(step.into())));
+        assert!(matches!(events.as_slice(), [Event::Reloaded { .. }]), "{events:?}");
+        session.frame(&camera, None).expect("a frame");
+        session.runtime.finish();
+        let job = session.accuracy_job(&camera).expect("fragment_raycast has an image and a march");
+        let a = super::accuracy::measure(&job);
+        assert!(a.pixels > 100 && a.line().contains("mean"), "{a:?}");
+        a.mean_abs
+    };
+    let coarse = error_at(&mut session, 2.0);
+    let fine = error_at(&mut session, 0.25);
+    assert!(coarse > 2.0 * fine, "step 2 (mean {coarse:.2e}) vs step 0.25 (mean {fine:.2e})");
+    assert!(fine < 1.0 / 255.0, "a fine step is close to the converged reference: {fine:.2e}");
+    let _ = std::fs::remove_dir_all(&s.dir);
+}
+
 #[test]
 fn a_resize_rebuilds_no_pipeline() {
     let s = scratch("resize", "graphs/basic/fragment_raycast.ron");

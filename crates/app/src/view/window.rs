@@ -47,6 +47,10 @@ pub struct Viewer {
     cursor: Option<(f64, f64)>,
     /// Coarser frames while the camera moves.
     lod: super::lod::Lod,
+    /// The view's error against the converged reference, measured once it rests.
+    accuracy: super::accuracy::LiveAccuracy,
+    /// Since when the view on screen has changed without being measured.
+    unmeasured_since: Option<std::time::Instant>,
     screenshot_now: Option<PathBuf>,
     quit: bool,
     /// The outcome: an error ends the program with status 1.
@@ -69,6 +73,8 @@ impl Viewer {
             modifiers: ModifiersState::empty(),
             cursor: None,
             lod: super::lod::Lod::default(),
+            accuracy: Default::default(),
+            unmeasured_since: Some(std::time::Instant::now()),
             screenshot_now: None,
             quit: false,
             failure: None,
@@ -138,6 +144,9 @@ impl Viewer {
     }
 
     fn handle(&mut self, events: Vec<Event>) {
+        if !events.is_empty() {
+            self.unmeasured_since = Some(std::time::Instant::now());
+        }
         for e in &events {
             emit(e);
             if let Event::Error { message, .. } = e {
@@ -152,6 +161,9 @@ impl Viewer {
     }
 
     fn apply_actions(&mut self, actions: Vec<Action>) {
+        if !actions.is_empty() {
+            self.unmeasured_since = Some(std::time::Instant::now());
+        }
         for action in actions {
             let Some(session) = self.session.as_mut() else { return };
             let events = match action {
@@ -301,6 +313,7 @@ impl Viewer {
         let target = PresentTarget { view: &view, format: gfx.config.format, size, output: session.shown_output() };
         if let Some(turn) = self.view.turn_degrees {
             self.orbit.turn(turn);
+            self.unmeasured_since = Some(std::time::Instant::now());
         }
         let events = match session.frame(&self.orbit.camera, Some(&target)) {
             Ok(events) => events,
@@ -328,8 +341,32 @@ impl Viewer {
                 .cursor
                 .filter(|_| !self.orbit.is_dragging())
                 .and_then(|c| session.probe_line(&self.orbit.camera, c));
+            // What accuracy costs, live: once the view has rested (and the full image is back),
+            // one comparison with the converged reference on a worker thread.
+            self.accuracy.poll();
+            if let Some(since) = self.unmeasured_since
+                && since.elapsed() > std::time::Duration::from_millis(600)
+                && self.lod.step_factor() == 1.0
+                && !self.orbit.is_dragging()
+                && !self.accuracy.busy()
+            {
+                self.unmeasured_since = None;
+                match session.accuracy_job(&self.orbit.camera) {
+                    Some(job) => self.accuracy.start(job),
+                    None => self.accuracy.last = None,
+                }
+            }
+            let accuracy_line = match (&self.accuracy.last, self.accuracy.busy()) {
+                (_, true) => "error vs converged f64 reference: measuring…".to_string(),
+                (Some(a), false) if self.unmeasured_since.is_none() => a.line(),
+                (Some(_), false) => {
+                    "error vs converged f64 reference: the view changed; measured once it rests".to_string()
+                }
+                (None, false) => "error vs converged f64 reference: not measured for this graph".to_string(),
+            };
             let output = ctx.run_ui(raw, |ui| {
-                actions = panel::show(ui, session, &self.timings, &adapter, probe.as_deref(), &self.lod);
+                actions =
+                    panel::show(ui, session, &self.timings, &adapter, probe.as_deref(), &self.lod, &accuracy_line);
             });
             let egui::FullOutput { platform_output, mut textures_delta, shapes, pixels_per_point, .. } = output;
             gfx.egui.handle_platform_output(&gfx.window, platform_output);
@@ -438,6 +475,7 @@ impl ApplicationHandler for Viewer {
                 self.cursor = Some((position.x, position.y));
                 if self.orbit.is_dragging() {
                     self.lod.moved();
+                    self.unmeasured_since = Some(std::time::Instant::now());
                 }
                 let height = self.gfx.as_ref().map_or(1.0, |g| g.config.height as f64);
                 self.orbit.moved(position.x, position.y, height);
@@ -449,6 +487,7 @@ impl ApplicationHandler for Viewer {
                 };
                 self.orbit.wheel(lines);
                 self.lod.moved();
+                self.unmeasured_since = Some(std::time::Instant::now());
             }
             _ => {}
         }

@@ -37,12 +37,11 @@ impl Accuracy {
     /// The panel's line.
     pub fn line(&self) -> String {
         format!(
-            "error vs converged f64 reference (step {REFERENCE_STEP}, every {}th pixel, {} px): mean {:.2}/255, max {:.1}/255 ({:.0} ms)",
-            self.stride,
-            self.pixels,
+            "error vs converged f64: mean {:.2}/255, max {:.1}/255 ({} px, {:.1} s)",
             self.mean_abs * 255.0,
             self.max_abs * 255.0,
-            self.ms
+            self.pixels,
+            self.ms / 1e3
         )
     }
 }

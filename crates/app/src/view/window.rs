@@ -357,12 +357,10 @@ impl Viewer {
                 }
             }
             let accuracy_line = match (&self.accuracy.last, self.accuracy.busy()) {
-                (_, true) => "error vs converged f64 reference: measuring…".to_string(),
+                (_, true) => "error vs converged f64: measuring…".to_string(),
                 (Some(a), false) if self.unmeasured_since.is_none() => a.line(),
-                (Some(_), false) => {
-                    "error vs converged f64 reference: the view changed; measured once it rests".to_string()
-                }
-                (None, false) => "error vs converged f64 reference: not measured for this graph".to_string(),
+                (Some(_), false) => "error vs converged f64: measured once the view rests".to_string(),
+                (None, false) => "error vs converged f64: not measured for this graph".to_string(),
             };
             let output = ctx.run_ui(raw, |ui| {
                 actions =

@@ -247,7 +247,7 @@ fn the_live_error_follows_the_step() {
     let s = scratch("accuracy", "graphs/basic/fragment_raycast.ron");
     let mut session = open(&s, None);
     let camera = volgraph_accel::camera::OrbitCamera::default();
-    let mut error_at = |session: &mut LiveSession, step: f64| {
+    let error_at = |session: &mut LiveSession, step: f64| {
         let events =
             session.set_param("march", "step_voxels", ron::Value::Number(ron::value::Number::F64(step.into())));
         assert!(matches!(events.as_slice(), [Event::Reloaded { .. }]), "{events:?}");

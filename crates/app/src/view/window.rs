@@ -176,7 +176,11 @@ impl Viewer {
                     self.lod.target_ms = 1000.0 / target_fps.max(1.0);
                     Vec::new()
                 }
-                Action::TransferFunction(TfAction::Edit(tf)) => session.edit_transfer_function(tf),
+                Action::TransferFunction(TfAction::Edit(tf)) => {
+                    // A point dragged in the editor is motion too: coarse frames until it rests.
+                    self.lod.moved();
+                    session.edit_transfer_function(tf)
+                }
                 Action::TransferFunction(TfAction::Save) => session.save_transfer_function_events(),
                 Action::TransferFunction(TfAction::SaveOnChange(on)) => {
                     session.save_tf_on_change = on;

@@ -45,7 +45,11 @@ pub fn show(
     save_on_change: bool,
 ) -> Option<TfAction> {
     let mut action = None;
-    let (lo, hi) = if range.1 > range.0 { range } else { tf.domain };
+    // The data's range (a constant volume has none: the TF's domain, or a unit span, instead).
+    let (lo, hi) = [range, tf.domain]
+        .into_iter()
+        .find(|(a, b)| a.is_finite() && b.is_finite() && b > a)
+        .unwrap_or((range.0.min(0.0), range.0.max(0.0) + 1.0));
     let selected_id = ui.make_persistent_id("tf_selected");
     let mut selected: Option<usize> = ui.data(|d| d.get_temp(selected_id)).filter(|&i| i < tf.points.len());
     let (response, painter) = ui.allocate_painter(Vec2::new(ui.available_width(), HEIGHT), Sense::click_and_drag());
@@ -157,7 +161,12 @@ pub fn show(
         selected = None;
         action = Some(TfAction::Edit(next));
     }
-    ui.small("click: add a point · drag: move · right-click: delete · histogram: log scale, data units");
+    ui.horizontal(|ui| {
+        ui.small(format!("{lo:.4}"));
+        ui.small("data values (histogram: log scale)");
+        ui.small(format!("{hi:.4}"));
+    });
+    ui.small("click: add a point · drag: move · right-click: delete");
     if let Some(i) = selected.filter(|&i| i < tf.points.len()) {
         let p = &tf.points[i];
         let (mut value, mut alpha) = (p.value, p.alpha);
@@ -252,6 +261,30 @@ mod tests {
     fn at(h: &Harness<'_, State>, v: f64, a: f64) -> Pos2 {
         let s = h.state();
         Pos2::new(s.origin.x + (v / 100.0) as f32 * s.width, s.origin.y + HEIGHT - a as f32 * HEIGHT)
+    }
+
+    /// A constant volume (no value range) and a degenerate TF domain still draw and edit.
+    #[test]
+    fn a_constant_volume_still_draws() {
+        let mut tf = start();
+        tf.domain = (5.0, 5.0);
+        let mut h = Harness::builder().with_size(Vec2::new(420.0, 320.0)).build_ui_state(
+            |ui, tf: &mut TransferFunction| {
+                if let Some(TfAction::Edit(next)) = show(ui, tf, &[7], (5.0, 5.0), &[], false) {
+                    *tf = next;
+                }
+            },
+            tf,
+        );
+        h.run();
+        let at = Pos2::new(200.0, 60.0);
+        h.hover_at(at);
+        h.step();
+        h.drag_at(at);
+        h.step();
+        h.drop_at(at);
+        h.run();
+        assert!(h.state().points.iter().all(|p| p.value.is_finite() && p.alpha.is_finite()), "{:?}", h.state());
     }
 
     #[test]

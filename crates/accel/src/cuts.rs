@@ -13,6 +13,9 @@ use glam::DVec3;
 /// The most clip planes a scene may set (the frame uniforms hold this many).
 pub const MAX_CLIP_PLANES: usize = 6;
 
+/// The largest plane offset (for a unit normal, in volume widths) a clip plane may have.
+pub const MAX_PLANE_OFFSET: f64 = 1000.0;
+
 /// A box in volume fractions, `lo < hi` on every axis, inside `[0,1]³`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CropBox {
@@ -23,10 +26,13 @@ pub struct CropBox {
 }
 
 /// A plane that keeps the fractions `f` with `normal · f >= offset` (the side its normal points
-/// to): `normal (1,0,0), offset 0.5` keeps the half of the volume at x >= 0.5.
+/// to): `normal (1,0,0), offset 0.5` keeps the half of the volume at x >= 0.5. [`Self::new`]
+/// keeps the numbers as written unless the normal's largest component lies outside
+/// 1e-6..1e6; such a plane is scaled to a unit normal (the same half-space), so its numbers fit
+/// the f32 frame uniforms.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ClipPlane {
-    /// The normal (any nonzero length; the kept side is the one it points to).
+    /// The normal (the kept side is the one it points to).
     pub normal: DVec3,
     /// The plane's offset: `normal · f = offset` on the plane.
     pub offset: f64,
@@ -74,6 +80,12 @@ pub enum CutError {
     /// A zero normal.
     #[error("clip plane: the normal ({}, {}, {}) has no direction; give the side to keep, e.g. 1,0,0", .0[0], .0[1], .0[2])]
     ZeroNormal([f64; 3]),
+    /// A plane so far from the volume that it keeps all of it or none: surely a typo.
+    #[error(
+        "clip plane: the offset {0:e} (for a unit normal) lies more than {MAX_PLANE_OFFSET} volume widths away; \
+         planes through the volume have offsets within about ±2"
+    )]
+    FarPlane(f64),
     /// More planes than the frame holds.
     #[error("{0} clip planes: at most {MAX_CLIP_PLANES} are supported")]
     TooManyPlanes(usize),
@@ -123,7 +135,7 @@ impl CropBox {
 }
 
 impl ClipPlane {
-    /// A checked plane.
+    /// A checked plane (see the type for when it is rescaled).
     pub fn new(normal: DVec3, offset: f64) -> Result<Self, CutError> {
         if !normal.is_finite() || !offset.is_finite() {
             return Err(CutError::NotANumber {
@@ -133,10 +145,22 @@ impl ClipPlane {
                 form: "NX,NY,NZ,D",
             });
         }
-        if normal == DVec3::ZERO {
+        // Scaled by its largest component first, so 1e-300 or 1e300 components neither underflow
+        // nor overflow on the way to a unit vector.
+        let largest = normal.abs().max_element();
+        if !(largest > 0.0) {
             return Err(CutError::ZeroNormal(normal.to_array()));
         }
-        Ok(Self { normal, offset })
+        let scaled = normal / largest;
+        let length = scaled.length();
+        let unit_offset = offset / largest / length;
+        if !(unit_offset.abs() <= MAX_PLANE_OFFSET) {
+            return Err(CutError::FarPlane(unit_offset));
+        }
+        if (1e-6..=1e6).contains(&largest) {
+            return Ok(Self { normal, offset });
+        }
+        Ok(Self { normal: scaled / length, offset: unit_offset })
     }
 
     /// `NX,NY,NZ,D` (the `--clip` form).
@@ -163,14 +187,16 @@ impl Cuts {
     /// No cut.
     pub const NONE: Self = Self { crop: None, planes: [None; MAX_CLIP_PLANES] };
 
-    /// Checked cuts.
+    /// Checked cuts: the box and every plane are checked again here (their fields are public,
+    /// a panel slider may have built them), so no unchecked number reaches the GPU.
     pub fn new(crop: Option<CropBox>, planes: &[ClipPlane]) -> Result<Self, CutError> {
         if planes.len() > MAX_CLIP_PLANES {
             return Err(CutError::TooManyPlanes(planes.len()));
         }
+        let crop = crop.map(|c| CropBox::new(c.lo, c.hi)).transpose()?;
         let mut out = Self { crop, planes: [None; MAX_CLIP_PLANES] };
         for (slot, p) in out.planes.iter_mut().zip(planes) {
-            *slot = Some(*p);
+            *slot = Some(ClipPlane::new(p.normal, p.offset)?);
         }
         Ok(out)
     }
@@ -263,6 +289,17 @@ mod tests {
         assert!(e.contains("no direction"), "{e}");
         let e = ClipPlane::parse("1,0,0,inf").unwrap_err().to_string();
         assert!(e.contains("\"inf\""), "{e}");
+        for nan in ["nan,0,0,1", "1,0,0,NaN"] {
+            assert!(ClipPlane::parse(nan).is_err(), "{nan}");
+        }
+        // Huge and tiny normals are the same half-space as a unit one; a far offset is refused.
+        let huge = ClipPlane::parse("1e39,0,0,5e38").expect("a plane");
+        assert_eq!((huge.normal, huge.offset), (DVec3::X, 0.5));
+        let tiny = ClipPlane::parse("0,-1e-300,0,-0.5e-300").expect("a plane");
+        assert_eq!((tiny.normal, tiny.offset), (DVec3::NEG_Y, -0.5));
+        let e = ClipPlane::parse("1,0,0,1e39").unwrap_err().to_string();
+        assert!(e.contains("more than 1000 volume widths"), "{e}");
+        assert!(CropBox::parse("0,0,0,1e39,1,1").is_err() && CropBox::parse("-1,0,0,1,1,1").is_err());
         let seven = [p; 7];
         assert!(matches!(Cuts::new(None, &seven), Err(CutError::TooManyPlanes(7))));
     }

@@ -74,6 +74,8 @@ mod tests {
         let p = first_visible(&volume, &lut, &camera, (65, 65), (32, 32), 0.25, &Cuts::NONE).expect("a hit");
         let centre = DVec3::splat(n as f64 / 2.0);
         let r = (p.voxel - centre).length();
+        // Within a voxel: trilinear filtering puts the 0.5 level of a binary sphere within half a
+        // voxel of its radius, and the first sample past it is at most a 0.25-voxel step on.
         assert!((r - 0.25 * n as f64 / 2.0).abs() < 1.0, "on the surface: r = {r}, at {:?}", p.voxel);
         assert!(p.voxel.z > centre.z, "on the side facing the camera (+z): {:?}", p.voxel);
         assert!(p.value >= volume.value_range.0 + 0.49 * (volume.value_range.1 - volume.value_range.0));
@@ -82,6 +84,8 @@ mod tests {
             Cuts::new(Some(crate::cuts::CropBox::new(DVec3::ZERO, DVec3::new(1.0, 1.0, 0.5)).expect("box")), &[])
                 .expect("cuts");
         let q = first_visible(&volume, &lut, &camera, (65, 65), (32, 32), 0.25, &half).expect("a hit");
+        // The first kept sample lies within one step (0.25 voxel) of the face; 0.6 allows the
+        // step's slant along this nearly axial ray.
         assert!((q.voxel.z - n as f64 / 2.0).abs() < 0.6, "at the crop face: {:?}", q.voxel);
         // A ray past the sphere stays transparent.
         assert_eq!(first_visible(&volume, &lut, &camera, (65, 65), (1, 1), 0.25, &Cuts::NONE), None);

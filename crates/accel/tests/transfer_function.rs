@@ -342,6 +342,8 @@ fn an_edited_tf_saves_as_it_came_and_reads_back() {
     assert_eq!(value[0]["RGBPoints"].as_array().map(Vec::len), Some(8));
     assert_eq!(value[1]["Name"], "second");
     let back = TransferFunction::load_paraview_map_from_str(&written, path, Some("second")).expect("reads back");
+    // 1e-9: the only change is linear → sRGB → linear in f64 (round-off ~1e-15 per channel);
+    // anything near 1e-9 would be a wrong formula, not rounding.
     for v in [0.0, 10.0, 20.0, 55.0, 90.0, 150.0, 200.0, 255.0] {
         let (a, b) = (tf.eval(v), back.eval(v));
         for c in 0..4 {

@@ -654,10 +654,7 @@ impl SavedView {
     /// Writes the scene to `path` (through a temporary file and a rename, so a reader never
     /// sees half a file) and reads it back as a check.
     pub fn save(&self, path: &Path) -> anyhow::Result<()> {
-        let text = self.to_ron();
-        let tmp = path.with_extension("ron.tmp");
-        std::fs::write(&tmp, &text).map_err(|e| anyhow::anyhow!("{}: {e}", tmp.display()))?;
-        std::fs::rename(&tmp, path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        crate::atomic_write::write_atomically(path, &self.to_ron())?;
         Scene::load(path).map_err(|e| anyhow::anyhow!("the saved scene does not read back: {e}"))?;
         Ok(())
     }

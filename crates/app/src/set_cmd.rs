@@ -44,7 +44,7 @@ pub fn run(graph: &Path, assignments: &[String]) -> Result<String, CliError> {
     // Checked like a compile: the edited text must compile, else nothing is written.
     let options = compile_options("256x256", &[], &[])?;
     compile(&display_name(graph), &edited, &crate::program::registry(), &options).map_err(CliError::Graph)?;
-    write_atomically(graph, &edited)?;
+    crate::atomic_write::write_atomically(graph, &edited)?;
     let lines = edits
         .iter()
         .map(|(target, value, edit)| {
@@ -57,19 +57,4 @@ pub fn run(graph: &Path, assignments: &[String]) -> Result<String, CliError> {
         .collect::<Vec<_>>()
         .join("\n");
     Ok(lines + "\n")
-}
-
-/// Writes `text` to `path` by renaming a sibling temporary file over it: a reader (the viewer's
-/// watcher) sees the old file or the new one, never half of it.
-fn write_atomically(path: &Path, text: &str) -> anyhow::Result<()> {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.volgraph-set.tmp"));
-    std::fs::write(&tmp, text).map_err(|e| anyhow!("{}: cannot write: {e}", tmp.display()))?;
-    if let Ok(meta) = std::fs::metadata(path) {
-        let _ = std::fs::set_permissions(&tmp, meta.permissions());
-    }
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        anyhow!("{}: cannot replace the file: {e}", path.display())
-    })
 }

@@ -260,42 +260,46 @@ fn hot_reload_in_a_window_keeps_the_last_good_graph_and_matches_the_headless_ren
     assert!(status.success(), "viewer exited with {status}:\n{stderr}");
     assert!(!stderr.contains("panicked") && !stderr.contains("internal error"), "{stderr}");
 
-    // The same graph rendered headless.
-    let headless = dir.join("headless.png");
-    let out = Command::new(env!("CARGO_BIN_EXE_volgraph"))
-        .args(["render", &graph.display().to_string(), "--size", "96x96", "--crop", "0,0,0,0.6,1,1", "--clip"])
-        .args(["0,1,1,0.9", "--tf", &tf.display().to_string(), "-o"])
-        .arg(&headless)
-        .arg("--shaders")
-        .arg(dir.join("shaders"))
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .expect("render runs");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let (a, b) = (read_rgba(&shots), read_rgba(&headless));
-    assert_eq!(a.dimensions(), b.dimensions());
+    // `volgraph render ARGS -o DIR/NAME --shaders DIR/shaders` (the shaders folder is a flag, not
+    // part of a scene), read back.
+    let render = |args: &[&str], name: &str| {
+        let path = dir.join(name);
+        let out = Command::new(env!("CARGO_BIN_EXE_volgraph"))
+            .arg("render")
+            .args(args)
+            .arg("-o")
+            .arg(&path)
+            .arg("--shaders")
+            .arg(dir.join("shaders"))
+            .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+            .output()
+            .expect("render runs");
+        assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+        read_rgba(&path)
+    };
     // Tolerance 2/255 per channel: the window shows the 8-bit sRGB `display` output through the
     // blit, which decodes it to linear for the sRGB surface, where it is encoded to 8 bits again;
     // the round trip moves a value by at most one step, and lavapipe's sRGB encode may round the
     // other way (so two). Everything else is the same GPU work.
-    let max = a.pixels().zip(b.pixels()).flat_map(|(p, q)| (0..3).map(move |c| p[c].abs_diff(q[c]))).max().unwrap_or(0);
-    let lit = b.pixels().filter(|p| p[0] > 20 || p[1] > 20 || p[2] > 20).count();
+    let max_difference = |a: &image::RgbaImage, b: &image::RgbaImage| {
+        assert_eq!(a.dimensions(), b.dimensions(), "the same viewport");
+        a.pixels().zip(b.pixels()).flat_map(|(p, q)| (0..3).map(move |c| p[c].abs_diff(q[c]))).max().unwrap_or(0)
+    };
+    let window = read_rgba(&shots);
+    // The same graph rendered headless, with the cuts and TF set in the viewer.
+    let graph_arg = graph.display().to_string();
+    let tf_arg = tf.display().to_string();
+    let headless = render(
+        &[&graph_arg, "--size", "96x96", "--crop", "0,0,0,0.6,1,1", "--clip", "0,1,1,0.9", "--tf", &tf_arg],
+        "headless.png",
+    );
+    let lit = headless.pixels().filter(|p| p[0] > 20 || p[1] > 20 || p[2] > 20).count();
     assert!(lit > 96 * 96 / 10, "the headless render shows the volume ({lit} lit pixels)");
+    let max = max_difference(&window, &headless);
     assert!(max <= 2, "screenshot vs headless render: max channel difference {max}/255");
-    // The saved scene draws the same view (the shaders folder is a flag, not part of a scene).
-    let from_scene = dir.join("from_scene.png");
-    let out = Command::new(env!("CARGO_BIN_EXE_volgraph"))
-        .args(["render", "--scene", &saved.display().to_string(), "-o"])
-        .arg(&from_scene)
-        .arg("--shaders")
-        .arg(dir.join("shaders"))
-        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
-        .output()
-        .expect("render runs");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let c = read_rgba(&from_scene);
-    assert_eq!(a.dimensions(), c.dimensions(), "the scene keeps the viewport");
-    let max = a.pixels().zip(c.pixels()).flat_map(|(p, q)| (0..3).map(move |c| p[c].abs_diff(q[c]))).max().unwrap_or(0);
+    // The saved scene draws the same view.
+    let from_scene = render(&["--scene", &saved.display().to_string()], "from_scene.png");
+    let max = max_difference(&window, &from_scene);
     assert!(max <= 2, "screenshot vs render --scene of the saved view: max channel difference {max}/255");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -28,7 +28,7 @@ pub struct CutsArgs {
     #[arg(long, default_value = "800x600")]
     pub size: String,
     /// Timed frames per case (the median is reported).
-    #[arg(long, default_value_t = 12)]
+    #[arg(long, default_value_t = 12, value_parser = clap::value_parser!(u32).range(1..=10_000))]
     pub frames: u32,
     /// Write the figures as JSON here.
     #[arg(long)]
@@ -108,12 +108,6 @@ pub fn run(args: &CutsArgs) -> anyhow::Result<serde_json::Value> {
         "graph": args.graph.display().to_string(), "dataset": args.dataset, "size": args.size,
         "frames": args.frames, "adapter": adapter, "clock": clock, "rows": json,
     });
-    if let Some(path) = &args.markdown {
-        std::fs::write(path, &table).with_context(|| format!("writing {}", path.display()))?;
-    }
-    if let Some(path) = &args.json {
-        std::fs::write(path, serde_json::to_string_pretty(&value)?)
-            .with_context(|| format!("writing {}", path.display()))?;
-    }
+    crate::report_files::write_markdown_and_json((args.markdown.as_deref(), &table), (args.json.as_deref(), &value))?;
     Ok(value)
 }

@@ -7,9 +7,9 @@
 //! second as a fraction of it.
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use anyhow::{Context as _, anyhow};
+use anyhow::anyhow;
 use serde::Serialize;
 use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::volume::Volume;
@@ -191,16 +191,9 @@ pub fn run(args: &FetchArgs) -> anyhow::Result<FetchReport> {
     };
     let markdown = to_markdown(&report);
     volgraph_app::stdout::write_stdout(&markdown)?;
-    write_file(args.json.as_deref(), &(serde_json::to_string_pretty(&report)? + "\n"), "--json")?;
-    write_file(args.markdown.as_deref(), &markdown, "--markdown")?;
+    crate::report_files::write_file(args.json.as_deref(), &(serde_json::to_string_pretty(&report)? + "\n"), "--json")?;
+    crate::report_files::write_file(args.markdown.as_deref(), &markdown, "--markdown")?;
     Ok(report)
-}
-
-fn write_file(path: Option<&Path>, text: &str, flag: &str) -> anyhow::Result<()> {
-    match path {
-        Some(p) => std::fs::write(p, text).with_context(|| format!("{flag} {}: cannot write the file", p.display())),
-        None => Ok(()),
-    }
 }
 
 /// The markdown table.

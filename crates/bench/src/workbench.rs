@@ -34,7 +34,7 @@ pub struct WorkbenchArgs {
     #[arg(long, default_value = "800x600")]
     pub size: String,
     /// Timed edits and frames per case (the median is reported).
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=10_000))]
     pub frames: u32,
     /// Skip the per-graph drag frame times (only the TF edit).
     #[arg(long)]
@@ -180,12 +180,6 @@ pub fn run(args: &WorkbenchArgs) -> anyhow::Result<serde_json::Value> {
         "adapter": adapter, "size": args.size, "volume": volume.display().to_string(),
         "steady_frame_ms": steady_ms, "tf_upload_ms": upload_ms, "tf_edit_to_frame_ms": edit_ms, "drag": drag_rows,
     });
-    if let Some(path) = &args.markdown {
-        std::fs::write(path, &md).with_context(|| format!("writing {}", path.display()))?;
-    }
-    if let Some(path) = &args.json {
-        std::fs::write(path, serde_json::to_string_pretty(&value)?)
-            .with_context(|| format!("writing {}", path.display()))?;
-    }
+    crate::report_files::write_markdown_and_json((args.markdown.as_deref(), &md), (args.json.as_deref(), &value))?;
     Ok(value)
 }

@@ -9,6 +9,8 @@ use std::collections::BTreeSet;
 
 use volgraph_accel::cuts::Cuts;
 
+use crate::decl::PassDecl;
+
 /// The scene feature of a crop box.
 pub const CROP: &str = "crop";
 /// The scene feature of clip planes.
@@ -33,6 +35,14 @@ pub fn features_of(cuts: &Cuts) -> BTreeSet<String> {
 pub fn defines_of<'a>(features: impl IntoIterator<Item = &'a String>) -> Vec<&'static str> {
     let on: BTreeSet<&str> = features.into_iter().map(String::as_str).collect();
     CUT_DEFINES.iter().filter(|(feature, _)| on.contains(feature)).map(|(_, define)| *define).collect()
+}
+
+/// The cut `#if` names pass `decl` is compiled with when `cut_defines` are the frame's: all of
+/// them for a pass that honours a sub-box of the volume, none for any other (a plan with cuts
+/// and such a pass is refused, `compile::passes_that_cannot_cut`). The one rule the plan check,
+/// the runtime's node creation and the tests share.
+pub fn defines_for_pass<D: PassDecl + ?Sized>(decl: &D, cut_defines: &[&'static str]) -> Vec<&'static str> {
+    if decl.honours_volume_window() { cut_defines.to_vec() } else { Vec::new() }
 }
 
 /// Whether `feature` is a cut (always known to the compiler, whatever the graph declares).

@@ -66,6 +66,13 @@ pub struct Step {
     pub ports: Vec<BoundPort>,
 }
 
+impl Step {
+    /// The names of the ports the graph wires (what `shaders_wired` and its `#if` names take).
+    pub fn wired_ports(&self) -> Vec<&str> {
+        self.ports.iter().filter(|bp| bp.binding != Binding::Unbound).map(|bp| bp.port.as_str()).collect()
+    }
+}
+
 /// What one port of a step is bound to.
 #[derive(Clone, Debug)]
 pub struct BoundPort {

@@ -33,16 +33,6 @@ use support::{gpu, graph_source};
 
 const SIZE: u32 = 96;
 
-const CAMERA: OrbitCamera = OrbitCamera {
-    azimuth_deg: 30.0,
-    elevation_deg: 20.0,
-    distance: 3.2,
-    fov_y_deg: 30.0,
-    near: 0.01,
-    far: 100.0,
-    target: [0.0; 3],
-};
-
 /// `graph` rendered on the GPU with `cuts`, and the reference settings of its "march" pass.
 fn render_cut(
     gpu: &std::sync::Arc<volgraph_core::runtime::Gpu>,
@@ -105,12 +95,12 @@ fn every_raycaster_crops_and_clips_like_the_reference() {
         "klein_2005/leap_iso.ron",
     ] {
         for (name, cuts) in cuts_to_test() {
-            let (image, settings) = render_cut(&gpu, graph, &volume, &lut, &CAMERA, cuts);
-            let reference = render_reference(&volume, &lut, &CAMERA, SIZE, SIZE, &settings);
+            let (image, settings) = render_cut(&gpu, graph, &volume, &lut, &OrbitCamera::default(), cuts);
+            let reference = render_reference(&volume, &lut, &OrbitCamera::default(), SIZE, SIZE, &settings);
             let uncut = render_reference(
                 &volume,
                 &lut,
-                &CAMERA,
+                &OrbitCamera::default(),
                 SIZE,
                 SIZE,
                 &volgraph_accel::reference::RaycastSettings { cuts: Cuts::NONE, ..settings },
@@ -156,7 +146,8 @@ fn a_crop_to_half_renders_like_the_other_half_zeroed() {
     let zeroed = Volume { data: VoxelData::F32(zeroed_data), ..volume.clone() };
     let half = Cuts::new(Some(CropBox::new(DVec3::ZERO, DVec3::new(0.5, 1.0, 1.0)).expect("box")), &[]).expect("cuts");
     // Looking down -z with a narrow field: most rays stay on one side of x = 0.5.
-    let camera = OrbitCamera { azimuth_deg: 0.0, elevation_deg: 0.0, distance: 4.0, fov_y_deg: 20.0, ..CAMERA };
+    let camera =
+        OrbitCamera { azimuth_deg: 0.0, elevation_deg: 0.0, distance: 4.0, fov_y_deg: 20.0, ..OrbitCamera::default() };
     let frame = camera.frame(SIZE, SIZE);
     for graph in ["basic/fragment_raycast.ron", "modern/fastest.ron", "basic/isosurface.ron"] {
         let (cropped, _) = render_cut(&gpu, graph, &volume, &lut, &camera, half);
@@ -210,10 +201,11 @@ fn cuts_set_after_the_plan_are_refused_until_it_is_applied_again() {
     runtime.apply(plan.clone(), &registry).expect("applies");
     let crop = Cuts::new(Some(CropBox::new(DVec3::ZERO, DVec3::splat(0.5)).expect("box")), &[]).expect("cuts");
     runtime.set_cuts(crop);
-    let err = runtime.render(CameraData::from_orbit(&CAMERA, (32, 32))).expect_err("not compiled for a crop");
+    let err =
+        runtime.render(CameraData::from_orbit(&OrbitCamera::default(), (32, 32))).expect_err("not compiled for a crop");
     assert!(err.to_string().contains("crop") && err.to_string().contains("apply the plan again"), "{err}");
     runtime.apply(plan, &registry).expect("applies with the crop");
-    runtime.render(CameraData::from_orbit(&CAMERA, (32, 32))).expect("renders cropped");
+    runtime.render(CameraData::from_orbit(&OrbitCamera::default(), (32, 32))).expect("renders cropped");
 }
 
 /// A graph with a pass that samples the volume its own way (slice-based rendering) is refused

@@ -111,14 +111,10 @@ fn pass_code_with_cuts(graph: &str, pass: &str, options: CompileOptions) -> BTre
     let step = plan.steps.iter().find(|s| s.pass_id == pass).expect("the step");
     let plugin = registry.get(&step.kind).expect("registered");
     assert!(plugin.honours_volume_window(), "{}: the raycasters take cuts", step.kind);
+    let cuts = volgraph_core::cut_effects::defines_of(&plan.features);
     let mut defines = plugin.shader_defines(&step.params);
-    defines.extend(volgraph_core::cut_effects::defines_of(&plan.features));
-    let wired: Vec<&str> = step
-        .ports
-        .iter()
-        .filter(|p| p.binding != volgraph_core::plan::Binding::Unbound)
-        .map(|p| p.port.as_str())
-        .collect();
+    defines.extend(volgraph_core::cut_effects::defines_for_pass(plugin.as_ref(), &cuts));
+    let wired = step.wired_ports();
     plugin
         .shaders_wired(&step.params, &wired)
         .iter()

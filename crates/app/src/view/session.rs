@@ -52,6 +52,14 @@ pub enum Event {
         /// What changed.
         what: String,
     },
+    /// A file could not be written (a TF, a saved view, the graph's values); nothing else
+    /// changed.
+    NotSaved {
+        /// What was to be saved.
+        what: String,
+        /// Why, and the path.
+        message: String,
+    },
     /// The viewer wrote a file (a TF edit saved).
     Saved {
         /// What was saved.
@@ -72,6 +80,9 @@ impl fmt::Display for Event {
             }
             Event::Recovered { what } => write!(f, "recovered: {what} is good again"),
             Event::Saved { what, path } => write!(f, "saved {what} {}", path.display()),
+            Event::NotSaved { what, message } => {
+                write!(f, "not saved: {what}: {}", message.lines().next().unwrap_or_default())
+            }
         }
     }
 }
@@ -435,6 +446,21 @@ impl LiveSession {
         &self.tf_presets
     }
 
+    /// Whether a TF point at data value `value` is one the editor could place: within the
+    /// data's range, or one range-width beyond either end (a ramp may start outside the data).
+    pub fn check_tf_value(&self, value: f64) -> Result<(), String> {
+        let (lo, hi) = self.volume.value_range;
+        let width = if hi > lo { hi - lo } else { 1.0 };
+        if value.is_finite() && value >= lo - width && value <= hi + width {
+            return Ok(());
+        }
+        Err(format!(
+            "{value}: a TF point must lie within the data's values {lo}..{hi} or one range beyond ({}..{})",
+            lo - width,
+            hi + width
+        ))
+    }
+
     /// The transfer function on screen.
     pub fn transfer_function(&self) -> &TransferFunction {
         &self.tf
@@ -485,9 +511,7 @@ impl LiveSession {
         } else {
             self.tf.to_ron_string()
         };
-        let tmp = path.with_extension("tmp~");
-        std::fs::write(&tmp, &text).map_err(|e| anyhow!("{}: {e}", tmp.display()))?;
-        std::fs::rename(&tmp, &path).map_err(|e| anyhow!("{}: {e}", path.display()))?;
+        crate::atomic_write::write_atomically(&path, &text)?;
         self.tf_written = Some(text);
         self.tf_path = Some(path.clone());
         Ok(path)
@@ -497,7 +521,7 @@ impl LiveSession {
     pub fn save_transfer_function_events(&mut self) -> Vec<Event> {
         match self.save_transfer_function() {
             Ok(path) => vec![Event::Saved { what: "transfer function".to_string(), path }],
-            Err(e) => vec![Event::Error { what: "save transfer function".to_string(), message: format!("{e:#}") }],
+            Err(e) => vec![Event::NotSaved { what: "transfer function".to_string(), message: format!("{e:#}") }],
         }
     }
 

@@ -302,6 +302,8 @@ mod tests {
         h.drop_at(to);
         h.step();
         let p = &h.state().tf.points[1];
+        // One screen point is 100/404 ≈ 0.25 data units across and 1/130 ≈ 0.008 opacity up;
+        // the pointer lands on a point's position rounded by egui: within 1 unit and 0.02.
         assert!((p.value - 30.0).abs() < 1.0 && (p.alpha - 0.8).abs() < 0.02, "moved to {p:?}");
         assert_eq!(p.color, [1.0, 0.0, 0.0], "the colour stays with the point");
         assert!(h.state().edits >= 1);

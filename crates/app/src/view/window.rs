@@ -149,7 +149,7 @@ impl Viewer {
         }
         for e in &events {
             emit(e);
-            if let Event::Error { message, .. } = e {
+            if let Event::Error { message, .. } | Event::NotSaved { message, .. } = e {
                 crate::stdout::eprintln_escaped!("{message}");
             }
         }
@@ -192,7 +192,7 @@ impl Viewer {
                         Vec::new()
                     }
                     Err(e) => {
-                        vec![super::session::Event::Error { what: "save view".to_string(), message: format!("{e:#}") }]
+                        vec![super::session::Event::NotSaved { what: "view".to_string(), message: format!("{e:#}") }]
                     }
                 },
                 Action::Screenshot => {
@@ -211,8 +211,8 @@ impl Viewer {
                         }
                         Vec::new()
                     }
-                    Err(e) => vec![super::session::Event::Error {
-                        what: "write to graph file".to_string(),
+                    Err(e) => vec![super::session::Event::NotSaved {
+                        what: "values to the graph file".to_string(),
                         message: format!("{e:#}"),
                     }],
                 },
@@ -235,6 +235,10 @@ impl Viewer {
                 Ok(Some(ScriptCommand::SaveScene(path))) => self.apply_actions(vec![Action::SaveScene(path)]),
                 Ok(Some(ScriptCommand::TfPoint(point))) => {
                     let Some(session) = self.session.as_ref() else { continue };
+                    if let Err(message) = session.check_tf_value(point.value) {
+                        crate::stdout::eprintln_escaped!("script: tf-point {message}");
+                        continue;
+                    }
                     let mut tf = session.transfer_function().clone();
                     tf.points.retain(|p| p.value != point.value);
                     let at = tf.points.partition_point(|p| p.value <= point.value);

@@ -33,17 +33,14 @@ pub fn check_plan_bindings(plan: &Plan, registry: &dyn KindLookup, sources: &Sha
         }
         let Some(plugin) = registry.decl(&step.kind) else { continue };
         let ports: Vec<PortInfo> = port_infos(plan, step, &plugin.ports(&step.params));
-        let wired: Vec<&str> = step
-            .ports
-            .iter()
-            .filter(|bp| bp.binding != crate::plan::Binding::Unbound)
-            .map(|bp| bp.port.as_str())
+        let wired = step.wired_ports();
+        let cuts = crate::cut_effects::defines_of(&plan.features);
+        let defines: BTreeSet<String> = plugin
+            .shader_defines(&step.params)
+            .into_iter()
+            .chain(crate::cut_effects::defines_for_pass(plugin.as_ref(), &cuts))
+            .map(str::to_string)
             .collect();
-        let mut defines: BTreeSet<String> =
-            plugin.shader_defines(&step.params).into_iter().map(str::to_string).collect();
-        if plugin.honours_volume_window() {
-            defines.extend(crate::cut_effects::defines_of(&plan.features).into_iter().map(str::to_string));
-        }
         for shader in plugin.shaders_wired(&step.params, &wired) {
             let problem = |message: String| {
                 Diagnostic::new(Location::File, format!("pass \"{}\" ({}): {message}", step.pass_id, step.kind))

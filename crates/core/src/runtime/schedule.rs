@@ -191,7 +191,7 @@ pub(crate) fn build(
         let ports = port_infos(&plan, step, &plugin.ports(&step.params));
         // The scene's cuts compile into the passes that take only the samples they keep (the
         // compiler refused a plan with a cut and any other pass).
-        let frame_defines = if plugin.honours_volume_window() { cut_defines.to_vec() } else { Vec::new() };
+        let frame_defines = crate::cut_effects::defines_for_pass(plugin.as_ref(), cut_defines);
         if !cut_defines.is_empty() && !plugin.honours_volume_window() {
             return Err((ApplyError::CannotCut { pass: step.pass_id.clone(), kind: step.kind.clone() }, old));
         }

@@ -108,7 +108,6 @@ pub fn run(args: &WorkbenchArgs) -> anyhow::Result<serde_json::Value> {
         edits.push(t0.elapsed().as_secs_f64() * 1e3);
     }
     let (steady_ms, edit_ms, upload_ms) = (median(&steady), median(&edits), median(&uploads));
-    let dims = session.histogram().0.len();
     drop(session);
     let mut md = format!(
         "# The viewer as a workbench (issue 24)\n\nMeasured through the viewer's session (no window) on {adapter}, \
@@ -119,7 +118,6 @@ pub fn run(args: &WorkbenchArgs) -> anyhow::Result<serde_json::Value> {
         args.size,
         args.frames
     );
-    let _ = dims;
     let mut drag_rows = Vec::new();
     if !args.no_drag {
         md.push_str(

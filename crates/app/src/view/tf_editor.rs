@@ -142,12 +142,9 @@ pub fn show(
             None => {
                 let (value, alpha) = from_screen(pos);
                 let [r, g, b, _] = tf.eval(value);
-                let mut next = tf.clone();
-                let point = ControlPoint { value, color: [r, g, b], alpha };
-                let at = next.points.partition_point(|p| p.value <= value);
-                next.points.insert(at, point);
-                selected = Some(at);
-                action = Some(TfAction::Edit(widen(next)));
+                let next = with_point(tf, ControlPoint { value, color: [r, g, b], alpha });
+                selected = next.points.iter().position(|p| p.value == value);
+                action = Some(TfAction::Edit(next));
             }
         }
     }
@@ -203,6 +200,16 @@ pub fn show(
     });
     ui.data_mut(|d| d.insert_temp(selected_id, selected));
     action
+}
+
+/// `tf` with `point` added in value order (replacing a point at the same value), the domain
+/// stretched over it: the editor's click and the script's `tf-point`.
+pub fn with_point(tf: &TransferFunction, point: ControlPoint) -> TransferFunction {
+    let mut next = tf.clone();
+    next.points.retain(|p| p.value != point.value);
+    let at = next.points.partition_point(|p| p.value <= point.value);
+    next.points.insert(at, point);
+    widen(next)
 }
 
 /// The domain stretched over every point (a point dragged past an end takes the domain along).

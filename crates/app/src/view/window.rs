@@ -239,27 +239,24 @@ impl Viewer {
                         crate::stdout::eprintln_escaped!("script: tf-point {message}");
                         continue;
                     }
-                    let mut tf = session.transfer_function().clone();
-                    tf.points.retain(|p| p.value != point.value);
-                    let at = tf.points.partition_point(|p| p.value <= point.value);
-                    tf.points.insert(at, point);
-                    tf.domain =
-                        (tf.domain.0.min(tf.points[0].value), tf.domain.1.max(tf.points[tf.points.len() - 1].value));
+                    let tf = super::tf_editor::with_point(session.transfer_function(), point);
                     self.apply_actions(vec![Action::TransferFunction(TfAction::Edit(tf))]);
                 }
                 Ok(Some(ScriptCommand::TfSave)) => self.apply_actions(vec![Action::TransferFunction(TfAction::Save)]),
                 Ok(Some(ScriptCommand::Crop(crop))) => {
                     let Some(session) = self.session.as_ref() else { continue };
                     let planes: Vec<_> = session.runtime.cuts().planes().copied().collect();
-                    if let Ok(cuts) = volgraph_accel::cuts::Cuts::new(crop, &planes) {
-                        self.apply_actions(vec![Action::Cuts(cuts)]);
+                    match volgraph_accel::cuts::Cuts::new(crop, &planes) {
+                        Ok(cuts) => self.apply_actions(vec![Action::Cuts(cuts)]),
+                        Err(e) => crate::stdout::eprintln_escaped!("script: crop: {e}"),
                     }
                 }
                 Ok(Some(ScriptCommand::Clip(plane))) => {
                     let Some(session) = self.session.as_ref() else { continue };
                     let crop = session.runtime.cuts().crop();
-                    if let Ok(cuts) = volgraph_accel::cuts::Cuts::new(crop, plane.as_slice()) {
-                        self.apply_actions(vec![Action::Cuts(cuts)]);
+                    match volgraph_accel::cuts::Cuts::new(crop, plane.as_slice()) {
+                        Ok(cuts) => self.apply_actions(vec![Action::Cuts(cuts)]),
+                        Err(e) => crate::stdout::eprintln_escaped!("script: clip: {e}"),
                     }
                 }
                 Ok(None) => {}

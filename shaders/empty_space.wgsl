@@ -3,8 +3,10 @@
 // `volgraph_accel::classify::OpacityClassifier`: with a LUT of N texels sampled linearly between
 // texel centres (i+0.5)/N and clamped at the ends, [lo, hi] may be visible iff some texel
 // i ∈ [ceil(lo·N − 1.5), floor(hi·N + 0.5)] (clamped to the LUT) has alpha > 0 (or NaN), the
-// range first widened by VALUE_MARGIN. Run every frame (cheap: one invocation per block), so a
-// changed transfer function is picked up at once.
+// range first widened by VALUE_MARGIN. That test is one subtraction of `visible_before`, the
+// count of such texels before each texel (built by the pass from the LUT it uploads), so a
+// block costs the same whatever its range (a loop over the range's texels took ~10 ms of a TF
+// edit on the engine's 64³ blocks under lavapipe). Rerun when the grid or the TF changes.
 //
 // Entry point: `cs_classify` → `empty` (R32Float 3D: 1 = empty, 0 = may be visible).
 
@@ -13,6 +15,8 @@
 // The min/max grid of minmax_grid.wgsl (r = min, g = max).
 @group(0) @binding(auto) var grid: texture_3d<f32>;
 @group(0) @binding(auto) var empty: texture_storage_3d<r32float, write>;
+// visible_before[i]: how many texels j < i of the LUT have alpha > 0 or NaN (N + 1 entries).
+@group(0) @binding(auto) var<storage, read> visible_before: array<u32>;
 
 // `volgraph_accel::classify::VALUE_MARGIN`: covers f32 rounding of interpolated values.
 const VALUE_MARGIN: f32 = 1e-6;
@@ -54,13 +58,6 @@ fn cs_classify(@builtin(global_invocation_id) id: vec3<u32>) {
         first = clamp(i32(clamp(ceil(lo * n - 1.5), -1.0, n)), 0, texels - 1);
         last = clamp(i32(clamp(floor(hi * n + 0.5), -1.0, n)), 0, texels - 1);
     }
-    var visible = false;
-    for (var i = first; i <= last; i += 1) {
-        let a = textureLoad(tf, vec2<i32>(i, 0), 0).a;
-        if (a > 0.0 || a != a) {
-            visible = true;
-            break;
-        }
-    }
+    let visible = visible_before[last + 1] > visible_before[first];
     textureStore(empty, vec3<i32>(id), vec4<f32>(select(1.0, 0.0, visible), 0.0, 0.0, 0.0));
 }

@@ -73,6 +73,12 @@ impl OpacityClassifier {
         Ok(Self { texels: lut.len(), prefix })
     }
 
+    /// `prefix[i]`: how many texels before `i` have non-zero (or NaN) alpha; `texels + 1`
+    /// entries. The GPU classification (`shaders/empty_space.wgsl`) reads this very table.
+    pub fn visible_before(&self) -> &[u32] {
+        &self.prefix
+    }
+
     /// Number of LUT texels.
     pub fn texels(&self) -> usize {
         self.texels

@@ -41,6 +41,10 @@ pub struct RenderArgs {
     /// How --distributed ranks composite their images.
     #[arg(long, value_enum, default_value = "radix-k", requires = "distributed")]
     pub composite: crate::distributed::CompositeAlgorithm,
+    /// Time every pass by wall clock, each submitted on its own and waited for: per-pass costs
+    /// where GPU timestamps do not cover compute work (lavapipe). The frames get slower.
+    #[arg(long)]
+    pub time_each_pass: bool,
     /// The largest group of a radix-k round (IceT's default: 8; 2 is binary swap).
     #[arg(long = "radix-k", default_value_t = 8, value_parser = clap::value_parser!(u32).range(2..=64), requires = "distributed")]
     pub radix_k: u32,
@@ -176,6 +180,7 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
         );
     }
     runtime.apply(plan, &registry).map_err(|e| anyhow!(e))?;
+    runtime.set_step_profiling(args.time_each_pass);
     // Frames one at a time, so each has its own time (the first includes pipeline JIT).
     let mut stats = Vec::new();
     for f in 0..frames {
@@ -198,7 +203,11 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
         ImageKind::Png => image_out::write_png(&args.out, &image, srgb)?,
     }
     if let Some(stats) = last {
-        let clock = if stats.wall_time_fallback { "wall time" } else { "GPU time" };
+        let clock = match (stats.steps_serialised, stats.wall_time_fallback) {
+            (true, _) => "wall time, passes one by one",
+            (false, true) => "wall time",
+            (false, false) => "GPU time",
+        };
         crate::stdout::eprintln_escaped!(
             "{}: {}x{} on {}, last frame {:.2} ms {clock} → {}",
             graph.display(),
@@ -218,10 +227,10 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
         if stats.step_gpu_ms.is_some() {
             // Per pass, repeat-group instances summed, in schedule order.
             let list: Vec<String> = stats.per_pass_ms().iter().map(|(id, ms)| format!("{id} {ms:.2}")).collect();
-            let caveat = if runtime.gpu().timestamps_cover_work {
+            let caveat = if runtime.gpu().timestamps_cover_work || stats.steps_serialised {
                 ""
             } else {
-                " (timestamps of a CPU adapter: compute passes are not covered)"
+                " (timestamps of a CPU adapter: compute passes are not covered; --time-each-pass times them)"
             };
             crate::stdout::eprintln_escaped!("  per pass (ms){caveat}: {}", list.join(", "));
         }

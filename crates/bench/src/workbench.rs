@@ -72,6 +72,58 @@ fn timed_frame(session: &mut LiveSession, camera: &OrbitCamera) -> anyhow::Resul
     Ok(t0.elapsed().as_secs_f64() * 1e3)
 }
 
+/// Times `frames` TF edits, each moving the middle point's opacity as a drag in the editor
+/// does, through the session: (median ms for the check + upload, median ms from the edit to
+/// its frame finished).
+fn time_tf_edits(session: &mut LiveSession, camera: &OrbitCamera, frames: u32) -> anyhow::Result<(f64, f64)> {
+    let mut edits = Vec::new();
+    let mut uploads = Vec::new();
+    for i in 0..frames {
+        let mut tf = session.transfer_function().clone();
+        let k = tf.points.len() / 2;
+        tf.points[k].alpha = (0.2 + 0.05 * (i % 8) as f64).min(1.0);
+        let t0 = Instant::now();
+        let events = session.edit_transfer_function(tf);
+        if let Some(e) = events.iter().find(|e| matches!(e, volgraph_app::view::session::Event::Error { .. })) {
+            return Err(anyhow!("TF edit: {e}"));
+        }
+        uploads.push(t0.elapsed().as_secs_f64() * 1e3);
+        session.frame(camera, None).map_err(|e| anyhow!(e))?;
+        session.runtime.finish();
+        edits.push(t0.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok((median(&uploads), median(&edits)))
+}
+
+/// Per pass: (id, wall ms in a steady frame, wall ms in the frame after a TF edit), each step
+/// submitted on its own (the medians of 3).
+fn pass_times_of_an_edit(session: &mut LiveSession, camera: &OrbitCamera) -> anyhow::Result<Vec<(String, f64, f64)>> {
+    session.runtime.set_step_profiling(true);
+    let profiled = |session: &mut LiveSession, edit: bool| -> anyhow::Result<Vec<Vec<(String, f64)>>> {
+        (0..3)
+            .map(|i| {
+                if edit {
+                    let mut tf = session.transfer_function().clone();
+                    let k = tf.points.len() / 2;
+                    tf.points[k].alpha = 0.3 + 0.05 * i as f64;
+                    session.edit_transfer_function(tf);
+                }
+                session.frame(camera, None).map_err(|e| anyhow!(e))?;
+                let stats = session.runtime.finish();
+                Ok(stats.last().map(|s| s.per_pass_ms()).unwrap_or_default())
+            })
+            .collect()
+    };
+    timed_frame(session, camera)?;
+    let steady = profiled(session, false)?;
+    let edited = profiled(session, true)?;
+    session.runtime.set_step_profiling(false);
+    let median_of = |runs: &[Vec<(String, f64)>], pass: &str| {
+        median(&runs.iter().filter_map(|r| r.iter().find(|(p, _)| p == pass).map(|(_, ms)| *ms)).collect::<Vec<_>>())
+    };
+    Ok(steady[0].iter().map(|(pass, _)| (pass.clone(), median_of(&steady, pass), median_of(&edited, pass))).collect())
+}
+
 /// Runs the benchmark, prints the tables and returns the JSON.
 pub fn run(args: &WorkbenchArgs) -> anyhow::Result<serde_json::Value> {
     let viewport = volgraph_app::inputs::parse_size(&args.size)?;
@@ -90,34 +142,49 @@ pub fn run(args: &WorkbenchArgs) -> anyhow::Result<serde_json::Value> {
     timed_frame(&mut session, &camera)?;
     let steady: Vec<f64> =
         (0..args.frames).map(|_| timed_frame(&mut session, &camera)).collect::<anyhow::Result<_>>()?;
-    let mut edits = Vec::new();
-    let mut uploads = Vec::new();
-    for i in 0..args.frames {
-        let mut tf = session.transfer_function().clone();
-        // Move the middle point's opacity, as a drag in the editor does.
-        let k = tf.points.len() / 2;
-        tf.points[k].alpha = (0.2 + 0.05 * (i % 8) as f64).min(1.0);
-        let t0 = Instant::now();
-        let events = session.edit_transfer_function(tf);
-        if let Some(e) = events.iter().find(|e| matches!(e, volgraph_app::view::session::Event::Error { .. })) {
-            return Err(anyhow!("TF edit: {e}"));
-        }
-        uploads.push(t0.elapsed().as_secs_f64() * 1e3);
-        session.frame(&camera, None).map_err(|e| anyhow!(e))?;
-        session.runtime.finish();
-        edits.push(t0.elapsed().as_secs_f64() * 1e3);
-    }
-    let (steady_ms, edit_ms, upload_ms) = (median(&steady), median(&edits), median(&uploads));
+    let steady_ms = median(&steady);
+    let (upload_ms, edit_ms) = time_tf_edits(&mut session, &camera, args.frames)?;
+    // The same view with the last edited TF: what the new TF costs by itself.
+    let edited: Vec<f64> =
+        (0..args.frames).map(|_| timed_frame(&mut session, &camera)).collect::<anyhow::Result<_>>()?;
+    let edited_ms = median(&edited);
+    // Dragging a point in the editor counts as motion for the level of detail (view/lod.rs),
+    // so the frames that follow the drag are the coarse ones, as in the viewer.
+    let mut lod = volgraph_app::view::lod::Lod::default();
+    lod.observe(steady_ms);
+    lod.moved();
+    let coarse = lod.viewport(viewport);
+    session.resize(coarse.0, coarse.1);
+    let step = if session.set_step_factor(lod.step_factor()) { lod.step_factor() } else { 1.0 };
+    timed_frame(&mut session, &camera)?;
+    let (_, drag_edit_ms) = time_tf_edits(&mut session, &camera, args.frames)?;
+    let lod_text = format!("{:.2} per axis, step ×{step}", coarse.0 as f64 / viewport.0 as f64);
+    session.set_step_factor(1.0);
+    session.resize(viewport.0, viewport.1);
+    let passes = pass_times_of_an_edit(&mut session, &camera)?;
     drop(session);
     let mut md = format!(
         "# The viewer as a workbench (issue 24)\n\nMeasured through the viewer's session (no window) on {adapter}, \
-         {} at {}, medians of {} in one run.\n\n## From a TF edit to the first frame showing it (goal ≤ 50 ms)\n\n\
+         {} with {} at {}, medians of {} in one run.\n\n## From a TF edit to the first frame showing it (goal ≤ 50 ms)\n\n\
+         Each edit moves the middle point's opacity, as a drag in the editor does; only what depends on the TF reruns \
+         (the LUT upload, the empty-block classification and the distance map, then the frame).\n\n\
          | | ms |\n|---|---:|\n| steady frame (same view, no edit) | {steady_ms:.1} |\n| TF edit: check + LUT upload | {upload_ms:.2} |\n\
-         | TF edit → frame finished | {edit_ms:.1} |\n\n",
+         | TF edit → full frame finished | {edit_ms:.1} |\n| steady frame with the edited TF | {edited_ms:.1} |\n\
+         | TF point dragged → frame finished, at the viewer's level of detail ({lod_text}) | {drag_edit_ms:.1} |\n\n",
         volume.file_name().map(|f| f.to_string_lossy().to_string()).unwrap_or_default(),
+        args.graph.display(),
         args.size,
         args.frames
     );
+    md.push_str(
+        "Where the time goes: one frame with every step submitted on its own and waited for \
+         (`Runtime::set_step_profiling`; lavapipe's timestamps do not cover compute work), at full size:\n\n\
+         | pass | steady frame ms | frame after a TF edit ms |\n|---|---:|---:|\n",
+    );
+    for (pass, steady, edited) in &passes {
+        md.push_str(&format!("| {pass} | {steady:.1} | {edited:.1} |\n"));
+    }
+    md.push('\n');
     let mut drag_rows = Vec::new();
     if !args.no_drag {
         md.push_str(
@@ -176,7 +243,9 @@ pub fn run(args: &WorkbenchArgs) -> anyhow::Result<serde_json::Value> {
     println!("{md}");
     let value = serde_json::json!({
         "adapter": adapter, "size": args.size, "volume": volume.display().to_string(),
-        "steady_frame_ms": steady_ms, "tf_upload_ms": upload_ms, "tf_edit_to_frame_ms": edit_ms, "drag": drag_rows,
+        "steady_frame_ms": steady_ms, "tf_upload_ms": upload_ms, "tf_edit_to_frame_ms": edit_ms,
+        "steady_frame_edited_tf_ms": edited_ms, "tf_drag_to_lod_frame_ms": drag_edit_ms, "tf_drag_lod": lod_text,
+        "pass_ms": passes.iter().map(|(p, s, e)| serde_json::json!({"pass": p, "steady_ms": s, "after_tf_edit_ms": e})).collect::<Vec<_>>(), "drag": drag_rows,
     });
     crate::report_files::write_markdown_and_json((args.markdown.as_deref(), &md), (args.json.as_deref(), &value))?;
     Ok(value)

@@ -1,22 +1,37 @@
 //! `empty_distance`: the Chebyshev distance, in blocks, from each block of `empty_space`'s grid
 //! to the nearest block that may be visible — the distance map with which a raycaster leaps over
 //! many empty blocks at once instead of one at a time (`raycast_compute` wired to `distance`). A
-//! separable L∞ distance transform, one compute dispatch per axis, rebuilt every frame with the
-//! flags (it costs a few thousand line scans). The leap stays lossless: every sample it skips
-//! lies in an empty block. Shader: `shaders/empty_distance.wgsl`.
+//! separable L∞ distance transform, one compute dispatch per axis and O(n) per line, rebuilt
+//! when the flags change (a TF edit). The leap stays lossless: every sample it skips lies in an
+//! empty block. Equal cell for cell to `volgraph_accel::chebyshev` (`tests/empty_distance.rs`).
+//! Shader: `shaders/empty_distance.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
 use volgraph_core::{Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, Rerun};
 
 use crate::empty_space::EMPTY_BLOCKS;
+use crate::grid_tap::GridTap;
 use crate::minmax_grid::{bound_size, create_grid_texture};
 
 /// The Owned type name of the distance map.
 pub const EMPTY_DISTANCE: &str = "empty_distance";
 
-/// The plugin.
-pub struct EmptyDistance;
+/// Longest grid line the shader solves (`MAX_LINE` of `empty_distance.wgsl`).
+const MAX_LINE: u32 = 2048;
+
+/// The plugin; [`EmptyDistance::tapped`] also hands the distance texture to a [`GridTap`].
+#[derive(Default)]
+pub struct EmptyDistance {
+    tap: Option<GridTap>,
+}
+
+impl EmptyDistance {
+    /// An `empty_distance` pass that stores its map in `tap` (tests, tools).
+    pub fn tapped(tap: GridTap) -> Self {
+        Self { tap: Some(tap) }
+    }
+}
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
@@ -65,36 +80,55 @@ impl PassPlugin for EmptyDistance {
         })?;
         let axes = [0u32, 1, 2]
             .map(|axis| ctx.uniform_with(&format!("axis{axis}"), &DistanceParamsGpu { axis, _pad: [0; 3] }));
-        Ok(Box::new(EmptyDistanceNode { pipeline, axes, textures: None }))
+        Ok(Box::new(EmptyDistanceNode { pipeline, axes, textures: None, tap: self.tap.clone() }))
     }
+}
+
+/// The published map, the scratch texture of the middle pass, and their size in blocks.
+struct DistanceTextures {
+    out: wgpu::TextureView,
+    scratch: wgpu::TextureView,
+    dims: [u32; 3],
 }
 
 struct EmptyDistanceNode {
     pipeline: ComputePassPipeline,
     axes: [wgpu::Buffer; 3],
-    /// The published map and the scratch texture of the middle pass, with their size.
-    textures: Option<(wgpu::TextureView, wgpu::TextureView, [u32; 3])>,
+    textures: Option<DistanceTextures>,
+    tap: Option<GridTap>,
 }
 
 impl PassNode for EmptyDistanceNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let dims = bound_size(ctx, "empty")?;
-        if self.textures.as_ref().is_none_or(|(_, _, d)| *d != dims) {
+        if dims.iter().any(|n| *n > MAX_LINE) {
+            return Err(PassError {
+                pass: ctx.label.to_string(),
+                message: format!(
+                    "the block grid is {dims:?}, longer than {MAX_LINE} blocks along an axis; raise block_size"
+                ),
+            });
+        }
+        if self.textures.as_ref().is_none_or(|t| t.dims != dims) {
             let make = |what: &str| {
                 create_grid_texture(ctx, &format!("{} {what}", ctx.label), wgpu::TextureFormat::R32Float, dims)
-                    .create_view(&wgpu::TextureViewDescriptor::default())
             };
-            self.textures = Some((make("distance"), make("partial distance"), dims));
+            let out = make("distance");
+            if let Some(tap) = &self.tap {
+                tap.set(&out);
+            }
+            let view = |t: wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
+            self.textures = Some(DistanceTextures { out: view(out), scratch: view(make("partial distance")), dims });
         }
-        let Some((out, scratch, _)) = self.textures.clone() else {
+        let Some(textures) = &self.textures else {
             return Err(PassError { pass: ctx.label.to_string(), message: "distance textures missing".to_string() });
         };
-        let empty = ctx.view("empty")?;
-        // x: empty → out; y: out → scratch; z: scratch → out.
-        let steps = [(empty, &out, &scratch), (&out, &scratch, &out), (&scratch, &out, &scratch)];
+        // x: flags → out; y: out → scratch; z: scratch → out. Pass x reads the flags, not
+        // `partial`, which is bound to a texture it does not write.
+        let (out, scratch) = (&textures.out, &textures.scratch);
+        let steps = [(scratch, out), (out, scratch), (scratch, out)];
         let mut groups = Vec::with_capacity(3);
-        for (axis, (partial, write, _)) in steps.iter().enumerate() {
-            let partial: &wgpu::TextureView = if axis == 0 { &scratch } else { partial };
+        for (axis, (partial, write)) in steps.iter().enumerate() {
             groups.push(ctx.bind_group(
                 &self.pipeline,
                 &[
@@ -120,7 +154,7 @@ impl PassNode for EmptyDistanceNode {
 
     fn owned_output(&self, port: &str) -> Option<wgpu::TextureView> {
         match port {
-            "distance" => self.textures.as_ref().map(|(out, _, _)| out.clone()),
+            "distance" => self.textures.as_ref().map(|t| t.out.clone()),
             _ => None,
         }
     }

@@ -14,6 +14,7 @@ use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind,
 
 use crate::grid_tap::GridTap;
 use crate::minmax_grid::{MINMAX_GRID, bound_size, create_grid_texture, dispatch_grid};
+use volgraph_accel::classify::OpacityClassifier;
 
 /// The Owned type name of the empty-block flags.
 pub const EMPTY_BLOCKS: &str = "empty_blocks";
@@ -96,7 +97,7 @@ impl PassDecl for EmptySpace {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse::new("empty_space.wgsl", "cs_classify")]
+        vec![ShaderUse::new("empty_space.wgsl", "cs_classify").binds(&["visible_before"])]
     }
 }
 
@@ -109,13 +110,15 @@ impl PassPlugin for EmptySpace {
             defines: &defines,
             ..Default::default()
         })?;
-        Ok(Box::new(EmptySpaceNode { pipeline, flags: None, tap: self.tap.clone() }))
+        Ok(Box::new(EmptySpaceNode { pipeline, flags: None, visible_before: None, tap: self.tap.clone() }))
     }
 }
 
 struct EmptySpaceNode {
     pipeline: ComputePassPipeline,
     flags: Option<(wgpu::Texture, wgpu::TextureView, [u32; 3])>,
+    /// The LUT's visible-texel prefix counts (`visible_before` of the shader) and their length.
+    visible_before: Option<(wgpu::Buffer, usize)>,
     tap: Option<GridTap>,
 }
 
@@ -135,7 +138,29 @@ impl PassNode for EmptySpaceNode {
             pass: ctx.label.to_string(),
             message: "empty-block texture missing right after creation".to_string(),
         })?;
-        let bg = ctx.bind_group(&self.pipeline, &[("empty", wgpu::BindingResource::TextureView(&view))])?;
+        let classifier = OpacityClassifier::new(ctx.table("tf")?)
+            .map_err(|e| PassError { pass: ctx.label.to_string(), message: format!("transfer function: {e}") })?;
+        let counts = classifier.visible_before();
+        if self.visible_before.as_ref().is_none_or(|(_, n)| *n != counts.len()) {
+            let buffer = ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(&format!("{} visible texels before", ctx.label)),
+                size: (counts.len() * 4) as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            self.visible_before = Some((buffer, counts.len()));
+        }
+        let Some((counts_buffer, _)) = &self.visible_before else {
+            return Err(PassError { pass: ctx.label.to_string(), message: "prefix buffer missing".to_string() });
+        };
+        ctx.write_buffer(counts_buffer, 0, bytemuck::cast_slice(counts));
+        let bg = ctx.bind_group(
+            &self.pipeline,
+            &[
+                ("empty", wgpu::BindingResource::TextureView(&view)),
+                ("visible_before", counts_buffer.as_entire_binding()),
+            ],
+        )?;
         dispatch_grid(ctx, &self.pipeline, &bg, dims);
         Ok(())
     }

@@ -64,7 +64,7 @@ pub fn register_builtin(registry: &mut Registry) {
         .register(termination_test::TerminationTest)
         .register(minmax_grid::MinMaxGridPass::default())
         .register(empty_space::EmptySpace::default())
-        .register(empty_distance::EmptyDistance)
+        .register(empty_distance::EmptyDistance::default())
         .register(fetch_probe::FetchProbe)
         .register(slice_render::SliceRender)
         .register(reprojection_splat::ReprojectionSplat)

@@ -352,3 +352,23 @@ fn a_plan_that_fails_to_apply_leaves_the_previous_one_running() {
     frame(&mut rt);
     assert_eq!(red(&mut rt), 102.0, "the last good graph keeps rendering");
 }
+
+#[test]
+fn step_profiling_times_every_step_and_renders_the_same() {
+    let mut rt = runtime();
+    apply(&mut rt, CHAIN, &CompileOptions::new(8, 4));
+    frame(&mut rt);
+    let plain = red(&mut rt);
+    rt.set_step_profiling(true);
+    let c = camera(&rt);
+    let stats = rt.render(c).expect("profiled frame");
+    assert!(stats.steps_serialised, "the stats say the steps were submitted one by one");
+    let ms = stats.step_gpu_ms.as_ref().expect("a time per step");
+    assert_eq!(ms.len(), stats.pass_ids.len(), "one time per step: {:?}", stats.pass_ids);
+    assert!(ms.iter().all(|t| t.is_finite() && *t >= 0.0), "wall times: {ms:?}");
+    assert_eq!(stats.per_pass_ms().len(), 4, "start, a, b, c");
+    assert_eq!(red(&mut rt), plain, "submitting step by step renders what one submit does");
+    rt.set_step_profiling(false);
+    let stats = rt.render(c).expect("frame");
+    assert!(!stats.steps_serialised, "profiling off again");
+}

@@ -31,6 +31,8 @@ pub enum Action {
     SaveScene(std::path::PathBuf),
     /// The TF editor's action.
     TransferFunction(super::tf_editor::TfAction),
+    /// Time every pass on its own (`Runtime::set_step_profiling`) or not.
+    TimeEachPass(bool),
     /// Level of detail while moving: on or off, and the frame rate to hold.
     Lod {
         /// Render coarser while moving.
@@ -46,6 +48,8 @@ pub struct Timings {
     per_pass: Vec<(String, f64)>,
     frame_ms: f64,
     wall_fallback: bool,
+    /// The last frame's passes were submitted one by one.
+    serialised: bool,
     /// Frames presented.
     pub frames: u64,
 }
@@ -59,6 +63,7 @@ impl Timings {
         let blend = |old: f64, new: f64| if old == 0.0 { new } else { old + SMOOTHING * (new - old) };
         self.frame_ms = blend(self.frame_ms, stats.frame_ms);
         self.wall_fallback = stats.wall_time_fallback;
+        self.serialised = stats.steps_serialised;
         let fresh = stats.per_pass_ms();
         let mut merged = Vec::with_capacity(fresh.len());
         for (pass, ms) in fresh {
@@ -134,7 +139,11 @@ pub fn show(
     egui::Panel::right("volgraph").default_size(320.0).show(root, |ui| {
         let Some(plan) = session.plan() else { return };
         ui.heading(&plan.name);
-        let clock = if timings.wall_fallback { "wall" } else { "GPU" };
+        let clock = match (timings.serialised, timings.wall_fallback) {
+            (true, _) => "wall, passes one by one",
+            (false, true) => "wall",
+            (false, false) => "GPU",
+        };
         ui.label(format!(
             "{:.2} ms/frame {clock} ({:.0} fps) · {}x{} · {adapter}",
             timings.frame_ms,
@@ -177,6 +186,12 @@ pub fn show(
             ui.label(egui::RichText::new(line).small());
         }
         ui.separator();
+        let mut each = session.runtime.step_profiling();
+        let hint = "Submit and wait for every pass on its own, so each one's time is measured even where GPU \
+                    timestamps miss compute work (lavapipe); frames get slower";
+        if ui.checkbox(&mut each, "time each pass").on_hover_text(hint).changed() {
+            actions.push(Action::TimeEachPass(each));
+        }
         let max = timings.per_pass.iter().map(|(_, ms)| *ms).fold(1e-6, f64::max);
         egui::Grid::new("passes").num_columns(3).show(ui, |ui| {
             for (pass, ms) in &timings.per_pass {

@@ -171,6 +171,10 @@ impl Viewer {
                 Action::Scalar(name, value) => session.set_scalar(&name, value),
                 Action::Feature(name, on) => session.set_feature(&name, on),
                 Action::Cuts(cuts) => session.set_cuts(cuts),
+                Action::TimeEachPass(on) => {
+                    session.runtime.set_step_profiling(on);
+                    Vec::new()
+                }
                 Action::Lod { enabled, target_fps } => {
                     self.lod.enabled = enabled;
                     self.lod.target_ms = 1000.0 / target_fps.max(1.0);

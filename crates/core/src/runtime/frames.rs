@@ -29,6 +29,9 @@ pub struct FrameStats {
     pub wall_ms: f64,
     /// True when `frame_ms` is wall time because the adapter has no timestamp queries.
     pub wall_time_fallback: bool,
+    /// True when `step_gpu_ms` are wall times of steps submitted one by one
+    /// (`Runtime::set_step_profiling`); `frame_ms` is then their sum.
+    pub steps_serialised: bool,
 }
 
 impl FrameStats {
@@ -61,6 +64,8 @@ struct Pending {
     submitted: Instant,
     mapped: Arc<AtomicBool>,
     done_at: Arc<Mutex<Option<Instant>>>,
+    /// Per-step wall times measured while recording (step profiling).
+    profiled: Option<Vec<f64>>,
 }
 
 #[derive(Default)]
@@ -143,6 +148,7 @@ impl FrameRing {
         frame_index: u64,
         pass_ids: Arc<Vec<String>>,
         submitted: Instant,
+        profiled: Option<Vec<f64>>,
     ) {
         let slot = &mut self.slots[self.next];
         let mapped = Arc::new(AtomicBool::new(false));
@@ -151,7 +157,7 @@ impl FrameRing {
         {
             let done_at = done_at.clone();
             let mapped_no_queries = mapped.clone();
-            let has_queries = slot.queries.is_some() && steps > 0;
+            let has_queries = slot.queries.is_some() && steps > 0 && profiled.is_none();
             gpu.queue.on_submitted_work_done(move || {
                 if let Ok(mut d) = done_at.lock() {
                     *d = Some(Instant::now());
@@ -170,7 +176,7 @@ impl FrameRing {
                 });
             }
         }
-        slot.pending = Some(Pending { submission, frame_index, pass_ids, steps, submitted, mapped, done_at });
+        slot.pending = Some(Pending { submission, frame_index, pass_ids, steps, submitted, mapped, done_at, profiled });
         self.next = (self.next + 1) % self.slots.len();
     }
 
@@ -179,6 +185,18 @@ impl FrameRing {
         let Some(p) = slot.pending.take() else { return };
         let done = p.done_at.lock().ok().and_then(|d| *d).unwrap_or_else(Instant::now);
         let wall_ms = done.saturating_duration_since(p.submitted).as_secs_f64() * 1e3;
+        if let Some(ms) = p.profiled {
+            self.finished.push_back(FrameStats {
+                frame_index: p.frame_index,
+                pass_ids: p.pass_ids,
+                frame_ms: ms.iter().sum(),
+                step_gpu_ms: Some(ms),
+                wall_ms,
+                wall_time_fallback: false,
+                steps_serialised: true,
+            });
+            return;
+        }
         let mut step_gpu_ms = None;
         if let Some(q) = &slot.queries
             && p.steps > 0
@@ -211,6 +229,7 @@ impl FrameRing {
             step_gpu_ms,
             frame_ms,
             wall_ms,
+            steps_serialised: false,
         });
     }
 

@@ -22,6 +22,7 @@ pub mod readback;
 pub mod record;
 pub mod schedule;
 pub mod shaders;
+mod step_clock;
 pub mod textures;
 pub mod uniforms;
 pub mod upload;
@@ -164,6 +165,8 @@ pub struct Runtime {
     cuts: Cuts,
     /// GPU memory passes that stream data may use (`--gpu-memory-mb`); `None`: the adapter's.
     gpu_memory_budget: Option<u64>,
+    /// Submit and time every step on its own ([`Runtime::set_step_profiling`]).
+    profile_steps: bool,
 }
 
 impl Runtime {
@@ -190,7 +193,21 @@ impl Runtime {
             window: None,
             cuts: Cuts::NONE,
             gpu_memory_budget: None,
+            profile_steps: false,
         }
+    }
+
+    /// Times every step of the following frames by wall clock, each submitted on its own and
+    /// waited for (`FrameStats::step_gpu_ms` then holds these times, `steps_serialised` says
+    /// so): per-pass costs on adapters whose timestamps do not cover compute work (lavapipe).
+    /// Serialises the GPU, so the frames themselves get slower.
+    pub fn set_step_profiling(&mut self, on: bool) {
+        self.profile_steps = on;
+    }
+
+    /// Whether [`Runtime::set_step_profiling`] is on.
+    pub fn step_profiling(&self) -> bool {
+        self.profile_steps
     }
 
     /// Bounds the GPU memory passes that stream data may hold (a brick pool), in bytes; `None`
@@ -509,7 +526,8 @@ impl Runtime {
         let gpu = self.gpu.clone();
         self.gpu.queue.write_buffer(&self.system.frame, 0, bytemuck::bytes_of(&FrameUniforms::of(&frame)));
         let steps = schedule.plan.steps.len();
-        let timestamps = self.frames.begin(&gpu, steps);
+        let timestamps = self.frames.begin(&gpu, steps).filter(|_| !self.profile_steps);
+        let mut clock = self.profile_steps.then(|| step_clock::StepClock::new(&gpu));
         let what = format!("frame {} of graph \"{}\"", frame.frame_index, schedule.plan.name);
         let history = &mut self.history;
         let inputs = &self.inputs;
@@ -532,7 +550,20 @@ impl Runtime {
                         .device
                         .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(&schedule.plan.name) });
                     history.begin_frame(&mut encoder);
-                    record_steps(&gpu, schedule, history, inputs, system, &frame, &mut encoder, timestamps.as_ref())?;
+                    record_steps(
+                        &gpu,
+                        schedule,
+                        history,
+                        inputs,
+                        system,
+                        &frame,
+                        &mut encoder,
+                        timestamps.as_ref(),
+                        clock.as_mut(),
+                    )?;
+                    if let Some(clock) = clock.as_mut() {
+                        clock.lap(&mut encoder);
+                    }
                     if let Some(target) = present {
                         let (view, encoded) = output_view(schedule, history, target.output)?;
                         blitter.record(&gpu, &mut encoder, &view, encoded, target)?;
@@ -546,7 +577,8 @@ impl Runtime {
         let submission = gpu.checked(|| what.clone(), || gpu.queue.submit([commands])).map_err(named)?;
         self.history.end_frame();
         let pass_ids = schedule.pass_ids.clone();
-        self.frames.submitted(&gpu, submission, frame.frame_index, pass_ids, submitted);
+        let profiled = clock.map(|c| c.ms);
+        self.frames.submitted(&gpu, submission, frame.frame_index, pass_ids, submitted, profiled);
         schedule.bind_groups.borrow_mut().evict_older_than(frame.frame_index, 8);
         self.last_camera = Some((camera, frame.viewport));
         self.frame_index += 1;
@@ -748,9 +780,14 @@ fn record_steps(
     frame: &FrameData,
     encoder: &mut wgpu::CommandEncoder,
     timestamps: Option<&(wgpu::QuerySet, u32)>,
+    mut clock: Option<&mut step_clock::StepClock<'_>>,
 ) -> Result<(), RuntimeError> {
     let Schedule { plan, nodes, slots, owned, bind_groups, skippable, owned_versions, next_version, .. } = schedule;
     for (i, step) in plan.steps.iter().enumerate() {
+        // Profiling: what came before this step is done before its clock starts.
+        if let Some(clock) = clock.as_deref_mut() {
+            clock.lap(encoder);
+        }
         // A pass that runs only when its inputs change: the versions of what it reads (None when
         // it reads something made every frame).
         let read_versions = if skippable[i] { input_versions(plan, step, inputs, owned_versions) } else { None };

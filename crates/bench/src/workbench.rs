@@ -190,7 +190,7 @@ pub fn run(args: &WorkbenchArgs) -> anyhow::Result<serde_json::Value> {
         md.push_str(
             "## Frame time while the camera moves (goal ≤ 100 ms)\n\nFull: every frame at full resolution. With LOD: \
              the viewer's level of detail (`view/lod.rs`, target 15 fps) picks the scale from the full frame time and \
-             doubles every raycaster's step; \
+             doubles every raycaster's step (a slicer's slice distance, a multipass graph's segment length); \
              refined: from input at rest to the full image finished (the viewport restored, one frame).\n\n\
              | graph | full ms/frame | LOD | ms/frame while moving | within 100 ms | refined ms |\n\
              |---|---:|---:|---:|:---:|---:|\n",

@@ -78,7 +78,9 @@ impl Lod {
     }
 
     /// The factor on every raycaster's step: twice as far apart while the image is coarse (the
-    /// samples per ray halve, as VTK's AutoAdjustSampleDistances does), 1 for the full image.
+    /// samples per ray halve, as VTK's AutoAdjustSampleDistances does; a slicer's slices and a
+    /// multipass graph's segments get as much further apart and longer:
+    /// `LiveSession::set_step_factor`), 1 for the full image.
     pub fn step_factor(&self) -> f64 {
         if self.scale < 1.0 && !self.step_refused { STEP_FACTOR } else { 1.0 }
     }

@@ -31,6 +31,8 @@ pub enum Action {
     SaveScene(std::path::PathBuf),
     /// The TF editor's action.
     TransferFunction(super::tf_editor::TfAction),
+    /// Set a value typed as `PASS.PARAM=VALUE` or `input.NAME=VALUE`.
+    Assign(String),
     /// Time every pass on its own (`Runtime::set_step_profiling`) or not.
     TimeEachPass(bool),
     /// Level of detail while moving: on or off, and the frame rate to hold.
@@ -259,6 +261,9 @@ pub fn show(
                 });
             }
             ui.collapsing("Parameters", |ui| {
+                if let Some(text) = assign_field(ui) {
+                    actions.push(Action::Assign(text));
+                }
                 // The graph's own WGSL-only kinds have parameters too.
                 let registry = volgraph_core::wgsl_pass::with_graph_kinds(session.registry(), &plan.kinds);
                 let mut seen = Vec::new();
@@ -327,6 +332,29 @@ pub const SAVED_SCENE: &str = "view.scene.ron";
 /// The crop box (a checkbox and a low/high slider per axis) and the first clip plane (normal and
 /// offset); planes after the first (from `--clip`) are kept and listed. Returns new cuts when a
 /// control changed them.
+/// A field for a value typed as `PASS.PARAM=VALUE` or `input.NAME=VALUE` (what `volgraph set`
+/// takes); Enter submits it. Sliders clamp to a parameter's declared range, so this is where a
+/// value outside it or a misspelt name can be typed — and is refused with its message
+/// (`LiveSession::assign`). The text stays, to be corrected.
+pub fn assign_field(ui: &mut egui::Ui) -> Option<String> {
+    let id = ui.make_persistent_id("assign");
+    let mut text: String = ui.data_mut(|d| d.get_temp(id)).unwrap_or_default();
+    let response = ui
+        .horizontal(|ui| {
+            let label = ui.label("set");
+            ui.add(
+                egui::TextEdit::singleline(&mut text)
+                    .hint_text("march.step_voxels=0.7 or input.NAME=1.5")
+                    .desired_width(220.0),
+            )
+            .labelled_by(label.id)
+        })
+        .inner;
+    let submitted = response.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+    ui.data_mut(|d| d.insert_temp(id, text.clone()));
+    (submitted && !text.trim().is_empty()).then_some(text)
+}
+
 fn cuts_section(ui: &mut egui::Ui, cuts: Cuts) -> Option<Cuts> {
     let mut crop = cuts.crop();
     let mut planes: Vec<ClipPlane> = cuts.planes().copied().collect();

@@ -14,6 +14,7 @@ use anyhow::anyhow;
 use volgraph_accel::cuts::Cuts;
 use volgraph_accel::transfer_function::TransferFunction;
 use volgraph_accel::volume::Volume;
+use volgraph_core::graph::edit::{SetTarget, apply as apply_edits, edit_for};
 use volgraph_core::runtime::{ApplyReport, CameraData, Gpu, PresentTarget, Runtime, ShaderLibrary};
 use volgraph_core::{CompileOptions, Plan, Registry, cut_effects};
 
@@ -169,9 +170,52 @@ pub struct LiveSession {
     pub save_tf_on_change: bool,
     /// The TF editor's presets for this volume (computed once: MR's reads percentiles).
     tf_presets: Vec<(&'static str, TransferFunction)>,
-    /// While the level of detail widens the step: the factor and the parameter overrides from
-    /// before it (restored when it ends).
-    coarse_step: Option<(f64, std::collections::BTreeMap<String, ron::Value>)>,
+    /// While the level of detail widens the step: the factor and the overrides from before it
+    /// (restored when it ends).
+    coarse_step: Option<(f64, StepBase)>,
+}
+
+/// What the level of detail's step replaces: the parameter overrides and graph scalars from
+/// before it.
+#[derive(Clone)]
+struct StepBase {
+    params: std::collections::BTreeMap<String, ron::Value>,
+    scalars: std::collections::BTreeMap<String, f64>,
+}
+
+/// The sample spacings the level of detail widens in every pass that declares one: a
+/// raycaster's step, a slicer's slice distance.
+const STEP_PARAMS: [&str; 2] = ["step_voxels", "slice_voxels"];
+
+/// The parameters the level of detail widens where a graph input feeds them: the step, and a
+/// multipass raycaster's segment length (Krüger & Westermann 2003 §3's M), whose pass count —
+/// and so the per-pass fixed cost that dominates a small coarse image — falls with it.
+const WIDENED_PARAMS: [&str; 2] = ["step_voxels", "segment_steps"];
+
+/// The graph inputs wired into a parameter of [`WIDENED_PARAMS`] (`"step_voxels":
+/// "input.NAME"`), and the ids of the passes whose `step_voxels` they feed. Widening such an
+/// input, not each pass's parameter, also shortens what is computed from it — a
+/// Krüger–Westermann repeat group's segment count.
+fn step_inputs(source: &str) -> (std::collections::BTreeSet<String>, std::collections::BTreeSet<String>) {
+    let (mut inputs, mut passes) = (std::collections::BTreeSet::new(), std::collections::BTreeSet::new());
+    let Ok(doc) = volgraph_core::graph::parse_graph(source) else { return (inputs, passes) };
+    let all = doc.passes.iter().flat_map(|node| match node {
+        volgraph_core::graph::ast::NodeDoc::Pass(p) => std::slice::from_ref(p).iter(),
+        volgraph_core::graph::ast::NodeDoc::Repeat(r) => r.body.iter(),
+    });
+    for pass in all {
+        for param in WIDENED_PARAMS {
+            if let Some(ron::Value::String(wire)) = pass.params.get(param)
+                && let Some(name) = wire.strip_prefix("input.")
+            {
+                inputs.insert(name.to_string());
+                if param == "step_voxels" {
+                    passes.insert(pass.id.clone());
+                }
+            }
+        }
+    }
+    (inputs, passes)
 }
 
 impl LiveSession {
@@ -540,6 +584,45 @@ impl LiveSession {
         Ok(())
     }
 
+    /// The panel's "set" field: `PASS.PARAM=VALUE` or `input.NAME=VALUE`, checked as
+    /// `volgraph set` checks it — the graph text with the value written in must compile, so a
+    /// bad value or an unknown name is refused with its located message (and a "did you mean")
+    /// — then applied as a slider would apply it (the file changes only with "write to graph
+    /// file").
+    pub fn assign(&mut self, text: &str) -> Vec<Event> {
+        let start = Instant::now();
+        match self.check_assignment(text) {
+            Err(message) => self.outcome(format!("set {}", text.trim()), start, Err(message)),
+            Ok((SetTarget::Param { pass, param }, value)) => self.set_param(&pass, &param, value),
+            Ok((SetTarget::Input(name), value)) => match value {
+                ron::Value::Number(n) => self.set_scalar(&name, n.into_f64()),
+                _ => self.outcome(
+                    format!("set {}", text.trim()),
+                    start,
+                    Err(format!("input.{name}: a Scalar input takes a number, such as 0.5")),
+                ),
+            },
+        }
+    }
+
+    fn check_assignment(&self, text: &str) -> Result<(SetTarget, ron::Value), String> {
+        let Some((target, value)) = text.split_once('=') else {
+            return Err(format!("\"{}\": expected PASS.PARAM=VALUE or input.NAME=VALUE", text.trim()));
+        };
+        let target = SetTarget::parse(target.trim())?;
+        let edits = edit_for(&self.source, &target, value)?;
+        let edited = apply_edits(&self.source, &edits);
+        // The panel's own value for this name would hide the one being checked.
+        let mut options = self.options.clone();
+        match &target {
+            SetTarget::Param { pass, param } => options.param_overrides.remove(&format!("{pass}.{param}")),
+            SetTarget::Input(name) => options.scalars.remove(name).map(ron::Value::from),
+        };
+        compile_for(&self.graph_name, &edited, &self.registry, &options, &self.volume).map_err(|d| d.to_string())?;
+        let value = ron::from_str::<ron::Value>(value.trim()).map_err(|e| format!("{}: {e}", value.trim()))?;
+        Ok((target, value))
+    }
+
     /// Writes the parameters and graph inputs changed in the panel into the graph file at their
     /// place (`volgraph set`'s code: only the values' text changes), then runs from the file:
     /// the panel's overrides are cleared, as the file now says what they said. Returns one line
@@ -603,11 +686,15 @@ impl LiveSession {
     pub fn set_param(&mut self, pass: &str, param: &str, value: ron::Value) -> Vec<Event> {
         let start = Instant::now();
         let mut options = self.options.clone();
-        options.param_overrides.insert(format!("{pass}.{param}"), value);
+        options.param_overrides.insert(format!("{pass}.{param}"), value.clone());
         let source = self.source.clone();
         let result = self.compile_and_apply(&source, &options).map(|r| describe(&r));
         if result.is_ok() {
             self.options = options;
+            // Kept when the level of detail's step ends.
+            if let Some((_, base)) = &mut self.coarse_step {
+                base.params.insert(format!("{pass}.{param}"), value);
+            }
         }
         self.outcome(format!("parameter {pass}.{param}"), start, result)
     }
@@ -621,6 +708,10 @@ impl LiveSession {
         let result = self.compile_and_apply(&source, &options).map(|r| describe(&r));
         if result.is_ok() {
             self.options = options;
+            // Kept when the level of detail's step ends.
+            if let Some((_, base)) = &mut self.coarse_step {
+                base.scalars.insert(name.to_string(), value);
+            }
         }
         self.outcome(format!("scalar {name}"), start, result)
     }
@@ -690,35 +781,53 @@ impl LiveSession {
     }
 
     /// The level of detail's step: every pass with a `step_voxels` samples `factor` times further
-    /// apart while the camera moves (1: the graph's own steps again, with the overrides from
-    /// before). A graph that refuses the wider step (a range) just keeps its own; no error is
+    /// apart while the camera moves, and a multipass graph's segments (an input wired to
+    /// `segment_steps`) get `factor` times longer (1: the graph's own values again, with the
+    /// overrides from before). A graph that refuses the wider step (a range) just keeps its own; no error is
     /// shown for it. Returns whether the step is now `factor`.
     pub fn set_step_factor(&mut self, factor: f64) -> bool {
         let current = self.coarse_step.as_ref().map_or(1.0, |(f, _)| *f);
         if factor == current {
             return true;
         }
-        let base = self.coarse_step.as_ref().map_or_else(|| self.options.param_overrides.clone(), |(_, b)| b.clone());
+        let base = self.coarse_step.as_ref().map_or_else(
+            || StepBase { params: self.options.param_overrides.clone(), scalars: self.options.scalars.clone() },
+            |(_, b)| b.clone(),
+        );
         let mut options = self.options.clone();
-        options.param_overrides = base.clone();
+        options.param_overrides = base.params.clone();
+        options.scalars = base.scalars.clone();
         if factor != 1.0 {
-            // The graph's own step of each pass: its plan at factor 1 (the current one).
             let Some(plan) = self.plan() else { return false };
-            let steps: Vec<(String, f64)> = plan
-                .steps
-                .iter()
-                .filter(|s| s.params.declares("step_voxels"))
-                .map(|s| (s.pass_id.clone(), s.params.float("step_voxels")))
-                .collect();
-            let base_step = |pass: &str, planned: f64| match base.get(&format!("{pass}.step_voxels")) {
-                Some(ron::Value::Number(n)) => n.into_f64(),
-                _ => planned,
-            };
-            for (pass, planned) in steps {
-                let wide = base_step(&pass, planned) * factor;
-                options
-                    .param_overrides
-                    .insert(format!("{pass}.step_voxels"), ron::Value::Number(ron::value::Number::F64(wide.into())));
+            let (inputs, fed) = step_inputs(&self.source);
+            for name in &inputs {
+                let own = match plan.inputs.get(name) {
+                    Some(volgraph_core::graph::ast::InputKind::Scalar(default)) => *default,
+                    _ => continue,
+                };
+                let step = base.scalars.get(name).copied().unwrap_or(own);
+                options.scalars.insert(name.clone(), step * factor);
+            }
+            // The graph's own step of each other pass: its plan at factor 1 (the current one).
+            let mut steps: Vec<(String, f64)> = Vec::new();
+            for step in &plan.steps {
+                for param in STEP_PARAMS {
+                    let key = format!("{}.{param}", step.pass_id);
+                    let fed_by_input = param == "step_voxels" && fed.contains(&step.pass_id);
+                    if step.params.declares(param)
+                        && (!fed_by_input || base.params.contains_key(&key))
+                        && !steps.iter().any(|(k, _)| *k == key)
+                    {
+                        let own = match base.params.get(&key) {
+                            Some(ron::Value::Number(n)) => n.into_f64(),
+                            _ => step.params.float(param),
+                        };
+                        steps.push((key, own));
+                    }
+                }
+            }
+            for (key, own) in steps {
+                options.param_overrides.insert(key, ron::Value::Number(ron::value::Number::F64((own * factor).into())));
             }
         }
         let source = self.source.clone();

@@ -550,3 +550,104 @@ fn a_shader_edit_the_gpu_rejects_keeps_the_last_good_pipelines() {
     assert!(session.frame(&camera, None).expect("the fixed shader renders").is_empty());
     let _ = std::fs::remove_dir_all(&s.dir);
 }
+
+/// The level of detail's wider step reaches what is computed from a step input: the
+/// Krüger–Westermann graphs wire `step_voxels` and `segment_steps` to inputs, which their repeat
+/// group divides the longest ray by, so twice the step and twice the segment length are a
+/// quarter of the segments (not the same count of segments each marching further). A parameter
+/// moved while it is coarse is kept when the view refines.
+#[test]
+fn the_coarse_step_widens_the_step_inputs_and_quarters_the_segments() {
+    let s = scratch("coarse_step", "graphs/kruger_westermann_2003/rc_b.ron");
+    let mut session = open(&s, None);
+    let segments = |session: &LiveSession| {
+        let plan = session.plan().expect("a plan");
+        plan.steps.iter().filter(|st| st.pass_id == "march").count()
+    };
+    let full = segments(&session);
+    let sharp = frame(&mut session);
+    assert!(session.set_step_factor(2.0), "the wider step applies");
+    let coarse = segments(&session);
+    assert_eq!(
+        coarse,
+        full.div_ceil(4),
+        "{full} segments at the graph's values, {coarse} at twice the step and length"
+    );
+    let step = session.plan().expect("plan").steps.iter().find(|st| st.pass_id == "march").expect("march");
+    assert_eq!(step.params.float("step_voxels"), 1.0, "the input's 0.5, doubled");
+    assert_eq!(step.params.uint("segment_steps"), 16, "the input's 8, doubled");
+    session.set_param("march", "threshold", ron::Value::from(0.9));
+    assert!(session.set_step_factor(1.0), "back to the graph's step");
+    assert_eq!(segments(&session), full);
+    let step = session.plan().expect("plan").steps.iter().find(|st| st.pass_id == "march").expect("march");
+    assert_eq!(step.params.float("step_voxels"), 0.5);
+    assert_eq!(step.params.uint("segment_steps"), 8);
+    assert_eq!(step.params.float("threshold"), 0.9, "the edit made while coarse is kept");
+    session.set_param("march", "threshold", ron::Value::from(0.95));
+    assert_eq!(frame(&mut session), sharp, "the graph's own image again");
+    let _ = std::fs::remove_dir_all(&s.dir);
+    // A slicer's slices get twice as far apart.
+    let s = scratch("coarse_slices", "graphs/kruger_westermann_2003/sbvr.ron");
+    let mut session = open(&s, None);
+    let spacing = |session: &LiveSession| {
+        let plan = session.plan().expect("a plan");
+        plan.steps.iter().find(|st| st.pass_id == "slices").expect("slices").params.float("slice_voxels")
+    };
+    assert_eq!(spacing(&session), 0.5);
+    assert!(session.set_step_factor(2.0));
+    assert_eq!(spacing(&session), 1.0);
+    assert!(session.set_step_factor(1.0));
+    assert_eq!(spacing(&session), 0.5);
+    let _ = std::fs::remove_dir_all(&s.dir);
+}
+
+/// The panel's "set" field driven with egui's test harness: a value outside the parameter's
+/// range and a misspelt name typed into it are refused with their messages (the image and plan
+/// stay), a good value applies. The sliders clamp, so this field is where bad values can be typed.
+#[test]
+fn a_bad_value_typed_into_the_set_field_is_refused_with_its_message() {
+    use egui_kittest::Harness;
+    use egui_kittest::kittest::Queryable as _;
+
+    let s = scratch("assign", "graphs/basic/fragment_raycast.ron");
+    let mut session = open(&s, None);
+    let before = frame(&mut session);
+    let mut h = Harness::builder().with_size(egui::Vec2::new(480.0, 240.0)).build_ui_state(
+        |ui, session: &mut LiveSession| {
+            if let Some(text) = super::panel::assign_field(ui) {
+                session.assign(&text);
+            }
+            if let Some((what, message)) = session.error() {
+                ui.label(format!("error in {what}: {message}"));
+            }
+        },
+        session,
+    );
+    let submit = |h: &mut Harness<'_, LiveSession>, text: &str| {
+        h.get_by_label("set").focus();
+        h.run();
+        // Select what the field holds, type over it, press Enter.
+        h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+        h.get_by_label("set").type_text(text);
+        h.run();
+        h.key_press(egui::Key::Enter);
+        h.run();
+    };
+    submit(&mut h, "march.step_voxels=-1");
+    let message = |h: &Harness<'_, LiveSession>| h.state().error().map(|(_, m)| m.to_string()).unwrap_or_default();
+    let refused = message(&h);
+    assert!(refused.contains("step_voxels") && refused.contains("-1"), "the message names the value: {refused}");
+    assert!(h.query_by_label_contains("error in set march.step_voxels=-1").is_some(), "shown in the panel");
+    submit(&mut h, "march.step_voxle=1");
+    let refused = message(&h);
+    assert!(refused.contains("did you mean") && refused.contains("step_voxels"), "a did-you-mean: {refused}");
+    assert!(h.query_by_label_contains("did you mean").is_some(), "shown in the panel");
+    let session = h.state_mut();
+    assert_eq!(frame(session), before, "nothing bad reached the graph");
+    drop(h);
+    let mut session = open(&s, None);
+    let events = session.assign("march.step_voxels=1.5");
+    assert!(matches!(events.first(), Some(Event::Reloaded { .. })), "{events:?}");
+    assert_ne!(frame(&mut session), before, "a good value applies");
+    let _ = std::fs::remove_dir_all(&s.dir);
+}

@@ -171,6 +171,7 @@ impl Viewer {
                 Action::Scalar(name, value) => session.set_scalar(&name, value),
                 Action::Feature(name, on) => session.set_feature(&name, on),
                 Action::Cuts(cuts) => session.set_cuts(cuts),
+                Action::Assign(text) => session.assign(&text),
                 Action::TimeEachPass(on) => {
                     session.runtime.set_step_profiling(on);
                     Vec::new()

@@ -5,6 +5,9 @@
 //!
 //! The scale is `sqrt(target / full)` (ray-cast frames cost in proportion to pixels), snapped to
 //! a few steps so a drag does not reallocate targets every frame, and never below a quarter.
+//! Samples get twice as far apart in a coarse image; where the quarter scale still misses the
+//! target (a frame whose cost is per slice or per pass, not per pixel: slice-based rendering),
+//! they get further apart again, up to eight times, until the frames fit.
 
 use std::time::{Duration, Instant};
 
@@ -14,6 +17,8 @@ const REST: Duration = Duration::from_millis(300);
 const MIN_SCALE: f64 = 0.25;
 /// The step factor of a coarse image.
 const STEP_FACTOR: f64 = 2.0;
+/// The largest step factor, where the coarsest scale alone misses the target.
+const MAX_STEP_FACTOR: f64 = 8.0;
 /// The scales a drag may take (per axis).
 const STEPS: [f64; 5] = [1.0, 0.75, 0.5, 0.35, 0.25];
 
@@ -31,6 +36,10 @@ pub struct Lod {
     scale: f64,
     /// The graph refused a wider step (a parameter range): only the resolution drops.
     pub step_refused: bool,
+    /// The step factor of the coarse image now (2, more where the coarsest scale misses the target).
+    step: f64,
+    /// The widest step the graph took (a wider one was refused).
+    step_cap: f64,
 }
 
 impl Default for Lod {
@@ -42,6 +51,8 @@ impl Default for Lod {
             full_ms: 0.0,
             scale: 1.0,
             step_refused: false,
+            step: STEP_FACTOR,
+            step_cap: MAX_STEP_FACTOR,
         }
     }
 }
@@ -55,8 +66,25 @@ impl Lod {
     /// A finished frame's time; it counts toward the full-resolution figure only when the full
     /// image was on screen and nothing moved.
     pub fn observe(&mut self, frame_ms: f64) {
-        if self.scale == 1.0 && !self.moving() && frame_ms.is_finite() && frame_ms > 0.0 {
+        if !(frame_ms.is_finite() && frame_ms > 0.0) {
+            return;
+        }
+        if self.scale == 1.0 && !self.moving() {
             self.full_ms = if self.full_ms == 0.0 { frame_ms } else { self.full_ms + 0.2 * (frame_ms - self.full_ms) };
+        } else if self.scale <= MIN_SCALE && self.moving() && frame_ms > self.target_ms {
+            // The coarsest image still misses the target: samples further apart.
+            self.step = (self.step * 2.0).min(self.step_cap);
+        }
+    }
+
+    /// The graph refused the step factor asked for (a parameter's range): fall back to the last
+    /// one it took, or to the graph's own step.
+    pub fn refuse_step(&mut self) {
+        if self.step > STEP_FACTOR {
+            self.step /= 2.0;
+            self.step_cap = self.step;
+        } else {
+            self.step_refused = true;
         }
     }
 
@@ -71,6 +99,7 @@ impl Lod {
             // The largest step that still fits the target.
             STEPS.iter().copied().find(|s| *s <= wanted + 1e-9).unwrap_or(MIN_SCALE)
         } else {
+            self.step = STEP_FACTOR;
             1.0
         };
         let scaled = |n: u32| ((n as f64 * self.scale).round() as u32).max(1);
@@ -82,7 +111,7 @@ impl Lod {
     /// multipass graph's segments get as much further apart and longer:
     /// `LiveSession::set_step_factor`), 1 for the full image.
     pub fn step_factor(&self) -> f64 {
-        if self.scale < 1.0 && !self.step_refused { STEP_FACTOR } else { 1.0 }
+        if self.scale < 1.0 && !self.step_refused { self.step } else { 1.0 }
     }
 
     /// What the panel says about the image on screen.
@@ -91,7 +120,7 @@ impl Lod {
             format!(
                 "image: coarse, {:.0}% per axis{} while moving (full: {:.0} ms, target {:.0} ms)",
                 self.scale * 100.0,
-                if self.step_factor() > 1.0 { format!(", step ×{STEP_FACTOR}") } else { String::new() },
+                if self.step_factor() > 1.0 { format!(", step ×{}", self.step_factor()) } else { String::new() },
                 self.full_ms,
                 self.target_ms
             )
@@ -128,5 +157,33 @@ mod tests {
         assert_eq!(fast.viewport((800, 600)), (800, 600));
         fast.enabled = false;
         assert_eq!(fast.viewport((800, 600)), (800, 600));
+    }
+
+    #[test]
+    fn where_the_coarsest_image_misses_the_target_the_step_widens_up_to_eight() {
+        let mut lod = Lod::default();
+        lod.observe(3000.0);
+        lod.moved();
+        assert_eq!(lod.viewport((800, 600)), (200, 150), "the coarsest scale");
+        assert_eq!(lod.step_factor(), 2.0);
+        lod.observe(130.0);
+        assert_eq!(lod.step_factor(), 4.0, "130 ms > the 67 ms target");
+        lod.observe(90.0);
+        lod.observe(80.0);
+        assert_eq!(lod.step_factor(), 8.0, "never more than eight");
+        lod.observe(40.0);
+        assert_eq!(lod.step_factor(), 8.0, "kept while moving");
+        // The graph refuses ×8: back to ×4, and never asked for more.
+        lod.refuse_step();
+        assert_eq!(lod.step_factor(), 4.0);
+        lod.observe(200.0);
+        assert_eq!(lod.step_factor(), 4.0);
+        // At rest the full image, and the next drag starts at ×2 again.
+        lod.last_motion = Some(Instant::now() - REST - Duration::from_millis(1));
+        assert_eq!(lod.viewport((800, 600)), (800, 600));
+        assert_eq!(lod.step_factor(), 1.0);
+        lod.moved();
+        lod.viewport((800, 600));
+        assert_eq!(lod.step_factor(), 2.0);
     }
 }

@@ -300,7 +300,7 @@ impl Viewer {
                 lod_events = session.resize(want.0, want.1);
             }
             if !session.set_step_factor(self.lod.step_factor()) {
-                self.lod.step_refused = true;
+                self.lod.refuse_step();
             }
         }
         self.handle(lod_events);

@@ -39,7 +39,11 @@ fn box_span(eye: vec3<f32>, dir: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> vec
 // samples from `begin` to `len`. The identity without a sort-last window or cuts. A cut ray
 // keeps its entry `u0`, so every sample lies on the one step grid: each sample belongs to the
 // one box that holds it, and a crop drops samples without moving the others.
+// Where the ray being marched starts, uncut (for `cap_normal`).
+var<private> ray_start: vec3<f32>;
+
 fn own_segment(ray: Ray) -> Ray {
+    ray_start = ray.u0;
     var begin = ray.begin;
     var end = ray.len;
     var looks_back = false;
@@ -98,6 +102,63 @@ fn clip_segment(u0: vec3<f32>, d: vec3<f32>, kept_in: vec2<f32>) -> vec2<f32> {
     return kept;
 }
 #endif
+
+// "Capping" (docs/rendering_model.md "Cuts"; f64 twin `Cuts::cap_normal` in
+// crates/accel/src/cuts.rs): the shading normal `n` at `u`, on a ray starting at `ray_start`
+// and running along world direction `d_world`, turned toward the world normal of every cut face
+// the ray entered through within CAP_VOXELS of `u`, each by 1 - distance / CAP_VOXELS (weights scaled to sum to 1 where
+// faces meet). A cut face then shows the plane it was cut along instead of the noisy gradient of
+// the material just behind it. Crop faces on the volume's own boundary (the window's grid) are
+// not cuts. Called only where a cut is compiled in.
+const CAP_VOXELS: f32 = 2.0;
+
+// One face (texture-space half-space normal·u >= offset): its world normal on n's side, times
+// its weight, and the weight; nothing unless the ray entered through it (it started on the side
+// the face cuts away and runs into the kept one).
+fn cap_face(normal: vec3<f32>, offset: f32, u: vec3<f32>, d_tex: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
+    if (dot(normal, d_tex) <= 0.0 || dot(normal, ray_start) >= offset) {
+        return vec4<f32>(0.0);
+    }
+    let voxels = (dot(normal, u) - offset) / length(normal / frame.volume_dims.xyz);
+    let w = clamp(1.0 - voxels / CAP_VOXELS, 0.0, 1.0);
+    if (!(w > 0.0)) {
+        return vec4<f32>(0.0);
+    }
+    let world = normalize(normal / frame.half_extent.xyz);
+    return vec4<f32>(select(world, -world, dot(world, n) < 0.0) * w, w);
+}
+
+fn cap_normal(u: vec3<f32>, d_world: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    // Texture space runs along world / (2 · half extent).
+    let d_tex = d_world / frame.half_extent.xyz;
+    var acc = vec4<f32>(0.0);
+#if CROP
+    for (var a = 0; a < 3; a += 1) {
+        var e = vec3<f32>(0.0);
+        e[a] = 1.0;
+        if (frame.crop_lo[a] > frame.grid_lo[a]) {
+            acc += cap_face(e, frame.crop_lo[a], u, d_tex, n);
+        }
+        if (frame.crop_hi[a] < frame.grid_hi[a]) {
+            acc += cap_face(-e, -frame.crop_hi[a], u, d_tex, n);
+        }
+    }
+#endif
+#if CLIP
+    for (var i = 0u; i < 6u; i += 1u) {
+        let plane = frame.clip_planes[i];
+        if (any(plane.xyz != vec3<f32>(0.0))) {
+            acc += cap_face(plane.xyz, plane.w, u, d_tex, n);
+        }
+    }
+#endif
+    if (!(acc.w > 0.0)) {
+        return n;
+    }
+    let scale = select(1.0, 1.0 / acc.w, acc.w > 1.0);
+    let mixed = n * (1.0 - acc.w * scale) + acc.xyz * scale;
+    return select(n, normalize(mixed), length(mixed) > 1e-12);
+}
 
 // The ray of pixel centre `pixel` clipped to the box and the near plane, as
 // `volgraph_accel::reference::ray_segment` clips it (slab test; start at max(t_in, t_near); the

@@ -16,6 +16,9 @@ pub const MAX_CLIP_PLANES: usize = 6;
 /// The largest plane offset (for a unit normal, in volume widths) a clip plane may have.
 pub const MAX_PLANE_OFFSET: f64 = 1000.0;
 
+/// How far behind a cut face its flat shading reaches, in voxels ([`Cuts::cap_normal`]).
+pub const CAP_VOXELS: f64 = 2.0;
+
 /// A box in volume fractions, `lo < hi` on every axis, inside `[0,1]³`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CropBox {
@@ -246,6 +249,58 @@ impl Cuts {
     }
 }
 
+impl Cuts {
+    /// The shading normal at fraction-space point `f` of a ray that starts (uncut) at `start`
+    /// and runs along `d` (fraction space, any length), given `n`, the world unit normal of the
+    /// field's gradient there: "capping". A shaded cut face would otherwise show the gradient of
+    /// the material just behind it — noise, as the material is cut, not bounded, there — so `n`
+    /// is turned toward the world normal of every cut face the ray enters through (its start
+    /// lies on the side the face cuts away) within [`CAP_VOXELS`] of `f`, each by
+    /// `1 − distance / CAP_VOXELS` (weights scaled to sum to 1 where faces meet at an edge):
+    /// continuous in `f`, so the f32 GPU and this f64 twin agree closely, and flat on the face.
+    /// Crop faces on the volume's own boundary are not cuts. `dims`: voxels per axis, `half`:
+    /// the box's world half extent. The headlight is two-sided (`|n·l|`), so the face normals
+    /// are taken on `n`'s side. WGSL twin: `cap_normal` in `shaders/common/ray_box.wgsl`.
+    #[allow(clippy::too_many_arguments, reason = "the point, its ray and the volume's scale, each needed once")]
+    pub fn cap_normal(&self, f: DVec3, start: DVec3, d: DVec3, n: DVec3, dims: DVec3, half: DVec3) -> DVec3 {
+        let (mut sum, mut total) = (DVec3::ZERO, 0.0);
+        let mut face = |normal: DVec3, offset: f64| {
+            // The ray entered the kept side through this face: it started on the side the face
+            // cuts away and runs into the kept one.
+            if normal.dot(d) <= 0.0 || normal.dot(start) >= offset {
+                return;
+            }
+            let voxels = (normal.dot(f) - offset) / (normal / dims).length();
+            let w = (1.0 - voxels / CAP_VOXELS).clamp(0.0, 1.0);
+            if w > 0.0 {
+                let world = (normal / half).normalize();
+                sum += w * if world.dot(n) < 0.0 { -world } else { world };
+                total += w;
+            }
+        };
+        if let Some(c) = self.crop {
+            for a in 0..3 {
+                let e = DVec3::AXES[a];
+                if c.lo[a] > 0.0 {
+                    face(e, c.lo[a]);
+                }
+                if c.hi[a] < 1.0 {
+                    face(-e, -c.hi[a]);
+                }
+            }
+        }
+        for p in self.planes() {
+            face(p.normal, p.offset);
+        }
+        if total <= 0.0 {
+            return n;
+        }
+        let scale = if total > 1.0 { 1.0 / total } else { 1.0 };
+        let mixed = n * (1.0 - total * scale) + sum * scale;
+        if mixed.length() > 1e-12 { mixed.normalize() } else { n }
+    }
+}
+
 /// The part `[t_in, t_out]` of the line `eye + t·dir` inside the box `[lo, hi]` (empty when
 /// `t_in > t_out`); an axis the line runs parallel to bounds it only when the eye is outside
 /// that slab. The f64 twin of `box_span` in `shaders/common/ray_box.wgsl`.
@@ -269,6 +324,47 @@ pub fn box_span(eye: DVec3, dir: DVec3, lo: DVec3, hi: DVec3) -> (f64, f64) {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    /// On a clip plane's face the normal is the plane's; CAP_VOXELS behind it the gradient's
+    /// again; in between a blend. A face the ray leaves through, and a crop face on the volume's
+    /// boundary, change nothing.
+    #[test]
+    fn capping_turns_the_normal_to_the_face_the_ray_enters_through() {
+        let (dims, half) = (DVec3::splat(100.0), DVec3::splat(1.0));
+        let gradient = DVec3::new(0.0, 1.0, 0.0);
+        let plane = Cuts::new(None, &[ClipPlane::new(DVec3::X, 0.5).expect("plane")]).expect("cuts");
+        let (entering, start) = (DVec3::new(1.0, 0.2, 0.0), DVec3::new(0.0, 0.4, 0.5));
+        let cap = |cuts: &Cuts, f: DVec3, start: DVec3, d: DVec3, n: DVec3| cuts.cap_normal(f, start, d, n, dims, half);
+        let on_face = cap(&plane, DVec3::new(0.5, 0.5, 0.5), start, entering, gradient);
+        assert!((on_face - DVec3::X).length() < 1e-12, "{on_face}");
+        let behind = cap(&plane, DVec3::new(0.5 + 2.0 / 100.0, 0.5, 0.5), start, entering, gradient);
+        assert!((behind - gradient).length() < 1e-12, "{behind}");
+        let between = cap(&plane, DVec3::new(0.51, 0.5, 0.5), start, entering, gradient);
+        assert!((between - DVec3::new(1.0, 1.0, 0.0).normalize()).length() < 1e-12, "halfway: {between}");
+        let leaving = cap(&plane, DVec3::new(0.5, 0.5, 0.5), DVec3::new(1.0, 0.5, 0.5), -entering, gradient);
+        assert_eq!(leaving, gradient);
+        // A ray that starts on the kept side runs past the plane without crossing it: no face.
+        let alongside = cap(&plane, DVec3::new(0.505, 0.5, 0.5), DVec3::new(0.501, 0.0, 0.5), DVec3::Y, gradient);
+        assert_eq!(alongside, gradient);
+        // A crop whose low x face is the volume's own face: not a cut there.
+        let crop =
+            Cuts::new(Some(CropBox::new(DVec3::ZERO, DVec3::new(0.5, 1.0, 1.0)).expect("box")), &[]).expect("cuts");
+        assert_eq!(cap(&crop, DVec3::new(0.0, 0.5, 0.5), DVec3::new(0.0, 0.5, 0.5), DVec3::X, gradient), gradient);
+        let hi_face = cap(&crop, DVec3::new(0.5, 0.5, 0.5), DVec3::new(1.0, 0.5, 0.5), -DVec3::X, gradient);
+        assert!((hi_face.abs() - DVec3::X).length() < 1e-12, "the cut face at x = 0.5, seen from +x: {hi_face}");
+        // Anisotropic voxels and box: the world normal of a slanted plane, on the gradient's side.
+        let slanted = Cuts::new(None, &[ClipPlane::new(DVec3::new(1.0, 1.0, 0.0), 1.0).expect("plane")]).expect("cuts");
+        let half = DVec3::new(1.0, 0.5, 1.0);
+        let n = slanted.cap_normal(
+            DVec3::new(0.5, 0.5, 0.5),
+            DVec3::ZERO,
+            DVec3::new(1.0, 1.0, 0.0),
+            -gradient,
+            dims,
+            half,
+        );
+        assert!((n - DVec3::new(-1.0, -2.0, 0.0).normalize()).length() < 1e-12, "{n}");
+    }
 
     #[test]
     fn parses_the_cli_forms_and_names_what_is_wrong() {

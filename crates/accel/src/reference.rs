@@ -362,7 +362,12 @@ impl<'a> March<'a> {
             s(u + DVec3::new(0.0, 0.0, off.z)) - s(u - DVec3::new(0.0, 0.0, off.z)),
         );
         let l = -self.seg.dir_world;
-        let n = if g.length() >= ZERO_GRADIENT { -(g * dims / self.volume.half_extent_world()).normalize() } else { l };
+        let half = self.volume.half_extent_world();
+        let mut n = if g.length() >= ZERO_GRADIENT { -(g * dims / half).normalize() } else { l };
+        if !self.settings.cuts.is_none() {
+            // A cut face shows the plane it was cut along ("capping", crate::cuts).
+            n = self.settings.cuts.cap_normal(u, self.seg.u0, self.seg.d_tex, n, dims, half);
+        }
         let n_dot_l = n.dot(l).abs();
         let spec = if n_dot_l > 0.0 { p.specular * n_dot_l.powf(p.shininess) } else { 0.0 };
         (p.ambient + p.diffuse * n_dot_l, spec)

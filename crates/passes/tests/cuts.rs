@@ -20,7 +20,7 @@ use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::cuts::{ClipPlane, CropBox, Cuts};
 use volgraph_accel::image_diff::{fraction_over, image_diff};
 use volgraph_accel::reference::{ray_segment, render_reference};
-use volgraph_accel::transfer_function::TransferFunction;
+use volgraph_accel::transfer_function::{Preset, TransferFunction};
 use volgraph_accel::volume::{Volume, VoxelData};
 use volgraph_core::runtime::{CameraData, Image, VolumeDesc, scene_values_of};
 use volgraph_core::{CompileOptions, compile, cut_effects};
@@ -42,9 +42,24 @@ fn render_cut(
     camera: &OrbitCamera,
     cuts: Cuts,
 ) -> (Image, volgraph_accel::reference::RaycastSettings) {
+    render_cut_with(gpu, graph, volume, lut, camera, cuts, &[])
+}
+
+/// [`render_cut`] with scene `features` on too.
+fn render_cut_with(
+    gpu: &std::sync::Arc<volgraph_core::runtime::Gpu>,
+    graph: &str,
+    volume: &Volume,
+    lut: &[[f32; 4]],
+    camera: &OrbitCamera,
+    cuts: Cuts,
+    features: &[&str],
+) -> (Image, volgraph_accel::reference::RaycastSettings) {
     let registry = builtin_registry();
     let source = graph_source(graph);
-    let mut options = CompileOptions::new(SIZE, SIZE).with_features(cut_effects::features_of(&cuts));
+    let mut all = cut_effects::features_of(&cuts);
+    all.extend(features.iter().map(|f| f.to_string()));
+    let mut options = CompileOptions::new(SIZE, SIZE).with_features(all);
     options.scene = scene_values_of(&VolumeDesc::of(volume));
     let plan = compile(graph, &source, &registry, &options).unwrap_or_else(|d| panic!("{graph}: {d}"));
     // Krüger–Westermann's termination test stops between segments, the reference per sample:
@@ -118,6 +133,40 @@ fn every_raycaster_crops_and_clips_like_the_reference() {
                 changed * 100.0
             );
             assert!(changed > 0.05, "{graph} {name}: the cut must change the image ({:.1}%)", changed * 100.0);
+            assert!(over <= 0.005, "{graph} {name}: {:.2}% of pixels over 2/255", over * 100.0);
+            assert!(diff.mean_abs <= 0.5 / 255.0, "{graph} {name}: mean {:.3}/255", diff.mean_abs * 255.0);
+        }
+    }
+}
+
+/// Shaded DVR with cuts: the cut faces are capped (shaded with the plane they were cut along,
+/// `Cuts::cap_normal`) on the GPU as in the reference, within the bounds above. The engine's
+/// opaque material makes the faces visible; the blend toward the face normal is continuous, so
+/// f32 and f64 differ only by rounding there.
+#[test]
+fn shaded_cut_faces_are_capped_like_the_reference() {
+    let gpu = gpu();
+    let volume = volgraph_accel::generate::marschner_lobb_f32(64);
+    // Opaque material: rays end a few samples behind a cut face, so its shading is what shows.
+    let lut = TransferFunction::preset(Preset::Opaque, volume.value_range).to_lut_for(&volume, 256);
+    let camera = OrbitCamera { azimuth_deg: 25.0, elevation_deg: 15.0, ..OrbitCamera::default() };
+    for graph in ["basic/fragment_raycast.ron", "modern/fastest.ron"] {
+        for (name, cuts) in cuts_to_test() {
+            let (image, settings) = render_cut_with(&gpu, graph, &volume, &lut, &camera, cuts, &["shading"]);
+            assert!(settings.effects.shading, "{graph}: shading reaches the reference settings");
+            let reference = render_reference(&volume, &lut, &camera, SIZE, SIZE, &settings);
+            let got = image.to_rgba_f64();
+            let diff = image_diff(&got, &reference.color).expect("same size");
+            let over = fraction_over(&got, &reference.color, 2.0 / 255.0).expect("same size");
+            let visible = got.iter().filter(|p| p[3] > 0.05).count() as f64 / got.len() as f64;
+            eprintln!(
+                "{graph} {name} shaded: max {:.2}/255 mean {:.3}/255, {:.2}% over 2/255, {:.0}% of pixels visible",
+                diff.max_abs * 255.0,
+                diff.mean_abs * 255.0,
+                over * 100.0,
+                visible * 100.0
+            );
+            assert!(visible > 0.1, "{graph} {name}: the shaded, cut volume is on screen");
             assert!(over <= 0.005, "{graph} {name}: {:.2}% of pixels over 2/255", over * 100.0);
             assert!(diff.mean_abs <= 0.5 / 255.0, "{graph} {name}: mean {:.3}/255", diff.mean_abs * 255.0);
         }

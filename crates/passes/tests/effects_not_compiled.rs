@@ -145,6 +145,18 @@ fn a_cut_is_compiled_only_when_the_scene_cuts() {
         let clip = pass_code_with_cuts(graph, pass, CompileOptions::new(64, 64).with_features(["clip"]));
         assert!(clip.contains("clip_segment") && !clip.contains("crop_segment"), "{graph} with a clip: {clip:?}");
     }
+    // Capping (the cut faces' flat shading) comes with shading and a cut, and only then.
+    for graph in ["basic/fragment_raycast.ron", "modern/fastest.ron"] {
+        let shaded = pass_code_with_cuts(graph, "march", CompileOptions::new(64, 64).with_features(["shading"]));
+        assert!(shaded.contains("headlight") && !shaded.contains("cap_normal"), "{graph}: {shaded:?}");
+        for cut in ["crop", "clip"] {
+            let capped =
+                pass_code_with_cuts(graph, "march", CompileOptions::new(64, 64).with_features(["shading", cut]));
+            assert!(capped.contains("cap_normal"), "{graph} shaded with a {cut}: {capped:?}");
+        }
+        let unshaded = pass_code_with_cuts(graph, "march", CompileOptions::new(64, 64).with_features(["crop"]));
+        assert!(!unshaded.contains("cap_normal"), "{graph}: no shading, no capping: {unshaded:?}");
+    }
 }
 
 #[test]

@@ -40,6 +40,11 @@ struct DistanceParamsGpu {
     _pad: [u32; 3],
 }
 
+/// The pass's one entry point, declared once for `shaders()` and `create`.
+fn shader() -> ShaderUse {
+    ShaderUse::new("empty_distance.wgsl", "cs_line").binds(&["partial", "distance", "pass_params"])
+}
+
 impl PassDecl for EmptyDistance {
     fn honours_volume_window(&self) -> bool {
         true
@@ -67,17 +72,13 @@ impl PassDecl for EmptyDistance {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse::new("empty_distance.wgsl", "cs_line").binds(&["partial", "distance", "pass_params"])]
+        vec![shader()]
     }
 }
 
 impl PassPlugin for EmptyDistance {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
-            shader: "empty_distance.wgsl",
-            entry: "cs_line",
-            ..Default::default()
-        })?;
+        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec::of(&shader()))?;
         let axes = [0u32, 1, 2]
             .map(|axis| ctx.uniform_with(&format!("axis{axis}"), &DistanceParamsGpu { axis, _pad: [0; 3] }));
         Ok(Box::new(EmptyDistanceNode { pipeline, axes, textures: None, tap: self.tap.clone() }))

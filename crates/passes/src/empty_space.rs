@@ -62,6 +62,11 @@ volgraph_core::pass_params! {
     }
 }
 
+/// The pass's one entry point, declared once for `shaders()` and `create`.
+fn shader() -> ShaderUse {
+    ShaderUse::new("empty_space.wgsl", "cs_classify").binds(&["visible_before"])
+}
+
 impl PassDecl for EmptySpace {
     fn honours_volume_window(&self) -> bool {
         true
@@ -97,19 +102,15 @@ impl PassDecl for EmptySpace {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse::new("empty_space.wgsl", "cs_classify").binds(&["visible_before"])]
+        vec![shader()]
     }
 }
 
 impl PassPlugin for EmptySpace {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let defines = self.shader_defines(ctx.params);
-        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
-            shader: "empty_space.wgsl",
-            entry: "cs_classify",
-            defines: &defines,
-            ..Default::default()
-        })?;
+        let pipeline =
+            ctx.compute_pipeline(&ComputePipelineSpec { defines: &defines, ..ComputePipelineSpec::of(&shader()) })?;
         Ok(Box::new(EmptySpaceNode { pipeline, flags: None, visible_before: None, tap: self.tap.clone() }))
     }
 }

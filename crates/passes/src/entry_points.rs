@@ -11,6 +11,12 @@ use volgraph_core::{Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, 
 /// The plugin.
 pub struct EntryPoints;
 
+/// The box's faces, the entry on its front faces, and the near plane where the eye is inside:
+/// declared once for `shaders()` and `create`.
+const BOX: ShaderUse = ShaderUse::new("entry_points.wgsl", "vs_box");
+const FRONT_FACES: ShaderUse = ShaderUse::new("entry_points.wgsl", "fs_entry");
+const NEAR_PLANE: ShaderUse = ShaderUse::new("entry_points.wgsl", "fs_near_plane");
+
 impl PassDecl for EntryPoints {
     fn honours_volume_window(&self) -> bool {
         true
@@ -29,29 +35,17 @@ impl PassDecl for EntryPoints {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![
-            ShaderUse::new("entry_points.wgsl", "vs_box"),
-            ShaderUse::new("entry_points.wgsl", "fs_entry"),
-            ShaderUse::new("entry_points.wgsl", "fs_near_plane"),
-        ]
+        vec![BOX, FRONT_FACES, NEAR_PLANE]
     }
 }
 
 impl PassPlugin for EntryPoints {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let faces = ctx.render_pipeline(&RenderPipelineSpec {
-            shader: "entry_points.wgsl",
-            vertex: "vs_box",
-            fragment: "fs_entry",
             cull: Some(wgpu::Face::Back),
-            ..Default::default()
+            ..RenderPipelineSpec::drawing(&BOX, &FRONT_FACES)
         })?;
-        let near_plane = ctx.render_pipeline(&RenderPipelineSpec {
-            shader: "entry_points.wgsl",
-            vertex: "vs_fullscreen",
-            fragment: "fs_near_plane",
-            ..Default::default()
-        })?;
+        let near_plane = ctx.render_pipeline(&RenderPipelineSpec::fullscreen(&NEAR_PLANE))?;
         Ok(Box::new(EntryPointsNode { faces, near_plane }))
     }
 }

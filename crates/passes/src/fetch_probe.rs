@@ -24,6 +24,12 @@ volgraph_core::pass_params! {
     }
 }
 
+/// The pass's entry point (counting samples or not), declared once for `shaders()` and `create`.
+fn shader(params: &Params) -> ShaderUse {
+    let entry_point = if Counting::from_params(params).count_samples { "cs_counted" } else { "cs_main" };
+    ShaderUse::new("fetch_probe.wgsl", entry_point).uniform(RaycastParamsGpu::bound("params"))
+}
+
 impl PassDecl for FetchProbe {
     fn kind(&self) -> &'static str {
         "fetch_probe"
@@ -49,8 +55,7 @@ impl PassDecl for FetchProbe {
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        let entry_point = if Counting::from_params(params).count_samples { "cs_counted" } else { "cs_main" };
-        vec![ShaderUse::new("fetch_probe.wgsl", entry_point).uniform(RaycastParamsGpu::bound("params"))]
+        vec![shader(params)]
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
@@ -65,10 +70,9 @@ impl PassPlugin for FetchProbe {
         let wg = Workgroup::checked_size(ctx)?;
         let counted = Counting::from_params(ctx.params).count_samples;
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
-            shader: "fetch_probe.wgsl",
-            entry: if counted { "cs_counted" } else { "cs_main" },
             constants: &[("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)],
             defines: &crate::effects::jitter_defines(ctx.params),
+            ..ComputePipelineSpec::of(&shader(ctx.params))
         })?;
         let params = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());
         Ok(Box::new(FetchProbeNode { pipeline, params, workgroup: wg, counted }))

@@ -115,19 +115,20 @@ impl PassDecl for MinMaxGridPass {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse::new("minmax_grid.wgsl", "cs_minmax").uniform(BlockSize::bound_as("minmax"))]
+        vec![shader()]
     }
+}
+
+/// The pass's one entry point, declared once for `shaders()` and `create`.
+fn shader() -> ShaderUse {
+    ShaderUse::new("minmax_grid.wgsl", "cs_minmax").uniform(BlockSize::bound_as("minmax"))
 }
 
 impl PassPlugin for MinMaxGridPass {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let defines = self.shader_defines(ctx.params);
-        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
-            shader: "minmax_grid.wgsl",
-            entry: "cs_minmax",
-            defines: &defines,
-            ..Default::default()
-        })?;
+        let pipeline =
+            ctx.compute_pipeline(&ComputePipelineSpec { defines: &defines, ..ComputePipelineSpec::of(&shader()) })?;
         let block_size = BlockSize::of(ctx.params);
         // `MinMaxParams` of the shader: the block edge, padded to 16 bytes.
         let params = ctx.uniform_from_bytes("minmax", &BlockSize { block_size }.uniform_bytes());

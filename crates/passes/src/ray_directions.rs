@@ -10,6 +10,10 @@ use volgraph_core::{Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec};
 /// The plugin.
 pub struct RayDirections;
 
+/// The box's back faces and the direction each pixel's ray takes, declared once.
+const VERTEX: ShaderUse = ShaderUse::new("ray_directions.wgsl", "vs_box");
+const FRAGMENT: ShaderUse = ShaderUse::new("ray_directions.wgsl", "fs_dir");
+
 impl PassDecl for RayDirections {
     fn honours_volume_window(&self) -> bool {
         true
@@ -31,18 +35,15 @@ impl PassDecl for RayDirections {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse::new("ray_directions.wgsl", "vs_box"), ShaderUse::new("ray_directions.wgsl", "fs_dir")]
+        vec![VERTEX, FRAGMENT]
     }
 }
 
 impl PassPlugin for RayDirections {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
-            shader: "ray_directions.wgsl",
-            vertex: "vs_box",
-            fragment: "fs_dir",
             cull: Some(wgpu::Face::Front),
-            ..Default::default()
+            ..RenderPipelineSpec::drawing(&VERTEX, &FRAGMENT)
         })?;
         Ok(Box::new(RayDirectionsNode { pipeline }))
     }

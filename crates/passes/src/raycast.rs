@@ -92,11 +92,7 @@ impl PassDecl for Raycast {
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        let own = ShaderUse::new("raycast.wgsl", fragment_entry(params))
-            .binds(&["preintegrated"])
-            .uniform(RaycastParamsGpu::bound("params"))
-            .uniform(BlockSize::bound_as("blocks"));
-        [vec![own], crate::effects::effect_shader_uses(params)].concat()
+        [vec![march_shader(params)], crate::effects::effect_shader_uses(params)].concat()
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
@@ -107,18 +103,24 @@ impl PassDecl for Raycast {
     }
 }
 
+/// The march's entry point for `params` (DVR or iso, leap hits or not) and what it binds,
+/// declared once for `shaders()` and `create`.
+fn march_shader(params: &Params) -> ShaderUse {
+    ShaderUse::new("raycast.wgsl", fragment_entry(params))
+        .binds(&["preintegrated"])
+        .uniform(RaycastParamsGpu::bound("params"))
+        .uniform(BlockSize::bound_as("blocks"))
+}
+
 impl PassPlugin for Raycast {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let fragment = fragment_entry(ctx.params);
-        let defines = [self.shader_defines(ctx.params), wired_defines(ctx.params, &ctx.wired())].concat();
+        let own = march_shader(ctx.params).defines(wired_defines(ctx.params, &ctx.wired()));
+        let defines = [self.shader_defines(ctx.params), own.defines.clone()].concat();
         let leaping = Leaping::new(ctx)?;
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
-            shader: "raycast.wgsl",
-            vertex: "vs_fullscreen",
-            fragment,
             defines: &defines,
             constants: &leaping.constants(),
-            ..Default::default()
+            ..RenderPipelineSpec::fullscreen(&own)
         })?;
         let own = RaycastOwn::from_params(ctx.params);
         let settings = gpu_block(ctx.params);

@@ -127,11 +127,7 @@ impl PassDecl for RaycastBricks {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![
-            ShaderUse::new("raycast_bricks.wgsl", "cs_main")
-                .binds(&["bricks", "table", "leaf_distance", "acc", "volume"])
-                .uniform(RaycastParamsGpu::bound("params")),
-        ]
+        vec![march_shader()]
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
@@ -143,6 +139,13 @@ impl PassDecl for RaycastBricks {
     }
 }
 
+/// The brick march's entry point and what it binds, declared once for `shaders()` and `create`.
+fn march_shader() -> ShaderUse {
+    ShaderUse::new("raycast_bricks.wgsl", "cs_main")
+        .binds(&["bricks", "table", "leaf_distance", "acc", "volume"])
+        .uniform(RaycastParamsGpu::bound("params"))
+}
+
 impl PassPlugin for RaycastBricks {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let settings = BrickSettings::from_params(ctx.params);
@@ -152,10 +155,9 @@ impl PassPlugin for RaycastBricks {
             defines.push("COLOR_F32");
         }
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
-            shader: "raycast_bricks.wgsl",
-            entry: "cs_main",
             defines: &defines,
             constants: &[("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)],
+            ..ComputePipelineSpec::of(&march_shader())
         })?;
         let params = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());
         let uniform = ctx.uniform_buffer("bricks", std::mem::size_of::<BrickParamsGpu>() as u64);

@@ -101,11 +101,7 @@ impl PassDecl for RaycastCompute {
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        let own = ShaderUse::new("raycast_compute.wgsl", entry(params))
-            .binds(&["corrected", "preintegrated"])
-            .uniform(RaycastParamsGpu::bound("params"))
-            .uniform(BlockSize::bound_as("blocks"));
-        let mut uses = vec![own];
+        let mut uses = vec![march_shader(params)];
         if uses_table(params) {
             uses.extend(table_shader_uses());
         }
@@ -126,13 +122,23 @@ impl PassDecl for RaycastCompute {
     }
 }
 
+/// The march's entry point for `params` and what it binds, declared once for `shaders()` and
+/// `create`.
+fn march_shader(params: &Params) -> ShaderUse {
+    ShaderUse::new("raycast_compute.wgsl", entry(params))
+        .binds(&["corrected", "preintegrated"])
+        .uniform(RaycastParamsGpu::bound("params"))
+        .uniform(BlockSize::bound_as("blocks"))
+}
+
 impl PassPlugin for RaycastCompute {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let wg = Workgroup::checked_size(ctx)?;
         let sampling = Sampling::from_params(ctx.params);
         let leaping = Leaping::new(ctx)?;
         let table = uses_table(ctx.params).then(|| opacity_table(ctx)).transpose()?;
-        let mut defines = [self.shader_defines(ctx.params), wired_defines(ctx.params, &ctx.wired())].concat();
+        let own = march_shader(ctx.params).defines(wired_defines(ctx.params, &ctx.wired()));
+        let mut defines = [self.shader_defines(ctx.params), own.defines.clone()].concat();
         if color_is_f32(ctx) {
             defines.push("COLOR_F32");
         }
@@ -143,10 +149,9 @@ impl PassPlugin for RaycastCompute {
                 constants.push(("HALF_STEP", 1.0));
             }
             ctx.compute_pipeline(&ComputePipelineSpec {
-                shader: "raycast_compute.wgsl",
-                entry: entry(ctx.params),
                 constants: &constants,
                 defines: &defines,
+                ..ComputePipelineSpec::of(&own)
             })
         };
         let pipeline = variant(false)?;

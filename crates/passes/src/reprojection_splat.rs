@@ -41,6 +41,10 @@ volgraph_core::pass_params! {
     }
 }
 
+/// The splat quads and what they write, declared once for `shaders()` and `create`.
+const VERTEX: ShaderUse = ShaderUse::new("reprojection_splat.wgsl", "vs_splat").binds(&["splat"]);
+const FRAGMENT: ShaderUse = ShaderUse::new("reprojection_splat.wgsl", "fs_splat").binds(&["splat"]);
+
 impl PassDecl for ReprojectionSplat {
     fn honours_volume_window(&self) -> bool {
         true
@@ -67,10 +71,7 @@ impl PassDecl for ReprojectionSplat {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![
-            ShaderUse::new("reprojection_splat.wgsl", "vs_splat").binds(&["splat"]),
-            ShaderUse::new("reprojection_splat.wgsl", "fs_splat").binds(&["splat"]),
-        ]
+        vec![VERTEX, FRAGMENT]
     }
 
     fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
@@ -81,12 +82,9 @@ impl PassDecl for ReprojectionSplat {
 impl PassPlugin for ReprojectionSplat {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
-            shader: "reprojection_splat.wgsl",
-            vertex: "vs_splat",
-            fragment: "fs_splat",
             depth: Some(DepthSpec { port: "depth", write: true, compare: wgpu::CompareFunction::Less }),
             topology: wgpu::PrimitiveTopology::TriangleStrip,
-            ..Default::default()
+            ..RenderPipelineSpec::drawing(&VERTEX, &FRAGMENT)
         })?;
         let uniform = ctx.uniform_buffer("splat", std::mem::size_of::<SplatParamsGpu>() as u64);
         let settings = SplatSettings::from_params(ctx.params);

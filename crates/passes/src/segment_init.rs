@@ -28,6 +28,11 @@ fn fragment(params: &Params) -> &'static str {
 /// The value the early-z buffer holds for a live ray (the paper's "z = 0").
 pub(crate) const DEPTH_LIVE: f32 = 0.0;
 
+/// The pass's fragment entry point over the fullscreen triangle, declared once.
+fn shader(params: &Params) -> ShaderUse {
+    ShaderUse::new("segment_init.wgsl", fragment(params))
+}
+
 impl PassDecl for SegmentInit {
     fn honours_volume_window(&self) -> bool {
         true
@@ -57,18 +62,15 @@ impl PassDecl for SegmentInit {
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        vec![ShaderUse::new("segment_init.wgsl", fragment(params))]
+        vec![shader(params)]
     }
 }
 
 impl PassPlugin for SegmentInit {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
-            shader: "segment_init.wgsl",
-            vertex: "vs_fullscreen",
-            fragment: fragment(ctx.params),
             depth: Some(DepthSpec { port: "depth", write: true, compare: wgpu::CompareFunction::Always }),
-            ..Default::default()
+            ..RenderPipelineSpec::fullscreen(&shader(ctx.params))
         })?;
         Ok(Box::new(SegmentInitNode { pipeline }))
     }

@@ -32,6 +32,12 @@ volgraph_core::pass_params! {
     }
 }
 
+/// The slices' vertex and fragment entry points, declared once.
+fn stages() -> [ShaderUse; 2] {
+    ["vs_slice", "fs_slice"]
+        .map(|entry| ShaderUse::new("slice_render.wgsl", entry).uniform(SliceParams::bound_as("slices")))
+}
+
 impl PassDecl for SliceRender {
     fn kind(&self) -> &'static str {
         "slice_render"
@@ -54,9 +60,7 @@ impl PassDecl for SliceRender {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        ["vs_slice", "fs_slice"]
-            .map(|entry| ShaderUse::new("slice_render.wgsl", entry).uniform(SliceParams::bound_as("slices")))
-            .to_vec()
+        stages().to_vec()
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
@@ -67,12 +71,10 @@ impl PassDecl for SliceRender {
 
 impl PassPlugin for SliceRender {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        let [vertex, fragment] = stages();
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
-            shader: "slice_render.wgsl",
-            vertex: "vs_slice",
-            fragment: "fs_slice",
             blend: Some(front_to_back_blend()),
-            ..Default::default()
+            ..RenderPipelineSpec::drawing(&vertex, &fragment)
         })?;
         let uniforms = UniformBlocks::create(ctx, &self.shaders(ctx.params));
         Ok(Box::new(SliceRenderNode {

@@ -37,6 +37,14 @@ volgraph_core::pass_params! {
     }
 }
 
+/// The segment's quad (with and without the alpha-only culling) and the two tests, declared
+/// once for `shaders()` and `create`.
+fn stages() -> [ShaderUse; 4] {
+    ["vs_segment", "vs_terminate_alpha", "fs_terminate", "fs_terminate_empty"].map(|entry| {
+        ShaderUse::new("termination_test.wgsl", entry).binds(&["segment"]).uniform(RaycastParamsGpu::bound("params"))
+    })
+}
+
 impl PassDecl for TerminationTest {
     fn honours_volume_window(&self) -> bool {
         true
@@ -68,13 +76,7 @@ impl PassDecl for TerminationTest {
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        ["vs_segment", "vs_terminate_alpha", "fs_terminate", "fs_terminate_empty"]
-            .map(|entry| {
-                ShaderUse::new("termination_test.wgsl", entry)
-                    .binds(&["segment"])
-                    .uniform(RaycastParamsGpu::bound("params"))
-            })
-            .to_vec()
+        stages().to_vec()
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
@@ -85,21 +87,18 @@ impl PassDecl for TerminationTest {
 impl PassPlugin for TerminationTest {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let defines = crate::effects::jitter_defines(ctx.params);
-        let spec = |fragment| RenderPipelineSpec {
-            shader: "termination_test.wgsl",
-            vertex: "vs_segment",
-            fragment,
-            depth: Some(DepthSpec { port: "depth", write: true, compare: wgpu::CompareFunction::Always }),
-            defines: &defines,
-            ..Default::default()
-        };
+        let [segment_vs, alpha_vs, terminate, terminate_empty] = stages();
         // RC-a never re-enables a ray, so its test is culled by early-z itself (see the shader).
         let alpha_only = ctx.render_pipeline(&RenderPipelineSpec {
-            vertex: "vs_terminate_alpha",
             depth: Some(DepthSpec { port: "depth", write: true, compare: wgpu::CompareFunction::Greater }),
-            ..spec("fs_terminate")
+            defines: &defines,
+            ..RenderPipelineSpec::drawing(&alpha_vs, &terminate)
         })?;
-        let with_empty = ctx.render_pipeline(&spec("fs_terminate_empty"))?;
+        let with_empty = ctx.render_pipeline(&RenderPipelineSpec {
+            depth: Some(DepthSpec { port: "depth", write: true, compare: wgpu::CompareFunction::Always }),
+            defines: &defines,
+            ..RenderPipelineSpec::drawing(&segment_vs, &terminate_empty)
+        })?;
         let params = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());
         let segment = ctx.uniform_buffer("segment", std::mem::size_of::<SegmentParamsGpu>() as u64);
         ctx.gpu.queue.write_buffer(&segment, 0, bytemuck::bytes_of(&SegmentParamsGpu::from_params(ctx.params)));

@@ -83,6 +83,13 @@ impl<'a> ComputePipelineSpec<'a> {
 }
 
 impl<'a> RenderPipelineSpec<'a> {
+    /// The pipeline of a declared vertex and fragment entry point (two of a pass's
+    /// `shaders()`, of one file), so the file and entry points are named once.
+    pub fn drawing(vertex: &ShaderUse, fragment: &ShaderUse) -> Self {
+        debug_assert_eq!(vertex.file, fragment.file, "a render pipeline's stages come from one shader file");
+        Self { shader: vertex.file, vertex: vertex.entry_point, fragment: fragment.entry_point, ..Default::default() }
+    }
+
     /// The pipeline drawing a declared fragment entry point over the fullscreen triangle of
     /// `shaders/common/fullscreen.wgsl` (`vs_fullscreen`); override `vertex` for other draws.
     pub fn fullscreen(declared: &ShaderUse) -> Self {

@@ -100,7 +100,8 @@ fn cs_line(@builtin(global_invocation_id) id: vec3<u32>) {
     // The backward sweep's answers, four 8-bit distances to a word.
     var from_above: array<u32, MAX_LINE / 4u>;
     // The candidates, (position in sweep order << 8) | f, a ring of DISTANCE_CAP + 1 entries
-    // between `oldest` and `next` (both counting up).
+    // between `oldest` and `next` (both counting up); `& DISTANCE_CAP` is the ring's modulo, as
+    // the cap is 2⁸ − 1 (f also fits the 8 bits under the position).
     var queue: array<u32, DISTANCE_CAP + 1u>;
     for (var sweep = 0u; sweep < 2u; sweep += 1u) {
         let backward = sweep == 0u;

@@ -42,7 +42,8 @@ struct Frame {
     own_hi: vec4<f32>,
     // A scene's crop box (read under #if CROP) and clip planes (#if CLIP: keep u with
     // dot(xyz, u) >= w; unused planes (0, 0, 0, -1)), in the bound texture's coordinates
-    // (common/ray_box.wgsl `cut_segment`).
+    // (common/ray_box.wgsl `cut_segment`). crop_lo.w: which crop faces are cuts (bit a: the low
+    // face of axis a, bit 3 + a: the high one), for capping.
     crop_lo: vec4<f32>,
     crop_hi: vec4<f32>,
     clip_planes: array<vec4<f32>, 6>,

@@ -35,13 +35,13 @@ fn box_span(eye: vec3<f32>, dir: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> vec
     return vec2<f32>(max(t_lo.x, max(t_lo.y, t_lo.z)), min(t_hi.x, min(t_hi.y, t_hi.z)));
 }
 
+// Where the ray being marched starts, uncut (for `cap_normal`); set by `own_segment`.
+var<private> ray_start: vec3<f32>;
+
 // `ray` (met with the grid box) cut to this frame's own box and to what the scene's cuts keep:
 // samples from `begin` to `len`. The identity without a sort-last window or cuts. A cut ray
 // keeps its entry `u0`, so every sample lies on the one step grid: each sample belongs to the
 // one box that holds it, and a crop drops samples without moving the others.
-// Where the ray being marched starts, uncut (for `cap_normal`).
-var<private> ray_start: vec3<f32>;
-
 fn own_segment(ray: Ray) -> Ray {
     ray_start = ray.u0;
     var begin = ray.begin;
@@ -133,13 +133,15 @@ fn cap_normal(u: vec3<f32>, d_world: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let d_tex = d_world / frame.half_extent.xyz;
     var acc = vec4<f32>(0.0);
 #if CROP
-    for (var a = 0; a < 3; a += 1) {
+    // Which crop faces are cuts (FrameUniforms::with_cuts): bit a low, bit 3 + a high.
+    let faces = u32(frame.crop_lo.w);
+    for (var a = 0u; a < 3u; a += 1u) {
         var e = vec3<f32>(0.0);
         e[a] = 1.0;
-        if (frame.crop_lo[a] > frame.grid_lo[a]) {
+        if (((faces >> a) & 1u) != 0u) {
             acc += cap_face(e, frame.crop_lo[a], u, d_tex, n);
         }
-        if (frame.crop_hi[a] < frame.grid_hi[a]) {
+        if (((faces >> (3u + a)) & 1u) != 0u) {
             acc += cap_face(-e, -frame.crop_hi[a], u, d_tex, n);
         }
     }

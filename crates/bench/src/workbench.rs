@@ -151,7 +151,7 @@ pub fn run(args: &WorkbenchArgs) -> anyhow::Result<serde_json::Value> {
     // Dragging a point in the editor counts as motion for the level of detail (view/lod.rs),
     // so the frames that follow the drag are the coarse ones, as in the viewer.
     let mut lod = volgraph_app::view::lod::Lod::default();
-    lod.observe(steady_ms);
+    lod.observe(0, steady_ms);
     lod.moved();
     let coarse = lod.viewport(viewport);
     session.resize(coarse.0, coarse.1);
@@ -219,7 +219,7 @@ pub fn run(args: &WorkbenchArgs) -> anyhow::Result<serde_json::Value> {
             };
             let full = drag(&mut session)?;
             let mut lod = volgraph_app::view::lod::Lod::default();
-            lod.observe(full);
+            lod.observe(0, full);
             lod.moved();
             let coarse_vp = lod.viewport(viewport);
             session.resize(coarse_vp.0, coarse_vp.1);
@@ -234,7 +234,8 @@ pub fn run(args: &WorkbenchArgs) -> anyhow::Result<serde_json::Value> {
             for _ in 0..3 {
                 let ms = timed_frame(&mut session, &camera)?;
                 lod.moved();
-                lod.observe(ms);
+                // Frames here are waited for one by one: each was rendered as set.
+                lod.observe(0, ms);
                 apply_step(&mut session, &mut lod);
             }
             let step = lod.step_factor();

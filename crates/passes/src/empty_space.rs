@@ -142,6 +142,17 @@ impl PassNode for EmptySpaceNode {
         let classifier = OpacityClassifier::new(ctx.table("tf")?)
             .map_err(|e| PassError { pass: ctx.label.to_string(), message: format!("transfer function: {e}") })?;
         let counts = classifier.visible_before();
+        let texels = ctx.view("tf")?.texture().width() as usize;
+        if counts.len() != texels + 1 {
+            return Err(PassError {
+                pass: ctx.label.to_string(),
+                message: format!(
+                    "the transfer function's CPU table has {} texels but its texture {texels}; bind the LUT with \
+                     Runtime::bind_lut (a texture bound by hand has no table to classify with)",
+                    counts.len() - 1
+                ),
+            });
+        }
         if self.visible_before.as_ref().is_none_or(|(_, n)| *n != counts.len()) {
             let buffer = ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(&format!("{} visible texels before", ctx.label)),

@@ -40,6 +40,9 @@ pub struct Lod {
     step: f64,
     /// The widest step the graph took (a wider one was refused).
     step_cap: f64,
+    /// Frames before this index were submitted before the scale or step last changed: their
+    /// times say nothing about the image on screen now.
+    valid_from: u64,
 }
 
 impl Default for Lod {
@@ -53,6 +56,7 @@ impl Default for Lod {
             step_refused: false,
             step: STEP_FACTOR,
             step_cap: MAX_STEP_FACTOR,
+            valid_from: 0,
         }
     }
 }
@@ -63,10 +67,16 @@ impl Lod {
         self.last_motion = Some(Instant::now());
     }
 
-    /// A finished frame's time; it counts toward the full-resolution figure only when the full
-    /// image was on screen and nothing moved.
-    pub fn observe(&mut self, frame_ms: f64) {
-        if !(frame_ms.is_finite() && frame_ms > 0.0) {
+    /// The scale or step just changed: frames from `next_frame` on are rendered with them.
+    pub fn changed_at(&mut self, next_frame: u64) {
+        self.valid_from = next_frame;
+    }
+
+    /// Finished frame `frame_index`'s time; it counts toward the full-resolution figure only when
+    /// the full image was on screen and nothing moved, and widens a coarse image's step only
+    /// when it was rendered with the scale and step on screen now ([`Self::changed_at`]).
+    pub fn observe(&mut self, frame_index: u64, frame_ms: f64) {
+        if !(frame_ms.is_finite() && frame_ms > 0.0) || frame_index < self.valid_from {
             return;
         }
         if self.scale == 1.0 && !self.moving() {
@@ -137,7 +147,7 @@ mod tests {
     #[test]
     fn moving_renders_coarser_to_hold_the_target_and_resting_restores_the_full_image() {
         let mut lod = Lod::default();
-        lod.observe(400.0);
+        lod.observe(0, 400.0);
         assert_eq!(lod.viewport((800, 600)), (800, 600), "at rest: the full image");
         lod.moved();
         // sqrt(66.7 / 400) = 0.41 → the 0.35 step.
@@ -145,14 +155,14 @@ mod tests {
         assert!(lod.line().contains("coarse, 35% per axis, step ×2"), "{}", lod.line());
         assert_eq!(lod.step_factor(), 2.0);
         // A frame observed while moving does not count as a full-resolution time.
-        lod.observe(30.0);
+        lod.observe(0, 30.0);
         assert_eq!(lod.viewport((800, 600)), (280, 210));
         lod.last_motion = Some(Instant::now() - REST - Duration::from_millis(1));
         assert_eq!(lod.viewport((800, 600)), (800, 600), "rested: full again");
         assert_eq!(lod.step_factor(), 1.0);
         // A view that already fits the target is never coarsened.
         let mut fast = Lod::default();
-        fast.observe(20.0);
+        fast.observe(0, 20.0);
         fast.moved();
         assert_eq!(fast.viewport((800, 600)), (800, 600));
         fast.enabled = false;
@@ -162,21 +172,25 @@ mod tests {
     #[test]
     fn where_the_coarsest_image_misses_the_target_the_step_widens_up_to_eight() {
         let mut lod = Lod::default();
-        lod.observe(3000.0);
+        lod.observe(0, 3000.0);
         lod.moved();
         assert_eq!(lod.viewport((800, 600)), (200, 150), "the coarsest scale");
         assert_eq!(lod.step_factor(), 2.0);
-        lod.observe(130.0);
+        lod.observe(0, 130.0);
         assert_eq!(lod.step_factor(), 4.0, "130 ms > the 67 ms target");
-        lod.observe(90.0);
-        lod.observe(80.0);
+        lod.observe(0, 90.0);
+        lod.observe(0, 80.0);
         assert_eq!(lod.step_factor(), 8.0, "never more than eight");
-        lod.observe(40.0);
+        lod.observe(0, 40.0);
         assert_eq!(lod.step_factor(), 8.0, "kept while moving");
+        // A frame submitted before the step changed does not widen it again.
+        lod.changed_at(10);
+        lod.observe(9, 500.0);
+        assert_eq!(lod.step_factor(), 8.0);
         // The graph refuses ×8: back to ×4, and never asked for more.
         lod.refuse_step();
         assert_eq!(lod.step_factor(), 4.0);
-        lod.observe(200.0);
+        lod.observe(11, 200.0);
         assert_eq!(lod.step_factor(), 4.0);
         // At rest the full image, and the next drag starts at ×2 again.
         lod.last_motion = Some(Instant::now() - REST - Duration::from_millis(1));

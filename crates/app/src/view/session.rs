@@ -176,11 +176,13 @@ pub struct LiveSession {
 }
 
 /// What the level of detail's step replaces: the parameter overrides and graph scalars from
-/// before it.
+/// before it, and the graph's own spacing of each pass it widens by parameter (`PASS.PARAM`,
+/// taken from the plan at factor 1, so a ×2 → ×4 change widens the graph's value, not ×2's).
 #[derive(Clone)]
 struct StepBase {
     params: std::collections::BTreeMap<String, ron::Value>,
     scalars: std::collections::BTreeMap<String, f64>,
+    steps: Vec<(String, f64)>,
 }
 
 /// The sample spacings the level of detail widens in every pass that declares one: a
@@ -691,9 +693,13 @@ impl LiveSession {
         let result = self.compile_and_apply(&source, &options).map(|r| describe(&r));
         if result.is_ok() {
             self.options = options;
-            // Kept when the level of detail's step ends.
+            // Kept when the level of detail's step ends; a spacing the user sets is the new own one.
             if let Some((_, base)) = &mut self.coarse_step {
-                base.params.insert(format!("{pass}.{param}"), value);
+                let key = format!("{pass}.{param}");
+                if let (Some(entry), ron::Value::Number(n)) = (base.steps.iter_mut().find(|(k, _)| *k == key), &value) {
+                    entry.1 = n.into_f64();
+                }
+                base.params.insert(key, value);
             }
         }
         self.outcome(format!("parameter {pass}.{param}"), start, result)
@@ -780,6 +786,11 @@ impl LiveSession {
         self.outcome(what.to_string(), start, result)
     }
 
+    /// The factor the level of detail's step is widened by now (1: the graph's own).
+    pub fn step_factor(&self) -> f64 {
+        self.coarse_step.as_ref().map_or(1.0, |(f, _)| *f)
+    }
+
     /// The level of detail's step: every pass with a `step_voxels` samples `factor` times further
     /// apart while the camera moves, and a multipass graph's segments (an input wired to
     /// `segment_steps`) get `factor` times longer (1: the graph's own values again, with the
@@ -790,16 +801,33 @@ impl LiveSession {
         if factor == current {
             return true;
         }
-        let base = self.coarse_step.as_ref().map_or_else(
-            || StepBase { params: self.options.param_overrides.clone(), scalars: self.options.scalars.clone() },
-            |(_, b)| b.clone(),
-        );
+        let (inputs, fed) = step_inputs(&self.source);
+        let base = match &self.coarse_step {
+            Some((_, base)) => base.clone(),
+            None => {
+                // At factor 1: the plan holds the graph's own (or the user's) spacings.
+                let Some(plan) = self.plan() else { return false };
+                let mut steps: Vec<(String, f64)> = Vec::new();
+                for step in &plan.steps {
+                    for param in STEP_PARAMS {
+                        let key = format!("{}.{param}", step.pass_id);
+                        let fed_by_input = param == "step_voxels" && fed.contains(&step.pass_id);
+                        if step.params.declares(param)
+                            && (!fed_by_input || self.options.param_overrides.contains_key(&key))
+                            && !steps.iter().any(|(k, _)| *k == key)
+                        {
+                            steps.push((key, step.params.float(param)));
+                        }
+                    }
+                }
+                StepBase { params: self.options.param_overrides.clone(), scalars: self.options.scalars.clone(), steps }
+            }
+        };
         let mut options = self.options.clone();
         options.param_overrides = base.params.clone();
         options.scalars = base.scalars.clone();
         if factor != 1.0 {
             let Some(plan) = self.plan() else { return false };
-            let (inputs, fed) = step_inputs(&self.source);
             for name in &inputs {
                 let own = match plan.inputs.get(name) {
                     Some(volgraph_core::graph::ast::InputKind::Scalar(default)) => *default,
@@ -808,26 +836,10 @@ impl LiveSession {
                 let step = base.scalars.get(name).copied().unwrap_or(own);
                 options.scalars.insert(name.clone(), step * factor);
             }
-            // The graph's own step of each other pass: its plan at factor 1 (the current one).
-            let mut steps: Vec<(String, f64)> = Vec::new();
-            for step in &plan.steps {
-                for param in STEP_PARAMS {
-                    let key = format!("{}.{param}", step.pass_id);
-                    let fed_by_input = param == "step_voxels" && fed.contains(&step.pass_id);
-                    if step.params.declares(param)
-                        && (!fed_by_input || base.params.contains_key(&key))
-                        && !steps.iter().any(|(k, _)| *k == key)
-                    {
-                        let own = match base.params.get(&key) {
-                            Some(ron::Value::Number(n)) => n.into_f64(),
-                            _ => step.params.float(param),
-                        };
-                        steps.push((key, own));
-                    }
-                }
-            }
-            for (key, own) in steps {
-                options.param_overrides.insert(key, ron::Value::Number(ron::value::Number::F64((own * factor).into())));
+            for (key, own) in &base.steps {
+                options
+                    .param_overrides
+                    .insert(key.clone(), ron::Value::Number(ron::value::Number::F64((own * factor).into())));
             }
         }
         let source = self.source.clone();

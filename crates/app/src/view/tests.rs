@@ -596,6 +596,9 @@ fn the_coarse_step_widens_the_step_inputs_and_quarters_the_segments() {
     assert_eq!(spacing(&session), 0.5);
     assert!(session.set_step_factor(2.0));
     assert_eq!(spacing(&session), 1.0);
+    // ×2 → ×4 widens the graph's spacing, not ×2's.
+    assert!(session.set_step_factor(4.0));
+    assert_eq!(spacing(&session), 2.0);
     assert!(session.set_step_factor(1.0));
     assert_eq!(spacing(&session), 0.5);
     let _ = std::fs::remove_dir_all(&s.dir);

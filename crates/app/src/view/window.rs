@@ -295,6 +295,7 @@ impl Viewer {
         // Level of detail: fewer pixels while the camera moves, the full image once it rests.
         let mut lod_events = Vec::new();
         if let (Some(session), Some(gfx)) = (self.session.as_mut(), self.gfx.as_ref()) {
+            let before = (session.options().viewport, session.step_factor());
             let want = self.lod.viewport((gfx.config.width, gfx.config.height));
             if want != session.options().viewport {
                 lod_events = session.resize(want.0, want.1);
@@ -302,12 +303,15 @@ impl Viewer {
             if !session.set_step_factor(self.lod.step_factor()) {
                 self.lod.refuse_step();
             }
+            if (session.options().viewport, session.step_factor()) != before {
+                self.lod.changed_at(session.runtime.next_frame_index());
+            }
         }
         self.handle(lod_events);
         let Some(session) = self.session.as_mut() else { return };
         for stats in session.runtime.poll() {
             self.timings.add(&stats);
-            self.lod.observe(stats.frame_ms);
+            self.lod.observe(stats.frame_index, stats.frame_ms);
         }
         let Some(gfx) = self.gfx.as_mut() else { return };
         let frame = match gfx.surface.get_current_texture() {

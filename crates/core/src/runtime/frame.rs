@@ -294,7 +294,8 @@ pub struct FrameUniforms {
     pub own_lo: [f32; 4],
     /// See `own_lo`.
     pub own_hi: [f32; 4],
-    /// The scene's crop box in the bound texture's coordinates (xyz); read under `#if CROP`.
+    /// The scene's crop box in the bound texture's coordinates (xyz); read under `#if CROP`. w:
+    /// which crop faces are cuts (bit a: the low face of axis a, bit 3 + a: the high one).
     pub crop_lo: [f32; 4],
     /// See `crop_lo`.
     pub crop_hi: [f32; 4],
@@ -359,7 +360,15 @@ impl FrameUniforms {
     fn with_cuts(mut self, cuts: &Cuts, grid: (DVec3, DVec3)) -> Self {
         let (lo, size) = (grid.0, grid.1 - grid.0);
         if let Some(c) = cuts.crop() {
-            self.crop_lo = with_w(lo + c.lo * size, 0.0);
+            // crop_lo.w: which faces are cuts, not the volume's own faces (bit a: the low face
+            // of axis a, bit 3 + a: the high one), decided here in f64 as `Cuts::cap_normal`
+            // decides it, for the shader's capping.
+            let mut faces = 0u32;
+            for a in 0..3 {
+                faces |= u32::from(c.lo[a] > 0.0) << a;
+                faces |= u32::from(c.hi[a] < 1.0) << (3 + a);
+            }
+            self.crop_lo = with_w(lo + c.lo * size, faces as f32);
             self.crop_hi = with_w(lo + c.hi * size, 0.0);
         }
         for (slot, p) in self.clip_planes.iter_mut().zip(cuts.planes()) {

@@ -186,12 +186,14 @@ impl FrameRing {
         let done = p.done_at.lock().ok().and_then(|d| *d).unwrap_or_else(Instant::now);
         let wall_ms = done.saturating_duration_since(p.submitted).as_secs_f64() * 1e3;
         if let Some(ms) = p.profiled {
+            let steps_ms: f64 = ms.iter().sum();
             self.finished.push_back(FrameStats {
                 frame_index: p.frame_index,
                 pass_ids: p.pass_ids,
-                frame_ms: ms.iter().sum(),
+                frame_ms: steps_ms,
                 step_gpu_ms: Some(ms),
-                wall_ms,
+                // The steps were waited for before the last submit (the blit) was timed.
+                wall_ms: steps_ms + wall_ms,
                 wall_time_fallback: false,
                 steps_serialised: true,
             });

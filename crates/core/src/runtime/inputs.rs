@@ -206,6 +206,8 @@ impl InputStore {
     pub fn bind_texture(&mut self, name: &str, texture: wgpu::Texture) {
         let content = self.uploads.wrapping_add(0x9e37_79b9_7f4a_7c15);
         self.insert(name, texture, content);
+        // Whatever LUT was bound here before is not what the texture holds.
+        self.tables.remove(name);
     }
 
     fn insert(&mut self, name: &str, texture: wgpu::Texture, content: u64) {

@@ -205,6 +205,11 @@ impl Runtime {
         self.profile_steps = on;
     }
 
+    /// The index the next submitted frame gets (`FrameStats::frame_index`).
+    pub fn next_frame_index(&self) -> u64 {
+        self.frame_index
+    }
+
     /// Whether [`Runtime::set_step_profiling`] is on.
     pub fn step_profiling(&self) -> bool {
         self.profile_steps
@@ -526,7 +531,9 @@ impl Runtime {
         let gpu = self.gpu.clone();
         self.gpu.queue.write_buffer(&self.system.frame, 0, bytemuck::bytes_of(&FrameUniforms::of(&frame)));
         let steps = schedule.plan.steps.len();
-        let timestamps = self.frames.begin(&gpu, steps).filter(|_| !self.profile_steps);
+        // Profiled frames time their steps by wall clock: no timestamp queries to write or resolve.
+        let timed_steps = if self.profile_steps { 0 } else { steps };
+        let timestamps = self.frames.begin(&gpu, timed_steps);
         let mut clock = self.profile_steps.then(|| step_clock::StepClock::new(&gpu));
         let what = format!("frame {} of graph \"{}\"", frame.frame_index, schedule.plan.name);
         let history = &mut self.history;
@@ -568,7 +575,7 @@ impl Runtime {
                         let (view, encoded) = output_view(schedule, history, target.output)?;
                         blitter.record(&gpu, &mut encoder, &view, encoded, target)?;
                     }
-                    frames.resolve(&mut encoder, steps);
+                    frames.resolve(&mut encoder, timed_steps);
                     Ok(encoder.finish())
                 },
             )

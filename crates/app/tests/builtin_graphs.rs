@@ -96,12 +96,26 @@ fn bench_without_the_bench_program_says_how_to_install_it() {
     let dir = empty_folder("no-bench");
     let copied = dir.join("volgraph");
     std::fs::copy(env!("CARGO_BIN_EXE_volgraph"), &copied).expect("copy the binary");
-    let out = Command::new(&copied)
-        .args(["sweep", "--knobs", "step"])
-        .current_dir(&dir)
-        .env("PATH", dir.join("no-such-folder"))
-        .output()
-        .expect("runs");
+    // Another test thread forking while the copy was open for writing holds it open until its
+    // child execs: running the copy then fails with "Text file busy" for a moment. Try again.
+    let run = || {
+        Command::new(&copied)
+            .args(["sweep", "--knobs", "step"])
+            .current_dir(&dir)
+            .env("PATH", dir.join("no-such-folder"))
+            .output()
+    };
+    let mut out = run();
+    for _ in 0..20 {
+        match &out {
+            Err(e) if e.kind() == std::io::ErrorKind::ExecutableFileBusy => {
+                std::thread::sleep(std::time::Duration::from_millis(50));
+                out = run();
+            }
+            _ => break,
+        }
+    }
+    let out = out.expect("runs");
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("volgraph-bench") && err.contains("cargo install --path crates/bench"), "{err}");

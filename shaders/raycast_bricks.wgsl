@@ -48,11 +48,7 @@ struct BrickParams {
 @group(0) @binding(auto) var<storage, read> leaf_distance: array<u32>;
 // Per pixel: the premultiplied colour composited so far this frame.
 @group(0) @binding(auto) var<storage, read_write> acc: array<vec4<f32>>;
-#if COLOR_F32
-@group(0) @binding(auto) var color: texture_storage_2d<rgba32float, write>;
-#else
-@group(0) @binding(auto) var color: texture_storage_2d<rgba16float, write>;
-#endif
+#import "common/color_target.wgsl"
 
 // Voxel coordinates (voxel centres at integers) of texture-space `p`, clamped to the voxels.
 fn voxel_of(p: vec3<f32>) -> vec3<f32> {

@@ -14,12 +14,7 @@
 override WORKGROUP_X: u32 = 8u;
 override WORKGROUP_Y: u32 = 8u;
 
-// Premultiplied linear RGBA (Rgba32Float when the scene asks for f32 precision).
-#if COLOR_F32
-@group(0) @binding(auto) var color: texture_storage_2d<rgba32float, write>;
-#else
-@group(0) @binding(auto) var color: texture_storage_2d<rgba16float, write>;
-#endif
+#import "common/color_target.wgsl"
 // Texture-space hit position (w = 1), zero on a miss; only `cs_iso` writes it.
 @group(0) @binding(auto) var hit: texture_storage_2d<rgba32float, write>;
 

@@ -150,10 +150,7 @@ impl PassPlugin for RaycastBricks {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let settings = BrickSettings::from_params(ctx.params);
         let wg = Workgroup::checked_size(ctx)?;
-        let mut defines = self.shader_defines(ctx.params);
-        if crate::shared::color_is_f32(ctx) {
-            defines.push("COLOR_F32");
-        }
+        let defines = [self.shader_defines(ctx.params), crate::shared::color_precision_defines(ctx)].concat();
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
             defines: &defines,
             constants: &[("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)],

@@ -26,7 +26,7 @@ use crate::march::{Leaping, MarchSettings, march_defines, march_specs, same_marc
 use crate::opacity_lut::{opacity_table, table_shader_uses};
 use crate::raycast::raycast_ports;
 use crate::raycast_params::{RaycastParamsGpu, Sampling, Workgroup, is_iso, raycast_param_specs};
-use crate::shared::{BlockSize, color_is_f32};
+use crate::shared::{BlockSize, color_precision_defines};
 use crate::tf_table::TfTable;
 
 /// The plugin.
@@ -138,10 +138,7 @@ impl PassPlugin for RaycastCompute {
         let leaping = Leaping::new(ctx)?;
         let table = uses_table(ctx.params).then(|| opacity_table(ctx)).transpose()?;
         let own = march_shader(ctx.params).defines(wired_defines(ctx.params, &ctx.wired()));
-        let mut defines = [self.shader_defines(ctx.params), own.defines.clone()].concat();
-        if color_is_f32(ctx) {
-            defines.push("COLOR_F32");
-        }
+        let defines = [self.shader_defines(ctx.params), own.defines.clone(), color_precision_defines(ctx)].concat();
         let variant = |half_step: bool| {
             let mut constants = vec![("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)];
             constants.extend(leaping.constants());

@@ -43,8 +43,14 @@ pub fn front_to_back_blend() -> wgpu::BlendState {
 
 /// Whether the graph (or the scene's precision) made `color` an Rgba32Float target: the node
 /// then compiles its shader with `COLOR_F32`.
-pub fn color_is_f32(ctx: &CreateContext<'_>) -> bool {
+fn color_is_f32(ctx: &CreateContext<'_>) -> bool {
     ctx.port("color").and_then(|p| p.format) == Some(wgpu::TextureFormat::Rgba32Float)
+}
+
+/// The `#if` names of the colour target's precision (`shaders/common/color_target.wgsl`): the
+/// one place a compute march learns whether it writes f16 or f32.
+pub fn color_precision_defines(ctx: &CreateContext<'_>) -> Vec<&'static str> {
+    if color_is_f32(ctx) { vec!["COLOR_F32"] } else { Vec::new() }
 }
 
 /// A built-in shader assembled as the GPU gets it (imports resolved, bindings numbered), for

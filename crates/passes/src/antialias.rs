@@ -33,6 +33,17 @@ struct AaParamsGpu {
 
 const _: () = assert!(std::mem::size_of::<AaParamsGpu>() == 16);
 
+/// The block as the shader use declares it (bound as `aa`), so the plan checks the WGSL struct
+/// `AaParams` member by member; the node writes it itself.
+fn aa_layout() -> volgraph_core::UniformLayout {
+    volgraph_core::UniformLayout {
+        global: "aa",
+        fields: vec![("contrast", "f32"), ("pattern", "u32"), ("directions", "u32"), ("full", "u32")],
+        params: Vec::new(),
+        bytes: |p| bytemuck::bytes_of(&AaParamsGpu::from_params(p)).to_vec(),
+    }
+}
+
 volgraph_core::param_choice! {
     /// The sub-pixel pattern.
     pub enum Pattern { Two = "2x", Four = "4x", RotatedGrid = "rgss" }
@@ -84,7 +95,7 @@ fn ray_block(p: &Params) -> RaycastParamsGpu {
 /// Its pipeline for these parameters.
 fn shader(params: &Params) -> ShaderUse {
     ShaderUse::new("antialias.wgsl", if is_iso(params) { "fs_aa_iso" } else { "fs_aa_dvr" })
-        .binds(&["aa"])
+        .uniform(aa_layout())
         .uniform(RaycastParamsGpu::bound("params"))
 }
 

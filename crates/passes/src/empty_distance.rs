@@ -42,7 +42,15 @@ struct DistanceParamsGpu {
 
 /// The pass's one entry point, declared once for `shaders()` and `create`.
 fn shader() -> ShaderUse {
-    ShaderUse::new("empty_distance.wgsl", "cs_line").binds(&["partial", "distance", "pass_params"])
+    ShaderUse::new("empty_distance.wgsl", "cs_line").binds(&["partial", "distance"]).uniform(
+        volgraph_core::UniformLayout {
+            global: "pass_params",
+            fields: vec![("axis", "u32")],
+            params: Vec::new(),
+            // One block per axis, written by the node (`DistanceParamsGpu`).
+            bytes: |_| bytemuck::bytes_of(&DistanceParamsGpu { axis: 0, _pad: [0; 3] }).to_vec(),
+        },
+    )
 }
 
 impl PassDecl for EmptyDistance {

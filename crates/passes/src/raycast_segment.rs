@@ -84,6 +84,18 @@ pub struct SegmentParamsGpu {
 const _: () = assert!(std::mem::size_of::<SegmentParamsGpu>() == 16);
 
 impl SegmentParamsGpu {
+    /// The block as a shader use declares it (bound as `segment`), so the plan checks the WGSL
+    /// struct `SegmentParams` member by member. The node writes it itself (no parameter is
+    /// claimed for in-place updates).
+    pub fn layout() -> volgraph_core::UniformLayout {
+        volgraph_core::UniformLayout {
+            global: "segment",
+            fields: vec![("steps", "u32"), ("block_size", "u32"), ("threshold", "f32")],
+            params: Vec::new(),
+            bytes: |p| bytemuck::bytes_of(&SegmentParamsGpu::from_params(p)).to_vec(),
+        }
+    }
+
     /// From the checked parameters of a kind that declares the [`SegmentSteps`], [`BlockSize`]
     /// and [`Termination`] blocks (`raycast_segment`, `termination_test`).
     pub fn from_params(p: &Params) -> Self {
@@ -148,10 +160,9 @@ impl PassDecl for RaycastSegment {
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
         let (file, entry_point) = self.entry(params);
         // The counting variant (a bench tool's) binds the invocation counter too.
-        let extra: &'static [&'static str] =
-            if self.counter.is_some() { &["segment", "invocations"] } else { &["segment"] };
+        let extra: &'static [&'static str] = if self.counter.is_some() { &["invocations"] } else { &[] };
         [ShaderUse::new(file, "vs_segment"), ShaderUse::new(file, entry_point)]
-            .map(|u| u.binds(extra).uniform(RaycastParamsGpu::bound("params")))
+            .map(|u| u.binds(extra).uniform(RaycastParamsGpu::bound("params")).uniform(SegmentParamsGpu::layout()))
             .to_vec()
     }
 

@@ -41,7 +41,9 @@ volgraph_core::pass_params! {
 /// once for `shaders()` and `create`.
 fn stages() -> [ShaderUse; 4] {
     ["vs_segment", "vs_terminate_alpha", "fs_terminate", "fs_terminate_empty"].map(|entry| {
-        ShaderUse::new("termination_test.wgsl", entry).binds(&["segment"]).uniform(RaycastParamsGpu::bound("params"))
+        ShaderUse::new("termination_test.wgsl", entry)
+            .uniform(RaycastParamsGpu::bound("params"))
+            .uniform(SegmentParamsGpu::layout())
     })
 }
 

@@ -103,13 +103,14 @@ fn clip_segment(u0: vec3<f32>, d: vec3<f32>, kept_in: vec2<f32>) -> vec2<f32> {
 }
 #endif
 
+#if CUTS
 // "Capping" (docs/rendering_model.md "Cuts"; f64 twin `Cuts::cap_normal` in
 // crates/accel/src/cuts.rs): the shading normal `n` at `u`, on a ray starting at `ray_start`
 // and running along world direction `d_world`, turned toward the world normal of every cut face
 // the ray entered through within CAP_VOXELS of `u`, each by 1 - distance / CAP_VOXELS (weights scaled to sum to 1 where
 // faces meet). A cut face then shows the plane it was cut along instead of the noisy gradient of
 // the material just behind it. Crop faces on the volume's own boundary (the window's grid) are
-// not cuts. Called only where a cut is compiled in.
+// not cuts. Compiled with a cut (#if CUTS).
 const CAP_VOXELS: f32 = 2.0;
 
 // One face (texture-space half-space normal·u >= offset): its world normal on n's side, times
@@ -161,6 +162,7 @@ fn cap_normal(u: vec3<f32>, d_world: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let mixed = n * (1.0 - acc.w * scale) + acc.xyz * scale;
     return select(n, normalize(mixed), length(mixed) > 1e-12);
 }
+#endif
 
 // The ray of pixel centre `pixel` clipped to the box and the near plane, as
 // `volgraph_accel::reference::ray_segment` clips it (slab test; start at max(t_in, t_near); the

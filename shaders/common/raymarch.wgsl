@@ -257,12 +257,8 @@ fn headlight(u: vec3<f32>, d_world: vec3<f32>) -> vec2<f32> {
         n = -normalize(g * frame.volume_dims.xyz / frame.half_extent.xyz);
     }
     // A cut face shows the plane it was cut along (common/ray_box.wgsl).
-#if CROP
+#if CUTS
     n = cap_normal(u, d_world, n);
-#else
-#if CLIP
-    n = cap_normal(u, d_world, n);
-#endif
 #endif
     // Headlight: l = v = -d, so h = normalize(l + v) = l.
     let n_dot_l = abs(dot(n, l));

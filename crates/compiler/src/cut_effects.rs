@@ -1,6 +1,7 @@
 //! A scene's crop box and clip planes as effects (`volgraph_accel::cuts`): the scene features
 //! `crop` and `clip`, each the `#if` name of the same word in capitals that
-//! `shaders/common/ray_box.wgsl` compiles its cut into. Unlike the DVR effects, which a graph
+//! `shaders/common/ray_box.wgsl` compiles its cut into, and `CUTS` with either (code every cut
+//! needs, such as capping's shading normal). Unlike the DVR effects, which a graph
 //! wires per pass (`"shading": "feature.shading"`), a cut belongs to the frame: every pass that
 //! honours a sub-box of the volume ([`crate::decl::PassDecl::honours_volume_window`]) takes it
 //! without the graph saying so, and a scene without cuts compiles none of their code.
@@ -31,10 +32,18 @@ pub fn features_of(cuts: &Cuts) -> BTreeSet<String> {
     out
 }
 
-/// The `#if` names of the cut features among `features`.
+/// The `#if` name compiled with any cut.
+const ANY_CUT: &str = "CUTS";
+
+/// The `#if` names of the cut features among `features`, and [`ANY_CUT`] with any of them.
 pub fn defines_of<'a>(features: impl IntoIterator<Item = &'a String>) -> Vec<&'static str> {
     let on: BTreeSet<&str> = features.into_iter().map(String::as_str).collect();
-    CUT_DEFINES.iter().filter(|(feature, _)| on.contains(feature)).map(|(_, define)| *define).collect()
+    let mut defines: Vec<&'static str> =
+        CUT_DEFINES.iter().filter(|(feature, _)| on.contains(feature)).map(|(_, define)| *define).collect();
+    if !defines.is_empty() {
+        defines.push(ANY_CUT);
+    }
+    defines
 }
 
 /// The cut `#if` names pass `decl` is compiled with when `cut_defines` are the frame's: all of

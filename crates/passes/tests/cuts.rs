@@ -33,20 +33,9 @@ use support::{gpu, graph_source};
 
 const SIZE: u32 = 96;
 
-/// `graph` rendered on the GPU with `cuts`, and the reference settings of its "march" pass.
+/// `graph` rendered on the GPU with `cuts` and scene `features`, and the reference settings of
+/// its "march" pass.
 fn render_cut(
-    gpu: &std::sync::Arc<volgraph_core::runtime::Gpu>,
-    graph: &str,
-    volume: &Volume,
-    lut: &[[f32; 4]],
-    camera: &OrbitCamera,
-    cuts: Cuts,
-) -> (Image, volgraph_accel::reference::RaycastSettings) {
-    render_cut_with(gpu, graph, volume, lut, camera, cuts, &[])
-}
-
-/// [`render_cut`] with scene `features` on too.
-fn render_cut_with(
     gpu: &std::sync::Arc<volgraph_core::runtime::Gpu>,
     graph: &str,
     volume: &Volume,
@@ -110,7 +99,7 @@ fn every_raycaster_crops_and_clips_like_the_reference() {
         "klein_2005/leap_iso.ron",
     ] {
         for (name, cuts) in cuts_to_test() {
-            let (image, settings) = render_cut(&gpu, graph, &volume, &lut, &OrbitCamera::default(), cuts);
+            let (image, settings) = render_cut(&gpu, graph, &volume, &lut, &OrbitCamera::default(), cuts, &[]);
             let reference = render_reference(&volume, &lut, &OrbitCamera::default(), SIZE, SIZE, &settings);
             let uncut = render_reference(
                 &volume,
@@ -152,7 +141,7 @@ fn shaded_cut_faces_are_capped_like_the_reference() {
     let camera = OrbitCamera { azimuth_deg: 25.0, elevation_deg: 15.0, ..OrbitCamera::default() };
     for graph in ["basic/fragment_raycast.ron", "modern/fastest.ron"] {
         for (name, cuts) in cuts_to_test() {
-            let (image, settings) = render_cut_with(&gpu, graph, &volume, &lut, &camera, cuts, &["shading"]);
+            let (image, settings) = render_cut(&gpu, graph, &volume, &lut, &camera, cuts, &["shading"]);
             assert!(settings.effects.shading, "{graph}: shading reaches the reference settings");
             let reference = render_reference(&volume, &lut, &camera, SIZE, SIZE, &settings);
             let got = image.to_rgba_f64();
@@ -199,8 +188,8 @@ fn a_crop_to_half_renders_like_the_other_half_zeroed() {
         OrbitCamera { azimuth_deg: 0.0, elevation_deg: 0.0, distance: 4.0, fov_y_deg: 20.0, ..OrbitCamera::default() };
     let frame = camera.frame(SIZE, SIZE);
     for graph in ["basic/fragment_raycast.ron", "modern/fastest.ron", "basic/isosurface.ron"] {
-        let (cropped, _) = render_cut(&gpu, graph, &volume, &lut, &camera, half);
-        let (zeroed_image, _) = render_cut(&gpu, graph, &zeroed, &lut, &camera, Cuts::NONE);
+        let (cropped, _) = render_cut(&gpu, graph, &volume, &lut, &camera, half, &[]);
+        let (zeroed_image, _) = render_cut(&gpu, graph, &zeroed, &lut, &camera, Cuts::NONE, &[]);
         let (a, b) = (cropped.to_rgba_f64(), zeroed_image.to_rgba_f64());
         let (mut compared, mut worst, mut visible) = (0usize, 0.0f64, 0usize);
         for y in 0..SIZE {

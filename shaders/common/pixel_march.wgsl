@@ -6,6 +6,9 @@
 // - START: begin each ray at the `start` estimate (Klein et al. 2005 §4.2);
 // - LEAP_HITS: report where the next frame's ray should start (`leap_hit`);
 // - COUNT: add the samples taken to `samples` (benchmarks).
+// - COUNT_LEAPABLE (with LEAP_HITS): add to `leapable` the samples a perfect start estimate
+//   would let the ray leap over — those before its leap point less the step back — whatever
+//   its start was: the measure a graph's bypass weighs reprojection's fixed cost against.
 
 #import "common/frame.wgsl"
 #import "common/raymarch.wgsl"
@@ -35,10 +38,17 @@ fn block_edge() -> u32 {
 @group(0) @binding(auto) var start: texture_2d<f32>;
 #endif
 
-#if COUNT
-// Samples taken per image row (row y adds into samples[y % SAMPLE_ROWS]; benchmarks sum them).
-@group(0) @binding(auto) var<storage, read_write> samples: array<atomic<u32>>;
+// Words of the counting buffers: image row y adds into word y % SAMPLE_ROWS.
 const SAMPLE_ROWS: u32 = 4096u;
+
+#if COUNT
+// Samples taken per image row (benchmarks sum them).
+@group(0) @binding(auto) var<storage, read_write> samples: array<atomic<u32>>;
+#endif
+
+#if COUNT_LEAPABLE
+// Samples a perfect start estimate would leap over, per image row (a bypass sums them).
+@group(0) @binding(auto) var<storage, read_write> leapable: array<atomic<u32>>;
 #endif
 
 // A pixel's colour and point: the isosurface hit (w = 1, zero on a miss) or, with LEAP_HITS,
@@ -63,6 +73,19 @@ fn count_samples(pixel: vec2<u32>, n: u32) {
 #endif
 }
 
+// `reach`: the sample the ray's leap point lies at (`s.count` when it met nothing); the next
+// frame's ray would start `step_back` samples before it.
+fn count_leapable(pixel: vec2<u32>, s: Samples, reach: u32) {
+#if COUNT_LEAPABLE
+    // One pixel in 16 (a 4×4 lattice) counts for its 16: a mean over the image needs no more,
+    // and an atomic per pixel costs as much as a sample where lanes run atomics one by one.
+    if (s.count > 0u && (pixel.x & 3u) == 0u && (pixel.y & 3u) == 0u) {
+        let back = u32(params.step_back);
+        atomicAdd(&leapable[pixel.y % SAMPLE_ROWS], 16u * (reach - min(reach, back)));
+    }
+#endif
+}
+
 // Direct volume rendering of one pixel: premultiplied linear RGBA over a transparent background.
 fn march_pixel_dvr(pixel: vec2<u32>) -> PixelMarch {
     let ray = pixel_ray(pixel);
@@ -74,6 +97,7 @@ fn march_pixel_dvr(pixel: vec2<u32>) -> PixelMarch {
     var point = vec4<f32>(0.0);
 #if LEAP_HITS
     point = leap_point(ray, s, select(vec4<f32>(0.0), vec4<f32>(sample_at(s, m.first), 1.0), m.first != NO_SAMPLE));
+    count_leapable(pixel, s, select(s.count, m.first, m.first != NO_SAMPLE));
 #endif
     return PixelMarch(m.color, point);
 }
@@ -85,6 +109,7 @@ fn march_pixel_iso(pixel: vec2<u32>) -> PixelMarch {
     let m = march_iso(s, first_sample(pixel, ray, s), s.count);
     count_samples(pixel, m.samples);
 #if LEAP_HITS
+    count_leapable(pixel, s, m.at);
     return PixelMarch(m.color, leap_point(ray, s, m.hit));
 #else
     return PixelMarch(m.color, m.hit);

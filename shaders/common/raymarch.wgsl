@@ -277,11 +277,12 @@ fn shade_iso(u: vec3<f32>, d_world: vec3<f32>) -> vec3<f32> {
 }
 
 // What an isosurface march found: shaded colour (alpha 1) and texture-space hit (w = 1), zero
-// on a miss; the samples it took.
+// on a miss; the samples it took; the sample it stopped at (the hit's, or `end` on a miss).
 struct IsoMarch {
     color: vec4<f32>,
     hit: vec4<f32>,
     samples: u32,
+    at: u32,
 }
 
 // First-hit isosurface over samples [k0, end) of `s`: the first sample k with value >= iso,
@@ -292,7 +293,7 @@ struct IsoMarch {
 // after it: inside the loop, every lane of a SIMD group would wait through the shading of each
 // other lane's hit.
 fn march_iso(s: Samples, k0: u32, end: u32) -> IsoMarch {
-    var out = IsoMarch(vec4<f32>(0.0), vec4<f32>(0.0), 0u);
+    var out = IsoMarch(vec4<f32>(0.0), vec4<f32>(0.0), 0u, end);
     let iso = params.iso_value;
     var k = k0;
     var prev = 0.0;
@@ -312,6 +313,7 @@ fn march_iso(s: Samples, k0: u32, end: u32) -> IsoMarch {
         prev = sample_volume(s.first - s.delta);
         out.samples = 1u;
         if (prev >= iso) {
+            out.at = 0u;
             return out;
         }
         has_prev = true;
@@ -334,6 +336,7 @@ fn march_iso(s: Samples, k0: u32, end: u32) -> IsoMarch {
         return out;
     }
     out.samples += k - first + 1u;
+    out.at = k;
     var x = f32(k);
     if (has_prev || k > first) {
         x = x - 1.0 + (iso - prev) / (v - prev);

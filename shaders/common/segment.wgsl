@@ -88,7 +88,7 @@ fn segment_dvr(s: Samples, index: u32) -> vec4<f32> {
 fn segment_iso(s: Samples, index: u32) -> IsoMarch {
     let r = segment_range(s, index);
     if (r.x >= r.y) {
-        return IsoMarch(vec4<f32>(0.0), vec4<f32>(0.0), 0u);
+        return IsoMarch(vec4<f32>(0.0), vec4<f32>(0.0), 0u, 0u);
     }
     return march_iso(s, r.x, r.y);
 }

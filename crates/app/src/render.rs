@@ -237,6 +237,9 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
         for line in crate::render::counter_lines(&runtime.pass_counters()) {
             crate::stdout::eprintln_escaped!("  {line}");
         }
+        for b in runtime.bypass_status() {
+            crate::stdout::eprintln_escaped!("  {}", bypass_line(&b));
+        }
     }
     Ok(())
 }
@@ -277,4 +280,17 @@ pub fn counter_lines(counters: &[(String, &'static str, f64)]) -> Vec<String> {
             }
         })
         .collect()
+}
+
+/// One line saying what a graph's bypass did over the frames rendered.
+pub(crate) fn bypass_line(b: &volgraph_core::runtime::BypassStatus) -> String {
+    let frames = b.frames_bypassed + b.frames_run;
+    let measure = b.measure.map_or("not measured yet".to_string(), |m| format!("last measure {m:.1} per pixel"));
+    format!(
+        "bypass {}: left out in {} of {frames} frames ({measure}, threshold {}; the last frame {})",
+        b.name,
+        b.frames_bypassed,
+        b.below,
+        if b.bypassed { "left them out" } else { "ran them" }
+    )
 }

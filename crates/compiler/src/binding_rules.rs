@@ -33,6 +33,9 @@ pub struct PortInfo {
     /// The texture dimension the port binds, where its kind fixes one (targets and the TF are
     /// 2D, the volume 3D); `None` for owned resources and buffers.
     pub dim: Option<wgpu::TextureViewDimension>,
+    /// An input a graph's bypass may clear to zeros for a frame (its producer left out): a
+    /// node may build a variant that does without it (`RecordContext::reads_zeros`).
+    pub may_read_zeros: bool,
 }
 
 /// Names a texture dimension as WGSL writes it.
@@ -84,7 +87,11 @@ pub fn port_infos(plan: &Plan, step: &crate::plan::Step, specs: &[crate::decl::P
                 (None, Some(PortKind::Volume)) => Some(wgpu::TextureViewDimension::D3),
                 _ => None,
             };
-            PortInfo { name: bp.port.clone(), access: bp.access, format, owned, buffer, bound, dim }
+            let may_read_zeros = match &bp.binding {
+                Binding::Resource { id, .. } => plan.bypass.iter().any(|b| b.clears.contains(id)),
+                _ => false,
+            };
+            PortInfo { name: bp.port.clone(), access: bp.access, format, owned, buffer, bound, dim, may_read_zeros }
         })
         .collect()
 }

@@ -101,27 +101,38 @@ pub struct PortSpec {
     pub kind: PortKind,
     /// When false, the graph may leave this input unwired.
     pub required: bool,
+    /// An input that reads a target of zeros as "none here", the same as unwired (a graph's
+    /// `bypass` clears what a left-out pass would have written; only such ports may read it).
+    pub zero_means_none: bool,
 }
 
 impl PortSpec {
     /// A required input.
     pub fn read(name: &'static str, kind: PortKind) -> Self {
-        Self { name, access: Access::Read, kind, required: true }
+        Self { name, access: Access::Read, kind, required: true, zero_means_none: false }
     }
 
     /// An output.
     pub fn write(name: &'static str, kind: PortKind) -> Self {
-        Self { name, access: Access::Write, kind, required: true }
+        Self { name, access: Access::Write, kind, required: true, zero_means_none: false }
     }
 
     /// A read-modify-write port.
     pub fn modify(name: &'static str, kind: PortKind) -> Self {
-        Self { name, access: Access::Modify, kind, required: true }
+        Self { name, access: Access::Modify, kind, required: true, zero_means_none: false }
     }
 
     /// Marks an input optional.
     pub fn optional(mut self) -> Self {
         self.required = false;
+        self
+    }
+
+    /// Marks an optional input that reads zeros as if it were unwired, so a graph may bypass
+    /// the pass that writes it (see `GraphDoc::bypass`).
+    pub fn zero_means_none(mut self) -> Self {
+        self.required = false;
+        self.zero_means_none = true;
         self
     }
 

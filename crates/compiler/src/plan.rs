@@ -36,6 +36,8 @@ pub struct Plan {
     pub outputs: BTreeMap<String, ResourceId>,
     /// History entries: name → what they track.
     pub history: BTreeMap<String, History>,
+    /// Steps the runtime may leave out by measurement (`GraphDoc::bypass`).
+    pub bypass: Vec<Bypass>,
     /// Pass kinds the graph declares itself (WGSL-only passes): the runtime adds them to its
     /// registry when it applies the plan ([`crate::wgsl_kind::with_graph_kinds`]).
     pub kinds: BTreeMap<String, crate::graph::ast::WgslKindDoc>,
@@ -219,6 +221,27 @@ impl Slot {
     }
 }
 
+/// A bypass, in plan terms (`GraphDoc::bypass`): steps the runtime leaves out while the
+/// per-pixel mean of buffer `measure` (the sum of its u32 words over the viewport's pixels,
+/// read back from the last finished frame) is below `below`; while they are left out, each
+/// target in `clears` (written by them, read by steps that run) is cleared to zero where its
+/// producer would have run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bypass {
+    /// The name the graph gives it.
+    pub name: String,
+    /// Indices into `Plan::steps` of the steps left out.
+    pub steps: Vec<usize>,
+    /// Resources those steps write that other steps read.
+    pub clears: Vec<ResourceId>,
+    /// The step that writes the measure (it runs either way).
+    pub measure_step: usize,
+    /// The buffer resource it writes.
+    pub measure: ResourceId,
+    /// The threshold per viewport pixel.
+    pub below: f64,
+}
+
 /// A history entry.
 #[derive(Clone, Debug)]
 pub struct History {
@@ -299,6 +322,19 @@ impl Plan {
         if !self.gated.is_empty() {
             let g: Vec<String> = self.gated.iter().map(|(p, f)| format!("{p} (needs {})", f.join(", "))).collect();
             let _ = writeln!(s, "off by features: {}", g.join(", "));
+        }
+        for b in &self.bypass {
+            let steps: Vec<&str> = b.steps.iter().map(|&i| self.steps[i].label.as_str()).collect();
+            let clears: Vec<&str> = b.clears.iter().map(|&r| self.resources[r].name.as_str()).collect();
+            let _ = writeln!(
+                s,
+                "bypass {}: leaves out {} while {} < {} per pixel (then clears {})",
+                b.name,
+                if steps.is_empty() { "nothing".to_string() } else { steps.join(", ") },
+                self.resources[b.measure].name,
+                b.below,
+                if clears.is_empty() { "nothing".to_string() } else { clears.join(", ") }
+            );
         }
         let _ = writeln!(s, "slots:");
         for (i, slot) in self.slots.iter().enumerate() {

@@ -22,7 +22,9 @@ use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, Rende
 use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::effects::{EffectFlags, EffectState, effect_defines, same_effects};
-use crate::march::{Leaping, MarchSettings, march_defines, march_ports, march_specs, same_march, wired_defines};
+use crate::march::{
+    Leaping, MarchSettings, SAMPLE_ROWS, march_defines, march_ports, march_specs, same_march, wired_defines,
+};
 use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
 use crate::shared::BlockSize;
 
@@ -62,8 +64,12 @@ impl PassDecl for Raycast {
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
         let mut defines = [effect_defines(params), march_defines(params)].concat();
-        if RaycastOwn::from_params(params).leaps(params) {
+        let own = RaycastOwn::from_params(params);
+        if own.leaps(params) {
             defines.extend(["LEAP_HITS", "FIRST_VISIBLE"]);
+        }
+        if own.counts_leapable() {
+            defines.push("COUNT_LEAPABLE");
         }
         defines
     }
@@ -84,9 +90,13 @@ impl PassDecl for Raycast {
         if own.leaps(params) {
             // The leap variant writes `leap_hit` instead of the exact isosurface `hit`.
             ports.retain(|p| p.name != "hit");
-            // Leave unwired to start every ray at the box (the first frame of Klein's loop).
-            ports.push(PortSpec::read("start", PortKind::target(&[TargetFormat::Rgba32Float])).optional());
+            // Leave unwired, or zero (a bypassed splat), to start every ray at the box (the first
+            // frame of Klein's loop): `start_sample` reads w = 0 as no estimate.
+            ports.push(PortSpec::read("start", PortKind::target(&[TargetFormat::Rgba32Float])).zero_means_none());
             ports.push(PortSpec::write("leap_hit", PortKind::target(&[TargetFormat::Rgba32Float])));
+        }
+        if own.counts_leapable() {
+            ports.push(PortSpec::write("leapable", PortKind::buffer(4 * SAMPLE_ROWS)));
         }
         ports
     }
@@ -99,7 +109,11 @@ impl PassDecl for Raycast {
         // Every parameter but the mode, the effects, the march's settings and the leap outputs
         // is a uniform value.
         let (a, b) = (RaycastOwn::from_params(old), RaycastOwn::from_params(new));
-        is_iso(old) == is_iso(new) && same_effects(old, new) && same_march(old, new) && a.leaps(old) == b.leaps(new)
+        is_iso(old) == is_iso(new)
+            && same_effects(old, new)
+            && same_march(old, new)
+            && a.leaps(old) == b.leaps(new)
+            && a.counts_leapable() == b.counts_leapable()
     }
 }
 
@@ -114,26 +128,41 @@ fn march_shader(params: &Params) -> ShaderUse {
 
 impl PassPlugin for Raycast {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let own = march_shader(ctx.params).defines(wired_defines(ctx.params, &ctx.wired()));
-        let defines = [self.shader_defines(ctx.params), own.defines.clone()].concat();
         let leaping = Leaping::new(ctx)?;
-        let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
-            defines: &defines,
-            constants: &leaping.constants(),
-            ..RenderPipelineSpec::fullscreen(&own)
-        })?;
+        let pipeline_for = |wired: &[&str]| {
+            let own = march_shader(ctx.params).defines(wired_defines(ctx.params, wired));
+            let defines = [self.shader_defines(ctx.params), own.defines.clone()].concat();
+            ctx.render_pipeline(&RenderPipelineSpec {
+                defines: &defines,
+                constants: &leaping.constants(),
+                ..RenderPipelineSpec::fullscreen(&own)
+            })
+        };
+        let wired = ctx.wired();
+        let pipeline = pipeline_for(&wired)?;
+        // A graph's bypass may leave the estimates out (zeros): then the march runs as if `start`
+        // were unwired, without reading it.
+        let without_start = match ctx.port("start") {
+            Some(p) if p.bound && p.may_read_zeros => {
+                let wired: Vec<&str> = wired.iter().copied().filter(|&w| w != "start").collect();
+                Some(pipeline_for(&wired)?)
+            }
+            _ => None,
+        };
         let own = RaycastOwn::from_params(ctx.params);
         let settings = gpu_block(ctx.params);
         let params = ctx.uniform_from_bytes("params", &settings.uniform_bytes());
         let effects = EffectState::new(ctx)?;
         Ok(Box::new(RaycastNode {
             pipeline,
+            without_start,
             params,
             effects,
             leaping,
             settings,
             conservative: own.step_back_rule == StepBackRule::Conservative,
             counted: MarchSettings::from_params(ctx.params).count_samples,
+            counts_leapable: own.counts_leapable(),
             written_step_back: None,
         }))
     }
@@ -157,6 +186,9 @@ volgraph_core::pass_params! {
         step_back: u32 = 2, 0..=64, "samples a leap hit is moved back along the ray (the paper: one to three suffice)";
         step_back_rule: StepBackRule = Fixed,
             "fixed: step_back samples; conservative: ⌈|voxel diagonal| / step⌉, never missing a voxel (Klein et al. 2005 §4.2)";
+        count_leapable: bool = false,
+            "with leap_hits: add to the `leapable` buffer the samples a perfect start estimate would leap over (one atomic \
+             per pixel), what a graph's `bypass` weighs reprojection's fixed cost against";
     }
 }
 
@@ -164,6 +196,11 @@ impl RaycastOwn {
     /// Whether the pass runs Klein's variant (leap hits written, or samples counted).
     fn leaps(&self, params: &Params) -> bool {
         self.leap_hits || MarchSettings::from_params(params).count_samples
+    }
+
+    /// Whether the pass writes `leapable` (only with leap hits: the count is of their samples).
+    fn counts_leapable(&self) -> bool {
+        self.leap_hits && self.count_leapable
     }
 }
 
@@ -189,6 +226,8 @@ fn conservative_step_back(volume: &volgraph_core::runtime::VolumeDesc, step_voxe
 
 struct RaycastNode {
     pipeline: RenderPassPipeline,
+    /// The same march without the `start` input, for frames whose estimates a bypass left out.
+    without_start: Option<RenderPassPipeline>,
     params: wgpu::Buffer,
     effects: EffectState,
     leaping: Leaping,
@@ -196,6 +235,7 @@ struct RaycastNode {
     settings: RaycastParamsGpu,
     conservative: bool,
     counted: bool,
+    counts_leapable: bool,
     written_step_back: Option<f32>,
 }
 
@@ -214,14 +254,21 @@ impl PassNode for RaycastNode {
         if self.counted {
             ctx.clear_buffer("samples")?;
         }
+        if self.counts_leapable {
+            ctx.clear_buffer("leapable")?;
+        }
         self.leaping.check(ctx)?;
         self.effects.update(ctx, &self.params, self.settings.step_voxels as f64)?;
         let mut extra = vec![("params", self.params.as_entire_binding())];
         extra.extend(self.leaping.bindings());
         extra.extend(self.effects.bindings());
-        let bg = ctx.bind_group(&self.pipeline, &extra)?;
-        let mut pass = ctx.begin_render_pass(&self.pipeline, None)?;
-        crate::draw(&mut pass, &self.pipeline, &bg, 0..3);
+        let pipeline = match &self.without_start {
+            Some(without) if ctx.reads_zeros("start") => without,
+            _ => &self.pipeline,
+        };
+        let bg = ctx.bind_group(pipeline, &extra)?;
+        let mut pass = ctx.begin_render_pass(pipeline, None)?;
+        crate::draw(&mut pass, pipeline, &bg, 0..3);
         Ok(())
     }
 

@@ -4,12 +4,16 @@
 //! for 30 frames, every frame equals the plain raycast within 1/255 on at least 99.9 % of its
 //! pixels (a start estimate can only be wrong where a surface appears that the last frame did
 //! not see); hole filling leaves no pixel of the volume's footprint without a start; a new
-//! transfer function, an isovalue edit or a camera jump starts again from the box. Failure
-//! images go to target/test-images.
+//! transfer function, an isovalue edit or a camera jump starts again from the box. The graphs'
+//! bypass leaves splat and hole fill out where reprojection cannot pay (a surface right at the
+//! box) and brings them back where it can, the image staying the plain raycast's; the measure it
+//! decides by is checked against the CPU. The tests of reprojection itself set the bypass's
+//! threshold so low that it never leaves the passes out. Failure images go to
+//! target/test-images.
 
 use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::reference::{Phong, RaycastSettings, RenderMode, render_supersampled};
-use volgraph_accel::transfer_function::{Preset, TransferFunction};
+use volgraph_accel::transfer_function::{ControlPoint, Preset, TransferFunction};
 use volgraph_accel::volume::Volume;
 use volgraph_core::CompileOptions;
 use volgraph_core::runtime::Image;
@@ -20,6 +24,15 @@ mod support;
 use support::{Live, as_reference, graph_source, save_images};
 
 const SIZE: u32 = 128;
+
+/// `input.reproject_below` low enough that the bypass never leaves reprojection out (a view
+/// where some ray crosses empty space measures more), for the tests of reprojection itself.
+const ALWAYS_REPROJECT: f64 = 1e-6;
+
+/// The options of a reprojection test: `SIZE`² with the bypass kept from leaving it out.
+fn reprojecting() -> CompileOptions {
+    CompileOptions::new(SIZE, SIZE).with_scalar("reproject_below", ALWAYS_REPROJECT)
+}
 
 /// The fraction of pixels with a channel more than 1/255 apart, and the largest difference, by
 /// the project's one metric (`volgraph_accel::image_diff`: a NaN is off and infinitely far).
@@ -57,7 +70,7 @@ fn rotation_matches_the_baseline(mode: &str) {
     let gpu = support::gpu();
     let registry = builtin_registry();
     for (volume, tf, iso) in datasets() {
-        let options = CompileOptions::new(SIZE, SIZE).with_scalar("iso_value", iso);
+        let options = reprojecting().with_scalar("iso_value", iso);
         let lut = tf.to_lut_for(&volume, 256);
         for degrees in [1.0, 2.0, 5.0] {
             let mut base =
@@ -126,9 +139,7 @@ fn hole_filling_leaves_no_pixel_of_the_footprint_without_a_start() {
     // Single-pixel splats leave the most holes (the paper's Fig. 4, left); with and without the
     // extended-splat step, every pixel of the footprint must end up with a start.
     for extend in [0u64, 1] {
-        let options = CompileOptions::new(SIZE, SIZE)
-            .with_param("splat", "splat_size", 1u64)
-            .with_param("holes", "extend", extend);
+        let options = reprojecting().with_param("splat", "splat_size", 1u64).with_param("holes", "extend", extend);
         let mut leap = Live::new(&gpu, &registry, "klein_2005/leap_iso.ron", &volume, &lut, &options);
         let mut holes_before_filling = 0;
         for f in 0..6 {
@@ -164,7 +175,7 @@ fn a_new_transfer_function_an_isovalue_edit_and_a_camera_jump_start_from_the_box
     let registry = builtin_registry();
     let (volume, tf, _) = datasets().remove(0);
     let lut = tf.to_lut_for(&volume, 256);
-    let options = CompileOptions::new(SIZE, SIZE);
+    let options = reprojecting();
     let mut leap = Live::new(&gpu, &registry, "klein_2005/leap_iso.ron", &volume, &lut, &options);
     leap.frame(&camera(10.0));
     assert!(started_at_the_box(&mut leap), "the first frame starts at the box");
@@ -196,6 +207,114 @@ fn a_new_transfer_function_an_isovalue_edit_and_a_camera_jump_start_from_the_box
     assert!(!started_at_the_box(&mut leap), "a 10° turn keeps the estimates");
     leap.frame(&camera(50.0));
     assert!(started_at_the_box(&mut leap), "a 25° jump starts from the box");
+}
+
+/// The bypass of `live`'s graph after its last frame.
+fn reprojection(live: &Live) -> volgraph_core::runtime::BypassStatus {
+    let status = live.runtime.bypass_status();
+    assert_eq!(status.len(), 1, "the Klein graphs have one bypass: {status:?}");
+    status[0].clone()
+}
+
+#[test]
+fn a_surface_at_the_box_bypasses_reprojection_and_a_deep_one_brings_it_back() {
+    let gpu = support::gpu();
+    let registry = builtin_registry();
+    let (volume, tf, iso) = datasets().remove(0);
+    let lut = tf.to_lut_for(&volume, 256);
+    for mode in ["iso", "dvr"] {
+        // Isovalue 0 (every sample is at or above it) and an opaque TF over all values: every
+        // ray stops at its first sample, nothing can be leapt over. Threshold 4 samples per pixel.
+        let at_the_box =
+            CompileOptions::new(SIZE, SIZE).with_scalar("iso_value", 0.0).with_scalar("reproject_below", 4.0);
+        let (lo, hi) = volume.value_range;
+        let opaque = TransferFunction {
+            domain: (lo, hi),
+            points: vec![
+                ControlPoint { value: lo, color: [1.0, 1.0, 1.0], alpha: 1.0 },
+                ControlPoint { value: hi, color: [1.0, 0.5, 0.2], alpha: 1.0 },
+            ],
+        }
+        .to_lut_for(&volume, 256);
+        let lut_at_box = if mode == "dvr" { &opaque } else { &lut };
+        let graph = format!("klein_2005/leap_{mode}.ron");
+        let mut leap = Live::new(&gpu, &registry, &graph, &volume, lut_at_box, &at_the_box);
+        let mut base =
+            Live::new(&gpu, &registry, &format!("klein_2005/baseline_{mode}.ron"), &volume, lut_at_box, &at_the_box);
+        for f in 0..5 {
+            let cam = camera(10.0 + f as f64);
+            let (l, b) = (leap.frame(&cam), base.frame(&cam));
+            let status = reprojection(&leap);
+            // Frame 0 has no measure yet and runs everything; each later frame reads the last.
+            assert_eq!(status.bypassed, f > 0, "{mode} frame {f}: {status:?}");
+            if f > 0 {
+                assert_eq!(status.measure, Some(0.0), "{mode} frame {f}: no ray can leap over a sample");
+                let start = leap.resource("holes.start");
+                assert!(start.data.iter().all(|&v| v == 0.0), "{mode} frame {f}: the left-out estimates read as zeros");
+            }
+            // Left out or not, the rays start at the box: the plain raycast's image, exactly.
+            assert_eq!(l.data, b.data, "{mode} frame {f}: the bypassed graph draws the plain raycast");
+        }
+        let status = reprojection(&leap);
+        assert_eq!((status.frames_bypassed, status.frames_run), (4, 1), "{mode}: {status:?}");
+
+        // The isosurface inside the volume (for DVR a TF transparent over the lower 60 % of the
+        // values): rays cross empty space first, the measure rises above the threshold and the
+        // splats come back.
+        let deep = at_the_box.clone().with_scalar("iso_value", iso);
+        let plan = leap.runtime.compile(&graph, &graph_source(&graph), &registry, &deep).expect("compiles");
+        if mode == "dvr" {
+            let inputs = plan.inputs.clone();
+            let hollow = tf.hidden_below(lo + 0.6 * (hi - lo)).to_lut_for(&volume, 256);
+            leap.runtime.bind_scene(&inputs, &volume, &hollow).expect("binds");
+        }
+        leap.runtime.apply(plan, &registry).expect("applies");
+        for f in 5..9 {
+            leap.frame(&camera(10.0 + f as f64));
+        }
+        let status = reprojection(&leap);
+        assert!(!status.bypassed, "{mode}: {status:?}");
+        assert!(status.measure.is_some_and(|m| m > 4.0), "{mode}: rays cross empty space first: {status:?}");
+        assert!(!started_at_the_box(&mut leap), "{mode}: the splats are back");
+    }
+}
+
+#[test]
+fn the_leapable_measure_counts_what_a_perfect_estimate_would_skip() {
+    let gpu = support::gpu();
+    let registry = builtin_registry();
+    let (volume, _, _) = datasets().remove(0);
+    // A transfer function transparent everywhere: no sample is visible, so a perfect estimate
+    // (the exit point) would skip every sample of the ray but the `step_back` = 2 before it.
+    // The march counts one pixel of each 4×4 block, ×16.
+    let (lo, hi) = volume.value_range;
+    let clear = |value| ControlPoint { value, color: [1.0, 1.0, 1.0], alpha: 0.0 };
+    let lut = TransferFunction { domain: (lo, hi), points: vec![clear(lo), clear(hi)] }.to_lut_for(&volume, 256);
+    let mut leap = Live::new(&gpu, &registry, "klein_2005/leap_dvr.ron", &volume, &lut, &reprojecting());
+    let cam = camera(20.0);
+    leap.frame(&cam);
+    leap.frame(&cam);
+    let measured = reprojection(&leap).measure.expect("measured after two frames");
+    let frame = cam.frame(SIZE, SIZE);
+    let (mut expected, mut rays) = (0.0, 0.0);
+    for y in (0..SIZE).step_by(4) {
+        for x in (0..SIZE).step_by(4) {
+            let Some(seg) = volgraph_accel::reference::ray_segment(&volume, &cam, &frame, x, y) else { continue };
+            let step = volgraph_accel::reference::step_tex(&volume, seg.d_tex, 0.5);
+            // `samples_along`: the samples (k + 0.5)·step inside the ray.
+            let count = (seg.len_tex / step - 0.5).ceil().max(0.0);
+            expected += 16.0 * (count - count.min(2.0));
+            rays += 1.0;
+        }
+    }
+    let pixels = f64::from(SIZE * SIZE);
+    expected /= pixels;
+    // f32 and f64 may put a ray's last sample on either side of its exit: one sample per
+    // counted ray, ×16.
+    let tolerance = 16.0 * rays / pixels;
+    eprintln!("leapable: GPU {measured:.2} per pixel, CPU {expected:.2} (± {tolerance:.2}), {rays} lattice rays");
+    assert!(rays > 50.0, "the volume is in view");
+    assert!((measured - expected).abs() <= tolerance, "GPU {measured} vs CPU {expected} ± {tolerance}");
 }
 
 /// Pixels whose colour differs from a 4-neighbour (clamped at the border) by more than

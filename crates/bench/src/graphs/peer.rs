@@ -134,6 +134,7 @@ pub fn run(
             error_viewport: None,
             pareto: None,
             counters: Default::default(),
+            bypass: Vec::new(),
         })
         .collect();
     Ok(PeerResult { rows, ran: format!("VTK {} {}", parsed.vtk, parsed.mapper) })

@@ -135,6 +135,10 @@ pub struct Row {
     /// `march.uploaded_bytes`, `march.pool_bytes`, ...).
     #[serde(default)]
     pub counters: BTreeMap<String, f64>,
+    /// What the graph's bypasses did over the case's frames: "NAME left out in X of Y frames
+    /// (last measure M/px, threshold T)" (Klein's reprojection skipped where it cannot pay).
+    #[serde(default)]
+    pub bypass: Vec<String>,
 }
 
 fn mib(bytes: u64) -> String {
@@ -208,6 +212,10 @@ impl GraphBenchReport {
         if pooled {
             header.extend(["uploaded MiB/frame", "batches", "pool MiB", "bricks drawn"]);
         }
+        let bypassing = self.rows.iter().any(|r| !r.bypass.is_empty());
+        if bypassing {
+            header.push("bypass");
+        }
         header.push("per pass (ms)");
         if errors {
             header.extend(["max err", "mean err", "PSNR dB"]);
@@ -256,6 +264,9 @@ impl GraphBenchReport {
                     (Some(v), Some(t)) => format!("{v:.0}/{t:.0}"),
                     _ => "n/a".to_string(),
                 });
+            }
+            if bypassing {
+                cells.push(if r.bypass.is_empty() { "n/a".to_string() } else { r.bypass.join("; ") });
             }
             cells.push(if passes.is_empty() { "n/a".to_string() } else { passes });
             if errors {

@@ -463,6 +463,16 @@ fn run_case(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<Row> {
     let median_ms = median(&timing.frame_ms);
     let counters =
         ctx.runtime.pass_counters().into_iter().map(|(pass, name, v)| (format!("{pass}.{name}"), v)).collect();
+    let bypass = ctx
+        .runtime
+        .bypass_status()
+        .iter()
+        .map(|b| {
+            let measure = b.measure.map_or("not measured".to_string(), |m| format!("last {m:.1}/px"));
+            let frames = b.frames_bypassed + b.frames_run;
+            format!("{} left out {}/{frames} frames ({measure}, below {})", b.name, b.frames_bypassed, b.below)
+        })
+        .collect();
     let counted = if config.gpu_count { count_on_gpu(ctx, case) } else { None };
     let step = settings.map_or(0.5, |s| s.step_voxels);
     let ceiling = counted.and_then(|_| fetch_ceiling(ctx, case, step));
@@ -505,6 +515,7 @@ fn run_case(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<Row> {
         error_viewport: error.map(|_| [error_viewport.0, error_viewport.1]),
         pareto: None,
         counters,
+        bypass,
     })
 }
 

@@ -30,6 +30,37 @@ pub struct GraphDoc {
     /// `{"edge_enhance": WgslKind(shader: "edge_enhance.wgsl", ...)}` (see [`WgslKindDoc`]).
     #[serde(default)]
     pub kinds: BTreeMap<String, WgslKindDoc>,
+    /// Passes left out while a measurement of the last frames says they do not pay:
+    /// `{"reprojection": (passes: ["splat", "holes"], measure: "march.leapable", below: 24.0)}`
+    /// (see [`BypassDoc`]).
+    #[serde(default)]
+    pub bypass: BTreeMap<String, BypassDoc>,
+}
+
+/// A bypass: `passes` are not run while the per-pixel mean of the buffer `measure` (u32 words a
+/// pass on the other side adds into, read back from the last finished frame) stays below
+/// `below`. Their outputs read by the passes that still run are cleared to zero, which such a
+/// reader's port must declare means "none" (`PortSpec::zero_means_none`): for Klein et al.
+/// 2005, a cleared `start` begins every ray at the box.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BypassDoc {
+    /// The passes left out together.
+    pub passes: Vec<String>,
+    /// `"<pass>.<buffer output>"`: the per-pixel measure, summed over its u32 words.
+    pub measure: String,
+    /// The threshold per viewport pixel: a number, or `"input.NAME"` (a Scalar input).
+    pub below: Threshold,
+}
+
+/// A number written in the file or the value of a Scalar graph input.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum Threshold {
+    /// The value itself.
+    Value(f64),
+    /// `"input.NAME"`.
+    Input(String),
 }
 
 /// A pass kind implemented by one WGSL compute shader, declared in the graph file: its ports and

@@ -10,6 +10,7 @@
 //! window blit, submit) → [`Runtime::poll`] / [`Runtime::finish`] (timings) and
 //! [`Runtime::read_output`] (readback).
 
+mod bypass;
 pub mod create;
 pub use volgraph_compiler::reflect;
 pub mod frame;
@@ -31,6 +32,7 @@ use std::collections::{BTreeMap, HashMap};
 use std::sync::Arc;
 use std::time::Instant;
 
+pub use bypass::BypassStatus;
 pub use create::{
     ComputePassPipeline, ComputePipelineSpec, CreateContext, DepthSpec, PassError, PassPipeline, PipelineCache,
     PipelineKind, PortInfo, RenderPassPipeline, RenderPipelineSpec,
@@ -167,6 +169,8 @@ pub struct Runtime {
     gpu_memory_budget: Option<u64>,
     /// Submit and time every step on its own ([`Runtime::set_step_profiling`]).
     profile_steps: bool,
+    /// The applied plan's bypasses: their measures and choices.
+    bypasses: bypass::Bypasses,
 }
 
 impl Runtime {
@@ -194,6 +198,7 @@ impl Runtime {
             cuts: Cuts::NONE,
             gpu_memory_budget: None,
             profile_steps: false,
+            bypasses: bypass::Bypasses::default(),
         }
     }
 
@@ -376,6 +381,8 @@ impl Runtime {
                     .history
                     .values()
                     .any(|h| h.reset_on_params_of.iter().any(|p| report.changed_passes.contains(p)));
+                // A measure taken at another size or with other parameters says nothing now.
+                self.bypasses.for_plan(&self.gpu, &schedule.plan, !(viewport_changed || stale));
                 self.schedule = Some(schedule);
                 self.stale_modules.clear();
                 if viewport_changed || stale {
@@ -416,6 +423,8 @@ impl Runtime {
     /// function or isovalue change, camera jump; Klein et al. 2005 §4).
     pub fn invalidate_history(&mut self) {
         self.history.invalidate();
+        // What a bypass measured was of the old view, volume or TF.
+        self.bypasses.forget(self.frame_index);
         if self.history_age > 0 {
             self.history_stats.restarts += 1;
         }
@@ -535,6 +544,8 @@ impl Runtime {
         let timed_steps = if self.profile_steps { 0 } else { steps };
         let timestamps = self.frames.begin(&gpu, timed_steps);
         let mut clock = self.profile_steps.then(|| step_clock::StepClock::new(&gpu));
+        let pixels = u64::from(frame.viewport.0) * u64::from(frame.viewport.1);
+        let bypassing = self.bypasses.begin_frame(&gpu, steps, frame.frame_index, pixels);
         let what = format!("frame {} of graph \"{}\"", frame.frame_index, schedule.plan.name);
         let history = &mut self.history;
         let inputs = &self.inputs;
@@ -567,6 +578,7 @@ impl Runtime {
                         &mut encoder,
                         timestamps.as_ref(),
                         clock.as_mut(),
+                        &bypassing,
                     )?;
                     if let Some(clock) = clock.as_mut() {
                         clock.lap(&mut encoder);
@@ -579,9 +591,25 @@ impl Runtime {
                     Ok(encoder.finish())
                 },
             )
-            .map_err(named)??;
+            .map_err(|fault| RuntimeError::from(named(fault)))
+            .and_then(|recorded| recorded);
+        drop(bypassing);
+        let commands = match commands {
+            Ok(c) => c,
+            Err(e) => {
+                self.bypasses.abandoned();
+                return Err(e);
+            }
+        };
         let submitted = Instant::now();
-        let submission = gpu.checked(|| what.clone(), || gpu.queue.submit([commands])).map_err(named)?;
+        let submission = match gpu.checked(|| what.clone(), || gpu.queue.submit([commands])) {
+            Ok(s) => s,
+            Err(fault) => {
+                self.bypasses.abandoned();
+                return Err(named(fault).into());
+            }
+        };
+        self.bypasses.submitted();
         self.history.end_frame();
         let pass_ids = schedule.pass_ids.clone();
         let profiled = clock.map(|c| c.ms);
@@ -626,6 +654,12 @@ impl Runtime {
             .into_iter()
             .find(|s| s.frame_index == index)
             .ok_or_else(|| RuntimeError::Readback(format!("frame {index} finished without stats")))
+    }
+
+    /// What each of the plan's bypasses (a graph's `bypass:`) did: left out or not in the last
+    /// submitted frame, its newest measure per pixel, frames counted since the plan was applied.
+    pub fn bypass_status(&self) -> Vec<BypassStatus> {
+        self.bypasses.status()
     }
 
     /// Stats of the frames the GPU has finished, without blocking.
@@ -788,6 +822,7 @@ fn record_steps(
     encoder: &mut wgpu::CommandEncoder,
     timestamps: Option<&(wgpu::QuerySet, u32)>,
     mut clock: Option<&mut step_clock::StepClock<'_>>,
+    bypassing: &bypass::FrameBypass<'_>,
 ) -> Result<(), RuntimeError> {
     let Schedule { plan, nodes, slots, owned, bind_groups, skippable, owned_versions, next_version, .. } = schedule;
     for (i, step) in plan.steps.iter().enumerate() {
@@ -841,7 +876,11 @@ fn record_steps(
                 Binding::History(name) => (history.get(name).map(|e| &e.previous().view), None),
                 Binding::Unbound => (None, None),
             };
+            let zeroed = bp.access == Access::Read
+                && matches!(bp.binding, Binding::Resource { id, .. }
+                    if bypassing.left_out.get(plan.resources[id].producer).copied().unwrap_or(false));
             ports.push(BoundPort {
+                zeroed,
                 name: bp.port.clone(),
                 access: bp.access,
                 view,
@@ -858,6 +897,15 @@ fn record_steps(
             _ => true,
         });
         let unchanged = read_versions.is_some() && read_versions == entry.last_inputs && outputs_published;
+        let left_out = bypassing.left_out.get(i).copied().unwrap_or(false);
+        if left_out {
+            // A graph's bypass leaves this step out: what the running steps read of it is zero.
+            bypass::clear_for_left_out(plan, i, encoder, |rid| match plan.resources[rid].slot.map(|s| &slots[s]) {
+                Some(SlotTexture::Transient(t)) => (Some(t.view.clone()), None),
+                Some(SlotTexture::Buffer(b)) => (None, Some(b.buffer.clone())),
+                _ => (None, None),
+            });
+        }
         let mut ctx = RecordContext {
             gpu,
             encoder,
@@ -872,13 +920,19 @@ fn record_steps(
             began_pass: false,
             bind_groups,
         };
-        if unchanged {
-            // Nothing it reads changed: its Owned outputs still hold what it wrote. An empty
-            // pass keeps the step's label and timestamps.
+        if unchanged || left_out {
+            // Nothing it reads changed (its Owned outputs still hold what it wrote), or a
+            // bypass leaves it out. An empty pass keeps the step's label and timestamps.
             drop(ctx.begin_compute_pass());
             continue;
         }
         entry.node.record(&mut ctx)?;
+        // A bypass's measure leaves its pooled slot for a read-back buffer right away.
+        for &(_, rid, readback, bytes) in bypassing.copies.iter().filter(|c| c.0 == i) {
+            if let Some(SlotTexture::Buffer(b)) = plan.resources[rid].slot.map(|s| &slots[s]) {
+                encoder.copy_buffer_to_buffer(&b.buffer, 0, readback, 0, bytes);
+            }
+        }
         entry.last_inputs = read_versions;
         for bp in &step.ports {
             if let Binding::Resource { id, .. } = &bp.binding

@@ -24,6 +24,8 @@ pub(crate) struct BoundPort<'a> {
     pub voxels: Option<&'a std::sync::Arc<volgraph_accel::volume::Volume>>,
     /// A transfer-function input's LUT on the CPU.
     pub table: Option<&'a std::sync::Arc<Vec<[f32; 4]>>>,
+    /// A graph's bypass left out this input's producer: it holds zeros this frame.
+    pub zeroed: bool,
 }
 
 /// Samplers and the frame uniform buffer.
@@ -127,6 +129,13 @@ impl<'a> RecordContext<'a> {
     /// (a pre-integration table rebuilt when the TF changes); `None` for targets and unwired ports.
     pub fn input_version(&self, port: &str) -> Option<u64> {
         self.port(port).and_then(|p| p.version)
+    }
+
+    /// Whether input `port` holds zeros this frame because a graph's bypass left out the pass
+    /// that writes it (its port reads zeros as "none"): a node may draw with a variant that
+    /// does without it (built when `PortInfo::may_read_zeros`), as if it were unwired.
+    pub fn reads_zeros(&self, port: &str) -> bool {
+        self.port(port).is_some_and(|p| p.zeroed)
     }
 
     /// The texture view bound to `port` (an input's value, or the target an output writes).

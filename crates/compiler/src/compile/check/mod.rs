@@ -1,5 +1,6 @@
 //! Validation: every problem of a graph file, located, with a fix, all at once.
 
+mod bypass;
 mod cycles;
 mod nodes;
 mod outputs;
@@ -18,6 +19,7 @@ use crate::graph::ast::{GraphDoc, HistoryInitial, InputKind, NodeDoc, RepeatCoun
 use crate::graph::locate::{Locator, PassPath};
 use crate::params::Params;
 use crate::suggest::comma_list;
+pub(crate) use bypass::CheckedBypass;
 
 /// A resolved reference to a value.
 #[derive(Clone, Debug, PartialEq)]
@@ -94,6 +96,8 @@ pub(crate) struct Checked {
     pub scene_values: Vec<String>,
     /// Scene features parameters read as `"feature.NAME"` (effects a pass specializes for).
     pub features_read: std::collections::BTreeSet<String>,
+    /// The graph's bypasses, resolved.
+    pub bypass: Vec<CheckedBypass>,
 }
 
 const RESERVED: [&str; 2] = ["input", "history"];
@@ -149,6 +153,7 @@ pub(crate) fn check(
     c.check_when_names();
     let outputs = c.check_graph_outputs();
     let history = c.check_history();
+    let bypass = c.check_bypasses(&outputs, &history);
     if c.diags.is_empty() {
         c.check_cycles();
     }
@@ -174,6 +179,7 @@ pub(crate) fn check(
             warnings: c.warnings,
             scene_values,
             features_read: c.features_read,
+            bypass,
         })
     } else {
         Err(c.diags)

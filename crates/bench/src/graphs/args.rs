@@ -73,6 +73,11 @@ pub struct GraphsArgs {
     /// effects) to every row.
     #[arg(long)]
     pub sweep: Option<String>,
+    /// A fixed value for every case, KEY=NUMBER (repeat the flag): PASS.PARAM or input.NAME, as
+    /// --sweep takes keys; added to the preset's own values, and it wins over them (e.g.
+    /// --set input.iso_value=0.2 with --sweep input.reproject_below=16,48).
+    #[arg(long = "set")]
+    pub set: Vec<String>,
     /// Compute error against the converged CPU reference even without --sweep.
     #[arg(long)]
     pub accuracy: bool,
@@ -175,6 +180,23 @@ pub struct BenchConfig {
 /// The label of a graph file in tables: its file stem.
 pub fn graph_label(path: &Path) -> String {
     path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| path.display().to_string())
+}
+
+/// Parses one `--set KEY=NUMBER`.
+pub fn parse_set(text: &str) -> anyhow::Result<(String, f64)> {
+    let fail = |why: &str| {
+        anyhow!("--set \"{text}\": {why}; expected PASS.PARAM=NUMBER or input.NAME=NUMBER, e.g. input.iso_value=0.2")
+    };
+    let (key, value) = text.split_once('=').ok_or_else(|| fail("no '='"))?;
+    let key = key.trim();
+    if !key.split_once('.').is_some_and(|(a, b)| !a.is_empty() && !b.is_empty()) {
+        return Err(fail("the key must be PASS.PARAM or input.NAME"));
+    }
+    let value: f64 = value.trim().parse().map_err(|_| fail("the value is not a number"))?;
+    if !value.is_finite() {
+        return Err(fail("the value is not finite"));
+    }
+    Ok((key.to_string(), value))
 }
 
 /// Parses `--sweep PASS.PARAM=V1,V2,...`.
@@ -346,7 +368,11 @@ impl GraphsArgs {
         if self.spp_size > 4096 {
             bail!("--spp-size {}: expected 0 (off) ..=4096 pixels", self.spp_size);
         }
-        let params = preset.map(|p| p.params.iter().map(|(k, v)| (k.to_string(), *v)).collect()).unwrap_or_default();
+        let mut params: Vec<(String, f64)> =
+            preset.map(|p| p.params.iter().map(|(k, v)| (k.to_string(), *v)).collect()).unwrap_or_default();
+        for text in &self.set {
+            params.push(parse_set(text)?);
+        }
         // The preset's own comparison: its pairs of graphs, its studies.
         let own = preset.filter(|_| self.graphs.is_empty());
         let baselines = own

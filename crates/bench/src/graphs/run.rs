@@ -85,10 +85,11 @@ impl Case<'_> {
 
     fn options(&self, config: &BenchConfig, viewport: (u32, u32)) -> CompileOptions {
         let mut options = CompileOptions::new(viewport.0, viewport.1);
-        for (key, value) in &config.params {
+        // The preset's per-dataset values, then the fixed ones (`--set` last, so it wins).
+        for (_, key, value) in config.dataset_params.iter().filter(|(d, _, _)| *d == self.dataset.name) {
             set_knob(&mut options, key, &ron::Value::from(*value));
         }
-        for (_, key, value) in config.dataset_params.iter().filter(|(d, _, _)| *d == self.dataset.name) {
+        for (key, value) in &config.params {
             set_knob(&mut options, key, &ron::Value::from(*value));
         }
         if let (Some(sweep), Some((_, value))) = (&config.sweep, self.sweep_value) {

@@ -113,6 +113,26 @@ fn bad_flags_name_the_flag_and_the_fix() {
         }),
         "--sweep \"step=1,2\": the key must be PASS.PARAM; expected PASS.PARAM=V1,V2,..., e.g. march.step_voxels=0.25,0.5,1,2"
     );
+    for (set, why) in [
+        ("iso=0.2", "the key must be PASS.PARAM or input.NAME"),
+        ("input.iso_value", "no '='"),
+        ("input.iso_value=low", "the value is not a number"),
+        ("input.iso_value=inf", "the value is not finite"),
+    ] {
+        assert_eq!(
+            error_of(GraphsArgs {
+                graphs: graphs.clone(),
+                set: vec![set.to_string()],
+                scale: 1.0,
+                reference_step: 0.1,
+                accuracy_size: 128,
+                ..GraphsArgs::default()
+            }),
+            format!(
+                "--set \"{set}\": {why}; expected PASS.PARAM=NUMBER or input.NAME=NUMBER, e.g. input.iso_value=0.2"
+            )
+        );
+    }
     assert_eq!(
         error_of(GraphsArgs { graphs, scale: 0.0, ..GraphsArgs::default() }),
         "--scale 0: expected a factor in (0, 8], e.g. 0.25 to render a quarter of each side"

@@ -1,11 +1,20 @@
 // Klein et al. 2005 §4.3–4.4: last frame's leap hits reprojected with this frame's camera as
-// k×k-pixel splats (instanced quads pulling their point from the `hits` texture: WebGPU has no
-// point size), depth-tested so the splat nearest the eye wins. Each fragment writes its point's
-// texture-space position as this pixel's ray start (w = 1); pixels no splat covers keep
+// k×k-pixel splats, depth-tested so the splat nearest the eye wins. Each covered pixel gets its
+// splat's texture-space position as this pixel's ray start (w = 1); pixels no splat covers keep
 // (0,0,0,0) for hole_fill. Only the pixels of last frame's screen rectangle of the volume are
 // drawn (the rectangle comes from the node, in `splat`). With `block` b > 1 one splat carries
 // the nearest of a b×b block of hits over the block's projected bounding box grown by k/2: b²
-// times fewer quads, each start at most as far as the hit it stands for.
+// times fewer splats, each start at most as far as the hit it stands for.
+//
+// Two ways to draw the same splats (`method`):
+// - quads (the paper's points; WebGPU has no point size): instanced quads pulling their point
+//   from the `hits` texture, the depth buffer `depth` a Depth32Float target;
+// - scatter (SCATTER): one compute invocation per block writes the splat's pixels itself, in two
+//   rounds over the same pixels — the nearest depth per pixel by atomicMax into the `depth`
+//   buffer (~bits of a depth in [0, 1]: the nearer, the larger; 0 = no splat), then the point of
+//   the splat whose depth won — with none of the rasterizer's per-quad setup, which is most of a
+//   quad's cost where the graphics pipeline is slow (lavapipe, and the few SMs that run it on
+//   an H100/H200). Pixel centres inside the quad are covered, as the rasterizer covers them.
 
 #import "common/frame.wgsl"
 
@@ -26,6 +35,55 @@ struct SplatParams {
 @group(0) @binding(auto) var hits: texture_2d<f32>;
 @group(0) @binding(auto) var<uniform> splat: SplatParams;
 
+// One block's splat: the nearest hit (xyz, w = 1; w = 0 when the block has none) at NDC depth
+// `z`, and the NDC rectangle its quad covers (the hits' bounding box grown by k/2 pixels).
+struct BlockSplat {
+    point: vec4<f32>,
+    z: f32,
+    lo: vec2<f32>,
+    hi: vec2<f32>,
+}
+
+// Blocks per row of last frame's rectangle.
+fn blocks_x() -> u32 {
+    let b = max(splat.block, 1u);
+    return max((splat.rect.z + b - 1u) / b, 1u);
+}
+
+// The splat of block `index` (row by row over last frame's rectangle).
+fn block_splat(index: u32) -> BlockSplat {
+    var out = BlockSplat(vec4<f32>(0.0), 2.0, vec2<f32>(3.0e38), vec2<f32>(-3.0e38));
+    let b = max(splat.block, 1u);
+    let base = splat.rect.xy + vec2<u32>(index % blocks_x(), index / blocks_x()) * b;
+    let end = splat.rect.xy + splat.rect.zw;
+    for (var i = 0u; i < b * b; i += 1u) {
+        let pixel = base + vec2<u32>(i % b, i / b);
+        if (any(pixel >= end)) {
+            continue;
+        }
+        let hit = textureLoad(hits, vec2<i32>(pixel), 0);
+        if (hit.w == 0.0) {
+            continue;
+        }
+        let clip = frame.clip_from_world * vec4<f32>(world_from_texture(hit.xyz), 1.0);
+        if (!(clip.w > 0.0)) {
+            continue;
+        }
+        let ndc = clip.xyz / clip.w;
+        out.lo = min(out.lo, ndc.xy);
+        out.hi = max(out.hi, ndc.xy);
+        if (ndc.z < out.z) {
+            out.z = ndc.z;
+            out.point = vec4<f32>(hit.xyz, 1.0);
+        }
+    }
+    // Half the splat edge in NDC units (y up).
+    let half = splat.size * vec2<f32>(frame.viewport.z, frame.viewport.w);
+    out.lo -= half;
+    out.hi += half;
+    return out;
+}
+
 struct SplatVertex {
     @builtin(position) clip: vec4<f32>,
     @location(0) @interpolate(flat) point: vec4<f32>,
@@ -43,45 +101,13 @@ fn vs_splat(@builtin(vertex_index) vertex_index: u32, @builtin(instance_index) i
     // Outside every clip volume: the rasterizer drops the quad.
     out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
     out.point = vec4<f32>(0.0);
-    let b = max(splat.block, 1u);
-    let blocks_x = max((splat.rect.z + b - 1u) / b, 1u);
-    let base = splat.rect.xy + vec2<u32>(instance % blocks_x, instance / blocks_x) * b;
-    let end = splat.rect.xy + splat.rect.zw;
-    // The nearest hit of the block (NDC depth), and the NDC bounding box of all its hits.
-    var nearest = vec4<f32>(0.0);
-    var nearest_z = 2.0;
-    var lo = vec2<f32>(3.0e38);
-    var hi = vec2<f32>(-3.0e38);
-    for (var i = 0u; i < b * b; i += 1u) {
-        let pixel = base + vec2<u32>(i % b, i / b);
-        if (any(pixel >= end)) {
-            continue;
-        }
-        let hit = textureLoad(hits, vec2<i32>(pixel), 0);
-        if (hit.w == 0.0) {
-            continue;
-        }
-        let clip = frame.clip_from_world * vec4<f32>(world_from_texture(hit.xyz), 1.0);
-        if (!(clip.w > 0.0)) {
-            continue;
-        }
-        let ndc = clip.xyz / clip.w;
-        lo = min(lo, ndc.xy);
-        hi = max(hi, ndc.xy);
-        if (ndc.z < nearest_z) {
-            nearest_z = ndc.z;
-            nearest = vec4<f32>(hit.xyz, 1.0);
-        }
-    }
-    if (nearest.w == 0.0) {
+    let s = block_splat(instance);
+    if (s.point.w == 0.0) {
         return out;
     }
-    // Half the splat edge in NDC units (y up).
-    let half = splat.size * vec2<f32>(frame.viewport.z, frame.viewport.w);
     let corner = quad_corner(vertex_index);
-    let xy = select(lo, hi, corner > vec2<f32>(0.0)) + corner * half;
-    out.clip = vec4<f32>(xy, nearest_z, 1.0);
-    out.point = nearest;
+    out.clip = vec4<f32>(select(s.lo, s.hi, corner > vec2<f32>(0.0)), s.z, 1.0);
+    out.point = s.point;
     return out;
 }
 
@@ -93,3 +119,72 @@ struct SplatOut {
 fn fs_splat(in: SplatVertex) -> SplatOut {
     return SplatOut(in.point);
 }
+
+#if SCATTER
+// Per pixel, row by row: ~bits of the nearest splat's depth (0: none). Cleared by the node.
+@group(0) @binding(auto) var<storage, read_write> depth: array<atomic<u32>>;
+@group(0) @binding(auto) var start: texture_storage_2d<rgba32float, write>;
+
+// The pixels [x0, x1) × [y0, y1) whose centres lie inside the splat's quad, within the
+// viewport; empty for a block without a hit or a depth outside [0, 1] (the rasterizer clips it).
+fn covered_pixels(s: BlockSplat) -> vec4<u32> {
+    if (s.point.w == 0.0 || !(s.z >= 0.0 && s.z <= 1.0)) {
+        return vec4<u32>(0u);
+    }
+    let size = frame.viewport.xy;
+    // Pixel-space edges of the quad (y down): centre x + 0.5 inside [left, right).
+    let left = (s.lo.x + 1.0) * 0.5 * size.x;
+    let right = (s.hi.x + 1.0) * 0.5 * size.x;
+    let top = (1.0 - s.hi.y) * 0.5 * size.y;
+    let bottom = (1.0 - s.lo.y) * 0.5 * size.y;
+    let lo = clamp(ceil(vec2<f32>(left, top) - 0.5), vec2<f32>(0.0), size);
+    let hi = clamp(ceil(vec2<f32>(right, bottom) - 0.5), vec2<f32>(0.0), size);
+    return vec4<u32>(vec2<u32>(lo), vec2<u32>(hi));
+}
+
+// The depth key of a splat: larger is nearer, never 0 for a depth in [0, 1].
+fn depth_key(z: f32) -> u32 {
+    return ~bitcast<u32>(z);
+}
+
+// The block this invocation draws, or none past the rectangle's last block.
+fn scatter_block(id: vec3<u32>) -> BlockSplat {
+    let b = max(splat.block, 1u);
+    let rows = (splat.rect.w + b - 1u) / b;
+    if (id.x >= blocks_x() || id.y >= rows) {
+        return BlockSplat(vec4<f32>(0.0), 2.0, vec2<f32>(0.0), vec2<f32>(0.0));
+    }
+    return block_splat(id.y * blocks_x() + id.x);
+}
+
+// Round 1: every pixel keeps the nearest splat's depth.
+@compute @workgroup_size(8, 8)
+fn cs_splat_depth(@builtin(global_invocation_id) id: vec3<u32>) {
+    let s = scatter_block(id);
+    let r = covered_pixels(s);
+    let key = depth_key(s.z);
+    let width = u32(frame.viewport.x);
+    for (var y = r.y; y < r.w; y += 1u) {
+        for (var x = r.x; x < r.z; x += 1u) {
+            atomicMax(&depth[y * width + x], key);
+        }
+    }
+}
+
+// Round 2: the splat whose depth won writes its point (splats at the same depth may both
+// write; either is a start at that depth).
+@compute @workgroup_size(8, 8)
+fn cs_splat_point(@builtin(global_invocation_id) id: vec3<u32>) {
+    let s = scatter_block(id);
+    let r = covered_pixels(s);
+    let key = depth_key(s.z);
+    let width = u32(frame.viewport.x);
+    for (var y = r.y; y < r.w; y += 1u) {
+        for (var x = r.x; x < r.z; x += 1u) {
+            if (atomicLoad(&depth[y * width + x]) == key) {
+                textureStore(start, vec2<u32>(x, y), s.point);
+            }
+        }
+    }
+}
+#endif

@@ -276,8 +276,9 @@ pub fn wgsl_struct_text(name: &str, fields: &[(&str, &str)]) -> String {
 }
 
 /// Checks that the struct `name` of WGSL module `source` has exactly the fields `fields`
-/// (`(name, "f32" | "u32")`) first, in order, at 4-byte offsets — what a `pass_params!`
-/// struct uploads. Members after them may only be padding (`_pad*`).
+/// (`(name, "f32" | "u32" | "vec4<u32>" ...)`) first, in order, at WGSL's uniform offsets —
+/// what a `pass_params!` struct (all scalars, 4 bytes apart) or a Rust twin uploads. Members
+/// after them may only be padding (`_pad*`).
 pub fn check_wgsl_struct(source: &str, name: &str, fields: &[(&str, &str)]) -> Result<(), String> {
     let module = naga::front::wgsl::parse_str(source).map_err(|e| format!("the shader does not parse: {e}"))?;
     let (handle, _) = module
@@ -311,7 +312,44 @@ pub fn check_uniform_layouts(module: &naga::Module, uniforms: &[crate::decl::Uni
     Ok(())
 }
 
-/// The members of struct type `ty` of `module` against `fields` (see [`check_wgsl_struct`]).
+/// The WGSL name of a member type the layout check describes: `f32`, `u32`, `i32` and their
+/// `vec2` / `vec3` / `vec4`; `None` for anything else.
+fn member_type_name(inner: &naga::TypeInner) -> Option<String> {
+    let scalar = |s: &naga::Scalar| match (s.kind, s.width) {
+        (naga::ScalarKind::Float, 4) => Some("f32"),
+        (naga::ScalarKind::Uint, 4) => Some("u32"),
+        (naga::ScalarKind::Sint, 4) => Some("i32"),
+        _ => None,
+    };
+    match inner {
+        naga::TypeInner::Scalar(s) => scalar(s).map(str::to_string),
+        naga::TypeInner::Vector { size, scalar: s } => scalar(s).map(|s| format!("vec{}<{s}>", *size as u32)),
+        _ => None,
+    }
+}
+
+/// WGSL's (alignment, size) in a uniform block of a member type `member_type_name` names.
+fn member_layout(name: &str) -> Option<(u32, u32)> {
+    match name {
+        "f32" | "u32" | "i32" => Some((4, 4)),
+        _ => {
+            let (n, rest) = name.strip_prefix("vec")?.split_at(1);
+            if !matches!(rest, "<f32>" | "<u32>" | "<i32>") {
+                return None;
+            }
+            match n {
+                "2" => Some((8, 8)),
+                "3" => Some((16, 12)),
+                "4" => Some((16, 16)),
+                _ => None,
+            }
+        }
+    }
+}
+
+/// The members of struct type `ty` of `module` against `fields`: the same names and types, in
+/// order, at the offsets WGSL's uniform layout gives them (scalars at 4, vec2 at 8, vec3 and
+/// vec4 at 16 bytes); members after them may only be padding (`_pad*`).
 fn check_struct_members(
     module: &naga::Module,
     ty: naga::Handle<naga::Type>,
@@ -322,29 +360,23 @@ fn check_struct_members(
     let naga::TypeInner::Struct { members, .. } = &ty.inner else {
         return Err(format!("{name} is not a struct"));
     };
+    let fix = "declare the WGSL struct as the pass lays it out (#import \"params/<Struct>.wgsl\", or wgsl_struct())";
+    let mut offset = 0u32;
     for (i, (field, want)) in fields.iter().enumerate() {
-        let m = members.get(i).ok_or_else(|| {
-            format!(
-                "{name} has no member {i} ({field}: {want}); declare the WGSL struct as `pass_params!` lays it out \
-                 (#import \"params/<Struct>.wgsl\", or wgsl_struct())"
-            )
+        let (align, size) = member_layout(want).ok_or_else(|| {
+            format!("the pass declares {name} member `{field}: {want}`, a type the layout check does not describe (scalars and vectors of f32, u32, i32)")
         })?;
-        let got = match &module.types[m.ty].inner {
-            naga::TypeInner::Scalar(naga::Scalar { kind: naga::ScalarKind::Float, width: 4 }) => "f32",
-            naga::TypeInner::Scalar(naga::Scalar { kind: naga::ScalarKind::Uint, width: 4 }) => "u32",
-            naga::TypeInner::Scalar(naga::Scalar { kind: naga::ScalarKind::Sint, width: 4 }) => "i32",
-            _ => "another type",
-        };
+        offset = offset.next_multiple_of(align);
+        let m = members.get(i).ok_or_else(|| format!("{name} has no member {i} ({field}: {want}); {fix}"))?;
+        let got = member_type_name(&module.types[m.ty].inner).unwrap_or_else(|| "another type".to_string());
         let member = m.name.as_deref().unwrap_or("?");
-        if member != *field || got != *want || m.offset != 4 * i as u32 {
+        if member != *field || got != *want || m.offset != offset {
             return Err(format!(
-                "{name} member {i} is `{member}: {got}` at offset {}, but the pass declares `{field}: {want}` at {}; \
-                 declare the WGSL struct as `pass_params!` lays it out (#import \"params/<Struct>.wgsl\", or \
-                 wgsl_struct())",
-                m.offset,
-                4 * i
+                "{name} member {i} is `{member}: {got}` at offset {}, but the pass declares `{field}: {want}` at {offset}; {fix}",
+                m.offset
             ));
         }
+        offset += size;
     }
     for m in &members[fields.len()..] {
         let member = m.name.as_deref().unwrap_or("?");
@@ -381,6 +413,28 @@ mod tests {
         let swapped = "struct Knobs { taps: u32, strength: f32 }";
         let err = super::check_wgsl_struct(swapped, "Knobs", &fields).expect_err("order differs");
         assert!(err.contains("member 0 is `taps: u32`"), "{err}");
+    }
+
+    #[test]
+    fn vector_members_are_checked_at_wgsl_uniform_offsets() {
+        // A vec4 aligns to 16, a vec2 to 8: `size` after `rect` sits at 16, `uv` after it at 24.
+        let fields = [("rect", "vec4<u32>"), ("size", "f32"), ("uv", "vec2<f32>"), ("tint", "vec3<f32>")];
+        let wgsl = "struct Block { rect: vec4<u32>, size: f32, uv: vec2<f32>, tint: vec3<f32>, _pad: f32 }";
+        assert_eq!(super::check_wgsl_struct(wgsl, "Block", &fields), Ok(()));
+        let scalar = "struct Block { rect: vec4<f32>, size: f32, uv: vec2<f32>, tint: vec3<f32> }";
+        let err = super::check_wgsl_struct(scalar, "Block", &fields).expect_err("vec4<f32> is not vec4<u32>");
+        assert!(
+            err.contains("member 0 is `rect: vec4<f32>` at offset 0, but the pass declares `rect: vec4<u32>`"),
+            "{err}"
+        );
+        let moved = "struct Block { rect: vec4<u32>, uv: vec2<f32>, size: f32, tint: vec3<f32> }";
+        let err = super::check_wgsl_struct(moved, "Block", &fields).expect_err("swapped");
+        assert!(
+            err.contains("member 1 is `uv: vec2<f32>` at offset 16, but the pass declares `size: f32` at 16"),
+            "{err}"
+        );
+        let unknown = super::check_wgsl_struct(wgsl, "Block", &[("m", "mat4x4<f32>")]).expect_err("a matrix");
+        assert!(unknown.contains("does not describe"), "{unknown}");
     }
 }
 

@@ -142,8 +142,27 @@ impl PassDecl for RaycastBricks {
 /// The brick march's entry point and what it binds, declared once for `shaders()` and `create`.
 fn march_shader() -> ShaderUse {
     ShaderUse::new("raycast_bricks.wgsl", "cs_main")
-        .binds(&["bricks", "table", "leaf_distance", "acc", "volume"])
+        .binds(&["table", "leaf_distance", "acc", "volume"])
         .uniform(RaycastParamsGpu::bound("params"))
+        .uniform(brick_layout())
+}
+
+/// The `bricks` block as `BrickParamsGpu` lays it out, checked against the shader's
+/// `BrickParams` when the graph is planned. The node writes it per frame (the pool's state).
+fn brick_layout() -> volgraph_core::UniformLayout {
+    volgraph_core::UniformLayout {
+        global: "bricks",
+        fields: vec![
+            ("grid", "vec4<u32>"),
+            ("slots", "vec4<u32>"),
+            ("slot_side", "vec4<u32>"),
+            ("leaves", "vec4<u32>"),
+            ("leaf_grid", "vec4<u32>"),
+            ("atlas", "vec4<f32>"),
+        ],
+        params: Vec::new(),
+        bytes: |_| bytemuck::bytes_of(&BrickParamsGpu::default()).to_vec(),
+    }
 }
 
 impl PassPlugin for RaycastBricks {

@@ -7,12 +7,16 @@
 //! completes the rest. With `block` b > 1 one quad stands for the nearest of b×b hits, drawn
 //! over their projected bounding box grown by k/2: b² fewer quads (vertex work is most of a
 //! splat's cost where the vertex stage is slow, as on lavapipe), starts never farther than the
-//! hits they stand for. Shader: `shaders/reprojection_splat.wgsl`.
+//! hits they stand for. With `method: "scatter"` the same splats are written by a compute
+//! pass instead of drawn (the nearest depth per pixel by an atomic, then the winner's point):
+//! none of the rasterizer's per-quad setup, the same starts. Shader:
+//! `shaders/reprojection_splat.wgsl`.
 
 use glam::{DVec3, DVec4};
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{
-    CameraData, CreateContext, DepthSpec, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
+    CameraData, ComputePassPipeline, ComputePipelineSpec, CreateContext, DepthSpec, Gpu, PassError, RecordContext,
+    RenderPassPipeline, RenderPipelineSpec,
 };
 use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
@@ -31,6 +35,16 @@ struct SplatParamsGpu {
 
 const _: () = assert!(std::mem::size_of::<SplatParamsGpu>() == 32);
 
+volgraph_core::param_choice! {
+    /// How the splats are drawn.
+    pub enum SplatMethod {
+        /// Instanced quads through the rasterizer, depth-tested (the paper's points).
+        Quads = "quads",
+        /// A compute pass writing each splat's pixels: nearest depth by atomicMax, then the point.
+        Scatter = "scatter",
+    }
+}
+
 volgraph_core::pass_params! {
     /// The pass's parameters, declared once (the GPU block adds the screen rectangle the node
     /// computes per frame, so it stays a struct of its own).
@@ -38,12 +52,47 @@ volgraph_core::pass_params! {
         splat_size: u32 = 2, 1..=16, "splat edge k in pixels (the paper: two or four closes the gaps)";
         block: u32 = 1, 1..=4,
             "hits per splat side: one splat carries the nearest of a block×block of hits (block² fewer quads; the paper: 1)";
+        method: SplatMethod = Quads,
+            "quads: instanced quads through the rasterizer (the paper); scatter: a compute pass writes the same splats \
+             (no per-quad setup: faster where the graphics pipeline is slow)";
     }
 }
 
 /// The splat quads and what they write, declared once for `shaders()` and `create`.
-const VERTEX: ShaderUse = ShaderUse::new("reprojection_splat.wgsl", "vs_splat").binds(&["splat"]);
-const FRAGMENT: ShaderUse = ShaderUse::new("reprojection_splat.wgsl", "fs_splat").binds(&["splat"]);
+fn vertex() -> ShaderUse {
+    ShaderUse::new("reprojection_splat.wgsl", "vs_splat").uniform(splat_layout())
+}
+
+fn fragment() -> ShaderUse {
+    ShaderUse::new("reprojection_splat.wgsl", "fs_splat").uniform(splat_layout())
+}
+
+/// The scatter's two rounds: nearest depth per pixel, then the winner's point.
+fn scatter_rounds() -> [ShaderUse; 2] {
+    [
+        ShaderUse::new("reprojection_splat.wgsl", "cs_splat_depth").uniform(splat_layout()),
+        ShaderUse::new("reprojection_splat.wgsl", "cs_splat_point").uniform(splat_layout()),
+    ]
+}
+
+/// The scatter's workgroup (`@workgroup_size` of both rounds): one invocation per block.
+const SCATTER_WORKGROUP: (u32, u32) = (8, 8);
+
+fn scatters(params: &Params) -> bool {
+    SplatSettings::from_params(params).method == SplatMethod::Scatter
+}
+
+/// The `splat` block as `SplatParamsGpu` lays it out, checked against the shader's
+/// `SplatParams` when the graph is planned. The node writes it per frame (last frame's screen
+/// rectangle of the volume).
+fn splat_layout() -> volgraph_core::UniformLayout {
+    volgraph_core::UniformLayout {
+        global: "splat",
+        fields: vec![("rect", "vec4<u32>"), ("size", "f32"), ("block", "u32")],
+        params: Vec::new(),
+        bytes: |_| bytemuck::bytes_of(&SplatParamsGpu::default()).to_vec(),
+    }
+}
 
 impl PassDecl for ReprojectionSplat {
     fn honours_volume_window(&self) -> bool {
@@ -62,39 +111,65 @@ impl PassDecl for ReprojectionSplat {
         SplatSettings::specs()
     }
 
-    fn ports(&self, _params: &Params) -> Vec<PortSpec> {
+    fn ports(&self, params: &Params) -> Vec<PortSpec> {
+        // The depth test's buffer: a depth target for quads, a u32 per pixel for the scatter.
+        let depth = if scatters(params) {
+            PortKind::Buffer { bytes: 0, bytes_per_pixel: 4 }
+        } else {
+            PortKind::target(&[TargetFormat::Depth32Float])
+        };
         vec![
             PortSpec::read("hits", PortKind::target(&[TargetFormat::Rgba32Float])),
             PortSpec::write("start", PortKind::target(&[TargetFormat::Rgba32Float])),
-            PortSpec::write("depth", PortKind::target(&[TargetFormat::Depth32Float])),
+            PortSpec::write("depth", depth),
         ]
     }
 
-    fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![VERTEX, FRAGMENT]
+    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
+        if scatters(params) { vec!["SCATTER"] } else { Vec::new() }
     }
 
-    fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
-        true
+    fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
+        if scatters(params) { scatter_rounds().to_vec() } else { vec![vertex(), fragment()] }
+    }
+
+    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
+        // The edge and block are uniforms; the method is another pipeline.
+        scatters(old) == scatters(new)
     }
 }
 
 impl PassPlugin for ReprojectionSplat {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
-            depth: Some(DepthSpec { port: "depth", write: true, compare: wgpu::CompareFunction::Less }),
-            topology: wgpu::PrimitiveTopology::TriangleStrip,
-            ..RenderPipelineSpec::drawing(&VERTEX, &FRAGMENT)
-        })?;
+        let draw = if scatters(ctx.params) {
+            let defines = self.shader_defines(ctx.params);
+            let [depth, point] = scatter_rounds();
+            let round = |shader: &ShaderUse| {
+                ctx.compute_pipeline(&ComputePipelineSpec { defines: &defines, ..ComputePipelineSpec::of(shader) })
+            };
+            Draw::Scatter { depth: round(&depth)?, point: round(&point)? }
+        } else {
+            Draw::Quads(ctx.render_pipeline(&RenderPipelineSpec {
+                depth: Some(DepthSpec { port: "depth", write: true, compare: wgpu::CompareFunction::Less }),
+                topology: wgpu::PrimitiveTopology::TriangleStrip,
+                ..RenderPipelineSpec::drawing(&vertex(), &fragment())
+            })?)
+        };
         let uniform = ctx.uniform_buffer("splat", std::mem::size_of::<SplatParamsGpu>() as u64);
         let settings = SplatSettings::from_params(ctx.params);
         let (size, block) = (settings.splat_size as f32, settings.block);
-        Ok(Box::new(SplatNode { pipeline, uniform, size, block, written: None }))
+        Ok(Box::new(SplatNode { draw, uniform, size, block, written: None }))
     }
 }
 
+/// The pipelines of a `method`.
+enum Draw {
+    Quads(RenderPassPipeline),
+    Scatter { depth: ComputePassPipeline, point: ComputePassPipeline },
+}
+
 struct SplatNode {
-    pipeline: RenderPassPipeline,
+    draw: Draw,
     uniform: wgpu::Buffer,
     size: f32,
     block: u32,
@@ -142,13 +217,32 @@ impl PassNode for SplatNode {
             ctx.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&settings));
             self.written = Some(settings);
         }
-        let bg = ctx.bind_group(&self.pipeline, &[("splat", self.uniform.as_entire_binding())])?;
-        let mut pass = ctx.begin_render_pass(&self.pipeline, Some(1.0))?;
-        let instances = rect[2].div_ceil(self.block) * rect[3].div_ceil(self.block);
-        if instances > 0 {
-            pass.set_pipeline(&self.pipeline.pipeline);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.draw(0..4, 0..instances);
+        let (bx, by) = (rect[2].div_ceil(self.block), rect[3].div_ceil(self.block));
+        let splat = [("splat", self.uniform.as_entire_binding())];
+        match &self.draw {
+            Draw::Quads(pipeline) => {
+                let bg = ctx.bind_group(pipeline, &splat)?;
+                let mut pass = ctx.begin_render_pass(pipeline, Some(1.0))?;
+                if bx * by > 0 {
+                    pass.set_pipeline(&pipeline.pipeline);
+                    pass.set_bind_group(0, &bg, &[]);
+                    pass.draw(0..4, 0..bx * by);
+                }
+            }
+            Draw::Scatter { depth, point } => {
+                ctx.clear_buffer("depth")?;
+                ctx.clear_target("start")?;
+                let (depth_bg, point_bg) = (ctx.bind_group(depth, &splat)?, ctx.bind_group(point, &splat)?);
+                let mut pass = ctx.begin_compute_pass();
+                if bx * by > 0 {
+                    let groups = (bx.div_ceil(SCATTER_WORKGROUP.0), by.div_ceil(SCATTER_WORKGROUP.1));
+                    for (pipeline, bg) in [(depth, &depth_bg), (point, &point_bg)] {
+                        pass.set_pipeline(&pipeline.pipeline);
+                        pass.set_bind_group(0, bg, &[]);
+                        pass.dispatch_workgroups(groups.0, groups.1, 1);
+                    }
+                }
+            }
         }
         Ok(())
     }

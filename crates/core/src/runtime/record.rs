@@ -184,6 +184,35 @@ impl<'a> RecordContext<'a> {
         Ok(())
     }
 
+    /// Clears the target bound to `port` to zero (a compute pass that scatters into part of
+    /// it starts from "nothing here"), labelled and timed with the step.
+    pub fn clear_target(&mut self, port: &str) -> Result<(), PassError> {
+        let view = self.view(port)?;
+        let ts = self.timestamp_indices();
+        let label = format!("{}: clear {port}", self.label);
+        drop(self.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(&label),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: ts.map(|(query_set, b, e)| wgpu::RenderPassTimestampWrites {
+                query_set,
+                beginning_of_pass_write_index: b,
+                end_of_pass_write_index: Some(e),
+            }),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        }));
+        Ok(())
+    }
+
     /// Uploads `data` into `buffer` at `offset` before this frame's work runs (per-frame CPU
     /// data: brick tables, streamed bricks).
     pub fn write_buffer(&self, buffer: &wgpu::Buffer, offset: u64, data: &[u8]) {

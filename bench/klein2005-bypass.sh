@@ -33,7 +33,7 @@ bench=target/debug/volgraph-bench
       --datasets "$d" --tf "$t" --frames 24 --set input.iso_value=$iso --no-gpu-count \
       --json "$out/base-$d.json" --markdown "$out/base-$d.md" > /dev/null
     $bench bench graphs --quiet --graphs graphs/klein_2005/leap_iso.ron --datasets "$d" --tf "$t" --frames 24 \
-      --set input.iso_value=$iso --no-gpu-count --sweep input.reproject_below=0.001,16,32,48,64,1000000 \
+      --set input.iso_value=$iso --no-gpu-count --sweep input.reproject_below=0.001,24,32,40,48,64,1000000 \
       --json "$out/sweep-$d.json" --markdown "$out/sweep-$d.md" > /dev/null
     echo "### $d"
     echo

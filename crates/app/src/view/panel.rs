@@ -172,6 +172,10 @@ pub fn show(
         if !plan.history.is_empty() {
             ui.label(history_line(&session.runtime.history_stats()));
         }
+        // What the graph's bypasses did (Klein's reprojection left out where it cannot pay).
+        for b in session.runtime.bypass_status() {
+            ui.label(crate::render::bypass_line(&b));
+        }
         ui.small(under_cursor.unwrap_or("under the cursor: nothing visible"));
         ui.horizontal(|ui| {
             let (mut enabled, mut fps) = (lod.enabled, 1000.0 / lod.target_ms);

@@ -423,6 +423,13 @@ fn the_viewer_counts_frames_from_reprojected_starts_and_an_isovalue_edit_restart
     assert_eq!((stats.frames_from_history, stats.run, stats.restarts), (2, 0, 1), "{stats:?}");
     session.submit(&OrbitCamera { azimuth_deg: 34.0, ..OrbitCamera::default() }, None).expect("frame");
     assert_eq!(session.runtime.history_stats().run, 1);
+    // The panel says what the graph's bypass did: one line per bypass, with its measure.
+    session.runtime.finish();
+    let status = session.runtime.bypass_status();
+    assert_eq!(status.len(), 1, "{status:?}");
+    let line = crate::render::bypass_line(&status[0]);
+    assert!(line.starts_with("bypass reprojection: left out in "), "{line}");
+    assert!(line.contains("threshold 40"), "{line}");
     let _ = std::fs::remove_dir_all(&s.dir);
 }
 

@@ -157,34 +157,33 @@ fn scatter_block(id: vec3<u32>) -> BlockSplat {
     return block_splat(id.y * blocks_x() + id.x);
 }
 
-// Round 1: every pixel keeps the nearest splat's depth.
-@compute @workgroup_size(8, 8)
-fn cs_splat_depth(@builtin(global_invocation_id) id: vec3<u32>) {
+// One round over the pixels of this invocation's splat: round 1 (`points` false) keeps in every
+// pixel the nearest splat's depth; round 2 writes the point of the splat whose depth won (splats
+// at the same depth may both write: either is a start at that depth).
+fn scatter_round(id: vec3<u32>, points: bool) {
     let s = scatter_block(id);
     let r = covered_pixels(s);
     let key = depth_key(s.z);
     let width = u32(frame.viewport.x);
     for (var y = r.y; y < r.w; y += 1u) {
         for (var x = r.x; x < r.z; x += 1u) {
-            atomicMax(&depth[y * width + x], key);
-        }
-    }
-}
-
-// Round 2: the splat whose depth won writes its point (splats at the same depth may both
-// write; either is a start at that depth).
-@compute @workgroup_size(8, 8)
-fn cs_splat_point(@builtin(global_invocation_id) id: vec3<u32>) {
-    let s = scatter_block(id);
-    let r = covered_pixels(s);
-    let key = depth_key(s.z);
-    let width = u32(frame.viewport.x);
-    for (var y = r.y; y < r.w; y += 1u) {
-        for (var x = r.x; x < r.z; x += 1u) {
-            if (atomicLoad(&depth[y * width + x]) == key) {
+            let i = y * width + x;
+            if (!points) {
+                atomicMax(&depth[i], key);
+            } else if (atomicLoad(&depth[i]) == key) {
                 textureStore(start, vec2<u32>(x, y), s.point);
             }
         }
     }
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_splat_depth(@builtin(global_invocation_id) id: vec3<u32>) {
+    scatter_round(id, false);
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_splat_point(@builtin(global_invocation_id) id: vec3<u32>) {
+    scatter_round(id, true);
 }
 #endif

@@ -77,7 +77,7 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
             h.max_camera_degrees = declared.max_camera_degrees;
         }
     }
-    let bypass = c.bypass.iter().map(|b| bypass_in_plan(&c, b, &steps, &resources)).collect();
+    let bypass = c.bypass.iter().filter_map(|b| bypass_in_plan(&c, b, &steps, &resources)).collect();
     Ok(Plan {
         name: doc.name.clone(),
         viewport: options.viewport,
@@ -114,13 +114,14 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
 }
 
 /// A checked bypass in plan terms: its steps, what they write that running steps read, and
-/// the resource of its measure.
+/// the resource of its measure; `None` when no output needs the measuring pass (culled: nothing
+/// measures, so every pass runs).
 fn bypass_in_plan(
     c: &Checked,
     b: &crate::compile::check::CheckedBypass,
     steps: &[crate::plan::Step],
     resources: &[Resource],
-) -> crate::plan::Bypass {
+) -> Option<crate::plan::Bypass> {
     let ids: Vec<&str> = b.passes.iter().map(|&p| c.passes[p].id.as_str()).collect();
     let left_out: Vec<usize> = (0..steps.len()).filter(|&i| ids.contains(&steps[i].pass_id.as_str())).collect();
     let mut clears = Vec::new();
@@ -135,17 +136,12 @@ fn bypass_in_plan(
         }
     }
     let (pass, port) = (&c.passes[b.measure.0].id, &b.measure.1);
-    let measure_step = steps.iter().position(|s| &s.pass_id == pass).unwrap_or(0);
-    let measure = steps[measure_step]
-        .ports
-        .iter()
-        .find(|bp| &bp.port == port)
-        .and_then(|bp| match bp.binding {
-            crate::plan::Binding::Resource { id, written } => Some(written.unwrap_or(id)),
-            _ => None,
-        })
-        .unwrap_or(0);
-    crate::plan::Bypass { name: b.name.clone(), steps: left_out, clears, measure_step, measure, below: b.below }
+    let measure_step = steps.iter().position(|s| &s.pass_id == pass)?;
+    let measure = steps[measure_step].ports.iter().find(|bp| &bp.port == port).and_then(|bp| match bp.binding {
+        crate::plan::Binding::Resource { id, written } => Some(written.unwrap_or(id)),
+        _ => None,
+    })?;
+    Some(crate::plan::Bypass { name: b.name.clone(), steps: left_out, clears, measure_step, measure, below: b.below })
 }
 
 /// 0. Bound the unrolled size before allocating anything for it.

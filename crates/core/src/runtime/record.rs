@@ -188,7 +188,7 @@ impl<'a> RecordContext<'a> {
     /// it starts from "nothing here"), labelled and timed with the step.
     pub fn clear_target(&mut self, port: &str) -> Result<(), PassError> {
         let view = self.view(port)?;
-        let ts = self.timestamp_indices();
+        let ts = self.render_pass_timestamps();
         let label = format!("{}: clear {port}", self.label);
         drop(self.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(&label),
@@ -202,11 +202,7 @@ impl<'a> RecordContext<'a> {
                 },
             })],
             depth_stencil_attachment: None,
-            timestamp_writes: ts.map(|(query_set, b, e)| wgpu::RenderPassTimestampWrites {
-                query_set,
-                beginning_of_pass_write_index: b,
-                end_of_pass_write_index: Some(e),
-            }),
+            timestamp_writes: ts,
             occlusion_query_set: None,
             multiview_mask: None,
         }));
@@ -298,6 +294,15 @@ impl<'a> RecordContext<'a> {
         Some((set, begin, base + 1))
     }
 
+    /// This step's timestamps for a render pass (the first pass of a step writes the beginning).
+    fn render_pass_timestamps(&mut self) -> Option<wgpu::RenderPassTimestampWrites<'a>> {
+        self.timestamp_indices().map(|(query_set, b, e)| wgpu::RenderPassTimestampWrites {
+            query_set,
+            beginning_of_pass_write_index: b,
+            end_of_pass_write_index: Some(e),
+        })
+    }
+
     /// Begins a render pass into `pipeline`'s colour ports (Write ports cleared to 0, Modify
     /// ports loaded) and its depth port (`depth_clear`: Some(value) clears, None loads),
     /// labelled and timed.
@@ -336,17 +341,13 @@ impl<'a> RecordContext<'a> {
             }
             None => None,
         };
-        let ts = self.timestamp_indices();
+        let ts = self.render_pass_timestamps();
         let label = self.label.to_string();
         let pass = self.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(&label),
             color_attachments: &colors,
             depth_stencil_attachment: depth,
-            timestamp_writes: ts.map(|(query_set, b, e)| wgpu::RenderPassTimestampWrites {
-                query_set,
-                beginning_of_pass_write_index: b,
-                end_of_pass_write_index: Some(e),
-            }),
+            timestamp_writes: ts,
             occlusion_query_set: None,
             multiview_mask: None,
         });

@@ -240,26 +240,7 @@ pub(crate) fn clear_for_left_out(
             let depth =
                 matches!(plan.resources[rid].desc, ResourceDesc::Target { format: TargetFormat::Depth32Float, .. });
             let label = format!("bypass {}: clear {}", b.name, plan.resources[rid].name);
-            let color = [Some(wgpu::RenderPassColorAttachment {
-                view: &view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })];
-            let depth_attachment = wgpu::RenderPassDepthStencilAttachment {
-                view: &view,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
-                stencil_ops: None,
-            };
-            drop(encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some(&label),
-                color_attachments: if depth { &[] } else { &color },
-                depth_stencil_attachment: depth.then_some(depth_attachment),
-                ..Default::default()
-            }));
+            super::record::clear_view(encoder, &view, depth, &label, None);
         }
     }
 }

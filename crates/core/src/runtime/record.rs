@@ -190,22 +190,7 @@ impl<'a> RecordContext<'a> {
         let view = self.view(port)?;
         let ts = self.render_pass_timestamps();
         let label = format!("{}: clear {port}", self.label);
-        drop(self.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(&label),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: ts,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        }));
+        clear_view(self.encoder, view, false, &label, ts);
         Ok(())
     }
 
@@ -387,4 +372,32 @@ impl<'a> RecordContext<'a> {
             })
             .forget_lifetime()
     }
+}
+
+/// Clears `view` to zero in a render pass of its own (a depth target when `depth`), labelled and,
+/// with `timestamps`, timed: what a pass clears before scattering into part of a target
+/// (`RecordContext::clear_target`) and what a bypassed pass would have written
+/// (`bypass::clear_for_left_out`).
+pub(crate) fn clear_view(
+    encoder: &mut wgpu::CommandEncoder,
+    view: &wgpu::TextureView,
+    depth: bool,
+    label: &str,
+    timestamps: Option<wgpu::RenderPassTimestampWrites<'_>>,
+) {
+    let zero = wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store };
+    let color = [Some(wgpu::RenderPassColorAttachment { view, depth_slice: None, resolve_target: None, ops: zero })];
+    let depth_attachment = wgpu::RenderPassDepthStencilAttachment {
+        view,
+        depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(0.0), store: wgpu::StoreOp::Store }),
+        stencil_ops: None,
+    };
+    drop(encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: if depth { &[] } else { &color },
+        depth_stencil_attachment: depth.then_some(depth_attachment),
+        timestamp_writes: timestamps,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    }));
 }

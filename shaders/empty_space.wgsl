@@ -47,7 +47,7 @@ fn cs_classify(@builtin(global_invocation_id) id: vec3<u32>) {
     let range = textureLoad(grid, vec3<i32>(id), 0).rg;
     let unknown = false;
 #endif
-    let texels = i32(textureDimensions(tf).x);
+    let texels = i32(textureDimensions(tf));
     let n = f32(texels);
     var first = 0;
     var last = texels - 1;

@@ -13,7 +13,7 @@
 @group(0) @binding(auto) var table16: texture_storage_2d<rgba16float, write>;
 
 fn segment(s_front: f32, s_back: f32) -> vec4<f32> {
-    let texels = f32(textureDimensions(tf).x);
+    let texels = f32(textureDimensions(tf));
     let crossed = ceil(abs(s_back - s_front) * texels);
     let n = u32(clamp(4.0 * crossed, 64.0, 65536.0));
     let dx = step_exponent() / f32(n);

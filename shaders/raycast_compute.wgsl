@@ -18,20 +18,39 @@ override WORKGROUP_Y: u32 = 8u;
 // Texture-space hit position (w = 1), zero on a miss; only `cs_iso` writes it.
 @group(0) @binding(auto) var hit: texture_storage_2d<rgba32float, write>;
 
-@compute @workgroup_size(WORKGROUP_X, WORKGROUP_Y)
-fn cs_dvr(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (!in_viewport(id.xy)) {
-        return;
+// The pixel of invocation `local` of workgroup `group`. Consecutive invocations — the lanes of
+// one SIMD vector, 8 on llvmpipe — cover a 4×2 tile of the workgroup's rectangle instead of a
+// row of 8, so a vector's rays start closer together and take more alike paths
+// (bench/one-march.md: 2 % fewer instructions in the march on hydrogen). A GPU's 32-lane warp
+// covers the same 8×4 (or 16×2) pixels either way. Workgroups whose sides are not multiples of 4
+// and 2 keep rows.
+fn invocation_pixel(group: vec3<u32>, local: u32) -> vec2<u32> {
+    var offset = vec2<u32>(local % WORKGROUP_X, local / WORKGROUP_X);
+    if (WORKGROUP_X % 4u == 0u && WORKGROUP_Y % 2u == 0u) {
+        let tile = local / 8u;
+        let lane = local % 8u;
+        let tiles_per_row = WORKGROUP_X / 4u;
+        offset = vec2<u32>((tile % tiles_per_row) * 4u + lane % 4u, (tile / tiles_per_row) * 2u + lane / 4u);
     }
-    textureStore(color, vec2<i32>(id.xy), march_pixel_dvr(id.xy).color);
+    return group.xy * vec2<u32>(WORKGROUP_X, WORKGROUP_Y) + offset;
 }
 
 @compute @workgroup_size(WORKGROUP_X, WORKGROUP_Y)
-fn cs_iso(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (!in_viewport(id.xy)) {
+fn cs_dvr(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let pixel = invocation_pixel(group, local);
+    if (!in_viewport(pixel)) {
         return;
     }
-    let m = march_pixel_iso(id.xy);
-    textureStore(color, vec2<i32>(id.xy), m.color);
-    textureStore(hit, vec2<i32>(id.xy), m.point);
+    textureStore(color, vec2<i32>(pixel), march_pixel_dvr(pixel).color);
+}
+
+@compute @workgroup_size(WORKGROUP_X, WORKGROUP_Y)
+fn cs_iso(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let pixel = invocation_pixel(group, local);
+    if (!in_viewport(pixel)) {
+        return;
+    }
+    let m = march_pixel_iso(pixel);
+    textureStore(color, vec2<i32>(pixel), m.color);
+    textureStore(hit, vec2<i32>(pixel), m.point);
 }

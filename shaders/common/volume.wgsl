@@ -5,8 +5,9 @@
 @group(0) @binding(auto) var volume: texture_3d<f32>;
 // Filtering sampler, clamp-to-edge on every axis (used for `volume` and `tf`).
 @group(0) @binding(auto) var linear_clamp: sampler;
-// The transfer-function LUT as an N×1 RGBA texture (straight colour, alpha per unit step).
-@group(0) @binding(auto) var tf: texture_2d<f32>;
+// The transfer-function LUT as a 1D RGBA texture of N texels (straight colour, alpha per unit
+// step).
+@group(0) @binding(auto) var tf: texture_1d<f32>;
 
 // s(u): the normalized scalar at texture-space position `u`, trilinear.
 fn sample_trilinear(u: vec3<f32>) -> f32 {
@@ -64,5 +65,5 @@ fn sample_volume(u: vec3<f32>) -> f32 {
 
 // The LUT at scalar `s`: linear between texel centres (i+0.5)/N, clamped at the ends.
 fn sample_tf(s: f32) -> vec4<f32> {
-    return textureSampleLevel(tf, linear_clamp, vec2<f32>(s, 0.5), 0.0);
+    return textureSampleLevel(tf, linear_clamp, s, 0.0);
 }

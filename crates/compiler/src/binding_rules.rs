@@ -81,9 +81,8 @@ pub fn port_infos(plan: &Plan, step: &crate::plan::Step, specs: &[crate::decl::P
             let dim = match (desc, declared) {
                 (Some(ResourceDesc::Target { .. }), _) => Some(wgpu::TextureViewDimension::D2),
                 (Some(_), _) => None,
-                (None, Some(PortKind::Target { .. } | PortKind::TransferFunction)) => {
-                    Some(wgpu::TextureViewDimension::D2)
-                }
+                (None, Some(PortKind::Target { .. })) => Some(wgpu::TextureViewDimension::D2),
+                (None, Some(PortKind::TransferFunction)) => Some(wgpu::TextureViewDimension::D1),
                 (None, Some(PortKind::Volume)) => Some(wgpu::TextureViewDimension::D3),
                 _ => None,
             };
@@ -144,7 +143,11 @@ pub fn check_bindings(
                 b.name,
                 wgsl_dim(have),
                 b.name,
-                if want == wgpu::TextureViewDimension::D3 { "3D" } else { "2D" },
+                match want {
+                    wgpu::TextureViewDimension::D1 => "1D",
+                    wgpu::TextureViewDimension::D3 => "3D",
+                    _ => "2D",
+                },
                 wgsl_dim(want),
             ));
         }

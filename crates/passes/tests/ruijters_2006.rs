@@ -13,7 +13,7 @@ use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::reference::{RaycastSettings, render_reference};
 use volgraph_accel::transfer_function::{ControlPoint, Preset, TransferFunction};
 use volgraph_accel::volume::{Volume, VoxelData};
-use volgraph_core::runtime::{CameraData, Gpu, Image};
+use volgraph_core::runtime::{CameraData, Gpu, Image, volume_texture_format};
 use volgraph_core::{CompileOptions, Registry};
 use volgraph_passes::builtin_registry;
 
@@ -173,8 +173,10 @@ fn a_pool_of_a_few_bricks_thrashes_but_gives_the_same_image() {
     let mut base = live(&gpu, &registry, "unoptimized", &volume, &lut, &CompileOptions::new(SIZE, SIZE));
     let options = CompileOptions::new(SIZE, SIZE).with_scalar("brick_cells", 16.0).with_scalar("node_cells", 4.0);
     let mut small = live(&gpu, &registry, "bricks_octree", &volume, &lut, &options);
-    // (16 + 3)³ voxels of one byte per slot: room for three bricks.
-    small.runtime.set_gpu_memory_budget(Some(3 * 19 * 19 * 19));
+    // (16 + 3)³ voxels per slot in the device's format (R16Unorm on lavapipe): room for three
+    // bricks.
+    let voxel_bytes = volume_texture_format(&gpu, &volume).bytes() as u64;
+    small.runtime.set_gpu_memory_budget(Some(3 * 19 * 19 * 19 * voxel_bytes));
     for azimuth in [0.0, 40.0, 80.0] {
         let cam = camera(azimuth, 2.6);
         let want = base.frame(&cam);
@@ -427,7 +429,7 @@ fn a_thin_slab_is_bricked_thin() {
     let cam = OrbitCamera { azimuth_deg: 0.0, elevation_deg: 80.0, distance: 2.0, ..OrbitCamera::default() };
     let mut bricked = live(&gpu, &registry, "bricks", &volume, &lut, &options);
     let got = bricked.frame(&cam);
-    let slot = 35.0 * 35.0 * 4.0;
+    let slot = 35.0 * 35.0 * 4.0 * volume_texture_format(&gpu, &volume).bytes() as f64;
     let (slots, pool) = (bricked.counter("pool_slots"), bricked.counter("pool_bytes"));
     assert_eq!(pool, slots * slot, "{slots} slots of 35×35×4 voxels");
     let mut base = live(&gpu, &registry, "unoptimized", &volume, &lut, &options);

@@ -156,7 +156,7 @@ pub struct WgslParamDoc {
 pub enum InputKind {
     /// The scalar volume, bound as a 3D texture.
     Volume,
-    /// The transfer function, bound as a LUT texture.
+    /// The transfer function, bound as a 1D LUT texture (`texture_1d<f32>`, N RGBA texels).
     TransferFunction,
     /// A scene scalar with its default value (repeat counts, thresholds).
     Scalar(f64),

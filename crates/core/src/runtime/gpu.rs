@@ -101,6 +101,9 @@ pub struct Gpu {
     /// Whether 16-bit normalized textures (R16Unorm) exist: 16-bit volumes are uploaded as they
     /// are; without it they are widened to 32-bit float.
     pub norm16: bool,
+    /// Whether the adapter is a CPU rasterizer (Mesa lavapipe): some choices that cost the same
+    /// on a GPU differ there (8-bit volumes go up as R16Unorm, upload.rs).
+    pub is_cpu: bool,
     /// Whether fragment shaders may force early depth tests (`@early_depth_test(force)`,
     /// Vulkan only): needed where a shader with side effects, such as a debug counter, must
     /// still be skipped by early-z (Krüger–Westermann 2003 §2.1).
@@ -173,6 +176,7 @@ impl Gpu {
             float32_filterable: features.contains(wgpu::Features::FLOAT32_FILTERABLE),
             float32_blendable: features.contains(wgpu::Features::FLOAT32_BLENDABLE),
             norm16: features.contains(wgpu::Features::TEXTURE_FORMAT_16BIT_NORM),
+            is_cpu: info.device_type == wgpu::DeviceType::Cpu,
             early_depth_test: features.contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST),
             limits,
             uncaptured,

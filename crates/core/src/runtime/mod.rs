@@ -295,7 +295,8 @@ impl Runtime {
         Ok(self.inputs.bind_lut(&self.gpu, name, lut)?)
     }
 
-    /// Binds an application-made texture to graph input `name`.
+    /// Binds an application-made texture to graph input `name` (a transfer function's is 1D,
+    /// one RGBA texel per LUT entry, as `bind_lut` uploads it; a volume's is 3D).
     pub fn bind_texture(&mut self, name: &str, texture: wgpu::Texture) {
         self.inputs.bind_texture(name, texture);
     }

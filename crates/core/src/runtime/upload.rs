@@ -103,9 +103,15 @@ pub struct UploadedVolume {
     pub format: VolumeFormat,
 }
 
-/// The texture format `texels` get on `gpu` (see the module documentation).
+/// The texture format `texels` get on `gpu` (see the module documentation). On a CPU adapter
+/// 8-bit voxels go up as R16Unorm — `v · 257 / 65535` is exactly `v / 255` — because llvmpipe
+/// filters 16-bit texels with a fifth fewer instructions than 8-bit ones, whose path works in
+/// packed integers with 8-bit weights, and more accurately (bench/one-march.md: hydrogen's
+/// `fastest` frame −8 %, the isosurface's mean error against the f64 reference ÷2–40). A brick
+/// pool stores bricks in the same format, so it renders like the single texture.
 pub fn volume_format_for(gpu: &Gpu, texels: &VolumeTexels<'_>) -> VolumeFormat {
     match texels {
+        VolumeTexels::Unorm8(_) if gpu.is_cpu && gpu.norm16 => VolumeFormat::R16Unorm,
         VolumeTexels::Unorm8(_) => VolumeFormat::R8Unorm,
         VolumeTexels::Unorm16(_) if gpu.norm16 => VolumeFormat::R16Unorm,
         VolumeTexels::Unorm16(_) | VolumeTexels::Float(_) if gpu.float32_filterable => VolumeFormat::R32Float,
@@ -125,6 +131,10 @@ pub fn texel_bytes(texels: &VolumeTexels<'_>, format: VolumeFormat) -> Vec<u8> {
     match (format, texels) {
         (VolumeFormat::R8Unorm, VolumeTexels::Unorm8(v)) => v.to_vec(),
         (VolumeFormat::R16Unorm, VolumeTexels::Unorm16(v)) => bytemuck::cast_slice(v).to_vec(),
+        (VolumeFormat::R16Unorm, VolumeTexels::Unorm8(v)) => {
+            let widened: Vec<u16> = v.iter().map(|x| u16::from(*x) * 257).collect();
+            bytemuck::cast_slice(&widened).to_vec()
+        }
         (VolumeFormat::R32Float, t) => bytemuck::cast_slice(&as_f32(t)).to_vec(),
         (VolumeFormat::R16Float, t) => {
             let halves: Vec<u16> = as_f32(t).into_iter().map(f32_to_f16).collect();
@@ -188,8 +198,10 @@ pub fn upload_volume(
     Ok(UploadedVolume { texture, format })
 }
 
-/// Uploads an RGBA LUT as an `N × 1` texture: Rgba32Float where the adapter filters 32-bit
-/// floats, else Rgba16Float.
+/// Uploads an RGBA LUT as a 1D texture of `N` texels: Rgba32Float where the adapter filters
+/// 32-bit floats, else Rgba16Float. One dimension, not an `N × 1` 2D texture: a linear lookup
+/// then reads two texels instead of four (llvmpipe fetches both rows of a bilinear footprint even
+/// when the second has weight 0, bench/one-march.md).
 pub fn upload_lut(gpu: &Gpu, label: &str, rgba: &[[f32; 4]]) -> Result<wgpu::Texture, GpuFault> {
     let width = rgba.len().max(1) as u32;
     let (format, bytes): (wgpu::TextureFormat, Vec<u8>) = if gpu.float32_filterable {
@@ -208,7 +220,7 @@ pub fn upload_lut(gpu: &Gpu, label: &str, rgba: &[[f32; 4]]) -> Result<wgpu::Tex
                 size,
                 mip_level_count: 1,
                 sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
+                dimension: wgpu::TextureDimension::D1,
                 format,
                 usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
                 view_formats: &[],

@@ -29,7 +29,9 @@ fn invocation_pixel(group: vec3<u32>, local: u32) -> vec2<u32> {
     if (WORKGROUP_X % 4u == 0u && WORKGROUP_Y % 2u == 0u) {
         let tile = local / 8u;
         let lane = local % 8u;
-        let tiles_per_row = WORKGROUP_X / 4u;
+        // At least 1: the constants are folded even where the branch is not taken, and a
+        // workgroup narrower than 4 would divide by zero (the pipeline fails to build).
+        let tiles_per_row = max(WORKGROUP_X / 4u, 1u);
         offset = vec2<u32>((tile % tiles_per_row) * 4u + lane % 4u, (tile / tiles_per_row) * 2u + lane / 4u);
     }
     return group.xy * vec2<u32>(WORKGROUP_X, WORKGROUP_Y) + offset;

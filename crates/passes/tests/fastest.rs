@@ -331,3 +331,29 @@ fn a_new_transfer_function_reclassifies_the_blocks() {
     let (changed, _) = diff_reference(&after, &as_reference(&old));
     assert!(changed > 2.0 / 255.0, "the two TFs give visibly different images");
 }
+
+/// `raycast_compute` maps consecutive invocations to 4×2 tiles where the workgroup's sides allow
+/// it (`invocation_pixel` in raycast_compute.wgsl) and to rows otherwise: every shape, tiled or
+/// not, must write every pixel exactly once with its own ray. Pixels share nothing, so the images
+/// are compared bit for bit against one-invocation workgroups (no tiling); a pixel written twice
+/// or never shows as a difference, the case's image covering a fair part of the frame.
+#[test]
+fn every_workgroup_shape_writes_every_pixel_with_its_own_ray() {
+    let case = cases().remove(0);
+    let camera = &CAMERAS[1];
+    let shape = |x: u64, y: u64| {
+        [("march.workgroup_x", ron::Value::from(x)), ("march.workgroup_y", ron::Value::from(y))]
+    };
+    let (want, ..) = render_fastest(&case, camera, &shape(1, 1));
+    assert!(coverage(&want) > 0.05, "the volume fills part of the frame ({:.3})", coverage(&want));
+    // Tiled: 8×8 (the default), 16×12 (the thesis's), 4×2 (one tile), 12×6 (three tiles a row);
+    // rows: 6×3, 32×1, 5×4, 7×7 (a side that does not divide 128 leaves partial groups).
+    for (x, y) in [(8, 8), (16, 12), (4, 2), (12, 6), (6, 3), (32, 1), (5, 4), (7, 7)] {
+        let (got, ..) = render_fastest(&case, camera, &shape(x, y));
+        let differ = (0..got.height)
+            .flat_map(|py| (0..got.width).map(move |px| (px, py)))
+            .filter(|&(px, py)| got.rgba(px, py) != want.rgba(px, py))
+            .count();
+        assert_eq!(differ, 0, "workgroup {x}×{y}: {differ} pixels differ from 1×1 workgroups");
+    }
+}

@@ -91,3 +91,18 @@ fn a_workgroup_over_the_device_limit_names_both_sizes() {
         );
     }
 }
+
+/// The transfer function is a 1D texture: a LUT over the device's 1D limit, or one with no
+/// entries, is a fault naming the upload, never a panic, and the device keeps working.
+#[test]
+fn a_lut_the_device_cannot_hold_is_a_fault_naming_it() {
+    let gpu = gpu();
+    let limit = gpu.limits.max_texture_dimension_1d as usize;
+    for (entries, what) in [(limit + 1, "over the 1D limit"), (0, "empty")] {
+        let lut = vec![[0.5f32, 0.5, 0.5, 0.1]; entries];
+        let fault = volgraph_core::runtime::upload_lut(&gpu, "tf", &lut).expect_err(what);
+        let text = fault.to_string();
+        assert!(text.starts_with("uploading the transfer-function LUT \"tf\""), "{what}: {text}");
+    }
+    assert!(volgraph_core::runtime::upload_lut(&gpu, "tf", &[[0.0; 4]; 256]).is_ok(), "a 256-entry LUT uploads");
+}

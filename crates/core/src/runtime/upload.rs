@@ -105,9 +105,10 @@ pub struct UploadedVolume {
 
 /// The texture format `texels` get on `gpu` (see the module documentation). On a CPU adapter
 /// 8-bit voxels go up as R16Unorm — `v · 257 / 65535` is exactly `v / 255` — because llvmpipe
-/// filters 16-bit texels with a fifth fewer instructions than 8-bit ones, whose path works in
-/// packed integers with 8-bit weights, and more accurately (bench/one-march.md: hydrogen's
-/// `fastest` frame −8 %, the isosurface's mean error against the f64 reference ÷2–40). A brick
+/// filters them faster than 8-bit texels, whose path works in packed integers with 8-bit
+/// weights, and more accurately (bench/one-march.md: hydrogen's `fastest` run 9.8 % fewer
+/// instructions and its frame ~7 % faster, the isosurface's mean error against the f64
+/// reference ÷2–40). A brick
 /// pool stores bricks in the same format, so it renders like the single texture.
 pub fn volume_format_for(gpu: &Gpu, texels: &VolumeTexels<'_>) -> VolumeFormat {
     match texels {

@@ -123,15 +123,17 @@ def ab_table(folder, kind, title):
 
 
 def main():
-    folder = sys.argv[1]
-    lines = [HEADER, "## The presets, before and after"]
+    tables_only = "--tables-only" in sys.argv[1:]
+    folder = [a for a in sys.argv[1:] if a != "--tables-only"][0]
+    lines = ["## The presets, before and after"] if tables_only else [HEADER, "## The presets, before and after"]
     for preset in ("peer", "klein2005", "ruijters2006", "kw2003-table1", "thesis-tables"):
         lines += preset_table(folder, preset)
     lines.append("\n## Focused A/B (the two binaries alternating, three rounds)")
     lines += ab_table(folder, "klein", "Klein 2005 DVR, the rows whose single run moved")
     lines += ab_table(folder, "bricks", "Ruijters & Vilanova 2006 bricks + octree on the vessel tree")
     lines += ab_table(folder, "fixed", "Klein 2005's fixed cost: isovalue 0, every ray hits at its first sample")
-    lines.append(FOOTER)
+    if not tables_only:
+        lines.append(FOOTER)
     print("\n".join(lines))
 
 

@@ -5,15 +5,28 @@
 # Then a focused A/B that alternates the two binaries three times on the rows that moved.
 # Writes bench/one-march/*.json|md; bench/one-march.md is assembled from them
 # (bench/one-march-table.py). Run from the workspace root; takes ~50 minutes on 2 cores.
+# PROFILE=release builds both binaries with the release profile instead of dev (optimized);
+# OUT=DIR writes the JSON there and TABLE=FILE the tables (then without the first run's text:
+# `one-march-table.py --tables-only`), so a rerun leaves the first run's record as it is.
 set -eu
 root=$(pwd)
 old=${OLD_WORKTREE:-/tmp/volgraph-05041dd}
 [ -d "$old" ] || git worktree add -f "$old" 05041dd
-(cd "$old" && CARGO_TARGET_DIR="$root/target" cargo build -p volgraph-bench)
-cp target/debug/volgraph-bench /tmp/volgraph-bench-old
-cargo build -p volgraph-bench
-cp target/debug/volgraph-bench /tmp/volgraph-bench-new
-out="$root/bench/one-march"
+profile=${PROFILE:-dev}
+bin_dir=$([ "$profile" = dev ] && echo debug || echo "$profile")
+# The old side builds in a target folder of its own: cargo names a workspace crate's artifacts
+# by its path inside the workspace, the same in both checkouts, so one shared folder would link
+# one side's binary against the other side's crates. Seeded from ours for the dependencies;
+# each side's sources are touched so that its crates are rebuilt from them whatever the copy
+# or an earlier run left.
+[ -d "$old/target/$bin_dir" ] || { mkdir -p "$old/target"; cp -a "target/$bin_dir" "$old/target/"; }
+find "$old/crates" -name '*.rs' -exec touch {} +
+(cd "$old" && CARGO_TARGET_DIR="$old/target" cargo build --profile "$profile" -p volgraph-bench)
+cp "$old/target/$bin_dir/volgraph-bench" /tmp/volgraph-bench-old
+find crates -name '*.rs' -exec touch {} +
+cargo build --profile "$profile" -p volgraph-bench
+cp "target/$bin_dir/volgraph-bench" /tmp/volgraph-bench-new
+out=${OUT:-"$root/bench/one-march"}
 mkdir -p "$out"
 run() { # side, then bench arguments
   side=$1; shift
@@ -37,4 +50,8 @@ for round in 1 2 3; do
       --json "$out/ab-bricks-$side-$round.json"
   done
 done > /dev/null
-python3 bench/one-march-table.py "$out" > bench/one-march.md
+if [ -n "${TABLE:-}" ]; then
+  python3 bench/one-march-table.py --tables-only "$out" > "$TABLE"
+else
+  python3 bench/one-march-table.py "$out" > bench/one-march.md
+fi

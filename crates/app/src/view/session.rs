@@ -739,14 +739,20 @@ impl LiveSession {
         self.outcome(format!("feature {name} {}", if on { "on" } else { "off" }), start, result)
     }
 
-    /// What "save view" writes: this graph, volume, TF, effects and cuts seen by `camera`.
-    pub fn saved_view(&self, camera: &volgraph_accel::camera::OrbitCamera) -> crate::scene::SavedView {
+    /// What "save view" writes: this graph, volume, TF, effects and cuts seen by `camera` in a
+    /// window of `viewport` pixels (the window's, not the level of detail's coarse image while
+    /// something moves).
+    pub fn saved_view(
+        &self,
+        camera: &volgraph_accel::camera::OrbitCamera,
+        viewport: (u32, u32),
+    ) -> crate::scene::SavedView {
         crate::scene::SavedView {
             graph: self.graph.clone(),
             volume: self.volume_source.clone(),
             transfer_function: self.tf_path.clone(),
             camera: *camera,
-            viewport: self.options.viewport,
+            viewport,
             effects: self.options.features.iter().filter(|f| !cut_effects::is_cut_feature(f)).cloned().collect(),
             precision: self.options.precision,
             opacity_reference: self.opacity_reference,

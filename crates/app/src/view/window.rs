@@ -191,15 +191,22 @@ impl Viewer {
                     session.save_tf_on_change = on;
                     Vec::new()
                 }
-                Action::SaveScene(path) => match session.saved_view(&self.orbit.camera).save(&path) {
-                    Ok(()) => {
-                        crate::stdout::println_escaped!("saved scene {}", path.display());
-                        Vec::new()
+                Action::SaveScene(path) => {
+                    let window =
+                        self.gfx.as_ref().map_or(session.options().viewport, |g| (g.config.width, g.config.height));
+                    match session.saved_view(&self.orbit.camera, window).save(&path) {
+                        Ok(()) => {
+                            crate::stdout::println_escaped!("saved scene {}", path.display());
+                            Vec::new()
+                        }
+                        Err(e) => {
+                            vec![super::session::Event::NotSaved {
+                                what: "view".to_string(),
+                                message: format!("{e:#}"),
+                            }]
+                        }
                     }
-                    Err(e) => {
-                        vec![super::session::Event::NotSaved { what: "view".to_string(), message: format!("{e:#}") }]
-                    }
-                },
+                }
                 Action::Screenshot => {
                     self.screenshot_now =
                         Some(self.view.screenshot.clone().unwrap_or_else(|| PathBuf::from("volgraph.png")));

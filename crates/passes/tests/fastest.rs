@@ -341,9 +341,8 @@ fn a_new_transfer_function_reclassifies_the_blocks() {
 fn every_workgroup_shape_writes_every_pixel_with_its_own_ray() {
     let case = cases().remove(0);
     let camera = &CAMERAS[1];
-    let shape = |x: u64, y: u64| {
-        [("march.workgroup_x", ron::Value::from(x)), ("march.workgroup_y", ron::Value::from(y))]
-    };
+    let shape =
+        |x: u64, y: u64| [("march.workgroup_x", ron::Value::from(x)), ("march.workgroup_y", ron::Value::from(y))];
     let (want, ..) = render_fastest(&case, camera, &shape(1, 1));
     assert!(coverage(&want) > 0.05, "the volume fills part of the frame ({:.3})", coverage(&want));
     // Tiled: 8×8 (the default), 16×12 (the thesis's), 4×2 (one tile), 12×6 (three tiles a row);

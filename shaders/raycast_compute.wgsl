@@ -3,7 +3,8 @@
 // pre-corrected table and sample counting, volgraph's fastest path: the same per-pixel march as
 // the fragment raycaster (common/pixel_march.wgsl), written to storage textures. Dispatch
 // ceil(w / WORKGROUP_X) × ceil(h / WORKGROUP_Y); invocations outside the viewport return at
-// once.
+// once, after the workgroup has copied the TF into its memory (TF_WORKGROUP, with PREFETCH the
+// pipelined sample loop of `sample_loop: "pipelined"`).
 //
 // Entry points: `cs_dvr` → `color`; `cs_iso` → `color`, `hit`.
 
@@ -39,6 +40,9 @@ fn invocation_pixel(group: vec3<u32>, local: u32) -> vec2<u32> {
 
 @compute @workgroup_size(WORKGROUP_X, WORKGROUP_Y)
 fn cs_dvr(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+#if TF_WORKGROUP
+    load_tf_workgroup(local, WORKGROUP_X * WORKGROUP_Y);
+#endif
     let pixel = invocation_pixel(group, local);
     if (!in_viewport(pixel)) {
         return;
@@ -48,6 +52,9 @@ fn cs_dvr(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_ind
 
 @compute @workgroup_size(WORKGROUP_X, WORKGROUP_Y)
 fn cs_iso(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+#if TF_WORKGROUP
+    load_tf_workgroup(local, WORKGROUP_X * WORKGROUP_Y);
+#endif
     let pixel = invocation_pixel(group, local);
     if (!in_viewport(pixel)) {
         return;

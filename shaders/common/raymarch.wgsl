@@ -16,7 +16,8 @@
 // 2001: each sample composites the segment from the previous one through a 2D table), TRICUBIC
 // (common/volume.wgsl), JITTER; and the pass's choices: CORRECTED_TABLE (classify through a
 // table pre-corrected for the step, opacity_lut.wgsl), LEAP (`march_dvr` leaps in rounds),
-// FIRST_VISIBLE (`march_dvr` records its first visible sample for Klein's leap hits).
+// FIRST_VISIBLE (`march_dvr` records its first visible sample for Klein's leap hits), PREFETCH
+// (the compute raycaster's pipelined loop: each run fetches one sample ahead).
 
 #import "common/frame.wgsl"
 #import "common/volume.wgsl"
@@ -139,7 +140,11 @@ fn resume_ray(before: vec3<f32>) {
 // The premultiplied, opacity-corrected colour the sample at texture-space `u` adds, with the
 // effects compiled in.
 fn classify_sample(u: vec3<f32>) -> vec4<f32> {
-    let s = sample_volume(u);
+    return classify_value(u, sample_volume(u));
+}
+
+// `classify_sample` of the scalar `s` already fetched at `u`.
+fn classify_value(u: vec3<f32>, s: f32) -> vec4<f32> {
 #if PREINTEGRATION
     var p = lookup_preintegrated(ray_prev_scalar, s);
     ray_prev_scalar = s;
@@ -216,8 +221,20 @@ fn march_dvr(s: Samples, k0: u32, end: u32, start: vec4<f32>) -> Marched {
         // k < run_end here, so the run tests its two ends once per sample, after it, with `|`
         // (no short circuit: one branch, not two — 3 % fewer instructions on llvmpipe).
         let run_start = k;
+#if PREFETCH
+        // The pipelined loop: the next sample's fetch is issued before this one is classified,
+        // so the lookup's latency hides behind a fetch (one extra fetch per run, a loss where
+        // the volume fetch is a function call, as on llvmpipe).
+        var next = sample_volume(sample_at(s, k));
+#endif
         loop {
+#if PREFETCH
+            let value = next;
+            next = sample_volume(sample_at(s, k + 1u));
+            let p = classify_value(sample_at(s, k), value);
+#else
             let p = classify_sample(sample_at(s, k));
+#endif
 #if FIRST_VISIBLE
             out.first = select(out.first, k, out.first == NO_SAMPLE && p.a > 0.0);
 #endif

@@ -44,7 +44,7 @@ use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind,
 use wgpu::util::DeviceExt;
 
 use crate::brick_pool::{Batch, BrickPool};
-use crate::raycast_params::{RaycastParamsGpu, Sampling, Termination, Workgroup};
+use crate::raycast_params::{RaycastParamsGpu, SampleLoopChoice, Sampling, Termination, Workgroup};
 
 /// The plugin.
 pub struct RaycastBricks;
@@ -107,11 +107,12 @@ impl PassDecl for RaycastBricks {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        [Sampling::specs(), Termination::specs(), BrickSettings::specs(), Workgroup::specs()].concat()
+        [Sampling::specs(), Termination::specs(), BrickSettings::specs(), Workgroup::specs(), SampleLoopChoice::specs()]
+            .concat()
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        crate::effects::jitter_defines(params)
+        [crate::effects::jitter_defines(params), SampleLoopChoice::defines(params, None)].concat()
     }
 
     fn uses_gpu_memory_budget(&self) -> bool {
@@ -135,6 +136,7 @@ impl PassDecl for RaycastBricks {
         // shape the pool and the leaves.
         BrickSettings::from_params(old) == BrickSettings::from_params(new)
             && Workgroup::from_params(old) == Workgroup::from_params(new)
+            && SampleLoopChoice::from_params(old) == SampleLoopChoice::from_params(new)
             && self.shader_defines(old) == self.shader_defines(new)
     }
 }
@@ -169,7 +171,11 @@ impl PassPlugin for RaycastBricks {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let settings = BrickSettings::from_params(ctx.params);
         let wg = Workgroup::checked_size(ctx)?;
-        let defines = [self.shader_defines(ctx.params), crate::shared::color_precision_defines(ctx)].concat();
+        let defines = SampleLoopChoice::with_gpu_defines(
+            [self.shader_defines(ctx.params), crate::shared::color_precision_defines(ctx)].concat(),
+            ctx.params,
+            ctx.gpu,
+        );
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
             defines: &defines,
             constants: &[("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)],

@@ -65,6 +65,57 @@ volgraph_core::pass_params! {
     }
 }
 
+volgraph_core::param_choice! {
+    /// How a compute raycaster's sample loop is built.
+    pub enum SampleLoop {
+        /// `pipelined` on a GPU, `plain` on a CPU adapter (llvmpipe).
+        Auto = "auto",
+        /// The TF read from its texture, each sample fetched as it is classified.
+        Plain = "plain",
+        /// The TF copied into workgroup memory, the next sample fetched before this one is
+        /// classified.
+        Pipelined = "pipelined",
+    }
+}
+
+volgraph_core::pass_params! {
+    /// The compute raycasters' sample loop (`raycast_compute`, `raycast_bricks`).
+    pub struct SampleLoopChoice {
+        sample_loop: SampleLoop = Auto,
+            "pipelined: the TF copied into workgroup memory and interpolated by hand, the next sample fetched before \
+             this one is classified (on an H200, 43 % → 94 % of the fetch ceiling: bench/device/README.md; slower on \
+             llvmpipe, where workgroup memory and the extra fetch cost more than they hide); plain: neither; auto: \
+             pipelined on GPUs, plain on CPU adapters";
+    }
+}
+
+impl SampleLoopChoice {
+    /// The defines of the pipelined loop (`TF_WORKGROUP`, `PREFETCH`) when `params` ask for it
+    /// on `gpu`; `None` at plan time, where only an explicit `pipelined` is known.
+    pub fn defines(params: &volgraph_core::Params, gpu: Option<&volgraph_core::runtime::Gpu>) -> Vec<&'static str> {
+        let pipelined = match Self::from_params(params).sample_loop {
+            SampleLoop::Pipelined => true,
+            SampleLoop::Plain => false,
+            SampleLoop::Auto => gpu.is_some_and(|g| !g.is_cpu),
+        };
+        if pipelined { vec!["TF_WORKGROUP", "PREFETCH"] } else { Vec::new() }
+    }
+
+    /// `defines` at plan time followed by those `gpu` adds: the list a pipeline is built with.
+    pub fn with_gpu_defines(
+        mut defines: Vec<&'static str>,
+        params: &volgraph_core::Params,
+        gpu: &volgraph_core::runtime::Gpu,
+    ) -> Vec<&'static str> {
+        for define in Self::defines(params, Some(gpu)) {
+            if !defines.contains(&define) {
+                defines.push(define);
+            }
+        }
+        defines
+    }
+}
+
 impl Shading {
     /// The coefficients of a kind that declares them, else 0 (what its shader never reads).
     pub fn of(p: &Params) -> Self {

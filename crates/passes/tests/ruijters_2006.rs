@@ -190,6 +190,42 @@ fn a_pool_of_a_few_bricks_thrashes_but_gives_the_same_image() {
     }
 }
 
+/// The pipelined sample loop (`march.sample_loop: "pipelined"`, what `auto` picks on a GPU and
+/// not on llvmpipe, so forced here) in the brick march: the LUT in workgroup memory and the next
+/// sample fetched ahead — from the brick's slot in the atlas, where a run's last look-ahead falls
+/// into a neighbouring slot and must not matter. Both raycasters pipelined against both plain,
+/// in core and streaming through a pool of three bricks (several batches).
+#[test]
+fn the_pipelined_loop_gives_the_same_image_through_the_brick_pool() {
+    let gpu = support::gpu();
+    let registry = builtin_registry();
+    let volume = volgraph_accel::vessels::vessel_tree(64, 5);
+    let lut = TransferFunction::preset(Preset::Sparse, (0.0, 255.0)).to_lut_for(&volume, 256);
+    let with_loop = |options: CompileOptions, sample_loop: &str| {
+        let mut options = options;
+        options.param_overrides.insert("march.sample_loop".into(), ron::Value::String(sample_loop.into()));
+        options
+    };
+    let cam = camera(40.0, 2.6);
+    let want =
+        live(&gpu, &registry, "unoptimized", &volume, &lut, &with_loop(CompileOptions::new(SIZE, SIZE), "plain"))
+            .frame(&cam);
+    assert!(coverage(&want) > 0.02, "the vessels are in view");
+    let unoptimized =
+        live(&gpu, &registry, "unoptimized", &volume, &lut, &with_loop(CompileOptions::new(SIZE, SIZE), "pipelined"))
+            .frame(&cam);
+    assert_same("rv_pipelined_unoptimized", &unoptimized, &want, SAME);
+    let bricks = CompileOptions::new(SIZE, SIZE).with_scalar("brick_cells", 16.0).with_scalar("node_cells", 4.0);
+    let mut in_core =
+        live(&gpu, &registry, "bricks_octree_ert", &volume, &lut, &with_loop(bricks.clone(), "pipelined"));
+    assert_same("rv_pipelined_in_core", &in_core.frame(&cam), &want, SAME_ERT);
+    let mut small = live(&gpu, &registry, "bricks_octree_ert", &volume, &lut, &with_loop(bricks, "pipelined"));
+    let voxel_bytes = volume_texture_format(&gpu, &volume).bytes() as u64;
+    small.runtime.set_gpu_memory_budget(Some(3 * 19 * 19 * 19 * voxel_bytes));
+    assert_same("rv_pipelined_small_pool", &small.frame(&cam), &want, SAME_ERT);
+    assert!(small.counter("batches") > 1.0, "the pool streams the frame in batches");
+}
+
 #[test]
 fn the_camera_inside_the_volume_sees_the_same_image() {
     let gpu = support::gpu();

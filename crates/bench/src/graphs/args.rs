@@ -312,9 +312,12 @@ impl GraphsArgs {
         if let Some(peer) = preset.and_then(|p| p.peer).filter(|_| !self.no_peer) {
             labels.push(peer.label.to_string());
         }
+        // A preset whose baseline is its peer program (`peer`: VTK) measures against its first
+        // graph when `--no-peer` leaves the peer out (on a machine without VTK, say).
+        let peer_left_out = |b: &str| self.no_peer && preset.and_then(|p| p.peer).is_some_and(|peer| peer.label == b);
         let baseline = match (&self.baseline, preset) {
             (Some(b), _) => b.clone(),
-            (None, Some(p)) if self.graphs.is_empty() => p.baseline.to_string(),
+            (None, Some(p)) if self.graphs.is_empty() && !peer_left_out(p.baseline) => p.baseline.to_string(),
             _ => labels[0].clone(),
         };
         if !labels.contains(&baseline) {

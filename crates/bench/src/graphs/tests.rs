@@ -81,6 +81,26 @@ fn tiny_sweep_writes_json_with_every_field_finite() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+#[test]
+fn peer_preset_without_its_peer_measures_against_its_first_graph() {
+    // The `peer` preset's baseline is VTK; `--no-peer` (a machine without VTK) once failed with
+    // "--baseline \"vtk_fixed_point\": not one of the graphs".
+    // The command line's defaults for what `Default` leaves at zero.
+    let peer = |no_peer: bool| GraphsArgs {
+        preset: Some("peer".to_string()),
+        no_peer,
+        scale: 1.0,
+        accuracy_size: 128,
+        reference_step: 0.1,
+        spp_size: 128,
+        ..GraphsArgs::default()
+    };
+    let config = peer(true).resolve().expect("the peer preset resolves without its peer");
+    assert_eq!(config.baseline, "single_pass_ess_ert");
+    assert!(!config.peer);
+    assert_eq!(peer(false).resolve().expect("the peer preset resolves").baseline, "vtk_fixed_point");
+}
+
 fn error_of(args: GraphsArgs) -> String {
     match args.resolve() {
         Ok(_) => panic!("expected an error"),

@@ -1,0 +1,358 @@
+// The one sampling core of every raycaster — fragment (`raycast`), compute (`raycast_compute`),
+// multipass segments (`raycast_segment`, `termination_test`), bricks (`raycast_bricks`) and
+// `antialias`'s sub-pixel rays — implementing docs/rendering_model.md ("Samples", "Ray segment
+// inside the box", "Classification and compositing", "Effects", "First-hit isosurface") exactly
+// like `volgraph_accel::reference`. Krüger & Westermann 2003 §2.1 (DVR, early ray termination),
+// §2.2 (first-hit isosurface), §2.3 (empty-space skipping, through `leap`).
+//
+// One rule for where samples lie (`Samples` in common/ray_box.wgsl, jitter here), one box exit
+// (`past_box`), one compositing step (`classify_sample`), one leap over empty space
+// (`leap`, common/leap_empty.wgsl), one DVR loop (`march_dvr`) and one isosurface loop
+// (`march_iso`) over any range of samples [k0, end): a whole ray, a ray started late from a
+// reprojected estimate (Klein et al. 2005), a segment of M samples, a run inside a brick.
+//
+// Effects a scene turns on are compiled in with `#if` (crates/compiler/src/shader_source.rs):
+// SHADING (Blinn–Phong of every DVR sample with the gradient), PREINTEGRATION (Engel et al.
+// 2001: each sample composites the segment from the previous one through a 2D table), TRICUBIC
+// (common/volume.wgsl), JITTER; and the pass's choices: CORRECTED_TABLE (classify through a
+// table pre-corrected for the step, opacity_lut.wgsl), LEAP (`march_dvr` leaps in rounds),
+// FIRST_VISIBLE (`march_dvr` records its first visible sample for Klein's leap hits).
+
+#import "common/frame.wgsl"
+#import "common/volume.wgsl"
+#import "common/raycast_params.wgsl"
+#import "common/ray_box.wgsl"
+
+// The correction exponent (step over opacity unit) is exactly 0.5: the exact correction is a
+// square root, no pow. A compute raycaster picks this pipeline per frame (the opacity unit is
+// frame data): no branch on it may sit in the sample loop, which on llvmpipe slows every sample.
+override HALF_STEP: bool = false;
+// With LEAP: samples in a run between two looks at the empty-space structure (`march_dvr`).
+override CHECK_EVERY: u32 = 16u;
+
+// O'Neill's PCG hash (state = v*747796405 + 2891336453, then the RXS-M-XS output permutation).
+fn pcg_hash(v: u32) -> u32 {
+    let state = v * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+// The per-pixel offset of the first sample, in steps, in [-0.5, 0.5); compiled in only with
+// JITTER (the `jitter` effect), else 0. Stable across frames, unless JITTER_PER_FRAME
+// (`jitter_per_frame`) moves it every frame (the hash of pixel + frame · pixels; frame 0 equals
+// the stable offsets) so that accumulating frames averages the noise away.
+fn ray_jitter(pixel: vec2<u32>) -> f32 {
+#if JITTER
+    let width = u32(frame.viewport.x);
+    var key = pixel.x + pixel.y * width;
+#if JITTER_PER_FRAME
+    key = key + frame.frame_index * width * u32(frame.viewport.y);
+#endif
+    return f32(pcg_hash(key)) / 4294967296.0 - 0.5;
+#else
+    return 0.0;
+#endif
+}
+
+// The step of this pass's `step_voxels` along unit texture-space direction `d_tex`.
+fn ray_step_tex(d_tex: vec3<f32>) -> f32 {
+    return step_tex_for(params.step_voxels, d_tex);
+}
+
+// True when the ray (u0, d_tex, len_tex) can be marched: positive finite length, a unit
+// direction, a positive finite step. Written with `>`/`<` so NaN fails every test.
+// In a sort-last window the box is the whole volume's (frame.grid_lo/hi), not [0,1]³.
+fn ray_is_valid(u0: vec3<f32>, d_tex: vec3<f32>, len_tex: f32) -> bool {
+    let d_len = length(d_tex);
+    let lo = select(vec3<f32>(0.0), frame.grid_lo.xyz, is_window());
+    let size = select(vec3<f32>(1.0), frame.grid_hi.xyz - frame.grid_lo.xyz, is_window());
+    if (!(len_tex > 0.0) || !(len_tex < 4.0 * max(size.x, max(size.y, size.z))) || !(d_len > 0.5) || !(d_len < 1.5)) {
+        return false;
+    }
+    if (!all(abs((u0 - lo) / size - vec3<f32>(0.5)) < vec3<f32>(1.0))) {
+        return false;
+    }
+    let step_tex = ray_step_tex(d_tex);
+    return step_tex > 0.0 && step_tex < 1e30;
+}
+
+// The opacity-correction exponent of one step: step_voxels over the TF's opacity unit in voxels
+// (frame.volume_dims.w: 1 for opacity per voxel, 1/unit_world for opacity per world unit).
+fn step_exponent() -> f32 {
+    return params.step_voxels / frame.volume_dims.w;
+}
+
+// Opacity correction from the LUT's per-unit alpha to this step: 1 - (1 - a)^step_exponent.
+// The ends are handled explicitly because pow(0, y) is undefined in WGSL.
+fn corrected_alpha(a_tf: f32) -> f32 {
+    let a = clamp(a_tf, 0.0, 1.0);
+    if (a >= 1.0) {
+        return 1.0;
+    }
+    if (a <= 0.0) {
+        return 0.0;
+    }
+    if (HALF_STEP) {
+        return 1.0 - sqrt(1.0 - a);
+    }
+    return 1.0 - pow(1.0 - a, step_exponent());
+}
+
+#if PREINTEGRATION
+// The pre-integration table (crates/passes/src/preintegration.rs): texel (i, j) holds the
+// premultiplied RGBA of a segment from scalar i/(N-1) to j/(N-1), N×N, filtered linearly.
+@group(0) @binding(auto) var preintegrated: texture_2d<f32>;
+
+fn lookup_preintegrated(s_front: f32, s_back: f32) -> vec4<f32> {
+    let n = vec2<f32>(textureDimensions(preintegrated));
+    let st = (clamp(vec2<f32>(s_front, s_back), vec2<f32>(0.0), vec2<f32>(1.0)) * (n - 1.0) + 0.5) / n;
+    return textureSampleLevel(preintegrated, linear_clamp, st, 0.0);
+}
+#endif
+
+#if CORRECTED_TABLE
+// (rgb·α', α') per scalar, α' corrected for the step (opacity_lut.wgsl): one filtered lookup
+// instead of the TF and a pow.
+@group(0) @binding(auto) var corrected: texture_2d<f32>;
+#endif
+
+// Per-ray state of the effects: the unit world view direction (SHADING) and the scalar of the
+// previous sample, the front of the next segment (PREINTEGRATION).
+var<private> ray_view_world: vec3<f32>;
+var<private> ray_prev_scalar: f32;
+
+// Starts marching `s` at sample k0: the view direction, and the front value of sample k0's
+// segment (the field one step before it).
+fn begin_ray(s: Samples, k0: u32) {
+    ray_view_world = normalize(s.delta * 2.0 * frame.half_extent.xyz);
+    resume_ray(sample_at(s, k0) - s.delta);
+}
+
+// After skipping samples: `before` is the position of the sample just before the next one
+// taken, the front of its segment.
+fn resume_ray(before: vec3<f32>) {
+#if PREINTEGRATION
+    ray_prev_scalar = sample_volume(before);
+#endif
+}
+
+// The premultiplied, opacity-corrected colour the sample at texture-space `u` adds, with the
+// effects compiled in.
+fn classify_sample(u: vec3<f32>) -> vec4<f32> {
+    return classify_value(u, sample_volume(u));
+}
+
+// `classify_sample` of a scalar already fetched at `u`.
+fn classify_value(u: vec3<f32>, s: f32) -> vec4<f32> {
+#if PREINTEGRATION
+    var p = lookup_preintegrated(ray_prev_scalar, s);
+    ray_prev_scalar = s;
+#else
+#if CORRECTED_TABLE
+    var p = textureSampleLevel(corrected, linear_clamp, vec2<f32>(s, 0.5), 0.0);
+#else
+    let c = sample_tf(s);
+    let a = corrected_alpha(c.a);
+    var p = vec4<f32>(c.rgb * a, a);
+#endif
+#endif
+#if SHADING
+    if (p.a > 0.0) {
+        let light = headlight(u, ray_view_world);
+        p = vec4<f32>(p.rgb * light.x + vec3<f32>(p.a * light.y), p.a);
+    }
+#endif
+    return p;
+}
+
+// The samples of a pixel's ray (`count` 0 when there is no ray to march): step and jitter of
+// this pass.
+fn pixel_samples(ray: Ray, pixel: vec2<u32>) -> Samples {
+    if (!(ray.len > 0.0) || !ray_is_valid(ray.u0, ray.d, ray.len)) {
+        return Samples(ray.u0, vec3<f32>(0.0), 0u, 1.0, 0.5, false);
+    }
+    return samples_along(ray, ray_step_tex(ray.d), ray_jitter(pixel), params.max_steps);
+}
+
+// No such sample (`Marched::first`).
+const NO_SAMPLE: u32 = 0xffffffffu;
+
+// What a DVR march did: the premultiplied colour, its first visible sample (with FIRST_VISIBLE;
+// NO_SAMPLE when none), the samples it took and where it stopped.
+struct Marched {
+    color: vec4<f32>,
+    first: u32,
+    samples: u32,
+    end: u32,
+}
+
+// Direct volume rendering of samples [k0, end) of `s` behind the premultiplied `start`, front to
+// back (docs/rendering_model.md), stopping after the sample that makes A >= threshold. Call
+// `begin_ray` (or `resume_ray`) first. With LEAP it goes in rounds: leap while the sample lies
+// in empty space (`leap`), then a run of up to CHECK_EVERY samples with nothing else in the
+// loop. The lanes of a SIMD group go through the rounds together, so they look at the
+// empty-space structure at the same time; a sample taken in an empty block adds nothing (its
+// classified alpha is 0), so a lane entering empty space during a run loses time, never
+// accuracy. (On llvmpipe, a leap check inside the sample loop — even one never taken — makes
+// every sample ~1.7× slower: bench/peer.md.)
+fn march_dvr(s: Samples, k0: u32, end: u32, start: vec4<f32>) -> Marched {
+    var out = Marched(start, NO_SAMPLE, 0u, k0);
+    var k = k0;
+    // Termination is tested after a sample, never before the first (T = 0 takes one sample, as
+    // the reference does).
+    loop {
+        if (k >= end) {
+            break;
+        }
+#if LEAP
+        let before = k;
+        k = leap(k, s, end);
+        if (k >= end) {
+            break;
+        }
+        if (k != before) {
+            resume_ray(sample_at(s, k) - s.delta);
+        }
+        let run_end = min(k + CHECK_EVERY, end);
+#else
+        let run_end = end;
+#endif
+        // k < run_end here, so the run tests its two ends once per sample, after it, with `|`
+        // (no short circuit: one branch, not two — 3 % fewer instructions on llvmpipe).
+        let run_start = k;
+        // Software pipelining: the next sample's fetch is issued before this one is classified,
+        // so the TF lookup's latency overlaps a volume fetch (one extra fetch per run).
+        var v_next = sample_volume(sample_at(s, k));
+        loop {
+            let u = sample_at(s, k);
+            let v = v_next;
+            v_next = sample_volume(sample_at(s, k + 1u));
+            let p = classify_value(u, v);
+#if FIRST_VISIBLE
+            out.first = select(out.first, k, out.first == NO_SAMPLE && p.a > 0.0);
+#endif
+            out.color = out.color + (1.0 - out.color.a) * p;
+            k += 1u;
+            if ((k >= run_end) | (out.color.a >= params.threshold)) {
+                break;
+            }
+        }
+        out.samples += k - run_start;
+        if (out.color.a >= params.threshold) {
+            break;
+        }
+    }
+    out.end = k;
+    return out;
+}
+
+
+// Blinn–Phong headlight at texture-space point `u` seen along the unit world direction `d_world`
+// (docs/rendering_model.md "First-hit isosurface", "Effects"): (ambient + diffuse·|n·l|, the
+// white specular term), n from the central-difference gradient of the reconstructed field, the
+// light facing the eye where the gradient vanishes (constant regions: no NaN).
+fn headlight(u: vec3<f32>, d_world: vec3<f32>) -> vec2<f32> {
+    let off = 1.0 / frame.volume_dims.xyz;
+    let g = vec3<f32>(
+        sample_volume(u + vec3<f32>(off.x, 0.0, 0.0)) - sample_volume(u - vec3<f32>(off.x, 0.0, 0.0)),
+        sample_volume(u + vec3<f32>(0.0, off.y, 0.0)) - sample_volume(u - vec3<f32>(0.0, off.y, 0.0)),
+        sample_volume(u + vec3<f32>(0.0, 0.0, off.z)) - sample_volume(u - vec3<f32>(0.0, 0.0, off.z)),
+    );
+    let l = -d_world;
+    var n = l;
+    if (length(g) >= 1e-6) {
+        // g spans two voxels per axis: the world gradient is g / (2 · voxel_world) with
+        // voxel_world = 2·half / dims, so its direction is that of g · dims / half.
+        n = -normalize(g * frame.volume_dims.xyz / frame.half_extent.xyz);
+    }
+    // A cut face shows the plane it was cut along (common/ray_box.wgsl).
+#if CUTS
+    n = cap_normal(u, d_world, n);
+#endif
+    // Headlight: l = v = -d, so h = normalize(l + v) = l.
+    let n_dot_l = abs(dot(n, l));
+    var spec = 0.0;
+    if (n_dot_l > 0.0) {
+        spec = params.specular * pow(n_dot_l, params.shininess);
+    }
+    return vec2<f32>(params.ambient + params.diffuse * n_dot_l, spec);
+}
+
+// The shaded colour of the isosurface at `u`.
+fn shade_iso(u: vec3<f32>, d_world: vec3<f32>) -> vec3<f32> {
+    let light = headlight(u, d_world);
+    let base = sample_tf(params.iso_value).rgb;
+    return clamp(base * light.x + vec3<f32>(light.y), vec3<f32>(0.0), vec3<f32>(1.0));
+}
+
+// What an isosurface march found: shaded colour (alpha 1) and texture-space hit (w = 1), zero
+// on a miss; the samples it took; the sample it stopped at (the hit's, or `end` on a miss).
+struct IsoMarch {
+    color: vec4<f32>,
+    hit: vec4<f32>,
+    samples: u32,
+    at: u32,
+}
+
+// First-hit isosurface over samples [k0, end) of `s`: the first sample k with value >= iso,
+// refined linearly against sample k - 1 (read again when k0 > 0, so a segment or a late start
+// refines like the whole ray; a start already past the surface reports the sample before it,
+// unrefined), shaded with the headlight. The loop only finds k — one fetch and one compare per
+// sample, like the DVR run's body — and the refinement and shading (six more fetches) run once
+// after it: inside the loop, every lane of a SIMD group would wait through the shading of each
+// other lane's hit.
+fn march_iso(s: Samples, k0: u32, end: u32) -> IsoMarch {
+    var out = IsoMarch(vec4<f32>(0.0), vec4<f32>(0.0), 0u, end);
+    let iso = params.iso_value;
+    var k = k0;
+    var prev = 0.0;
+    var has_prev = false;
+    if (k0 > 0u && k0 <= s.count) {
+        prev = sample_volume(sample_at(s, k0 - 1u));
+        out.samples = 1u;
+        has_prev = true;
+        if (prev >= iso) {
+            // The start was past the surface: take the sample that saw it again.
+            k = k0 - 1u;
+            has_prev = false;
+        }
+    } else if (s.cut && k0 == 0u && s.count > 0u) {
+        // A sort-last window cut the ray: the sample before is another rank's. Where it already
+        // saw the surface, the hit is that rank's; otherwise it brackets a hit here.
+        prev = sample_volume(s.first - s.delta);
+        out.samples = 1u;
+        if (prev >= iso) {
+            out.at = 0u;
+            return out;
+        }
+        has_prev = true;
+    }
+    let first = k;
+    var v = 0.0;
+    loop {
+        if (k >= end) {
+            break;
+        }
+        v = sample_volume(sample_at(s, k));
+        if (v >= iso) {
+            break;
+        }
+        prev = v;
+        k += 1u;
+    }
+    if (k >= end) {
+        out.samples += k - first;
+        return out;
+    }
+    out.samples += k - first + 1u;
+    out.at = k;
+    var x = f32(k);
+    if (has_prev || k > first) {
+        x = x - 1.0 + (iso - prev) / (v - prev);
+    }
+    let u = s.first + x * s.delta;
+    let d_world = normalize(s.delta * 2.0 * frame.half_extent.xyz);
+    out.color = vec4<f32>(shade_iso(u, d_world), 1.0);
+    out.hit = vec4<f32>(u, 1.0);
+    return out;
+}

@@ -3,7 +3,10 @@
 # `--shaders` (no rebuild): `base` (shaders/ as committed), `prefetch` (the next sample's fetch
 # issued before this one is classified), `sharedtf` (the TF copied into workgroup memory,
 # interpolated by hand), `both`; base is run again at the end to see the drift of the clocks.
-# Run like run.sh (carry: .gl .devcarry).
+# Run like run.sh (carry: .gl .devcarry). The shader folders were removed once their technique
+# became the `sample_loop` parameter (run.sh's *-sample-loop steps measure that); to rerun this
+# script, restore them first:
+#   git checkout 72c3885 -- bench/device/shaders-prefetch bench/device/shaders-sharedtf bench/device/shaders-both
 set -u
 SETUP_ONLY=1 source bench/device/run.sh
 P=bench/device/march_probe.ron

@@ -145,6 +145,14 @@ fn over_tolerance(image: &Image, reference: &[[f64; 4]], tolerance: f64) -> f64 
     over as f64 / (image.width * image.height) as f64
 }
 
+/// The pixels of `got` not bit for bit those of `want`.
+fn differing_pixels(got: &Image, want: &Image) -> usize {
+    (0..got.height)
+        .flat_map(|y| (0..got.width).map(move |x| (x, y)))
+        .filter(|&(x, y)| got.rgba(x, y) != want.rgba(x, y))
+        .count()
+}
+
 fn coverage(image: &Image) -> f64 {
     let covered = (0..image.height).flat_map(|y| (0..image.width).map(move |x| (x, y)));
     covered.filter(|&(x, y)| image.rgba(x, y)[3] > 0.0).count() as f64 / (image.width * image.height) as f64
@@ -349,10 +357,7 @@ fn every_workgroup_shape_writes_every_pixel_with_its_own_ray() {
     // rows: 6×3, 32×1, 5×4, 7×7 (a side that does not divide 128 leaves partial groups).
     for (x, y) in [(8, 8), (16, 12), (4, 2), (12, 6), (6, 3), (32, 1), (5, 4), (7, 7)] {
         let (got, ..) = render_fastest(&case, camera, &shape(x, y));
-        let differ = (0..got.height)
-            .flat_map(|py| (0..got.width).map(move |px| (px, py)))
-            .filter(|&(px, py)| got.rgba(px, py) != want.rgba(px, py))
-            .count();
+        let differ = differing_pixels(&got, &want);
         assert_eq!(differ, 0, "workgroup {x}×{y}: {differ} pixels differ from 1×1 workgroups");
     }
 }
@@ -397,10 +402,7 @@ fn the_pipelined_loop_gives_the_plain_loops_image() {
     let (want, ..) = render_fastest(&case, camera, &shape(8, 8));
     for (x, y) in [(1, 1), (7, 7), (16, 12), (32, 1)] {
         let (got, ..) = render_fastest(&case, camera, &shape(x, y));
-        let differ = (0..got.height)
-            .flat_map(|py| (0..got.width).map(move |px| (px, py)))
-            .filter(|&(px, py)| got.rgba(px, py) != want.rgba(px, py))
-            .count();
+        let differ = differing_pixels(&got, &want);
         assert_eq!(differ, 0, "pipelined, workgroup {x}×{y}: {differ} pixels differ from 8×8 workgroups");
     }
 }

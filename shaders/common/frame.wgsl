@@ -51,9 +51,16 @@ struct Frame {
 
 @group(0) @binding(auto) var<uniform> frame: Frame;
 
-// True when the bound volume is a window of a larger one (sort-last rendering).
+// True when the bound volume is a window of a larger one (sort-last rendering). The window's
+// code is compiled in only where a window is set (WINDOW, a frame define like the cuts'): every
+// ray's set-up pays for it otherwise, and a pass that runs per pixel and per segment (KW03's
+// termination test) took 1.2× the time with it (bench/one-march-final.md).
 fn is_window() -> bool {
+#if WINDOW
     return frame.grid_lo.w != 0.0;
+#else
+    return false;
+#endif
 }
 
 // World position -> texture-space position (docs/rendering_model.md "Volume and world space").

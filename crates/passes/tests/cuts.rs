@@ -22,7 +22,7 @@ use volgraph_accel::image_diff::{fraction_over, image_diff};
 use volgraph_accel::reference::{ray_segment, render_reference};
 use volgraph_accel::transfer_function::{Preset, TransferFunction};
 use volgraph_accel::volume::{Volume, VoxelData};
-use volgraph_core::runtime::{CameraData, Image, VolumeDesc, scene_values_of};
+use volgraph_core::runtime::{CameraData, Image, VolumeDesc, VolumeWindow, scene_values_of};
 use volgraph_core::{CompileOptions, compile, cut_effects};
 use volgraph_passes::builtin_registry;
 use volgraph_passes::raycast_params::reference_settings;
@@ -244,6 +244,49 @@ fn cuts_set_after_the_plan_are_refused_until_it_is_applied_again() {
     assert!(err.to_string().contains("crop") && err.to_string().contains("apply the plan again"), "{err}");
     runtime.apply(plan, &registry).expect("applies with the crop");
     runtime.render(CameraData::from_orbit(&OrbitCamera::default(), (32, 32))).expect("renders cropped");
+}
+
+/// A sort-last window is compiled in like a cut (the `WINDOW` define, so that frames without one
+/// pay nothing for it): a window set after the plan is refused at the next frame, never drawn
+/// as the whole volume; applied again, the frame renders the window's half only.
+#[test]
+fn a_window_set_after_the_plan_is_refused_until_it_is_applied_again() {
+    let gpu = gpu();
+    let registry = builtin_registry();
+    let volume = volgraph_accel::generate::marschner_lobb(32);
+    let lut = TransferFunction::default_for(&volume).to_lut_for(&volume, 256);
+    let source = graph_source("modern/fastest.ron");
+    let mut options = CompileOptions::new(32, 32);
+    options.scene = scene_values_of(&VolumeDesc::of(&volume));
+    let plan = compile("fastest", &source, &registry, &options).expect("compiles");
+    let mut runtime = support::runtime(&gpu);
+    runtime.bind_scene(&plan.inputs, &volume, &lut).expect("binds");
+    runtime.apply(plan.clone(), &registry).expect("applies");
+    let camera = CameraData::from_orbit(&OrbitCamera::default(), (32, 32));
+    runtime.render(camera).expect("renders the whole volume");
+    let whole = runtime.read_output("image").expect("image");
+    // This rank owns the low half in x of the 32³ volume (all of whose voxels it holds).
+    let dims = glam::UVec3::splat(32);
+    let window =
+        VolumeWindow::new(dims, DVec3::ONE, glam::UVec3::ZERO, glam::UVec3::ZERO, glam::UVec3::new(16, 32, 32));
+    runtime.set_volume_window(Some(window));
+    let err = runtime.render(camera).expect_err("not compiled for a window");
+    assert!(err.to_string().contains("window") && err.to_string().contains("apply the plan again"), "{err}");
+    runtime.apply(plan, &registry).expect("applies with the window");
+    runtime.render(camera).expect("renders the window");
+    let half = runtime.read_output("image").expect("image");
+    let alpha = |image: &Image| -> f64 {
+        (0..image.height)
+            .flat_map(|y| (0..image.width).map(move |x| (x, y)))
+            .map(|(x, y)| image.rgba(x, y)[3] as f64)
+            .sum()
+    };
+    let (whole_alpha, half_alpha) = (alpha(&whole), alpha(&half));
+    assert!(whole_alpha > 1.0, "the volume is in view ({whole_alpha})");
+    assert!(
+        half_alpha > 0.05 * whole_alpha && half_alpha < 0.95 * whole_alpha,
+        "the window renders part of the volume: {half_alpha} of {whole_alpha}"
+    );
 }
 
 /// A graph with a pass that samples the volume its own way (slice-based rendering) is refused

@@ -110,7 +110,16 @@ pub enum RuntimeError {
         /// The cut features set.
         wanted: String,
     },
+    /// A volume window was set that the applied plan was not compiled with.
+    #[error(
+        "a volume window (sort-last rendering) was set after the plan was applied; apply the plan again after Runtime::set_volume_window"
+    )]
+    WindowNotApplied,
 }
+
+/// The `#if` name of a sort-last volume window (`shaders/common/frame.wgsl` `is_window`),
+/// compiled into the passes that honour a sub-box of the volume while a window is set.
+pub const WINDOW_DEFINE: &str = "WINDOW";
 
 /// Memory the runtime holds, for reports and soak tests.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -475,11 +484,17 @@ impl Runtime {
         self.cuts
     }
 
-    /// The cut `#if` names a plan with `features` is built with: the plan's and the set cuts'.
+    /// The frame `#if` names a plan with `features` is built with (for the passes that honour a
+    /// sub-box of the volume): the plan's and the set cuts', and [`WINDOW_DEFINE`] while a
+    /// volume window is set.
     fn cut_defines_for(&self, features: &std::collections::BTreeSet<String>) -> Vec<&'static str> {
         let mut all = cut_effects::features_of(&self.cuts);
         all.extend(features.iter().cloned());
-        cut_effects::defines_of(&all)
+        let mut defines = cut_effects::defines_of(&all);
+        if self.window.is_some() {
+            defines.push(WINDOW_DEFINE);
+        }
+        defines
     }
 
     /// The bound volume as the frame contract describes it (windowed when a window is set).
@@ -529,6 +544,9 @@ impl Runtime {
         if !wanted.iter().all(|d| schedule.cut_defines.contains(d)) {
             let wanted = cut_effects::features_of(&self.cuts).into_iter().collect::<Vec<_>>().join(", ");
             return Err(RuntimeError::CutsNotApplied { wanted });
+        }
+        if self.window.is_some() && !schedule.cut_defines.contains(&WINDOW_DEFINE) {
+            return Err(RuntimeError::WindowNotApplied);
         }
         Self::check_inputs_of(&self.inputs, &schedule.plan)?;
         for step in &schedule.plan.steps {

@@ -189,10 +189,12 @@ pub(crate) fn build(
             return Err((ApplyError::UnknownKind(step.kind.clone()), old));
         };
         let ports = port_infos(&plan, step, &plugin.ports(&step.params));
-        // The scene's cuts compile into the passes that take only the samples they keep (the
-        // compiler refused a plan with a cut and any other pass).
+        // The scene's cuts (and a sort-last window) compile into the passes that take only the
+        // samples they keep (the compiler refused a plan with a cut and any other pass; a
+        // distributed render refuses a graph with one).
         let frame_defines = crate::cut_effects::defines_for_pass(plugin.as_ref(), cut_defines);
-        if !cut_defines.is_empty() && !plugin.honours_volume_window() {
+        let cuts = cut_defines.iter().any(|d| *d != super::WINDOW_DEFINE);
+        if cuts && !plugin.honours_volume_window() {
             return Err((ApplyError::CannotCut { pass: step.pass_id.clone(), kind: step.kind.clone() }, old));
         }
         let previous = old.as_ref().and_then(|o| o.nodes.get(&step.pass_id));

@@ -46,6 +46,26 @@ pub fn defines_of<'a>(features: impl IntoIterator<Item = &'a String>) -> Vec<&'s
     defines
 }
 
+/// The `#if` name of a sort-last volume window (`shaders/common/frame.wgsl` `is_window`): the
+/// third frame define beside the cuts', compiled into the same passes while a window is set
+/// (`Runtime::set_volume_window`), so that no frame without one pays for its branches.
+pub const WINDOW: &str = "WINDOW";
+
+/// The frame `#if` names of a frame with the cut `features` and, when `window`, a volume window.
+pub fn frame_defines<'a>(features: impl IntoIterator<Item = &'a String>, window: bool) -> Vec<&'static str> {
+    let mut defines = defines_of(features);
+    if window {
+        defines.push(WINDOW);
+    }
+    defines
+}
+
+/// Whether frame `defines` cut the volume (a window alone does not: a pass that cannot cut may
+/// still run; a distributed render refuses it itself).
+pub fn cuts_among(defines: &[&str]) -> bool {
+    defines.iter().any(|d| *d != WINDOW)
+}
+
 /// The cut `#if` names pass `decl` is compiled with when `cut_defines` are the frame's: all of
 /// them for a pass that honours a sub-box of the volume, none for any other (a plan with cuts
 /// and such a pass is refused, `compile::passes_that_cannot_cut`). The one rule the plan check,

@@ -193,8 +193,10 @@ fn a_pool_of_a_few_bricks_thrashes_but_gives_the_same_image() {
 /// The pipelined sample loop (`march.sample_loop: "pipelined"`, what `auto` picks on a GPU and
 /// not on llvmpipe, so forced here) in the brick march: the LUT in workgroup memory and the next
 /// sample fetched ahead — from the brick's slot in the atlas, where a run's last look-ahead falls
-/// into a neighbouring slot and must not matter. Both raycasters pipelined against both plain,
-/// in core and streaming through a pool of three bricks (several batches).
+/// into a neighbouring slot and must not matter. The single-texture raycaster and the brick
+/// march pipelined against the plain single-texture one, in core and streaming through a pool of
+/// three bricks (several batches); and a LUT longer than the workgroup copy holds (256 texels),
+/// which the pipelined loop reads from its texture instead.
 #[test]
 fn the_pipelined_loop_gives_the_same_image_through_the_brick_pool() {
     let gpu = support::gpu();
@@ -224,6 +226,12 @@ fn the_pipelined_loop_gives_the_same_image_through_the_brick_pool() {
     small.runtime.set_gpu_memory_budget(Some(3 * 19 * 19 * 19 * voxel_bytes));
     assert_same("rv_pipelined_small_pool", &small.frame(&cam), &want, SAME_ERT);
     assert!(small.counter("batches") > 1.0, "the pool streams the frame in batches");
+    let long_lut = TransferFunction::preset(Preset::Sparse, (0.0, 255.0)).to_lut_for(&volume, 1024);
+    let plain = CompileOptions::new(SIZE, SIZE);
+    let want = live(&gpu, &registry, "unoptimized", &volume, &long_lut, &with_loop(plain.clone(), "plain")).frame(&cam);
+    let got = live(&gpu, &registry, "unoptimized", &volume, &long_lut, &with_loop(plain, "pipelined")).frame(&cam);
+    // The same texture lookups on both sides: only the order of the fetches differs.
+    assert_same("rv_pipelined_long_lut", &got, &want, SAME);
 }
 
 #[test]

@@ -117,10 +117,6 @@ pub enum RuntimeError {
     WindowNotApplied,
 }
 
-/// The `#if` name of a sort-last volume window (`shaders/common/frame.wgsl` `is_window`),
-/// compiled into the passes that honour a sub-box of the volume while a window is set.
-pub const WINDOW_DEFINE: &str = "WINDOW";
-
 /// Memory the runtime holds, for reports and soak tests.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct MemoryInUse {
@@ -373,7 +369,7 @@ impl Runtime {
             &extended
         };
         let viewport_changed = self.plan().is_some_and(|p| p.viewport != plan.viewport);
-        let cut_defines = self.cut_defines_for(&plan.features);
+        let cut_defines = self.frame_defines_for(&plan.features);
         let old = self.schedule.take();
         let resources = schedule::Resources {
             gpu: &self.gpu,
@@ -485,16 +481,11 @@ impl Runtime {
     }
 
     /// The frame `#if` names a plan with `features` is built with (for the passes that honour a
-    /// sub-box of the volume): the plan's and the set cuts', and [`WINDOW_DEFINE`] while a
-    /// volume window is set.
-    fn cut_defines_for(&self, features: &std::collections::BTreeSet<String>) -> Vec<&'static str> {
+    /// sub-box of the volume): the plan's and the set cuts', and the window's while one is set.
+    fn frame_defines_for(&self, features: &std::collections::BTreeSet<String>) -> Vec<&'static str> {
         let mut all = cut_effects::features_of(&self.cuts);
         all.extend(features.iter().cloned());
-        let mut defines = cut_effects::defines_of(&all);
-        if self.window.is_some() {
-            defines.push(WINDOW_DEFINE);
-        }
-        defines
+        cut_effects::frame_defines(&all, self.window.is_some())
     }
 
     /// The bound volume as the frame contract describes it (windowed when a window is set).
@@ -545,7 +536,7 @@ impl Runtime {
             let wanted = cut_effects::features_of(&self.cuts).into_iter().collect::<Vec<_>>().join(", ");
             return Err(RuntimeError::CutsNotApplied { wanted });
         }
-        if self.window.is_some() && !schedule.cut_defines.contains(&WINDOW_DEFINE) {
+        if self.window.is_some() && !schedule.cut_defines.contains(&cut_effects::WINDOW) {
             return Err(RuntimeError::WindowNotApplied);
         }
         Self::check_inputs_of(&self.inputs, &schedule.plan)?;

@@ -84,11 +84,23 @@ fn leaf_of(c: vec3<f32>) -> vec3<u32> {
 // What this dispatch leaps over (common/leap_empty.wgsl): the largest cube of leaves no box to
 // draw covers, and a brick drawn in another batch; a leaf to draw reports its box (within its
 // brick), which the march runs to.
-fn empty_region_at(p: vec3<f32>) -> EmptyRegion {
+// The constants of a leap's look-ups, read once per leap.
+struct LeapGrid {
+    // The last voxel's index per axis.
+    last: vec3<f32>,
+    leaf_cells: f32,
+    leaf_grid: vec3<u32>,
+}
+
+fn leap_grid() -> LeapGrid {
+    return LeapGrid(max(frame.volume_dims.xyz - vec3<f32>(1.0), vec3<f32>(0.0)), f32(bricks.leaves.x), bricks.leaf_grid.xyz);
+}
+
+fn empty_region_at(p: vec3<f32>, grid: LeapGrid) -> EmptyRegion {
     let c = voxel_of(p);
-    let last = max(frame.volume_dims.xyz - vec3<f32>(1.0), vec3<f32>(0.0));
-    let leaf_cells = f32(bricks.leaves.x);
-    let leaf_grid = bricks.leaf_grid.xyz;
+    let last = grid.last;
+    let leaf_cells = grid.leaf_cells;
+    let leaf_grid = grid.leaf_grid;
     let l = leaf_of(c);
     let d = leaf_distance[l.x + leaf_grid.x * (l.y + leaf_grid.y * l.z)];
     if (d > 0u) {
@@ -118,11 +130,15 @@ fn march_bricks(s: Samples, start: vec4<f32>) -> vec4<f32> {
     let brick_cells = f32(bricks.grid.w);
     let inv_atlas = vec3<f32>(1.0) / bricks.atlas.xyz;
     let delta_atlas = s.delta * n * inv_atlas;
+    // Read once per ray, not per leaf (common/raymarch.wgsl's `march_dvr` says why).
+    let threshold = params.threshold;
+    let slots = bricks.slots;
+    let slot_side = bricks.slot_side.xyz;
     var k = 0u;
     loop {
         let stop = leap_stop(k, s, s.count);
         k = stop.k;
-        if (k >= s.count || out.a >= params.threshold) {
+        if (k >= s.count || out.a >= threshold) {
             break;
         }
         // A leaf to draw, up to where the ray leaves it (within its brick).
@@ -132,8 +148,7 @@ fn march_bricks(s: Samples, start: vec4<f32>) -> vec4<f32> {
         let b = brick_of(voxel_of(p));
         let lo = vec3<f32>(b) * brick_cells;
         let slot = table[1u + brick_index(b)] - 1u;
-        let slots = bricks.slots;
-        let origin = vec3<f32>(vec3<u32>(slot % slots.x, (slot / slots.x) % slots.y, slot / (slots.x * slots.y)) * bricks.slot_side.xyz);
+        let origin = vec3<f32>(vec3<u32>(slot % slots.x, (slot / slots.x) % slots.y, slot / (slots.x * slots.y)) * slot_side);
         let shift = origin + vec3<f32>(1.5) - lo - vec3<f32>(0.5);
         let atlas = Samples((s.first * n + shift) * inv_atlas, delta_atlas, s.count, s.step, s.offset, s.cut);
         resume_ray(sample_at(atlas, k) - atlas.delta);

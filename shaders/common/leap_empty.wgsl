@@ -1,7 +1,9 @@
 // Empty-space leaping, the one rule (Krüger & Westermann 2003 §2.3; the modern single-pass
 // form): from sample k, while it lies in a region the importing shader's empty-space structure
 // says is fully transparent, jump to the first sample past that region's box (`past_box`). The
-// structure provides `fn empty_region_at(p: vec3<f32>) -> EmptyRegion` for texture-space `p`:
+// structure provides `struct LeapGrid`, `fn leap_grid() -> LeapGrid` (its constants: uniforms,
+// texture sizes) and `fn empty_region_at(p: vec3<f32>, grid: LeapGrid) -> EmptyRegion` for
+// texture-space `p`:
 // common/empty_blocks.wgsl (per-block flags), common/empty_cubes.wgsl (Chebyshev distance map:
 // the largest cube of empty blocks), raycast_bricks.wgsl (empty leaves, bricks of other batches).
 // Lossless: every sample leapt over lies in the closed box of an empty region, whose
@@ -28,16 +30,20 @@ struct LeapStop {
 fn leap_stop(k_from: u32, s: Samples, end: u32) -> LeapStop {
     var k = k_from;
     var region = EmptyRegion(false, vec3<f32>(0.0), vec3<f32>(0.0));
+    // Read once per leap, not per step: on llvmpipe a uniform or texture-size read inside a loop
+    // that calls a texture function is repeated every iteration, one lane at a time.
+    let grid = leap_grid();
+    let step = step_exit(s.delta);
     loop {
         if (k >= end) {
             break;
         }
         let p = sample_at(s, k);
-        region = empty_region_at(p);
+        region = empty_region_at(p, grid);
         if (!region.empty) {
             break;
         }
-        k = past_box(k, p, s.delta, region.lo, region.hi);
+        k = past_box_by(k, p, step, region.lo, region.hi);
     }
     return LeapStop(min(k, end), region);
 }

@@ -259,9 +259,29 @@ fn first_sample_at(s: Samples, t: f32) -> u32 {
 // Axes the ray runs parallel to never bound it. Every empty-space leap and every brick exit is
 // this function: the samples it passes over lie in the closed box.
 fn past_box(k: u32, p: vec3<f32>, delta: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> u32 {
-    let bound = select(lo, hi, delta > vec3<f32>(0.0));
+    return past_box_by(k, p, step_exit(delta), lo, hi);
+}
+
+// A ray's step as `past_box` needs it, computed once per ray or leap rather than per box: its
+// direction per axis and its reciprocal (1 on axes it runs parallel to, which never bound it).
+// Three divisions less per box (on llvmpipe nine divisions were a third of a leap step).
+struct StepExit {
+    positive: vec3<bool>,
+    parallel: vec3<bool>,
+    inverse: vec3<f32>,
+}
+
+fn step_exit(delta: vec3<f32>) -> StepExit {
     let parallel = delta == vec3<f32>(0.0);
-    let x = select((bound - p) / select(delta, vec3<f32>(1.0), parallel), vec3<f32>(3.0e38), parallel);
+    return StepExit(delta > vec3<f32>(0.0), parallel, vec3<f32>(1.0) / select(delta, vec3<f32>(1.0), parallel));
+}
+
+// `past_box` with the step's `StepExit`. The reciprocal moves `steps` by an ulp at most: a
+// sample within rounding of a face may be leapt over, and the empty ranges' one-voxel apron
+// covers it (common/empty_blocks.wgsl).
+fn past_box_by(k: u32, p: vec3<f32>, step: StepExit, lo: vec3<f32>, hi: vec3<f32>) -> u32 {
+    let bound = select(lo, hi, step.positive);
+    let x = select((bound - p) * step.inverse, vec3<f32>(3.0e38), step.parallel);
     let steps = min(x.x, min(x.y, x.z));
     return k + max(1u, u32(clamp(floor(steps) + 1.0, 0.0, 16777216.0)));
 }

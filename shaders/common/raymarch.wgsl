@@ -199,6 +199,9 @@ struct Marched {
 fn march_dvr(s: Samples, k0: u32, end: u32, start: vec4<f32>) -> Marched {
     var out = Marched(start, NO_SAMPLE, 0u, k0);
     var k = k0;
+    // Read once: on llvmpipe a uniform read inside a loop that calls a texture function is
+    // repeated every sample, one lane at a time (bench/one-march-final.md, "llvmpipe profile").
+    let threshold = params.threshold;
     // Termination is tested after a sample, never before the first (T = 0 takes one sample, as
     // the reference does).
     loop {
@@ -240,12 +243,12 @@ fn march_dvr(s: Samples, k0: u32, end: u32, start: vec4<f32>) -> Marched {
 #endif
             out.color = out.color + (1.0 - out.color.a) * p;
             k += 1u;
-            if ((k >= run_end) | (out.color.a >= params.threshold)) {
+            if ((k >= run_end) | (out.color.a >= threshold)) {
                 break;
             }
         }
         out.samples += k - run_start;
-        if (out.color.a >= params.threshold) {
+        if (out.color.a >= threshold) {
             break;
         }
     }

@@ -134,9 +134,10 @@ fn march_bricks(s: Samples, start: vec4<f32>) -> vec4<f32> {
     let threshold = params.threshold;
     let slots = bricks.slots;
     let slot_side = bricks.slot_side.xyz;
+    let leaping = leaping_for(s);
     var k = 0u;
     loop {
-        let stop = leap_stop(k, s, s.count);
+        let stop = leap_stop(k, s, s.count, leaping);
         k = stop.k;
         if (k >= s.count || out.a >= threshold) {
             break;

@@ -39,7 +39,7 @@ fn ray_is_done(pixel: vec2<u32>, s: Samples, index: u32) -> bool {
 // per block it crosses rather than one per sample.
 fn segment_is_empty(s: Samples, index: u32) -> bool {
     let r = segment_range(s, index);
-    return leap(r.x, s, r.y) >= r.y;
+    return leap(r.x, s, r.y, leaping_for(s)) >= r.y;
 }
 
 // RC-a: early ray termination only. A ray never comes back once terminated, so this test can

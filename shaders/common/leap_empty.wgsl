@@ -27,13 +27,23 @@ struct LeapStop {
     region: EmptyRegion,
 }
 
-fn leap_stop(k_from: u32, s: Samples, end: u32) -> LeapStop {
+// What every leap of a ray reads, read once per ray (`leaping_for`): the structure's constants
+// and the step's reciprocal. On llvmpipe a uniform or texture-size read inside a loop that calls
+// a texture function is repeated every iteration, one lane at a time.
+struct Leaping {
+    grid: LeapGrid,
+    step: StepExit,
+}
+
+fn leaping_for(s: Samples) -> Leaping {
+    return Leaping(leap_grid(), step_exit(s.delta));
+}
+
+fn leap_stop(k_from: u32, s: Samples, end: u32, leaping: Leaping) -> LeapStop {
     var k = k_from;
     var region = EmptyRegion(false, vec3<f32>(0.0), vec3<f32>(0.0));
-    // Read once per leap, not per step: on llvmpipe a uniform or texture-size read inside a loop
-    // that calls a texture function is repeated every iteration, one lane at a time.
-    let grid = leap_grid();
-    let step = step_exit(s.delta);
+    let grid = leaping.grid;
+    let step = leaping.step;
     loop {
         if (k >= end) {
             break;
@@ -49,6 +59,6 @@ fn leap_stop(k_from: u32, s: Samples, end: u32) -> LeapStop {
 }
 
 // The first sample at or after k (before `end`) that may be visible, or `end`.
-fn leap(k_from: u32, s: Samples, end: u32) -> u32 {
-    return leap_stop(k_from, s, end).k;
+fn leap(k_from: u32, s: Samples, end: u32, leaping: Leaping) -> u32 {
+    return leap_stop(k_from, s, end, leaping).k;
 }

@@ -202,6 +202,9 @@ fn march_dvr(s: Samples, k0: u32, end: u32, start: vec4<f32>) -> Marched {
     // Read once: on llvmpipe a uniform read inside a loop that calls a texture function is
     // repeated every sample, one lane at a time (bench/one-march-final.md, "llvmpipe profile").
     let threshold = params.threshold;
+#if LEAP
+    let leaping = leaping_for(s);
+#endif
     // Termination is tested after a sample, never before the first (T = 0 takes one sample, as
     // the reference does).
     loop {
@@ -210,7 +213,7 @@ fn march_dvr(s: Samples, k0: u32, end: u32, start: vec4<f32>) -> Marched {
         }
 #if LEAP
         let before = k;
-        k = leap(k, s, end);
+        k = leap(k, s, end, leaping);
         if (k >= end) {
             break;
         }

@@ -102,6 +102,9 @@ fn grid_classification_and_distance_run_only_when_what_they_read_changes() {
     let plan = compile(&mut runtime, &CompileOptions::new(32, 32));
     runtime.bind_scene(&plan.inputs, &volume, &lut).expect("binds");
     let inputs = plan.inputs.clone();
+    // Compiled again with the volume bound, as an application does: the scene values (the
+    // volume's block size, 2 here against the graph's default 4) are the plan's from now on.
+    let plan = compile(&mut runtime, &CompileOptions::new(32, 32));
     runtime.apply(plan, &registry).expect("applies");
     let frame = |runtime: &mut Runtime, azimuth: f64| {
         let camera = OrbitCamera { azimuth_deg: azimuth, ..OrbitCamera::default() };

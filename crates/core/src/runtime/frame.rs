@@ -187,10 +187,34 @@ impl VolumeDesc {
 /// The scene value every graph may read for the bound volume: its box diagonal in voxels.
 pub const LONGEST_RAY_VOXELS: &str = "longest_ray_voxels";
 
+/// The scene value a graph's `block_size` input takes when the user sets none: the edge, in
+/// voxels, of the empty-space blocks (Krüger & Westermann 2003 §2.3) for the bound volume
+/// ([`VolumeDesc::block_size`]).
+pub const BLOCK_SIZE: &str = "block_size";
+
+impl VolumeDesc {
+    /// The empty-space block edge for this volume: the smallest of 2, 3 and 4 voxels whose grid
+    /// has at most 64 blocks along the longest axis (2 up to 128 voxels, 4 from 193 on). Finer
+    /// blocks leave fewer invisible samples in the blocks a ray marches through (hydrogen 128³:
+    /// 16.6 samples per pixel at 2 against 19.0 at 4, 7 % less time on llvmpipe:
+    /// bench/one-march-final.md), but the grid is rebuilt after every transfer-function edit,
+    /// and 64³ blocks is what the viewer's edit-to-frame goal was measured with
+    /// (bench/workbench.md, the engine at 4); coarser than 4 loses on every peer dataset
+    /// (bench/peer-ablation.md).
+    pub fn block_size(&self) -> f64 {
+        let longest = self.dims.max_element().max(1);
+        f64::from(longest.div_ceil(64).clamp(2, 4))
+    }
+}
+
 /// The scene values a volume gives graphs ([`CompileOptions::scene`](crate::CompileOptions)):
-/// computed here and nowhere else.
+/// computed here and nowhere else. A Scalar graph input takes the scene value of its name when
+/// the user sets none ([`LONGEST_RAY_VOXELS`] for repeat counts, [`BLOCK_SIZE`]).
 pub fn scene_values_of(volume: &VolumeDesc) -> std::collections::BTreeMap<String, f64> {
-    std::collections::BTreeMap::from([(LONGEST_RAY_VOXELS.to_string(), volume.longest_ray_voxels())])
+    std::collections::BTreeMap::from([
+        (LONGEST_RAY_VOXELS.to_string(), volume.longest_ray_voxels()),
+        (BLOCK_SIZE.to_string(), volume.block_size()),
+    ])
 }
 
 /// Everything a pass may know about the frame it records.
@@ -407,5 +431,26 @@ mod tests {
                 assert!((d_world.dot(camera.forward) - 1.0).abs() < 1e-9, "unit forward distance");
             }
         }
+    }
+
+    /// The block edge: 2 up to 128 voxels on the longest axis, 3 up to 192, then 4, whatever
+    /// the other axes; a graph's `block_size` input reads it as a scene value.
+    #[test]
+    fn the_block_size_keeps_the_grid_within_64_blocks_from_2_to_4_voxels() {
+        let edge = |x: u32, y: u32, z: u32| {
+            let data = volgraph_accel::volume::VoxelData::U8(vec![0; (x * y * z) as usize]);
+            let volume = volgraph_accel::volume::Volume::new("v", UVec3::new(x, y, z), DVec3::ONE, data);
+            VolumeDesc::of(&volume).block_size()
+        };
+        assert_eq!(edge(1, 1, 1), 2.0);
+        assert_eq!(edge(64, 64, 64), 2.0);
+        assert_eq!(edge(128, 128, 128), 2.0);
+        assert_eq!(edge(129, 16, 16), 3.0);
+        assert_eq!(edge(16, 192, 16), 3.0);
+        assert_eq!(edge(16, 16, 193), 4.0);
+        assert_eq!(edge(256, 256, 256), 4.0);
+        assert_eq!(edge(512, 64, 64), 4.0);
+        let volume = volgraph_accel::generate::marschner_lobb(64);
+        assert_eq!(scene_values_of(&VolumeDesc::of(&volume)).get(BLOCK_SIZE), Some(&2.0));
     }
 }

@@ -38,8 +38,8 @@ pub use create::{
     PipelineKind, PortInfo, RenderPassPipeline, RenderPipelineSpec,
 };
 pub use frame::{
-    CameraData, FrameData, FrameUniforms, LONGEST_RAY_VOXELS, OpacityReference, PixelRays, VolumeDesc, VolumeWindow,
-    WindowBoxes, scene_values_of,
+    BLOCK_SIZE, CameraData, FrameData, FrameUniforms, LONGEST_RAY_VOXELS, OpacityReference, PixelRays, VolumeDesc,
+    VolumeWindow, WindowBoxes, scene_values_of,
 };
 pub use frames::{FrameStats, MAX_FRAMES_IN_FLIGHT};
 pub use gpu::{Gpu, GpuError, GpuFault, GpuFaultKind, GpuOptions};
@@ -312,7 +312,7 @@ impl Runtime {
     }
 
     /// Scene values of what is bound, for compiling: the bound volume's
-    /// [`LONGEST_RAY_VOXELS`]. Computed in this one place.
+    /// [`LONGEST_RAY_VOXELS`] and [`BLOCK_SIZE`]. Computed in this one place.
     pub fn scene_values(&self) -> BTreeMap<String, f64> {
         self.volume_desc().map(|v| frame::scene_values_of(&v)).unwrap_or_default()
     }

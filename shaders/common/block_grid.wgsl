@@ -7,6 +7,12 @@
 
 #import "common/frame.wgsl"
 
+// The grids are read through the non-filtering sampler at texel centres (`block_texel`) rather
+// than with `textureLoad`: llvmpipe's texel fetch takes a level per lane and reads every
+// level's size and strides lane by lane, and was 1.7× the time of this lookup (8.7 against
+// 5.0 % of a `fastest` frame on hydrogen; bench/one-march-final.md, "llvmpipe profile").
+@group(0) @binding(auto) var nearest_clamp: sampler;
+
 // The constants of block look-ups, read once per leap (common/leap_empty.wgsl's `LeapGrid`).
 struct BlockGrid {
     // Blocks per texture-space unit (n / B) and its inverse (B / n), per axis.
@@ -14,13 +20,20 @@ struct BlockGrid {
     units_per_block: vec3<f32>,
     // The last block's index per axis.
     last: vec3<i32>,
+    // One texel of the grid's texture, in its texture coordinates.
+    texel: vec3<f32>,
 }
 
 // The grid of blocks of edge `edge` voxels whose texture has `dims` texels.
 fn block_grid(dims: vec3<u32>, edge: u32) -> BlockGrid {
     let n = frame.volume_dims.xyz;
     let b = f32(edge);
-    return BlockGrid(n / b, b / n, vec3<i32>(dims) - vec3<i32>(1));
+    return BlockGrid(n / b, b / n, vec3<i32>(dims) - vec3<i32>(1), vec3<f32>(1.0) / vec3<f32>(dims));
+}
+
+// The texture coordinates of block `b`'s texel centre: a nearest lookup there reads texel b.
+fn block_texel(b: vec3<i32>, grid: BlockGrid) -> vec3<f32> {
+    return (vec3<f32>(b) + vec3<f32>(0.5)) * grid.texel;
 }
 
 // The block holding texture-space position `u`: floor(u·n / B), clamped to the grid.

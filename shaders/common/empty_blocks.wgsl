@@ -19,5 +19,6 @@ fn leap_grid() -> LeapGrid {
 // The block at `p` and its box: empty when its flag says so.
 fn empty_region_at(p: vec3<f32>, grid: LeapGrid) -> EmptyRegion {
     let b = block_at(p, grid);
-    return EmptyRegion(textureLoad(empty, b, 0).r > 0.5, blocks_box_lo(b, grid), blocks_box_hi(b, grid));
+    let flag = textureSampleLevel(empty, nearest_clamp, block_texel(b, grid), 0.0).r;
+    return EmptyRegion(flag > 0.5, blocks_box_lo(b, grid), blocks_box_hi(b, grid));
 }

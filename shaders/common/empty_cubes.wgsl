@@ -22,7 +22,7 @@ fn leap_grid() -> LeapGrid {
 // The cube of empty blocks around `p` (or its block, which may be visible).
 fn empty_region_at(p: vec3<f32>, grid: LeapGrid) -> EmptyRegion {
     let b = block_at(p, grid);
-    let dist = textureLoad(distance, b, 0).r;
+    let dist = textureSampleLevel(distance, nearest_clamp, block_texel(b, grid), 0.0).r;
     let reach = select(0, i32(dist) - 1, LEAP_CUBES && dist >= 1.0);
     let lo = max(b - vec3<i32>(reach), vec3<i32>(0));
     let hi = min(b + vec3<i32>(reach), grid.last);

@@ -336,6 +336,9 @@ impl<'a> CreateContext<'a> {
             .iter()
             .map(|b| {
                 let filterable = match self.port(&b.name) {
+                    // The nearest sampler binds as non-filtering, so a shader may read any float
+                    // texture through it (an owned grid's texel by coordinates).
+                    _ if b.name == "nearest_clamp" => false,
                     Some(p) if p.owned => false,
                     Some(PortInfo { format: Some(f), .. }) => self.gpu.filterable(*f),
                     _ => true,

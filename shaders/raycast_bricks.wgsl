@@ -81,10 +81,7 @@ fn leaf_of(c: vec3<f32>) -> vec3<u32> {
     return min(vec3<u32>(c / f32(bricks.leaves.x)), bricks.leaf_grid.xyz - vec3<u32>(1u));
 }
 
-// What this dispatch leaps over (common/leap_empty.wgsl): the largest cube of leaves no box to
-// draw covers, and a brick drawn in another batch; a leaf to draw reports its box (within its
-// brick), which the march runs to.
-// The constants of a leap's look-ups, read once per leap.
+// The constants of the leaps' look-ups, read once per ray (common/leap_empty.wgsl's `Leaping`).
 struct LeapGrid {
     // The last voxel's index per axis.
     last: vec3<f32>,
@@ -96,6 +93,9 @@ fn leap_grid() -> LeapGrid {
     return LeapGrid(max(frame.volume_dims.xyz - vec3<f32>(1.0), vec3<f32>(0.0)), f32(bricks.leaves.x), bricks.leaf_grid.xyz);
 }
 
+// What this dispatch leaps over (common/leap_empty.wgsl): the largest cube of leaves no box to
+// draw covers, and a brick drawn in another batch; a leaf to draw reports its box (within its
+// brick), which the march runs to.
 fn empty_region_at(p: vec3<f32>, grid: LeapGrid) -> EmptyRegion {
     let c = voxel_of(p);
     let last = grid.last;

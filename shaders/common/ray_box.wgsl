@@ -264,7 +264,7 @@ fn past_box(k: u32, p: vec3<f32>, delta: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>
 
 // A ray's step as `past_box` needs it, computed once per ray or leap rather than per box: its
 // direction per axis and its reciprocal (1 on axes it runs parallel to, which never bound it).
-// Three divisions less per box (on llvmpipe nine divisions were a third of a leap step).
+// Three divisions less per box (a leap step on llvmpipe had nine, bench/one-march-final.md).
 struct StepExit {
     positive: vec3<bool>,
     parallel: vec3<bool>,
@@ -278,7 +278,8 @@ fn step_exit(delta: vec3<f32>) -> StepExit {
 
 // `past_box` with the step's `StepExit`. The reciprocal moves `steps` by an ulp at most: a
 // sample within rounding of a face may be leapt over, and the empty ranges' one-voxel apron
-// covers it (common/empty_blocks.wgsl).
+// covers it (common/block_grid.wgsl); a brick's run may end a sample early or late, which its
+// slot's one-voxel border covers (raycast_bricks.wgsl).
 fn past_box_by(k: u32, p: vec3<f32>, step: StepExit, lo: vec3<f32>, hi: vec3<f32>) -> u32 {
     let bound = select(lo, hi, step.positive);
     let x = select((bound - p) * step.inverse, vec3<f32>(3.0e38), step.parallel);

@@ -195,7 +195,12 @@ fn only_the_leaping_segment_loop_compiles_empty_space_code() {
     // (rc_b_leap.ron): the shared core's leap over the block flags.
     let plain = reachable("raycast_segment.wgsl", "fs_dvr");
     let leaping = reachable_with("raycast_segment.wgsl", "fs_dvr", &["LEAP", "LEAP_BLOCKS"]);
-    let empty_space = |f: &String| f == "leap" || f == "empty_region_at" || f == "block_of";
+    let empty_space = |f: &String| {
+        ["leap", "leap_stop", "leaping_for", "empty_region_at", "block_at", "block_grid"].contains(&f.as_str())
+    };
     assert!(!plain.iter().any(empty_space), "{plain:?}");
-    assert!(leaping.contains("leap") && leaping.contains("empty_region_at"), "{leaping:?}");
+    assert!(
+        leaping.contains("leap") && leaping.contains("empty_region_at") && leaping.contains("block_at"),
+        "{leaping:?}"
+    );
 }

@@ -2,10 +2,7 @@
 # Klein 2005's preset on lobster and hydrogen (the cases below 2× on llvmpipe), before (shaders
 # of 09e7f8f) and after, alternating twice.
 set -u
-export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp/xdg-root} VOLGRAPH_DATA=${VOLGRAPH_DATA:-../shared/data}
-cd "$(dirname "$0")/../../.."
-BEFORE=${BEFORE:-/tmp/volgraph-shaders-09e7f8f}
-[ -d "$BEFORE" ] || { mkdir -p "$BEFORE" && git archive 09e7f8f shaders | tar -x -C "$BEFORE"; }
+source "$(dirname "$0")/before-shaders.sh"
 OUT=bench/one-march-final/llvmpipe-profile/tables
 run() { # side round
     local s=(); [ "$1" = before ] && s=(--shaders "$BEFORE/shaders")

@@ -3,10 +3,7 @@
 # slicer they are compared with, before (shaders of 09e7f8f) and after, alternating twice.
 # (The whole kw2003-table1 preset takes ~27 minutes per side here.)
 set -u
-export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp/xdg-root} VOLGRAPH_DATA=${VOLGRAPH_DATA:-../shared/data}
-cd "$(dirname "$0")/../../.."
-BEFORE=${BEFORE:-/tmp/volgraph-shaders-09e7f8f}
-[ -d "$BEFORE" ] || { mkdir -p "$BEFORE" && git archive 09e7f8f shaders | tar -x -C "$BEFORE"; }
+source "$(dirname "$0")/before-shaders.sh"
 OUT=bench/one-march-final/llvmpipe-profile/tables
 run() { # side round
     local s=(); [ "$1" = before ] && s=(--shaders "$BEFORE/shaders")

@@ -1,10 +1,7 @@
 #!/usr/bin/env bash
 # Before/after on the peer preset with VTK, alternating: before = the shaders of 09e7f8f (the
 # stop's start) with blocks of 4, as main rendered then; after = the working tree.
-export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp/xdg-root} VOLGRAPH_DATA=${VOLGRAPH_DATA:-../shared/data}
-cd "$(dirname "$0")/../../.."
-BEFORE=${BEFORE:-/tmp/volgraph-shaders-09e7f8f}
-[ -d "$BEFORE" ] || { mkdir -p "$BEFORE" && git archive 09e7f8f shaders | tar -x -C "$BEFORE"; }
+source "$(dirname "$0")/before-shaders.sh"
 OUT=${OUT:-bench/one-march-final/llvmpipe-profile}
 mkdir -p $OUT
 for r in $(seq ${ROUNDS:-3}); do

@@ -3,10 +3,7 @@
 # same binary with the shaders of 09e7f8f (the stop's start, extracted to $BEFORE), "after" the
 # working tree's. Each preset at its own settings.
 set -u
-export XDG_RUNTIME_DIR=/tmp/xdg-root VOLGRAPH_DATA=/work/shared/data
-cd "$(dirname "$0")/../../.."
-BEFORE=${BEFORE:-/tmp/volgraph-shaders-09e7f8f}
-[ -d "$BEFORE" ] || { mkdir -p "$BEFORE" && git archive 09e7f8f shaders | tar -x -C "$BEFORE"; }
+source "$(dirname "$0")/before-shaders.sh"
 OUT=bench/one-march-final/llvmpipe-profile/tables
 run() { # preset side
     local s=(); [ "$2" = before ] && s=(--shaders "$BEFORE/shaders")

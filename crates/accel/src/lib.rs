@@ -21,6 +21,7 @@ pub mod mip;
 pub mod octree;
 pub mod probe;
 pub mod reference;
+pub mod srgb;
 pub mod stats;
 pub mod transfer_function;
 pub mod vessels;

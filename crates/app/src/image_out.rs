@@ -35,16 +35,14 @@ impl ImageKind {
     }
 }
 
-/// The sRGB transfer function.
+/// The sRGB transfer function (IEC 61966-2-1), through the workspace's one definition.
 fn srgb_encode(c: f32) -> f32 {
-    let c = c.clamp(0.0, 1.0);
-    if c <= 0.003_130_8 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+    volgraph_accel::srgb::encode(f64::from(c)) as f32
 }
 
 /// The inverse of [`srgb_encode`].
 fn srgb_decode(c: f32) -> f32 {
-    let c = c.clamp(0.0, 1.0);
-    if c <= 0.040_45 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+    volgraph_accel::srgb::decode(f64::from(c)) as f32
 }
 
 /// Writes `bytes` to `path` and waits until the file system has them: a full disk or a

@@ -197,9 +197,18 @@ fn every_leap_rule_block_size_and_run_length_gives_the_same_image() {
     let camera = &CAMERAS[1];
     let (base, ..) = render_fastest(&case, camera, &plain());
     let base = as_reference(&base);
-    for (leap, block, check) in
-        [("cubes", 4.0, 16u64), ("blocks", 4.0, 16), ("cubes", 8.0, 1), ("cubes", 16.0, 64), ("blocks", 8.0, 7)]
-    {
+    for (leap, block, check) in [
+        ("cubes", 4.0, 16u64),
+        ("blocks", 4.0, 16),
+        ("cubes", 8.0, 1),
+        ("cubes", 16.0, 64),
+        ("blocks", 8.0, 7),
+        // The scene value's other edges (VolumeDesc::block_size): 3 leaves a partial block
+        // on every axis of a 64³ volume.
+        ("cubes", 2.0, 16),
+        ("blocks", 3.0, 16),
+        ("cubes", 3.0, 5),
+    ] {
         let mut options = CompileOptions::new(SIZE, SIZE);
         options.scalars.insert("block_size".into(), block);
         let overrides =
@@ -404,5 +413,33 @@ fn the_pipelined_loop_gives_the_plain_loops_image() {
         let (got, ..) = render_fastest(&case, camera, &shape(x, y));
         let differ = differing_pixels(&got, &want);
         assert_eq!(differ, 0, "pipelined, workgroup {x}×{y}: {differ} pixels differ from 8×8 workgroups");
+    }
+}
+
+/// `fastest.ron`'s `block_size` input takes the bound volume's scene value (2 voxels for 64³,
+/// `VolumeDesc::block_size`) in every pass that reads it, 4 without a volume, and a user's value
+/// over both.
+#[test]
+fn the_block_size_is_the_volumes_unless_the_user_sets_one() {
+    let registry = builtin_registry();
+    let source = graph_source("modern/fastest.ron");
+    let volume = volgraph_accel::generate::marschner_lobb(64);
+    let scene = volgraph_core::runtime::scene_values_of(&volgraph_core::runtime::VolumeDesc::of(&volume));
+    let block_sizes = |options: &CompileOptions| -> Vec<(String, f64)> {
+        let plan = volgraph_core::compile("modern/fastest.ron", &source, &registry, options).expect("compiles");
+        plan.steps
+            .iter()
+            .filter(|s| s.params.declares("block_size"))
+            .map(|s| (s.pass_id.clone(), s.params.float("block_size")))
+            .collect()
+    };
+    let mut with_volume = CompileOptions::new(32, 32);
+    with_volume.scene = scene.clone();
+    let mut user = with_volume.clone();
+    user.scalars.insert("block_size".into(), 8.0);
+    for (options, want) in [(CompileOptions::new(32, 32), 4.0), (with_volume, 2.0), (user, 8.0)] {
+        let found = block_sizes(&options);
+        assert_eq!(found.len(), 2, "the grid and the march read it: {found:?}");
+        assert!(found.iter().all(|(_, b)| *b == want), "want {want}: {found:?}");
     }
 }

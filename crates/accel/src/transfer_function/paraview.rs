@@ -6,12 +6,7 @@ use std::path::Path;
 use serde_json::Value;
 
 use super::{ControlPoint, TfError, TransferFunction};
-
-/// sRGB-encoded channel → linear (IEC 61966-2-1).
-fn srgb_to_linear(c: f64) -> f64 {
-    let c = c.clamp(0.0, 1.0);
-    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
-}
+use crate::srgb;
 
 /// Groups a flat number array `[x, a, b, c, x, …]` into `[x, a, b, c]` quadruples, checking the
 /// shape and that x never decreases.
@@ -243,7 +238,7 @@ pub(super) fn parse_map(text: &str, path: &Path, wanted: Option<&str>) -> Result
         return Err(fail(format!("every point has x = {lo}; a colour map needs two different x values")));
     }
 
-    let colors: Vec<(f64, [f64; 3])> = rgb.iter().map(|q| (q[0], [q[1], q[2], q[3]].map(srgb_to_linear))).collect();
+    let colors: Vec<(f64, [f64; 3])> = rgb.iter().map(|q| (q[0], [q[1], q[2], q[3]].map(srgb::decode))).collect();
     let alphas: Vec<(f64, [f64; 1])> = match &opacity {
         Some(points) => points.iter().map(|q| (q[0], [q[1]])).collect(),
         None => vec![(lo, [0.0]), (hi, [1.0])],
@@ -260,12 +255,6 @@ pub(super) fn parse_map(text: &str, path: &Path, wanted: Option<&str>) -> Result
     tf.validate(path)?;
     let name = map.get("Name").and_then(Value::as_str).map(str::to_string);
     Ok(ParaviewColorMap { tf, name, index, all, notes })
-}
-
-/// Linear channel → sRGB-encoded (IEC 61966-2-1), the inverse of `srgb_to_linear`.
-fn linear_to_srgb(c: f64) -> f64 {
-    let c = c.clamp(0.0, 1.0);
-    if c <= 0.0031308 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
 }
 
 /// `tf` as ParaView colour-map JSON, written into `original` (the file it came from) when that
@@ -285,7 +274,7 @@ pub(super) fn write_map(tf: &TransferFunction, original: Option<&str>, index: us
     }
     let rgb: Vec<Value> = points
         .iter()
-        .flat_map(|p| [p.value, linear_to_srgb(p.color[0]), linear_to_srgb(p.color[1]), linear_to_srgb(p.color[2])])
+        .flat_map(|p| [p.value, srgb::encode(p.color[0]), srgb::encode(p.color[1]), srgb::encode(p.color[2])])
         .map(Value::from)
         .collect();
     let alpha: Vec<Value> = points.iter().flat_map(|p| [p.value, p.alpha, 0.5, 0.0]).map(Value::from).collect();

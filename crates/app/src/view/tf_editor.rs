@@ -26,11 +26,7 @@ pub enum TfAction {
 
 /// Linear → sRGB for display (the points hold linear RGB).
 fn display_color(c: [f64; 3], alpha: f64) -> Color32 {
-    let s = |x: f64| {
-        let x = x.clamp(0.0, 1.0);
-        let e = if x <= 0.0031308 { x * 12.92 } else { 1.055 * x.powf(1.0 / 2.4) - 0.055 };
-        (e * 255.0).round() as u8
-    };
+    let s = |x: f64| (volgraph_accel::srgb::encode(x) * 255.0).round() as u8;
     Color32::from_rgba_unmultiplied(s(c[0]), s(c[1]), s(c[2]), (alpha.clamp(0.0, 1.0) * 255.0) as u8)
 }
 

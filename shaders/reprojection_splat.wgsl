@@ -24,11 +24,16 @@ struct SplatParams {
     rect: vec4<u32>,
     // Splat edge in pixels (k).
     size: f32,
-    // Hits per splat side (b).
-    block: u32,
+    _pad0: f32,
     _pad1: f32,
     _pad2: f32,
 }
+
+// Hits per splat side (b), a pipeline constant: the b² loop below bounded by a uniform made
+// lavapipe (Mesa 22.3) inline the uniform and recompile both scatter rounds at every dispatch
+// — 2 LLVM compiles per frame, most of leap_iso's time on hydrogen (bench/one-march-final.md,
+// "Shaders recompiled at every bind").
+override SPLAT_BLOCK: u32 = 1u;
 
 // Last frame's leap hits: xyz texture space, w = 1 (surface) or 0.5 (exit point); w = 0 where
 // there was no ray.
@@ -46,14 +51,14 @@ struct BlockSplat {
 
 // Blocks per row of last frame's rectangle.
 fn blocks_x() -> u32 {
-    let b = max(splat.block, 1u);
+    let b = max(SPLAT_BLOCK, 1u);
     return max((splat.rect.z + b - 1u) / b, 1u);
 }
 
 // The splat of block `index` (row by row over last frame's rectangle).
 fn block_splat(index: u32) -> BlockSplat {
     var out = BlockSplat(vec4<f32>(0.0), 2.0, vec2<f32>(3.0e38), vec2<f32>(-3.0e38));
-    let b = max(splat.block, 1u);
+    let b = max(SPLAT_BLOCK, 1u);
     let base = splat.rect.xy + vec2<u32>(index % blocks_x(), index / blocks_x()) * b;
     let end = splat.rect.xy + splat.rect.zw;
     for (var i = 0u; i < b * b; i += 1u) {
@@ -149,7 +154,7 @@ fn depth_key(z: f32) -> u32 {
 
 // The block this invocation draws, or none past the rectangle's last block.
 fn scatter_block(id: vec3<u32>) -> BlockSplat {
-    let b = max(splat.block, 1u);
+    let b = max(SPLAT_BLOCK, 1u);
     let rows = (splat.rect.w + b - 1u) / b;
     if (id.x >= blocks_x() || id.y >= rows) {
         return BlockSplat(vec4<f32>(0.0), 2.0, vec2<f32>(0.0), vec2<f32>(0.0));

@@ -29,8 +29,7 @@ pub struct ReprojectionSplat;
 struct SplatParamsGpu {
     rect: [u32; 4],
     size: f32,
-    block: u32,
-    _pad: [f32; 2],
+    _pad: [f32; 3],
 }
 
 const _: () = assert!(std::mem::size_of::<SplatParamsGpu>() == 32);
@@ -88,7 +87,7 @@ fn scatters(params: &Params) -> bool {
 fn splat_layout() -> volgraph_core::UniformLayout {
     volgraph_core::UniformLayout {
         global: "splat",
-        fields: vec![("rect", "vec4<u32>"), ("size", "f32"), ("block", "u32")],
+        fields: vec![("rect", "vec4<u32>"), ("size", "f32")],
         params: Vec::new(),
         bytes: |_| bytemuck::bytes_of(&SplatParamsGpu::default()).to_vec(),
     }
@@ -134,29 +133,37 @@ impl PassDecl for ReprojectionSplat {
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        // The edge and block are uniforms; the method is another pipeline.
-        scatters(old) == scatters(new)
+        // The edge is a uniform; the block is a pipeline constant (`SPLAT_BLOCK`) and the
+        // method another pipeline.
+        let (old, new) = (SplatSettings::from_params(old), SplatSettings::from_params(new));
+        old.method == new.method && old.block == new.block
     }
 }
 
 impl PassPlugin for ReprojectionSplat {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
+        let settings = SplatSettings::from_params(ctx.params);
+        let constants = [("SPLAT_BLOCK", f64::from(settings.block))];
         let draw = if scatters(ctx.params) {
             let defines = self.shader_defines(ctx.params);
             let [depth, point] = scatter_rounds();
             let round = |shader: &ShaderUse| {
-                ctx.compute_pipeline(&ComputePipelineSpec { defines: &defines, ..ComputePipelineSpec::of(shader) })
+                ctx.compute_pipeline(&ComputePipelineSpec {
+                    defines: &defines,
+                    constants: &constants,
+                    ..ComputePipelineSpec::of(shader)
+                })
             };
             Draw::Scatter { depth: round(&depth)?, point: round(&point)? }
         } else {
             Draw::Quads(ctx.render_pipeline(&RenderPipelineSpec {
                 depth: Some(DepthSpec { port: "depth", write: true, compare: wgpu::CompareFunction::Less }),
                 topology: wgpu::PrimitiveTopology::TriangleStrip,
+                constants: &constants,
                 ..RenderPipelineSpec::drawing(&vertex(), &fragment())
             })?)
         };
         let uniform = ctx.uniform_buffer("splat", std::mem::size_of::<SplatParamsGpu>() as u64);
-        let settings = SplatSettings::from_params(ctx.params);
         let (size, block) = (settings.splat_size as f32, settings.block);
         Ok(Box::new(SplatNode { draw, uniform, size, block, written: None }))
     }
@@ -212,7 +219,7 @@ impl PassNode for SplatNode {
             }
             _ => [0; 4],
         };
-        let settings = SplatParamsGpu { rect, size: self.size, block: self.block, _pad: [0.0; 2] };
+        let settings = SplatParamsGpu { rect, size: self.size, _pad: [0.0; 3] };
         if self.written != Some(settings) {
             ctx.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&settings));
             self.written = Some(settings);
@@ -248,9 +255,35 @@ impl PassNode for SplatNode {
     }
 
     fn update_params(&mut self, _gpu: &Gpu, params: &Params) {
-        let settings = SplatSettings::from_params(params);
-        self.size = settings.splat_size as f32;
-        self.block = settings.block;
+        // Only the edge: a new block is a new pipeline (`updates_in_place`).
+        self.size = SplatSettings::from_params(params).splat_size as f32;
         self.written = None;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use volgraph_core::{ParamValue, Params, PassDecl};
+
+    use super::ReprojectionSplat;
+
+    fn params(edits: &[(&str, ParamValue)]) -> Params {
+        let mut params = Params::defaults(&ReprojectionSplat.params());
+        for (name, value) in edits {
+            params.set(name, value.clone());
+        }
+        params
+    }
+
+    /// The splat edge is a uniform, edited in place; the block is the pipeline constant
+    /// `SPLAT_BLOCK` and the method a pipeline of its own, so editing either rebuilds the node.
+    #[test]
+    fn only_the_splat_edge_updates_in_place() {
+        let base = params(&[]);
+        assert!(ReprojectionSplat.updates_in_place(&base, &params(&[("splat_size", ParamValue::UInt(4))])));
+        assert!(!ReprojectionSplat.updates_in_place(&base, &params(&[("block", ParamValue::UInt(2))])));
+        assert!(
+            !ReprojectionSplat.updates_in_place(&base, &params(&[("method", ParamValue::Choice("scatter".into()))]))
+        );
     }
 }

@@ -48,7 +48,7 @@ fn the_shipped_bypass_is_in_the_plan() {
     let text = plan.to_text();
     assert!(
         text.contains(
-            "bypass reprojection: leaves out splat, holes while march.leapable < 40 per pixel (then clears holes.start)"
+            "bypass reprojection: leaves out splat, holes while march.leapable < 16 per pixel (then clears holes.start)"
         ),
         "{text}"
     );

@@ -429,7 +429,7 @@ fn the_viewer_counts_frames_from_reprojected_starts_and_an_isovalue_edit_restart
     assert_eq!(status.len(), 1, "{status:?}");
     let line = crate::render::bypass_line(&status[0]);
     assert!(line.starts_with("bypass reprojection: left out in "), "{line}");
-    assert!(line.contains("threshold 40"), "{line}");
+    assert!(line.contains("threshold 16"), "{line}");
     let _ = std::fs::remove_dir_all(&s.dir);
 }
 

@@ -31,8 +31,8 @@ struct SplatParams {
 
 // Hits per splat side (b), a pipeline constant: the b² loop below bounded by a uniform made
 // lavapipe (Mesa 22.3) inline the uniform and recompile both scatter rounds at every dispatch
-// — 2 LLVM compiles per frame, most of leap_iso's time on hydrogen (bench/one-march-final.md,
-// "Shaders recompiled at every bind").
+// — 2 LLVM compiles per frame; leap_iso on hydrogen took 142 ms a frame in one run against 39
+// with the constant (bench/one-march-final.md, "Shaders recompiled at every bind").
 override SPLAT_BLOCK: u32 = 1u;
 
 // Last frame's leap hits: xyz texture space, w = 1 (surface) or 0.5 (exit point); w = 0 where

@@ -12,6 +12,17 @@ use crate::reflect::{BindingKind, ReflectedBinding};
 /// Names the runtime binds itself, in every pass that declares them.
 pub const SYSTEM_BINDINGS: [&str; 3] = ["frame", "linear_clamp", "nearest_clamp"];
 
+/// Whether the system sampler `name` filters: `linear_clamp` does; `nearest_clamp` binds as
+/// non-filtering, so a shader may read any float texture through it, filterable or not (the
+/// empty-space grids by texel centre, common/block_grid.wgsl). `None` for other names.
+pub fn system_sampler_filters(name: &str) -> Option<bool> {
+    match name {
+        "linear_clamp" => Some(true),
+        "nearest_clamp" => Some(false),
+        _ => None,
+    }
+}
+
 /// What a port of a pass is, as the runtime resolved it.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct PortInfo {
@@ -21,8 +32,9 @@ pub struct PortInfo {
     pub access: Access,
     /// Texture format, when known at build time (targets; graph inputs are filterable formats).
     pub format: Option<wgpu::TextureFormat>,
-    /// A texture another pass owns (a min/max grid): bound as unfilterable float, read with
-    /// `textureLoad`, so 32-bit float grids need no FLOAT32_FILTERABLE. True for an Owned port
+    /// A texture another pass owns (a min/max grid): bound as unfilterable float, read by texel
+    /// (`textureLoad`, or `nearest_clamp` at texel centres), so 32-bit float grids need no
+    /// FLOAT32_FILTERABLE. True for an Owned port
     /// whether or not it is wired (see `bound`).
     pub owned: bool,
     /// A storage buffer (counters, point lists) rather than a texture.

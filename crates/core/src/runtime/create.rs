@@ -15,7 +15,7 @@ use super::reflect::{BindingKind, ReflectedBinding, layout_entry, reflect};
 use super::shaders::ShaderLibrary;
 use crate::params::Params;
 use crate::plugin::{Access, PassPlugin, ShaderUse};
-pub use volgraph_compiler::binding_rules::{PortInfo, SYSTEM_BINDINGS, check_bindings};
+pub use volgraph_compiler::binding_rules::{PortInfo, SYSTEM_BINDINGS, check_bindings, system_sampler_filters};
 
 /// A pass failed to build or record.
 #[derive(Clone, Debug, thiserror::Error, PartialEq, Eq)]
@@ -335,12 +335,10 @@ impl<'a> CreateContext<'a> {
         bindings
             .iter()
             .map(|b| {
-                let filterable = match self.port(&b.name) {
-                    // The nearest sampler binds as non-filtering, so a shader may read any float
-                    // texture through it (an owned grid's texel by coordinates).
-                    _ if b.name == "nearest_clamp" => false,
-                    Some(p) if p.owned => false,
-                    Some(PortInfo { format: Some(f), .. }) => self.gpu.filterable(*f),
+                let filterable = match (system_sampler_filters(&b.name), self.port(&b.name)) {
+                    (Some(filters), _) => filters,
+                    (None, Some(p)) if p.owned => false,
+                    (None, Some(PortInfo { format: Some(f), .. })) => self.gpu.filterable(*f),
                     _ => true,
                 };
                 // Writable storage in a vertex stage needs VERTEX_WRITABLE_STORAGE; volgraph's

@@ -223,7 +223,7 @@ impl Checker<'_> {
             self.err(
                 at,
                 format!("bypass \"{name}\": threshold {value} is not a positive number"),
-                Some("write the measure per pixel under which the passes do not pay, e.g. 40.0".to_string()),
+                Some("write the measure per pixel under which the passes do not pay, e.g. 16.0".to_string()),
             );
             return None;
         }

@@ -9,10 +9,10 @@
 // Two ways to draw the same splats (`method`):
 // - quads (the paper's points; WebGPU has no point size): instanced quads pulling their point
 //   from the `hits` texture, the depth buffer `depth` a Depth32Float target;
-// - scatter (SCATTER): one compute invocation per block writes the splat's pixels itself, in two
-//   rounds over the same pixels — the nearest depth per pixel by atomicMax into the `depth`
-//   buffer (~bits of a depth in [0, 1]: the nearer, the larger; 0 = no splat), then the point of
-//   the splat whose depth won — with none of the rasterizer's per-quad setup, which is most of a
+// - scatter (SCATTER): after a round that clears every pixel, one compute invocation per block
+//   writes the splat's pixels itself, in two rounds over the same pixels — the nearest depth per
+//   pixel by atomicMax into the `depth` buffer (~bits of a depth in [0, 1]: the nearer, the
+//   larger; 0 = no splat), then the point of the splat whose depth won — with none of the rasterizer's per-quad setup, which is most of a
 //   quad's cost where the graphics pipeline is slow (lavapipe, and the few SMs that run it on
 //   an H100/H200). Pixel centres inside the quad are covered, as the rasterizer covers them.
 
@@ -126,9 +126,24 @@ fn fs_splat(in: SplatVertex) -> SplatOut {
 }
 
 #if SCATTER
-// Per pixel, row by row: ~bits of the nearest splat's depth (0: none). Cleared by the node.
+// Per pixel, row by row: ~bits of the nearest splat's depth (0: none), zeroed by
+// `cs_splat_clear`.
 @group(0) @binding(auto) var<storage, read_write> depth: array<atomic<u32>>;
 @group(0) @binding(auto) var start: texture_storage_2d<rgba32float, write>;
+
+// Round 0, one invocation per pixel of the viewport: no splat yet (depth 0, start zero). A
+// shader writes the 16-byte texels as fast as any other store, where lavapipe clears a
+// 128-bit target outside a draw one texel at a time (`memcpy` per texel: 5 % of a `leap_iso`
+// frame; bench/one-march-final.md, "The start target's clear").
+@compute @workgroup_size(8, 8)
+fn cs_splat_clear(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = vec2<u32>(frame.viewport.xy);
+    if (any(id.xy >= size)) {
+        return;
+    }
+    atomicStore(&depth[id.y * size.x + id.x], 0u);
+    textureStore(start, id.xy, vec4<f32>(0.0));
+}
 
 // The pixels [x0, x1) × [y0, y1) whose centres lie inside the splat's quad, within the
 // viewport; empty for a block without a hit or a depth outside [0, 1] (the rasterizer clips it).

@@ -63,6 +63,9 @@ pub struct Reflection {
     pub bindings: Vec<ReflectedBinding>,
     /// Fragment outputs `(name, location)`, for a fragment entry point.
     pub fragment_outputs: Vec<(String, u32)>,
+    /// True when a fragment entry point can `discard` (itself or a function it calls): the
+    /// fragments it runs for may leave their pixels unwritten.
+    pub may_discard: bool,
 }
 
 /// Reflects `entry_points` of a parsed and validated module.
@@ -99,6 +102,9 @@ pub fn reflect(
                 uniform_size,
             });
         }
+        if ep.stage == naga::ShaderStage::Fragment {
+            out.may_discard |= block_may_discard(module, &ep.function.body);
+        }
         if ep.stage == naga::ShaderStage::Fragment
             && let Some(result) = &ep.function.result
         {
@@ -119,6 +125,22 @@ pub fn reflect(
     }
     out.bindings.sort_by_key(|b| (b.group, b.binding));
     Ok(out)
+}
+
+/// Whether `block`, or a function it calls, contains a `discard` (naga's `Kill`).
+fn block_may_discard(module: &naga::Module, block: &naga::Block) -> bool {
+    use naga::Statement;
+    block.iter().any(|statement| match statement {
+        Statement::Kill => true,
+        Statement::Block(inner) => block_may_discard(module, inner),
+        Statement::If { accept, reject, .. } => block_may_discard(module, accept) || block_may_discard(module, reject),
+        Statement::Switch { cases, .. } => cases.iter().any(|c| block_may_discard(module, &c.body)),
+        Statement::Loop { body, continuing, .. } => {
+            block_may_discard(module, body) || block_may_discard(module, continuing)
+        }
+        Statement::Call { function, .. } => block_may_discard(module, &module.functions[*function].body),
+        _ => false,
+    })
 }
 
 fn binding_kind(module: &naga::Module, var: &naga::GlobalVariable) -> Result<BindingKind, String> {
@@ -232,4 +254,41 @@ pub fn layout_entry(
         }),
     };
     wgpu::BindGroupLayoutEntry { binding: b.binding, visibility, ty, count: None }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn may_discard(source: &str, entry: &str) -> bool {
+        let module = naga::front::wgsl::parse_str(source).expect("parses");
+        let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+            .validate(&module)
+            .expect("validates");
+        reflect(&module, &info, &[entry]).expect("reflects").may_discard
+    }
+
+    const SHADER: &str = r#"
+        fn maybe(x: f32) { if (x < 0.5) { loop { if (x < 0.25) { discard; } break; } } }
+        @fragment fn direct(@builtin(position) p: vec4<f32>) -> @location(0) vec4<f32> {
+            if (p.x < 1.0) { discard; }
+            return vec4<f32>(1.0);
+        }
+        @fragment fn called(@builtin(position) p: vec4<f32>) -> @location(0) vec4<f32> {
+            maybe(p.x);
+            return vec4<f32>(1.0);
+        }
+        @fragment fn never(@builtin(position) p: vec4<f32>) -> @location(0) vec4<f32> {
+            return vec4<f32>(p.x);
+        }
+    "#;
+
+    /// A `discard` anywhere a fragment stage can reach (nested in a loop of a called function)
+    /// means it may leave pixels unwritten.
+    #[test]
+    fn a_fragment_stage_that_can_discard_is_found() {
+        assert!(may_discard(SHADER, "direct"));
+        assert!(may_discard(SHADER, "called"));
+        assert!(!may_discard(SHADER, "never"));
+    }
 }

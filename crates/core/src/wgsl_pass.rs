@@ -38,7 +38,7 @@ impl PassPlugin for WgslKind {
             })?),
             WgslForm::Fragment => Pipeline::Fragment(ctx.render_pipeline(&RenderPipelineSpec {
                 shader: &self.doc().shader,
-                vertex: "vs_fullscreen",
+                vertex: crate::runtime::FULLSCREEN_VERTEX,
                 fragment: self.doc().entry_point(),
                 ..Default::default()
             })?),
@@ -72,11 +72,7 @@ impl PassNode for WgslPassNode {
             Pipeline::Compute(p) => ctx.dispatch_over(p, &extra, self.kind.first_output(), self.kind.doc().workgroup),
             Pipeline::Fragment(p) => {
                 let bind_group = ctx.bind_group(p, &extra)?;
-                let mut pass = ctx.begin_render_pass(p, None)?;
-                pass.set_pipeline(&p.pipeline);
-                pass.set_bind_group(0, &bind_group, &[]);
-                pass.draw(0..3, 0..1);
-                Ok(())
+                ctx.draw_fullscreen(p, &bind_group)
             }
         }
     }

@@ -164,9 +164,7 @@ impl PassNode for AntialiasNode {
             &self.pipeline,
             &[("params", self.params.as_entire_binding()), ("aa", self.aa.as_entire_binding())],
         )?;
-        let mut pass = ctx.begin_render_pass(&self.pipeline, None)?;
-        crate::draw(&mut pass, &self.pipeline, &bg, 0..3);
-        Ok(())
+        ctx.draw_fullscreen(&self.pipeline, &bg)
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {

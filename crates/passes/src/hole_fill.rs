@@ -81,9 +81,7 @@ struct HoleFillNode {
 impl PassNode for HoleFillNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let bg = ctx.bind_group(&self.pipeline, &self.uniforms.bindings())?;
-        let mut pass = ctx.begin_render_pass(&self.pipeline, None)?;
-        crate::draw(&mut pass, &self.pipeline, &bg, 0..3);
-        Ok(())
+        ctx.draw_fullscreen(&self.pipeline, &bg)
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {

@@ -267,9 +267,7 @@ impl PassNode for RaycastNode {
             _ => &self.pipeline,
         };
         let bg = ctx.bind_group(pipeline, &extra)?;
-        let mut pass = ctx.begin_render_pass(pipeline, None)?;
-        crate::draw(&mut pass, pipeline, &bg, 0..3);
-        Ok(())
+        ctx.draw_fullscreen(pipeline, &bg)
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {

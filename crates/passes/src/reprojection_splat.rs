@@ -67,8 +67,10 @@ fn fragment() -> ShaderUse {
 }
 
 /// The scatter's two rounds: nearest depth per pixel, then the winner's point.
-fn scatter_rounds() -> [ShaderUse; 2] {
+/// The scatter's rounds: clear every pixel, nearest depth per pixel, the winners' points.
+fn scatter_rounds() -> [ShaderUse; 3] {
     [
+        ShaderUse::new("reprojection_splat.wgsl", "cs_splat_clear"),
         ShaderUse::new("reprojection_splat.wgsl", "cs_splat_depth").uniform(splat_layout()),
         ShaderUse::new("reprojection_splat.wgsl", "cs_splat_point").uniform(splat_layout()),
     ]
@@ -146,7 +148,7 @@ impl PassPlugin for ReprojectionSplat {
         let constants = [("SPLAT_BLOCK", f64::from(settings.block))];
         let draw = if scatters(ctx.params) {
             let defines = self.shader_defines(ctx.params);
-            let [depth, point] = scatter_rounds();
+            let [clear, depth, point] = scatter_rounds();
             let round = |shader: &ShaderUse| {
                 ctx.compute_pipeline(&ComputePipelineSpec {
                     defines: &defines,
@@ -154,7 +156,7 @@ impl PassPlugin for ReprojectionSplat {
                     ..ComputePipelineSpec::of(shader)
                 })
             };
-            Draw::Scatter { depth: round(&depth)?, point: round(&point)? }
+            Draw::Scatter { clear: round(&clear)?, depth: round(&depth)?, point: round(&point)? }
         } else {
             Draw::Quads(ctx.render_pipeline(&RenderPipelineSpec {
                 depth: Some(DepthSpec { port: "depth", write: true, compare: wgpu::CompareFunction::Less }),
@@ -172,7 +174,7 @@ impl PassPlugin for ReprojectionSplat {
 /// The pipelines of a `method`.
 enum Draw {
     Quads(RenderPassPipeline),
-    Scatter { depth: ComputePassPipeline, point: ComputePassPipeline },
+    Scatter { clear: ComputePassPipeline, depth: ComputePassPipeline, point: ComputePassPipeline },
 }
 
 struct SplatNode {
@@ -236,11 +238,16 @@ impl PassNode for SplatNode {
                     pass.draw(0..4, 0..bx * by);
                 }
             }
-            Draw::Scatter { depth, point } => {
-                ctx.clear_buffer("depth")?;
-                ctx.clear_target("start")?;
+            Draw::Scatter { clear, depth, point } => {
+                let clear_bg = ctx.bind_group(clear, &[])?;
                 let (depth_bg, point_bg) = (ctx.bind_group(depth, &splat)?, ctx.bind_group(point, &splat)?);
                 let mut pass = ctx.begin_compute_pass();
+                // Every pixel starts without a splat: a round of its own, not a clear of the
+                // target (lavapipe clears 128-bit texels one memcpy at a time, outside a draw).
+                let (w, h) = ctx.viewport;
+                pass.set_pipeline(&clear.pipeline);
+                pass.set_bind_group(0, &clear_bg, &[]);
+                pass.dispatch_workgroups(w.div_ceil(SCATTER_WORKGROUP.0), h.div_ceil(SCATTER_WORKGROUP.1), 1);
                 if bx * by > 0 {
                     let groups = (bx.div_ceil(SCATTER_WORKGROUP.0), by.div_ceil(SCATTER_WORKGROUP.1));
                     for (pipeline, bg) in [(depth, &depth_bg), (point, &point_bg)] {

@@ -95,13 +95,16 @@ impl<'a> RenderPipelineSpec<'a> {
     pub fn fullscreen(declared: &ShaderUse) -> Self {
         Self {
             shader: declared.file,
-            vertex: "vs_fullscreen",
+            vertex: FULLSCREEN_VERTEX,
             fragment: declared.entry_point,
             topology: wgpu::PrimitiveTopology::TriangleList,
             ..Default::default()
         }
     }
 }
+
+/// The vertex entry point of the screen-covering triangle (`shaders/common/fullscreen.wgsl`).
+pub const FULLSCREEN_VERTEX: &str = "vs_fullscreen";
 
 /// The compiled pipeline of a pass with its reflected bindings; cheap to clone. Typed by what
 /// it is: [`RenderPassPipeline`] from [`CreateContext::render_pipeline`], [`ComputePassPipeline`]
@@ -121,6 +124,11 @@ pub struct PassPipeline<K = PipelineKind> {
     pub color_ports: Vec<String>,
     /// The depth port, if any.
     pub depth_port: Option<String>,
+    /// True when drawing vertices 0..3 writes every pixel of every colour target: the
+    /// fullscreen triangle, no depth test, no blending, a fragment stage that cannot discard.
+    /// [`RecordContext::draw_fullscreen`](super::RecordContext::draw_fullscreen) then skips
+    /// clearing the targets it would overwrite anyway.
+    pub covers_viewport: bool,
 }
 
 /// A render pipeline of a pass.
@@ -132,8 +140,16 @@ pub type ComputePassPipeline = PassPipeline<wgpu::ComputePipeline>;
 impl PassPipeline {
     /// The typed form, if this is a `T` pipeline.
     fn typed<T>(self, pick: impl FnOnce(PipelineKind) -> Option<T>) -> Option<PassPipeline<T>> {
-        let PassPipeline { label, pipeline, layout, bindings, color_ports, depth_port } = self;
-        pick(pipeline).map(|pipeline| PassPipeline { label, pipeline, layout, bindings, color_ports, depth_port })
+        let PassPipeline { label, pipeline, layout, bindings, color_ports, depth_port, covers_viewport } = self;
+        pick(pipeline).map(|pipeline| PassPipeline {
+            label,
+            pipeline,
+            layout,
+            bindings,
+            color_ports,
+            depth_port,
+            covers_viewport,
+        })
     }
 }
 
@@ -444,6 +460,11 @@ impl<'a> CreateContext<'a> {
             spec.topology
         );
         let label = format!("{}/{}", self.pass_id, spec.fragment);
+        let covers_viewport = spec.vertex == FULLSCREEN_VERTEX
+            && spec.topology == wgpu::PrimitiveTopology::TriangleList
+            && spec.depth.is_none()
+            && spec.blend.is_none()
+            && !r.may_discard;
         self.pipelines
             .get_or_build(key, || {
                 let device = &self.gpu.device;
@@ -503,6 +524,7 @@ impl<'a> CreateContext<'a> {
                     bindings: r.bindings.clone(),
                     color_ports: color_ports.clone(),
                     depth_port: spec.depth.map(|d| d.port.to_string()),
+                    covers_viewport,
                 })
             })
             .map(|mut p| {
@@ -570,6 +592,7 @@ impl<'a> CreateContext<'a> {
                     bindings: r.bindings.clone(),
                     color_ports: Vec::new(),
                     depth_port: None,
+                    covers_viewport: false,
                 })
             })
             .map(|mut p| {

@@ -34,8 +34,8 @@ use std::time::Instant;
 
 pub use bypass::BypassStatus;
 pub use create::{
-    ComputePassPipeline, ComputePipelineSpec, CreateContext, DepthSpec, PassError, PassPipeline, PipelineCache,
-    PipelineKind, PortInfo, RenderPassPipeline, RenderPipelineSpec,
+    ComputePassPipeline, ComputePipelineSpec, CreateContext, DepthSpec, FULLSCREEN_VERTEX, PassError, PassPipeline,
+    PipelineCache, PipelineKind, PortInfo, RenderPassPipeline, RenderPipelineSpec,
 };
 pub use frame::{
     BLOCK_SIZE, CameraData, FrameData, FrameUniforms, LONGEST_RAY_VOXELS, OpacityReference, PixelRays, VolumeDesc,

@@ -296,11 +296,38 @@ impl<'a> RecordContext<'a> {
         pipeline: &RenderPassPipeline,
         depth_clear: Option<f32>,
     ) -> Result<wgpu::RenderPass<'static>, PassError> {
+        self.begin_render_pass_over(pipeline, depth_clear, false)
+    }
+
+    /// The common fragment pass in one call: the fullscreen triangle of `pipeline` with
+    /// `bind_group`. Where the pipeline writes every pixel (`PassPipeline::covers_viewport`) its
+    /// Write ports are not cleared first: on lavapipe a clear of a 128-bit target is a `memcpy`
+    /// per texel, 5 % of a Klein `leap_iso` frame (bench/one-march-final.md, "Clears").
+    pub fn draw_fullscreen(
+        &mut self,
+        pipeline: &RenderPassPipeline,
+        bind_group: &wgpu::BindGroup,
+    ) -> Result<(), PassError> {
+        let mut pass = self.begin_render_pass_over(pipeline, None, pipeline.covers_viewport)?;
+        pass.set_pipeline(&pipeline.pipeline);
+        pass.set_bind_group(0, bind_group, &[]);
+        pass.draw(0..3, 0..1);
+        Ok(())
+    }
+
+    /// `begin_render_pass`; `overwritten`: the draw writes every pixel of the Write ports, so
+    /// they are loaded (their old content never shows) instead of cleared.
+    fn begin_render_pass_over(
+        &mut self,
+        pipeline: &RenderPassPipeline,
+        depth_clear: Option<f32>,
+        overwritten: bool,
+    ) -> Result<wgpu::RenderPass<'static>, PassError> {
         let mut colors = Vec::new();
         for port in &pipeline.color_ports {
             let p = self.port(port).ok_or_else(|| self.error(format!("no port {port}")))?;
             let view = p.view.ok_or_else(|| self.error(format!("port \"{port}\" is not bound")))?;
-            let load = if p.access == Access::Modify {
+            let load = if p.access == Access::Modify || overwritten {
                 wgpu::LoadOp::Load
             } else {
                 wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)

@@ -134,7 +134,7 @@ fn fs_splat(in: SplatVertex) -> SplatOut {
 // Round 0, one invocation per pixel of the viewport: no splat yet (depth 0, start zero). A
 // shader writes the 16-byte texels as fast as any other store, where lavapipe clears a
 // 128-bit target outside a draw one texel at a time (`memcpy` per texel: 5 % of a `leap_iso`
-// frame; bench/one-march-final.md, "The start target's clear").
+// frame; bench/one-march-final.md, "Clears").
 @compute @workgroup_size(8, 8)
 fn cs_splat_clear(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = vec2<u32>(frame.viewport.xy);

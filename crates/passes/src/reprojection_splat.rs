@@ -156,7 +156,11 @@ impl PassPlugin for ReprojectionSplat {
                     ..ComputePipelineSpec::of(shader)
                 })
             };
-            Draw::Scatter { clear: round(&clear)?, depth: round(&depth)?, point: round(&point)? }
+            Draw::Scatter(Box::new(ScatterRounds {
+                clear: round(&clear)?,
+                depth: round(&depth)?,
+                point: round(&point)?,
+            }))
         } else {
             Draw::Quads(ctx.render_pipeline(&RenderPipelineSpec {
                 depth: Some(DepthSpec { port: "depth", write: true, compare: wgpu::CompareFunction::Less }),
@@ -174,7 +178,14 @@ impl PassPlugin for ReprojectionSplat {
 /// The pipelines of a `method`.
 enum Draw {
     Quads(RenderPassPipeline),
-    Scatter { clear: ComputePassPipeline, depth: ComputePassPipeline, point: ComputePassPipeline },
+    Scatter(Box<ScatterRounds>),
+}
+
+/// The scatter's three compute pipelines (`scatter_rounds`).
+struct ScatterRounds {
+    clear: ComputePassPipeline,
+    depth: ComputePassPipeline,
+    point: ComputePassPipeline,
 }
 
 struct SplatNode {
@@ -238,7 +249,8 @@ impl PassNode for SplatNode {
                     pass.draw(0..4, 0..bx * by);
                 }
             }
-            Draw::Scatter { clear, depth, point } => {
+            Draw::Scatter(rounds) => {
+                let ScatterRounds { clear, depth, point } = rounds.as_ref();
                 let clear_bg = ctx.bind_group(clear, &[])?;
                 let (depth_bg, point_bg) = (ctx.bind_group(depth, &splat)?, ctx.bind_group(point, &splat)?);
                 let mut pass = ctx.begin_compute_pass();

@@ -75,8 +75,7 @@ fn run(kind: &str, frames: u32) -> Vec<f32> {
         rt.render(camera).expect("frame");
     }
     let image = rt.read_output("image").expect("image");
-    let red = (0..8).map(|x| image.rgba(x, 1)[0]).collect();
-    red
+    (0..8).map(|x| image.rgba(x, 1)[0]).collect()
 }
 
 #[test]

@@ -66,7 +66,6 @@ fn fragment() -> ShaderUse {
     ShaderUse::new("reprojection_splat.wgsl", "fs_splat").uniform(splat_layout())
 }
 
-/// The scatter's two rounds: nearest depth per pixel, then the winner's point.
 /// The scatter's rounds: clear every pixel, nearest depth per pixel, the winners' points.
 fn scatter_rounds() -> [ShaderUse; 3] {
     [

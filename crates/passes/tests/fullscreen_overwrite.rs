@@ -3,24 +3,27 @@
 //! `discard` still starts from zeros, not from what the pooled texture held (here: the
 //! previous frame's image).
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use volgraph_accel::camera::OrbitCamera;
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{
-    CameraData, CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec, Runtime,
-    ShaderLibrary,
+    CameraData, CreateContext, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec, Runtime, ShaderLibrary,
 };
 use volgraph_core::{
     CompileOptions, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, Registry, TargetFormat, compile,
 };
 
+mod support;
+
 const SHADER: &str = "fullscreen_cover.wgsl";
 
-/// A fullscreen pass drawing `entry` of the test shader into `image`.
+/// A fullscreen pass drawing `entry` of the test shader into `image`; `covers` records the
+/// built pipeline's `covers_viewport`.
 struct Fullscreen {
     kind: &'static str,
     entry: &'static str,
+    covers: Arc<Mutex<Option<bool>>>,
 }
 
 struct Draw {
@@ -52,19 +55,24 @@ impl PassDecl for Fullscreen {
 impl PassPlugin for Fullscreen {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec::fullscreen(&ShaderUse::new(SHADER, self.entry)))?;
+        *self.covers.lock().expect("not poisoned") = Some(pipeline.covers_viewport);
         Ok(Box::new(Draw { pipeline }))
     }
 }
 
-/// Row 1's red channel after `frames` frames of a graph of one `kind` pass.
-fn run(kind: &str, frames: u32) -> Vec<f32> {
-    let gpu = Arc::new(Gpu::new_headless().expect("a Vulkan adapter (lavapipe without a GPU)"));
+/// Whether `kind`'s pipeline covers the viewport, and row 1's red channel after `frames` frames
+/// of a graph of one `kind` pass.
+fn run(kind: &'static str, frames: u32) -> (bool, Vec<f32>) {
+    let gpu = support::gpu();
+    let covers = Arc::new(Mutex::new(None));
     let sources = volgraph_passes::builtin_shaders()
         .prepend_disk(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/shaders"));
     let mut registry = Registry::new();
-    registry
-        .register(Fullscreen { kind: "cover", entry: "fs_cover" })
-        .register(Fullscreen { kind: "half", entry: "fs_half" });
+    registry.register(Fullscreen {
+        kind,
+        entry: if kind == "cover" { "fs_cover" } else { "fs_half" },
+        covers: covers.clone(),
+    });
     let mut rt = Runtime::new(gpu, ShaderLibrary::new(sources));
     let graph =
         format!(r#"Graph(name: "t", passes: [Pass(id: "draw", kind: "{kind}")], outputs: {{"image": "draw.image"}})"#);
@@ -75,18 +83,21 @@ fn run(kind: &str, frames: u32) -> Vec<f32> {
         rt.render(camera).expect("frame");
     }
     let image = rt.read_output("image").expect("image");
-    (0..8).map(|x| image.rgba(x, 1)[0]).collect()
+    let covers = covers.lock().expect("not poisoned").expect("the pass was built");
+    (covers, (0..8).map(|x| image.rgba(x, 1)[0]).collect())
 }
 
 #[test]
 fn a_draw_over_every_pixel_overwrites_without_a_clear() {
-    let red = run("cover", 3);
+    let (covers, red) = run("cover", 3);
+    assert!(covers, "the fullscreen triangle without discard, depth test or blending covers the viewport");
     assert_eq!(red, vec![3.0; 8], "frame 2 writes 3 everywhere");
 }
 
 #[test]
 fn a_fullscreen_stage_that_can_discard_still_starts_from_zeros() {
-    let red = run("half", 2);
+    let (covers, red) = run("half", 2);
+    assert!(!covers, "a fragment stage that calls a function with a discard may leave pixels unwritten");
     // Frame 1 discards the left half: cleared, not frame 0's 1.0.
     assert_eq!(red, vec![0.0, 0.0, 0.0, 0.0, 2.0, 2.0, 2.0, 2.0]);
 }

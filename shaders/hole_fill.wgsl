@@ -18,6 +18,10 @@
 // The reprojected starts (w = 1 where a splat landed).
 @group(0) @binding(auto) var splats: texture_2d<f32>;
 @group(0) @binding(auto) var<uniform> holes: HoleParams;
+// Per image row, the range [x0, x1] of the pixel centres lying inside the footprint (the pixels
+// whose ray meets the box) by a margin; x0 > x1 for none. The node computes it each frame from
+// the footprint's polygon (crates/passes/src/screen_footprint.rs).
+@group(0) @binding(auto) var<storage, read> footprint_rows: array<vec2<f32>>;
 
 // (u0, 1) where pixel `p`'s ray enters the box, (0,0,0,0) where it misses.
 fn entry_of(p: vec2<i32>) -> vec4<f32> {
@@ -25,21 +29,21 @@ fn entry_of(p: vec2<i32>) -> vec4<f32> {
     return select(vec4<f32>(0.0), vec4<f32>(r.u0, 1.0), r.len > 0.0);
 }
 
-// True when some pixel within `band` of `pixel` has no ray (the footprint's edge is near). The
-// footprint — the pixels whose rays meet the box past the near plane — is the projection of a
-// convex body, so it is convex: the square around `pixel` lies inside it when its four corners
-// do.
+// True when some pixel within `band` of `pixel` may have no ray (the footprint's edge is near).
+// The footprint — the pixels whose rays meet the box past the near plane — is the projection of
+// a convex body, so it is convex: the square around `pixel` (clamped to the viewport) lies
+// inside it when its four corners do, that is when its first and last rows' spans hold both its
+// ends. Two reads where four corner rays met the box took 2 of a 4.6 ms pass on llvmpipe
+// (bench/one-march-final.md, "Hole fill's footprint").
 fn near_silhouette(pixel: vec2<i32>) -> bool {
     let size = vec2<i32>(frame.viewport.xy);
     let b = holes.silhouette_band;
-    let corners = array<vec2<i32>, 4>(vec2<i32>(-b, -b), vec2<i32>(b, -b), vec2<i32>(-b, b), vec2<i32>(b, b));
-    for (var i = 0u; i < 4u; i += 1u) {
-        let q = clamp(pixel + corners[i], vec2<i32>(0), size - vec2<i32>(1));
-        if (entry_of(q).w == 0.0) {
-            return true;
-        }
-    }
-    return false;
+    let lo = clamp(pixel - vec2<i32>(b), vec2<i32>(0), size - vec2<i32>(1));
+    let hi = clamp(pixel + vec2<i32>(b), vec2<i32>(0), size - vec2<i32>(1));
+    let first = footprint_rows[lo.y];
+    let last = footprint_rows[hi.y];
+    let x = vec2<f32>(vec2<i32>(lo.x, hi.x)) + vec2<f32>(0.5);
+    return !(x.x >= max(first.x, last.x) && x.y <= min(first.y, last.y));
 }
 
 // The splat within `extend` pixels of `pixel` nearest the eye; w = 0 when there is none.

@@ -5,13 +5,17 @@
 //! front face, met analytically (the entry of a raycaster with `rays: "analytic"`). Also
 //! every pixel within `silhouette_band` pixels of the footprint's edge: while the volume turns,
 //! a k×k splat can carry a neighbour's hit across the silhouette into a pixel whose ray, newly
-//! in view, meets the box in front of that hit (`crates/passes/tests/klein_2005.rs` measures
-//! it). Reads the splats' `splats` start target, writes `start`. Shader: `shaders/hole_fill.wgsl`.
+//! in view, meets the box in front of that hit (`crates/passes/tests/klein_2005.rs` tests the
+//! rule). Whether a pixel is that close comes from the footprint's convex polygon, which the
+//! node turns into one span per image row each frame (`screen_footprint`). Reads the splats'
+//! `splats` start target, writes `start`. Shader: `shaders/hole_fill.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{
-    CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec, UniformBlocks,
+    CreateContext, FrameUniforms, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec, UniformBlocks,
 };
+
+use crate::screen_footprint::footprint;
 use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
@@ -27,10 +31,16 @@ volgraph_core::pass_params! {
     }
 }
 
-/// Its one pipeline, declared once (file, entry point, the uniform block `holes`).
+/// Its one pipeline, declared once (file, entry point, the uniform block `holes`, the footprint's
+/// row spans the node writes each frame).
 fn shader() -> ShaderUse {
-    ShaderUse::new("hole_fill.wgsl", "fs_hole").uniform(HoleParams::bound_as("holes"))
+    ShaderUse::new("hole_fill.wgsl", "fs_hole").uniform(HoleParams::bound_as("holes")).binds(&["footprint_rows"])
 }
+
+/// How far inside the footprint (pixels) a pixel centre must lie for its row's span
+/// (`screen_footprint`): the polygon is exact in f64 and the shader meets rays with the box in
+/// f32, whose rounding moves a silhouette by far less than this at any viewport the GPU can hold.
+const FOOTPRINT_MARGIN: f64 = 1.0 / 64.0;
 
 impl PassDecl for HoleFill {
     fn honours_volume_window(&self) -> bool {
@@ -69,18 +79,46 @@ impl PassPlugin for HoleFill {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let shader = shader();
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec::fullscreen(&shader))?;
-        Ok(Box::new(HoleFillNode { pipeline, uniforms: UniformBlocks::create(ctx, &[shader]) }))
+        let uniforms = UniformBlocks::create(ctx, &[shader]);
+        Ok(Box::new(HoleFillNode { pipeline, uniforms, rows: None }))
     }
 }
 
 struct HoleFillNode {
     pipeline: RenderPassPipeline,
     uniforms: UniformBlocks,
+    /// The footprint's row spans (`vec2<f32>` per image row) and what they were written from.
+    rows: Option<(wgpu::Buffer, Vec<[f32; 2]>)>,
+}
+
+impl HoleFillNode {
+    /// This frame's row spans, written where they changed.
+    fn footprint_rows(&mut self, ctx: &RecordContext<'_>) -> &wgpu::Buffer {
+        let spans = footprint(&FrameUniforms::of(ctx.frame)).row_spans(ctx.viewport.1.max(1), FOOTPRINT_MARGIN);
+        if self.rows.as_ref().is_none_or(|(_, written)| written.len() != spans.len()) {
+            let buffer = ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(&format!("{} footprint rows", ctx.label)),
+                size: std::mem::size_of_val(spans.as_slice()) as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            self.rows = Some((buffer, Vec::new()));
+        }
+        let (buffer, written) = self.rows.as_mut().expect("created above");
+        if *written != spans {
+            ctx.write_buffer(buffer, 0, bytemuck::cast_slice(&spans));
+            *written = spans;
+        }
+        buffer
+    }
 }
 
 impl PassNode for HoleFillNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
-        let bg = ctx.bind_group(&self.pipeline, &self.uniforms.bindings())?;
+        let rows = self.footprint_rows(ctx).clone();
+        let mut bindings = self.uniforms.bindings();
+        bindings.push(("footprint_rows", rows.as_entire_binding()));
+        let bg = ctx.bind_group(&self.pipeline, &bindings)?;
         ctx.draw_fullscreen(&self.pipeline, &bg)
     }
 

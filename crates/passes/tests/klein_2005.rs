@@ -162,6 +162,81 @@ fn hole_filling_leaves_no_pixel_of_the_footprint_without_a_start() {
     }
 }
 
+/// §4.4's silhouette rule, as the hole fill applies it from the footprint's row spans
+/// (`volgraph_passes::screen_footprint`): a pixel within `silhouette_band` pixels of a pixel
+/// whose ray misses the box starts at the box's front face — its entry, not the splat that
+/// landed on it — and a pixel deeper inside keeps its splat. The footprint comes from the CPU
+/// reference's rays (f64). The square of corners ±band pixels is inside when the one a pixel
+/// larger is (its rays all meet the box by more than a sliver), and not inside when the one a
+/// pixel smaller is not (by convexity); pixels in between, whose square's corner lies within a
+/// pixel of the silhouette, are left out, as the shader's rounding and the span's 1/64-pixel
+/// margin may go either way there.
+#[test]
+fn pixels_near_the_silhouette_start_at_the_box_and_deeper_ones_keep_their_splat() {
+    let gpu = support::gpu();
+    let registry = builtin_registry();
+    let (volume, tf, iso) = datasets().remove(0);
+    let lut = tf.to_lut_for(&volume, 256);
+    let band = 2i64;
+    let options = reprojecting().with_scalar("iso_value", iso).with_param("holes", "silhouette_band", band as u64);
+    let mut leap = Live::new(&gpu, &registry, "klein_2005/leap_iso.ron", &volume, &lut, &options);
+    let (mut overridden, mut kept) = (0, 0);
+    for f in 0..4 {
+        let cam = camera(20.0 + 2.0 * f as f64);
+        leap.frame(&cam);
+        if f == 0 {
+            continue;
+        }
+        let frame = cam.frame(SIZE, SIZE);
+        let segment = |x: i64, y: i64| {
+            let (x, y) = (x.clamp(0, SIZE as i64 - 1) as u32, y.clamp(0, SIZE as i64 - 1) as u32);
+            volgraph_accel::reference::ray_segment(&volume, &cam, &frame, x, y)
+        };
+        // Whether the rays of the (clamped) corners ±r around (x, y) all meet the box by more
+        // than a sliver, and whether one misses it.
+        let corners = |x: i64, y: i64, r: i64| {
+            let rays = [(-r, -r), (r, -r), (-r, r), (r, r)].map(|(dx, dy)| segment(x + dx, y + dy));
+            (rays.iter().all(|s| s.is_some_and(|s| s.len_tex > 1e-3)), rays.iter().any(Option::is_none))
+        };
+        let square_inside = |x: i64, y: i64| {
+            if corners(x, y, band + 1).0 {
+                Some(true)
+            } else if corners(x, y, band - 1).1 {
+                Some(false)
+            } else {
+                None
+            }
+        };
+        let (splats, start) = (leap.resource("splat.start"), leap.resource("holes.start"));
+        for y in 0..SIZE {
+            for x in 0..SIZE {
+                let Some(entry) = segment(x as i64, y as i64) else { continue };
+                let (splat, got) = (splats.rgba(x, y), start.rgba(x, y));
+                if splat[3] == 0.0 {
+                    continue;
+                }
+                let is_entry = (0..3).all(|c| (got[c] as f64 - entry.u0[c]).abs() < 1e-4) && got[3] == 1.0;
+                match square_inside(x as i64, y as i64) {
+                    Some(false) => {
+                        assert!(
+                            is_entry,
+                            "frame {f}, pixel ({x}, {y}) near the silhouette: start {got:?}, entry {:?}",
+                            entry.u0
+                        );
+                        overridden += (splat != got) as usize;
+                    }
+                    Some(true) => {
+                        assert_eq!(splat, got, "frame {f}, pixel ({x}, {y}) inside: the splat is its start");
+                        kept += 1;
+                    }
+                    None => {}
+                }
+            }
+        }
+    }
+    assert!(overridden > 0 && kept > 1000, "{overridden} splats near the silhouette replaced, {kept} kept");
+}
+
 #[test]
 fn scattered_splats_are_the_rasterized_quads() {
     let gpu = support::gpu();

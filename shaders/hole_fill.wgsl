@@ -8,7 +8,7 @@
 // in front of that hit.
 
 #import "common/frame.wgsl"
-#import "common/fullscreen.wgsl"
+#import "common/footprint.wgsl"
 #import "common/ray_box.wgsl"
 
 // Declared once: `HoleParams` (pass_params!) in crates/passes/src/hole_fill.rs,
@@ -20,7 +20,7 @@
 @group(0) @binding(auto) var<uniform> holes: HoleParams;
 // Per image row, the range [x0, x1] of the pixel centres lying inside the footprint (the pixels
 // whose ray meets the box) by a margin; x0 > x1 for none. The node computes it each frame from
-// the footprint's polygon (crates/passes/src/screen_footprint.rs).
+// the footprint's polygon (crates/core/src/runtime/footprint.rs).
 @group(0) @binding(auto) var<storage, read> footprint_rows: array<vec2<f32>>;
 
 // (u0, 1) where pixel `p`'s ray enters the box, (0,0,0,0) where it misses.

@@ -1,13 +1,14 @@
 // The single-pass fragment raycaster (Krüger & Westermann 2003 §2.1 "main passes" folded into
-// one loop, §2.2 for the isosurface): a screen-covering triangle marches each pixel's ray
+// one loop, §2.2 for the isosurface): the volume's screen footprint marches each pixel's ray
 // through the shared core (common/pixel_march.wgsl, common/raymarch.wgsl;
 // docs/rendering_model.md). Leaping over empty blocks, analytic rays, Klein et al. 2005's start
 // estimates and leap hits, and sample counting are compiled in by the pass's settings.
 //
-// Pipelines: `vs_fullscreen` + `fs_dvr` → `color`; `fs_iso` → `color`, `hit`;
+// Pipelines: `vs_footprint` (the volume's screen footprint, common/footprint.wgsl) + `fs_dvr` →
+// `color`; `fs_iso` → `color`, `hit`;
 // `fs_dvr_leap` / `fs_iso_leap` (LEAP_HITS) → `color`, `leap_hit`.
 
-#import "common/fullscreen.wgsl"
+#import "common/footprint.wgsl"
 #import "common/pixel_march.wgsl"
 
 struct DvrOut {

@@ -47,6 +47,15 @@ struct Frame {
     crop_lo: vec4<f32>,
     crop_hi: vec4<f32>,
     clip_planes: array<vec4<f32>, 6>,
+    // The volume's screen footprint grown by a pixel (crates/core/src/runtime/footprint.rs): the
+    // vertices of a convex polygon in pixels, two per entry (xy, zw), that vs_footprint
+    // (common/footprint.wgsl) draws; footprint_vertices of them, 0 for none, 0xffffffff for the
+    // whole viewport.
+    footprint: array<vec4<f32>, 6>,
+    footprint_vertices: u32,
+    _pad2: u32,
+    _pad3: u32,
+    _pad4: u32,
 }
 
 @group(0) @binding(auto) var<uniform> frame: Frame;

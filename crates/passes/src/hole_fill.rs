@@ -7,7 +7,7 @@
 //! a k×k splat can carry a neighbour's hit across the silhouette into a pixel whose ray, newly
 //! in view, meets the box in front of that hit (`crates/passes/tests/klein_2005.rs` tests the
 //! rule). Whether a pixel is that close comes from the footprint's convex polygon, which the
-//! node turns into one span per image row each frame (`screen_footprint`). Reads the splats'
+//! node turns into one span per image row each frame (`volgraph_core::runtime::footprint`). Reads the splats'
 //! `splats` start target, writes `start`. Shader: `shaders/hole_fill.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
@@ -15,7 +15,7 @@ use volgraph_core::runtime::{
     CreateContext, FrameUniforms, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec, UniformBlocks,
 };
 
-use crate::screen_footprint::footprint;
+use volgraph_core::runtime::footprint::footprint;
 use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
@@ -38,7 +38,7 @@ fn shader() -> ShaderUse {
 }
 
 /// How far inside the footprint (pixels) a pixel centre must lie for its row's span
-/// (`screen_footprint`): the polygon is exact in f64 and the shader meets rays with the box in
+/// (`volgraph_core::runtime::footprint`): the polygon is exact in f64 and the shader meets rays with the box in
 /// f32, whose rounding moves a silhouette by far less than this at any viewport the GPU can hold.
 const FOOTPRINT_MARGIN: f64 = 1.0 / 64.0;
 
@@ -78,7 +78,7 @@ impl PassDecl for HoleFill {
 impl PassPlugin for HoleFill {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let shader = shader();
-        let pipeline = ctx.render_pipeline(&RenderPipelineSpec::fullscreen(&shader))?;
+        let pipeline = ctx.render_pipeline(&RenderPipelineSpec::footprint(&shader))?;
         let uniforms = UniformBlocks::create(ctx, &[shader]);
         Ok(Box::new(HoleFillNode { pipeline, uniforms, rows: None }))
     }
@@ -119,7 +119,7 @@ impl PassNode for HoleFillNode {
         let mut bindings = self.uniforms.bindings();
         bindings.push(("footprint_rows", rows.as_entire_binding()));
         let bg = ctx.bind_group(&self.pipeline, &bindings)?;
-        ctx.draw_fullscreen(&self.pipeline, &bg)
+        ctx.draw_footprint(&self.pipeline, &bg)
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {

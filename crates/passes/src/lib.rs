@@ -23,7 +23,6 @@ pub mod raycast_compute;
 pub mod raycast_params;
 pub mod raycast_segment;
 pub mod reprojection_splat;
-pub mod screen_footprint;
 pub mod segment_init;
 pub mod shared;
 pub mod slice_render;

@@ -135,7 +135,7 @@ impl PassPlugin for Raycast {
             ctx.render_pipeline(&RenderPipelineSpec {
                 defines: &defines,
                 constants: &leaping.constants(),
-                ..RenderPipelineSpec::fullscreen(&own)
+                ..RenderPipelineSpec::footprint(&own)
             })
         };
         let wired = ctx.wired();
@@ -267,7 +267,7 @@ impl PassNode for RaycastNode {
             _ => &self.pipeline,
         };
         let bg = ctx.bind_group(pipeline, &extra)?;
-        ctx.draw_fullscreen(pipeline, &bg)
+        ctx.draw_footprint(pipeline, &bg)
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {

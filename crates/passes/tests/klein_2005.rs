@@ -163,7 +163,7 @@ fn hole_filling_leaves_no_pixel_of_the_footprint_without_a_start() {
 }
 
 /// §4.4's silhouette rule, as the hole fill applies it from the footprint's row spans
-/// (`volgraph_passes::screen_footprint`): a pixel within `silhouette_band` pixels of a pixel
+/// (`volgraph_core::runtime::footprint`): a pixel within `silhouette_band` pixels of a pixel
 /// whose ray misses the box starts at the box's front face — its entry, not the splat that
 /// landed on it — and a pixel deeper inside keeps its splat. The footprint comes from the CPU
 /// reference's rays (f64). The square of corners ±band pixels is inside when the one a pixel

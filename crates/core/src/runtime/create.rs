@@ -101,10 +101,23 @@ impl<'a> RenderPipelineSpec<'a> {
             ..Default::default()
         }
     }
+
+    /// The pipeline drawing a declared fragment entry point over the volume's screen footprint
+    /// (`vs_footprint` of `shaders/common/footprint.wgsl`, which the shader file imports), for
+    /// [`RecordContext::draw_footprint`](super::RecordContext::draw_footprint): the fragment
+    /// stage must write zeros wherever a pixel's ray misses the box, as the pixels outside the
+    /// fan read the targets' clear value.
+    pub fn footprint(declared: &ShaderUse) -> Self {
+        Self { vertex: FOOTPRINT_VERTEX, cull: None, ..Self::fullscreen(declared) }
+    }
 }
 
 /// The vertex entry point of the screen-covering triangle (`shaders/common/fullscreen.wgsl`).
 pub const FULLSCREEN_VERTEX: &str = "vs_fullscreen";
+
+/// The vertex entry point of the volume's screen footprint, a fan of triangles
+/// (`shaders/common/footprint.wgsl`, [`super::footprint`]).
+pub const FOOTPRINT_VERTEX: &str = "vs_footprint";
 
 /// The compiled pipeline of a pass with its reflected bindings; cheap to clone. Typed by what
 /// it is: [`RenderPassPipeline`] from [`CreateContext::render_pipeline`], [`ComputePassPipeline`]
@@ -392,13 +405,13 @@ impl<'a> CreateContext<'a> {
         let r = reflect(&shader.module, &shader.info, &[spec.vertex, spec.fragment])
             .map_err(|e| self.error(format!("{} {e}", spec.shader)))?;
         // A vertex stage that binds anything (the frame, a point texture) is declared like the
-        // fragment stage, so `volgraph plan` checks it too; one that binds nothing (the
-        // fullscreen triangle) needs no declaration.
+        // fragment stage, so `volgraph plan` checks it too; the runtime's own need no
+        // declaration: the fullscreen triangle binds nothing, the footprint fan only `frame`.
         let vertex = reflect(&shader.module, &shader.info, &[spec.vertex])
             .map_err(|e| self.error(format!("{} {e}", spec.shader)))?;
         let mut extra: Vec<&str> = declared.node_bindings();
         self.check_uniforms(spec.shader, &shader.module, declared)?;
-        if !vertex.bindings.is_empty() {
+        if !vertex.bindings.is_empty() && spec.vertex != FOOTPRINT_VERTEX {
             let vertex_use = self.declared_use(spec.shader, spec.vertex)?;
             extra.extend(vertex_use.node_bindings());
             self.check_uniforms(spec.shader, &shader.module, vertex_use)?;

@@ -8,6 +8,8 @@ use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::cuts::{Cuts, MAX_CLIP_PLANES};
 use volgraph_accel::volume::Volume;
 
+use super::footprint::{Coverage, FAN_VERTICES};
+
 /// One frame's camera, as both the GPU passes and the f64 reference use it
 /// (`docs/rendering_model.md`, "Camera").
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -326,9 +328,26 @@ pub struct FrameUniforms {
     /// The scene's clip planes in the bound texture's coordinates: keep `u` with
     /// `dot(xyz, u) >= w`; unused planes are `(0, 0, 0, -1)`. Read under `#if CLIP`.
     pub clip_planes: [[f32; 4]; MAX_CLIP_PLANES],
+    /// The screen footprint of the volume grown by [`FOOTPRINT_GROW`] pixels
+    /// ([`super::footprint`]): the vertices of a convex polygon in pixels (row 0 at the top),
+    /// two per entry (xy, zw), that a footprint draw covers with a fan of triangles.
+    pub footprint: [[f32; 4]; FAN_VERTICES / 2],
+    /// How many `footprint` vertices there are; 0: no pixel's ray meets the box;
+    /// [`FOOTPRINT_WHOLE`]: the draw covers the whole viewport.
+    pub footprint_vertices: u32,
+    /// Padding to 16 bytes.
+    pub _pad_footprint: [u32; 3],
 }
 
-const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 544);
+const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 656);
+
+/// [`FrameUniforms::footprint_vertices`] of a footprint draw that covers the whole viewport.
+pub const FOOTPRINT_WHOLE: u32 = u32::MAX;
+
+/// How far (pixels) a footprint draw's polygon lies outside the footprint: rays through pixel
+/// centres, met with the box in f32, leave it by far less, so the rasterizer covers every
+/// pixel whose ray meets the box.
+pub const FOOTPRINT_GROW: f64 = 1.0;
 
 /// A plane that keeps every point (fills the unused clip-plane slots).
 const KEEP_ALL: [f32; 4] = [0.0, 0.0, 0.0, -1.0];
@@ -375,8 +394,28 @@ impl FrameUniforms {
             crop_lo: with_w(grid.0, 0.0),
             crop_hi: with_w(grid.1, 0.0),
             clip_planes: [KEEP_ALL; MAX_CLIP_PLANES],
+            footprint: [[0.0; 4]; FAN_VERTICES / 2],
+            footprint_vertices: FOOTPRINT_WHOLE,
+            _pad_footprint: [0; 3],
         }
         .with_cuts(&frame.cuts, grid)
+        .with_footprint()
+    }
+
+    /// The footprint of the rays, boxes and cuts already set ([`super::footprint`]).
+    fn with_footprint(mut self) -> Self {
+        match super::footprint::footprint(&self).coverage(FOOTPRINT_GROW) {
+            Coverage::Nothing => self.footprint_vertices = 0,
+            Coverage::Whole => self.footprint_vertices = FOOTPRINT_WHOLE,
+            Coverage::Polygon(vertices) => {
+                for (i, v) in vertices.iter().enumerate() {
+                    self.footprint[i / 2][2 * (i % 2)] = v.x as f32;
+                    self.footprint[i / 2][2 * (i % 2) + 1] = v.y as f32;
+                }
+                self.footprint_vertices = vertices.len() as u32;
+            }
+        }
+        self
     }
 
     /// The cuts (volume fractions of the whole volume) in the bound texture's coordinates, where

@@ -13,6 +13,7 @@
 mod bypass;
 pub mod create;
 pub use volgraph_compiler::reflect;
+pub mod footprint;
 pub mod frame;
 pub mod frames;
 pub mod gpu;
@@ -34,12 +35,12 @@ use std::time::Instant;
 
 pub use bypass::BypassStatus;
 pub use create::{
-    ComputePassPipeline, ComputePipelineSpec, CreateContext, DepthSpec, FULLSCREEN_VERTEX, PassError, PassPipeline,
-    PipelineCache, PipelineKind, PortInfo, RenderPassPipeline, RenderPipelineSpec,
+    ComputePassPipeline, ComputePipelineSpec, CreateContext, DepthSpec, FOOTPRINT_VERTEX, FULLSCREEN_VERTEX, PassError,
+    PassPipeline, PipelineCache, PipelineKind, PortInfo, RenderPassPipeline, RenderPipelineSpec,
 };
 pub use frame::{
-    BLOCK_SIZE, CameraData, FrameData, FrameUniforms, LONGEST_RAY_VOXELS, OpacityReference, PixelRays, VolumeDesc,
-    VolumeWindow, WindowBoxes, scene_values_of,
+    BLOCK_SIZE, CameraData, FOOTPRINT_GROW, FOOTPRINT_WHOLE, FrameData, FrameUniforms, LONGEST_RAY_VOXELS,
+    OpacityReference, PixelRays, VolumeDesc, VolumeWindow, WindowBoxes, scene_values_of,
 };
 pub use frames::{FrameStats, MAX_FRAMES_IN_FLIGHT};
 pub use gpu::{Gpu, GpuError, GpuFault, GpuFaultKind, GpuOptions};

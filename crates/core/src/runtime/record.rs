@@ -317,6 +317,22 @@ impl<'a> RecordContext<'a> {
         Ok(())
     }
 
+    /// Draws a pipeline of [`RenderPipelineSpec::footprint`](super::RenderPipelineSpec::footprint) over this frame's screen footprint
+    /// of the volume ([`super::footprint`]): its Write ports are cleared to zeros and only the
+    /// fragments inside the footprint (grown by a pixel) run — the same image as the fullscreen
+    /// triangle for a fragment stage that writes zeros where a pixel's ray misses the box.
+    pub fn draw_footprint(
+        &mut self,
+        pipeline: &RenderPassPipeline,
+        bind_group: &wgpu::BindGroup,
+    ) -> Result<(), PassError> {
+        let mut pass = self.begin_render_pass_over(pipeline, None, false)?;
+        pass.set_pipeline(&pipeline.pipeline);
+        pass.set_bind_group(0, bind_group, &[]);
+        pass.draw(0..super::footprint::FAN_DRAW_VERTICES, 0..1);
+        Ok(())
+    }
+
     /// `begin_render_pass`; `overwritten`: the draw writes every pixel of the Write ports, so
     /// they are loaded (their old content never shows) instead of cleared.
     fn begin_render_pass_over(

@@ -2,16 +2,42 @@
 //! are met with (`shaders/common/ray_box.wgsl` `analytic_ray`: the grid box, cut to a sort-last
 //! window's own box, the scene's crop box and clip planes, past the near plane) — the projection
 //! of a convex body, so a convex polygon, computed once per frame on the CPU from the frame's
-//! uniform block, and handed to the GPU as one span per image row. `hole_fill` asks it whether a
-//! pixel lies near the footprint's edge with two reads where it used to meet four corner rays
-//! with the box (Klein et al. 2005 §4.4; bench/one-march-final.md, "Hole fill's footprint").
+//! uniform block. Two uses:
+//! - the frame block carries it, grown by a pixel, as a fan of triangles
+//!   ([`FrameUniforms::footprint`], `shaders/common/footprint.wgsl`): a fragment pass whose
+//!   pixels without a ray write zeros draws that instead of the screen
+//!   ([`super::RecordContext::draw_footprint`]), so no fragment outside it runs — on llvmpipe,
+//!   which runs every line of a shader for every pixel it draws, that is most of a raycast's
+//!   fixed cost (bench/one-march-final.md, "Footprint draws");
+//! - `hole_fill` takes one span per image row ([`Footprint::row_spans`]) and asks whether a
+//!   pixel lies near the footprint's edge with two reads where it used to meet four corner rays
+//!   with the box (Klein et al. 2005 §4.4).
 //!
 //! Everything happens in the texture space of the shaders: image point (x, y) (pixel centres at
 //! +0.5) looks along `base + x·dx + y·dy` from the eye (`FrameUniforms::ray_*_texture`), so a
 //! point p lies on the ray of (x, y) at parameter t where `[base dx dy]·(t, t·x, t·y) = p − eye`.
 
 use glam::{DMat3, DVec2, DVec3};
-use volgraph_core::runtime::FrameUniforms;
+
+use super::FrameUniforms;
+
+/// The most vertices of the polygon a footprint draw takes (`FOOTPRINT_FAN_VERTICES` in
+/// `shaders/common/footprint.wgsl`); one with more draws the whole viewport.
+pub const FAN_VERTICES: usize = 12;
+
+/// The vertices a footprint draw takes: a fan of `FAN_VERTICES - 2` triangles.
+pub const FAN_DRAW_VERTICES: u32 = 3 * (FAN_VERTICES as u32 - 2);
+
+/// What a footprint draw covers.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Coverage {
+    /// No pixel: no ray meets the box.
+    Nothing,
+    /// The convex polygon of these vertices (pixels, in order around it).
+    Polygon(Vec<DVec2>),
+    /// The whole viewport (a footprint not computed, or of more than [`FAN_VERTICES`] vertices).
+    Whole,
+}
 
 /// A frame's footprint.
 #[derive(Clone, Debug, PartialEq)]
@@ -26,6 +52,33 @@ pub enum Footprint {
 }
 
 impl Footprint {
+    /// The polygon grown by `grow` pixels (every edge moved out by it), for a footprint draw:
+    /// every pixel centre inside the footprint lies inside it by `grow`, so the rasterizer covers
+    /// it whatever its rounding.
+    pub fn coverage(&self, grow: f64) -> Coverage {
+        let edges = match self {
+            Footprint::Polygon(edges) => edges,
+            Footprint::Nothing => return Coverage::Nothing,
+            Footprint::Unknown => return Coverage::Whole,
+        };
+        let mut vertices = Vec::with_capacity(edges.len());
+        for (i, &[a0, b0, c0]) in edges.iter().enumerate() {
+            let [a1, b1, c1] = edges[(i + 1) % edges.len()];
+            // The corner the two grown edges meet at: a·x + b·y + c + grow = 0 for both.
+            let det = a0 * b1 - a1 * b0;
+            if det.abs() < 1e-12 {
+                continue;
+            }
+            let (r0, r1) = (-(c0 + grow), -(c1 + grow));
+            vertices.push(DVec2::new((r0 * b1 - r1 * b0) / det, (a0 * r1 - a1 * r0) / det));
+        }
+        // Far corners (an eye at the box) would lose f32 precision; they lie off screen anyway.
+        if vertices.len() > FAN_VERTICES || vertices.iter().any(|v| !(v.abs().max_element() < 1.0e6)) {
+            return Coverage::Whole;
+        }
+        Coverage::Polygon(vertices)
+    }
+
     /// For each of `rows` image rows, the x range `[x0, x1]` of its pixel centres' line
     /// (y = row + 0.5) lying at least `margin` pixels inside the polygon; `x0 > x1` where none
     /// does (every row of [`Footprint::Nothing`] and [`Footprint::Unknown`]).
@@ -73,7 +126,8 @@ fn box_faces(lo: DVec3, hi: DVec3) -> impl Iterator<Item = HalfSpace> {
     })
 }
 
-/// The footprint of the frame whose uniform block is `u`.
+/// The footprint of the frame whose uniform block is `u` (its rays, boxes and cuts; the
+/// footprint fields are not read).
 pub fn footprint(u: &FrameUniforms) -> Footprint {
     let near = u.camera_forward[3] as f64;
     let eye = v3(u.eye_texture);
@@ -178,7 +232,8 @@ mod tests {
     use super::*;
     use glam::UVec3;
     use volgraph_accel::camera::OrbitCamera;
-    use volgraph_core::runtime::{CameraData, FrameData, VolumeDesc};
+
+    use crate::runtime::{CameraData, FrameData, VolumeDesc};
 
     fn frame(orbit: OrbitCamera, viewport: (u32, u32)) -> FrameData {
         let data = volgraph_accel::volume::VoxelData::U8(vec![0; 40 * 30 * 20]);
@@ -270,5 +325,32 @@ mod tests {
         }
         assert_eq!(footprint(&u), Footprint::Nothing);
         assert!(Footprint::Nothing.row_spans(3, 0.01).iter().all(|[x0, x1]| x0 > x1));
+    }
+
+    /// The grown polygon holds every pixel centre whose ray meets the box by a pixel's margin:
+    /// each of its edges lies a pixel out from an edge of the footprint.
+    #[test]
+    fn the_grown_polygon_lies_a_pixel_outside_the_footprint() {
+        let viewport = (96, 64);
+        for (azimuth, elevation, distance) in [(30.0, 20.0, 3.2), (200.0, -60.0, 1.2), (10.0, 5.0, 0.9)] {
+            let orbit = OrbitCamera { azimuth_deg: azimuth, elevation_deg: elevation, distance, ..Default::default() };
+            let u = FrameUniforms::of(&frame(orbit, viewport));
+            let polygon = footprint(&u);
+            let Footprint::Polygon(edges) = &polygon else { panic!("{orbit:?}: in view") };
+            let Coverage::Polygon(grown) = polygon.coverage(1.0) else { panic!("{orbit:?}: a polygon") };
+            assert_eq!(grown.len(), edges.len(), "{orbit:?}");
+            for v in &grown {
+                // Each grown corner lies a pixel out from the two edges it moved, and outside none.
+                let distances: Vec<f64> = edges.iter().map(|e| e[0] * v.x + e[1] * v.y + e[2]).collect();
+                assert_eq!(
+                    distances.iter().filter(|d| (**d + 1.0).abs() < 1e-9).count(),
+                    2,
+                    "{orbit:?}: {distances:?}"
+                );
+                assert!(distances.iter().all(|d| *d >= -1.0 - 1e-9), "{orbit:?}: {distances:?}");
+            }
+        }
+        assert_eq!(Footprint::Nothing.coverage(1.0), Coverage::Nothing);
+        assert_eq!(Footprint::Unknown.coverage(1.0), Coverage::Whole);
     }
 }

@@ -49,9 +49,8 @@ fn segment_is_empty(s: Samples, index: u32) -> bool {
 // is written, so the depth test stays early.
 @vertex
 fn vs_terminate_alpha(@builtin(vertex_index) vertex_index: u32, @builtin(instance_index) instance: u32) -> SegmentVertex {
-    let x = f32((vertex_index & 1u) << 2u) - 1.0;
-    let y = f32((vertex_index & 2u) << 1u) - 1.0;
-    return SegmentVertex(vec4<f32>(x, y, TERMINATED, 1.0), instance);
+    let p = footprint_position(vertex_index);
+    return SegmentVertex(vec4<f32>(p.xy, TERMINATED, 1.0), instance);
 }
 
 @fragment

@@ -19,22 +19,28 @@ fn footprint_vertex(k: u32) -> vec2<f32> {
     return select(pair.xy, pair.zw, (k & 1u) == 1u);
 }
 
-// Vertex `vertex_index` (0..30) of the fan: triangle t = vertex_index / 3 is (0, t + 1, t + 2);
-// triangles past the polygon collapse to a point, which the rasterizer drops. A footprint
-// wider than the fan draws the fullscreen triangle as triangle 0.
-@vertex
-fn vs_footprint(@builtin(vertex_index) vertex_index: u32) -> FullscreenVertex {
+// Clip position (depth 0) of vertex `vertex_index` (0..30) of the fan: triangle
+// t = vertex_index / 3 is (0, t + 1, t + 2); triangles past the polygon collapse to a point,
+// which the rasterizer drops. A footprint wider than the fan draws the fullscreen triangle as
+// triangle 0. Passes that draw at a depth of their own (KW03's segments and termination test)
+// take the position from here.
+fn footprint_position(vertex_index: u32) -> vec4<f32> {
     let n = frame.footprint_vertices;
     let t = vertex_index / 3u;
     let corner = vertex_index % 3u;
     let collapsed = vec4<f32>(-2.0, -2.0, 0.0, 1.0);
     if (n > FOOTPRINT_FAN_VERTICES) {
-        return FullscreenVertex(select(collapsed, fullscreen_position(corner), t == 0u));
+        return select(collapsed, fullscreen_position(corner), t == 0u);
     }
     if (t + 2u >= n) {
-        return FullscreenVertex(collapsed);
+        return collapsed;
     }
     let p = footprint_vertex(select(t + corner, 0u, corner == 0u));
     let ndc = vec2<f32>(2.0 * p.x * frame.viewport.z - 1.0, 1.0 - 2.0 * p.y * frame.viewport.w);
-    return FullscreenVertex(vec4<f32>(ndc, 0.0, 1.0));
+    return vec4<f32>(ndc, 0.0, 1.0);
+}
+
+@vertex
+fn vs_footprint(@builtin(vertex_index) vertex_index: u32) -> FullscreenVertex {
+    return FullscreenVertex(footprint_position(vertex_index));
 }

@@ -5,11 +5,13 @@
 // raycast_segment_counted.wgsl (the same with an invocation counter) and termination_test.wgsl
 // (the intermediate pass deciding whether the next segment runs).
 //
-// Segments are drawn as one screen-covering triangle at depth SEGMENT_DEPTH with the segment
-// index as the instance index (draw(0..3, i..i+1)), so one node records every iteration without
-// per-iteration uniform buffers.
+// Segments are drawn over the volume's screen footprint (common/footprint.wgsl: a fan of
+// triangles, the pixels outside it have no ray and keep RES at zero) at depth SEGMENT_DEPTH with
+// the segment index as the instance index (draw(0..30, i..i+1)), so one node records every
+// iteration without per-iteration uniform buffers.
 
 #import "common/frame.wgsl"
+#import "common/footprint.wgsl"
 #import "common/raymarch.wgsl"
 #import "common/pixel_ray.wgsl"
 
@@ -43,12 +45,11 @@ struct SegmentVertex {
     @location(0) @interpolate(flat) index: u32,
 }
 
-// One screen-covering triangle at SEGMENT_DEPTH carrying the segment index.
+// The footprint's fan at SEGMENT_DEPTH carrying the segment index.
 @vertex
 fn vs_segment(@builtin(vertex_index) vertex_index: u32, @builtin(instance_index) instance: u32) -> SegmentVertex {
-    let x = f32((vertex_index & 1u) << 2u) - 1.0;
-    let y = f32((vertex_index & 2u) << 1u) - 1.0;
-    return SegmentVertex(vec4<f32>(x, y, SEGMENT_DEPTH, 1.0), instance);
+    let p = footprint_position(vertex_index);
+    return SegmentVertex(vec4<f32>(p.xy, SEGMENT_DEPTH, 1.0), instance);
 }
 
 // The samples of a pixel's ray (the single-pass raycaster's).

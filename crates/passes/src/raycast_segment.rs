@@ -19,6 +19,7 @@
 use std::sync::{Arc, Mutex};
 
 use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::footprint::FAN_DRAW_VERTICES;
 use volgraph_core::runtime::{
     CreateContext, DepthSpec, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
 };
@@ -284,7 +285,7 @@ impl PassNode for RaycastSegmentNode {
         let mut pass = ctx.begin_render_pass(pipeline, None)?;
         pass.set_pipeline(&pipeline.pipeline);
         pass.set_bind_group(0, &bg, &[]);
-        pass.draw(0..3, index..index + 1);
+        pass.draw(0..FAN_DRAW_VERTICES, index..index + 1);
         Ok(())
     }
 }

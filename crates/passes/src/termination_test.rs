@@ -15,6 +15,7 @@
 //! pass's. Shader: `shaders/termination_test.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::footprint::FAN_DRAW_VERTICES;
 use volgraph_core::runtime::{
     CreateContext, DepthSpec, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
 };
@@ -127,7 +128,7 @@ impl PassNode for TerminationTestNode {
         let mut pass = ctx.begin_render_pass(pipeline, None)?;
         pass.set_pipeline(&pipeline.pipeline);
         pass.set_bind_group(0, &bg, &[]);
-        pass.draw(0..3, next..next + 1);
+        pass.draw(0..FAN_DRAW_VERTICES, next..next + 1);
         Ok(())
     }
 }

@@ -383,18 +383,36 @@ fn early_z_rejects_terminated_fragments_before_the_segment_shader_runs() {
     let rc = render_with(&gpu, &registry, "kruger_westermann_2003/rc.ron", &v, &l, &CAMERA, &opts);
     let segments = rc.plan.steps.iter().filter(|s| s.pass_id == "march").count() as u64;
     let without = counter.read(&gpu).expect("counter") as u64;
-    let pixels = (SIZE * SIZE) as u64;
-    assert_eq!(without, pixels * segments, "without the termination test every fragment of every segment runs");
+    // Segments draw the volume's screen footprint grown by a pixel (`draw_footprint`'s fan):
+    // every pixel whose ray meets the box, and none further than two pixels from one.
+    let frame = CAMERA.frame(SIZE, SIZE);
+    let has_ray: Vec<bool> =
+        (0..SIZE * SIZE).map(|i| ray_segment(&v, &CAMERA, &frame, i % SIZE, i / SIZE).is_some()).collect();
+    let near_a_ray = |x: u32, y: u32| {
+        let (x0, x1, y0, y1) = (x.saturating_sub(2), (x + 2).min(SIZE - 1), y.saturating_sub(2), (y + 2).min(SIZE - 1));
+        (y0..=y1).any(|yy| (x0..=x1).any(|xx| has_ray[(yy * SIZE + xx) as usize]))
+    };
+    let rays = has_ray.iter().filter(|&&r| r).count() as u64;
+    let near = (0..SIZE * SIZE).filter(|i| near_a_ray(i % SIZE, i / SIZE)).count() as u64;
+    assert_eq!(without % segments, 0, "without the termination test every fragment drawn runs in every segment");
+    let drawn = without / segments;
+    assert!(
+        (rays..=near).contains(&drawn) && near < (SIZE * SIZE) as u64,
+        "{drawn} pixels drawn per segment: every one of the {rays} with a ray, none beyond the {near} near one"
+    );
 
     let rc_a = render_with(&gpu, &registry, "kruger_westermann_2003/rc_a.ron", &v, &l, &CAMERA, &opts);
     let with = counter.read(&gpu).expect("counter") as u64;
     let t = rc_a.plan.steps.iter().find(|s| s.pass_id == "terminate").expect("terminate").params.float("threshold");
     let m = rc_a.plan.steps.iter().find(|s| s.pass_id == "terminate").expect("terminate").params.uint("segment_steps")
         as u32;
+    // The drawn pixels without a ray run segment 0 only (the test then finds no sample left).
     let expected: u64 = (0..SIZE)
         .flat_map(|y| (0..SIZE).map(move |x| (x, y)))
+        .filter(|&(x, y)| has_ray[(y * SIZE + x) as usize])
         .map(|(x, y)| live_segments(&v, &l, &CAMERA, x, y, m, segments as u32, t) as u64)
-        .sum();
+        .sum::<u64>()
+        + (drawn - rays);
     eprintln!(
         "segment fragments: {without} without termination, {with} with (expected {expected}), {segments} segments"
     );

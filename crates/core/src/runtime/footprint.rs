@@ -73,7 +73,8 @@ impl Footprint {
             vertices.push(DVec2::new((r0 * b1 - r1 * b0) / det, (a0 * r1 - a1 * r0) / det));
         }
         // Far corners (an eye at the box) would lose f32 precision; they lie off screen anyway.
-        if vertices.len() > FAN_VERTICES || vertices.iter().any(|v| !(v.abs().max_element() < 1.0e6)) {
+        let far = |v: &DVec2| !v.is_finite() || v.abs().max_element() >= 1.0e6;
+        if vertices.len() > FAN_VERTICES || vertices.iter().any(far) {
             return Coverage::Whole;
         }
         Coverage::Polygon(vertices)

@@ -1,9 +1,12 @@
-"""Before/after tables of stop39-tables/run.sh: per preset, each row's ms and in-run ratio on the
-old (05041dd) and new side; rounds given as PRESET-SIDE[-N].json."""
+"""Before/after tables of stop39-tables/run.sh (and, given its folder as the argument, of
+stop40-tables/run.sh): per preset, each row's ms and in-run ratio on the old (05041dd) and new
+side; rounds given as PRESET-SIDE[-N].json."""
 import glob, json, os, sys
 
-here = os.path.dirname(os.path.abspath(__file__))
-for preset in ['klein2005', 'ruijters2006', 'thesis-tables']:
+here = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
+for preset in ['klein2005', 'kw2003-table1', 'ruijters2006', 'thesis-tables', 'peer']:
+    if not glob.glob(f'{here}/{preset}-*.json'):
+        continue
     runs = {}
     for side in ['old', 'new']:
         for f in sorted(glob.glob(f'{here}/{preset}-{side}*.json'), key=lambda p: (len(p), p)):

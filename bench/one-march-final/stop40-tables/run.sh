@@ -2,7 +2,7 @@
 # Stop 40's before/after in one run: the release binary of 05041dd (before the fold, its own
 # checkout, graphs and shaders: bench/one-march.sh builds it) against this checkout's, preset by
 # preset at the presets' own settings but for the sample counts (--spp-size 0 --no-gpu-count:
-# ms/frame and ratios only), the sides alternating.
+# ms/frame and ratios only), the sides alternating. Tables: python3 stop39-tables/table.py stop40-tables.
 set -u
 export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp/xdg-root} VOLGRAPH_DATA=${VOLGRAPH_DATA:-/work/shared/data}
 root=$(pwd)

@@ -7,15 +7,15 @@
 //! a k×k splat can carry a neighbour's hit across the silhouette into a pixel whose ray, newly
 //! in view, meets the box in front of that hit (`crates/passes/tests/klein_2005.rs` tests the
 //! rule). Whether a pixel is that close comes from the footprint's convex polygon, which the
-//! node turns into one span per image row each frame (`volgraph_core::runtime::footprint`). Reads the splats'
-//! `splats` start target, writes `start`. Shader: `shaders/hole_fill.wgsl`.
+//! node turns into one span per image row each frame (`volgraph_core::runtime::footprint`;
+//! the frame block holds the same polygon grown, for the draw). Reads the splats' `splats`
+//! start target, writes `start`. Shader: `shaders/hole_fill.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
+use volgraph_core::runtime::footprint::footprint;
 use volgraph_core::runtime::{
     CreateContext, FrameUniforms, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec, UniformBlocks,
 };
-
-use volgraph_core::runtime::footprint::footprint;
 use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 /// The plugin.
@@ -38,8 +38,9 @@ fn shader() -> ShaderUse {
 }
 
 /// How far inside the footprint (pixels) a pixel centre must lie for its row's span
-/// (`volgraph_core::runtime::footprint`): the polygon is exact in f64 and the shader meets rays with the box in
-/// f32, whose rounding moves a silhouette by far less than this at any viewport the GPU can hold.
+/// (`volgraph_core::runtime::footprint`): the polygon is exact in f64 and the shader meets rays
+/// with the box in f32, whose rounding moves a silhouette by far less than this at any viewport
+/// the GPU can hold.
 const FOOTPRINT_MARGIN: f64 = 1.0 / 64.0;
 
 impl PassDecl for HoleFill {

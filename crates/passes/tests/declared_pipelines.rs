@@ -4,7 +4,7 @@
 //! nothing else but the fullscreen triangle's vertex stage (which binds nothing).
 
 use volgraph_core::runtime::schedule::port_infos;
-use volgraph_core::runtime::{CreateContext, FOOTPRINT_VERTEX, FULLSCREEN_VERTEX, PipelineCache, ShaderLibrary};
+use volgraph_core::runtime::{CreateContext, PipelineCache, RUNTIME_VERTEX_STAGES, ShaderLibrary};
 use volgraph_core::{CompileOptions, compile};
 use volgraph_passes::{builtin_registry, builtin_shaders};
 
@@ -87,8 +87,7 @@ fn every_pass_builds_exactly_the_shaders_it_declares() {
                 }
                 // Vertex stages are declared like the others, but for the runtime's own: the
                 // fullscreen triangle, which binds nothing, and the footprint fan (`frame`).
-                let runtime_vertex = |e: &str| e == FULLSCREEN_VERTEX || e == FOOTPRINT_VERTEX;
-                for b in built.difference(&declared).filter(|(_, e)| !runtime_vertex(e)) {
+                for b in built.difference(&declared).filter(|(_, e)| !RUNTIME_VERTEX_STAGES.contains(&e.as_str())) {
                     failures.push(format!(
                         "{} {features:?}: {} builds {b:?} without declaring it",
                         path.display(),

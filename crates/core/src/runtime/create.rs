@@ -119,6 +119,10 @@ pub const FULLSCREEN_VERTEX: &str = "vs_fullscreen";
 /// (`shaders/common/footprint.wgsl`, [`super::footprint`]).
 pub const FOOTPRINT_VERTEX: &str = "vs_footprint";
 
+/// The runtime's own vertex stages, which a pass uses without declaring them in `shaders()`: the
+/// fullscreen triangle binds nothing, the footprint fan only the system binding `frame`.
+pub const RUNTIME_VERTEX_STAGES: [&str; 2] = [FULLSCREEN_VERTEX, FOOTPRINT_VERTEX];
+
 /// The compiled pipeline of a pass with its reflected bindings; cheap to clone. Typed by what
 /// it is: [`RenderPassPipeline`] from [`CreateContext::render_pipeline`], [`ComputePassPipeline`]
 /// from [`CreateContext::compute_pipeline`], so a render pipeline cannot be dispatched (or a
@@ -406,12 +410,12 @@ impl<'a> CreateContext<'a> {
             .map_err(|e| self.error(format!("{} {e}", spec.shader)))?;
         // A vertex stage that binds anything (the frame, a point texture) is declared like the
         // fragment stage, so `volgraph plan` checks it too; the runtime's own need no
-        // declaration: the fullscreen triangle binds nothing, the footprint fan only `frame`.
+        // declaration (`RUNTIME_VERTEX_STAGES`).
         let vertex = reflect(&shader.module, &shader.info, &[spec.vertex])
             .map_err(|e| self.error(format!("{} {e}", spec.shader)))?;
         let mut extra: Vec<&str> = declared.node_bindings();
         self.check_uniforms(spec.shader, &shader.module, declared)?;
-        if !vertex.bindings.is_empty() && spec.vertex != FOOTPRINT_VERTEX {
+        if !vertex.bindings.is_empty() && !RUNTIME_VERTEX_STAGES.contains(&spec.vertex) {
             let vertex_use = self.declared_use(spec.shader, spec.vertex)?;
             extra.extend(vertex_use.node_bindings());
             self.check_uniforms(spec.shader, &shader.module, vertex_use)?;

@@ -36,7 +36,7 @@ use std::time::Instant;
 pub use bypass::BypassStatus;
 pub use create::{
     ComputePassPipeline, ComputePipelineSpec, CreateContext, DepthSpec, FOOTPRINT_VERTEX, FULLSCREEN_VERTEX, PassError,
-    PassPipeline, PipelineCache, PipelineKind, PortInfo, RenderPassPipeline, RenderPipelineSpec,
+    PassPipeline, PipelineCache, PipelineKind, PortInfo, RUNTIME_VERTEX_STAGES, RenderPassPipeline, RenderPipelineSpec,
 };
 pub use frame::{
     BLOCK_SIZE, CameraData, FOOTPRINT_GROW, FOOTPRINT_WHOLE, FrameData, FrameUniforms, LONGEST_RAY_VOXELS,

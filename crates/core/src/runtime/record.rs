@@ -317,8 +317,10 @@ impl<'a> RecordContext<'a> {
         Ok(())
     }
 
-    /// Draws a pipeline of [`RenderPipelineSpec::footprint`](super::RenderPipelineSpec::footprint) over this frame's screen footprint
-    /// of the volume ([`super::footprint`]): its Write ports are cleared to zeros and only the
+    /// Draws a pipeline of [`RenderPipelineSpec::footprint`](super::RenderPipelineSpec::footprint)
+    /// over this frame's screen footprint of the volume ([`super::footprint`]): its Write ports
+    /// are cleared to zeros (on lavapipe a 128-bit target costs a `memcpy` per texel, less than
+    /// the fragments left out where measured) and only the
     /// fragments inside the footprint (grown by a pixel) run — the same image as the fullscreen
     /// triangle for a fragment stage that writes zeros where a pixel's ray misses the box.
     pub fn draw_footprint(

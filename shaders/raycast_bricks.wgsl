@@ -11,7 +11,8 @@
 // - a brick not in this dispatch's batch is left in one step (§5, §7: bricks drawn front to
 //   back, one batch of resident bricks after another when the pool is smaller than the
 //   visible bricks);
-// - the samples of a leaf worth drawing are a run with nothing but sampling in the loop.
+// - the samples of a cube of leaves worth drawing (within one brick) are a run with nothing but
+//   sampling in the loop.
 // The ray's colour survives between batches in `acc` (per pixel), so a frame drawn in several
 // batches composites exactly like one drawn in a single pass; a ray stops at `threshold` (early
 // ray termination: its remaining bricks cost nothing).
@@ -43,8 +44,10 @@ struct BrickParams {
 // This batch: word 0 = 1 for the first batch of the frame (start from a clear ray); word 1 + b
 // = slot + 1 of brick b when it is drawn in this batch, 0 when it is not.
 @group(0) @binding(auto) var<storage, read> table: array<u32>;
-// Per leaf of the volume (x fastest): 0 where a box to draw covers it, else the Chebyshev
-// distance in leaves to the nearest such leaf (every leaf closer is empty too).
+// Per leaf of the volume (x fastest; `leaf_word` in raycast_bricks.rs): where no box to draw
+// covers it, the Chebyshev distance d (1..=255) in leaves to the nearest such leaf (every leaf
+// closer is empty too); where one does, `reach << 8`: the cube of leaves reach - 1 around it is
+// drawn too, inside its brick.
 @group(0) @binding(auto) var<storage, read> leaf_distance: array<u32>;
 // Per pixel: the premultiplied colour composited so far this frame.
 @group(0) @binding(auto) var<storage, read_write> acc: array<vec4<f32>>;
@@ -94,35 +97,38 @@ fn leap_grid() -> LeapGrid {
 }
 
 // What this dispatch leaps over (common/leap_empty.wgsl): the largest cube of leaves no box to
-// draw covers, and a brick drawn in another batch; a leaf to draw reports its box (within its
-// brick), which the march runs to.
+// draw covers, and a brick drawn in another batch; a leaf to draw reports the largest cube of
+// leaves to draw around it within its brick, which the march runs to.
 fn empty_region_at(p: vec3<f32>, grid: LeapGrid) -> EmptyRegion {
     let c = voxel_of(p);
     let last = grid.last;
     let leaf_cells = grid.leaf_cells;
     let leaf_grid = grid.leaf_grid;
     let l = leaf_of(c);
-    let d = leaf_distance[l.x + leaf_grid.x * (l.y + leaf_grid.y * l.z)];
+    let word = leaf_distance[l.x + leaf_grid.x * (l.y + leaf_grid.y * l.z)];
+    let d = word & 0xffu;
+    // The cube of leaves within reach - 1 of l: empty (a leap) or drawn (a run of samples).
+    let reach = vec3<u32>(select(word >> 8u, d, d > 0u) - 1u);
+    let lo_leaf = l - min(l, reach);
+    let hi_leaf = min(l + reach, leaf_grid - vec3<u32>(1u));
+    let cube_lo = voxel_box_lo(vec3<f32>(lo_leaf) * leaf_cells);
+    let cube_hi = voxel_box_hi(min(vec3<f32>(hi_leaf + vec3<u32>(1u)) * leaf_cells, last));
     if (d > 0u) {
-        let reach = vec3<u32>(d - 1u);
-        let lo_leaf = l - min(l, reach);
-        let hi_leaf = min(l + reach, leaf_grid - vec3<u32>(1u));
-        let hi = min(vec3<f32>(hi_leaf + vec3<u32>(1u)) * leaf_cells, last);
-        return EmptyRegion(true, voxel_box_lo(vec3<f32>(lo_leaf) * leaf_cells), voxel_box_hi(hi));
+        return EmptyRegion(true, cube_lo, cube_hi);
     }
     let b = brick_of(c);
-    let lo = vec3<f32>(b) * f32(bricks.grid.w);
-    let hi = min(lo + vec3<f32>(f32(bricks.grid.w)), last);
     if (table[1u + brick_index(b)] == 0u) {
+        let lo = vec3<f32>(b) * f32(bricks.grid.w);
+        let hi = min(lo + vec3<f32>(f32(bricks.grid.w)), last);
         return EmptyRegion(true, voxel_box_lo(lo), voxel_box_hi(hi));
     }
-    let leaf_lo = vec3<f32>(l) * leaf_cells;
-    return EmptyRegion(false, voxel_box_lo(leaf_lo), voxel_box_hi(min(leaf_lo + vec3<f32>(leaf_cells), hi)));
+    return EmptyRegion(false, cube_lo, cube_hi);
 }
 
 // The samples of `ray` from colour `start` on, through this batch's bricks: in rounds, like
 // every leaping march (common/raymarch.wgsl): every lane leaps until it stands in a leaf to
-// draw, then marches that leaf's samples — the same samples, read from the brick's slot.
+// draw, then marches the samples of the drawn cube around it — the same samples, read from the
+// brick's slot.
 fn march_bricks(s: Samples, start: vec4<f32>) -> vec4<f32> {
     var out = start;
     begin_ray(s, 0u);
@@ -142,12 +148,18 @@ fn march_bricks(s: Samples, start: vec4<f32>) -> vec4<f32> {
         if (k >= s.count || out.a >= threshold) {
             break;
         }
-        // A leaf to draw, up to where the ray leaves it (within its brick).
+        // A cube of leaves to draw, up to where the ray leaves it — and on through its brick to
+        // CHECK_EVERY samples at least, like every leaping run (common/raymarch.wgsl): the whole
+        // brick is in its slot, and a sample in an empty leaf adds nothing, so a run that does
+        // not stop at every thin cluster of leaves (a vessel) saves a round of leaps.
         let p = sample_at(s, k);
-        let exit = min(past_box(k, p, s.delta, stop.region.lo, stop.region.hi), s.count);
-        // Its samples in the atlas: voxel v of the brick lies at texel origin + 1.5 + (v - lo).
         let b = brick_of(voxel_of(p));
         let lo = vec3<f32>(b) * brick_cells;
+        let hi = min(lo + vec3<f32>(brick_cells), leaping.grid.last);
+        let cube_exit = past_box_by(k, p, leaping.step, stop.region.lo, stop.region.hi);
+        let brick_exit = past_box_by(k, p, leaping.step, voxel_box_lo(lo), voxel_box_hi(hi));
+        let exit = min(max(cube_exit, min(k + CHECK_EVERY, brick_exit)), s.count);
+        // Its samples in the atlas: voxel v of the brick lies at texel origin + 1.5 + (v - lo).
         let slot = table[1u + brick_index(b)] - 1u;
         let origin = vec3<f32>(vec3<u32>(slot % slots.x, (slot / slots.x) % slots.y, slot / (slots.x * slots.y)) * slot_side);
         let shift = origin + vec3<f32>(1.5) - lo - vec3<f32>(0.5);

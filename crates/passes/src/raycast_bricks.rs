@@ -555,8 +555,9 @@ pub fn leaf_grid(volume_dims: UVec3, node_cells: u32) -> UVec3 {
 pub struct LeafClassification {
     /// Per brick: visible under the TF.
     pub visible: Vec<bool>,
-    /// Per leaf of the volume (x fastest): 0 where a box to draw covers it, else the Chebyshev
-    /// distance in leaves to the nearest such leaf (capped at 255).
+    /// Per leaf of the volume (x fastest), what the march reads ([`leaf_word`]): where no box
+    /// to draw covers it, the Chebyshev distance in leaves to the nearest such leaf (capped at
+    /// 255); where one does, how far the drawn leaves around it reach within its brick.
     pub distance: Vec<u32>,
     /// Fraction of the leaves drawn.
     pub drawn_fraction: f64,
@@ -593,8 +594,46 @@ pub fn classify_leaves(
         }
     }
     let drawn_fraction = drawn.iter().filter(|d| **d).count() as f64 / drawn.len().max(1) as f64;
-    let distance = volgraph_accel::chebyshev::chebyshev_distance(&drawn, grid, MAX_LEAP);
+    let distance = leaf_words(&drawn, grid, layout.brick_cells().div_ceil(leaf).max(1));
     LeafClassification { visible, distance, drawn_fraction }
+}
+
+/// Every leaf's [`leaf_word`] for the drawn leaves `drawn` (x fastest in `grid`), in bricks of
+/// `leaves_per_brick` leaves per side.
+pub fn leaf_words(drawn: &[bool], grid: UVec3, leaves_per_brick: u32) -> Vec<u32> {
+    let to_drawn = volgraph_accel::chebyshev::chebyshev_distance(drawn, grid, MAX_LEAP);
+    let not_drawn: Vec<bool> = drawn.iter().map(|d| !d).collect();
+    let to_not_drawn = volgraph_accel::chebyshev::chebyshev_distance(&not_drawn, grid, leaves_per_brick);
+    let mut words = Vec::with_capacity(drawn.len());
+    for z in 0..grid.z {
+        for y in 0..grid.y {
+            for x in 0..grid.x {
+                let i = (x + grid.x * (y + grid.y * z)) as usize;
+                let reach = to_not_drawn[i].min(reach_within_brick(UVec3::new(x, y, z), leaves_per_brick, grid));
+                words.push(leaf_word(drawn[i], to_drawn[i], reach));
+            }
+        }
+    }
+    words
+}
+
+/// The word `raycast_bricks.wgsl` reads per leaf (`empty_region_at`): the leap distance
+/// `to_drawn` (1..=255) of a leaf no box covers; `reach << 8` for a drawn one, whose cube of
+/// `2·reach − 1` leaves around it is drawn and inside its brick, so one run of samples crosses it
+/// (a dense brick in a few runs, not one per leaf).
+pub fn leaf_word(drawn: bool, to_drawn: u32, reach: u32) -> u32 {
+    if drawn { reach.clamp(1, 0x00ff_ffff) << 8 } else { to_drawn.clamp(1, MAX_LEAP) }
+}
+
+/// How far a cube around leaf `l` may reach and stay inside its brick (of `leaves_per_brick`
+/// leaves per side, fewer in the last brick of an axis): 1 next to another brick. The volume's
+/// faces do not bound it: the march clamps the cube to the leaf grid.
+fn reach_within_brick(l: UVec3, leaves_per_brick: u32, grid: UVec3) -> u32 {
+    let lo = l / leaves_per_brick * leaves_per_brick;
+    let hi = (lo + leaves_per_brick).min(grid) - 1;
+    let to_lo = UVec3::select(lo.cmpeq(UVec3::ZERO), UVec3::MAX, l - lo);
+    let to_hi = UVec3::select(hi.cmpeq(grid - 1), UVec3::MAX, hi - l);
+    to_lo.min(to_hi).min_element().saturating_add(1)
 }
 
 /// Whether rank `ranks.0` of `ranks.1` draws brick `brick`: the brick grid is cut into
@@ -786,5 +825,41 @@ mod tests {
         // Padding: 64 MiB holds ~1561 bricks of 42875 bytes, not the 214 a 256-byte row each allows.
         assert!(staging_bricks_per_chunk(brick_row, rows, 64 << 20) > 1500);
         assert_eq!(staging_bricks_per_chunk(brick_row, rows, 1000), 0, "not even one brick");
+    }
+
+    /// The words the march leaps and runs by, against brute force on random leaf masks: an
+    /// empty leaf's distance is the Chebyshev distance to the nearest drawn leaf; a drawn leaf's
+    /// reach is the largest cube around it that is all drawn and inside its brick (the last
+    /// brick of an axis is thinner).
+    #[test]
+    fn leaf_words_are_leap_distances_and_drawn_cubes_within_a_brick() {
+        let grid = UVec3::new(9, 8, 7);
+        let per_brick = 4;
+        let index = |l: UVec3| (l.x + grid.x * (l.y + grid.y * l.z)) as usize;
+        let leaves = || (0..grid.z).flat_map(move |z| (0..grid.y).flat_map(move |y| (0..grid.x).map(move |x| UVec3::new(x, y, z))));
+        let cube = |l: UVec3, r: u32| {
+            let lo = l.saturating_sub(UVec3::splat(r));
+            let hi = (l + r).min(grid - 1);
+            leaves().filter(move |m| m.cmpge(lo).all() && m.cmple(hi).all())
+        };
+        let mut rng = volgraph_accel::generate::SplitMix64(7);
+        for density in [0.1, 0.6, 0.95, 1.0] {
+            let drawn: Vec<bool> =
+                (0..grid.element_product()).map(|_| (rng.next_u64() as f64 / u64::MAX as f64) < density).collect();
+            let words = leaf_words(&drawn, grid, per_brick);
+            for l in leaves() {
+                let word = words[index(l)];
+                if !drawn[index(l)] {
+                    let want = leaves().filter(|m| drawn[index(*m)]).map(|m| (m.as_ivec3() - l.as_ivec3()).abs().max_element() as u32).min();
+                    assert_eq!(word, want.unwrap_or(MAX_LEAP).clamp(1, MAX_LEAP), "{density}: empty leaf {l}");
+                    continue;
+                }
+                assert_eq!(word & 0xff, 0, "{density}: drawn leaf {l}");
+                let fits = |r: u32| cube(l, r).all(|m| drawn[index(m)] && m / per_brick == l / per_brick);
+                let reach = word >> 8;
+                assert!(reach >= 1 && fits(reach - 1), "{density}: leaf {l} reach {reach}");
+                assert!(!fits(reach) || cube(l, reach).count() == cube(l, reach - 1).count(), "{density}: leaf {l}: reach {reach} is the largest");
+            }
+        }
     }
 }

@@ -20,9 +20,7 @@
 #import "common/frame.wgsl"
 #import "common/raymarch.wgsl"
 #import "common/leap_empty.wgsl"
-
-override WORKGROUP_X: u32 = 8u;
-override WORKGROUP_Y: u32 = 8u;
+#import "common/workgroup_pixel.wgsl"
 
 struct BrickParams {
     // Bricks per axis (xyz); w = cells per brick side.
@@ -173,13 +171,13 @@ fn march_bricks(s: Samples, start: vec4<f32>) -> vec4<f32> {
 }
 
 @compute @workgroup_size(WORKGROUP_X, WORKGROUP_Y)
-fn cs_main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+fn cs_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
 #if TF_WORKGROUP
     // The pipelined sample loop (`sample_loop`, common/volume.wgsl): the LUT into workgroup
     // memory, by every invocation, before any returns.
     load_tf_workgroup(local, WORKGROUP_X * WORKGROUP_Y);
 #endif
-    let p = id.xy;
+    let p = invocation_pixel(group, local);
     if (!in_viewport(p)) {
         return;
     }

@@ -11,32 +11,10 @@
 #import "common/frame.wgsl"
 #import "common/pixel_march.wgsl"
 
-// Workgroup size, overridable per pipeline (the thesis found 16×12 best on its hardware).
-override WORKGROUP_X: u32 = 8u;
-override WORKGROUP_Y: u32 = 8u;
-
+#import "common/workgroup_pixel.wgsl"
 #import "common/color_target.wgsl"
 // Texture-space hit position (w = 1), zero on a miss; only `cs_iso` writes it.
 @group(0) @binding(auto) var hit: texture_storage_2d<rgba32float, write>;
-
-// The pixel of invocation `local` of workgroup `group`. Consecutive invocations — the lanes of
-// one SIMD vector, 8 on llvmpipe — cover a 4×2 tile of the workgroup's rectangle instead of a
-// row of 8, so a vector's rays start closer together and take more alike paths
-// (bench/one-march.md: 2 % fewer instructions in the march on hydrogen). A GPU's 32-lane warp
-// covers the same 8×4 (or 16×2) pixels either way. Workgroups whose sides are not multiples of 4
-// and 2 keep rows.
-fn invocation_pixel(group: vec3<u32>, local: u32) -> vec2<u32> {
-    var offset = vec2<u32>(local % WORKGROUP_X, local / WORKGROUP_X);
-    if (WORKGROUP_X % 4u == 0u && WORKGROUP_Y % 2u == 0u) {
-        let tile = local / 8u;
-        let lane = local % 8u;
-        // At least 1: the constants are folded even where the branch is not taken, and a
-        // workgroup narrower than 4 would divide by zero (the pipeline fails to build).
-        let tiles_per_row = max(WORKGROUP_X / 4u, 1u);
-        offset = vec2<u32>((tile % tiles_per_row) * 4u + lane % 4u, (tile / tiles_per_row) * 2u + lane / 4u);
-    }
-    return group.xy * vec2<u32>(WORKGROUP_X, WORKGROUP_Y) + offset;
-}
 
 @compute @workgroup_size(WORKGROUP_X, WORKGROUP_Y)
 fn cs_dvr(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {

@@ -161,6 +161,39 @@ fn every_bricked_graph_equals_the_single_texture_raycast() {
     }
 }
 
+/// The brick march maps invocations to pixels like `raycast_compute` (`invocation_pixel`,
+/// common/workgroup_pixel.wgsl: 4×2 tiles where the workgroup allows, rows otherwise), and its
+/// per-pixel `acc` buffer is indexed by that pixel: every shape must write every pixel exactly
+/// once with its own ray. Pixels share nothing, so the images are compared bit for bit against
+/// one-invocation workgroups; a pixel written twice, never, or with another's colour shows.
+#[test]
+fn every_workgroup_shape_writes_every_brick_pixel_with_its_own_ray() {
+    let gpu = support::gpu();
+    let registry = builtin_registry();
+    let volume = volgraph_accel::vessels::vessel_tree(64, 5);
+    let lut = TransferFunction::preset(Preset::Sparse, (0.0, 255.0)).to_lut_for(&volume, 256);
+    let cam = camera(40.0, 2.6);
+    let shaped = |x: u64, y: u64| {
+        let mut options =
+            CompileOptions::new(SIZE, SIZE).with_scalar("brick_cells", 16.0).with_scalar("node_cells", 4.0);
+        options.param_overrides.insert("march.workgroup_x".into(), ron::Value::from(x));
+        options.param_overrides.insert("march.workgroup_y".into(), ron::Value::from(y));
+        live(&gpu, &registry, "bricks_octree", &volume, &lut, &options).frame(&cam)
+    };
+    let want = shaped(1, 1);
+    assert!(coverage(&want) > 0.02, "the vessels are in view");
+    // Tiled: 8×8 (the default), 4×2 (one tile), 12×6 (three tiles a row); rows: 6×3, 7×7 (96 is
+    // no multiple of 7: partial groups at the edges).
+    for (x, y) in [(8, 8), (4, 2), (12, 6), (6, 3), (7, 7)] {
+        let got = shaped(x, y);
+        let differ = (0..want.height)
+            .flat_map(|py| (0..want.width).map(move |px| (px, py)))
+            .filter(|&(px, py)| got.rgba(px, py) != want.rgba(px, py))
+            .count();
+        assert_eq!(differ, 0, "workgroup {x}×{y}: {differ} pixels differ from 1×1 workgroups");
+    }
+}
+
 /// A pool of a handful of bricks: every frame streams the bricks in batches and evicts the least
 /// recently used — slower, and the same image.
 #[test]

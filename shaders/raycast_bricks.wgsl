@@ -25,8 +25,6 @@
 struct BrickParams {
     // Bricks per axis (xyz); w = cells per brick side.
     grid: vec4<u32>,
-    // Slots per atlas axis (xyz).
-    slots: vec4<u32>,
     // Voxels per slot and axis (xyz): brick_cells + 3 (voxel lo - 1 first), fewer on an axis
     // thinner than a brick.
     slot_side: vec4<u32>,
@@ -40,7 +38,8 @@ struct BrickParams {
 
 @group(0) @binding(auto) var<uniform> bricks: BrickParams;
 // This batch: word 0 = 1 for the first batch of the frame (start from a clear ray); word 1 + b
-// = slot + 1 of brick b when it is drawn in this batch, 0 when it is not.
+// = 0 when brick b is not drawn in this batch, else bit 31 and its slot's coordinates in the
+// atlas, 10 bits per axis, x lowest (`slot_word` in raycast_bricks.rs).
 @group(0) @binding(auto) var<storage, read> table: array<u32>;
 // Per leaf of the volume (x fastest; `leaf_word` in raycast_bricks.rs): where no box to draw
 // covers it, the Chebyshev distance d (1..=255) in leaves to the nearest such leaf (every leaf
@@ -136,7 +135,6 @@ fn march_bricks(s: Samples, start: vec4<f32>) -> vec4<f32> {
     let delta_atlas = s.delta * n * inv_atlas;
     // Read once per ray, not per leaf (common/raymarch.wgsl's `march_dvr` says why).
     let threshold = params.threshold;
-    let slots = bricks.slots;
     let slot_side = bricks.slot_side.xyz;
     let leaping = leaping_for(s);
     var k = 0u;
@@ -158,8 +156,9 @@ fn march_bricks(s: Samples, start: vec4<f32>) -> vec4<f32> {
         let brick_exit = past_box_by(k, p, leaping.step, voxel_box_lo(lo), voxel_box_hi(hi));
         let exit = min(max(cube_exit, min(k + CHECK_EVERY, brick_exit)), s.count);
         // Its samples in the atlas: voxel v of the brick lies at texel origin + 1.5 + (v - lo).
-        let slot = table[1u + brick_index(b)] - 1u;
-        let origin = vec3<f32>(vec3<u32>(slot % slots.x, (slot / slots.x) % slots.y, slot / (slots.x * slots.y)) * slot_side);
+        let word = table[1u + brick_index(b)];
+        let slot = vec3<u32>(word, word >> 10u, word >> 20u) & vec3<u32>(0x3ffu);
+        let origin = vec3<f32>(slot * slot_side);
         let shift = origin + vec3<f32>(1.5) - lo - vec3<f32>(0.5);
         let atlas = Samples((s.first * n + shift) * inv_atlas, delta_atlas, s.count, s.step, s.offset, s.cut);
         resume_ray(sample_at(atlas, k) - atlas.delta);

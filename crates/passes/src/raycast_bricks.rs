@@ -75,14 +75,13 @@ const DEFAULT_BUDGET_BYTES: u64 = 2 << 30;
 #[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
 struct BrickParamsGpu {
     grid: [u32; 4],
-    slots: [u32; 4],
     slot_side: [u32; 4],
     leaves: [u32; 4],
     leaf_grid: [u32; 4],
     atlas: [f32; 4],
 }
 
-const _: () = assert!(std::mem::size_of::<BrickParamsGpu>() == 96);
+const _: () = assert!(std::mem::size_of::<BrickParamsGpu>() == 80);
 
 /// The largest staging buffer one upload batch uses, whatever the adapter allows: a frame's
 /// uploads are split into chunks of at most this many bytes (and at most the device's
@@ -156,7 +155,6 @@ fn brick_layout() -> volgraph_core::UniformLayout {
         global: "bricks",
         fields: vec![
             ("grid", "vec4<u32>"),
-            ("slots", "vec4<u32>"),
             ("slot_side", "vec4<u32>"),
             ("leaves", "vec4<u32>"),
             ("leaf_grid", "vec4<u32>"),
@@ -326,7 +324,8 @@ impl VolumeState {
                 ),
             ));
         }
-        let per_axis = UVec3::splat(max_dim) / side;
+        // At most SLOTS_PER_AXIS slots per axis: the table's slot words have 10 bits per axis.
+        let per_axis = (UVec3::splat(max_dim) / side).min(UVec3::splat(SLOTS_PER_AXIS));
         let cube = (layout.brick_count() as f64).cbrt().ceil() as u32;
         let row = (cube.clamp(1, per_axis.x), cube.clamp(1, per_axis.y));
         let leaf_grid =
@@ -495,8 +494,7 @@ impl VolumeState {
             usage: wgpu::BufferUsages::COPY_SRC,
         });
         for (i, (_, slot)) in chunk.iter().enumerate() {
-            let s = atlas.slots;
-            let at = UVec3::new(slot % s.x, (slot / s.x) % s.y, slot / (s.x * s.y)) * side;
+            let at = slot_coord(*slot, atlas.slots) * side;
             ctx.encoder.copy_buffer_to_texture(
                 wgpu::TexelCopyBufferInfo {
                     buffer: &buffer,
@@ -516,6 +514,25 @@ impl VolumeState {
             );
         }
     }
+}
+
+/// Slots per atlas axis, at most: a slot word ([`slot_word`]) has 10 bits per axis. (A slot is
+/// at least 4 voxels wide, so a 3D texture limit of 4096 or less never meets it.)
+const SLOTS_PER_AXIS: u32 = 1 << 10;
+
+/// Where slot `slot` lies in an atlas of `slots` slots per axis, in slots: x fastest.
+fn slot_coord(slot: u32, slots: UVec3) -> UVec3 {
+    UVec3::new(slot % slots.x, (slot / slots.x) % slots.y, slot / (slots.x * slots.y))
+}
+
+/// A drawn brick's word in the batch table (`raycast_bricks.wgsl`'s `table`): bit 31 set (0 is
+/// "not in this batch") and its slot's coordinates, 10 bits per axis, x lowest — so the march
+/// finds the slot's origin with a multiply instead of three integer divisions per brick entered,
+/// which llvmpipe runs one lane at a time (2 % of the `bricks` graph's time on the engine,
+/// bench/one-march-final.md "Brick runs").
+pub fn slot_word(coord: UVec3) -> u32 {
+    debug_assert!(coord.max_element() < SLOTS_PER_AXIS);
+    1 << 31 | coord.x | coord.y << 10 | coord.z << 20
 }
 
 /// Bytes per staging row for `bricks` bricks of `brick_row` bytes side by side, padded to the
@@ -664,7 +681,7 @@ impl RaycastBricksNode {
 
     /// The per-batch tables (header word + slot + 1 per brick) in one buffer, one region per
     /// batch at a stride the storage-offset alignment allows.
-    fn write_tables(&mut self, ctx: &RecordContext<'_>, batches: &[Batch], bricks: usize) -> u64 {
+    fn write_tables(&mut self, ctx: &RecordContext<'_>, batches: &[Batch], bricks: usize, slots: UVec3) -> u64 {
         let align = ctx.gpu.limits.min_storage_buffer_offset_alignment as u64;
         let stride = (4 * (1 + bricks as u64)).div_ceil(align) * align;
         let count = batches.len().max(1);
@@ -683,7 +700,7 @@ impl RaycastBricksNode {
             let base = i * (stride / 4) as usize;
             data[base] = u32::from(i == 0);
             for (brick, slot) in &batch.bricks {
-                data[base + 1 + *brick as usize] = slot + 1;
+                data[base + 1 + *brick as usize] = slot_word(slot_coord(*slot, slots));
             }
         }
         if let Some((buffer, _, _)) = &self.tables {
@@ -729,7 +746,6 @@ impl PassNode for RaycastBricksNode {
         let grid = state.layout.grid_dims();
         let uniform = BrickParamsGpu {
             grid: [grid.x, grid.y, grid.z, self.brick_cells],
-            slots: [atlas_slots.x, atlas_slots.y, atlas_slots.z, 0],
             slot_side: [state.side.x, state.side.y, state.side.z, 0],
             leaves: [state.octree.min_node_cells(), self.brick_cells / state.octree.min_node_cells(), 0, 0],
             leaf_grid: [state.leaf_grid.x, state.leaf_grid.y, state.leaf_grid.z, 0],
@@ -747,7 +763,7 @@ impl PassNode for RaycastBricksNode {
             });
             self.acc = Some((buffer, (w, h)));
         }
-        let stride = self.write_tables(ctx, &batches, bricks);
+        let stride = self.write_tables(ctx, &batches, bricks, atlas_slots);
         let state = self.volume.as_ref().expect("set above");
         let (Some(atlas), Some(leaf_buffer), Some((acc, _)), Some((tables, _, _))) =
             (&state.atlas, &state.leaf_buffer, &self.acc, &self.tables)

@@ -12,9 +12,8 @@
 //! start target, writes `start`. Shader: `shaders/hole_fill.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
-use volgraph_core::runtime::footprint::footprint;
 use volgraph_core::runtime::{
-    CreateContext, FrameUniforms, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec, UniformBlocks,
+    CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec, UniformBlocks,
 };
 use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
@@ -95,7 +94,7 @@ struct HoleFillNode {
 impl HoleFillNode {
     /// This frame's row spans, written where they changed.
     fn footprint_rows(&mut self, ctx: &RecordContext<'_>) -> &wgpu::Buffer {
-        let spans = footprint(&FrameUniforms::of(ctx.frame)).row_spans(ctx.viewport.1.max(1), FOOTPRINT_MARGIN);
+        let spans = ctx.footprint.row_spans(ctx.viewport.1.max(1), FOOTPRINT_MARGIN);
         if self.rows.as_ref().is_none_or(|(_, written)| written.len() != spans.len()) {
             let buffer = ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(&format!("{} footprint rows", ctx.label)),

@@ -852,7 +852,9 @@ mod tests {
         let grid = UVec3::new(9, 8, 7);
         let per_brick = 4;
         let index = |l: UVec3| (l.x + grid.x * (l.y + grid.y * l.z)) as usize;
-        let leaves = || (0..grid.z).flat_map(move |z| (0..grid.y).flat_map(move |y| (0..grid.x).map(move |x| UVec3::new(x, y, z))));
+        let leaves = || {
+            (0..grid.z).flat_map(move |z| (0..grid.y).flat_map(move |y| (0..grid.x).map(move |x| UVec3::new(x, y, z))))
+        };
         let cube = |l: UVec3, r: u32| {
             let lo = l.saturating_sub(UVec3::splat(r));
             let hi = (l + r).min(grid - 1);
@@ -866,7 +868,10 @@ mod tests {
             for l in leaves() {
                 let word = words[index(l)];
                 if !drawn[index(l)] {
-                    let want = leaves().filter(|m| drawn[index(*m)]).map(|m| (m.as_ivec3() - l.as_ivec3()).abs().max_element() as u32).min();
+                    let want = leaves()
+                        .filter(|m| drawn[index(*m)])
+                        .map(|m| (m.as_ivec3() - l.as_ivec3()).abs().max_element() as u32)
+                        .min();
                     assert_eq!(word, want.unwrap_or(MAX_LEAP).clamp(1, MAX_LEAP), "{density}: empty leaf {l}");
                     continue;
                 }
@@ -874,7 +879,10 @@ mod tests {
                 let fits = |r: u32| cube(l, r).all(|m| drawn[index(m)] && m / per_brick == l / per_brick);
                 let reach = word >> 8;
                 assert!(reach >= 1 && fits(reach - 1), "{density}: leaf {l} reach {reach}");
-                assert!(!fits(reach) || cube(l, reach).count() == cube(l, reach - 1).count(), "{density}: leaf {l}: reach {reach} is the largest");
+                assert!(
+                    !fits(reach) || cube(l, reach).count() == cube(l, reach - 1).count(),
+                    "{density}: leaf {l}: reach {reach} is the largest"
+                );
             }
         }
     }

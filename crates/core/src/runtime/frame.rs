@@ -8,7 +8,7 @@ use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::cuts::{Cuts, MAX_CLIP_PLANES};
 use volgraph_accel::volume::Volume;
 
-use super::footprint::{Coverage, FAN_VERTICES};
+use super::footprint::{Coverage, FAN_VERTICES, Footprint};
 
 /// One frame's camera, as both the GPU passes and the f64 reference use it
 /// (`docs/rendering_model.md`, "Camera").
@@ -359,6 +359,19 @@ fn mat(m: DMat4) -> [[f32; 4]; 4] {
 impl FrameUniforms {
     /// The uniform block of `frame`.
     pub fn of(frame: &FrameData) -> Self {
+        Self::and_footprint(frame).0
+    }
+
+    /// The uniform block of `frame` and the volume's screen footprint it carries, computed once
+    /// per frame: the runtime hands it to every node (`RecordContext::footprint`).
+    pub fn and_footprint(frame: &FrameData) -> (Self, Footprint) {
+        let uniforms = Self::without_footprint(frame);
+        let footprint = super::footprint::footprint(&uniforms);
+        (uniforms.with_footprint(&footprint), footprint)
+    }
+
+    /// Every field but the footprint's (a draw of the whole viewport).
+    fn without_footprint(frame: &FrameData) -> Self {
         let c = &frame.camera;
         let (half, unit, dims, opacity_unit) = match &frame.volume {
             Some(v) => (v.half_extent, v.unit_step, v.dims.as_dvec3(), v.opacity_unit_voxels),
@@ -399,12 +412,12 @@ impl FrameUniforms {
             _pad_footprint: [0; 3],
         }
         .with_cuts(&frame.cuts, grid)
-        .with_footprint()
     }
 
-    /// The footprint of the rays, boxes and cuts already set ([`super::footprint`]).
-    fn with_footprint(mut self) -> Self {
-        match super::footprint::footprint(&self).coverage(FOOTPRINT_GROW) {
+    /// `footprint`, of the rays, boxes and cuts already set ([`super::footprint`]), as the
+    /// polygon a footprint draw covers.
+    fn with_footprint(mut self, footprint: &Footprint) -> Self {
+        match footprint.coverage(FOOTPRINT_GROW) {
             Coverage::Nothing => self.footprint_vertices = 0,
             Coverage::Whole => self.footprint_vertices = FOOTPRINT_WHOLE,
             Coverage::Polygon(vertices) => {

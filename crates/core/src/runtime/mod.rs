@@ -549,7 +549,8 @@ impl Runtime {
             }
         }
         let gpu = self.gpu.clone();
-        self.gpu.queue.write_buffer(&self.system.frame, 0, bytemuck::bytes_of(&FrameUniforms::of(&frame)));
+        let (uniforms, footprint) = FrameUniforms::and_footprint(&frame);
+        self.gpu.queue.write_buffer(&self.system.frame, 0, bytemuck::bytes_of(&uniforms));
         let steps = schedule.plan.steps.len();
         // Profiled frames time their steps by wall clock: no timestamp queries to write or resolve.
         let timed_steps = if self.profile_steps { 0 } else { steps };
@@ -585,7 +586,7 @@ impl Runtime {
                         history,
                         inputs,
                         system,
-                        &frame,
+                        (&frame, &footprint),
                         &mut encoder,
                         timestamps.as_ref(),
                         clock.as_mut(),
@@ -829,7 +830,7 @@ fn record_steps(
     history: &history::HistoryStore,
     inputs: &inputs::InputStore,
     system: &SystemBindings,
-    frame: &FrameData,
+    (frame, footprint): (&FrameData, &footprint::Footprint),
     encoder: &mut wgpu::CommandEncoder,
     timestamps: Option<&(wgpu::QuerySet, u32)>,
     mut clock: Option<&mut step_clock::StepClock<'_>>,
@@ -925,6 +926,7 @@ fn record_steps(
             params: &step.params,
             viewport: plan.viewport,
             frame,
+            footprint,
             ports,
             system,
             timestamps: timestamps.map(|(set, base)| (set, base + 2 * i as u32)),

@@ -108,6 +108,9 @@ pub struct RecordContext<'a> {
     pub viewport: (u32, u32),
     /// The frame contract: cameras (this and the previous frame), counters, the volume.
     pub frame: &'a FrameData,
+    /// The volume's screen footprint this frame (`super::footprint`), computed once for the
+    /// frame block: what a footprint draw covers, and row spans for a pass that needs them.
+    pub footprint: &'a super::footprint::Footprint,
     pub(crate) ports: Vec<BoundPort<'a>>,
     pub(crate) system: &'a SystemBindings,
     pub(crate) timestamps: Option<(&'a wgpu::QuerySet, u32)>,

@@ -171,12 +171,7 @@ fn march_bricks(s: Samples, start: vec4<f32>) -> vec4<f32> {
 
 @compute @workgroup_size(WORKGROUP_X, WORKGROUP_Y)
 fn cs_main(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-#if TF_WORKGROUP
-    // The pipelined sample loop (`sample_loop`, common/volume.wgsl): the LUT into workgroup
-    // memory, by every invocation, before any returns.
-    load_tf_workgroup(local, WORKGROUP_X * WORKGROUP_Y);
-#endif
-    let p = invocation_pixel(group, local);
+    let p = begin_invocation(group, local);
     if (!in_viewport(p)) {
         return;
     }

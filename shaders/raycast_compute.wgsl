@@ -18,10 +18,7 @@
 
 @compute @workgroup_size(WORKGROUP_X, WORKGROUP_Y)
 fn cs_dvr(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-#if TF_WORKGROUP
-    load_tf_workgroup(local, WORKGROUP_X * WORKGROUP_Y);
-#endif
-    let pixel = invocation_pixel(group, local);
+    let pixel = begin_invocation(group, local);
     if (!in_viewport(pixel)) {
         return;
     }
@@ -30,10 +27,7 @@ fn cs_dvr(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_ind
 
 @compute @workgroup_size(WORKGROUP_X, WORKGROUP_Y)
 fn cs_iso(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-#if TF_WORKGROUP
-    load_tf_workgroup(local, WORKGROUP_X * WORKGROUP_Y);
-#endif
-    let pixel = invocation_pixel(group, local);
+    let pixel = begin_invocation(group, local);
     if (!in_viewport(pixel)) {
         return;
     }

@@ -2,6 +2,8 @@
 // overridable per pipeline (the `workgroup_x`/`workgroup_y` parameters; the DirectCompute thesis
 // found 16×12 best on its hardware), and which pixel each invocation marches.
 
+#import "common/volume.wgsl"
+
 override WORKGROUP_X: u32 = 8u;
 override WORKGROUP_Y: u32 = 8u;
 
@@ -23,4 +25,14 @@ fn invocation_pixel(group: vec3<u32>, local: u32) -> vec2<u32> {
         offset = vec2<u32>((tile % tiles_per_row) * 4u + lane % 4u, (tile / tiles_per_row) * 2u + lane / 4u);
     }
     return group.xy * vec2<u32>(WORKGROUP_X, WORKGROUP_Y) + offset;
+}
+
+// What every invocation of a compute raycaster does first: with TF_WORKGROUP (the pipelined
+// sample loop, common/volume.wgsl) its share of copying the LUT into workgroup memory, which
+// ends with a barrier, so it comes before any invocation returns; then the pixel it marches.
+fn begin_invocation(group: vec3<u32>, local: u32) -> vec2<u32> {
+#if TF_WORKGROUP
+    load_tf_workgroup(local, WORKGROUP_X * WORKGROUP_Y);
+#endif
+    return invocation_pixel(group, local);
 }

@@ -95,12 +95,14 @@ fn raw_layout(raw: &crate::cli::RawArgs) -> anyhow::Result<RawOptions> {
     Ok(o)
 }
 
-/// Loads `--volume` (a file, a DICOM folder or slice files), or generates the default
-/// (Marschner–Lobb 64³) when none is given. What the loader repaired or reordered comes back as
-/// notes for stderr. A DICOM series shows a progress bar on a terminal while it loads.
+/// Loads `--volume` (a file, a DICOM folder or slice files, or a name: see [`named_volume`]),
+/// or generates the default (Marschner–Lobb 64³) when none is given. What the loader repaired or
+/// reordered comes back as notes for stderr. A DICOM series shows a progress bar on a terminal
+/// while it loads.
 pub fn volume(paths: &[PathBuf], options: &LoadOptions<'_>) -> anyhow::Result<(Volume, Vec<String>)> {
     match paths {
         [] => Ok((default_volume().clone(), Vec::new())),
+        [name] if is_volume_name(name) => named_volume(&name.to_string_lossy()),
         paths => {
             let p = &paths[0];
             let loaded = crate::load_progress::load_with_progress(paths, options).map_err(|e| anyhow!("{e}"))?;
@@ -108,6 +110,33 @@ pub fn volume(paths: &[PathBuf], options: &LoadOptions<'_>) -> anyhow::Result<(V
             if loaded.report.non_finite_replaced() > 0 {
                 notes.push(format!("{}: replaced {} NaN/Inf voxels", p.display(), loaded.report.non_finite_replaced()));
             }
+            Ok((loaded.volume, notes))
+        }
+    }
+}
+
+/// Whether `--volume` names a volume rather than a path: no such file or folder, no folder part
+/// and no extension (`lobster`, `ml64`), as `volgraph bench graphs --datasets` takes them.
+fn is_volume_name(path: &Path) -> bool {
+    path.symlink_metadata().is_err() && path.components().count() == 1 && path.extension().is_none()
+}
+
+/// The volume `--volume NAME` asks for: a generated one (`ml64`, `vessels128`: `generate::by_name`)
+/// or a dataset of the data folder (`lobster`, `hydrogen_atom`: `$VOLGRAPH_DATA/volumes`, with the
+/// voxel spacing of its MANIFEST row).
+fn named_volume(name: &str) -> anyhow::Result<(Volume, Vec<String>)> {
+    use volgraph_accel::generate::{self, NAMED_GENERATORS, NamedVolumeError};
+    match generate::by_name(name) {
+        Ok(volume) => Ok((volume, Vec::new())),
+        Err(e @ NamedVolumeError::Edge { .. }) => bail!("{e}"),
+        Err(NamedVolumeError::Unknown { .. }) => {
+            let loaded = volgraph_accel::data_dir::load_dataset(name).map_err(|e| {
+                anyhow!(
+                    "{name}: no such file or folder, and not a volume's name: {e}; a generated volume is \
+                     named {NAMED_GENERATORS}"
+                )
+            })?;
+            let notes = loaded.report.notes.iter().map(|n| format!("{name}: {n}")).collect();
             Ok((loaded.volume, notes))
         }
     }

@@ -22,8 +22,9 @@ pub struct SceneArgs {
     #[arg(long)]
     pub scene: Option<PathBuf>,
     /// The volume: a file (.raw named NAME_XxYxZ_TYPE.raw, .nrrd, .nhdr, .mhd, .mha, .nii,
-    /// .nii.gz), a folder of DICOM slices, or DICOM slice files (`--volume dir/*.dcm`); default:
-    /// a generated Marschner–Lobb 64³.
+    /// .nii.gz), a folder of DICOM slices, DICOM slice files (`--volume dir/*.dcm`), or a name: a
+    /// dataset of the data folder (`lobster`) or a generated volume (`ml64`, `vessels128`);
+    /// default: a generated Marschner–Lobb 64³.
     #[arg(long, num_args = 1..)]
     pub volume: Vec<PathBuf>,
     /// How to read a headerless raw volume.

@@ -140,3 +140,42 @@ fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
         }
     }
 }
+
+/// `--volume` takes a name where no such file is, as `bench graphs --datasets` does: a generated
+/// volume renders; an unknown name says what names there are (the data folder's datasets and the
+/// generated ones); a bad edge says its range.
+#[test]
+fn a_volume_name_is_a_dataset_or_a_generated_volume() {
+    let o = out_png();
+    let (code, err) =
+        volgraph(&["render", "graphs/basic/fragment_raycast.ron", "--volume", "sphere24", "--size", "32x32", "-o", &o]);
+    assert_eq!(code, 0, "{err}");
+    // A dataset of the data folder by its short name, with its manifest row's spacing (the
+    // lobster's voxels are 1.4 deep): `info` reads `--volume`'s way too.
+    if volgraph_accel::data_dir::require_dataset("lobster").is_some() {
+        let (code, err) = volgraph(&[
+            "render",
+            "graphs/basic/fragment_raycast.ron",
+            "--volume",
+            "lobster",
+            "--size",
+            "32x32",
+            "-o",
+            &o,
+        ]);
+        assert_eq!(code, 0, "{err}");
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let info = Command::new(env!("CARGO_BIN_EXE_volgraph")).args(["info", "lobster"]).current_dir(&root).output();
+        let info = info.expect("the volgraph binary runs");
+        let text = String::from_utf8_lossy(&info.stdout);
+        assert!(info.status.success() && text.contains("301 × 324 × 56") && text.contains("1.4"), "{text}");
+    }
+    let (code, err) =
+        volgraph(&["render", "graphs/basic/fragment_raycast.ron", "--volume", "no_such_volume", "-o", &o]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("no_such_volume: no such file or folder, and not a volume's name"), "{err}");
+    assert!(err.contains("ml<N>, mlf<N>, sphere<N>, noise<N> or vessels<N>"), "{err}");
+    let (code, err) = volgraph(&["render", "graphs/basic/fragment_raycast.ron", "--volume", "ml1", "-o", &o]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("\"ml1\"") && err.contains("edge must be 2..="), "{err}");
+}

@@ -16,6 +16,9 @@
 //!   leaves and its complement into Chebyshev leap distances ([`volgraph_accel::chebyshev`]):
 //!   a ray leaves the largest cube of leaves no box covers in one step — the octree's empty
 //!   nodes, and empty bricks, as one lookup (without an octree the leaves are the bricks).
+//!   Where it stands in a drawn leaf it marches one run: through the cube of drawn leaves
+//!   around it ([`leaf_words`]) and on through its brick to `CHECK_EVERY` samples at least, so
+//!   a thin vessel or a dense brick does not cost a round of leaps per leaf.
 //! - **termination**: a ray stops at `threshold` and skips the bricks behind it (per-brick
 //!   early ray termination: with `threshold < 1` a saturated pixel costs nothing in later
 //!   batches either).

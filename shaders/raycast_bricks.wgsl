@@ -144,17 +144,21 @@ fn march_bricks(s: Samples, start: vec4<f32>) -> vec4<f32> {
         if (k >= s.count || out.a >= threshold) {
             break;
         }
-        // A cube of leaves to draw, up to where the ray leaves it — and on through its brick to
-        // CHECK_EVERY samples at least, like every leaping run (common/raymarch.wgsl): the whole
-        // brick is in its slot, and a sample in an empty leaf adds nothing, so a run that does
-        // not stop at every thin cluster of leaves (a vessel) saves a round of leaps.
+        // A cube of leaves to draw, up to where the ray leaves it — and on through its brick,
+        // up to CHECK_EVERY samples in all, like every leaping run (common/raymarch.wgsl): the
+        // whole brick is in its slot, and a sample in an empty leaf adds nothing, so a run that
+        // does not stop at every thin cluster of leaves (a vessel) saves a round of leaps.
         let p = sample_at(s, k);
         let b = brick_of(voxel_of(p));
         let lo = vec3<f32>(b) * brick_cells;
         let hi = min(lo + vec3<f32>(brick_cells), leaping.grid.last);
         let cube_exit = past_box_by(k, p, leaping.step, stop.region.lo, stop.region.hi);
         let brick_exit = past_box_by(k, p, leaping.step, voxel_box_lo(lo), voxel_box_hi(hi));
-        let exit = min(max(cube_exit, min(k + CHECK_EVERY, brick_exit)), s.count);
+        // Never one sample short of the brick's exit: that sample may lie on the brick's face,
+        // where `brick_of` gives it to the next brick, and a batch (or sort-last rank) without
+        // that brick leaps over its closed box, as the next brick's batch leaps over this one's.
+        let run_end = k + CHECK_EVERY;
+        let exit = min(max(cube_exit, select(run_end, brick_exit, run_end + 1u >= brick_exit)), s.count);
         // Its samples in the atlas: voxel v of the brick lies at texel origin + 1.5 + (v - lo).
         let word = table[1u + brick_index(b)];
         let slot = vec3<u32>(word, word >> 10u, word >> 20u) & vec3<u32>(0x3ffu);

@@ -21,7 +21,7 @@ struct EmptyRegion {
 
 // Where a leap stopped: the first sample at or after the start (before `end`) that may be
 // visible, or `end`, and the region around it the importer reported (not empty), whose box a
-// march over that region can run to (a brick's leaf).
+// march over that region can run to (a brick's cube of drawn leaves).
 struct LeapStop {
     k: u32,
     region: EmptyRegion,

@@ -275,6 +275,13 @@ fn parse_manifest(path: &Path, text: &str) -> Result<Vec<ManifestEntry>, DataErr
 /// Loads dataset `name` with the voxel spacing its manifest row gives (raw files carry none;
 /// `lobster` is 1 × 1 × 1.4). Without a manifest row the spacing is (1, 1, 1).
 pub fn load_dataset(name: &str) -> Result<LoadedVolume, DataError> {
+    let (path, spacing) = dataset_file(name)?;
+    Ok(load_volume(&path, &RawOptions { spacing, ..RawOptions::default() })?)
+}
+
+/// Dataset `name`'s file and the voxel spacing its manifest row gives (`None` without a row), for
+/// a reader of its own (a sort-last rank reads only its box of the file).
+pub fn dataset_file(name: &str) -> Result<(PathBuf, Option<DVec3>), DataError> {
     let path = dataset_path(name)?;
     let file_name = path.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default();
     // No manifest: spacing (1, 1, 1). A manifest that is there but malformed is an error, not a
@@ -284,7 +291,7 @@ pub fn load_dataset(name: &str) -> Result<LoadedVolume, DataError> {
     } else {
         None
     };
-    Ok(load_volume(&path, &RawOptions { spacing, ..RawOptions::default() })?)
+    Ok((path, spacing))
 }
 
 #[cfg(test)]

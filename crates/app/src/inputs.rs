@@ -95,51 +95,92 @@ fn raw_layout(raw: &crate::cli::RawArgs) -> anyhow::Result<RawOptions> {
     Ok(o)
 }
 
-/// Loads `--volume` (a file, a DICOM folder or slice files, or a name: see [`named_volume`]),
+/// Loads `--volume` (a file, a DICOM folder or slice files, or a volume's name: [`volume_name`]),
 /// or generates the default (Marschner–Lobb 64³) when none is given. What the loader repaired or
 /// reordered comes back as notes for stderr. A DICOM series shows a progress bar on a terminal
 /// while it loads.
 pub fn volume(paths: &[PathBuf], options: &LoadOptions<'_>) -> anyhow::Result<(Volume, Vec<String>)> {
     match paths {
         [] => Ok((default_volume().clone(), Vec::new())),
-        [name] if is_volume_name(name) => named_volume(&name.to_string_lossy()),
-        paths => {
-            let p = &paths[0];
-            let loaded = crate::load_progress::load_with_progress(paths, options).map_err(|e| anyhow!("{e}"))?;
-            let mut notes: Vec<String> = loaded.report.notes.iter().map(|n| format!("{}: {n}", p.display())).collect();
-            if loaded.report.non_finite_replaced() > 0 {
-                notes.push(format!("{}: replaced {} NaN/Inf voxels", p.display(), loaded.report.non_finite_replaced()));
-            }
-            Ok((loaded.volume, notes))
-        }
+        [one] => match volume_name(one) {
+            Some(name) => named_volume(&name, options),
+            None => volume_files(paths, options),
+        },
+        paths => volume_files(paths, options),
     }
 }
 
-/// Whether `--volume` names a volume rather than a path: no such file or folder, no folder part
-/// and no extension (`lobster`, `ml64`), as `volgraph bench graphs --datasets` takes them.
-fn is_volume_name(path: &Path) -> bool {
-    path.symlink_metadata().is_err() && path.components().count() == 1 && path.extension().is_none()
+/// Loads a volume file, a DICOM folder or DICOM slice files (never a name: a scene's `File`
+/// is a path relative to the scene).
+pub fn volume_files(paths: &[PathBuf], options: &LoadOptions<'_>) -> anyhow::Result<(Volume, Vec<String>)> {
+    let Some(p) = paths.first() else { bail!("no volume file given") };
+    let loaded = crate::load_progress::load_with_progress(paths, options).map_err(|e| anyhow!("{e}"))?;
+    Ok((loaded.volume, load_notes(&p.display().to_string(), &loaded.report)))
 }
 
-/// The volume `--volume NAME` asks for: a generated one (`ml64`, `vessels128`: `generate::by_name`)
-/// or a dataset of the data folder (`lobster`, `hydrogen_atom`: `$VOLGRAPH_DATA/volumes`, with the
-/// voxel spacing of its MANIFEST row).
-fn named_volume(name: &str) -> anyhow::Result<(Volume, Vec<String>)> {
-    use volgraph_accel::generate::{self, NAMED_GENERATORS, NamedVolumeError};
-    match generate::by_name(name) {
-        Ok(volume) => Ok((volume, Vec::new())),
-        Err(e @ NamedVolumeError::Edge { .. }) => bail!("{e}"),
-        Err(NamedVolumeError::Unknown { .. }) => {
-            let loaded = volgraph_accel::data_dir::load_dataset(name).map_err(|e| {
-                anyhow!(
-                    "{name}: no such file or folder, and not a volume's name: {e}; a generated volume is \
-                     named {NAMED_GENERATORS}"
-                )
+/// What the loader of `what` repaired or ignored, for stderr.
+fn load_notes(what: &str, report: &volgraph_accel::load::LoadReport) -> Vec<String> {
+    let mut notes: Vec<String> = report.notes.iter().map(|n| format!("{what}: {n}")).collect();
+    if report.non_finite_replaced() > 0 {
+        notes.push(format!("{what}: replaced {} NaN/Inf voxels", report.non_finite_replaced()));
+    }
+    notes
+}
+
+/// A volume given by name where a path could stand (`--volume lobster`, `--volume ml64`), as
+/// `volgraph bench graphs --datasets` takes them.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum VolumeName {
+    /// A generated volume (`ml64`, `vessels128`: `volgraph_accel::generate::by_name`).
+    Generated(String),
+    /// A dataset of the data folder (`lobster`: `$VOLGRAPH_DATA/volumes`, with its MANIFEST
+    /// row's voxel spacing).
+    Dataset(String),
+}
+
+/// `path` as a volume's name: there is no such file or folder, and it has no folder part and no
+/// extension. A generator's name (or one with a generator's prefix and a bad edge, whose error
+/// then says the range) is generated; any other is a data-folder dataset.
+pub fn volume_name(path: &Path) -> Option<VolumeName> {
+    use volgraph_accel::generate::{NamedVolumeError, by_name};
+    let missing = path.symlink_metadata().is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound);
+    if !missing || path.components().count() != 1 || path.extension().is_some() {
+        return None;
+    }
+    let name = path.to_str()?.to_string();
+    Some(match by_name(&name) {
+        Err(NamedVolumeError::Unknown { .. }) => VolumeName::Dataset(name),
+        _ => VolumeName::Generated(name),
+    })
+}
+
+/// Loads a named volume. `--spacing` overrides the volume's; the flags that describe a file's
+/// layout (`--dims`, `--dtype`, `--big-endian`, `--series`, `--frame`) are refused.
+fn named_volume(name: &VolumeName, options: &LoadOptions<'_>) -> anyhow::Result<(Volume, Vec<String>)> {
+    use volgraph_accel::generate::{NAMED_GENERATORS, by_name};
+    let (VolumeName::Generated(n) | VolumeName::Dataset(n)) = name;
+    let raw = &options.raw;
+    let big_endian = matches!(raw.endianness, volgraph_accel::load::Endianness::Big);
+    if raw.dims.is_some() || raw.dtype.is_some() || big_endian || options.series.is_some() || options.frame.is_some() {
+        bail!(
+            "{n} names a volume, not a file: --dims, --dtype, --big-endian, --series and --frame describe a file's \
+             layout; remove them (--spacing may stay)"
+        );
+    }
+    let (mut volume, notes) = match name {
+        VolumeName::Generated(_) => (by_name(n).map_err(|e| anyhow!("{e}"))?, Vec::new()),
+        VolumeName::Dataset(_) => {
+            let loaded = volgraph_accel::data_dir::load_dataset(n).map_err(|e| {
+                anyhow!("{n}: no such file or folder, and not a volume's name: {e}; a generated volume is named {NAMED_GENERATORS}")
             })?;
-            let notes = loaded.report.notes.iter().map(|n| format!("{name}: {n}")).collect();
-            Ok((loaded.volume, notes))
+            let notes = load_notes(n, &loaded.report);
+            (loaded.volume, notes)
         }
+    };
+    if let Some(spacing) = raw.spacing {
+        volume.spacing = spacing;
     }
+    Ok((volume, notes))
 }
 
 /// The generated default volume, made once per process.
@@ -311,4 +352,21 @@ pub fn data_scene_values(volume: &Volume) -> Vec<(String, f64)> {
     use volgraph_core::graph::ast::{DATA_AUTO_ISO, DATA_HIGH, DATA_LOW};
     let (lo, hi, auto) = volgraph_accel::histogram::data_scale(volume);
     vec![(DATA_LOW.to_string(), lo), (DATA_HIGH.to_string(), hi), (DATA_AUTO_ISO.to_string(), auto)]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Only a missing path without a folder part or an extension is a volume's name; what a
+    /// generator would make is generated (a bad edge too, so its error names the range).
+    #[test]
+    fn volume_names_are_missing_plain_names() {
+        assert_eq!(volume_name(Path::new("ml64")), Some(VolumeName::Generated("ml64".into())));
+        assert_eq!(volume_name(Path::new("ml1")), Some(VolumeName::Generated("ml1".into())));
+        assert_eq!(volume_name(Path::new("lobster")), Some(VolumeName::Dataset("lobster".into())));
+        for path in ["lobster.raw", "dir/lobster", "./lobster", "..", ".", ""] {
+            assert_eq!(volume_name(Path::new(path)), None, "{path}");
+        }
+    }
 }

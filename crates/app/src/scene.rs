@@ -424,7 +424,7 @@ pub fn load_volume(
     let at = |e: anyhow::Error| anyhow::anyhow!("{}: volume: {e:#}", scene.path.display());
     match &scene.volume {
         VolumeSource::File(p) => {
-            let (v, notes) = crate::inputs::volume(&[PathBuf::from(p)], raw).map_err(at)?;
+            let (v, notes) = crate::inputs::volume_files(&[PathBuf::from(p)], raw).map_err(at)?;
             Ok((v, false, notes))
         }
         VolumeSource::Dataset(name) => {

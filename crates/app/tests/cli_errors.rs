@@ -175,6 +175,11 @@ fn a_volume_name_is_a_dataset_or_a_generated_volume() {
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("no_such_volume: no such file or folder, and not a volume's name"), "{err}");
     assert!(err.contains("ml<N>, mlf<N>, sphere<N>, noise<N> or vessels<N>"), "{err}");
+    // A name is no file: the flags of a file's layout are refused, not silently dropped.
+    let (code, err) =
+        volgraph(&["render", "graphs/basic/fragment_raycast.ron", "--volume", "sphere24", "--dims", "8x8x8", "-o", &o]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("sphere24 names a volume, not a file: --dims"), "{err}");
     let (code, err) = volgraph(&["render", "graphs/basic/fragment_raycast.ron", "--volume", "ml1", "-o", &o]);
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("\"ml1\"") && err.contains("edge must be 2..="), "{err}");

@@ -359,7 +359,7 @@ impl VolumeState {
     }
 
     /// Re-classifies bricks and octree leaves for a new TF (§7: only the TF-dependent part)
-    /// and uploads the leaves' leap distances; returns the time it took in ms.
+    /// and uploads the leaves' words ([`leaf_words`]); returns the time it took in ms.
     fn classify(&mut self, ctx: &RecordContext<'_>, lut: &[[f32; 4]], ratio: f32) -> Result<f64, PassError> {
         let started = Instant::now();
         let classifier = OpacityClassifier::new(lut).map_err(|e| pass_error(ctx, e.to_string()))?;
@@ -379,7 +379,7 @@ impl VolumeState {
         let size = (bytes.len() as u64).max(4);
         if self.leaf_buffer.as_ref().is_none_or(|b| b.size() != size) {
             self.leaf_buffer = Some(ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("leaf leap distances"),
+                label: Some("leaf words"),
                 size,
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
@@ -584,7 +584,7 @@ pub struct LeafClassification {
 }
 
 /// Rasterizes every visible brick's boxes to draw (§7's ratio rule at `ratio`) into the leaf
-/// grid and turns the rest into leap distances ([`volgraph_accel::chebyshev`]).
+/// grid and turns them into the march's words ([`leaf_words`]: leap distances, drawn cubes).
 pub fn classify_leaves(
     octree: &OctreeHierarchy,
     visibility: &OctreeVisibility,
@@ -682,8 +682,8 @@ impl RaycastBricksNode {
         }
     }
 
-    /// The per-batch tables (header word + slot + 1 per brick) in one buffer, one region per
-    /// batch at a stride the storage-offset alignment allows.
+    /// The per-batch tables in one buffer, one region per batch at a stride the storage-offset
+    /// alignment allows: a header word, then per brick its [`slot_word`] (0: not in this batch).
     fn write_tables(&mut self, ctx: &RecordContext<'_>, batches: &[Batch], bricks: usize, slots: UVec3) -> u64 {
         let align = ctx.gpu.limits.min_storage_buffer_offset_alignment as u64;
         let stride = (4 * (1 + bricks as u64)).div_ceil(align) * align;

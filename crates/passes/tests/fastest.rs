@@ -350,10 +350,11 @@ fn a_new_transfer_function_reclassifies_the_blocks() {
 }
 
 /// `raycast_compute` maps consecutive invocations to 4×2 tiles where the workgroup's sides allow
-/// it (`invocation_pixel` in common/workgroup_pixel.wgsl, which `raycast_bricks` shares) and to rows otherwise: every shape, tiled or
-/// not, must write every pixel exactly once with its own ray. Pixels share nothing, so the images
-/// are compared bit for bit against one-invocation workgroups (no tiling); a pixel written twice
-/// or never shows as a difference, the case's image covering a fair part of the frame.
+/// it (`invocation_pixel` in common/workgroup_pixel.wgsl, which `raycast_bricks` shares) and to
+/// rows otherwise: every shape, tiled or not, must write every pixel exactly once with its own
+/// ray. Pixels share nothing, so the images are compared bit for bit against one-invocation
+/// workgroups (no tiling); a pixel written twice or never shows as a difference, the case's
+/// image covering a fair part of the frame.
 #[test]
 fn every_workgroup_shape_writes_every_pixel_with_its_own_ray() {
     let case = cases().remove(0);

@@ -299,7 +299,24 @@ impl Job {
             }
             _ => return Err(anyhow!("--distributed reads one volume file or DICOM folder; give one --volume")),
         };
-        let raw = inputs::raw_options(&args.inputs.raw)?;
+        let mut raw = inputs::raw_options(&args.inputs.raw)?;
+        // A dataset's name reads its file, with the manifest's spacing unless --spacing is given.
+        let dataset_file;
+        let path = match inputs::volume_name(path) {
+            None => path,
+            Some(inputs::VolumeName::Generated(name)) => {
+                return Err(anyhow!(
+                    "--distributed: each rank reads its box of a volume file, and {name} is generated; give a file"
+                ));
+            }
+            Some(inputs::VolumeName::Dataset(name)) => {
+                let (file, spacing) =
+                    volgraph_accel::data_dir::dataset_file(&name).map_err(|e| anyhow!("--volume {name}: {e}"))?;
+                raw.raw.spacing = raw.raw.spacing.or(spacing);
+                dataset_file = file;
+                &dataset_file
+            }
+        };
         let header = VolumeHeader::read(path, &raw).map_err(|e| anyhow!("{e}"))?;
         let source = inputs::read_graph(&resolved.graph)?;
         let mut options = compile_options(&resolved.size, &args.inputs.features, &[])?;

@@ -949,12 +949,17 @@ fn compile_for(
     volgraph_core::compile(file, source, registry, &options)
 }
 
-/// Where the session's volume came from: the one `--volume` file (or the folder of a DICOM
-/// series given as files), else the scene's, else the generated Marschner–Lobb 64³.
+/// Where the session's volume came from: the one `--volume` file or name (or the folder of a
+/// DICOM series given as files), else the scene's, else the generated Marschner–Lobb 64³.
 fn volume_source_of(args: &SessionArgs) -> crate::scene::VolumeSource {
+    use crate::inputs::VolumeName;
     use crate::scene::VolumeSource;
     match (args.volume.as_slice(), &args.scene) {
-        ([one], _) => VolumeSource::File(one.display().to_string()),
+        ([one], _) => match crate::inputs::volume_name(one) {
+            Some(VolumeName::Generated(name)) => VolumeSource::Generated(name),
+            Some(VolumeName::Dataset(name)) => VolumeSource::Dataset(name),
+            None => VolumeSource::File(one.display().to_string()),
+        },
         ([first, ..], _) => VolumeSource::File(first.parent().unwrap_or(Path::new(".")).display().to_string()),
         ([], Some(scene)) => scene.volume.clone(),
         ([], None) => VolumeSource::Generated("ml64".to_string()),

@@ -7,7 +7,7 @@
 // skips what the transfer function leaves empty:
 // - in a leaf of the octrees (`leaf_cells`³ cells, the node limit of §7) that no box chosen by
 //   the ratio rule covers, the ray leaps out of the largest cube of such leaves around it
-//   (`leaf_distance`, Chebyshev distances: empty nodes and empty bricks alike);
+//   (`leaf_words`: Chebyshev distances, empty nodes and empty bricks alike);
 // - a brick not in this dispatch's batch is left in one step (§5, §7: bricks drawn front to
 //   back, one batch of resident bricks after another when the pool is smaller than the
 //   visible bricks);
@@ -45,7 +45,7 @@ struct BrickParams {
 // covers it, the Chebyshev distance d (1..=255) in leaves to the nearest such leaf (every leaf
 // closer is empty too); where one does, `reach << 8`: the cube of leaves reach - 1 around it is
 // drawn too, inside its brick.
-@group(0) @binding(auto) var<storage, read> leaf_distance: array<u32>;
+@group(0) @binding(auto) var<storage, read> leaf_words: array<u32>;
 // Per pixel: the premultiplied colour composited so far this frame.
 @group(0) @binding(auto) var<storage, read_write> acc: array<vec4<f32>>;
 #import "common/color_target.wgsl"
@@ -102,7 +102,7 @@ fn empty_region_at(p: vec3<f32>, grid: LeapGrid) -> EmptyRegion {
     let leaf_cells = grid.leaf_cells;
     let leaf_grid = grid.leaf_grid;
     let l = leaf_of(c);
-    let word = leaf_distance[l.x + leaf_grid.x * (l.y + leaf_grid.y * l.z)];
+    let word = leaf_words[l.x + leaf_grid.x * (l.y + leaf_grid.y * l.z)];
     let d = word & 0xffu;
     // The cube of leaves within reach - 1 of l: empty (a leap) or drawn (a run of samples).
     let reach = vec3<u32>(select(word >> 8u, d, d > 0u) - 1u);

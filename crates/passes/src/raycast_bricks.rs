@@ -17,8 +17,8 @@
 //!   a ray leaves the largest cube of leaves no box covers in one step — the octree's empty
 //!   nodes, and empty bricks, as one lookup (without an octree the leaves are the bricks).
 //!   Where it stands in a drawn leaf it marches one run: through the cube of drawn leaves
-//!   around it ([`leaf_words`]) and on through its brick to `CHECK_EVERY` samples at least, so
-//!   a thin vessel or a dense brick does not cost a round of leaps per leaf.
+//!   around it ([`leaf_words`]) and on through its brick, up to `CHECK_EVERY` samples in all,
+//!   so a thin vessel or a dense brick does not cost a round of leaps per leaf.
 //! - **termination**: a ray stops at `threshold` and skips the bricks behind it (per-brick
 //!   early ray termination: with `threshold < 1` a saturated pixel costs nothing in later
 //!   batches either).
@@ -91,7 +91,8 @@ const _: () = assert!(std::mem::size_of::<BrickParamsGpu>() == 80);
 /// `max_buffer_size`), so a 1024³ volume never needs a gigabyte of staging at once.
 const MAX_STAGING_BYTES: u64 = 64 << 20;
 
-/// Leap distances are capped here (a cube of 2·255 − 1 leaves is wider than any volume).
+/// Leap distances are capped here: a leap out of a cube of 2·255 − 1 leaves is long enough that a
+/// larger one would save little (the cap only shortens leaps, it never skips a drawn leaf).
 const MAX_LEAP: u32 = 255;
 
 impl PassDecl for RaycastBricks {
@@ -146,7 +147,7 @@ impl PassDecl for RaycastBricks {
 /// The brick march's entry point and what it binds, declared once for `shaders()` and `create`.
 fn march_shader() -> ShaderUse {
     ShaderUse::new("raycast_bricks.wgsl", "cs_main")
-        .binds(&["table", "leaf_distance", "acc", "volume"])
+        .binds(&["table", "leaf_words", "acc", "volume"])
         .uniform(RaycastParamsGpu::bound("params"))
         .uniform(brick_layout())
 }
@@ -374,7 +375,7 @@ impl VolumeState {
         self.visibility = Some(visibility);
         self.visible = leaves.visible;
         self.drawn_leaves = leaves.drawn_fraction;
-        let bits = leaves.distance;
+        let bits = leaves.words;
         let bytes: &[u8] = bytemuck::cast_slice(&bits);
         let size = (bytes.len() as u64).max(4);
         if self.leaf_buffer.as_ref().is_none_or(|b| b.size() != size) {
@@ -571,14 +572,14 @@ pub fn leaf_grid(volume_dims: UVec3, node_cells: u32) -> UVec3 {
 }
 
 /// The CPU work of a TF change after the octrees' visible counts are rebuilt: which bricks are
-/// visible, and every leaf's leap distance.
+/// visible, and every leaf's word ([`leaf_words`]).
 pub struct LeafClassification {
     /// Per brick: visible under the TF.
     pub visible: Vec<bool>,
     /// Per leaf of the volume (x fastest), what the march reads ([`leaf_word`]): where no box
     /// to draw covers it, the Chebyshev distance in leaves to the nearest such leaf (capped at
     /// 255); where one does, how far the drawn leaves around it reach within its brick.
-    pub distance: Vec<u32>,
+    pub words: Vec<u32>,
     /// Fraction of the leaves drawn.
     pub drawn_fraction: f64,
 }
@@ -614,8 +615,8 @@ pub fn classify_leaves(
         }
     }
     let drawn_fraction = drawn.iter().filter(|d| **d).count() as f64 / drawn.len().max(1) as f64;
-    let distance = leaf_words(&drawn, grid, layout.brick_cells().div_ceil(leaf).max(1));
-    LeafClassification { visible, distance, drawn_fraction }
+    let words = leaf_words(&drawn, grid, layout.brick_cells().div_ceil(leaf).max(1));
+    LeafClassification { visible, words, drawn_fraction }
 }
 
 /// Every leaf's [`leaf_word`] for the drawn leaves `drawn` (x fastest in `grid`), in bricks of
@@ -787,7 +788,7 @@ impl PassNode for RaycastBricksNode {
                 ("params", self.params.as_entire_binding()),
                 ("bricks", self.uniform.as_entire_binding()),
                 ("table", wgpu::BindingResource::Buffer(table)),
-                ("leaf_distance", leaf_buffer.as_entire_binding()),
+                ("leaf_words", leaf_buffer.as_entire_binding()),
                 ("acc", acc.as_entire_binding()),
                 ("volume", wgpu::BindingResource::TextureView(&atlas.view)),
             ];

@@ -284,6 +284,28 @@ pub enum LoadError {
         z: f64,
     },
 
+    /// Voxel sides so unequal that the box cannot be drawn (see
+    /// [`super::MAX_SPACING_RATIO`]).
+    #[error(
+        "{at}: {what} ({x}, {y}, {z}): the longest voxel side is {ratio:.1e} times the shortest; at most 1e4, or the \
+         volume renders black (give the spacing in one unit, e.g. mm for every axis: fix the header, or override it \
+         with --spacing X,Y,Z)"
+    )]
+    SpacingRatio {
+        /// The file.
+        at: Location,
+        /// `the header's voxel spacing` or `--spacing`.
+        what: &'static str,
+        /// Spacing along x.
+        x: f64,
+        /// Spacing along y.
+        y: f64,
+        /// Spacing along z.
+        z: f64,
+        /// Longest over shortest.
+        ratio: f64,
+    },
+
     /// The amount of voxel data differs from what the dimensions and type need.
     #[error(
         "{}: {dims} {dtype} voxels need {expected} bytes, but the data has {actual} bytes; {hint}",

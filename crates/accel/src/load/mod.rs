@@ -148,14 +148,55 @@ pub fn load_volumes(paths: &[PathBuf], options: &LoadOptions<'_>) -> Result<Load
                     reason: "picks a volume of a 4D NIfTI file, but this is not NIfTI",
                 });
             }
-            return load_file(&first, &options.raw);
+            load_file(&first, &options.raw)?
         }
     };
-    if let Some(spacing) = options.raw.spacing {
-        check_spacing(&Location::file(&first), spacing)?;
-        loaded.volume.spacing = spacing;
-    }
+    finish_loaded(&first, options.raw.spacing, &mut loaded)?;
     Ok(loaded)
+}
+
+/// The largest ratio of the longest voxel side to the shortest: the box is scaled to its longest
+/// side in f32, and beyond this the shortest side falls below f32's resolution and the volume
+/// renders black. `--spacing` and every header's spacing are held to it.
+pub const MAX_SPACING_RATIO: f64 = 1e4;
+
+/// What every loaded volume passes through, whatever its format: `spacing` (`--spacing`),
+/// checked, replaces the header's; a spacing whose sides differ by more than
+/// [`MAX_SPACING_RATIO`] is refused; a constant volume gets its one value as its range (16-bit
+/// data; 8-bit data keeps the type range its texture is normalized by) and a note.
+fn finish_loaded(path: &Path, spacing: Option<DVec3>, loaded: &mut LoadedVolume) -> Result<(), LoadError> {
+    let at = Location::file(path);
+    let (spacing, what) = match spacing {
+        Some(s) => (s, "--spacing"),
+        None => (loaded.volume.spacing, "the header's voxel spacing"),
+    };
+    check_spacing(&at, spacing)?;
+    let ratio = spacing.max_element() / spacing.min_element();
+    if ratio > MAX_SPACING_RATIO {
+        return Err(LoadError::SpacingRatio { at, what, x: spacing.x, y: spacing.y, z: spacing.z, ratio });
+    }
+    loaded.volume.spacing = spacing;
+    note_constant(loaded);
+    Ok(())
+}
+
+/// A constant volume: its range is its value (as a constant float volume's is), with a note.
+fn note_constant(loaded: &mut LoadedVolume) {
+    let volume = &mut loaded.volume;
+    if volume.voxel_count() == 0 {
+        return;
+    }
+    let (lo, hi) = volume.data_min_max();
+    if lo != hi {
+        return;
+    }
+    if matches!(volume.data, VoxelData::U16(_) | VoxelData::I16(_)) {
+        volume.value_range = (lo, lo);
+    }
+    loaded.report.notes.push(format!(
+        "every voxel holds the value {lo}: the volume is constant, so a transfer function shows it as an empty or a \
+         uniform box"
+    ));
 }
 
 /// Raw layout options on a file with a header are an error.
@@ -229,7 +270,7 @@ pub fn load_volume(path: &Path, opts: &RawOptions) -> Result<LoadedVolume, LoadE
     load_volumes(&[path.to_path_buf()], &LoadOptions { raw: opts.clone(), ..LoadOptions::default() })
 }
 
-/// One volume file by extension.
+/// One volume file by extension (`opts.spacing` is applied by the caller).
 fn load_file(path: &Path, opts: &RawOptions) -> Result<LoadedVolume, LoadError> {
     // A directory or FIFO is named as such before its (missing) extension is; a path that does
     // not exist gets the extension check first and the read error after.
@@ -240,20 +281,13 @@ fn load_file(path: &Path, opts: &RawOptions) -> Result<LoadedVolume, LoadError> 
     if matches!(extension.as_str(), "nrrd" | "nhdr" | "mhd" | "mha") || is_nifti(path) {
         check_no_raw_layout(path, opts)?;
     }
-    let mut loaded = match extension.as_str() {
-        "raw" => raw::load(path, opts)?,
-        "nrrd" | "nhdr" => nrrd::load(path)?,
-        "mhd" | "mha" => metaimage::load(path)?,
-        _ if is_nifti(path) => nifti::load(path, None)?,
-        _ => {
-            return Err(LoadError::UnknownFormat { path: path.to_path_buf(), extension });
-        }
-    };
-    if let Some(spacing) = opts.spacing {
-        check_spacing(&Location::file(path), spacing)?;
-        loaded.volume.spacing = spacing;
+    match extension.as_str() {
+        "raw" => raw::load(path, opts),
+        "nrrd" | "nhdr" => nrrd::load(path),
+        "mhd" | "mha" => metaimage::load(path),
+        _ if is_nifti(path) => nifti::load(path, None),
+        _ => Err(LoadError::UnknownFormat { path: path.to_path_buf(), extension }),
     }
-    Ok(loaded)
 }
 
 /// Parses a NRRD header and data held in memory; `path` is used for messages and to find a

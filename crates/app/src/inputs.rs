@@ -39,8 +39,8 @@ pub fn read_graph(path: &Path) -> anyhow::Result<String> {
     }
 }
 
-/// The largest ratio of voxel sides `--spacing` accepts.
-const MAX_SPACING_RATIO: f64 = 1e4;
+/// The largest ratio of voxel sides `--spacing` accepts (as for a header's spacing).
+const MAX_SPACING_RATIO: f64 = volgraph_accel::load::MAX_SPACING_RATIO;
 
 /// How to read the volume: `--dims`, `--dtype`, `--spacing`, `--big-endian` for raw files,
 /// `--series`, `--frame` for scanner data.
@@ -252,7 +252,7 @@ pub fn transfer_function(
         // `graphs/tf/NAME.ron` where no such file exists: the copy compiled into the program.
         Some(p) => match crate::builtin_graphs::find_tf(p) {
             Some((_, text)) => TransferFunction::from_ron_str(text, p).map_err(|e| anyhow!("{e}"))?,
-            None => TransferFunction::load(p).map_err(|e| anyhow!("{e}"))?,
+            None => TransferFunction::load(p).map_err(|e| tf_read_error(p, e))?,
         },
     };
     if let Some(p) = path
@@ -261,6 +261,28 @@ pub fn transfer_function(
         notes.push(format!("{}: {note}", p.display()));
     }
     Ok((tf, notes))
+}
+
+/// A `--tf` file that cannot be read; where no such file exists, the preset it may have meant
+/// (`CT-BONE`, `ct_bone`, `ct-bones` → `ct-bone`), or the presets when it looks like a name.
+fn tf_read_error(path: &Path, error: volgraph_accel::transfer_function::TfError) -> anyhow::Error {
+    let missing = path.symlink_metadata().is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound);
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or_default();
+    if !missing {
+        return anyhow!("{error}");
+    }
+    match ScannerPreset::closest(name) {
+        Some(preset) => anyhow!(
+            "{error}; did you mean the built-in preset \"{}\" (--tf {})? The presets are {}",
+            preset.name(),
+            preset.name(),
+            ScannerPreset::names()
+        ),
+        None if path.components().count() == 1 && path.extension().is_none() => {
+            anyhow!("{error}; nor is it a built-in preset: they are {}", ScannerPreset::names())
+        }
+        None => anyhow!("{error}"),
+    }
 }
 
 /// A warning when the TF's domain and the volume's values do not overlap: every voxel then

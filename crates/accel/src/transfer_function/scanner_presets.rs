@@ -56,6 +56,25 @@ impl ScannerPreset {
         ScannerPreset::ALL.into_iter().find(|p| p.name() == name)
     }
 
+    /// The preset `name` most likely means, when it is none exactly: compared without case and
+    /// with `_` read as `-`, then by edit distance (`CT-BONE`, `ct_bone`, `ct-bones` → `ct-bone`).
+    /// A suggestion for a message only: `--tf` takes the exact name ([`Self::from_name`]).
+    pub fn closest(name: &str) -> Option<ScannerPreset> {
+        let wanted = name.to_lowercase().replace('_', "-");
+        ScannerPreset::ALL
+            .into_iter()
+            .map(|p| (strsim::normalized_levenshtein(&wanted, p.name()), p))
+            .filter(|(score, _)| *score >= 0.6)
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(_, p)| p)
+    }
+
+    /// Every preset's name: `ct-bone, ct-soft-tissue, … and mr-default`.
+    pub fn names() -> String {
+        let names: Vec<&str> = ScannerPreset::ALL.iter().map(|p| p.name()).collect();
+        format!("{} and {}", names[..names.len() - 1].join(", "), names[names.len() - 1])
+    }
+
     /// True for the presets written in Hounsfield units.
     pub fn is_ct(self) -> bool {
         self != ScannerPreset::MrDefault

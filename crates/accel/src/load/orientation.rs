@@ -36,7 +36,14 @@ impl AxisOrientation {
     /// along that axis), with the voxel spacing along world x, y, z. `at` and `field` name the
     /// header line in errors.
     pub fn from_directions(directions: [DVec3; 3], at: &Location, field: &str) -> Result<(Self, DVec3), LoadError> {
-        let text = directions.iter().map(|d| format!("({},{},{})", d.x, d.y, d.z)).collect::<Vec<_>>().join(" ");
+        // Shortest round-trip text, in scientific notation where that would run to hundreds of
+        // digits (a header's 1e300).
+        let short = |v: f64| if v != 0.0 && !(1e-4..1e9).contains(&v.abs()) { format!("{v:e}") } else { format!("{v}") };
+        let text = directions
+            .iter()
+            .map(|d| format!("({},{},{})", short(d.x), short(d.y), short(d.z)))
+            .collect::<Vec<_>>()
+            .join(" ");
         let mut orientation = AxisOrientation::default();
         let mut spacing = DVec3::ONE;
         let mut taken = [false; 3];

@@ -19,6 +19,9 @@ const SPACING_TOLERANCE: f64 = 0.01;
 const GAP_FACTOR: f64 = 1.5;
 /// Direction cosines that differ by less than this are the same orientation.
 const ORIENTATION_TOLERANCE: f64 = 1e-4;
+/// ImageOrientationPatient's vectors are unit length and perpendicular within this (headers
+/// round the cosines to a few digits).
+const UNIT_TOLERANCE: f64 = 1e-2;
 
 /// What geometry needs of one slice's header.
 #[derive(Clone, Debug, PartialEq)]
@@ -87,12 +90,12 @@ pub fn stack(series: &str, slices: &[SliceGeometry], slice_thickness: Option<f64
             return Err(geometry_error(
                 series,
                 format!(
-                    "{} has ImageOrientationPatient {:?} but {} has {:?}; the slices of one volume share one \
+                    "{} has ImageOrientationPatient {} but {} has {}; the slices of one volume share one \
                      orientation (pick one series with --series)",
                     name(s),
-                    o,
+                    numbers_text(&o),
                     name(first),
-                    orientation
+                    numbers_text(&orientation)
                 ),
             ));
         }
@@ -100,18 +103,39 @@ pub fn stack(series: &str, slices: &[SliceGeometry], slice_thickness: Option<f64
     let row = DVec3::new(orientation[0], orientation[1], orientation[2]);
     let column = DVec3::new(orientation[3], orientation[4], orientation[5]);
     let normal = row.cross(column);
-    if !(row.length() > 0.5 && column.length() > 0.5 && normal.length() > 0.5) {
+    let unit = |v: DVec3| (v.length() - 1.0).abs() <= UNIT_TOLERANCE;
+    if !(unit(row) && unit(column) && row.dot(column).abs() <= UNIT_TOLERANCE) {
         return Err(geometry_error(
             series,
-            format!("{}: ImageOrientationPatient {:?} is not two perpendicular unit vectors", name(first), orientation),
+            format!(
+                "{}: ImageOrientationPatient (0020,0037) {} is not two perpendicular unit vectors (lengths {} and {}, \
+                 dot product {}); fix the header (e.g. with dcmodify) or remove the file",
+                name(first),
+                numbers_text(&orientation),
+                num(row.length()),
+                num(column.length()),
+                num(row.dot(column))
+            ),
         ));
     }
     let (row, column, normal) = (row.normalize(), column.normalize(), normal.normalize());
+    let mut notes = Vec::new();
+    if first.pixel_spacing.is_none() {
+        notes.push(format!(
+            "{} has no PixelSpacing (0028,0030): 1 × 1 mm pixels assumed; give --spacing if the images have a known size",
+            name(first)
+        ));
+    }
     let [row_spacing, column_spacing] = first.pixel_spacing.unwrap_or([1.0, 1.0]);
     if !(row_spacing > 0.0 && column_spacing > 0.0 && row_spacing.is_finite() && column_spacing.is_finite()) {
         return Err(geometry_error(
             series,
-            format!("{}: PixelSpacing {row_spacing}\\{column_spacing} must be two positive numbers (mm)", name(first)),
+            format!(
+                "{}: PixelSpacing (0028,0030) {}\\{} must be two positive numbers (mm)",
+                name(first),
+                num(row_spacing),
+                num(column_spacing)
+            ),
         ));
     }
 
@@ -136,7 +160,6 @@ pub fn stack(series: &str, slices: &[SliceGeometry], slice_thickness: Option<f64
     let mut order: Vec<usize> = (0..slices.len()).collect();
     order.sort_by(|&a, &b| along[a].total_cmp(&along[b]));
 
-    let mut notes = Vec::new();
     let spacing = if order.len() < 2 {
         slice_thickness.filter(|t| *t > 0.0 && t.is_finite()).unwrap_or(row_spacing.min(column_spacing))
     } else {
@@ -208,6 +231,18 @@ pub fn stack(series: &str, slices: &[SliceGeometry], slice_thickness: Option<f64
         }
         mean
     };
+    if !(spacing.is_finite() && spacing > 0.0) {
+        return Err(geometry_error(
+            series,
+            format!(
+                "the slices' ImagePositionPatient (0020,0032) values, from {} to {}, give a slice spacing of {} mm, not \
+                 a finite positive distance; fix the header (e.g. with dcmodify) or remove the odd files",
+                position_text(positions[order[0]]),
+                position_text(positions[order[order.len() - 1]]),
+                num(spacing)
+            ),
+        ));
+    }
     Ok(Stack {
         origin: positions[order[0]],
         order,
@@ -217,7 +252,24 @@ pub fn stack(series: &str, slices: &[SliceGeometry], slice_thickness: Option<f64
 }
 
 fn position_text(p: DVec3) -> String {
-    format!("({:.3}, {:.3}, {:.3})", p.x, p.y, p.z)
+    format!("({}, {}, {})", num(p.x), num(p.y), num(p.z))
+}
+
+/// `v` for a message: up to three decimals, or in scientific notation where that would print
+/// hundreds of digits (1e300) or only zeros.
+fn num(v: f64) -> String {
+    if v == 0.0 || (1e-3..1e9).contains(&v.abs()) {
+        let text = format!("{v:.3}");
+        let text = text.trim_end_matches('0').trim_end_matches('.');
+        if text == "-0" { "0".to_string() } else { text.to_string() }
+    } else {
+        format!("{v:.3e}")
+    }
+}
+
+/// Numbers as a DICOM multi-value: `1\\0\\0\\0\\1\\0`.
+fn numbers_text(values: &[f64]) -> String {
+    values.iter().map(|&v| num(v)).collect::<Vec<_>>().join("\\")
 }
 
 #[cfg(test)]

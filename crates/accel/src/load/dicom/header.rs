@@ -10,7 +10,7 @@ use dicom_object::{DefaultDicomObject, OpenFileOptions};
 use glam::DVec3;
 
 use super::geometry::SliceGeometry;
-use crate::load::LoadError;
+use crate::load::{LoadError, Location};
 
 /// MediaStorageSOPClassUID of a DICOMDIR (Media Storage Directory Storage).
 const DICOMDIR_CLASS: &str = "1.2.840.10008.1.3.10";
@@ -21,6 +21,9 @@ pub enum Probe {
     NotDicom,
     /// A DICOMDIR: an index of other files, skipped with a note.
     Dicomdir,
+    /// A DICOM object without an image (no Rows and no Columns: a report, a presentation
+    /// state), skipped with a note.
+    NoImage,
     /// An image.
     Image(Box<FileHeader>),
 }
@@ -44,6 +47,8 @@ pub struct FileHeader {
     pub samples_per_pixel: u16,
     /// BitsAllocated.
     pub bits_allocated: u16,
+    /// PhotometricInterpretation ("" when absent).
+    pub photometric: String,
     /// NumberOfFrames (1 when absent).
     pub frames: u32,
     /// RescaleSlope, RescaleIntercept (1, 0 when absent).
@@ -60,8 +65,9 @@ pub struct FileHeader {
     pub frame_geometry: Vec<SliceGeometry>,
 }
 
-/// Reads `path`'s header. `Ok(Probe::NotDicom)` for a file without the `DICM` magic; an error
-/// for a DICOM file that cannot be parsed (a corrupt or truncated slice).
+/// Reads `path`'s header. `Ok(Probe::NotDicom)` for a file without the `DICM` magic (after the
+/// 128-byte preamble, or at the start of a file written without one); an error for a DICOM file
+/// that cannot be parsed (a corrupt or truncated slice) or whose attributes are malformed.
 pub fn probe(path: &Path) -> Result<Probe, LoadError> {
     // A FIFO or a device would block the read of the magic: refuse it by name.
     match crate::input_file::special_kind(path) {
@@ -72,17 +78,25 @@ pub fn probe(path: &Path) -> Result<Probe, LoadError> {
     if !has_dicom_magic(path)? {
         return Ok(Probe::NotDicom);
     }
+    // Float and Double Float Pixel Data (7FE0,0008/0009) come just before PixelData: the
+    // header stops at the first pixel element of any kind. The default preamble detection
+    // reads files with and without the 128-byte preamble.
     let object = OpenFileOptions::new()
-        .read_until(tags::PIXEL_DATA)
+        .read_until(tags::FLOAT_PIXEL_DATA)
         .open_file(path)
         .map_err(|e| LoadError::DicomRead { path: path.to_path_buf(), reason: e.to_string() })?;
     if object.meta().media_storage_sop_class_uid().trim_end_matches('\0') == DICOMDIR_CLASS {
         return Ok(Probe::Dicomdir);
     }
-    Ok(Probe::Image(Box::new(FileHeader::of(path, &object)?)))
+    if object.get(tags::ROWS).is_none() && object.get(tags::COLUMNS).is_none() {
+        return Ok(Probe::NoImage);
+    }
+    let file_len = std::fs::metadata(path).map_err(|source| LoadError::Io { path: path.to_path_buf(), source })?.len();
+    Ok(Probe::Image(Box::new(FileHeader::of(path, &object, file_len)?)))
 }
 
-/// True when `path` has the 128-byte preamble and `DICM` (PS3.10 §7.1).
+/// True when `path` has the 128-byte preamble and `DICM` (PS3.10 §7.1), or `DICM` at its start
+/// (a file written without the preamble, which dicom-rs reads as well).
 fn has_dicom_magic(path: &Path) -> Result<bool, LoadError> {
     use std::io::Read;
     let mut head = [0u8; 132];
@@ -90,12 +104,12 @@ fn has_dicom_magic(path: &Path) -> Result<bool, LoadError> {
     let mut read = 0;
     while read < head.len() {
         match file.read(&mut head[read..]) {
-            Ok(0) => return Ok(false),
+            Ok(0) => break,
             Ok(n) => read += n,
             Err(source) => return Err(LoadError::Io { path: path.to_path_buf(), source }),
         }
     }
-    Ok(&head[128..132] == b"DICM")
+    Ok((read >= 132 && &head[128..132] == b"DICM") || (read >= 4 && &head[..4] == b"DICM"))
 }
 
 /// The text of `tag`, trimmed; `None` when absent or empty.
@@ -110,21 +124,85 @@ pub fn numbers(object: &DefaultDicomObject, tag: Tag) -> Option<Vec<f64>> {
     object.get(tag)?.to_multi_float64().ok().filter(|v| !v.is_empty())
 }
 
+/// The first finite number of `tag`, where a malformed value only loses a label (SeriesNumber,
+/// the display window).
 fn number(object: &DefaultDicomObject, tag: Tag) -> Option<f64> {
     numbers(object, tag).and_then(|v| v.first().copied()).filter(|v| v.is_finite())
 }
 
-fn vec3(v: Option<Vec<f64>>) -> Option<DVec3> {
-    v.filter(|v| v.len() == 3).map(|v| DVec3::new(v[0], v[1], v[2]))
+type Element = dicom_object::mem::InMemElement;
+
+/// An attribute as messages name it: `RescaleSlope (0028,1053)`.
+fn attribute(name: &str, tag: Tag) -> String {
+    format!("{name} {tag}")
 }
 
-fn six(v: Option<Vec<f64>>) -> Option<[f64; 6]> {
-    v.filter(|v| v.len() == 6).map(|v| [v[0], v[1], v[2], v[3], v[4], v[5]])
+/// The error for `element` (attribute `name`, `tag`) of `path` holding a value that is not
+/// `expected`; the value shown with its control characters escaped, cut to 80 characters.
+fn bad(path: &Path, element: Option<&Element>, name: &str, tag: Tag, expected: &'static str) -> LoadError {
+    let value = match element.map(|e| e.to_str()) {
+        None => "(absent)".to_string(),
+        Some(Ok(text)) => super::one_line(&text.chars().take(80).collect::<String>()),
+        Some(Err(_)) => "(not a number)".to_string(),
+    };
+    LoadError::BadField { at: Location::file(path), field: attribute(name, tag), value, expected }
 }
 
-fn two(v: Option<Vec<f64>>) -> Option<[f64; 2]> {
-    v.filter(|v| v.len() == 2).map(|v| [v[0], v[1]])
+/// The numbers `element` holds: `Ok(None)` when it is absent or empty; an error naming `path`
+/// and the attribute when its value is not `count` finite numbers (`NaN`, `abc`, one value of
+/// a pair). Nothing is taken as a default in place of a malformed value.
+fn checked(
+    path: &Path,
+    element: Option<&Element>,
+    name: &str,
+    tag: Tag,
+    count: usize,
+    expected: &'static str,
+) -> Result<Option<Vec<f64>>, LoadError> {
+    let Some(e) = element else { return Ok(None) };
+    if e.to_str().is_ok_and(|t| t.trim_matches(|c: char| c.is_whitespace() || c == '\0').is_empty()) {
+        return Ok(None);
+    }
+    match e.to_multi_float64() {
+        Ok(v) if v.len() == count && v.iter().all(|x| x.is_finite()) => Ok(Some(v)),
+        _ => Err(bad(path, element, name, tag, expected)),
+    }
 }
+
+/// A whole number in `range` from `element`, `Ok(None)` when absent or empty.
+fn whole(
+    path: &Path,
+    element: Option<&Element>,
+    name: &str,
+    tag: Tag,
+    range: std::ops::RangeInclusive<f64>,
+    expected: &'static str,
+) -> Result<Option<u32>, LoadError> {
+    match checked(path, element, name, tag, 1, expected)? {
+        Some(v) if v[0].fract() == 0.0 && range.contains(&v[0]) => Ok(Some(v[0] as u32)),
+        Some(_) => Err(bad(path, element, name, tag, expected)),
+        None => Ok(None),
+    }
+}
+
+const ROWS_EXPECTED: &str = "a whole number of pixels from 1 to 65535 (Rows is the image's height, Columns its \
+                             width); the header is corrupt: remove the file or copy it again";
+const FRAMES_EXPECTED: &str = "a whole number of frames, at least 1; the header is corrupt: remove the file or copy \
+                               it again";
+const SLOPE_EXPECTED: &str = "one finite, non-zero number (data value = stored value × slope + intercept, e.g. 1); \
+                              fix the header (e.g. with dcmodify) or remove the file";
+const INTERCEPT_EXPECTED: &str = "one finite number (data value = stored value × slope + intercept, e.g. -1024); \
+                                  fix the header (e.g. with dcmodify) or remove the file";
+const SPACING_EXPECTED: &str = "two positive numbers in mm, the row spacing then the column spacing (e.g. \
+                                0.5\\0.5); fix the header (e.g. with dcmodify) or remove the file";
+const ORIENTATION_EXPECTED: &str = "six finite numbers, the row direction then the column direction (e.g. \
+                                    1\\0\\0\\0\\1\\0); fix the header (e.g. with dcmodify) or remove the file";
+const POSITION_EXPECTED: &str = "three finite numbers in mm, the centre of the first pixel (e.g. -120\\-80\\35.5); \
+                                 fix the header (e.g. with dcmodify) or remove the file";
+const THICKNESS_EXPECTED: &str = "one finite number in mm (e.g. 1.25); fix the header (e.g. with dcmodify) or \
+                                  remove the file";
+const SAMPLES_EXPECTED: &str = "a whole number from 1 to 4 (1 for a greyscale image); the header is corrupt";
+const BITS_EXPECTED: &str = "a whole number from 1 to 64 (8, 16 or 32 for greyscale images); the header is corrupt";
 
 /// The first item of sequence `tag` in `object`'s item `items[index]`.
 fn nested<'a>(
@@ -135,18 +213,115 @@ fn nested<'a>(
     items.get(index)?.get(tag)?.items()?.first()
 }
 
+/// Fails when the pixels `rows × columns × frames` claims cannot be in a file of `file_len`
+/// bytes: before anything is allocated per frame, a 3 KB file claiming 10⁸ frames is refused.
+/// Native pixels need their bytes; encapsulated frames at least one 8-byte item each; a
+/// deflated data set at most deflate's 1032:1.
+fn check_size(
+    path: &Path,
+    transfer_syntax: &str,
+    (rows, columns, frames, samples, bits): (u32, u32, u32, u32, u32),
+    file_len: u64,
+) -> Result<(), LoadError> {
+    use dicom_encoding::transfer_syntax::TransferSyntaxIndex;
+    let bits_per_frame = u128::from(rows) * u128::from(columns) * u128::from(samples) * u128::from(bits);
+    let needed = (bits_per_frame * u128::from(frames)).div_ceil(8);
+    let ts = dicom_transfer_syntax_registry::TransferSyntaxRegistry.get(transfer_syntax);
+    let (limit, what) = match ts {
+        Some(ts) if ts.is_encapsulated_pixel_data() => {
+            if u64::from(frames) <= file_len / 8 {
+                return Ok(());
+            }
+            return Err(LoadError::DicomPixels {
+                path: path.to_path_buf(),
+                message: format!(
+                    "NumberOfFrames {} is {frames}, but the file has only {file_len} bytes, too few for {frames} \
+                     compressed frames (each takes at least 8); NumberOfFrames is wrong or the file is truncated: \
+                     remove the file or copy it again",
+                    tags::NUMBER_OF_FRAMES
+                ),
+            });
+        }
+        Some(ts) if ts.is_codec_free() => (u128::from(file_len), "has only"),
+        _ => (u128::from(file_len) * 1032, "can inflate to at most 1032 ×"),
+    };
+    if needed <= limit {
+        return Ok(());
+    }
+    Err(LoadError::DicomPixels {
+        path: path.to_path_buf(),
+        message: format!(
+            "Rows {} {rows} × Columns {} {columns} × NumberOfFrames {} {frames} × {samples} sample(s) of BitsAllocated \
+             {} {bits} need {needed} bytes of pixel data, but the file {what} {file_len} bytes; one of those \
+             attributes is wrong or the file is truncated: remove the file or copy it again",
+            tags::ROWS,
+            tags::COLUMNS,
+            tags::NUMBER_OF_FRAMES,
+            tags::BITS_ALLOCATED
+        ),
+    })
+}
+
 impl FileHeader {
-    fn of(path: &Path, object: &DefaultDicomObject) -> Result<FileHeader, LoadError> {
-        let rows = number(object, tags::ROWS).unwrap_or(0.0) as u32;
-        let columns = number(object, tags::COLUMNS).unwrap_or(0.0) as u32;
-        let frames = number(object, tags::NUMBER_OF_FRAMES).map_or(1, |n| n.max(1.0) as u32);
-        let mut slice_thickness = number(object, tags::SLICE_THICKNESS);
-        let spacing_between_slices = number(object, tags::SPACING_BETWEEN_SLICES);
+    fn of(path: &Path, object: &DefaultDicomObject, file_len: u64) -> Result<FileHeader, LoadError> {
+        let get = |tag: Tag| object.get(tag);
+        let size = |tag: Tag, name: &str| -> Result<u32, LoadError> {
+            whole(path, get(tag), name, tag, 1.0..=65535.0, ROWS_EXPECTED)?
+                .ok_or_else(|| bad(path, None, name, tag, ROWS_EXPECTED))
+        };
+        let rows = size(tags::ROWS, "Rows")?;
+        let columns = size(tags::COLUMNS, "Columns")?;
+        let frames = whole(
+            path,
+            get(tags::NUMBER_OF_FRAMES),
+            "NumberOfFrames",
+            tags::NUMBER_OF_FRAMES,
+            1.0..=4.0e9,
+            FRAMES_EXPECTED,
+        )?
+        .unwrap_or(1);
+        let samples_per_pixel = whole(
+            path,
+            get(tags::SAMPLES_PER_PIXEL),
+            "SamplesPerPixel",
+            tags::SAMPLES_PER_PIXEL,
+            1.0..=4.0,
+            SAMPLES_EXPECTED,
+        )?
+        .unwrap_or(1);
+        let bits_allocated =
+            whole(path, get(tags::BITS_ALLOCATED), "BitsAllocated", tags::BITS_ALLOCATED, 1.0..=64.0, BITS_EXPECTED)?
+                .unwrap_or(16);
+        let transfer_syntax = object.meta().transfer_syntax().trim_end_matches('\0').to_string();
+        check_size(path, &transfer_syntax, (rows, columns, frames, samples_per_pixel, bits_allocated), file_len)?;
+
+        let one = |tag: Tag, name: &str, expected| -> Result<Option<f64>, LoadError> {
+            Ok(checked(path, get(tag), name, tag, 1, expected)?.map(|v| v[0]))
+        };
+        let mut slice_thickness = one(tags::SLICE_THICKNESS, "SliceThickness", THICKNESS_EXPECTED)?;
+        let spacing_between_slices = one(tags::SPACING_BETWEEN_SLICES, "SpacingBetweenSlices", THICKNESS_EXPECTED)?;
+        let position = |e: Option<&Element>| -> Result<Option<DVec3>, LoadError> {
+            let v = checked(path, e, "ImagePositionPatient", tags::IMAGE_POSITION_PATIENT, 3, POSITION_EXPECTED)?;
+            Ok(v.map(|v| DVec3::new(v[0], v[1], v[2])))
+        };
+        let orientation = |e: Option<&Element>| -> Result<Option<[f64; 6]>, LoadError> {
+            let v =
+                checked(path, e, "ImageOrientationPatient", tags::IMAGE_ORIENTATION_PATIENT, 6, ORIENTATION_EXPECTED)?;
+            Ok(v.map(|v| [v[0], v[1], v[2], v[3], v[4], v[5]]))
+        };
+        let pixel_spacing = |e: Option<&Element>| -> Result<Option<[f64; 2]>, LoadError> {
+            let v = checked(path, e, "PixelSpacing", tags::PIXEL_SPACING, 2, SPACING_EXPECTED)?;
+            match v {
+                Some(v) if v[0] > 0.0 && v[1] > 0.0 => Ok(Some([v[0], v[1]])),
+                Some(_) => Err(bad(path, e, "PixelSpacing", tags::PIXEL_SPACING, SPACING_EXPECTED)),
+                None => Ok(None),
+            }
+        };
         let top = SliceGeometry {
             path: path.to_path_buf(),
-            position: vec3(numbers(object, tags::IMAGE_POSITION_PATIENT)),
-            orientation: six(numbers(object, tags::IMAGE_ORIENTATION_PATIENT)),
-            pixel_spacing: two(numbers(object, tags::PIXEL_SPACING)),
+            position: position(get(tags::IMAGE_POSITION_PATIENT))?,
+            orientation: orientation(get(tags::IMAGE_ORIENTATION_PATIENT))?,
+            pixel_spacing: pixel_spacing(get(tags::PIXEL_SPACING))?,
             rows,
             columns,
         };
@@ -160,63 +335,83 @@ impl FileHeader {
             // orientation and pixel measures shared, one plane position per frame.
             let shared = object.get(tags::SHARED_FUNCTIONAL_GROUPS_SEQUENCE).and_then(|e| e.items());
             let per_frame = object.get(tags::PER_FRAME_FUNCTIONAL_GROUPS_SEQUENCE).and_then(|e| e.items());
-            let shared_orientation = shared
-                .and_then(|s| nested(s, 0, tags::PLANE_ORIENTATION_SEQUENCE))
-                .and_then(|o| six(o.get(tags::IMAGE_ORIENTATION_PATIENT)?.to_multi_float64().ok()));
+            let shared_orientation = orientation(
+                shared
+                    .and_then(|s| nested(s, 0, tags::PLANE_ORIENTATION_SEQUENCE))
+                    .and_then(|o| o.get(tags::IMAGE_ORIENTATION_PATIENT)),
+            )?;
             let measures = shared.and_then(|s| nested(s, 0, tags::PIXEL_MEASURES_SEQUENCE));
-            let shared_spacing = measures.and_then(|m| two(m.get(tags::PIXEL_SPACING)?.to_multi_float64().ok()));
-            if let Some(t) = measures.and_then(|m| m.get(tags::SLICE_THICKNESS)?.to_float64().ok()) {
-                slice_thickness = Some(t);
+            let shared_spacing = pixel_spacing(measures.and_then(|m| m.get(tags::PIXEL_SPACING)))?;
+            if let Some(t) = checked(
+                path,
+                measures.and_then(|m| m.get(tags::SLICE_THICKNESS)),
+                "SliceThickness",
+                tags::SLICE_THICKNESS,
+                1,
+                THICKNESS_EXPECTED,
+            )? {
+                slice_thickness = Some(t[0]);
             }
             let orientation = shared_orientation.or(top.orientation);
             let pixel_spacing = shared_spacing.or(top.pixel_spacing);
             (0..frames as usize)
                 .map(|f| {
-                    let position = per_frame
-                        .and_then(|p| nested(p, f, tags::PLANE_POSITION_SEQUENCE))
-                        .and_then(|p| vec3(p.get(tags::IMAGE_POSITION_PATIENT)?.to_multi_float64().ok()))
-                        .or_else(|| {
-                            // A legacy multi-frame file: frames stepped along the normal, by
-                            // the grid's offsets or the slice spacing.
-                            let (p0, o) = (top.position?, orientation?);
-                            let normal =
-                                DVec3::new(o[0], o[1], o[2]).cross(DVec3::new(o[3], o[4], o[5])).normalize_or_zero();
-                            let offset = match &grid_offsets {
-                                Some(offsets) => offsets[f],
-                                None => spacing_between_slices.or(slice_thickness)? * f as f64,
-                            };
-                            Some(p0 + normal * offset)
-                        });
-                    SliceGeometry {
+                    let own = position(
+                        per_frame
+                            .and_then(|p| nested(p, f, tags::PLANE_POSITION_SEQUENCE))
+                            .and_then(|p| p.get(tags::IMAGE_POSITION_PATIENT)),
+                    )?;
+                    let position = own.or_else(|| {
+                        // A legacy multi-frame file: frames stepped along the normal, by the
+                        // grid's offsets or the slice spacing.
+                        let (p0, o) = (top.position?, orientation?);
+                        let normal =
+                            DVec3::new(o[0], o[1], o[2]).cross(DVec3::new(o[3], o[4], o[5])).normalize_or_zero();
+                        let offset = match &grid_offsets {
+                            Some(offsets) => offsets[f],
+                            None => spacing_between_slices.or(slice_thickness)? * f as f64,
+                        };
+                        Some(p0 + normal * offset)
+                    });
+                    Ok(SliceGeometry {
                         path: PathBuf::from(format!("{} frame {f}", path.display())),
                         position,
                         orientation,
                         pixel_spacing,
                         rows,
                         columns,
-                    }
+                    })
                 })
-                .collect()
+                .collect::<Result<Vec<_>, LoadError>>()?
         };
         let window = match (number(object, tags::WINDOW_CENTER), number(object, tags::WINDOW_WIDTH)) {
             (Some(c), Some(w)) if w > 0.0 => Some((c, w)),
             _ => None,
         };
+        // RT Dose scales by DoseGridScaling (PS3.3 C.8.8.3) instead of a rescale.
+        let slope = match one(tags::RESCALE_SLOPE, "RescaleSlope", SLOPE_EXPECTED)? {
+            Some(s) => Some((s, "RescaleSlope", tags::RESCALE_SLOPE)),
+            None => one(tags::DOSE_GRID_SCALING, "DoseGridScaling", SLOPE_EXPECTED)?
+                .map(|s| (s, "DoseGridScaling", tags::DOSE_GRID_SCALING)),
+        };
+        if let Some((s, name, tag)) = slope
+            && s == 0.0
+        {
+            return Err(bad(path, get(tag), name, tag, SLOPE_EXPECTED));
+        }
+        let intercept = one(tags::RESCALE_INTERCEPT, "RescaleIntercept", INTERCEPT_EXPECTED)?;
         Ok(FileHeader {
             path: path.to_path_buf(),
-            transfer_syntax: object.meta().transfer_syntax().trim_end_matches('\0').to_string(),
+            transfer_syntax,
             series_uid: text(object, tags::SERIES_INSTANCE_UID).unwrap_or_default(),
             series_number: number(object, tags::SERIES_NUMBER).map(|n| n as i64),
             description: text(object, tags::SERIES_DESCRIPTION).unwrap_or_default(),
             modality: text(object, tags::MODALITY).unwrap_or_default(),
-            samples_per_pixel: number(object, tags::SAMPLES_PER_PIXEL).map_or(1, |n| n as u16),
-            bits_allocated: number(object, tags::BITS_ALLOCATED).map_or(16, |n| n as u16),
+            samples_per_pixel: samples_per_pixel as u16,
+            bits_allocated: bits_allocated as u16,
+            photometric: text(object, tags::PHOTOMETRIC_INTERPRETATION).unwrap_or_default(),
             frames,
-            // RT Dose scales by DoseGridScaling (PS3.3 C.8.8.3) instead of a rescale.
-            rescale: (
-                number(object, tags::RESCALE_SLOPE).or(number(object, tags::DOSE_GRID_SCALING)).unwrap_or(1.0),
-                number(object, tags::RESCALE_INTERCEPT).unwrap_or(0.0),
-            ),
+            rescale: (slope.map_or(1.0, |s| s.0), intercept.unwrap_or(0.0)),
             rescale_type: text(object, tags::RESCALE_TYPE).or_else(|| text(object, tags::DOSE_UNITS)),
             window,
             slice_thickness,
@@ -226,7 +421,7 @@ impl FileHeader {
     }
 }
 
-/// True when `path` is a readable file with the DICOM preamble and magic.
+/// True when `path` is a readable file with the DICOM magic (with or without the preamble).
 pub fn looks_like_dicom(path: &Path) -> bool {
     // Never open a FIFO or a device to look: that could block.
     matches!(crate::input_file::special_kind(path), Ok(None)) && has_dicom_magic(path).unwrap_or(false)

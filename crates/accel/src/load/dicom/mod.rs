@@ -6,6 +6,7 @@
 //! frame, oblique stacks rejected. Values: RescaleSlope/Intercept applied (CT in HU), kept as
 //! int16/uint16/uint8 where the rescaled values are integers that fit, float32 otherwise.
 
+mod checks;
 mod geometry;
 mod header;
 mod pixels;
@@ -54,18 +55,35 @@ impl SeriesSummary {
         let description = if self.description.is_empty() {
             "(no description)".to_string()
         } else {
-            format!("\"{}\"", self.description)
+            format!("\"{}\"", one_line(&self.description))
         };
         format!(
             "  {position}. series {} {description} {}: {} slice(s) of {}x{} (UID {})",
             self.number.map_or("-".to_string(), |n| n.to_string()),
-            self.modality,
+            one_line(&self.modality),
             self.slices,
             self.size.0,
             self.size.1,
-            self.uid
+            one_line(&self.uid)
         )
     }
+}
+
+/// `text` from a file's header made safe to show on one line: every control character (a
+/// newline or CR that would forge a line of output, ESC, BEL, tab) and every bidirectional
+/// override written as a visible escape (`\n`, `\u{1b}`, `\u{202e}`). The app's terminal escaping
+/// (volgraph-compiler's `terminal`, which this crate cannot depend on: the compiler depends on
+/// it) keeps newlines, as its messages have lines; a header string never does.
+pub fn one_line(text: &str) -> String {
+    let unsafe_char = |c: char| c.is_control() || matches!(c, '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}');
+    text.chars().fold(String::with_capacity(text.len()), |mut out, c| {
+        if unsafe_char(c) {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+        out
+    })
 }
 
 /// The lines listing `series`, one per series.
@@ -84,30 +102,43 @@ pub fn is_dicom_input(paths: &[PathBuf]) -> bool {
     })
 }
 
-/// Every file under `paths` (folders searched recursively, in name order).
+/// Every file under `paths` (folders searched recursively, in name order). Links are followed,
+/// but each real folder is read once and each real file taken once (by canonical path): a link
+/// to `.` or to a parent neither loops nor doubles the slices, and a file reached through two
+/// links is one file.
 fn collect_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, LoadError> {
-    fn walk(dir: &Path, out: &mut Vec<PathBuf>) -> Result<(), LoadError> {
+    use std::collections::HashSet;
+    let real = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
+    struct Walk {
+        folders: HashSet<PathBuf>,
+        files: HashSet<PathBuf>,
+        out: Vec<PathBuf>,
+    }
+    fn walk(dir: &Path, w: &mut Walk, real: &dyn Fn(&Path) -> PathBuf) -> Result<(), LoadError> {
+        if !w.folders.insert(real(dir)) {
+            return Ok(());
+        }
         let entries = std::fs::read_dir(dir).map_err(|source| LoadError::Io { path: dir.to_path_buf(), source })?;
         let mut paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
         paths.sort();
         for p in paths {
             if p.is_dir() {
-                walk(&p, out)?;
-            } else if p.is_file() {
-                out.push(p);
+                walk(&p, w, real)?;
+            } else if p.is_file() && w.files.insert(real(&p)) {
+                w.out.push(p);
             }
         }
         Ok(())
     }
-    let mut files = Vec::new();
+    let mut w = Walk { folders: HashSet::new(), files: HashSet::new(), out: Vec::new() };
     for p in paths {
         if p.is_dir() {
-            walk(p, &mut files)?;
-        } else {
-            files.push(p.clone());
+            walk(p, &mut w, &real)?;
+        } else if w.files.insert(real(p)) {
+            w.out.push(p.clone());
         }
     }
-    Ok(files)
+    Ok(w.out)
 }
 
 /// The headers of the images among `paths`, grouped into series (in SeriesNumber, then UID,
@@ -115,22 +146,34 @@ fn collect_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, LoadError> {
 pub fn scan(paths: &[PathBuf]) -> Result<(Vec<Vec<FileHeader>>, Vec<String>), LoadError> {
     let files = collect_files(paths)?;
     let probes: Vec<Result<Probe, LoadError>> = files.par_iter().map(|f| header::probe(f)).collect();
-    let (mut images, mut not_dicom, mut dicomdirs) = (Vec::new(), 0usize, 0usize);
+    let (mut images, mut not_dicom, mut dicomdirs, mut no_image) = (Vec::new(), 0usize, 0usize, 0usize);
     for probe in probes {
         match probe? {
             Probe::NotDicom => not_dicom += 1,
             Probe::Dicomdir => dicomdirs += 1,
+            Probe::NoImage => no_image += 1,
             Probe::Image(h) => images.push(*h),
         }
     }
     let place = paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
     if images.is_empty() {
         let what = if paths.len() == 1 && paths[0].is_dir() { "is a folder with" } else { "holds" };
-        return Err(LoadError::NoDicomImages { place, what, files: files.len(), not_dicom, dicomdirs });
+        return Err(LoadError::NoDicomImages {
+            place,
+            what,
+            files: files.len(),
+            not_dicom: not_dicom + no_image,
+            dicomdirs,
+        });
     }
     let mut notes = Vec::new();
     if not_dicom > 0 {
         notes.push(format!("skipped {not_dicom} file(s) that are not DICOM"));
+    }
+    if no_image > 0 {
+        notes.push(format!(
+            "skipped {no_image} DICOM file(s) without an image (no Rows or Columns: reports, presentation states)"
+        ));
     }
     if dicomdirs > 0 {
         notes.push(format!("skipped {dicomdirs} DICOMDIR index file(s); the images were read from the folder itself"));
@@ -181,14 +224,39 @@ fn choose(place: &str, groups: Vec<Vec<FileHeader>>, wanted: Option<&str>) -> Re
     };
     let index = match wanted.parse::<usize>() {
         Ok(n) if (1..=groups.len()).contains(&n) => Some(n - 1),
-        _ => groups
-            .iter()
-            .position(|g| g[0].series_uid == wanted)
-            .or_else(|| groups.iter().position(|g| g[0].description.eq_ignore_ascii_case(wanted))),
+        _ => match groups.iter().position(|g| g[0].series_uid == wanted) {
+            Some(i) => Some(i),
+            None => by_description(place, &groups, wanted)?,
+        },
     };
     match index {
         Some(i) => Ok(groups.into_iter().nth(i).unwrap_or_default()),
-        None => Err(LoadError::NoSuchSeries { place: place.to_string(), wanted: wanted.to_string(), list }),
+        None => Err(LoadError::NoSuchSeries { place: place.to_string(), wanted: one_line(wanted), list }),
+    }
+}
+
+/// The series whose description is `wanted`: the one spelled exactly so, else the one equal
+/// ignoring case; two series that match equally well are an error listing them.
+fn by_description(place: &str, groups: &[Vec<FileHeader>], wanted: &str) -> Result<Option<usize>, LoadError> {
+    let matching = |same: &dyn Fn(&str) -> bool| -> Vec<usize> {
+        groups.iter().enumerate().filter(|(_, g)| same(&g[0].description)).map(|(i, _)| i).collect()
+    };
+    let exact = matching(&|d| d == wanted);
+    let candidates = if exact.is_empty() { matching(&|d| d.eq_ignore_ascii_case(wanted)) } else { exact };
+    match candidates.as_slice() {
+        [] => Ok(None),
+        [only] => Ok(Some(*only)),
+        several => {
+            let all = summaries(groups);
+            let list = several.iter().map(|&i| all[i].line(i + 1)).collect::<Vec<_>>().join("\n");
+            Err(LoadError::DicomGeometry {
+                series: format!("series \"{}\"", one_line(wanted)),
+                message: format!(
+                    "{} series under {place} have this description; choose one with --series N or --series UID:\n{list}",
+                    several.len()
+                ),
+            })
+        }
     }
 }
 
@@ -202,7 +270,8 @@ pub fn load(
     let Stacked { series, ordered, stack, file_dims, mut notes } = stack_series(paths, options.series.as_deref())?;
     notes.extend(stack.notes.iter().cloned());
     let first = series[0].clone();
-    let voxels = pixels::read(&series, &ordered, file_dims, progress)?;
+    let (voxels, pixel_notes) = pixels::read(&series, &ordered, file_dims, progress)?;
+    notes.extend(pixel_notes);
 
     let at = Location::file(&first.path);
     let (orientation, spacing) = AxisOrientation::from_directions(stack.directions, &at, "ImageOrientationPatient")?;
@@ -259,7 +328,7 @@ fn stack_series(paths: &[PathBuf], wanted: Option<&str>) -> Result<Stacked, Load
     let series_name = if first.description.is_empty() {
         format!("series {}", first.series_number.map_or(first.series_uid.clone(), |n| n.to_string()))
     } else {
-        format!("series \"{}\"", first.description)
+        format!("series \"{}\"", one_line(&first.description))
     };
     for h in &series {
         if h.samples_per_pixel != 1 {
@@ -270,6 +339,16 @@ fn stack_series(paths: &[PathBuf], wanted: Option<&str>) -> Result<Stacked, Load
                      series (SamplesPerPixel 1)",
                     h.samples_per_pixel
                 ),
+            });
+        }
+        if h.photometric.eq_ignore_ascii_case("PALETTE COLOR") {
+            return Err(LoadError::DicomPixels {
+                path: h.path.clone(),
+                message:
+                    "PhotometricInterpretation (0028,0004) is PALETTE COLOR: its pixels are indices into a colour \
+                          table, not measured values; volgraph renders scalar volumes: use a greyscale series \
+                          (MONOCHROME1 or MONOCHROME2), or convert the images to greyscale first"
+                        .to_string(),
             });
         }
         pixels::check_transfer_syntax(&h.path, &h.transfer_syntax)?;
@@ -343,7 +422,7 @@ impl SeriesSlices {
         let reindexed: Vec<(usize, usize)> =
             wanted.iter().map(|&(f, frame)| (files.binary_search(&f).unwrap_or(0), frame)).collect();
         let dims = glam::UVec3::new(self.dims.x, self.dims.y, wanted.len() as u32);
-        let voxels = pixels::read(&subset, &reindexed, dims, None)?;
+        let (voxels, _) = pixels::read(&subset, &reindexed, dims, None)?;
         Ok(match voxels {
             crate::volume::VoxelData::U8(v) => v.into_iter().map(f32::from).collect(),
             crate::volume::VoxelData::U16(v) => v.into_iter().map(f32::from).collect(),

@@ -142,15 +142,70 @@ impl Histogram {
 /// about −700); a CT peak above it is tissue, not background.
 const CT_AIR_BELOW_HU: f64 = -500.0;
 
-/// The background of `volume` ([`Histogram::background`] of its 256-bin histogram), where the
-/// data's units allow it: in CT (values in HU) only a peak of air counts — a field of view
-/// filled with soft tissue has no background, however common its values.
+/// Bins of [`ValueSummary::histogram`]: the finest any fitted default reads (the MR preset's
+/// percentiles); coarser histograms are exact sums of its bins.
+pub const FIT_BINS: usize = 1024;
+
+/// What the fitted defaults — the default transfer function, the MR preset's percentiles, the
+/// automatic iso value — read of a volume: the histogram of its normalized values in
+/// [`FIT_BINS`] bins, its value range and whether its values are Hounsfield units. One process
+/// takes it from the volume ([`ValueSummary::of`]); a sort-last render sums every rank's share
+/// of the file into the same counts, so every rank fits what one process would.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ValueSummary {
+    /// Voxels per normalized-value bin, [`FIT_BINS`] bins over \[0,1\].
+    pub histogram: Histogram,
+    /// The range the values normalize over.
+    pub value_range: (f64, f64),
+    /// True for CT data in HU ([`crate::volume_meta::VolumeMeta::is_ct_hu`]).
+    pub ct_hu: bool,
+}
+
+impl ValueSummary {
+    /// The summary of `volume`.
+    pub fn of(volume: &Volume) -> ValueSummary {
+        ValueSummary {
+            histogram: Histogram::of(volume, FIT_BINS),
+            value_range: volume.value_range,
+            ct_hu: volume.meta.is_ct_hu(),
+        }
+    }
+
+    /// The histogram in `bins` bins, which must divide [`FIT_BINS`]: exactly
+    /// [`Histogram::of`]`(volume, bins)` (a bin of `v·bins` is the bin of `v·FIT_BINS` divided by
+    /// `FIT_BINS / bins`, both products exact in binary floating point).
+    pub fn binned(&self, bins: usize) -> Histogram {
+        let group = (FIT_BINS / bins.clamp(1, FIT_BINS)).max(1);
+        let counts: Vec<u64> = self.histogram.counts.chunks(group).map(|c| c.iter().sum()).collect();
+        Histogram { total: counts.iter().sum(), counts }
+    }
+
+    /// The data value of normalized value `s`.
+    pub fn data_value(&self, s: f64) -> f64 {
+        let (lo, hi) = self.value_range;
+        lo + s * (hi - lo)
+    }
+}
+
+/// The background of `volume` ([`background_in`] of its summary).
 pub fn background_of(volume: &Volume) -> Option<Background> {
-    let b = Histogram::of(volume, 256).background()?;
-    if volume.meta.is_ct_hu() && volume.data_value(b.mode) > CT_AIR_BELOW_HU {
+    background_in(&ValueSummary::of(volume))
+}
+
+/// The background ([`Histogram::background`] of the 256-bin histogram), where the data's units
+/// allow it: in CT (values in HU) only a peak of air counts — a field of view filled with soft
+/// tissue has no background, however common its values.
+pub fn background_in(values: &ValueSummary) -> Option<Background> {
+    let b = values.binned(256).background()?;
+    if values.ct_hu && values.data_value(b.mode) > CT_AIR_BELOW_HU {
         return None;
     }
     Some(b)
+}
+
+/// The iso value a graph gets for `Data(Auto)` ([`auto_iso_in`] of `volume`'s summary).
+pub fn auto_iso(volume: &Volume) -> f64 {
+    auto_iso_in(&ValueSummary::of(volume))
 }
 
 /// The iso value a graph gets for `Data(Auto)` (normalized): halfway between the background
@@ -159,9 +214,9 @@ pub fn background_of(volume: &Volume) -> Option<Background> {
 /// tissue, the skin. Never below the top of the background peak, so the surface is the
 /// object's and not the box of noise. A volume without a background gets Otsu's threshold
 /// (0.5 without contrast).
-pub fn auto_iso(volume: &Volume) -> f64 {
-    let h = Histogram::of(volume, 256);
-    match background_of(volume) {
+pub fn auto_iso_in(values: &ValueSummary) -> f64 {
+    let h = values.binned(256);
+    match background_in(values) {
         Some(b) => {
             let foreground = h.percentile_above(b.ceiling, 0.5);
             (0.5 * (b.mode + foreground)).max(b.ceiling)
@@ -174,7 +229,12 @@ pub fn auto_iso(volume: &Volume) -> f64 {
 /// graph's `Data(...)` inputs are resolved with (the compiler's `DATA_LOW`, `DATA_HIGH`,
 /// `DATA_AUTO_ISO` scene values).
 pub fn data_scale(volume: &Volume) -> (f64, f64, f64) {
-    (volume.value_range.0, volume.value_range.1, auto_iso(volume))
+    data_scale_in(&ValueSummary::of(volume))
+}
+
+/// [`data_scale`] from a summary.
+pub fn data_scale_in(values: &ValueSummary) -> (f64, f64, f64) {
+    (values.value_range.0, values.value_range.1, auto_iso_in(values))
 }
 
 #[cfg(test)]
@@ -210,5 +270,14 @@ mod tests {
         // A constant volume: nothing above the peak.
         let flat = Volume::new("flat", UVec3::splat(4), DVec3::ONE, VoxelData::U8(vec![30; 64]));
         assert_eq!(Histogram::of(&flat, 256).background(), None);
+    }
+
+    #[test]
+    fn a_summary_rebins_to_exactly_the_histogram_of_the_volume() {
+        let v = crate::generate::scanned_sphere(32);
+        let summary = ValueSummary::of(&v);
+        for bins in [1, 4, 256, 1024] {
+            assert_eq!(summary.binned(bins), Histogram::of(&v, bins), "{bins} bins");
+        }
     }
 }

@@ -245,10 +245,16 @@ impl TransferFunction {
     /// [`Self::to_lut_for`] agree for it. A volume whose range is empty (a constant float
     /// volume) gets the domain (lo, lo + 1).
     pub fn default_for(volume: &Volume) -> TransferFunction {
-        let (lo, hi) = volume.value_range;
+        Self::default_fitted(&crate::histogram::ValueSummary::of(volume))
+    }
+
+    /// [`Self::default_for`] from what it reads of a volume (a sort-last render's ranks fit it to
+    /// the whole file's summary, so each gets what one process would).
+    pub fn default_fitted(values: &crate::histogram::ValueSummary) -> TransferFunction {
+        let (lo, hi) = values.value_range;
         let hi = if hi > lo { hi } else { lo + 1.0 };
         let ramp = TransferFunction::preset(Preset::Default, (lo, hi));
-        let Some(background) = crate::histogram::background_of(volume) else { return ramp };
+        let Some(background) = crate::histogram::background_in(values) else { return ramp };
         ramp.hidden_below(lo + background.ceiling * (hi - lo))
     }
 

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail};
 use volgraph_accel::camera::OrbitCamera;
+use volgraph_accel::histogram::ValueSummary;
 use volgraph_accel::load::{LoadOptions, RawOptions};
 use volgraph_accel::transfer_function::{ScannerPreset, TransferFunction};
 use volgraph_accel::volume::Volume;
@@ -203,6 +204,19 @@ pub fn transfer_function(
     volume: &Volume,
     generated: bool,
 ) -> anyhow::Result<(TransferFunction, Vec<String>)> {
+    transfer_function_fitted(path, map, volume, &ValueSummary::of(volume), generated)
+}
+
+/// [`transfer_function`] with the fitted defaults (the default TF, the MR preset) taken from
+/// `values`, the summary of the whole volume, where `volume` may be only a part or a preview of
+/// it (a sort-last render: every rank fits to the whole file's histogram, as one process does).
+pub fn transfer_function_fitted(
+    path: Option<&PathBuf>,
+    map: Option<&str>,
+    volume: &Volume,
+    values: &ValueSummary,
+    generated: bool,
+) -> anyhow::Result<(TransferFunction, Vec<String>)> {
     let is_json = path.is_some_and(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("json")));
     if let Some(name) = map
         && !is_json
@@ -218,7 +232,7 @@ pub fn transfer_function(
             TransferFunction::from_ron_str(MARSCHNER_LOBB_TF, Path::new("graphs/tf/marschner_lobb.ron"))
                 .map_err(|e| anyhow!("{e}"))?
         }
-        None => TransferFunction::default_for(volume),
+        None => TransferFunction::default_fitted(values),
         Some(p) if is_json => {
             let chosen = TransferFunction::load_paraview_map(p, map).map_err(|e| anyhow!("{e}"))?;
             if chosen.all.len() > 1 && map.is_none() {
@@ -239,7 +253,7 @@ pub fn transfer_function(
             if !p.exists()
                 && let Some(preset) = p.to_str().and_then(ScannerPreset::from_name) =>
         {
-            if preset.is_ct() && !volume.meta.is_ct_hu() {
+            if preset.is_ct() && !values.ct_hu {
                 notes.push(format!(
                     "warning: --tf {} is written in Hounsfield units, but the volume's values are {}; the preset \
                      fits CT data (DICOM CT, or NIfTI/NRRD holding HU)",
@@ -247,7 +261,7 @@ pub fn transfer_function(
                     volume.meta.units.as_deref().map_or("in no known unit".to_string(), |u| format!("in {u}"))
                 ));
             }
-            preset.for_volume(volume)
+            preset.fitted(values)
         }
         // `graphs/tf/NAME.ron` where no such file exists: the copy compiled into the program.
         Some(p) => match crate::builtin_graphs::find_tf(p) {
@@ -371,8 +385,13 @@ pub fn parse_camera(text: &str) -> anyhow::Result<OrbitCamera> {
 /// The scene values a graph's `Data(...)` inputs (`iso_value: Data(Auto)`, values in HU) are
 /// resolved with: the volume's data range and automatic iso value.
 pub fn data_scene_values(volume: &Volume) -> Vec<(String, f64)> {
+    data_scene_values_of(&ValueSummary::of(volume))
+}
+
+/// [`data_scene_values`] from the summary of the whole volume.
+pub fn data_scene_values_of(values: &ValueSummary) -> Vec<(String, f64)> {
     use volgraph_core::graph::ast::{DATA_AUTO_ISO, DATA_HIGH, DATA_LOW};
-    let (lo, hi, auto) = volgraph_accel::histogram::data_scale(volume);
+    let (lo, hi, auto) = volgraph_accel::histogram::data_scale_in(values);
     vec![(DATA_LOW.to_string(), lo), (DATA_HIGH.to_string(), hi), (DATA_AUTO_ISO.to_string(), auto)]
 }
 

@@ -178,8 +178,9 @@ fn rank_zero_command_line_is_the_job() {
     assert!(worst <= 2.0 / 255.0, "worst {:.2}/255", worst * 255.0);
 }
 
-/// Rank 1 finds no GPU (its Vulkan driver list points nowhere): every rank ends, non-zero,
-/// with rank 1's message — no hang.
+/// Rank 1 finds no GPU (its Vulkan driver list points nowhere): every rank ends, non-zero, and
+/// rank 0 prints rank 1's message once — no hang. An error every rank meets alike (a file no rank
+/// can read) is the job's: printed once, naming no rank.
 #[test]
 fn an_error_on_one_rank_ends_every_rank_with_its_message() {
     if !mpi_ready() {
@@ -192,13 +193,37 @@ fn an_error_on_one_rank_ends_every_rank_with_its_message() {
     assert_ne!(run.code, 0, "{}", run.stderr);
     // (Lines of two processes may interleave on the shared stderr: count the messages.)
     let reports = run.stderr.matches("rank 1: no GPU adapter found").count();
-    assert_eq!(reports, 2, "both ranks report rank 1's error:\n{}", run.stderr);
-    // A file no rank can read: the loader's message, from every rank.
+    assert_eq!(reports, 1, "rank 0 reports rank 1's error once:\n{}", run.stderr);
+    // A file no rank can read: the loader's message, once, as the job's (not "rank 0").
     let missing =
         ["basic/fragment_raycast", "--volume", "/nonexistent/gone_8x8x8_uint8.raw", "--distributed", "-o", &out];
     let run = mpirun(3, &missing, &[]);
     assert_ne!(run.code, 0);
-    assert!(run.stderr.contains("gone_8x8x8_uint8.raw"), "{}", run.stderr);
+    assert_eq!(run.stderr.matches("gone_8x8x8_uint8.raw").count(), 1, "{}", run.stderr);
+    assert!(!run.stderr.contains("rank 0:"), "every rank failed alike: no rank is to blame\n{}", run.stderr);
+}
+
+/// `-n 3` on a 32³ volume renders (8-voxel bricks), and a volume that truly cannot be split
+/// between the ranks says so once, not "rank 0" from every rank.
+#[test]
+fn a_small_volume_splits_between_3_ranks_and_a_tiny_one_is_refused_once() {
+    if !mpi_ready() {
+        return;
+    }
+    let Some(volume) = dataset("bucky") else { return };
+    let out = scratch("bucky_3.png").to_string_lossy().into_owned();
+    let args = ["modern/fastest", "--volume", &volume, "--size", "48x48", "--distributed", "-o", &out];
+    let run = mpirun(3, &args, &[]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(run.stderr.contains("rank 2 of 3 holds"), "{}", run.stderr);
+    let tiny = scratch("tiny_2x2x2_uint8.raw");
+    std::fs::write(&tiny, [0u8, 50, 100, 150, 200, 250, 30, 90]).expect("tiny volume");
+    let tiny = tiny.to_string_lossy().into_owned();
+    let args = ["modern/fastest", "--volume", &tiny, "--size", "16x16", "--distributed", "-o", &out];
+    let run = mpirun(3, &args, &[]);
+    assert_ne!(run.code, 0);
+    assert_eq!(run.stderr.matches("cannot be split into 3 boxes").count(), 1, "{}", run.stderr);
+    assert!(!run.stderr.contains("rank 0:"), "{}", run.stderr);
 }
 
 /// Without `--distributed`'s prerequisites the flags are refused by name.

@@ -21,6 +21,12 @@ pub enum ExchangeError {
         /// Its error.
         message: String,
     },
+    /// Every process failed with the same message: the job is wrong, not one process.
+    #[error("{message}")]
+    Everywhere {
+        /// The error.
+        message: String,
+    },
 }
 
 /// Point-to-point messages between the processes of one job.
@@ -56,7 +62,8 @@ pub fn broadcast_from_root<E: Exchange + ?Sized>(ex: &mut E, message: Vec<u8>) -
 }
 
 /// Every process's outcome of a step, agreed: `Ok` on every process when every process
-/// succeeded, else the lowest failing rank's message on every process. Call it after every step
+/// succeeded, [`ExchangeError::Everywhere`] when every process failed alike, else the lowest
+/// failing rank's message on every process. Call it after every step
 /// that can fail on one process only (reading its box, opening its GPU, rendering), so that no
 /// process waits forever for one that gave up.
 pub fn agree<E: Exchange + ?Sized, T>(ex: &mut E, outcome: Result<T, String>) -> Result<T, ExchangeError> {
@@ -69,6 +76,9 @@ pub fn agree<E: Exchange + ?Sized, T>(ex: &mut E, outcome: Result<T, String>) ->
         }
     };
     let all = all_gather(ex, mine)?;
+    if !all[0].is_empty() && all.iter().all(|m| *m == all[0]) {
+        return Err(ExchangeError::Everywhere { message: String::from_utf8_lossy(&all[0][1..]).into_owned() });
+    }
     if let Some((rank, failed)) = all.iter().enumerate().find(|(_, m)| !m.is_empty()) {
         return Err(ExchangeError::Remote { rank, message: String::from_utf8_lossy(&failed[1..]).into_owned() });
     }
@@ -149,6 +159,24 @@ mod tests {
         });
         for r in results {
             assert_eq!(r, Err(ExchangeError::Remote { rank: 2, message: "cannot read box".into() }));
+        }
+    }
+
+    /// A job that fails alike everywhere (a volume too small for the ranks, a file no rank can
+    /// read) is the job's error, not rank 0's.
+    #[test]
+    fn the_same_failure_everywhere_names_no_rank() {
+        let results: Vec<Result<(), ExchangeError>> = std::thread::scope(|s| {
+            let handles: Vec<_> = LocalGroup::new(3)
+                .into_iter()
+                .map(|mut ex| s.spawn(move || agree(&mut ex, Err::<(), _>("too small".to_string()))))
+                .collect();
+            handles.into_iter().map(|h| h.join().expect("thread")).collect()
+        });
+        for r in results {
+            let e = r.expect_err("every rank failed");
+            assert_eq!(e, ExchangeError::Everywhere { message: "too small".into() });
+            assert_eq!(e.to_string(), "too small");
         }
     }
 }

@@ -11,6 +11,7 @@ use super::dicom::SeriesSlices;
 use super::{Endianness, Layout, LoadError, LoadOptions, decode, raw};
 use crate::kd_split::VoxelBox;
 use crate::volume::{Volume, VoxelData, VoxelType};
+use crate::volume_meta::VolumeMeta;
 
 /// What a volume file holds, from its name or header, with where its voxels start: enough to
 /// read any box of it.
@@ -26,6 +27,9 @@ pub struct VolumeHeader {
     pub order: Endianness,
     /// Physical voxel size.
     pub spacing: DVec3,
+    /// What the file says besides voxels (a DICOM series' modality and units; the default for
+    /// files whose header has none), as the whole-volume loaders give it.
+    pub meta: VolumeMeta,
     source: Source,
 }
 
@@ -56,7 +60,8 @@ impl VolumeHeader {
                 super::metaimage::raw_data(path, &head)?
             };
             let source = Source::File { path: data_path, offset };
-            return Ok(Self { name, dims, dtype, order, spacing: opts.spacing.unwrap_or(spacing), source });
+            let spacing = opts.spacing.unwrap_or(spacing);
+            return Ok(Self { name, dims, dtype, order, spacing, meta: VolumeMeta::default(), source });
         }
         if path.is_dir() || extension == "dcm" {
             let slices = SeriesSlices::open(&[path.to_path_buf()], options.series.as_deref())?;
@@ -66,6 +71,7 @@ impl VolumeHeader {
                 dtype: VoxelType::F32,
                 order: Endianness::Little,
                 spacing: opts.spacing.unwrap_or(slices.spacing),
+                meta: slices.meta.clone(),
                 source: Source::Dicom { slices: Box::new(slices), path: path.to_path_buf() },
             });
         }
@@ -84,6 +90,7 @@ impl VolumeHeader {
             dtype,
             order,
             spacing: opts.spacing.unwrap_or(spacing),
+            meta: VolumeMeta::default(),
             source: Source::File { path: path.to_path_buf(), offset: 0 },
         })
     }
@@ -126,6 +133,7 @@ impl VolumeHeader {
                 }
                 let mut volume = Volume::new(self.name.clone(), size, self.spacing, VoxelData::F32(values));
                 volume.value_range = value_range;
+                volume.meta = self.meta.clone();
                 return Ok(volume);
             }
         };
@@ -156,6 +164,7 @@ impl VolumeHeader {
         }
         let mut volume = Volume::new(self.name.clone(), size, self.spacing, data);
         volume.value_range = value_range;
+        volume.meta = self.meta.clone();
         Ok(volume)
     }
 

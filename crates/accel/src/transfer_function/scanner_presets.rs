@@ -9,7 +9,7 @@
 //! muscle 20…80, contrast-filled vessels 150…500, bone from ~300, cortical bone over 700.
 
 use super::{ControlPoint, TransferFunction};
-use crate::histogram::Histogram;
+use crate::histogram::ValueSummary;
 use crate::volume::Volume;
 
 /// A built-in scanner preset.
@@ -121,6 +121,11 @@ impl ScannerPreset {
     /// the 5th to the 99.5th percentile of the voxels above the background, in the volume's
     /// values.
     pub fn for_volume(self, volume: &Volume) -> TransferFunction {
+        self.fitted(&ValueSummary::of(volume))
+    }
+
+    /// [`Self::for_volume`] from what it reads of a volume (its summary).
+    pub fn fitted(self, values: &ValueSummary) -> TransferFunction {
         let point = |(value, color, alpha): (f64, [f64; 3], f64)| ControlPoint { value, color, alpha };
         if self.is_ct() {
             return TransferFunction {
@@ -128,9 +133,9 @@ impl ScannerPreset {
                 points: self.ct_points().iter().copied().map(point).collect(),
             };
         }
-        let (lo, hi) = volume.value_range;
+        let (lo, hi) = values.value_range;
         let hi = if hi > lo { hi } else { lo + 1.0 };
-        let h = Histogram::of(volume, 1024);
+        let h = values.binned(1024);
         let floor = h.background().map_or(0.0, |b| b.ceiling);
         let at = |p: f64| lo + h.percentile_above(floor, p) * (hi - lo);
         let mut values = [at(0.05), at(0.5), at(0.95), at(0.995)];

@@ -95,17 +95,21 @@ pub fn launch() -> Result<(), CliError> {
         .into_render_args()
         .ok_or_else(|| CliError::Other(anyhow!("internal: rank 0's command is not render")))?;
     let outcome = run(&mut ex, &args);
-    // One write of the whole line: lines of ranks sharing a stderr pipe never interleave.
+    // One write of the whole line: lines of ranks sharing a stderr pipe never interleave. An
+    // error is the same on every rank (they agreed on it, naming the rank it came from unless
+    // every rank failed alike): rank 0 prints it once.
     use std::io::Write as _;
     let line = match &outcome {
         Ok(report) => format!("{}\n", report.line()),
-        Err(e) => format!("error: {}\n", volgraph_core::terminal::escape_controls(&crate::cli::error_text(e))),
+        Err(e) if ex.rank() == 0 => {
+            format!("error: {}\n", volgraph_core::terminal::escape_controls(&crate::cli::error_text(e)))
+        }
+        Err(_) => String::new(),
     };
     let _ = std::io::stderr().write_all(line.as_bytes());
     if outcome.is_err() {
-        // Every rank has its error (the ranks agreed on it): wait until every rank has printed
-        // it, since mpirun ends the job as soon as one rank exits non-zero; then leave MPI and
-        // exit without printing it again.
+        // Wait until rank 0 has printed the error, since mpirun ends the job as soon as one rank
+        // exits non-zero; then leave MPI and exit without printing it again.
         let _ = agree(&mut ex, Ok(()));
         drop(ex);
         std::process::exit(1);
@@ -136,7 +140,9 @@ fn step<E: Exchange + ?Sized, T>(ex: &mut E, outcome: anyhow::Result<T>) -> Resu
 pub fn run<E: Exchange + ?Sized>(ex: &mut E, args: &RenderArgs) -> Result<RankReport, CliError> {
     let (rank, ranks) = (ex.rank(), ex.size());
     let job = step(ex, Job::read(args))?;
-    let surveyed = survey::survey(ex, &job.header).map_err(|e| anyhow!(e));
+    let factors = radix_factors(ranks, args.radix_k.max(2) as usize);
+    let brick = step(ex, survey::brick_for(job.header.dims, &factors).map_err(|e| anyhow!("{e}")))?;
+    let surveyed = survey::survey(ex, &job.header, brick).map_err(|e| anyhow!(e));
     let survey = step(ex, surveyed)?;
     let (lut, plan) = step(ex, job.compile(&survey))?;
     if rank == 0
@@ -150,7 +156,6 @@ pub fn run<E: Exchange + ?Sized>(ex: &mut E, args: &RenderArgs) -> Result<RankRe
         );
     }
     let weights = survey.weights(job.header.dims, &lut);
-    let factors = radix_factors(ranks, args.radix_k.max(2) as usize);
     let tree = step(ex, KdTree::balanced(&weights, &factors).map_err(|e| anyhow!("{e}")))?;
     let own = tree.boxes[rank];
     let held = own.with_apron(APRON, job.header.dims);
@@ -339,16 +344,24 @@ impl Job {
         })
     }
 
-    /// The LUT (fitted to the preview when no --tf is given) and the plan, compiled with the
-    /// whole volume's scene values.
+    /// The LUT (fitted to the whole volume's histogram when no --tf is given) and the plan,
+    /// compiled with the whole volume's scene values.
     fn compile(&self, survey: &survey::Survey) -> anyhow::Result<(Vec<[f32; 4]>, volgraph_core::Plan)> {
-        let (tf, _) = inputs::transfer_function(self.tf.as_ref(), self.tf_map.as_deref(), &survey.preview, false)?;
+        // Fitted to the whole file's histogram, which every rank holds: every rank gets the TF
+        // one process would fit (the preview alone would differ, and knows no units).
+        let (tf, _) = inputs::transfer_function_fitted(
+            self.tf.as_ref(),
+            self.tf_map.as_deref(),
+            &survey.preview,
+            &survey.values,
+            false,
+        )?;
         let lut = tf.to_lut_for(&survey.preview, inputs::LUT_SIZE);
         let mut options = self.options.clone();
         let whole =
             VolumeWindow::new(self.header.dims, self.header.spacing, UVec3::ZERO, UVec3::ZERO, self.header.dims);
         options.scene = scene_values_of(&VolumeDesc::of_window(self.header.dims, &whole));
-        options.scene.extend(inputs::data_scene_values(&survey.preview));
+        options.scene.extend(inputs::data_scene_values_of(&survey.values));
         let registry = crate::program::registry();
         let plan = compile(&display_name(&self.graph), &self.source, &registry, &options)
             .map_err(|e| anyhow!("{}", crate::cli::error_text(&CliError::Graph(e))))?;

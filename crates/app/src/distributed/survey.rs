@@ -1,19 +1,26 @@
 //! The first pass of a sort-last render: the file is read once in total, split in z-slabs
 //! between the processes, for what every process must agree on before it knows its box — the
-//! value range of float data, a subsampled preview (what the default transfer function and the
-//! data's automatic values are fitted to), and per-brick histograms (what the kd-tree balances:
+//! value range of float data, the whole volume's histogram (what the default transfer function
+//! and the data's automatic values are fitted to, as one process fits them), a subsampled
+//! preview, and per-brick histograms (what the kd-tree balances:
 //! the voxels visible under the transfer function).
 
 use glam::UVec3;
-use volgraph_accel::kd_split::BrickWeights;
+use volgraph_accel::histogram::{FIT_BINS, Histogram, ValueSummary};
+use volgraph_accel::kd_split::{BrickWeights, KdTree, SplitError};
 use volgraph_accel::load::VolumeHeader;
 use volgraph_accel::volume::{Volume, VoxelData, VoxelType};
 use volgraph_composite::{Exchange, agree, all_gather};
 
 /// Histogram bins per brick: one per LUT texel (`inputs::LUT_SIZE`).
 pub const BINS: usize = crate::inputs::LUT_SIZE;
-/// The brick edge of the decomposition, in voxels: where split planes may lie.
-pub const BRICK: u32 = 16;
+/// The brick edges the decomposition may use, in voxels (split planes lie on brick faces),
+/// coarsest first: 16 keeps the per-brick histograms small; a small volume split between many
+/// ranks takes finer bricks ([`brick_for`]).
+const BRICKS: [u32; 5] = [16, 8, 4, 2, 1];
+/// The most memory the per-brick histograms may take: a finer brick than this allows is not
+/// tried.
+const MAX_BIN_BYTES: u64 = 256 << 20;
 /// The preview's longest side, in voxels.
 const PREVIEW: u32 = 64;
 
@@ -23,8 +30,13 @@ pub struct Survey {
     pub value_range: (f64, f64),
     /// The volume subsampled every `stride` voxels (its spacing scaled to match).
     pub preview: Volume,
+    /// The brick edge of the per-brick histograms ([`brick_for`]).
+    pub brick: u32,
     /// Voxels per brick per normalized-value bin, brick-major.
     pub bins: Vec<u64>,
+    /// The whole volume's histogram, value range and units: what the default transfer function
+    /// and the data's automatic values are fitted to, exactly as one process fits them.
+    pub values: ValueSummary,
     /// Voxels this process read.
     pub bytes_read: u64,
 }
@@ -33,7 +45,7 @@ impl Survey {
     /// The per-brick weights under `lut`: the voxels whose bin (or a neighbour, which linear
     /// filtering blends in) has non-zero opacity.
     pub fn weights(&self, dims: UVec3, lut: &[[f32; 4]]) -> BrickWeights {
-        let mut weights = BrickWeights::zeros(dims, BRICK);
+        let mut weights = BrickWeights::zeros(dims, self.brick);
         let visible: Vec<bool> = (0..BINS)
             .map(|b| {
                 let texel = |i: usize| lut.get(i * lut.len() / BINS).is_some_and(|t| t[3] > 0.0);
@@ -48,6 +60,23 @@ impl Survey {
     }
 }
 
+/// The coarsest brick edge of [`BRICKS`] at which a volume of `dims` splits into the boxes of
+/// `factors` (where each level finds enough brick faces), or the error at the finest tried.
+pub fn brick_for(dims: UVec3, factors: &[usize]) -> Result<u32, SplitError> {
+    let mut last = Err(SplitError::NoParts);
+    for brick in BRICKS {
+        let zeros = BrickWeights::zeros(dims, brick);
+        if brick < BRICKS[0] && zeros.weight.len() as u64 * (BINS * 8) as u64 > MAX_BIN_BYTES {
+            break;
+        }
+        last = KdTree::balanced(&zeros, factors).map(|_| brick);
+        if last.is_ok() {
+            break;
+        }
+    }
+    last
+}
+
 fn stride_of(dims: UVec3) -> u32 {
     dims.max_element().div_ceil(PREVIEW).max(1)
 }
@@ -59,8 +88,9 @@ fn slab(dims: UVec3, stride: u32, rank: usize, size: usize) -> std::ops::Range<u
     (j0 as u32 * stride).min(dims.z)..(j1 as u32 * stride).min(dims.z)
 }
 
-/// Surveys `header`'s file with every process of `ex`.
-pub fn survey<E: Exchange + ?Sized>(ex: &mut E, header: &VolumeHeader) -> Result<Survey, String> {
+/// Surveys `header`'s file with every process of `ex`, with per-brick histograms of bricks of
+/// edge `brick` ([`brick_for`]).
+pub fn survey<E: Exchange + ?Sized>(ex: &mut E, header: &VolumeHeader, brick: u32) -> Result<Survey, String> {
     let (rank, size) = (ex.rank(), ex.size());
     let dims = header.dims;
     let stride = stride_of(dims);
@@ -90,11 +120,12 @@ pub fn survey<E: Exchange + ?Sized>(ex: &mut E, header: &VolumeHeader) -> Result
             if lo <= hi { (lo, hi) } else { (0.0, 0.0) }
         }
     };
-    let n_bricks = BrickWeights::zeros(dims, BRICK).weight.len();
+    let n_bricks = BrickWeights::zeros(dims, brick).weight.len();
     let mut bins = vec![0u64; n_bricks * BINS];
     let preview_dims = UVec3::new(dims.x.div_ceil(stride), dims.y.div_ceil(stride), dims.z.div_ceil(stride));
     let mut preview_part: Vec<f32> = Vec::new();
-    let weights = BrickWeights::zeros(dims, BRICK);
+    let mut fit = vec![0u64; FIT_BINS];
+    let weights = BrickWeights::zeros(dims, brick);
     let mut bytes_read = 0u64;
     let read = header.for_each_slab(z.clone(), stride, value_range, |z0, v| {
         bytes_read += v.voxel_count() as u64 * header.dtype.size_bytes() as u64;
@@ -102,8 +133,11 @@ pub fn survey<E: Exchange + ?Sized>(ex: &mut E, header: &VolumeHeader) -> Result
             for y in 0..v.dims.y {
                 for x in 0..v.dims.x {
                     let i = v.index(x, y, lz);
-                    let bin = ((v.normalized(i) * BINS as f64) as usize).min(BINS - 1);
+                    let s = v.normalized(i);
+                    let bin = ((s * BINS as f64) as usize).min(BINS - 1);
                     bins[weights.brick_of(UVec3::new(x, y, z0 + lz)) * BINS + bin] += 1;
+                    // As `Histogram::of` bins: non-finite values count in bin 0.
+                    fit[if s.is_finite() { ((s * FIT_BINS as f64) as usize).min(FIT_BINS - 1) } else { 0 }] += 1;
                 }
             }
         }
@@ -123,6 +157,12 @@ pub fn survey<E: Exchange + ?Sized>(ex: &mut E, header: &VolumeHeader) -> Result
             *s += u64::from_le_bytes(c.try_into().unwrap_or([0; 8]));
         }
     }
+    let mut fit_summed = vec![0u64; FIT_BINS];
+    for m in &all_gather(ex, u64_bytes(&fit)).map_err(fail)? {
+        for (s, c) in fit_summed.iter_mut().zip(m.chunks_exact(8)) {
+            *s += u64::from_le_bytes(c.try_into().unwrap_or([0; 8]));
+        }
+    }
     let all_preview = all_gather(ex, preview_part.iter().flat_map(|v| v.to_le_bytes()).collect()).map_err(fail)?;
     let values: Vec<f32> = all_preview
         .iter()
@@ -139,7 +179,13 @@ pub fn survey<E: Exchange + ?Sized>(ex: &mut E, header: &VolumeHeader) -> Result
     };
     let mut preview = Volume::new(header.name.clone(), preview_dims, header.spacing * stride as f64, data);
     preview.value_range = value_range;
-    Ok(Survey { value_range, preview, bins: summed, bytes_read })
+    preview.meta = header.meta.clone();
+    let values = ValueSummary {
+        histogram: Histogram { total: fit_summed.iter().sum(), counts: fit_summed },
+        value_range,
+        ct_hu: header.meta.is_ct_hu(),
+    };
+    Ok(Survey { value_range, preview, values, brick, bins: summed, bytes_read })
 }
 
 fn u64_bytes(v: &[u64]) -> Vec<u8> {
@@ -164,5 +210,19 @@ mod tests {
             }
             assert_eq!(next, dims.z);
         }
+    }
+
+    /// `-n 3` and `-n 6` on a 32³ volume: two 16-voxel bricks per axis cannot make three slabs,
+    /// 8-voxel bricks can (the split said "no brick face to split at" before).
+    #[test]
+    fn a_small_volume_split_between_many_ranks_takes_finer_bricks() {
+        let dims = UVec3::splat(32);
+        assert_eq!(brick_for(dims, &[2]), Ok(16));
+        assert_eq!(brick_for(dims, &[3]), Ok(8));
+        assert_eq!(brick_for(dims, &[3, 2]), Ok(8));
+        assert_eq!(brick_for(dims, &[2, 2, 2, 2, 2, 2]), Ok(8));
+        // Only what truly cannot be split is refused: 5 slabs of a 4-voxel axis.
+        let err = brick_for(UVec3::new(4, 1, 1), &[5]).expect_err("4 voxels cannot make 5 boxes");
+        assert!(err.to_string().contains("cannot be split into 5 boxes"), "{err}");
     }
 }

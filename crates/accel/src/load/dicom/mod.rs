@@ -291,20 +291,26 @@ pub fn load(
     let name = if first.description.is_empty() { dicom_name(paths) } else { first.description.clone() };
     let mut volume = Volume::new(name, orientation.world_dims(file_dims), spacing, data);
     volume.fit_range_to_data();
+    volume.meta = series_meta(&first, origin);
+    Ok(LoadedVolume { volume, report })
+}
+
+/// What a series' first file says of the volume besides its voxels; `origin` is the centre of
+/// voxel (0, 0, 0) in the patient frame.
+fn series_meta(first: &FileHeader, origin: glam::DVec3) -> VolumeMeta {
     let units = match (first.modality.as_str(), first.rescale_type.as_deref()) {
         (_, Some(t)) if !t.eq_ignore_ascii_case("US") => Some(t.to_string()),
         ("CT", _) => Some("HU".to_string()),
         _ => None,
     };
-    volume.meta = VolumeMeta {
+    VolumeMeta {
         modality: (!first.modality.is_empty()).then(|| first.modality.clone()),
         units,
         window: first.window.map(|(center, width)| Window { center, width }),
         frame: WorldFrame::Lps,
         origin: Some(origin),
         description: (!first.description.is_empty()).then(|| first.description.clone()),
-    };
-    Ok(LoadedVolume { volume, report })
+    }
 }
 
 /// A series' frames in stack order.
@@ -391,6 +397,8 @@ pub struct SeriesSlices {
     /// True when every file stores 8 bits per pixel (the whole volume normalizes over 0..=255
     /// then, as [`load`] gives it).
     pub eight_bit: bool,
+    /// Modality, units (HU for CT), window and origin, as [`load`] gives them.
+    pub meta: VolumeMeta,
 }
 
 impl SeriesSlices {
@@ -409,7 +417,9 @@ impl SeriesSlices {
         }
         let name = if first.description.is_empty() { dicom_name(paths) } else { first.description.clone() };
         let eight_bit = series.iter().all(|h| h.bits_allocated == 8 && h.rescale == (1.0, 0.0));
-        Ok(Self { series, ordered, dims: file_dims, spacing, name, eight_bit })
+        // The axes are the world's (checked above), so voxel (0, 0, 0) is the stack's origin.
+        let meta = series_meta(first, stack.origin);
+        Ok(Self { series, ordered, dims: file_dims, spacing, name, eight_bit, meta })
     }
 
     /// The rescaled values of slices `z` (whole slices, x fastest), reading only their files.

@@ -225,13 +225,19 @@ fn latency_of(
 pub fn run(args: &LiveArgs) -> anyhow::Result<()> {
     let viewport = volgraph_app::inputs::parse_size(&args.size)?;
     let soak_viewport = volgraph_app::inputs::parse_size(&args.soak_size)?;
+    // The graph first: a missing graph file is named as such, not as a missing shaders folder.
+    let original = volgraph_accel::input_file::read_text(&args.graph, "graph file")?;
+    let shaders_root = volgraph_app::shader_dir::find_beside(&args.graph).ok_or_else(|| {
+        anyhow!(
+            "{}: no shaders/ folder beside the graph file or in a folder above it, to copy; give a graph inside a \
+             volgraph checkout (e.g. graphs/basic/fragment_raycast.ron)",
+            args.graph.display()
+        )
+    })?;
     let dir = std::env::temp_dir().join(format!("volgraph-bench-live-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let shaders_root = volgraph_app::shader_dir::find_beside(&args.graph)
-        .ok_or_else(|| anyhow!("{}: no shaders/ folder beside the graph to copy", args.graph.display()))?;
     copy_dir(&shaders_root, &dir.join("shaders"))?;
     let graph = dir.join("graph.ron");
-    let original = std::fs::read_to_string(&args.graph).with_context(|| format!("reading {}", args.graph.display()))?;
     std::fs::write(&graph, &original)?;
     let gpu = Arc::new(Gpu::new_headless().map_err(|e| anyhow!(e))?);
     let open = |viewport: (u32, u32)| {

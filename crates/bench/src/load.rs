@@ -15,24 +15,71 @@ use volgraph_accel::volume::{Volume, VoxelData};
 /// `bench load` arguments.
 #[derive(clap::Args, Debug)]
 pub struct LoadArgs {
-    /// Slices in the series.
-    #[arg(long, default_value_t = 512)]
+    /// Slices in the series (1..=4096).
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=MAX_EDGE))]
     pub slices: u32,
-    /// Rows and columns of each slice.
-    #[arg(long, default_value_t = 512)]
+    /// Rows and columns of each slice (1..=4096).
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=MAX_EDGE))]
     pub size: u32,
-    /// Loads of each (the median is reported).
-    #[arg(long, default_value_t = 3)]
-    pub repeats: usize,
+    /// Loads of each (the median is reported; 1..=1000).
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    pub repeats: u64,
     /// Write the figures as JSON here.
     #[arg(long)]
     pub json: Option<PathBuf>,
 }
 
+/// The most slices, and rows and columns per slice: 4096² int16 slices are 32 MiB each, and
+/// DICOM's Rows and Columns are 16-bit.
+const MAX_EDGE: i64 = 4096;
+
+/// Copies of the phantom's voxels the run holds at once, at most: the phantom, the raw file's
+/// bytes, and the volume each loader returns with what it reads.
+const COPIES: u64 = 5;
+
+/// Refuses a series that would not fit in memory, before anything is allocated.
+fn check_memory(args: &LoadArgs) -> anyhow::Result<()> {
+    let bytes = u64::from(args.size) * u64::from(args.size) * u64::from(args.slices) * 2;
+    let need = bytes.saturating_mul(COPIES);
+    if let Some(available) = available_memory()
+        && need > available
+    {
+        anyhow::bail!(
+            "--size {} --slices {}: the phantom is {:.0} MB of int16 and the benchmark holds up to {COPIES} copies of \
+             it ({:.0} MB), more than the {:.0} MB of memory available; choose a smaller --size or --slices",
+            args.size,
+            args.slices,
+            bytes as f64 / 1e6,
+            need as f64 / 1e6,
+            available as f64 / 1e6
+        );
+    }
+    Ok(())
+}
+
+/// The memory this process may still take, where the system says: `MemAvailable` of
+/// `/proc/meminfo`, or the address-space limit (`ulimit -v`, for the whole process) when lower.
+fn available_memory() -> Option<u64> {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok().and_then(|text| {
+        let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+        line.split_whitespace().nth(1)?.parse::<u64>().ok().map(|kib| kib * 1024)
+    });
+    let limit = std::fs::read_to_string("/proc/self/limits").ok().and_then(|text| {
+        let line = text.lines().find(|l| l.starts_with("Max address space"))?;
+        line.split_whitespace().nth(3)?.parse::<u64>().ok()
+    });
+    match (meminfo, limit) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    }
+}
+
 /// A CT-like phantom in HU: air, a body of soft tissue, a bone core, with noise.
-fn phantom(size: u32, slices: u32) -> Volume {
+fn phantom(size: u32, slices: u32) -> anyhow::Result<Volume> {
     let (n, nz) = (size as usize, slices as usize);
-    let mut values = vec![0i16; n * n * nz];
+    let mut values = Vec::new();
+    values.try_reserve_exact(n * n * nz).map_err(|_| anyhow::anyhow!("not enough memory for the phantom"))?;
+    values.resize(n * n * nz, 0i16);
     values.chunks_mut(n * n).enumerate().for_each(|(z, slice)| {
         for (i, v) in slice.iter_mut().enumerate() {
             let (x, y) = ((i % n) as f64 / n as f64 - 0.5, (i / n) as f64 / n as f64 - 0.5);
@@ -47,7 +94,7 @@ fn phantom(size: u32, slices: u32) -> Volume {
             } + noise;
         }
     });
-    Volume::new("bench_ct", UVec3::new(size, size, slices), DVec3::new(0.7, 0.7, 1.0), VoxelData::I16(values))
+    Ok(Volume::new("bench_ct", UVec3::new(size, size, slices), DVec3::new(0.7, 0.7, 1.0), VoxelData::I16(values)))
 }
 
 fn median_ms(mut runs: Vec<f64>) -> f64 {
@@ -57,9 +104,10 @@ fn median_ms(mut runs: Vec<f64>) -> f64 {
 
 /// Runs the benchmark and prints the table.
 pub fn run(args: &LoadArgs) -> anyhow::Result<serde_json::Value> {
+    check_memory(args)?;
     let dir = std::env::temp_dir().join(format!("volgraph-bench-load-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let volume = phantom(args.size, args.slices);
+    let volume = phantom(args.size, args.slices)?;
     eprintln!("writing {} slices of {}² int16 to {} …", args.slices, args.size, dir.display());
     let series = dir.join("series");
     volgraph_accel::load::dicom::write_ct_series(&series, &volume).context("writing the series")?;
@@ -77,7 +125,7 @@ pub fn run(args: &LoadArgs) -> anyhow::Result<serde_json::Value> {
     let (_, from_dicom) = time(std::slice::from_ref(&series))?;
     anyhow::ensure!(from_raw.data == from_dicom.data, "the series and its raw twin loaded different voxels");
     let (mut raw_ms, mut dicom_ms) = (Vec::new(), Vec::new());
-    for _ in 0..args.repeats.max(1) {
+    for _ in 0..args.repeats {
         raw_ms.push(time(std::slice::from_ref(&raw))?.0);
         dicom_ms.push(time(std::slice::from_ref(&series))?.0);
     }

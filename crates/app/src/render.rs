@@ -81,13 +81,8 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     options.precision = scene.as_ref().and_then(|s| s.precision);
     let frames = args.frames.or(scene.as_ref().map(Scene::frame_count)).unwrap_or(1);
     let raw = inputs::raw_options(&args.inputs.raw)?;
-    let (volume, generated, mut notes) = match (args.inputs.volume.as_slice(), &scene) {
-        ([], Some(scene)) => crate::scene::load_volume(scene, &raw)?,
-        (volume, _) => {
-            let (v, notes) = inputs::volume(volume, &raw)?;
-            (v, volume.is_empty(), notes)
-        }
-    };
+    let shown = crate::scene::load_shown_volume(&args.inputs.volume, scene.as_ref(), &raw)?;
+    let (volume, generated, mut notes) = (shown.volume, shown.marschner_lobb_tf, shown.notes);
     let (tf, tf_notes) = match (&args.inputs.tf, &scene) {
         (None, Some(scene)) => {
             let (tf, _, notes) =

@@ -17,8 +17,13 @@
 //!     opacity_reference: Voxel,                   // or World
 //!     crop: (0, 0, 0, 0.5, 1, 1),                 // optional: X0,Y0,Z0,X1,Y1,Z1 in volume fractions
 //!     clip: [(0, 1, 1, 0.8)],                     // optional: planes NX,NY,NZ,D keeping n·f >= D
+//!     volume_options: (series: "2", spacing: (0.5, 0.5, 1.2)),  // optional: how to read the volume
 //! )
 //! ```
+//!
+//! A relative `graph` or `File(...)` transfer function names the file beside the scene when
+//! there is one; where there is none, a built-in graph's name (`klein_2005/leap_iso`) or a TF
+//! preset's (`ct-bone`, `graphs/tf/vessels.ron`) is resolved as the command line resolves it.
 
 use std::path::{Path, PathBuf};
 
@@ -51,12 +56,75 @@ pub enum VolumeSource {
 /// Where a scene's transfer function comes from.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 pub enum TfSource {
-    /// A RON or ParaView JSON file, relative to the scene file.
+    /// A RON or ParaView JSON file, relative to the scene file (or, where no such file is
+    /// beside the scene, a built-in TF's or a scanner preset's name, as `--tf` takes it).
     File(String),
-    /// `default`, `opaque` or `sparse`, stretched over the volume's values.
+    /// `default`, `opaque` or `sparse`, stretched over the volume's values; or a scanner preset
+    /// as `--tf` names it (`ct-bone`, `ct-soft-tissue`, `ct-lung`, `ct-angio`, `mr-default`).
     Preset(String),
     /// A file `$VOLGRAPH_DATA/tf/<name>.ron` (the peer benchmark's `engine_opaque`, ...).
     Data(String),
+}
+
+/// How to read the scene's volume: what the command line's `--series`, `--frame`, `--dims`,
+/// `--dtype`, `--big-endian` and `--spacing` say (flags given as well win, field by field).
+/// A named volume (`Dataset`, `Generated`) takes only `spacing`.
+#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct VolumeOptions {
+    /// The DICOM series of a folder holding several: its number, UID or description.
+    #[serde(default)]
+    pub series: Option<String>,
+    /// The volume of a 4D NIfTI file (0-based).
+    #[serde(default)]
+    pub frame: Option<u64>,
+    /// A headerless raw file's voxels per axis.
+    #[serde(default)]
+    pub dims: Option<(u32, u32, u32)>,
+    /// A headerless raw file's voxel type: uint8, uint16, int16 or float32.
+    #[serde(default)]
+    pub dtype: Option<String>,
+    /// A raw file's 16/32-bit voxels are big-endian.
+    #[serde(default)]
+    pub big_endian: bool,
+    /// The voxel spacing X, Y, Z (over the file's header or the dataset's).
+    #[serde(default)]
+    pub spacing: Option<(f64, f64, f64)>,
+}
+
+impl VolumeOptions {
+    /// The options a volume was read with, as a scene writes them.
+    pub fn of(options: &volgraph_accel::load::LoadOptions<'_>) -> VolumeOptions {
+        let raw = &options.raw;
+        VolumeOptions {
+            series: options.series.clone(),
+            frame: options.frame,
+            dims: raw.dims.map(|d| (d.x, d.y, d.z)),
+            dtype: raw.dtype.map(|t| t.name().to_string()),
+            big_endian: matches!(raw.endianness, volgraph_accel::load::Endianness::Big),
+            spacing: raw.spacing.map(|s| (s.x, s.y, s.z)),
+        }
+    }
+
+    /// The loader's options, checked as the command line checks its flags (the message names
+    /// the flag the field stands for).
+    pub fn load_options(&self) -> anyhow::Result<volgraph_accel::load::LoadOptions<'static>> {
+        let raw = crate::cli::RawArgs {
+            series: self.series.clone(),
+            frame: self.frame,
+            dims: self.dims.map(|(x, y, z)| format!("{x}x{y}x{z}")),
+            dtype: self.dtype.clone(),
+            // `Display` writes the shortest text that parses back to the same f64.
+            spacing: self.spacing.map(|(x, y, z)| format!("{x},{y},{z}")),
+            big_endian: self.big_endian,
+        };
+        crate::inputs::raw_options(&raw)
+    }
+
+    /// True when no option is set.
+    pub fn is_empty(&self) -> bool {
+        *self == VolumeOptions::default()
+    }
 }
 
 /// One keyframe of a camera path.
@@ -120,6 +188,8 @@ struct SceneDoc {
     crop: Option<(f64, f64, f64, f64, f64, f64)>,
     #[serde(default)]
     clip: Vec<(f64, f64, f64, f64)>,
+    #[serde(default)]
+    volume_options: VolumeOptions,
 }
 
 /// A scene read and checked, its paths resolved against the scene file's folder.
@@ -147,6 +217,8 @@ pub struct Scene {
     pub frames: Option<u32>,
     /// The crop box and clip planes (volume fractions).
     pub cuts: Cuts,
+    /// How to read the volume (checked).
+    pub volume_options: VolumeOptions,
 }
 
 /// Why a scene could not be read.
@@ -270,17 +342,25 @@ impl Scene {
         if let Some(TfSource::Data(name)) = &doc.transfer_function {
             check_data_name(name).map_err(|m| field("transfer_function", m))?;
         }
+        if let Some(TfSource::Preset(name)) = &doc.transfer_function
+            && tf_preset(name).is_none()
+        {
+            return Err(field("transfer_function", format!("Preset(\"{name}\") is not a preset; {PRESETS}")));
+        }
+        doc.volume_options.load_options().map_err(|e| {
+            field("volume_options", format!("{e:#} (the field volume_options says what that flag says)"))
+        })?;
         let volume = match doc.volume {
             VolumeSource::File(p) => VolumeSource::File(resolve(&p).display().to_string()),
             other => other,
         };
         let transfer_function = doc.transfer_function.map(|t| match t {
-            TfSource::File(p) => TfSource::File(resolve(&p).display().to_string()),
+            TfSource::File(p) => TfSource::File(beside_or_name(&p, &dir, is_tf_name).display().to_string()),
             other => other,
         });
         Ok(Scene {
             path: path.to_path_buf(),
-            graph: doc.graph.as_deref().map(resolve),
+            graph: doc.graph.as_deref().map(|g| beside_or_name(g, &dir, |p| crate::builtin_graphs::find(p).is_some())),
             volume,
             transfer_function,
             camera: doc.camera,
@@ -290,6 +370,7 @@ impl Scene {
             opacity_reference: doc.opacity_reference,
             frames: doc.frames,
             cuts,
+            volume_options: doc.volume_options,
         })
     }
 
@@ -304,6 +385,44 @@ impl Scene {
         }
     }
 }
+
+/// A relative path written in a scene: the file beside the scene when there is one (a dangling
+/// link too: it is the user's file), else — where `names_builtin` says so — the name as written,
+/// which the command line's rules resolve (a built-in graph, a TF preset), else the path beside
+/// the scene (whose error then names it).
+fn beside_or_name(written: &str, dir: &Path, names_builtin: impl Fn(&Path) -> bool) -> PathBuf {
+    let path = Path::new(written);
+    if path.is_absolute() {
+        return path.to_path_buf();
+    }
+    let beside = dir.join(path);
+    if beside.symlink_metadata().is_err() && names_builtin(path) { path.to_path_buf() } else { beside }
+}
+
+/// Whether `--tf PATH` would read `path` as a built-in: a scanner preset's name or a built-in TF
+/// (`graphs/tf/vessels.ron`).
+fn is_tf_name(path: &Path) -> bool {
+    path.to_str().and_then(volgraph_accel::transfer_function::ScannerPreset::from_name).is_some()
+        || crate::builtin_graphs::find_tf(path).is_some()
+}
+
+/// A preset a scene's `Preset("…")` names: a general one (stretched over the volume's values) or
+/// a scanner preset.
+enum NamedPreset {
+    General(volgraph_accel::transfer_function::Preset),
+    Scanner(volgraph_accel::transfer_function::ScannerPreset),
+}
+
+fn tf_preset(name: &str) -> Option<NamedPreset> {
+    use volgraph_accel::transfer_function::{Preset, ScannerPreset};
+    Preset::from_name(name)
+        .map(NamedPreset::General)
+        .or_else(|| ScannerPreset::from_name(name).map(NamedPreset::Scanner))
+}
+
+/// The presets a scene's `Preset("…")` may name, for messages.
+const PRESETS: &str = "use default, opaque or sparse, a scanner preset (ct-bone, ct-soft-tissue, ct-lung, ct-angio, \
+                       mr-default), or File(\"path.ron\")";
 
 /// A `Data("name")` transfer function names a file of `$VOLGRAPH_DATA/tf` by its stem: no
 /// folders, no `..`, so a scene cannot read a file outside that folder.
@@ -415,71 +534,187 @@ impl CameraSpec {
     }
 }
 
-/// A scene's volume, loaded: (volume, whether it is generated, notes for stderr). The error
-/// names the scene file and field.
-pub fn load_volume(
-    scene: &Scene,
-    raw: &volgraph_accel::load::LoadOptions<'static>,
-) -> anyhow::Result<(volgraph_accel::volume::Volume, bool, Vec<String>)> {
-    let at = |e: anyhow::Error| anyhow::anyhow!("{}: volume: {e:#}", scene.path.display());
-    match &scene.volume {
-        VolumeSource::File(p) => {
-            let (v, notes) = crate::inputs::volume_files(&[PathBuf::from(p)], raw).map_err(at)?;
-            Ok((v, false, notes))
+/// The volume `render` and `view` show, loaded, and where it came from.
+pub struct ShownVolume {
+    /// The voxels.
+    pub volume: volgraph_accel::volume::Volume,
+    /// Where it came from, as a saved view writes it.
+    pub source: VolumeSource,
+    /// How it was read (the flags, over the scene's `volume_options` for the scene's volume).
+    pub options: volgraph_accel::load::LoadOptions<'static>,
+    /// Its default transfer function is Marschner–Lobb's ([`marschner_lobb_tf`]).
+    pub marschner_lobb_tf: bool,
+    /// Notes for stderr (what the loader repaired or chose).
+    pub notes: Vec<String>,
+}
+
+/// Loads the volume `render` and `view` show: `--volume` (files, a DICOM folder or slices, or a
+/// volume's name) read with the command line's flags; else the scene's volume, read with its
+/// `volume_options` under the flags; else the generated Marschner–Lobb 64³. One function for
+/// both commands, so a view saved as a scene renders with the same volume and default TF.
+pub fn load_shown_volume(
+    paths: &[PathBuf],
+    scene: Option<&Scene>,
+    flags: &volgraph_accel::load::LoadOptions<'static>,
+) -> anyhow::Result<ShownVolume> {
+    use crate::inputs::VolumeName;
+    let source = match (paths, scene) {
+        ([one], _) => match crate::inputs::volume_name(one) {
+            Some(VolumeName::Generated(name)) => VolumeSource::Generated(name),
+            Some(VolumeName::Dataset(name)) => VolumeSource::Dataset(name),
+            None => VolumeSource::File(one.display().to_string()),
+        },
+        // DICOM slices given one by one: their folder.
+        ([first, ..], _) => VolumeSource::File(first.parent().unwrap_or(Path::new(".")).display().to_string()),
+        ([], Some(scene)) => scene.volume.clone(),
+        ([], None) => VolumeSource::Generated("ml64".to_string()),
+    };
+    let marschner_lobb_tf = marschner_lobb_tf(&source);
+    let (volume, options, notes) = match (paths, scene) {
+        ([], Some(scene)) => {
+            let options = merged_options(
+                flags,
+                &scene
+                    .volume_options
+                    .load_options()
+                    .map_err(|e| anyhow::anyhow!("{}: volume_options: {e:#}", scene.path.display()))?,
+            );
+            let (volume, notes) = load_volume(scene, &options)?;
+            (volume, options, notes)
         }
-        VolumeSource::Dataset(name) => {
-            let loaded = volgraph_accel::data_dir::load_dataset(name).map_err(|e| at(anyhow::anyhow!("{e}")))?;
-            Ok((loaded.volume, false, Vec::new()))
+        _ => {
+            let (volume, notes) = crate::inputs::volume(paths, flags)?;
+            (volume, flags.clone(), notes)
         }
-        VolumeSource::Generated(name) => {
-            let v = volgraph_accel::generate::by_name(name).map_err(|e| {
-                at(match e {
-                    volgraph_accel::generate::NamedVolumeError::Unknown { .. } => anyhow::anyhow!(
-                        "Generated(\"{name}\") names no generated volume; use {}",
-                        volgraph_accel::generate::NAMED_GENERATORS
-                    ),
-                    other => anyhow::anyhow!("Generated(\"{name}\"): {other}"),
-                })
-            })?;
-            Ok((v, true, Vec::new()))
-        }
+    };
+    Ok(ShownVolume { volume, source, options, marschner_lobb_tf, notes })
+}
+
+/// Whether a volume's default transfer function (none given) is `graphs/tf/marschner_lobb.ron`,
+/// which shows Marschner–Lobb's rings: for the generated Marschner–Lobb volumes (`ml64`, the
+/// default, and `mlf64`, any edge); every other volume gets one fitted to its data. The one rule
+/// for `render`, `view` and scenes.
+pub fn marschner_lobb_tf(source: &VolumeSource) -> bool {
+    matches!(source, VolumeSource::Generated(name) if name.starts_with("ml"))
+}
+
+/// `flags`, each over the scene's `scene` value.
+fn merged_options(
+    flags: &volgraph_accel::load::LoadOptions<'static>,
+    scene: &volgraph_accel::load::LoadOptions<'static>,
+) -> volgraph_accel::load::LoadOptions<'static> {
+    use volgraph_accel::load::{Endianness, LoadOptions, RawOptions};
+    let big = |o: &LoadOptions<'_>| matches!(o.raw.endianness, Endianness::Big);
+    LoadOptions {
+        raw: RawOptions {
+            dims: flags.raw.dims.or(scene.raw.dims),
+            dtype: flags.raw.dtype.or(scene.raw.dtype),
+            endianness: if big(flags) || big(scene) { Endianness::Big } else { Endianness::default() },
+            spacing: flags.raw.spacing.or(scene.raw.spacing),
+        },
+        series: flags.series.clone().or_else(|| scene.series.clone()),
+        frame: flags.frame.or(scene.frame),
+        progress: None,
     }
 }
 
+/// A scene's volume read with `options` (the flags over its `volume_options`), with notes for
+/// stderr. The error names the scene file and field.
+fn load_volume(
+    scene: &Scene,
+    options: &volgraph_accel::load::LoadOptions<'static>,
+) -> anyhow::Result<(volgraph_accel::volume::Volume, Vec<String>)> {
+    let at = |e: anyhow::Error| anyhow::anyhow!("{}: volume: {e:#}", scene.path.display());
+    let name = match &scene.volume {
+        VolumeSource::File(p) => return crate::inputs::volume_files(&[PathBuf::from(p)], options).map_err(at),
+        VolumeSource::Dataset(name) | VolumeSource::Generated(name) => name,
+    };
+    let raw = &options.raw;
+    let big_endian = matches!(raw.endianness, volgraph_accel::load::Endianness::Big);
+    if raw.dims.is_some() || raw.dtype.is_some() || big_endian || options.series.is_some() || options.frame.is_some() {
+        return Err(anyhow::anyhow!(
+            "{}: volume_options: \"{name}\" names a volume, not a file: series, frame, dims, dtype and big_endian (or \
+             --series, --frame, --dims, --dtype, --big-endian) describe a file's layout; remove them (spacing may stay)",
+            scene.path.display()
+        ));
+    }
+    let mut volume = match &scene.volume {
+        VolumeSource::Dataset(name) => {
+            volgraph_accel::data_dir::load_dataset(name).map_err(|e| at(anyhow::anyhow!("{e}")))?.volume
+        }
+        _ => volgraph_accel::generate::by_name(name).map_err(|e| {
+            at(match e {
+                volgraph_accel::generate::NamedVolumeError::Unknown { .. } => anyhow::anyhow!(
+                    "Generated(\"{name}\") names no generated volume; use {}",
+                    volgraph_accel::generate::NAMED_GENERATORS
+                ),
+                other => anyhow::anyhow!("Generated(\"{name}\"): {other}"),
+            })
+        })?,
+    };
+    if let Some(spacing) = raw.spacing {
+        volume.spacing = spacing;
+    }
+    Ok((volume, Vec::new()))
+}
+
 /// A scene's transfer function for `volume`: a file (also returned, so a viewer can watch it),
-/// a preset, or the default fitted to the data; with notes for stderr.
+/// a preset, or the default fitted to the data; with notes for stderr. `marschner_lobb_tf`:
+/// [`ShownVolume::marschner_lobb_tf`].
 pub fn load_transfer_function(
     scene: &Scene,
     tf_map: Option<&str>,
     volume: &volgraph_accel::volume::Volume,
-    generated: bool,
+    marschner_lobb_tf: bool,
 ) -> anyhow::Result<(volgraph_accel::transfer_function::TransferFunction, Option<PathBuf>, Vec<String>)> {
-    use volgraph_accel::transfer_function::{Preset, TransferFunction};
+    use volgraph_accel::transfer_function::TransferFunction;
     match &scene.transfer_function {
         Some(source @ (TfSource::File(_) | TfSource::Data(_))) => {
             let path = match source {
                 TfSource::Data(name) => volgraph_accel::data_dir::data_dir().join("tf").join(format!("{name}.ron")),
                 TfSource::File(p) | TfSource::Preset(p) => PathBuf::from(p),
             };
-            let (tf, notes) = crate::inputs::transfer_function(Some(&path), tf_map, volume, generated)
+            let (tf, notes) = crate::inputs::transfer_function(Some(&path), tf_map, volume, marschner_lobb_tf)
                 .map_err(|e| anyhow::anyhow!("{}: transfer_function: {e:#}", scene.path.display()))?;
-            Ok((tf, Some(path), notes))
+            // A preset's name is no file to watch or save to.
+            let file = (!is_tf_name(&path) || path.symlink_metadata().is_ok()).then_some(path);
+            Ok((tf, file, notes))
         }
         Some(TfSource::Preset(name)) => {
-            let preset = Preset::from_name(name).ok_or_else(|| {
-                anyhow::anyhow!(
-                    "{}: transfer_function: Preset(\"{name}\") is not a preset; use default, opaque or sparse, or File(\"path.ron\")",
-                    scene.path.display()
-                )
-            })?;
-            let (lo, hi) = volume.value_range;
-            Ok((TransferFunction::preset(preset, (lo, if hi > lo { hi } else { lo + 1.0 })), None, Vec::new()))
+            let tf = match tf_preset(name) {
+                Some(NamedPreset::General(preset)) => {
+                    let (lo, hi) = volume.value_range;
+                    TransferFunction::preset(preset, (lo, if hi > lo { hi } else { lo + 1.0 }))
+                }
+                Some(NamedPreset::Scanner(preset)) => preset.for_volume(volume),
+                None => {
+                    return Err(anyhow::anyhow!(
+                        "{}: transfer_function: Preset(\"{name}\") is not a preset; {PRESETS}",
+                        scene.path.display()
+                    ));
+                }
+            };
+            Ok((tf, None, Vec::new()))
         }
         None => {
-            let (tf, notes) = crate::inputs::transfer_function(None, tf_map, volume, generated)?;
+            let (tf, notes) = crate::inputs::transfer_function(None, tf_map, volume, marschner_lobb_tf)?;
             Ok((tf, None, notes))
         }
     }
+}
+
+/// Where "save view" writes an edited transfer function that no file holds: beside the scene,
+/// `NAME.tf.ron` for `NAME.scene.ron` or `NAME.ron`.
+pub fn tf_file_beside(scene: &Path) -> PathBuf {
+    let name = scene.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let stem = name.strip_suffix(".ron").unwrap_or(&name);
+    let stem = stem.strip_suffix(".scene").unwrap_or(stem);
+    let file = if stem.is_empty() || format!("{stem}.tf.ron") == name {
+        format!("{name}.tf.ron")
+    } else {
+        format!("{stem}.tf.ron")
+    };
+    scene.with_file_name(file)
 }
 
 #[cfg(test)]
@@ -579,12 +814,15 @@ mod tests {
 /// screen again, pixel for pixel.
 #[derive(Clone, Debug)]
 pub struct SavedView {
-    /// The graph file.
+    /// The graph file, or a built-in graph's name.
     pub graph: PathBuf,
     /// The volume.
     pub volume: VolumeSource,
-    /// The transfer function file; `None`: fitted to the data (as it was).
-    pub transfer_function: Option<PathBuf>,
+    /// How the volume was read (`--series`, `--frame`, `--dims`, `--spacing`, ...).
+    pub volume_options: VolumeOptions,
+    /// The transfer function: a file (or a built-in TF's name), a preset, a data-folder TF;
+    /// `None`: fitted to the data (as it was).
+    pub transfer_function: Option<TfSource>,
     /// The camera on screen.
     pub camera: OrbitCamera,
     /// The viewport.
@@ -600,7 +838,8 @@ pub struct SavedView {
 }
 
 impl SavedView {
-    /// The scene file's text. Paths are written absolute, so the file may be moved.
+    /// The scene file's text. Paths of files are written absolute, so the file may be moved; a
+    /// built-in graph's or TF's name stays a name (a scene resolves it as the command line does).
     pub fn to_ron(&self) -> String {
         let quote = |p: &Path| {
             let p = std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
@@ -618,8 +857,34 @@ impl SavedView {
                 VolumeSource::Generated(n) => format!("Generated({n:?})"),
             }
         );
-        if let Some(tf) = &self.transfer_function {
-            out += &format!("    transfer_function: File({}),\n", quote(tf));
+        let o = &self.volume_options;
+        if !o.is_empty() {
+            let mut fields = Vec::new();
+            if let Some(series) = &o.series {
+                fields.push(format!("series: {series:?}"));
+            }
+            if let Some(frame) = o.frame {
+                fields.push(format!("frame: {frame}"));
+            }
+            if let Some((x, y, z)) = o.dims {
+                fields.push(format!("dims: ({x}, {y}, {z})"));
+            }
+            if let Some(dtype) = &o.dtype {
+                fields.push(format!("dtype: {dtype:?}"));
+            }
+            if o.big_endian {
+                fields.push("big_endian: true".to_string());
+            }
+            if let Some((x, y, z)) = o.spacing {
+                fields.push(format!("spacing: ({x:?}, {y:?}, {z:?})"));
+            }
+            out += &format!("    volume_options: ({}),\n", fields.join(", "));
+        }
+        match &self.transfer_function {
+            Some(TfSource::File(p)) => out += &format!("    transfer_function: File({}),\n", quote(Path::new(p))),
+            Some(TfSource::Preset(n)) => out += &format!("    transfer_function: Preset({n:?}),\n"),
+            Some(TfSource::Data(n)) => out += &format!("    transfer_function: Data({n:?}),\n"),
+            None => {}
         }
         let c = &self.camera;
         // Rust's shortest round-trip formatting: the file reads back the same f64.
@@ -683,6 +948,7 @@ mod saved_view_tests {
         let view = SavedView {
             graph: PathBuf::from("/nonexistent/graph.ron"),
             volume: VolumeSource::Generated("ml64".into()),
+            volume_options: VolumeOptions { spacing: Some((1.0, 0.1, 1.0 / 3.0)), ..Default::default() },
             transfer_function: None,
             camera,
             viewport: (320, 200),
@@ -693,6 +959,7 @@ mod saved_view_tests {
         };
         let scene = Scene::from_str(&view.to_ron(), Path::new("/tmp/x.scene.ron")).expect("reads back");
         assert_eq!(scene.cuts, cuts);
+        assert_eq!(scene.volume_options.spacing, Some((1.0, 0.1, 1.0 / 3.0)));
         assert_eq!(scene.viewport, Some((320, 200)));
         assert_eq!(scene.effects, vec!["shading".to_string()]);
         assert_eq!(scene.precision, Some(Precision::F16));

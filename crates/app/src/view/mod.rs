@@ -59,6 +59,17 @@ fn parse_turn(text: &str) -> Result<f64, String> {
     }
 }
 
+/// Refuses a screenshot path that is no file to write: a FIFO (writing one blocks until a
+/// reader comes, and the window with it), a directory, a device. The message names the path.
+pub fn screenshot_target(path: &std::path::Path) -> Result<(), String> {
+    match volgraph_accel::input_file::special_kind(path) {
+        Ok(Some(kind)) => {
+            Err(format!("{}: is {kind}, not a file to write a PNG screenshot to; give a file's path", path.display()))
+        }
+        _ => Ok(()),
+    }
+}
+
 /// What only the window needs.
 #[derive(Clone, Debug)]
 pub struct ViewOptions {
@@ -87,6 +98,7 @@ pub fn run(args: ViewArgs) -> Result<(), CliError> {
     let viewport = inputs::parse_size(&resolved.size)?;
     let camera = resolved.camera.at(0);
     if let Some(path) = &args.screenshot {
+        screenshot_target(path).map_err(|e| CliError::Other(anyhow::anyhow!("--screenshot {e}")))?;
         let kind = crate::image_out::ImageKind::from_path("--screenshot", path)?;
         if kind != crate::image_out::ImageKind::Png {
             return Err(CliError::Other(anyhow::anyhow!(

@@ -157,6 +157,13 @@ pub struct LiveSession {
     unproven: bool,
     /// Where the volume came from, for "save view".
     volume_source: crate::scene::VolumeSource,
+    /// How the volume was read (`--series`, `--frame`, `--dims`, `--spacing`, ...), for "save view".
+    volume_options: volgraph_accel::load::LoadOptions<'static>,
+    /// Where the TF came from, for "save view" (`None`: fitted to the data).
+    tf_source: Option<crate::scene::TfSource>,
+    /// The TF as its source gives it (the file's, the preset's, the fitted one): the TF on
+    /// screen differs from it after an edit that is not saved.
+    tf_pristine: TransferFunction,
     /// What the TF's opacity is per (the scene's).
     opacity_reference: volgraph_core::runtime::OpacityReference,
     /// The transfer function on screen (the TF editor's).
@@ -235,13 +242,8 @@ impl LiveSession {
     ) -> Result<(Self, Event), crate::cli::CliError> {
         let start = Instant::now();
         let source = inputs::read_graph(&args.graph)?;
-        let (volume, generated, notes) = match (args.volume.as_slice(), &args.scene) {
-            ([], Some(scene)) => crate::scene::load_volume(scene, &args.raw)?,
-            (volume, _) => {
-                let (v, notes) = inputs::volume(volume, &args.raw)?;
-                (v, volume.is_empty(), notes)
-            }
-        };
+        let shown = crate::scene::load_shown_volume(&args.volume, args.scene.as_ref(), &args.raw)?;
+        let (volume, generated, notes) = (shown.volume, shown.marschner_lobb_tf, shown.notes);
         for note in notes {
             crate::stdout::eprintln_escaped!("note: {note}");
         }
@@ -251,8 +253,17 @@ impl LiveSession {
             }
             (tf, _) => {
                 let (t, notes) = inputs::transfer_function(tf.as_ref(), args.tf_map.as_deref(), &volume, generated)?;
-                (t, tf.clone(), notes)
+                // A preset's name is no file: nothing to watch, and "save TF" writes elsewhere.
+                (t, tf.clone().filter(|p| scanner_preset_named(p).is_none()), notes)
             }
+        };
+        let tf_source = match (&args.tf, &args.scene) {
+            (None, Some(scene)) => scene.transfer_function.clone(),
+            (None, None) => None,
+            (Some(p), _) => Some(match scanner_preset_named(p) {
+                Some(name) => crate::scene::TfSource::Preset(name.to_string()),
+                None => crate::scene::TfSource::File(p.display().to_string()),
+            }),
         };
         for note in tf_notes {
             crate::stdout::eprintln_escaped!("note: {note}");
@@ -321,7 +332,10 @@ impl LiveSession {
             error: None,
             validated: None,
             unproven: true,
-            volume_source: volume_source_of(args),
+            volume_source: shown.source,
+            volume_options: shown.options,
+            tf_source,
+            tf_pristine: tf.clone(),
             tf,
             histogram,
             tf_written: None,
@@ -434,6 +448,7 @@ impl LiveSession {
                 .map_err(|e| format!("{e:#}"))
                 .and_then(|(tf, _)| {
                     self.set_transfer_function(&tf).map_err(|e| format!("{e:#}"))?;
+                    self.tf_pristine = tf.clone();
                     self.tf = tf;
                     Ok(())
                 })
@@ -523,7 +538,7 @@ impl LiveSession {
     /// when "save on change" is on.
     pub fn edit_transfer_function(&mut self, tf: TransferFunction) -> Vec<Event> {
         let start = Instant::now();
-        let path = self.tf_path.clone().unwrap_or_else(|| PathBuf::from(SAVED_TF));
+        let path = self.tf_save_path();
         let result = tf
             .validate(&path)
             .map_err(|e| e.to_string())
@@ -539,10 +554,27 @@ impl LiveSession {
         events
     }
 
+    /// Where "save TF" writes: the TF's file; for a scanner preset (`--tf ct-bone`)
+    /// `NAME.tf.ron` in the current folder (a name `--tf NAME` never reads in the preset's place);
+    /// for a fitted TF `view.tf.ron` there. Absolute, so the "saved" line says where it went.
+    fn tf_save_path(&self) -> PathBuf {
+        let path = match (&self.tf_path, &self.tf_source) {
+            (Some(path), _) => return path.clone(),
+            // A preset, or a built-in TF's name (`graphs/tf/vessels.ron` where no such file is).
+            (None, Some(crate::scene::TfSource::Preset(name) | crate::scene::TfSource::File(name))) => {
+                let stem = Path::new(name).file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned());
+                PathBuf::from(format!("{}.tf.ron", stem.strip_suffix(".ron").unwrap_or(&stem)))
+            }
+            (None, _) => PathBuf::from(SAVED_TF),
+        };
+        std::env::current_dir().map_or(path.clone(), |dir| dir.join(path))
+    }
+
     /// Saves the TF to its file as it came (RON, or ParaView JSON with the file's other maps
-    /// kept), or to `view.tf.ron` for a fitted TF (which the viewer then watches); atomic.
+    /// kept), or where [`Self::tf_save_path`] says for a preset or a fitted TF (which the
+    /// viewer then watches); atomic.
     pub fn save_transfer_function(&mut self) -> anyhow::Result<PathBuf> {
-        let path = self.tf_path.clone().unwrap_or_else(|| PathBuf::from(SAVED_TF));
+        let path = self.tf_save_path();
         let is_json = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("json"));
         let text = if is_json {
             let original = volgraph_accel::input_file::read_text(&path, "transfer function").ok();
@@ -560,6 +592,11 @@ impl LiveSession {
         crate::atomic_write::write_atomically(&path, &text)?;
         self.tf_written = Some(text);
         self.tf_path = Some(path.clone());
+        self.tf_source = Some(crate::scene::TfSource::File(path.display().to_string()));
+        // What the file gives back (a ParaView map's colours pass through sRGB): a view saved
+        // now refers to the file only if it draws the TF on screen.
+        self.tf_pristine = inputs::transfer_function(Some(&path), self.tf_map.as_deref(), &self.volume, self.generated)
+            .map_or_else(|_| self.tf_pristine.clone(), |(tf, _)| tf);
         Ok(path)
     }
 
@@ -750,7 +787,8 @@ impl LiveSession {
         crate::scene::SavedView {
             graph: self.graph.clone(),
             volume: self.volume_source.clone(),
-            transfer_function: self.tf_path.clone(),
+            volume_options: crate::scene::VolumeOptions::of(&self.volume_options),
+            transfer_function: self.tf_source.clone(),
             camera: *camera,
             viewport,
             effects: self.options.features.iter().filter(|f| !cut_effects::is_cut_feature(f)).cloned().collect(),
@@ -758,6 +796,44 @@ impl LiveSession {
             opacity_reference: self.opacity_reference,
             cuts: self.runtime.cuts(),
         }
+    }
+
+    /// Whether the TF on screen is not what its source gives (an edit not saved, a preset picked
+    /// in the editor), or is a colour map a scene cannot name (`--tf-map`).
+    pub fn tf_edited(&self) -> bool {
+        self.tf != self.tf_pristine || self.tf_map.is_some()
+    }
+
+    /// "Save view": the scene [`Self::saved_view`] describes, written to `path`. A TF on screen
+    /// that its source does not give ([`Self::tf_edited`]) is written beside the scene first
+    /// ([`crate::scene::tf_file_beside`]) and the scene refers to that file, so the scene draws
+    /// what is on screen; returns that file.
+    pub fn save_view(
+        &self,
+        camera: &volgraph_accel::camera::OrbitCamera,
+        viewport: (u32, u32),
+        path: &Path,
+    ) -> anyhow::Result<Option<PathBuf>> {
+        let mut view = self.saved_view(camera, viewport);
+        let mut tf_file = None;
+        if self.tf_edited() {
+            let beside = crate::scene::tf_file_beside(path);
+            let text = self.tf.to_ron_string();
+            let back = TransferFunction::from_ron_str(&text, &beside).map_err(|e| anyhow!("{e}"))?;
+            if back != self.tf {
+                return Err(anyhow!(
+                    "{}: the edited transfer function does not read back the same from RON; save it with \"save TF\" \
+                     and save the view again",
+                    beside.display()
+                ));
+            }
+            crate::atomic_write::write_atomically(&beside, &text)
+                .map_err(|e| anyhow!("{e:#} (the edited transfer function the saved view needs)"))?;
+            view.transfer_function = Some(crate::scene::TfSource::File(beside.display().to_string()));
+            tf_file = Some(beside);
+        }
+        view.save(path)?;
+        Ok(tf_file)
     }
 
     /// Sets the crop box and clip planes (the panel's sliders, `--crop`/`--clip`, a scene's
@@ -949,21 +1025,13 @@ fn compile_for(
     volgraph_core::compile(file, source, registry, &options)
 }
 
-/// Where the session's volume came from: the one `--volume` file or name (or the folder of a
-/// DICOM series given as files), else the scene's, else the generated Marschner–Lobb 64³.
-fn volume_source_of(args: &SessionArgs) -> crate::scene::VolumeSource {
-    use crate::inputs::VolumeName;
-    use crate::scene::VolumeSource;
-    match (args.volume.as_slice(), &args.scene) {
-        ([one], _) => match crate::inputs::volume_name(one) {
-            Some(VolumeName::Generated(name)) => VolumeSource::Generated(name),
-            Some(VolumeName::Dataset(name)) => VolumeSource::Dataset(name),
-            None => VolumeSource::File(one.display().to_string()),
-        },
-        ([first, ..], _) => VolumeSource::File(first.parent().unwrap_or(Path::new(".")).display().to_string()),
-        ([], Some(scene)) => scene.volume.clone(),
-        ([], None) => VolumeSource::Generated("ml64".to_string()),
+/// The scanner preset `--tf PATH` reads (no such file, a preset's name), as
+/// `inputs::transfer_function` decides it.
+fn scanner_preset_named(path: &Path) -> Option<&'static str> {
+    if path.exists() {
+        return None;
     }
+    path.to_str().and_then(volgraph_accel::transfer_function::ScannerPreset::from_name).map(|p| p.name())
 }
 
 /// Bins of the TF editor's histogram.

@@ -51,7 +51,8 @@ pub struct Viewer {
     accuracy: super::accuracy::LiveAccuracy,
     /// Since when the view on screen has changed without being measured.
     unmeasured_since: Option<std::time::Instant>,
-    screenshot_now: Option<PathBuf>,
+    /// Screenshots asked for since the last frame, each written (in order) after it.
+    screenshots_now: Vec<PathBuf>,
     quit: bool,
     /// The outcome: an error ends the program with status 1.
     pub failure: Option<String>,
@@ -75,7 +76,7 @@ impl Viewer {
             lod: super::lod::Lod::default(),
             accuracy: Default::default(),
             unmeasured_since: Some(std::time::Instant::now()),
-            screenshot_now: None,
+            screenshots_now: Vec::new(),
             quit: false,
             failure: None,
         }
@@ -194,9 +195,15 @@ impl Viewer {
                 Action::SaveScene(path) => {
                     let window =
                         self.gfx.as_ref().map_or(session.options().viewport, |g| (g.config.width, g.config.height));
-                    match session.saved_view(&self.orbit.camera, window).save(&path) {
-                        Ok(()) => {
+                    match session.save_view(&self.orbit.camera, window, &path) {
+                        Ok(tf_file) => {
                             crate::stdout::println_escaped!("saved scene {}", path.display());
+                            if let Some(tf) = tf_file {
+                                crate::stdout::println_escaped!(
+                                    "saved transfer function {} (the edited one on screen, which the scene reads)",
+                                    tf.display()
+                                );
+                            }
                             Vec::new()
                         }
                         Err(e) => {
@@ -208,8 +215,8 @@ impl Viewer {
                     }
                 }
                 Action::Screenshot => {
-                    self.screenshot_now =
-                        Some(self.view.screenshot.clone().unwrap_or_else(|| PathBuf::from("volgraph.png")));
+                    self.screenshots_now
+                        .push(self.view.screenshot.clone().unwrap_or_else(|| PathBuf::from("volgraph.png")));
                     Vec::new()
                 }
                 Action::ResetCamera => {
@@ -239,7 +246,10 @@ impl Viewer {
         for line in lines {
             match super::script::parse_line(&line) {
                 Ok(Some(ScriptCommand::Quit)) => self.quit = true,
-                Ok(Some(ScriptCommand::Screenshot(path))) => self.screenshot_now = Some(path),
+                Ok(Some(ScriptCommand::Screenshot(path))) => match super::screenshot_target(&path) {
+                    Ok(()) => self.screenshots_now.push(path),
+                    Err(e) => crate::stdout::eprintln_escaped!("script: {e}"),
+                },
                 Ok(Some(ScriptCommand::Param { pass, name, value })) => {
                     self.apply_actions(vec![Action::Param(pass, name, value)])
                 }
@@ -278,6 +288,8 @@ impl Viewer {
     }
 
     fn save_screenshot(&mut self, path: &PathBuf) -> Result<(), String> {
+        // Checked again when writing: a FIFO made since would block the window for good.
+        super::screenshot_target(path)?;
         let (Some(session), Some(gfx)) = (self.session.as_mut(), self.gfx.as_ref()) else { return Ok(()) };
         let output = session.shown_output();
         let (w, h) = (gfx.config.width, gfx.config.height);
@@ -422,10 +434,10 @@ impl Viewer {
         gfx.gpu.queue.present(frame);
         self.timings.frames += 1;
         self.apply_actions(actions);
-        if let Some(path) = self.screenshot_now.take()
-            && let Err(e) = self.save_screenshot(&path)
-        {
-            crate::stdout::eprintln_escaped!("error: {e}");
+        for path in std::mem::take(&mut self.screenshots_now) {
+            if let Err(e) = self.save_screenshot(&path) {
+                crate::stdout::eprintln_escaped!("error: {e}");
+            }
         }
         let done = self.view.frames.is_some_and(|n| self.timings.frames >= n);
         if done || self.quit {

@@ -45,17 +45,20 @@ pub fn describe(path: &Path, volume: &Volume) -> String {
     let d = volume.dims;
     let e = volume.extent();
     let meta = &volume.meta;
-    let units = meta.units.as_deref().map_or(String::new(), |u| format!(" {u}"));
+    // Header text (a DICOM SeriesDescription, a NIfTI `descrip`) shown on one line: a newline
+    // in it would forge a line of this report (`error: …`).
+    let shown = |text: &str| dicom::one_line(text);
+    let units = meta.units.as_deref().map_or(String::new(), |u| format!(" {}", shown(u)));
     let mut out = String::new();
     let _ = writeln!(out, "{}", path.display());
     if let Some(description) = &meta.description {
-        let _ = writeln!(out, "  description  {description}");
+        let _ = writeln!(out, "  description  {}", shown(description));
     }
     let _ = writeln!(
         out,
         "  modality     {}, values in {}",
-        meta.modality.as_deref().unwrap_or("unknown"),
-        meta.units.as_deref().unwrap_or("file units (no physical unit given)")
+        meta.modality.as_deref().map_or("unknown".into(), shown),
+        meta.units.as_deref().map_or("file units (no physical unit given)".into(), shown)
     );
     let _ = writeln!(out, "  dimensions   {} × {} × {} voxels, {}", d.x, d.y, d.z, volume.data.type_name());
     let _ = writeln!(

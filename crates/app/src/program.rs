@@ -88,7 +88,10 @@ pub fn shaders() -> ShaderSources {
 /// the chosen one and turns its outcome into an exit code, graph problems drawn with their
 /// source excerpts. No input makes it panic; should a bug do so anyway, it says so in one line.
 pub fn main_with(extension: Extension) -> ExitCode {
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn,notify=error")).init();
+    // jpeg2k logs OpenJPEG's messages on a corrupt codestream (eight lines before the error);
+    // the loader's error says what failed, so they are shown only when RUST_LOG asks.
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn,notify=error,jpeg2k=off"))
+        .init();
     std::panic::set_hook(Box::new(|info| {
         let location = info.location().map_or(String::new(), |l| format!(" at {}:{}", l.file(), l.line()));
         let message = info

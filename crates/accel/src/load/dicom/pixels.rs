@@ -220,6 +220,22 @@ fn stored_values(bytes: &[u8], bits_allocated: u16, bits_stored: u16, signed: bo
     })
 }
 
+/// `e` and its sources, `outer: inner: innermost` (dicom-rs's outer message alone says only
+/// "Could not decode pixel data").
+fn causes(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        let next = s.to_string();
+        if !text.ends_with(&next) {
+            text.push_str(": ");
+            text.push_str(&next);
+        }
+        source = s.source();
+    }
+    text
+}
+
 fn read_file(h: &FileHeader, per_slice: usize) -> Result<Vec<Slice>, LoadError> {
     let pixels_error = |message: String| LoadError::DicomPixels { path: h.path.clone(), message };
     let object = dicom_object::open_file(&h.path)
@@ -234,7 +250,7 @@ fn read_file(h: &FileHeader, per_slice: usize) -> Result<Vec<Slice>, LoadError> 
     }
     checks::pixel_data(h, &object, per_slice)?;
     let decoded = checks::guarded(&h.path, || object.decode_pixel_data())?
-        .map_err(|e| pixels_error(format!("cannot decode the pixel data: {e}")))?;
+        .map_err(|e| pixels_error(format!("cannot decode the pixel data: {}", causes(&e))))?;
     if decoded.samples_per_pixel() != 1 {
         return Err(pixels_error(format!(
             "has {} samples per pixel (a colour image); volgraph renders scalar volumes",

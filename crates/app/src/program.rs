@@ -118,8 +118,30 @@ pub fn main_with(extension: Extension) -> ExitCode {
     if let Some(about) = about {
         command = command.about(about);
     }
-    let matches = command.get_matches();
+    // A usage error quotes the arguments as given: drawn by a copy of the command without
+    // styles, its only control characters are the user's, and they are escaped (an argument
+    // holding an escape sequence would otherwise retitle or clear the terminal).
+    let plain = command.clone().styles(clap::builder::Styles::plain());
+    let matches = match command.try_get_matches() {
+        Ok(matches) => matches,
+        Err(e) if e.use_stderr() => return clap_exit(&plain.try_get_matches().err().unwrap_or(e)),
+        Err(e) => return clap_exit(&e),
+    };
     report(run(&matches, &commands))
+}
+
+/// Prints what clap has to say and gives its exit status: `--help` and `--version` as clap
+/// draws them (status 0); a usage error (status 2) with every control character of its text
+/// escaped (styles, if any, included: call it with an error drawn without them).
+fn clap_exit(e: &clap::Error) -> ExitCode {
+    let code = u8::try_from(e.exit_code()).unwrap_or(2);
+    if !e.use_stderr() {
+        let _ = e.print();
+        return ExitCode::from(code);
+    }
+    let text = e.render().ansi().to_string();
+    eprint!("{}", volgraph_core::terminal::escape_controls(&text));
+    ExitCode::from(code)
 }
 
 fn run(matches: &clap::ArgMatches, commands: &[Box<dyn Commands>]) -> Result<ExitCode, CliError> {
@@ -136,7 +158,10 @@ fn run(matches: &clap::ArgMatches, commands: &[Box<dyn Commands>]) -> Result<Exi
     match chosen {
         Some(c) => c.run(matches),
         None => {
-            let cli = Cli::from_arg_matches(matches).unwrap_or_else(|e| e.exit());
+            let cli = match Cli::from_arg_matches(matches) {
+                Ok(cli) => cli,
+                Err(e) => return Ok(clap_exit(&e)),
+            };
             crate::cli::run(cli).map(|()| ExitCode::SUCCESS)
         }
     }

@@ -1,14 +1,16 @@
 //! `volgraph set GRAPH PASS.PARAM=VALUE… input.NAME=VALUE…`: values written into a graph file at
-//! their place — only the values' text changes, comments, order and layout stay
-//! (`volgraph_core::graph::edit`). The edited text is compiled first: a bad value or an unknown
-//! name is a located error (with a "did you mean") and the file is left untouched; the write is
-//! atomic (a sibling temporary file renamed over the graph).
+//! their place — only the values' text changes, comments, order, layout, line endings, a
+//! byte-order mark and `#![enable(...)]` attributes stay (`volgraph_core::graph::edit`). A key
+//! the file writes twice is set where it takes effect (its last copy) and the earlier copies are
+//! named. The edited text is compiled first: a bad value or an unknown name is a located error
+//! (with a "did you mean") and the file is left untouched; the write is atomic
+//! ([`crate::atomic_write`]: through a symbolic link to its target, never over a read-only file).
 
 use std::path::Path;
 
 use anyhow::anyhow;
 use volgraph_core::compile;
-use volgraph_core::graph::edit::{SetTarget, TextEdit, apply, edit_for};
+use volgraph_core::graph::edit::{SetTarget, apply, edit_for, shadowed_copies};
 use volgraph_core::graph::spans::line_col;
 
 use crate::cli::{CliError, compile_options, display_name};
@@ -27,33 +29,51 @@ pub fn run(graph: &Path, assignments: &[String]) -> Result<String, CliError> {
     if assignments.is_empty() {
         return Err(CliError::Other(anyhow!("nothing to set: give PASS.PARAM=VALUE or input.NAME=VALUE")));
     }
-    let mut edits: Vec<(SetTarget, String, Vec<TextEdit>)> = Vec::new();
+    let shown = graph.display();
+    // Applied one after another, each on the text the ones before it left (two new parameters
+    // of a pass without `params` make one map); `at` follows each value's place as later edits
+    // insert text before it.
+    let mut edited = source.clone();
+    let mut done: Vec<(SetTarget, String, usize, String)> = Vec::new();
     for assignment in assignments {
         let Some((target, value)) = assignment.split_once('=') else {
             return Err(anyhow!("\"{assignment}\": expected PASS.PARAM=VALUE or input.NAME=VALUE").into());
         };
         let target = SetTarget::parse(target.trim()).map_err(|e| anyhow!("{e}"))?;
-        if edits.iter().any(|(t, _, _)| *t == target) {
+        if done.iter().any(|(t, ..)| *t == target) {
             return Err(anyhow!("{target} is set twice; give each name once").into());
         }
-        let edit = edit_for(&source, &target, value).map_err(|e| anyhow!("{}: {e}", graph.display()))?;
-        edits.push((target, value.trim().to_string(), edit));
+        let edit = edit_for(&edited, &target, value).map_err(|e| anyhow!("{shown}: {e}"))?;
+        let last = &edit[edit.len() - 1];
+        let was = &edited[last.span.start..last.span.end];
+        let mut note = if was.is_empty() { "not in the file".to_string() } else { format!("was {was}") };
+        let shadowed: Vec<String> =
+            shadowed_copies(&edited, &target).iter().map(|s| line_col(&edited, s.start).0.to_string()).collect();
+        if !shadowed.is_empty() {
+            note += &format!(
+                "; line {} writes it too, with no effect: the last copy counts — delete the other",
+                shadowed.join(", ")
+            );
+        }
+        for (_, _, at, _) in &mut done {
+            let before: Vec<_> = edit.iter().filter(|e| e.span.end <= *at).collect();
+            for e in before {
+                *at = (*at + e.text.len()).saturating_sub(e.span.end - e.span.start);
+            }
+        }
+        let at = last.span.start;
+        edited = apply(&edited, &edit);
+        done.push((target, value.trim().to_string(), at, note));
     }
-    let all: Vec<TextEdit> = edits.iter().flat_map(|(_, _, e)| e.iter().cloned()).collect();
-    let edited = apply(&source, &all);
     // Checked like a compile: the edited text must compile, else nothing is written.
     let options = compile_options("256x256", &[], &[])?;
     compile(&display_name(graph), &edited, &crate::program::registry(), &options).map_err(CliError::Graph)?;
-    crate::atomic_write::write_atomically(graph, &edited)?;
-    let lines = edits
+    if edited != source {
+        crate::atomic_write::write_atomically(graph, &edited)?;
+    }
+    let lines = done
         .iter()
-        .map(|(target, value, edit)| {
-            let first = &edit[edit.len() - 1];
-            let (line, _) = line_col(&source, first.span.start);
-            let was = &source[first.span.start..first.span.end];
-            let was = if was.is_empty() { "not in the file".to_string() } else { format!("was {was}") };
-            format!("{}:{line}: {target} = {value} ({was})", graph.display())
-        })
+        .map(|(target, value, at, note)| format!("{shown}:{}: {target} = {value} ({note})", line_col(&edited, *at).0))
         .collect::<Vec<_>>()
         .join("\n");
     Ok(lines + "\n")

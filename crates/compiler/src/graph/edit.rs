@@ -2,7 +2,9 @@
 //! changes a parameter or a graph input and wants the file to learn of it. Only the value's text
 //! changes — comments, order and layout stay — because the edit replaces the value's span in the
 //! source ([`super::spans`]). A parameter the file does not write yet is added to the pass's
-//! `params` map (the map is created after `kind` when the pass has none).
+//! `params` map (the map is created after `kind` when the pass has none), with the file's own
+//! line ending. A key the file writes twice is edited where it takes effect: its last copy,
+//! the one the compiler reads.
 
 use super::ast::{GraphDoc, InputKind, NodeDoc};
 use super::parse_graph;
@@ -54,15 +56,98 @@ pub struct TextEdit {
     pub text: String,
 }
 
-/// The edits that set `target` to `value` (RON text, checked to parse as one value) in
-/// `source`. Names the graph does not have are errors with a "did you mean".
+/// The edits that set `target` to `value` (RON text, checked to be exactly one value on one
+/// line, with no comment) in `source`. Names the graph does not have are errors with a "did you
+/// mean". A byte-order mark and RON attributes (`#![enable(...)]`) before the graph stay.
 pub fn edit_for(source: &str, target: &SetTarget, value: &str) -> Result<Vec<TextEdit>, String> {
     let value = value.trim();
+    check_value(target, value)?;
+    // A UTF-8 byte-order mark is not part of the graph (as `compile` reads it); spans are
+    // counted in `source`, the mark included.
+    let bom = if source.starts_with('\u{feff}') { '\u{feff}'.len_utf8() } else { 0 };
+    let mut edits = edits_in(&source[bom..], target, value)?;
+    for e in &mut edits {
+        e.span.start += bom;
+        e.span.end += bom;
+    }
+    Ok(edits)
+}
+
+/// Spans of the copies of `target`'s key that `source` writes before the one that takes effect
+/// (a map key written twice: the compiler reads the last); empty when it is written once.
+pub fn shadowed_copies(source: &str, target: &SetTarget) -> Vec<Span> {
+    let bom = if source.starts_with('\u{feff}') { '\u{feff}'.len_utf8() } else { 0 };
+    let Some(tree) = parse_spanned(&source[bom..]) else { return Vec::new() };
+    let root = tree.unwrap_variant();
+    let (map, key) = match target {
+        SetTarget::Input(name) => (root.field("inputs"), name.as_str()),
+        SetTarget::Param { pass, param } => {
+            let doc: Option<GraphDoc> = parse_graph(&source[bom..]).ok();
+            let node = doc.and_then(|doc| pass_node(&doc, root, pass));
+            (node.and_then(|n| n.field("params")), param.as_str())
+        }
+    };
+    let Some(map) = map else { return Vec::new() };
+    let mut copies: Vec<Span> = map.entries(key).map(|(k, _)| k.span).collect();
+    copies.pop();
+    copies.iter().map(|s| Span { start: s.start + bom, end: s.end + bom }).collect()
+}
+
+/// A value `set` writes: one RON value, on one line, with no comment — a `//` would comment
+/// out what follows the value on its line, a line break would mix line endings.
+fn check_value(target: &SetTarget, value: &str) -> Result<(), String> {
+    let shown = crate::terminal::escape_controls(value);
     if ron::from_str::<ron::Value>(value).is_err() {
         return Err(format!(
-            "{target}={value}: \"{value}\" is not a RON value; write numbers as 0.5, booleans as true, strings in quotes (\"feature.shading\")"
+            "{target}={shown}: \"{shown}\" is not a RON value; write numbers as 0.5, booleans as true, strings in quotes (\"feature.shading\")"
         ));
     }
+    if value.chars().any(char::is_control) {
+        return Err(format!(
+            "{target}={shown}: the value holds a line break or another control character; write it on one line (inside a string, as an escape: \\n)"
+        ));
+    }
+    // The lenient reading skips comments: a value it reads whole has none before or after it.
+    let whole = parse_spanned(value).is_some_and(|v| v.span.start == 0 && v.span.end == value.len());
+    if !whole {
+        return Err(format!(
+            "{target}={shown}: write one plain RON value (a number, true/false, a \"string\", a list), with no comment before or after it"
+        ));
+    }
+    Ok(())
+}
+
+/// The spanned node of pass `pass` (the last pass of that id, at the top level or in a repeat
+/// group's body).
+fn pass_node<'a>(doc: &GraphDoc, root: &'a SpannedValue, pass: &str) -> Option<&'a SpannedValue> {
+    let (top, body) = pass_path(doc, pass)?;
+    let node = root.field("passes").and_then(|l| l.index(top)).map(SpannedValue::unwrap_variant);
+    match body {
+        None => node,
+        Some(i) => node.and_then(|n| n.field("body")).and_then(|l| l.index(i)).map(SpannedValue::unwrap_variant),
+    }
+}
+
+/// Where pass `pass` sits: (index in `passes`, index in its repeat group's body).
+fn pass_path(doc: &GraphDoc, pass: &str) -> Option<(usize, Option<usize>)> {
+    let mut path = None;
+    for (top, node) in doc.passes.iter().enumerate() {
+        match node {
+            NodeDoc::Pass(p) if p.id == pass => path = Some((top, None)),
+            NodeDoc::Pass(_) => {}
+            NodeDoc::Repeat(r) => {
+                for (i, p) in r.body.iter().enumerate() {
+                    if p.id == pass {
+                        path = Some((top, Some(i)));
+                    }
+                }
+            }
+        }
+    }
+    path
+}
+
+fn edits_in(source: &str, target: &SetTarget, value: &str) -> Result<Vec<TextEdit>, String> {
     let doc: GraphDoc = parse_graph(source).map_err(|d| format!("the graph does not parse: {}", d.message))?;
     let tree = parse_spanned(source).ok_or_else(|| "the graph's text could not be read for positions".to_string())?;
     let root = tree.unwrap_variant();
@@ -91,41 +176,22 @@ pub fn edit_for(source: &str, target: &SetTarget, value: &str) -> Result<Vec<Tex
             Ok(vec![TextEdit { span: inner.span, text: value.to_string() }])
         }
         SetTarget::Param { pass, param } => {
-            let mut ids = Vec::new();
-            let mut path = None;
-            for (top, node) in doc.passes.iter().enumerate() {
-                match node {
-                    NodeDoc::Pass(p) => {
-                        ids.push(p.id.clone());
-                        if &p.id == pass {
-                            path = Some((top, None));
-                        }
-                    }
-                    NodeDoc::Repeat(r) => {
-                        for (i, p) in r.body.iter().enumerate() {
-                            ids.push(p.id.clone());
-                            if &p.id == pass {
-                                path = Some((top, Some(i)));
-                            }
-                        }
-                    }
-                }
-            }
-            let Some((top, body)) = path else {
-                let names: Vec<&str> = ids.iter().map(String::as_str).collect();
+            if pass_path(&doc, pass).is_none() {
+                let ids: Vec<&str> = doc
+                    .passes
+                    .iter()
+                    .flat_map(|n| match n {
+                        NodeDoc::Pass(p) => vec![p.id.as_str()],
+                        NodeDoc::Repeat(r) => r.body.iter().map(|p| p.id.as_str()).collect(),
+                    })
+                    .collect();
                 return Err(format!(
                     "{target}: the graph has no pass \"{pass}\"; {}",
-                    guess_then(pass, names.iter().copied(), "", format!("its passes are: {}", comma_list(&names)))
+                    guess_then(pass, ids.iter().copied(), "", format!("its passes are: {}", comma_list(&ids)))
                 ));
-            };
-            let node = root.field("passes").and_then(|l| l.index(top)).map(SpannedValue::unwrap_variant);
-            let node = match body {
-                None => node,
-                Some(i) => {
-                    node.and_then(|n| n.field("body")).and_then(|l| l.index(i)).map(SpannedValue::unwrap_variant)
-                }
             }
-            .ok_or_else(|| format!("{target}: cannot find pass \"{pass}\" in the text"))?;
+            let node = pass_node(&doc, root, pass)
+                .ok_or_else(|| format!("{target}: cannot find pass \"{pass}\" in the text"))?;
             insert_or_replace(source, node, param, value)
                 .ok_or_else(|| format!("{target}: cannot find where to write it"))
         }
@@ -169,7 +235,9 @@ fn insert_or_replace(source: &str, node: &SpannedValue, param: &str, value: &str
             });
         }
         let at = anchor_value.end + rest.find('\n')? + 1;
-        edits.push(TextEdit { span: Span { start: at, end: at }, text: format!("{indent}{new_text},\n") });
+        // The anchor line's own ending: a CRLF file stays CRLF.
+        let newline = if source[..at].ends_with("\r\n") { "\r\n" } else { "\n" };
+        edits.push(TextEdit { span: Span { start: at, end: at }, text: format!("{indent}{new_text},{newline}") });
     } else {
         let at = if has_comma { anchor_value.end + rest.find(',')? + 1 } else { anchor_value.end };
         let text = if has_comma { format!(" {new_text},") } else { format!(", {new_text}") };
@@ -264,5 +332,24 @@ Graph(
         let e = set("march.step_voxels", "0.5 0.25").expect_err("not one value");
         assert!(e.contains("is not a RON value"), "{e}");
         assert!(SetTarget::parse("march").is_err());
+    }
+
+    #[test]
+    fn a_value_with_a_comment_or_a_line_break_is_refused() {
+        // `// x` would comment out the rest of the value's line (a one-line map's other entries).
+        for value in ["0.25 // x", "/* x */ 0.25", "[1,\n2]", "0.25 0.5"] {
+            assert!(set("march.step_voxels", value).is_err(), "{value:?} was written");
+        }
+        assert!(set("march.step_voxels", "\"a // b\"").is_ok(), "a `//` inside a string is text");
+    }
+
+    #[test]
+    fn crlf_files_and_a_byte_order_mark_keep_their_bytes() {
+        let crlf = format!("\u{feff}{}", GRAPH.replace('\n', "\r\n"));
+        let t = SetTarget::parse("march.threshold").expect("target");
+        let out = apply(&crlf, &edit_for(&crlf, &t, "0.9").expect("set"));
+        assert!(out.starts_with('\u{feff}'));
+        assert_eq!(out.matches('\n').count(), out.matches("\r\n").count(), "{out:?}");
+        assert!(out.contains("\"threshold\": 0.9,\r\n"), "{out:?}");
     }
 }

@@ -88,14 +88,25 @@ impl SpannedValue {
         }
     }
 
-    /// For a map with string keys: the entry whose key is `key` → (key, value).
+    /// For a map with string keys: the entry whose key is `key` → (key, value). A key written
+    /// twice gives its last entry, the one the graph uses (serde keeps the last of a map's
+    /// duplicate keys).
     pub fn entry(&self, key: &str) -> Option<(&SpannedValue, &SpannedValue)> {
         match &self.node {
             Node::Map(entries) => {
-                entries.iter().find(|(k, _)| matches!(&k.node, Node::Str(s) if s == key)).map(|(k, v)| (k, v))
+                entries.iter().rev().find(|(k, _)| matches!(&k.node, Node::Str(s) if s == key)).map(|(k, v)| (k, v))
             }
             _ => None,
         }
+    }
+
+    /// For a map with string keys: every entry whose key is `key`, in the text's order.
+    pub fn entries<'a>(&'a self, key: &'a str) -> impl Iterator<Item = (&'a SpannedValue, &'a SpannedValue)> + 'a {
+        let entries = match &self.node {
+            Node::Map(entries) => entries.as_slice(),
+            _ => &[],
+        };
+        entries.iter().filter(move |(k, _)| matches!(&k.node, Node::Str(s) if s == key)).map(|(k, v)| (k, v))
     }
 
     /// `Pass(id: ..)` is a struct named `Pass` with fields; RON also allows `Pass((id: ..))`.
@@ -108,10 +119,13 @@ impl SpannedValue {
     }
 }
 
-/// Parses `source` leniently; `None` when even the lenient reading fails.
+/// Parses `source` leniently; `None` when even the lenient reading fails. A UTF-8 byte-order
+/// mark counts as whitespace and RON's inner attributes (`#![enable(implicit_some)]`) before
+/// the value are skipped, as RON reads them.
 pub fn parse_spanned(source: &str) -> Option<SpannedValue> {
     let tokens = tokenize(source);
     let mut p = Parser { tokens: &tokens, pos: 0 };
+    p.skip_attributes();
     p.value()
 }
 
@@ -130,6 +144,8 @@ fn tokenize(src: &str) -> Vec<(Tok, Span)> {
         let c = bytes[i];
         if c.is_ascii_whitespace() {
             i += 1;
+        } else if src[i..].starts_with('\u{feff}') {
+            i += '\u{feff}'.len_utf8();
         } else if c == b'/' && bytes.get(i + 1) == Some(&b'/') {
             while i < bytes.len() && bytes[i] != b'\n' {
                 i += 1;
@@ -190,6 +206,39 @@ struct Parser<'a> {
 impl Parser<'_> {
     fn peek(&self) -> Option<&(Tok, Span)> {
         self.tokens.get(self.pos)
+    }
+
+    /// Skips `#![...]` attributes: a `#`, a `!` (one token with it or not) and a bracketed list.
+    fn skip_attributes(&mut self) {
+        loop {
+            let start = self.pos;
+            match self.peek() {
+                Some((Tok::Atom(a), _)) if a == "#!" => self.pos += 1,
+                Some((Tok::Atom(a), _)) if a == "#" => {
+                    self.pos += 1;
+                    if !matches!(self.peek(), Some((Tok::Atom(b), _)) if b == "!") {
+                        self.pos = start;
+                        return;
+                    }
+                    self.pos += 1;
+                }
+                _ => return,
+            }
+            if !self.eat('[') {
+                self.pos = start;
+                return;
+            }
+            let mut depth = 1;
+            while depth > 0 {
+                match self.peek() {
+                    None => return,
+                    Some((Tok::Punct('['), _)) => depth += 1,
+                    Some((Tok::Punct(']'), _)) => depth -= 1,
+                    _ => {}
+                }
+                self.pos += 1;
+            }
+        }
     }
 
     fn eat(&mut self, c: char) -> bool {
@@ -285,6 +334,23 @@ mod tests {
         let (_, v) = pass.and_then(|p| p.field("inputs")).and_then(|m| m.entry("x")).expect("entry");
         assert_eq!(&src[v.span.start..v.span.end], "\"b.y\"");
         assert_eq!(line_col(src, v.span.start), (1, 55));
+    }
+
+    #[test]
+    fn attributes_and_a_byte_order_mark_are_skipped() {
+        let src = "\u{feff}#![enable(implicit_some)]\n# ! [enable(unwrap_newtypes)]\nGraph(name: \"g\")";
+        let tree = parse_spanned(src).expect("lenient parse");
+        let name = tree.field("name").expect("name");
+        assert_eq!(&src[name.span.start..name.span.end], "\"g\"");
+    }
+
+    #[test]
+    fn a_duplicated_key_gives_its_last_entry() {
+        let src = "{\"a\": 1, \"b\": 2, \"a\": 3}";
+        let tree = parse_spanned(src).expect("lenient parse");
+        let (_, v) = tree.entry("a").expect("entry");
+        assert_eq!(&src[v.span.start..v.span.end], "3");
+        assert_eq!(tree.entries("a").count(), 2);
     }
 
     #[test]

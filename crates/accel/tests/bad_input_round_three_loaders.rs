@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{DVec3, UVec3};
 use nifti_support::{NiftiSpec, gzip, voxels};
-use volgraph_accel::load::{LoadOptions, LoadedVolume, RawOptions, load_volume, load_volumes};
+use volgraph_accel::load::{LoadOptions, LoadedVolume, RawOptions, VolumeHeader, load_volume, load_volumes};
 
 fn load(path: &Path, frame: Option<u64>) -> Result<LoadedVolume, String> {
     load_volumes(&[path.to_path_buf()], &LoadOptions { frame, ..LoadOptions::default() }).map_err(|e| e.to_string())
@@ -169,6 +169,11 @@ fn header_spacing_with_a_million_to_one_ratio_is_refused_in_every_format() {
         let wide = RawOptions { spacing: Some(DVec3::new(1e6, 1.0, 1.0)), ..RawOptions::default() };
         let e = load_volume(path, &wide).expect_err("--spacing too").to_string();
         assert!(e.contains("--spacing (1000000, 1, 1): ") && e.contains(RATIO_MESSAGE), "{e}");
+    }
+    // A box read (render --distributed) reads the header alone, and is held to the same bound.
+    for path in [&nrrd, &mha, &series] {
+        let e = VolumeHeader::read(path, &LoadOptions::default()).map(|_| ()).expect_err("a box read").to_string();
+        assert!(e.contains("the header's voxel spacing (") && e.contains(RATIO_MESSAGE), "{e}");
     }
 }
 

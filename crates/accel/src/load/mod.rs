@@ -165,19 +165,26 @@ pub const MAX_SPACING_RATIO: f64 = 1e4;
 /// [`MAX_SPACING_RATIO`] is refused; a constant volume gets its one value as its range (16-bit
 /// data; 8-bit data keeps the type range its texture is normalized by) and a note.
 fn finish_loaded(path: &Path, spacing: Option<DVec3>, loaded: &mut LoadedVolume) -> Result<(), LoadError> {
+    loaded.volume.spacing = checked_spacing(path, spacing, loaded.volume.spacing)?;
+    note_constant(loaded);
+    Ok(())
+}
+
+/// The spacing a volume is drawn with: `option` (`--spacing`) where given, else the header's,
+/// finite, positive and within [`MAX_SPACING_RATIO`]. [`region::VolumeHeader::read`] holds a
+/// box read's header to it too.
+fn checked_spacing(path: &Path, option: Option<DVec3>, header: DVec3) -> Result<DVec3, LoadError> {
     let at = Location::file(path);
-    let (spacing, what) = match spacing {
+    let (spacing, what) = match option {
         Some(s) => (s, "--spacing"),
-        None => (loaded.volume.spacing, "the header's voxel spacing"),
+        None => (header, "the header's voxel spacing"),
     };
     check_spacing(&at, spacing)?;
     let ratio = spacing.max_element() / spacing.min_element();
     if ratio > MAX_SPACING_RATIO {
         return Err(LoadError::SpacingRatio { at, what, x: spacing.x, y: spacing.y, z: spacing.z, ratio });
     }
-    loaded.volume.spacing = spacing;
-    note_constant(loaded);
-    Ok(())
+    Ok(spacing)
 }
 
 /// A constant volume: its range is its value (as a constant float volume's is), with a note.

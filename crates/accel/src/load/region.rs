@@ -47,8 +47,14 @@ impl VolumeHeader {
     /// (`.nrrd`, `.nhdr`) and uncompressed MetaImage (`.mha`, `.mhd`), attached or detached, and
     /// DICOM series (a folder or a `.dcm` file; `options.series` picks one), whose axes are the
     /// world's; anything else (NIfTI, compressed or reoriented data) is a
-    /// [`LoadError::NoBoxRead`].
+    /// [`LoadError::NoBoxRead`]. Its spacing is held to what a whole-volume load allows.
     pub fn read(path: &Path, options: &LoadOptions<'_>) -> Result<Self, LoadError> {
+        let mut header = Self::read_header(path, options)?;
+        header.spacing = super::checked_spacing(path, options.raw.spacing, header.spacing)?;
+        Ok(header)
+    }
+
+    fn read_header(path: &Path, options: &LoadOptions<'_>) -> Result<Self, LoadError> {
         let opts = &options.raw;
         let extension = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
         if matches!(extension.as_str(), "nrrd" | "nhdr" | "mhd" | "mha") {

@@ -220,6 +220,13 @@ fn constant_int16_volume_reports_its_value_not_the_type_range() {
         "{}",
         run.stderr
     );
+    // Drawn with the default TF it is the background with the same note a constant float32
+    // volume gets, not a solid box.
+    let out = dir.join("flat16.png").display().to_string();
+    let run =
+        volgraph(&["render", "graphs/basic/fragment_raycast.ron", "--volume", &path, "-o", &out, "--size", "16x16"]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(run.stderr.contains("volume \"flat16\" is constant (every voxel normalizes to 0.0000)"), "{}", run.stderr);
 }
 
 #[test]

@@ -401,18 +401,17 @@ fn run_viewer(x: &Xvfb, cwd: &Path, args: &[&str], lines: &[&str]) -> ViewerRun 
         let _ = writeln!(stdin, "{line}");
     }
     drop(stdin);
-    let mut status = None;
-    while Instant::now() < deadline {
-        if let Ok(Some(s)) = viewer.try_wait() {
-            status = Some(s);
-            break;
+    let status = loop {
+        match viewer.try_wait() {
+            Ok(Some(status)) => break Some(status),
+            Ok(None) if Instant::now() < deadline => std::thread::sleep(Duration::from_millis(50)),
+            _ => {
+                let _ = viewer.kill();
+                let _ = viewer.wait();
+                break None;
+            }
         }
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    if status.is_none() {
-        let _ = viewer.kill();
-        let _ = viewer.wait();
-    }
+    };
     seen.extend(rx.try_iter());
     ViewerRun { status, stdout: seen.join("\n"), stderr: errors.join().unwrap_or_default() }
 }

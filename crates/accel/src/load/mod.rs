@@ -13,7 +13,12 @@
 //!   to 0 and never widen the range), `+Inf` by the maximum finite value and `-Inf` by the
 //!   minimum; a volume with no finite value at all becomes all zeros with range (0, 0).
 //!
-//! Parsers never panic on any input (`tests/load_fuzz.rs` checks it with proptest).
+//! - the spacing (the header's, or [`RawOptions::spacing`] where set) must be finite, positive
+//!   and within [`MAX_SPACING_RATIO`] in every format; a constant volume gets its one value as
+//!   its range (16-bit data) and a note.
+//!
+//! Parsers never panic on any input (`tests/load_fuzz.rs` and, for NIfTI, `tests/nifti_fuzz.rs`
+//! check it with proptest).
 
 pub mod dicom;
 mod error;

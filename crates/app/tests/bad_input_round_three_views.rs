@@ -274,7 +274,7 @@ fn a_tf_edited_after_save_tf_is_saved_with_the_view() {
     edit(&mut session, point(160.0, [1.0, 0.0, 0.6], 1.0));
     let text = assert_renders_back(&mut session, &dir);
     assert_eq!(std::fs::read_to_string(&tf).expect("tf"), saved_tf, "the TF's file is not changed by save view");
-    let beside = dir.join("saved").join("view.tf.ron");
+    let beside = dir.join("saved").join("view.scene.tf.ron");
     assert!(
         text.contains(&format!("File({:?})", beside.canonicalize().expect("written").display().to_string())),
         "{text}"

@@ -175,15 +175,10 @@ pub fn load_transfer_function(
 }
 
 /// Where "save view" writes an edited transfer function that no file holds: beside the scene,
-/// `NAME.tf.ron` for `NAME.scene.ron` or `NAME.ron`.
+/// `NAME.tf.ron` for `NAME.ron` (`view.scene.ron` → `view.scene.tf.ron`, not the `view.tf.ron`
+/// that "save TF" writes a fitted TF to).
 pub fn tf_file_beside(scene: &Path) -> PathBuf {
     let name = scene.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let stem = name.strip_suffix(".ron").unwrap_or(&name);
-    let stem = stem.strip_suffix(".scene").unwrap_or(stem);
-    let file = if stem.is_empty() || format!("{stem}.tf.ron") == name {
-        format!("{name}.tf.ron")
-    } else {
-        format!("{stem}.tf.ron")
-    };
-    scene.with_file_name(file)
+    scene.with_file_name(format!("{stem}.tf.ron"))
 }

@@ -1,21 +1,23 @@
 //! NIfTI-1 and NIfTI-2 single files (`.nii`, `.nii.gz`). The header (348 or 540 bytes,
-//! [`header`]) is read first, from the file or from the gzip stream, and checked; only then are
-//! the voxels of the one frame wanted read — from a plain file after checking its length, from
-//! a gzip stream only as far as the header says, after checking that the compressed size can
-//! hold that much at all (DEFLATE expands at most 1032 times) — so a small hostile file cannot
-//! make the loader inflate or allocate gigabytes. Both versions become one geometry: the sform
-//! (when its code is set), else the qform quaternion, else the plain pixdim scale; RAS world
-//! coordinates are turned into LPS as ITK does (x and y negated), so a NIfTI file and the DICOM
-//! series it came from render alike. `scl_slope`/`scl_inter` are applied; a 4D file needs a
-//! frame.
+//! [`header`]) is read first, from the file or from the gzip stream, and checked ([`layout`]);
+//! only then are the voxels of the one frame wanted read — from a plain file after checking its
+//! length, from a gzip stream only as far as the header says, after checking that the
+//! compressed size can hold that much at all (DEFLATE expands at most 1032 times) — so a small
+//! hostile file cannot make the loader inflate or allocate gigabytes. Both versions become one
+//! geometry: the sform (when its code is set), else the qform quaternion, else the plain pixdim
+//! scale; RAS world coordinates are turned into LPS as ITK does (x and y negated), so a NIfTI
+//! file and the DICOM series it came from render alike. `scl_slope`/`scl_inter` are applied; a
+//! 4D file needs a frame.
 
 mod header;
+mod layout;
 
 use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
 
-use glam::{DMat3, DQuat, DVec3, UVec3};
-use header::{Header, ReadValue};
+use glam::{DMat3, DQuat, DVec3};
+use header::Header;
+use layout::{Layout, layout, size_error};
 
 use super::{AxisOrientation, LoadError, LoadReport, LoadedVolume, Location, VolumeFormat};
 use crate::volume::{Volume, VoxelData};
@@ -24,9 +26,6 @@ use crate::volume_meta::{VolumeMeta, Window, WorldFrame};
 /// The most bytes DEFLATE produces from one compressed byte (RFC 1951's longest match, 258
 /// bytes, in under two bits: 1032:1); a gzip file of `n` bytes inflates to at most `1032·n`.
 const DEFLATE_MAX_RATIO: u64 = 1032;
-
-/// The datatypes read, as a message lists them.
-const SUPPORTED: &str = "uint8, int8, int16, uint16, int32, uint32, int64, uint64, float32, float64 (scalar)";
 
 /// Loads `path`; `frame` picks the volume of a 4D file.
 pub fn load(path: &Path, frame: Option<u64>) -> Result<LoadedVolume, LoadError> {
@@ -182,151 +181,6 @@ fn try_vec<T>(path: &Path, count: u64) -> Result<Vec<T>, LoadError> {
     let count = usize::try_from(count).map_err(|_| fail())?;
     v.try_reserve_exact(count).map_err(|_| fail())?;
     Ok(v)
-}
-
-/// Where the wanted voxels lie in the file and how to read them.
-struct Layout {
-    /// Voxels along the file's axes i, j, k (`dim[1..=3]`).
-    file_dims: UVec3,
-    /// Volumes in the file (`dim[4]`) and the one read.
-    frames: u64,
-    frame: u64,
-    /// The datatype's name, bytes per voxel and reader.
-    type_name: &'static str,
-    size: usize,
-    read: ReadValue,
-    /// Byte range of the frame in the (inflated) file.
-    start: u64,
-    frame_bytes: u64,
-    end: u64,
-    /// What was defaulted, for the report.
-    notes: Vec<String>,
-}
-
-/// The error for a file that holds fewer bytes than the header asks for; `found` says how many
-/// it holds.
-fn size_error(path: &Path, l: &Layout, found: &str) -> LoadError {
-    let d = l.file_dims;
-    let frame = if l.frames > 1 { format!(" of frame {} (of {})", l.frame, l.frames) } else { String::new() };
-    read_error(
-        path,
-        format!(
-            "{}x{}x{} {} voxels{frame} need {} bytes from byte {} (to byte {}), but {found}; the file is truncated (copy \
-             it again) or its header (dim, datatype, vox_offset) is wrong",
-            d.x, d.y, d.z, l.type_name, l.frame_bytes, l.start, l.end
-        ),
-    )
-}
-
-/// Checks the header's sizes, type, frame and offset, and where the voxels lie.
-fn layout(path: &Path, h: &Header, frame: Option<u64>) -> Result<Layout, LoadError> {
-    let ndim = h.dim[0];
-    if !(2..=7).contains(&ndim) {
-        return Err(LoadError::NotThreeD { at: Location::file(path), field: "dim[0]", found: ndim.to_string() });
-    }
-    let n = ndim as usize;
-    let text = h.dim[1..=n].iter().map(i64::to_string).collect::<Vec<_>>().join(" × ");
-    if let Some(i) = (1..=n).find(|&i| h.dim[i] < 1) {
-        return Err(read_error(
-            path,
-            format!("dim[{i}] is {} (dim = {text}); every axis needs at least one voxel", h.dim[i]),
-        ));
-    }
-    if let Some(i) = (5..=n).find(|&i| h.dim[i] > 1) {
-        return Err(read_error(
-            path,
-            format!(
-                "dim = {text}: dim[{i}] = {} makes this vector or higher-dimensional data; volgraph reads scalar 3D \
-                 volumes and 4D series of them",
-                h.dim[i]
-            ),
-        ));
-    }
-    let axis = |i: usize| if i <= n { h.dim[i] as u64 } else { 1 };
-    let frames = axis(4);
-    let frame = match frame {
-        None if frames > 1 => {
-            return Err(LoadError::NiftiFrame {
-                path: path.to_path_buf(),
-                frames,
-                what: "no --frame was given".into(),
-            });
-        }
-        None | Some(0) => 0,
-        Some(_) if frames == 1 => {
-            return Err(LoadError::OptionDoesNotApply {
-                path: path.to_path_buf(),
-                option: "--frame",
-                reason: "picks a volume of a 4D NIfTI file, but this file holds a single 3D volume: there are no \
-                         frames to pick",
-            });
-        }
-        Some(f) if f >= frames => {
-            return Err(LoadError::NiftiFrame {
-                path: path.to_path_buf(),
-                frames,
-                what: format!("--frame {f} is past the end"),
-            });
-        }
-        Some(f) => f,
-    };
-    let file_dims = super::check_dims(&Location::file(path), "dim", &text, [axis(1), axis(2), axis(3)])?;
-    let type_name = header::datatype_name(h.datatype);
-    let (size, read) = header::element(h.datatype).ok_or_else(|| LoadError::UnsupportedType {
-        at: Location::file(path),
-        found: match type_name {
-            Some(name) => format!("NIfTI datatype {} ({name})", h.datatype),
-            None => format!("NIfTI datatype {}", h.datatype),
-        },
-        supported: SUPPORTED,
-    })?;
-    let mut notes = Vec::new();
-    let first = if h.version == 1 { 352 } else { 544 };
-    if !(h.vox_offset.is_finite() && h.vox_offset >= 0.0) {
-        return Err(read_error(
-            path,
-            format!(
-                "vox_offset is {}; it must be the byte offset of the voxels, at least {first} in a .nii file",
-                h.vox_offset
-            ),
-        ));
-    }
-    // `as` saturates: an offset past any file is caught by the length check.
-    let mut offset = h.vox_offset as u64;
-    if offset < first {
-        notes.push(format!(
-            "vox_offset {} lies inside the header; the voxels are read from byte {first}, right after it",
-            h.vox_offset
-        ));
-        offset = first;
-    }
-    let voxels = (file_dims.x as u64).checked_mul(file_dims.y as u64).and_then(|v| v.checked_mul(file_dims.z as u64));
-    let frame_bytes = voxels.and_then(|v| v.checked_mul(size as u64));
-    let start = frame_bytes.and_then(|b| b.checked_mul(frame)).and_then(|b| b.checked_add(offset));
-    let (Some(frame_bytes), Some(start)) = (frame_bytes, start) else {
-        return Err(read_error(
-            path,
-            format!(
-                "dim = {text} of {} voxels from byte {offset}: more bytes than any file holds; the header is corrupt",
-                type_name.unwrap_or("?")
-            ),
-        ));
-    };
-    let Some(end) = start.checked_add(frame_bytes) else {
-        return Err(read_error(path, format!("vox_offset {offset}: past the end of any file; the header is corrupt")));
-    };
-    Ok(Layout {
-        file_dims,
-        frames,
-        frame,
-        type_name: type_name.unwrap_or("?"),
-        size,
-        read,
-        start,
-        frame_bytes,
-        end,
-        notes,
-    })
 }
 
 /// The world step of one voxel along each file axis and the position of voxel (0,0,0), in LPS,

@@ -27,6 +27,8 @@ pub mod render;
 pub mod scene;
 pub mod scene_args;
 pub mod set_cmd;
+#[cfg(test)]
+mod set_fuzz;
 pub mod shader_dir;
 pub mod stdout;
 pub mod view;

@@ -444,6 +444,9 @@ fn set_writable(path: &Path) -> std::io::Result<()> {
     std::fs::set_permissions(path, p)
 }
 
+/// Cases run so far (each counted once it passed; a failing case stops the run).
+static DONE: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
 #[test]
 fn set_on_mutated_graphs_edits_one_value_or_leaves_the_file_untouched() {
     let count = seeds().texts.len();
@@ -483,7 +486,13 @@ fn set_on_mutated_graphs_edits_one_value_or_leaves_the_file_untouched() {
         },
         |case| {
             let (bytes, target, value, read_only) = prepared(case);
-            run_case(&bytes, &target, &value, read_only)
+            let outcome = run_case(&bytes, &target, &value, read_only);
+            // A long run says how far it got (a run stopped early is reported by its count).
+            let done = DONE.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            if done % 50_000 == 0 {
+                eprintln!("set fuzz: {done} cases passed so far");
+            }
+            outcome
         },
     );
     let _ = std::fs::remove_dir_all(&seeds().dir);

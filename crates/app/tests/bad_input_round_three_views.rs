@@ -232,9 +232,15 @@ fn a_saved_view_keeps_the_voxel_spacing() {
         raw: volgraph_accel::load::RawOptions { spacing: Some(glam::DVec3::new(1.0, 1.0, 2.5)), ..Default::default() },
         ..Default::default()
     };
-    let mut session = open(&root().join("graphs/basic/fragment_raycast.ron"), &[PathBuf::from("ml32")], options, None);
+    let graph = root().join("graphs/basic/fragment_raycast.ron");
+    let mut session = open(&graph, &[PathBuf::from("ml32")], options.clone(), None);
     let text = assert_renders_back(&mut session, &dir);
     assert!(text.contains("spacing: (1.0, 1.0, 2.5)"), "{text}");
+    // The default volume (no --volume) takes --spacing as well: it is saved as Generated("ml64").
+    let dir = scratch("spacing_default");
+    let mut session = open(&graph, &[], options, None);
+    let text = assert_renders_back(&mut session, &dir);
+    assert!(text.contains("Generated(\"ml64\")") && text.contains("spacing: (1.0, 1.0, 2.5)"), "{text}");
 }
 
 /// Issue 47 §5: `view --volume ml32` drew a TF fitted to the data, and its saved

@@ -53,6 +53,22 @@ pub fn load_shown_volume(
             let (volume, notes) = load_volume(scene, &options)?;
             (volume, options, notes)
         }
+        // The default volume is `Generated("ml64")` (what a saved view writes): `--spacing`
+        // applies to it as to a named volume, and the flags of a file's layout are refused.
+        ([], None) => {
+            if has_layout(flags) {
+                return Err(anyhow::anyhow!(
+                    "no --volume was given, and the default volume (the generated ml64) is no file: --series, \
+                     --frame, --dims, --dtype and --big-endian describe a file's layout; give --volume FILE or \
+                     remove them (--spacing may stay)"
+                ));
+            }
+            let (mut volume, notes) = crate::inputs::volume(paths, flags)?;
+            if let Some(spacing) = flags.raw.spacing {
+                volume.spacing = spacing;
+            }
+            (volume, flags.clone(), notes)
+        }
         _ => {
             let (volume, notes) = crate::inputs::volume(paths, flags)?;
             (volume, flags.clone(), notes)
@@ -89,6 +105,17 @@ fn merged_options(
     }
 }
 
+/// Whether `options` say how to read a file (`--series`, `--frame`, `--dims`, `--dtype`,
+/// `--big-endian`), which a named or the default volume is not.
+fn has_layout(options: &volgraph_accel::load::LoadOptions<'_>) -> bool {
+    let raw = &options.raw;
+    raw.dims.is_some()
+        || raw.dtype.is_some()
+        || matches!(raw.endianness, volgraph_accel::load::Endianness::Big)
+        || options.series.is_some()
+        || options.frame.is_some()
+}
+
 /// A scene's volume read with `options` (the flags over its `volume_options`), with notes for
 /// stderr. The error names the scene file and field.
 fn load_volume(
@@ -100,9 +127,7 @@ fn load_volume(
         VolumeSource::File(p) => return crate::inputs::volume_files(&[PathBuf::from(p)], options).map_err(at),
         VolumeSource::Dataset(name) | VolumeSource::Generated(name) => name,
     };
-    let raw = &options.raw;
-    let big_endian = matches!(raw.endianness, volgraph_accel::load::Endianness::Big);
-    if raw.dims.is_some() || raw.dtype.is_some() || big_endian || options.series.is_some() || options.frame.is_some() {
+    if has_layout(options) {
         return Err(anyhow::anyhow!(
             "{}: volume_options: \"{name}\" names a volume, not a file: series, frame, dims, dtype and big_endian (or \
              --series, --frame, --dims, --dtype, --big-endian) describe a file's layout; remove them (spacing may stay)",
@@ -123,7 +148,7 @@ fn load_volume(
             })
         })?,
     };
-    if let Some(spacing) = raw.spacing {
+    if let Some(spacing) = options.raw.spacing {
         volume.spacing = spacing;
     }
     Ok((volume, Vec::new()))

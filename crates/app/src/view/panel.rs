@@ -318,7 +318,8 @@ pub fn show(
             if ui
                 .button("save view")
                 .on_hover_text(format!(
-                    "camera, crop, clip, TF and effects to {SAVED_SCENE}: render --scene draws it again"
+                    "graph, volume, camera, crop, clip, TF and effects to {SAVED_SCENE} (an edited TF beside it): render \
+                     --scene draws it again"
                 ))
                 .clicked()
             {

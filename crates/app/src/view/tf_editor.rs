@@ -186,7 +186,7 @@ pub fn show(
                 }
             }
         });
-        if ui.button("save TF").on_hover_text("to its file, RON or ParaView JSON as it came").clicked() {
+        if ui.button("save TF").on_hover_text("to its file, RON or ParaView JSON as it came; a preset's or a fitted TF to NAME.tf.ron or view.tf.ron in the current folder").clicked() {
             action = Some(TfAction::Save);
         }
         let mut on = save_on_change;

@@ -631,4 +631,53 @@ mod tests {
         }
         parse("Scene(volume: Generated(\"ml32\"), transfer_function: Data(\"engine_opaque\"))").expect("a stem");
     }
+
+    /// Issue 47 §5: a built-in graph or a TF preset named in a scene resolved only in the scene's
+    /// folder. A relative name is the file beside the scene where there is one, else the built-in.
+    #[test]
+    fn names_resolve_beside_the_scene_first_else_as_built_ins() {
+        let dir = std::env::temp_dir().join(format!("volgraph-scene-names-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("scratch");
+        let text = "Scene(graph: \"basic/fragment_raycast\", volume: Generated(\"ml32\"), transfer_function: \
+                    File(\"ct-bone\"))";
+        let s = Scene::from_str(text, &dir.join("s.ron")).expect("parses");
+        assert_eq!(s.graph, Some(PathBuf::from("basic/fragment_raycast")));
+        assert_eq!(s.transfer_function, Some(TfSource::File("ct-bone".into())));
+        // A file of that name beside the scene wins.
+        std::fs::write(dir.join("ct-bone"), "").expect("file");
+        let s = Scene::from_str(text, &dir.join("s.ron")).expect("parses");
+        assert_eq!(s.transfer_function, Some(TfSource::File(dir.join("ct-bone").display().to_string())));
+        let _ = std::fs::remove_dir_all(&dir);
+        // Preset() takes the scanner presets; a wrong name is refused with the list.
+        parse("Scene(volume: Generated(\"ml32\"), transfer_function: Preset(\"mr-default\"))").expect("a preset");
+        let err = parse("Scene(volume: Generated(\"ml32\"), transfer_function: Preset(\"ct-bones\"))")
+            .expect_err("no such preset")
+            .to_string();
+        assert!(
+            err.contains("transfer_function: Preset(\"ct-bones\") is not a preset") && err.contains("ct-bone,"),
+            "{err}"
+        );
+    }
+
+    /// Issue 47 §5: `volume_options` are checked as the flags they stand for.
+    #[test]
+    fn volume_options_are_checked_like_the_flags() {
+        let s = parse(
+            "Scene(volume: File(\"v.raw\"), volume_options: (dims: (4, 4, 2), dtype: \"uint16\", series: \"2\"))",
+        )
+        .expect("parses");
+        let o = s.volume_options.load_options().expect("valid");
+        assert_eq!((o.raw.dims, o.series.as_deref()), (Some(glam::UVec3::new(4, 4, 2)), Some("2")));
+        for (options, expected) in [
+            ("(dims: (0, 4, 4))", "volume_options: --dims \"0x4x4\""),
+            ("(dtype: \"int64\")", "--dtype \"int64\""),
+            ("(spacing: (1, 1, 1e9))", "times the shortest"),
+            ("(colour: 1)", "scenes/test.ron:1:"),
+        ] {
+            let err = parse(&format!("Scene(volume: File(\"v.raw\"), volume_options: {options})"))
+                .expect_err(options)
+                .to_string();
+            assert!(err.contains(expected), "{options}: {err}");
+        }
+    }
 }

@@ -111,6 +111,20 @@ fn truncated_native_pixel_data_is_an_error_naming_its_size() {
     assert_names(&e, &path, &["PixelData (7FE0,0010) holds 14 bytes", "need 60"]);
 }
 
+#[test]
+fn a_corrupt_length_is_an_error_before_dicom_rs_sizes_a_buffer_by_it() {
+    // PhotometricInterpretation's VR "CS" made unknown: read as UN, its 4-byte length is
+    // "MONO" (1.3 GB) in an 800-byte file; dicom-parser would allocate and zero that first.
+    let dir = fresh(&root(), "bad_length");
+    let mut bytes = Image::default().bytes();
+    let at = bytes.windows(6).position(|w| w == [0x28, 0x00, 0x04, 0x00, b'C', b'S']).expect("the element");
+    bytes[at + 4..at + 6].copy_from_slice(b"XX");
+    let path = dir.join("IM0001.dcm");
+    std::fs::write(&path, &bytes).expect("written");
+    let e = load(std::slice::from_ref(&path)).map(|_| ()).expect_err("an error");
+    assert_names(&e, &path, &[&format!("element (0028,0004) at byte {at} claims 1330532173 bytes, but only")]);
+}
+
 fn folder_of_three(name: &str) -> PathBuf {
     let dir = fresh(&root(), name);
     series(&dir, 3, &Image::default());

@@ -75,9 +75,11 @@ pub fn probe(path: &Path) -> Result<Probe, LoadError> {
         Ok(Some(what)) => return Err(LoadError::NotAFile { path: path.to_path_buf(), what }),
         Err(source) => return Err(LoadError::Io { path: path.to_path_buf(), source }),
     }
-    if !has_dicom_magic(path)? {
+    let Some(magic_at) = dicom_magic_at(path)? else {
         return Ok(Probe::NotDicom);
-    }
+    };
+    // Every length must fit in the file before dicom-rs sizes a buffer by it.
+    super::lengths::check(path, magic_at)?;
     // Float and Double Float Pixel Data (7FE0,0008/0009) come just before PixelData: the
     // header stops at the first pixel element of any kind. The default preamble detection
     // reads files with and without the 128-byte preamble.
@@ -98,6 +100,11 @@ pub fn probe(path: &Path) -> Result<Probe, LoadError> {
 /// True when `path` has the 128-byte preamble and `DICM` (PS3.10 §7.1), or `DICM` at its start
 /// (a file written without the preamble, which dicom-rs reads as well).
 fn has_dicom_magic(path: &Path) -> Result<bool, LoadError> {
+    Ok(dicom_magic_at(path)?.is_some())
+}
+
+/// Where `DICM` is in `path`: at byte 128 (after the preamble) or 0 (a file without it).
+fn dicom_magic_at(path: &Path) -> Result<Option<u64>, LoadError> {
     use std::io::Read;
     let mut head = [0u8; 132];
     let mut file = std::fs::File::open(path).map_err(|source| LoadError::Io { path: path.to_path_buf(), source })?;
@@ -109,7 +116,13 @@ fn has_dicom_magic(path: &Path) -> Result<bool, LoadError> {
             Err(source) => return Err(LoadError::Io { path: path.to_path_buf(), source }),
         }
     }
-    Ok((read >= 132 && &head[128..132] == b"DICM") || (read >= 4 && &head[..4] == b"DICM"))
+    Ok(if read >= 132 && &head[128..132] == b"DICM" {
+        Some(128)
+    } else if read >= 4 && &head[..4] == b"DICM" {
+        Some(0)
+    } else {
+        None
+    })
 }
 
 /// The text of `tag`, trimmed; `None` when absent or empty.
@@ -205,11 +218,7 @@ const SAMPLES_EXPECTED: &str = "a whole number from 1 to 4 (1 for a greyscale im
 const BITS_EXPECTED: &str = "a whole number from 1 to 64 (8, 16 or 32 for greyscale images); the header is corrupt";
 
 /// The first item of sequence `tag` in `object`'s item `items[index]`.
-fn nested<'a>(
-    items: &'a [dicom_object::InMemDicomObject],
-    index: usize,
-    tag: Tag,
-) -> Option<&'a dicom_object::InMemDicomObject> {
+fn nested(items: &[dicom_object::InMemDicomObject], index: usize, tag: Tag) -> Option<&dicom_object::InMemDicomObject> {
     items.get(index)?.get(tag)?.items()?.first()
 }
 

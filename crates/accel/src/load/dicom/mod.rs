@@ -9,6 +9,7 @@
 mod checks;
 mod geometry;
 mod header;
+mod lengths;
 mod pixels;
 mod write;
 

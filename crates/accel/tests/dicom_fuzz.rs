@@ -1,0 +1,349 @@
+//! The DICOM fuzzer (issue 47): valid small files (native 16-bit, multi-frame, RLE Lossless,
+//! JPEG 2000, Float Pixel Data, with and without the preamble) with attributes replaced by
+//! hostile values (sizes 0 and 2³²−1, NumberOfFrames 10⁸, NaN, inf, 1e300, junk text, wrong
+//! value counts, PALETTE COLOR, newlines), RLE headers and segments made of junk, bytes flipped
+//! and the file cut short. Every load must return Ok or Err: a panic, or a case slower than
+//! `HANG_SECONDS`, fails the test; a watchdog ends the process on a real hang. The files are a
+//! few hundred bytes and the cases run in a child process under `ulimit -v` of 4 GiB: a loader
+//! that allocated what a hostile header claims rather than what the file holds aborts it, and
+//! the test fails.
+//!
+//! `VOLGRAPH_FUZZ_CASES` sets the number of cases (default 1000, a few seconds); the summary
+//! line on stderr gives the counts a long run is recorded with.
+
+mod dicom_support;
+
+use std::cell::{Cell, RefCell};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use dicom_core::value::PrimitiveValue;
+use dicom_core::{DataElement, Tag, VR};
+use dicom_dictionary_std::tags;
+use dicom_support::*;
+use proptest::prelude::*;
+use proptest::test_runner::{Config, TestRunner};
+use volgraph_accel::load::{LoadOptions, load_volumes};
+
+const HANG_SECONDS: f64 = 5.0;
+/// The address-space limit (KiB) the cases run under: a 4 GiB `ulimit -v`.
+const MEMORY_LIMIT_KIB: u64 = 4 << 20;
+/// Set in the child process that runs the cases under the limit.
+const CHILD: &str = "VOLGRAPH_DICOM_FUZZ_CHILD";
+
+fn cases() -> u32 {
+    std::env::var("VOLGRAPH_FUZZ_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(1000)
+}
+
+/// The attributes replaced, each with the VR its hostile text is written as.
+const FIELDS: &[(Tag, VR)] = &[
+    (tags::ROWS, VR::IS),
+    (tags::COLUMNS, VR::IS),
+    (tags::NUMBER_OF_FRAMES, VR::IS),
+    (tags::BITS_ALLOCATED, VR::IS),
+    (tags::BITS_STORED, VR::IS),
+    (tags::HIGH_BIT, VR::IS),
+    (tags::PIXEL_REPRESENTATION, VR::IS),
+    (tags::SAMPLES_PER_PIXEL, VR::IS),
+    (tags::RESCALE_SLOPE, VR::DS),
+    (tags::RESCALE_INTERCEPT, VR::DS),
+    (tags::PIXEL_SPACING, VR::DS),
+    (tags::IMAGE_ORIENTATION_PATIENT, VR::DS),
+    (tags::IMAGE_POSITION_PATIENT, VR::DS),
+    (tags::SLICE_THICKNESS, VR::DS),
+    (tags::SPACING_BETWEEN_SLICES, VR::DS),
+    (tags::GRID_FRAME_OFFSET_VECTOR, VR::DS),
+    (tags::PHOTOMETRIC_INTERPRETATION, VR::CS),
+    (tags::SERIES_DESCRIPTION, VR::LO),
+    (tags::WINDOW_CENTER, VR::DS),
+    (tags::WINDOW_WIDTH, VR::DS),
+    (tags::DOSE_GRID_SCALING, VR::DS),
+    (tags::PLANAR_CONFIGURATION, VR::IS),
+];
+
+/// Hostile values.
+const VALUES: &[&str] = &[
+    "0",
+    "1",
+    "-1",
+    "2",
+    "3",
+    "8",
+    "15",
+    "16",
+    "31",
+    "32",
+    "64",
+    "65535",
+    "65536",
+    "2147483647",
+    "4294967295",
+    "100000000",
+    "NaN",
+    "inf",
+    "-inf",
+    "1e300",
+    "-1e300",
+    "1e39",
+    "1e-300",
+    "abc",
+    "",
+    "1\\2",
+    "1\\2\\3",
+    "1\\0\\0\\0\\1",
+    "1\\0\\0\\0\\1\\0",
+    "0\\1\\0\\1\\0\\0",
+    "0.6\\0.8\\0\\0\\0\\1",
+    "0\\0\\0\\0\\0\\0",
+    "0.5\\0.5",
+    "PALETTE COLOR",
+    "MONOCHROME1",
+    "RGB",
+    "axial\nerror: fake",
+    "\u{1b}]0;x\u{7}",
+];
+
+/// Which valid file a case starts from.
+#[derive(Clone, Copy, Debug)]
+enum Base {
+    Native,
+    MultiFrame,
+    Rle,
+    Jpeg2000,
+    Float,
+}
+
+/// One fuzz case.
+#[derive(Clone, Debug)]
+struct Case {
+    base: Base,
+    /// (field, value) indices into [`FIELDS`] and [`VALUES`].
+    edits: Vec<(usize, usize)>,
+    /// An RLE frame in place of the base's pixels: segment count, offsets, body.
+    rle: Option<(u32, Vec<u32>, Vec<u8>)>,
+    /// (position, xor) byte flips, positions taken modulo the length.
+    flips: Vec<(usize, u8)>,
+    /// Keep this many thousandths of the file.
+    cut: Option<u16>,
+    no_preamble: bool,
+}
+
+impl Case {
+    fn bytes(&self) -> Vec<u8> {
+        let mut image = Image::default();
+        match self.base {
+            Base::Native => {}
+            Base::MultiFrame => {
+                let values: Vec<u16> = (0..90).map(|i| i * 7).collect();
+                image.pixels = Some(DataElement::new(tags::PIXEL_DATA, VR::OW, PrimitiveValue::U16(values.into())));
+                image = image.with(tags::NUMBER_OF_FRAMES, VR::IS, "3").with(tags::SPACING_BETWEEN_SLICES, VR::DS, "2");
+            }
+            Base::Rle => {
+                image.transfer_syntax = RLE;
+                image.pixels = Some(encapsulated(vec![rle_constant(30, 1100)]));
+            }
+            Base::Jpeg2000 => {
+                image.transfer_syntax = JPEG2000;
+                let mut fragment = vec![0xFF, 0x4F, 0xFF, 0x51, 0x00, 0x29, 0x00, 0x00];
+                fragment.extend((0..64u32).map(|i| (i * 29 + 3) as u8));
+                image.pixels = Some(encapsulated(vec![fragment]));
+            }
+            Base::Float => {
+                let values: Vec<f32> = (0..30).map(|i| i as f32 - 3.5).collect();
+                image.pixels = Some(DataElement::new(Tag(0x7FE0, 0x0008), VR::OF, PrimitiveValue::F32(values.into())));
+                image = image.with(tags::BITS_ALLOCATED, VR::US, "32");
+            }
+        }
+        if let Some((count, offsets, body)) = &self.rle {
+            image.transfer_syntax = RLE;
+            image.pixels = Some(encapsulated(vec![rle_frame(*count, offsets, body)]));
+        }
+        for &(field, value) in &self.edits {
+            let (tag, vr) = FIELDS[field % FIELDS.len()];
+            image = image.with(tag, vr, VALUES[value % VALUES.len()]);
+        }
+        let mut bytes = image.bytes();
+        if self.no_preamble {
+            bytes.drain(..128);
+        }
+        let len = bytes.len();
+        for &(at, xor) in &self.flips {
+            bytes[at % len] ^= xor;
+        }
+        if let Some(keep) = self.cut {
+            bytes.truncate(len * usize::from(keep) / 1000);
+        }
+        bytes
+    }
+}
+
+fn case() -> impl Strategy<Value = Case> {
+    let base = prop_oneof![
+        Just(Base::Native),
+        Just(Base::MultiFrame),
+        Just(Base::Rle),
+        Just(Base::Jpeg2000),
+        Just(Base::Float)
+    ];
+    let count = prop_oneof![0u32..20, Just(0xFFFF_FFFFu32), any::<u32>()];
+    let rle = proptest::option::weighted(
+        0.25,
+        (
+            count,
+            proptest::collection::vec(prop_oneof![40u32..200, any::<u32>()], 0..4),
+            proptest::collection::vec(any::<u8>(), 0..160),
+        ),
+    );
+    (
+        base,
+        proptest::collection::vec((0..FIELDS.len(), 0..VALUES.len()), 0..4),
+        rle,
+        proptest::collection::vec((any::<usize>(), 1..=255u8), 0..3),
+        proptest::option::weighted(0.15, 0..1000u16),
+        proptest::bool::weighted(0.1),
+    )
+        .prop_map(|(base, edits, rle, flips, cut, no_preamble)| Case { base, edits, rle, flips, cut, no_preamble })
+}
+
+/// This process's scratch file.
+fn scratch_file() -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("dicom_fuzz").join(std::process::id().to_string());
+    std::fs::create_dir_all(&dir).expect("fuzz folder");
+    dir.join("IM0001.dcm")
+}
+
+#[test]
+fn valid_fuzz_bases_load() {
+    let path = scratch_file().with_file_name("base.dcm");
+    for base in [Base::Native, Base::MultiFrame, Base::Rle, Base::Float] {
+        for no_preamble in [false, true] {
+            let case = Case { base, edits: Vec::new(), rle: None, flips: Vec::new(), cut: None, no_preamble };
+            std::fs::write(&path, case.bytes()).expect("written");
+            let loaded = load_volumes(std::slice::from_ref(&path), &LoadOptions::default())
+                .unwrap_or_else(|e| panic!("{case:?}: {e}"));
+            let want = if matches!(base, Base::MultiFrame) { 90 } else { 30 };
+            assert_eq!(loaded.volume.voxel_count(), want, "{case:?}");
+        }
+    }
+}
+
+#[test]
+fn hostile_dicom_files_are_errors_never_panics_aborts_or_hangs() {
+    if std::env::var_os(CHILD).is_some() {
+        return run_cases();
+    }
+    // The cases run in this test binary again, under the memory limit.
+    let exe = std::env::current_exe().expect("the test binary");
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -v {MEMORY_LIMIT_KIB}; exec \"$0\" \"$@\""))
+        .arg(exe)
+        .args([
+            "--exact",
+            "hostile_dicom_files_are_errors_never_panics_aborts_or_hangs",
+            "--nocapture",
+            "--test-threads=1",
+        ])
+        .env(CHILD, "1")
+        .output()
+        .expect("the child runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    eprint!("{stderr}");
+    assert!(out.status.success(), "the cases failed or aborted under a 4 GiB limit ({:?}):\n{stderr}", out.status);
+}
+
+fn run_cases() {
+    let total = cases();
+    let path = scratch_file();
+    let mut runner = TestRunner::new(Config { cases: total, failure_persistence: None, ..Config::default() });
+    let (ok, err, panics, slow) = (Cell::new(0u64), Cell::new(0u64), Cell::new(0u64), Cell::new(0u64));
+    let first_failure = RefCell::new(None::<String>);
+    let slowest = Cell::new(Duration::ZERO);
+    let current = Arc::new(Mutex::new(None::<(Instant, String)>));
+    let done = Arc::new(AtomicBool::new(false));
+    let started = Arc::new(AtomicU64::new(0));
+    let watchdog = {
+        let (current, done) = (current.clone(), done.clone());
+        std::thread::spawn(move || {
+            while !done.load(Ordering::Relaxed) {
+                std::thread::sleep(Duration::from_millis(200));
+                if let Ok(c) = current.lock()
+                    && let Some((start, what)) = c.as_ref()
+                    && start.elapsed().as_secs_f64() > HANG_SECONDS * 10.0
+                {
+                    eprintln!("dicom fuzz: a case hung for over {}s: {what}", HANG_SECONDS * 10.0);
+                    std::process::exit(1);
+                }
+            }
+        })
+    };
+    let began = Instant::now();
+    let name = path.display().to_string();
+    let result = runner.run(&case(), |case| {
+        let n = started.fetch_add(1, Ordering::Relaxed) + 1;
+        if n.is_multiple_of(50_000) {
+            eprintln!(
+                "dicom fuzz: {n} cases, {} Ok, {} Err, {} panics, {} slow, {:.0}s",
+                ok.get(),
+                err.get(),
+                panics.get(),
+                slow.get(),
+                began.elapsed().as_secs_f64()
+            );
+        }
+        std::fs::write(&path, case.bytes()).expect("written");
+        if let Ok(mut c) = current.lock() {
+            *c = Some((Instant::now(), format!("{case:?}")));
+        }
+        let start = Instant::now();
+        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            load_volumes(std::slice::from_ref(&path), &LoadOptions::default())
+        }));
+        let took = start.elapsed();
+        if let Ok(mut c) = current.lock() {
+            *c = None;
+        }
+        slowest.set(slowest.get().max(took));
+        let mut failure = None;
+        match outcome {
+            Ok(Ok(_)) => ok.set(ok.get() + 1),
+            Ok(Err(e)) => {
+                err.set(err.get() + 1);
+                let text = e.to_string();
+                if !text.contains(&name) || text.contains('\n') {
+                    failure = Some(format!("an error that does not name the file on one line: {text}"));
+                }
+            }
+            Err(_) => {
+                panics.set(panics.get() + 1);
+                failure = Some("panicked".to_string());
+            }
+        }
+        if took.as_secs_f64() > HANG_SECONDS {
+            slow.set(slow.get() + 1);
+            failure = Some(format!("took {took:?}"));
+        }
+        if let Some(what) = failure {
+            first_failure.borrow_mut().get_or_insert_with(|| format!("{what} on {case:?}"));
+        }
+        Ok(())
+    });
+    done.store(true, Ordering::Relaxed);
+    let _ = watchdog.join();
+    eprintln!(
+        "dicom fuzz: {} cases: {} Ok, {} Err, {} panics, 0 aborts (the process lived), {} hangs over {HANG_SECONDS}s; \
+         slowest {:.1} ms, {:.0}s in all",
+        ok.get() + err.get() + panics.get(),
+        ok.get(),
+        err.get(),
+        panics.get(),
+        slow.get(),
+        slowest.get().as_secs_f64() * 1e3,
+        began.elapsed().as_secs_f64()
+    );
+    assert!(result.is_ok(), "{result:?}");
+    assert_eq!(first_failure.into_inner(), None);
+    assert!(ok.get() > 0 && err.get() > 0, "both outcomes are reached: {} Ok, {} Err", ok.get(), err.get());
+}

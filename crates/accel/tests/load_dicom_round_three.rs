@@ -166,8 +166,11 @@ fn a_newline_in_the_description_cannot_forge_a_line() {
     assert!(list.lines().all(|l| l.starts_with("  ")), "a forged line in:\n{list}");
     assert!(list.contains("\"axial\\nerror: fake message\""), "{list}");
     assert!(list.contains("\"b\\r\\u{1b}[2J\""), "{list}");
-    let e = load(&[dir]).map(|_| ()).expect_err("two series");
+    let e = load(std::slice::from_ref(&dir)).map(|_| ()).expect_err("two series");
     assert!(e.lines().all(|l| !l.starts_with("error")), "a forged line in:\n{e}");
+    let one = load(&[dir.join("a")]).expect("one series").volume;
+    assert_eq!(one.name, "axial\\nerror: fake message", "the name is shown in notes");
+    assert_eq!(one.meta.description.as_deref(), Some("axial\nerror: fake message"), "the raw text is kept");
 }
 
 #[test]

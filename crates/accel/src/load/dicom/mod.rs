@@ -289,7 +289,7 @@ pub fn load(
         if orientation.flipped[i] { o + stack.directions[i] * (file_dims[i] as f64 - 1.0) } else { o }
     });
     let data = orientation.reorder(file_dims, voxels);
-    let name = if first.description.is_empty() { dicom_name(paths) } else { first.description.clone() };
+    let name = series_label(paths, &first);
     let mut volume = Volume::new(name, orientation.world_dims(file_dims), spacing, data);
     volume.fit_range_to_data();
     volume.meta = series_meta(&first, origin);
@@ -416,7 +416,7 @@ impl SeriesSlices {
                 format: "DICOM series with flipped or swapped axes",
             });
         }
-        let name = if first.description.is_empty() { dicom_name(paths) } else { first.description.clone() };
+        let name = series_label(paths, &first);
         let eight_bit = series.iter().all(|h| h.bits_allocated == 8 && h.rescale == (1.0, 0.0));
         // The axes are the world's (checked above), so voxel (0, 0, 0) is the stack's origin.
         let meta = series_meta(first, stack.origin);
@@ -441,6 +441,12 @@ impl SeriesSlices {
             crate::volume::VoxelData::F32(v) => v,
         })
     }
+}
+
+/// The volume's name: the series' description on one line (it is shown in notes and titles;
+/// the raw text stays in `VolumeMeta::description`), else the folder's or file's name.
+fn series_label(paths: &[PathBuf], first: &FileHeader) -> String {
+    if first.description.is_empty() { dicom_name(paths) } else { one_line(&first.description) }
 }
 
 /// A name for a series without a description: the folder's (or first file's) name.

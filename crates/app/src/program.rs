@@ -90,8 +90,7 @@ pub fn shaders() -> ShaderSources {
 pub fn main_with(extension: Extension) -> ExitCode {
     // jpeg2k logs OpenJPEG's messages on a corrupt codestream (eight lines before the error);
     // the loader's error says what failed, so they are shown only when RUST_LOG asks.
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn,notify=error,jpeg2k=off"))
-        .init();
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn,notify=error,jpeg2k=off")).init();
     std::panic::set_hook(Box::new(|info| {
         let location = info.location().map_or(String::new(), |l| format!(" at {}:{}", l.file(), l.line()));
         let message = info

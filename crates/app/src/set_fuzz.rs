@@ -58,16 +58,64 @@ fn seeds() -> &'static Seeds {
 
 /// Tokens and values chosen to break the file or the value written.
 const HOSTILE: &[&str] = &[
-    "", "\"", "(", ")", "[", "]", "{", "}", ",", ":", "0", "-1", "0.25", "1e39", "NaN", "inf", "true",
-    "4294967296", "\"feature.shading\"", "\"input.threshold\"", "\"dvr\"", "\"iso\"", "Scalar(0.5)",
-    "// c", "/* c */", "/*", "\u{1b}]0;x\u{7}", "\u{feff}", "\r", "\n", "\r\n", "é", "Some(1)", "r#\"x\"#",
-    "'a'", "[1, 2]", "{\"a\": 1}", "0.5 // c", "#![enable(implicit_some)]",
+    "",
+    "\"",
+    "(",
+    ")",
+    "[",
+    "]",
+    "{",
+    "}",
+    ",",
+    ":",
+    "0",
+    "-1",
+    "0.25",
+    "1e39",
+    "NaN",
+    "inf",
+    "true",
+    "4294967296",
+    "\"feature.shading\"",
+    "\"input.threshold\"",
+    "\"dvr\"",
+    "\"iso\"",
+    "Scalar(0.5)",
+    "// c",
+    "/* c */",
+    "/*",
+    "\u{1b}]0;x\u{7}",
+    "\u{feff}",
+    "\r",
+    "\n",
+    "\r\n",
+    "é",
+    "Some(1)",
+    "r#\"x\"#",
+    "'a'",
+    "[1, 2]",
+    "{\"a\": 1}",
+    "0.5 // c",
+    "#![enable(implicit_some)]",
 ];
 
 /// Names a graph may or may not use.
 const NAMES: &[&str] = &[
-    "step_voxels", "max_steps", "threshold", "background", "iso_value", "mode", "shading", "jitter",
-    "nope", "", "volume", "tf", "a.b", "\u{1b}[2J", "é",
+    "step_voxels",
+    "max_steps",
+    "threshold",
+    "background",
+    "iso_value",
+    "mode",
+    "shading",
+    "jitter",
+    "nope",
+    "",
+    "volume",
+    "tf",
+    "a.b",
+    "\u{1b}[2J",
+    "é",
 ];
 
 /// One edit of a seed text.
@@ -191,10 +239,51 @@ enum Pick {
 
 /// Values to set: the first `VALID` are values most parameters take.
 const VALUES: &[&str] = &[
-    "0.25", "0.5", "0.75", "1", "0.01", "16", "true", "false", "\"iso\"", "0", "-1", "1e39", "NaN", "inf", "true", "false", "4096", "1048577", "0.01", "16",
-    "\"dvr\"", "\"iso\"", "\"feature.shading\"", "\"input.threshold\"", "\"x\"", "\"a // b\"", "\"a\\nb\"",
-    " 0.75 ", "0.25 // c", "/* c */ 1", "[1, 2]", "(", "", "\u{1b}", "1\n", "\r\n0.5", "0.5,", "0.5}",
-    "Some(1)", "0.5 0.25", "'a'", "r#\"x\"#", "1_000", "0x10", "Scalar(1)",
+    "0.25",
+    "0.5",
+    "0.75",
+    "1",
+    "0.01",
+    "16",
+    "true",
+    "false",
+    "\"iso\"",
+    "0",
+    "-1",
+    "1e39",
+    "NaN",
+    "inf",
+    "true",
+    "false",
+    "4096",
+    "1048577",
+    "0.01",
+    "16",
+    "\"dvr\"",
+    "\"iso\"",
+    "\"feature.shading\"",
+    "\"input.threshold\"",
+    "\"x\"",
+    "\"a // b\"",
+    "\"a\\nb\"",
+    " 0.75 ",
+    "0.25 // c",
+    "/* c */ 1",
+    "[1, 2]",
+    "(",
+    "",
+    "\u{1b}",
+    "1\n",
+    "\r\n0.5",
+    "0.5,",
+    "0.5}",
+    "Some(1)",
+    "0.5 0.25",
+    "'a'",
+    "r#\"x\"#",
+    "1_000",
+    "0x10",
+    "Scalar(1)",
 ];
 
 const VALID: usize = 9;
@@ -254,7 +343,10 @@ fn target_text(text: &str, pick: &Pick) -> (String, Option<String>) {
                 passes.iter().flat_map(|(id, _, params)| params.iter().map(move |p| format!("{id}.{p}"))).collect();
             if let Some(d) = &doc {
                 all.extend(
-                    d.inputs.iter().filter(|(_, k)| matches!(k, InputKind::Scalar(_))).map(|(n, _)| format!("input.{n}")),
+                    d.inputs
+                        .iter()
+                        .filter(|(_, k)| matches!(k, InputKind::Scalar(_)))
+                        .map(|(n, _)| format!("input.{n}")),
                 );
             }
             all.get(i % all.len().max(1)).cloned().unwrap_or_else(|| "march.step_voxels".to_string())
@@ -298,7 +390,8 @@ fn no_bom(text: &str) -> &str {
 fn expected_doc(mut doc: GraphDoc, target: &SetTarget, value: &str) -> Result<GraphDoc, String> {
     match target {
         SetTarget::Input(name) => {
-            let kind: InputKind = ron::from_str(&format!("Scalar({value})")).map_err(|e| format!("Scalar({value}): {e}"))?;
+            let kind: InputKind =
+                ron::from_str(&format!("Scalar({value})")).map_err(|e| format!("Scalar({value}): {e}"))?;
             doc.inputs.insert(name.clone(), kind);
         }
         SetTarget::Param { pass, param } => {
@@ -315,11 +408,20 @@ fn expected_doc(mut doc: GraphDoc, target: &SetTarget, value: &str) -> Result<Gr
 }
 
 /// Checks the text of a successful edit: one value replaced, or only the new entry inserted.
-fn check_text(original: &str, edited: &str, edits: &[TextEdit], target: &SetTarget, value: &str) -> Result<Outcome, String> {
+fn check_text(
+    original: &str,
+    edited: &str,
+    edits: &[TextEdit],
+    target: &SetTarget,
+    value: &str,
+) -> Result<Outcome, String> {
     if apply_edits(original, edits) != edited {
         return Err("the file is not the original with the reported edits".into());
     }
-    if original.contains('\n') && !original.replace("\r\n", "").contains('\n') && edited.replace("\r\n", "").contains('\n') {
+    if original.contains('\n')
+        && !original.replace("\r\n", "").contains('\n')
+        && edited.replace("\r\n", "").contains('\n')
+    {
         return Err("a CRLF file got an LF line end".into());
     }
     match edits {
@@ -463,17 +565,19 @@ fn set_on_mutated_graphs_edits_one_value_or_leaves_the_file_untouched() {
         let bytes = mutate(&seeds().texts[*seed], mutations);
         let (target, declared_value) = target_text(&String::from_utf8_lossy(&bytes), pick);
         // usize::MAX: the value the file writes now, written again (a no-op).
-        let value = declared_value.unwrap_or_else(|| VALUES.get(*value).map_or_else(
-            || {
-                let text = String::from_utf8_lossy(&bytes).into_owned();
-                SetTarget::parse(&target)
-                    .ok()
-                    .and_then(|t| edit_for(&text, &t, "0").ok())
-                    .and_then(|e| e.first().map(|e| text[e.span.start..e.span.end].to_string()))
-                    .unwrap_or_default()
-            },
-            |v| (*v).to_string(),
-        ));
+        let value = declared_value.unwrap_or_else(|| {
+            VALUES.get(*value).map_or_else(
+                || {
+                    let text = String::from_utf8_lossy(&bytes).into_owned();
+                    SetTarget::parse(&target)
+                        .ok()
+                        .and_then(|t| edit_for(&text, &t, "0").ok())
+                        .and_then(|e| e.first().map(|e| text[e.span.start..e.span.end].to_string()))
+                        .unwrap_or_default()
+                },
+                |v| (*v).to_string(),
+            )
+        });
         (bytes, target, value, *read_only)
     };
     let run = crate::fuzz_runner::fuzz(
@@ -489,7 +593,7 @@ fn set_on_mutated_graphs_edits_one_value_or_leaves_the_file_untouched() {
             let outcome = run_case(&bytes, &target, &value, read_only);
             // A long run says how far it got (a run stopped early is reported by its count).
             let done = DONE.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-            if done % 50_000 == 0 {
+            if done.is_multiple_of(50_000) {
                 eprintln!("set fuzz: {done} cases passed so far");
             }
             outcome

@@ -60,7 +60,10 @@ fn set_through_a_planted_temp_link_leaves_its_target_alone() {
     assert_eq!(code, 0, "{stderr}");
     assert_eq!(std::fs::read_to_string(&victim).expect("victim"), "precious", "the link's target was overwritten");
     assert!(planted.symlink_metadata().expect("the link").file_type().is_symlink(), "the planted link was replaced");
-    assert_eq!(param(&std::fs::read_to_string(&graph).expect("graph"), "march", "step_voxels"), Some("0.25".to_string()));
+    assert_eq!(
+        param(&std::fs::read_to_string(&graph).expect("graph"), "march", "step_voxels"),
+        Some("0.25".to_string())
+    );
     // No temporary file of volgraph's own is left beside the graph.
     let left: Vec<String> = std::fs::read_dir(&dir)
         .expect("folder")
@@ -151,7 +154,8 @@ fn set_accepts_a_bom_and_an_enable_header() {
 fn set_edits_the_duplicate_key_that_takes_effect() {
     let dir = folder("duplicate");
     let graph = dir.join("g.ron");
-    let original = shipped().replace("\"threshold\": 1.0,", "\"threshold\": 1.0,\n                \"step_voxels\": 0.75,");
+    let original =
+        shipped().replace("\"threshold\": 1.0,", "\"threshold\": 1.0,\n                \"step_voxels\": 0.75,");
     assert_eq!(param(&original, "march", "step_voxels"), Some("0.75".to_string()), "the last copy counts");
     std::fs::write(&graph, &original).expect("graph");
     let (code, stdout, stderr) = set(&graph, &["march.step_voxels=0.25"]);

@@ -164,3 +164,34 @@ fn a_file_without_the_preamble_is_described() {
     assert_eq!(run.code, Some(0), "{}", run.stderr);
     assert!(run.stdout.contains("5 × 6 × 1 voxels"), "{}", run.stdout);
 }
+
+/// A NIfTI-1 file of 2×2×2 uint8 voxels whose `descrip` is `description`.
+fn nifti_with_description(description: &[u8]) -> Vec<u8> {
+    let mut h = vec![0u8; 352];
+    h[0..4].copy_from_slice(&348i32.to_le_bytes());
+    for (i, d) in [3i16, 2, 2, 2, 1, 1, 1, 1].iter().enumerate() {
+        h[40 + 2 * i..42 + 2 * i].copy_from_slice(&d.to_le_bytes());
+    }
+    h[70..72].copy_from_slice(&2i16.to_le_bytes()); // uint8
+    h[72..74].copy_from_slice(&8i16.to_le_bytes());
+    for i in 0..8 {
+        h[76 + 4 * i..80 + 4 * i].copy_from_slice(&1f32.to_le_bytes());
+    }
+    h[108..112].copy_from_slice(&352f32.to_le_bytes());
+    h[148..148 + description.len()].copy_from_slice(description);
+    h[344..348].copy_from_slice(b"n+1\0");
+    h.extend([0, 10, 20, 30, 40, 50, 60, 70]);
+    h
+}
+
+#[test]
+fn a_newline_in_a_nifti_description_cannot_forge_a_line_in_info() {
+    let dir = fresh(&root(), "cli_nifti_newline");
+    let path = dir.join("head.nii");
+    std::fs::write(&path, nifti_with_description(b"T1\nerror: fake message")).expect("written");
+    let run = volgraph_limited(&["info", path.to_str().expect("utf-8")], Duration::from_secs(60));
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let all = format!("{}{}", run.stdout, run.stderr);
+    assert!(!all.lines().any(|l| l.starts_with("error")), "a forged line:\n{all}");
+    assert!(run.stdout.contains("description  T1\\nerror: fake message"), "{}", run.stdout);
+}

@@ -365,6 +365,18 @@ struct ViewerRun {
 /// Runs `volgraph view ARGS --script` in `cwd` on `x`'s display; once it has loaded, writes the
 /// script `lines` and waits up to 60 s for it to end (killed after that).
 fn run_viewer(x: &Xvfb, cwd: &Path, args: &[&str], lines: &[&str]) -> ViewerRun {
+    run_viewer_with(x, cwd, args, |_, _| {}, lines)
+}
+
+/// [`run_viewer`], calling `during` with the event lines (and the list of those seen) once the
+/// viewer has loaded, before the script lines are written.
+fn run_viewer_with(
+    x: &Xvfb,
+    cwd: &Path,
+    args: &[&str],
+    during: impl FnOnce(&Receiver<String>, &mut Vec<String>),
+    lines: &[&str],
+) -> ViewerRun {
     let mut viewer = Command::new(env!("CARGO_BIN_EXE_volgraph"))
         .arg("view")
         .args(args)
@@ -402,6 +414,7 @@ fn run_viewer(x: &Xvfb, cwd: &Path, args: &[&str], lines: &[&str]) -> ViewerRun 
             Err(_) => break,
         }
     }
+    during(&rx, &mut seen);
     let mut stdin = viewer.stdin.take().expect("stdin");
     for line in lines {
         let _ = writeln!(stdin, "{line}");
@@ -500,4 +513,57 @@ fn save_tf_of_a_preset_writes_a_tf_file_that_does_not_shadow_the_preset() {
     assert!(!dir.join("ct-bone").exists(), "no file shadows the preset");
     let text = std::fs::read_to_string(&saved).expect("the saved TF");
     assert!(text.contains("500.0"), "{text}");
+}
+
+/// Waits up to 30 s for an event line starting with `prefix`; `false` if none came.
+fn wait_for(lines: &Receiver<String>, seen: &mut Vec<String>, prefix: &str) -> bool {
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while let Some(left) = deadline.checked_duration_since(Instant::now()) {
+        match lines.recv_timeout(left) {
+            Ok(line) => {
+                let found = line.starts_with(prefix);
+                seen.push(line);
+                if found {
+                    return true;
+                }
+            }
+            Err(_) => return false,
+        }
+    }
+    false
+}
+
+/// Issue 47 §6: the viewer stopped watching a graph whose folder was deleted and made again
+/// (the folder's watch died with it): edits after that never reloaded.
+#[test]
+fn a_graph_whose_folder_was_deleted_and_made_again_still_reloads() {
+    let dir = scratch("folder_again");
+    let Some(x) = start_xvfb() else { return };
+    let folder = dir.join("graphs");
+    std::fs::create_dir_all(&folder).expect("folder");
+    let graph = folder.join("graph.ron");
+    let text = std::fs::read_to_string(root().join("graphs/basic/fragment_raycast.ron")).expect("graph");
+    assert!(text.contains("\"step_voxels\": 0.5"), "the graph sets its step");
+    std::fs::write(&graph, &text).expect("graph");
+    let (mut deleted_seen, mut reloaded) = (false, false);
+    let run = run_viewer_with(
+        &x,
+        &dir,
+        &[&graph.display().to_string()],
+        |lines, seen| {
+            std::fs::remove_dir_all(&folder).expect("delete the folder");
+            deleted_seen = wait_for(lines, seen, "error in graph");
+            std::fs::create_dir_all(&folder).expect("make it again");
+            std::fs::write(&graph, &text).expect("the graph again");
+            wait_for(lines, seen, "recovered");
+            // An edit after the folder came back.
+            std::thread::sleep(Duration::from_millis(300));
+            std::fs::write(&graph, text.replacen("\"step_voxels\": 0.5", "\"step_voxels\": 0.75", 1)).expect("edit");
+            reloaded = wait_for(lines, seen, "reloaded graph");
+        },
+        &["quit"],
+    );
+    assert!(run.status.is_some_and(|s| s.success()), "{}\n{}", run.stdout, run.stderr);
+    assert!(deleted_seen, "the deleted graph is an error:\n{}", run.stdout);
+    assert!(reloaded, "the edit after the folder came back is reloaded:\n{}", run.stdout);
 }

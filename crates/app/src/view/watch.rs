@@ -3,8 +3,9 @@
 //! `QUIET`. Folders are watched rather than files, because an editor that saves by renaming
 //! replaces the file a watch would have followed. A watched folder that is deleted takes its
 //! watch with it; every `RECHECK` the folders are looked at again, and one that is back (or was
-//! replaced by another folder of that name) is watched anew and its watched files are
-//! delivered as changed (they may have been written before the new watch began).
+//! replaced by another folder of that name: another inode or creation time, or an event saying
+//! the watched folder itself went) is watched anew and its watched files are delivered as
+//! changed (they may have been written before the new watch began).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -19,20 +20,21 @@ pub const QUIET: Duration = Duration::from_millis(15);
 /// How often the watched folders are checked for having been deleted and made again.
 pub const RECHECK: Duration = Duration::from_millis(200);
 
-/// Which folder is at a path: its device and inode (on Unix), `None` while there is none.
-type FolderId = Option<(u64, u64)>;
+/// Which folder is at a path: its device, inode and creation time (on Unix; a folder deleted
+/// and made again may get the same inode number back), `None` while there is none.
+type FolderId = Option<(u64, u64, Option<std::time::SystemTime>)>;
 
 fn folder_id(path: &Path) -> FolderId {
     let meta = std::fs::metadata(path).ok().filter(std::fs::Metadata::is_dir)?;
+    let created = meta.created().ok();
     #[cfg(unix)]
     {
         use std::os::unix::fs::MetadataExt;
-        Some((meta.dev(), meta.ino()))
+        Some((meta.dev(), meta.ino(), created))
     }
     #[cfg(not(unix))]
     {
-        let _ = meta;
-        Some((0, 0))
+        Some((0, 0, created))
     }
 }
 
@@ -140,6 +142,14 @@ impl FileWatch {
             }
             for path in event.paths {
                 let path = canonical(&path);
+                // The watched folder itself went (deleted, or renamed away): its watch went with
+                // it, and the next check watches whatever folder is there then.
+                if let Some(id) = self.folders.get_mut(&path) {
+                    let renamed = matches!(event.kind, notify::EventKind::Modify(notify::event::ModifyKind::Name(_)));
+                    if matches!(event.kind, notify::EventKind::Remove(_)) || (renamed && folder_id(&path) != *id) {
+                        *id = None;
+                    }
+                }
                 if self.files.contains(&path) {
                     self.pending.insert(path);
                     self.last_event = Some(Instant::now());
@@ -189,8 +199,7 @@ mod tests {
         assert!(delivers(&mut watch, &graph), "an edit is seen");
         std::fs::remove_dir_all(&dir).expect("delete the folder");
         assert!(delivers(&mut watch, &graph), "the deletion is seen");
-        std::thread::sleep(RECHECK * 2);
-        let _ = watch.poll();
+        // Made again at once: the new folder may get the old one's inode number back.
         std::fs::create_dir_all(&dir).expect("make it again");
         std::fs::write(&graph, "three").expect("write");
         assert!(delivers(&mut watch, &graph), "the file in the new folder is seen");

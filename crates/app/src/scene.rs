@@ -659,6 +659,17 @@ mod tests {
         );
     }
 
+    /// Issue 47 §5: `view --volume ml32` and its saved `Generated("ml32")` got two default TFs;
+    /// one rule now, and only where the TF's 0..255 points fit (not the float `mlf` volumes).
+    #[test]
+    fn the_marschner_lobb_tf_is_the_default_of_the_8_bit_ml_volumes_only() {
+        let generated = |n: &str| VolumeSource::Generated(n.to_string());
+        assert!(marschner_lobb_tf(&generated("ml32")) && marschner_lobb_tf(&generated("ml64")));
+        for other in [generated("mlf64"), generated("sphere32"), VolumeSource::Dataset("ml32".into())] {
+            assert!(!marschner_lobb_tf(&other), "{other:?}");
+        }
+    }
+
     /// Issue 47 §5: `volume_options` are checked as the flags they stand for.
     #[test]
     fn volume_options_are_checked_like_the_flags() {

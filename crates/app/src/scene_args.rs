@@ -32,8 +32,10 @@ pub struct SceneArgs {
     pub raw: RawArgs,
     /// Transfer function (RON, or ParaView color-map .json; the viewer watches it for edits), or
     /// a built-in preset for scanner data: ct-bone, ct-soft-tissue, ct-lung, ct-angio (in HU),
-    /// mr-default (percentiles); default: one fitted to the data (transparent up to its
-    /// background of air or noise; see `volgraph info`).
+    /// mr-default (percentiles); default: for a generated 8-bit Marschner–Lobb volume (the
+    /// default volume, `ml64`, `ml32`) the band that shows its rings (graphs/tf/marschner_lobb.ron),
+    /// else one fitted to the data (transparent up to its background of air or noise; see
+    /// `volgraph info`).
     #[arg(long)]
     pub tf: Option<PathBuf>,
     /// The colour map to use from a ParaView .json holding several (its "Name"); default: the first.

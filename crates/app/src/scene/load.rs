@@ -78,11 +78,12 @@ pub fn load_shown_volume(
 }
 
 /// Whether a volume's default transfer function (none given) is `graphs/tf/marschner_lobb.ron`,
-/// which shows Marschner–Lobb's rings: for the generated Marschner–Lobb volumes (`ml64`, the
-/// default, and `mlf64`, any edge); every other volume gets one fitted to its data. The one rule
-/// for `render`, `view` and scenes.
+/// which shows Marschner–Lobb's rings: for the generated 8-bit Marschner–Lobb volumes (`ml64`,
+/// the default, any edge), whose values the file's 0..255 points are written in; every other
+/// volume (the float `mlf64` too, valued 0..1) gets one fitted to its data. The one rule for
+/// `render`, `view` and scenes.
 pub fn marschner_lobb_tf(source: &VolumeSource) -> bool {
-    matches!(source, VolumeSource::Generated(name) if name.starts_with("ml"))
+    matches!(source, VolumeSource::Generated(name) if name.starts_with("ml") && !name.starts_with("mlf"))
 }
 
 /// `flags`, each over the scene's `scene` value.

@@ -288,7 +288,8 @@ impl Viewer {
     }
 
     fn save_screenshot(&mut self, path: &PathBuf) -> Result<(), String> {
-        // Checked again when writing: a FIFO made since would block the window for good.
+        // Checked again when writing (a FIFO made since the line was read would block the
+        // window for good); one made between this check and the write is not caught.
         super::screenshot_target(path)?;
         let (Some(session), Some(gfx)) = (self.session.as_mut(), self.gfx.as_ref()) else { return Ok(()) };
         let output = session.shown_output();

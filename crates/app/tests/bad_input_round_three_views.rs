@@ -143,6 +143,14 @@ fn a_saved_view_of_a_built_in_graph_and_a_tf_preset_renders_back_from_any_folder
     let text = assert_renders_back(&mut session, &dir);
     assert!(text.contains("graph: \"basic/fragment_raycast\""), "{text}");
     assert!(text.contains("transfer_function: Preset(\"ct-bone\")"), "{text}");
+    // A built-in TF by its path in the repository (no such file in the test's folder).
+    let dir = scratch("builtin_tf");
+    let tf = Path::new("graphs/tf/marschner_lobb.ron");
+    assert!(!tf.exists(), "the test runs where graphs/tf is not");
+    let mut session =
+        open(Path::new("basic/fragment_raycast"), &[PathBuf::from("ml32")], LoadOptions::default(), Some(tf));
+    let text = assert_renders_back(&mut session, &dir);
+    assert!(text.contains("transfer_function: File(\"graphs/tf/marschner_lobb.ron\")"), "{text}");
 }
 
 /// Issue 47 §5: `--dims` (with `--dtype`), `--series` and `--frame` were dropped from the saved

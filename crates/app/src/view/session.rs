@@ -258,8 +258,11 @@ impl LiveSession {
             }
             (tf, _) => {
                 let (t, notes) = inputs::transfer_function(tf.as_ref(), args.tf_map.as_deref(), &volume, generated)?;
-                // A preset's name is no file: nothing to watch, and "save TF" writes elsewhere.
-                (t, tf.clone().filter(|p| scanner_preset_named(p).is_none()), notes)
+                // A preset's or a built-in TF's name is no file: nothing to watch, and "save TF"
+                // writes elsewhere.
+                let file =
+                    |p: &PathBuf| scanner_preset_named(p).is_none() && crate::builtin_graphs::find_tf(p).is_none();
+                (t, tf.clone().filter(file), notes)
             }
         };
         let tf_source = match (&args.tf, &args.scene) {

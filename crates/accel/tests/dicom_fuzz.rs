@@ -2,7 +2,8 @@
 //! JPEG 2000, Float Pixel Data, with and without the preamble) with attributes replaced by
 //! hostile values (sizes 0 and 2³²−1, NumberOfFrames 10⁸, NaN, inf, 1e300, junk text, wrong
 //! value counts, PALETTE COLOR, newlines), RLE headers and segments made of junk, bytes flipped
-//! and the file cut short. Every load must return Ok or Err: a panic, or a case slower than
+//! and the file cut short; some cases load a folder of it and a second slice with its own
+//! hostile attributes. Every load must return Ok or Err: a panic, or a case slower than
 //! `HANG_SECONDS`, fails the test; a watchdog ends the process on a real hang. The files are a
 //! few hundred bytes and the cases run in a child process under `ulimit -v` of 4 GiB: a loader
 //! that allocated what a hostile header claims rather than what the file holds aborts it, and
@@ -128,9 +129,26 @@ struct Case {
     /// Keep this many thousandths of the file.
     cut: Option<u16>,
     no_preamble: bool,
+    /// A second slice of the same series (2 mm on) with these edits; the folder is loaded.
+    neighbour: Option<Vec<(usize, usize)>>,
 }
 
 impl Case {
+    /// The neighbour's bytes, when there is one.
+    fn neighbour_bytes(&self) -> Option<Vec<u8>> {
+        let edits = self.neighbour.as_ref()?;
+        let mut image = Image { z: 2.0, ..Image::default() };
+        if matches!(self.base, Base::Rle) {
+            image.transfer_syntax = RLE;
+            image.pixels = Some(encapsulated(vec![rle_constant(30, 1000)]));
+        }
+        for &(field, value) in edits {
+            let (tag, vr) = FIELDS[field % FIELDS.len()];
+            image = image.with(tag, vr, VALUES[value % VALUES.len()]);
+        }
+        Some(image.bytes())
+    }
+
     fn bytes(&self) -> Vec<u8> {
         let mut image = Image::default();
         match self.base {
@@ -203,8 +221,17 @@ fn case() -> impl Strategy<Value = Case> {
         proptest::collection::vec((any::<usize>(), 1..=255u8), 0..3),
         proptest::option::weighted(0.15, 0..1000u16),
         proptest::bool::weighted(0.1),
+        proptest::option::weighted(0.3, proptest::collection::vec((0..FIELDS.len(), 0..VALUES.len()), 0..2)),
     )
-        .prop_map(|(base, edits, rle, flips, cut, no_preamble)| Case { base, edits, rle, flips, cut, no_preamble })
+        .prop_map(|(base, edits, rle, flips, cut, no_preamble, neighbour)| Case {
+            base,
+            edits,
+            rle,
+            flips,
+            cut,
+            no_preamble,
+            neighbour,
+        })
 }
 
 /// This process's scratch file.
@@ -219,7 +246,8 @@ fn valid_fuzz_bases_load() {
     let path = scratch_file().with_file_name("base.dcm");
     for base in [Base::Native, Base::MultiFrame, Base::Rle, Base::Float] {
         for no_preamble in [false, true] {
-            let case = Case { base, edits: Vec::new(), rle: None, flips: Vec::new(), cut: None, no_preamble };
+            let case =
+                Case { base, edits: Vec::new(), rle: None, flips: Vec::new(), cut: None, no_preamble, neighbour: None };
             std::fs::write(&path, case.bytes()).expect("written");
             let loaded = load_volumes(std::slice::from_ref(&path), &LoadOptions::default())
                 .unwrap_or_else(|e| panic!("{case:?}: {e}"));
@@ -280,7 +308,9 @@ fn run_cases() {
         })
     };
     let began = Instant::now();
-    let name = path.display().to_string();
+    let folder = path.parent().expect("a folder").to_path_buf();
+    let second = folder.join("IM0002.dcm");
+    let name = folder.display().to_string();
     let result = runner.run(&case(), |case| {
         let n = started.fetch_add(1, Ordering::Relaxed) + 1;
         if n.is_multiple_of(50_000) {
@@ -294,12 +324,22 @@ fn run_cases() {
             );
         }
         std::fs::write(&path, case.bytes()).expect("written");
+        let input = match case.neighbour_bytes() {
+            Some(bytes) => {
+                std::fs::write(&second, bytes).expect("written");
+                folder.clone()
+            }
+            None => {
+                let _ = std::fs::remove_file(&second);
+                path.clone()
+            }
+        };
         if let Ok(mut c) = current.lock() {
             *c = Some((Instant::now(), format!("{case:?}")));
         }
         let start = Instant::now();
         let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            load_volumes(std::slice::from_ref(&path), &LoadOptions::default())
+            load_volumes(std::slice::from_ref(&input), &LoadOptions::default())
         }));
         let took = start.elapsed();
         if let Ok(mut c) = current.lock() {
@@ -312,8 +352,11 @@ fn run_cases() {
             Ok(Err(e)) => {
                 err.set(err.get() + 1);
                 let text = e.to_string();
-                if !text.contains(&name) || text.contains('\n') {
-                    failure = Some(format!("an error that does not name the file on one line: {text}"));
+                // The first line names the file (or its folder); more lines only list series.
+                let mut lines = text.lines();
+                let first_names = lines.next().is_some_and(|l| l.contains(&name));
+                if !first_names || !lines.all(|l| l.starts_with("  ")) {
+                    failure = Some(format!("an error that does not name the file, or forges a line: {text}"));
                 }
             }
             Err(_) => {

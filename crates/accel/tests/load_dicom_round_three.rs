@@ -174,6 +174,20 @@ fn a_newline_in_the_description_cannot_forge_a_line() {
 }
 
 #[test]
+fn dicom_rs_quoting_a_newline_from_the_file_cannot_forge_a_line() {
+    // Found by the fuzzer: a transfer syntax UID with a newline, quoted by dicom-rs's error.
+    let dir = fresh(&root(), "ts_newline");
+    let mut bytes = Image::default().bytes();
+    let at = bytes.windows(19).position(|w| w == EXPLICIT_LE.as_bytes()).expect("the UID");
+    bytes[at + 12] = b'\n';
+    let path = dir.join("IM0001.dcm");
+    std::fs::write(&path, &bytes).expect("written");
+    let e = load(std::slice::from_ref(&path)).map(|_| ()).expect_err("an error");
+    assert_names(&e, &path, &["1.2.840.1000\\n.1.2.1"]);
+    assert_eq!(e.lines().count(), 1, "{e}");
+}
+
+#[test]
 fn a_malformed_rescale_slope_is_an_error_not_one() {
     for bad in ["NaN", "abc", "0"] {
         let (path, e) = error_of("slope", Image::default().with(tags::RESCALE_SLOPE, VR::DS, bad));

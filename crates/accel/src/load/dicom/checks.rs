@@ -68,7 +68,7 @@ pub fn guarded<T>(path: &Path, decode: impl FnOnce() -> T) -> Result<T, LoadErro
             .downcast_ref::<&str>()
             .map(|s| s.to_string())
             .or_else(|| payload.downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "(no message)".to_string());
+            .map_or_else(|| "(no message)".to_string(), |m| super::one_line(&m));
         LoadError::DicomPixels {
             path: path.to_path_buf(),
             message: format!(

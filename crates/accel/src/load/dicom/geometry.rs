@@ -164,6 +164,19 @@ pub fn stack(series: &str, slices: &[SliceGeometry], slice_thickness: Option<f64
         slice_thickness.filter(|t| *t > 0.0 && t.is_finite()).unwrap_or(row_spacing.min(column_spacing))
     } else {
         let steps: Vec<f64> = order.windows(2).map(|w| along[w[1]] - along[w[0]]).collect();
+        if let Some(k) = steps.iter().position(|s| !s.is_finite()) {
+            return Err(geometry_error(
+                series,
+                format!(
+                    "{} at {} and {} at {} are too far apart to measure (ImagePositionPatient (0020,0032) values \
+                     near 1e308); fix the header (e.g. with dcmodify) or remove the odd file",
+                    name(&slices[order[k]]),
+                    position_text(positions[order[k]]),
+                    name(&slices[order[k + 1]]),
+                    position_text(positions[order[k + 1]])
+                ),
+            ));
+        }
         for (k, &step) in steps.iter().enumerate() {
             if step < SAME_POSITION_MM {
                 let (a, b) = (&slices[order[k]], &slices[order[k + 1]]);
@@ -184,7 +197,7 @@ pub fn stack(series: &str, slices: &[SliceGeometry], slice_thickness: Option<f64
         sorted.sort_by(f64::total_cmp);
         let median = sorted[sorted.len() / 2];
         if let Some(k) = steps.iter().position(|&s| s >= GAP_FACTOR * median) {
-            let missing = (steps[k] / median).round() as usize - 1;
+            let missing = ((steps[k] / median).round() as usize).saturating_sub(1);
             return Err(geometry_error(
                 series,
                 format!(
@@ -302,6 +315,16 @@ mod tests {
         let e = stack("s", &slices, None).expect_err("a gap").to_string();
         assert!(
             e.contains("between s2.dcm at 4.000 mm and s3.dcm at 8.000 mm") && e.contains("1 slice(s) missing"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn positions_too_far_apart_are_an_error_not_a_panic() {
+        let slices: Vec<_> = [-1.7e308, 1.7e308].iter().enumerate().map(|(i, &z)| slice(i, z)).collect();
+        let e = stack("s", &slices, None).expect_err("too far").to_string();
+        assert!(
+            e.contains("s0.dcm at (-10, -20, -1.700e308) and s1.dcm at (-10, -20, 1.700e308) are too far apart"),
             "{e}"
         );
     }

@@ -86,7 +86,7 @@ pub fn probe(path: &Path) -> Result<Probe, LoadError> {
     let object = OpenFileOptions::new()
         .read_until(tags::FLOAT_PIXEL_DATA)
         .open_file(path)
-        .map_err(|e| LoadError::DicomRead { path: path.to_path_buf(), reason: e.to_string() })?;
+        .map_err(|e| LoadError::DicomRead { path: path.to_path_buf(), reason: super::one_line(&e.to_string()) })?;
     if object.meta().media_storage_sop_class_uid().trim_end_matches('\0') == DICOMDIR_CLASS {
         return Ok(Probe::Dicomdir);
     }

@@ -38,7 +38,8 @@ pub fn check_transfer_syntax(path: &Path, uid: &str) -> Result<(), LoadError> {
     };
     Err(LoadError::DicomTransferSyntax {
         path: path.to_path_buf(),
-        uid: uid.to_string(),
+        // The UID as the file spells it, on one line.
+        uid: super::one_line(uid),
         name,
         supported: supported_transfer_syntaxes(),
     })
@@ -233,13 +234,14 @@ fn causes(e: &dyn std::error::Error) -> String {
         }
         source = s.source();
     }
-    text
+    // dicom-rs quotes what it read (a transfer syntax UID, a value): one line, escaped.
+    super::one_line(&text)
 }
 
 fn read_file(h: &FileHeader, per_slice: usize) -> Result<Vec<Slice>, LoadError> {
     let pixels_error = |message: String| LoadError::DicomPixels { path: h.path.clone(), message };
     let object = dicom_object::open_file(&h.path)
-        .map_err(|e| LoadError::DicomRead { path: h.path.clone(), reason: e.to_string() })?;
+        .map_err(|e| LoadError::DicomRead { path: h.path.clone(), reason: super::one_line(&e.to_string()) })?;
     let slice = |stored: Stored| Slice { stored, slope: h.rescale.0, intercept: h.rescale.1 };
     if let Some(values) = checks::float_pixels(h, &object, per_slice)? {
         return Ok(values
@@ -261,7 +263,7 @@ fn read_file(h: &FileHeader, per_slice: usize) -> Result<Vec<Slice>, LoadError> 
     let signed = decoded.pixel_representation() == dicom_pixeldata::PixelRepresentation::Signed;
     (0..h.frames)
         .map(|frame| {
-            let bytes = decoded.frame_data(frame).map_err(|e| pixels_error(format!("frame {frame}: {e}")))?;
+            let bytes = decoded.frame_data(frame).map_err(|e| pixels_error(format!("frame {frame}: {}", causes(&e))))?;
             let raw = stored_values(bytes, bits, stored, signed).ok_or_else(|| {
                 pixels_error(format!(
                     "BitsAllocated {bits} is not supported; volgraph reads 1-, 8-, 16- and 32-bit greyscale pixels"

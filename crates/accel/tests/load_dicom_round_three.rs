@@ -188,6 +188,32 @@ fn dicom_rs_quoting_a_newline_from_the_file_cannot_forge_a_line() {
 }
 
 #[test]
+fn numbers_written_with_vr_un_are_read_as_their_text() {
+    // As pydicom's rtdose_rle.dcm has them: DS text in an element whose VR is UN.
+    let dir = fresh(&root(), "un_numbers");
+    let mut image = Image::default();
+    image.replace.push((tags::PIXEL_SPACING, VR::UN, String::new()));
+    let path = image.write(&dir, "IM0001.dcm");
+    let mut o = dicom_object::open_file(&path).expect("written");
+    o.put(dicom_core::DataElement::new(
+        tags::PIXEL_SPACING,
+        VR::UN,
+        dicom_core::value::PrimitiveValue::U8(b"0.25\\0.75".to_vec().into()),
+    ));
+    o.write_to_file(&path).expect("rewritten");
+    let v = load(&[path]).expect("loads").volume;
+    assert_eq!((v.spacing.x, v.spacing.y), (0.75, 0.25), "column spacing along x, row spacing along y");
+}
+
+#[test]
+fn a_dicom_file_without_an_image_says_so() {
+    let mut image = Image::default();
+    image.remove = vec![tags::ROWS, tags::COLUMNS];
+    let (path, e) = error_of("no_image", image);
+    assert_names(&e, &path, &["is a DICOM object without an image (no Rows or Columns"]);
+}
+
+#[test]
 fn a_malformed_rescale_slope_is_an_error_not_one() {
     for bad in ["NaN", "abc", "0"] {
         let (path, e) = error_of("slope", Image::default().with(tags::RESCALE_SLOPE, VR::DS, bad));

@@ -127,14 +127,22 @@ fn dicom_magic_at(path: &Path) -> Result<Option<u64>, LoadError> {
 
 /// The text of `tag`, trimmed; `None` when absent or empty.
 pub fn text(object: &DefaultDicomObject, tag: Tag) -> Option<String> {
-    let value = object.get(tag)?.to_str().ok()?;
+    let e = object.get(tag)?;
+    let value = match e.value() {
+        // Text written with VR UN stays bytes in dicom-rs.
+        dicom_core::value::Value::Primitive(dicom_core::value::PrimitiveValue::U8(bytes)) => {
+            String::from_utf8_lossy(bytes).into_owned().into()
+        }
+        _ => e.to_str().ok()?,
+    };
     let value = value.trim_matches(|c: char| c.is_whitespace() || c == '\0');
     (!value.is_empty()).then(|| value.to_string())
 }
 
 /// The numbers of `tag` (DS, IS, FD, US…).
 pub fn numbers(object: &DefaultDicomObject, tag: Tag) -> Option<Vec<f64>> {
-    object.get(tag)?.to_multi_float64().ok().filter(|v| !v.is_empty())
+    let e = object.get(tag)?;
+    un_numbers(e).or_else(|| e.to_multi_float64().ok()).filter(|v| !v.is_empty())
 }
 
 /// The first finite number of `tag`, where a malformed value only loses a label (SeriesNumber,
@@ -176,10 +184,24 @@ fn checked(
     if e.to_str().is_ok_and(|t| t.trim_matches(|c: char| c.is_whitespace() || c == '\0').is_empty()) {
         return Ok(None);
     }
-    match e.to_multi_float64() {
-        Ok(v) if v.len() == count && v.iter().all(|x| x.is_finite()) => Ok(Some(v)),
+    match un_numbers(e).or_else(|| e.to_multi_float64().ok()) {
+        Some(v) if v.len() == count && v.iter().all(|x| x.is_finite()) => Ok(Some(v)),
         _ => Err(bad(path, element, name, tag, expected)),
     }
+}
+
+/// The numbers of an element written with VR UN (unknown) whose bytes are a DS or IS text, as
+/// some converters write them (pydicom's `rtdose_rle.dcm`).
+fn un_numbers(e: &Element) -> Option<Vec<f64>> {
+    // dicom-rs keeps such a value as bytes (whatever VR it then gives the element).
+    let dicom_core::value::Value::Primitive(dicom_core::value::PrimitiveValue::U8(bytes)) = e.value() else {
+        return None;
+    };
+    let text = std::str::from_utf8(bytes).ok()?;
+    text.trim_matches(|c: char| c.is_whitespace() || c == '\0')
+        .split('\\')
+        .map(|v| v.trim().parse::<f64>().ok())
+        .collect()
 }
 
 /// A whole number in `range` from `element`, `Ok(None)` when absent or empty.
@@ -228,12 +250,18 @@ fn nested(items: &[dicom_object::InMemDicomObject], index: usize, tag: Tag) -> O
 /// deflated data set at most deflate's 1032:1.
 fn check_size(
     path: &Path,
-    transfer_syntax: &str,
+    (transfer_syntax, photometric): (&str, &str),
     (rows, columns, frames, samples, bits): (u32, u32, u32, u32, u32),
     file_len: u64,
 ) -> Result<(), LoadError> {
     use dicom_encoding::transfer_syntax::TransferSyntaxIndex;
-    let bits_per_frame = u128::from(rows) * u128::from(columns) * u128::from(samples) * u128::from(bits);
+    // Half-samples per pixel: chroma subsampled YBR stores 2 (4:2:2) or 1.5 (4:2:0) samples.
+    let half_samples = match photometric {
+        p if p.ends_with("_422") => 4,
+        p if p.ends_with("_420") => 3,
+        _ => 2 * u128::from(samples),
+    };
+    let bits_per_frame = u128::from(rows) * u128::from(columns) * half_samples * u128::from(bits) / 2;
     let needed = (bits_per_frame * u128::from(frames)).div_ceil(8);
     let ts = dicom_transfer_syntax_registry::TransferSyntaxRegistry.get(transfer_syntax);
     let (limit, what) = match ts {
@@ -302,7 +330,13 @@ impl FileHeader {
             whole(path, get(tags::BITS_ALLOCATED), "BitsAllocated", tags::BITS_ALLOCATED, 1.0..=64.0, BITS_EXPECTED)?
                 .unwrap_or(16);
         let transfer_syntax = object.meta().transfer_syntax().trim_end_matches('\0').to_string();
-        check_size(path, &transfer_syntax, (rows, columns, frames, samples_per_pixel, bits_allocated), file_len)?;
+        let photometric = text(object, tags::PHOTOMETRIC_INTERPRETATION).unwrap_or_default();
+        check_size(
+            path,
+            (&transfer_syntax, &photometric),
+            (rows, columns, frames, samples_per_pixel, bits_allocated),
+            file_len,
+        )?;
 
         let one = |tag: Tag, name: &str, expected| -> Result<Option<f64>, LoadError> {
             Ok(checked(path, get(tag), name, tag, 1, expected)?.map(|v| v[0]))
@@ -418,7 +452,7 @@ impl FileHeader {
             modality: text(object, tags::MODALITY).unwrap_or_default(),
             samples_per_pixel: samples_per_pixel as u16,
             bits_allocated: bits_allocated as u16,
-            photometric: text(object, tags::PHOTOMETRIC_INTERPRETATION).unwrap_or_default(),
+            photometric,
             frames,
             rescale: (slope.map_or(1.0, |s| s.0), intercept.unwrap_or(0.0)),
             rescale_type: text(object, tags::RESCALE_TYPE).or_else(|| text(object, tags::DOSE_UNITS)),

@@ -147,33 +147,42 @@ fn collect_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, LoadError> {
 pub fn scan(paths: &[PathBuf]) -> Result<(Vec<Vec<FileHeader>>, Vec<String>), LoadError> {
     let files = collect_files(paths)?;
     let probes: Vec<Result<Probe, LoadError>> = files.par_iter().map(|f| header::probe(f)).collect();
-    let (mut images, mut not_dicom, mut dicomdirs, mut no_image) = (Vec::new(), 0usize, 0usize, 0usize);
-    for probe in probes {
+    let (mut images, mut not_dicom, mut dicomdirs, mut no_image) = (Vec::new(), 0usize, 0usize, Vec::new());
+    for (probe, file) in probes.into_iter().zip(&files) {
         match probe? {
             Probe::NotDicom => not_dicom += 1,
             Probe::Dicomdir => dicomdirs += 1,
-            Probe::NoImage => no_image += 1,
+            Probe::NoImage => no_image.push(file),
             Probe::Image(h) => images.push(*h),
         }
     }
     let place = paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
+    if let (true, Some(first)) = (images.is_empty(), no_image.first()) {
+        return Err(LoadError::DicomPixels {
+            path: first.to_path_buf(),
+            message: format!(
+                "is a DICOM object without an image (no Rows or Columns: a report, plan, structure set or \
+                 waveform){}; give the folder or files of the image slices",
+                if no_image.len() > 1 {
+                    format!(", as are {} other file(s) here", no_image.len() - 1)
+                } else {
+                    String::new()
+                }
+            ),
+        });
+    }
     if images.is_empty() {
         let what = if paths.len() == 1 && paths[0].is_dir() { "is a folder with" } else { "holds" };
-        return Err(LoadError::NoDicomImages {
-            place,
-            what,
-            files: files.len(),
-            not_dicom: not_dicom + no_image,
-            dicomdirs,
-        });
+        return Err(LoadError::NoDicomImages { place, what, files: files.len(), not_dicom, dicomdirs });
     }
     let mut notes = Vec::new();
     if not_dicom > 0 {
         notes.push(format!("skipped {not_dicom} file(s) that are not DICOM"));
     }
-    if no_image > 0 {
+    if !no_image.is_empty() {
         notes.push(format!(
-            "skipped {no_image} DICOM file(s) without an image (no Rows or Columns: reports, presentation states)"
+            "skipped {} DICOM file(s) without an image (no Rows or Columns: reports, presentation states)",
+            no_image.len()
         ));
     }
     if dicomdirs > 0 {

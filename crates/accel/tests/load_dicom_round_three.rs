@@ -191,9 +191,7 @@ fn dicom_rs_quoting_a_newline_from_the_file_cannot_forge_a_line() {
 fn numbers_written_with_vr_un_are_read_as_their_text() {
     // As pydicom's rtdose_rle.dcm has them: DS text in an element whose VR is UN.
     let dir = fresh(&root(), "un_numbers");
-    let mut image = Image::default();
-    image.replace.push((tags::PIXEL_SPACING, VR::UN, String::new()));
-    let path = image.write(&dir, "IM0001.dcm");
+    let path = Image::default().write(&dir, "IM0001.dcm");
     let mut o = dicom_object::open_file(&path).expect("written");
     o.put(dicom_core::DataElement::new(
         tags::PIXEL_SPACING,
@@ -207,8 +205,7 @@ fn numbers_written_with_vr_un_are_read_as_their_text() {
 
 #[test]
 fn a_dicom_file_without_an_image_says_so() {
-    let mut image = Image::default();
-    image.remove = vec![tags::ROWS, tags::COLUMNS];
+    let image = Image { remove: vec![tags::ROWS, tags::COLUMNS], ..Image::default() };
     let (path, e) = error_of("no_image", image);
     assert_names(&e, &path, &["is a DICOM object without an image (no Rows or Columns"]);
 }

@@ -425,7 +425,7 @@ impl SeriesSlices {
                 format: "DICOM series with flipped or swapped axes",
             });
         }
-        let name = series_label(paths, &first);
+        let name = series_label(paths, first);
         let eight_bit = series.iter().all(|h| h.bits_allocated == 8 && h.rescale == (1.0, 0.0));
         // The axes are the world's (checked above), so voxel (0, 0, 0) is the stack's origin.
         let meta = series_meta(first, stack.origin);

@@ -289,6 +289,7 @@ fn run_cases() {
     let (ok, err, panics, slow) = (Cell::new(0u64), Cell::new(0u64), Cell::new(0u64), Cell::new(0u64));
     let first_failure = RefCell::new(None::<String>);
     let slowest = Cell::new(Duration::ZERO);
+    let slowest_case = RefCell::new(String::new());
     let current = Arc::new(Mutex::new(None::<(Instant, String)>));
     let done = Arc::new(AtomicBool::new(false));
     let started = Arc::new(AtomicU64::new(0));
@@ -345,7 +346,10 @@ fn run_cases() {
         if let Ok(mut c) = current.lock() {
             *c = None;
         }
-        slowest.set(slowest.get().max(took));
+        if took > slowest.get() {
+            slowest.set(took);
+            *slowest_case.borrow_mut() = format!("{case:?}");
+        }
         let mut failure = None;
         match outcome {
             Ok(Ok(_)) => ok.set(ok.get() + 1),
@@ -377,13 +381,14 @@ fn run_cases() {
     let _ = watchdog.join();
     eprintln!(
         "dicom fuzz: {} cases: {} Ok, {} Err, {} panics, 0 aborts (the process lived), {} hangs over {HANG_SECONDS}s; \
-         slowest {:.1} ms, {:.0}s in all",
+         slowest {:.1} ms ({}), {:.0}s in all",
         ok.get() + err.get() + panics.get(),
         ok.get(),
         err.get(),
         panics.get(),
         slow.get(),
         slowest.get().as_secs_f64() * 1e3,
+        slowest_case.borrow(),
         began.elapsed().as_secs_f64()
     );
     assert!(result.is_ok(), "{result:?}");

@@ -125,6 +125,26 @@ fn a_corrupt_length_is_an_error_before_dicom_rs_sizes_a_buffer_by_it() {
     assert_names(&e, &path, &[&format!("element (0028,0004) at byte {at} claims 1330532173 bytes, but only")]);
 }
 
+#[test]
+fn a_length_that_is_not_a_whole_number_of_values_is_an_error_not_seconds_of_allocation() {
+    // Found by the fuzzer: HighBit's VR US flipped to UL keeps its length 2; dicom-rs reads no
+    // 4-byte value, leaves 2 bytes, and takes value bytes as the next header (a 1.5 GB length).
+    let dir = fresh(&root(), "misaligned");
+    let mut bytes = Image::default().bytes();
+    let at = bytes.windows(6).position(|w| w == [0x28, 0x00, 0x02, 0x01, b'U', b'S']).expect("HighBit");
+    bytes[at + 5] = b'L';
+    let path = dir.join("IM0001.dcm");
+    std::fs::write(&path, &bytes).expect("written");
+    let started = std::time::Instant::now();
+    let e = load(std::slice::from_ref(&path)).map(|_| ()).expect_err("an error");
+    assert_names(
+        &e,
+        &path,
+        &[&format!("element (0028,0102) at byte {at} has VR UL and length 2, not a multiple of its 4-byte values")],
+    );
+    assert!(started.elapsed().as_millis() < 500, "{:?}", started.elapsed());
+}
+
 fn folder_of_three(name: &str) -> PathBuf {
     let dir = fresh(&root(), name);
     series(&dir, 3, &Image::default());

@@ -23,6 +23,27 @@ const SHORT_VRS: [&[u8; 2]; 21] = [
     b"ST", b"TM", b"UI", b"UL", b"US",
 ];
 
+/// Bytes per value of the binary VRs dicom-rs reads as arrays (1 for the others). It reads
+/// `length / size` values and leaves the rest: a length that is not a multiple misaligns its
+/// parse, which then takes value bytes for the next header (and its length, up to 4 GB).
+fn value_size(vr: &[u8; 2]) -> u32 {
+    match vr {
+        b"US" | b"SS" | b"OW" => 2,
+        b"UL" | b"SL" | b"FL" | b"OF" | b"OL" | b"AT" => 4,
+        b"FD" | b"OD" | b"SV" | b"UV" | b"OV" => 8,
+        _ => 1,
+    }
+}
+
+/// The VR the standard dictionary gives `tag` (what dicom-rs reads an implicit VR element as).
+fn dictionary_vr(group: u16, element: u16) -> Option<[u8; 2]> {
+    use dicom_core::dictionary::{DataDictionary, DataDictionaryEntry, VirtualVr};
+    match dicom_dictionary_std::StandardDataDictionary.by_tag(dicom_core::Tag(group, element))?.vr() {
+        VirtualVr::Exact(vr) => Some(vr.to_bytes()),
+        _ => None,
+    }
+}
+
 struct Walk<R> {
     from: R,
     at: u64,
@@ -109,6 +130,16 @@ impl<R: Read + Seek> Walk<R> {
                 continue;
             }
             self.fits(start, (group, element), length)?;
+            if let Some(v) = vr.or_else(|| dictionary_vr(group, element)) {
+                let size = value_size(&v);
+                if length % size != 0 {
+                    return Err(format!(
+                        "element ({group:04X},{element:04X}) at byte {start} has VR {} and length {length}, not a \
+                         multiple of its {size}-byte values",
+                        super::one_line(&String::from_utf8_lossy(&v))
+                    ));
+                }
+            }
             if vr == Some(*b"SQ") {
                 let seq_end = self.at + u64::from(length);
                 self.elements(seq_end, explicit, big, depth + 1)?;

@@ -171,10 +171,11 @@ impl ValueSummary {
         }
     }
 
-    /// The histogram in `bins` bins, which must divide [`FIT_BINS`]: exactly
-    /// [`Histogram::of`]`(volume, bins)` (a bin of `v·bins` is the bin of `v·FIT_BINS` divided by
-    /// `FIT_BINS / bins`, both products exact in binary floating point).
+    /// The histogram in `bins` bins, which must divide [`FIT_BINS`] (the callers ask for 256
+    /// and 1024): exactly [`Histogram::of`]`(volume, bins)` (a bin of `v·bins` is the bin of
+    /// `v·FIT_BINS` divided by `FIT_BINS / bins`, both products exact in binary floating point).
     pub fn binned(&self, bins: usize) -> Histogram {
+        debug_assert!(bins > 0 && FIT_BINS % bins == 0, "{bins} bins do not divide {FIT_BINS}");
         let group = (FIT_BINS / bins.clamp(1, FIT_BINS)).max(1);
         let counts: Vec<u64> = self.histogram.counts.chunks(group).map(|c| c.iter().sum()).collect();
         Histogram { total: counts.iter().sum(), counts }

@@ -57,13 +57,22 @@ pub struct BrickWeights {
 impl BrickWeights {
     /// Bricks per axis.
     pub fn bricks(dims: UVec3, brick: u32) -> UVec3 {
-        (dims + UVec3::splat(brick.max(1) - 1)) / brick.max(1)
+        let b = brick.max(1);
+        UVec3::new(dims.x.div_ceil(b), dims.y.div_ceil(b), dims.z.div_ceil(b))
+    }
+
+    /// How many bricks of `brick` voxels a volume of `dims` has (in u64: no overflow for any
+    /// dims, so callers can check it before [`Self::zeros`] allocates a weight for each).
+    pub fn count(dims: UVec3, brick: u32) -> u64 {
+        let n = Self::bricks(dims, brick);
+        n.x as u64 * n.y as u64 * n.z as u64
     }
 
     /// Zero weights for `dims` in bricks of `brick` voxels.
     pub fn zeros(dims: UVec3, brick: u32) -> Self {
         let n = Self::bricks(dims, brick);
-        Self { dims, brick: brick.max(1), weight: vec![0; (n.x * n.y * n.z) as usize] }
+        let count = n.x as usize * n.y as usize * n.z as usize;
+        Self { dims, brick: brick.max(1), weight: vec![0; count] }
     }
 
     /// The index of the brick holding voxel `v`.

@@ -22,6 +22,13 @@ const MAX_LINKS: usize = 40;
 /// (checked on the permission bits, so root is refused too). Errors name `path`, never the
 /// temporary file, which is removed when anything fails.
 pub fn write_atomically(path: &Path, text: &str) -> anyhow::Result<()> {
+    write_bytes_atomically(path, text.as_bytes())
+}
+
+/// [`write_atomically`] for bytes (an image): the one implementation. Never opens `path` itself,
+/// so a FIFO there (made at any moment) never blocks the writer: it is refused, or replaced by
+/// the rename.
+pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     let shown = path.display();
     if let Ok(Some(kind)) = volgraph_accel::input_file::special_kind(path) {
         return Err(anyhow!("{shown}: is {kind}, not a file to write; give the path of a file"));
@@ -41,7 +48,10 @@ pub fn write_atomically(path: &Path, text: &str) -> anyhow::Result<()> {
         _ => PathBuf::from("."),
     };
     let name = target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let prefix = format!(".{name}.");
+    // At most 32 characters of the name: a legal name near NAME_MAX (255 bytes) would make the
+    // temporary name too long and the folder seem to refuse a new file.
+    let short: String = name.chars().take(32).collect();
+    let prefix = format!(".{short}.");
     let mut builder = tempfile::Builder::new();
     builder.prefix(&prefix).suffix(".volgraph.tmp");
     // Created with the old file's permissions (or, for a new file, what the umask leaves of
@@ -53,7 +63,7 @@ pub fn write_atomically(path: &Path, text: &str) -> anyhow::Result<()> {
         anyhow!("{shown}: cannot write: the folder {} refused a new file: {}", dir.display(), os_reason(&e))
     })?;
     use std::io::Write as _;
-    tmp.write_all(text.as_bytes())
+    tmp.write_all(bytes)
         .and_then(|()| tmp.flush())
         .map_err(|e| anyhow!("{shown}: cannot write: {}", os_reason(&e)))?;
     if let Some(meta) = &existing {
@@ -173,5 +183,15 @@ mod tests {
         std::os::unix::fs::symlink("a", dir.join("b")).expect("link");
         let e = write_atomically(&dir.join("a"), "x").expect_err("a loop");
         assert!(e.to_string().contains("a loop?"), "{e}");
+    }
+
+    /// A legal name of 250 bytes: the temporary name beside it was longer than NAME_MAX, and
+    /// the folder seemed to refuse a new file.
+    #[test]
+    fn a_name_near_the_length_limit_is_written() {
+        let dir = scratch("long");
+        let path = dir.join(format!("{}.ron", "g".repeat(246)));
+        write_atomically(&path, "one").expect("a legal name is written");
+        assert_eq!(std::fs::read_to_string(&path).expect("read"), "one");
     }
 }

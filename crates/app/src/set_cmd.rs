@@ -34,7 +34,9 @@ pub fn run(graph: &Path, assignments: &[String]) -> Result<String, CliError> {
     // of a pass without `params` make one map); `at` follows each value's place as later edits
     // insert text before it.
     let mut edited = source.clone();
-    let mut done: Vec<(SetTarget, String, usize, String)> = Vec::new();
+    // Per assignment: what, the value, where it now is, its note, and where the copies it
+    // shadows are (offsets, moved with every later edit as `at` is).
+    let mut done: Vec<(SetTarget, String, usize, String, Vec<usize>)> = Vec::new();
     for assignment in assignments {
         let Some((target, value)) = assignment.split_once('=') else {
             return Err(anyhow!("\"{assignment}\": expected PASS.PARAM=VALUE or input.NAME=VALUE").into());
@@ -44,26 +46,26 @@ pub fn run(graph: &Path, assignments: &[String]) -> Result<String, CliError> {
             return Err(anyhow!("{target} is set twice; give each name once").into());
         }
         let edit = edit_for(&edited, &target, value).map_err(|e| anyhow!("{shown}: {e}"))?;
-        let last = &edit[edit.len() - 1];
+        let last = edit.last().ok_or_else(|| anyhow!("{shown}: internal: no edit for {target}"))?;
         let was = &edited[last.span.start..last.span.end];
-        let mut note = if was.is_empty() { "not in the file".to_string() } else { format!("was {was}") };
-        let shadowed: Vec<String> =
-            shadowed_copies(&edited, &target).iter().map(|s| line_col(&edited, s.start).0.to_string()).collect();
-        if !shadowed.is_empty() {
-            note += &format!(
-                "; line {} writes it too, with no effect: the last copy counts — delete the other",
-                shadowed.join(", ")
-            );
-        }
-        for (_, _, at, _) in &mut done {
+        let note = if was.is_empty() { "not in the file".to_string() } else { format!("was {was}") };
+        let shadowed: Vec<usize> = shadowed_copies(&edited, &target).iter().map(|s| s.start).collect();
+        // This edit moves every place found so far that lies after the text it replaces.
+        let moved = |at: &mut usize| {
             let before: Vec<_> = edit.iter().filter(|e| e.span.end <= *at).collect();
             for e in before {
                 *at = (*at + e.text.len()).saturating_sub(e.span.end - e.span.start);
             }
+        };
+        for (_, _, at, _, copies) in &mut done {
+            moved(at);
+            copies.iter_mut().for_each(moved);
         }
+        let mut shadowed = shadowed;
+        shadowed.iter_mut().for_each(moved);
         let at = last.span.start;
         edited = apply(&edited, &edit);
-        done.push((target, value.trim().to_string(), at, note));
+        done.push((target, value.trim().to_string(), at, note, shadowed));
     }
     // Checked like a compile: the edited text must compile, else nothing is written.
     let options = compile_options("256x256", &[], &[])?;
@@ -73,7 +75,17 @@ pub fn run(graph: &Path, assignments: &[String]) -> Result<String, CliError> {
     }
     let lines = done
         .iter()
-        .map(|(target, value, at, note)| format!("{shown}:{}: {target} = {value} ({note})", line_col(&edited, *at).0))
+        .map(|(target, value, at, note, copies)| {
+            let mut note = note.clone();
+            if !copies.is_empty() {
+                let lines: Vec<String> = copies.iter().map(|c| line_col(&edited, *c).0.to_string()).collect();
+                note += &format!(
+                    "; line {} writes it too, with no effect: the last copy counts — delete the other",
+                    lines.join(", ")
+                );
+            }
+            format!("{shown}:{}: {target} = {value} ({note})", line_col(&edited, *at).0)
+        })
         .collect::<Vec<_>>()
         .join("\n");
     Ok(lines + "\n")

@@ -96,15 +96,18 @@ pub fn launch() -> Result<(), CliError> {
         .ok_or_else(|| CliError::Other(anyhow!("internal: rank 0's command is not render")))?;
     let outcome = run(&mut ex, &args);
     // One write of the whole line: lines of ranks sharing a stderr pipe never interleave. An
-    // error is the same on every rank (they agreed on it, naming the rank it came from unless
-    // every rank failed alike): rank 0 prints it once.
+    // error the ranks agreed on is the same on every rank (naming the rank it came from unless
+    // every rank failed alike): rank 0 prints it once. Any other error (compositing's exchanges)
+    // is this rank's own: it prints it, naming itself.
     use std::io::Write as _;
+    let text = |e: &CliError| volgraph_core::terminal::escape_controls(&crate::cli::error_text(e)).into_owned();
     let line = match &outcome {
         Ok(report) => format!("{}\n", report.line()),
-        Err(e) if ex.rank() == 0 => {
-            format!("error: {}\n", volgraph_core::terminal::escape_controls(&crate::cli::error_text(e)))
-        }
-        Err(_) => String::new(),
+        Err(e) if is_agreed(e) => match ex.rank() {
+            0 => format!("error: {}\n", text(e)),
+            _ => String::new(),
+        },
+        Err(e) => format!("error: rank {}: {}\n", ex.rank(), text(e)),
     };
     let _ = std::io::stderr().write_all(line.as_bytes());
     if outcome.is_err() {
@@ -130,9 +133,19 @@ fn other(e: ExchangeError) -> CliError {
     CliError::Other(anyhow!("{e}"))
 }
 
-/// Agrees on a step's outcome: every rank gets the first failing rank's message.
+/// Agrees on a step's outcome: every rank gets the first failing rank's message (or, when every
+/// rank failed alike, the message naming no rank), kept as the [`ExchangeError`] it is, so that
+/// [`is_agreed`] knows it.
 fn step<E: Exchange + ?Sized, T>(ex: &mut E, outcome: anyhow::Result<T>) -> Result<T, CliError> {
-    agree(ex, outcome.map_err(|e| format!("{e:#}"))).map_err(other)
+    agree(ex, outcome.map_err(|e| format!("{e:#}"))).map_err(|e| match e {
+        ExchangeError::Remote { .. } | ExchangeError::Everywhere { .. } => CliError::Other(anyhow::Error::new(e)),
+        transport => other(transport),
+    })
+}
+
+/// True for an error every rank holds alike (a [`step`]'s): one rank prints it for all.
+fn is_agreed(e: &CliError) -> bool {
+    matches!(e, CliError::Other(e) if e.downcast_ref::<ExchangeError>().is_some())
 }
 
 /// Renders the job `args` as rank `ex.rank()` of `ex.size()`: the whole of `--distributed`

@@ -65,11 +65,12 @@ impl Survey {
 pub fn brick_for(dims: UVec3, factors: &[usize]) -> Result<u32, SplitError> {
     let mut last = Err(SplitError::NoParts);
     for brick in BRICKS {
-        let zeros = BrickWeights::zeros(dims, brick);
-        if brick < BRICKS[0] && zeros.weight.len() as u64 * (BINS * 8) as u64 > MAX_BIN_BYTES {
+        // Checked before the weights are made: a finer brick than the histograms can afford is
+        // not tried (the coarsest always is, as the loaders' checks bound the volume).
+        if brick < BRICKS[0] && BrickWeights::count(dims, brick).saturating_mul((BINS * 8) as u64) > MAX_BIN_BYTES {
             break;
         }
-        last = KdTree::balanced(&zeros, factors).map(|_| brick);
+        last = KdTree::balanced(&BrickWeights::zeros(dims, brick), factors).map(|_| brick);
         if last.is_ok() {
             break;
         }
@@ -150,19 +151,8 @@ pub fn survey<E: Exchange + ?Sized>(ex: &mut E, header: &VolumeHeader, brick: u3
     });
     agree(ex, read.map_err(|e| e.to_string())).map_err(fail)?;
     // Everyone gets the histograms (summed) and the preview slices (in rank order = z order).
-    let all_bins = all_gather(ex, u64_bytes(&bins)).map_err(fail)?;
-    let mut summed = vec![0u64; bins.len()];
-    for m in &all_bins {
-        for (s, c) in summed.iter_mut().zip(m.chunks_exact(8)) {
-            *s += u64::from_le_bytes(c.try_into().unwrap_or([0; 8]));
-        }
-    }
-    let mut fit_summed = vec![0u64; FIT_BINS];
-    for m in &all_gather(ex, u64_bytes(&fit)).map_err(fail)? {
-        for (s, c) in fit_summed.iter_mut().zip(m.chunks_exact(8)) {
-            *s += u64::from_le_bytes(c.try_into().unwrap_or([0; 8]));
-        }
-    }
+    let summed = summed_over_ranks(ex, &bins).map_err(fail)?;
+    let fit_summed = summed_over_ranks(ex, &fit).map_err(fail)?;
     let all_preview = all_gather(ex, preview_part.iter().flat_map(|v| v.to_le_bytes()).collect()).map_err(fail)?;
     let values: Vec<f32> = all_preview
         .iter()
@@ -186,6 +176,20 @@ pub fn survey<E: Exchange + ?Sized>(ex: &mut E, header: &VolumeHeader, brick: u3
         ct_hu: header.meta.is_ct_hu(),
     };
     Ok(Survey { value_range, preview, values, brick, bins: summed, bytes_read })
+}
+
+/// Every rank's `counts`, added element by element: the counts of the whole file.
+fn summed_over_ranks<E: Exchange + ?Sized>(
+    ex: &mut E,
+    counts: &[u64],
+) -> Result<Vec<u64>, volgraph_composite::ExchangeError> {
+    let mut summed = vec![0u64; counts.len()];
+    for m in &all_gather(ex, u64_bytes(counts))? {
+        for (s, c) in summed.iter_mut().zip(m.chunks_exact(8)) {
+            *s += u64::from_le_bytes(c.try_into().unwrap_or([0; 8]));
+        }
+    }
+    Ok(summed)
 }
 
 fn u64_bytes(v: &[u64]) -> Vec<u8> {

@@ -37,16 +37,20 @@ const MAX_EDGE: i64 = 4096;
 /// bytes, and the volume each loader returns with what it reads.
 const COPIES: u64 = 5;
 
+/// Address space kept free under `ulimit -v` besides the copies: thread stacks, allocator
+/// arenas, the DICOM writer's and reader's buffers, libraries mapped later.
+const MARGIN: u64 = 256 << 20;
+
 /// Refuses a series that would not fit in memory, before anything is allocated.
 fn check_memory(args: &LoadArgs) -> anyhow::Result<()> {
     let bytes = u64::from(args.size) * u64::from(args.size) * u64::from(args.slices) * 2;
     let need = bytes.saturating_mul(COPIES);
-    if let Some(available) = available_memory()
+    if let Some((available, which)) = available_memory()
         && need > available
     {
         anyhow::bail!(
             "--size {} --slices {}: the phantom is {:.0} MB of int16 and the benchmark holds up to {COPIES} copies of \
-             it ({:.0} MB), more than the {:.0} MB of memory available; choose a smaller --size or --slices",
+             it ({:.0} MB), more than the {:.0} MB of memory available; choose a smaller --size or --slices (available: {which})",
             args.size,
             args.slices,
             bytes as f64 / 1e6,
@@ -57,9 +61,12 @@ fn check_memory(args: &LoadArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The memory this process may still take, where the system says: `MemAvailable` of
-/// `/proc/meminfo`, or the address-space limit (`ulimit -v`, for the whole process) when lower.
-fn available_memory() -> Option<u64> {
+/// The memory this process may still take, where the system says, and where the figure comes
+/// from: `MemAvailable` of `/proc/meminfo`, or, when lower, what the address-space limit
+/// (`ulimit -v`, for the whole process) leaves: the limit less the address space the process
+/// already uses (`VmSize` of `/proc/self/status`) less [`MARGIN`]. Where `VmSize` cannot be
+/// read, the whole limit is taken, as before.
+fn available_memory() -> Option<(u64, String)> {
     let meminfo = std::fs::read_to_string("/proc/meminfo").ok().and_then(|text| {
         let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
         line.split_whitespace().nth(1)?.parse::<u64>().ok().map(|kib| kib * 1024)
@@ -68,8 +75,26 @@ fn available_memory() -> Option<u64> {
         let line = text.lines().find(|l| l.starts_with("Max address space"))?;
         line.split_whitespace().nth(3)?.parse::<u64>().ok()
     });
+    let used = std::fs::read_to_string("/proc/self/status").ok().and_then(|text| {
+        let line = text.lines().find(|l| l.starts_with("VmSize:"))?;
+        line.split_whitespace().nth(1)?.parse::<u64>().ok().map(|kib| kib * 1024)
+    });
+    let limit = limit.map(|limit| match used {
+        Some(used) => (
+            limit.saturating_sub(used).saturating_sub(MARGIN),
+            format!(
+                "the address-space limit of {:.0} MB less the {:.0} MB this process already uses and a margin of \
+                 {:.0} MB",
+                limit as f64 / 1e6,
+                used as f64 / 1e6,
+                MARGIN as f64 / 1e6
+            ),
+        ),
+        None => (limit, format!("the address-space limit of {:.0} MB", limit as f64 / 1e6)),
+    });
+    let meminfo = meminfo.map(|a| (a, "MemAvailable of /proc/meminfo".to_string()));
     match (meminfo, limit) {
-        (Some(a), Some(b)) => Some(a.min(b)),
+        (Some(a), Some(b)) => Some(if b.0 < a.0 { b } else { a }),
         (a, b) => a.or(b),
     }
 }

@@ -59,6 +59,29 @@ fn bench_load_too_large_for_memory_is_refused_before_allocating() {
 }
 
 #[test]
+fn bench_load_just_under_the_address_space_limit_counts_what_the_process_already_uses() {
+    // 4096 × 4096 × 25 int16 is 839 MB, five copies 4194 MB: under the 4295 MB of `ulimit -v`
+    // 4 GiB, so the whole limit let it through, but not under what the limit leaves once the
+    // process's own address space (VmSize) and the margin are counted.
+    let run = bench(&["bench", "load", "--size", "4096", "--slices", "25"]);
+    assert_eq!(run.code, 1, "{}", run.stderr);
+    assert!(
+        run.stderr.contains("--size 4096 --slices 25: the phantom is 839 MB of int16")
+            && run.stderr.contains("up to 5 copies of it (4194 MB), more than the"),
+        "{}",
+        run.stderr
+    );
+    // The figure is the limit's (unless the machine has less memory free than that).
+    assert!(
+        run.stderr.contains("(available: the address-space limit of 4295 MB less the ")
+            && run.stderr.contains("MB this process already uses and a margin of 268 MB)")
+            || run.stderr.contains("(available: MemAvailable of /proc/meminfo)"),
+        "{}",
+        run.stderr
+    );
+}
+
+#[test]
 fn bench_live_with_a_missing_graph_names_the_graph_file_not_a_shaders_folder() {
     let run = bench(&["bench", "live", "--graph", "missing.ron"]);
     assert_eq!(run.code, 1, "{}", run.stderr);

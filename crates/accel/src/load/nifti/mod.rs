@@ -6,8 +6,8 @@
 //! hostile file cannot make the loader inflate or allocate gigabytes. Both versions become one
 //! geometry: the sform (when its code is set), else the qform quaternion, else the plain pixdim
 //! scale; RAS world coordinates are turned into LPS as ITK does (x and y negated), so a NIfTI
-//! file and the DICOM series it came from render alike. `scl_slope`/`scl_inter` are applied; a
-//! 4D file needs a frame.
+//! file and the DICOM series it came from render alike. `scl_slope`/`scl_inter` are applied (one
+//! that is not finite is ignored, with a note naming it); a 4D file needs a frame.
 
 mod header;
 mod layout;
@@ -158,11 +158,37 @@ impl<R: Read> Stream<'_, R> {
         Ok(())
     }
 
-    /// Reads the frame's bytes, allocating as they come (a stream may end early).
+    /// Reads the frame's bytes. A plain file's length was checked against the header, so the
+    /// whole frame is reserved at once; a gzip stream may end early (and a small file may claim
+    /// up to 1032 times its size), so its bytes are reserved as they come: at most
+    /// [`GZIP_CHUNK`] ahead of what was read, the capacity doubling up to the frame's size.
     fn take(&mut self, layout: &Layout) -> Result<Vec<u8>, LoadError> {
-        let mut data = try_vec(self.path, layout.frame_bytes)?;
-        (&mut self.reader).take(layout.frame_bytes).read_to_end(&mut data).map_err(|e| self.error(e))?;
-        if (data.len() as u64) < layout.frame_bytes {
+        let total = layout.frame_bytes;
+        let mut data;
+        if self.gzip {
+            data = try_vec(self.path, total.min(GZIP_CHUNK))?;
+            let mut rest = total;
+            while rest > 0 {
+                let chunk = rest.min(GZIP_CHUNK);
+                let spare = (data.capacity() - data.len()) as u64;
+                if spare < chunk {
+                    // Double the capacity (fewer copies), but never past the frame's size.
+                    let target = (data.capacity() as u64).saturating_mul(2).max(data.len() as u64 + chunk).min(total);
+                    let more =
+                        usize::try_from(target - data.len() as u64).map_err(|_| no_memory(self.path, total, 1))?;
+                    data.try_reserve_exact(more).map_err(|_| no_memory(self.path, total, 1))?;
+                }
+                let got = (&mut self.reader).take(chunk).read_to_end(&mut data).map_err(|e| self.error(e))? as u64;
+                rest -= got;
+                if got < chunk {
+                    break;
+                }
+            }
+        } else {
+            data = try_vec(self.path, total)?;
+            (&mut self.reader).take(total).read_to_end(&mut data).map_err(|e| self.error(e))?;
+        }
+        if (data.len() as u64) < total {
             let found = format!("the file holds {} bytes{}", layout.start + data.len() as u64, self.inflated());
             return Err(size_error(self.path, layout, &found));
         }
@@ -170,14 +196,20 @@ impl<R: Read> Stream<'_, R> {
     }
 }
 
+/// What a gzip stream's frame is reserved ahead of the bytes read, at most (64 MiB).
+const GZIP_CHUNK: u64 = 64 << 20;
+
+/// The error for `count` elements of `size` bytes that cannot be allocated.
+fn no_memory(path: &Path, count: u64, size: usize) -> LoadError {
+    let mb = count as f64 * size as f64 / 1e6;
+    read_error(path, format!("cannot allocate {mb:.0} MB for the voxels: not enough memory"))
+}
+
 /// An empty vector with room for `count` elements, or an error naming the file when the
 /// memory is not there (instead of aborting the process).
 fn try_vec<T>(path: &Path, count: u64) -> Result<Vec<T>, LoadError> {
     let mut v = Vec::new();
-    let fail = || {
-        let mb = count as f64 * std::mem::size_of::<T>() as f64 / 1e6;
-        read_error(path, format!("cannot allocate {mb:.0} MB for the voxels: not enough memory"))
-    };
+    let fail = || no_memory(path, count, std::mem::size_of::<T>());
     let count = usize::try_from(count).map_err(|_| fail())?;
     v.try_reserve_exact(count).map_err(|_| fail())?;
     Ok(v)
@@ -224,6 +256,12 @@ fn build(path: &Path, h: &Header, layout: Layout, data: &[u8]) -> Result<LoadedV
             .notes
             .push(format!("scl_slope is {}, not a number to scale by; the voxels are not rescaled", h.scl_slope));
         (1.0, 0.0)
+    } else if !h.scl_inter.is_finite() {
+        report.notes.push(format!(
+            "scl_inter is {}, not a number to add; the voxels are scaled by scl_slope only",
+            h.scl_inter
+        ));
+        (h.scl_slope, 0.0)
     } else {
         (h.scl_slope, h.scl_inter)
     };

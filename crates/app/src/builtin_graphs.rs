@@ -61,6 +61,12 @@ pub fn find_tf(argument: &Path) -> Option<(&'static str, &'static str)> {
     if argument.symlink_metadata().is_ok() {
         return None;
     }
+    builtin_tf(argument)
+}
+
+/// The built-in transfer function a name spells (`graphs/tf/vessels.ron`, `tf/vessels`), whatever
+/// exists at that path: for a scene, whose names never depend on the folder it is rendered from.
+pub fn builtin_tf(argument: &Path) -> Option<(&'static str, &'static str)> {
     let name = normalized(argument);
     let stem = name.strip_prefix("tf/")?;
     EMBEDDED_TFS.iter().find(|(n, _)| *n == stem).copied()

@@ -70,6 +70,12 @@ pub enum TfSource {
     Preset(String),
     /// A file `$VOLGRAPH_DATA/tf/<name>.ron` (the peer benchmark's `engine_opaque`, ...).
     Data(String),
+    /// A built-in TF by its stem (`vessels` for `graphs/tf/vessels.ron`): what a scene's
+    /// `File("graphs/tf/vessels.ron")` becomes where no such file is beside the scene, read from
+    /// the program's own copy (never a file of that name in the current folder). Not written in
+    /// scene files.
+    #[serde(skip_deserializing)]
+    BuiltIn(String),
 }
 
 /// How to read the scene's volume: what the command line's `--series`, `--frame`, `--dims`,
@@ -361,7 +367,7 @@ impl Scene {
             other => other,
         };
         let transfer_function = doc.transfer_function.map(|t| match t {
-            TfSource::File(p) => TfSource::File(beside_or_name(&p, &dir, is_tf_name).display().to_string()),
+            TfSource::File(p) => tf_file_or_builtin(&p, &dir),
             other => other,
         });
         Ok(Scene {
@@ -403,6 +409,27 @@ fn beside_or_name(written: &str, dir: &Path, names_builtin: impl Fn(&Path) -> bo
     }
     let beside = dir.join(path);
     if beside.symlink_metadata().is_err() && names_builtin(path) { path.to_path_buf() } else { beside }
+}
+
+/// A scene's `File("…")` transfer function: the file beside the scene when there is one (a
+/// dangling link too), else a scanner preset's name as that preset, else a built-in TF's name as
+/// the built-in; else the path beside the scene (whose error then names it). Never a path
+/// relative to the current folder, so a scene renders the same from any folder.
+fn tf_file_or_builtin(written: &str, dir: &Path) -> TfSource {
+    let path = Path::new(written);
+    if path.is_absolute() {
+        return TfSource::File(written.to_string());
+    }
+    let beside = dir.join(path);
+    if beside.symlink_metadata().is_err() {
+        if let Some(preset) = volgraph_accel::transfer_function::ScannerPreset::from_name(written) {
+            return TfSource::Preset(preset.name().to_string());
+        }
+        if let Some((name, _)) = crate::builtin_graphs::builtin_tf(path) {
+            return TfSource::BuiltIn(name.to_string());
+        }
+    }
+    TfSource::File(beside.display().to_string())
 }
 
 /// Whether `--tf PATH` would read `path` as a built-in: a scanner preset's name or a built-in TF
@@ -642,7 +669,7 @@ mod tests {
                     File(\"ct-bone\"))";
         let s = Scene::from_str(text, &dir.join("s.ron")).expect("parses");
         assert_eq!(s.graph, Some(PathBuf::from("basic/fragment_raycast")));
-        assert_eq!(s.transfer_function, Some(TfSource::File("ct-bone".into())));
+        assert_eq!(s.transfer_function, Some(TfSource::Preset("ct-bone".into())));
         // A file of that name beside the scene wins.
         std::fs::write(dir.join("ct-bone"), "").expect("file");
         let s = Scene::from_str(text, &dir.join("s.ron")).expect("parses");

@@ -575,3 +575,125 @@ fn a_graph_whose_folder_was_deleted_and_made_again_still_reloads() {
     assert!(deleted_seen, "the deleted graph is an error:\n{}", run.stdout);
     assert!(reloaded, "the edit after the folder came back is reloaded:\n{}", run.stdout);
 }
+
+// --- The reviewer's findings on the fixes above ---
+
+/// A TF edit on `ml32`, so "save view" has a TF to write beside the scene.
+fn session_with_an_edited_tf() -> LiveSession {
+    let mut session =
+        open(&root().join("graphs/basic/fragment_raycast.ron"), &[PathBuf::from("ml32")], LoadOptions::default(), None);
+    let next = volgraph_app::view::tf_editor::with_point(
+        session.transfer_function(),
+        ControlPoint { value: 120.0, color: [1.0, 0.2, 0.2], alpha: 0.8 },
+    );
+    let events = session.edit_transfer_function(next);
+    assert!(session.error().is_none(), "{events:?}");
+    assert!(session.tf_edited());
+    session
+}
+
+/// Review of issue 47: "save view" wrote `NAME.tf.ron` before it knew the scene could be
+/// written: a scene path that is a FIFO, a folder or a read-only file left a TF file behind.
+/// Every refusal now writes nothing; a save that writes the TF says so, and says when it
+/// replaced this scene name's own companion from an earlier save.
+#[cfg(unix)]
+#[test]
+fn a_refused_save_view_writes_no_tf_file() {
+    use std::os::unix::fs::PermissionsExt as _;
+    let dir = scratch("refused_save_view");
+    let session = session_with_an_edited_tf();
+    let fifo = dir.join("fifo.ron");
+    mkfifo(&fifo);
+    let folder = dir.join("folder.ron");
+    std::fs::create_dir_all(&folder).expect("folder");
+    let read_only = dir.join("ro.ron");
+    std::fs::write(&read_only, "old").expect("file");
+    std::fs::set_permissions(&read_only, std::fs::Permissions::from_mode(0o444)).expect("chmod");
+    for (scene, words) in [(&fifo, "FIFO"), (&folder, "folder"), (&read_only, "read-only")] {
+        let e = session.save_view(&camera(), (48, 48), scene).expect_err("refused");
+        let text = format!("{e:#}");
+        assert!(text.contains(&scene.display().to_string()) && text.contains(words), "{text}");
+        let tf = volgraph_app::scene::tf_file_beside(scene);
+        assert!(tf.symlink_metadata().is_err(), "{} was written though the scene was refused", tf.display());
+    }
+    assert_eq!(std::fs::read_to_string(&read_only).expect("file"), "old");
+    // A scene whose TF path is a FIFO is refused too, before the scene is written.
+    let scene = dir.join("piped.ron");
+    mkfifo(&volgraph_app::scene::tf_file_beside(&scene));
+    let e = session.save_view(&camera(), (48, 48), &scene).expect_err("refused");
+    assert!(format!("{e:#}").contains("FIFO"), "{e:#}");
+    assert!(!scene.exists(), "the scene was written though its TF could not be");
+    // A good path: the TF is written and reported new, then reported as replaced.
+    let scene = dir.join("good.ron");
+    let first = session.save_view(&camera(), (48, 48), &scene).expect("saved").expect("a TF file");
+    assert_eq!(first.path, volgraph_app::scene::tf_file_beside(&scene));
+    assert!(!first.replaced && first.path.is_file() && scene.is_file());
+    let again = session.save_view(&camera(), (48, 48), &scene).expect("saved").expect("a TF file");
+    assert!(again.replaced, "the second save replaces the scene's own TF file and says so");
+}
+
+/// Review of issue 47: a scene's TF named by a preset's or a built-in TF's name (`File("ct-bone")`,
+/// `File("graphs/tf/vessels.ron")`, no such file beside the scene) was read as a file relative to
+/// the current folder where one was there: the scene's image depended on where it was rendered
+/// from. It is the built-in itself, from any folder.
+#[test]
+fn a_scenes_built_in_tf_name_is_not_read_from_the_current_folder() {
+    let dir = scratch("tf_names_cwd");
+    let clean = dir.join("clean");
+    let shadowed = dir.join("shadowed");
+    std::fs::create_dir_all(shadowed.join("graphs/tf")).expect("folders");
+    std::fs::create_dir_all(&clean).expect("folder");
+    // What a current folder might hold under those names: a TF that would render differently.
+    let other_tf = "TransferFunction(domain: (0.0, 255.0), points: [(value: 0.0, color: (0.0, 0.0, 1.0), \
+                    alpha: 1.0), (value: 255.0, color: (0.0, 0.0, 1.0), alpha: 1.0)])";
+    std::fs::write(shadowed.join("ct-bone"), other_tf).expect("file");
+    std::fs::write(shadowed.join("graphs/tf/vessels.ron"), other_tf).expect("file");
+    for (name, tf) in [("preset", "ct-bone"), ("builtin", "graphs/tf/vessels.ron")] {
+        let scene = dir.join(format!("{name}.scene.ron"));
+        std::fs::write(
+            &scene,
+            format!(
+                "Scene(graph: \"basic/fragment_raycast\", volume: Generated(\"ml32\"), transfer_function: \
+                 File({tf:?}), viewport: (32, 32))"
+            ),
+        )
+        .expect("scene");
+        let render = |cwd: &Path| {
+            let png = cwd.join(format!("{name}.png"));
+            let out = volgraph_in(
+                cwd,
+                &["render", "--scene", &scene.display().to_string(), "-o", &png.display().to_string()],
+            );
+            assert!(out.status.success(), "{name} from {}: {}", cwd.display(), String::from_utf8_lossy(&out.stderr));
+            read_rgba(&png)
+        };
+        let (a, b) = (render(&clean), render(&shadowed));
+        assert!(a == b, "{name}: the scene's image depends on the current folder ({tf} there)");
+    }
+}
+
+/// Review of issue 47: a screenshot was checked, then written by `image.save(path)`, which
+/// blocks on a FIFO made in between. It is now written by `write_bytes_atomically`, which never
+/// opens the path: the PNG's bytes arrive whole, and a FIFO is refused without blocking.
+#[cfg(unix)]
+#[test]
+fn a_screenshot_is_written_without_opening_its_path() {
+    let dir = scratch("bytes_atomic");
+    let png = dir.join("shot.png");
+    let image = image::RgbaImage::from_pixel(3, 2, image::Rgba([10, 20, 30, 255]));
+    let mut bytes = Vec::new();
+    image.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png).expect("encoded");
+    volgraph_app::atomic_write::write_bytes_atomically(&png, &bytes).expect("written");
+    assert_eq!(std::fs::read(&png).expect("read"), bytes);
+    assert_eq!(read_rgba(&png), image);
+    let fifo = dir.join("fifo.png");
+    mkfifo(&fifo);
+    let (tx, rx) = channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(volgraph_app::atomic_write::write_bytes_atomically(&fifo, b"png").map_err(|e| e.to_string()));
+    });
+    let result = rx.recv_timeout(Duration::from_secs(20)).expect("the write onto a FIFO returned");
+    assert!(result.as_ref().is_err_and(|e| e.contains("FIFO")), "{result:?}");
+    let names: Vec<_> = std::fs::read_dir(&dir).expect("dir").flatten().map(|e| e.file_name()).collect();
+    assert_eq!(names.len(), 2, "no temporary file stays: {names:?}");
+}

@@ -9,8 +9,9 @@ use super::{NamedPreset, PRESETS, Scene, TfSource, VolumeSource, is_tf_name, tf_
 pub struct ShownVolume {
     /// The voxels.
     pub volume: volgraph_accel::volume::Volume,
-    /// Where it came from, as a saved view writes it.
-    pub source: VolumeSource,
+    /// Where it came from, as a saved view writes it; `Err`: why a saved view cannot name it
+    /// (DICOM slices given one by one that are not all of their folder's).
+    pub source: Result<VolumeSource, String>,
     /// How it was read (the flags, over the scene's `volume_options` for the scene's volume).
     pub options: volgraph_accel::load::LoadOptions<'static>,
     /// Its default transfer function is Marschner–Lobb's ([`marschner_lobb_tf`]).
@@ -31,16 +32,16 @@ pub fn load_shown_volume(
     use crate::inputs::VolumeName;
     let source = match (paths, scene) {
         ([one], _) => match crate::inputs::volume_name(one) {
-            Some(VolumeName::Generated(name)) => VolumeSource::Generated(name),
-            Some(VolumeName::Dataset(name)) => VolumeSource::Dataset(name),
-            None => VolumeSource::File(one.display().to_string()),
+            Some(VolumeName::Generated(name)) => Ok(VolumeSource::Generated(name)),
+            Some(VolumeName::Dataset(name)) => Ok(VolumeSource::Dataset(name)),
+            None => Ok(VolumeSource::File(one.display().to_string())),
         },
-        // DICOM slices given one by one: their folder.
-        ([first, ..], _) => VolumeSource::File(first.parent().unwrap_or(Path::new(".")).display().to_string()),
-        ([], Some(scene)) => scene.volume.clone(),
-        ([], None) => VolumeSource::Generated("ml64".to_string()),
+        // DICOM slices given one by one: their folder, if they are all of it.
+        ([_, ..], _) => slices_folder(paths),
+        ([], Some(scene)) => Ok(scene.volume.clone()),
+        ([], None) => Ok(VolumeSource::Generated("ml64".to_string())),
     };
-    let marschner_lobb_tf = marschner_lobb_tf(&source);
+    let marschner_lobb_tf = source.as_ref().is_ok_and(marschner_lobb_tf);
     let (volume, options, notes) = match (paths, scene) {
         ([], Some(scene)) => {
             let options = merged_options(
@@ -75,6 +76,77 @@ pub fn load_shown_volume(
         }
     };
     Ok(ShownVolume { volume, source, options, marschner_lobb_tf, notes })
+}
+
+/// The folder of DICOM slices given one by one, as a saved view names them: only when the files
+/// are exactly the DICOM files that loading their one folder reads (compared canonicalized), so
+/// the saved scene loads the same slices; else why not, and what to give instead. (A part of a
+/// folder saved as the folder would load other slices, or another series; a bare file name's
+/// `parent()` is `""`, the scene's own folder.)
+fn slices_folder(paths: &[PathBuf]) -> Result<VolumeSource, String> {
+    use std::collections::BTreeSet;
+    let refuse = |why: String| {
+        format!(
+            "cannot save this view: {why}; a scene names a DICOM volume by its folder, which would load other \
+             slices. Give the folder instead (volgraph view GRAPH --volume DIR, with --series N where it holds \
+             several series), then save the view"
+        )
+    };
+    let mut given = BTreeSet::new();
+    let mut folder: Option<PathBuf> = None;
+    for p in paths {
+        let real = p.canonicalize().map_err(|e| refuse(format!("{}: {e}", p.display())))?;
+        if real.is_dir() {
+            return Err(refuse(format!("{} is a folder, given with other paths", p.display())));
+        }
+        let parent = real.parent().map(Path::to_path_buf).unwrap_or_default();
+        match &folder {
+            Some(f) if *f != parent => {
+                return Err(refuse(format!(
+                    "the slices given lie in more than one folder ({} and {})",
+                    f.display(),
+                    parent.display()
+                )));
+            }
+            _ => folder = Some(parent),
+        }
+        given.insert(real);
+    }
+    let folder = folder.unwrap_or_default();
+    let mut in_folder = BTreeSet::new();
+    let mut seen = BTreeSet::new();
+    let mut stack = vec![folder.clone()];
+    while let Some(dir) = stack.pop() {
+        if !seen.insert(dir.canonicalize().unwrap_or_else(|_| dir.clone())) {
+            continue;
+        }
+        let Ok(entries) = std::fs::read_dir(&dir) else { continue };
+        for entry in entries.flatten() {
+            let path = entry.path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.is_file() && volgraph_accel::load::dicom::is_dicom_input(std::slice::from_ref(&path)) {
+                in_folder.insert(path.canonicalize().unwrap_or(path));
+            }
+        }
+    }
+    if let Some(other) = in_folder.difference(&given).next() {
+        return Err(refuse(format!(
+            "the {} slices given are not all the DICOM files of their folder {} ({} more there, e.g. {})",
+            given.len(),
+            folder.display(),
+            in_folder.difference(&given).count(),
+            other.display()
+        )));
+    }
+    if let Some(odd) = given.difference(&in_folder).next() {
+        return Err(refuse(format!(
+            "{} is not a DICOM file loading the folder {} reads",
+            odd.display(),
+            folder.display()
+        )));
+    }
+    Ok(VolumeSource::File(folder.display().to_string()))
 }
 
 /// Whether a volume's default transfer function (none given) is `graphs/tf/marschner_lobb.ron`,
@@ -169,13 +241,30 @@ pub fn load_transfer_function(
         Some(source @ (TfSource::File(_) | TfSource::Data(_))) => {
             let path = match source {
                 TfSource::Data(name) => volgraph_accel::data_dir::data_dir().join("tf").join(format!("{name}.ron")),
-                TfSource::File(p) | TfSource::Preset(p) => PathBuf::from(p),
+                TfSource::File(p) | TfSource::Preset(p) | TfSource::BuiltIn(p) => PathBuf::from(p),
             };
             let (tf, notes) = crate::inputs::transfer_function(Some(&path), tf_map, volume, marschner_lobb_tf)
                 .map_err(|e| anyhow::anyhow!("{}: transfer_function: {e:#}", scene.path.display()))?;
             // A preset's name is no file to watch or save to.
             let file = (!is_tf_name(&path) || path.symlink_metadata().is_ok()).then_some(path);
             Ok((tf, file, notes))
+        }
+        // The program's own copy, whatever file of that name the current folder holds.
+        Some(TfSource::BuiltIn(name)) => {
+            let at = |e: String| anyhow::anyhow!("{}: transfer_function: {e}", scene.path.display());
+            let shown = PathBuf::from(format!("graphs/tf/{name}.ron"));
+            if tf_map.is_some() {
+                return Err(at(format!(
+                    "--tf-map picks a colour map from a ParaView .json file, but {} is a built-in RON TF; remove \
+                     --tf-map",
+                    shown.display()
+                )));
+            }
+            let (_, text) =
+                crate::builtin_graphs::builtin_tf(&shown).ok_or_else(|| at(format!("no built-in TF \"{name}\"")))?;
+            let tf = TransferFunction::from_ron_str(text, &shown).map_err(|e| at(e.to_string()))?;
+            let notes = crate::inputs::domain_note(&tf, volume).into_iter().collect();
+            Ok((tf, None, notes))
         }
         Some(TfSource::Preset(name)) => {
             let tf = match tf_preset(name) {
@@ -207,4 +296,47 @@ pub fn tf_file_beside(scene: &Path) -> PathBuf {
     let name = scene.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let stem = name.strip_suffix(".ron").unwrap_or(&name);
     scene.with_file_name(format!("{stem}.tf.ron"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Review of issue 47: DICOM slices given one by one were saved as `File(first.parent())`:
+    /// some of a folder's slices saved as the whole folder (another volume on load), and a bare
+    /// file name's parent `""` saved as `File("")` (the scene's own folder). The folder is saved
+    /// only when the slices are exactly its DICOM files; else "save view" says why and what to
+    /// give instead.
+    #[test]
+    fn dicom_slices_are_saved_as_their_folder_only_when_they_are_all_of_it() {
+        let dir = std::env::temp_dir().join(format!("volgraph-slices-folder-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("scratch");
+        let slices: Vec<PathBuf> = ["a.dcm", "b.dcm", "c.dcm"].iter().map(|n| dir.join(n)).collect();
+        for s in &slices {
+            std::fs::write(s, b"").expect("slice");
+        }
+        std::fs::write(dir.join("notes.txt"), b"not DICOM").expect("other file");
+        let real = dir.canonicalize().expect("real").display().to_string();
+        assert_eq!(slices_folder(&slices), Ok(VolumeSource::File(real.clone())));
+        // Given by a relative path (as bare names are): the folder is still the real one.
+        let cwd = std::env::current_dir().expect("cwd");
+        let up: PathBuf = cwd.components().skip(1).map(|_| "..").collect();
+        let relative: Vec<PathBuf> = slices.iter().map(|s| up.join(s.strip_prefix("/").expect("absolute"))).collect();
+        assert_eq!(slices_folder(&relative), Ok(VolumeSource::File(real)));
+        // Two of the three: refused, saying what to give instead.
+        let e = slices_folder(&slices[..2]).expect_err("a part of the folder");
+        assert!(e.contains("cannot save this view") && e.contains("c.dcm") && e.contains("--volume DIR"), "{e}");
+        // A slice in a subfolder, which loading the folder reads too.
+        std::fs::create_dir_all(dir.join("sub")).expect("sub");
+        std::fs::write(dir.join("sub").join("d.dcm"), b"").expect("slice");
+        let e = slices_folder(&slices).expect_err("the folder holds more");
+        assert!(e.contains("d.dcm") && e.contains("--series N"), "{e}");
+        // Slices from two folders.
+        let mut two = slices.clone();
+        two.push(dir.join("sub").join("d.dcm"));
+        let e = slices_folder(&two).expect_err("two folders");
+        assert!(e.contains("more than one folder"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

@@ -83,6 +83,9 @@ impl SavedView {
             Some(TfSource::File(p)) => out += &format!("    transfer_function: File({}),\n", quote(Path::new(p))),
             Some(TfSource::Preset(n)) => out += &format!("    transfer_function: Preset({n:?}),\n"),
             Some(TfSource::Data(n)) => out += &format!("    transfer_function: Data({n:?}),\n"),
+            Some(TfSource::BuiltIn(n)) => {
+                out += &format!("    transfer_function: File({:?}),\n", format!("graphs/tf/{n}.ron"));
+            }
             None => {}
         }
         let c = &self.camera;

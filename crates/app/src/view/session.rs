@@ -22,8 +22,8 @@ use crate::inputs;
 
 mod tf;
 
-pub use tf::SAVED_TF;
 use tf::{HISTOGRAM_BINS, scanner_preset_named, tf_presets_for};
+pub use tf::{SAVED_TF, SavedTf};
 
 /// What the session reports, one line each on stdout.
 #[derive(Clone, Debug, PartialEq)]
@@ -160,8 +160,8 @@ pub struct LiveSession {
     validated: Option<(String, CompileOptions, volgraph_core::runtime::shaders::ShaderSnapshot)>,
     /// True until a frame of the current plan has rendered.
     unproven: bool,
-    /// Where the volume came from, for "save view".
-    volume_source: crate::scene::VolumeSource,
+    /// Where the volume came from, for "save view"; `Err`: why "save view" cannot name it.
+    volume_source: Result<crate::scene::VolumeSource, String>,
     /// How the volume was read (`--series`, `--frame`, `--dims`, `--spacing`, ...), for "save view".
     volume_options: volgraph_accel::load::LoadOptions<'static>,
     /// Where the TF came from, for "save view" (`None`: fitted to the data).

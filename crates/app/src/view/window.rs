@@ -200,8 +200,13 @@ impl Viewer {
                             crate::stdout::println_escaped!("saved scene {}", path.display());
                             if let Some(tf) = tf_file {
                                 crate::stdout::println_escaped!(
-                                    "saved transfer function {} (the edited one on screen, which the scene reads)",
-                                    tf.display()
+                                    "saved transfer function {} (the edited one on screen, which the scene reads){}",
+                                    tf.path.display(),
+                                    if tf.replaced {
+                                        "; it replaced the file of that name, this scene name's own TF from an earlier save"
+                                    } else {
+                                        ""
+                                    }
                                 );
                             }
                             Vec::new()
@@ -288,8 +293,9 @@ impl Viewer {
     }
 
     fn save_screenshot(&mut self, path: &PathBuf) -> Result<(), String> {
-        // Checked again when writing (a FIFO made since the line was read would block the
-        // window for good); one made between this check and the write is not caught.
+        // A FIFO here would block the window for good: refused now with the screenshot's own
+        // message, and the PNG is written with `write_bytes_atomically`, which never opens the
+        // path itself (a FIFO made after this check is refused or replaced, never waited on).
         super::screenshot_target(path)?;
         let (Some(session), Some(gfx)) = (self.session.as_mut(), self.gfx.as_ref()) else { return Ok(()) };
         let output = session.shown_output();
@@ -306,7 +312,12 @@ impl Viewer {
             px[3] = 255;
         }
         let image = image::RgbaImage::from_raw(w, h, rgba).ok_or("screenshot size mismatch")?;
-        image.save(path).map_err(|e| format!("{}: cannot write the screenshot: {e}", path.display()))?;
+        let mut png = Vec::new();
+        image
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .map_err(|e| format!("{}: cannot encode the screenshot: {e}", path.display()))?;
+        crate::atomic_write::write_bytes_atomically(path, &png)
+            .map_err(|e| format!("cannot write the screenshot: {e:#}"))?;
         crate::stdout::println_escaped!("screenshot {}", path.display());
         Ok(())
     }

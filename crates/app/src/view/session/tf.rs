@@ -85,12 +85,21 @@ impl LiveSession {
 
     /// Where "save TF" writes: the TF's file; for a scanner preset (`--tf ct-bone`)
     /// `NAME.tf.ron` in the current folder (a name `--tf NAME` never reads in the preset's place);
-    /// for a fitted TF `view.tf.ron` there. Absolute, so the "saved" line says where it went.
+    /// for a fitted TF `view.tf.ron` there. The TF's own file is returned as `--tf` gave it (relative
+    /// to the current folder where it was given so, the path the viewer watches); the preset's and
+    /// the fitted TF's new files are made absolute, so the "saved" line says where they went.
     fn tf_save_path(&self) -> PathBuf {
         let path = match (&self.tf_path, &self.tf_source) {
             (Some(path), _) => return path.clone(),
             // A preset, or a built-in TF's name (`graphs/tf/vessels.ron` where no such file is).
-            (None, Some(crate::scene::TfSource::Preset(name) | crate::scene::TfSource::File(name))) => {
+            (
+                None,
+                Some(
+                    crate::scene::TfSource::Preset(name)
+                    | crate::scene::TfSource::File(name)
+                    | crate::scene::TfSource::BuiltIn(name),
+                ),
+            ) => {
                 let stem = Path::new(name).file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned());
                 PathBuf::from(format!("{}.tf.ron", stem.strip_suffix(".ron").unwrap_or(&stem)))
             }
@@ -154,15 +163,16 @@ impl LiveSession {
 
     /// What "save view" writes: this graph, volume, TF, effects and cuts seen by `camera` in a
     /// window of `viewport` pixels (the window's, not the level of detail's coarse image while
-    /// something moves).
+    /// something moves). An error where a scene cannot name the volume (DICOM slices given one
+    /// by one that are not all of their folder's), saying what to give instead.
     pub fn saved_view(
         &self,
         camera: &volgraph_accel::camera::OrbitCamera,
         viewport: (u32, u32),
-    ) -> crate::scene::SavedView {
-        crate::scene::SavedView {
+    ) -> anyhow::Result<crate::scene::SavedView> {
+        Ok(crate::scene::SavedView {
             graph: self.graph.clone(),
-            volume: self.volume_source.clone(),
+            volume: self.volume_source.clone().map_err(|why| anyhow!("{why}"))?,
             volume_options: crate::scene::VolumeOptions::of(&self.volume_options),
             transfer_function: self.tf_source.clone(),
             camera: *camera,
@@ -171,7 +181,7 @@ impl LiveSession {
             precision: self.options.precision,
             opacity_reference: self.opacity_reference,
             cuts: self.runtime.cuts(),
-        }
+        })
     }
 
     /// Whether the TF on screen is not what its source gives (an edit not saved, a preset picked
@@ -181,16 +191,20 @@ impl LiveSession {
     }
 
     /// "Save view": the scene [`Self::saved_view`] describes, written to `path`. A TF on screen
-    /// that its source does not give ([`Self::tf_edited`]) is written beside the scene first
+    /// that its source does not give ([`Self::tf_edited`]) is written beside the scene
     /// ([`crate::scene::tf_file_beside`]) and the scene refers to that file, so the scene draws
-    /// what is on screen; returns that file.
+    /// what is on screen. Both targets are checked (not a folder, FIFO or device; not read-only;
+    /// a folder that takes a new file) before anything is written, so a refused scene leaves no
+    /// TF file behind. Returns the TF file written, if any, and whether it replaced an earlier
+    /// one (the same scene name's own companion, from an earlier save).
     pub fn save_view(
         &self,
         camera: &volgraph_accel::camera::OrbitCamera,
         viewport: (u32, u32),
         path: &Path,
-    ) -> anyhow::Result<Option<PathBuf>> {
-        let mut view = self.saved_view(camera, viewport);
+    ) -> anyhow::Result<Option<SavedTf>> {
+        let mut view = self.saved_view(camera, viewport)?;
+        check_write_target(path, "the scene")?;
         let mut tf_file = None;
         if self.tf_edited() {
             let beside = crate::scene::tf_file_beside(path);
@@ -202,6 +216,7 @@ impl LiveSession {
                     beside.display()
                 ));
             }
+            check_write_target(&beside, "the edited transfer function the saved view needs")?;
             let text = self.tf.to_ron_string();
             let back = TransferFunction::from_ron_str(&text, &beside).map_err(|e| anyhow!("{e}"))?;
             if back != self.tf {
@@ -211,14 +226,68 @@ impl LiveSession {
                     beside.display()
                 ));
             }
+            let replaced = beside.symlink_metadata().is_ok();
             crate::atomic_write::write_atomically(&beside, &text)
                 .map_err(|e| anyhow!("{e:#} (the edited transfer function the saved view needs)"))?;
             view.transfer_function = Some(crate::scene::TfSource::File(beside.display().to_string()));
-            tf_file = Some(beside);
+            tf_file = Some(SavedTf { path: beside, replaced });
         }
-        view.save(path)?;
+        if let Err(e) = view.save(path) {
+            // The scene was refused after all (changed since the check): a TF file this save
+            // made new is no one's companion.
+            if let Some(tf) = tf_file.as_ref().filter(|tf| !tf.replaced) {
+                let _ = std::fs::remove_file(&tf.path);
+            }
+            return Err(e);
+        }
         Ok(tf_file)
     }
+}
+
+/// The transfer-function file "save view" wrote beside the scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SavedTf {
+    /// `NAME.tf.ron` beside `NAME.ron`.
+    pub path: PathBuf,
+    /// It replaced a file of that name: the companion an earlier save of this scene name wrote.
+    pub replaced: bool,
+}
+
+/// Refuses a path "save view" cannot write `what` to, before anything is written: a folder,
+/// FIFO or device (a FIFO would block the window), a file its owner may not write (by the
+/// permission bits, as [`crate::atomic_write::write_atomically`] decides), a folder that is
+/// missing or takes no new file.
+fn check_write_target(path: &Path, what: &str) -> anyhow::Result<()> {
+    let shown = path.display();
+    if let Ok(Some(kind)) = volgraph_accel::input_file::special_kind(path) {
+        return Err(anyhow!("{shown}: is {kind}, not a file to write {what} to; give the path of a file"));
+    }
+    if let Ok(meta) = std::fs::metadata(path) {
+        #[cfg(unix)]
+        let read_only = {
+            use std::os::unix::fs::PermissionsExt as _;
+            meta.permissions().mode() & 0o200 == 0
+        };
+        #[cfg(not(unix))]
+        let read_only = meta.permissions().readonly();
+        if read_only {
+            return Err(anyhow!(
+                "{shown} is read-only; make it writable (chmod u+w) or save the view elsewhere (nothing was written)"
+            ));
+        }
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    tempfile::Builder::new().prefix(".volgraph-save-check.").tempfile_in(&dir).map(drop).map_err(|e| {
+        let reason =
+            e.raw_os_error().map_or_else(|| e.kind().to_string(), |c| std::io::Error::from_raw_os_error(c).to_string());
+        anyhow!(
+            "{shown}: cannot write {what}: the folder {} refused a new file: {reason} (nothing was written)",
+            dir.display()
+        )
+    })
 }
 
 /// The scanner preset `--tf PATH` reads (no such file, a preset's name), as

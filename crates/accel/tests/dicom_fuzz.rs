@@ -10,33 +10,27 @@
 //! the test fails.
 //!
 //! `VOLGRAPH_FUZZ_CASES` sets the number of cases (default 1000, a few seconds); the summary
-//! line on stderr gives the counts a long run is recorded with.
+//! line on stderr gives the counts a long run is recorded with. The watchdog, the counters and
+//! `HANG_SECONDS` are `fuzz_support`'s, shared with the NIfTI fuzzer.
 
 mod dicom_support;
+mod fuzz_support;
 
-use std::cell::{Cell, RefCell};
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
 
 use dicom_core::value::PrimitiveValue;
 use dicom_core::{DataElement, Tag, VR};
 use dicom_dictionary_std::tags;
 use dicom_support::*;
+use fuzz_support::Harness;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 use volgraph_accel::load::{LoadOptions, load_volumes};
 
-const HANG_SECONDS: f64 = 5.0;
 /// The address-space limit (KiB) the cases run under: a 4 GiB `ulimit -v`.
 const MEMORY_LIMIT_KIB: u64 = 4 << 20;
 /// Set in the child process that runs the cases under the limit.
 const CHILD: &str = "VOLGRAPH_DICOM_FUZZ_CHILD";
-
-fn cases() -> u32 {
-    std::env::var("VOLGRAPH_FUZZ_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(1000)
-}
 
 /// The attributes replaced, each with the VR its hostile text is written as.
 const FIELDS: &[(Tag, VR)] = &[
@@ -283,47 +277,14 @@ fn hostile_dicom_files_are_errors_never_panics_aborts_or_hangs() {
 }
 
 fn run_cases() {
-    let total = cases();
     let path = scratch_file();
-    let mut runner = TestRunner::new(Config { cases: total, failure_persistence: None, ..Config::default() });
-    let (ok, err, panics, slow) = (Cell::new(0u64), Cell::new(0u64), Cell::new(0u64), Cell::new(0u64));
-    let first_failure = RefCell::new(None::<String>);
-    let slowest = Cell::new(Duration::ZERO);
-    let slowest_case = RefCell::new(String::new());
-    let current = Arc::new(Mutex::new(None::<(Instant, String)>));
-    let done = Arc::new(AtomicBool::new(false));
-    let started = Arc::new(AtomicU64::new(0));
-    let watchdog = {
-        let (current, done) = (current.clone(), done.clone());
-        std::thread::spawn(move || {
-            while !done.load(Ordering::Relaxed) {
-                std::thread::sleep(Duration::from_millis(200));
-                if let Ok(c) = current.lock()
-                    && let Some((start, what)) = c.as_ref()
-                    && start.elapsed().as_secs_f64() > HANG_SECONDS * 10.0
-                {
-                    eprintln!("dicom fuzz: a case hung for over {}s: {what}", HANG_SECONDS * 10.0);
-                    std::process::exit(1);
-                }
-            }
-        })
-    };
-    let began = Instant::now();
+    let mut runner =
+        TestRunner::new(Config { cases: fuzz_support::cases(1000), failure_persistence: None, ..Config::default() });
+    let harness = Harness::new("dicom fuzz", 50_000);
     let folder = path.parent().expect("a folder").to_path_buf();
     let second = folder.join("IM0002.dcm");
     let name = folder.display().to_string();
     let result = runner.run(&case(), |case| {
-        let n = started.fetch_add(1, Ordering::Relaxed) + 1;
-        if n.is_multiple_of(50_000) {
-            eprintln!(
-                "dicom fuzz: {n} cases, {} Ok, {} Err, {} panics, {} slow, {:.0}s",
-                ok.get(),
-                err.get(),
-                panics.get(),
-                slow.get(),
-                began.elapsed().as_secs_f64()
-            );
-        }
         std::fs::write(&path, case.bytes()).expect("written");
         let input = match case.neighbour_bytes() {
             Some(bytes) => {
@@ -335,63 +296,18 @@ fn run_cases() {
                 path.clone()
             }
         };
-        if let Ok(mut c) = current.lock() {
-            *c = Some((Instant::now(), format!("{case:?}")));
-        }
-        let start = Instant::now();
-        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            load_volumes(std::slice::from_ref(&input), &LoadOptions::default())
-        }));
-        let took = start.elapsed();
-        if let Ok(mut c) = current.lock() {
-            *c = None;
-        }
-        if took > slowest.get() {
-            slowest.set(took);
-            *slowest_case.borrow_mut() = format!("{case:?}");
-        }
-        let mut failure = None;
-        match outcome {
-            Ok(Ok(_)) => ok.set(ok.get() + 1),
-            Ok(Err(e)) => {
-                err.set(err.get() + 1);
-                let text = e.to_string();
+        harness.run(
+            &case,
+            || load_volumes(std::slice::from_ref(&input), &LoadOptions::default()),
+            |text| {
                 // The first line names the file (or its folder); more lines only list series.
                 let mut lines = text.lines();
                 let first_names = lines.next().is_some_and(|l| l.contains(&name));
-                if !first_names || !lines.all(|l| l.starts_with("  ")) {
-                    failure = Some(format!("an error that does not name the file, or forges a line: {text}"));
-                }
-            }
-            Err(_) => {
-                panics.set(panics.get() + 1);
-                failure = Some("panicked".to_string());
-            }
-        }
-        if took.as_secs_f64() > HANG_SECONDS {
-            slow.set(slow.get() + 1);
-            failure = Some(format!("took {took:?}"));
-        }
-        if let Some(what) = failure {
-            first_failure.borrow_mut().get_or_insert_with(|| format!("{what} on {case:?}"));
-        }
+                (!first_names || !lines.all(|l| l.starts_with("  ")))
+                    .then(|| format!("an error that does not name the file, or forges a line: {text}"))
+            },
+        );
         Ok(())
     });
-    done.store(true, Ordering::Relaxed);
-    let _ = watchdog.join();
-    eprintln!(
-        "dicom fuzz: {} cases: {} Ok, {} Err, {} panics, 0 aborts (the process lived), {} hangs over {HANG_SECONDS}s; \
-         slowest {:.1} ms ({}), {:.0}s in all",
-        ok.get() + err.get() + panics.get(),
-        ok.get(),
-        err.get(),
-        panics.get(),
-        slow.get(),
-        slowest.get().as_secs_f64() * 1e3,
-        slowest_case.borrow(),
-        began.elapsed().as_secs_f64()
-    );
-    assert!(result.is_ok(), "{result:?}");
-    assert_eq!(first_failure.into_inner(), None);
-    assert!(ok.get() > 0 && err.get() > 0, "both outcomes are reached: {} Ok, {} Err", ok.get(), err.get());
+    harness.finish(result);
 }

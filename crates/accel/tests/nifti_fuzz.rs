@@ -9,25 +9,18 @@
 //! would show; run it under `ulimit -v` to make such an allocation an abort.
 //!
 //! `VOLGRAPH_FUZZ_CASES` sets the number of cases (default 2000, a few seconds); the summary
-//! line on stderr gives the counts a long run is recorded with.
+//! line on stderr gives the counts a long run is recorded with. The watchdog, the counters and
+//! `HANG_SECONDS` are `fuzz_support`'s, shared with the DICOM fuzzer.
 
+mod fuzz_support;
 mod nifti_support;
 
-use std::cell::{Cell, RefCell};
 use std::path::Path;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
 
+use fuzz_support::Harness;
 use nifti_support::{NiftiSpec, gzip, voxels};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
-
-const HANG_SECONDS: f64 = 5.0;
-
-fn cases() -> u32 {
-    std::env::var("VOLGRAPH_FUZZ_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(2000)
-}
 
 /// The datatype codes tried: every one the loader reads, the ones it refuses, and junk.
 const DATATYPES: &[i16] =
@@ -199,97 +192,21 @@ fn valid_fuzz_bases_load() {
 
 #[test]
 fn hostile_nifti_headers_and_data_are_errors_never_panics_or_hangs() {
-    let total = cases();
-    let mut runner = TestRunner::new(Config { cases: total, failure_persistence: None, ..Config::default() });
-    let (ok, err) = (Cell::new(0u64), Cell::new(0u64));
-    let panics = Cell::new(0u64);
-    let slow = Cell::new(0u64);
-    let first_failure = RefCell::new(None::<String>);
-    let slowest = Cell::new(Duration::ZERO);
-    // The watchdog: a case running ten times the limit is a real hang; name it and stop.
-    let current = Arc::new(Mutex::new(None::<(Instant, String)>));
-    let done = Arc::new(AtomicBool::new(false));
-    let started = Arc::new(AtomicU64::new(0));
-    let watchdog = {
-        let (current, done) = (current.clone(), done.clone());
-        std::thread::spawn(move || {
-            while !done.load(Ordering::Relaxed) {
-                std::thread::sleep(Duration::from_millis(200));
-                if let Ok(c) = current.lock()
-                    && let Some((start, what)) = c.as_ref()
-                    && start.elapsed().as_secs_f64() > HANG_SECONDS * 10.0
-                {
-                    eprintln!("nifti fuzz: a case hung for over {}s: {what}", HANG_SECONDS * 10.0);
-                    std::process::exit(1);
-                }
-            }
-        })
-    };
-    let began = Instant::now();
+    let mut runner =
+        TestRunner::new(Config { cases: fuzz_support::cases(2000), failure_persistence: None, ..Config::default() });
+    let harness = Harness::new("nifti fuzz", 100_000);
     let result = runner.run(&case(), |case| {
-        let n = started.fetch_add(1, Ordering::Relaxed) + 1;
-        if n % 100_000 == 0 {
-            eprintln!(
-                "nifti fuzz: {n} cases, {} Ok, {} Err, {} panics, {} slow, {:.0}s",
-                ok.get(),
-                err.get(),
-                panics.get(),
-                slow.get(),
-                began.elapsed().as_secs_f64()
-            );
-        }
         let bytes = case.bytes();
         let name = if case.gzip { "fuzz.nii.gz" } else { "fuzz.nii" };
-        if let Ok(mut c) = current.lock() {
-            *c = Some((Instant::now(), format!("{case:?}")));
-        }
-        let start = Instant::now();
-        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            volgraph_accel::load::nifti::parse(Path::new(name), &bytes, case.frame)
-        }));
-        let took = start.elapsed();
-        if let Ok(mut c) = current.lock() {
-            *c = None;
-        }
-        slowest.set(slowest.get().max(took));
-        let mut failure = None;
-        match outcome {
-            Ok(Ok(_)) => ok.set(ok.get() + 1),
-            Ok(Err(e)) => {
-                err.set(err.get() + 1);
-                let text = e.to_string();
-                if !text.contains(name) || text.contains('\n') {
-                    failure = Some(format!("an error that does not name the file on one line: {text}"));
-                }
-            }
-            Err(_) => {
-                panics.set(panics.get() + 1);
-                failure = Some("panicked".to_string());
-            }
-        }
-        if took.as_secs_f64() > HANG_SECONDS {
-            slow.set(slow.get() + 1);
-            failure = Some(format!("took {took:?}"));
-        }
-        if let Some(what) = failure {
-            first_failure.borrow_mut().get_or_insert_with(|| format!("{what} on {case:?}"));
-        }
+        harness.run(
+            &case,
+            || volgraph_accel::load::nifti::parse(Path::new(name), &bytes, case.frame),
+            |text| {
+                (!text.contains(name) || text.contains('\n'))
+                    .then(|| format!("an error that does not name the file on one line: {text}"))
+            },
+        );
         Ok(())
     });
-    done.store(true, Ordering::Relaxed);
-    let _ = watchdog.join();
-    eprintln!(
-        "nifti fuzz: {} cases: {} Ok, {} Err, {} panics, 0 aborts (the process lived), {} hangs over {HANG_SECONDS}s; \
-         slowest {:.1} ms, {:.0}s in all",
-        ok.get() + err.get() + panics.get(),
-        ok.get(),
-        err.get(),
-        panics.get(),
-        slow.get(),
-        slowest.get().as_secs_f64() * 1e3,
-        began.elapsed().as_secs_f64()
-    );
-    assert!(result.is_ok(), "{result:?}");
-    assert_eq!(first_failure.into_inner(), None);
-    assert!(ok.get() > 0 && err.get() > 0, "both outcomes are reached: {} Ok, {} Err", ok.get(), err.get());
+    harness.finish(result);
 }

@@ -63,9 +63,7 @@ pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
         anyhow!("{shown}: cannot write: the folder {} refused a new file: {}", dir.display(), os_reason(&e))
     })?;
     use std::io::Write as _;
-    tmp.write_all(bytes)
-        .and_then(|()| tmp.flush())
-        .map_err(|e| anyhow!("{shown}: cannot write: {}", os_reason(&e)))?;
+    tmp.write_all(bytes).and_then(|()| tmp.flush()).map_err(|e| anyhow!("{shown}: cannot write: {}", os_reason(&e)))?;
     if let Some(meta) = &existing {
         // The mode the file was created with lost what the umask masks; set it exactly.
         let _ = tmp.as_file().set_permissions(meta.permissions());

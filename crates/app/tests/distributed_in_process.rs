@@ -259,9 +259,20 @@ fn soft_tissue_ct() -> volgraph_accel::volume::Volume {
             for x in 0..dims.x {
                 let p = (DVec3::new(x as f64, y as f64, z as f64) + 0.5) / dims.as_dvec3() - 0.5;
                 let air = (p - DVec3::splat(-0.4)).length() < 0.2;
-                values.push(if p.length() < 0.2 { 3000 } else if air { -1000 } else { 40 } as i16);
+                values.push(if p.length() < 0.2 {
+                    3000
+                } else if air {
+                    -1000
+                } else {
+                    40
+                } as i16);
             }
         }
     }
-    volgraph_accel::volume::Volume::new("soft", dims, DVec3::new(0.8, 0.8, 1.5), volgraph_accel::volume::VoxelData::I16(values))
+    volgraph_accel::volume::Volume::new(
+        "soft",
+        dims,
+        DVec3::new(0.8, 0.8, 1.5),
+        volgraph_accel::volume::VoxelData::I16(values),
+    )
 }

@@ -311,3 +311,4 @@ fn run_cases() {
     });
     harness.finish(result);
 }
+

@@ -145,6 +145,22 @@ fn a_length_that_is_not_a_whole_number_of_values_is_an_error_not_seconds_of_allo
     assert!(started.elapsed().as_millis() < 500, "{:?}", started.elapsed());
 }
 
+#[test]
+fn an_undefined_length_outside_pixel_data_is_an_error_not_a_4_gb_read() {
+    // Found by the fuzzer: RLE PixelData's tag flipped to (7FB8,0010) keeps VR OB and length
+    // 0xFFFFFFFF, which dicom-rs read as 4 GB to allocate and zero (11 s).
+    let dir = fresh(&root(), "undefined_ob");
+    let mut bytes = rle_image(rle_constant(30, 1100)).bytes();
+    let at = bytes.windows(4).position(|w| w == [0xE0, 0x7F, 0x10, 0x00]).expect("PixelData");
+    bytes[at] = 0xB8;
+    let path = dir.join("IM0001.dcm");
+    std::fs::write(&path, &bytes).expect("written");
+    let started = std::time::Instant::now();
+    let e = load(std::slice::from_ref(&path)).map(|_| ()).expect_err("an error");
+    assert_names(&e, &path, &[&format!("element (7FB8,0010) at byte {at} has VR OB and an undefined length")]);
+    assert!(started.elapsed().as_millis() < 500, "{:?}", started.elapsed());
+}
+
 fn folder_of_three(name: &str) -> PathBuf {
     let dir = fresh(&root(), name);
     series(&dir, 3, &Image::default());

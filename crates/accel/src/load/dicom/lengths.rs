@@ -120,12 +120,25 @@ impl<R: Read + Seek> Walk<R> {
                 if (group, element) == (0x7FE0, 0x0010) {
                     // Encapsulated pixel data: items holding fragments, then a delimiter.
                     self.fragments(big)?;
-                } else if vr.is_some_and(|vr| vr == *b"SQ") || !explicit {
-                    self.elements(u64::MAX, explicit, big, depth + 1)?;
-                } else {
-                    // UN (or an unknown VR) of undefined length: a sequence in implicit VR
-                    // little endian (PS3.5 6.2.2).
-                    self.elements(u64::MAX, false, false, depth + 1)?;
+                    continue;
+                }
+                // Only sequences, UN and pixel data may have an undefined length (PS3.5 7.1);
+                // dicom-rs reads any other element's 0xFFFFFFFF as a 4 GB length.
+                let known = vr.or_else(|| dictionary_vr(group, element));
+                let unknown = |v: [u8; 2]| v == *b"UN" || dicom_core::VR::from_binary(v).is_none();
+                match known {
+                    Some(v) if v == *b"SQ" => self.elements(u64::MAX, explicit, big, depth + 1)?,
+                    // UN (or a VR dicom-rs does not know, read as UN): a sequence in implicit
+                    // VR little endian (PS3.5 6.2.2).
+                    Some(v) if unknown(v) => self.elements(u64::MAX, false, false, depth + 1)?,
+                    None => self.elements(u64::MAX, explicit, big, depth + 1)?,
+                    Some(v) => {
+                        return Err(format!(
+                            "element ({group:04X},{element:04X}) at byte {start} has VR {} and an undefined length, \
+                             which only sequences and pixel data may have",
+                            super::one_line(&String::from_utf8_lossy(&v))
+                        ));
+                    }
                 }
                 continue;
             }

@@ -144,6 +144,7 @@ fn step<E: Exchange + ?Sized, T>(ex: &mut E, outcome: anyhow::Result<T>) -> Resu
 }
 
 /// True for an error every rank holds alike (a [`step`]'s): one rank prints it for all.
+#[cfg(feature = "mpi")]
 fn is_agreed(e: &CliError) -> bool {
     matches!(e, CliError::Other(e) if e.downcast_ref::<ExchangeError>().is_some())
 }

@@ -175,7 +175,7 @@ impl ValueSummary {
     /// and 1024): exactly [`Histogram::of`]`(volume, bins)` (a bin of `v·bins` is the bin of
     /// `v·FIT_BINS` divided by `FIT_BINS / bins`, both products exact in binary floating point).
     pub fn binned(&self, bins: usize) -> Histogram {
-        debug_assert!(bins > 0 && FIT_BINS % bins == 0, "{bins} bins do not divide {FIT_BINS}");
+        debug_assert!(bins > 0 && FIT_BINS.is_multiple_of(bins), "{bins} bins do not divide {FIT_BINS}");
         let group = (FIT_BINS / bins.clamp(1, FIT_BINS)).max(1);
         let counts: Vec<u64> = self.histogram.counts.chunks(group).map(|c| c.iter().sum()).collect();
         Histogram { total: counts.iter().sum(), counts }

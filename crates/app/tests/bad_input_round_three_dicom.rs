@@ -124,11 +124,33 @@ fn a_malformed_rescale_slope_is_exit_1_naming_the_attribute() {
 
 #[test]
 fn a_corrupt_jpeg2000_frame_prints_only_the_error_not_the_decoders_log() {
-    // The JPEG 2000 start-of-codestream and size markers, then junk.
-    let mut fragment = vec![0xFF, 0x4F, 0xFF, 0x51, 0x00, 0x29];
+    // The JPEG 2000 start-of-codestream and size markers (the header's 5 × 6 pixels, one
+    // component), then junk.
+    let mut fragment = siz(5, 6);
     fragment.extend((0..200u32).map(|i| (i * 37 + 11) as u8));
     let image = Image { transfer_syntax: JPEG2000, pixels: Some(encapsulated(vec![fragment])), ..Image::default() };
     assert_info_fails("cli_jpeg2k", image, &["cannot decode the pixel data"]);
+}
+
+/// SOC and a SIZ marker (ITU-T T.800 A.5.1) for `width` × `height` pixels of one 16-bit
+/// component, in one tile.
+fn siz(width: u32, height: u32) -> Vec<u8> {
+    let mut bytes = vec![0xFF, 0x4F, 0xFF, 0x51, 0x00, 0x29, 0x00, 0x00];
+    for v in [width, height, 0, 0, width, height, 0, 0] {
+        bytes.extend(v.to_be_bytes());
+    }
+    bytes.extend([0x00, 0x01, 0x0F, 0x01, 0x01]);
+    bytes
+}
+
+/// A codestream claiming 60000 × 60000 pixels under Rows 6 and Columns 5: OpenJPEG would
+/// decode (and allocate) at the codestream's size; it is refused from its SIZ marker first.
+#[test]
+fn a_jpeg2000_codestream_larger_than_rows_and_columns_is_refused_before_decoding() {
+    let mut fragment = siz(60000, 60000);
+    fragment.extend((0..200u32).map(|i| (i * 37 + 11) as u8));
+    let image = Image { transfer_syntax: JPEG2000, pixels: Some(encapsulated(vec![fragment])), ..Image::default() };
+    assert_info_fails("cli_jpeg2k_siz", image, &["SIZ marker says 60000 × 60000 pixels", "are 5 × 6"]);
 }
 
 #[cfg(unix)]

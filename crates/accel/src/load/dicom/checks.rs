@@ -3,7 +3,8 @@
 //! word: native PixelData must hold Rows × Columns × NumberOfFrames samples; RLE Lossless
 //! (PS3.5 Annex G) must have one fragment per frame, a 64-byte header claiming 1 to 15 segments
 //! (as many as the samples' bytes), offsets inside the fragment, and segments that decode to a
-//! whole plane. The third-party decoders (dicom-rs's adapters, OpenJPEG) run under
+//! whole plane; a JPEG 2000 codestream's SIZ marker must declare Columns × Rows ×
+//! SamplesPerPixel. The third-party decoders (dicom-rs's adapters, OpenJPEG) run under
 //! `catch_unwind`: a panic in them becomes an error naming the file, never an abort.
 
 use std::cell::RefCell;
@@ -101,6 +102,9 @@ pub fn pixel_data(h: &FileHeader, object: &DefaultDicomObject, per_slice: usize)
                 "PixelData (7FE0,0010) holds no compressed fragment; the file is corrupt".to_string(),
             ));
         }
+        if JPEG_2000.contains(&h.transfer_syntax.as_str()) {
+            return jpeg2000(h, fragments);
+        }
         return Ok(());
     }
     let bytes = element.to_bytes().map(|b| b.len()).unwrap_or(0) as u128;
@@ -115,6 +119,56 @@ pub fn pixel_data(h: &FileHeader, object: &DefaultDicomObject, per_slice: usize)
                  Columns, NumberOfFrames or BitsAllocated are wrong"
             ),
         ));
+    }
+    Ok(())
+}
+
+/// JPEG 2000 (lossless, lossy) and High-Throughput JPEG 2000 transfer syntaxes.
+const JPEG_2000: [&str; 5] = [
+    "1.2.840.10008.1.2.4.90",
+    "1.2.840.10008.1.2.4.91",
+    "1.2.840.10008.1.2.4.201",
+    "1.2.840.10008.1.2.4.202",
+    "1.2.840.10008.1.2.4.203",
+];
+
+/// The size every JPEG 2000 codestream among `fragments` declares in its SIZ marker (ITU-T
+/// T.800 A.5.1: SOC, then SIZ with Xsiz, Ysiz, XOsiz, YOsiz … Csiz, big-endian) must be the
+/// header's Columns × Rows × SamplesPerPixel: OpenJPEG decodes, and allocates, at the size the
+/// codestream claims. A fragment that does not start a codestream (a frame's continuation) is
+/// left to the decoder.
+fn jpeg2000(h: &FileHeader, fragments: &[Vec<u8>]) -> Result<(), LoadError> {
+    let Some(first) = h.frame_geometry.first() else { return Ok(()) };
+    for (index, fragment) in fragments.iter().enumerate() {
+        if !fragment.starts_with(&[0xFF, 0x4F, 0xFF, 0x51]) {
+            continue;
+        }
+        let bad = |what: String| {
+            error(
+                h,
+                format!(
+                    "JPEG 2000 fragment {index}: {what}; the pixel data is corrupt: remove the file or copy it again"
+                ),
+            )
+        };
+        let Some(siz) = fragment.get(4..42) else {
+            return Err(bad(format!("{} bytes, cut short inside its SIZ marker (42 bytes)", fragment.len())));
+        };
+        let word = |at: usize| u32::from_be_bytes([siz[at], siz[at + 1], siz[at + 2], siz[at + 3]]);
+        let (xsiz, ysiz, x0, y0) = (word(4), word(8), word(12), word(16));
+        let components = u16::from_be_bytes([siz[36], siz[37]]);
+        let (Some(width), Some(height)) = (xsiz.checked_sub(x0), ysiz.checked_sub(y0)) else {
+            return Err(bad(format!(
+                "its SIZ marker puts the image origin ({x0}, {y0}) past its end ({xsiz}, {ysiz})"
+            )));
+        };
+        if (width, height, components) != (first.columns, first.rows, h.samples_per_pixel) {
+            return Err(bad(format!(
+                "the codestream's SIZ marker says {width} × {height} pixels of {components} component(s), but Columns \
+                 × Rows (0028,0011 × 0028,0010) are {} × {} of SamplesPerPixel {}",
+                first.columns, first.rows, h.samples_per_pixel
+            )));
+        }
     }
     Ok(())
 }

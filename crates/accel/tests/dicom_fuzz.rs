@@ -311,4 +311,3 @@ fn run_cases() {
     });
     harness.finish(result);
 }
-

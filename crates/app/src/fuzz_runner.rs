@@ -95,3 +95,25 @@ where
         failure: result.err().map(|e| e.to_string()),
     }
 }
+
+/// The byte range of the token around `at` (a run of identifier characters, `.` and `-`, or a
+/// quoted string): what the fuzzers' mutations replace and swap.
+pub fn token_at(bytes: &[u8], at: usize) -> (usize, usize) {
+    let word = |b: u8| b.is_ascii_alphanumeric() || b == b'_' || b == b'.' || b == b'-';
+    if bytes.is_empty() {
+        return (0, 0);
+    }
+    let at = at.min(bytes.len() - 1);
+    if bytes[at] == b'"' {
+        let end = bytes[at + 1..].iter().position(|b| *b == b'"').map_or(bytes.len(), |e| at + 2 + e);
+        return (at, end);
+    }
+    let (mut start, mut end) = (at, at);
+    while start > 0 && word(bytes[start - 1]) {
+        start -= 1;
+    }
+    while end < bytes.len() && word(bytes[end]) {
+        end += 1;
+    }
+    (start, end.max(start))
+}

@@ -13,6 +13,8 @@ use std::sync::OnceLock;
 
 use proptest::prelude::*;
 use volgraph_core::shader_source::ShaderSources;
+
+use crate::fuzz_runner::token_at;
 use volgraph_core::{CompileOptions, Registry, check_plan_bindings, compile};
 
 const HANG_SECONDS: f64 = 5.0;
@@ -196,28 +198,6 @@ fn edit() -> impl Strategy<Value = Edit> {
         4 => (at.clone(), token).prop_map(|(a, t)| Edit::Replace(a, t)),
         2 => (at.clone(), at).prop_map(|(a, b)| Edit::Swap(a, b)),
     ]
-}
-
-/// The byte range of the token around `at` (identifier run or quoted string).
-fn token_at(bytes: &[u8], at: usize) -> (usize, usize) {
-    let word = |b: u8| b.is_ascii_alphanumeric() || b == b'_' || b == b'.';
-    let at = at.min(bytes.len().saturating_sub(1));
-    if bytes.is_empty() {
-        return (0, 0);
-    }
-    if bytes[at] == b'"' {
-        let end = bytes[at + 1..].iter().position(|b| *b == b'"').map_or(bytes.len(), |e| at + 2 + e);
-        return (at, end);
-    }
-    let mut start = at;
-    while start > 0 && word(bytes[start - 1]) {
-        start -= 1;
-    }
-    let mut end = at;
-    while end < bytes.len() && word(bytes[end]) {
-        end += 1;
-    }
-    (start, end.max(start))
 }
 
 fn apply(text: &str, edits: &[Edit]) -> String {

@@ -21,6 +21,8 @@ use volgraph_core::graph::ast::{GraphDoc, InputKind, NodeDoc};
 use volgraph_core::graph::edit::{SetTarget, TextEdit, apply as apply_edits, edit_for};
 use volgraph_core::graph::parse_graph;
 
+use crate::fuzz_runner::token_at;
+
 const HANG_SECONDS: f64 = 5.0;
 
 fn cases() -> u32 {
@@ -153,27 +155,6 @@ fn mutation() -> impl Strategy<Value = Mutation> {
         3 => (at.clone(), any::<bool>()).prop_map(|(a, b)| Mutation::Comment(a, b)),
         1 => at.prop_map(Mutation::Truncate),
     ]
-}
-
-/// The byte range of the token around `at` (identifier run or quoted string).
-fn token_at(bytes: &[u8], at: usize) -> (usize, usize) {
-    let word = |b: u8| b.is_ascii_alphanumeric() || b == b'_' || b == b'.' || b == b'-';
-    if bytes.is_empty() {
-        return (0, 0);
-    }
-    let at = at.min(bytes.len() - 1);
-    if bytes[at] == b'"' {
-        let end = bytes[at + 1..].iter().position(|b| *b == b'"').map_or(bytes.len(), |e| at + 2 + e);
-        return (at, end);
-    }
-    let (mut start, mut end) = (at, at);
-    while start > 0 && word(bytes[start - 1]) {
-        start -= 1;
-    }
-    while end < bytes.len() && word(bytes[end]) {
-        end += 1;
-    }
-    (start, end.max(start))
 }
 
 fn mutate(text: &str, mutations: &[Mutation]) -> Vec<u8> {

@@ -38,7 +38,8 @@ impl AxisOrientation {
     pub fn from_directions(directions: [DVec3; 3], at: &Location, field: &str) -> Result<(Self, DVec3), LoadError> {
         // Shortest round-trip text, in scientific notation where that would run to hundreds of
         // digits (a header's 1e300).
-        let short = |v: f64| if v != 0.0 && !(1e-4..1e9).contains(&v.abs()) { format!("{v:e}") } else { format!("{v}") };
+        let short =
+            |v: f64| if v != 0.0 && !(1e-4..1e9).contains(&v.abs()) { format!("{v:e}") } else { format!("{v}") };
         let text = directions
             .iter()
             .map(|d| format!("({},{},{})", short(d.x), short(d.y), short(d.z)))

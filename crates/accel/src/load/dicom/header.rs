@@ -302,33 +302,19 @@ fn check_size(
 impl FileHeader {
     fn of(path: &Path, object: &DefaultDicomObject, file_len: u64) -> Result<FileHeader, LoadError> {
         let get = |tag: Tag| object.get(tag);
+        // A whole number in `range`, when the file has the attribute.
+        let count = |tag: Tag, name: &str, range: std::ops::RangeInclusive<f64>, expected| {
+            whole(path, get(tag), name, tag, range, expected)
+        };
         let size = |tag: Tag, name: &str| -> Result<u32, LoadError> {
-            whole(path, get(tag), name, tag, 1.0..=65535.0, ROWS_EXPECTED)?
-                .ok_or_else(|| bad(path, None, name, tag, ROWS_EXPECTED))
+            count(tag, name, 1.0..=65535.0, ROWS_EXPECTED)?.ok_or_else(|| bad(path, None, name, tag, ROWS_EXPECTED))
         };
         let rows = size(tags::ROWS, "Rows")?;
         let columns = size(tags::COLUMNS, "Columns")?;
-        let frames = whole(
-            path,
-            get(tags::NUMBER_OF_FRAMES),
-            "NumberOfFrames",
-            tags::NUMBER_OF_FRAMES,
-            1.0..=4.0e9,
-            FRAMES_EXPECTED,
-        )?
-        .unwrap_or(1);
-        let samples_per_pixel = whole(
-            path,
-            get(tags::SAMPLES_PER_PIXEL),
-            "SamplesPerPixel",
-            tags::SAMPLES_PER_PIXEL,
-            1.0..=4.0,
-            SAMPLES_EXPECTED,
-        )?
-        .unwrap_or(1);
-        let bits_allocated =
-            whole(path, get(tags::BITS_ALLOCATED), "BitsAllocated", tags::BITS_ALLOCATED, 1.0..=64.0, BITS_EXPECTED)?
-                .unwrap_or(16);
+        let frames = count(tags::NUMBER_OF_FRAMES, "NumberOfFrames", 1.0..=4.0e9, FRAMES_EXPECTED)?.unwrap_or(1);
+        let samples_per_pixel =
+            count(tags::SAMPLES_PER_PIXEL, "SamplesPerPixel", 1.0..=4.0, SAMPLES_EXPECTED)?.unwrap_or(1);
+        let bits_allocated = count(tags::BITS_ALLOCATED, "BitsAllocated", 1.0..=64.0, BITS_EXPECTED)?.unwrap_or(16);
         let transfer_syntax = object.meta().transfer_syntax().trim_end_matches('\0').to_string();
         let photometric = text(object, tags::PHOTOMETRIC_INTERPRETATION).unwrap_or_default();
         check_size(

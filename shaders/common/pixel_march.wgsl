@@ -4,6 +4,7 @@
 // - LEAP with LEAP_BLOCKS (`empty` flags) or LEAP_CUBES (`distance` map): empty-space leaping
 //   (Krüger & Westermann 2003 §2.3 in one pass); `blocks` holds the block edge;
 // - START: begin each ray at the `start` estimate (Klein et al. 2005 §4.2);
+// - START_TILES: begin each ray at its tile's depth bound (`start_tiles`, reprojection_tiles);
 // - LEAP_HITS: report where the next frame's ray should start (`leap_hit`);
 // - COUNT: add the samples taken to `samples` (benchmarks).
 // - COUNT_LEAPABLE (with LEAP_HITS): add to `leapable` the samples a perfect start estimate
@@ -38,6 +39,12 @@ fn block_edge() -> u32 {
 @group(0) @binding(auto) var start: texture_2d<f32>;
 #endif
 
+#if START_TILES
+#import "common/reprojected_tiles.wgsl"
+// Per-tile view-depth bounds (common/reprojected_tiles.wgsl's layout).
+@group(0) @binding(auto) var<storage, read> start_tiles: array<u32>;
+#endif
+
 // Words of the counting buffers: image row y adds into word y % SAMPLE_ROWS.
 const SAMPLE_ROWS: u32 = 4096u;
 
@@ -63,9 +70,27 @@ fn first_sample(pixel: vec2<u32>, ray: Ray, s: Samples) -> u32 {
 #if START
     return start_sample(textureLoad(start, vec2<i32>(pixel), 0), ray, s);
 #else
+#if START_TILES
+    return tile_start_sample(pixel, ray, s);
+#else
     return 0u;
 #endif
+#endif
 }
+
+#if START_TILES
+// The first sample of this pixel's ray from its tile's depth bound, less `step_back` samples
+// (common/leap.wgsl's rule for a point estimate).
+fn tile_start_sample(pixel: vec2<u32>, ray: Ray, s: Samples) -> u32 {
+    let edge = start_tiles[0];
+    if (edge == 0u) {
+        return 0u;
+    }
+    let key = start_tiles[TILES_HEADER + (pixel.y / edge) * start_tiles[1] + pixel.x / edge];
+    let t = tile_bound_t(key, ray.u0, ray.d);
+    return first_sample_at(s, max(t - params.step_back * s.step, 0.0));
+}
+#endif
 
 fn count_samples(pixel: vec2<u32>, n: u32) {
 #if COUNT

@@ -23,6 +23,7 @@ pub mod probe;
 pub mod reference;
 pub mod srgb;
 pub mod stats;
+pub mod tooth;
 pub mod transfer_function;
 pub mod vessels;
 pub mod volume;

@@ -23,6 +23,7 @@ pub mod raycast_compute;
 pub mod raycast_params;
 pub mod raycast_segment;
 pub mod reprojection_splat;
+pub mod reprojection_tiles;
 pub mod segment_init;
 pub mod shared;
 pub mod slice_render;
@@ -48,6 +49,7 @@ pub fn params_structs() -> Vec<(String, String)> {
         shared::BlockSize::wgsl_import(),
         present::PresentParams::wgsl_import(),
         hole_fill::HoleParams::wgsl_import(),
+        reprojection_tiles::TileBoundsParams::wgsl_import(),
         slice_render::SliceParams::wgsl_import(),
     ]
 }
@@ -69,6 +71,7 @@ pub fn register_builtin(registry: &mut Registry) {
         .register(slice_render::SliceRender)
         .register(reprojection_splat::ReprojectionSplat)
         .register(hole_fill::HoleFill)
+        .register(reprojection_tiles::ReprojectionTiles)
         .register(antialias::Antialias)
         .register(raycast_bricks::RaycastBricks)
         .register(present::Present);

@@ -140,12 +140,15 @@ impl Source {
 }
 
 /// The `#if` names the wiring adds to the shared march: the leap over the wired empty-space
-/// input, START for a wired `start` estimate (both empty-space inputs wired: no leap; node
+/// input, START for a wired `start` estimate, START_TILES for wired per-tile bounds (both empty-space inputs wired: no leap; node
 /// creation reports it).
 pub fn wired_defines(params: &Params, wired: &[&str]) -> Vec<&'static str> {
     let mut defines = Source::of(params, wired).map(Source::defines).unwrap_or_default();
     if wired.contains(&"start") {
         defines.push("START");
+    }
+    if wired.contains(&"start_tiles") {
+        defines.push("START_TILES");
     }
     defines
 }

@@ -31,6 +31,9 @@ use crate::shared::BlockSize;
 /// The plugin.
 pub struct Raycast;
 
+/// The inputs a leap march may start its rays from: per-pixel estimates or per-tile bounds.
+const START_PORTS: [&str; 2] = ["start", "start_tiles"];
+
 /// The ports of both single-pass raycasters: the shared march's, the volume and TF, `color`
 /// in `color` formats and, in mode iso, `hit`.
 pub(crate) fn raycast_ports(params: &Params, color: &[TargetFormat], hit: &[TargetFormat]) -> Vec<PortSpec> {
@@ -93,6 +96,10 @@ impl PassDecl for Raycast {
             // Leave unwired, or zero (a bypassed splat), to start every ray at the box (the first
             // frame of Klein's loop): `start_sample` reads w = 0 as no estimate.
             ports.push(PortSpec::read("start", PortKind::target(&[TargetFormat::Rgba32Float])).zero_means_none());
+            // Or per-tile depth bounds (`reprojection_tiles`), read the same way.
+            ports.push(
+                PortSpec::read("start_tiles", PortKind::Buffer { bytes: 16, bytes_per_pixel: 4 }).zero_means_none(),
+            );
             ports.push(PortSpec::write("leap_hit", PortKind::target(&[TargetFormat::Rgba32Float])));
         }
         if own.counts_leapable() {
@@ -140,11 +147,17 @@ impl PassPlugin for Raycast {
         };
         let wired = ctx.wired();
         let pipeline = pipeline_for(&wired)?;
-        // A graph's bypass may leave the estimates out (zeros): then the march runs as if `start`
-        // were unwired, without reading it.
-        let without_start = match ctx.port("start") {
+        if wired.contains(&"start") && wired.contains(&"start_tiles") {
+            return Err(PassError {
+                pass: ctx.pass_id.to_string(),
+                message: "both \"start\" and \"start_tiles\" are wired; wire one source of start estimates".into(),
+            });
+        }
+        // A graph's bypass may leave the estimates out (zeros): then the march runs as if they
+        // were unwired, without reading them.
+        let without_start = match START_PORTS.iter().filter_map(|&name| ctx.port(name)).find(|p| p.bound) {
             Some(p) if p.bound && p.may_read_zeros => {
-                let wired: Vec<&str> = wired.iter().copied().filter(|&w| w != "start").collect();
+                let wired: Vec<&str> = wired.iter().copied().filter(|w| !START_PORTS.contains(w)).collect();
                 Some(pipeline_for(&wired)?)
             }
             _ => None,
@@ -263,7 +276,7 @@ impl PassNode for RaycastNode {
         extra.extend(self.leaping.bindings());
         extra.extend(self.effects.bindings());
         let pipeline = match &self.without_start {
-            Some(without) if ctx.reads_zeros("start") => without,
+            Some(without) if START_PORTS.iter().any(|&p| ctx.reads_zeros(p)) => without,
             _ => &self.pipeline,
         };
         let bg = ctx.bind_group(pipeline, &extra)?;

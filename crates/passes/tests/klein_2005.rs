@@ -50,6 +50,23 @@ fn coverage(image: &Image) -> f64 {
 /// Datasets with a TF (DVR) and an isovalue (iso) that show something: generated
 /// Marschner–Lobb, and the real hydrogen_atom and neghip where the data folder has them.
 fn datasets() -> Vec<(Volume, TransferFunction, f64)> {
+    let mut out = smooth_datasets();
+    out.push(tooth());
+    out
+}
+
+/// The hard case of issue 47: a CT of a tooth (`volgraph_accel::tooth`, 128 × 128 × 81, noisy
+/// air, thin enamel over dentin, root canals) under the TF `volgraph render` fits to it, at the
+/// isovalue of its outer surface (0.45). Per-pixel splats left some rays starting past a
+/// surface that turned into view (up to 30/255 on a few pixels at 5° per frame).
+fn tooth() -> (Volume, TransferFunction, f64) {
+    let t = volgraph_accel::tooth::tooth(128);
+    let tf = TransferFunction::default_for(&t);
+    (t, tf, 0.45)
+}
+
+/// `datasets()` but the tooth.
+fn smooth_datasets() -> Vec<(Volume, TransferFunction, f64)> {
     let ml = volgraph_accel::generate::marschner_lobb(48);
     let mut out = vec![(ml.clone(), TransferFunction::preset(Preset::Opaque, ml.value_range), 0.3)];
     for (name, iso) in [("hydrogen_atom", 0.12), ("neghip", 0.25)] {
@@ -66,41 +83,53 @@ fn camera(azimuth: f64) -> OrbitCamera {
     OrbitCamera { azimuth_deg: azimuth, elevation_deg: 20.0, distance: 2.6, ..OrbitCamera::default() }
 }
 
-fn rotation_matches_the_baseline(mode: &str) {
+/// Turns the camera 1°, 2° and 5° per frame for 30 frames and compares every frame of
+/// `klein_2005/{leap}.ron` with the plain raycast: at most `allowed` of the pixels may differ by
+/// more than 1/255.
+fn rotation_matches_the_baseline(mode: &str, leap: &str, allowed: f64) {
     let gpu = support::gpu();
     let registry = builtin_registry();
+    let leap_name = leap;
     for (volume, tf, iso) in datasets() {
         let options = reprojecting().with_scalar("iso_value", iso);
         let lut = tf.to_lut_for(&volume, 256);
         for degrees in [1.0, 2.0, 5.0] {
             let mut base =
                 Live::new(&gpu, &registry, &format!("klein_2005/baseline_{mode}.ron"), &volume, &lut, &options);
-            let mut leap = Live::new(&gpu, &registry, &format!("klein_2005/leap_{mode}.ron"), &volume, &lut, &options);
+            let mut leap = Live::new(&gpu, &registry, &format!("klein_2005/{leap}.ron"), &volume, &lut, &options);
             let mut worst = (0.0, 0.0, 0);
             for f in 0..30 {
                 let cam = camera(10.0 + degrees * f as f64);
                 let (b, l) = (base.frame(&cam), leap.frame(&cam));
                 if f == 0 {
                     assert!(coverage(&b) > 0.05, "{}: the volume is in view", volume.name);
-                    assert_eq!(l.data, b.data, "{mode} {}: the first frame is the plain raycast, exactly", volume.name);
+                    assert_eq!(
+                        l.data, b.data,
+                        "{leap_name} {}: the first frame is the plain raycast, exactly",
+                        volume.name
+                    );
                 }
                 let (off, max) = compare(&l, &b);
                 if off > worst.0 {
                     worst = (off, max, f);
                 }
-                if off > 0.001 {
-                    save_images(&format!("klein_{mode}_{}_{degrees}deg_frame{f}", volume.name), &l, &as_reference(&b));
+                if off > allowed {
+                    save_images(
+                        &format!("klein_{leap_name}_{}_{degrees}deg_frame{f}", volume.name),
+                        &l,
+                        &as_reference(&b),
+                    );
                 }
                 assert!(
-                    off <= 0.001,
-                    "{mode} {} at {degrees}°/frame, frame {f}: {:.3}% of pixels differ by more than 1/255 (max {:.1}/255)",
+                    off <= allowed,
+                    "{leap_name} {} at {degrees}°/frame, frame {f}: {:.3}% of pixels differ by more than 1/255 (max {:.1}/255)",
                     volume.name,
                     off * 100.0,
                     max * 255.0
                 );
             }
             eprintln!(
-                "{mode} {} {degrees}°/frame: worst frame {} with {:.3}% over 1/255 (max {:.2}/255)",
+                "{leap_name} {} {degrees}°/frame: worst frame {} with {:.3}% over 1/255 (max {:.2}/255)",
                 volume.name,
                 worst.2,
                 worst.0 * 100.0,
@@ -110,14 +139,25 @@ fn rotation_matches_the_baseline(mode: &str) {
     }
 }
 
+/// Per-tile depth bounds (`reprojection_tiles`, the graphs `leap_iso` and `leap_dvr`) are the
+/// nearest reprojected depth around each tile, never farther than a per-pixel splat of the
+/// margin's size: no ray starts past what it would have met, so every frame is the plain
+/// raycast's (the same samples on the same step grid) to within 1/255 on every pixel, the
+/// tooth included.
 #[test]
-fn leaping_isosurface_equals_the_plain_raycast_while_rotating() {
-    rotation_matches_the_baseline("iso");
+fn tile_bounds_leave_every_frame_the_plain_raycast_while_rotating_the_tooth_included() {
+    rotation_matches_the_baseline("iso", "leap_iso", 0.0);
+    rotation_matches_the_baseline("dvr", "leap_dvr", 0.0);
+    // With the empty cubes behind the first visible sample leapt as well (§6's suggestion).
+    rotation_matches_the_baseline("dvr", "leap_dvr_cubes", 0.0);
 }
 
+/// The paper's per-pixel splats (`leap_*_splats`): a start estimate can be wrong where a
+/// surface appears that the last frame did not see, on at most 0.1 % of the pixels.
 #[test]
-fn leaping_dvr_equals_the_plain_raycast_while_rotating() {
-    rotation_matches_the_baseline("dvr");
+fn per_pixel_splats_equal_the_plain_raycast_on_all_but_a_tenth_of_a_percent_while_rotating() {
+    rotation_matches_the_baseline("iso", "leap_iso_splats", 0.001);
+    rotation_matches_the_baseline("dvr", "leap_dvr_splats", 0.001);
 }
 
 /// The pixels whose ray crosses the volume box by more than a sliver (CPU, f64): the footprint
@@ -140,7 +180,7 @@ fn hole_filling_leaves_no_pixel_of_the_footprint_without_a_start() {
     // extended-splat step, every pixel of the footprint must end up with a start.
     for extend in [0u64, 1] {
         let options = reprojecting().with_param("splat", "splat_size", 1u64).with_param("holes", "extend", extend);
-        let mut leap = Live::new(&gpu, &registry, "klein_2005/leap_iso.ron", &volume, &lut, &options);
+        let mut leap = Live::new(&gpu, &registry, "klein_2005/leap_iso_splats.ron", &volume, &lut, &options);
         let mut holes_before_filling = 0;
         for f in 0..6 {
             let cam = camera(20.0 + 3.0 * f as f64);
@@ -179,7 +219,7 @@ fn pixels_near_the_silhouette_start_at_the_box_and_deeper_ones_keep_their_splat(
     let lut = tf.to_lut_for(&volume, 256);
     let band = 2i64;
     let options = reprojecting().with_scalar("iso_value", iso).with_param("holes", "silhouette_band", band as u64);
-    let mut leap = Live::new(&gpu, &registry, "klein_2005/leap_iso.ron", &volume, &lut, &options);
+    let mut leap = Live::new(&gpu, &registry, "klein_2005/leap_iso_splats.ron", &volume, &lut, &options);
     let (mut overridden, mut kept) = (0, 0);
     for f in 0..4 {
         let cam = camera(20.0 + 2.0 * f as f64);
@@ -241,7 +281,7 @@ fn pixels_near_the_silhouette_start_at_the_box_and_deeper_ones_keep_their_splat(
 fn scattered_splats_are_the_rasterized_quads() {
     let gpu = support::gpu();
     let registry = builtin_registry();
-    for (volume, tf, iso) in datasets() {
+    for (volume, tf, iso) in smooth_datasets() {
         let lut = tf.to_lut_for(&volume, 256);
         for (size, block) in [(4u64, 2u64), (1, 1), (3, 1)] {
             let options = |method: &str| {
@@ -251,8 +291,10 @@ fn scattered_splats_are_the_rasterized_quads() {
                     .with_param("splat", "splat_size", size)
                     .with_param("splat", "block", block)
             };
-            let mut quads = Live::new(&gpu, &registry, "klein_2005/leap_iso.ron", &volume, &lut, &options("quads"));
-            let mut scatter = Live::new(&gpu, &registry, "klein_2005/leap_iso.ron", &volume, &lut, &options("scatter"));
+            let mut quads =
+                Live::new(&gpu, &registry, "klein_2005/leap_iso_splats.ron", &volume, &lut, &options("quads"));
+            let mut scatter =
+                Live::new(&gpu, &registry, "klein_2005/leap_iso_splats.ron", &volume, &lut, &options("scatter"));
             for f in 0..4 {
                 let cam = camera(10.0 + 3.0 * f as f64);
                 quads.frame(&cam);
@@ -282,11 +324,25 @@ fn scattered_splats_are_the_rasterized_quads() {
     }
 }
 
-/// Whether every pixel of the last frame started at the box: no reprojected splat landed, so
-/// hole filling gave every pixel its box entry.
+/// The keys of `reprojection_tiles`' buffer (shaders/common/reprojected_tiles.wgsl): none yet,
+/// and "from the box".
+const NO_BOUND_YET: u32 = 0;
+const FROM_THE_BOX: u32 = u32::MAX;
+
+/// The tile keys of the last frame (past the header: tile edge, tiles per row).
+fn tile_keys(leap: &mut Live) -> Vec<u32> {
+    let words = leap.buffer_words("bounds.tiles");
+    let (edge, per_row) = (words[0], words[1]);
+    if edge == 0 {
+        return Vec::new();
+    }
+    let rows = SIZE.div_ceil(edge);
+    words[2..2 + (per_row * rows) as usize].to_vec()
+}
+
+/// Whether every ray of the last frame started at the box: no reprojected hit bounded a tile.
 fn started_at_the_box(leap: &mut Live) -> bool {
-    let splats = leap.resource("splat.start");
-    (0..splats.height).all(|y| (0..splats.width).all(|x| splats.rgba(x, y)[3] == 0.0))
+    tile_keys(leap).iter().all(|&k| k == NO_BOUND_YET || k == FROM_THE_BOX)
 }
 
 #[test]
@@ -369,8 +425,8 @@ fn a_surface_at_the_box_bypasses_reprojection_and_a_deep_one_brings_it_back() {
             assert_eq!(status.bypassed, f > 0, "{mode} frame {f}: {status:?}");
             if f > 0 {
                 assert_eq!(status.measure, Some(0.0), "{mode} frame {f}: no ray can leap over a sample");
-                let start = leap.resource("holes.start");
-                assert!(start.data.iter().all(|&v| v == 0.0), "{mode} frame {f}: the left-out estimates read as zeros");
+                let words = leap.buffer_words("bounds.tiles");
+                assert!(words.iter().all(|&w| w == 0), "{mode} frame {f}: the left-out bounds read as zeros");
             }
             // Left out or not, the rays start at the box: the plain raycast's image, exactly.
             assert_eq!(l.data, b.data, "{mode} frame {f}: the bypassed graph draws the plain raycast");
@@ -395,7 +451,121 @@ fn a_surface_at_the_box_bypasses_reprojection_and_a_deep_one_brings_it_back() {
         let status = reprojection(&leap);
         assert!(!status.bypassed, "{mode}: {status:?}");
         assert!(status.measure.is_some_and(|m| m > 4.0), "{mode}: rays cross empty space first: {status:?}");
-        assert!(!started_at_the_box(&mut leap), "{mode}: the splats are back");
+        assert!(!started_at_the_box(&mut leap), "{mode}: the bounds are back");
+    }
+}
+
+/// The view depth a tile key stands for (`depth_key` inverted).
+fn key_depth(key: u32) -> f32 {
+    f32::from_bits(!key)
+}
+
+/// Every tile's bound is at most the view depth of every hit of last frame that lands within
+/// `margin` pixels of it (checked on the CPU in f64 from last frame's hits and this frame's
+/// camera): rays start in front of everything last frame saw there. Tiles near the silhouette
+/// start at the box; inside the footprint, tiles are bounded.
+#[test]
+fn a_tile_bound_lies_in_front_of_every_hit_reprojected_near_the_tile() {
+    let gpu = support::gpu();
+    let registry = builtin_registry();
+    let (volume, tf, iso) = tooth();
+    let lut = tf.to_lut_for(&volume, 256);
+    let margin = 2.0;
+    for mode in ["iso", "dvr"] {
+        let options = reprojecting().with_scalar("iso_value", iso);
+        let mut leap = Live::new(&gpu, &registry, &format!("klein_2005/leap_{mode}.ron"), &volume, &lut, &options);
+        leap.frame(&camera(10.0));
+        let hits = leap.resource("march.leap_hit");
+        let cam = camera(13.0);
+        leap.frame(&cam);
+        let words = leap.buffer_words("bounds.tiles");
+        let (edge, per_row) = (words[0], words[1]);
+        assert_eq!((edge, per_row), (4, SIZE / 4), "{mode}: the header");
+        let keys = &words[2..];
+        let data = volgraph_core::runtime::CameraData::from_orbit(&cam, (SIZE, SIZE));
+        let half = volume.half_extent_world();
+        let (mut checked, mut bounded, mut from_box) = (0usize, 0usize, 0usize);
+        for y in 0..SIZE {
+            for x in 0..SIZE {
+                let h = hits.rgba(x, y);
+                if h[3] == 0.0 {
+                    continue;
+                }
+                let u = glam::DVec3::new(h[0] as f64, h[1] as f64, h[2] as f64);
+                let world = (u - glam::DVec3::splat(0.5)) * 2.0 * half;
+                let clip = data.clip_from_world * world.extend(1.0);
+                if clip.w <= 0.0 {
+                    continue;
+                }
+                let p = glam::DVec2::new(
+                    (clip.x / clip.w + 1.0) * 0.5 * SIZE as f64,
+                    (1.0 - clip.y / clip.w) * 0.5 * SIZE as f64,
+                );
+                let depth = (world - data.eye).dot(data.forward);
+                // The pixels whose centre lies within the margin, less a hundredth of a pixel
+                // (f32 and f64 may round a centre on the edge either way).
+                let lo =
+                    (p - glam::DVec2::splat(margin - 0.01) - glam::DVec2::splat(0.5)).ceil().max(glam::DVec2::ZERO);
+                let hi = (p + glam::DVec2::splat(margin - 0.01) - glam::DVec2::splat(0.5))
+                    .floor()
+                    .min(glam::DVec2::splat(SIZE as f64 - 1.0));
+                if lo.x > hi.x || lo.y > hi.y {
+                    continue;
+                }
+                for ty in (lo.y as u32 / edge)..=(hi.y as u32 / edge) {
+                    for tx in (lo.x as u32 / edge)..=(hi.x as u32 / edge) {
+                        let key = keys[(ty * per_row + tx) as usize];
+                        checked += 1;
+                        if key == FROM_THE_BOX {
+                            continue;
+                        }
+                        assert_ne!(key, NO_BOUND_YET, "{mode}: tile ({tx}, {ty}) has a hit nearby but no bound");
+                        // f32 depths of a few world units: a few ulps.
+                        let bound = key_depth(key) as f64;
+                        assert!(
+                            bound <= depth + 1e-5 * depth.abs().max(1.0),
+                            "{mode}: tile ({tx}, {ty}) bound {bound} behind a hit at depth {depth}"
+                        );
+                    }
+                }
+            }
+        }
+        for &k in &keys[..(per_row * per_row) as usize] {
+            bounded += (k != NO_BOUND_YET && k != FROM_THE_BOX) as usize;
+            from_box += (k == FROM_THE_BOX) as usize;
+        }
+        eprintln!("{mode}: {checked} hit-tile pairs checked, {bounded} tiles bounded, {from_box} from the box");
+        assert!(checked > 1000 && bounded > 100 && from_box > 10, "{mode}: {checked} {bounded} {from_box}");
+    }
+}
+
+/// The samples the march takes in the last frame, per pixel (`count_samples`).
+fn samples_per_pixel(live: &mut Live) -> f64 {
+    let words = live.buffer_words("march.samples");
+    words.iter().map(|&w| w as f64).sum::<f64>() / f64::from(SIZE * SIZE)
+}
+
+/// What the bounds are for: on the tooth, turning 1° per frame, the march started from the tile
+/// bounds takes well under half the plain raycast's samples (measured: about a fifth for the
+/// isosurface, a third for DVR at 128²).
+#[test]
+fn tile_bounds_leap_most_of_the_empty_space_in_front_of_the_tooth() {
+    let gpu = support::gpu();
+    let registry = builtin_registry();
+    let (volume, tf, iso) = tooth();
+    let lut = tf.to_lut_for(&volume, 256);
+    for mode in ["iso", "dvr"] {
+        let options = reprojecting().with_scalar("iso_value", iso).with_param("march", "count_samples", true);
+        let mut base = Live::new(&gpu, &registry, &format!("klein_2005/baseline_{mode}.ron"), &volume, &lut, &options);
+        let mut leap = Live::new(&gpu, &registry, &format!("klein_2005/leap_{mode}.ron"), &volume, &lut, &options);
+        for f in 0..4 {
+            let cam = camera(10.0 + f as f64);
+            base.frame(&cam);
+            leap.frame(&cam);
+        }
+        let (b, l) = (samples_per_pixel(&mut base), samples_per_pixel(&mut leap));
+        eprintln!("{mode}: {b:.2} samples per pixel plain, {l:.2} from the tile bounds");
+        assert!(b > 5.0 && l < 0.5 * b, "{mode}: {l} of {b} samples per pixel");
     }
 }
 

@@ -194,9 +194,9 @@ pub(crate) mod tests {
     fn the_picture_has_the_marks_of_the_dot_output() {
         let p = layout(&plan("klein_2005/leap_iso.ron"));
         let march = p.nodes.iter().position(|n| n.text.starts_with("march\n")).expect("march");
-        let splat = p.nodes.iter().position(|n| n.text.starts_with("splat\n")).expect("splat");
-        assert!(p.nodes[march].at.0 > p.nodes[splat].at.0, "the raycast comes after the splats");
-        assert!(p.edges.iter().any(|e| e.dashed && e.from == march && e.to == splat), "last frame's hits: dashed");
+        let bounds = p.nodes.iter().position(|n| n.text.starts_with("bounds\n")).expect("bounds");
+        assert!(p.nodes[march].at.0 > p.nodes[bounds].at.0, "the raycast comes after the bounds");
+        assert!(p.edges.iter().any(|e| e.dashed && e.from == march && e.to == bounds), "last frame's hits: dashed");
         let rc = layout(&plan("kruger_westermann_2003/rc.ron"));
         assert!(rc.nodes.iter().any(|n| n.group.is_some()), "the segment loop is a group");
     }

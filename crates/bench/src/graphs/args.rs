@@ -22,7 +22,7 @@ pub struct GraphsArgs {
     #[arg(long, value_delimiter = ',')]
     pub graphs: Vec<PathBuf>,
     /// Datasets, comma separated: names in $VOLGRAPH_DATA/volumes (hydrogen_atom, neghip, ...) or
-    /// generated volumes (ml64 = Marschner–Lobb 64³, mlf64 = its f32 twin, sphere64, noise64).
+    /// generated volumes (ml64 = Marschner–Lobb 64³, mlf64 = its f32 twin, sphere64, noise64, tooth256 = a molar CT).
     #[arg(long, value_delimiter = ',')]
     pub datasets: Vec<String>,
     /// Viewports WIDTHxHEIGHT, comma separated (default 512x512).
@@ -48,8 +48,8 @@ pub struct GraphsArgs {
     #[arg(long)]
     pub baseline: Option<String>,
     /// Transfer functions, comma separated: presets stretched over each volume's values (default,
-    /// opaque, sparse), .ron/.json files, or names of files in $VOLGRAPH_DATA/tf (engine_opaque,
-    /// hydrogen, ...).
+    /// opaque, sparse), `fitted` (transparent up to the volume's background, as `volgraph render`
+    /// picks), .ron/.json files, or names of files in $VOLGRAPH_DATA/tf (engine_opaque, hydrogen, ...).
     #[arg(long, value_delimiter = ',')]
     pub tf: Vec<String>,
     /// A shader folder to read before the built-in shaders (default: the `shaders/` folder of the

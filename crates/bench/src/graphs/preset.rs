@@ -155,19 +155,32 @@ pub const PRESETS: &[BenchPreset] = &[
     BenchPreset {
         name: "klein2005",
         about: "Klein et al. 2005 Table 1: the plain single-pass raycast against empty-space leaping by reprojected \
-                hit points (splats, hole fill, raycast from the estimates), isosurface and DVR, while the volume turns \
-                1° per frame at 512², step 0.5 voxel; samples per pixel with and without leaping counted on the GPU. \
+                hit points, isosurface and DVR, while the volume turns 1° per frame at 512², step 0.5 voxel: \
+                `leap_*` reproject them as per-tile depth bounds (reprojection_tiles), `leap_*_splats` as the paper's \
+                per-pixel splats and hole fill, `leap_dvr_cubes` adds the paper's §6 suggestion (skip the empty \
+                blocks behind the first visible sample too, by a min/max grid's distance map); samples per pixel with and without leaping counted on the GPU. \
                 Speed-up: each leaping graph against its baseline (the paper: engine 1.8×, head 2.2×, foot 2.7×; \
-                177 → 25 samples per pixel on its abdomen). Then §5's antialiasing study and the pooled memory of \
+                177 → 25 samples per pixel on its abdomen). tooth256 is the generated molar CT (volgraph_accel::tooth) \
+                under the TF `volgraph render` fits to it, at the isovalue of a real surface, 0.45. Then §5's antialiasing study and the pooled memory of \
                 leap_iso_aa at 1920×1080",
         graphs: &[
             "graphs/klein_2005/baseline_iso.ron",
             "graphs/klein_2005/leap_iso.ron",
+            "graphs/klein_2005/leap_iso_splats.ron",
             "graphs/klein_2005/baseline_dvr.ron",
             "graphs/klein_2005/leap_dvr.ron",
+            "graphs/klein_2005/leap_dvr_splats.ron",
+            "graphs/klein_2005/leap_dvr_cubes.ron",
         ],
         baseline: "baseline_iso",
-        baselines: &[("leap_iso", "baseline_iso"), ("baseline_dvr", "baseline_dvr"), ("leap_dvr", "baseline_dvr")],
+        baselines: &[
+            ("leap_iso", "baseline_iso"),
+            ("leap_iso_splats", "baseline_iso"),
+            ("baseline_dvr", "baseline_dvr"),
+            ("leap_dvr", "baseline_dvr"),
+            ("leap_dvr_splats", "baseline_dvr"),
+            ("leap_dvr_cubes", "baseline_dvr"),
+        ],
         datasets: &[],
         viewports: &[(512, 512)],
         tfs: &[],
@@ -176,6 +189,7 @@ pub const PRESETS: &[BenchPreset] = &[
             ("lobster", "default"),
             ("hydrogen_atom", "hydrogen"),
             ("neghip", "default"),
+            ("tooth256", "fitted"),
         ],
         params: &[("input.step_voxels", 0.5)],
         dataset_params: &[
@@ -183,6 +197,7 @@ pub const PRESETS: &[BenchPreset] = &[
             ("lobster", "input.iso_value", 0.2),
             ("hydrogen_atom", "input.iso_value", 0.12),
             ("neghip", "input.iso_value", 0.25),
+            ("tooth256", "input.iso_value", 0.45),
         ],
         frames: 24,
         camera: None,

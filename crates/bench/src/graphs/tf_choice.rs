@@ -1,5 +1,6 @@
 //! A benchmark transfer function: a built-in preset stretched over each volume's value range
-//! (`default`, `opaque`, `sparse`), or a file — a path to a `.ron` / ParaView `.json`, or the
+//! (`default`, `opaque`, `sparse`), `fitted` (the default ramp made transparent up to the
+//! volume's background of air or noise: what `volgraph render` picks for a scan), or a file — a path to a `.ron` / ParaView `.json`, or the
 //! name of one in `$VOLGRAPH_DATA/tf/` (the peer benchmark's `engine_opaque`, `hydrogen`, …),
 //! whose points are in the volume's own values.
 
@@ -17,6 +18,8 @@ use volgraph_app::inputs::LUT_SIZE;
 pub enum TfChoice {
     /// Stretched over the volume's value range.
     Preset(Preset),
+    /// `TransferFunction::default_for` the volume: the ramp, transparent up to its background.
+    Fitted,
     /// One of `graphs/tf/`, compiled into the program (`graphs/tf/vessels.ron` where no such
     /// file exists): the presets name these, and they work from any folder.
     Builtin {
@@ -51,6 +54,9 @@ impl TfChoice {
         if let Some(p) = Preset::from_name(text) {
             return Ok(TfChoice::Preset(p));
         }
+        if text == "fitted" {
+            return Ok(TfChoice::Fitted);
+        }
         let stem = |p: &Path| p.file_stem().map_or_else(|| text.to_string(), |s| s.to_string_lossy().into_owned());
         if is_tf_file(text) {
             let path = PathBuf::from(text);
@@ -64,7 +70,7 @@ impl TfChoice {
             return Ok(TfChoice::File { name: text.to_string(), path: named });
         }
         Err(anyhow!(
-            "--tf \"{text}\": expected a preset (default, opaque, sparse), a transfer-function file (.ron or ParaView \
+            "--tf \"{text}\": expected a preset (default, opaque, sparse), fitted, a transfer-function file (.ron or ParaView \
              .json), or the name of a file in {} (without .ron)",
             tf_dir().display()
         ))
@@ -74,6 +80,7 @@ impl TfChoice {
     pub fn name(&self) -> String {
         match self {
             TfChoice::Preset(p) => p.name().to_string(),
+            TfChoice::Fitted => "fitted".to_string(),
             TfChoice::Builtin { name, .. } => name.to_string(),
             TfChoice::File { name, .. } => name.clone(),
         }
@@ -86,6 +93,7 @@ impl TfChoice {
                 let (lo, hi) = volume.value_range;
                 TransferFunction::preset(*p, (lo, if hi > lo { hi } else { lo + 1.0 }))
             }
+            TfChoice::Fitted => TransferFunction::default_for(volume),
             TfChoice::Builtin { name, text } => {
                 TransferFunction::from_ron_str(text, Path::new(&format!("graphs/tf/{name}.ron")))
                     .map_err(|e| anyhow!("{e}"))?

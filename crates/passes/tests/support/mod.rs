@@ -135,6 +135,13 @@ impl Live {
         self.runtime.read_resource(rid).expect("reads")
     }
 
+    /// A buffer of the last frame by resource name (`bounds.tiles`, `march.samples`), as words.
+    pub fn buffer_words(&mut self, name: &str) -> Vec<u32> {
+        let rid = self.runtime.plan().expect("plan").resources.iter().position(|r| r.name == name).expect(name);
+        let bytes = self.runtime.read_buffer_resource(rid).expect("reads");
+        bytes.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect()
+    }
+
     /// A figure a pass reported about the last frame (`PassNode::counters`), by name.
     pub fn counter(&self, name: &str) -> f64 {
         let counters = self.runtime.pass_counters();

@@ -14,8 +14,9 @@
 //   near the silhouette;
 // - `cs_tiles_scatter`, one invocation per HIT_BLOCK × HIT_BLOCK block of last frame's screen
 //   rectangle of the volume (where its hits can be; the node computes it from last frame's
-//   camera): the block's hits projected, their nearest depth raised by atomicMax into every tile their
-//   projected bounding box grown by `margin` touches.
+//   camera): the block's hits projected, and each tile within `margin` of one of them raised by
+//   atomicMax to the nearest depth among the hits near it — one atomic per tile the block
+//   touches.
 
 #import "common/frame.wgsl"
 #import "common/ray_box.wgsl"
@@ -80,6 +81,25 @@ fn cs_tiles_clear(@builtin(global_invocation_id) id: vec3<u32>) {
     atomicStore(&tiles[TILES_HEADER + id.y * tiles_per_row() + id.x], key);
 }
 
+// The hits one invocation keeps to bound each tile by the hits near it alone, and the most
+// tiles per side such a block may touch; a block beyond either (a silhouette with depths far
+// apart) bounds every tile it touches by its nearest hit, which is nearer still.
+const LOCAL_HITS: u32 = 64u;
+const LOCAL_TILES: u32 = 5u;
+const FAR: f32 = 3.0e38;
+
+// The tiles (first x, y, last x, y) holding a pixel centre (x + 0.5) within `margin` of the
+// pixel-space box [lo, hi]; first > last when none (off screen).
+fn tiles_near(lo: vec2<f32>, hi: vec2<f32>) -> vec4<i32> {
+    let margin = f32(tile_bounds.margin);
+    let first = max(ceil(lo - vec2<f32>(margin + 0.5)), vec2<f32>(0.0));
+    let last = min(floor(hi + vec2<f32>(margin - 0.5)), frame.viewport.xy - 1.0);
+    if (any(first > last)) {
+        return vec4<i32>(1, 1, 0, 0);
+    }
+    return vec4<i32>(vec2<i32>(first) / i32(TILE), vec2<i32>(last) / i32(TILE));
+}
+
 @compute @workgroup_size(8, 8)
 fn cs_tiles_scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = vec2<u32>(frame.viewport.xy);
@@ -88,10 +108,13 @@ fn cs_tiles_scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     if (any(base >= end)) {
         return;
     }
-    // The block's hits in this frame: nearest view depth, bounding box in pixels (y down).
-    var nearest = 3.0e38;
-    var lo = vec2<f32>(3.0e38);
-    var hi = vec2<f32>(-3.0e38);
+    // The block's hits in this frame: where each lands (pixels, y down) and its view depth;
+    // their nearest depth and bounding box.
+    var points: array<vec3<f32>, LOCAL_HITS>;
+    var count = 0u;
+    var nearest = FAR;
+    var lo = vec2<f32>(FAR);
+    var hi = vec2<f32>(-FAR);
     for (var i = 0u; i < HIT_BLOCK * HIT_BLOCK; i += 1u) {
         let pixel = base + vec2<u32>(i % HIT_BLOCK, i / HIT_BLOCK);
         if (any(pixel >= end)) {
@@ -110,27 +133,52 @@ fn cs_tiles_scatter(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         let ndc = clip.xy / clip.w;
         let p = vec2<f32>((ndc.x + 1.0) * 0.5 * frame.viewport.x, (1.0 - ndc.y) * 0.5 * frame.viewport.y);
+        let depth = view_depth(world);
+        if (count < LOCAL_HITS) {
+            points[count] = vec3<f32>(p, depth);
+        }
+        count += 1u;
         lo = min(lo, p);
         hi = max(hi, p);
-        nearest = min(nearest, view_depth(world));
+        nearest = min(nearest, depth);
     }
-    if (nearest == 3.0e38) {
+    let range = tiles_near(lo, hi);
+    if (count == 0u || any(range.xy > range.zw)) {
         return;
     }
-    // The pixels whose centre (x + 0.5) lies within `margin` of the box, and their tiles; none
-    // when the box is off screen.
-    let margin = f32(tile_bounds.margin);
-    let first = ceil(lo - vec2<f32>(margin + 0.5));
-    let last = floor(hi + vec2<f32>(margin - 0.5));
-    if (any(last < vec2<f32>(0.0)) || any(first > frame.viewport.xy - 1.0) || any(first > last)) {
-        return;
-    }
-    let t0 = vec2<u32>(max(first, vec2<f32>(0.0))) / TILE;
-    let t1 = vec2<u32>(min(last, frame.viewport.xy - 1.0)) / TILE;
-    let key = depth_key(nearest);
     let per_row = tiles_per_row();
-    for (var ty = t0.y; ty <= t1.y; ty += 1u) {
-        for (var tx = t0.x; tx <= t1.x; tx += 1u) {
+    let n = vec2<u32>(range.zw - range.xy) + vec2<u32>(1u);
+    if (count <= LOCAL_HITS && all(n <= vec2<u32>(LOCAL_TILES))) {
+        // Each tile by the hits within `margin` of it: as tight as splatting every hit alone,
+        // one atomic per tile touched.
+        var mins: array<f32, 25>;
+        for (var t = 0u; t < LOCAL_TILES * LOCAL_TILES; t += 1u) {
+            mins[t] = FAR;
+        }
+        for (var i = 0u; i < count; i += 1u) {
+            let q = points[i];
+            let r = tiles_near(q.xy, q.xy) - vec4<i32>(range.xy, range.xy);
+            for (var ty = r.y; ty <= r.w; ty += 1) {
+                for (var tx = r.x; tx <= r.z; tx += 1) {
+                    let t = u32(ty) * LOCAL_TILES + u32(tx);
+                    mins[t] = min(mins[t], q.z);
+                }
+            }
+        }
+        for (var ty = 0u; ty < n.y; ty += 1u) {
+            for (var tx = 0u; tx < n.x; tx += 1u) {
+                let z = mins[ty * LOCAL_TILES + tx];
+                if (z < FAR) {
+                    let tile = vec2<u32>(range.xy) + vec2<u32>(tx, ty);
+                    atomicMax(&tiles[TILES_HEADER + tile.y * per_row + tile.x], depth_key(z));
+                }
+            }
+        }
+        return;
+    }
+    let key = depth_key(nearest);
+    for (var ty = u32(range.y); ty <= u32(range.w); ty += 1u) {
+        for (var tx = u32(range.x); tx <= u32(range.z); tx += 1u) {
             atomicMax(&tiles[TILES_HEADER + ty * per_row + tx], key);
         }
     }

@@ -2,19 +2,20 @@
 //! place of per-pixel splats and hole filling. Last frame's leap hits (a history of the
 //! raycaster's `leap_hit`) are reprojected with this frame's camera; every `tile`×`tile`
 //! screen tile keeps the nearest view depth among the hits that land on it or within `margin`
-//! pixels of it, and a raycaster wired to `tiles` (its `start_tiles` input) starts each ray of
-//! the tile at that depth, on the ray's own step grid, `step_back` samples early. A tile no hit
-//! reached, or one within `silhouette_band` pixels of the volume's silhouette, starts at the
-//! box.
+//! pixels of it (each tile by the hits near it alone, as if every hit were splatted on its
+//! own), and a raycaster wired to `tiles` (its `start_tiles` input) starts each ray of the tile
+//! at that depth, on the ray's own step grid, `step_back` samples early. A tile no hit reached,
+//! or one within `silhouette_band` pixels of the volume's silhouette, starts at the box.
 //!
 //! Why tiles: per pixel, the splats and the hole fill cost as much as a third of the march they
-//! shorten (9.0 + 2.8 ms against an 11.7 ms march for a tooth at 512² on llvmpipe, issue 47);
-//! here one compute invocation reads a `hit_block`² block of hits and raises one atomic per tile
-//! its projection touches — a few per block — and the march reads one word per pixel. And the
-//! bound is the nearest over a neighbourhood, never farther than the per-pixel splat of half
-//! size `margin` it replaces, so a start errs on the early (exact) side where a surface appears
-//! between last frame's hits. Shader: `shaders/reprojection_tiles.wgsl`; the layout the march
-//! reads: `shaders/common/reprojected_tiles.wgsl`.
+//! shorten (9.0 + 2.8 ms against an 11.7 ms march for a tooth at 512², issue 47); here one
+//! compute invocation reads a `hit_block`² block of hits, takes per tile the nearest of the hits
+//! near it in registers and raises one atomic per tile the block touches — a few per block —
+//! and the march reads one word per pixel. And a tile's bound is never farther than the
+//! per-pixel splats of half size `margin` would put any of its pixels, so a start errs on the
+//! early (exact) side where a surface appears between last frame's hits. Shader:
+//! `shaders/reprojection_tiles.wgsl`; the layout the march reads:
+//! `shaders/common/reprojected_tiles.wgsl`.
 
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{
@@ -32,8 +33,9 @@ volgraph_core::pass_params! {
     pub struct TileBoundsParams {
         tile: u32 = 4, 1..=32, "tile edge in pixels: every ray of a tile starts at the tile's nearest reprojected depth";
         hit_block: u32 = 4, 1..=16, "last frame's hits one invocation reads per side (fewer atomics, the same bounds)";
-        margin: u32 = 2, 0..=16,
-            "a hit bounds the tiles within this many pixels of where it lands (a per-pixel splat's half size: 2 for the paper's 4×4)";
+        margin: u32 = 4, 0..=16,
+            "a hit bounds the tiles within this many pixels of where it lands (the paper's 4×4 splats reach 2; \
+             4 leaves every test frame the plain raycast's)";
         silhouette_band: u32 = 2, 0..=16,
             "tiles this close to the volume's silhouette start at the box (rays newly in view enter it before any old hit)";
     }

@@ -12,6 +12,10 @@
 //! fragments of terminated rays never run (§2.1; the shader writes no depth, keeping early-z
 //! on). Mode `iso` is §2.2: the closest hit of each segment, shaded, alpha 1.
 //!
+//! The scene effects (shading, pre-integration, tricubic reconstruction, jitter: `effects.rs`)
+//! come from the shared march, as in the single-pass raycasters: a segment resumes a ray where
+//! the last one stopped, pre-integration included (its first segment takes the sample before).
+//!
 //! Debugging early-z: [`RaycastSegment::counting`] registers a variant whose fragment shader
 //! counts its invocations (`shaders/raycast_segment_counted.wgsl`, forced early depth test).
 //! Shader: `shaders/raycast_segment.wgsl`.
@@ -25,8 +29,9 @@ use volgraph_core::runtime::{
 };
 use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
+use crate::effects::{EffectFlags, EffectState, effect_defines, effect_shader_uses};
 use crate::empty_space::EMPTY_BLOCKS;
-use crate::raycast_params::{RaycastParamsGpu, Termination, is_iso, raycast_param_specs};
+use crate::raycast_params::{RaycastParamsGpu, Sampling, Termination, is_iso, raycast_param_specs};
 use crate::shared::{ACCUM_FORMATS, BlockSize, FLOAT_TARGETS, HIT_FORMATS, front_to_back_blend};
 
 /// The plugin. [`Default`] is the production pass; [`RaycastSegment::counting`] adds the debug
@@ -136,7 +141,7 @@ impl PassDecl for RaycastSegment {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        [raycast_param_specs(), SegmentSteps::specs(), BlockSize::specs()].concat()
+        [raycast_param_specs(), EffectFlags::specs(), SegmentSteps::specs(), BlockSize::specs()].concat()
     }
 
     fn ports(&self, params: &Params) -> Vec<PortSpec> {
@@ -162,13 +167,20 @@ impl PassDecl for RaycastSegment {
         let (file, entry_point) = self.entry(params);
         // The counting variant (a bench tool's) binds the invocation counter too.
         let extra: &'static [&'static str] = if self.counter.is_some() { &["invocations"] } else { &[] };
-        [ShaderUse::new(file, "vs_segment"), ShaderUse::new(file, entry_point)]
-            .map(|u| u.binds(extra).uniform(RaycastParamsGpu::bound("params")).uniform(SegmentParamsGpu::layout()))
-            .to_vec()
+        let mut uses = [ShaderUse::new(file, "vs_segment"), ShaderUse::new(file, entry_point)]
+            .map(|u| {
+                u.binds(extra)
+                    .binds(&["preintegrated"])
+                    .uniform(RaycastParamsGpu::bound("params"))
+                    .uniform(SegmentParamsGpu::layout())
+            })
+            .to_vec();
+        uses.extend(effect_shader_uses(params));
+        uses
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        crate::effects::jitter_defines(params)
+        effect_defines(params)
     }
 
     fn shaders_wired(&self, params: &Params, wired: &[&str]) -> Vec<ShaderUse> {
@@ -244,7 +256,9 @@ impl PassPlugin for RaycastSegment {
             }
             None => None,
         };
-        Ok(Box::new(RaycastSegmentNode { free, early_z, params, segment, invocations }))
+        let effects = EffectState::new(ctx)?;
+        let step_voxels = Sampling::from_params(ctx.params).step_voxels;
+        Ok(Box::new(RaycastSegmentNode { free, early_z, params, segment, invocations, effects, step_voxels }))
     }
 }
 
@@ -267,14 +281,19 @@ struct RaycastSegmentNode {
     params: wgpu::Buffer,
     segment: wgpu::Buffer,
     invocations: Option<wgpu::Buffer>,
+    /// The pre-integration table when that effect is on.
+    effects: EffectState,
+    step_voxels: f64,
 }
 
 impl PassNode for RaycastSegmentNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let index = segment_index(ctx);
         let pipeline = if ctx.is_bound("depth") { &self.early_z } else { &self.free };
+        self.effects.update(ctx, &self.params, self.step_voxels)?;
         let mut extra =
             vec![("params", self.params.as_entire_binding()), ("segment", self.segment.as_entire_binding())];
+        extra.extend(self.effects.bindings());
         if let Some(counter) = &self.invocations {
             if index == 0 {
                 ctx.encoder.clear_buffer(counter, 0, None);

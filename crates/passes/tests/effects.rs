@@ -32,8 +32,41 @@ const CAMERA: OrbitCamera = OrbitCamera {
     target: [0.0; 3],
 };
 
-const DVR_GRAPHS: [&str; 4] =
-    ["basic/fragment_raycast.ron", "basic/compute_raycast.ron", "modern/single_pass_ess_ert.ron", "modern/fastest.ron"];
+/// One graph of each raycaster family that takes the effects: fragment, compute, the single
+/// pass with leaping, the fastest path, and Krüger–Westermann's multipass segments with
+/// termination and skipping (rc_b) and with the leap inside the segments (rc_b_leap).
+const DVR_GRAPHS: [&str; 6] = [
+    "basic/fragment_raycast.ron",
+    "basic/compute_raycast.ron",
+    "modern/single_pass_ess_ert.ron",
+    "modern/fastest.ron",
+    "kruger_westermann_2003/rc_b.ron",
+    "kruger_westermann_2003/rc_b_leap.ron",
+];
+
+/// Every DVR graph of the papers that must take every scene effect (`--features`).
+const PAPER_DVR_GRAPHS: [&str; 4] = [
+    "kruger_westermann_2003/rc.ron",
+    "kruger_westermann_2003/rc_a.ron",
+    "kruger_westermann_2003/rc_b.ron",
+    "kruger_westermann_2003/rc_b_leap.ron",
+];
+
+/// Every paper DVR graph compiles with every scene effect on, and compiles each into its march.
+#[test]
+fn every_paper_dvr_graph_takes_every_effect() {
+    let registry = builtin_registry();
+    let features = ["shading", "preintegration", "tricubic", "jitter"];
+    for graph in PAPER_DVR_GRAPHS {
+        let options = CompileOptions::new(64, 64).with_features(features);
+        let plan = volgraph_core::compile(graph, &graph_source(graph), &registry, &options)
+            .unwrap_or_else(|d| panic!("{graph} with {features:?}:\n{d}"));
+        let march = plan.steps.iter().find(|s| s.pass_id == "march").expect("march");
+        for name in features {
+            assert!(march.params.boolean(name), "{graph}: {name} reaches the march");
+        }
+    }
+}
 
 /// The fraction of pixels with a channel more than `tolerance` off.
 fn over(image: &Image, reference: &[[f64; 4]], tolerance: f64) -> f64 {
@@ -75,6 +108,12 @@ fn render_and_compare(
     // each side stops) and the graph's own step.
     let options =
         CompileOptions::new(SIZE, SIZE).with_features(features.iter().copied()).with_param("march", "threshold", 1.0);
+    // The segment graphs take the threshold from their input (the termination test reads it too).
+    let options = if graph.starts_with("kruger_westermann_2003/") {
+        CompileOptions::new(SIZE, SIZE).with_features(features.iter().copied()).with_scalar("threshold", 1.0)
+    } else {
+        options
+    };
     let source = graph_source(graph);
     let lut = tf.to_lut_for(volume, 256);
     let gpu = gpu();

@@ -82,9 +82,16 @@ const EFFECT_MARKERS: [(&str, &str); 4] = [
     ("jitter", "pcg_hash"),
 ];
 
-/// The DVR graphs that take every effect (graphs/basic and graphs/modern).
-const DVR_GRAPHS: [&str; 4] =
-    ["basic/fragment_raycast.ron", "basic/compute_raycast.ron", "modern/single_pass_ess_ert.ron", "modern/fastest.ron"];
+/// The DVR graphs that take every effect: graphs/basic and graphs/modern, and Krüger–Westermann's
+/// multipass segments (each segment pass compiles the effects it was asked for).
+const DVR_GRAPHS: [&str; 6] = [
+    "basic/fragment_raycast.ron",
+    "basic/compute_raycast.ron",
+    "modern/single_pass_ess_ert.ron",
+    "modern/fastest.ron",
+    "kruger_westermann_2003/rc_b.ron",
+    "kruger_westermann_2003/rc_b_leap.ron",
+];
 
 #[test]
 fn every_scene_effect_is_compiled_only_when_the_scene_turns_it_on() {

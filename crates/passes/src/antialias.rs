@@ -14,8 +14,8 @@ use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind,
 
 use volgraph_core::declare::ParamChoice;
 
-use crate::effects::jitter_defines;
-use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
+use crate::effects::{EffectFlags, EffectState, effect_defines, effect_shader_uses, same_effects};
+use crate::raycast_params::{RaycastParamsGpu, Sampling, is_iso, raycast_param_specs};
 use crate::shared::FLOAT_TARGETS;
 
 /// The plugin.
@@ -95,6 +95,7 @@ fn ray_block(p: &Params) -> RaycastParamsGpu {
 /// Its pipeline for these parameters.
 fn shader(params: &Params) -> ShaderUse {
     ShaderUse::new("antialias.wgsl", if is_iso(params) { "fs_aa_iso" } else { "fs_aa_dvr" })
+        .binds(&["preintegrated"])
         .uniform(aa_layout())
         .uniform(RaycastParamsGpu::bound("params"))
 }
@@ -113,7 +114,9 @@ impl PassDecl for Antialias {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        [raycast_param_specs(), AaOwn::specs()].concat()
+        // The sub-pixel rays march like the raycaster's, scene effects included (wire the same
+        // features to both).
+        [raycast_param_specs(), EffectFlags::specs(), AaOwn::specs()].concat()
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -127,15 +130,15 @@ impl PassDecl for Antialias {
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        jitter_defines(params)
+        effect_defines(params)
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        vec![shader(params)]
+        [vec![shader(params)], effect_shader_uses(params)].concat()
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        is_iso(old) == is_iso(new) && jitter_defines(old) == jitter_defines(new)
+        is_iso(old) == is_iso(new) && same_effects(old, new)
     }
 }
 
@@ -148,7 +151,9 @@ impl PassPlugin for Antialias {
         })?;
         let params = ctx.uniform_from_bytes("params", &ray_block(ctx.params).uniform_bytes());
         let aa = ctx.uniform_with("aa", &AaParamsGpu::from_params(ctx.params));
-        Ok(Box::new(AntialiasNode { pipeline, params, aa }))
+        let effects = EffectState::new(ctx)?;
+        let step_voxels = Sampling::from_params(ctx.params).step_voxels;
+        Ok(Box::new(AntialiasNode { pipeline, params, aa, effects, step_voxels }))
     }
 }
 
@@ -156,19 +161,24 @@ struct AntialiasNode {
     pipeline: RenderPassPipeline,
     params: wgpu::Buffer,
     aa: wgpu::Buffer,
+    /// The pre-integration table when that effect is on.
+    effects: EffectState,
+    step_voxels: f64,
 }
 
 impl PassNode for AntialiasNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
-        let bg = ctx.bind_group(
-            &self.pipeline,
-            &[("params", self.params.as_entire_binding()), ("aa", self.aa.as_entire_binding())],
-        )?;
+        self.effects.update(ctx, &self.params, self.step_voxels)?;
+        let mut bindings = vec![("params", self.params.as_entire_binding()), ("aa", self.aa.as_entire_binding())];
+        bindings.extend(self.effects.bindings());
+        let bg = ctx.bind_group(&self.pipeline, &bindings)?;
         ctx.draw_fullscreen(&self.pipeline, &bg)
     }
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
         gpu.queue.write_buffer(&self.params, 0, &ray_block(params).uniform_bytes());
         gpu.queue.write_buffer(&self.aa, 0, bytemuck::bytes_of(&AaParamsGpu::from_params(params)));
+        self.step_voxels = Sampling::from_params(params).step_voxels;
+        self.effects.invalidate();
     }
 }

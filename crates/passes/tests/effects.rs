@@ -34,22 +34,29 @@ const CAMERA: OrbitCamera = OrbitCamera {
 
 /// One graph of each raycaster family that takes the effects: fragment, compute, the single
 /// pass with leaping, the fastest path, and Krüger–Westermann's multipass segments with
-/// termination and skipping (rc_b) and with the leap inside the segments (rc_b_leap).
-const DVR_GRAPHS: [&str; 6] = [
+/// termination and skipping (rc_b) and with the leap inside the segments (rc_b_leap), and Klein
+/// et al.'s leaping march (its first frame: every ray from the box) alone and with empty cubes.
+const DVR_GRAPHS: [&str; 8] = [
     "basic/fragment_raycast.ron",
     "basic/compute_raycast.ron",
     "modern/single_pass_ess_ert.ron",
     "modern/fastest.ron",
     "kruger_westermann_2003/rc_b.ron",
     "kruger_westermann_2003/rc_b_leap.ron",
+    "klein_2005/leap_dvr.ron",
+    "klein_2005/leap_dvr_cubes.ron",
 ];
 
 /// Every DVR graph of the papers that must take every scene effect (`--features`).
-const PAPER_DVR_GRAPHS: [&str; 4] = [
+const PAPER_DVR_GRAPHS: [&str; 8] = [
     "kruger_westermann_2003/rc.ron",
     "kruger_westermann_2003/rc_a.ron",
     "kruger_westermann_2003/rc_b.ron",
     "kruger_westermann_2003/rc_b_leap.ron",
+    "klein_2005/baseline_dvr.ron",
+    "klein_2005/leap_dvr.ron",
+    "klein_2005/leap_dvr_splats.ron",
+    "klein_2005/leap_dvr_cubes.ron",
 ];
 
 /// Every paper DVR graph compiles with every scene effect on, and compiles each into its march.
@@ -108,8 +115,9 @@ fn render_and_compare(
     // each side stops) and the graph's own step.
     let options =
         CompileOptions::new(SIZE, SIZE).with_features(features.iter().copied()).with_param("march", "threshold", 1.0);
-    // The segment graphs take the threshold from their input (the termination test reads it too).
-    let options = if graph.starts_with("kruger_westermann_2003/") {
+    // The segment and Klein graphs take the threshold from a Scalar input (the termination test
+    // reads it too).
+    let options = if graph.starts_with("kruger_westermann_2003/") || graph.starts_with("klein_2005/") {
         CompileOptions::new(SIZE, SIZE).with_features(features.iter().copied()).with_scalar("threshold", 1.0)
     } else {
         options

@@ -83,14 +83,16 @@ const EFFECT_MARKERS: [(&str, &str); 4] = [
 ];
 
 /// The DVR graphs that take every effect: graphs/basic and graphs/modern, and Krüger–Westermann's
-/// multipass segments (each segment pass compiles the effects it was asked for).
-const DVR_GRAPHS: [&str; 6] = [
+/// multipass segments (each segment pass compiles the effects it was asked for), Klein et al.'s
+/// leaping march.
+const DVR_GRAPHS: [&str; 7] = [
     "basic/fragment_raycast.ron",
     "basic/compute_raycast.ron",
     "modern/single_pass_ess_ert.ron",
     "modern/fastest.ron",
     "kruger_westermann_2003/rc_b.ron",
     "kruger_westermann_2003/rc_b_leap.ron",
+    "klein_2005/leap_dvr.ron",
 ];
 
 #[test]

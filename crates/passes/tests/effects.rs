@@ -48,7 +48,10 @@ const DVR_GRAPHS: [&str; 8] = [
 ];
 
 /// Every DVR graph of the papers that must take every scene effect (`--features`).
-const PAPER_DVR_GRAPHS: [&str; 8] = [
+const PAPER_DVR_GRAPHS: [&str; 11] = [
+    "compute_raycast_2013/pixel_shader.ron",
+    "compute_raycast_2013/compute_shader.ron",
+    "ruijters_vilanova_2006/unoptimized.ron",
     "kruger_westermann_2003/rc.ron",
     "kruger_westermann_2003/rc_a.ron",
     "kruger_westermann_2003/rc_b.ron",

@@ -4,16 +4,16 @@
 //! §5 and §7, the orbit camera, and the f64 reference raycaster every GPU image is checked
 //! against. The rendering conventions are in `docs/rendering_model.md`.
 
+pub use volgraph_base::{cuts, input_file};
+
 pub mod bricks;
 pub mod camera;
 pub mod chebyshev;
 pub mod classify;
-pub mod cuts;
 pub mod data_dir;
 pub mod generate;
 pub mod histogram;
 pub mod image_diff;
-pub mod input_file;
 pub mod kd_split;
 pub mod load;
 pub mod minmax;

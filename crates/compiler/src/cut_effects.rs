@@ -1,4 +1,4 @@
-//! A scene's crop box and clip planes as effects (`volgraph_accel::cuts`): the scene features
+//! A scene's crop box and clip planes as effects (`volgraph_base::cuts`): the scene features
 //! `crop` and `clip`, each the `#if` name of the same word in capitals that
 //! `shaders/common/ray_box.wgsl` compiles its cut into, and `CUTS` with either (code every cut
 //! needs, such as capping's shading normal). Unlike the DVR effects, which a graph
@@ -8,7 +8,7 @@
 
 use std::collections::BTreeSet;
 
-use volgraph_accel::cuts::Cuts;
+use volgraph_base::cuts::Cuts;
 
 use crate::decl::PassDecl;
 

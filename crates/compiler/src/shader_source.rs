@@ -201,7 +201,7 @@ impl ShaderSources {
                                 reason: "it is a link that leads out of its shader folder",
                             });
                         }
-                        let text = volgraph_accel::input_file::read_text(&path, "WGSL shader")
+                        let text = volgraph_base::input_file::read_text(&path, "WGSL shader")
                             .map_err(|e| ShaderSourceError::Read { path: path.clone(), reason: e.to_string() })?;
                         return Ok((SourceFile { name: relative.to_string(), path: Some(path) }, text));
                     }

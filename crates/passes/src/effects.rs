@@ -10,6 +10,7 @@
 use volgraph_core::Params;
 use volgraph_core::runtime::{CreateContext, PassError, RecordContext};
 
+use crate::defines;
 use crate::preintegration::PreintegrationTable;
 use crate::raycast_params::Sampling;
 
@@ -35,10 +36,14 @@ impl EffectFlags {
 
     /// The `#if` names of the effects turned on.
     pub fn defines(&self) -> Vec<&'static str> {
-        [(self.shading, "SHADING"), (self.preintegration, "PREINTEGRATION"), (self.tricubic, "TRICUBIC")]
-            .into_iter()
-            .filter_map(|(on, define)| on.then_some(define))
-            .collect()
+        [
+            (self.shading, defines::SHADING),
+            (self.preintegration, defines::PREINTEGRATION),
+            (self.tricubic, defines::TRICUBIC),
+        ]
+        .into_iter()
+        .filter_map(|(on, define)| on.then_some(define))
+        .collect()
     }
 }
 
@@ -65,8 +70,8 @@ pub fn jitter_defines(params: &Params) -> Vec<&'static str> {
     let sampling = Sampling::try_from_params(params);
     match sampling.map(|s| (s.jitter, s.jitter_per_frame)) {
         None | Some((false, _)) => Vec::new(),
-        Some((true, false)) => vec!["JITTER"],
-        Some((true, true)) => vec!["JITTER", "JITTER_PER_FRAME"],
+        Some((true, false)) => vec![defines::JITTER],
+        Some((true, true)) => vec![defines::JITTER, defines::JITTER_PER_FRAME],
     }
 }
 

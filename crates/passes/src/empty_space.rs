@@ -98,7 +98,7 @@ impl PassDecl for EmptySpace {
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        if ClassifySettings::from_params(params).segments { vec!["SEGMENTS"] } else { Vec::new() }
+        if ClassifySettings::from_params(params).segments { vec![crate::defines::SEGMENTS] } else { Vec::new() }
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {

@@ -4,6 +4,7 @@
 
 pub mod antialias;
 pub mod brick_pool;
+pub mod defines;
 pub mod effects;
 pub mod empty_distance;
 pub mod empty_space;

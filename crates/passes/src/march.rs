@@ -8,6 +8,7 @@
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext};
 use volgraph_core::{Params, PortKind, PortSpec};
 
+use crate::defines;
 use crate::empty_distance::EMPTY_DISTANCE;
 use crate::empty_space::{EMPTY_BLOCKS, check_block_grid};
 use crate::minmax_grid::bound_size;
@@ -91,10 +92,10 @@ pub fn march_defines(params: &Params) -> Vec<&'static str> {
     let settings = MarchSettings::from_params(params);
     let mut defines = Vec::new();
     if settings.analytic() {
-        defines.push("ANALYTIC");
+        defines.push(defines::ANALYTIC);
     }
     if settings.count_samples {
-        defines.push("COUNT");
+        defines.push(defines::COUNT);
     }
     defines
 }
@@ -133,8 +134,8 @@ impl Source {
     fn defines(self) -> Vec<&'static str> {
         match self {
             Source::None => vec![],
-            Source::Blocks => vec!["LEAP", "LEAP_BLOCKS"],
-            Source::Distance { .. } => vec!["LEAP", "LEAP_CUBES"],
+            Source::Blocks => vec![defines::LEAP, defines::LEAP_BLOCKS],
+            Source::Distance { .. } => vec![defines::LEAP, defines::LEAP_CUBES],
         }
     }
 }
@@ -145,10 +146,10 @@ impl Source {
 pub fn wired_defines(params: &Params, wired: &[&str]) -> Vec<&'static str> {
     let mut defines = Source::of(params, wired).map(Source::defines).unwrap_or_default();
     if wired.contains(&"start") {
-        defines.push("START");
+        defines.push(defines::START);
     }
     if wired.contains(&"start_tiles") {
-        defines.push("START_TILES");
+        defines.push(defines::START_TILES);
     }
     defines
 }

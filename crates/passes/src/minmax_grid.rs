@@ -107,7 +107,7 @@ impl PassDecl for MinMaxGridPass {
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        if GridApron::from_params(params).tricubic { vec!["TRICUBIC"] } else { Vec::new() }
+        if GridApron::from_params(params).tricubic { vec![crate::defines::TRICUBIC] } else { Vec::new() }
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {

@@ -69,10 +69,10 @@ impl PassDecl for Raycast {
         let mut defines = [effect_defines(params), march_defines(params)].concat();
         let own = RaycastOwn::from_params(params);
         if own.leaps(params) {
-            defines.extend(["LEAP_HITS", "FIRST_VISIBLE"]);
+            defines.extend([crate::defines::LEAP_HITS, crate::defines::FIRST_VISIBLE]);
         }
         if own.counts_leapable() {
-            defines.push("COUNT_LEAPABLE");
+            defines.push(crate::defines::COUNT_LEAPABLE);
         }
         defines
     }

@@ -93,7 +93,7 @@ impl PassDecl for RaycastCompute {
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
         let mut defines = [effect_defines(params), march_defines(params)].concat();
         if uses_table(params) {
-            defines.push("CORRECTED_TABLE");
+            defines.push(crate::defines::CORRECTED_TABLE);
         }
         defines.extend(SampleLoopChoice::defines(params, None));
         defines

@@ -8,6 +8,7 @@
 use volgraph_accel::reference::{Phong, RaycastSettings, RenderMode};
 use volgraph_core::Params;
 
+use crate::defines;
 use crate::effects::EffectFlags;
 
 volgraph_core::param_choice! {
@@ -98,7 +99,7 @@ impl SampleLoopChoice {
             SampleLoop::Plain => false,
             SampleLoop::Auto => gpu.is_some_and(|g| !g.is_cpu),
         };
-        if pipelined { vec!["TF_WORKGROUP", "PREFETCH"] } else { Vec::new() }
+        if pipelined { vec![defines::TF_WORKGROUP, defines::PREFETCH] } else { Vec::new() }
     }
 
     /// `defines` at plan time followed by those `gpu` adds: the list a pipeline is built with.

@@ -29,6 +29,7 @@ use volgraph_core::runtime::{
 };
 use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
+use crate::defines;
 use crate::effects::{EffectFlags, EffectState, effect_defines, effect_shader_uses};
 use crate::empty_space::EMPTY_BLOCKS;
 use crate::raycast_params::{RaycastParamsGpu, Sampling, Termination, is_iso, raycast_param_specs};
@@ -185,7 +186,8 @@ impl PassDecl for RaycastSegment {
 
     fn shaders_wired(&self, params: &Params, wired: &[&str]) -> Vec<ShaderUse> {
         // §2.3 inside the segment: the shared march leaps over the wired block flags.
-        let leap: Vec<&'static str> = if wired.contains(&"empty") { vec!["LEAP", "LEAP_BLOCKS"] } else { vec![] };
+        let leap: Vec<&'static str> =
+            if wired.contains(&"empty") { vec![defines::LEAP, defines::LEAP_BLOCKS] } else { vec![] };
         self.shaders(params).into_iter().map(|u| u.defines(leap.clone())).collect()
     }
 }
@@ -221,7 +223,7 @@ impl PassPlugin for RaycastSegment {
         };
         let mut defines = self.shader_defines(ctx.params);
         if leap {
-            defines.extend(["LEAP", "LEAP_BLOCKS"]);
+            defines.extend([defines::LEAP, defines::LEAP_BLOCKS]);
         }
         let spec = |depth: Option<DepthSpec<'static>>| RenderPipelineSpec {
             shader,

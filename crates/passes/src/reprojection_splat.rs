@@ -126,7 +126,7 @@ impl PassDecl for ReprojectionSplat {
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        if scatters(params) { vec!["SCATTER"] } else { Vec::new() }
+        if scatters(params) { vec![crate::defines::SCATTER] } else { Vec::new() }
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {

@@ -50,7 +50,7 @@ fn color_is_f32(ctx: &CreateContext<'_>) -> bool {
 /// The `#if` names of the colour target's precision (`shaders/common/color_target.wgsl`): the
 /// one place a compute march learns whether it writes f16 or f32.
 pub fn color_precision_defines(ctx: &CreateContext<'_>) -> Vec<&'static str> {
-    if color_is_f32(ctx) { vec!["COLOR_F32"] } else { Vec::new() }
+    if color_is_f32(ctx) { vec![crate::defines::COLOR_F32] } else { Vec::new() }
 }
 
 /// A built-in shader assembled as the GPU gets it (imports resolved, bindings numbered), for
@@ -77,7 +77,7 @@ mod tests {
     fn the_block_size_uniforms_match_their_shader_structs() {
         BlockSize::check_shader(&assembled("minmax_grid.wgsl"), "BlockSize").unwrap_or_else(|e| panic!("{e}"));
         for file in ["raycast.wgsl", "raycast_compute.wgsl"] {
-            let text = assembled_with(file, &["LEAP", "LEAP_CUBES"]);
+            let text = assembled_with(file, &[crate::defines::LEAP, crate::defines::LEAP_CUBES]);
             BlockSize::check_shader(&text, "BlockSize").unwrap_or_else(|e| panic!("{file}: {e}"));
         }
         assert_eq!(BlockSize { block_size: 8 }.uniform_bytes().len(), 16);

@@ -1,0 +1,80 @@
+//! The `#if` names the built-in passes assemble their shaders with, typed once: a pass names a
+//! define through these constants, never a bare string, and `tests/shader_defines.rs` fails when
+//! a WGSL `#if NAME` under `shaders/` has no constant here (or in the compiler's frame defines,
+//! `volgraph_compiler::cut_effects`) or a constant here is used by no shader. Grouped by what
+//! turns them on.
+
+// Scene effects (`effects.rs`): compiled in only when a scene asks for them.
+/// Blinn–Phong shading of every DVR sample (`effects::EffectFlags::shading`).
+pub const SHADING: &str = "SHADING";
+/// Pre-integrated classification (Engel et al. 2001; `effects::EffectFlags::preintegration`).
+pub const PREINTEGRATION: &str = "PREINTEGRATION";
+/// Tricubic B-spline reconstruction (`effects::EffectFlags::tricubic`; the min/max grid's apron).
+pub const TRICUBIC: &str = "TRICUBIC";
+/// A per-pixel sample offset (`raycast_params::Sampling::jitter`).
+pub const JITTER: &str = "JITTER";
+/// The offset changes every frame (`Sampling::jitter_per_frame`).
+pub const JITTER_PER_FRAME: &str = "JITTER_PER_FRAME";
+
+// The shared march's settings and wiring (`march.rs`).
+/// Rays met with the box in the shader (`rays: "analytic"`) instead of entry/direction targets.
+pub const ANALYTIC: &str = "ANALYTIC";
+/// Sample counting (benchmarks).
+pub const COUNT: &str = "COUNT";
+/// Empty-space leaping, with one of its providers below.
+pub const LEAP: &str = "LEAP";
+/// … over the empty-block flags (`empty`).
+pub const LEAP_BLOCKS: &str = "LEAP_BLOCKS";
+/// … over cubes of empty blocks (a `distance` map).
+pub const LEAP_CUBES: &str = "LEAP_CUBES";
+/// Rays start at per-pixel estimates (`start`; Klein et al. 2005 §4.2).
+pub const START: &str = "START";
+/// Rays start at per-tile depth bounds (`start_tiles`, `reprojection_tiles`).
+pub const START_TILES: &str = "START_TILES";
+
+// The fragment raycaster's Klein variant (`raycast.rs`).
+/// Write `leap_hit`, where the next frame's ray starts.
+pub const LEAP_HITS: &str = "LEAP_HITS";
+/// Report the first visible DVR sample.
+pub const FIRST_VISIBLE: &str = "FIRST_VISIBLE";
+/// Count the samples a perfect start estimate would leap over (a bypass's measure).
+pub const COUNT_LEAPABLE: &str = "COUNT_LEAPABLE";
+
+// Other passes.
+/// The compute raycaster classifies through the pre-corrected TF table (`raycast_compute.rs`).
+pub const CORRECTED_TABLE: &str = "CORRECTED_TABLE";
+/// The sample loop's pipelined variant: the TF in workgroup memory (`raycast_params.rs`).
+pub const TF_WORKGROUP: &str = "TF_WORKGROUP";
+/// … and the next sample fetched ahead.
+pub const PREFETCH: &str = "PREFETCH";
+/// A compute march writes f32 colour (`shared::color_precision_defines`).
+pub const COLOR_F32: &str = "COLOR_F32";
+/// The classification of pre-integrated segments (`empty_space.rs`).
+pub const SEGMENTS: &str = "SEGMENTS";
+/// The splats written by a compute scatter (`reprojection_splat.rs`).
+pub const SCATTER: &str = "SCATTER";
+
+/// Every `#if` name of the built-in passes.
+pub const BUILT_IN: [&str; 21] = [
+    SHADING,
+    PREINTEGRATION,
+    TRICUBIC,
+    JITTER,
+    JITTER_PER_FRAME,
+    ANALYTIC,
+    COUNT,
+    LEAP,
+    LEAP_BLOCKS,
+    LEAP_CUBES,
+    START,
+    START_TILES,
+    LEAP_HITS,
+    FIRST_VISIBLE,
+    COUNT_LEAPABLE,
+    CORRECTED_TABLE,
+    TF_WORKGROUP,
+    PREFETCH,
+    COLOR_F32,
+    SEGMENTS,
+    SCATTER,
+];

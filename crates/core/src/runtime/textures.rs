@@ -1,4 +1,4 @@
-//! The runtime's texture pool: transient targets keyed by descriptor. A schedule acquires its
+//! The runtime's texture pool: transient targets keyed by descriptor. A live plan acquires its
 //! slots' textures here and gives them back when a new plan replaces it, so a graph edit that
 //! keeps a target's format and size keeps its texture, and a resize reallocates only the
 //! viewport-sized targets. Textures nobody took back within one further plan change are freed,

@@ -1,8 +1,13 @@
-//! A plan made live: one node per pass, a texture per slot, the owned resources nodes publish and
-//! a bind-group cache. `build` makes one from a plan and the previous schedule, reusing what did
-//! not change: a node whose kind, ports and shaders are unchanged is kept (its parameters updated
-//! in place where the plugin can), everything else is created with pipelines from the runtime's
-//! cache. Building is all-or-nothing: on any error the previous schedule is untouched.
+//! The live plan: a compiled [`Plan`] made live on the GPU — one node per pass, a texture per
+//! slot, the owned resources nodes publish and a bind-group cache. (Not the compiler's scheduler,
+//! `crates/compiler/src/compile/schedule.rs`, which orders a graph's passes into the plan; this is
+//! what the runtime builds from that plan.) `build` makes one from a plan and the previous live
+//! plan, reusing what did not change: a node whose kind, ports and shaders are unchanged is kept
+//! (its parameters updated in place where the plugin can), everything else is created with
+//! pipelines from the runtime's cache. Building is all-or-nothing: on any error the previous
+//! live plan is untouched.
+//!
+//! This module was `runtime/schedule.rs`; `volgraph_core::runtime::schedule` still names it.
 
 use std::cell::RefCell;
 use std::collections::{BTreeSet, HashMap};
@@ -46,7 +51,7 @@ pub(crate) enum SlotTexture {
     History(String),
 }
 
-/// What a fresh slot got: a texture or buffer, and whether it is shared with the old schedule.
+/// What a fresh slot got: a texture or buffer, and whether it is shared with the old live plan.
 enum Fresh {
     Texture(PooledTexture, bool),
     Buffer(PooledBuffer, bool),
@@ -63,7 +68,7 @@ impl Fresh {
 }
 
 /// A live plan.
-pub(crate) struct Schedule {
+pub(crate) struct LivePlan {
     pub plan: Plan,
     pub nodes: HashMap<String, NodeEntry>,
     pub slots: Vec<SlotTexture>,
@@ -157,7 +162,7 @@ enum Decision {
     Create(Box<dyn PassNode>, BTreeSet<String>),
 }
 
-/// The runtime's long-lived state a schedule is built against.
+/// The runtime's long-lived state a live plan is built against.
 pub(crate) struct Resources<'a> {
     pub gpu: &'a Gpu,
     pub shaders: &'a ShaderLibrary,
@@ -166,17 +171,20 @@ pub(crate) struct Resources<'a> {
     pub history: &'a mut HistoryStore,
 }
 
-#[allow(clippy::result_large_err, reason = "the old schedule is handed back by value on failure, once per plan change")]
-/// Builds the schedule of `plan`, reusing from `old` (consumed only on success: on error `old`
+#[allow(
+    clippy::result_large_err,
+    reason = "the old live plan is handed back by value on failure, once per plan change"
+)]
+/// Builds the live plan of `plan`, reusing from `old` (consumed only on success: on error `old`
 /// is handed back untouched). `stale_modules` are shader modules edited since `old` was built.
 pub(crate) fn build(
     r: Resources<'_>,
     registry: &Registry,
     plan: Plan,
-    old: Option<Schedule>,
+    old: Option<LivePlan>,
     stale_modules: &[String],
     cut_defines: &[&'static str],
-) -> Result<(Schedule, ApplyReport), (ApplyError, Option<Schedule>)> {
+) -> Result<(LivePlan, ApplyReport), (ApplyError, Option<LivePlan>)> {
     let (hits0, misses0) = r.pipelines.counts();
     let created0 = r.textures.created();
     // 1. Decide per pass; build new nodes (fallible, no side effects on `old`).
@@ -225,7 +233,7 @@ pub(crate) fn build(
         };
         decisions.push((step.pass_id.clone(), decision, step.kind.clone(), step.params.clone(), ports, frame_defines));
     }
-    // 2. Textures and buffers for the transient slots: the old schedule's of the same descriptor
+    // 2. Textures and buffers for the transient slots: the old live plan's of the same descriptor
     //    (shared, handed over on commit), else one from the pool (given back on failure).
     let mut claimed = vec![false; old.as_ref().map_or(0, |o| o.slots.len())];
     let mut fresh: Vec<Option<Fresh>> = Vec::with_capacity(plan.slots.len());
@@ -379,7 +387,7 @@ pub(crate) fn build(
         })
         .collect();
     owned_versions.retain(|name, _| plan.resources.iter().any(|r| &r.name == name));
-    let schedule = Schedule {
+    let live = LivePlan {
         plan,
         nodes,
         slots,
@@ -391,5 +399,5 @@ pub(crate) fn build(
         owned_versions,
         next_version,
     };
-    Ok((schedule, report))
+    Ok((live, report))
 }

@@ -6,6 +6,7 @@
 
 pub use volgraph_base::{cuts, input_file};
 
+pub mod brick_leaves;
 pub mod bricks;
 pub mod camera;
 pub mod chebyshev;

@@ -278,13 +278,13 @@ fn bench_octree(repeats: usize) -> anyhow::Result<OctreeBench> {
         traverse.push(ms);
     }
     // The whole CPU side of a TF change in raycast_bricks (ratio 1, as its graphs use).
-    let grid = volgraph_passes::raycast_bricks::leaf_grid(layout.volume_dims(), min_node_cells);
+    let grid = volgraph_accel::brick_leaves::leaf_grid(layout.volume_dims(), min_node_cells);
     let mut tf_change = Vec::new();
     for _ in 0..repeats {
         for classifier in &classifiers {
             let (_, ms) = time_ms(|| {
                 hierarchy.classify_into(classifier, &mut visibility);
-                volgraph_passes::raycast_bricks::classify_leaves(&hierarchy, &visibility, &layout, grid, 1.0)
+                volgraph_accel::brick_leaves::classify_leaves(&hierarchy, &visibility, &layout, grid, 1.0)
             });
             tf_change.push(ms);
         }

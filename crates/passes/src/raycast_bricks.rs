@@ -17,8 +17,9 @@
 //!   a ray leaves the largest cube of leaves no box covers in one step — the octree's empty
 //!   nodes, and empty bricks, as one lookup (without an octree the leaves are the bricks).
 //!   Where it stands in a drawn leaf it marches one run: through the cube of drawn leaves
-//!   around it ([`leaf_words`]) and on through its brick, up to `CHECK_EVERY` samples in all,
-//!   so a thin vessel or a dense brick does not cost a round of leaps per leaf.
+//!   around it ([`volgraph_accel::brick_leaves::leaf_words`]) and on through its brick, up to
+//!   `CHECK_EVERY` samples in all, so a thin vessel or a dense brick does not cost a round of
+//!   leaps per leaf.
 //! - **termination**: a ray stops at `threshold` and skips the bricks behind it (per-brick
 //!   early ray termination: with `threshold < 1` a saturated pixel costs nothing in later
 //!   batches either).
@@ -27,27 +28,30 @@
 //! compositing), so the image equals the single-texture raycast up to rounding
 //! (crates/passes/tests/ruijters_2006.rs). A TF change re-classifies bricks and octrees
 //! (CPU, [`volgraph_accel::octree`]) and uploads only bricks not yet resident.
-//! Shader: `shaders/raycast_bricks.wgsl`.
+//! The CPU side (slot words, leaf words, rank slabs) is [`volgraph_accel::brick_leaves`]; the
+//! atlas texture and its uploads are `raycast_bricks/atlas.rs`. Shader: `shaders/raycast_bricks.wgsl`.
 
 use std::sync::Arc;
 use std::time::Instant;
 
 use glam::{DVec3, UVec3};
+use volgraph_accel::brick_leaves::{SLOTS_PER_AXIS, classify_leaves, leaf_grid, owns, slot_coord, slot_word};
 use volgraph_accel::bricks::{BrickLayout, ViewPoint};
 use volgraph_accel::classify::OpacityClassifier;
-use volgraph_accel::octree::{DrawBox, OctreeHierarchy, OctreeVisibility};
+use volgraph_accel::octree::{OctreeHierarchy, OctreeVisibility};
 use volgraph_accel::volume::Volume;
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::upload::VolumeFormat;
 use volgraph_core::runtime::{
-    ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, volume_region_bytes,
-    volume_texture_format,
+    ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, volume_texture_format,
 };
 use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
-use wgpu::util::DeviceExt;
 
 use crate::brick_pool::{Batch, BrickPool};
 use crate::raycast_params::{RaycastParamsGpu, SampleLoopChoice, Sampling, Termination, Workgroup};
+
+mod atlas;
+use atlas::Atlas;
 
 /// The plugin.
 pub struct RaycastBricks;
@@ -85,15 +89,6 @@ struct BrickParamsGpu {
 }
 
 const _: () = assert!(std::mem::size_of::<BrickParamsGpu>() == 80);
-
-/// The largest staging buffer one upload batch uses, whatever the adapter allows: a frame's
-/// uploads are split into chunks of at most this many bytes (and at most the device's
-/// `max_buffer_size`), so a 1024³ volume never needs a gigabyte of staging at once.
-const MAX_STAGING_BYTES: u64 = 64 << 20;
-
-/// Leap distances are capped here: a leap out of a cube of 2·255 − 1 leaves is long enough that a
-/// larger one would save little (the cap only shortens leaps, it never skips a drawn leaf).
-const MAX_LEAP: u32 = 255;
 
 impl PassDecl for RaycastBricks {
     fn honours_volume_window(&self) -> bool {
@@ -240,14 +235,6 @@ struct FrameCounters {
     drawn_leaves: f64,
 }
 
-/// The atlas texture and how its slots are laid out.
-struct Atlas {
-    texture: wgpu::Texture,
-    view: wgpu::TextureView,
-    /// Slots per axis (x, y fixed for the volume; z grows).
-    slots: UVec3,
-}
-
 /// Everything derived from one bound volume.
 struct VolumeState {
     version: u64,
@@ -332,8 +319,7 @@ impl VolumeState {
         let per_axis = (UVec3::splat(max_dim) / side).min(UVec3::splat(SLOTS_PER_AXIS));
         let cube = (layout.brick_count() as f64).cbrt().ceil() as u32;
         let row = (cube.clamp(1, per_axis.x), cube.clamp(1, per_axis.y));
-        let leaf_grid =
-            UVec3::new(cells.x.div_ceil(node_cells), cells.y.div_ceil(node_cells), cells.z.div_ceil(node_cells));
+        let leaf_grid = leaf_grid(voxels.dims, node_cells);
         Ok(Self {
             version,
             format: volume_texture_format(ctx.gpu, &voxels),
@@ -360,7 +346,7 @@ impl VolumeState {
     }
 
     /// Re-classifies bricks and octree leaves for a new TF (§7: only the TF-dependent part)
-    /// and uploads the leaves' words ([`leaf_words`]); returns the time it took in ms.
+    /// and uploads the leaves' words ([`volgraph_accel::brick_leaves::leaf_words`]); returns the time it took in ms.
     fn classify(&mut self, ctx: &RecordContext<'_>, lut: &[[f32; 4]], ratio: f32) -> Result<f64, PassError> {
         let started = Instant::now();
         let classifier = OpacityClassifier::new(lut).map_err(|e| pass_error(ctx, e.to_string()))?;
@@ -393,286 +379,6 @@ impl VolumeState {
         }
         Ok(started.elapsed().as_secs_f64() * 1e3)
     }
-
-    /// Sizes the pool for the visible bricks under `budget` bytes: grows the atlas (keeping
-    /// resident bricks where they are) or, when the budget changed, starts over.
-    fn size_pool(&mut self, ctx: &mut RecordContext<'_>, budget: u64) -> Result<(), PassError> {
-        if budget != self.budget {
-            self.pool = BrickPool::new(0, self.layout.brick_count());
-            self.atlas = None;
-            self.budget = budget;
-        }
-        let visible = self.visible.iter().filter(|v| **v).count() as u64;
-        let per_layer = self.slots_xy.0 * self.slots_xy.1;
-        let most = (budget / self.slot_bytes()).min((per_layer * self.max_layers) as u64);
-        if most == 0 {
-            return Err(pass_error(
-                ctx,
-                format!(
-                    "the brick pool's budget of {budget} bytes holds no {}-byte brick; raise --gpu-memory-mb (or \
-                     pool_mb) or lower brick_cells",
-                    self.slot_bytes()
-                ),
-            ));
-        }
-        let wanted = visible.min(most).max(1) as u32;
-        if wanted <= self.pool.slots() {
-            return Ok(());
-        }
-        let layers = wanted.div_ceil(per_layer);
-        let slots = UVec3::new(self.slots_xy.0, self.slots_xy.1, layers);
-        let size = slots * self.side;
-        let texture = ctx.gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("brick atlas"),
-            size: wgpu::Extent3d { width: size.x, height: size.y, depth_or_array_layers: size.z },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D3,
-            format: self.format.wgpu(),
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        if let Some(old) = &self.atlas {
-            let s = old.slots * self.side;
-            ctx.encoder.copy_texture_to_texture(
-                old.texture.as_image_copy(),
-                texture.as_image_copy(),
-                wgpu::Extent3d { width: s.x, height: s.y, depth_or_array_layers: s.z },
-            );
-        }
-        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
-        let slot_count = (slots.x * slots.y * slots.z).min(most as u32);
-        self.pool.grow(slot_count - self.pool.slots());
-        self.atlas = Some(Atlas { texture, view, slots });
-        Ok(())
-    }
-
-    /// Records the copies of `uploads` into the atlas, through staging buffers of at most
-    /// [`MAX_STAGING_BYTES`] and the device's `max_buffer_size` each; returns the voxel bytes
-    /// uploaded.
-    fn upload(&self, ctx: &mut RecordContext<'_>, uploads: &[(u32, u32)]) -> Result<u64, PassError> {
-        let Some(atlas) = &self.atlas else { return Ok(0) };
-        let texel = self.format.bytes() as u64;
-        let brick_row = self.side.x as u64 * texel;
-        let rows = self.side.y as u64 * self.side.z as u64;
-        // Chunks of MAX_STAGING_BYTES, or one brick where a brick is larger; never more than
-        // the device's largest buffer.
-        let one_brick = staging_row_bytes(brick_row, 1) * rows;
-        let device = ctx.gpu.limits.max_buffer_size;
-        let per_chunk = staging_bricks_per_chunk(brick_row, rows, MAX_STAGING_BYTES.max(one_brick).min(device));
-        if per_chunk == 0 {
-            return Err(pass_error(
-                ctx,
-                format!(
-                    "one brick of {}x{}x{} voxels needs {one_brick} bytes of staging, more than this device's \
-                     largest buffer ({device} bytes); lower brick_cells",
-                    self.side.x, self.side.y, self.side.z
-                ),
-            ));
-        }
-        for chunk in uploads.chunks(per_chunk) {
-            self.upload_chunk(ctx, atlas, chunk, brick_row);
-        }
-        Ok(uploads.len() as u64 * self.slot_bytes())
-    }
-
-    /// One staging buffer for `chunk`: the bricks side by side along x (brick `i`'s row `r` at
-    /// `r · row + i · brick_row`), so rows share the 256-byte alignment a buffer-to-texture
-    /// copy needs instead of padding every brick's row to it.
-    fn upload_chunk(&self, ctx: &mut RecordContext<'_>, atlas: &Atlas, chunk: &[(u32, u32)], brick_row: u64) {
-        let side = self.side;
-        let row = staging_row_bytes(brick_row, chunk.len());
-        let mut staging = vec![0u8; (row * side.y as u64 * side.z as u64) as usize];
-        for (i, (brick, _)) in chunk.iter().enumerate() {
-            let (lo, _) = self.layout.brick_cells_box(self.layout.brick_coord(*brick as usize));
-            let origin = lo.as_ivec3() - glam::IVec3::ONE;
-            let tight = volume_region_bytes(&self.voxels, origin, side, self.format);
-            for (r, src) in tight.chunks_exact(brick_row as usize).enumerate() {
-                let at = (r as u64 * row + i as u64 * brick_row) as usize;
-                staging[at..at + src.len()].copy_from_slice(src);
-            }
-        }
-        let buffer = ctx.gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("brick uploads"),
-            contents: &staging,
-            usage: wgpu::BufferUsages::COPY_SRC,
-        });
-        for (i, (_, slot)) in chunk.iter().enumerate() {
-            let at = slot_coord(*slot, atlas.slots) * side;
-            ctx.encoder.copy_buffer_to_texture(
-                wgpu::TexelCopyBufferInfo {
-                    buffer: &buffer,
-                    layout: wgpu::TexelCopyBufferLayout {
-                        offset: i as u64 * brick_row,
-                        bytes_per_row: Some(row as u32),
-                        rows_per_image: Some(side.y),
-                    },
-                },
-                wgpu::TexelCopyTextureInfo {
-                    texture: &atlas.texture,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d { x: at.x, y: at.y, z: at.z },
-                    aspect: wgpu::TextureAspect::All,
-                },
-                wgpu::Extent3d { width: side.x, height: side.y, depth_or_array_layers: side.z },
-            );
-        }
-    }
-}
-
-/// Slots per atlas axis, at most: a slot word ([`slot_word`]) has 10 bits per axis. (A slot is
-/// at least 4 voxels wide, so a 3D texture limit of 4096 or less never meets it.)
-const SLOTS_PER_AXIS: u32 = 1 << 10;
-
-/// Where slot `slot` lies in an atlas of `slots` slots per axis, in slots: x fastest.
-fn slot_coord(slot: u32, slots: UVec3) -> UVec3 {
-    UVec3::new(slot % slots.x, (slot / slots.x) % slots.y, slot / (slots.x * slots.y))
-}
-
-/// A drawn brick's word in the batch table (`raycast_bricks.wgsl`'s `table`): bit 31 set (0 is
-/// "not in this batch") and its slot's coordinates, 10 bits per axis, x lowest — so the march
-/// finds the slot's origin with a multiply instead of three integer divisions per brick entered,
-/// which llvmpipe runs one lane at a time (2 % of the `bricks` graph's time on the engine,
-/// bench/one-march-final.md "Brick runs").
-pub fn slot_word(coord: UVec3) -> u32 {
-    debug_assert!(coord.max_element() < SLOTS_PER_AXIS);
-    1 << 31 | coord.x | coord.y << 10 | coord.z << 20
-}
-
-/// Bytes per staging row for `bricks` bricks of `brick_row` bytes side by side, padded to the
-/// copy alignment.
-fn staging_row_bytes(brick_row: u64, bricks: usize) -> u64 {
-    let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as u64;
-    (brick_row * bricks as u64).div_ceil(align) * align
-}
-
-/// How many bricks (`rows` rows of `brick_row` bytes each) one staging buffer of at most
-/// `limit` bytes holds (0: not even one). Row pitch stays within `u32`, as copies need.
-pub fn staging_bricks_per_chunk(brick_row: u64, rows: u64, limit: u64) -> usize {
-    let fits = |n: u64| {
-        let row = staging_row_bytes(brick_row, n as usize);
-        row <= u64::from(u32::MAX) && row * rows <= limit
-    };
-    if !fits(1) {
-        return 0;
-    }
-    // The largest n that fits: rows grow monotonically with n.
-    let (mut lo, mut hi) = (1u64, (limit / (brick_row * rows).max(1)).max(1) + 1);
-    while lo + 1 < hi {
-        let mid = lo + (hi - lo) / 2;
-        if fits(mid) { lo = mid } else { hi = mid }
-    }
-    lo as usize
-}
-
-/// Leaves of `node_cells`³ cells per axis over a volume of `volume_dims` voxels.
-pub fn leaf_grid(volume_dims: UVec3, node_cells: u32) -> UVec3 {
-    let cells = volgraph_accel::bricks::cell_dims(volume_dims);
-    UVec3::new(cells.x.div_ceil(node_cells), cells.y.div_ceil(node_cells), cells.z.div_ceil(node_cells))
-}
-
-/// The CPU work of a TF change after the octrees' visible counts are rebuilt: which bricks are
-/// visible, and every leaf's word ([`leaf_words`]).
-pub struct LeafClassification {
-    /// Per brick: visible under the TF.
-    pub visible: Vec<bool>,
-    /// Per leaf of the volume (x fastest), what the march reads ([`leaf_word`]): where no box
-    /// to draw covers it, the Chebyshev distance in leaves to the nearest such leaf (capped at
-    /// 255); where one does, how far the drawn leaves around it reach within its brick.
-    pub words: Vec<u32>,
-    /// Fraction of the leaves drawn.
-    pub drawn_fraction: f64,
-}
-
-/// Rasterizes every visible brick's boxes to draw (§7's ratio rule at `ratio`) into the leaf
-/// grid and turns them into the march's words ([`leaf_words`]: leap distances, drawn cubes).
-pub fn classify_leaves(
-    octree: &OctreeHierarchy,
-    visibility: &OctreeVisibility,
-    layout: &BrickLayout,
-    grid: UVec3,
-    ratio: f32,
-) -> LeafClassification {
-    let count = layout.brick_count();
-    let visible: Vec<bool> = (0..count).map(|b| visibility.brick_visible_cells(b) > 0).collect();
-    let mut drawn = vec![false; (grid.x * grid.y * grid.z) as usize];
-    let mut boxes: Vec<DrawBox> = Vec::new();
-    let leaf = octree.min_node_cells();
-    for b in (0..count).filter(|b| visible[*b]) {
-        boxes.clear();
-        octree.draw_boxes(visibility, b, ratio, ViewPoint::Direction(DVec3::Z), &mut boxes);
-        for d in &boxes {
-            let lo = d.cells_lo / leaf;
-            let hi = UVec3::new(d.cells_hi.x.div_ceil(leaf), d.cells_hi.y.div_ceil(leaf), d.cells_hi.z.div_ceil(leaf))
-                .min(grid);
-            for z in lo.z..hi.z {
-                for y in lo.y..hi.y {
-                    for x in lo.x..hi.x {
-                        drawn[(x + grid.x * (y + grid.y * z)) as usize] = true;
-                    }
-                }
-            }
-        }
-    }
-    let drawn_fraction = drawn.iter().filter(|d| **d).count() as f64 / drawn.len().max(1) as f64;
-    let words = leaf_words(&drawn, grid, layout.brick_cells().div_ceil(leaf).max(1));
-    LeafClassification { visible, words, drawn_fraction }
-}
-
-/// Every leaf's [`leaf_word`] for the drawn leaves `drawn` (x fastest in `grid`), in bricks of
-/// `leaves_per_brick` leaves per side.
-pub fn leaf_words(drawn: &[bool], grid: UVec3, leaves_per_brick: u32) -> Vec<u32> {
-    let to_drawn = volgraph_accel::chebyshev::chebyshev_distance(drawn, grid, MAX_LEAP);
-    let not_drawn: Vec<bool> = drawn.iter().map(|d| !d).collect();
-    let to_not_drawn = volgraph_accel::chebyshev::chebyshev_distance(&not_drawn, grid, leaves_per_brick);
-    let mut words = Vec::with_capacity(drawn.len());
-    for z in 0..grid.z {
-        for y in 0..grid.y {
-            for x in 0..grid.x {
-                let i = (x + grid.x * (y + grid.y * z)) as usize;
-                let reach = to_not_drawn[i].min(reach_within_brick(UVec3::new(x, y, z), leaves_per_brick, grid));
-                words.push(leaf_word(drawn[i], to_drawn[i], reach));
-            }
-        }
-    }
-    words
-}
-
-/// The word `raycast_bricks.wgsl` reads per leaf (`empty_region_at`): the leap distance
-/// `to_drawn` (1..=255) of a leaf no box covers; `reach << 8` for a drawn one, whose cube of
-/// `2·reach − 1` leaves around it is drawn and inside its brick, so one run of samples crosses it
-/// (a dense brick in a few runs, not one per leaf).
-pub fn leaf_word(drawn: bool, to_drawn: u32, reach: u32) -> u32 {
-    if drawn { reach.clamp(1, 0x00ff_ffff) << 8 } else { to_drawn.clamp(1, MAX_LEAP) }
-}
-
-/// How far a cube around leaf `l` may reach and stay inside its brick (of `leaves_per_brick`
-/// leaves per side, fewer in the last brick of an axis): 1 next to another brick. The volume's
-/// faces do not bound it: the march clamps the cube to the leaf grid.
-fn reach_within_brick(l: UVec3, leaves_per_brick: u32, grid: UVec3) -> u32 {
-    let lo = l / leaves_per_brick * leaves_per_brick;
-    let hi = (lo + leaves_per_brick).min(grid) - 1;
-    let to_lo = UVec3::select(lo.cmpeq(UVec3::ZERO), UVec3::MAX, l - lo);
-    let to_hi = UVec3::select(hi.cmpeq(grid - 1), UVec3::MAX, hi - l);
-    to_lo.min(to_hi).min_element().saturating_add(1)
-}
-
-/// Whether rank `ranks.0` of `ranks.1` draws brick `brick`: the brick grid is cut into
-/// `ranks.1` slabs along its longest axis (a one-level kd-tree; docs/scaling.md).
-pub fn owns(layout: &BrickLayout, brick: u32, (rank, ranks): (u32, u32)) -> bool {
-    if ranks <= 1 {
-        return true;
-    }
-    let grid = layout.grid_dims();
-    let axis = if grid.x >= grid.y && grid.x >= grid.z {
-        0
-    } else if grid.y >= grid.z {
-        1
-    } else {
-        2
-    };
-    let c = layout.brick_coord(brick as usize)[axis] as u64;
-    (c * ranks as u64 / grid[axis] as u64) as u32 == rank
 }
 
 impl RaycastBricksNode {
@@ -823,71 +529,5 @@ impl PassNode for RaycastBricksNode {
             ("classify_ms", c.classify_ms),
             ("drawn_leaves", c.drawn_leaves),
         ]
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Chunks fill the limit without passing it; rows are padded to the copy alignment once per
-    /// chunk, not once per brick.
-    #[test]
-    fn staging_chunks_fit_the_limit() {
-        // 35-voxel u8 rows, 35·35 rows per brick.
-        let (brick_row, rows) = (35u64, 35 * 35u64);
-        for limit in [64 << 20, 512 << 10, 400_000, 256 * rows] {
-            let n = staging_bricks_per_chunk(brick_row, rows, limit);
-            assert!(n >= 1, "{limit}");
-            assert!(staging_row_bytes(brick_row, n) * rows <= limit, "{limit}: {n} bricks");
-            assert!(staging_row_bytes(brick_row, n + 1) * rows > limit, "{limit}: {n} is the most");
-        }
-        // Padding: 64 MiB holds ~1561 bricks of 42875 bytes, not the 214 a 256-byte row each allows.
-        assert!(staging_bricks_per_chunk(brick_row, rows, 64 << 20) > 1500);
-        assert_eq!(staging_bricks_per_chunk(brick_row, rows, 1000), 0, "not even one brick");
-    }
-
-    /// The words the march leaps and runs by, against brute force on random leaf masks: an
-    /// empty leaf's distance is the Chebyshev distance to the nearest drawn leaf; a drawn leaf's
-    /// reach is the largest cube around it that is all drawn and inside its brick (the last
-    /// brick of an axis is thinner).
-    #[test]
-    fn leaf_words_are_leap_distances_and_drawn_cubes_within_a_brick() {
-        let grid = UVec3::new(9, 8, 7);
-        let per_brick = 4;
-        let index = |l: UVec3| (l.x + grid.x * (l.y + grid.y * l.z)) as usize;
-        let leaves = || {
-            (0..grid.z).flat_map(move |z| (0..grid.y).flat_map(move |y| (0..grid.x).map(move |x| UVec3::new(x, y, z))))
-        };
-        let cube = |l: UVec3, r: u32| {
-            let lo = l.saturating_sub(UVec3::splat(r));
-            let hi = (l + r).min(grid - 1);
-            leaves().filter(move |m| m.cmpge(lo).all() && m.cmple(hi).all())
-        };
-        let mut rng = volgraph_accel::generate::SplitMix64(7);
-        for density in [0.1, 0.6, 0.95, 1.0] {
-            let drawn: Vec<bool> =
-                (0..grid.element_product()).map(|_| (rng.next_u64() as f64 / u64::MAX as f64) < density).collect();
-            let words = leaf_words(&drawn, grid, per_brick);
-            for l in leaves() {
-                let word = words[index(l)];
-                if !drawn[index(l)] {
-                    let want = leaves()
-                        .filter(|m| drawn[index(*m)])
-                        .map(|m| (m.as_ivec3() - l.as_ivec3()).abs().max_element() as u32)
-                        .min();
-                    assert_eq!(word, want.unwrap_or(MAX_LEAP).clamp(1, MAX_LEAP), "{density}: empty leaf {l}");
-                    continue;
-                }
-                assert_eq!(word & 0xff, 0, "{density}: drawn leaf {l}");
-                let fits = |r: u32| cube(l, r).all(|m| drawn[index(m)] && m / per_brick == l / per_brick);
-                let reach = word >> 8;
-                assert!(reach >= 1 && fits(reach - 1), "{density}: leaf {l} reach {reach}");
-                assert!(
-                    !fits(reach) || cube(l, reach).count() == cube(l, reach - 1).count(),
-                    "{density}: leaf {l}: reach {reach} is the largest"
-                );
-            }
-        }
     }
 }

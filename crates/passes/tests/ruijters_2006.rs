@@ -415,7 +415,7 @@ fn sort_last_compositing_of_brick_slabs_equals_the_single_render() {
             let mut slabs: Vec<(f64, Image)> = (0..ranks)
                 .map(|rank| {
                     let xs: Vec<u32> = (0..layout.brick_count() as u32)
-                        .filter(|b| volgraph_passes::raycast_bricks::owns(&layout, *b, (rank, ranks)))
+                        .filter(|b| volgraph_accel::brick_leaves::owns(&layout, *b, (rank, ranks)))
                         .map(|b| layout.brick_coord(b as usize).x)
                         .collect();
                     let lo = *xs.iter().min().expect("every rank owns bricks") as f64 * 16.0;

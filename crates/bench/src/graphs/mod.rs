@@ -7,12 +7,14 @@
 //!
 //! Layout: [`args`] (flags → configuration), [`preset`] (the papers' comparisons as data),
 //! [`dataset`], [`measure`] (frames and clocks), [`accuracy`] (CPU reference side), [`run`]
-//! (the case loop), [`report`] (rows, markdown), [`plot`], [`antialias_study`] (Klein et al.
-//! 2005 §5, run by the `klein2005` preset after its table).
+//! (the case loop, cross-row figures), [`case`] (one case: compile, time, count, error),
+//! [`report`] (rows, markdown), [`plot`], [`antialias_study`] (Klein et al. 2005 §5, run by the
+//! `klein2005` preset after its table).
 
 pub mod accuracy;
 pub mod antialias_study;
 pub mod args;
+pub mod case;
 pub mod dataset;
 pub mod gpu_count;
 pub mod measure;

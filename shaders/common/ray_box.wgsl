@@ -105,7 +105,7 @@ fn clip_segment(u0: vec3<f32>, d: vec3<f32>, kept_in: vec2<f32>) -> vec2<f32> {
 
 #if CUTS
 // "Capping" (docs/rendering_model.md "Cuts"; f64 twin `Cuts::cap_normal` in
-// crates/accel/src/cuts.rs): the shading normal `n` at `u`, on a ray starting at `ray_start`
+// crates/base/src/cuts.rs): the shading normal `n` at `u`, on a ray starting at `ray_start`
 // and running along world direction `d_world`, turned toward the world normal of every cut face
 // the ray entered through within CAP_VOXELS of `u`, each by 1 - distance / CAP_VOXELS (weights scaled to sum to 1 where
 // faces meet). A cut face then shows the plane it was cut along instead of the noisy gradient of

@@ -3,7 +3,7 @@
 //! pass's declared `(file, entry point)` pairs are built by `create`, and `create` builds
 //! nothing else but the fullscreen triangle's vertex stage (which binds nothing).
 
-use volgraph_core::runtime::schedule::port_infos;
+use volgraph_core::binding_rules::port_infos;
 use volgraph_core::runtime::{CreateContext, PipelineCache, RUNTIME_VERTEX_STAGES, ShaderLibrary};
 use volgraph_core::{CompileOptions, compile};
 use volgraph_passes::{builtin_registry, builtin_shaders};

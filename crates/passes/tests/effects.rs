@@ -32,20 +32,8 @@ const CAMERA: OrbitCamera = OrbitCamera {
     target: [0.0; 3],
 };
 
-/// One graph of each raycaster family that takes the effects: fragment, compute, the single
-/// pass with leaping, the fastest path, and Krüger–Westermann's multipass segments with
-/// termination and skipping (rc_b) and with the leap inside the segments (rc_b_leap), and Klein
-/// et al.'s leaping march (its first frame: every ray from the box) alone and with empty cubes.
-const DVR_GRAPHS: [&str; 8] = [
-    "basic/fragment_raycast.ron",
-    "basic/compute_raycast.ron",
-    "modern/single_pass_ess_ert.ron",
-    "modern/fastest.ron",
-    "kruger_westermann_2003/rc_b.ron",
-    "kruger_westermann_2003/rc_b_leap.ron",
-    "klein_2005/leap_dvr.ron",
-    "klein_2005/leap_dvr_cubes.ron",
-];
+/// The graphs the effects are rendered with (one per raycaster family).
+const DVR_GRAPHS: [&str; 8] = support::EFFECT_GRAPHS;
 
 /// Every DVR graph of the papers that must take every scene effect (`--features`).
 const PAPER_DVR_GRAPHS: [&str; 11] = [

@@ -14,6 +14,8 @@ use volgraph_core::shader_source::{ShaderSources, assemble_with, default_shader_
 use volgraph_core::{CompileOptions, compile};
 use volgraph_passes::builtin_registry;
 
+mod support;
+
 /// Names of the functions reachable from entry point `entry` of `file`.
 fn reachable(file: &str, entry: &str) -> BTreeSet<String> {
     reachable_with(file, entry, &[])
@@ -82,18 +84,8 @@ const EFFECT_MARKERS: [(&str, &str); 4] = [
     ("jitter", "pcg_hash"),
 ];
 
-/// The DVR graphs that take every effect: graphs/basic and graphs/modern, and Krüger–Westermann's
-/// multipass segments (each segment pass compiles the effects it was asked for), Klein et al.'s
-/// leaping march.
-const DVR_GRAPHS: [&str; 7] = [
-    "basic/fragment_raycast.ron",
-    "basic/compute_raycast.ron",
-    "modern/single_pass_ess_ert.ron",
-    "modern/fastest.ron",
-    "kruger_westermann_2003/rc_b.ron",
-    "kruger_westermann_2003/rc_b_leap.ron",
-    "klein_2005/leap_dvr.ron",
-];
+/// The DVR graphs that take every effect, one per raycaster family.
+const DVR_GRAPHS: [&str; 8] = support::EFFECT_GRAPHS;
 
 #[test]
 fn every_scene_effect_is_compiled_only_when_the_scene_turns_it_on() {

@@ -7,7 +7,7 @@
 //! pipelines from the runtime's cache. Building is all-or-nothing: on any error the previous
 //! live plan is untouched.
 //!
-//! This module was `runtime/schedule.rs`; `volgraph_core::runtime::schedule` still names it.
+//! This module was `runtime/schedule.rs` (the compiler's scheduler is `compile/schedule.rs`).
 
 use std::cell::RefCell;
 use std::collections::{BTreeSet, HashMap};

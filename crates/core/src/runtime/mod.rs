@@ -50,10 +50,6 @@ pub mod textures;
 pub mod uniforms;
 pub mod upload;
 
-/// The old name of [`live_plan`] (`volgraph_core::runtime::schedule::port_infos` keeps working).
-#[doc(hidden)]
-pub use live_plan as schedule;
-
 use std::sync::Arc;
 
 pub use bypass::BypassStatus;

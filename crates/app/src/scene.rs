@@ -29,14 +29,19 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use serde::Deserialize;
-use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::cuts::{ClipPlane, CropBox, Cuts};
 use volgraph_core::Precision;
 use volgraph_core::runtime::OpacityReference;
 
+mod camera;
 mod load;
 mod saved_view;
 
+#[cfg(test)]
+mod tests;
+
+use camera::check_camera;
+pub use camera::{CameraSpec, Keyframe, MAX_DISTANCE, MIN_DISTANCE};
 pub use load::{ShownVolume, load_shown_volume, load_transfer_function, marschner_lobb_tf, tf_file_beside};
 pub use saved_view::SavedView;
 
@@ -137,42 +142,6 @@ impl VolumeOptions {
     pub fn is_empty(&self) -> bool {
         *self == VolumeOptions::default()
     }
-}
-
-/// One keyframe of a camera path.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct Keyframe {
-    /// The frame it holds at.
-    pub frame: u32,
-    /// Degrees about +y.
-    pub azimuth: f64,
-    /// Degrees above the xz plane.
-    pub elevation: f64,
-    /// Distance from the volume's centre, world units.
-    pub distance: f64,
-}
-
-/// The camera of a scene.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
-pub enum CameraSpec {
-    /// One orbit camera; with `frames` > 1 it turns 1° about y per frame (as `render --frames`).
-    Orbit {
-        /// Degrees about +y.
-        azimuth: f64,
-        /// Degrees above the xz plane.
-        elevation: f64,
-        /// Distance, world units.
-        distance: f64,
-        /// The point it orbits (world units; default the volume's centre): a viewer's pan.
-        #[serde(default)]
-        target: Option<(f64, f64, f64)>,
-    },
-    /// Keyframes, interpolated linearly in azimuth, elevation and distance.
-    Path {
-        /// At least one, in increasing frame order.
-        keyframes: Vec<Keyframe>,
-    },
 }
 
 /// A scene file as written.
@@ -472,250 +441,4 @@ fn check_data_name(name: &str) -> Result<(), String> {
         "Data(\"{name}\") must name a file of $VOLGRAPH_DATA/tf by its stem (e.g. Data(\"engine_opaque\")), \
          without folders or \"..\"; for a file elsewhere write File(\"path.ron\")"
     ))
-}
-
-/// The orbit values the CLI's `--camera` accepts: finite degrees, an elevation within ±90°
-/// (beyond it the orbit flips over the pole) and a positive distance at which a ray can still
-/// be set up (at 1e-300 world units the eye is inside the volume at a point, and the
-/// projection divides by it).
-fn check_orbit(azimuth: f64, elevation: f64, distance: f64) -> Result<(), String> {
-    if !(azimuth.is_finite() && elevation.is_finite() && distance.is_finite()) {
-        return Err("azimuth, elevation and distance must be finite numbers".into());
-    }
-    // 1e-300 as written, not as three hundred zeros.
-    let number = |x: f64| if x != 0.0 && !(1e-4..1e7).contains(&x.abs()) { format!("{x:e}") } else { format!("{x}") };
-    if elevation.abs() > 90.0 {
-        return Err(format!("elevation {} must be within -90..=90 degrees", number(elevation)));
-    }
-    if !(MIN_DISTANCE..=MAX_DISTANCE).contains(&distance) {
-        return Err(format!(
-            "distance {} must be within {MIN_DISTANCE}..={MAX_DISTANCE} world units (the volume's longest side is 1)",
-            number(distance)
-        ));
-    }
-    Ok(())
-}
-
-/// The nearest eye distance from the volume's centre (inside the volume is fine, the centre is
-/// not a camera).
-pub const MIN_DISTANCE: f64 = 1e-3;
-/// The farthest (beyond it the volume is under a pixel at any sensible field of view).
-pub const MAX_DISTANCE: f64 = 1e6;
-
-fn check_camera(camera: &CameraSpec) -> Result<(), String> {
-    match camera {
-        CameraSpec::Orbit { azimuth, elevation, distance, target } => {
-            check_orbit(*azimuth, *elevation, *distance)?;
-            if target.is_some_and(|(x, y, z)| !(x.is_finite() && y.is_finite() && z.is_finite())) {
-                return Err("target must be three finite numbers (world units)".into());
-            }
-        }
-        CameraSpec::Path { keyframes } => {
-            if keyframes.is_empty() {
-                return Err("a Path needs at least one keyframe".into());
-            }
-            for (i, k) in keyframes.iter().enumerate() {
-                check_orbit(k.azimuth, k.elevation, k.distance).map_err(|m| format!("keyframe {i}: {m}"))?;
-                if k.frame >= MAX_FRAMES {
-                    return Err(format!(
-                        "keyframe {i}: frame {} is beyond the last frame a scene renders ({}); a path holds at most \
-                         {MAX_FRAMES} frames",
-                        k.frame,
-                        MAX_FRAMES - 1
-                    ));
-                }
-                if i > 0 && k.frame <= keyframes[i - 1].frame {
-                    return Err(format!(
-                        "keyframe {i}: frame {} does not come after {}",
-                        k.frame,
-                        keyframes[i - 1].frame
-                    ));
-                }
-            }
-        }
-    }
-    Ok(())
-}
-
-impl CameraSpec {
-    /// The orbit camera of frame `index`: an orbit turns 1° about y per frame (as `render
-    /// --frames`); a path interpolates its keyframes linearly and holds the ends.
-    pub fn at(&self, index: u32) -> OrbitCamera {
-        match self {
-            CameraSpec::Orbit { azimuth, elevation, distance, target } => OrbitCamera {
-                azimuth_deg: azimuth + index as f64,
-                elevation_deg: *elevation,
-                distance: *distance,
-                target: target.map_or([0.0; 3], |(x, y, z)| [x, y, z]),
-                ..OrbitCamera::default()
-            },
-            CameraSpec::Path { keyframes } => {
-                let orbit = |k: &Keyframe| (k.azimuth, k.elevation, k.distance);
-                let (a, e, d) = match keyframes.iter().position(|k| k.frame >= index) {
-                    None => keyframes.last().map_or((30.0, 20.0, 3.2), orbit),
-                    Some(0) => orbit(&keyframes[0]),
-                    Some(i) => {
-                        let (k0, k1) = (&keyframes[i - 1], &keyframes[i]);
-                        let t = (index - k0.frame) as f64 / (k1.frame - k0.frame) as f64;
-                        let lerp = |x: f64, y: f64| x + (y - x) * t;
-                        (lerp(k0.azimuth, k1.azimuth), lerp(k0.elevation, k1.elevation), lerp(k0.distance, k1.distance))
-                    }
-                };
-                OrbitCamera { azimuth_deg: a, elevation_deg: e, distance: d, ..OrbitCamera::default() }
-            }
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn parse(text: &str) -> Result<Scene, SceneError> {
-        Scene::from_str(text, Path::new("scenes/test.ron"))
-    }
-
-    #[test]
-    fn a_full_scene_resolves_paths_against_its_folder() {
-        let s = parse(
-            r#"Scene(graph: "../graphs/modern/fastest.ron", volume: File("v.raw"),
-                transfer_function: File("tf.ron"), camera: Orbit(azimuth: 10, elevation: 5, distance: 2.5),
-                viewport: (64, 32), effects: ["shading", "jitter"], precision: F32, opacity_reference: World)"#,
-        )
-        .expect("parses");
-        assert_eq!(s.graph, Some(PathBuf::from("scenes/../graphs/modern/fastest.ron")));
-        assert_eq!(s.volume, VolumeSource::File("scenes/v.raw".into()));
-        assert_eq!(s.transfer_function, Some(TfSource::File("scenes/tf.ron".into())));
-        assert_eq!(
-            (s.viewport, s.precision, s.opacity_reference),
-            (Some((64, 32)), Some(Precision::F32), OpacityReference::World)
-        );
-        assert_eq!(s.frame_count(), 1);
-    }
-
-    #[test]
-    fn a_camera_path_interpolates_and_sets_the_frame_count() {
-        let s = parse(
-            r#"Scene(volume: Generated("ml32"), camera: Path(keyframes: [
-                (frame: 0, azimuth: 0, elevation: 0, distance: 3),
-                (frame: 10, azimuth: 90, elevation: 20, distance: 2)]))"#,
-        )
-        .expect("parses");
-        assert_eq!(s.frame_count(), 11);
-        let cam = s.camera.as_ref().expect("a camera");
-        let mid = cam.at(5);
-        assert!((mid.azimuth_deg - 45.0).abs() < 1e-12 && (mid.distance - 2.5).abs() < 1e-12);
-        assert_eq!(cam.at(20).azimuth_deg, 90.0);
-    }
-
-    #[test]
-    fn mistakes_name_the_line_or_field_and_the_fix() {
-        let err =
-            parse("Scene(volume: Generated(\"ml32\"), effects: [\"shadng\"])").expect_err("bad effect").to_string();
-        assert!(err.contains("effects: \"shadng\" is not an effect") && err.contains("shading"), "{err}");
-        let err = parse("Scene(\n  volume: Generated(\"ml32\"),\n  colour: 3)").expect_err("unknown field").to_string();
-        assert!(err.starts_with("scenes/test.ron:3:"), "{err}");
-        let err = parse("Scene(volume: Generated(\"ml32\"), viewport: (0, 5))").expect_err("bad size").to_string();
-        assert!(err.contains("viewport: (0, 5)"), "{err}");
-        let err =
-            parse("Scene(volume: Generated(\"ml32\"), camera: Path(keyframes: []))").expect_err("empty").to_string();
-        assert!(err.contains("camera: a Path needs at least one keyframe"), "{err}");
-    }
-
-    /// Issue 19: a keyframe at frame 10⁹ rendered 10⁹ frames, one at 2³²−1 wrapped to 0 frames
-    /// (a black PNG); elevations beyond ±90° and distances like 1e-300 were accepted.
-    #[test]
-    fn camera_paths_and_orbits_are_bounded_like_the_cli() {
-        let path = |frame: u64| {
-            format!(
-                "Scene(volume: Generated(\"ml32\"), camera: Path(keyframes: [(frame: 0, azimuth: 0, elevation: 0, \
-                 distance: 3), (frame: {frame}, azimuth: 9, elevation: 0, distance: 3)]))"
-            )
-        };
-        for frame in [1_000_000_000u64, u64::from(u32::MAX)] {
-            let err = parse(&path(frame)).expect_err("too long").to_string();
-            assert!(err.contains(&format!("keyframe 1: frame {frame} is beyond the last frame")), "{err}");
-        }
-        assert_eq!(parse(&path(u64::from(MAX_FRAMES - 1))).expect("the longest path").frame_count(), MAX_FRAMES);
-        for (camera, expected) in [
-            ("Orbit(azimuth: 0, elevation: 91, distance: 3)", "elevation 91 must be within -90..=90"),
-            ("Orbit(azimuth: 0, elevation: -200, distance: 3)", "elevation -200 must be within"),
-            ("Orbit(azimuth: 0, elevation: 0, distance: 1e-300)", "distance 1e-300 must be within"),
-        ] {
-            let err =
-                parse(&format!("Scene(volume: Generated(\"ml32\"), camera: {camera})")).expect_err(camera).to_string();
-            assert!(err.contains(expected), "{camera}: {err}");
-        }
-    }
-
-    /// Issue 19: `Data("…")` climbed out of `$VOLGRAPH_DATA/tf`.
-    #[test]
-    fn a_data_transfer_function_stays_in_the_data_folder() {
-        for name in ["../../../etc/passwd", "/etc/passwd", "..", "a/b", ""] {
-            let text = format!("Scene(volume: Generated(\"ml32\"), transfer_function: Data(\"{name}\"))");
-            let err = parse(&text).expect_err(name).to_string();
-            assert!(err.contains("transfer_function: Data(") && err.contains("without folders"), "{name}: {err}");
-        }
-        parse("Scene(volume: Generated(\"ml32\"), transfer_function: Data(\"engine_opaque\"))").expect("a stem");
-    }
-
-    /// Issue 47 §5: a built-in graph or a TF preset named in a scene resolved only in the scene's
-    /// folder. A relative name is the file beside the scene where there is one, else the built-in.
-    #[test]
-    fn names_resolve_beside_the_scene_first_else_as_built_ins() {
-        let dir = std::env::temp_dir().join(format!("volgraph-scene-names-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).expect("scratch");
-        let text = "Scene(graph: \"basic/fragment_raycast\", volume: Generated(\"ml32\"), transfer_function: \
-                    File(\"ct-bone\"))";
-        let s = Scene::from_str(text, &dir.join("s.ron")).expect("parses");
-        assert_eq!(s.graph, Some(PathBuf::from("basic/fragment_raycast")));
-        assert_eq!(s.transfer_function, Some(TfSource::Preset("ct-bone".into())));
-        // A file of that name beside the scene wins.
-        std::fs::write(dir.join("ct-bone"), "").expect("file");
-        let s = Scene::from_str(text, &dir.join("s.ron")).expect("parses");
-        assert_eq!(s.transfer_function, Some(TfSource::File(dir.join("ct-bone").display().to_string())));
-        let _ = std::fs::remove_dir_all(&dir);
-        // Preset() takes the scanner presets; a wrong name is refused with the list.
-        parse("Scene(volume: Generated(\"ml32\"), transfer_function: Preset(\"mr-default\"))").expect("a preset");
-        let err = parse("Scene(volume: Generated(\"ml32\"), transfer_function: Preset(\"ct-bones\"))")
-            .expect_err("no such preset")
-            .to_string();
-        assert!(
-            err.contains("transfer_function: Preset(\"ct-bones\") is not a preset") && err.contains("ct-bone,"),
-            "{err}"
-        );
-    }
-
-    /// Issue 47 §5: `view --volume ml32` and its saved `Generated("ml32")` got two default TFs;
-    /// one rule now, and only where the TF's 0..255 points fit (not the float `mlf` volumes).
-    #[test]
-    fn the_marschner_lobb_tf_is_the_default_of_the_8_bit_ml_volumes_only() {
-        let generated = |n: &str| VolumeSource::Generated(n.to_string());
-        assert!(marschner_lobb_tf(&generated("ml32")) && marschner_lobb_tf(&generated("ml64")));
-        for other in [generated("mlf64"), generated("sphere32"), VolumeSource::Dataset("ml32".into())] {
-            assert!(!marschner_lobb_tf(&other), "{other:?}");
-        }
-    }
-
-    /// Issue 47 §5: `volume_options` are checked as the flags they stand for.
-    #[test]
-    fn volume_options_are_checked_like_the_flags() {
-        let s = parse(
-            "Scene(volume: File(\"v.raw\"), volume_options: (dims: (4, 4, 2), dtype: \"uint16\", series: \"2\"))",
-        )
-        .expect("parses");
-        let o = s.volume_options.load_options().expect("valid");
-        assert_eq!((o.raw.dims, o.series.as_deref()), (Some(glam::UVec3::new(4, 4, 2)), Some("2")));
-        for (options, expected) in [
-            ("(dims: (0, 4, 4))", "volume_options: --dims \"0x4x4\""),
-            ("(dtype: \"int64\")", "--dtype \"int64\""),
-            ("(spacing: (1, 1, 1e9))", "times the shortest"),
-            ("(colour: 1)", "scenes/test.ron:1:"),
-        ] {
-            let err = parse(&format!("Scene(volume: File(\"v.raw\"), volume_options: {options})"))
-                .expect_err(options)
-                .to_string();
-            assert!(err.contains(expected), "{options}: {err}");
-        }
-    }
 }

@@ -64,7 +64,12 @@ impl Default for Lod {
 impl Lod {
     /// The camera moved (a drag step, a wheel turn).
     pub fn moved(&mut self) {
-        self.last_motion = Some(Instant::now());
+        self.moved_at(Instant::now());
+    }
+
+    /// The camera moved at `at`.
+    pub fn moved_at(&mut self, at: Instant) {
+        self.last_motion = Some(at);
     }
 
     /// The scale or step just changed: frames from `next_frame` on are rendered with them.

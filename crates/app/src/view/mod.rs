@@ -14,6 +14,7 @@ pub mod session;
 pub mod tf_editor;
 pub mod watch;
 pub mod window;
+pub mod workbench;
 
 #[cfg(test)]
 mod tests;

@@ -224,12 +224,10 @@ pub fn show(
             }
             if plan.inputs.values().any(|k| *k == InputKind::TransferFunction) {
                 egui::CollapsingHeader::new("Transfer function").default_open(true).show(ui, |ui| {
-                    let (histogram, range) = session.histogram();
-                    let tf = session.transfer_function();
-                    let presets = session.tf_presets();
-                    if let Some(a) =
-                        super::tf_editor::show(ui, tf, histogram, range, presets, session.save_tf_on_change)
-                    {
+                    let model = &session.workbench().tf;
+                    let (histogram, range) = model.histogram();
+                    let (tf, presets) = (model.transfer_function(), model.presets());
+                    if let Some(a) = super::tf_editor::show(ui, tf, histogram, range, presets, model.save_on_change) {
                         actions.push(Action::TransferFunction(a));
                     }
                 });
@@ -269,7 +267,7 @@ pub fn show(
                     actions.push(Action::Assign(text));
                 }
                 // The graph's own WGSL-only kinds have parameters too.
-                let registry = volgraph_core::wgsl_pass::with_graph_kinds(session.registry(), &plan.kinds);
+                let registry = volgraph_core::wgsl_pass::with_graph_kinds(session.workbench().graph.registry(), &plan.kinds);
                 let mut seen = Vec::new();
                 for step in &plan.steps {
                     if seen.contains(&step.pass_id) {

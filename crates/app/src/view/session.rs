@@ -3,27 +3,30 @@
 //! a parameter slider, a scene feature or scalar, a resize. Each change recompiles (a pure
 //! function) and applies; any failure leaves the last good graph running and becomes an
 //! [`Event::Error`] with located diagnostics; the next good change is an [`Event::Recovered`].
+//! What the user edits — the graph text and its overrides, the transfer function, the level of
+//! detail's step — is the GPU-free [`Workbench`] (`workbench/`): the session asks it for the
+//! options of a change, compiles and applies them on the runtime, and tells it once they run.
 //! The window (`window.rs`) and the tests drive the same object.
 
 use std::fmt;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::time::Instant;
 
-use anyhow::anyhow;
 use volgraph_accel::cuts::Cuts;
-use volgraph_accel::transfer_function::TransferFunction;
 use volgraph_accel::volume::Volume;
-use volgraph_core::graph::edit::{SetTarget, apply as apply_edits, edit_for};
-use volgraph_core::runtime::{ApplyReport, CameraData, Gpu, PresentTarget, Runtime, ShaderLibrary};
-use volgraph_core::{CompileOptions, Plan, Registry, cut_effects};
+use volgraph_core::graph::edit::SetTarget;
+use volgraph_core::runtime::{ApplyReport, CameraData, PresentTarget, Runtime};
+use volgraph_core::{CompileOptions, Plan};
 
+use super::workbench::{LodTarget, StepRequest, Workbench};
 use crate::inputs;
 
+mod measure;
+mod open;
 mod tf;
 
-use tf::{HISTOGRAM_BINS, scanner_preset_named, tf_presets_for};
-pub use tf::{SAVED_TF, SavedTf};
+pub use super::workbench::SAVED_TF;
+pub use tf::SavedTf;
 
 /// What the session reports, one line each on stdout.
 #[derive(Clone, Debug, PartialEq)]
@@ -141,17 +144,11 @@ pub struct SessionArgs {
 pub struct LiveSession {
     /// The runtime.
     pub runtime: Runtime,
-    registry: Registry,
-    graph: PathBuf,
-    graph_name: String,
-    /// The text of the graph that is running.
-    source: String,
-    tf_path: Option<PathBuf>,
-    tf_map: Option<String>,
+    /// The graph and transfer function being edited.
+    bench: Workbench,
     volume: Volume,
+    /// The LUT of the transfer function on screen.
     lut: Vec<[f32; 4]>,
-    generated: bool,
-    options: CompileOptions,
     shader_dirs: Vec<PathBuf>,
     /// The last change's error, while it lasts.
     error: Option<(String, String)>,
@@ -164,196 +161,20 @@ pub struct LiveSession {
     volume_source: Result<crate::scene::VolumeSource, String>,
     /// How the volume was read (`--series`, `--frame`, `--dims`, `--spacing`, ...), for "save view".
     volume_options: volgraph_accel::load::LoadOptions<'static>,
-    /// Where the TF came from, for "save view" (`None`: fitted to the data).
-    tf_source: Option<crate::scene::TfSource>,
-    /// The TF as its source gives it (the file's, the preset's, the fitted one): the TF on
-    /// screen differs from it after an edit that is not saved.
-    tf_pristine: TransferFunction,
     /// What the TF's opacity is per (the scene's).
     opacity_reference: volgraph_core::runtime::OpacityReference,
-    /// The transfer function on screen (the TF editor's).
-    tf: TransferFunction,
-    /// Voxels per bin of the volume's normalized values (the TF editor's histogram).
-    histogram: Vec<u64>,
-    /// The text this viewer last wrote to the TF file: the watcher's event for it is not a
-    /// reload.
-    tf_written: Option<String>,
-    /// Save the TF file after every edit (the panel's toggle).
-    pub save_tf_on_change: bool,
-    /// The TF editor's presets for this volume (computed once: MR's reads percentiles).
-    tf_presets: Vec<(&'static str, TransferFunction)>,
-    /// While the level of detail widens the step: the factor and the overrides from before it
-    /// (restored when it ends).
-    coarse_step: Option<(f64, StepBase)>,
-}
-
-/// What the level of detail's step replaces: the parameter overrides and graph scalars from
-/// before it, and the graph's own spacing of each pass it widens by parameter (`PASS.PARAM`,
-/// taken from the plan at factor 1, so a ×2 → ×4 change widens the graph's value, not ×2's).
-#[derive(Clone)]
-struct StepBase {
-    params: std::collections::BTreeMap<String, ron::Value>,
-    scalars: std::collections::BTreeMap<String, f64>,
-    steps: Vec<(String, f64)>,
-}
-
-/// The sample spacings the level of detail widens in every pass that declares one: a
-/// raycaster's step, a slicer's slice distance.
-const STEP_PARAMS: [&str; 2] = ["step_voxels", "slice_voxels"];
-
-/// The parameters the level of detail widens where a graph input feeds them: the step, and a
-/// multipass raycaster's segment length (Krüger & Westermann 2003 §3's M), whose pass count —
-/// and so the per-pass fixed cost that dominates a small coarse image — falls with it.
-const WIDENED_PARAMS: [&str; 2] = ["step_voxels", "segment_steps"];
-
-/// The graph inputs wired into a parameter of [`WIDENED_PARAMS`] (`"step_voxels":
-/// "input.NAME"`), and the ids of the passes whose `step_voxels` they feed. Widening such an
-/// input, not each pass's parameter, also shortens what is computed from it — a
-/// Krüger–Westermann repeat group's segment count.
-fn step_inputs(source: &str) -> (std::collections::BTreeSet<String>, std::collections::BTreeSet<String>) {
-    let (mut inputs, mut passes) = (std::collections::BTreeSet::new(), std::collections::BTreeSet::new());
-    let Ok(doc) = volgraph_core::graph::parse_graph(source) else { return (inputs, passes) };
-    let all = doc.passes.iter().flat_map(|node| match node {
-        volgraph_core::graph::ast::NodeDoc::Pass(p) => std::slice::from_ref(p).iter(),
-        volgraph_core::graph::ast::NodeDoc::Repeat(r) => r.body.iter(),
-    });
-    for pass in all {
-        for param in WIDENED_PARAMS {
-            if let Some(ron::Value::String(wire)) = pass.params.get(param)
-                && let Some(name) = wire.strip_prefix("input.")
-            {
-                inputs.insert(name.to_string());
-                if param == "step_voxels" {
-                    passes.insert(pass.id.clone());
-                }
-            }
-        }
-    }
-    (inputs, passes)
 }
 
 impl LiveSession {
-    /// Loads the scene and the graph on `gpu`; fails (with located diagnostics) when the graph
-    /// does not compile or build at all.
-    pub fn open(gpu: Arc<Gpu>, args: &SessionArgs) -> Result<(Self, Event), crate::cli::CliError> {
-        Self::open_with(gpu, args, crate::program::registry())
+    /// The graph and transfer function being edited.
+    pub fn workbench(&self) -> &Workbench {
+        &self.bench
     }
 
-    /// [`Self::open`] with another registry (built-ins plus a plugin crate's kinds).
-    pub fn open_with(
-        gpu: Arc<Gpu>,
-        args: &SessionArgs,
-        registry: Registry,
-    ) -> Result<(Self, Event), crate::cli::CliError> {
-        let start = Instant::now();
-        let source = inputs::read_graph(&args.graph)?;
-        let shown = crate::scene::load_shown_volume(&args.volume, args.scene.as_ref(), &args.raw)?;
-        let (volume, generated, notes) = (shown.volume, shown.marschner_lobb_tf, shown.notes);
-        for note in notes {
-            crate::stdout::eprintln_escaped!("note: {note}");
-        }
-        let (tf, tf_path, tf_notes) = match (&args.tf, &args.scene) {
-            (None, Some(scene)) => {
-                crate::scene::load_transfer_function(scene, args.tf_map.as_deref(), &volume, generated)?
-            }
-            (tf, _) => {
-                let (t, notes) = inputs::transfer_function(tf.as_ref(), args.tf_map.as_deref(), &volume, generated)?;
-                // A preset's or a built-in TF's name is no file: nothing to watch, and "save TF"
-                // writes elsewhere.
-                let file =
-                    |p: &PathBuf| scanner_preset_named(p).is_none() && crate::builtin_graphs::find_tf(p).is_none();
-                (t, tf.clone().filter(file), notes)
-            }
-        };
-        let tf_source = match (&args.tf, &args.scene) {
-            (None, Some(scene)) => scene.transfer_function.clone(),
-            (None, None) => None,
-            (Some(p), _) => Some(match scanner_preset_named(p) {
-                Some(name) => crate::scene::TfSource::Preset(name.to_string()),
-                None => crate::scene::TfSource::File(p.display().to_string()),
-            }),
-        };
-        for note in tf_notes {
-            crate::stdout::eprintln_escaped!("note: {note}");
-        }
-        let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
-        let histogram = volgraph_accel::histogram::Histogram::of(&volume, HISTOGRAM_BINS).counts;
-        let tf_presets = tf_presets_for(&volume);
-        let (sources, _) = crate::shader_dir::sources_for(&args.graph, args.shaders.as_deref());
-        // Every folder read (and so watched), in search order: the start line and the panel name
-        // all of them, not just the first.
-        let shader_dirs: Vec<PathBuf> = sources.disk_roots().into_iter().map(Path::to_path_buf).collect();
-        let mut runtime = Runtime::new(gpu, ShaderLibrary::new(sources));
-        runtime.set_gpu_memory_budget(args.gpu_memory_mb.map(|mb| mb << 20));
-        let mut options = CompileOptions::new(args.viewport.0, args.viewport.1)
-            .with_features(args.features.iter().filter(|f| !f.is_empty()).cloned());
-        options.features.extend(cut_effects::features_of(&args.cuts));
-        runtime.set_cuts(args.cuts);
-        if let Some(scene) = &args.scene {
-            options.features.extend(scene.effects.iter().cloned());
-            options.precision = scene.precision;
-            runtime.set_opacity_reference(scene.opacity_reference);
-        }
-        let graph_name = args.graph.display().to_string();
-        let plan =
-            compile_for(&graph_name, &source, &registry, &options, &volume).map_err(crate::cli::CliError::Graph)?;
-        // A scene's effect the graph does not offer is left out with a note; a --features typo is
-        // an error.
-        if let Some(scene) = &args.scene {
-            for effect in &scene.effects {
-                if !plan.known_features.contains(effect) && !args.features.contains(effect) {
-                    crate::stdout::eprintln_escaped!(
-                        "note: graph \"{}\" does not offer the scene's effect \"{effect}\"; it is left out",
-                        plan.name
-                    );
-                    options.features.remove(effect);
-                }
-            }
-        }
-        crate::cli::check_user_names(&plan, &options)?;
-        if let Some(note) = crate::render::budget_note(&plan, &registry, args.gpu_memory_mb) {
-            crate::stdout::eprintln_escaped!("{note}");
-        }
-        let shaders = match shader_dirs.as_slice() {
-            [] => "built-in shaders".to_string(),
-            dirs => format!(
-                "shaders from {} (watched), then the built-in ones",
-                dirs.iter().map(|d| d.display().to_string()).collect::<Vec<_>>().join(", ")
-            ),
-        };
-        let loaded = format!("{}, {shaders}", summary(&plan));
-        runtime.bind_scene(&plan.inputs, &volume, &lut).map_err(|e| crate::cli::CliError::Other(anyhow!(e)))?;
-        runtime.apply(plan, &registry).map_err(|e| crate::cli::CliError::Other(anyhow!(e)))?;
-        let session = Self {
-            runtime,
-            registry,
-            graph: args.graph.clone(),
-            graph_name: graph_name.clone(),
-            source,
-            tf_path,
-            tf_map: args.tf_map.clone(),
-            volume,
-            lut,
-            generated,
-            options,
-            shader_dirs,
-            error: None,
-            validated: None,
-            unproven: true,
-            volume_source: shown.source,
-            volume_options: shown.options,
-            tf_source,
-            tf_pristine: tf.clone(),
-            tf,
-            histogram,
-            tf_written: None,
-            save_tf_on_change: false,
-            tf_presets,
-            coarse_step: None,
-            opacity_reference: args.scene.as_ref().map(|s| s.opacity_reference).unwrap_or_default(),
-        };
-        let ms = start.elapsed().as_secs_f64() * 1e3;
-        Ok((session, Event::Loaded { graph: graph_name, ms, summary: loaded }))
+    /// The graph and transfer function being edited, to change what needs no device (the TF
+    /// editor's "save on change").
+    pub fn workbench_mut(&mut self) -> &mut Workbench {
+        &mut self.bench
     }
 
     /// The running plan.
@@ -361,14 +182,9 @@ impl LiveSession {
         self.runtime.plan()
     }
 
-    /// The registry (for parameter specs).
-    pub fn registry(&self) -> &Registry {
-        &self.registry
-    }
-
     /// The current compile options (features, scalars, parameter overrides, viewport).
     pub fn options(&self) -> &CompileOptions {
-        &self.options
+        self.bench.graph.options()
     }
 
     /// The error of the last change, while the last good graph runs: (what, message).
@@ -384,22 +200,23 @@ impl LiveSession {
     /// Every file whose edit changes what is shown: the graph, the transfer function, and every
     /// shader file the running pipelines were built from (imports included).
     pub fn watched_files(&self) -> Vec<PathBuf> {
-        let mut files = vec![self.graph.clone()];
-        files.extend(self.tf_path.clone());
+        let mut files = vec![self.bench.graph.path().to_path_buf()];
+        files.extend(self.bench.tf.path().map(Path::to_path_buf));
         files.extend(self.runtime.shaders().watched_files());
         files
     }
 
     /// Compiles `source` with `options` and applies it; the report, or the error message.
     fn compile_and_apply(&mut self, source: &str, options: &CompileOptions) -> Result<ApplyReport, String> {
-        let plan =
-            compile_for(&self.graph_name, source, &self.registry, options, &self.volume).map_err(|d| d.to_string())?;
-        crate::cli::check_user_names(&plan, options).map_err(|e| match e {
-            crate::cli::CliError::Graph(d) => d.to_string(),
-            crate::cli::CliError::Other(e) => e.to_string(),
-        })?;
+        let plan = self.bench.graph.plan_for(source, options)?;
         self.runtime.bind_scene(&plan.inputs, &self.volume, &self.lut).map_err(|e| e.to_string())?;
-        self.runtime.apply(plan, &self.registry).map_err(|e| e.to_string())
+        self.runtime.apply(plan, self.bench.graph.registry()).map_err(|e| e.to_string())
+    }
+
+    /// Compiles the running graph text with `options` and applies it; the change's detail.
+    fn apply_options(&mut self, options: &CompileOptions) -> Result<String, String> {
+        let source = self.bench.graph.source().to_string();
+        self.compile_and_apply(&source, options).map(|r| describe(&r))
     }
 
     /// Turns a change's outcome into events (an error keeps the last good graph).
@@ -424,10 +241,10 @@ impl LiveSession {
     /// The graph file changed: recompile it and apply.
     pub fn reload_graph(&mut self) -> Vec<Event> {
         let start = Instant::now();
-        let result = inputs::read_graph(&self.graph).map_err(|e| format!("{e:#}")).and_then(|source| {
-            let options = self.options.clone();
+        let result = inputs::read_graph(self.bench.graph.path()).map_err(|e| format!("{e:#}")).and_then(|source| {
+            let options = self.bench.graph.options().clone();
             let report = self.compile_and_apply(&source, &options)?;
-            self.source = source;
+            self.bench.graph.set_source(source);
             Ok(describe(&report))
         });
         self.outcome("graph".to_string(), start, result)
@@ -441,65 +258,17 @@ impl LiveSession {
             return Vec::new();
         }
         let what = format!("shader {}", modules.join(", "));
-        let source = self.source.clone();
-        let options = self.options.clone();
-        let result = self.compile_and_apply(&source, &options).map(|r| describe(&r));
+        let options = self.bench.graph.options().clone();
+        let result = self.apply_options(&options);
         self.outcome(what, start, result)
     }
 
-    /// What lies under window pixel `cursor` (physical pixels) seen by `camera`: the first
-    /// visible point along its ray (the TF, the crop and clip planes as drawn) and the data value
-    /// there, as a line for the panel in the data's units; `None` off the volume.
-    pub fn probe_line(&self, camera: &volgraph_accel::camera::OrbitCamera, cursor: (f64, f64)) -> Option<String> {
-        let (w, h) = self.options.viewport;
-        if !(cursor.0 >= 0.0 && cursor.1 >= 0.0) {
-            return None;
-        }
-        let pixel = (cursor.0 as u32, cursor.1 as u32);
-        let cuts = self.runtime.cuts();
-        let p = volgraph_accel::probe::first_visible(&self.volume, &self.lut, camera, (w, h), pixel, 0.5, &cuts)?;
-        let units = self.volume.meta.units.as_deref().map_or(String::new(), |u| format!(" {u}"));
-        Some(format!(
-            "under the cursor: {:.4}{units} at voxel ({:.1}, {:.1}, {:.1}), α {:.2}",
-            p.value, p.voxel.x, p.voxel.y, p.voxel.z, p.alpha
-        ))
-    }
-
-    /// A comparison of the view on screen (the last frame's `image`) with the converged
-    /// reference, for a worker thread; `None` for a graph without a float `image` output or a
-    /// raycaster (`march`) to take the settings from.
-    pub fn accuracy_job(&mut self, camera: &volgraph_accel::camera::OrbitCamera) -> Option<super::accuracy::Job> {
-        let plan = self.plan()?;
-        let march = plan.steps.iter().find(|s| s.pass_id == "march" && s.params.declares("step_voxels"))?;
-        let mut settings = volgraph_passes::raycast_params::reference_settings(&march.params);
-        settings.opacity_unit_voxels = match self.opacity_reference {
-            volgraph_core::runtime::OpacityReference::World => 1.0 / self.volume.unit_step_world(),
-            volgraph_core::runtime::OpacityReference::Voxel => 1.0,
-        };
-        let size = plan.viewport;
-        let image = self.runtime.read_output("image").ok()?;
-        if (image.width, image.height) != size || image.channels != 4 {
-            return None;
-        }
-        Some(super::accuracy::Job {
-            image: image.to_rgba_f64(),
-            size,
-            volume: self.volume.clone(),
-            lut: self.lut.clone(),
-            camera: *camera,
-            settings,
-            cuts: self.runtime.cuts(),
-        })
-    }
-
     /// The panel's "set" field: `PASS.PARAM=VALUE` or `input.NAME=VALUE`, checked as
-    /// `volgraph set` checks it — the graph text with the value written in must compile, so a
-    /// bad value or an unknown name is refused with its located message (and a "did you mean")
-    /// — then applied as a slider would apply it (the file changes only with "write to graph
-    /// file").
+    /// `volgraph set` checks it ([`GraphEdits::check_assignment`]) — then applied as a slider
+    /// would apply it (the file changes only with "write to graph file").
     pub fn assign(&mut self, text: &str) -> Vec<Event> {
         let start = Instant::now();
-        match self.check_assignment(text) {
+        match self.bench.graph.check_assignment(text) {
             Err(message) => self.outcome(format!("set {}", text.trim()), start, Err(message)),
             Ok((SetTarget::Param { pass, param }, value)) => self.set_param(&pass, &param, value),
             Ok((SetTarget::Input(name), value)) => match value {
@@ -513,73 +282,22 @@ impl LiveSession {
         }
     }
 
-    fn check_assignment(&self, text: &str) -> Result<(SetTarget, ron::Value), String> {
-        let Some((target, value)) = text.split_once('=') else {
-            return Err(format!("\"{}\": expected PASS.PARAM=VALUE or input.NAME=VALUE", text.trim()));
-        };
-        let target = SetTarget::parse(target.trim())?;
-        let edits = edit_for(&self.source, &target, value)?;
-        let edited = apply_edits(&self.source, &edits);
-        // The panel's own value for this name would hide the one being checked.
-        let mut options = self.options.clone();
-        match &target {
-            SetTarget::Param { pass, param } => options.param_overrides.remove(&format!("{pass}.{param}")),
-            SetTarget::Input(name) => options.scalars.remove(name).map(ron::Value::from),
-        };
-        compile_for(&self.graph_name, &edited, &self.registry, &options, &self.volume).map_err(|d| d.to_string())?;
-        let value = ron::from_str::<ron::Value>(value.trim()).map_err(|e| format!("{}: {e}", value.trim()))?;
-        Ok((target, value))
-    }
-
-    /// Writes the parameters and graph inputs changed in the panel into the graph file at their
-    /// place (`volgraph set`'s code: only the values' text changes), then runs from the file:
-    /// the panel's overrides are cleared, as the file now says what they said. Returns one line
-    /// per value written; an error (a built-in graph, an unwritable file) changes nothing.
+    /// Writes the parameters and graph inputs changed in the panel into the graph file
+    /// ([`GraphEdits::write_back`]), the graph's own step, not the level of detail's wider one.
     pub fn write_back(&mut self) -> anyhow::Result<Vec<String>> {
-        // The level of detail's wider step is not the user's: the graph's own values are written.
         self.set_step_factor(1.0);
-        let mut assignments: Vec<String> = Vec::new();
-        for (key, value) in &self.options.param_overrides {
-            let text = ron::to_string(value).map_err(|e| anyhow!("{key}: {e}"))?;
-            assignments.push(format!("{key}={text}"));
-        }
-        let plan_inputs = self.plan().map(|p| p.inputs.clone()).unwrap_or_default();
-        for (name, value) in &self.options.scalars {
-            if plan_inputs.contains_key(name) {
-                assignments.push(format!("input.{name}={value:?}"));
-            }
-        }
-        if assignments.is_empty() {
-            return Ok(Vec::new());
-        }
-        let lines =
-            crate::set_cmd::run(&self.graph, &assignments).map_err(|e| anyhow!("{}", crate::cli::error_text(&e)))?;
-        self.source = inputs::read_graph(&self.graph)?;
-        self.options.param_overrides.clear();
-        self.options.scalars.retain(|name, _| !plan_inputs.contains_key(name));
-        Ok(lines.lines().map(str::to_string).collect())
+        let inputs = self.plan().map(|p| p.inputs.clone()).unwrap_or_default();
+        self.bench.graph.write_back(&inputs)
     }
 
-    /// Files changed on disk: the events of reloading what they affect. A graph file whose text
-    /// is the running one (the viewer's own write-back) is not reloaded, unless the last change
-    /// failed (then the same text is the fix, and reloading it recovers).
+    /// Files changed on disk: the events of reloading what they affect (see
+    /// [`GraphEdits::needs_reload`] and [`TfEdits::needs_reload`]).
     pub fn files_changed(&mut self, changed: &[PathBuf]) -> Vec<Event> {
-        let same =
-            |a: &Path, b: &Path| a == b || matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y);
         let mut events = Vec::new();
-        if changed.iter().any(|c| same(c, &self.graph))
-            // (Read without blocking: a FIFO swapped in for the graph must not freeze the viewer.)
-            && (self.error().is_some()
-                || volgraph_accel::input_file::read_text(&self.graph, "graph file").map_or(true, |text| text != self.source))
-        {
+        if self.bench.graph.needs_reload(changed, self.error.is_some()) {
             events.extend(self.reload_graph());
         }
-        if let Some(tf) = self.tf_path.clone()
-            && changed.iter().any(|c| same(c, &tf))
-            // The viewer's own save is not an edit to reload.
-            && (self.tf_written.is_none()
-                || volgraph_accel::input_file::read_text(&tf, "transfer function").ok() != self.tf_written)
-        {
+        if self.bench.tf.needs_reload(changed) {
             events.extend(self.reload_transfer_function());
         }
         let shaders: Vec<PathBuf> =
@@ -593,20 +311,10 @@ impl LiveSession {
     /// Sets a pass parameter (a slider): written in place where the pass allows.
     pub fn set_param(&mut self, pass: &str, param: &str, value: ron::Value) -> Vec<Event> {
         let start = Instant::now();
-        let mut options = self.options.clone();
-        options.param_overrides.insert(format!("{pass}.{param}"), value.clone());
-        let source = self.source.clone();
-        let result = self.compile_and_apply(&source, &options).map(|r| describe(&r));
+        let options = self.bench.graph.with_param(pass, param, &value);
+        let result = self.apply_options(&options);
         if result.is_ok() {
-            self.options = options;
-            // Kept when the level of detail's step ends; a spacing the user sets is the new own one.
-            if let Some((_, base)) = &mut self.coarse_step {
-                let key = format!("{pass}.{param}");
-                if let (Some(entry), ron::Value::Number(n)) = (base.steps.iter_mut().find(|(k, _)| *k == key), &value) {
-                    entry.1 = n.into_f64();
-                }
-                base.params.insert(key, value);
-            }
+            self.bench.graph.param_set(pass, param, &value, options);
         }
         self.outcome(format!("parameter {pass}.{param}"), start, result)
     }
@@ -614,16 +322,10 @@ impl LiveSession {
     /// Sets a scene scalar (a Scalar graph input).
     pub fn set_scalar(&mut self, name: &str, value: f64) -> Vec<Event> {
         let start = Instant::now();
-        let mut options = self.options.clone();
-        options.scalars.insert(name.to_string(), value);
-        let source = self.source.clone();
-        let result = self.compile_and_apply(&source, &options).map(|r| describe(&r));
+        let options = self.bench.graph.with_scalar(name, value);
+        let result = self.apply_options(&options);
         if result.is_ok() {
-            self.options = options;
-            // Kept when the level of detail's step ends.
-            if let Some((_, base)) = &mut self.coarse_step {
-                base.scalars.insert(name.to_string(), value);
-            }
+            self.bench.graph.scalar_set(name, value, options);
         }
         self.outcome(format!("scalar {name}"), start, result)
     }
@@ -631,16 +333,10 @@ impl LiveSession {
     /// Turns a scene feature on or off: gated passes appear and disappear.
     pub fn set_feature(&mut self, name: &str, on: bool) -> Vec<Event> {
         let start = Instant::now();
-        let mut options = self.options.clone();
-        if on {
-            options.features.insert(name.to_string());
-        } else {
-            options.features.remove(name);
-        }
-        let source = self.source.clone();
-        let result = self.compile_and_apply(&source, &options).map(|r| describe(&r));
+        let options = self.bench.graph.with_feature(name, on);
+        let result = self.apply_options(&options);
         if result.is_ok() {
-            self.options = options;
+            self.bench.graph.set_options(options);
         }
         self.outcome(format!("feature {name} {}", if on { "on" } else { "off" }), start, result)
     }
@@ -653,18 +349,15 @@ impl LiveSession {
         if cuts == old {
             return Vec::new();
         }
-        let mut options = self.options.clone();
-        options.features.retain(|f| !cut_effects::is_cut_feature(f));
-        options.features.extend(cut_effects::features_of(&cuts));
+        let options = self.bench.graph.with_cuts(&cuts);
         self.runtime.set_cuts(cuts);
-        if options.features == self.options.features {
+        if options.features == self.options().features {
             return Vec::new();
         }
         let start = Instant::now();
-        let source = self.source.clone();
-        let result = self.compile_and_apply(&source, &options).map(|r| describe(&r));
+        let result = self.apply_options(&options);
         if result.is_ok() {
-            self.options = options;
+            self.bench.graph.set_options(options);
         } else {
             self.runtime.set_cuts(old);
         }
@@ -679,65 +372,25 @@ impl LiveSession {
 
     /// The factor the level of detail's step is widened by now (1: the graph's own).
     pub fn step_factor(&self) -> f64 {
-        self.coarse_step.as_ref().map_or(1.0, |(f, _)| *f)
+        self.bench.graph.step_factor()
     }
 
     /// The level of detail's step: every pass with a `step_voxels` samples `factor` times further
     /// apart while the camera moves, and a multipass graph's segments (an input wired to
     /// `segment_steps`) get `factor` times longer (1: the graph's own values again, with the
-    /// overrides from before). A graph that refuses the wider step (a range) just keeps its own; no error is
-    /// shown for it. Returns whether the step is now `factor`.
+    /// overrides from before; [`super::workbench::StepWidening`]). A graph that refuses the wider
+    /// step (a range) just keeps its own; no error is shown for it. Returns whether the step is
+    /// now `factor`.
     pub fn set_step_factor(&mut self, factor: f64) -> bool {
-        let current = self.coarse_step.as_ref().map_or(1.0, |(f, _)| *f);
-        if factor == current {
-            return true;
-        }
-        let (inputs, fed) = step_inputs(&self.source);
-        let base = match &self.coarse_step {
-            Some((_, base)) => base.clone(),
-            None => {
-                // At factor 1: the plan holds the graph's own (or the user's) spacings.
-                let Some(plan) = self.plan() else { return false };
-                let mut steps: Vec<(String, f64)> = Vec::new();
-                for step in &plan.steps {
-                    for param in STEP_PARAMS {
-                        let key = format!("{}.{param}", step.pass_id);
-                        let fed_by_input = param == "step_voxels" && fed.contains(&step.pass_id);
-                        if step.params.declares(param)
-                            && (!fed_by_input || self.options.param_overrides.contains_key(&key))
-                            && !steps.iter().any(|(k, _)| *k == key)
-                        {
-                            steps.push((key, step.params.float(param)));
-                        }
-                    }
-                }
-                StepBase { params: self.options.param_overrides.clone(), scalars: self.options.scalars.clone(), steps }
-            }
+        let change = match self.bench.graph.step_request(factor, self.runtime.plan()) {
+            StepRequest::Unchanged => return true,
+            StepRequest::NoPlan => return false,
+            StepRequest::Apply(change) => change,
         };
-        let mut options = self.options.clone();
-        options.param_overrides = base.params.clone();
-        options.scalars = base.scalars.clone();
-        if factor != 1.0 {
-            let Some(plan) = self.plan() else { return false };
-            for name in &inputs {
-                let own = match plan.inputs.get(name) {
-                    Some(volgraph_core::graph::ast::InputKind::Scalar(default)) => *default,
-                    _ => continue,
-                };
-                let step = base.scalars.get(name).copied().unwrap_or(own);
-                options.scalars.insert(name.clone(), step * factor);
-            }
-            for (key, own) in &base.steps {
-                options
-                    .param_overrides
-                    .insert(key.clone(), ron::Value::Number(ron::value::Number::F64((own * factor).into())));
-            }
-        }
-        let source = self.source.clone();
-        match self.compile_and_apply(&source, &options) {
+        let source = self.bench.graph.source().to_string();
+        match self.compile_and_apply(&source, &change.options) {
             Ok(_) => {
-                self.options = options;
-                self.coarse_step = (factor != 1.0).then_some((factor, base));
+                self.bench.graph.step_applied(change);
                 true
             }
             Err(_) => false,
@@ -746,16 +399,14 @@ impl LiveSession {
 
     /// The window was resized: only viewport-sized targets are reallocated.
     pub fn resize(&mut self, width: u32, height: u32) -> Vec<Event> {
-        if (width, height) == self.options.viewport || width == 0 || height == 0 {
+        if (width, height) == self.options().viewport || width == 0 || height == 0 {
             return Vec::new();
         }
         let start = Instant::now();
-        let mut options = self.options.clone();
-        options.viewport = (width, height);
-        let source = self.source.clone();
-        let result = self.compile_and_apply(&source, &options).map(|r| describe(&r));
+        let options = self.bench.graph.with_viewport((width, height));
+        let result = self.apply_options(&options);
         if result.is_ok() {
-            self.options = options;
+            self.bench.graph.set_options(options);
         }
         self.outcome(format!("viewport {width}x{height}"), start, result)
     }
@@ -766,7 +417,7 @@ impl LiveSession {
         camera: &volgraph_accel::camera::OrbitCamera,
         target: Option<&PresentTarget<'_>>,
     ) -> Result<u64, volgraph_core::runtime::RuntimeError> {
-        let viewport = self.options.viewport;
+        let viewport = self.options().viewport;
         self.runtime.submit(CameraData::from_orbit(camera, viewport), target)
     }
 
@@ -783,7 +434,9 @@ impl LiveSession {
             Ok(_) => {
                 if self.unproven {
                     self.unproven = false;
-                    self.validated = Some((self.source.clone(), self.options.clone(), self.runtime.shader_snapshot()));
+                    let graph = &self.bench.graph;
+                    self.validated =
+                        Some((graph.source().to_string(), graph.options().clone(), self.runtime.shader_snapshot()));
                 }
                 Ok(Vec::new())
             }
@@ -802,8 +455,8 @@ impl LiveSession {
                         "{e}; and the last good graph no longer applies: {revert}"
                     )));
                 }
-                self.source = source;
-                self.options = options;
+                self.bench.graph.set_source(source);
+                self.bench.graph.set_options(options);
                 self.unproven = false;
                 Ok(vec![Event::Error { what, message }])
             }
@@ -819,17 +472,25 @@ impl LiveSession {
     }
 }
 
-/// Compiles `source` with the scene values of `volume` (its longest ray: computed in one place,
-/// `volgraph_core::runtime::scene_values_of`).
-fn compile_for(
-    file: &str,
-    source: &str,
-    registry: &Registry,
-    options: &CompileOptions,
-    volume: &Volume,
-) -> Result<Plan, volgraph_core::Diagnostics> {
-    let mut options = options.clone();
-    options.scene = volgraph_core::runtime::scene_values_of(&volgraph_core::runtime::VolumeDesc::of(volume));
-    options.scene.extend(crate::inputs::data_scene_values(volume));
-    volgraph_core::compile(file, source, registry, &options)
+/// The level of detail changes the session's viewport and step.
+impl LodTarget for LiveSession {
+    fn viewport(&self) -> (u32, u32) {
+        self.options().viewport
+    }
+
+    fn resize(&mut self, width: u32, height: u32) -> Vec<Event> {
+        LiveSession::resize(self, width, height)
+    }
+
+    fn step_factor(&self) -> f64 {
+        LiveSession::step_factor(self)
+    }
+
+    fn set_step_factor(&mut self, factor: f64) -> bool {
+        LiveSession::set_step_factor(self, factor)
+    }
+
+    fn next_frame_index(&self) -> u64 {
+        self.runtime.next_frame_index()
+    }
 }

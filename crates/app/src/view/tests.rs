@@ -198,7 +198,7 @@ fn a_tf_editor_edit_applies_at_once_and_saves_without_reloading_itself() {
         alpha: 0.9,
     });
     tf.points.sort_by(|a, b| a.value.total_cmp(&b.value));
-    session.save_tf_on_change = true;
+    session.workbench_mut().tf.save_on_change = true;
     let events = session.edit_transfer_function(tf.clone());
     assert!(matches!(events.as_slice(), [Event::Reloaded { .. }, Event::Saved { .. }]), "{events:?}");
     assert_eq!(session.runtime.uploads(), uploads + 1, "one LUT upload, no volume upload");

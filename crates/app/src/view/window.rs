@@ -20,6 +20,7 @@ use super::script::ScriptCommand;
 use super::session::{Event, LiveSession, SessionArgs};
 use super::tf_editor::TfAction;
 use super::watch::FileWatch;
+use super::workbench::FramePolicy;
 use super::{ViewOptions, emit};
 
 struct Gfx {
@@ -45,12 +46,10 @@ pub struct Viewer {
     panel_open: bool,
     /// The pointer's last position in the window (physical pixels), for "under the cursor".
     cursor: Option<(f64, f64)>,
-    /// Coarser frames while the camera moves.
-    lod: super::lod::Lod,
+    /// Coarser frames while the camera moves, and when to measure the view's accuracy.
+    frames: FramePolicy,
     /// The view's error against the converged reference, measured once it rests.
     accuracy: super::accuracy::LiveAccuracy,
-    /// Since when the view on screen has changed without being measured.
-    unmeasured_since: Option<std::time::Instant>,
     /// Screenshots asked for since the last frame, each written (in order) after it.
     screenshots_now: Vec<PathBuf>,
     quit: bool,
@@ -73,9 +72,8 @@ impl Viewer {
             timings: Timings::default(),
             modifiers: ModifiersState::empty(),
             cursor: None,
-            lod: super::lod::Lod::default(),
+            frames: FramePolicy::default(),
             accuracy: Default::default(),
-            unmeasured_since: Some(std::time::Instant::now()),
             screenshots_now: Vec::new(),
             quit: false,
             failure: None,
@@ -146,7 +144,7 @@ impl Viewer {
 
     fn handle(&mut self, events: Vec<Event>) {
         if !events.is_empty() {
-            self.unmeasured_since = Some(std::time::Instant::now());
+            self.frames.changed();
         }
         for e in &events {
             emit(e);
@@ -163,7 +161,7 @@ impl Viewer {
 
     fn apply_actions(&mut self, actions: Vec<Action>) {
         if !actions.is_empty() {
-            self.unmeasured_since = Some(std::time::Instant::now());
+            self.frames.changed();
         }
         for action in actions {
             let Some(session) = self.session.as_mut() else { return };
@@ -178,18 +176,17 @@ impl Viewer {
                     Vec::new()
                 }
                 Action::Lod { enabled, target_fps } => {
-                    self.lod.enabled = enabled;
-                    self.lod.target_ms = 1000.0 / target_fps.max(1.0);
+                    self.frames.set_lod(enabled, target_fps);
                     Vec::new()
                 }
                 Action::TransferFunction(TfAction::Edit(tf)) => {
                     // A point dragged in the editor is motion too: coarse frames until it rests.
-                    self.lod.moved();
+                    self.frames.moved();
                     session.edit_transfer_function(tf)
                 }
                 Action::TransferFunction(TfAction::Save) => session.save_transfer_function_events(),
                 Action::TransferFunction(TfAction::SaveOnChange(on)) => {
-                    session.save_tf_on_change = on;
+                    session.workbench_mut().tf.save_on_change = on;
                     Vec::new()
                 }
                 Action::SaveScene(path) => {
@@ -262,7 +259,7 @@ impl Viewer {
                 Ok(Some(ScriptCommand::SaveScene(path))) => self.apply_actions(vec![Action::SaveScene(path)]),
                 Ok(Some(ScriptCommand::TfPoint(point))) => {
                     let Some(session) = self.session.as_ref() else { continue };
-                    if let Err(message) = session.check_tf_value(point.value) {
+                    if let Err(message) = session.workbench().tf.check_value(point.value) {
                         crate::stdout::eprintln_escaped!("script: tf-point {message}");
                         continue;
                     }
@@ -326,23 +323,13 @@ impl Viewer {
         // Level of detail: fewer pixels while the camera moves, the full image once it rests.
         let mut lod_events = Vec::new();
         if let (Some(session), Some(gfx)) = (self.session.as_mut(), self.gfx.as_ref()) {
-            let before = (session.options().viewport, session.step_factor());
-            let want = self.lod.viewport((gfx.config.width, gfx.config.height));
-            if want != session.options().viewport {
-                lod_events = session.resize(want.0, want.1);
-            }
-            if !session.set_step_factor(self.lod.step_factor()) {
-                self.lod.refuse_step();
-            }
-            if (session.options().viewport, session.step_factor()) != before {
-                self.lod.changed_at(session.runtime.next_frame_index());
-            }
+            lod_events = self.frames.apply_lod((gfx.config.width, gfx.config.height), session);
         }
         self.handle(lod_events);
         let Some(session) = self.session.as_mut() else { return };
         for stats in session.runtime.poll() {
             self.timings.add(&stats);
-            self.lod.observe(stats.frame_index, stats.frame_ms);
+            self.frames.observe(stats.frame_index, stats.frame_ms);
         }
         let Some(gfx) = self.gfx.as_mut() else { return };
         let frame = match gfx.surface.get_current_texture() {
@@ -358,7 +345,7 @@ impl Viewer {
         let target = PresentTarget { view: &view, format: gfx.config.format, size, output: session.shown_output() };
         if let Some(turn) = self.view.turn_degrees {
             self.orbit.turn(turn);
-            self.unmeasured_since = Some(std::time::Instant::now());
+            self.frames.changed();
         }
         let events = match session.frame(&self.orbit.camera, Some(&target)) {
             Ok(events) => events,
@@ -389,27 +376,23 @@ impl Viewer {
             // What accuracy costs, live: once the view has rested (and the full image is back),
             // one comparison with the converged reference on a worker thread.
             self.accuracy.poll();
-            if let Some(since) = self.unmeasured_since
-                && since.elapsed() > std::time::Duration::from_millis(600)
-                && self.lod.step_factor() == 1.0
-                && !self.orbit.is_dragging()
-                && !self.accuracy.busy()
-            {
-                self.unmeasured_since = None;
+            if self.frames.measure_now(self.orbit.is_dragging(), self.accuracy.busy()) {
                 match session.accuracy_job(&self.orbit.camera) {
                     Some(job) => self.accuracy.start(job),
                     None => self.accuracy.last = None,
                 }
             }
-            let accuracy_line = match (&self.accuracy.last, self.accuracy.busy()) {
-                (_, true) => "error vs converged f64: measuring…".to_string(),
-                (Some(a), false) if self.unmeasured_since.is_none() => a.line(),
-                (Some(_), false) => "error vs converged f64: measured once the view rests".to_string(),
-                (None, false) => "error vs converged f64: not measured for this graph".to_string(),
-            };
+            let accuracy_line = self.frames.accuracy_line(self.accuracy.last.as_ref(), self.accuracy.busy());
             let output = ctx.run_ui(raw, |ui| {
-                actions =
-                    panel::show(ui, session, &self.timings, &adapter, probe.as_deref(), &self.lod, &accuracy_line);
+                actions = panel::show(
+                    ui,
+                    session,
+                    &self.timings,
+                    &adapter,
+                    probe.as_deref(),
+                    self.frames.lod(),
+                    &accuracy_line,
+                );
             });
             let egui::FullOutput { platform_output, mut textures_delta, shapes, pixels_per_point, .. } = output;
             gfx.egui.handle_platform_output(&gfx.window, platform_output);
@@ -517,8 +500,7 @@ impl ApplicationHandler for Viewer {
             WindowEvent::CursorMoved { position, .. } => {
                 self.cursor = Some((position.x, position.y));
                 if self.orbit.is_dragging() {
-                    self.lod.moved();
-                    self.unmeasured_since = Some(std::time::Instant::now());
+                    self.frames.moved();
                 }
                 let height = self.gfx.as_ref().map_or(1.0, |g| g.config.height as f64);
                 self.orbit.moved(position.x, position.y, height);
@@ -529,8 +511,7 @@ impl ApplicationHandler for Viewer {
                     MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
                 };
                 self.orbit.wheel(lines);
-                self.lod.moved();
-                self.unmeasured_since = Some(std::time::Instant::now());
+                self.frames.moved();
             }
             _ => {}
         }

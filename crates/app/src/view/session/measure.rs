@@ -1,0 +1,54 @@
+//! What the panel reads off the running view: the data value under the cursor, and the live
+//! accuracy's comparison job (the last frame's image with everything the converged reference
+//! needs).
+
+use volgraph_accel::camera::OrbitCamera;
+
+use super::LiveSession;
+
+impl LiveSession {
+    /// What lies under window pixel `cursor` (physical pixels) seen by `camera`: the first
+    /// visible point along its ray (the TF, the crop and clip planes as drawn) and the data value
+    /// there, as a line for the panel in the data's units; `None` off the volume.
+    pub fn probe_line(&self, camera: &OrbitCamera, cursor: (f64, f64)) -> Option<String> {
+        let (w, h) = self.options().viewport;
+        if !(cursor.0 >= 0.0 && cursor.1 >= 0.0) {
+            return None;
+        }
+        let pixel = (cursor.0 as u32, cursor.1 as u32);
+        let cuts = self.runtime.cuts();
+        let p = volgraph_accel::probe::first_visible(&self.volume, &self.lut, camera, (w, h), pixel, 0.5, &cuts)?;
+        let units = self.volume.meta.units.as_deref().map_or(String::new(), |u| format!(" {u}"));
+        Some(format!(
+            "under the cursor: {:.4}{units} at voxel ({:.1}, {:.1}, {:.1}), α {:.2}",
+            p.value, p.voxel.x, p.voxel.y, p.voxel.z, p.alpha
+        ))
+    }
+
+    /// A comparison of the view on screen (the last frame's `image`) with the converged
+    /// reference, for a worker thread; `None` for a graph without a float `image` output or a
+    /// raycaster (`march`) to take the settings from.
+    pub fn accuracy_job(&mut self, camera: &OrbitCamera) -> Option<crate::view::accuracy::Job> {
+        let plan = self.plan()?;
+        let march = plan.steps.iter().find(|s| s.pass_id == "march" && s.params.declares("step_voxels"))?;
+        let mut settings = volgraph_passes::raycast_params::reference_settings(&march.params);
+        settings.opacity_unit_voxels = match self.opacity_reference {
+            volgraph_core::runtime::OpacityReference::World => 1.0 / self.volume.unit_step_world(),
+            volgraph_core::runtime::OpacityReference::Voxel => 1.0,
+        };
+        let size = plan.viewport;
+        let image = self.runtime.read_output("image").ok()?;
+        if (image.width, image.height) != size || image.channels != 4 {
+            return None;
+        }
+        Some(crate::view::accuracy::Job {
+            image: image.to_rgba_f64(),
+            size,
+            volume: self.volume.clone(),
+            lut: self.lut.clone(),
+            camera: *camera,
+            settings,
+            cuts: self.runtime.cuts(),
+        })
+    }
+}

@@ -1,0 +1,126 @@
+//! Opening a live session: the volume, the transfer function and the graph of a scene or the
+//! command line, compiled (a failure here is the command's error, with located diagnostics) and
+//! applied on a new runtime.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::anyhow;
+use volgraph_core::runtime::{Gpu, Runtime, ShaderLibrary};
+use volgraph_core::{CompileOptions, Registry, cut_effects};
+
+use super::tf::scanner_preset_named;
+use super::{Event, LiveSession, SessionArgs, summary};
+use crate::inputs;
+use crate::view::workbench::{GraphEdits, TfEdits, Workbench};
+
+impl LiveSession {
+    /// Loads the scene and the graph on `gpu`; fails (with located diagnostics) when the graph
+    /// does not compile at start.
+    pub fn open(gpu: Arc<Gpu>, args: &SessionArgs) -> Result<(Self, Event), crate::cli::CliError> {
+        Self::open_with(gpu, args, crate::program::registry())
+    }
+
+    /// [`Self::open`] with another registry (built-ins plus a plugin crate's kinds).
+    pub fn open_with(
+        gpu: Arc<Gpu>,
+        args: &SessionArgs,
+        registry: Registry,
+    ) -> Result<(Self, Event), crate::cli::CliError> {
+        let start = Instant::now();
+        let source = inputs::read_graph(&args.graph)?;
+        let shown = crate::scene::load_shown_volume(&args.volume, args.scene.as_ref(), &args.raw)?;
+        let (volume, generated, notes) = (shown.volume, shown.marschner_lobb_tf, shown.notes);
+        for note in notes {
+            crate::stdout::eprintln_escaped!("note: {note}");
+        }
+        let (tf, tf_path, tf_notes) = match (&args.tf, &args.scene) {
+            (None, Some(scene)) => {
+                crate::scene::load_transfer_function(scene, args.tf_map.as_deref(), &volume, generated)?
+            }
+            (tf, _) => {
+                let (t, notes) = inputs::transfer_function(tf.as_ref(), args.tf_map.as_deref(), &volume, generated)?;
+                // A preset's or a built-in TF's name is no file: nothing to watch, and "save TF"
+                // writes elsewhere.
+                let file =
+                    |p: &PathBuf| scanner_preset_named(p).is_none() && crate::builtin_graphs::find_tf(p).is_none();
+                (t, tf.clone().filter(file), notes)
+            }
+        };
+        let tf_source = match (&args.tf, &args.scene) {
+            (None, Some(scene)) => scene.transfer_function.clone(),
+            (None, None) => None,
+            (Some(p), _) => Some(match scanner_preset_named(p) {
+                Some(name) => crate::scene::TfSource::Preset(name.to_string()),
+                None => crate::scene::TfSource::File(p.display().to_string()),
+            }),
+        };
+        for note in tf_notes {
+            crate::stdout::eprintln_escaped!("note: {note}");
+        }
+        let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
+        let tf = TfEdits::new(tf, tf_path, args.tf_map.clone(), tf_source, &volume, generated);
+        let (sources, _) = crate::shader_dir::sources_for(&args.graph, args.shaders.as_deref());
+        // Every folder read (and so watched), in search order: the start line and the panel name
+        // all of them, not just the first.
+        let shader_dirs: Vec<PathBuf> = sources.disk_roots().into_iter().map(Path::to_path_buf).collect();
+        let mut runtime = Runtime::new(gpu, ShaderLibrary::new(sources));
+        runtime.set_gpu_memory_budget(args.gpu_memory_mb.map(|mb| mb << 20));
+        let mut options = CompileOptions::new(args.viewport.0, args.viewport.1)
+            .with_features(args.features.iter().filter(|f| !f.is_empty()).cloned());
+        options.features.extend(cut_effects::features_of(&args.cuts));
+        runtime.set_cuts(args.cuts);
+        if let Some(scene) = &args.scene {
+            options.features.extend(scene.effects.iter().cloned());
+            options.precision = scene.precision;
+            runtime.set_opacity_reference(scene.opacity_reference);
+        }
+        let mut graph = GraphEdits::new(&args.graph, source, options.clone(), registry, &volume);
+        let plan = graph.compile(graph.source(), &options).map_err(crate::cli::CliError::Graph)?;
+        // A scene's effect the graph does not offer is left out with a note; a --features typo is
+        // an error.
+        if let Some(scene) = &args.scene {
+            for effect in &scene.effects {
+                if !plan.known_features.contains(effect) && !args.features.contains(effect) {
+                    crate::stdout::eprintln_escaped!(
+                        "note: graph \"{}\" does not offer the scene's effect \"{effect}\"; it is left out",
+                        plan.name
+                    );
+                    options.features.remove(effect);
+                }
+            }
+        }
+        crate::cli::check_user_names(&plan, &options)?;
+        if let Some(note) = crate::render::budget_note(&plan, graph.registry(), args.gpu_memory_mb) {
+            crate::stdout::eprintln_escaped!("{note}");
+        }
+        let shaders = match shader_dirs.as_slice() {
+            [] => "built-in shaders".to_string(),
+            dirs => format!(
+                "shaders from {} (watched), then the built-in ones",
+                dirs.iter().map(|d| d.display().to_string()).collect::<Vec<_>>().join(", ")
+            ),
+        };
+        let loaded = format!("{}, {shaders}", summary(&plan));
+        runtime.bind_scene(&plan.inputs, &volume, &lut).map_err(|e| crate::cli::CliError::Other(anyhow!(e)))?;
+        runtime.apply(plan, graph.registry()).map_err(|e| crate::cli::CliError::Other(anyhow!(e)))?;
+        graph.set_options(options);
+        let graph_name = graph.name().to_string();
+        let session = Self {
+            runtime,
+            bench: Workbench { graph, tf },
+            volume,
+            lut,
+            shader_dirs,
+            error: None,
+            validated: None,
+            unproven: true,
+            volume_source: shown.source,
+            volume_options: shown.options,
+            opacity_reference: args.scene.as_ref().map(|s| s.opacity_reference).unwrap_or_default(),
+        };
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        Ok((session, Event::Loaded { graph: graph_name, ms, summary: loaded }))
+    }
+}

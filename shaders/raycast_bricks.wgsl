@@ -25,8 +25,10 @@
 struct BrickParams {
     // Bricks per axis (xyz); w = cells per brick side.
     grid: vec4<u32>,
-    // Voxels per slot and axis (xyz): brick_cells + 3 (voxel lo - 1 first), fewer on an axis
-    // thinner than a brick.
+    // Voxels per slot and axis (xyz): brick_cells + 1 + 2·apron (voxel lo - apron first), fewer
+    // on an axis thinner than a brick; w = the apron: voxels kept on every side of the brick's
+    // own, so that every filter tap near a face reads what the whole volume holds (1: trilinear
+    // samples and central-difference gradients; 3 with tricubic reconstruction).
     slot_side: vec4<u32>,
     // x = cells per leaf side, y = leaves per brick side.
     leaves: vec4<u32>,
@@ -39,9 +41,9 @@ struct BrickParams {
 @group(0) @binding(auto) var<uniform> bricks: BrickParams;
 // This batch: word 0 = 1 for the first batch of the frame (start from a clear ray); word 1 + b
 // = 0 when brick b is not drawn in this batch, else bit 31 and its slot's coordinates in the
-// atlas, 10 bits per axis, x lowest (`slot_word` in raycast_bricks.rs).
+// atlas, 10 bits per axis, x lowest (`slot_word` in crates/accel/src/brick_leaves.rs).
 @group(0) @binding(auto) var<storage, read> table: array<u32>;
-// Per leaf of the volume (x fastest; `leaf_word` in raycast_bricks.rs): where no box to draw
+// Per leaf of the volume (x fastest; `leaf_word` in crates/accel/src/brick_leaves.rs): where no box to draw
 // covers it, the Chebyshev distance d (1..=255) in leaves to the nearest such leaf (every leaf
 // closer is empty too); where one does, `reach << 8`: the cube of leaves reach - 1 around it is
 // drawn too, inside its brick.
@@ -136,6 +138,7 @@ fn march_bricks(s: Samples, start: vec4<f32>) -> vec4<f32> {
     // Read once per ray, not per leaf (common/raymarch.wgsl's `march_dvr` says why).
     let threshold = params.threshold;
     let slot_side = bricks.slot_side.xyz;
+    let apron = f32(bricks.slot_side.w);
     let leaping = leaping_for(s);
     var k = 0u;
     loop {
@@ -159,12 +162,16 @@ fn march_bricks(s: Samples, start: vec4<f32>) -> vec4<f32> {
         // that brick leaps over its closed box, as the next brick's batch leaps over this one's.
         let run_end = k + CHECK_EVERY;
         let exit = min(max(cube_exit, select(run_end, brick_exit, run_end + 1u >= brick_exit)), s.count);
-        // Its samples in the atlas: voxel v of the brick lies at texel origin + 1.5 + (v - lo).
+        // Its samples in the atlas: voxel v of the brick lies at texel origin + apron + 0.5 +
+        // (v - lo).
         let word = table[1u + brick_index(b)];
         let slot = vec3<u32>(word, word >> 10u, word >> 20u) & vec3<u32>(0x3ffu);
         let origin = vec3<f32>(slot * slot_side);
-        let shift = origin + vec3<f32>(1.5) - lo - vec3<f32>(0.5);
+        let shift = origin + vec3<f32>(apron + 0.5) - lo - vec3<f32>(0.5);
         let atlas = Samples((s.first * n + shift) * inv_atlas, delta_atlas, s.count, s.step, s.offset, s.cut);
+        // The way back to the volume's texture space, for what is defined there (cut faces).
+        sampled_scale = bricks.atlas.xyz / n;
+        sampled_offset = -shift / n;
         resume_ray(sample_at(atlas, k) - atlas.delta);
         let m = march_dvr(atlas, k, exit, out);
         out = m.color;

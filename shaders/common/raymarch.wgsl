@@ -260,12 +260,25 @@ fn march_dvr(s: Samples, k0: u32, end: u32, start: vec4<f32>) -> Marched {
 }
 
 
+// Where the point `u` of the texture sampled lies in the volume's texture space: `u` itself,
+// but where a march samples a brick atlas, whose run of samples in one slot maps back by
+// `u · sampled_scale + sampled_offset` (raycast_bricks.wgsl sets both per run). The cut faces a
+// shading normal turns toward are in the volume's space.
+var<private> sampled_scale: vec3<f32> = vec3<f32>(1.0);
+var<private> sampled_offset: vec3<f32> = vec3<f32>(0.0);
+
+fn volume_position(u: vec3<f32>) -> vec3<f32> {
+    return u * sampled_scale + sampled_offset;
+}
+
 // Blinn–Phong headlight at texture-space point `u` seen along the unit world direction `d_world`
 // (docs/rendering_model.md "First-hit isosurface", "Effects"): (ambient + diffuse·|n·l|, the
 // white specular term), n from the central-difference gradient of the reconstructed field, the
 // light facing the eye where the gradient vanishes (constant regions: no NaN).
 fn headlight(u: vec3<f32>, d_world: vec3<f32>) -> vec2<f32> {
-    let off = 1.0 / frame.volume_dims.xyz;
+    // One voxel of the texture sampled: the volume, or a brick atlas (raycast_bricks.wgsl),
+    // whose slots hold the brick's neighbours on every side.
+    let off = 1.0 / vec3<f32>(textureDimensions(volume));
     let g = vec3<f32>(
         sample_volume(u + vec3<f32>(off.x, 0.0, 0.0)) - sample_volume(u - vec3<f32>(off.x, 0.0, 0.0)),
         sample_volume(u + vec3<f32>(0.0, off.y, 0.0)) - sample_volume(u - vec3<f32>(0.0, off.y, 0.0)),
@@ -280,7 +293,7 @@ fn headlight(u: vec3<f32>, d_world: vec3<f32>) -> vec2<f32> {
     }
     // A cut face shows the plane it was cut along (common/ray_box.wgsl).
 #if CUTS
-    n = cap_normal(u, d_world, n);
+    n = cap_normal(volume_position(u), d_world, n);
 #endif
     // Headlight: l = v = -d, so h = normalize(l + v) = l.
     let n_dot_l = abs(dot(n, l));

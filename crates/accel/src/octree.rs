@@ -114,6 +114,19 @@ impl OctreeHierarchy {
     /// Builds every brick's leaf ranges and node cell counts, in parallel over bricks. Leaves
     /// are `min_node_cells³` cells (the paper's octree limit, e.g. 8).
     pub fn build(volume: &Volume, layout: &BrickLayout, min_node_cells: u32) -> Result<Self, GridError> {
+        Self::build_with_apron(volume, layout, min_node_cells, 0)
+    }
+
+    /// [`Self::build`] with each leaf's value range taken over its cells' corner voxels and
+    /// `apron` more voxels on every side (clamped to the volume): what a reconstruction wider
+    /// than trilinear reads for a sample in the leaf (the tricubic B-spline: 1), so a leaf is
+    /// empty only where nothing it shows can be visible.
+    pub fn build_with_apron(
+        volume: &Volume,
+        layout: &BrickLayout,
+        min_node_cells: u32,
+        apron: u32,
+    ) -> Result<Self, GridError> {
         if min_node_cells == 0 {
             return Err(GridError::ZeroSize { what: "min_node_cells" });
         }
@@ -129,7 +142,7 @@ impl OctreeHierarchy {
             .into_par_iter()
             .map(|i| {
                 let (lo, hi) = layout.brick_cells_box(layout.brick_coord(i));
-                build_tree(volume, lo, hi, min_node_cells)
+                build_tree(volume, lo, hi, min_node_cells, apron)
             })
             .collect();
         Ok(Self { layout: *layout, min_node_cells, trees })
@@ -276,7 +289,7 @@ fn sum_into_parents(children: &[u32], cd: UVec3, parents: &mut [u32], pd: UVec3)
     }
 }
 
-fn build_tree(volume: &Volume, cells_lo: UVec3, cells_hi: UVec3, min_node_cells: u32) -> BrickTree {
+fn build_tree(volume: &Volume, cells_lo: UVec3, cells_hi: UVec3, min_node_cells: u32, apron: u32) -> BrickTree {
     let extent = cells_hi - cells_lo;
     let leaf_dims = (extent - 1) / min_node_cells + 1;
     let mut levels = Vec::new();
@@ -298,6 +311,7 @@ fn build_tree(volume: &Volume, cells_lo: UVec3, cells_hi: UVec3, min_node_cells:
                 let lo = cells_lo + UVec3::new(x, y, z) * min_node_cells;
                 let hi = lo.saturating_add(UVec3::splat(min_node_cells)).min(cells_hi);
                 let (vlo, vhi) = cells_corner_voxels(volume.dims, lo, hi);
+                let (vlo, vhi) = (vlo.saturating_sub(UVec3::splat(apron)), (vhi + apron).min(volume.dims - 1));
                 node_cells[leaf_ranges.len()] = (hi - lo).element_product();
                 leaf_ranges.push(voxel_box_range(volume, vlo, vhi));
             }

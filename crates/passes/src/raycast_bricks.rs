@@ -3,9 +3,10 @@
 //!
 //! - §5 **bricks**: the volume is cut into bricks of `brick_cells`³ cells that keep the voxels
 //!   of their cells' corners (the one-voxel overlap trilinear samples inside a brick need) and
-//!   one more voxel on every side, so that a filter tap at a brick face blends exactly the
+//!   an apron of more voxels on every side — one, three with tricubic reconstruction — so that
+//!   every filter tap near a brick face (trilinear, gradients, the B-spline) blends exactly the
 //!   voxels the whole volume would and images have no seams. Non-empty bricks (for the current
-//!   TF) live in a 3D atlas texture, `brick_cells + 3` voxels per side per slot; empty bricks
+//!   TF) live in a 3D atlas texture, `brick_cells + 1 + 2·apron` voxels per side per slot; empty bricks
 //!   are never uploaded. The pool is bounded by a memory budget (`pool_mb`, else the runtime's
 //!   `--gpu-memory-mb`, else 2 GiB bounded by the 3D texture limit); a frame streams the bricks it needs
 //!   front to back and evicts the least recently used ([`crate::brick_pool`]). A volume larger
@@ -25,7 +26,8 @@
 //!   batches either).
 //!
 //! Samples are those of every raycaster (`common/ray_box.wgsl`: k + 0.5 steps from the analytic box entry, same
-//! compositing), so the image equals the single-texture raycast up to rounding
+//! compositing) and so are the scene effects (shading, pre-integration, tricubic, jitter: the
+//! shared march's; a leaf's value range takes in a voxel more with tricubic or pre-integration), so the image equals the single-texture raycast up to rounding
 //! (crates/passes/tests/ruijters_2006.rs). A TF change re-classifies bricks and octrees
 //! (CPU, [`volgraph_accel::octree`]) and uploads only bricks not yet resident.
 //! The CPU side (slot words, leaf words, rank slabs) is [`volgraph_accel::brick_leaves`]; the
@@ -48,6 +50,7 @@ use volgraph_core::runtime::{
 use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 
 use crate::brick_pool::{Batch, BrickPool};
+use crate::effects::{EffectFlags, EffectState, effect_defines, effect_shader_uses, same_effects};
 use crate::raycast_params::{RaycastParamsGpu, SampleLoopChoice, Sampling, Termination, Workgroup};
 
 mod atlas;
@@ -105,12 +108,19 @@ impl PassDecl for RaycastBricks {
     }
 
     fn params(&self) -> Vec<ParamSpec> {
-        [Sampling::specs(), Termination::specs(), BrickSettings::specs(), Workgroup::specs(), SampleLoopChoice::specs()]
-            .concat()
+        [
+            Sampling::specs(),
+            Termination::specs(),
+            EffectFlags::specs(),
+            BrickSettings::specs(),
+            Workgroup::specs(),
+            SampleLoopChoice::specs(),
+        ]
+        .concat()
     }
 
     fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        [crate::effects::jitter_defines(params), SampleLoopChoice::defines(params, None)].concat()
+        [effect_defines(params), SampleLoopChoice::defines(params, None)].concat()
     }
 
     fn uses_gpu_memory_budget(&self) -> bool {
@@ -125,8 +135,8 @@ impl PassDecl for RaycastBricks {
         ]
     }
 
-    fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![march_shader()]
+    fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
+        [vec![march_shader()], effect_shader_uses(params)].concat()
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
@@ -136,13 +146,14 @@ impl PassDecl for RaycastBricks {
             && Workgroup::from_params(old) == Workgroup::from_params(new)
             && SampleLoopChoice::from_params(old) == SampleLoopChoice::from_params(new)
             && self.shader_defines(old) == self.shader_defines(new)
+            && same_effects(old, new)
     }
 }
 
 /// The brick march's entry point and what it binds, declared once for `shaders()` and `create`.
 fn march_shader() -> ShaderUse {
     ShaderUse::new("raycast_bricks.wgsl", "cs_main")
-        .binds(&["table", "leaf_words", "acc", "volume"])
+        .binds(&["table", "leaf_words", "acc", "volume", "preintegrated"])
         .uniform(RaycastParamsGpu::bound("params"))
         .uniform(brick_layout())
 }
@@ -201,7 +212,11 @@ impl PassPlugin for RaycastBricks {
                 message: format!("rank {rank} is not below ranks {ranks}; ranks are numbered 0..ranks"),
             });
         }
+        let effects = EffectState::new(ctx)?;
         Ok(Box::new(RaycastBricksNode {
+            effects,
+            step_voxels: Sampling::from_params(ctx.params).step_voxels,
+            effects_on: EffectFlags::of(ctx.params),
             ranks: (rank, ranks),
             pipeline,
             params,
@@ -242,9 +257,11 @@ struct VolumeState {
     layout: BrickLayout,
     octree: OctreeHierarchy,
     format: VolumeFormat,
-    /// Voxels per slot and axis: `brick_cells + 3`, or fewer on an axis thinner than a brick
-    /// (a 1-voxel-thick slab stores 4 layers per brick, not 35).
+    /// Voxels per slot and axis: `brick_cells + 1 + 2·apron`, or fewer on an axis thinner than
+    /// a brick (a 1-voxel-thick slab stores 4 layers per brick, not 35, with apron 1).
     side: UVec3,
+    /// Voxels kept on every side of a brick's own ([`apron`]).
+    apron: u32,
     /// Slots per atlas row and column (fixed), and the most layers the device allows.
     slots_xy: (u32, u32),
     max_layers: u32,
@@ -264,7 +281,28 @@ struct VolumeState {
     budget: u64,
 }
 
+/// Voxels a slot keeps on every side of its brick's own: what the filter taps near a brick face
+/// read beyond it. Trilinear samples and the central differences of shading reach one voxel;
+/// the tricubic B-spline two more (its 4³ support), three with shading on top.
+fn apron(effects: EffectFlags) -> u32 {
+    if effects.tricubic { 3 } else { 1 }
+}
+
+/// Voxels beyond a leaf's cells its value range takes in (`OctreeHierarchy::build_with_apron`):
+/// the tricubic B-spline blends a cell's corners and one more voxel on every side, and a
+/// pre-integrated segment runs between two samples less than a voxel apart, whose values both
+/// lie in the range of either leaf grown by one voxel — so a leaf is empty only where no
+/// reconstruction or segment through it can be visible.
+fn range_apron(effects: EffectFlags) -> u32 {
+    u32::from(effects.tricubic || effects.preintegration)
+}
+
 struct RaycastBricksNode {
+    /// The pre-integration table when that effect is on.
+    effects: EffectState,
+    step_voxels: f64,
+    /// The effects compiled in ([`apron`], [`range_apron`]).
+    effects_on: EffectFlags,
     pipeline: ComputePassPipeline,
     params: wgpu::Buffer,
     uniform: wgpu::Buffer,
@@ -294,16 +332,18 @@ impl VolumeState {
         version: u64,
         brick_cells: u32,
         node_cells: u32,
+        apron: u32,
+        range_apron: u32,
     ) -> Result<Self, PassError> {
         let layout = BrickLayout::new(voxels.dims, brick_cells, 1).map_err(|e| pass_error(ctx, e.to_string()))?;
-        let octree =
-            OctreeHierarchy::build(&voxels, &layout, node_cells).map_err(|e| pass_error(ctx, e.to_string()))?;
-        // The brick's voxels and one more on every side (clamped to the volume like the
+        let octree = OctreeHierarchy::build_with_apron(&voxels, &layout, node_cells, range_apron)
+            .map_err(|e| pass_error(ctx, e.to_string()))?;
+        // The brick's voxels and `apron` more on every side (clamped to the volume like the
         // sampler): a filter tap at a brick face blends exactly what it would in the whole
         // volume, even where the hardware's fixed-point weights give the next texel 1/256.
         // An axis with fewer cells than a brick holds one brick of that many cells.
         let cells = volgraph_accel::bricks::cell_dims(voxels.dims);
-        let side = cells.min(UVec3::splat(brick_cells)) + 3;
+        let side = cells.min(UVec3::splat(brick_cells)) + 1 + 2 * apron;
         let max_dim = ctx.gpu.limits.max_texture_dimension_3d;
         if side.max_element() > max_dim {
             return Err(pass_error(
@@ -328,6 +368,7 @@ impl VolumeState {
             layout,
             octree,
             side,
+            apron,
             slots_xy: row,
             max_layers: per_axis.z,
             tf_version: None,
@@ -425,8 +466,11 @@ impl PassNode for RaycastBricksNode {
         let voxels = ctx.voxels("volume")?.clone();
         let version = ctx.input_version("volume").unwrap_or(0);
         if self.volume.as_ref().is_none_or(|v| v.version != version) {
-            self.volume = Some(VolumeState::new(ctx, voxels, version, self.brick_cells, self.node_cells)?);
+            let (apron, range_apron) = (apron(self.effects_on), range_apron(self.effects_on));
+            self.volume =
+                Some(VolumeState::new(ctx, voxels, version, self.brick_cells, self.node_cells, apron, range_apron)?);
         }
+        self.effects.update(ctx, &self.params, self.step_voxels)?;
         let tf_version = ctx.input_version("tf");
         let lut = ctx.table("tf")?.clone();
         let budget = self.budget(ctx);
@@ -456,7 +500,7 @@ impl PassNode for RaycastBricksNode {
         let grid = state.layout.grid_dims();
         let uniform = BrickParamsGpu {
             grid: [grid.x, grid.y, grid.z, self.brick_cells],
-            slot_side: [state.side.x, state.side.y, state.side.z, 0],
+            slot_side: [state.side.x, state.side.y, state.side.z, state.apron],
             leaves: [state.octree.min_node_cells(), self.brick_cells / state.octree.min_node_cells(), 0, 0],
             leaf_grid: [state.leaf_grid.x, state.leaf_grid.y, state.leaf_grid.z, 0],
             atlas: [atlas_size.x, atlas_size.y, atlas_size.z, 0.0],
@@ -490,7 +534,7 @@ impl PassNode for RaycastBricksNode {
                 offset: i as u64 * stride,
                 size: std::num::NonZeroU64::new(stride),
             };
-            let extra = [
+            let mut extra = vec![
                 ("params", self.params.as_entire_binding()),
                 ("bricks", self.uniform.as_entire_binding()),
                 ("table", wgpu::BindingResource::Buffer(table)),
@@ -498,6 +542,7 @@ impl PassNode for RaycastBricksNode {
                 ("acc", acc.as_entire_binding()),
                 ("volume", wgpu::BindingResource::TextureView(&atlas.view)),
             ];
+            extra.extend(self.effects.bindings());
             ctx.dispatch_over(&self.pipeline, &extra, "color", self.workgroup)?;
         }
         counters.batches = batches.len() as u64;
@@ -513,6 +558,8 @@ impl PassNode for RaycastBricksNode {
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
         gpu.queue.write_buffer(&self.params, 0, &RaycastParamsGpu::of(params).uniform_bytes());
+        self.step_voxels = Sampling::from_params(params).step_voxels;
+        self.effects.invalidate();
     }
 
     fn counters(&self) -> Vec<(&'static str, f64)> {

@@ -85,7 +85,7 @@ const EFFECT_MARKERS: [(&str, &str); 4] = [
 ];
 
 /// The DVR graphs that take every effect, one per raycaster family.
-const DVR_GRAPHS: [&str; 8] = support::EFFECT_GRAPHS;
+const DVR_GRAPHS: [&str; 9] = support::EFFECT_GRAPHS;
 
 #[test]
 fn every_scene_effect_is_compiled_only_when_the_scene_turns_it_on() {

@@ -121,7 +121,7 @@ impl VolumeState {
         let mut staging = vec![0u8; (row * side.y as u64 * side.z as u64) as usize];
         for (i, (brick, _)) in chunk.iter().enumerate() {
             let (lo, _) = self.layout.brick_cells_box(self.layout.brick_coord(*brick as usize));
-            let origin = lo.as_ivec3() - glam::IVec3::ONE;
+            let origin = lo.as_ivec3() - glam::IVec3::splat(self.apron as i32);
             let tight = volume_region_bytes(&self.voxels, origin, side, self.format);
             for (r, src) in tight.chunks_exact(brick_row as usize).enumerate() {
                 let at = (r as u64 * row + i as u64 * brick_row) as usize;

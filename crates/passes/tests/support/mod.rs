@@ -14,10 +14,11 @@ use volgraph_core::{CompileOptions, Plan, Registry};
 /// One DVR graph of each raycaster family that takes every scene effect: fragment, compute, the
 /// single pass with leaping, the fastest path, Krüger–Westermann's multipass segments with
 /// termination and skipping (rc_b) and with the leap inside the segments (rc_b_leap), and Klein
-/// et al.'s leaping march alone and with empty cubes (its first frame: every ray from the box).
+/// et al.'s leaping march alone and with empty cubes (its first frame: every ray from the box),
+/// and Ruijters & Vilanova's brick pool with per-brick octrees.
 /// `effects.rs` renders each against the reference, `effects_not_compiled.rs` checks each
 /// compiles an effect only when asked.
-pub const EFFECT_GRAPHS: [&str; 8] = [
+pub const EFFECT_GRAPHS: [&str; 9] = [
     "basic/fragment_raycast.ron",
     "basic/compute_raycast.ron",
     "modern/single_pass_ess_ert.ron",
@@ -26,6 +27,7 @@ pub const EFFECT_GRAPHS: [&str; 8] = [
     "kruger_westermann_2003/rc_b_leap.ron",
     "klein_2005/leap_dvr.ron",
     "klein_2005/leap_dvr_cubes.ron",
+    "ruijters_vilanova_2006/bricks_octree.ron",
 ];
 
 /// The headless GPU. Under CI a missing adapter is a failure, never a skip.

@@ -7,10 +7,12 @@
 //! viewer under Xvfb (skipped with a note where Xvfb is missing, a failure under CI).
 
 mod support;
+#[path = "support/xvfb.rs"]
+mod xvfb;
 
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::sync::Arc;
 use std::sync::mpsc::{Receiver, channel};
 use std::time::{Duration, Instant};
@@ -20,6 +22,7 @@ use volgraph_accel::load::LoadOptions;
 use volgraph_accel::transfer_function::ControlPoint;
 use volgraph_accel::volume::{Volume, VoxelData};
 use volgraph_app::view::session::{LiveSession, SessionArgs};
+use xvfb::Xvfb;
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -303,64 +306,9 @@ fn a_tf_edited_after_save_tf_is_saved_with_the_view() {
 
 // --- The window, under Xvfb ---
 
-/// An Xvfb server on a free display, killed on drop.
-struct Xvfb {
-    child: Child,
-    display: String,
-}
-
-impl Drop for Xvfb {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
+/// Displays apart from viewer_window.rs's (60..120), so the two test binaries can run at once.
 fn start_xvfb() -> Option<Xvfb> {
-    let found = Command::new("Xvfb").arg("-help").stdout(Stdio::null()).stderr(Stdio::null()).status().is_ok();
-    if !found {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "Xvfb is missing under CI; .ci/run installs it (apt-get install xvfb)"
-        );
-        eprintln!("note: skipping a window test: Xvfb is not installed (apt-get install xvfb)");
-        return None;
-    }
-    // Displays apart from viewer_window.rs's (60..), so the two test binaries can run at once.
-    for n in 130..190u32 {
-        let socket = PathBuf::from(format!("/tmp/.X11-unix/X{n}"));
-        if socket.exists() || Path::new(&format!("/tmp/.X{n}-lock")).exists() {
-            continue;
-        }
-        let Ok(child) = Command::new("Xvfb")
-            .args([
-                format!(":{n}"),
-                "-screen".into(),
-                "0".into(),
-                "320x240x24".into(),
-                "-nolisten".into(),
-                "tcp".into(),
-            ])
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-        else {
-            continue;
-        };
-        let mut server = Xvfb { child, display: format!(":{n}") };
-        let start = Instant::now();
-        while start.elapsed() < Duration::from_secs(10) {
-            if socket.exists() {
-                return Some(server);
-            }
-            if server.child.try_wait().ok().flatten().is_some() {
-                break;
-            }
-            std::thread::sleep(Duration::from_millis(50));
-        }
-        let _ = server.child.kill();
-    }
-    panic!("no free X display for Xvfb");
+    xvfb::start_xvfb(130..190, "320x240x24")
 }
 
 /// What a viewer run printed, and how it ended (`None`: killed after the time limit).

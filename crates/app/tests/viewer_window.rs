@@ -8,66 +8,19 @@
 
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::sync::mpsc::{Receiver, channel};
 use std::time::{Duration, Instant};
+
+#[path = "support/xvfb.rs"]
+mod xvfb;
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-/// An Xvfb server on a free display, killed on drop.
-struct Xvfb {
-    child: Child,
-    display: String,
-}
-
-impl Drop for Xvfb {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-fn start_xvfb() -> Option<Xvfb> {
-    let found = Command::new("Xvfb").arg("-help").stdout(Stdio::null()).stderr(Stdio::null()).status().is_ok();
-    if !found {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "Xvfb is missing under CI; .ci/run installs it (apt-get install xvfb)"
-        );
-        eprintln!("note: skipping the window test: Xvfb is not installed (apt-get install xvfb)");
-        return None;
-    }
-    for n in 60..120u32 {
-        let socket = PathBuf::from(format!("/tmp/.X11-unix/X{n}"));
-        if socket.exists() || Path::new(&format!("/tmp/.X{n}-lock")).exists() {
-            continue;
-        }
-        let child = Command::new("Xvfb")
-            .args([
-                format!(":{n}"),
-                "-screen".into(),
-                "0".into(),
-                "640x480x24".into(),
-                "-nolisten".into(),
-                "tcp".into(),
-            ])
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .ok()?;
-        let start = Instant::now();
-        while start.elapsed() < Duration::from_secs(10) {
-            if socket.exists() {
-                return Some(Xvfb { child, display: format!(":{n}") });
-            }
-            std::thread::sleep(Duration::from_millis(50));
-        }
-        let mut failed = Xvfb { child, display: String::new() };
-        let _ = failed.child.kill();
-    }
-    panic!("no free X display for Xvfb");
+fn start_xvfb() -> Option<xvfb::Xvfb> {
+    xvfb::start_xvfb(60..120, "640x480x24")
 }
 
 fn copy_dir(from: &Path, to: &Path) {

@@ -49,9 +49,10 @@ pub use saved_view::SavedView;
 /// `render --frames` is capped): a keyframe at frame 10⁹ is an error, not a day of rendering.
 pub const MAX_FRAMES: u32 = 100_000;
 
-/// The effects a scene may ask for (issue "effects a scene asks for"); graphs read them as
+/// The effects a scene may ask for: those the built-in raycasters declare
+/// (`volgraph_passes::effects::SCENE_EFFECTS`, `PassDecl::scene_effects`); graphs read them as
 /// `"feature.NAME"`.
-pub const EFFECTS: [&str; 4] = volgraph_core::compile::SCENE_EFFECTS;
+pub const EFFECTS: [&str; 4] = volgraph_passes::effects::SCENE_EFFECTS;
 
 /// Where a scene's volume comes from.
 #[derive(Clone, Debug, Deserialize, PartialEq)]

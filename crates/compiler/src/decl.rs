@@ -184,6 +184,14 @@ pub trait PassDecl: Send + Sync {
         Vec::new()
     }
 
+    /// The scene effects this kind can compile in (`scenes/*.ron`'s `effects:`, `--features`),
+    /// each a boolean parameter a graph wires to `"feature.NAME"`: what a scene may ask for is
+    /// what the registered kinds declare here ([`KindLookup::scene_effects`]), not a list in
+    /// the compiler.
+    fn scene_effects(&self) -> &'static [&'static str] {
+        &[]
+    }
+
     /// Shader modules and entry points this pass uses with its parameters, so the compiler can
     /// check the shaders' bindings against the ports (see [`crate::reflect`]).
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
@@ -373,6 +381,19 @@ pub trait KindLookup {
 
     /// All kind names, sorted.
     fn kind_names(&self) -> Vec<&'static str>;
+
+    /// The scene effects some kind declares ([`PassDecl::scene_effects`]), sorted.
+    fn scene_effects(&self) -> Vec<&'static str> {
+        let mut effects: Vec<&'static str> = self
+            .kind_names()
+            .into_iter()
+            .filter_map(|kind| self.decl(kind))
+            .flat_map(|decl| decl.scene_effects().iter().copied())
+            .collect();
+        effects.sort_unstable();
+        effects.dedup();
+        effects
+    }
 }
 
 /// Pass kinds by name, as declarations only: what a compiler-only tool registers.

@@ -109,6 +109,10 @@ impl PassDecl for Antialias {
         "antialias"
     }
 
+    fn scene_effects(&self) -> &'static [&'static str] {
+        &crate::effects::SCENE_EFFECTS
+    }
+
     fn summary(&self) -> &'static str {
         "selective super-sampling where a pixel differs from a 4-neighbour; 2x, 4x, rotated grid (Klein et al. 2005 §5)"
     }

@@ -14,6 +14,11 @@ use crate::defines;
 use crate::preintegration::PreintegrationTable;
 use crate::raycast_params::Sampling;
 
+/// The scene effects the built-in raycasters compile in, each a boolean parameter a graph wires
+/// to `"feature.NAME"`: every kind that marches with the shared core declares them
+/// (`PassDecl::scene_effects`), and a scene may ask for what some registered kind declares.
+pub const SCENE_EFFECTS: [&str; 4] = ["shading", "preintegration", "tricubic", "jitter"];
+
 volgraph_core::pass_params! {
     /// The effect switches, declared once (all off by default); each is an `#if` of the same
     /// name in capitals in the shaders ([`EffectFlags::defines`]).
@@ -120,6 +125,39 @@ impl EffectState {
     pub fn invalidate(&mut self) {
         if let Some(t) = &mut self.table {
             t.invalidate();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use volgraph_core::KindLookup;
+
+    use super::SCENE_EFFECTS;
+
+    /// What a scene may ask for is what the kinds declare: every kind that declares the scene
+    /// effects takes each as a parameter (a graph wires it to `"feature.NAME"`), the marching
+    /// families all declare them, and the registry's list is theirs.
+    #[test]
+    fn the_scene_effects_are_what_the_raycasters_declare() {
+        let registry = crate::builtin_registry();
+        let mut expected = SCENE_EFFECTS.to_vec();
+        expected.sort_unstable();
+        assert_eq!(registry.scene_effects(), expected);
+        let declaring: Vec<&str> = registry
+            .kind_names()
+            .into_iter()
+            .filter(|k| !registry.decl(k).expect("kind").scene_effects().is_empty())
+            .collect();
+        for family in ["raycast", "raycast_compute", "raycast_segment", "raycast_bricks", "antialias"] {
+            assert!(declaring.contains(&family), "{family} declares the scene effects: {declaring:?}");
+        }
+        for kind in declaring {
+            let decl = registry.decl(kind).expect("kind");
+            let params: Vec<&str> = decl.params().iter().map(|p| p.name).collect();
+            for effect in decl.scene_effects() {
+                assert!(params.contains(effect), "{kind} declares {effect} but has no such parameter: {params:?}");
+            }
         }
     }
 }

@@ -56,6 +56,10 @@ impl PassDecl for Raycast {
         "raycast"
     }
 
+    fn scene_effects(&self) -> &'static [&'static str] {
+        &crate::effects::SCENE_EFFECTS
+    }
+
     fn summary(&self) -> &'static str {
         "single-pass fragment raycaster, DVR or first-hit isosurface, optionally analytic rays, empty-space leaping, \
          Klein's start estimates and leap hits, sample counting (Krüger–Westermann 2003 §2.1–2.3; Klein et al. 2005 §4.2)"

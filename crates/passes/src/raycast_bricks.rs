@@ -102,6 +102,10 @@ impl PassDecl for RaycastBricks {
         "raycast_bricks"
     }
 
+    fn scene_effects(&self) -> &'static [&'static str] {
+        &crate::effects::SCENE_EFFECTS
+    }
+
     fn summary(&self) -> &'static str {
         "compute DVR through a GPU brick pool (LRU, memory budget, out of core) with per-brick octrees and early \
          ray termination (Ruijters & Vilanova 2006 §5–7)"

@@ -73,6 +73,10 @@ impl PassDecl for RaycastCompute {
         "raycast_compute"
     }
 
+    fn scene_effects(&self) -> &'static [&'static str] {
+        &crate::effects::SCENE_EFFECTS
+    }
+
     fn summary(&self) -> &'static str {
         "compute-shader raycaster, DVR or first-hit isosurface, optionally analytic rays, empty-space leaping, \
          pre-corrected TF table, sample counting (DirectCompute thesis RAYCASTSIMPLE_CS; Krüger–Westermann 2003 §2.1–2.3)"

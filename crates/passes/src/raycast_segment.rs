@@ -137,6 +137,10 @@ impl PassDecl for RaycastSegment {
         "raycast_segment"
     }
 
+    fn scene_effects(&self) -> &'static [&'static str] {
+        &crate::effects::SCENE_EFFECTS
+    }
+
     fn summary(&self) -> &'static str {
         "M raycasting steps per pass blended into an accumulation target, early-z tested (Krüger–Westermann 2003 §2.1–2.2)"
     }

@@ -86,10 +86,6 @@ impl CompileOptions {
 
 pub use bindings::check_plan_bindings;
 
-/// The effects a scene may ask for (`scenes/*.ron`'s `effects:`, `--features`); passes read
-/// them as `"feature.NAME"` and gate on them with `when: [NAME]`.
-pub const SCENE_EFFECTS: [&str; 4] = ["shading", "preintegration", "jitter", "tricubic"];
-
 /// Compiles graph text named `file` (used in messages) into a plan.
 pub fn compile(
     file: &str,

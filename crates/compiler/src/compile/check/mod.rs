@@ -192,7 +192,8 @@ impl Checker<'_> {
     /// on: an error with "did you mean". Names far from every known one are the graph's own
     /// features (`"reprojection"`, turned on by `--features`).
     fn check_when_names(&mut self) {
-        let mut known: std::collections::BTreeSet<&str> = crate::compile::SCENE_EFFECTS.into_iter().collect();
+        let effects = self.registry.scene_effects();
+        let mut known: std::collections::BTreeSet<&str> = effects.iter().copied().collect();
         known.extend(self.features_read.iter().map(String::as_str));
         let mut uses: HashMap<&str, usize> = HashMap::new();
         for p in &self.passes {
@@ -226,7 +227,7 @@ impl Checker<'_> {
                         format!(
                             "did you mean \"{best}\"? (a feature of the graph's own is turned on with --features \
                              {name}) the scene effects are: {}",
-                            comma_list(&crate::compile::SCENE_EFFECTS)
+                            comma_list(&effects)
                         ),
                     ));
                 }

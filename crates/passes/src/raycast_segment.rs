@@ -171,14 +171,11 @@ impl PassDecl for RaycastSegment {
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
         let (file, entry_point) = self.entry(params);
         // The counting variant (a bench tool's) binds the invocation counter too.
-        let extra: &'static [&'static str] = if self.counter.is_some() { &["invocations"] } else { &[] };
+        // The pre-integration table's (an effect's), and the counting variant's counter.
+        let binds: &'static [&'static str] =
+            if self.counter.is_some() { &["invocations", "preintegrated"] } else { &["preintegrated"] };
         let mut uses = [ShaderUse::new(file, "vs_segment"), ShaderUse::new(file, entry_point)]
-            .map(|u| {
-                u.binds(extra)
-                    .binds(&["preintegrated"])
-                    .uniform(RaycastParamsGpu::bound("params"))
-                    .uniform(SegmentParamsGpu::layout())
-            })
+            .map(|u| u.binds(binds).uniform(RaycastParamsGpu::bound("params")).uniform(SegmentParamsGpu::layout()))
             .to_vec();
         uses.extend(effect_shader_uses(params));
         uses
@@ -192,7 +189,12 @@ impl PassDecl for RaycastSegment {
         // §2.3 inside the segment: the shared march leaps over the wired block flags.
         let leap: Vec<&'static str> =
             if wired.contains(&"empty") { vec![defines::LEAP, defines::LEAP_BLOCKS] } else { vec![] };
-        self.shaders(params).into_iter().map(|u| u.defines(leap.clone())).collect()
+        // The segment's own two stages only: the effects' table pipelines do not march.
+        let mut uses = self.shaders(params);
+        for u in uses.iter_mut().take(2) {
+            *u = u.clone().defines(leap.clone());
+        }
+        uses
     }
 }
 

@@ -1,13 +1,14 @@
 //! A graph's `bypass:` is checked like the rest of the file: every way leaving passes out could
 //! change the image other than as declared is a located error with a fix (`graphs/klein_2005/
-//! leap_iso.ron` edited one way at a time), and a good one is listed in the plan.
+//! leap_iso_splats.ron` edited one way at a time: the per-pixel splats, whose hole fill reads
+//! the splat), and a good one is listed in the plan.
 
 use volgraph_core::{CompileOptions, compile};
 use volgraph_passes::builtin_registry;
 
 mod support;
 
-const GRAPH: &str = "klein_2005/leap_iso.ron";
+const GRAPH: &str = "klein_2005/leap_iso_splats.ron";
 
 /// The shipped graph with `from` replaced by `to` (which must occur).
 fn edited(from: &str, to: &str) -> String {
@@ -23,7 +24,7 @@ fn line_of(source: &str, needle: &str) -> usize {
 
 /// The diagnostics of `source`, which must not compile.
 fn errors_of(source: &str) -> String {
-    match compile("leap_iso.ron", source, &builtin_registry(), &CompileOptions::new(64, 64)) {
+    match compile("leap_iso_splats.ron", source, &builtin_registry(), &CompileOptions::new(64, 64)) {
         Ok(_) => panic!("compiled:\n{source}"),
         Err(d) => d.to_string(),
     }
@@ -31,7 +32,7 @@ fn errors_of(source: &str) -> String {
 
 /// Asserts `errors` has a problem on `line` whose text holds every one of `phrases`.
 fn assert_reported(errors: &str, line: usize, phrases: &[&str]) {
-    let at = format!("leap_iso.ron:{line}:");
+    let at = format!("leap_iso_splats.ron:{line}:");
     assert!(
         errors.lines().any(|l| l.starts_with(&at)) && phrases.iter().all(|p| errors.contains(p)),
         "expected {phrases:?} at {at}, got:\n{errors}"

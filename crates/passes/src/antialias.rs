@@ -8,11 +8,11 @@
 //! baseline. Its raycast parameters (step, threshold, mode, isovalue, shading, step back) must
 //! be the raycaster's: share them through Scalar inputs. Shader: `shaders/antialias.wgsl`.
 
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
-use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{PassNode, PassPlugin};
 
-use volgraph_core::declare::ParamChoice;
+use volgraph_compiler::declare::ParamChoice;
 
 use crate::effects::{EffectFlags, EffectState, effect_defines, effect_shader_uses, same_effects};
 use crate::raycast_params::{RaycastParamsGpu, Sampling, is_iso, raycast_param_specs};
@@ -35,8 +35,8 @@ const _: () = assert!(std::mem::size_of::<AaParamsGpu>() == 16);
 
 /// The block as the shader use declares it (bound as `aa`), so the plan checks the WGSL struct
 /// `AaParams` member by member; the node writes it itself.
-fn aa_layout() -> volgraph_core::UniformLayout {
-    volgraph_core::UniformLayout {
+fn aa_layout() -> volgraph_compiler::UniformLayout {
+    volgraph_compiler::UniformLayout {
         global: "aa",
         fields: vec![("contrast", "f32"), ("pattern", "u32"), ("directions", "u32"), ("full", "u32")],
         params: Vec::new(),
@@ -44,22 +44,22 @@ fn aa_layout() -> volgraph_core::UniformLayout {
     }
 }
 
-volgraph_core::param_choice! {
+volgraph_compiler::param_choice! {
     /// The sub-pixel pattern.
     pub enum Pattern { Two = "2x", Four = "4x", RotatedGrid = "rgss" }
 }
 
-volgraph_core::param_choice! {
+volgraph_compiler::param_choice! {
     /// Where the sub-pixel rays' directions come from.
     pub enum Directions { Linear = "linear", Bilinear = "bilinear", Exact = "exact" }
 }
 
-volgraph_core::param_choice! {
+volgraph_compiler::param_choice! {
     /// Which pixels are re-rendered.
     pub enum Selection { Selective = "selective", Full = "full" }
 }
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// The antialiasing pass's own parameters (Klein et al. 2005 §5).
     pub struct AaOwn {
         step_back: u32 = 2, 0..=64, "the raycaster's step back (sub-pixel rays start like its rays)";

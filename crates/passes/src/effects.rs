@@ -7,7 +7,7 @@
 //! `jitter` parameter, wired the same way. The f64 reference computes the same effects
 //! (`volgraph_accel::reference::Effects`).
 
-use volgraph_core::Params;
+use volgraph_compiler::Params;
 use volgraph_core::runtime::{CreateContext, PassError, RecordContext};
 
 use crate::defines;
@@ -19,7 +19,7 @@ use crate::raycast_params::Sampling;
 /// (`PassDecl::scene_effects`), and a scene may ask for what some registered kind declares.
 pub const SCENE_EFFECTS: [&str; 4] = ["shading", "preintegration", "tricubic", "jitter"];
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// The effect switches, declared once (all off by default); each is an `#if` of the same
     /// name in capitals in the shaders ([`EffectFlags::defines`]).
     pub struct EffectFlags {
@@ -54,7 +54,7 @@ impl EffectFlags {
 
 /// The shader uses the effects add to a raycaster's own: the pre-integration table's compute
 /// pipelines when `preintegration` is on (one of the two is built, by what the device filters).
-pub fn effect_shader_uses(params: &Params) -> Vec<volgraph_core::plugin::ShaderUse> {
+pub fn effect_shader_uses(params: &Params) -> Vec<volgraph_compiler::ShaderUse> {
     if EffectFlags::of(params).preintegration {
         crate::preintegration::table_shader_uses().to_vec()
     } else {
@@ -131,7 +131,7 @@ impl EffectState {
 
 #[cfg(test)]
 mod tests {
-    use volgraph_core::KindLookup;
+    use volgraph_compiler::KindLookup;
 
     use super::SCENE_EFFECTS;
 

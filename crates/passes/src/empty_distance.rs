@@ -6,9 +6,9 @@
 //! empty block. Equal cell for cell to `volgraph_accel::chebyshev` (`tests/empty_distance.rs`).
 //! Shader: `shaders/empty_distance.wgsl`.
 
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, Rerun, ShaderUse};
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
-use volgraph_core::{Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, Rerun};
+use volgraph_core::{PassNode, PassPlugin};
 
 use crate::empty_space::EMPTY_BLOCKS;
 use crate::grid_tap::GridTap;
@@ -43,7 +43,7 @@ struct DistanceParamsGpu {
 /// The pass's one entry point, declared once for `shaders()` and `create`.
 fn shader() -> ShaderUse {
     ShaderUse::new("empty_distance.wgsl", "cs_line").binds(&["partial", "distance"]).uniform(
-        volgraph_core::UniformLayout {
+        volgraph_compiler::UniformLayout {
             global: "pass_params",
             fields: vec![("axis", "u32")],
             params: Vec::new(),

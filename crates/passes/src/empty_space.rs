@@ -8,9 +8,9 @@
 //! new TF takes effect in the next frame and a steady one costs nothing. Shader:
 //! `shaders/empty_space.wgsl`.
 
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, Rerun, ShaderUse};
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
-use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, Rerun};
+use volgraph_core::{PassNode, PassPlugin};
 
 use crate::grid_tap::GridTap;
 use crate::minmax_grid::{MINMAX_GRID, bound_size, create_grid_texture, dispatch_grid};
@@ -54,7 +54,7 @@ pub(crate) fn check_block_grid(
     Ok(())
 }
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// The pass's parameters, declared once.
     pub struct ClassifySettings {
         segments: bool = false,

@@ -4,9 +4,9 @@
 //! screen-covering triangle writes each ray's near-plane point instead (at any pixel at most one
 //! of the two writes, so both are always drawn). Shader: `shaders/entry_points.wgsl`.
 
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{CreateContext, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
-use volgraph_core::{Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{PassNode, PassPlugin};
 
 /// The plugin.
 pub struct EntryPoints;

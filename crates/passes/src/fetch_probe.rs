@@ -7,9 +7,9 @@
 //! average-intensity projection) to `color`, and with `count_samples` the samples it took to
 //! `samples`. Shader: `shaders/fetch_probe.wgsl`.
 
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
-use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{PassNode, PassPlugin};
 
 use crate::march::SAMPLE_ROWS;
 use crate::raycast_params::{RaycastParamsGpu, Sampling, Workgroup};
@@ -17,7 +17,7 @@ use crate::raycast_params::{RaycastParamsGpu, Sampling, Workgroup};
 /// The plugin.
 pub struct FetchProbe;
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// Whether the probe counts its samples.
     pub struct Counting {
         count_samples: bool = false, "write the number of samples taken to the `samples` buffer";

@@ -11,16 +11,16 @@
 //! the frame block holds the same polygon grown, for the draw). Reads the splats' `splats`
 //! start target, writes `start`. Shader: `shaders/hole_fill.wgsl`.
 
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{
     CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec, UniformBlocks,
 };
-use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{PassNode, PassPlugin};
 
 /// The plugin.
 pub struct HoleFill;
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// The parameters, declared once: spec, typed values and `HoleParams` of
     /// `shaders/hole_fill.wgsl` (a test compares the two).
     pub struct HoleParams {

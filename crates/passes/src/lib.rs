@@ -31,8 +31,8 @@ pub mod slice_render;
 pub mod termination_test;
 pub mod tf_table;
 
+use volgraph_compiler::shader_source::ShaderSources;
 use volgraph_core::Registry;
-use volgraph_core::shader_source::ShaderSources;
 
 include!(concat!(env!("OUT_DIR"), "/embedded_shaders.rs"));
 

@@ -5,8 +5,8 @@
 //! (`empty_distance`'s Chebyshev map) input, and sample counting. Declared once here, so the two
 //! kinds cannot drift and a paper comparison between them is a comparison of settings.
 
+use volgraph_compiler::{Params, PortKind, PortSpec};
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext};
-use volgraph_core::{Params, PortKind, PortSpec};
 
 use crate::defines;
 use crate::empty_distance::EMPTY_DISTANCE;
@@ -18,7 +18,7 @@ use crate::shared::{BlockSize, FLOAT_TARGETS};
 /// y mod SAMPLE_ROWS, so a word holds at most a row's samples.
 pub const SAMPLE_ROWS: u64 = 4096;
 
-volgraph_core::param_choice! {
+volgraph_compiler::param_choice! {
     /// Where a ray's entry and direction come from.
     pub enum Rays {
         /// The `entry` and `dir` inputs (K-W 2003 §2.1).
@@ -28,7 +28,7 @@ volgraph_core::param_choice! {
     }
 }
 
-volgraph_core::param_choice! {
+volgraph_compiler::param_choice! {
     /// What a ray leaps out of when the empty-space input says it may.
     pub enum Leap {
         /// The largest cube of empty blocks around the sample (`distance` input).
@@ -40,7 +40,7 @@ volgraph_core::param_choice! {
     }
 }
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// The single-pass raycasters' rays, leaping and counting.
     pub struct MarchSettings {
         rays: Rays = Raster,
@@ -64,7 +64,7 @@ impl MarchSettings {
 
 /// The parameter blocks of the shared march: its settings and the block edge of the empty-space
 /// inputs.
-pub fn march_specs() -> Vec<volgraph_core::ParamSpec> {
+pub fn march_specs() -> Vec<volgraph_compiler::ParamSpec> {
     [MarchSettings::specs(), BlockSize::specs()].concat()
 }
 

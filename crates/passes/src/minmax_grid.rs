@@ -6,14 +6,14 @@
 //! on the first frame (its size comes from the bound volume) and rebuilt only when the volume's
 //! content changes (`Rerun::WhenInputsChange`). Shader: `shaders/minmax_grid.wgsl`.
 
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, Rerun, ShaderUse};
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
-use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, Rerun};
+use volgraph_core::{PassNode, PassPlugin};
 
 use crate::grid_tap::GridTap;
 use crate::shared::BlockSize;
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// Whether the grid covers what the tricubic effect reads.
     pub struct GridApron {
         tricubic: bool = false,

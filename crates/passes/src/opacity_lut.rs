@@ -8,7 +8,7 @@
 //! stored as Rgba32Float where the device can filter it, else Rgba16Float (filterable on every
 //! device). Shader: `shaders/opacity_lut.wgsl`.
 
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::ShaderUse;
 use volgraph_core::runtime::{CreateContext, PassError};
 
 use crate::tf_table::{TfTable, table_shaders};

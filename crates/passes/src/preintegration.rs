@@ -5,7 +5,7 @@
 //! and rebuilds it on the GPU only when the transfer function's content (its input version) or
 //! the step changes, so table and march always agree. Shader: `shaders/preintegration.wgsl`.
 
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::ShaderUse;
 use volgraph_core::runtime::{CreateContext, PassError, RecordContext};
 
 use crate::tf_table::{TfTable, table_shaders};

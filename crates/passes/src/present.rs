@@ -4,16 +4,16 @@
 //! A compute pass (a third of the fullscreen draw's time on llvmpipe; compute is the fast path on
 //! data-centre GPUs too). Shader: `shaders/present.wgsl`.
 
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{
     ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, UniformBlocks,
 };
-use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{PassNode, PassPlugin};
 
 /// The plugin.
 pub struct Present;
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// The parameters, declared once: the spec, typed values, the uniform bytes and the struct
     /// `shaders/present.wgsl` imports (`params/PresentParams.wgsl`).
     pub struct PresentParams {

@@ -3,9 +3,9 @@
 //! direction and, in alpha, the ray length. Shader: `shaders/ray_directions.wgsl`.
 
 use crate::shared::FLOAT_TARGETS;
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse};
 use volgraph_core::runtime::{CreateContext, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
-use volgraph_core::{Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec};
+use volgraph_core::{PassNode, PassPlugin};
 
 /// The plugin.
 pub struct RayDirections;

@@ -17,9 +17,9 @@
 //! input wired, begins each ray at that estimate on the same step grid (common/leap.wgsl).
 //! Shader: `shaders/raycast.wgsl`.
 
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
-use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{PassNode, PassPlugin};
 
 use crate::effects::{EffectFlags, EffectState, effect_defines, same_effects};
 use crate::march::{
@@ -185,7 +185,7 @@ impl PassPlugin for Raycast {
     }
 }
 
-volgraph_core::param_choice! {
+volgraph_compiler::param_choice! {
     /// How far a leap hit is moved back along the ray (Klein et al. 2005 §4.2).
     pub enum StepBackRule {
         /// `step_back` samples.
@@ -195,7 +195,7 @@ volgraph_core::param_choice! {
     }
 }
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// The fragment raycaster's own parameters: Klein et al. 2005's leap hits.
     pub struct RaycastOwn {
         leap_hits: bool = false,

@@ -42,12 +42,12 @@ use volgraph_accel::bricks::{BrickLayout, ViewPoint};
 use volgraph_accel::classify::OpacityClassifier;
 use volgraph_accel::octree::{OctreeHierarchy, OctreeVisibility};
 use volgraph_accel::volume::Volume;
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::upload::VolumeFormat;
 use volgraph_core::runtime::{
     ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, volume_texture_format,
 };
-use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{PassNode, PassPlugin};
 
 use crate::brick_pool::{Batch, BrickPool};
 use crate::effects::{EffectFlags, EffectState, effect_defines, effect_shader_uses, same_effects};
@@ -59,7 +59,7 @@ use atlas::Atlas;
 /// The plugin.
 pub struct RaycastBricks;
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// The brick pass's own parameters, declared once (the sampling, termination and workgroup
     /// blocks are the other raycasters': `raycast_params`).
     pub struct BrickSettings {
@@ -164,8 +164,8 @@ fn march_shader() -> ShaderUse {
 
 /// The `bricks` block as `BrickParamsGpu` lays it out, checked against the shader's
 /// `BrickParams` when the graph is planned. The node writes it per frame (the pool's state).
-fn brick_layout() -> volgraph_core::UniformLayout {
-    volgraph_core::UniformLayout {
+fn brick_layout() -> volgraph_compiler::UniformLayout {
+    volgraph_compiler::UniformLayout {
         global: "bricks",
         fields: vec![
             ("grid", "vec4<u32>"),

@@ -20,9 +20,9 @@
 //! [`crate::march`]), so the two differ only in how pixels are scheduled. The workgroup size is
 //! a parameter (pipeline-overridable constants). Shader: `shaders/raycast_compute.wgsl`.
 
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::{ParamSpec, Params, PassDecl, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
-use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortSpec, TargetFormat};
+use volgraph_core::{PassNode, PassPlugin};
 
 use crate::effects::{EffectFlags, EffectState, effect_defines, same_effects};
 use crate::march::{Leaping, MarchSettings, march_defines, march_specs, same_march, wired_defines};
@@ -35,7 +35,7 @@ use crate::tf_table::TfTable;
 /// The plugin.
 pub struct RaycastCompute;
 
-volgraph_core::param_choice! {
+volgraph_compiler::param_choice! {
     /// How a sample is classified.
     pub enum Classify {
         /// The TF and the exact per-sample opacity correction.
@@ -45,7 +45,7 @@ volgraph_core::param_choice! {
     }
 }
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// The compute raycaster's own parameter; it chooses the pipeline.
     pub struct ComputeOwn {
         classify: Classify = Exact,

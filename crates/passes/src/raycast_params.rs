@@ -1,17 +1,17 @@
 //! Parameters shared by the raycasters, declared once as blocks, and their GPU twin.
 //!
-//! Each block is a [`pass_params!`](volgraph_core::pass_params) declaration; a kind lists the
+//! Each block is a [`pass_params!`](volgraph_compiler::pass_params) declaration; a kind lists the
 //! blocks it takes whole (`[Sampling::specs(), Termination::specs()].concat()`), and code that
 //! serves several kinds reads a block with `try_from_params` (`Some` where the kind declares
 //! it). No parameter name is written anywhere else. docs/rendering_model.md gives their meaning.
 
 use volgraph_accel::reference::{Phong, RaycastSettings, RenderMode};
-use volgraph_core::Params;
+use volgraph_compiler::Params;
 
 use crate::defines;
 use crate::effects::EffectFlags;
 
-volgraph_core::param_choice! {
+volgraph_compiler::param_choice! {
     /// What a raycaster computes.
     pub enum Mode {
         /// Direct volume rendering: the emission–absorption integral.
@@ -21,7 +21,7 @@ volgraph_core::param_choice! {
     }
 }
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// How each ray is sampled: every raycaster.
     pub struct Sampling {
         step_voxels: f64 = 0.5, 0.01..=16.0, "sample distance in units of the smallest voxel side";
@@ -32,7 +32,7 @@ volgraph_core::pass_params! {
     }
 }
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// Early ray termination (Krüger–Westermann 2003 §2.2).
     pub struct Termination {
         threshold: f64 = 1.0, 0.0..=1.0,
@@ -40,7 +40,7 @@ volgraph_core::pass_params! {
     }
 }
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// What the raycaster computes: the integral or the first isosurface hit.
     pub struct Surface {
         mode: Mode = Dvr, "direct volume rendering or first-hit isosurface";
@@ -48,7 +48,7 @@ volgraph_core::pass_params! {
     }
 }
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// Blinn–Phong headlight coefficients: the isosurface's, and DVR's with the shading effect.
     pub struct Shading {
         ambient: f64 = 0.15, 0.0..=1.0, "Blinn–Phong ambient coefficient (mode \"iso\", or the shading effect)";
@@ -58,7 +58,7 @@ volgraph_core::pass_params! {
     }
 }
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// The compute raycasters' workgroup.
     pub struct Workgroup {
         workgroup_x: u32 = 8, 1..=256, "workgroup width in pixels";
@@ -66,7 +66,7 @@ volgraph_core::pass_params! {
     }
 }
 
-volgraph_core::param_choice! {
+volgraph_compiler::param_choice! {
     /// How a compute raycaster's sample loop is built.
     pub enum SampleLoop {
         /// `pipelined` on a GPU, `plain` on a CPU adapter (llvmpipe).
@@ -79,7 +79,7 @@ volgraph_core::param_choice! {
     }
 }
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// The compute raycasters' sample loop (`raycast_compute`, `raycast_bricks`).
     pub struct SampleLoopChoice {
         sample_loop: SampleLoop = Auto,
@@ -93,7 +93,7 @@ volgraph_core::pass_params! {
 impl SampleLoopChoice {
     /// The defines of the pipelined loop (`TF_WORKGROUP`, `PREFETCH`) when `params` ask for it
     /// on `gpu`; `None` at plan time, where only an explicit `pipelined` is known.
-    pub fn defines(params: &volgraph_core::Params, gpu: Option<&volgraph_core::runtime::Gpu>) -> Vec<&'static str> {
+    pub fn defines(params: &volgraph_compiler::Params, gpu: Option<&volgraph_core::runtime::Gpu>) -> Vec<&'static str> {
         let pipelined = match Self::from_params(params).sample_loop {
             SampleLoop::Pipelined => true,
             SampleLoop::Plain => false,
@@ -105,7 +105,7 @@ impl SampleLoopChoice {
     /// `defines` at plan time followed by those `gpu` adds: the list a pipeline is built with.
     pub fn with_gpu_defines(
         mut defines: Vec<&'static str>,
-        params: &volgraph_core::Params,
+        params: &volgraph_compiler::Params,
         gpu: &volgraph_core::runtime::Gpu,
     ) -> Vec<&'static str> {
         for define in Self::defines(params, Some(gpu)) {
@@ -153,11 +153,11 @@ impl Workgroup {
 
 /// Every block of the full raycaster (`raycast`, `raycast_compute`, `raycast_segment`,
 /// `antialias`): sampling, termination, isosurface and shading.
-pub fn raycast_param_specs() -> Vec<volgraph_core::ParamSpec> {
+pub fn raycast_param_specs() -> Vec<volgraph_compiler::ParamSpec> {
     [Sampling::specs(), Termination::specs(), Surface::specs(), Shading::specs()].concat()
 }
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// The raycasters' shared uniform `params`, imported by `shaders/common/raycast_params.wgsl`
     /// as the generated `params/RaycastParamsGpu.wgsl`. It has no
     /// parameters of its own; [`RaycastParamsGpu::of`] fills it from the blocks a kind declares.
@@ -179,7 +179,7 @@ volgraph_core::pass_params! {
 impl RaycastParamsGpu {
     /// This block as the uniform `global` of a shader use: its bytes are [`Self::of`] the
     /// blocks a kind declares, so every parameter of those blocks is carried by it.
-    pub fn bound(global: &'static str) -> volgraph_core::UniformLayout {
+    pub fn bound(global: &'static str) -> volgraph_compiler::UniformLayout {
         let params = raycast_param_specs().iter().map(|s| s.name).collect();
         Self::bound_as_with(global, params, |p| Self::of(p).uniform_bytes())
     }

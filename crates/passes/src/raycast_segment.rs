@@ -22,12 +22,12 @@
 
 use std::sync::{Arc, Mutex};
 
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::footprint::FAN_DRAW_VERTICES;
 use volgraph_core::runtime::{
     CreateContext, DepthSpec, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
 };
-use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{PassNode, PassPlugin};
 
 use crate::defines;
 use crate::effects::{EffectFlags, EffectState, effect_defines, effect_shader_uses};
@@ -94,8 +94,8 @@ impl SegmentParamsGpu {
     /// The block as a shader use declares it (bound as `segment`), so the plan checks the WGSL
     /// struct `SegmentParams` member by member. The node writes it itself (no parameter is
     /// claimed for in-place updates).
-    pub fn layout() -> volgraph_core::UniformLayout {
-        volgraph_core::UniformLayout {
+    pub fn layout() -> volgraph_compiler::UniformLayout {
+        volgraph_compiler::UniformLayout {
             global: "segment",
             fields: vec![("steps", "u32"), ("block_size", "u32"), ("threshold", "f32")],
             params: Vec::new(),
@@ -115,7 +115,7 @@ impl SegmentParamsGpu {
     }
 }
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// The segment length, shared with `termination_test` (both must agree).
     pub struct SegmentSteps {
         segment_steps: u32 = 8, 1..=4096,

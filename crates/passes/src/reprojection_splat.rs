@@ -13,12 +13,12 @@
 //! `shaders/reprojection_splat.wgsl`.
 
 use glam::{DVec3, DVec4};
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{
     CameraData, ComputePassPipeline, ComputePipelineSpec, CreateContext, DepthSpec, Gpu, PassError, RecordContext,
     RenderPassPipeline, RenderPipelineSpec,
 };
-use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{PassNode, PassPlugin};
 
 /// The plugin.
 pub struct ReprojectionSplat;
@@ -34,7 +34,7 @@ struct SplatParamsGpu {
 
 const _: () = assert!(std::mem::size_of::<SplatParamsGpu>() == 32);
 
-volgraph_core::param_choice! {
+volgraph_compiler::param_choice! {
     /// How the splats are drawn.
     pub enum SplatMethod {
         /// Instanced quads through the rasterizer, depth-tested (the paper's points).
@@ -44,7 +44,7 @@ volgraph_core::param_choice! {
     }
 }
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// The pass's parameters, declared once (the GPU block adds the screen rectangle the node
     /// computes per frame, so it stays a struct of its own).
     pub struct SplatSettings {
@@ -85,8 +85,8 @@ fn scatters(params: &Params) -> bool {
 /// The `splat` block as `SplatParamsGpu` lays it out, checked against the shader's
 /// `SplatParams` when the graph is planned. The node writes it per frame (last frame's screen
 /// rectangle of the volume).
-fn splat_layout() -> volgraph_core::UniformLayout {
-    volgraph_core::UniformLayout {
+fn splat_layout() -> volgraph_compiler::UniformLayout {
+    volgraph_compiler::UniformLayout {
         global: "splat",
         fields: vec![("rect", "vec4<u32>"), ("size", "f32")],
         params: Vec::new(),
@@ -281,7 +281,7 @@ impl PassNode for SplatNode {
 
 #[cfg(test)]
 mod tests {
-    use volgraph_core::{ParamValue, Params, PassDecl};
+    use volgraph_compiler::{ParamValue, Params, PassDecl};
 
     use super::ReprojectionSplat;
 

@@ -17,16 +17,16 @@
 //! `shaders/reprojection_tiles.wgsl`; the layout the march reads:
 //! `shaders/common/reprojected_tiles.wgsl`.
 
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{
     ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, UniformBlocks,
 };
-use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{PassNode, PassPlugin};
 
 /// The plugin.
 pub struct ReprojectionTiles;
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// The parameters, declared once: spec, typed values and `TileBoundsParams` of
     /// `shaders/reprojection_tiles.wgsl` (`tile` and `hit_block` are also its pipeline
     /// constants `TILE` and `HIT_BLOCK`).
@@ -51,8 +51,8 @@ struct HitRectGpu {
 
 /// The `hit_rect` block as `HitRectGpu` lays it out, checked against the shader's `HitRect`
 /// when the graph is planned.
-fn hit_rect_layout() -> volgraph_core::UniformLayout {
-    volgraph_core::UniformLayout {
+fn hit_rect_layout() -> volgraph_compiler::UniformLayout {
+    volgraph_compiler::UniformLayout {
         global: "hit_rect",
         fields: vec![("rect", "vec4<u32>")],
         params: Vec::new(),
@@ -188,7 +188,7 @@ impl PassNode for TilesNode {
 
 #[cfg(test)]
 mod tests {
-    use volgraph_core::{ParamValue, Params, PassDecl};
+    use volgraph_compiler::{ParamValue, Params, PassDecl};
 
     use super::ReprojectionTiles;
 

@@ -5,13 +5,13 @@
 //! Shader: `shaders/segment_init.wgsl`.
 
 use crate::shared::{ACCUM_FORMATS, HIT_FORMATS};
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{
     CreateContext, DepthSpec, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
 };
-use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{PassNode, PassPlugin};
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// The pass's parameters, declared once.
     pub struct InitSettings {
         with_hit: bool = false, "also clear a hit-position target for isosurface segments";

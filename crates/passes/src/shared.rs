@@ -2,7 +2,7 @@
 //! format sets ports accept, the block-size rule of the empty-space passes, the front-to-back
 //! blend, and how a node tells which colour precision its graph picked.
 
-use volgraph_core::TargetFormat;
+use volgraph_compiler::TargetFormat;
 use volgraph_core::runtime::CreateContext;
 
 /// Float RGBA targets a ray pass reads or writes (entry points, directions, hits); the first is
@@ -16,7 +16,7 @@ pub const ACCUM_FORMATS: [TargetFormat; 2] = FLOAT_TARGETS;
 /// Formats of the isosurface hit target blended like the colour (§2.2).
 pub const HIT_FORMATS: [TargetFormat; 2] = FLOAT_TARGETS;
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// The `block_size` parameter of the min/max grid and everything that reads it (Krüger &
     /// Westermann 2003 §2.3): one declaration, so the passes that must agree cannot drift.
     pub struct BlockSize {
@@ -26,7 +26,7 @@ volgraph_core::pass_params! {
 
 impl BlockSize {
     /// The block edge of `params` (at least 1).
-    pub fn of(params: &volgraph_core::Params) -> u32 {
+    pub fn of(params: &volgraph_compiler::Params) -> u32 {
         Self::from_params(params).block_size.max(1)
     }
 }
@@ -64,7 +64,7 @@ pub(crate) fn assembled(file: &str) -> String {
 #[cfg(test)]
 pub(crate) fn assembled_with(file: &str, defines: &[&str]) -> String {
     let defines = defines.iter().map(|d| d.to_string()).collect();
-    volgraph_core::shader_source::assemble_with(&crate::builtin_shaders(), file, &defines).expect("assembles").text
+    volgraph_compiler::shader_source::assemble_with(&crate::builtin_shaders(), file, &defines).expect("assembles").text
 }
 
 #[cfg(test)]

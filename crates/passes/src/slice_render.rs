@@ -7,16 +7,16 @@
 //! planes past the box draw nothing. Shader: `shaders/slice_render.wgsl`.
 
 use crate::shared::front_to_back_blend;
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{
     CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec, UniformBlocks,
 };
-use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{PassNode, PassPlugin};
 
 /// The plugin.
 pub struct SliceRender;
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// The plane spacing, declared once: spec, typed value and `SliceParams` of
     /// `shaders/slice_render.wgsl` (a test compares the two).
     pub struct SliceParams {
@@ -24,7 +24,7 @@ volgraph_core::pass_params! {
     }
 }
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// What stays on the CPU: the instance count bound.
     pub struct SliceLimits {
         max_slices: u32 = 8192, 1..=1048576,

@@ -14,12 +14,12 @@
 //! test recomputes where the next segment's samples lie), and `block_size` the `minmax_grid`
 //! pass's. Shader: `shaders/termination_test.wgsl`.
 
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::footprint::FAN_DRAW_VERTICES;
 use volgraph_core::runtime::{
     CreateContext, DepthSpec, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
 };
-use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{PassNode, PassPlugin};
 
 use crate::empty_space::EMPTY_BLOCKS;
 use crate::raycast_params::{RaycastParamsGpu, Sampling};
@@ -29,7 +29,7 @@ use crate::shared::{ACCUM_FORMATS, BlockSize, FLOAT_TARGETS};
 /// The plugin.
 pub struct TerminationTest;
 
-volgraph_core::pass_params! {
+volgraph_compiler::pass_params! {
     /// The test's threshold: the `threshold` of the shared termination block (the segment
     /// pass's), with the paper's T = 0.95 as its default.
     pub struct TestThreshold {

@@ -5,7 +5,7 @@
 //! variant, writing the storage binding `table32` or `table16`, and reads the raycaster's
 //! uniform `params` for the step.
 
-use volgraph_core::plugin::ShaderUse;
+use volgraph_compiler::ShaderUse;
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
 
 /// A derived table, the pipeline that fills it and the texture it fills.

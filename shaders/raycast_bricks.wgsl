@@ -28,7 +28,7 @@ struct BrickParams {
     // Voxels per slot and axis (xyz): brick_cells + 1 + 2·apron (voxel lo - apron first), fewer
     // on an axis thinner than a brick; w = the apron: voxels kept on every side of the brick's
     // own, so that every filter tap near a face reads what the whole volume holds (1: trilinear
-    // samples and central-difference gradients; 3 with tricubic reconstruction).
+    // samples; +1 for shading's central differences, +2 for tricubic reconstruction).
     slot_side: vec4<u32>,
     // x = cells per leaf side, y = leaves per brick side.
     leaves: vec4<u32>,

@@ -158,6 +158,12 @@ mod tests {
             for effect in decl.scene_effects() {
                 assert!(params.contains(effect), "{kind} declares {effect} but has no such parameter: {params:?}");
             }
+            // Shading reads the headlight's coefficients: without the block they are zeros
+            // and a shaded image is black (raycast_bricks was, on both the GPU and its
+            // reference, which read the same parameters).
+            for coefficient in ["ambient", "diffuse", "specular", "shininess"] {
+                assert!(params.contains(&coefficient), "{kind} takes shading but not {coefficient}: {params:?}");
+            }
         }
     }
 }

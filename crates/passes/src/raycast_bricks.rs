@@ -3,7 +3,7 @@
 //!
 //! - §5 **bricks**: the volume is cut into bricks of `brick_cells`³ cells that keep the voxels
 //!   of their cells' corners (the one-voxel overlap trilinear samples inside a brick need) and
-//!   an apron of more voxels on every side — one, three with tricubic reconstruction — so that
+//!   an apron of more voxels on every side — one, two with shading, three with tricubic, four with both — so that
 //!   every filter tap near a brick face (trilinear, gradients, the B-spline) blends exactly the
 //!   voxels the whole volume would and images have no seams. Non-empty bricks (for the current
 //!   TF) live in a 3D atlas texture, `brick_cells + 1 + 2·apron` voxels per side per slot; empty bricks
@@ -51,7 +51,7 @@ use volgraph_core::{PassNode, PassPlugin};
 
 use crate::brick_pool::{Batch, BrickPool};
 use crate::effects::{EffectFlags, EffectState, effect_defines, effect_shader_uses, same_effects};
-use crate::raycast_params::{RaycastParamsGpu, SampleLoopChoice, Sampling, Termination, Workgroup};
+use crate::raycast_params::{RaycastParamsGpu, SampleLoopChoice, Sampling, Shading, Termination, Workgroup};
 
 mod atlas;
 use atlas::Atlas;
@@ -116,6 +116,8 @@ impl PassDecl for RaycastBricks {
             Sampling::specs(),
             Termination::specs(),
             EffectFlags::specs(),
+            // The headlight's coefficients, which the shading effect reads.
+            Shading::specs(),
             BrickSettings::specs(),
             Workgroup::specs(),
             SampleLoopChoice::specs(),
@@ -286,10 +288,11 @@ struct VolumeState {
 }
 
 /// Voxels a slot keeps on every side of its brick's own: what the filter taps near a brick face
-/// read beyond it. Trilinear samples and the central differences of shading reach one voxel;
-/// the tricubic B-spline two more (its 4³ support), three with shading on top.
+/// read beyond it. A trilinear sample reaches one voxel (a border brick's samples run half a
+/// voxel past its corner voxels, to the volume's face); shading's central differences one more,
+/// the tricubic B-spline (its 4³ support) two more.
 fn apron(effects: EffectFlags) -> u32 {
-    if effects.tricubic { 3 } else { 1 }
+    1 + u32::from(effects.shading) + 2 * u32::from(effects.tricubic)
 }
 
 /// Voxels beyond a leaf's cells its value range takes in (`OctreeHierarchy::build_with_apron`):

@@ -35,12 +35,6 @@ override HIT_BLOCK: u32 = 4u;
 // there was no ray.
 @group(0) @binding(auto) var hits: texture_2d<f32>;
 @group(0) @binding(auto) var<uniform> tile_bounds: TileBoundsParams;
-// Rust twin: `HitRectGpu` in crates/passes/src/reprojection_tiles.rs.
-struct HitRect {
-    // Last frame's screen rectangle of the volume: origin x, y, width, height (pixels).
-    rect: vec4<u32>,
-}
-@group(0) @binding(auto) var<uniform> hit_rect: HitRect;
 // TILES_HEADER words, then one key per tile, row by row (common/reprojected_tiles.wgsl).
 @group(0) @binding(auto) var<storage, read_write> tiles: array<atomic<u32>>;
 
@@ -103,8 +97,9 @@ fn tiles_near(lo: vec2<f32>, hi: vec2<f32>) -> vec4<i32> {
 @compute @workgroup_size(8, 8)
 fn cs_tiles_scatter(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = vec2<u32>(frame.viewport.xy);
-    let base = hit_rect.rect.xy + id.xy * HIT_BLOCK;
-    let end = min(hit_rect.rect.xy + hit_rect.rect.zw, size);
+    let origin = vec2<u32>(tile_bounds.rect_x, tile_bounds.rect_y);
+    let base = origin + id.xy * HIT_BLOCK;
+    let end = min(origin + vec2<u32>(tile_bounds.rect_w, tile_bounds.rect_h), size);
     if (any(base >= end)) {
         return;
     }

@@ -82,7 +82,7 @@ fn inside(d: f64, voxel: f64) -> f64 {
 /// The molar CT at edge `n` (n × n × ⌈0.63 n⌉ voxels, like the scan's 256×256×161), u16,
 /// voxel spacing 1, its value range fitted to the data (as a scanner loader's).
 pub fn tooth(n: u32) -> Volume {
-    let n = n.max(4);
+    let n = n.max(1);
     let dims = UVec3::new(n, n, (n as f64 * 0.63).ceil() as u32);
     // Normalized units per voxel: the longest side spans [-1, 1].
     let voxel = 2.0 / n as f64;

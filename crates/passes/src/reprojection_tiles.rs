@@ -18,9 +18,7 @@
 //! `shaders/common/reprojected_tiles.wgsl`.
 
 use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
-use volgraph_core::runtime::{
-    ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, UniformBlocks,
-};
+use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
 use volgraph_core::{PassNode, PassPlugin};
 
 /// The plugin.
@@ -38,25 +36,10 @@ volgraph_compiler::pass_params! {
              4 leaves every test frame the plain raycast's)";
         silhouette_band: u32 = 2, 0..=16,
             "tiles this close to the volume's silhouette start at the box (rays newly in view enter it before any old hit)";
-    }
-}
-
-/// Rust twin of `HitRect` in `shaders/reprojection_tiles.wgsl`: last frame's screen rectangle
-/// of the volume, which the node computes each frame.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-struct HitRectGpu {
-    rect: [u32; 4],
-}
-
-/// The `hit_rect` block as `HitRectGpu` lays it out, checked against the shader's `HitRect`
-/// when the graph is planned.
-fn hit_rect_layout() -> volgraph_compiler::UniformLayout {
-    volgraph_compiler::UniformLayout {
-        global: "hit_rect",
-        fields: vec![("rect", "vec4<u32>")],
-        params: Vec::new(),
-        bytes: |_| bytemuck::bytes_of(&HitRectGpu::default()).to_vec(),
+        rect_x: u32 = computed, "last frame's screen rectangle of the volume (pixels), where its hits can be: origin x";
+        rect_y: u32 = computed, "… origin y";
+        rect_w: u32 = computed, "… width";
+        rect_h: u32 = computed, "… height";
     }
 }
 
@@ -66,8 +49,7 @@ fn rounds() -> [ShaderUse; 2] {
     [
         ShaderUse::new("reprojection_tiles.wgsl", "cs_tiles_clear").uniform(TileBoundsParams::bound_as("tile_bounds")),
         ShaderUse::new("reprojection_tiles.wgsl", "cs_tiles_scatter")
-            .uniform(TileBoundsParams::bound_as("tile_bounds"))
-            .uniform(hit_rect_layout()),
+            .uniform(TileBoundsParams::bound_as("tile_bounds")),
     ]
 }
 
@@ -120,30 +102,18 @@ impl PassPlugin for ReprojectionTiles {
             ctx.compute_pipeline(&ComputePipelineSpec { constants: &constants, ..ComputePipelineSpec::of(shader) })
         };
         let [clear, scatter] = [round(&uses[0])?, round(&uses[1])?];
-        let uniforms = UniformBlocks::create(ctx, &uses[..1]);
-        let hit_rect = ctx.uniform_buffer("hit_rect", std::mem::size_of::<HitRectGpu>() as u64);
-        Ok(Box::new(TilesNode {
-            clear,
-            scatter,
-            uniforms,
-            hit_rect,
-            written: None,
-            tile: settings.tile,
-            hit_block: settings.hit_block,
-        }))
+        let uniform = ctx.uniform_from_bytes("tile_bounds", &settings.uniform_bytes());
+        Ok(Box::new(TilesNode { clear, scatter, uniform, settings, written: None }))
     }
 }
 
 struct TilesNode {
     clear: ComputePassPipeline,
     scatter: ComputePassPipeline,
-    /// `tile_bounds`, from the parameters.
-    uniforms: UniformBlocks,
-    /// `hit_rect`, written per frame where it changed.
-    hit_rect: wgpu::Buffer,
-    written: Option<HitRectGpu>,
-    tile: u32,
-    hit_block: u32,
+    /// `tile_bounds`: the parameters and last frame's screen rectangle, written where it changed.
+    uniform: wgpu::Buffer,
+    settings: TileBoundsParams,
+    written: Option<TileBoundsParams>,
 }
 
 impl PassNode for TilesNode {
@@ -156,18 +126,18 @@ impl PassNode for TilesNode {
             }
             _ => [0; 4],
         };
-        let rect = HitRectGpu { rect };
-        if self.written != Some(rect) {
-            ctx.write_buffer(&self.hit_rect, 0, bytemuck::bytes_of(&rect));
-            self.written = Some(rect);
+        let block =
+            TileBoundsParams { rect_x: rect[0], rect_y: rect[1], rect_w: rect[2], rect_h: rect[3], ..self.settings };
+        if self.written != Some(block) {
+            ctx.write_buffer(&self.uniform, 0, &block.uniform_bytes());
+            self.written = Some(block);
         }
-        let mut bindings = self.uniforms.bindings();
+        let bindings = [("tile_bounds", self.uniform.as_entire_binding())];
         let clear_bg = ctx.bind_group(&self.clear, &bindings)?;
-        bindings.push(("hit_rect", self.hit_rect.as_entire_binding()));
         let scatter_bg = ctx.bind_group(&self.scatter, &bindings)?;
         let (w, h) = ctx.viewport;
-        let tiles = (w.div_ceil(self.tile), h.div_ceil(self.tile));
-        let blocks = (rect.rect[2].div_ceil(self.hit_block), rect.rect[3].div_ceil(self.hit_block));
+        let tiles = (w.div_ceil(self.settings.tile), h.div_ceil(self.settings.tile));
+        let blocks = (rect[2].div_ceil(self.settings.hit_block), rect[3].div_ceil(self.settings.hit_block));
         let mut pass = ctx.begin_compute_pass();
         pass.set_pipeline(&self.clear.pipeline);
         pass.set_bind_group(0, &clear_bg, &[]);
@@ -180,9 +150,11 @@ impl PassNode for TilesNode {
         Ok(())
     }
 
-    fn update_params(&mut self, gpu: &Gpu, params: &Params) {
-        // Only the uniforms: a new tile or block is a new pipeline (`updates_in_place`).
-        self.uniforms.write(gpu, params);
+    fn update_params(&mut self, _gpu: &Gpu, params: &Params) {
+        // Only the uniforms: a new tile or block is a new pipeline (`updates_in_place`); the
+        // block is written with this frame's rectangle when the pass next records.
+        self.settings = TileBoundsParams::from_params(params);
+        self.written = None;
     }
 }
 

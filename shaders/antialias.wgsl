@@ -10,18 +10,8 @@
 #import "common/frame.wgsl"
 #import "common/fullscreen.wgsl"
 #import "common/leap.wgsl"
-
-// Rust twin: `AaParamsGpu` in crates/passes/src/antialias.rs.
-struct AaParams {
-    // Colour difference to a 4-neighbour that flags a pixel.
-    contrast: f32,
-    // 2: 2x, 4: 4x regular, 5: 4x rotated grid.
-    pattern: u32,
-    // 0: linear, 1: bilinear, 2: exact.
-    directions: u32,
-    // 1: every pixel (full-scene super-sampling).
-    full: u32,
-}
+// The `aa` block, declared once in Rust (`AaParams` in crates/passes/src/antialias.rs).
+#import "params/AaParams.wgsl"
 
 // The raycast colour.
 @group(0) @binding(auto) var color: texture_2d<f32>;

@@ -20,13 +20,8 @@ const DISTANCE_CAP: u32 = 255u;
 // Longest grid line: the largest 3D texture edge wgpu guarantees (checked by the pass).
 const MAX_LINE: u32 = 2048u;
 
-struct DistanceParams {
-    // 0, 1, 2: the axis this dispatch runs along.
-    axis: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-}
+// Declared once in Rust (`DistanceParams` in crates/passes/src/empty_distance.rs).
+#import "params/DistanceParams.wgsl"
 
 // 1.0 = empty (empty_space.wgsl).
 @group(0) @binding(auto) var empty: texture_3d<f32>;

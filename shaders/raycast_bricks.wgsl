@@ -22,21 +22,8 @@
 #import "common/leap_empty.wgsl"
 #import "common/workgroup_pixel.wgsl"
 
-struct BrickParams {
-    // Bricks per axis (xyz); w = cells per brick side.
-    grid: vec4<u32>,
-    // Voxels per slot and axis (xyz): brick_cells + 1 + 2·apron (voxel lo - apron first), fewer
-    // on an axis thinner than a brick; w = the apron: voxels kept on every side of the brick's
-    // own, so that every filter tap near a face reads what the whole volume holds (1: trilinear
-    // samples; +1 for shading's central differences, +2 for tricubic reconstruction).
-    slot_side: vec4<u32>,
-    // x = cells per leaf side, y = leaves per brick side.
-    leaves: vec4<u32>,
-    // Leaves per axis over the whole volume (xyz).
-    leaf_grid: vec4<u32>,
-    // Atlas size in texels (xyz).
-    atlas: vec4<f32>,
-}
+// Declared once in Rust (`BrickParams` in crates/passes/src/raycast_bricks.rs).
+#import "params/BrickParams.wgsl"
 
 @group(0) @binding(auto) var<uniform> bricks: BrickParams;
 // This batch: word 0 = 1 for the first batch of the frame (start from a clear ray); word 1 + b

@@ -18,16 +18,8 @@
 
 #import "common/frame.wgsl"
 
-// Rust twin: `SplatParamsGpu` in crates/passes/src/reprojection_splat.rs.
-struct SplatParams {
-    // Last frame's screen rectangle of the volume: origin x, y, width, height (pixels).
-    rect: vec4<u32>,
-    // Splat edge in pixels (k).
-    size: f32,
-    _pad0: f32,
-    _pad1: f32,
-    _pad2: f32,
-}
+// Declared once in Rust (`SplatParams` in crates/passes/src/reprojection_splat.rs).
+#import "params/SplatParams.wgsl"
 
 // Hits per splat side (b), a pipeline constant: the b² loop below bounded by a uniform made
 // lavapipe (Mesa 22.3) inline the uniform and recompile both scatter rounds at every dispatch

@@ -15,16 +15,8 @@
 #import "common/raymarch.wgsl"
 #import "common/pixel_ray.wgsl"
 
-// Rust twin: `SegmentParamsGpu` in crates/passes/src/raycast_segment.rs.
-struct SegmentParams {
-    // M: samples per segment.
-    steps: u32,
-    // Edge of an empty-space block in voxels (leaping inside a segment, the termination test).
-    block_size: u32,
-    // T: the termination test stops rays whose accumulated alpha is >= T.
-    threshold: f32,
-    _pad0: u32,
-}
+// Declared once in Rust (`SegmentParams` in crates/passes/src/raycast_segment.rs).
+#import "params/SegmentParams.wgsl"
 
 @group(0) @binding(auto) var<uniform> segment: SegmentParams;
 

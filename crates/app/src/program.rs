@@ -19,8 +19,8 @@ use std::process::ExitCode;
 use std::sync::OnceLock;
 
 use clap::{CommandFactory as _, FromArgMatches as _};
-use volgraph_core::Registry;
 use volgraph_core::shader_source::{EmbeddedShaders, ShaderSources};
+use volgraph_core::{KindLookup as _, Registry};
 
 use crate::cli::{Cli, CliError};
 
@@ -43,17 +43,16 @@ pub struct Extension {
     /// Adds the program's pass kinds to the built-in ones.
     pub register: fn(&mut Registry),
     /// The program's own shaders, searched before volgraph's (whose `common/` they may import).
+    /// The WGSL structs of its kinds' uniform blocks come with them, as `params/NAME.wgsl`
+    /// (gathered from what the kinds declare: `KindLookup::uniform_imports`).
     pub shaders: EmbeddedShaders,
-    /// The WGSL structs of the program's `pass_params!` uniform blocks (`Name::wgsl_import()`),
-    /// which its shaders import as `params/NAME.wgsl`.
-    pub params_structs: fn() -> Vec<(String, String)>,
     /// Subcommands beyond volgraph's own.
     pub commands: Vec<Box<dyn Commands>>,
 }
 
 impl Default for Extension {
     fn default() -> Self {
-        Self { name: "volgraph", register: |_| {}, shaders: &[], params_structs: Vec::new, commands: Vec::new() }
+        Self { name: "volgraph", register: |_| {}, shaders: &[], commands: Vec::new() }
     }
 }
 
@@ -61,7 +60,6 @@ impl Default for Extension {
 struct Program {
     register: fn(&mut Registry),
     shaders: EmbeddedShaders,
-    params_structs: fn() -> Vec<(String, String)>,
 }
 
 static PROGRAM: OnceLock<Program> = OnceLock::new();
@@ -75,11 +73,12 @@ pub fn registry() -> Registry {
     registry
 }
 
-/// The shaders compiled into this program: its extension's first, then volgraph's.
+/// The shaders compiled into this program: its extension's first, then volgraph's, with the
+/// uniform structs every registered kind declares.
 pub fn shaders() -> ShaderSources {
     let builtin = volgraph_passes::builtin_shaders();
     match PROGRAM.get() {
-        Some(p) => builtin.prepend_embedded(p.shaders).with_generated((p.params_structs)()),
+        Some(p) => builtin.prepend_embedded(p.shaders).with_generated(registry().uniform_imports()),
         None => builtin,
     }
 }
@@ -106,8 +105,8 @@ pub fn main_with(extension: Extension) -> ExitCode {
     }));
     // An installed binary finds data where its user says, never in the build machine's tree.
     volgraph_accel::data_dir::forget_build_path();
-    let Extension { name, register, shaders, params_structs, commands } = extension;
-    let _ = PROGRAM.set(Program { register, shaders, params_structs });
+    let Extension { name, register, shaders, commands } = extension;
+    let _ = PROGRAM.set(Program { register, shaders });
     let mut command = Cli::command().name(name).bin_name(name);
     let about = command.get_about().cloned();
     for c in &commands {

@@ -7,8 +7,9 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
+use crate::block::{ParamBlock, block_defines, block_params, no_rebuild_block_changed};
 use crate::format::TargetFormat;
-use crate::params::{ParamSpec, Params};
+use crate::params::{ParamKind, ParamSpec, ParamValue, Params};
 
 /// How a pass uses a port.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -171,9 +172,15 @@ pub trait PassDecl: Send + Sync {
     /// One line saying what the pass does and which paper section it follows.
     fn summary(&self) -> &'static str;
 
-    /// Declared parameters.
-    fn params(&self) -> Vec<ParamSpec> {
+    /// The blocks of settings the kind takes, in order ([`crate::block`]): its parameters,
+    /// `#if` names and in-place rule are derived from them unless it says otherwise.
+    fn blocks(&self) -> Vec<ParamBlock> {
         Vec::new()
+    }
+
+    /// Declared parameters: those of [`Self::blocks`].
+    fn params(&self) -> Vec<ParamSpec> {
+        block_params(&self.blocks())
     }
 
     /// Ports, which may depend on parameters (an isosurface raycaster also writes `hit`).
@@ -206,10 +213,48 @@ pub trait PassDecl: Send + Sync {
         self.shaders(params)
     }
 
+    /// The generated WGSL structs of the uniform blocks its shader uses declare
+    /// ([`UniformLayout::import`]), as `(params/NAME.wgsl, text)`: gathered from its uses at the
+    /// default parameters, at each value of each choice and flag, with every optional input
+    /// wired. A kind whose uses depend on numbers alone adds what those reach.
+    fn uniform_imports(&self) -> Vec<(String, String)> {
+        let specs = self.params();
+        let defaults = Params::defaults(&specs);
+        let mut variants = vec![defaults.clone()];
+        for spec in &specs {
+            let values: Vec<ParamValue> = match &spec.kind {
+                ParamKind::Bool { default } => vec![ParamValue::Bool(!default)],
+                ParamKind::Choice { options, .. } => {
+                    options.iter().map(|o| ParamValue::Choice(o.to_string())).collect()
+                }
+                _ => Vec::new(),
+            };
+            for value in values {
+                let mut params = defaults.clone();
+                params.set(spec.name, value);
+                variants.push(params);
+            }
+        }
+        let mut imports: Vec<(String, String)> = Vec::new();
+        for params in &variants {
+            let optional: Vec<&str> =
+                self.ports(params).iter().filter(|p| !p.required && p.is_input()).map(|p| p.name).collect();
+            let uses = [self.shaders(params), self.shaders_wired(params, &optional)].concat();
+            for uniform in uses.iter().flat_map(|u| &u.uniforms) {
+                let import = (uniform.import)();
+                if !imports.iter().any(|(path, _)| *path == import.0) {
+                    imports.push(import);
+                }
+            }
+        }
+        imports
+    }
+
     /// The `#if` names its shaders are assembled with for these parameters (the scene effects it
-    /// specializes for), so tools that walk the shaders see exactly what the GPU compiles.
-    fn shader_defines(&self, _params: &Params) -> Vec<&'static str> {
-        Vec::new()
+    /// specializes for), so tools that walk the shaders see exactly what the GPU compiles: those
+    /// its [`Self::blocks`] imply.
+    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
+        block_defines(&self.blocks(), params)
     }
 
     /// Checks a module of one of its declared shader uses against what this kind declares
@@ -272,11 +317,24 @@ pub trait PassDecl: Send + Sync {
         old.iter().zip(new.iter()).all(|((name, a), (_, b))| a == b || carried(name))
     }
 
+    /// Whether the edit from `old` to `new` changes only values of [`crate::block::OnChange::InPlace`] blocks:
+    /// no [`crate::block::OnChange::Rebuild`] block changed, and the shader uses, `#if` names and ports are the
+    /// same (a mode switch that picks another entry point or define rebuilds, whatever block
+    /// holds it). The default of [`Self::updates_in_place`] for a kind that lists blocks.
+    fn only_in_place_blocks_change(&self, old: &Params, new: &Params) -> bool {
+        no_rebuild_block_changed(&self.blocks(), old, new)
+            && self.shader_defines(old) == self.shader_defines(new)
+            && self.ports(old) == self.ports(new)
+            && self.shaders(old) == self.shaders(new)
+    }
+
     /// Whether a node built with `old` parameters can take `new` ones through
     /// the node's `update_params` (uniform values) instead of being rebuilt (pipeline changes:
     /// a mode switch, a workgroup size). A parameter edit in the viewer then rebuilds nothing.
-    fn updates_in_place(&self, _old: &Params, _new: &Params) -> bool {
-        false
+    /// Derived from [`Self::blocks`] ([`Self::only_in_place_blocks_change`]); false for a kind
+    /// that lists none.
+    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
+        !self.blocks().is_empty() && self.only_in_place_blocks_change(old, new)
     }
 }
 
@@ -347,7 +405,7 @@ impl ShaderUse {
 }
 
 /// A uniform block as a node uploads it: the global it is bound to, its members `(name, WGSL
-/// scalar type)` at 4-byte offsets in order, the parameters it is made of and how its bytes
+/// type)` at WGSL's uniform offsets in order, the parameters it is made of and how its bytes
 /// are made from them — what a `pass_params!` struct declares (`Name::bound_as(global)`).
 /// Enough for the runtime to create, fill and rewrite the buffer
 /// (`volgraph_core::runtime::UniformBlocks`) and to tell an edit that only changes uniform
@@ -362,6 +420,9 @@ pub struct UniformLayout {
     pub params: Vec<&'static str>,
     /// The block's bytes for a pass's parameters (padded to 16).
     pub bytes: fn(&Params) -> Vec<u8>,
+    /// The WGSL struct as a generated shader file `(params/NAME.wgsl, text)` the shader may
+    /// import: what [`KindLookup::uniform_imports`] gathers from the kinds that declare it.
+    pub import: fn() -> (String, String),
 }
 
 impl PartialEq for UniformLayout {
@@ -393,6 +454,21 @@ pub trait KindLookup {
         effects.sort_unstable();
         effects.dedup();
         effects
+    }
+
+    /// The generated WGSL structs every kind's uniform blocks declare
+    /// ([`PassDecl::uniform_imports`]), sorted by path, each once: the `params/NAME.wgsl` files
+    /// shaders import (`ShaderSources::with_generated`), from what the kinds declare.
+    fn uniform_imports(&self) -> Vec<(String, String)> {
+        let mut imports: Vec<(String, String)> = self
+            .kind_names()
+            .into_iter()
+            .filter_map(|kind| self.decl(kind))
+            .flat_map(|decl| decl.uniform_imports())
+            .collect();
+        imports.sort();
+        imports.dedup_by(|a, b| a.0 == b.0);
+        imports
     }
 }
 

@@ -16,10 +16,13 @@
 //!   enum (its names in the graph file), the variant's index as a `u32` on the GPU;
 //! - `name: f32 = computed, "doc";` — no parameter: a number the node computes (a count derived
 //!   from the volume) that still has its place in the uniform block; `from_params` sets 0.
-//!   Numbers only (`f32`, `u32`, `i32`): a computed flag or choice does not compile.
+//!   Numbers (`f32`, `u32`, `i32`) and vectors of them (`[u32; 4]` is a `vec4<u32>`, `[f32; 2]`
+//!   a `vec2<f32>`): a computed flag or choice does not compile.
 //!
-//! All are 4 bytes on the GPU, so the struct has no padding inside and its layout is the
-//! declaration order.
+//! The bytes follow WGSL's uniform layout ([`UniformMember`]: scalars 4 bytes apart, a `vec2`
+//! aligned to 8, a `vec3` and a `vec4` to 16), so a block the node fills itself — a screen
+//! rectangle, a brick pool's grid — is declared here too, its Rust struct, WGSL struct and
+//! plan-time layout check from the one list.
 //!
 //! A block several pass kinds share (the raycasters' sampling, shading, isosurface blocks) is
 //! declared once and listed whole by each kind that takes it (`[A::specs(), B::specs()].concat()`).
@@ -104,7 +107,12 @@ macro_rules! pass_params {
         $crate::pass_params!(@fields [$(#[$meta])*] [$vis] $name [] $($body)*);
     };
 
-    // Each field line, normalized to `[field, type, form, (default), (range), doc]`.
+    // Each field line, normalized to `[field, type, form, (default), (range), doc]` (the type
+    // one token tree: `f32`, `Mode` or `[u32; 4]`).
+    (@fields $m:tt $v:tt $name:ident [$($done:tt)*]
+        $field:ident : [$elem:ident; $n:literal] = computed, $doc:literal; $($rest:tt)*) => {
+        $crate::pass_params!(@fields $m $v $name [$($done)* [$field, [$elem; $n], computed, (), (), $doc]] $($rest)*);
+    };
     (@fields $m:tt $v:tt $name:ident [$($done:tt)*]
         $field:ident : bool = $d:literal, $doc:literal; $($rest:tt)*) => {
         $crate::pass_params!(@fields $m $v $name [$($done)* [$field, bool, flag, ($d), (), $doc]] $($rest)*);
@@ -123,7 +131,7 @@ macro_rules! pass_params {
     };
 
     (@fields [$($meta:tt)*] [$vis:vis] $name:ident
-        [$( [$field:ident, $ty:ident, $form:ident, $d:tt, $range:tt, $doc:literal] )*]) => {
+        [$( [$field:ident, $ty:tt, $form:ident, $d:tt, $range:tt, $doc:literal] )*]) => {
         $($meta)*
         #[derive(Clone, Copy, Debug, PartialEq)]
         $vis struct $name {
@@ -152,16 +160,24 @@ macro_rules! pass_params {
                 Self { $( $field: $crate::pass_params!(@get $form, $ty, p, stringify!($field)), )* }
             }
 
+            /// This struct as a [`ParamBlock`]($crate::block::ParamBlock) a kind lists
+            /// ([`PassDecl::blocks`]($crate::PassDecl::blocks)), implying no `#if` name until
+            /// [`with_defines`]($crate::block::ParamBlock::with_defines) says which.
+            pub fn block(on_change: $crate::block::OnChange) -> $crate::block::ParamBlock {
+                $crate::block::ParamBlock { name: stringify!($name), specs: Self::specs, defines: |_| Vec::new(), on_change }
+            }
+
             /// The block's values when the pass declares it (a block shared by several kinds
             /// is declared whole or not at all), else `None`.
             pub fn try_from_params(p: &$crate::Params) -> Option<Self> {
                 Self::specs().iter().all(|s| p.declares(s.name)).then(|| Self::from_params(p))
             }
 
-            /// The values as a uniform buffer's bytes, zero-padded to a multiple of 16.
+            /// The values as a uniform buffer's bytes at WGSL's offsets, zero-padded to a
+            /// multiple of 16.
             pub fn uniform_bytes(&self) -> Vec<u8> {
                 let mut bytes = Vec::with_capacity(16);
-                $( bytes.extend_from_slice(&$crate::pass_params!(@bytes $form, $ty, self.$field)); )*
+                $( $crate::pass_params!(@put $form, $ty, self.$field, bytes); )*
                 bytes.resize(bytes.len().div_ceil(16).max(1) * 16, 0);
                 bytes
             }
@@ -169,6 +185,11 @@ macro_rules! pass_params {
             /// The `(name, WGSL type)` of each member, in order.
             pub fn wgsl_fields() -> Vec<(&'static str, &'static str)> {
                 vec![ $( (stringify!($field), $crate::pass_params!(@wgsl $form, $ty)), )* ]
+            }
+
+            /// Each member's doc line, in order (the comments of the generated WGSL struct).
+            pub fn wgsl_docs() -> Vec<&'static str> {
+                vec![ $( $doc, )* ]
             }
 
             /// Checks that the struct `wgsl_name` of the assembled shader `source` has these
@@ -180,7 +201,7 @@ macro_rules! pass_params {
             /// The WGSL struct the shader declares for these parameters (same name, same
             /// fields in the same order, padded to 16 bytes).
             pub fn wgsl_struct() -> String {
-                $crate::declare::wgsl_struct_text(stringify!($name), &Self::wgsl_fields())
+                $crate::declare::wgsl_struct_text(stringify!($name), &Self::wgsl_fields(), &Self::wgsl_docs())
             }
 
             /// This block as the uniform `global` of a [`ShaderUse`]($crate::ShaderUse): the
@@ -201,7 +222,13 @@ macro_rules! pass_params {
                 params: Vec<&'static str>,
                 bytes: fn(&$crate::Params) -> Vec<u8>,
             ) -> $crate::decl::UniformLayout {
-                $crate::decl::UniformLayout { global, fields: Self::wgsl_fields(), params, bytes }
+                $crate::decl::UniformLayout {
+                    global,
+                    fields: Self::wgsl_fields(),
+                    params,
+                    bytes,
+                    import: Self::wgsl_import,
+                }
             }
 
             /// `(path, text)` of [`Self::wgsl_struct`] as a generated shader file, which shaders
@@ -221,13 +248,13 @@ macro_rules! pass_params {
     };
     // A count a shader may use in signed arithmetic (loop bounds around a pixel): declared and
     // checked as an unsigned parameter, uploaded as i32.
-    (@spec $v:ident, number, $ty:ident, $n:expr, ($d:literal), ($lo:literal, $hi:literal), $doc:expr) => {
+    (@spec $v:ident, number, $ty:tt, $n:expr, ($d:literal), ($lo:literal, $hi:literal), $doc:expr) => {
         $v.push($crate::ParamSpec::uint($n, $d as u64, $lo as u64, $hi as u64, $doc))
     };
     (@spec $v:ident, flag, bool, $n:expr, ($d:literal), (), $doc:expr) => {
         $v.push($crate::ParamSpec::boolean($n, $d, $doc))
     };
-    (@spec $v:ident, choice, $ty:ident, $n:expr, ($d:ident), (), $doc:expr) => {
+    (@spec $v:ident, choice, $ty:tt, $n:expr, ($d:ident), (), $doc:expr) => {
         $v.push($crate::ParamSpec::choice(
             $n,
             $crate::declare::ParamChoice::name($ty::$d),
@@ -235,41 +262,103 @@ macro_rules! pass_params {
             $doc,
         ))
     };
-    (@spec $v:ident, computed, $ty:ident, $n:expr, (), (), $doc:expr) => {};
+    (@spec $v:ident, computed, $ty:tt, $n:expr, (), (), $doc:expr) => {};
 
     (@get number, f32, $p:expr, $n:expr) => { $p.float($n) as f32 };
     (@get number, f64, $p:expr, $n:expr) => { $p.float($n) };
     (@get number, u32, $p:expr, $n:expr) => { $p.uint($n) as u32 };
     (@get number, i32, $p:expr, $n:expr) => { $p.uint($n) as i32 };
     (@get flag, bool, $p:expr, $n:expr) => { $p.boolean($n) };
-    (@get choice, $ty:ident, $p:expr, $n:expr) => {
+    (@get choice, $ty:tt, $p:expr, $n:expr) => {
         // The compiler checked the name against NAMES; unchecked values read as the first.
         <$ty as $crate::declare::ParamChoice>::from_name($p.choice($n))
             .unwrap_or(<$ty as $crate::declare::ParamChoice>::VALUES[0])
     };
-    (@get computed, $ty:ident, $p:expr, $n:expr) => { <$ty>::default() };
+    (@get computed, $ty:tt, $p:expr, $n:expr) => { <$ty>::default() };
 
-    (@bytes flag, $ty:ident, $e:expr) => { u32::from($e).to_le_bytes() };
-    (@bytes choice, $ty:ident, $e:expr) => { ($crate::declare::ParamChoice::index($e) as u32).to_le_bytes() };
-    (@bytes $form:ident, f64, $e:expr) => { ($e as f32).to_le_bytes() };
-    (@bytes $form:ident, $ty:ident, $e:expr) => { $e.to_le_bytes() };
+    (@put choice, $ty:tt, $e:expr, $bytes:ident) => {
+        $crate::declare::UniformMember::put(&($crate::declare::ParamChoice::index($e) as u32), &mut $bytes)
+    };
+    (@put $form:ident, $ty:tt, $e:expr, $bytes:ident) => { $crate::declare::UniformMember::put(&$e, &mut $bytes) };
 
-    (@wgsl flag, $ty:ident) => { "u32" };
-    (@wgsl choice, $ty:ident) => { "u32" };
-    (@wgsl $form:ident, f64) => { "f32" };
-    (@wgsl $form:ident, $ty:ident) => { stringify!($ty) };
+    (@wgsl choice, $ty:tt) => { "u32" };
+    (@wgsl $form:ident, $ty:tt) => { <$ty as $crate::declare::UniformMember>::WGSL };
 }
 
-/// The WGSL text of a parameter struct: `struct NAME { a: f32, b: u32, _pad0: f32, ... }`,
-/// padded to 16 bytes.
-pub fn wgsl_struct_text(name: &str, fields: &[(&str, &str)]) -> String {
-    let mut s = format!("struct {name} {{\n");
-    for (field, ty) in fields {
-        s.push_str(&format!("    {field}: {ty},\n"));
+/// A member of a uniform block as WGSL lays it out: its type's name, alignment and bytes. The
+/// scalars a parameter can be (`f64` goes up as `f32`, `bool` as a `u32` 0 or 1) and vectors of
+/// 2–4 `f32`, `u32` or `i32` (`[u32; 4]` is a `vec4<u32>`).
+pub trait UniformMember {
+    /// The WGSL type, e.g. `vec4<u32>`.
+    const WGSL: &'static str;
+    /// Alignment in a uniform block, in bytes.
+    const ALIGN: usize;
+    /// The member's bytes (little-endian), without padding.
+    fn le_bytes(&self) -> Vec<u8>;
+    /// Appends the member to `bytes` at its aligned offset.
+    fn put(&self, bytes: &mut Vec<u8>) {
+        bytes.resize(bytes.len().next_multiple_of(Self::ALIGN), 0);
+        bytes.extend_from_slice(&self.le_bytes());
     }
-    let padded = fields.len().div_ceil(4).max(1) * 4;
-    for i in fields.len()..padded {
-        s.push_str(&format!("    _pad{}: f32,\n", i - fields.len()));
+}
+
+macro_rules! scalar_members {
+    ($($ty:ty => $wgsl:literal as $up:ty),* $(,)?) => {$(
+        impl UniformMember for $ty {
+            const WGSL: &'static str = $wgsl;
+            const ALIGN: usize = 4;
+            fn le_bytes(&self) -> Vec<u8> {
+                (<$up>::from(*self)).to_le_bytes().to_vec()
+            }
+        }
+    )*};
+}
+
+scalar_members!(f32 => "f32" as f32, u32 => "u32" as u32, i32 => "i32" as i32, bool => "u32" as u32);
+
+impl UniformMember for f64 {
+    const WGSL: &'static str = "f32";
+    const ALIGN: usize = 4;
+    fn le_bytes(&self) -> Vec<u8> {
+        (*self as f32).to_le_bytes().to_vec()
+    }
+}
+
+macro_rules! vector_members {
+    ($($elem:ty, $n:literal => $wgsl:literal, $align:literal;)*) => {$(
+        impl UniformMember for [$elem; $n] {
+            const WGSL: &'static str = $wgsl;
+            const ALIGN: usize = $align;
+            fn le_bytes(&self) -> Vec<u8> {
+                self.iter().flat_map(|v| v.to_le_bytes()).collect()
+            }
+        }
+    )*};
+}
+
+vector_members! {
+    f32, 2 => "vec2<f32>", 8; f32, 3 => "vec3<f32>", 16; f32, 4 => "vec4<f32>", 16;
+    u32, 2 => "vec2<u32>", 8; u32, 3 => "vec3<u32>", 16; u32, 4 => "vec4<u32>", 16;
+    i32, 2 => "vec2<i32>", 8; i32, 3 => "vec3<i32>", 16; i32, 4 => "vec4<i32>", 16;
+}
+
+/// The WGSL text of a parameter struct: `struct NAME { a: f32, b: u32, _pad0: f32, ... }`, each
+/// member under its doc line as a comment (`docs`, one per field, or none), padded with `f32`s
+/// to a multiple of 16 bytes at WGSL's uniform offsets.
+pub fn wgsl_struct_text(name: &str, fields: &[(&str, &str)], docs: &[&str]) -> String {
+    let mut s = format!("struct {name} {{\n");
+    let mut end = 0u32;
+    for (i, (field, ty)) in fields.iter().enumerate() {
+        if let Some(doc) = docs.get(i) {
+            s.push_str(&format!("    // {doc}\n"));
+        }
+        s.push_str(&format!("    {field}: {ty},\n"));
+        let (align, size) = member_layout(ty).unwrap_or((4, 4));
+        end = end.next_multiple_of(align) + size;
+    }
+    let padded = end.div_ceil(16).max(1) * 16;
+    for i in 0..(padded - end) / 4 {
+        s.push_str(&format!("    _pad{i}: f32,\n"));
     }
     s.push('}');
     s
@@ -407,7 +496,10 @@ mod tests {
         assert_eq!(bytes.len(), 16);
         assert_eq!(&bytes[4..8], &4u32.to_le_bytes());
         let wgsl = Knobs::wgsl_struct();
-        assert_eq!(wgsl, "struct Knobs {\n    strength: f32,\n    taps: u32,\n    _pad0: f32,\n    _pad1: f32,\n}");
+        assert_eq!(
+            wgsl,
+            "struct Knobs {\n    // how strong\n    strength: f32,\n    // how many\n    taps: u32,\n    _pad0: f32,\n    _pad1: f32,\n}"
+        );
         let fields = [("strength", "f32"), ("taps", "u32")];
         assert_eq!(super::check_wgsl_struct(&wgsl, "Knobs", &fields), Ok(()));
         let swapped = "struct Knobs { taps: u32, strength: f32 }";
@@ -435,6 +527,45 @@ mod tests {
         );
         let unknown = super::check_wgsl_struct(wgsl, "Block", &[("m", "mat4x4<f32>")]).expect_err("a matrix");
         assert!(unknown.contains("does not describe"), "{unknown}");
+    }
+}
+
+#[cfg(test)]
+mod vector_tests {
+    crate::pass_params! {
+        /// A block a node fills itself, vectors among its members.
+        pub struct Screen {
+            size: f32 = computed, "splat edge";
+            rect: [u32; 4] = computed, "screen rectangle";
+            uv: [f32; 2] = computed, "a texture coordinate";
+            tint: [f32; 3] = computed, "a colour";
+            gain: f32 = 1.0, 0.0..=2.0, "a parameter after them";
+        }
+    }
+
+    #[test]
+    fn vector_members_sit_at_wgsl_uniform_offsets_in_bytes_struct_and_layout() {
+        let block = Screen { size: 2.0, rect: [1, 2, 3, 4], uv: [0.5, 0.25], tint: [1.0, 2.0, 3.0], gain: 1.5 };
+        let bytes = block.uniform_bytes();
+        // size 0, rect 16 (vec4 aligns to 16), uv 32, tint 48 (vec3 aligns to 16), gain 60.
+        assert_eq!(bytes.len(), 64);
+        assert_eq!(&bytes[0..4], &2.0f32.to_le_bytes());
+        assert_eq!(&bytes[16..20], &1u32.to_le_bytes());
+        assert_eq!(&bytes[28..32], &4u32.to_le_bytes());
+        assert_eq!(&bytes[36..40], &0.25f32.to_le_bytes());
+        assert_eq!(&bytes[56..60], &3.0f32.to_le_bytes());
+        assert_eq!(&bytes[60..64], &1.5f32.to_le_bytes());
+        assert_eq!(
+            Screen::wgsl_fields(),
+            [("size", "f32"), ("rect", "vec4<u32>"), ("uv", "vec2<f32>"), ("tint", "vec3<f32>"), ("gain", "f32")]
+        );
+        // The generated struct is what the layout check accepts, and naga lays it out as the bytes.
+        let wgsl = Screen::wgsl_struct();
+        assert_eq!(Screen::check_shader(&wgsl, "Screen"), Ok(()), "{wgsl}");
+        assert!(!wgsl.contains("_pad"), "64 bytes need no padding: {wgsl}");
+        assert_eq!(Screen::specs().len(), 1, "only gain is a parameter");
+        let layout = Screen::bound_as("screen");
+        assert_eq!((layout.import)(), ("params/Screen.wgsl".to_string(), wgsl));
     }
 }
 

@@ -9,6 +9,7 @@
 //! scheduling) → [`plan::Plan`] → [`compile::check_plan_bindings`] (shaders against ports).
 
 pub mod binding_rules;
+pub mod block;
 pub mod compile;
 pub mod cut_effects;
 pub mod decl;

@@ -162,6 +162,11 @@ impl Params {
         v
     }
 
+    /// The value of `name`, `None` where the pass does not declare it (comparing blocks).
+    pub fn value(&self, name: &str) -> Option<&ParamValue> {
+        self.values.get(name)
+    }
+
     /// Whether the pass declares parameter `name` (a shared block's `try_from_params`).
     pub fn declares(&self, name: &str) -> bool {
         self.values.contains_key(name)

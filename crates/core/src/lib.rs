@@ -8,8 +8,8 @@
 //! scheduling) → [`plan::Plan`] → [`runtime::Runtime::apply`] → frames submitted by the runtime.
 
 pub use volgraph_compiler::{
-    binding_rules, compile, cut_effects, declare, diagnostic, format, graph, param_choice, params, pass_params, plan,
-    reflect, shader_check, shader_source, suggest, terminal,
+    binding_rules, block, compile, cut_effects, declare, diagnostic, format, graph, param_choice, params, pass_params,
+    plan, reflect, shader_check, shader_source, suggest, terminal,
 };
 pub mod plugin;
 pub mod runtime;

@@ -8,40 +8,36 @@
 //! baseline. Its raycast parameters (step, threshold, mode, isovalue, shading, step back) must
 //! be the raycaster's: share them through Scalar inputs. Shader: `shaders/antialias.wgsl`.
 
-use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+use crate::effects::effect_block;
+use crate::raycast_params::raycast_blocks;
+use volgraph_compiler::block::{OnChange, ParamBlock};
+use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
 use volgraph_core::{PassNode, PassPlugin};
 
 use volgraph_compiler::declare::ParamChoice;
 
-use crate::effects::{EffectFlags, EffectState, effect_defines, effect_shader_uses, same_effects};
-use crate::raycast_params::{RaycastParamsGpu, Sampling, is_iso, raycast_param_specs};
+use crate::effects::{EffectState, effect_shader_uses};
+use crate::raycast_params::{RaycastParamsGpu, Sampling, is_iso};
 use crate::shared::FLOAT_TARGETS;
 
 /// The plugin.
 pub struct Antialias;
 
-/// Rust twin of `AaParams` in `shaders/antialias.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct AaParamsGpu {
-    contrast: f32,
-    pattern: u32,
-    directions: u32,
-    full: u32,
+volgraph_compiler::pass_params! {
+    /// The `aa` block of `shaders/antialias.wgsl` (which imports it), made from [`AaOwn`].
+    struct AaParams {
+        contrast: f32 = computed, "Colour difference to a 4-neighbour that flags a pixel.";
+        pattern: u32 = computed, "2: 2x, 4: 4x regular, 5: 4x rotated grid.";
+        directions: u32 = computed, "0: linear, 1: bilinear, 2: exact.";
+        full: u32 = computed, "1: every pixel (full-scene super-sampling).";
+    }
 }
 
-const _: () = assert!(std::mem::size_of::<AaParamsGpu>() == 16);
-
 /// The block as the shader use declares it (bound as `aa`), so the plan checks the WGSL struct
-/// `AaParams` member by member; the node writes it itself.
+/// member by member; the node writes it itself.
 fn aa_layout() -> volgraph_compiler::UniformLayout {
-    volgraph_compiler::UniformLayout {
-        global: "aa",
-        fields: vec![("contrast", "f32"), ("pattern", "u32"), ("directions", "u32"), ("full", "u32")],
-        params: Vec::new(),
-        bytes: |p| bytemuck::bytes_of(&AaParamsGpu::from_params(p)).to_vec(),
-    }
+    AaParams::bound_as_with("aa", Vec::new(), |p| AaParams::of(p).uniform_bytes())
 }
 
 volgraph_compiler::param_choice! {
@@ -70,8 +66,8 @@ volgraph_compiler::pass_params! {
     }
 }
 
-impl AaParamsGpu {
-    fn from_params(p: &Params) -> Self {
+impl AaParams {
+    fn of(p: &Params) -> Self {
         let own = AaOwn::from_params(p);
         Self {
             contrast: own.contrast,
@@ -117,10 +113,10 @@ impl PassDecl for Antialias {
         "selective super-sampling where a pixel differs from a 4-neighbour; 2x, 4x, rotated grid (Klein et al. 2005 §5)"
     }
 
-    fn params(&self) -> Vec<ParamSpec> {
+    fn blocks(&self) -> Vec<ParamBlock> {
         // The sub-pixel rays march like the raycaster's, scene effects included (wire the same
-        // features to both).
-        [raycast_param_specs(), EffectFlags::specs(), AaOwn::specs()].concat()
+        // features to both); the node rewrites both uniforms in place.
+        [raycast_blocks(OnChange::InPlace), vec![effect_block(), AaOwn::block(OnChange::InPlace)]].concat()
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -133,16 +129,8 @@ impl PassDecl for Antialias {
         ]
     }
 
-    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        effect_defines(params)
-    }
-
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
         [vec![shader(params)], effect_shader_uses(params)].concat()
-    }
-
-    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        is_iso(old) == is_iso(new) && same_effects(old, new)
     }
 }
 
@@ -154,7 +142,7 @@ impl PassPlugin for Antialias {
             ..RenderPipelineSpec::fullscreen(&shader(ctx.params))
         })?;
         let params = ctx.uniform_from_bytes("params", &ray_block(ctx.params).uniform_bytes());
-        let aa = ctx.uniform_with("aa", &AaParamsGpu::from_params(ctx.params));
+        let aa = ctx.uniform_from_bytes("aa", &AaParams::of(ctx.params).uniform_bytes());
         let effects = EffectState::new(ctx)?;
         let step_voxels = Sampling::from_params(ctx.params).step_voxels;
         Ok(Box::new(AntialiasNode { pipeline, params, aa, effects, step_voxels }))
@@ -181,7 +169,7 @@ impl PassNode for AntialiasNode {
 
     fn update_params(&mut self, gpu: &Gpu, params: &Params) {
         gpu.queue.write_buffer(&self.params, 0, &ray_block(params).uniform_bytes());
-        gpu.queue.write_buffer(&self.aa, 0, bytemuck::bytes_of(&AaParamsGpu::from_params(params)));
+        gpu.queue.write_buffer(&self.aa, 0, &AaParams::of(params).uniform_bytes());
         self.step_voxels = Sampling::from_params(params).step_voxels;
         self.effects.invalidate();
     }

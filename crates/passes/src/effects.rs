@@ -52,6 +52,12 @@ impl EffectFlags {
     }
 }
 
+/// The effect switches as a block: each turns its `#if` on; a change rebuilds the node (its
+/// pre-integration table is made with it).
+pub fn effect_block() -> volgraph_compiler::block::ParamBlock {
+    EffectFlags::block(volgraph_compiler::block::OnChange::Rebuild).with_defines(|p| EffectFlags::of(p).defines())
+}
+
 /// The shader uses the effects add to a raycaster's own: the pre-integration table's compute
 /// pipelines when `preintegration` is on (one of the two is built, by what the device filters).
 pub fn effect_shader_uses(params: &Params) -> Vec<volgraph_compiler::ShaderUse> {
@@ -62,15 +68,8 @@ pub fn effect_shader_uses(params: &Params) -> Vec<volgraph_compiler::ShaderUse> 
     }
 }
 
-/// The `#if` names of the effects `params` turn on (`jitter`, a sampling parameter, is JITTER).
-pub fn effect_defines(params: &Params) -> Vec<&'static str> {
-    let mut defines = EffectFlags::of(params).defines();
-    defines.extend(jitter_defines(params));
-    defines
-}
-
-/// `JITTER` when the `jitter` parameter is on: for passes that march the raycast samples
-/// without the other effects (the segment loop, its termination test, the fetch probe).
+/// `JITTER` when the `jitter` parameter is on: the `#if`s of the sampling block
+/// (`raycast_params::sampling_block`), so every kind that takes it compiles the jitter in.
 pub fn jitter_defines(params: &Params) -> Vec<&'static str> {
     let sampling = Sampling::try_from_params(params);
     match sampling.map(|s| (s.jitter, s.jitter_per_frame)) {
@@ -78,11 +77,6 @@ pub fn jitter_defines(params: &Params) -> Vec<&'static str> {
         Some((true, false)) => vec![defines::JITTER],
         Some((true, true)) => vec![defines::JITTER, defines::JITTER_PER_FRAME],
     }
-}
-
-/// Whether two parameter sets compile the same effects (else the node is rebuilt).
-pub fn same_effects(old: &Params, new: &Params) -> bool {
-    EffectFlags::of(old) == EffectFlags::of(new) && jitter_defines(old) == jitter_defines(new)
 }
 
 /// What a raycaster node keeps for its effects: the pre-integration table when that effect is on.

@@ -33,23 +33,18 @@ impl EmptyDistance {
     }
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct DistanceParamsGpu {
-    axis: u32,
-    _pad: [u32; 3],
+volgraph_compiler::pass_params! {
+    /// The `pass_params` block of `shaders/empty_distance.wgsl` (which imports it): one per
+    /// axis, written by the node.
+    struct DistanceParams {
+        axis: u32 = computed, "0, 1, 2: the axis this dispatch runs along.";
+    }
 }
 
 /// The pass's one entry point, declared once for `shaders()` and `create`.
 fn shader() -> ShaderUse {
     ShaderUse::new("empty_distance.wgsl", "cs_line").binds(&["partial", "distance"]).uniform(
-        volgraph_compiler::UniformLayout {
-            global: "pass_params",
-            fields: vec![("axis", "u32")],
-            params: Vec::new(),
-            // One block per axis, written by the node (`DistanceParamsGpu`).
-            bytes: |_| bytemuck::bytes_of(&DistanceParamsGpu { axis: 0, _pad: [0; 3] }).to_vec(),
-        },
+        DistanceParams::bound_as_with("pass_params", Vec::new(), |_| DistanceParams { axis: 0 }.uniform_bytes()),
     )
 }
 
@@ -88,7 +83,7 @@ impl PassPlugin for EmptyDistance {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec::of(&shader()))?;
         let axes = [0u32, 1, 2]
-            .map(|axis| ctx.uniform_with(&format!("axis{axis}"), &DistanceParamsGpu { axis, _pad: [0; 3] }));
+            .map(|axis| ctx.uniform_from_bytes(&format!("axis{axis}"), &DistanceParams { axis }.uniform_bytes()));
         Ok(Box::new(EmptyDistanceNode { pipeline, axes, textures: None, tap: self.tap.clone() }))
     }
 }

@@ -8,7 +8,8 @@
 //! new TF takes effect in the next frame and a steady one costs nothing. Shader:
 //! `shaders/empty_space.wgsl`.
 
-use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, Rerun, ShaderUse};
+use volgraph_compiler::block::{OnChange, ParamBlock};
+use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, Rerun, ShaderUse};
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
 use volgraph_core::{PassNode, PassPlugin};
 
@@ -93,12 +94,10 @@ impl PassDecl for EmptySpace {
         ]
     }
 
-    fn params(&self) -> Vec<ParamSpec> {
-        ClassifySettings::specs()
-    }
-
-    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        if ClassifySettings::from_params(params).segments { vec![crate::defines::SEGMENTS] } else { Vec::new() }
+    fn blocks(&self) -> Vec<ParamBlock> {
+        vec![ClassifySettings::block(OnChange::Rebuild).with_defines(|p| {
+            if ClassifySettings::from_params(p).segments { vec![crate::defines::SEGMENTS] } else { Vec::new() }
+        })]
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {

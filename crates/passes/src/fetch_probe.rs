@@ -7,12 +7,14 @@
 //! average-intensity projection) to `color`, and with `count_samples` the samples it took to
 //! `samples`. Shader: `shaders/fetch_probe.wgsl`.
 
-use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+use crate::raycast_params::sampling_block;
+use volgraph_compiler::block::{OnChange, ParamBlock};
+use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
 use volgraph_core::{PassNode, PassPlugin};
 
 use crate::march::SAMPLE_ROWS;
-use crate::raycast_params::{RaycastParamsGpu, Sampling, Workgroup};
+use crate::raycast_params::{RaycastParamsGpu, Workgroup};
 
 /// The plugin.
 pub struct FetchProbe;
@@ -39,8 +41,8 @@ impl PassDecl for FetchProbe {
         "fetch ceiling: every raycast sample along each pixel's ray, no classification or compositing (benchmarks)"
     }
 
-    fn params(&self) -> Vec<ParamSpec> {
-        [Sampling::specs(), Counting::specs(), Workgroup::specs()].concat()
+    fn blocks(&self) -> Vec<ParamBlock> {
+        vec![sampling_block(OnChange::InPlace), Counting::block(OnChange::Rebuild), Workgroup::block(OnChange::Rebuild)]
     }
 
     fn ports(&self, params: &Params) -> Vec<PortSpec> {
@@ -57,12 +59,6 @@ impl PassDecl for FetchProbe {
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
         vec![shader(params)]
     }
-
-    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        Workgroup::from_params(old) == Workgroup::from_params(new)
-            && Counting::from_params(old) == Counting::from_params(new)
-            && crate::effects::jitter_defines(old) == crate::effects::jitter_defines(new)
-    }
 }
 
 impl PassPlugin for FetchProbe {
@@ -71,7 +67,7 @@ impl PassPlugin for FetchProbe {
         let counted = Counting::from_params(ctx.params).count_samples;
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
             constants: &[("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)],
-            defines: &crate::effects::jitter_defines(ctx.params),
+            defines: &self.shader_defines(ctx.params),
             ..ComputePipelineSpec::of(&shader(ctx.params))
         })?;
         let params = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());

@@ -11,7 +11,8 @@
 //! the frame block holds the same polygon grown, for the draw). Reads the splats' `splats`
 //! start target, writes `start`. Shader: `shaders/hole_fill.wgsl`.
 
-use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+use volgraph_compiler::block::{OnChange, ParamBlock};
+use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{
     CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec, UniformBlocks,
 };
@@ -55,8 +56,9 @@ impl PassDecl for HoleFill {
         "pixels without a reprojected start, or near the silhouette, begin at the box's front faces (Klein et al. 2005 §4.4)"
     }
 
-    fn params(&self) -> Vec<ParamSpec> {
-        HoleParams::specs()
+    fn blocks(&self) -> Vec<ParamBlock> {
+        // A uniform the node rewrites (`UniformBlocks`).
+        vec![HoleParams::block(OnChange::InPlace)]
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -68,10 +70,6 @@ impl PassDecl for HoleFill {
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         vec![shader()]
-    }
-
-    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        self.only_uniforms_change(old, new)
     }
 }
 

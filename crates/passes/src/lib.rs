@@ -31,6 +31,7 @@ pub mod slice_render;
 pub mod termination_test;
 pub mod tf_table;
 
+use volgraph_compiler::KindLookup;
 use volgraph_compiler::shader_source::ShaderSources;
 use volgraph_core::Registry;
 
@@ -39,20 +40,14 @@ include!(concat!(env!("OUT_DIR"), "/embedded_shaders.rs"));
 /// The built-in shaders as a source layer, compiled into the binary. Put a folder on disk in
 /// front of it ([`ShaderSources::prepend_disk`]) to read (and hot-reload) a working copy.
 pub fn builtin_shaders() -> ShaderSources {
-    ShaderSources::new().with_embedded(EMBEDDED_SHADERS).with_generated(params_structs())
+    ShaderSources::new().with_embedded(EMBEDDED_SHADERS).with_generated(uniform_imports())
 }
 
-/// The WGSL struct of every built-in `pass_params!` block a shader binds as a uniform, as the
-/// generated files `params/NAME.wgsl` the shaders import: the struct is written once, in Rust.
-pub fn params_structs() -> Vec<(String, String)> {
-    vec![
-        raycast_params::RaycastParamsGpu::wgsl_import(),
-        shared::BlockSize::wgsl_import(),
-        present::PresentParams::wgsl_import(),
-        hole_fill::HoleParams::wgsl_import(),
-        reprojection_tiles::TileBoundsParams::wgsl_import(),
-        slice_render::SliceParams::wgsl_import(),
-    ]
+/// The WGSL struct of every uniform block the built-in kinds' shader uses declare, as the
+/// generated files `params/NAME.wgsl` the shaders import: each struct is written once, in Rust
+/// (`pass_params!`), and gathered from the declarations ([`KindLookup::uniform_imports`]).
+pub fn uniform_imports() -> Vec<(String, String)> {
+    builtin_registry().uniform_imports()
 }
 
 /// Adds every built-in pass kind to `registry`.

@@ -62,10 +62,12 @@ impl MarchSettings {
     }
 }
 
-/// The parameter blocks of the shared march: its settings and the block edge of the empty-space
-/// inputs.
-pub fn march_specs() -> Vec<volgraph_compiler::ParamSpec> {
-    [MarchSettings::specs(), BlockSize::specs()].concat()
+/// The parameter blocks of the shared march: its settings (rays, leaping and counting pick
+/// the pipeline and its `#if`s: a rebuild) and the block edge of the empty-space inputs (a
+/// uniform).
+pub fn march_blocks() -> Vec<volgraph_compiler::block::ParamBlock> {
+    use volgraph_compiler::block::OnChange;
+    vec![MarchSettings::block(OnChange::Rebuild).with_defines(march_defines), BlockSize::block(OnChange::InPlace)]
 }
 
 /// The ports the shared march adds: `entry`/`dir` for raster rays, the optional empty-space
@@ -98,12 +100,6 @@ pub fn march_defines(params: &Params) -> Vec<&'static str> {
         defines.push(defines::COUNT);
     }
     defines
-}
-
-/// Whether an edit from `old` to `new` keeps the march's pipeline (only the block edge, a
-/// uniform, may change).
-pub fn same_march(old: &Params, new: &Params) -> bool {
-    MarchSettings::from_params(old) == MarchSettings::from_params(new)
 }
 
 /// Which empty-space input a node leaps with.

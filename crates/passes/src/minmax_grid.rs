@@ -6,7 +6,8 @@
 //! on the first frame (its size comes from the bound volume) and rebuilt only when the volume's
 //! content changes (`Rerun::WhenInputsChange`). Shader: `shaders/minmax_grid.wgsl`.
 
-use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, Rerun, ShaderUse};
+use volgraph_compiler::block::{OnChange, ParamBlock};
+use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, Rerun, ShaderUse};
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
 use volgraph_core::{PassNode, PassPlugin};
 
@@ -102,12 +103,13 @@ impl PassDecl for MinMaxGridPass {
         Rerun::WhenInputsChange
     }
 
-    fn params(&self) -> Vec<ParamSpec> {
-        [BlockSize::specs(), GridApron::specs()].concat()
-    }
-
-    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        if GridApron::from_params(params).tricubic { vec![crate::defines::TRICUBIC] } else { Vec::new() }
+    fn blocks(&self) -> Vec<ParamBlock> {
+        vec![
+            BlockSize::block(OnChange::Rebuild),
+            GridApron::block(OnChange::Rebuild).with_defines(|p| {
+                if GridApron::from_params(p).tricubic { vec![crate::defines::TRICUBIC] } else { Vec::new() }
+            }),
+        ]
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {

@@ -4,7 +4,8 @@
 //! A compute pass (a third of the fullscreen draw's time on llvmpipe; compute is the fast path on
 //! data-centre GPUs too). Shader: `shaders/present.wgsl`.
 
-use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+use volgraph_compiler::block::{OnChange, ParamBlock};
+use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{
     ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, UniformBlocks,
 };
@@ -39,8 +40,9 @@ impl PassDecl for Present {
         "linear premultiplied colour → 8-bit sRGB over a background, for display and PNG"
     }
 
-    fn params(&self) -> Vec<ParamSpec> {
-        PresentParams::specs()
+    fn blocks(&self) -> Vec<ParamBlock> {
+        // A uniform the node rewrites (`UniformBlocks`).
+        vec![PresentParams::block(OnChange::InPlace)]
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -52,10 +54,6 @@ impl PassDecl for Present {
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         vec![shader()]
-    }
-
-    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        self.only_uniforms_change(old, new)
     }
 }
 

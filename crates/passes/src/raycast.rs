@@ -17,16 +17,15 @@
 //! input wired, begins each ray at that estimate on the same step grid (common/leap.wgsl).
 //! Shader: `shaders/raycast.wgsl`.
 
-use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
 use volgraph_core::{PassNode, PassPlugin};
 
-use crate::effects::{EffectFlags, EffectState, effect_defines, same_effects};
-use crate::march::{
-    Leaping, MarchSettings, SAMPLE_ROWS, march_defines, march_ports, march_specs, same_march, wired_defines,
-};
-use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_param_specs};
+use crate::effects::{EffectState, effect_block};
+use crate::march::{Leaping, MarchSettings, SAMPLE_ROWS, march_blocks, march_ports, wired_defines};
+use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_blocks};
 use crate::shared::BlockSize;
+use volgraph_compiler::block::{OnChange, ParamBlock};
 
 /// The plugin.
 pub struct Raycast;
@@ -65,20 +64,16 @@ impl PassDecl for Raycast {
          Klein's start estimates and leap hits, sample counting (Krüger–Westermann 2003 §2.1–2.3; Klein et al. 2005 §4.2)"
     }
 
-    fn params(&self) -> Vec<ParamSpec> {
-        [raycast_param_specs(), EffectFlags::specs(), march_specs(), RaycastOwn::specs()].concat()
-    }
-
-    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        let mut defines = [effect_defines(params), march_defines(params)].concat();
-        let own = RaycastOwn::from_params(params);
-        if own.leaps(params) {
-            defines.extend([crate::defines::LEAP_HITS, crate::defines::FIRST_VISIBLE]);
-        }
-        if own.counts_leapable() {
-            defines.push(crate::defines::COUNT_LEAPABLE);
-        }
-        defines
+    fn blocks(&self) -> Vec<ParamBlock> {
+        // Every value but the effects and the march's settings is a uniform value; a mode or
+        // leap switch changes the entry point, the ports or the `#if`s (a rebuild).
+        [
+            raycast_blocks(OnChange::InPlace),
+            vec![effect_block()],
+            march_blocks(),
+            vec![RaycastOwn::block(OnChange::InPlace).with_defines(own_defines)],
+        ]
+        .concat()
     }
 
     fn shaders_wired(&self, params: &Params, wired: &[&str]) -> Vec<ShaderUse> {
@@ -115,17 +110,19 @@ impl PassDecl for Raycast {
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
         [vec![march_shader(params)], crate::effects::effect_shader_uses(params)].concat()
     }
+}
 
-    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        // Every parameter but the mode, the effects, the march's settings and the leap outputs
-        // is a uniform value.
-        let (a, b) = (RaycastOwn::from_params(old), RaycastOwn::from_params(new));
-        is_iso(old) == is_iso(new)
-            && same_effects(old, new)
-            && same_march(old, new)
-            && a.leaps(old) == b.leaps(new)
-            && a.counts_leapable() == b.counts_leapable()
+/// Klein's `#if`s: the leap hits (and the first visible sample they need), the leapable count.
+fn own_defines(params: &Params) -> Vec<&'static str> {
+    let own = RaycastOwn::from_params(params);
+    let mut defines = Vec::new();
+    if own.leaps(params) {
+        defines.extend([crate::defines::LEAP_HITS, crate::defines::FIRST_VISIBLE]);
     }
+    if own.counts_leapable() {
+        defines.push(crate::defines::COUNT_LEAPABLE);
+    }
+    defines
 }
 
 /// The march's entry point for `params` (DVR or iso, leap hits or not) and what it binds,

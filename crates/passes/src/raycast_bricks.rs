@@ -33,8 +33,11 @@
 //! The CPU side (slot words, leaf words, rank slabs) is [`volgraph_accel::brick_leaves`]; the
 //! atlas texture and its uploads are `raycast_bricks/atlas.rs`. Shader: `shaders/raycast_bricks.wgsl`.
 
+use crate::effects::effect_block;
+use crate::raycast_params::sampling_block;
 use std::sync::Arc;
 use std::time::Instant;
+use volgraph_compiler::block::{OnChange, ParamBlock};
 
 use glam::{DVec3, UVec3};
 use volgraph_accel::brick_leaves::{SLOTS_PER_AXIS, classify_leaves, leaf_grid, owns, slot_coord, slot_word};
@@ -42,7 +45,7 @@ use volgraph_accel::bricks::{BrickLayout, ViewPoint};
 use volgraph_accel::classify::OpacityClassifier;
 use volgraph_accel::octree::{OctreeHierarchy, OctreeVisibility};
 use volgraph_accel::volume::Volume;
-use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::upload::VolumeFormat;
 use volgraph_core::runtime::{
     ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, volume_texture_format,
@@ -50,7 +53,7 @@ use volgraph_core::runtime::{
 use volgraph_core::{PassNode, PassPlugin};
 
 use crate::brick_pool::{Batch, BrickPool};
-use crate::effects::{EffectFlags, EffectState, effect_defines, effect_shader_uses, same_effects};
+use crate::effects::{EffectFlags, EffectState, effect_shader_uses};
 use crate::raycast_params::{RaycastParamsGpu, SampleLoopChoice, Sampling, Shading, Termination, Workgroup};
 
 mod atlas;
@@ -80,18 +83,26 @@ volgraph_compiler::pass_params! {
 /// atlas's 3D texture limit allows.
 const DEFAULT_BUDGET_BYTES: u64 = 2 << 30;
 
-/// Rust twin of `struct BrickParams` in `shaders/raycast_bricks.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
-struct BrickParamsGpu {
-    grid: [u32; 4],
-    slot_side: [u32; 4],
-    leaves: [u32; 4],
-    leaf_grid: [u32; 4],
-    atlas: [f32; 4],
+volgraph_compiler::pass_params! {
+    /// The `bricks` block of `shaders/raycast_bricks.wgsl` (which imports it): the pool's state,
+    /// written by the node each frame.
+    struct BrickParams {
+        grid: [u32; 4] = computed, "Bricks per axis (xyz); w = cells per brick side.";
+        slot_side: [u32; 4] = computed,
+            "Voxels per slot and axis (xyz): brick_cells + 1 + 2·apron (voxel lo - apron first), fewer on an axis \
+             thinner than a brick; w = the apron: voxels kept on every side of the brick's own, so that every filter \
+             tap near a face reads what the whole volume holds (1: trilinear samples; +1 for shading's central \
+             differences, +2 for tricubic reconstruction).";
+        leaves: [u32; 4] = computed, "x = cells per leaf side, y = leaves per brick side.";
+        leaf_grid: [u32; 4] = computed, "Leaves per axis over the whole volume (xyz).";
+        atlas: [f32; 4] = computed, "Atlas size in texels (xyz).";
+    }
 }
 
-const _: () = assert!(std::mem::size_of::<BrickParamsGpu>() == 80);
+impl BrickParams {
+    /// Before the pool is sized.
+    const EMPTY: Self = Self { grid: [0; 4], slot_side: [0; 4], leaves: [0; 4], leaf_grid: [0; 4], atlas: [0.0; 4] };
+}
 
 impl PassDecl for RaycastBricks {
     fn honours_volume_window(&self) -> bool {
@@ -111,22 +122,19 @@ impl PassDecl for RaycastBricks {
          ray termination (Ruijters & Vilanova 2006 §5–7)"
     }
 
-    fn params(&self) -> Vec<ParamSpec> {
-        [
-            Sampling::specs(),
-            Termination::specs(),
-            EffectFlags::specs(),
+    fn blocks(&self) -> Vec<ParamBlock> {
+        // The raycasting values are a uniform; the brick settings shape the pool and the
+        // leaves, the workgroup and the sample loop the pipeline.
+        vec![
+            sampling_block(OnChange::InPlace),
+            Termination::block(OnChange::InPlace),
+            effect_block(),
             // The headlight's coefficients, which the shading effect reads.
-            Shading::specs(),
-            BrickSettings::specs(),
-            Workgroup::specs(),
-            SampleLoopChoice::specs(),
+            Shading::block(OnChange::InPlace),
+            BrickSettings::block(OnChange::Rebuild),
+            Workgroup::block(OnChange::Rebuild),
+            SampleLoopChoice::block(OnChange::Rebuild).with_defines(|p| SampleLoopChoice::defines(p, None)),
         ]
-        .concat()
-    }
-
-    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        [effect_defines(params), SampleLoopChoice::defines(params, None)].concat()
     }
 
     fn uses_gpu_memory_budget(&self) -> bool {
@@ -144,16 +152,6 @@ impl PassDecl for RaycastBricks {
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
         [vec![march_shader()], effect_shader_uses(params)].concat()
     }
-
-    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        // Only the raycasting parameters (a uniform) change in place; the brick settings
-        // shape the pool and the leaves.
-        BrickSettings::from_params(old) == BrickSettings::from_params(new)
-            && Workgroup::from_params(old) == Workgroup::from_params(new)
-            && SampleLoopChoice::from_params(old) == SampleLoopChoice::from_params(new)
-            && self.shader_defines(old) == self.shader_defines(new)
-            && same_effects(old, new)
-    }
 }
 
 /// The brick march's entry point and what it binds, declared once for `shaders()` and `create`.
@@ -164,21 +162,10 @@ fn march_shader() -> ShaderUse {
         .uniform(brick_layout())
 }
 
-/// The `bricks` block as `BrickParamsGpu` lays it out, checked against the shader's
-/// `BrickParams` when the graph is planned. The node writes it per frame (the pool's state).
+/// The `bricks` block, checked against the shader's struct when the graph is planned. The
+/// node writes it per frame (the pool's state).
 fn brick_layout() -> volgraph_compiler::UniformLayout {
-    volgraph_compiler::UniformLayout {
-        global: "bricks",
-        fields: vec![
-            ("grid", "vec4<u32>"),
-            ("slot_side", "vec4<u32>"),
-            ("leaves", "vec4<u32>"),
-            ("leaf_grid", "vec4<u32>"),
-            ("atlas", "vec4<f32>"),
-        ],
-        params: Vec::new(),
-        bytes: |_| bytemuck::bytes_of(&BrickParamsGpu::default()).to_vec(),
-    }
+    BrickParams::bound_as_with("bricks", Vec::new(), |_| BrickParams::EMPTY.uniform_bytes())
 }
 
 impl PassPlugin for RaycastBricks {
@@ -196,7 +183,7 @@ impl PassPlugin for RaycastBricks {
             ..ComputePipelineSpec::of(&march_shader())
         })?;
         let params = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());
-        let uniform = ctx.uniform_buffer("bricks", std::mem::size_of::<BrickParamsGpu>() as u64);
+        let uniform = ctx.uniform_from_bytes("bricks", &BrickParams::EMPTY.uniform_bytes());
         let brick_cells = settings.brick_cells;
         let node_cells = match settings.node_cells {
             0 => brick_cells,
@@ -505,14 +492,14 @@ impl PassNode for RaycastBricksNode {
         let atlas_slots = state.atlas.as_ref().map_or(UVec3::ONE, |a| a.slots);
         let atlas_size = (atlas_slots * state.side).as_vec3();
         let grid = state.layout.grid_dims();
-        let uniform = BrickParamsGpu {
+        let uniform = BrickParams {
             grid: [grid.x, grid.y, grid.z, self.brick_cells],
             slot_side: [state.side.x, state.side.y, state.side.z, state.apron],
             leaves: [state.octree.min_node_cells(), self.brick_cells / state.octree.min_node_cells(), 0, 0],
             leaf_grid: [state.leaf_grid.x, state.leaf_grid.y, state.leaf_grid.z, 0],
             atlas: [atlas_size.x, atlas_size.y, atlas_size.z, 0.0],
         };
-        ctx.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+        ctx.write_buffer(&self.uniform, 0, &uniform.uniform_bytes());
 
         let (w, h) = ctx.extent("color");
         if self.acc.as_ref().is_none_or(|(_, size)| *size != (w, h)) {

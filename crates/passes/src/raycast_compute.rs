@@ -20,17 +20,19 @@
 //! [`crate::march`]), so the two differ only in how pixels are scheduled. The workgroup size is
 //! a parameter (pipeline-overridable constants). Shader: `shaders/raycast_compute.wgsl`.
 
-use volgraph_compiler::{ParamSpec, Params, PassDecl, PortSpec, ShaderUse, TargetFormat};
+use volgraph_compiler::{Params, PassDecl, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
 use volgraph_core::{PassNode, PassPlugin};
 
-use crate::effects::{EffectFlags, EffectState, effect_defines, same_effects};
-use crate::march::{Leaping, MarchSettings, march_defines, march_specs, same_march, wired_defines};
+use crate::effects::{EffectFlags, EffectState, effect_block};
+use crate::march::{Leaping, MarchSettings, march_blocks, wired_defines};
 use crate::opacity_lut::{opacity_table, table_shader_uses};
 use crate::raycast::raycast_ports;
-use crate::raycast_params::{RaycastParamsGpu, SampleLoopChoice, Sampling, Workgroup, is_iso, raycast_param_specs};
+use crate::raycast_params::raycast_blocks;
+use crate::raycast_params::{RaycastParamsGpu, SampleLoopChoice, Sampling, Workgroup, is_iso};
 use crate::shared::{BlockSize, color_precision_defines};
 use crate::tf_table::TfTable;
+use volgraph_compiler::block::{OnChange, ParamBlock};
 
 /// The plugin.
 pub struct RaycastCompute;
@@ -82,25 +84,20 @@ impl PassDecl for RaycastCompute {
          pre-corrected TF table, sample counting (DirectCompute thesis RAYCASTSIMPLE_CS; Krüger–Westermann 2003 §2.1–2.3)"
     }
 
-    fn params(&self) -> Vec<ParamSpec> {
+    fn blocks(&self) -> Vec<ParamBlock> {
+        // The workgroup, the sample loop and the classification shape the pipeline.
         [
-            raycast_param_specs(),
-            EffectFlags::specs(),
-            march_specs(),
-            ComputeOwn::specs(),
-            Workgroup::specs(),
-            SampleLoopChoice::specs(),
+            raycast_blocks(OnChange::InPlace),
+            vec![effect_block()],
+            march_blocks(),
+            vec![
+                ComputeOwn::block(OnChange::Rebuild)
+                    .with_defines(|p| if uses_table(p) { vec![crate::defines::CORRECTED_TABLE] } else { vec![] }),
+                Workgroup::block(OnChange::Rebuild),
+                SampleLoopChoice::block(OnChange::Rebuild).with_defines(|p| SampleLoopChoice::defines(p, None)),
+            ],
         ]
         .concat()
-    }
-
-    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        let mut defines = [effect_defines(params), march_defines(params)].concat();
-        if uses_table(params) {
-            defines.push(crate::defines::CORRECTED_TABLE);
-        }
-        defines.extend(SampleLoopChoice::defines(params, None));
-        defines
     }
 
     fn shaders_wired(&self, params: &Params, wired: &[&str]) -> Vec<ShaderUse> {
@@ -126,16 +123,10 @@ impl PassDecl for RaycastCompute {
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        // The mode picks the entry point; the workgroup size, the march settings, the
-        // classification and a half-voxel step choose the pipeline.
+        // The blocks' rule, and a half-voxel step picks the pipeline (the exact correction's
+        // sqrt) though the step is a uniform value.
         let half_step = |p: &Params| Sampling::from_params(p).step_voxels == 0.5;
-        is_iso(old) == is_iso(new)
-            && same_effects(old, new)
-            && same_march(old, new)
-            && ComputeOwn::from_params(old) == ComputeOwn::from_params(new)
-            && Workgroup::from_params(old) == Workgroup::from_params(new)
-            && SampleLoopChoice::from_params(old) == SampleLoopChoice::from_params(new)
-            && half_step(old) == half_step(new)
+        self.only_in_place_blocks_change(old, new) && half_step(old) == half_step(new)
     }
 }
 

@@ -7,6 +7,7 @@
 
 use volgraph_accel::reference::{Phong, RaycastSettings, RenderMode};
 use volgraph_compiler::Params;
+use volgraph_compiler::block::{OnChange, ParamBlock};
 
 use crate::defines;
 use crate::effects::EffectFlags;
@@ -151,10 +152,23 @@ impl Workgroup {
     }
 }
 
+/// The sampling block: its values travel in the raycasters' uniform, its `jitter` flags
+/// compile the jitter in (`JITTER`, `JITTER_PER_FRAME`) — for every kind that takes it.
+pub fn sampling_block(on_change: OnChange) -> ParamBlock {
+    Sampling::block(on_change).with_defines(crate::effects::jitter_defines)
+}
+
 /// Every block of the full raycaster (`raycast`, `raycast_compute`, `raycast_segment`,
-/// `antialias`): sampling, termination, isosurface and shading.
+/// `antialias`): sampling, termination, isosurface and shading, taken in place by a node that
+/// rewrites its [`RaycastParamsGpu`] (`on_change`). The mode picks an entry point, so a mode
+/// switch rebuilds whatever the block says.
+pub fn raycast_blocks(on_change: OnChange) -> Vec<ParamBlock> {
+    vec![sampling_block(on_change), Termination::block(on_change), Surface::block(on_change), Shading::block(on_change)]
+}
+
+/// The parameters of [`raycast_blocks`] (what [`RaycastParamsGpu`] carries).
 pub fn raycast_param_specs() -> Vec<volgraph_compiler::ParamSpec> {
-    [Sampling::specs(), Termination::specs(), Surface::specs(), Shading::specs()].concat()
+    volgraph_compiler::block::block_params(&raycast_blocks(OnChange::InPlace))
 }
 
 volgraph_compiler::pass_params! {

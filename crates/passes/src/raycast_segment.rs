@@ -20,9 +20,12 @@
 //! counts its invocations (`shaders/raycast_segment_counted.wgsl`, forced early depth test).
 //! Shader: `shaders/raycast_segment.wgsl`.
 
+use crate::effects::effect_block;
+use crate::raycast_params::raycast_blocks;
 use std::sync::{Arc, Mutex};
+use volgraph_compiler::block::{OnChange, ParamBlock};
 
-use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::footprint::FAN_DRAW_VERTICES;
 use volgraph_core::runtime::{
     CreateContext, DepthSpec, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
@@ -30,9 +33,9 @@ use volgraph_core::runtime::{
 use volgraph_core::{PassNode, PassPlugin};
 
 use crate::defines;
-use crate::effects::{EffectFlags, EffectState, effect_defines, effect_shader_uses};
+use crate::effects::{EffectState, effect_shader_uses};
 use crate::empty_space::EMPTY_BLOCKS;
-use crate::raycast_params::{RaycastParamsGpu, Sampling, Termination, is_iso, raycast_param_specs};
+use crate::raycast_params::{RaycastParamsGpu, Sampling, Termination, is_iso};
 use crate::shared::{ACCUM_FORMATS, BlockSize, FLOAT_TARGETS, HIT_FORMATS, front_to_back_blend};
 
 /// The plugin. [`Default`] is the production pass; [`RaycastSegment::counting`] adds the debug
@@ -74,43 +77,32 @@ impl InvocationCounter {
     }
 }
 
-/// Rust twin of `struct SegmentParams` in `shaders/common/segment.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct SegmentParamsGpu {
-    /// M: samples per segment.
-    pub steps: u32,
-    /// Empty-space block edge in voxels.
-    pub block_size: u32,
-    /// T: termination threshold on the accumulated alpha.
-    pub threshold: f32,
-    /// Padding.
-    pub _pad: u32,
+volgraph_compiler::pass_params! {
+    /// The `segment` block of `shaders/common/segment.wgsl` (which imports it), made from the
+    /// [`SegmentSteps`], [`BlockSize`] and [`Termination`] blocks.
+    pub struct SegmentParams {
+        steps: u32 = computed, "M: samples per segment.";
+        block_size: u32 = computed,
+            "Edge of an empty-space block in voxels (leaping inside a segment, the termination test).";
+        threshold: f32 = computed, "T: the termination test stops rays whose accumulated alpha is >= T.";
+    }
 }
 
-const _: () = assert!(std::mem::size_of::<SegmentParamsGpu>() == 16);
-
-impl SegmentParamsGpu {
+impl SegmentParams {
     /// The block as a shader use declares it (bound as `segment`), so the plan checks the WGSL
-    /// struct `SegmentParams` member by member. The node writes it itself (no parameter is
-    /// claimed for in-place updates).
+    /// struct member by member. The node writes it itself (no parameter is claimed for
+    /// in-place updates).
     pub fn layout() -> volgraph_compiler::UniformLayout {
-        volgraph_compiler::UniformLayout {
-            global: "segment",
-            fields: vec![("steps", "u32"), ("block_size", "u32"), ("threshold", "f32")],
-            params: Vec::new(),
-            bytes: |p| bytemuck::bytes_of(&SegmentParamsGpu::from_params(p)).to_vec(),
-        }
+        Self::bound_as_with("segment", Vec::new(), |p| Self::of(p).uniform_bytes())
     }
 
     /// From the checked parameters of a kind that declares the [`SegmentSteps`], [`BlockSize`]
     /// and [`Termination`] blocks (`raycast_segment`, `termination_test`).
-    pub fn from_params(p: &Params) -> Self {
+    pub fn of(p: &Params) -> Self {
         Self {
             steps: SegmentSteps::from_params(p).segment_steps,
             block_size: BlockSize::of(p),
             threshold: Termination::from_params(p).threshold as f32,
-            _pad: 0,
         }
     }
 }
@@ -145,8 +137,13 @@ impl PassDecl for RaycastSegment {
         "M raycasting steps per pass blended into an accumulation target, early-z tested (Krüger–Westermann 2003 §2.1–2.2)"
     }
 
-    fn params(&self) -> Vec<ParamSpec> {
-        [raycast_param_specs(), EffectFlags::specs(), SegmentSteps::specs(), BlockSize::specs()].concat()
+    fn blocks(&self) -> Vec<ParamBlock> {
+        // The node writes its uniforms once, when built: every change rebuilds it.
+        [
+            raycast_blocks(OnChange::Rebuild),
+            vec![effect_block(), SegmentSteps::block(OnChange::Rebuild), BlockSize::block(OnChange::Rebuild)],
+        ]
+        .concat()
     }
 
     fn ports(&self, params: &Params) -> Vec<PortSpec> {
@@ -175,14 +172,10 @@ impl PassDecl for RaycastSegment {
         let binds: &'static [&'static str] =
             if self.counter.is_some() { &["invocations", "preintegrated"] } else { &["preintegrated"] };
         let mut uses = [ShaderUse::new(file, "vs_segment"), ShaderUse::new(file, entry_point)]
-            .map(|u| u.binds(binds).uniform(RaycastParamsGpu::bound("params")).uniform(SegmentParamsGpu::layout()))
+            .map(|u| u.binds(binds).uniform(RaycastParamsGpu::bound("params")).uniform(SegmentParams::layout()))
             .to_vec();
         uses.extend(effect_shader_uses(params));
         uses
-    }
-
-    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        effect_defines(params)
     }
 
     fn shaders_wired(&self, params: &Params, wired: &[&str]) -> Vec<ShaderUse> {
@@ -247,8 +240,7 @@ impl PassPlugin for RaycastSegment {
             compare: wgpu::CompareFunction::Greater,
         })))?;
         let params = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());
-        let segment = ctx.uniform_buffer("segment", std::mem::size_of::<SegmentParamsGpu>() as u64);
-        ctx.gpu.queue.write_buffer(&segment, 0, bytemuck::bytes_of(&SegmentParamsGpu::from_params(ctx.params)));
+        let segment = ctx.uniform_from_bytes("segment", &SegmentParams::of(ctx.params).uniform_bytes());
         let invocations = match &self.counter {
             Some(counter) => {
                 let buffer = ctx.gpu.device.create_buffer(&wgpu::BufferDescriptor {

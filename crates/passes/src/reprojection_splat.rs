@@ -13,7 +13,8 @@
 //! `shaders/reprojection_splat.wgsl`.
 
 use glam::{DVec3, DVec4};
-use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+use volgraph_compiler::block::{OnChange, ParamBlock};
+use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{
     CameraData, ComputePassPipeline, ComputePipelineSpec, CreateContext, DepthSpec, Gpu, PassError, RecordContext,
     RenderPassPipeline, RenderPipelineSpec,
@@ -23,16 +24,15 @@ use volgraph_core::{PassNode, PassPlugin};
 /// The plugin.
 pub struct ReprojectionSplat;
 
-/// Rust twin of `SplatParams` in `shaders/reprojection_splat.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-struct SplatParamsGpu {
-    rect: [u32; 4],
-    size: f32,
-    _pad: [f32; 3],
+volgraph_compiler::pass_params! {
+    /// The `splat` block of `shaders/reprojection_splat.wgsl` (which imports it): what the node
+    /// computes per frame.
+    struct SplatParams {
+        rect: [u32; 4] = computed,
+            "Last frame's screen rectangle of the volume: origin x, y, width, height (pixels).";
+        size: f32 = computed, "Splat edge in pixels (k).";
+    }
 }
-
-const _: () = assert!(std::mem::size_of::<SplatParamsGpu>() == 32);
 
 volgraph_compiler::param_choice! {
     /// How the splats are drawn.
@@ -82,16 +82,10 @@ fn scatters(params: &Params) -> bool {
     SplatSettings::from_params(params).method == SplatMethod::Scatter
 }
 
-/// The `splat` block as `SplatParamsGpu` lays it out, checked against the shader's
-/// `SplatParams` when the graph is planned. The node writes it per frame (last frame's screen
+/// The `splat` block, checked against the shader's struct when the graph is planned. The node writes it per frame (last frame's screen
 /// rectangle of the volume).
 fn splat_layout() -> volgraph_compiler::UniformLayout {
-    volgraph_compiler::UniformLayout {
-        global: "splat",
-        fields: vec![("rect", "vec4<u32>"), ("size", "f32")],
-        params: Vec::new(),
-        bytes: |_| bytemuck::bytes_of(&SplatParamsGpu::default()).to_vec(),
-    }
+    SplatParams::bound_as_with("splat", Vec::new(), |_| SplatParams { rect: [0; 4], size: 0.0 }.uniform_bytes())
 }
 
 impl PassDecl for ReprojectionSplat {
@@ -107,8 +101,11 @@ impl PassDecl for ReprojectionSplat {
         "last frame's hit points reprojected as depth-tested k×k splats: ray start estimates (Klein et al. 2005 §4.3–4.4)"
     }
 
-    fn params(&self) -> Vec<ParamSpec> {
-        SplatSettings::specs()
+    fn blocks(&self) -> Vec<ParamBlock> {
+        vec![
+            SplatSettings::block(OnChange::InPlace)
+                .with_defines(|p| if scatters(p) { vec![crate::defines::SCATTER] } else { Vec::new() }),
+        ]
     }
 
     fn ports(&self, params: &Params) -> Vec<PortSpec> {
@@ -125,19 +122,15 @@ impl PassDecl for ReprojectionSplat {
         ]
     }
 
-    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        if scatters(params) { vec![crate::defines::SCATTER] } else { Vec::new() }
-    }
-
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
         if scatters(params) { scatter_rounds().to_vec() } else { vec![vertex(), fragment()] }
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        // The edge is a uniform; the block is a pipeline constant (`SPLAT_BLOCK`) and the
-        // method another pipeline.
-        let (old, new) = (SplatSettings::from_params(old), SplatSettings::from_params(new));
-        old.method == new.method && old.block == new.block
+        // The edge is a uniform; the method picks other entry points (the blocks' rule) and
+        // the block is a pipeline constant (`SPLAT_BLOCK`).
+        let block = |p: &Params| SplatSettings::from_params(p).block;
+        self.only_in_place_blocks_change(old, new) && block(old) == block(new)
     }
 }
 
@@ -168,7 +161,7 @@ impl PassPlugin for ReprojectionSplat {
                 ..RenderPipelineSpec::drawing(&vertex(), &fragment())
             })?)
         };
-        let uniform = ctx.uniform_buffer("splat", std::mem::size_of::<SplatParamsGpu>() as u64);
+        let uniform = ctx.uniform_from_bytes("splat", &SplatParams { rect: [0; 4], size: 0.0 }.uniform_bytes());
         let (size, block) = (settings.splat_size as f32, settings.block);
         Ok(Box::new(SplatNode { draw, uniform, size, block, written: None }))
     }
@@ -192,7 +185,7 @@ struct SplatNode {
     uniform: wgpu::Buffer,
     size: f32,
     block: u32,
-    written: Option<SplatParamsGpu>,
+    written: Option<SplatParams>,
 }
 
 /// The pixel rectangle `(x, y, w, h)` the volume box of half size `half` covers seen by
@@ -231,9 +224,9 @@ impl PassNode for SplatNode {
             }
             _ => [0; 4],
         };
-        let settings = SplatParamsGpu { rect, size: self.size, _pad: [0.0; 3] };
+        let settings = SplatParams { rect, size: self.size };
         if self.written != Some(settings) {
-            ctx.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&settings));
+            ctx.write_buffer(&self.uniform, 0, &settings.uniform_bytes());
             self.written = Some(settings);
         }
         let (bx, by) = (rect[2].div_ceil(self.block), rect[3].div_ceil(self.block));

@@ -17,7 +17,8 @@
 //! `shaders/reprojection_tiles.wgsl`; the layout the march reads:
 //! `shaders/common/reprojected_tiles.wgsl`.
 
-use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+use volgraph_compiler::block::{OnChange, ParamBlock};
+use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
 use volgraph_core::{PassNode, PassPlugin};
 
@@ -70,8 +71,8 @@ impl PassDecl for ReprojectionTiles {
          hole filling (Klein et al. 2005 §4.3–4.4)"
     }
 
-    fn params(&self) -> Vec<ParamSpec> {
-        TileBoundsParams::specs()
+    fn blocks(&self) -> Vec<ParamBlock> {
+        vec![TileBoundsParams::block(OnChange::InPlace)]
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -88,8 +89,11 @@ impl PassDecl for ReprojectionTiles {
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
         // `tile` and `hit_block` are pipeline constants; the margin and the band uniforms.
-        let (old, new) = (TileBoundsParams::from_params(old), TileBoundsParams::from_params(new));
-        old.tile == new.tile && old.hit_block == new.hit_block
+        let constants = |p: &Params| {
+            let block = TileBoundsParams::from_params(p);
+            (block.tile, block.hit_block)
+        };
+        self.only_in_place_blocks_change(old, new) && constants(old) == constants(new)
     }
 }
 

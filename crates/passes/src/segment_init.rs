@@ -5,7 +5,8 @@
 //! Shader: `shaders/segment_init.wgsl`.
 
 use crate::shared::{ACCUM_FORMATS, HIT_FORMATS};
-use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+use volgraph_compiler::block::{OnChange, ParamBlock};
+use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{
     CreateContext, DepthSpec, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
 };
@@ -46,8 +47,8 @@ impl PassDecl for SegmentInit {
         "cleared accumulation target and early-z buffer before the segment loop (Krüger–Westermann 2003 §2.1)"
     }
 
-    fn params(&self) -> Vec<ParamSpec> {
-        InitSettings::specs()
+    fn blocks(&self) -> Vec<ParamBlock> {
+        vec![InitSettings::block(OnChange::Rebuild)]
     }
 
     fn ports(&self, params: &Params) -> Vec<PortSpec> {

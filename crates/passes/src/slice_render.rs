@@ -7,7 +7,8 @@
 //! planes past the box draw nothing. Shader: `shaders/slice_render.wgsl`.
 
 use crate::shared::front_to_back_blend;
-use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+use volgraph_compiler::block::{OnChange, ParamBlock};
+use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::{
     CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec, UniformBlocks,
 };
@@ -47,8 +48,9 @@ impl PassDecl for SliceRender {
         "view-aligned slices through the box blended front to back: the SBVR baseline (Krüger–Westermann 2003 §1.1, Table 1)"
     }
 
-    fn params(&self) -> Vec<ParamSpec> {
-        [SliceParams::specs(), SliceLimits::specs()].concat()
+    fn blocks(&self) -> Vec<ParamBlock> {
+        // The plane spacing is a uniform value; the slice count sizes the draw (a rebuild).
+        vec![SliceParams::block(OnChange::InPlace), SliceLimits::block(OnChange::Rebuild)]
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -61,11 +63,6 @@ impl PassDecl for SliceRender {
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         stages().to_vec()
-    }
-
-    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        // The plane spacing is a uniform value; the slice count sizes the draw (a rebuild).
-        self.only_uniforms_change(old, new)
     }
 }
 

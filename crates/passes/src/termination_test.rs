@@ -14,7 +14,9 @@
 //! test recomputes where the next segment's samples lie), and `block_size` the `minmax_grid`
 //! pass's. Shader: `shaders/termination_test.wgsl`.
 
-use volgraph_compiler::{ParamSpec, Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+use crate::raycast_params::sampling_block;
+use volgraph_compiler::block::{OnChange, ParamBlock};
+use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 use volgraph_core::runtime::footprint::FAN_DRAW_VERTICES;
 use volgraph_core::runtime::{
     CreateContext, DepthSpec, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
@@ -22,8 +24,8 @@ use volgraph_core::runtime::{
 use volgraph_core::{PassNode, PassPlugin};
 
 use crate::empty_space::EMPTY_BLOCKS;
-use crate::raycast_params::{RaycastParamsGpu, Sampling};
-use crate::raycast_segment::{SegmentParamsGpu, SegmentSteps, segment_index};
+use crate::raycast_params::RaycastParamsGpu;
+use crate::raycast_segment::{SegmentParams, SegmentSteps, segment_index};
 use crate::shared::{ACCUM_FORMATS, BlockSize, FLOAT_TARGETS};
 
 /// The plugin.
@@ -44,7 +46,7 @@ fn stages() -> [ShaderUse; 4] {
     ["vs_segment", "vs_terminate_alpha", "fs_terminate", "fs_terminate_empty"].map(|entry| {
         ShaderUse::new("termination_test.wgsl", entry)
             .uniform(RaycastParamsGpu::bound("params"))
-            .uniform(SegmentParamsGpu::layout())
+            .uniform(SegmentParams::layout())
     })
 }
 
@@ -62,10 +64,16 @@ impl PassDecl for TerminationTest {
          §2.3); its sampling, segment_steps and block_size must be the segment pass's (share Scalar inputs)"
     }
 
-    fn params(&self) -> Vec<ParamSpec> {
+    fn blocks(&self) -> Vec<ParamBlock> {
         // The segment pass's sampling, segment length and block grid (they must match it; a
-        // graph shares them through Scalar inputs), and the test's own threshold.
-        [Sampling::specs(), TestThreshold::specs(), SegmentSteps::specs(), BlockSize::specs()].concat()
+        // graph shares them through Scalar inputs), and the test's own threshold; written once,
+        // when the node is built.
+        vec![
+            sampling_block(OnChange::Rebuild),
+            TestThreshold::block(OnChange::Rebuild),
+            SegmentSteps::block(OnChange::Rebuild),
+            BlockSize::block(OnChange::Rebuild),
+        ]
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -80,10 +88,6 @@ impl PassDecl for TerminationTest {
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         stages().to_vec()
-    }
-
-    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        crate::effects::jitter_defines(params)
     }
 }
 
@@ -103,8 +107,7 @@ impl PassPlugin for TerminationTest {
             ..RenderPipelineSpec::drawing(&segment_vs, &terminate_empty)
         })?;
         let params = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());
-        let segment = ctx.uniform_buffer("segment", std::mem::size_of::<SegmentParamsGpu>() as u64);
-        ctx.gpu.queue.write_buffer(&segment, 0, bytemuck::bytes_of(&SegmentParamsGpu::from_params(ctx.params)));
+        let segment = ctx.uniform_from_bytes("segment", &SegmentParams::of(ctx.params).uniform_bytes());
         Ok(Box::new(TerminationTestNode { alpha_only, with_empty, params, segment }))
     }
 }

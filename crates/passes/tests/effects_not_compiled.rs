@@ -24,7 +24,7 @@ fn reachable(file: &str, entry: &str) -> BTreeSet<String> {
 /// Names of the functions reachable from entry point `entry` of `file` assembled with `defines`.
 fn reachable_with(file: &str, entry: &str, defines: &[&str]) -> BTreeSet<String> {
     let sources =
-        ShaderSources::new().with_disk(default_shader_root()).with_generated(volgraph_passes::params_structs());
+        ShaderSources::new().with_disk(default_shader_root()).with_generated(volgraph_passes::uniform_imports());
     let defines: BTreeSet<String> = defines.iter().map(|d| d.to_string()).collect();
     let source = assemble_with(&sources, file, &defines).expect("shader loads");
     let (module, _) = parse_and_validate(file, &source.text).expect("shader validates");

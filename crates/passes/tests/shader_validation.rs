@@ -33,7 +33,7 @@ fn validate(root: &Path, relative: &str) -> Result<(naga::Module, Vec<PathBuf>),
 fn validate_with(root: &Path, relative: &str, defines: &[&str]) -> Result<(naga::Module, Vec<PathBuf>), String> {
     let sources = volgraph_core::shader_source::ShaderSources::new()
         .with_disk(root)
-        .with_generated(volgraph_passes::params_structs());
+        .with_generated(volgraph_passes::uniform_imports());
     let defines = defines.iter().map(|d| d.to_string()).collect();
     let source = assemble_with(&sources, relative, &defines).map_err(|e| e.to_string())?;
     let module = naga::front::wgsl::parse_str(&source.text)

@@ -18,16 +18,14 @@ pub const SHADERS: EmbeddedShaders = &[
     ("edge_enhance.wgsl", include_str!("../shaders/edge_enhance.wgsl")),
 ];
 
-/// The WGSL structs of this crate's `pass_params!` uniform blocks, as the generated files its
-/// shaders import (`#import "params/MipParams.wgsl"`).
-pub fn params_structs() -> Vec<(String, String)> {
-    vec![mip::MipParams::wgsl_import()]
-}
-
-/// volgraph's shaders with this crate's in front and its generated structs: what its tests and
-/// its binary compile from.
+/// volgraph's shaders with this crate's in front, and the uniform structs its kinds declare
+/// (`#import "params/MipParams.wgsl"`, gathered from [`register`]'s kinds): what its tests
+/// compile from.
 pub fn shader_sources() -> volgraph_core::shader_source::ShaderSources {
-    volgraph_passes::builtin_shaders().prepend_embedded(SHADERS).with_generated(params_structs())
+    use volgraph_core::KindLookup;
+    let mut registry = Registry::new();
+    register(&mut registry);
+    volgraph_passes::builtin_shaders().prepend_embedded(SHADERS).with_generated(registry.uniform_imports())
 }
 
 /// Adds this crate's Rust pass kinds to `registry` (the WGSL-only one needs no registration).

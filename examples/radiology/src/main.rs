@@ -8,7 +8,6 @@ fn main() -> ExitCode {
         name: "radiology",
         register: volgraph_example_radiology::register,
         shaders: volgraph_example_radiology::SHADERS,
-        params_structs: volgraph_example_radiology::params_structs,
         ..Default::default()
     })
 }

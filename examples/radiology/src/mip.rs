@@ -3,13 +3,14 @@
 //! samples (the same samples as volgraph's raycasters); the output is that value as grey,
 //! windowed by `level` and `width` like a radiology viewer, alpha 1 where the ray hits the box.
 
+use volgraph_core::block::{OnChange, ParamBlock};
 use volgraph_core::plugin::ShaderUse;
 use volgraph_core::runtime::{
     ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, UniformBlocks,
 };
-use volgraph_core::{ParamSpec, Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
+use volgraph_core::{Params, PassDecl, PassNode, PassPlugin, PortKind, PortSpec, TargetFormat};
 // volgraph's shared sampling block: the same step, sample count and jitter as its raycasters.
-use volgraph_passes::raycast_params::{RaycastParamsGpu, Sampling};
+use volgraph_passes::raycast_params::{RaycastParamsGpu, sampling_block};
 
 /// The plugin.
 pub struct Mip;
@@ -40,8 +41,10 @@ impl PassDecl for Mip {
         "maximum-intensity projection, windowed by level and width (examples/radiology)"
     }
 
-    fn params(&self) -> Vec<ParamSpec> {
-        [MipParams::specs(), Sampling::specs()].concat()
+    fn blocks(&self) -> Vec<ParamBlock> {
+        // The window, and volgraph's sampling block, whose `jitter` brings its `#if` of the
+        // shared ray code; the node rewrites both uniforms, so an edit of either rebuilds nothing.
+        vec![MipParams::block(OnChange::InPlace), sampling_block(OnChange::InPlace)]
     }
 
     fn ports(&self, _params: &Params) -> Vec<PortSpec> {
@@ -53,15 +56,6 @@ impl PassDecl for Mip {
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
         vec![shader()]
-    }
-
-    fn shader_defines(&self, params: &Params) -> Vec<&'static str> {
-        // `jitter` of the sampling block is an `#if` of the shared ray code.
-        volgraph_passes::effects::jitter_defines(params)
-    }
-
-    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        self.only_uniforms_change(old, new)
     }
 }
 

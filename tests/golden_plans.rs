@@ -4,18 +4,18 @@
 //! `VOLGRAPH_BLESS=1 cargo test -p volgraph-tests --test golden_plans` rewrites them.
 
 // The compiler's `compile` (`volgraph_compiler`) turns each graph into its plan; the built-in
-// passes contribute only their declarations (`KindLookup`). This test binary still links wgpu:
-// volgraph-passes keeps each kind's declaration and GPU code in one module.
+// passes contribute only their declarations (`builtin_kinds`, which volgraph-passes builds
+// without its `gpu` feature: crates/passes/tests/declarations_without_gpu.rs).
 use volgraph_compiler::{CompileOptions, KindLookup, compile};
-use volgraph_passes::builtin_registry;
+use volgraph_passes::builtin_kinds;
 use volgraph_tests::{check_golden, graph_files, relative_name};
 
 #[test]
 fn every_graph_matches_its_golden_plan() {
     let files = graph_files().expect("graphs/ is readable");
     assert!(files.len() >= 3, "expected the graphs/basic files, found {files:?}");
-    let registry = builtin_registry();
-    let kinds: &dyn KindLookup = &registry;
+    let declarations = builtin_kinds();
+    let kinds: &dyn KindLookup = &declarations;
     let options = CompileOptions::new(1920, 1080);
     let mut failures = Vec::new();
     for path in &files {
@@ -46,7 +46,7 @@ fn every_graph_matches_its_golden_plan() {
 fn fragment_raycast_plan_names_outputs_and_slots() {
     let path = volgraph_tests::repo_root().join("graphs/basic/fragment_raycast.ron");
     let source = std::fs::read_to_string(&path).expect("graphs/basic/fragment_raycast.ron exists");
-    let plan = compile("fragment_raycast.ron", &source, &builtin_registry(), &CompileOptions::new(1920, 1080))
+    let plan = compile("fragment_raycast.ron", &source, &builtin_kinds(), &CompileOptions::new(1920, 1080))
         .unwrap_or_else(|d| panic!("{d}"));
     let text = plan.to_text();
     assert!(text.starts_with("plan \"fragment_raycast\" at 1920x1080, features: none\n"), "{text}");

@@ -12,12 +12,16 @@ use crate::effects::effect_block;
 use crate::raycast_params::raycast_blocks;
 use volgraph_compiler::block::{OnChange, ParamBlock};
 use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
+#[cfg(feature = "gpu")]
 use volgraph_core::{PassNode, PassPlugin};
 
 use volgraph_compiler::declare::ParamChoice;
 
-use crate::effects::{EffectState, effect_shader_uses};
+#[cfg(feature = "gpu")]
+use crate::effects::EffectState;
+use crate::effects::effect_shader_uses;
 use crate::raycast_params::{RaycastParamsGpu, Sampling, is_iso};
 use crate::shared::FLOAT_TARGETS;
 
@@ -134,6 +138,7 @@ impl PassDecl for Antialias {
     }
 }
 
+#[cfg(feature = "gpu")]
 impl PassPlugin for Antialias {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let defines = self.shader_defines(ctx.params);
@@ -149,6 +154,7 @@ impl PassPlugin for Antialias {
     }
 }
 
+#[cfg(feature = "gpu")]
 struct AntialiasNode {
     pipeline: RenderPassPipeline,
     params: wgpu::Buffer,
@@ -158,6 +164,7 @@ struct AntialiasNode {
     step_voxels: f64,
 }
 
+#[cfg(feature = "gpu")]
 impl PassNode for AntialiasNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         self.effects.update(ctx, &self.params, self.step_voxels)?;

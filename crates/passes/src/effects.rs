@@ -8,9 +8,11 @@
 //! (`volgraph_accel::reference::Effects`).
 
 use volgraph_compiler::Params;
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{CreateContext, PassError, RecordContext};
 
 use crate::defines;
+#[cfg(feature = "gpu")]
 use crate::preintegration::PreintegrationTable;
 use crate::raycast_params::Sampling;
 
@@ -79,11 +81,13 @@ pub fn jitter_defines(params: &Params) -> Vec<&'static str> {
     }
 }
 
+#[cfg(feature = "gpu")]
 /// What a raycaster node keeps for its effects: the pre-integration table when that effect is on.
 pub struct EffectState {
     table: Option<PreintegrationTable>,
 }
 
+#[cfg(feature = "gpu")]
 impl EffectState {
     /// Builds what the effects in `ctx.params` need.
     pub fn new(ctx: &CreateContext<'_>) -> Result<Self, PassError> {

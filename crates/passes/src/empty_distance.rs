@@ -7,11 +7,15 @@
 //! Shader: `shaders/empty_distance.wgsl`.
 
 use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, Rerun, ShaderUse};
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
+#[cfg(feature = "gpu")]
 use volgraph_core::{PassNode, PassPlugin};
 
 use crate::empty_space::EMPTY_BLOCKS;
+#[cfg(feature = "gpu")]
 use crate::grid_tap::GridTap;
+#[cfg(feature = "gpu")]
 use crate::minmax_grid::{bound_size, create_grid_texture};
 
 /// The Owned type name of the distance map.
@@ -23,9 +27,11 @@ const MAX_LINE: u32 = 2048;
 /// The plugin; [`EmptyDistance::tapped`] also hands the distance texture to a [`GridTap`].
 #[derive(Default)]
 pub struct EmptyDistance {
+    #[cfg(feature = "gpu")]
     tap: Option<GridTap>,
 }
 
+#[cfg(feature = "gpu")]
 impl EmptyDistance {
     /// An `empty_distance` pass that stores its map in `tap` (tests, tools).
     pub fn tapped(tap: GridTap) -> Self {
@@ -79,6 +85,7 @@ impl PassDecl for EmptyDistance {
     }
 }
 
+#[cfg(feature = "gpu")]
 impl PassPlugin for EmptyDistance {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec::of(&shader()))?;
@@ -88,6 +95,7 @@ impl PassPlugin for EmptyDistance {
     }
 }
 
+#[cfg(feature = "gpu")]
 /// The published map, the scratch texture of the middle pass, and their size in blocks.
 struct DistanceTextures {
     out: wgpu::TextureView,
@@ -95,6 +103,7 @@ struct DistanceTextures {
     dims: [u32; 3],
 }
 
+#[cfg(feature = "gpu")]
 struct EmptyDistanceNode {
     pipeline: ComputePassPipeline,
     axes: [wgpu::Buffer; 3],
@@ -102,6 +111,7 @@ struct EmptyDistanceNode {
     tap: Option<GridTap>,
 }
 
+#[cfg(feature = "gpu")]
 impl PassNode for EmptyDistanceNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let dims = bound_size(ctx, "empty")?;

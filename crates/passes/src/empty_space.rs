@@ -10,11 +10,16 @@
 
 use volgraph_compiler::block::{OnChange, ParamBlock};
 use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, Rerun, ShaderUse};
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
+#[cfg(feature = "gpu")]
 use volgraph_core::{PassNode, PassPlugin};
 
+#[cfg(feature = "gpu")]
 use crate::grid_tap::GridTap;
-use crate::minmax_grid::{MINMAX_GRID, bound_size, create_grid_texture, dispatch_grid};
+use crate::minmax_grid::MINMAX_GRID;
+#[cfg(feature = "gpu")]
+use crate::minmax_grid::{bound_size, create_grid_texture, dispatch_grid};
 use volgraph_accel::classify::OpacityClassifier;
 
 /// The Owned type name of the empty-block flags.
@@ -23,9 +28,11 @@ pub const EMPTY_BLOCKS: &str = "empty_blocks";
 /// The plugin; [`EmptySpace::tapped`] also hands the flag texture to a [`GridTap`].
 #[derive(Default)]
 pub struct EmptySpace {
+    #[cfg(feature = "gpu")]
     tap: Option<GridTap>,
 }
 
+#[cfg(feature = "gpu")]
 impl EmptySpace {
     /// An `empty_space` pass that stores its texture in `tap` (tests, tools).
     pub fn tapped(tap: GridTap) -> Self {
@@ -33,6 +40,7 @@ impl EmptySpace {
     }
 }
 
+#[cfg(feature = "gpu")]
 /// Checks that the empty-block grid bound to `port` has `ceil(volume / block_size)` blocks per
 /// axis, i.e. that a consumer's `block_size` matches the `minmax_grid` pass's.
 pub(crate) fn check_block_grid(
@@ -105,6 +113,7 @@ impl PassDecl for EmptySpace {
     }
 }
 
+#[cfg(feature = "gpu")]
 impl PassPlugin for EmptySpace {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let defines = self.shader_defines(ctx.params);
@@ -114,6 +123,7 @@ impl PassPlugin for EmptySpace {
     }
 }
 
+#[cfg(feature = "gpu")]
 struct EmptySpaceNode {
     pipeline: ComputePassPipeline,
     flags: Option<(wgpu::Texture, wgpu::TextureView, [u32; 3])>,
@@ -122,6 +132,7 @@ struct EmptySpaceNode {
     tap: Option<GridTap>,
 }
 
+#[cfg(feature = "gpu")]
 impl PassNode for EmptySpaceNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let dims = bound_size(ctx, "grid")?;

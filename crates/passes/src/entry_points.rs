@@ -5,7 +5,9 @@
 //! of the two writes, so both are always drawn). Shader: `shaders/entry_points.wgsl`.
 
 use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{CreateContext, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
+#[cfg(feature = "gpu")]
 use volgraph_core::{PassNode, PassPlugin};
 
 /// The plugin.
@@ -39,6 +41,7 @@ impl PassDecl for EntryPoints {
     }
 }
 
+#[cfg(feature = "gpu")]
 impl PassPlugin for EntryPoints {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let faces = ctx.render_pipeline(&RenderPipelineSpec {
@@ -50,11 +53,13 @@ impl PassPlugin for EntryPoints {
     }
 }
 
+#[cfg(feature = "gpu")]
 struct EntryPointsNode {
     faces: RenderPassPipeline,
     near_plane: RenderPassPipeline,
 }
 
+#[cfg(feature = "gpu")]
 impl PassNode for EntryPointsNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let faces_bg = ctx.bind_group(&self.faces, &[])?;

@@ -10,7 +10,9 @@
 use crate::raycast_params::sampling_block;
 use volgraph_compiler::block::{OnChange, ParamBlock};
 use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
+#[cfg(feature = "gpu")]
 use volgraph_core::{PassNode, PassPlugin};
 
 use crate::march::SAMPLE_ROWS;
@@ -61,6 +63,7 @@ impl PassDecl for FetchProbe {
     }
 }
 
+#[cfg(feature = "gpu")]
 impl PassPlugin for FetchProbe {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let wg = Workgroup::checked_size(ctx)?;
@@ -75,6 +78,7 @@ impl PassPlugin for FetchProbe {
     }
 }
 
+#[cfg(feature = "gpu")]
 struct FetchProbeNode {
     pipeline: ComputePassPipeline,
     params: wgpu::Buffer,
@@ -82,6 +86,7 @@ struct FetchProbeNode {
     counted: bool,
 }
 
+#[cfg(feature = "gpu")]
 impl PassNode for FetchProbeNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         if self.counted {

@@ -4,14 +4,17 @@
 
 use std::sync::{Arc, Mutex};
 
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::Gpu;
 
+#[cfg(feature = "gpu")]
 /// Shared access to one owned 3D texture; cheap to clone.
 #[derive(Clone, Default)]
 pub struct GridTap {
     texture: Arc<Mutex<Option<wgpu::Texture>>>,
 }
 
+#[cfg(feature = "gpu")]
 impl GridTap {
     /// An empty tap (nothing built yet).
     pub fn new() -> Self {

@@ -13,9 +13,11 @@
 
 use volgraph_compiler::block::{OnChange, ParamBlock};
 use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{
     CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec, UniformBlocks,
 };
+#[cfg(feature = "gpu")]
 use volgraph_core::{PassNode, PassPlugin};
 
 /// The plugin.
@@ -57,7 +59,7 @@ impl PassDecl for HoleFill {
     }
 
     fn blocks(&self) -> Vec<ParamBlock> {
-        // A uniform the node rewrites (`UniformBlocks`).
+        // A uniform the node rewrites (its `UniformBlocks`).
         vec![HoleParams::block(OnChange::InPlace)]
     }
 
@@ -73,6 +75,7 @@ impl PassDecl for HoleFill {
     }
 }
 
+#[cfg(feature = "gpu")]
 impl PassPlugin for HoleFill {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let shader = shader();
@@ -82,6 +85,7 @@ impl PassPlugin for HoleFill {
     }
 }
 
+#[cfg(feature = "gpu")]
 struct HoleFillNode {
     pipeline: RenderPassPipeline,
     uniforms: UniformBlocks,
@@ -89,6 +93,7 @@ struct HoleFillNode {
     rows: Option<(wgpu::Buffer, Vec<[f32; 2]>)>,
 }
 
+#[cfg(feature = "gpu")]
 impl HoleFillNode {
     /// This frame's row spans, written where they changed.
     fn footprint_rows(&mut self, ctx: &RecordContext<'_>) -> &wgpu::Buffer {
@@ -111,6 +116,7 @@ impl HoleFillNode {
     }
 }
 
+#[cfg(feature = "gpu")]
 impl PassNode for HoleFillNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let rows = self.footprint_rows(ctx).clone();

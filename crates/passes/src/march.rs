@@ -6,11 +6,15 @@
 //! kinds cannot drift and a paper comparison between them is a comparison of settings.
 
 use volgraph_compiler::{Params, PortKind, PortSpec};
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext};
 
 use crate::defines;
 use crate::empty_distance::EMPTY_DISTANCE;
-use crate::empty_space::{EMPTY_BLOCKS, check_block_grid};
+use crate::empty_space::EMPTY_BLOCKS;
+#[cfg(feature = "gpu")]
+use crate::empty_space::check_block_grid;
+#[cfg(feature = "gpu")]
 use crate::minmax_grid::bound_size;
 use crate::shared::{BlockSize, FLOAT_TARGETS};
 
@@ -150,6 +154,7 @@ pub fn wired_defines(params: &Params, wired: &[&str]) -> Vec<&'static str> {
     defines
 }
 
+#[cfg(feature = "gpu")]
 /// A node's empty-space leaping: the input it reads, the block-edge uniform `blocks`, the
 /// defines and constants its pipeline is built with, and the grid check every frame.
 pub struct Leaping {
@@ -159,6 +164,7 @@ pub struct Leaping {
     blocks: Option<wgpu::Buffer>,
 }
 
+#[cfg(feature = "gpu")]
 impl Leaping {
     /// From the node's wiring and settings; both inputs wired is an error.
     pub fn new(ctx: &CreateContext<'_>) -> Result<Self, PassError> {

@@ -8,9 +8,12 @@
 
 use volgraph_compiler::block::{OnChange, ParamBlock};
 use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, Rerun, ShaderUse};
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
+#[cfg(feature = "gpu")]
 use volgraph_core::{PassNode, PassPlugin};
 
+#[cfg(feature = "gpu")]
 use crate::grid_tap::GridTap;
 use crate::shared::BlockSize;
 
@@ -28,9 +31,11 @@ pub const MINMAX_GRID: &str = "minmax_grid";
 /// The plugin; [`MinMaxGridPass::tapped`] also hands the grid texture to a [`GridTap`].
 #[derive(Default)]
 pub struct MinMaxGridPass {
+    #[cfg(feature = "gpu")]
     tap: Option<GridTap>,
 }
 
+#[cfg(feature = "gpu")]
 impl MinMaxGridPass {
     /// A `minmax_grid` pass that stores its texture in `tap` (tests, tools).
     pub fn tapped(tap: GridTap) -> Self {
@@ -41,6 +46,7 @@ impl MinMaxGridPass {
 /// Workgroup edge of `cs_minmax` and `cs_classify` (4³ blocks per workgroup).
 pub(crate) const GRID_WORKGROUP: u32 = 4;
 
+#[cfg(feature = "gpu")]
 /// A 3D float texture usable as a storage output and a sampled input.
 pub(crate) fn create_grid_texture(
     ctx: &RecordContext<'_>,
@@ -62,12 +68,14 @@ pub(crate) fn create_grid_texture(
     })
 }
 
+#[cfg(feature = "gpu")]
 /// Size of the texture bound to `port` (a 3D input or owned grid).
 pub(crate) fn bound_size(ctx: &RecordContext<'_>, port: &str) -> Result<[u32; 3], PassError> {
     let s = ctx.view(port)?.texture().size();
     Ok([s.width, s.height, s.depth_or_array_layers])
 }
 
+#[cfg(feature = "gpu")]
 /// Records one dispatch of `pipeline` over `dims` texels (4³ per workgroup); `dims = None`
 /// records an empty pass, which keeps the step's label and timestamps.
 pub(crate) fn dispatch_grid(
@@ -126,6 +134,7 @@ fn shader() -> ShaderUse {
     ShaderUse::new("minmax_grid.wgsl", "cs_minmax").uniform(BlockSize::bound_as("minmax"))
 }
 
+#[cfg(feature = "gpu")]
 impl PassPlugin for MinMaxGridPass {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let defines = self.shader_defines(ctx.params);
@@ -138,6 +147,7 @@ impl PassPlugin for MinMaxGridPass {
     }
 }
 
+#[cfg(feature = "gpu")]
 struct MinMaxGridNode {
     pipeline: ComputePassPipeline,
     params: wgpu::Buffer,
@@ -147,6 +157,7 @@ struct MinMaxGridNode {
     tap: Option<GridTap>,
 }
 
+#[cfg(feature = "gpu")]
 impl PassNode for MinMaxGridNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         // Recorded only when the volume changed (`Rerun::WhenInputsChange`); a new texture only

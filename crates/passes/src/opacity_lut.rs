@@ -9,9 +9,12 @@
 //! device). Shader: `shaders/opacity_lut.wgsl`.
 
 use volgraph_compiler::ShaderUse;
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{CreateContext, PassError};
 
-use crate::tf_table::{TfTable, table_shaders};
+#[cfg(feature = "gpu")]
+use crate::tf_table::TfTable;
+use crate::tf_table::table_shaders;
 
 /// Texels of the table: 16× the 256-entry LUT, so the table's own linear interpolation adds
 /// < 0.1/255 to the image for the peer TFs (crates/passes/tests/fastest.rs).
@@ -22,6 +25,7 @@ pub fn table_shader_uses() -> [ShaderUse; 2] {
     table_shaders("opacity_lut.wgsl")
 }
 
+#[cfg(feature = "gpu")]
 /// The corrected table of a raycaster (binding `corrected`), filled from its `tf` port with the
 /// step in its uniform `params` ([`TfTable::fill`], every frame).
 pub fn opacity_table(ctx: &CreateContext<'_>) -> Result<TfTable, PassError> {

@@ -6,9 +6,12 @@
 //! the step changes, so table and march always agree. Shader: `shaders/preintegration.wgsl`.
 
 use volgraph_compiler::ShaderUse;
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{CreateContext, PassError, RecordContext};
 
-use crate::tf_table::{TfTable, table_shaders};
+#[cfg(feature = "gpu")]
+use crate::tf_table::TfTable;
+use crate::tf_table::table_shaders;
 
 /// Texels per side: one per scalar value of an 8-bit volume.
 pub const TABLE_SIZE: u32 = 256;
@@ -18,6 +21,7 @@ pub fn table_shader_uses() -> [ShaderUse; 2] {
     table_shaders("preintegration.wgsl")
 }
 
+#[cfg(feature = "gpu")]
 /// A raycaster's pre-integration table and what it was built for.
 pub struct PreintegrationTable {
     /// The table, bound as `preintegrated`.
@@ -28,6 +32,7 @@ pub struct PreintegrationTable {
     pub builds: u64,
 }
 
+#[cfg(feature = "gpu")]
 impl PreintegrationTable {
     /// The pipeline (binding `params`: the raycaster's uniform) and the table texture.
     pub fn new(ctx: &CreateContext<'_>) -> Result<Self, PassError> {

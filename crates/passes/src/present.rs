@@ -6,9 +6,11 @@
 
 use volgraph_compiler::block::{OnChange, ParamBlock};
 use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{
     ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, UniformBlocks,
 };
+#[cfg(feature = "gpu")]
 use volgraph_core::{PassNode, PassPlugin};
 
 /// The plugin.
@@ -41,7 +43,7 @@ impl PassDecl for Present {
     }
 
     fn blocks(&self) -> Vec<ParamBlock> {
-        // A uniform the node rewrites (`UniformBlocks`).
+        // A uniform the node rewrites (its `UniformBlocks`).
         vec![PresentParams::block(OnChange::InPlace)]
     }
 
@@ -57,6 +59,7 @@ impl PassDecl for Present {
     }
 }
 
+#[cfg(feature = "gpu")]
 impl PassPlugin for Present {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let shader = shader();
@@ -65,11 +68,13 @@ impl PassPlugin for Present {
     }
 }
 
+#[cfg(feature = "gpu")]
 struct PresentNode {
     pipeline: ComputePassPipeline,
     uniforms: UniformBlocks,
 }
 
+#[cfg(feature = "gpu")]
 impl PassNode for PresentNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         ctx.dispatch_over(&self.pipeline, &self.uniforms.bindings(), "display", (8, 8))

@@ -4,7 +4,9 @@
 
 use crate::shared::FLOAT_TARGETS;
 use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse};
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{CreateContext, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
+#[cfg(feature = "gpu")]
 use volgraph_core::{PassNode, PassPlugin};
 
 /// The plugin.
@@ -39,6 +41,7 @@ impl PassDecl for RayDirections {
     }
 }
 
+#[cfg(feature = "gpu")]
 impl PassPlugin for RayDirections {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
@@ -49,10 +52,12 @@ impl PassPlugin for RayDirections {
     }
 }
 
+#[cfg(feature = "gpu")]
 struct RayDirectionsNode {
     pipeline: RenderPassPipeline,
 }
 
+#[cfg(feature = "gpu")]
 impl PassNode for RayDirectionsNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let bg = ctx.bind_group(&self.pipeline, &[])?;

@@ -18,11 +18,17 @@
 //! Shader: `shaders/raycast.wgsl`.
 
 use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec};
+#[cfg(feature = "gpu")]
 use volgraph_core::{PassNode, PassPlugin};
 
-use crate::effects::{EffectState, effect_block};
-use crate::march::{Leaping, MarchSettings, SAMPLE_ROWS, march_blocks, march_ports, wired_defines};
+#[cfg(feature = "gpu")]
+use crate::effects::EffectState;
+use crate::effects::effect_block;
+#[cfg(feature = "gpu")]
+use crate::march::Leaping;
+use crate::march::{MarchSettings, SAMPLE_ROWS, march_blocks, march_ports, wired_defines};
 use crate::raycast_params::{RaycastParamsGpu, is_iso, raycast_blocks};
 use crate::shared::BlockSize;
 use volgraph_compiler::block::{OnChange, ParamBlock};
@@ -134,6 +140,7 @@ fn march_shader(params: &Params) -> ShaderUse {
         .uniform(BlockSize::bound_as("blocks"))
 }
 
+#[cfg(feature = "gpu")]
 impl PassPlugin for Raycast {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let leaping = Leaping::new(ctx)?;
@@ -232,12 +239,14 @@ fn gpu_block(params: &Params) -> RaycastParamsGpu {
     RaycastParamsGpu { step_back: RaycastOwn::from_params(params).step_back as f32, ..RaycastParamsGpu::of(params) }
 }
 
+#[cfg(feature = "gpu")]
 /// ⌈|voxel diagonal| / h⌉ for the bound volume (Klein et al. 2005 §4.2's conservative bound).
 fn conservative_step_back(volume: &volgraph_core::runtime::VolumeDesc, step_voxels: f64) -> f32 {
     let voxel = 2.0 * volume.half_extent / volume.dims.as_dvec3();
     (voxel.length() / (step_voxels * volume.unit_step)).ceil() as f32
 }
 
+#[cfg(feature = "gpu")]
 struct RaycastNode {
     pipeline: RenderPassPipeline,
     /// The same march without the `start` input, for frames whose estimates a bypass left out.
@@ -253,6 +262,7 @@ struct RaycastNode {
     written_step_back: Option<f32>,
 }
 
+#[cfg(feature = "gpu")]
 impl PassNode for RaycastNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         if self.conservative

@@ -46,17 +46,25 @@ use volgraph_accel::classify::OpacityClassifier;
 use volgraph_accel::octree::{OctreeHierarchy, OctreeVisibility};
 use volgraph_accel::volume::Volume;
 use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::upload::VolumeFormat;
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{
     ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext, volume_texture_format,
 };
+#[cfg(feature = "gpu")]
 use volgraph_core::{PassNode, PassPlugin};
 
+#[cfg(feature = "gpu")]
 use crate::brick_pool::{Batch, BrickPool};
-use crate::effects::{EffectFlags, EffectState, effect_shader_uses};
+#[cfg(feature = "gpu")]
+use crate::effects::EffectState;
+use crate::effects::{EffectFlags, effect_shader_uses};
 use crate::raycast_params::{RaycastParamsGpu, SampleLoopChoice, Sampling, Shading, Termination, Workgroup};
 
+#[cfg(feature = "gpu")]
 mod atlas;
+#[cfg(feature = "gpu")]
 use atlas::Atlas;
 
 /// The plugin.
@@ -133,7 +141,7 @@ impl PassDecl for RaycastBricks {
             Shading::block(OnChange::InPlace),
             BrickSettings::block(OnChange::Rebuild),
             Workgroup::block(OnChange::Rebuild),
-            SampleLoopChoice::block(OnChange::Rebuild).with_defines(|p| SampleLoopChoice::defines(p, None)),
+            SampleLoopChoice::rebuild_block(),
         ]
     }
 
@@ -168,6 +176,7 @@ fn brick_layout() -> volgraph_compiler::UniformLayout {
     BrickParams::bound_as_with("bricks", Vec::new(), |_| BrickParams::EMPTY.uniform_bytes())
 }
 
+#[cfg(feature = "gpu")]
 impl PassPlugin for RaycastBricks {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let settings = BrickSettings::from_params(ctx.params);
@@ -243,6 +252,7 @@ struct FrameCounters {
     drawn_leaves: f64,
 }
 
+#[cfg(feature = "gpu")]
 /// Everything derived from one bound volume.
 struct VolumeState {
     version: u64,
@@ -291,6 +301,7 @@ fn range_apron(effects: EffectFlags) -> u32 {
     u32::from(effects.tricubic || effects.preintegration)
 }
 
+#[cfg(feature = "gpu")]
 struct RaycastBricksNode {
     /// The pre-integration table when that effect is on.
     effects: EffectState,
@@ -315,10 +326,12 @@ struct RaycastBricksNode {
     counters: FrameCounters,
 }
 
+#[cfg(feature = "gpu")]
 fn pass_error(ctx: &RecordContext<'_>, message: String) -> PassError {
     PassError { pass: ctx.label.to_string(), message }
 }
 
+#[cfg(feature = "gpu")]
 impl VolumeState {
     fn new(
         ctx: &RecordContext<'_>,
@@ -416,6 +429,7 @@ impl VolumeState {
     }
 }
 
+#[cfg(feature = "gpu")]
 impl RaycastBricksNode {
     fn budget(&self, ctx: &RecordContext<'_>) -> u64 {
         match self.pool_mb {
@@ -455,6 +469,7 @@ impl RaycastBricksNode {
     }
 }
 
+#[cfg(feature = "gpu")]
 impl PassNode for RaycastBricksNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let voxels = ctx.voxels("volume")?.clone();

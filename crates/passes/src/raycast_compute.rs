@@ -21,16 +21,27 @@
 //! a parameter (pipeline-overridable constants). Shader: `shaders/raycast_compute.wgsl`.
 
 use volgraph_compiler::{Params, PassDecl, PortSpec, ShaderUse, TargetFormat};
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
+#[cfg(feature = "gpu")]
 use volgraph_core::{PassNode, PassPlugin};
 
-use crate::effects::{EffectFlags, EffectState, effect_block};
-use crate::march::{Leaping, MarchSettings, march_blocks, wired_defines};
-use crate::opacity_lut::{opacity_table, table_shader_uses};
+#[cfg(feature = "gpu")]
+use crate::effects::EffectState;
+use crate::effects::{EffectFlags, effect_block};
+#[cfg(feature = "gpu")]
+use crate::march::Leaping;
+use crate::march::{MarchSettings, march_blocks, wired_defines};
+#[cfg(feature = "gpu")]
+use crate::opacity_lut::opacity_table;
+use crate::opacity_lut::table_shader_uses;
 use crate::raycast::raycast_ports;
 use crate::raycast_params::raycast_blocks;
 use crate::raycast_params::{RaycastParamsGpu, SampleLoopChoice, Sampling, Workgroup, is_iso};
-use crate::shared::{BlockSize, color_precision_defines};
+use crate::shared::BlockSize;
+#[cfg(feature = "gpu")]
+use crate::shared::color_precision_defines;
+#[cfg(feature = "gpu")]
 use crate::tf_table::TfTable;
 use volgraph_compiler::block::{OnChange, ParamBlock};
 
@@ -94,7 +105,7 @@ impl PassDecl for RaycastCompute {
                 ComputeOwn::block(OnChange::Rebuild)
                     .with_defines(|p| if uses_table(p) { vec![crate::defines::CORRECTED_TABLE] } else { vec![] }),
                 Workgroup::block(OnChange::Rebuild),
-                SampleLoopChoice::block(OnChange::Rebuild).with_defines(|p| SampleLoopChoice::defines(p, None)),
+                SampleLoopChoice::rebuild_block(),
             ],
         ]
         .concat()
@@ -139,6 +150,7 @@ fn march_shader(params: &Params) -> ShaderUse {
         .uniform(BlockSize::bound_as("blocks"))
 }
 
+#[cfg(feature = "gpu")]
 impl PassPlugin for RaycastCompute {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let wg = Workgroup::checked_size(ctx)?;
@@ -184,6 +196,7 @@ impl PassPlugin for RaycastCompute {
     }
 }
 
+#[cfg(feature = "gpu")]
 struct RaycastComputeNode {
     pipeline: ComputePassPipeline,
     /// The HALF_STEP variant, when the step is 0.5 voxel.
@@ -197,6 +210,7 @@ struct RaycastComputeNode {
     step_voxels: f64,
 }
 
+#[cfg(feature = "gpu")]
 impl PassNode for RaycastComputeNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         self.leaping.check(ctx)?;

@@ -93,23 +93,30 @@ volgraph_compiler::pass_params! {
 
 impl SampleLoopChoice {
     /// The defines of the pipelined loop (`TF_WORKGROUP`, `PREFETCH`) when `params` ask for it
-    /// on `gpu`; `None` at plan time, where only an explicit `pipelined` is known.
-    pub fn defines(params: &volgraph_compiler::Params, gpu: Option<&volgraph_core::runtime::Gpu>) -> Vec<&'static str> {
+    /// on an adapter that is (`Some(true)`) or is not a CPU; `None` at plan time, where only an
+    /// explicit `pipelined` is known.
+    pub fn defines(params: &volgraph_compiler::Params, cpu_adapter: Option<bool>) -> Vec<&'static str> {
         let pipelined = match Self::from_params(params).sample_loop {
             SampleLoop::Pipelined => true,
             SampleLoop::Plain => false,
-            SampleLoop::Auto => gpu.is_some_and(|g| !g.is_cpu),
+            SampleLoop::Auto => cpu_adapter == Some(false),
         };
         if pipelined { vec![defines::TF_WORKGROUP, defines::PREFETCH] } else { Vec::new() }
     }
 
+    /// The block: its plan-time defines; the pipeline is made with it (a rebuild).
+    pub fn rebuild_block() -> ParamBlock {
+        Self::block(OnChange::Rebuild).with_defines(|p| Self::defines(p, None))
+    }
+
     /// `defines` at plan time followed by those `gpu` adds: the list a pipeline is built with.
+    #[cfg(feature = "gpu")]
     pub fn with_gpu_defines(
         mut defines: Vec<&'static str>,
         params: &volgraph_compiler::Params,
         gpu: &volgraph_core::runtime::Gpu,
     ) -> Vec<&'static str> {
-        for define in Self::defines(params, Some(gpu)) {
+        for define in Self::defines(params, Some(gpu.is_cpu)) {
             if !defines.contains(&define) {
                 defines.push(define);
             }
@@ -133,6 +140,7 @@ impl Workgroup {
 
     /// The size a compute pass is created with, checked against the device's invocation limit:
     /// the one check every compute pass with a workgroup parameter makes in `create`.
+    #[cfg(feature = "gpu")]
     pub fn checked_size(
         ctx: &volgraph_core::runtime::CreateContext<'_>,
     ) -> Result<(u32, u32), volgraph_core::runtime::PassError> {

@@ -26,25 +26,44 @@ use std::sync::{Arc, Mutex};
 use volgraph_compiler::block::{OnChange, ParamBlock};
 
 use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::footprint::FAN_DRAW_VERTICES;
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{
     CreateContext, DepthSpec, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
 };
+#[cfg(feature = "gpu")]
 use volgraph_core::{PassNode, PassPlugin};
 
 use crate::defines;
-use crate::effects::{EffectState, effect_shader_uses};
+#[cfg(feature = "gpu")]
+use crate::effects::EffectState;
+use crate::effects::effect_shader_uses;
 use crate::empty_space::EMPTY_BLOCKS;
 use crate::raycast_params::{RaycastParamsGpu, Sampling, Termination, is_iso};
-use crate::shared::{ACCUM_FORMATS, BlockSize, FLOAT_TARGETS, HIT_FORMATS, front_to_back_blend};
+#[cfg(feature = "gpu")]
+use crate::shared::front_to_back_blend;
+use crate::shared::{ACCUM_FORMATS, BlockSize, FLOAT_TARGETS, HIT_FORMATS};
 
 /// The plugin. [`Default`] is the production pass; [`RaycastSegment::counting`] adds the debug
 /// invocation counter.
 #[derive(Default)]
 pub struct RaycastSegment {
+    #[cfg(feature = "gpu")]
     counter: Option<InvocationCounter>,
 }
 
+impl RaycastSegment {
+    /// Whether this is the counting variant (a bench tool's; never without the `gpu` feature).
+    fn counts(&self) -> bool {
+        #[cfg(feature = "gpu")]
+        return self.counter.is_some();
+        #[cfg(not(feature = "gpu"))]
+        false
+    }
+}
+
+#[cfg(feature = "gpu")]
 impl RaycastSegment {
     /// A `raycast_segment` whose fragment shader counts its invocations into `counter` (cleared
     /// at the first segment of every frame). Register it in place of the built-in one.
@@ -53,6 +72,7 @@ impl RaycastSegment {
     }
 }
 
+#[cfg(feature = "gpu")]
 /// A handle on the fragment-invocation counter of a counting [`RaycastSegment`]; clone it, give
 /// one clone to [`RaycastSegment::counting`], and read it after a frame.
 #[derive(Clone, Default)]
@@ -60,6 +80,7 @@ pub struct InvocationCounter {
     buffer: Arc<Mutex<Option<wgpu::Buffer>>>,
 }
 
+#[cfg(feature = "gpu")]
 impl InvocationCounter {
     /// A counter not yet attached to a pass.
     pub fn new() -> Self {
@@ -115,6 +136,7 @@ volgraph_compiler::pass_params! {
     }
 }
 
+#[cfg(feature = "gpu")]
 /// The segment index this record is for: the repeat iteration (0 outside a repeat group).
 pub(crate) fn segment_index(ctx: &RecordContext<'_>) -> u32 {
     ctx.iteration.map_or(0, |(i, _)| i)
@@ -170,7 +192,7 @@ impl PassDecl for RaycastSegment {
         // The counting variant (a bench tool's) binds the invocation counter too.
         // The pre-integration table's (an effect's), and the counting variant's counter.
         let binds: &'static [&'static str] =
-            if self.counter.is_some() { &["invocations", "preintegrated"] } else { &["preintegrated"] };
+            if self.counts() { &["invocations", "preintegrated"] } else { &["preintegrated"] };
         let mut uses = [ShaderUse::new(file, "vs_segment"), ShaderUse::new(file, entry_point)]
             .map(|u| u.binds(binds).uniform(RaycastParamsGpu::bound("params")).uniform(SegmentParams::layout()))
             .to_vec();
@@ -191,6 +213,7 @@ impl PassDecl for RaycastSegment {
     }
 }
 
+#[cfg(feature = "gpu")]
 impl PassPlugin for RaycastSegment {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let error = |message: String| PassError { pass: ctx.pass_id.to_string(), message };
@@ -264,7 +287,7 @@ impl PassPlugin for RaycastSegment {
 
 impl RaycastSegment {
     fn entry(&self, params: &Params) -> (&'static str, &'static str) {
-        match (self.counter.is_some(), is_iso(params)) {
+        match (self.counts(), is_iso(params)) {
             (false, false) => ("raycast_segment.wgsl", "fs_dvr"),
             (false, true) => ("raycast_segment.wgsl", "fs_iso"),
             (true, false) => ("raycast_segment_counted.wgsl", "fs_dvr_counted"),
@@ -273,6 +296,7 @@ impl RaycastSegment {
     }
 }
 
+#[cfg(feature = "gpu")]
 struct RaycastSegmentNode {
     /// Without the depth test (RC: no termination pass wired).
     free: RenderPassPipeline,
@@ -286,6 +310,7 @@ struct RaycastSegmentNode {
     step_voxels: f64,
 }
 
+#[cfg(feature = "gpu")]
 impl PassNode for RaycastSegmentNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let index = segment_index(ctx);

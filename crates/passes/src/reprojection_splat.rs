@@ -15,10 +15,12 @@
 use glam::{DVec3, DVec4};
 use volgraph_compiler::block::{OnChange, ParamBlock};
 use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{
     CameraData, ComputePassPipeline, ComputePipelineSpec, CreateContext, DepthSpec, Gpu, PassError, RecordContext,
     RenderPassPipeline, RenderPipelineSpec,
 };
+#[cfg(feature = "gpu")]
 use volgraph_core::{PassNode, PassPlugin};
 
 /// The plugin.
@@ -134,6 +136,7 @@ impl PassDecl for ReprojectionSplat {
     }
 }
 
+#[cfg(feature = "gpu")]
 impl PassPlugin for ReprojectionSplat {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let settings = SplatSettings::from_params(ctx.params);
@@ -167,12 +170,14 @@ impl PassPlugin for ReprojectionSplat {
     }
 }
 
+#[cfg(feature = "gpu")]
 /// The pipelines of a `method`.
 enum Draw {
     Quads(RenderPassPipeline),
     Scatter(Box<ScatterRounds>),
 }
 
+#[cfg(feature = "gpu")]
 /// The scatter's three compute pipelines (`scatter_rounds`).
 struct ScatterRounds {
     clear: ComputePassPipeline,
@@ -180,6 +185,7 @@ struct ScatterRounds {
     point: ComputePassPipeline,
 }
 
+#[cfg(feature = "gpu")]
 struct SplatNode {
     draw: Draw,
     uniform: wgpu::Buffer,
@@ -190,6 +196,7 @@ struct SplatNode {
 
 /// The pixel rectangle `(x, y, w, h)` the volume box of half size `half` covers seen by
 /// `camera` in a `viewport`; the whole viewport when a corner is behind the eye.
+#[cfg(feature = "gpu")]
 pub fn screen_rect(camera: &CameraData, half: DVec3, viewport: (u32, u32)) -> [u32; 4] {
     let (w, h) = (viewport.0 as f64, viewport.1 as f64);
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
@@ -214,6 +221,7 @@ pub fn screen_rect(camera: &CameraData, half: DVec3, viewport: (u32, u32)) -> [u
     [x0, y0, x1.saturating_sub(x0), y1.saturating_sub(y0)]
 }
 
+#[cfg(feature = "gpu")]
 impl PassNode for SplatNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         // Last frame's hits lie in last frame's rectangle; without a last frame history holds

@@ -19,7 +19,9 @@
 
 use volgraph_compiler::block::{OnChange, ParamBlock};
 use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, Gpu, PassError, RecordContext};
+#[cfg(feature = "gpu")]
 use volgraph_core::{PassNode, PassPlugin};
 
 /// The plugin.
@@ -97,6 +99,7 @@ impl PassDecl for ReprojectionTiles {
     }
 }
 
+#[cfg(feature = "gpu")]
 impl PassPlugin for ReprojectionTiles {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let settings = TileBoundsParams::from_params(ctx.params);
@@ -111,6 +114,7 @@ impl PassPlugin for ReprojectionTiles {
     }
 }
 
+#[cfg(feature = "gpu")]
 struct TilesNode {
     clear: ComputePassPipeline,
     scatter: ComputePassPipeline,
@@ -120,6 +124,7 @@ struct TilesNode {
     written: Option<TileBoundsParams>,
 }
 
+#[cfg(feature = "gpu")]
 impl PassNode for TilesNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         // Last frame's hits lie in last frame's screen rectangle of the volume; without a last

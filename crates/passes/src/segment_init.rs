@@ -7,9 +7,11 @@
 use crate::shared::{ACCUM_FORMATS, HIT_FORMATS};
 use volgraph_compiler::block::{OnChange, ParamBlock};
 use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{
     CreateContext, DepthSpec, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
 };
+#[cfg(feature = "gpu")]
 use volgraph_core::{PassNode, PassPlugin};
 
 volgraph_compiler::pass_params! {
@@ -67,6 +69,7 @@ impl PassDecl for SegmentInit {
     }
 }
 
+#[cfg(feature = "gpu")]
 impl PassPlugin for SegmentInit {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let pipeline = ctx.render_pipeline(&RenderPipelineSpec {
@@ -77,10 +80,12 @@ impl PassPlugin for SegmentInit {
     }
 }
 
+#[cfg(feature = "gpu")]
 struct SegmentInitNode {
     pipeline: RenderPassPipeline,
 }
 
+#[cfg(feature = "gpu")]
 impl PassNode for SegmentInitNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         // The Write colour port is cleared by the render pass; nothing is drawn.

@@ -3,6 +3,7 @@
 //! blend, and how a node tells which colour precision its graph picked.
 
 use volgraph_compiler::TargetFormat;
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::CreateContext;
 
 /// Float RGBA targets a ray pass reads or writes (entry points, directions, hits); the first is
@@ -31,6 +32,7 @@ impl BlockSize {
     }
 }
 
+#[cfg(feature = "gpu")]
 /// The front-to-back blend `dst + (1 - dst.a)·src` for colour and alpha.
 pub fn front_to_back_blend() -> wgpu::BlendState {
     let c = wgpu::BlendComponent {
@@ -41,12 +43,14 @@ pub fn front_to_back_blend() -> wgpu::BlendState {
     wgpu::BlendState { color: c, alpha: c }
 }
 
+#[cfg(feature = "gpu")]
 /// Whether the graph (or the scene's precision) made `color` an Rgba32Float target: the node
 /// then compiles its shader with `COLOR_F32`.
 fn color_is_f32(ctx: &CreateContext<'_>) -> bool {
     ctx.port("color").and_then(|p| p.format) == Some(wgpu::TextureFormat::Rgba32Float)
 }
 
+#[cfg(feature = "gpu")]
 /// The `#if` names of the colour target's precision (`shaders/common/color_target.wgsl`): the
 /// one place a compute march learns whether it writes f16 or f32.
 pub fn color_precision_defines(ctx: &CreateContext<'_>) -> Vec<&'static str> {

@@ -6,12 +6,15 @@
 //! same integral with a different sampling pattern. `max_slices` bounds the instance count;
 //! planes past the box draw nothing. Shader: `shaders/slice_render.wgsl`.
 
+#[cfg(feature = "gpu")]
 use crate::shared::front_to_back_blend;
 use volgraph_compiler::block::{OnChange, ParamBlock};
 use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{
     CreateContext, Gpu, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec, UniformBlocks,
 };
+#[cfg(feature = "gpu")]
 use volgraph_core::{PassNode, PassPlugin};
 
 /// The plugin.
@@ -66,6 +69,7 @@ impl PassDecl for SliceRender {
     }
 }
 
+#[cfg(feature = "gpu")]
 impl PassPlugin for SliceRender {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let [vertex, fragment] = stages();
@@ -82,12 +86,14 @@ impl PassPlugin for SliceRender {
     }
 }
 
+#[cfg(feature = "gpu")]
 struct SliceRenderNode {
     pipeline: RenderPassPipeline,
     uniforms: UniformBlocks,
     max_slices: u32,
 }
 
+#[cfg(feature = "gpu")]
 impl PassNode for SliceRenderNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let bg = ctx.bind_group(&self.pipeline, &self.uniforms.bindings())?;

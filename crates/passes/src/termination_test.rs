@@ -17,15 +17,20 @@
 use crate::raycast_params::sampling_block;
 use volgraph_compiler::block::{OnChange, ParamBlock};
 use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::footprint::FAN_DRAW_VERTICES;
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{
     CreateContext, DepthSpec, PassError, RecordContext, RenderPassPipeline, RenderPipelineSpec,
 };
+#[cfg(feature = "gpu")]
 use volgraph_core::{PassNode, PassPlugin};
 
 use crate::empty_space::EMPTY_BLOCKS;
 use crate::raycast_params::RaycastParamsGpu;
-use crate::raycast_segment::{SegmentParams, SegmentSteps, segment_index};
+#[cfg(feature = "gpu")]
+use crate::raycast_segment::segment_index;
+use crate::raycast_segment::{SegmentParams, SegmentSteps};
 use crate::shared::{ACCUM_FORMATS, BlockSize, FLOAT_TARGETS};
 
 /// The plugin.
@@ -91,6 +96,7 @@ impl PassDecl for TerminationTest {
     }
 }
 
+#[cfg(feature = "gpu")]
 impl PassPlugin for TerminationTest {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
         let defines = crate::effects::jitter_defines(ctx.params);
@@ -112,6 +118,7 @@ impl PassPlugin for TerminationTest {
     }
 }
 
+#[cfg(feature = "gpu")]
 struct TerminationTestNode {
     alpha_only: RenderPassPipeline,
     with_empty: RenderPassPipeline,
@@ -119,6 +126,7 @@ struct TerminationTestNode {
     segment: wgpu::Buffer,
 }
 
+#[cfg(feature = "gpu")]
 impl PassNode for TerminationTestNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         // This pass decides for the segment after the one just drawn.

@@ -6,8 +6,10 @@
 //! uniform `params` for the step.
 
 use volgraph_compiler::ShaderUse;
+#[cfg(feature = "gpu")]
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
 
+#[cfg(feature = "gpu")]
 /// A derived table, the pipeline that fills it and the texture it fills.
 pub struct TfTable {
     pipeline: ComputePassPipeline,
@@ -29,6 +31,7 @@ pub fn table_shaders(file: &'static str) -> [ShaderUse; 2] {
     ]
 }
 
+#[cfg(feature = "gpu")]
 impl TfTable {
     /// The table of `size` texels filled by `shaders` (the [`table_shaders`] of its file) with
     /// workgroups of `workgroup`, in the precision the device filters.

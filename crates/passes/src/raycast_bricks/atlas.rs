@@ -7,7 +7,10 @@
 
 use glam::UVec3;
 use volgraph_accel::brick_leaves::{COPY_ROW_ALIGNMENT, slot_coord, staging_bricks_per_chunk, staging_row_bytes};
-use volgraph_core::runtime::{PassError, RecordContext, volume_region_bytes};
+use volgraph_core::runtime::volume_region_bytes;
+#[cfg(feature = "gpu")]
+use volgraph_core::runtime::{PassError, RecordContext};
+#[cfg(feature = "gpu")]
 use wgpu::util::DeviceExt;
 
 use super::{VolumeState, pass_error};
@@ -19,8 +22,10 @@ use crate::brick_pool::BrickPool;
 const MAX_STAGING_BYTES: u64 = 64 << 20;
 
 // The staging rows `brick_leaves` lays out are padded to the alignment copies need.
+#[cfg(feature = "gpu")]
 const _: () = assert!(COPY_ROW_ALIGNMENT == wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as u64);
 
+#[cfg(feature = "gpu")]
 /// The atlas texture and how its slots are laid out.
 pub(super) struct Atlas {
     texture: wgpu::Texture,
@@ -29,6 +34,7 @@ pub(super) struct Atlas {
     pub(super) slots: UVec3,
 }
 
+#[cfg(feature = "gpu")]
 impl VolumeState {
     /// Sizes the pool for the visible bricks under `budget` bytes: grows the atlas (keeping
     /// resident bricks where they are) or, when the budget changed, starts over.

@@ -17,6 +17,7 @@
 //   an H100/H200). Pixel centres inside the quad are covered, as the rasterizer covers them.
 
 #import "common/frame.wgsl"
+#import "common/reprojected_hit.wgsl"
 
 // Declared once in Rust (`SplatParams` in crates/passes/src/reprojection_splat.rs).
 #import "params/SplatParams.wgsl"
@@ -58,20 +59,15 @@ fn block_splat(index: u32) -> BlockSplat {
         if (any(pixel >= end)) {
             continue;
         }
-        let hit = textureLoad(hits, vec2<i32>(pixel), 0);
-        if (hit.w == 0.0) {
+        let hit = reprojected_hit(pixel);
+        if (!hit.valid) {
             continue;
         }
-        let clip = frame.clip_from_world * vec4<f32>(world_from_texture(hit.xyz), 1.0);
-        if (!(clip.w > 0.0)) {
-            continue;
-        }
-        let ndc = clip.xyz / clip.w;
-        out.lo = min(out.lo, ndc.xy);
-        out.hi = max(out.hi, ndc.xy);
-        if (ndc.z < out.z) {
-            out.z = ndc.z;
-            out.point = vec4<f32>(hit.xyz, 1.0);
+        out.lo = min(out.lo, hit.ndc.xy);
+        out.hi = max(out.hi, hit.ndc.xy);
+        if (hit.ndc.z < out.z) {
+            out.z = hit.ndc.z;
+            out.point = vec4<f32>(hit.texture, 1.0);
         }
     }
     // Half the splat edge in NDC units (y up).

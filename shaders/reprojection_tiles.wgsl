@@ -21,6 +21,7 @@
 #import "common/frame.wgsl"
 #import "common/ray_box.wgsl"
 #import "common/reprojected_tiles.wgsl"
+#import "common/reprojected_hit.wgsl"
 
 // Declared once: `TileBoundsParams` (pass_params!) in crates/passes/src/reprojection_tiles.rs,
 // which generates the struct imported here.
@@ -115,20 +116,14 @@ fn cs_tiles_scatter(@builtin(global_invocation_id) id: vec3<u32>) {
         if (any(pixel >= end)) {
             continue;
         }
-        let hit = textureLoad(hits, vec2<i32>(pixel), 0);
-        if (hit.w == 0.0) {
+        // No hit, or behind the eye: bounds no ray of this frame (a tile it would have reached
+        // and no other hit does starts at the box).
+        let hit = reprojected_hit(pixel);
+        if (!hit.valid) {
             continue;
         }
-        let world = world_from_texture(hit.xyz);
-        let clip = frame.clip_from_world * vec4<f32>(world, 1.0);
-        // Behind the eye: bounds no ray of this frame (a tile it would have reached and no
-        // other hit does starts at the box).
-        if (!(clip.w > 0.0)) {
-            continue;
-        }
-        let ndc = clip.xy / clip.w;
-        let p = vec2<f32>((ndc.x + 1.0) * 0.5 * frame.viewport.x, (1.0 - ndc.y) * 0.5 * frame.viewport.y);
-        let depth = view_depth(world);
+        let p = pixel_from_ndc(hit.ndc.xy);
+        let depth = view_depth(hit.world);
         if (count < LOCAL_HITS) {
             points[count] = vec3<f32>(p, depth);
         }

@@ -12,12 +12,11 @@
 //! none of the rasterizer's per-quad setup, the same starts. Shader:
 //! `shaders/reprojection_splat.wgsl`.
 
-use glam::{DVec3, DVec4};
 use volgraph_compiler::block::{OnChange, ParamBlock};
 use volgraph_compiler::{Params, PassDecl, PortKind, PortSpec, ShaderUse, TargetFormat};
 #[cfg(feature = "gpu")]
 use volgraph_core::runtime::{
-    CameraData, ComputePassPipeline, ComputePipelineSpec, CreateContext, DepthSpec, Gpu, PassError, RecordContext,
+    ComputePassPipeline, ComputePipelineSpec, CreateContext, DepthSpec, Gpu, PassError, RecordContext,
     RenderPassPipeline, RenderPipelineSpec,
 };
 #[cfg(feature = "gpu")]
@@ -194,33 +193,6 @@ struct SplatNode {
     written: Option<SplatParams>,
 }
 
-/// The pixel rectangle `(x, y, w, h)` the volume box of half size `half` covers seen by
-/// `camera` in a `viewport`; the whole viewport when a corner is behind the eye.
-#[cfg(feature = "gpu")]
-pub fn screen_rect(camera: &CameraData, half: DVec3, viewport: (u32, u32)) -> [u32; 4] {
-    let (w, h) = (viewport.0 as f64, viewport.1 as f64);
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for i in 0..8 {
-        let corner = DVec3::new(
-            if i & 1 != 0 { half.x } else { -half.x },
-            if i & 2 != 0 { half.y } else { -half.y },
-            if i & 4 != 0 { half.z } else { -half.z },
-        );
-        let c = camera.clip_from_world * DVec4::new(corner.x, corner.y, corner.z, 1.0);
-        if c.w <= 1e-9 {
-            return [0, 0, viewport.0, viewport.1];
-        }
-        let (px, py) = ((c.x / c.w + 1.0) * 0.5 * w, (1.0 - c.y / c.w) * 0.5 * h);
-        lo = [lo[0].min(px), lo[1].min(py)];
-        hi = [hi[0].max(px), hi[1].max(py)];
-    }
-    let x0 = lo[0].floor().clamp(0.0, w) as u32;
-    let y0 = lo[1].floor().clamp(0.0, h) as u32;
-    let x1 = hi[0].ceil().clamp(0.0, w) as u32;
-    let y1 = hi[1].ceil().clamp(0.0, h) as u32;
-    [x0, y0, x1.saturating_sub(x0), y1.saturating_sub(y0)]
-}
-
 #[cfg(feature = "gpu")]
 impl PassNode for SplatNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
@@ -228,7 +200,7 @@ impl PassNode for SplatNode {
         // its initial value (no hits) and nothing is drawn.
         let rect = match (&ctx.frame.previous_camera, &ctx.frame.volume) {
             (Some(previous), Some(volume)) if ctx.frame.history_age > 0 => {
-                screen_rect(previous, volume.half_extent, ctx.frame.viewport)
+                crate::shared::screen_rect(previous, volume.half_extent, ctx.frame.viewport)
             }
             _ => [0; 4],
         };

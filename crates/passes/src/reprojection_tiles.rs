@@ -131,7 +131,7 @@ impl PassNode for TilesNode {
         // frame history holds its initial value (no hits) and nothing is scattered.
         let rect = match (&ctx.frame.previous_camera, &ctx.frame.volume) {
             (Some(previous), Some(volume)) if ctx.frame.history_age > 0 => {
-                crate::reprojection_splat::screen_rect(previous, volume.half_extent, ctx.frame.viewport)
+                crate::shared::screen_rect(previous, volume.half_extent, ctx.frame.viewport)
             }
             _ => [0; 4],
         };

@@ -57,6 +57,34 @@ pub fn color_precision_defines(ctx: &CreateContext<'_>) -> Vec<&'static str> {
     if color_is_f32(ctx) { vec![crate::defines::COLOR_F32] } else { Vec::new() }
 }
 
+/// The pixel rectangle `(x, y, w, h)` the volume box of half size `half` covers seen by
+/// `camera` in a `viewport`; the whole viewport when a corner is behind the eye: where last
+/// frame's hits lie, for both reprojections (`reprojection_splat`, `reprojection_tiles`).
+#[cfg(feature = "gpu")]
+pub fn screen_rect(camera: &volgraph_core::runtime::CameraData, half: glam::DVec3, viewport: (u32, u32)) -> [u32; 4] {
+    let (w, h) = (viewport.0 as f64, viewport.1 as f64);
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for i in 0..8 {
+        let corner = glam::DVec3::new(
+            if i & 1 != 0 { half.x } else { -half.x },
+            if i & 2 != 0 { half.y } else { -half.y },
+            if i & 4 != 0 { half.z } else { -half.z },
+        );
+        let c = camera.clip_from_world * glam::DVec4::new(corner.x, corner.y, corner.z, 1.0);
+        if c.w <= 1e-9 {
+            return [0, 0, viewport.0, viewport.1];
+        }
+        let (px, py) = ((c.x / c.w + 1.0) * 0.5 * w, (1.0 - c.y / c.w) * 0.5 * h);
+        lo = [lo[0].min(px), lo[1].min(py)];
+        hi = [hi[0].max(px), hi[1].max(py)];
+    }
+    let x0 = lo[0].floor().clamp(0.0, w) as u32;
+    let y0 = lo[1].floor().clamp(0.0, h) as u32;
+    let x1 = hi[0].ceil().clamp(0.0, w) as u32;
+    let y1 = hi[1].ceil().clamp(0.0, h) as u32;
+    [x0, y0, x1.saturating_sub(x0), y1.saturating_sub(y0)]
+}
+
 /// A built-in shader assembled as the GPU gets it (imports resolved, bindings numbered), for
 /// tests that compare a `pass_params!` declaration with its WGSL struct (`check_shader`).
 #[cfg(test)]

@@ -16,6 +16,7 @@ pub mod generate;
 pub mod histogram;
 pub mod image_diff;
 pub mod kd_split;
+pub mod labels;
 pub mod load;
 pub mod minmax;
 pub mod mip;

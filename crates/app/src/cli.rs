@@ -80,6 +80,14 @@ enum Command {
         /// .nii.gz), a folder of DICOM slices (its series are listed), or DICOM slice files.
         #[arg(required = true, num_args = 1..)]
         volume: Vec<PathBuf>,
+        /// The volume is a label map (a segmentation): list its labels — value, name, voxels and
+        /// volume in mL (a default palette names them without --label-table).
+        #[arg(long)]
+        labels: bool,
+        /// The label map's names and colours: an ITK-SNAP label description file or a 3D Slicer
+        /// colour table (.ctbl, .txt). Implies --labels.
+        #[arg(long, value_name = "TABLE")]
+        label_table: Option<PathBuf>,
         /// How to read a headerless raw volume.
         #[command(flatten)]
         raw: RawArgs,
@@ -292,8 +300,9 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             crate::stdout::write_stdout(&crate::builtin_graphs::listing())?;
             Ok(())
         }
-        Command::Info { volume, raw } => {
-            crate::stdout::write_stdout(&crate::info_cmd::run(&volume, &inputs::raw_options(&raw)?)?)?;
+        Command::Info { volume, labels, label_table, raw } => {
+            let labels = (labels || label_table.is_some()).then_some(crate::info_cmd::Labels { table: label_table });
+            crate::stdout::write_stdout(&crate::info_cmd::run(&volume, &inputs::raw_options(&raw)?, labels.as_ref())?)?;
             Ok(())
         }
         Command::Passes { kind, graph } => {

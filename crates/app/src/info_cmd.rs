@@ -14,9 +14,16 @@ use volgraph_accel::load::dicom;
 use volgraph_accel::transfer_function::TransferFunction;
 use volgraph_accel::volume::Volume;
 
+/// `--labels` / `--label-table TABLE`: report the volume as a label map, named by TABLE.
+#[derive(Clone, Debug, Default)]
+pub struct Labels {
+    /// The label table, or none for the default palette.
+    pub table: Option<PathBuf>,
+}
+
 /// The report for `paths`: the series list of a DICOM folder holding several (and the first
-/// series, or the one `--series` picks), else the one volume.
-pub fn run(paths: &[PathBuf], options: &LoadOptions<'static>) -> anyhow::Result<String> {
+/// series, or the one `--series` picks), else the one volume; with `labels`, its labels.
+pub fn run(paths: &[PathBuf], options: &LoadOptions<'static>, labels: Option<&Labels>) -> anyhow::Result<String> {
     let mut out = String::new();
     if dicom::is_dicom_input(paths) {
         let series = dicom::list_series(paths).map_err(|e| anyhow!("{e}"))?;
@@ -35,7 +42,86 @@ pub fn run(paths: &[PathBuf], options: &LoadOptions<'static>) -> anyhow::Result<
     }
     let name = paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(" ");
     out.push_str(&describe(Path::new(&name), &volume));
+    if let Some(labels) = labels {
+        out.push_str(&crate::info_cmd::label_report(&volume, labels)?);
+    }
     Ok(out)
+}
+
+/// The labels of `volume` as a label map: one line a value present, named by the table.
+pub fn label_report(volume: &Volume, labels: &Labels) -> anyhow::Result<String> {
+    use volgraph_accel::labels::{LabelTable, census::census};
+    let census = census(volume).map_err(|e| anyhow!("{e}"))?;
+    let values = census.values();
+    let table = match &labels.table {
+        Some(path) => LabelTable::read(path).map_err(|e| anyhow!("{e}"))?,
+        None => LabelTable::default_for(values.iter().copied()),
+    };
+    // Millilitres where the spacing is in millimetres: a file in the patient frame (DICOM, NIfTI,
+    // an anatomical NRRD space); a raw volume's spacing has no unit.
+    let physical = volume.meta.frame == volgraph_accel::volume_meta::WorldFrame::Lps;
+    let mut out = String::new();
+    let labelled = values.iter().filter(|v| **v != 0).count();
+    let _ = writeln!(
+        out,
+        "  labels       {labelled} label{} and {}, names from {}",
+        if labelled == 1 { "" } else { "s" },
+        if values.first() == Some(&0) { "the background (0)" } else { "no background (no 0)" },
+        dicom::one_line(&table.source)
+    );
+    let width = values.iter().map(|v| dicom::one_line(&table.label(*v).name).chars().count()).max().unwrap_or(4).max(4);
+    let size = if physical { "volume" } else { "volume (spacing units³)" };
+    let _ = writeln!(out, "    {:>6}  {:<width$}  {:>12}  {size}", "value", "name", "voxels");
+    for count in &census.counts {
+        let label = table.label(count.value);
+        let amount = census.millilitres(count.voxels);
+        let volume_text = if physical {
+            format!("{amount:.3} mL")
+        } else {
+            format!("{:.4}", count.voxels as f64 * census.voxel_volume)
+        };
+        let shown = if label.visible { "" } else { "  (hidden)" };
+        let _ = writeln!(
+            out,
+            "    {:>6}  {:<width$}  {:>12}  {volume_text}{shown}",
+            count.value,
+            dicom::one_line(&label.name),
+            count.voxels
+        );
+    }
+    if labels.table.is_some() {
+        let unnamed: Vec<u32> = values.iter().copied().filter(|v| *v != 0 && !table.labels.contains_key(v)).collect();
+        if !unnamed.is_empty() {
+            let _ = writeln!(
+                out,
+                "  note: {} value{} of the map {} no entry in the table ({}): shown with the default palette",
+                unnamed.len(),
+                if unnamed.len() == 1 { "" } else { "s" },
+                if unnamed.len() == 1 { "has" } else { "have" },
+                list(&unnamed)
+            );
+        }
+        let missing = table.missing_from(&values);
+        if !missing.is_empty() {
+            let _ = writeln!(
+                out,
+                "  note: the table names {} label{} the map lacks ({})",
+                missing.len(),
+                if missing.len() == 1 { "" } else { "s" },
+                list(&missing)
+            );
+        }
+    }
+    Ok(out)
+}
+
+/// Up to eight values, then how many more.
+fn list(values: &[u32]) -> String {
+    let shown: Vec<String> = values.iter().take(8).map(u32::to_string).collect();
+    match values.len() {
+        n if n > 8 => format!("{}, … {} more", shown.join(", "), n - 8),
+        _ => shown.join(", "),
+    }
 }
 
 /// The report on `volume`, read from `path`.

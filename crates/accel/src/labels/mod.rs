@@ -1,0 +1,161 @@
+//! Label maps and their tables (issue "several volumes", items 3 and 6): what a segmentation's
+//! integer values mean — a name, a colour, an opacity, whether it is shown — read from the
+//! tables the tools users segment with write, and the census of a label map (voxels and
+//! physical volume per label).
+//!
+//! - [`itksnap`]: ITK-SNAP's label description file (`IDX R G B A VIS MSH "LABEL"`).
+//! - [`slicer`]: 3D Slicer's colour table (`.ctbl`, `.txt`: `value name R G B A`).
+//! - [`census`]: the labels a volume holds, counted.
+//! - [`LabelTable::default_for`]: a palette with the map's own values where there is no table.
+//!
+//! A table names labels by value; a value without an entry takes [`default_label`] (and the
+//! caller says so once). Value 0 is the background: transparent unless a table says otherwise.
+
+pub mod census;
+pub mod itksnap;
+pub mod slicer;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// One label: what value `value` of a label map stands for.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Label {
+    /// The name a table gives it (or `Label N`).
+    pub name: String,
+    /// Colour, the sRGB bytes the table writes.
+    pub rgb: [u8; 3],
+    /// Opacity 0..1.
+    pub opacity: f32,
+    /// Whether it is shown.
+    pub visible: bool,
+}
+
+/// The labels of a map by value.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LabelTable {
+    /// Entries by label value.
+    pub labels: BTreeMap<u32, Label>,
+    /// Where the table came from (a file, or "default palette").
+    pub source: String,
+}
+
+/// A table file that cannot be read: the file, the line (1-based) and what is wrong there.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum LabelTableError {
+    /// A line that is not an entry of the format.
+    #[error("{file}:{line}: {message}")]
+    Line {
+        /// The table file.
+        file: String,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong and how to fix it.
+        message: String,
+    },
+    /// The file cannot be read, or is no table of a known format.
+    #[error("{file}: {message}")]
+    File {
+        /// The table file.
+        file: String,
+        /// What is wrong and how to fix it.
+        message: String,
+    },
+}
+
+/// The colour of label `value` where no table names it: value 0 (background) is black and
+/// hidden; others walk the hue circle by the golden angle, so neighbouring values differ.
+pub fn default_label(value: u32) -> Label {
+    if value == 0 {
+        return Label { name: "background".to_string(), rgb: [0, 0, 0], opacity: 0.0, visible: false };
+    }
+    let hue = (value as f64 * 137.507_764_050_037_9).rem_euclid(360.0);
+    Label { name: format!("Label {value}"), rgb: hsv_bytes(hue, 0.65, 0.95), opacity: 1.0, visible: true }
+}
+
+/// HSV (hue in degrees, s and v in 0..1) as RGB bytes.
+fn hsv_bytes(hue: f64, s: f64, v: f64) -> [u8; 3] {
+    let c = v * s;
+    let h = hue / 60.0;
+    let x = c * (1.0 - (h.rem_euclid(2.0) - 1.0).abs());
+    let (r, g, b) = match h as u32 {
+        0 => (c, x, 0.0),
+        1 => (x, c, 0.0),
+        2 => (0.0, c, x),
+        3 => (0.0, x, c),
+        4 => (x, 0.0, c),
+        _ => (c, 0.0, x),
+    };
+    let m = v - c;
+    [r, g, b].map(|t| ((t + m) * 255.0).round().clamp(0.0, 255.0) as u8)
+}
+
+impl LabelTable {
+    /// The default palette for the values `values` (a map's census), each [`default_label`].
+    pub fn default_for(values: impl IntoIterator<Item = u32>) -> Self {
+        Self {
+            labels: values.into_iter().map(|v| (v, default_label(v))).collect(),
+            source: "default palette".to_string(),
+        }
+    }
+
+    /// The label of `value`: the table's entry, else [`default_label`].
+    pub fn label(&self, value: u32) -> Label {
+        self.labels.get(&value).cloned().unwrap_or_else(|| default_label(value))
+    }
+
+    /// Reads a table file, its format told by its text: ITK-SNAP's (entries with a quoted
+    /// label, or its header comment) or 3D Slicer's colour table (`value name R G B A`).
+    pub fn read(path: &Path) -> Result<Self, LabelTableError> {
+        let file = path.display().to_string();
+        let bytes = std::fs::read(path).map_err(|e| LabelTableError::File {
+            file: file.clone(),
+            message: format!("cannot read the label table ({e})"),
+        })?;
+        let text = String::from_utf8(bytes).map_err(|_| LabelTableError::File {
+            file: file.clone(),
+            message: "the label table is not UTF-8 text; give an ITK-SNAP label description file or a 3D Slicer \
+                      colour table (.ctbl, .txt)"
+                .to_string(),
+        })?;
+        Self::parse(&file, &text)
+    }
+
+    /// [`Self::read`] of `text`, named `file` in messages.
+    pub fn parse(file: &str, text: &str) -> Result<Self, LabelTableError> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        if itksnap::looks_like(text) { itksnap::parse(file, text) } else { slicer::parse(file, text) }
+    }
+
+    /// Values the table names that `present` (a map's census) lacks, for the one note a caller
+    /// gives ("the table names labels the map lacks").
+    pub fn missing_from(&self, present: &[u32]) -> Vec<u32> {
+        self.labels.keys().copied().filter(|v| *v != 0 && present.binary_search(v).is_err()).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_palette_hides_the_background_and_tells_neighbours_apart() {
+        let background = default_label(0);
+        assert!(!background.visible && background.opacity == 0.0);
+        let (a, b) = (default_label(1), default_label(2));
+        assert!(a.visible && b.visible);
+        let distance: i32 = a.rgb.iter().zip(b.rgb).map(|(x, y)| (*x as i32 - y as i32).abs()).sum();
+        assert!(distance > 100, "labels 1 and 2 look alike: {:?} {:?}", a.rgb, b.rgb);
+        assert_eq!(default_label(65_535).name, "Label 65535");
+    }
+
+    #[test]
+    fn the_format_is_told_by_the_text() {
+        let itk = LabelTable::parse("a.txt", "    1   255    0    0        1  1  1    \"Liver\"\n").expect("itk-snap");
+        assert_eq!(itk.labels[&1].name, "Liver");
+        let slicer =
+            LabelTable::parse("b.ctbl", "# Color table file b.ctbl\n1 liver 221 130 101 255\n").expect("slicer");
+        assert_eq!(slicer.labels[&1].name, "liver");
+        assert_eq!(slicer.missing_from(&[0, 2]), [1]);
+    }
+}

@@ -1,0 +1,102 @@
+//! `volgraph info --labels` / `--label-table` (issue "several volumes", item 6): a label map's
+//! labels — value, name, voxels, volume in mL — named by an ITK-SNAP or 3D Slicer table, a
+//! default palette without one, notes for values the table lacks and labels the map lacks, and
+//! a located error for a bad table or a volume that holds no labels.
+//!
+//! The counts were cross-checked once against nibabel + numpy (a 64³ NIfTI of three spheres at
+//! 0.8 × 0.8 × 2 mm written by nibabel: `np.unique` gave 7123, 2969 and 485 voxels = 9.117,
+//! 3.800 and 0.621 mL, which `volgraph info seg.nii.gz --labels` printed); here an NRRD is made
+//! in-tree so the test needs no Python.
+
+use std::path::Path;
+use std::process::Command;
+
+/// An 8 × 8 × 4 uint16 NRRD in LPS at 0.5 × 0.5 × 2 mm (0.5 mm³ a voxel): label 3 in the first
+/// 16 voxels, 65535 in the last 2, else 0.
+fn label_map(dir: &Path) -> std::path::PathBuf {
+    let mut data = vec![0u16; 256];
+    data[..16].fill(3);
+    data[254..].fill(65_535);
+    let mut bytes = b"NRRD0004\ntype: uint16\ndimension: 3\nsizes: 8 8 4\nspace: left-posterior-superior\n\
+space directions: (0.5,0,0) (0,0.5,0) (0,0,2)\nspace origin: (0,0,0)\nencoding: raw\nendian: little\n\n"
+        .to_vec();
+    bytes.extend(data.iter().flat_map(|v| v.to_le_bytes()));
+    let path = dir.join("seg.nrrd");
+    std::fs::write(&path, bytes).expect("write nrrd");
+    path
+}
+
+fn info(args: &[&str], dir: &Path) -> (bool, String, String) {
+    let out =
+        Command::new(env!("CARGO_BIN_EXE_volgraph")).arg("info").args(args).current_dir(dir).output().expect("runs");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn scratch(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("volgraph-info-labels-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("scratch");
+    dir
+}
+
+#[test]
+fn a_label_map_lists_its_labels_with_voxels_and_millilitres() {
+    let dir = scratch("palette");
+    label_map(&dir);
+    let (ok, out, err) = info(&["seg.nrrd", "--labels"], &dir);
+    assert!(ok, "{err}");
+    assert!(out.contains("labels       2 labels and the background (0), names from default palette"), "{out}");
+    // 16 voxels × 0.5 mm³ = 0.008 mL; 2 voxels = 0.001 mL.
+    let row =
+        |value: &str| out.lines().find(|l| l.split_whitespace().next() == Some(value)).unwrap_or_default().to_string();
+    assert!(row("3").contains("Label 3") && row("3").contains(" 16 ") && row("3").ends_with("0.008 mL"), "{out}");
+    assert!(row("65535").contains(" 2 ") && row("65535").ends_with("0.001 mL"), "{out}");
+    assert!(row("0").contains(" 238 ") && row("0").ends_with("(hidden)"), "{out}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_table_names_the_labels_and_notes_what_does_not_match() {
+    let dir = scratch("table");
+    label_map(&dir);
+    std::fs::write(
+        dir.join("organs.ctbl"),
+        "# Color table file organs.ctbl\n0 background 0 0 0 0\n3 portal_vein 0 0 255 255\n9 aorta 255 0 0 255\n",
+    )
+    .expect("table");
+    let (ok, out, err) = info(&["seg.nrrd", "--label-table", "organs.ctbl"], &dir);
+    assert!(ok, "{err}");
+    assert!(out.contains("names from organs.ctbl"), "{out}");
+    assert!(out.lines().any(|l| l.trim_start().starts_with("3  portal vein")), "{out}");
+    assert!(
+        out.contains("note: 1 value of the map has no entry in the table (65535): shown with the default palette"),
+        "{out}"
+    );
+    assert!(out.contains("note: the table names 1 label the map lacks (9)"), "{out}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_bad_table_or_a_scan_is_an_error_that_says_where() {
+    let dir = scratch("bad");
+    label_map(&dir);
+    std::fs::write(dir.join("bad.txt"), "    1   255    0    0        1  1  1    \"a\"\n    1   0 0 0  1 1 1 \"b\"\n")
+        .expect("table");
+    let (ok, _, err) = info(&["seg.nrrd", "--label-table", "bad.txt"], &dir);
+    assert!(!ok);
+    assert!(err.contains("bad.txt:2: label 1 is described twice; keep one line for it"), "{err}");
+    let (ok, _, err) = info(&["seg.nrrd", "--label-table", "missing.txt"], &dir);
+    assert!(!ok && err.contains("missing.txt: cannot read the label table"), "{err}");
+    // A float volume of non-integers is no label map: the error names a voxel.
+    std::fs::write(
+        dir.join("scan_2x2x2_float32.raw"),
+        [0.0f32, 0.5, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0].iter().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>(),
+    )
+    .expect("raw");
+    let (ok, _, err) = info(&["scan_2x2x2_float32.raw", "--labels"], &dir);
+    assert!(!ok && err.contains("is not a label map: voxel (1, 0, 0) holds 0.5"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

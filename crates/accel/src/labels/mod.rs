@@ -6,6 +6,7 @@
 //! - [`itksnap`]: ITK-SNAP's label description file (`IDX R G B A VIS MSH "LABEL"`).
 //! - [`slicer`]: 3D Slicer's colour table (`.ctbl`, `.txt`: `value name R G B A`).
 //! - [`census`]: the labels a volume holds, counted.
+//! - [`sample`]: a label map sampled without mixing label numbers (nearest, smooth indicators).
 //! - [`LabelTable::default_for`]: a palette with the map's own values where there is no table.
 //!
 //! A table names labels by value; a value without an entry takes [`default_label`] (and the
@@ -13,6 +14,7 @@
 
 pub mod census;
 pub mod itksnap;
+pub mod sample;
 pub mod slicer;
 
 use std::collections::BTreeMap;

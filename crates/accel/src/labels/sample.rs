@@ -131,7 +131,8 @@ mod tests {
         }
         assert_eq!(seen.into_iter().collect::<Vec<_>>(), [0, 2, 4]);
         // The blend of values would have invented 3 on the sphere's boundary with the slab.
-        let boundary = DVec3::new(25.5, 16.5, 16.5) / 32.0;
+        // Halfway between the centres of voxel 25 (label 2) and voxel 26 (label 4).
+        let boundary = DVec3::new(26.0, 16.5, 16.5) / 32.0;
         assert!((v.sample_trilinear(boundary) * 255.0 - 3.0).abs() < 1.0);
         assert_ne!(sample_label(&v, boundary, LabelFilter::Smooth).0, 3);
     }

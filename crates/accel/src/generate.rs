@@ -220,8 +220,8 @@ pub fn non_finite_f32(n: u32) -> (Volume, (usize, usize, usize)) {
 pub const MAX_NAMED_EDGE: u32 = 512;
 
 /// The generated volumes [`by_name`] knows, for messages.
-pub const NAMED_GENERATORS: &str =
-    "ml<N>, mlf<N>, sphere<N>, noise<N>, vessels<N> or tooth<N> (N = edge in voxels), e.g. ml64";
+pub const NAMED_GENERATORS: &str = "ml<N>, mlf<N>, sphere<N>, noise<N>, vessels<N>, tooth<N>, organs<N> or organs_labels<N> (N = edge in voxels), \
+     e.g. ml64";
 
 /// Why a generated-volume name makes no volume.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -242,7 +242,8 @@ pub enum NamedVolumeError {
 
 /// The generated volume a name asks for: `ml64` (Marschner–Lobb, 64³ u8), `mlf64` (f32),
 /// `sphere64`, `noise64`, `vessels256` (the sparse vessel tree of [`crate::vessels`]), `tooth256`
-/// (the molar CT of [`crate::tooth`], n × n × ⌈0.63 n⌉). `Err(Unknown)`
+/// (the molar CT of [`crate::tooth`], n × n × ⌈0.63 n⌉), `organs128` / `organs_labels128` (the
+/// abdominal CT of [`crate::organs`] and its label map, n × n × n/2). `Err(Unknown)`
 /// for a name that is none of these, so callers can fall back on a data-folder dataset.
 pub fn by_name(name: &str) -> Result<Volume, NamedVolumeError> {
     let unknown = || NamedVolumeError::Unknown { name: name.to_string() };
@@ -258,6 +259,10 @@ pub fn by_name(name: &str) -> Result<Volume, NamedVolumeError> {
         (|n| crate::vessels::vessel_tree(n, 1), d)
     } else if let Some(d) = name.strip_prefix("tooth") {
         (crate::tooth::tooth, d)
+    } else if let Some(d) = name.strip_prefix("organs_labels") {
+        (crate::organs::organs_labels, d)
+    } else if let Some(d) = name.strip_prefix("organs") {
+        (crate::organs::organs_ct, d)
     } else {
         return Err(unknown());
     };

@@ -21,6 +21,7 @@ pub mod load;
 pub mod minmax;
 pub mod mip;
 pub mod octree;
+pub mod organs;
 pub mod probe;
 pub mod reference;
 pub mod srgb;

@@ -174,7 +174,10 @@ fn a_volume_name_is_a_dataset_or_a_generated_volume() {
         volgraph(&["render", "graphs/basic/fragment_raycast.ron", "--volume", "no_such_volume", "-o", &o]);
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("no_such_volume: no such file or folder, and not a volume's name"), "{err}");
-    assert!(err.contains("ml<N>, mlf<N>, sphere<N>, noise<N>, vessels<N> or tooth<N>"), "{err}");
+    assert!(
+        err.contains("ml<N>, mlf<N>, sphere<N>, noise<N>, vessels<N>, tooth<N>, organs<N> or organs_labels<N>"),
+        "{err}"
+    );
     // A name is no file: the flags of a file's layout are refused, not silently dropped.
     let (code, err) =
         volgraph(&["render", "graphs/basic/fragment_raycast.ron", "--volume", "sphere24", "--dims", "8x8x8", "-o", &o]);

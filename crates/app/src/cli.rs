@@ -84,8 +84,9 @@ enum Command {
         /// volume in mL (a default palette names them without --label-table).
         #[arg(long)]
         labels: bool,
-        /// The label map's names and colours: an ITK-SNAP label description file or a 3D Slicer
-        /// colour table (.ctbl, .txt). Implies --labels.
+        /// The label map's names and colours: an ITK-SNAP label description file, a 3D Slicer
+        /// colour table (.ctbl, .txt) or segmentation (.seg.nrrd, whose header names its
+        /// segments; a .seg.nrrd given as the volume names its own). Implies --labels.
         #[arg(long, value_name = "TABLE")]
         label_table: Option<PathBuf>,
         /// How to read a headerless raw volume.

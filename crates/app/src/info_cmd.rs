@@ -43,7 +43,14 @@ pub fn run(paths: &[PathBuf], options: &LoadOptions<'static>, labels: Option<&La
     let name = paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(" ");
     out.push_str(&describe(Path::new(&name), &volume));
     if let Some(labels) = labels {
-        out.push_str(&crate::info_cmd::label_report(&volume, labels)?);
+        // A 3D Slicer segmentation names its own segments.
+        let own = match (&labels.table, paths) {
+            (None, [one]) if volgraph_accel::labels::slicer_seg::is_seg_nrrd(one) => {
+                Labels { table: Some(one.clone()) }
+            }
+            _ => labels.clone(),
+        };
+        out.push_str(&label_report(&volume, &own)?);
     }
     Ok(out)
 }
@@ -53,9 +60,9 @@ pub fn label_report(volume: &Volume, labels: &Labels) -> anyhow::Result<String> 
     use volgraph_accel::labels::{LabelTable, census::census};
     let census = census(volume).map_err(|e| anyhow!("{e}"))?;
     let values = census.values();
-    let table = match &labels.table {
+    let (table, table_notes) = match &labels.table {
         Some(path) => LabelTable::read(path).map_err(|e| anyhow!("{e}"))?,
-        None => LabelTable::default_for(values.iter().copied()),
+        None => (LabelTable::default_for(values.iter().copied()), Vec::new()),
     };
     // Millilitres where the spacing is in millimetres: a file in the patient frame (DICOM, NIfTI,
     // an anatomical NRRD space); a raw volume's spacing has no unit.
@@ -88,6 +95,9 @@ pub fn label_report(volume: &Volume, labels: &Labels) -> anyhow::Result<String> 
             dicom::one_line(&label.name),
             count.voxels
         );
+    }
+    for note in table_notes {
+        let _ = writeln!(out, "  note: {}", dicom::one_line(&note));
     }
     if labels.table.is_some() {
         let unnamed: Vec<u32> = values.iter().copied().filter(|v| *v != 0 && !table.labels.contains_key(v)).collect();

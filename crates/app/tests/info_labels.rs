@@ -14,14 +14,21 @@ use std::process::Command;
 /// An 8 × 8 × 4 uint16 NRRD in LPS at 0.5 × 0.5 × 2 mm (0.5 mm³ a voxel): label 3 in the first
 /// 16 voxels, 65535 in the last 2, else 0.
 fn label_map(dir: &Path) -> std::path::PathBuf {
+    label_map_with(dir, "seg.nrrd", "")
+}
+
+/// [`label_map`] as `name`, with `keys` (`key:=value` lines) in its header.
+fn label_map_with(dir: &Path, name: &str, keys: &str) -> std::path::PathBuf {
     let mut data = vec![0u16; 256];
     data[..16].fill(3);
     data[254..].fill(65_535);
     let mut bytes = b"NRRD0004\ntype: uint16\ndimension: 3\nsizes: 8 8 4\nspace: left-posterior-superior\n\
-space directions: (0.5,0,0) (0,0.5,0) (0,0,2)\nspace origin: (0,0,0)\nencoding: raw\nendian: little\n\n"
+space directions: (0.5,0,0) (0,0.5,0) (0,0,2)\nspace origin: (0,0,0)\nencoding: raw\nendian: little\n"
         .to_vec();
+    bytes.extend(keys.as_bytes());
+    bytes.push(b'\n');
     bytes.extend(data.iter().flat_map(|v| v.to_le_bytes()));
-    let path = dir.join("seg.nrrd");
+    let path = dir.join(name);
     std::fs::write(&path, bytes).expect("write nrrd");
     path
 }
@@ -98,5 +105,20 @@ fn a_bad_table_or_a_scan_is_an_error_that_says_where() {
     .expect("raw");
     let (ok, _, err) = info(&["scan_2x2x2_float32.raw", "--labels"], &dir);
     assert!(!ok && err.contains("is not a label map: voxel (1, 0, 0) holds 0.5"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_slicer_segmentation_names_its_own_segments() {
+    let dir = scratch("seg");
+    let keys = "Segment0_Color:=0.866667 0.509804 0.396078\nSegment0_LabelValue:=3\nSegment0_Layer:=0\nSegment0_Name:=liver\n\
+                Segment1_LabelValue:=65535\nSegment1_Name:=portal vein\nSegment2_LabelValue:=1\nSegment2_Layer:=1\n";
+    label_map_with(&dir, "organs.seg.nrrd", keys);
+    let (ok, out, err) = info(&["organs.seg.nrrd", "--labels"], &dir);
+    assert!(ok, "{err}");
+    assert!(out.contains("names from organs.seg.nrrd"), "{out}");
+    assert!(out.lines().any(|l| l.trim_start().starts_with("3  liver")), "{out}");
+    assert!(out.lines().any(|l| l.trim_start().starts_with("65535  portal vein")), "{out}");
+    assert!(out.contains("1 segment of other layers (overlapping segments) left out"), "{out}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -5,6 +5,8 @@
 //!
 //! - [`itksnap`]: ITK-SNAP's label description file (`IDX R G B A VIS MSH "LABEL"`).
 //! - [`slicer`]: 3D Slicer's colour table (`.ctbl`, `.txt`: `value name R G B A`).
+//! - [`slicer_seg`]: the segment names and colours a 3D Slicer segmentation (`.seg.nrrd`) keeps in
+//!   its header.
 //! - [`census`]: the labels a volume holds, counted.
 //! - [`sample`]: a label map sampled without mixing label numbers (nearest, smooth indicators).
 //! - [`LabelTable::default_for`]: a palette with the map's own values where there is no table.
@@ -16,6 +18,7 @@ pub mod census;
 pub mod itksnap;
 pub mod sample;
 pub mod slicer;
+pub mod slicer_seg;
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -107,9 +110,18 @@ impl LabelTable {
     }
 
     /// Reads a table file, its format told by its text: ITK-SNAP's (entries with a quoted
-    /// label, or its header comment) or 3D Slicer's colour table (`value name R G B A`).
-    pub fn read(path: &Path) -> Result<Self, LabelTableError> {
+    /// label, or its header comment) or 3D Slicer's colour table (`value name R G B A`); or the
+    /// segments a 3D Slicer segmentation (`.seg.nrrd`) names in its header. Notes (segments
+    /// left out) come back beside the table.
+    pub fn read(path: &Path) -> Result<(Self, Vec<String>), LabelTableError> {
         let file = path.display().to_string();
+        if slicer_seg::is_seg_nrrd(path) {
+            let pairs = crate::load::nrrd_key_values(path).map_err(|e| LabelTableError::File {
+                file: file.clone(),
+                message: format!("cannot read its header ({e})"),
+            })?;
+            return slicer_seg::table_from_pairs(&file, &pairs);
+        }
         let bytes = std::fs::read(path).map_err(|e| LabelTableError::File {
             file: file.clone(),
             message: format!("cannot read the label table ({e})"),
@@ -120,7 +132,7 @@ impl LabelTable {
                       colour table (.ctbl, .txt)"
                 .to_string(),
         })?;
-        Self::parse(&file, &text)
+        Ok((Self::parse(&file, &text)?, Vec::new()))
     }
 
     /// [`Self::read`] of `text`, named `file` in messages.

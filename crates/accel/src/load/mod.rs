@@ -552,6 +552,26 @@ fn sibling(header: &Path, name: &str) -> PathBuf {
     if name.is_absolute() { name.to_path_buf() } else { header.parent().unwrap_or(Path::new("")).join(name) }
 }
 
+/// The `key:=value` pairs of a NRRD header (free-form metadata: 3D Slicer writes a
+/// segmentation's names and colours there), as `(line, key, value)`, from the header of the file
+/// at `path` (its first 4 MiB at most; the header ends at the first empty line).
+pub fn nrrd_key_values(path: &Path) -> Result<Vec<(usize, String, String)>, LoadError> {
+    use std::io::Read as _;
+    let file = std::fs::File::open(path).map_err(|source| LoadError::Io { path: path.to_path_buf(), source })?;
+    let mut bytes = Vec::new();
+    file.take(4 << 20).read_to_end(&mut bytes).map_err(|source| LoadError::Io { path: path.to_path_buf(), source })?;
+    let mut pairs = Vec::new();
+    for (number, text, _) in header_lines(&bytes) {
+        if text.is_empty() {
+            break;
+        }
+        if let Some((key, value)) = text.split_once(":=") {
+            pairs.push((number, key.trim().to_string(), value.to_string()));
+        }
+    }
+    Ok(pairs)
+}
+
 /// Splits `bytes` into header lines: `(1-based line number, text without the line end, byte
 /// offset just past the line end)`. Lines are decoded lossily; the caller decides where the
 /// header stops.

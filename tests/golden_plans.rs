@@ -50,6 +50,8 @@ fn fragment_raycast_plan_names_outputs_and_slots() {
         .unwrap_or_else(|d| panic!("{d}"));
     let text = plan.to_text();
     assert!(text.starts_with("plan \"fragment_raycast\" at 1920x1080, features: none\n"), "{text}");
+    // Each input the application binds, by name and kind (issue 43: graphs with several).
+    assert!(text.contains("\ninputs: tf (TransferFunction), volume (Volume)\n"), "{text}");
     assert!(text.contains("output image: march.color\n"), "{text}");
     assert!(text.contains("output display: present.display\n"), "{text}");
     let labels: Vec<&str> = plan.steps.iter().map(|s| s.label.as_str()).collect();

@@ -291,6 +291,10 @@ impl Plan {
         };
         let _ =
             writeln!(s, "plan \"{}\" at {}x{}, features: {}", self.name, self.viewport.0, self.viewport.1, features);
+        // What the application binds, each by its name (`volgraph render --volume`, `--tf`).
+        let inputs: Vec<String> =
+            self.inputs.iter().map(|(name, kind)| format!("{name} ({})", kind.describe())).collect();
+        let _ = writeln!(s, "inputs: {}", if inputs.is_empty() { "none".to_string() } else { inputs.join(", ") });
         let _ = writeln!(s, "steps ({}):", self.steps.len());
         for (i, step) in self.steps.iter().enumerate() {
             let _ = writeln!(s, "  {i:>3} {} [{}]", step.label, step.kind);

@@ -169,6 +169,20 @@ pub enum InputKind {
     Data(DataValue),
 }
 
+impl InputKind {
+    /// How `volgraph plan` names the kind: `Volume`, `TransferFunction`, `Scalar = 4`,
+    /// `Data(Auto)`, `Data(300)`.
+    pub fn describe(&self) -> String {
+        match self {
+            InputKind::Volume => "Volume".to_string(),
+            InputKind::TransferFunction => "TransferFunction".to_string(),
+            InputKind::Scalar(v) => format!("Scalar = {v}"),
+            InputKind::Data(DataValue::Auto) => "Data(Auto)".to_string(),
+            InputKind::Data(DataValue::Value(v)) => format!("Data({v})"),
+        }
+    }
+}
+
 /// The default of a [`InputKind::Data`] input.
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
 pub enum DataValue {

@@ -8,7 +8,7 @@
 //! — value, red, green, blue (0..255), opacity (0..1), visibility (0/1), mesh visibility (0/1)
 //! and the description in double quotes (which may hold spaces).
 
-use super::{Label, LabelTable, LabelTableError};
+use super::{Entry, Label, LabelTable, LabelTableError};
 
 /// Whether `text` is ITK-SNAP's format: its header comment, or an entry ending in a quoted label.
 pub fn looks_like(text: &str) -> bool {
@@ -21,34 +21,31 @@ pub fn looks_like(text: &str) -> bool {
 /// Parses the file's `text` (named `file` in messages).
 pub fn parse(file: &str, text: &str) -> Result<LabelTable, LabelTableError> {
     let mut table = LabelTable { labels: Default::default(), source: file.to_string() };
-    for (i, line) in text.lines().enumerate() {
-        let line = line.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let at = |message: String| LabelTableError::Line { file: file.to_string(), line: i + 1, message };
+    for (entry, line) in Entry::lines(file, text) {
         let (fields, name) = match line.find('"') {
             Some(q) => {
                 let rest = &line[q + 1..];
-                let end = rest.rfind('"').ok_or_else(|| at("the label's description has no closing \"".to_string()))?;
+                let end = rest
+                    .rfind('"')
+                    .ok_or_else(|| entry.error("the label's description has no closing \"".to_string()))?;
                 (&line[..q], rest[..end].to_string())
             }
-            None => return Err(at("no quoted description; an entry is IDX R G B A VIS MSH \"LABEL\"".to_string())),
+            None => {
+                return Err(entry.error("no quoted description; an entry is IDX R G B A VIS MSH \"LABEL\"".to_string()));
+            }
         };
-        let numbers: Vec<&str> = fields.split_whitespace().collect();
-        if numbers.len() != 7 {
-            return Err(at(format!(
+        // The numbers before the quoted description.
+        let entry = Entry { fields: fields.split_whitespace().collect(), ..entry };
+        if entry.fields.len() != 7 {
+            return Err(entry.error(format!(
                 "{} fields before the description, ITK-SNAP writes 7: IDX R G B A VIS MSH \"LABEL\"",
-                numbers.len()
+                entry.fields.len()
             )));
         }
-        let value: u32 = numbers[0]
-            .parse()
-            .map_err(|_| at(format!("label value \"{}\" is not a whole number 0..4294967295", numbers[0])))?;
-        let byte = |k: usize, what: &str| {
-            numbers[k].parse::<u8>().map_err(|_| at(format!("{what} \"{}\" is not a whole number 0..255", numbers[k])))
-        };
-        let rgb = [byte(1, "red")?, byte(2, "green")?, byte(3, "blue")?];
+        let numbers = &entry.fields;
+        let at = |message: String| entry.error(message);
+        let value = entry.value(0)?;
+        let rgb = [entry.byte(1, "red")?, entry.byte(2, "green")?, entry.byte(3, "blue")?];
         let opacity: f32 = numbers[4]
             .parse()
             .ok()

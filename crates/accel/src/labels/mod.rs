@@ -68,6 +68,44 @@ pub enum LabelTableError {
     },
 }
 
+/// One entry line of a table file, split into fields, whose errors name the file and the line.
+pub(crate) struct Entry<'a> {
+    file: &'a str,
+    line: usize,
+    /// The whitespace-separated fields.
+    pub fields: Vec<&'a str>,
+}
+
+impl<'a> Entry<'a> {
+    /// The entry lines of `text`: blank lines and `#` comments skipped, fields split on white space.
+    pub fn lines(file: &'a str, text: &'a str) -> impl Iterator<Item = (Entry<'a>, &'a str)> {
+        text.lines().enumerate().filter_map(move |(i, line)| {
+            let line = line.trim();
+            (!line.is_empty() && !line.starts_with('#'))
+                .then(|| (Entry { file, line: i + 1, fields: line.split_whitespace().collect() }, line))
+        })
+    }
+
+    /// An error at this line.
+    pub fn error(&self, message: String) -> LabelTableError {
+        LabelTableError::Line { file: self.file.to_string(), line: self.line, message }
+    }
+
+    /// Field `k` as a label value.
+    pub fn value(&self, k: usize) -> Result<u32, LabelTableError> {
+        self.fields[k]
+            .parse()
+            .map_err(|_| self.error(format!("label value \"{}\" is not a whole number 0..4294967295", self.fields[k])))
+    }
+
+    /// Field `k` as a colour byte, named `what` in the error.
+    pub fn byte(&self, k: usize, what: &str) -> Result<u8, LabelTableError> {
+        self.fields[k]
+            .parse()
+            .map_err(|_| self.error(format!("{what} \"{}\" is not a whole number 0..255", self.fields[k])))
+    }
+}
+
 /// The colour of label `value` where no table names it: value 0 (background) is black and
 /// hidden; others walk the hue circle by the golden angle, so neighbouring values differ.
 pub fn default_label(value: u32) -> Label {

@@ -8,36 +8,29 @@
 //! — value, name (one word: Slicer writes spaces as `_`), red, green, blue, alpha (0..255).
 //! Columns after the sixth (terminology codes of newer tables) are not read.
 
-use super::{Label, LabelTable, LabelTableError};
+use super::{Entry, Label, LabelTable, LabelTableError};
 
 /// Parses the file's `text` (named `file` in messages).
 pub fn parse(file: &str, text: &str) -> Result<LabelTable, LabelTableError> {
     let mut table = LabelTable { labels: Default::default(), source: file.to_string() };
-    for (i, line) in text.lines().enumerate() {
-        let line = line.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let at = |message: String| LabelTableError::Line { file: file.to_string(), line: i + 1, message };
-        let fields: Vec<&str> = line.split_whitespace().collect();
-        if fields.len() < 6 {
-            return Err(at(format!(
+    for (entry, _) in Entry::lines(file, text) {
+        if entry.fields.len() < 6 {
+            return Err(entry.error(format!(
                 "{} fields; a colour table entry is `value name R G B A` (an ITK-SNAP label file quotes its names)",
-                fields.len()
+                entry.fields.len()
             )));
         }
-        let value: u32 = fields[0]
-            .parse()
-            .map_err(|_| at(format!("label value \"{}\" is not a whole number 0..4294967295", fields[0])))?;
-        let byte = |k: usize, what: &str| {
-            fields[k].parse::<u8>().map_err(|_| at(format!("{what} \"{}\" is not a whole number 0..255", fields[k])))
+        let value = entry.value(0)?;
+        let rgb = [entry.byte(2, "red")?, entry.byte(3, "green")?, entry.byte(4, "blue")?];
+        let alpha = entry.byte(5, "alpha")?;
+        let label = Label {
+            name: entry.fields[1].replace('_', " "),
+            rgb,
+            opacity: f32::from(alpha) / 255.0,
+            visible: alpha > 0,
         };
-        let rgb = [byte(2, "red")?, byte(3, "green")?, byte(4, "blue")?];
-        let alpha = byte(5, "alpha")?;
-        let label =
-            Label { name: fields[1].replace('_', " "), rgb, opacity: f32::from(alpha) / 255.0, visible: alpha > 0 };
         if table.labels.insert(value, label).is_some() {
-            return Err(at(format!("label {value} is listed twice; keep one line for it")));
+            return Err(entry.error(format!("label {value} is listed twice; keep one line for it")));
         }
     }
     if table.labels.is_empty() {

@@ -20,6 +20,7 @@ pub mod info_cmd;
 mod input_fuzz;
 pub mod inputs;
 pub mod load_progress;
+pub mod named_inputs;
 pub mod passes_cmd;
 pub mod plan_svg;
 pub mod program;

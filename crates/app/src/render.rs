@@ -13,6 +13,7 @@ use volgraph_core::runtime::{CameraData, Gpu, Runtime, ShaderLibrary, VolumeDesc
 use crate::cli::{CliError, check_user_names, compile_options, display_name, warning_lines};
 use crate::image_out::{self, ImageKind};
 use crate::inputs;
+use crate::named_inputs::NamedBindings;
 use crate::scene::{CameraSpec, Scene};
 use crate::scene_args::{Resolved, SceneArgs};
 use volgraph_core::runtime::OpacityReference;
@@ -61,6 +62,8 @@ pub struct Prepared {
     cuts: volgraph_accel::cuts::Cuts,
     volume: volgraph_accel::volume::Volume,
     lut: Vec<[f32; 4]>,
+    /// Inputs bound by name (`--volume NAME=PATH`, `--tf NAME=…`), if any.
+    bindings: Option<NamedBindings>,
     plan: volgraph_core::Plan,
     output: String,
     /// Notes and warnings for stderr (repairs, choices made, capped counts, invisible data).
@@ -81,9 +84,18 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     options.precision = scene.as_ref().and_then(|s| s.precision);
     let frames = args.frames.or(scene.as_ref().map(Scene::frame_count)).unwrap_or(1);
     let raw = inputs::raw_options(&args.inputs.raw)?;
-    let shown = crate::scene::load_shown_volume(&args.inputs.volume, scene.as_ref(), &raw)?;
+    // `--volume NAME=PATH` / `--tf NAME=…` bind inputs by name; the frame's volume is the one
+    // bound to `volume`, else the first named (crate::named_inputs).
+    let named = crate::named_inputs::named_volumes(&args.inputs.volume)?;
+    let (plain_tf, named_tfs) = crate::named_inputs::split_tfs(&args.inputs.tf)?;
+    let primary = NamedBindings::primary_index(&named);
+    let shown_paths = match named.get(primary) {
+        Some((_, path)) => vec![path.clone()],
+        None => args.inputs.volume.clone(),
+    };
+    let shown = crate::scene::load_shown_volume(&shown_paths, scene.as_ref(), &raw)?;
     let (volume, generated, mut notes) = (shown.volume, shown.marschner_lobb_tf, shown.notes);
-    let (tf, tf_notes) = match (&args.inputs.tf, &scene) {
+    let (tf, tf_notes) = match (&plain_tf, &scene) {
         (None, Some(scene)) => {
             let (tf, _, notes) =
                 crate::scene::load_transfer_function(scene, args.inputs.tf_map.as_deref(), &volume, generated)?;
@@ -93,12 +105,39 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     };
     notes.extend(tf_notes);
     let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
+    let bindings = if named.is_empty() && named_tfs.is_empty() {
+        None
+    } else {
+        let mut others = Vec::new();
+        for (i, (name, path)) in named.iter().enumerate() {
+            if i != primary {
+                let shown = crate::scene::load_shown_volume(std::slice::from_ref(path), None, &raw)
+                    .map_err(|e| anyhow!("--volume {name}=…: {e:#}"))?;
+                notes.extend(shown.notes);
+                others.push((name.clone(), shown.volume));
+            }
+        }
+        let mut luts = Vec::new();
+        for (name, path) in &named_tfs {
+            // A TF named NAME_tf is fitted to (and its presets read in the units of) volume NAME.
+            let base =
+                name.strip_suffix("_tf").and_then(|b| others.iter().find(|(n, _)| n == b)).map_or(&volume, |(_, v)| v);
+            let (tf, tf_notes) = inputs::transfer_function(Some(path), args.inputs.tf_map.as_deref(), base, false)
+                .map_err(|e| anyhow!("--tf {name}=…: {e:#}"))?;
+            notes.extend(tf_notes);
+            luts.push((name.clone(), tf.to_lut_for(base, inputs::LUT_SIZE)));
+        }
+        Some(NamedBindings { primary: named.get(primary).map(|(n, _)| n.clone()), others, luts })
+    };
     let registry = crate::program::registry();
     let file = display_name(&graph);
     let opacity = scene.as_ref().map(|s| s.opacity_reference).unwrap_or_default();
     options.scene = scene_values_of(&VolumeDesc::of(&volume));
     options.scene.extend(crate::inputs::data_scene_values(&volume));
     let plan = compile(&file, &source, &registry, &options).map_err(CliError::Graph)?;
+    if let Some(bindings) = &bindings {
+        bindings.check(&plan, &file, &source, &volume)?;
+    }
     // A scene's effect the graph does not offer is a note (the scene may be shown with another
     // graph); a --features name it does not know is the user's typo: an error.
     let mut user = options.clone();
@@ -139,7 +178,7 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     {
         notes.push(note);
     }
-    Ok(Prepared { args, graph, kind, camera, frames, opacity, cuts, volume, lut, plan, output, notes })
+    Ok(Prepared { args, graph, kind, camera, frames, opacity, cuts, volume, lut, bindings, plan, output, notes })
 }
 
 /// A note when `--gpu-memory-mb` was given to a graph none of whose passes streams data within
@@ -158,7 +197,8 @@ pub fn budget_note(plan: &volgraph_core::Plan, registry: &volgraph_core::Registr
 
 /// Opens the GPU, renders the frames and writes the image.
 pub fn execute(prepared: Prepared) -> Result<(), CliError> {
-    let Prepared { args, graph, kind, camera, frames, opacity, cuts, volume, lut, plan, output, .. } = prepared;
+    let Prepared { args, graph, kind, camera, frames, opacity, cuts, volume, lut, bindings, plan, output, .. } =
+        prepared;
     let registry = crate::program::registry();
     let viewport = plan.viewport;
     let gpu = Arc::new(Gpu::new_headless().map_err(|e| anyhow!(e))?);
@@ -167,7 +207,11 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
     runtime.set_opacity_reference(opacity);
     runtime.set_cuts(cuts);
     runtime.set_gpu_memory_budget(args.inputs.gpu_memory_mb.map(|mb| mb << 20));
-    runtime.bind_scene(&plan.inputs, &volume, &lut).map_err(|e| anyhow!(e))?;
+    match &bindings {
+        Some(bindings) => bindings.bind(&mut runtime, &plan, &volume, &lut),
+        None => runtime.bind_scene(&plan.inputs, &volume, &lut),
+    }
+    .map_err(|e| anyhow!(e))?;
     if runtime.volume().is_some_and(|(_, f)| f == VolumeFormat::R16Float) && !matches!(volume.data, VoxelData::U8(_)) {
         crate::stdout::eprintln_escaped!(
             "note: this GPU filters neither 16-bit normalized nor 32-bit float textures; the volume is sampled as \

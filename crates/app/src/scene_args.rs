@@ -24,7 +24,8 @@ pub struct SceneArgs {
     /// The volume: a file (.raw named NAME_XxYxZ_TYPE.raw, .nrrd, .nhdr, .mhd, .mha, .nii,
     /// .nii.gz), a folder of DICOM slices, DICOM slice files (`--volume dir/*.dcm`), or a name: a
     /// dataset of the data folder (`lobster`) or a generated volume (`ml64`, `vessels128`);
-    /// default: a generated Marschner–Lobb 64³.
+    /// default: a generated Marschner–Lobb 64³. `--volume NAME=PATH` (repeat for each) binds
+    /// the graph's volume input NAME (render; volumes on one grid).
     #[arg(long, num_args = 1..)]
     pub volume: Vec<PathBuf>,
     /// How to read a headerless raw volume.
@@ -35,9 +36,10 @@ pub struct SceneArgs {
     /// mr-default (percentiles); default: for a generated 8-bit Marschner–Lobb volume (the
     /// default volume, `ml64`, `ml32`) the band that shows its rings (graphs/tf/marschner_lobb.ron),
     /// else one fitted to the data (transparent up to its background of air or noise; see
-    /// `volgraph info`).
-    #[arg(long)]
-    pub tf: Option<PathBuf>,
+    /// `volgraph info`). `--tf NAME=FILE|PRESET` (repeat for each) binds the graph's
+    /// transfer-function input NAME (render).
+    #[arg(long, action = clap::ArgAction::Append)]
+    pub tf: Vec<PathBuf>,
     /// The colour map to use from a ParaView .json holding several (its "Name"); default: the first.
     #[arg(long = "tf-map")]
     pub tf_map: Option<String>,
@@ -88,6 +90,20 @@ pub struct Resolved {
 }
 
 impl SceneArgs {
+    /// The one transfer function of a command that binds one volume and one transfer function
+    /// (`view`, `--distributed`): named inputs are refused there with what to use instead.
+    pub fn single_tf(&self, command: &str) -> anyhow::Result<Option<PathBuf>> {
+        let (plain, named) = crate::named_inputs::split_tfs(&self.tf)?;
+        let named_volume = crate::named_inputs::named_volumes(&self.volume)?;
+        if let Some(name) = named.first().map(|(n, _)| n).or(named_volume.first().map(|(n, _)| n)) {
+            return Err(anyhow!(
+                "{command} binds one volume and one transfer function; \"{name}=…\" names a graph input, which \
+                 `volgraph render` binds (or give plain --volume PATH / --tf FILE)"
+            ));
+        }
+        Ok(plain)
+    }
+
     /// Reads the scene and picks the graph, viewport and camera: a flag, else the
     /// scene's, else `default_size` and the 30,20,3.2 orbit. `usage` is the command line that
     /// names a graph, for the error when neither says one.

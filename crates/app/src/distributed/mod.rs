@@ -347,7 +347,7 @@ impl Job {
             source,
             viewport: options.viewport,
             options,
-            tf: args.inputs.tf.clone(),
+            tf: args.inputs.single_tf("volgraph render --distributed")?,
             tf_map: args.inputs.tf_map.clone(),
             camera: resolved.camera,
             frames: args.frames.unwrap_or(1),

@@ -108,12 +108,13 @@ pub fn run(args: ViewArgs) -> Result<(), CliError> {
             )));
         }
     }
+    let tf = args.inputs.single_tf("volgraph view")?;
     let session_args = session::SessionArgs {
         graph: resolved.graph,
         scene: resolved.scene,
         volume: args.inputs.volume,
         raw: inputs::raw_options(&args.inputs.raw)?,
-        tf: args.inputs.tf,
+        tf,
         tf_map: args.inputs.tf_map,
         viewport,
         features: args.inputs.features,

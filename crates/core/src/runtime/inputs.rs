@@ -36,7 +36,10 @@ struct BoundVoxels {
     content: u64,
 }
 
-/// Inputs by graph input name, and the bound volume's description.
+/// The volume input whose description the frame carries when several are bound.
+pub const PRIMARY_VOLUME: &str = "volume";
+
+/// Inputs by graph input name, and each bound volume's description.
 #[derive(Default)]
 pub struct InputStore {
     /// Textures: LUTs, application textures and volumes some pass read as a texture.
@@ -45,7 +48,8 @@ pub struct InputStore {
     volumes: BTreeMap<String, BoundVoxels>,
     /// Bound LUTs on the CPU (for passes that classify bricks with them).
     tables: BTreeMap<String, Arc<Vec<[f32; 4]>>>,
-    volume: Option<(VolumeDesc, VolumeFormat)>,
+    /// Each bound volume input's description and texture format, by name.
+    descs: BTreeMap<String, (VolumeDesc, VolumeFormat)>,
     uploads: u64,
 }
 
@@ -144,7 +148,7 @@ impl InputStore {
         let desc = VolumeDesc::of(volume);
         let format = volume_texture_format(gpu, volume);
         if self.volumes.get(name).is_some_and(|v| v.content == content) {
-            self.volume = Some((desc, format));
+            self.descs.insert(name.to_string(), (desc, format));
             return Ok(false);
         }
         let expected = volume.dims.x as u64 * volume.dims.y as u64 * volume.dims.z as u64;
@@ -153,7 +157,7 @@ impl InputStore {
         }
         self.inputs.remove(name);
         self.volumes.insert(name.to_string(), BoundVoxels { voxels: Arc::new(volume.clone()), content });
-        self.volume = Some((desc, format));
+        self.descs.insert(name.to_string(), (desc, format));
         Ok(true)
     }
 
@@ -221,9 +225,12 @@ impl InputStore {
         self.inputs.get(name)
     }
 
-    /// The bound volume's description and texture format.
+    /// The frame's volume — the description and texture format of the volume input named
+    /// `volume`, else of the first bound by name — which sets the box rays meet and the voxel
+    /// unit. A graph with several volume inputs binds volumes on one grid (`volgraph render`
+    /// checks it), so any of them describes the same box.
     pub fn volume(&self) -> Option<(VolumeDesc, VolumeFormat)> {
-        self.volume
+        self.descs.get(PRIMARY_VOLUME).or_else(|| self.descs.values().next()).copied()
     }
 
     /// Uploads done since the runtime started (binding unchanged content does none).

@@ -1,0 +1,250 @@
+//! Graph inputs bound by name from the command line (issue "several volumes", item 1):
+//! `--volume NAME=PATH` and `--tf NAME=FILE|PRESET`, repeatable, bind the graph's inputs of that
+//! name; a plain `--volume PATH` binds the one volume every volume input reads, as before. An
+//! existing file whose name holds `=` is a file, not a name.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::anyhow;
+use volgraph_accel::volume::Volume;
+use volgraph_core::graph::ast::InputKind;
+
+/// `NAME=PATH` split into its name and path, when `arg` is that form: the text before the
+/// first `=` is a name (a letter or `_`, then letters, digits, `_`), something follows it, and
+/// no file or folder is called `arg` itself.
+pub fn split_named(arg: &Path) -> Option<(String, PathBuf)> {
+    split_unless(arg, &|path| path.exists())
+}
+
+/// [`split_named`] with `exists` telling whether a file or folder is called `arg`.
+fn split_unless(arg: &Path, exists: &dyn Fn(&Path) -> bool) -> Option<(String, PathBuf)> {
+    let text = arg.to_str()?;
+    let (name, rest) = text.split_once('=')?;
+    let mut chars = name.chars();
+    let identifier = chars.next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_');
+    (identifier && !rest.is_empty() && !exists(arg)).then(|| (name.to_string(), PathBuf::from(rest)))
+}
+
+/// The named `--volume`s, in the order given (empty when none is named). When one is named,
+/// every one must be: several plain paths are one volume's DICOM slices, which a name cannot
+/// split.
+pub fn named_volumes(args: &[PathBuf]) -> anyhow::Result<Vec<(String, PathBuf)>> {
+    let split: Vec<Option<(String, PathBuf)>> = args.iter().map(|a| split_named(a)).collect();
+    if split.iter().all(Option::is_none) {
+        return Ok(Vec::new());
+    }
+    let mut named = Vec::new();
+    for (arg, one) in args.iter().zip(split) {
+        let Some((name, path)) = one else {
+            return Err(anyhow!(
+                "--volume {}: give every volume a name when one has one (--volume NAME=PATH, once per volume input \
+                 of the graph)",
+                arg.display()
+            ));
+        };
+        if named.iter().any(|(n, _): &(String, PathBuf)| *n == name) {
+            return Err(anyhow!("--volume {name}=…: the input \"{name}\" is given twice; give it once"));
+        }
+        named.push((name, path));
+    }
+    Ok(named)
+}
+
+/// The `--tf`s: the one for every transfer-function input not named (a plain `--tf`, at most
+/// one) and the named ones.
+pub fn split_tfs(args: &[PathBuf]) -> anyhow::Result<(Option<PathBuf>, Vec<(String, PathBuf)>)> {
+    let mut plain = None;
+    let mut named: Vec<(String, PathBuf)> = Vec::new();
+    for arg in args {
+        match split_named(arg) {
+            Some((name, path)) => {
+                if named.iter().any(|(n, _)| *n == name) {
+                    return Err(anyhow!("--tf {name}=…: the input \"{name}\" is given twice; give it once"));
+                }
+                named.push((name, path));
+            }
+            None if plain.is_some() => {
+                return Err(anyhow!(
+                    "--tf is given twice without a name; give one --tf for every transfer-function input, or name \
+                     each (--tf NAME=FILE|PRESET)"
+                ));
+            }
+            None => plain = Some(arg.clone()),
+        }
+    }
+    Ok((plain, named))
+}
+
+/// The line and column of input `name`'s declaration in a graph's `source` (its `"name":` key in
+/// the `inputs:` map), for an error that points at it.
+pub fn input_location(source: &str, name: &str) -> Option<(usize, usize)> {
+    let inputs = source.find("inputs:")?;
+    let key = format!("\"{name}\"");
+    let at = inputs + source[inputs..].find(&key)?;
+    let line = source[..at].matches('\n').count() + 1;
+    let column = at - source[..at].rfind('\n').map_or(0, |i| i + 1) + 1;
+    Some((line, column))
+}
+
+/// The volumes and transfer functions bound by name for one render: every volume input of the
+/// graph named on the command line, on one grid, and the named transfer functions.
+pub struct NamedBindings {
+    /// The input the frame's volume (the one loaded as the render's volume) is bound to, when
+    /// volumes are named.
+    pub primary: Option<String>,
+    /// The other named volumes, `(input, volume)`, in the order given.
+    pub others: Vec<(String, Volume)>,
+    /// `(input, LUT)`.
+    pub luts: Vec<(String, Vec<[f32; 4]>)>,
+}
+
+impl NamedBindings {
+    /// The index in `named` of the frame's volume: the input named `volume`, else the first.
+    pub fn primary_index(named: &[(String, PathBuf)]) -> usize {
+        named.iter().position(|(n, _)| n == volgraph_core::runtime::inputs::PRIMARY_VOLUME).unwrap_or(0)
+    }
+
+    /// Checks the bindings against the compiled graph's inputs (`graph` names its file in
+    /// messages, `source` is its text, for the line of an input): every named input exists with
+    /// the right kind, every volume input has a volume once one is named, and the volumes share
+    /// `primary`'s grid (one march samples them at the same positions, until volumes on different
+    /// grids are marched in the patient frame).
+    pub fn check(&self, plan: &volgraph_core::Plan, graph: &str, source: &str, primary: &Volume) -> anyhow::Result<()> {
+        let of_kind = |kind: &InputKind| -> Vec<&str> {
+            plan.inputs.iter().filter(|(_, k)| *k == kind).map(|(n, _)| n.as_str()).collect()
+        };
+        let unknown = |flag: &str, name: &str, kind: &InputKind, what: &str| {
+            let known = of_kind(kind);
+            let listed = if known.is_empty() {
+                format!("it has no {what} input")
+            } else {
+                format!("its {what} inputs are: {}", known.join(", "))
+            };
+            anyhow!("{flag} {name}=…: graph \"{}\" has no {what} input \"{name}\"; {listed}", plan.name)
+        };
+        let named: Vec<&str> =
+            self.primary.iter().map(String::as_str).chain(self.others.iter().map(|(n, _)| n.as_str())).collect();
+        for name in &named {
+            if plan.inputs.get(*name) != Some(&InputKind::Volume) {
+                return Err(unknown("--volume", name, &InputKind::Volume, "volume"));
+            }
+        }
+        for (name, _) in &self.luts {
+            if plan.inputs.get(name) != Some(&InputKind::TransferFunction) {
+                return Err(unknown("--tf", name, &InputKind::TransferFunction, "transfer-function"));
+            }
+        }
+        if let Some(first_name) = &self.primary {
+            for name in of_kind(&InputKind::Volume) {
+                if !named.contains(&name) {
+                    let at = input_location(source, name).map_or(String::new(), |(l, c)| format!(":{l}:{c}"));
+                    return Err(anyhow!(
+                        "{graph}{at}: volume input \"{name}\" has nothing bound; give --volume {name}=PATH (once one \
+                         volume is named, each is)"
+                    ));
+                }
+            }
+            for (name, volume) in &self.others {
+                if !same_grid(volume, primary) {
+                    return Err(anyhow!(
+                        "--volume {name}=…: volumes are marched together only on one grid for now; {first_name} is {} \
+                         and {name} is {}; resample one onto the other's grid",
+                        grid_text(primary),
+                        grid_text(volume)
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Binds every volume and transfer-function input of `plan`: the named ones, `volume` to the
+    /// primary (or, with no volume named, to every volume input) and `lut` to a
+    /// transfer-function input not named.
+    pub fn bind(
+        &self,
+        runtime: &mut volgraph_core::runtime::Runtime,
+        plan: &volgraph_core::Plan,
+        volume: &Volume,
+        lut: &[[f32; 4]],
+    ) -> Result<(), volgraph_core::runtime::RuntimeError> {
+        for (name, kind) in &plan.inputs {
+            match kind {
+                InputKind::Volume => match self.others.iter().find(|(n, _)| n == name) {
+                    Some((_, other)) => runtime.bind_volume(name, other)?,
+                    None => runtime.bind_volume(name, volume)?,
+                },
+                InputKind::TransferFunction => {
+                    let named = self.luts.iter().find(|(n, _)| n == name).map(|(_, l)| l.as_slice());
+                    runtime.bind_lut(name, named.unwrap_or(lut))?
+                }
+                InputKind::Scalar(_) | InputKind::Data(_) => false,
+            };
+        }
+        Ok(())
+    }
+}
+
+/// Whether `a` and `b` have the same voxels per axis, spacing, frame and origin.
+fn same_grid(a: &Volume, b: &Volume) -> bool {
+    a.dims == b.dims
+        && (a.spacing - b.spacing).abs().max_element() <= 1e-6 * b.spacing.max_element()
+        && a.meta.frame == b.meta.frame
+        && a.meta.origin == b.meta.origin
+}
+
+/// `N×N×N at sx × sy × sz, origin (x, y, z)` for a grid mismatch.
+fn grid_text(v: &Volume) -> String {
+    let origin = v.meta.origin.map_or(String::new(), |o| format!(", origin ({:.3}, {:.3}, {:.3})", o.x, o.y, o.z));
+    format!("{}×{}×{} at {} × {} × {}{origin}", v.dims.x, v.dims.y, v.dims.z, v.spacing.x, v.spacing.y, v.spacing.z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_name_is_an_identifier_before_the_first_equals_sign() {
+        assert_eq!(split_named(Path::new("ct=scan.nii.gz")), Some(("ct".into(), "scan.nii.gz".into())));
+        assert_eq!(split_named(Path::new("pet_1=a=b.nii")), Some(("pet_1".into(), "a=b.nii".into())));
+        for plain in ["scan.nii.gz", "=x", "1ct=x", "c t=x", "ct=", "dir/ct=x"] {
+            assert_eq!(split_named(Path::new(plain)), None, "{plain}");
+        }
+    }
+
+    #[test]
+    fn an_existing_file_whose_name_holds_an_equals_sign_is_a_file() {
+        let exists = |p: &Path| p == Path::new("ct=scan.raw");
+        assert_eq!(split_unless(Path::new("ct=scan.raw"), &exists), None, "the file wins");
+        assert_eq!(split_unless(Path::new("ct=other.raw"), &exists), Some(("ct".into(), "other.raw".into())));
+    }
+
+    #[test]
+    fn named_and_plain_volumes_and_tfs() {
+        let args = |v: &[&str]| v.iter().map(PathBuf::from).collect::<Vec<_>>();
+        assert!(named_volumes(&args(&["a.dcm", "b.dcm"])).expect("slices").is_empty());
+        let named = named_volumes(&args(&["ct=a.nii", "labels=b.nii"])).expect("named");
+        assert_eq!(named.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>(), ["ct", "labels"]);
+        assert!(
+            named_volumes(&args(&["ct=a.nii", "b.nii"]))
+                .expect_err("mixed")
+                .to_string()
+                .contains("give every volume a name")
+        );
+        assert!(named_volumes(&args(&["ct=a", "ct=b"])).expect_err("twice").to_string().contains("given twice"));
+        let (plain, named) = split_tfs(&args(&["ct-bone", "labels_tf=t.ron"])).expect("tfs");
+        assert_eq!(plain, Some(PathBuf::from("ct-bone")));
+        assert_eq!(named, [("labels_tf".to_string(), PathBuf::from("t.ron"))]);
+        assert!(
+            split_tfs(&args(&["a.ron", "b.ron"])).expect_err("two plain").to_string().contains("twice without a name")
+        );
+    }
+
+    #[test]
+    fn an_input_is_located_in_the_graph_text() {
+        let source = "Graph(\n    name: \"x\",\n    inputs: {\n        \"volume\": Volume,\n        \"mask\": Volume,\n    },\n)";
+        assert_eq!(input_location(source, "mask"), Some((5, 9)));
+        assert_eq!(input_location(source, "pet"), None);
+    }
+}

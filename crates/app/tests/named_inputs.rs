@@ -1,0 +1,173 @@
+//! Several volume and transfer-function inputs bound by name (issue "several volumes", item 1):
+//! `volgraph render --volume NAME=PATH --tf NAME=FILE|PRESET` binds the graph's inputs of that
+//! name; a missing one is an error at its line in the graph; an unknown name lists the graph's
+//! inputs; volumes on different grids are refused (until the patient-frame march); the viewer and
+//! `--distributed`, which bind one volume, refuse names with what to use instead.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// A graph of two volume inputs, each raycast on its own: `image` from `volume`, `mask_image`
+/// from `mask`.
+const TWO_VOLUMES: &str = r#"Graph(
+    name: "two_volumes",
+    description: "the volume and a mask, each raycast on its own",
+    inputs: {
+        "volume": Volume,
+        "mask": Volume,
+        "tf": TransferFunction,
+    },
+    passes: [
+        Pass(id: "a", kind: "raycast_compute", params: {"rays": "analytic"}, inputs: {"volume": "input.volume", "tf": "input.tf"}),
+        Pass(id: "b", kind: "raycast_compute", params: {"rays": "analytic"}, inputs: {"volume": "input.mask", "tf": "input.tf"}),
+    ],
+    outputs: {"image": "a.color", "mask_image": "b.color"},
+)
+"#;
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("volgraph-named-inputs-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("scratch");
+    std::fs::write(dir.join("two_volumes.ron"), TWO_VOLUMES).expect("graph");
+    dir
+}
+
+fn volgraph(args: &[&str], dir: &Path) -> (bool, String) {
+    let xdg = std::env::temp_dir().join(format!("volgraph-xdg-{}", std::process::id()));
+    std::fs::create_dir_all(&xdg).expect("xdg");
+    #[cfg(unix)]
+    std::os::unix::fs::PermissionsExt::set_mode(&mut std::fs::metadata(&xdg).expect("xdg").permissions(), 0o700);
+    let out = Command::new(env!("CARGO_BIN_EXE_volgraph"))
+        .args(args)
+        .current_dir(dir)
+        .env("XDG_RUNTIME_DIR", std::env::var_os("XDG_RUNTIME_DIR").unwrap_or(xdg.into_os_string()))
+        .output()
+        .expect("runs");
+    (out.status.success(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+/// The pixels of an EXR (the file's bytes vary run to run: its chunks are compressed in
+/// parallel).
+fn pixels(path: &Path) -> Vec<[f32; 4]> {
+    use exr::prelude::*;
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |resolution, _| (resolution.width(), vec![[0.0f32; 4]; resolution.width() * resolution.height()]),
+        |(w, pixels), position, (r, g, b, a): (f32, f32, f32, f32)| {
+            pixels[position.y() * *w + position.x()] = [r, g, b, a]
+        },
+    )
+    .expect("an EXR");
+    image.layer_data.channel_data.pixels.1
+}
+
+fn tf() -> String {
+    concat!(env!("CARGO_MANIFEST_DIR"), "/../../graphs/tf/marschner_lobb.ron").to_string()
+}
+
+#[test]
+fn each_named_volume_reaches_the_input_of_its_name() {
+    let dir = scratch("bind");
+    let tf = tf();
+    // The mask output of the sphere/ml pair is the ml volume's raycast: the same image as
+    // binding ml32 alone and reading the graph's first output.
+    let (ok, err) = volgraph(
+        &[
+            "render",
+            "two_volumes.ron",
+            "--volume",
+            "volume=sphere32",
+            "--volume",
+            "mask=ml32",
+            "--tf",
+            &tf,
+            "--output",
+            "mask_image",
+            "-o",
+            "named.exr",
+        ],
+        &dir,
+    );
+    assert!(ok, "{err}");
+    let (ok, err) = volgraph(
+        &["render", "two_volumes.ron", "--volume", "ml32", "--tf", &tf, "--output", "image", "-o", "alone.exr"],
+        &dir,
+    );
+    assert!(ok, "{err}");
+    let (named, alone) = (pixels(&dir.join("named.exr")), pixels(&dir.join("alone.exr")));
+    assert!(named == alone, "the mask input got ml32 and is raycast exactly as ml32 alone");
+    assert!(alone.iter().any(|p| p[3] > 0.1), "something is drawn");
+    // And the primary input got the sphere: its image differs from ml32's.
+    let (ok, err) = volgraph(
+        &[
+            "render",
+            "two_volumes.ron",
+            "--volume",
+            "volume=sphere32",
+            "--volume",
+            "mask=ml32",
+            "--tf",
+            &tf,
+            "--output",
+            "image",
+            "-o",
+            "sphere.exr",
+        ],
+        &dir,
+    );
+    assert!(ok, "{err}");
+    assert!(pixels(&dir.join("sphere.exr")) != alone, "the volume input got the sphere");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_missing_unknown_or_misplaced_input_is_an_error_that_says_what_to_give() {
+    let dir = scratch("errors");
+    let (ok, err) = volgraph(&["render", "two_volumes.ron", "--volume", "volume=ml32", "-o", "x.png"], &dir);
+    assert!(!ok);
+    assert!(
+        err.contains("two_volumes.ron:6:9: volume input \"mask\" has nothing bound; give --volume mask=PATH"),
+        "{err}"
+    );
+    let (ok, err) = volgraph(
+        &[
+            "render",
+            "two_volumes.ron",
+            "--volume",
+            "volume=ml32",
+            "--volume",
+            "mask=ml32",
+            "--volume",
+            "pet=ml32",
+            "-o",
+            "x.png",
+        ],
+        &dir,
+    );
+    assert!(!ok);
+    assert!(
+        err.contains(
+            "--volume pet=…: graph \"two_volumes\" has no volume input \"pet\"; its volume inputs are: mask, volume"
+        ),
+        "{err}"
+    );
+    let (ok, err) = volgraph(
+        &["render", "two_volumes.ron", "--volume", "volume=ml32", "--volume", "mask=ml48", "-o", "x.png"],
+        &dir,
+    );
+    assert!(!ok);
+    assert!(err.contains("only on one grid for now; volume is 32×32×32 at 1 × 1 × 1 and mask is 48×48×48"), "{err}");
+    let (ok, err) =
+        volgraph(&["render", "two_volumes.ron", "--volume", "volume=ml32", "--volume", "ml32", "-o", "x.png"], &dir);
+    assert!(!ok && err.contains("give every volume a name when one has one"), "{err}");
+    let (ok, err) = volgraph(&["render", "two_volumes.ron", "--tf", "ct-bone", "--tf", "ct-lung", "-o", "x.png"], &dir);
+    assert!(!ok && err.contains("--tf is given twice without a name"), "{err}");
+    let (ok, err) = volgraph(&["render", "two_volumes.ron", "--tf", "pet_tf=ct-bone", "-o", "x.png"], &dir);
+    assert!(
+        !ok && err.contains("has no transfer-function input \"pet_tf\"; its transfer-function inputs are: tf"),
+        "{err}"
+    );
+    let (ok, err) = volgraph(&["view", "two_volumes.ron", "--volume", "volume=ml32", "--volume", "mask=ml32"], &dir);
+    assert!(!ok && err.contains("volgraph view binds one volume and one transfer function"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -86,12 +86,26 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     let raw = inputs::raw_options(&args.inputs.raw)?;
     // `--volume NAME=PATH` / `--tf NAME=…` bind inputs by name; the frame's volume is the one
     // bound to `volume`, else the first named (crate::named_inputs).
-    let named = crate::named_inputs::named_volumes(&args.inputs.volume)?;
-    let (plain_tf, named_tfs) = crate::named_inputs::split_tfs(&args.inputs.tf)?;
+    let mut named = crate::named_inputs::named_volumes(&args.inputs.volume)?;
+    let (plain_tf, mut named_tfs) = crate::named_inputs::split_tfs(&args.inputs.tf)?;
+    // A scene's named inputs, where the command line names no volume: its `volume:` is then the
+    // input `volume` (an empty path: loaded from the scene below). Its TFs under the command
+    // line's of the same name.
+    let scene_named = args.inputs.volume.is_empty() && scene.as_ref().is_some_and(|s| !s.volumes.is_empty());
+    if let Some(scene) = scene.as_ref().filter(|_| scene_named) {
+        named = std::iter::once((volgraph_core::runtime::inputs::PRIMARY_VOLUME.to_string(), PathBuf::new()))
+            .chain(scene.volumes.iter().cloned())
+            .collect();
+    }
+    for (name, path) in scene.as_ref().map_or(&[][..], |s| s.tfs.as_slice()) {
+        if !named_tfs.iter().any(|(n, _)| n == name) {
+            named_tfs.push((name.clone(), path.clone()));
+        }
+    }
     let primary = NamedBindings::primary_index(&named);
     let shown_paths = match named.get(primary) {
-        Some((_, path)) => vec![path.clone()],
-        None => args.inputs.volume.clone(),
+        Some((_, path)) if !scene_named => vec![path.clone()],
+        _ => args.inputs.volume.clone(),
     };
     let shown = crate::scene::load_shown_volume(&shown_paths, scene.as_ref(), &raw)?;
     let (volume, generated, mut notes) = (shown.volume, shown.marschner_lobb_tf, shown.notes);

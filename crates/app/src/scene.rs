@@ -172,6 +172,10 @@ struct SceneDoc {
     clip: Vec<(f64, f64, f64, f64)>,
     #[serde(default)]
     volume_options: VolumeOptions,
+    #[serde(default)]
+    volumes: std::collections::BTreeMap<String, String>,
+    #[serde(default)]
+    tfs: std::collections::BTreeMap<String, String>,
 }
 
 /// A scene read and checked, its paths resolved against the scene file's folder.
@@ -201,6 +205,13 @@ pub struct Scene {
     pub cuts: Cuts,
     /// How to read the volume (checked).
     pub volume_options: VolumeOptions,
+    /// More volume inputs by name (`volumes: {"mask": "seg.nii.gz"}`): a path beside the scene
+    /// or a volume's name, as `--volume NAME=PATH` takes it; `volume:` is then the input
+    /// `volume`.
+    pub volumes: Vec<(String, PathBuf)>,
+    /// Transfer-function inputs by name (`tfs: {"mask_tf": "mask.ron"}`): a file beside the
+    /// scene, a preset's or a built-in TF's name, as `--tf NAME=…` takes it.
+    pub tfs: Vec<(String, PathBuf)>,
 }
 
 /// Why a scene could not be read.
@@ -332,6 +343,38 @@ impl Scene {
         doc.volume_options.load_options().map_err(|e| {
             field("volume_options", format!("{e:#} (the field volume_options says what that flag says)"))
         })?;
+        let input_name = |field: &'static str, name: &str| {
+            let mut chars = name.chars();
+            let ok = chars.next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+                && chars.all(|c| c.is_ascii_alphanumeric() || c == '_');
+            if !ok {
+                return Err(SceneError::Field {
+                    path: path.to_path_buf(),
+                    field,
+                    message: format!("\"{name}\" is no input name (a letter or _, then letters, digits, _)"),
+                });
+            }
+            Ok(())
+        };
+        let mut volumes = Vec::new();
+        for (name, written) in &doc.volumes {
+            input_name("volumes", name)?;
+            if name == volgraph_core::runtime::inputs::PRIMARY_VOLUME {
+                return Err(field("volumes", "\"volume\" is the scene's `volume:`; give the other inputs here".into()));
+            }
+            if written.trim().is_empty() {
+                return Err(field("volumes", format!("\"{name}\": \"\" names no volume")));
+            }
+            volumes.push((name.clone(), beside_or_name(written, &dir, |p| crate::inputs::volume_name(p).is_some())));
+        }
+        let mut tfs = Vec::new();
+        for (name, written) in &doc.tfs {
+            input_name("tfs", name)?;
+            if written.trim().is_empty() {
+                return Err(field("tfs", format!("\"{name}\": \"\" names no transfer function")));
+            }
+            tfs.push((name.clone(), beside_or_name(written, &dir, is_tf_name)));
+        }
         let volume = match doc.volume {
             VolumeSource::File(p) => VolumeSource::File(resolve(&p).display().to_string()),
             other => other,
@@ -353,6 +396,8 @@ impl Scene {
             frames: doc.frames,
             cuts,
             volume_options: doc.volume_options,
+            volumes,
+            tfs,
         })
     }
 

@@ -171,3 +171,35 @@ fn a_missing_unknown_or_misplaced_input_is_an_error_that_says_what_to_give() {
     assert!(!ok && err.contains("volgraph view binds one volume and one transfer function"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_scene_names_its_inputs_too() {
+    let dir = scratch("scene");
+    let tf = tf();
+    std::fs::write(
+        dir.join("both.ron"),
+        format!(
+            "Scene(graph: \"two_volumes.ron\", volume: Generated(\"sphere32\"), volumes: {{\"mask\": \"ml32\"}}, \
+             transfer_function: File(\"{tf}\"))"
+        ),
+    )
+    .expect("scene");
+    let (ok, err) = volgraph(&["render", "--scene", "both.ron", "--output", "mask_image", "-o", "scene.exr"], &dir);
+    assert!(ok, "{err}");
+    let (ok, err) = volgraph(
+        &["render", "two_volumes.ron", "--volume", "ml32", "--tf", &tf, "--output", "image", "-o", "alone.exr"],
+        &dir,
+    );
+    assert!(ok, "{err}");
+    assert!(pixels(&dir.join("scene.exr")) == pixels(&dir.join("alone.exr")), "the scene's mask is ml32");
+    // A name that is no identifier, or `volume` (the scene's `volume:`), is an error naming the field.
+    std::fs::write(dir.join("bad.ron"), "Scene(volume: Generated(\"ml32\"), volumes: {\"2nd\": \"ml32\"})")
+        .expect("scene");
+    let (ok, err) = volgraph(&["render", "two_volumes.ron", "--scene", "bad.ron", "-o", "x.png"], &dir);
+    assert!(!ok && err.contains("volumes") && err.contains("\"2nd\" is no input name"), "{err}");
+    std::fs::write(dir.join("twice.ron"), "Scene(volume: Generated(\"ml32\"), volumes: {\"volume\": \"ml32\"})")
+        .expect("scene");
+    let (ok, err) = volgraph(&["render", "two_volumes.ron", "--scene", "twice.ron", "-o", "x.png"], &dir);
+    assert!(!ok && err.contains("\"volume\" is the scene's `volume:`"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

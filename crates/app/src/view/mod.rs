@@ -96,6 +96,15 @@ pub fn emit(event: &session::Event) {
 /// Runs `volgraph view`.
 pub fn run(args: ViewArgs) -> Result<(), CliError> {
     let resolved = args.inputs.resolve("volgraph view GRAPH", "800x600")?;
+    // The viewer binds one volume and one transfer function: a scene that names inputs would
+    // show the wrong one in them.
+    if let Some(scene) = resolved.scene.as_ref().filter(|s| !s.volumes.is_empty() || !s.tfs.is_empty()) {
+        return Err(CliError::Other(anyhow::anyhow!(
+            "{}: volumes/tfs name graph inputs, which `volgraph render --scene` binds; the viewer binds one volume \
+             and one transfer function for now (remove volumes and tfs to view the scene's volume)",
+            scene.path.display()
+        )));
+    }
     let viewport = inputs::parse_size(&resolved.size)?;
     let camera = resolved.camera.at(0);
     if let Some(path) = &args.screenshot {

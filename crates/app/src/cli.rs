@@ -77,7 +77,9 @@ enum Command {
     /// function starts.
     Info {
         /// The volume: a file (.raw named NAME_XxYxZ_TYPE.raw, .nrrd, .nhdr, .mhd, .mha, .nii,
-        /// .nii.gz), a folder of DICOM slices (its series are listed), or DICOM slice files.
+        /// .nii.gz), a folder of DICOM slices (its series are listed), or DICOM slice files. Or
+        /// several as NAME=PATH (`ct=ct.nii.gz pet=pet.nii.gz`): each described, then whether
+        /// they share a grid and frame and where their boxes overlap.
         #[arg(required = true, num_args = 1..)]
         volume: Vec<PathBuf>,
         /// The volume is a label map (a segmentation): list its labels — value, name, voxels and

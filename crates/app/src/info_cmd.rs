@@ -24,6 +24,10 @@ pub struct Labels {
 /// The report for `paths`: the series list of a DICOM folder holding several (and the first
 /// series, or the one `--series` picks), else the one volume; with `labels`, its labels.
 pub fn run(paths: &[PathBuf], options: &LoadOptions<'static>, labels: Option<&Labels>) -> anyhow::Result<String> {
+    let named = crate::named_inputs::named_volumes(paths)?;
+    if !named.is_empty() {
+        return several(&named, options, labels);
+    }
     let mut out = String::new();
     if dicom::is_dicom_input(paths) {
         let series = dicom::list_series(paths).map_err(|e| anyhow!("{e}"))?;
@@ -53,6 +57,84 @@ pub fn run(paths: &[PathBuf], options: &LoadOptions<'static>, labels: Option<&La
         out.push_str(&label_report(&volume, &own)?);
     }
     Ok(out)
+}
+
+/// `volgraph info ct=CT pet=PET …`: each volume's report, then whether they lie in one frame and
+/// where their boxes overlap (issue 43, item 6) — what binding them to one graph needs.
+fn several(
+    named: &[(String, PathBuf)],
+    options: &LoadOptions<'static>,
+    labels: Option<&Labels>,
+) -> anyhow::Result<String> {
+    let mut out = String::new();
+    let mut volumes = Vec::new();
+    for (name, path) in named {
+        let (volume, notes) = crate::inputs::volume(std::slice::from_ref(path), options)
+            .map_err(|e| anyhow!("{name}={}: {e:#}", path.display()))?;
+        for note in notes {
+            crate::stdout::eprintln_escaped!("note: {note}");
+        }
+        let _ = write!(out, "{name}: ");
+        out.push_str(&describe(path, &volume));
+        volumes.push((name.as_str(), volume));
+    }
+    if let Some(labels) = labels {
+        // --labels describes the last volume (the segmentation listed after its scan).
+        if let Some((_, last)) = volumes.last() {
+            out.push_str(&label_report(last, labels)?);
+        }
+    }
+    let _ = writeln!(out, "together");
+    for (i, (a, va)) in volumes.iter().enumerate() {
+        for (b, vb) in &volumes[i + 1..] {
+            let _ = writeln!(out, "  {a} and {b}: {}", relation(va, vb));
+        }
+    }
+    Ok(out)
+}
+
+/// How two volumes lie to each other: the same grid, boxes overlapping (by what share of each),
+/// or apart — in the patient frame when both are in it, else in their index boxes.
+fn relation(a: &Volume, b: &Volume) -> String {
+    use volgraph_accel::volume_meta::WorldFrame;
+    let patient = a.meta.frame == WorldFrame::Lps && b.meta.frame == WorldFrame::Lps;
+    if a.meta.frame != b.meta.frame {
+        return format!(
+            "different frames ({} / {}): where one lies in the other is unknown",
+            a.meta.frame.describe(),
+            b.meta.frame.describe()
+        );
+    }
+    let same_grid = a.dims == b.dims
+        && (a.spacing - b.spacing).abs().max_element() <= 1e-6 * a.spacing.max_element()
+        && a.meta.origin == b.meta.origin;
+    // The box each covers (voxel centres ± half a voxel), in mm from the origin of the patient
+    // frame (or from voxel 0 where a file gives no origin).
+    let span = |v: &Volume| {
+        let lo = v.meta.origin.unwrap_or_default() - v.spacing * 0.5;
+        (lo, lo + v.spacing * v.dims.as_dvec3())
+    };
+    let ((alo, ahi), (blo, bhi)) = (span(a), span(b));
+    let (lo, hi) = (alo.max(blo), ahi.min(bhi));
+    let size = |lo: glam::DVec3, hi: glam::DVec3| (hi - lo).max(glam::DVec3::ZERO).element_product();
+    let common = size(lo, hi);
+    let frame = if patient { "in the patient frame" } else { "in index space (no patient frame)" };
+    let unit = if patient { " mm" } else { " (spacing units)" };
+    let fmt = |lo: glam::DVec3, hi: glam::DVec3| {
+        format!("({:.1}, {:.1}, {:.1})–({:.1}, {:.1}, {:.1}){unit}", lo.x, lo.y, lo.z, hi.x, hi.y, hi.z)
+    };
+    if same_grid {
+        format!("the same grid {frame} (one march can sample both voxel for voxel)")
+    } else if common <= 0.0 {
+        format!("warning: their boxes do not overlap {frame}: {} and {}", fmt(alo, ahi), fmt(blo, bhi))
+    } else {
+        format!(
+            "boxes overlap {frame} over {:.1} % of the first and {:.1} % of the second ({}); grids differ",
+            100.0 * common / size(alo, ahi),
+            100.0 * common / size(blo, bhi),
+            fmt(lo, hi)
+        )
+    }
 }
 
 /// The labels of `volume` as a label map: one line a value present, named by the table.

@@ -122,3 +122,20 @@ fn a_slicer_segmentation_names_its_own_segments() {
     assert!(out.contains("1 segment of other layers (overlapping segments) left out"), "{out}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn several_named_volumes_are_described_with_how_they_lie_to_each_other() {
+    let dir = scratch("several");
+    let (ok, out, err) = info(&["ct=organs32", "seg=organs_labels32"], &dir);
+    assert!(ok, "{err}");
+    assert!(out.starts_with("ct: organs32\n") && out.contains("\nseg: organs_labels32\n"), "{out}");
+    assert!(out.contains("ct and seg: the same grid in the patient frame"), "{out}");
+    let (ok, out, err) = info(&["a=ml32", "b=ml48"], &dir);
+    assert!(ok, "{err}");
+    // 32³ inside 48³ from the same corner: all of the first, (32/48)³ = 29.6 % of the second.
+    assert!(out.contains("a and b: boxes overlap in index space (no patient frame) over 100.0 % of the first and 29.6 % of the second"), "{out}");
+    let (ok, out, err) = info(&["ct=organs32", "other=ml32"], &dir);
+    assert!(ok, "{err}");
+    assert!(out.contains("ct and other: different frames"), "{out}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -127,6 +127,16 @@ mod tests {
     }
 
     #[test]
+    fn sixty_five_thousand_labels_are_counted() {
+        // Every u16 value once: 65,535 labels and the background (issue 43, item 7).
+        let data: Vec<u16> = (0..=u16::MAX).collect();
+        let counts = census(&map(VoxelData::U16(data), UVec3::new(256, 256, 1), DVec3::ONE)).expect("labels");
+        assert_eq!(counts.counts.len(), 65_536);
+        assert!(counts.counts.iter().all(|c| c.voxels == 1));
+        assert_eq!(counts.counts.last().map(|c| c.value), Some(65_535));
+    }
+
+    #[test]
     fn a_volume_of_non_labels_is_an_error_naming_a_voxel() {
         let mut data = vec![1.0f32; 8];
         data[5] = 2.5;

@@ -125,8 +125,14 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
         let mut others = Vec::new();
         for (i, (name, path)) in named.iter().enumerate() {
             if i != primary {
-                let shown = crate::scene::load_shown_volume(std::slice::from_ref(path), None, &raw)
-                    .map_err(|e| anyhow!("--volume {name}=…: {e:#}"))?;
+                let shown =
+                    crate::scene::load_shown_volume(std::slice::from_ref(path), None, &raw).map_err(|e| match scene
+                        .as_ref()
+                        .filter(|_| scene_named)
+                    {
+                        Some(scene) => anyhow!("{}: volumes: \"{name}\": {e:#}", scene.path.display()),
+                        None => anyhow!("--volume {name}=…: {e:#}"),
+                    })?;
                 notes.extend(shown.notes);
                 others.push((name.clone(), shown.volume));
             }

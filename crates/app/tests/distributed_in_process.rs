@@ -4,7 +4,7 @@
 //! composited image must equal the single-process render of the same job. The real mpirun runs
 //! are `distributed_mpi.rs`.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use clap::Parser;
 use volgraph_app::cli::Cli;
@@ -12,6 +12,7 @@ use volgraph_app::distributed;
 use volgraph_composite::LocalGroup;
 
 mod support;
+use support::read_exr;
 
 fn dataset(name: &str) -> Option<PathBuf> {
     match volgraph_accel::data_dir::dataset_path(name) {
@@ -28,20 +29,6 @@ fn render_args(args: &[&str]) -> volgraph_app::render::RenderArgs {
     let mut argv = vec!["volgraph", "render"];
     argv.extend(args);
     Cli::try_parse_from(argv).expect("a valid command line").into_render_args().expect("render")
-}
-
-fn read_exr(path: &Path) -> (usize, usize, Vec<[f32; 4]>) {
-    use exr::prelude::*;
-    let image = read_first_rgba_layer_from_file(
-        path,
-        |resolution, _| (resolution.width(), vec![[0.0f32; 4]; resolution.width() * resolution.height()]),
-        |(w, pixels), position, (r, g, b, a): (f32, f32, f32, f32)| {
-            pixels[position.y() * *w + position.x()] = [r, g, b, a]
-        },
-    )
-    .expect("an EXR");
-    let size = image.layer_data.size;
-    (size.width(), size.height(), image.layer_data.channel_data.pixels.1)
 }
 
 fn scratch(name: &str) -> PathBuf {

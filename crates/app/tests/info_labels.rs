@@ -139,3 +139,26 @@ fn several_named_volumes_are_described_with_how_they_lie_to_each_other() {
     assert!(out.contains("ct and other: different frames"), "{out}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_label_table_that_is_no_regular_text_file_is_refused_at_once() {
+    let dir = scratch("hostile");
+    label_map(&dir);
+    std::fs::create_dir_all(dir.join("folder")).expect("folder");
+    std::fs::write(dir.join("binary.txt"), [0xff, 0xfe, 0x00]).expect("binary");
+    let mut cases = vec![("folder", "is a directory"), ("binary.txt", "not UTF-8"), ("/dev/zero", "is a device")];
+    #[cfg(unix)]
+    {
+        // A FIFO would block a plain read for ever.
+        for name in ["labels.fifo", "fifo.seg.nrrd"] {
+            let made = Command::new("mkfifo").arg(dir.join(name)).status().is_ok_and(|s| s.success());
+            assert!(made, "mkfifo {name}");
+            cases.push((name, "is a FIFO"));
+        }
+    }
+    for (table, want) in cases {
+        let (ok, _, err) = info(&["seg.nrrd", "--label-table", table], &dir);
+        assert!(!ok && err.contains(want), "{table}: {err}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -7,6 +7,8 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+mod support;
+
 /// A graph of two volume inputs, each raycast on its own: `image` from `volume`, `mask_image`
 /// from `mask`.
 const TWO_VOLUMES: &str = r#"Graph(
@@ -46,19 +48,9 @@ fn volgraph(args: &[&str], dir: &Path) -> (bool, String) {
     (out.status.success(), String::from_utf8_lossy(&out.stderr).into_owned())
 }
 
-/// The pixels of an EXR (the file's bytes vary run to run: its chunks are compressed in
-/// parallel).
+/// The pixels of an EXR.
 fn pixels(path: &Path) -> Vec<[f32; 4]> {
-    use exr::prelude::*;
-    let image = read_first_rgba_layer_from_file(
-        path,
-        |resolution, _| (resolution.width(), vec![[0.0f32; 4]; resolution.width() * resolution.height()]),
-        |(w, pixels), position, (r, g, b, a): (f32, f32, f32, f32)| {
-            pixels[position.y() * *w + position.x()] = [r, g, b, a]
-        },
-    )
-    .expect("an EXR");
-    image.layer_data.channel_data.pixels.1
+    support::read_exr(path).2
 }
 
 fn tf() -> String {
@@ -69,54 +61,26 @@ fn tf() -> String {
 fn each_named_volume_reaches_the_input_of_its_name() {
     let dir = scratch("bind");
     let tf = tf();
+    // Renders output `output` of the two-volume graph with `volumes` to `out`, returning its pixels.
+    let render = |volumes: &[&str], output: &str, out: &str| {
+        let mut args = vec!["render", "two_volumes.ron"];
+        for v in volumes {
+            args.extend(["--volume", v]);
+        }
+        args.extend(["--tf", &tf, "--output", output, "-o", out]);
+        let (ok, err) = volgraph(&args, &dir);
+        assert!(ok, "{err}");
+        pixels(&dir.join(out))
+    };
     // The mask output of the sphere/ml pair is the ml volume's raycast: the same image as
     // binding ml32 alone and reading the graph's first output.
-    let (ok, err) = volgraph(
-        &[
-            "render",
-            "two_volumes.ron",
-            "--volume",
-            "volume=sphere32",
-            "--volume",
-            "mask=ml32",
-            "--tf",
-            &tf,
-            "--output",
-            "mask_image",
-            "-o",
-            "named.exr",
-        ],
-        &dir,
-    );
-    assert!(ok, "{err}");
-    let (ok, err) = volgraph(
-        &["render", "two_volumes.ron", "--volume", "ml32", "--tf", &tf, "--output", "image", "-o", "alone.exr"],
-        &dir,
-    );
-    assert!(ok, "{err}");
-    let (named, alone) = (pixels(&dir.join("named.exr")), pixels(&dir.join("alone.exr")));
+    let named = render(&["volume=sphere32", "mask=ml32"], "mask_image", "named.exr");
+    let alone = render(&["ml32"], "image", "alone.exr");
     assert!(named == alone, "the mask input got ml32 and is raycast exactly as ml32 alone");
     assert!(alone.iter().any(|p| p[3] > 0.1), "something is drawn");
     // And the primary input got the sphere: its image differs from ml32's.
-    let (ok, err) = volgraph(
-        &[
-            "render",
-            "two_volumes.ron",
-            "--volume",
-            "volume=sphere32",
-            "--volume",
-            "mask=ml32",
-            "--tf",
-            &tf,
-            "--output",
-            "image",
-            "-o",
-            "sphere.exr",
-        ],
-        &dir,
-    );
-    assert!(ok, "{err}");
-    assert!(pixels(&dir.join("sphere.exr")) != alone, "the volume input got the sphere");
+    let sphere = render(&["volume=sphere32", "mask=ml32"], "image", "sphere.exr");
+    assert!(sphere != alone, "the volume input got the sphere");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

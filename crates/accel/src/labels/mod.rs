@@ -160,15 +160,11 @@ impl LabelTable {
             })?;
             return slicer_seg::table_from_pairs(&file, &pairs);
         }
-        let bytes = std::fs::read(path).map_err(|e| LabelTableError::File {
+        // The project's one bounded reader of a user's text file: refuses a FIFO, a device or a
+        // folder, stops at its size limit, requires UTF-8.
+        let text = crate::input_file::read_text(path, "label table").map_err(|e| LabelTableError::File {
             file: file.clone(),
             message: format!("cannot read the label table ({e})"),
-        })?;
-        let text = String::from_utf8(bytes).map_err(|_| LabelTableError::File {
-            file: file.clone(),
-            message: "the label table is not UTF-8 text; give an ITK-SNAP label description file or a 3D Slicer \
-                      colour table (.ctbl, .txt)"
-                .to_string(),
         })?;
         Ok((Self::parse(&file, &text)?, Vec::new()))
     }

@@ -154,6 +154,9 @@ mod tests {
         // near 10 (9.5–10.5 for the stairs).
         let smooth = edge(LabelFilter::Smooth);
         let nearest = edge(LabelFilter::Nearest);
+        // Measured 9.835 on this ray (the indicator's ½-crossing of the voxel staircase lies
+        // 0.17 voxel inside the radius); 0.35 leaves room for the ray's angle while staying well
+        // under the half voxel a nearest boundary can be off along an axis.
         assert!((smooth - 10.0).abs() < 0.35, "smooth boundary at {smooth}");
         assert!((9.0..11.0).contains(&nearest), "nearest boundary at {nearest}");
     }

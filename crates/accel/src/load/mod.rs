@@ -557,6 +557,7 @@ fn sibling(header: &Path, name: &str) -> PathBuf {
 /// at `path` (its first 4 MiB at most; the header ends at the first empty line).
 pub fn nrrd_key_values(path: &Path) -> Result<Vec<(usize, String, String)>, LoadError> {
     use std::io::Read as _;
+    check_is_file(path)?;
     let file = std::fs::File::open(path).map_err(|source| LoadError::Io { path: path.to_path_buf(), source })?;
     let mut bytes = Vec::new();
     file.take(4 << 20).read_to_end(&mut bytes).map_err(|source| LoadError::Io { path: path.to_path_buf(), source })?;

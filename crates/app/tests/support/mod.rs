@@ -1,4 +1,5 @@
-//! What several integration tests of the app share.
+//! What several integration tests of the app share (each test binary uses a part of it).
+#![allow(dead_code)]
 
 use glam::{DVec3, UVec3};
 use volgraph_accel::volume::{Volume, VoxelData};
@@ -23,4 +24,20 @@ pub fn ct(n: u32, name: &str) -> Volume {
         }
     }
     Volume::new(name, dims, DVec3::new(0.8, 0.8, 1.5), VoxelData::I16(values))
+}
+
+/// The size and RGBA pixels of an EXR (compare pixels, not bytes: the file's chunks are
+/// compressed in parallel, so its bytes vary run to run).
+pub fn read_exr(path: &std::path::Path) -> (usize, usize, Vec<[f32; 4]>) {
+    use exr::prelude::*;
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |resolution, _| (resolution.width(), vec![[0.0f32; 4]; resolution.width() * resolution.height()]),
+        |(w, pixels), position, (r, g, b, a): (f32, f32, f32, f32)| {
+            pixels[position.y() * *w + position.x()] = [r, g, b, a]
+        },
+    )
+    .expect("an EXR");
+    let size = image.layer_data.size;
+    (size.width(), size.height(), image.layer_data.channel_data.pixels.1)
 }

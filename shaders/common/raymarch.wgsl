@@ -14,7 +14,7 @@
 // Effects a scene turns on are compiled in with `#if` (crates/compiler/src/shader_source.rs):
 // SHADING (Blinn–Phong of every DVR sample with the gradient), PREINTEGRATION (Engel et al.
 // 2001: each sample composites the segment from the previous one through a 2D table), TRICUBIC
-// (common/volume.wgsl), JITTER; and the pass's choices: CORRECTED_TABLE (classify through a
+// (common/volume.wgsl), JITTER; FUSION (several volumes per sample, common/fusion.wgsl); and the pass's choices: CORRECTED_TABLE (classify through a
 // table pre-corrected for the step, opacity_lut.wgsl), LEAP (`march_dvr` leaps in rounds),
 // FIRST_VISIBLE (`march_dvr` records its first visible sample for Klein's leap hits), PREFETCH
 // (the compute raycaster's pipelined loop: each run fetches one sample ahead).
@@ -126,6 +126,9 @@ var<private> ray_prev_scalar: f32;
 // segment (the field one step before it).
 fn begin_ray(s: Samples, k0: u32) {
     ray_view_world = normalize(s.delta * 2.0 * frame.half_extent.xyz);
+#if FUSION
+    begin_fusion();
+#endif
     resume_ray(sample_at(s, k0) - s.delta);
 }
 
@@ -143,8 +146,16 @@ fn classify_sample(u: vec3<f32>) -> vec4<f32> {
     return classify_value(u, sample_volume(u));
 }
 
+#if FUSION
+#import "common/fusion.wgsl"
+#endif
+
 // `classify_sample` of the scalar `s` already fetched at `u`.
 fn classify_value(u: vec3<f32>, s: f32) -> vec4<f32> {
+#if FUSION
+    // Several volumes: classified and combined per sample (pre-integration is of one TF).
+    var p = fused_sample(u, s);
+#else
 #if PREINTEGRATION
     var p = lookup_preintegrated(ray_prev_scalar, s);
     ray_prev_scalar = s;
@@ -155,6 +166,7 @@ fn classify_value(u: vec3<f32>, s: f32) -> vec4<f32> {
     let c = sample_tf(s);
     let a = corrected_alpha(c.a);
     var p = vec4<f32>(c.rgb * a, a);
+#endif
 #endif
 #endif
 #if SHADING

@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::camera::{CameraFrame, OrbitCamera};
 use crate::cuts::Cuts;
+use crate::fusion::Fusion;
 use crate::volume::Volume;
 
 /// Blinn–Phong headlight coefficients for the isosurface (`docs/rendering_model.md`,
@@ -256,6 +257,8 @@ pub fn corrected_alpha(a_tf: f64, step_voxels: f64) -> f64 {
 struct March<'a> {
     volume: &'a Volume,
     lut: &'a [[f32; 4]],
+    /// Several volumes: a second volume and how samples combine (`crate::fusion`).
+    fusion: Option<&'a Fusion<'a>>,
     settings: &'a RaycastSettings,
     seg: RaySegment,
     step_tex: f64,
@@ -273,6 +276,7 @@ impl<'a> March<'a> {
     fn new(
         volume: &'a Volume,
         lut: &'a [[f32; 4]],
+        fusion: Option<&'a Fusion<'a>>,
         settings: &'a RaycastSettings,
         seg: RaySegment,
         step_tex: f64,
@@ -282,7 +286,7 @@ impl<'a> March<'a> {
         let offset = 0.5 + jitter;
         let k0 = if begin < end { ((begin / step_tex - offset).ceil()).clamp(0.0, u32::MAX as f64) as u32 } else { 0 };
         let end_tex = if begin < end { end } else { 0.0 };
-        Self { volume, lut, settings, seg, step_tex, jitter, k0, end_tex }
+        Self { volume, lut, fusion, settings, seg, step_tex, jitter, k0, end_tex }
     }
 
     fn t(&self, k: u32) -> f64 {
@@ -302,7 +306,10 @@ impl<'a> March<'a> {
     /// pre-integration), shaded when asked.
     fn classify(&self, t: f64, s: f64, s_prev: f64) -> [f64; 4] {
         let exponent = self.settings.step_exponent();
-        let mut p = if self.settings.effects.preintegration {
+        let mut p = if let Some(fusion) = self.fusion {
+            // Several volumes: classified and combined per sample (pre-integration is of one TF).
+            fusion.classify(self.volume, self.lut, self.seg.u0 + t * self.seg.d_tex, s, exponent)
+        } else if self.settings.effects.preintegration {
             preintegrate(self.lut, s_prev, s, exponent)
         } else {
             let c = lut_sample(self.lut, s);
@@ -328,8 +335,11 @@ impl<'a> March<'a> {
         let mut k = self.k0;
         // Pre-integration: the front value of the first sample's segment is the field one step
         // before it.
-        let mut s_prev =
-            if self.settings.effects.preintegration { self.sample(self.t(k) - self.step_tex) } else { 0.0 };
+        let mut s_prev = if self.settings.effects.preintegration && self.fusion.is_none() {
+            self.sample(self.t(k) - self.step_tex)
+        } else {
+            0.0
+        };
         while k < self.settings.max_steps {
             let t = self.t(k);
             if t >= self.end_tex {
@@ -458,6 +468,21 @@ pub fn render_reference(
     height: u32,
     settings: &RaycastSettings,
 ) -> ReferenceImage {
+    render_fused_reference(volume, lut, None, camera, width, height, settings)
+}
+
+/// [`render_reference`] of several volumes in one march (`crate::fusion`): `volume` is the
+/// frame volume (its box is the one rays meet), `fusion` the second volume and how each sample
+/// combines them.
+pub fn render_fused_reference(
+    volume: &Volume,
+    lut: &[[f32; 4]],
+    fusion: Option<&Fusion<'_>>,
+    camera: &OrbitCamera,
+    width: u32,
+    height: u32,
+    settings: &RaycastSettings,
+) -> ReferenceImage {
     let pixels = width as usize * height as usize;
     let mut color = vec![[0.0; 4]; pixels];
     let mut hit = vec![[0.0; 4]; pixels];
@@ -475,7 +500,7 @@ pub fn render_reference(
         .map(|(y, (color_row, hit_row))| {
             let mut row_samples = 0;
             for x in 0..width {
-                let (c, h, n) = reference_pixel(volume, lut, camera, &frame, (x, y as u32), settings);
+                let (c, h, n) = fused_pixel(volume, lut, fusion, camera, &frame, (x, y as u32), settings);
                 color_row[x as usize] = c;
                 hit_row[x as usize] = h;
                 row_samples += n;
@@ -497,6 +522,19 @@ pub fn reference_pixel(
     (x, y): (u32, u32),
     settings: &RaycastSettings,
 ) -> ([f64; 4], [f64; 4], u64) {
+    fused_pixel(volume, lut, None, camera, frame, (x, y), settings)
+}
+
+/// [`reference_pixel`] of several volumes (`crate::fusion`).
+pub fn fused_pixel(
+    volume: &Volume,
+    lut: &[[f32; 4]],
+    fusion: Option<&Fusion<'_>>,
+    camera: &OrbitCamera,
+    frame: &CameraFrame,
+    (x, y): (u32, u32),
+    settings: &RaycastSettings,
+) -> ([f64; 4], [f64; 4], u64) {
     let Some(seg) = ray_segment(volume, camera, frame, x, y) else {
         return ([0.0; 4], [0.0; 4], 0);
     };
@@ -505,7 +543,7 @@ pub fn reference_pixel(
         return ([0.0; 4], [0.0; 4], 0);
     }
     let jitter = if settings.jitter { pixel_jitter(x, y, frame.width) } else { 0.0 };
-    let march = March::new(volume, lut, settings, seg, step_tex, jitter);
+    let march = March::new(volume, lut, fusion, settings, seg, step_tex, jitter);
     match settings.mode {
         RenderMode::Dvr => {
             let (c, n) = march.dvr();

@@ -52,6 +52,9 @@ pub struct VolumeMeta {
     pub origin: Option<DVec3>,
     /// Series description (DICOM SeriesDescription, NIfTI descrip).
     pub description: Option<String>,
+    /// DICOM FrameOfReferenceUID: series of one patient position share it; two that differ do
+    /// not lie in one patient frame even where both are LPS (`volgraph_accel::fusion`).
+    pub frame_of_reference: Option<String>,
 }
 
 impl VolumeMeta {

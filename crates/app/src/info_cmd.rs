@@ -105,6 +105,9 @@ fn relation(a: &Volume, b: &Volume) -> String {
             b.meta.frame.describe()
         );
     }
+    if let Err(e) = volgraph_accel::fusion::same_frame_of_reference(a, b) {
+        return format!("warning: {e}");
+    }
     let same_grid = a.dims == b.dims
         && (a.spacing - b.spacing).abs().max_element() <= 1e-6 * a.spacing.max_element()
         && a.meta.origin == b.meta.origin;

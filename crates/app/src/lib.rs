@@ -19,6 +19,7 @@ pub mod info_cmd;
 #[cfg(test)]
 mod input_fuzz;
 pub mod inputs;
+pub mod label_tables;
 pub mod load_progress;
 pub mod named_inputs;
 pub mod passes_cmd;

@@ -87,8 +87,9 @@ pub fn input_location(source: &str, name: &str) -> Option<(usize, usize)> {
     Some((line, column))
 }
 
-/// The volumes and transfer functions bound by name for one render: every volume input of the
-/// graph named on the command line, on one grid, and the named transfer functions.
+/// The volumes, transfer functions and label tables bound by name for one render: every volume
+/// input of the graph named on the command line (in one frame; grids may differ, the march
+/// samples each where it lies), the named transfer functions, the label tables.
 pub struct NamedBindings {
     /// The input the frame's volume (the one loaded as the render's volume) is bound to, when
     /// volumes are named.
@@ -97,6 +98,11 @@ pub struct NamedBindings {
     pub others: Vec<(String, Volume)>,
     /// `(input, LUT)`.
     pub luts: Vec<(String, Vec<[f32; 4]>)>,
+    /// `(input, label table by label value)` for the graph's `LabelTable` inputs.
+    pub tables: Vec<(String, Vec<[f32; 4]>)>,
+    /// Volumes of different DICOM frames of reference are shown as their files place them
+    /// (`--allow-frame-mismatch`) instead of refused.
+    pub allow_frame_mismatch: bool,
 }
 
 impl NamedBindings {
@@ -107,10 +113,16 @@ impl NamedBindings {
 
     /// Checks the bindings against the compiled graph's inputs (`graph` names its file in
     /// messages, `source` is its text, for the line of an input): every named input exists with
-    /// the right kind, every volume input has a volume once one is named, and the volumes share
-    /// `primary`'s grid (one march samples them at the same positions, until volumes on different
-    /// grids are marched in the patient frame).
-    pub fn check(&self, plan: &volgraph_core::Plan, graph: &str, source: &str, primary: &Volume) -> anyhow::Result<()> {
+    /// the right kind, every volume input has a volume once one is named, and the volumes lie in
+    /// `primary`'s frame (one march samples each where it lies). Returns warnings: volumes whose
+    /// boxes do not overlap the frame volume's.
+    pub fn check(
+        &self,
+        plan: &volgraph_core::Plan,
+        graph: &str,
+        source: &str,
+        primary: &Volume,
+    ) -> anyhow::Result<Vec<String>> {
         let of_kind = |kind: &InputKind| -> Vec<&str> {
             plan.inputs.iter().filter(|(_, k)| *k == kind).map(|(n, _)| n.as_str()).collect()
         };
@@ -135,6 +147,7 @@ impl NamedBindings {
                 return Err(unknown("--tf", name, &InputKind::TransferFunction, "transfer-function"));
             }
         }
+        let mut warnings = Vec::new();
         if let Some(first_name) = &self.primary {
             for name in of_kind(&InputKind::Volume) {
                 if !named.contains(&name) {
@@ -146,17 +159,28 @@ impl NamedBindings {
                 }
             }
             for (name, volume) in &self.others {
-                if !same_grid(volume, primary) {
-                    return Err(anyhow!(
-                        "--volume {name}=…: volumes are marched together only on one grid for now; {first_name} is {} \
-                         and {name} is {}; resample one onto the other's grid",
+                let map = volgraph_accel::fusion::TextureMap::between(primary, volume)
+                    .map_err(|e| anyhow!("--volume {name}=…: {e}"))?;
+                if let Err(e) = volgraph_accel::fusion::same_frame_of_reference(primary, volume) {
+                    if !self.allow_frame_mismatch {
+                        return Err(anyhow!("--volume {name}=…: {e}"));
+                    }
+                    warnings.push(format!("warning: --volume {name}=…: {e} (shown as placed: --allow-frame-mismatch)"));
+                }
+                // The frame volume's box in the other's texture space: disjoint from [0,1]³?
+                let (a, b) = (map.apply(glam::DVec3::ZERO), map.apply(glam::DVec3::ONE));
+                let (lo, hi) = (a.min(b).max(glam::DVec3::ZERO), a.max(b).min(glam::DVec3::ONE));
+                if lo.cmpge(hi).any() {
+                    warnings.push(format!(
+                        "warning: --volume {name}=…: its box does not overlap {first_name}'s, so rays through \
+                         {first_name}'s box never meet it; {first_name} is {} and {name} is {}",
                         grid_text(primary),
                         grid_text(volume)
                     ));
                 }
             }
         }
-        Ok(())
+        Ok(warnings)
     }
 
     /// Binds every volume and transfer-function input of `plan`: the named ones, `volume` to the
@@ -179,6 +203,10 @@ impl NamedBindings {
                     let named = self.luts.iter().find(|(n, _)| n == name).map(|(_, l)| l.as_slice());
                     runtime.bind_lut(name, named.unwrap_or(lut))?
                 }
+                InputKind::LabelTable => match self.tables.iter().find(|(n, _)| n == name) {
+                    Some((_, table)) => runtime.bind_label_table(name, table)?,
+                    None => false,
+                },
                 InputKind::Scalar(_) | InputKind::Data(_) => false,
             };
         }
@@ -186,15 +214,7 @@ impl NamedBindings {
     }
 }
 
-/// Whether `a` and `b` have the same voxels per axis, spacing, frame and origin.
-fn same_grid(a: &Volume, b: &Volume) -> bool {
-    a.dims == b.dims
-        && (a.spacing - b.spacing).abs().max_element() <= 1e-6 * b.spacing.max_element()
-        && a.meta.frame == b.meta.frame
-        && a.meta.origin == b.meta.origin
-}
-
-/// `N×N×N at sx × sy × sz, origin (x, y, z)` for a grid mismatch.
+/// `N×N×N at sx × sy × sz, origin (x, y, z)` for a message about two boxes.
 fn grid_text(v: &Volume) -> String {
     let origin = v.meta.origin.map_or(String::new(), |o| format!(", origin ({:.3}, {:.3}, {:.3})", o.x, o.y, o.z));
     format!("{}×{}×{} at {} × {} × {}{origin}", v.dims.x, v.dims.y, v.dims.z, v.spacing.x, v.spacing.y, v.spacing.z)

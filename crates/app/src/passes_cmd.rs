@@ -89,6 +89,7 @@ fn carries(kind: &PortKind) -> String {
         PortKind::Volume => "the volume (3D texture)".to_string(),
         PortKind::VolumeVoxels => "the volume's voxels (CPU; the pass uploads what it needs)".to_string(),
         PortKind::TransferFunction => "the transfer function (LUT)".to_string(),
+        PortKind::LabelTable => "a label table (2D, 256 labels per row)".to_string(),
         PortKind::Owned(t) => format!("owned resource \"{t}\""),
         PortKind::Buffer { bytes, bytes_per_pixel } => {
             format!("storage buffer ({bytes} bytes + {bytes_per_pixel} per pixel)")

@@ -2,7 +2,7 @@
 //! sizes, the output file's kind) before the GPU is opened, then frames are drawn and the last
 //! one is written. A scene (`--scene`) supplies what flags do not.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use anyhow::anyhow;
@@ -46,6 +46,10 @@ pub struct RenderArgs {
     /// where GPU timestamps do not cover compute work (lavapipe). The frames get slower.
     #[arg(long)]
     pub time_each_pass: bool,
+    /// Show volumes of different DICOM frames of reference (FrameOfReferenceUID) as their files
+    /// place them, with a warning, instead of refusing them: for series known to line up.
+    #[arg(long)]
+    pub allow_frame_mismatch: bool,
     /// The largest group of a radix-k round (IceT's default: 8; 2 is binary swap).
     #[arg(long = "radix-k", default_value_t = 8, value_parser = clap::value_parser!(u32).range(2..=64), requires = "distributed")]
     pub radix_k: u32,
@@ -119,45 +123,42 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     };
     notes.extend(tf_notes);
     let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
-    let bindings = if named.is_empty() && named_tfs.is_empty() {
-        None
-    } else {
-        let mut others = Vec::new();
-        for (i, (name, path)) in named.iter().enumerate() {
-            if i != primary {
-                let shown =
-                    crate::scene::load_shown_volume(std::slice::from_ref(path), None, &raw).map_err(|e| match scene
-                        .as_ref()
-                        .filter(|_| scene_named)
-                    {
+    let mut others = Vec::new();
+    for (i, (name, path)) in named.iter().enumerate() {
+        if i != primary {
+            let shown =
+                crate::scene::load_shown_volume(std::slice::from_ref(path), None, &raw).map_err(|e| {
+                    match scene.as_ref().filter(|_| scene_named) {
                         Some(scene) => anyhow!("{}: volumes: \"{name}\": {e:#}", scene.path.display()),
                         None => anyhow!("--volume {name}=…: {e:#}"),
-                    })?;
-                notes.extend(shown.notes);
-                others.push((name.clone(), shown.volume));
-            }
+                    }
+                })?;
+            notes.extend(shown.notes);
+            others.push((name.clone(), shown.volume));
         }
-        let mut luts = Vec::new();
-        for (name, path) in &named_tfs {
-            // A TF named NAME_tf is fitted to (and its presets read in the units of) volume NAME.
-            let base =
-                name.strip_suffix("_tf").and_then(|b| others.iter().find(|(n, _)| n == b)).map_or(&volume, |(_, v)| v);
-            let (tf, tf_notes) = inputs::transfer_function(Some(path), args.inputs.tf_map.as_deref(), base, false)
-                .map_err(|e| anyhow!("--tf {name}=…: {e:#}"))?;
-            notes.extend(tf_notes);
-            luts.push((name.clone(), tf.to_lut_for(base, inputs::LUT_SIZE)));
-        }
-        Some(NamedBindings { primary: named.get(primary).map(|(n, _)| n.clone()), others, luts })
-    };
+    }
     let registry = crate::program::registry();
     let file = display_name(&graph);
     let opacity = scene.as_ref().map(|s| s.opacity_reference).unwrap_or_default();
     options.scene = scene_values_of(&VolumeDesc::of(&volume));
     options.scene.extend(crate::inputs::data_scene_values(&volume));
     let plan = compile(&file, &source, &registry, &options).map_err(CliError::Graph)?;
-    if let Some(bindings) = &bindings {
-        bindings.check(&plan, &file, &source, &volume)?;
+    let frame_path = shown_paths.first().map(PathBuf::as_path);
+    let bindings = named_bindings(
+        &plan,
+        (&named, primary, frame_path),
+        others,
+        &named_tfs,
+        &volume,
+        args.inputs.tf_map.as_deref(),
+    )?;
+    let bindings =
+        bindings.map(|(b, notes)| (NamedBindings { allow_frame_mismatch: args.allow_frame_mismatch, ..b }, notes));
+    if let Some((bindings, binding_notes)) = &bindings {
+        notes.extend(binding_notes.iter().cloned());
+        notes.extend(bindings.check(&plan, &file, &source, &volume)?);
     }
+    let bindings = bindings.map(|(b, _)| b);
     // A scene's effect the graph does not offer is a note (the scene may be shown with another
     // graph); a --features name it does not know is the user's typo: an error.
     let mut user = options.clone();
@@ -193,12 +194,73 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
             )
         )));
     }
+    // (A label map coloured by its own table — `label_table` with no `labels` input — ignores the TF.)
+    let volume_is_labels = plan.inputs.iter().any(|(name, kind)| {
+        *kind == volgraph_core::graph::ast::InputKind::LabelTable
+            && crate::label_tables::map_input_of(name, &volume_input_names(&plan)).is_none()
+    });
     if plan.inputs.values().any(|k| *k == volgraph_core::graph::ast::InputKind::TransferFunction)
+        && !volume_is_labels
         && let Some(note) = inputs::invisible_volume_note(&volume, &lut)
     {
         notes.push(note);
     }
     Ok(Prepared { args, graph, kind, camera, frames, opacity, cuts, volume, lut, bindings, plan, output, notes })
+}
+
+/// The inputs bound by name, with the notes their reading gave: the named volumes (`others`,
+/// loaded; `named[primary]` is the frame's `volume`, read from `frame_path`), each named `--tf` as a transfer function
+/// or, for a `LabelTable` input, a label table, and every label table the graph reads (the
+/// map's own names or the default palette where none is named). `None` when nothing is named
+/// and the graph reads no label table.
+fn named_bindings(
+    plan: &volgraph_core::Plan,
+    (named, primary, frame_path): (&[(String, PathBuf)], usize, Option<&Path>),
+    others: Vec<(String, volgraph_accel::volume::Volume)>,
+    named_tfs: &[(String, PathBuf)],
+    volume: &volgraph_accel::volume::Volume,
+    tf_map: Option<&str>,
+) -> anyhow::Result<Option<(NamedBindings, Vec<String>)>> {
+    use volgraph_core::graph::ast::InputKind;
+    let table_inputs: Vec<&String> =
+        plan.inputs.iter().filter(|(_, k)| **k == InputKind::LabelTable).map(|(n, _)| n).collect();
+    if named.is_empty() && named_tfs.is_empty() && table_inputs.is_empty() {
+        return Ok(None);
+    }
+    let mut notes = Vec::new();
+    let by_name = |n: &str| others.iter().find(|(o, _)| o == n).map(|(_, v)| v);
+    let mut luts = Vec::new();
+    for (name, path) in named_tfs.iter().filter(|(n, _)| !table_inputs.contains(&n)) {
+        // A TF named NAME_tf is fitted to (and its presets read in the units of) volume NAME.
+        let base = name.strip_suffix("_tf").and_then(by_name).unwrap_or(volume);
+        let (tf, tf_notes) =
+            inputs::transfer_function(Some(path), tf_map, base, false).map_err(|e| anyhow!("--tf {name}=…: {e:#}"))?;
+        notes.extend(tf_notes);
+        luts.push((name.clone(), tf.to_lut_for(base, inputs::LUT_SIZE)));
+    }
+    let volume_inputs = volume_input_names(plan);
+    let mut tables = Vec::new();
+    for name in table_inputs {
+        let map_name = crate::label_tables::map_input_of(name, &volume_inputs);
+        let map = map_name.as_deref().and_then(by_name).unwrap_or(volume);
+        // The map's file (a .seg.nrrd names its own labels): a named one's, or the frame volume's.
+        let map_path = match map_name.as_deref().and_then(|m| named.iter().find(|(n, _)| n == m)) {
+            Some((_, path)) => Some(path.as_path()),
+            None => frame_path,
+        };
+        let given = named_tfs.iter().find(|(n, _)| n == name).map(|(_, p)| p.as_path());
+        let (lut, table_notes) = crate::label_tables::label_lut(map, map_path, given, &format!("--tf {name}"))?;
+        notes.extend(table_notes);
+        tables.push((name.clone(), lut));
+    }
+    let primary = named.get(primary).map(|(n, _)| n.clone());
+    Ok(Some((NamedBindings { primary, others, luts, tables, allow_frame_mismatch: false }, notes)))
+}
+
+/// The graph's volume inputs, by name.
+fn volume_input_names(plan: &volgraph_core::Plan) -> Vec<&str> {
+    let volume = volgraph_core::graph::ast::InputKind::Volume;
+    plan.inputs.iter().filter(|(_, k)| **k == volume).map(|(n, _)| n.as_str()).collect()
 }
 
 /// A note when `--gpu-memory-mb` was given to a graph none of whose passes streams data within

@@ -1,7 +1,8 @@
 //! Several volume and transfer-function inputs bound by name (issue "several volumes", item 1):
 //! `volgraph render --volume NAME=PATH --tf NAME=FILE|PRESET` binds the graph's inputs of that
 //! name; a missing one is an error at its line in the graph; an unknown name lists the graph's
-//! inputs; volumes on different grids are refused (until the patient-frame march); the viewer and
+//! inputs; volumes on different grids of one frame render together, in different frames are
+//! refused; label tables are bound from files with notes for what they lack; the viewer and
 //! `--distributed`, which bind one volume, refuse names with what to use instead.
 
 use std::path::{Path, PathBuf};
@@ -115,12 +116,22 @@ fn a_missing_unknown_or_misplaced_input_is_an_error_that_says_what_to_give() {
         ),
         "{err}"
     );
+    // Different grids of one frame are marched together, each sampled where it lies; volumes in
+    // different frames (index axes against the patient frame) are refused, naming both.
     let (ok, err) = volgraph(
         &["render", "two_volumes.ron", "--volume", "volume=ml32", "--volume", "mask=ml48", "-o", "x.png"],
         &dir,
     );
+    assert!(ok, "{err}");
+    let (ok, err) = volgraph(
+        &["render", "two_volumes.ron", "--volume", "volume=ml32", "--volume", "mask=organs_labels32", "-o", "x.png"],
+        &dir,
+    );
     assert!(!ok);
-    assert!(err.contains("only on one grid for now; volume is 32×32×32 at 1 × 1 × 1 and mask is 48×48×48"), "{err}");
+    assert!(
+        err.contains("--volume mask=…: ") && err.contains("lies in index axes (the file gives no orientation) and"),
+        "{err}"
+    );
     let (ok, err) =
         volgraph(&["render", "two_volumes.ron", "--volume", "volume=ml32", "--volume", "ml32", "-o", "x.png"], &dir);
     assert!(!ok && err.contains("give every volume a name when one has one"), "{err}");
@@ -171,4 +182,80 @@ fn a_scene_names_its_inputs_too() {
     let (ok, err) = volgraph(&["render", "two_volumes.ron", "--scene", "twice.ron", "-o", "x.png"], &dir);
     assert!(!ok && err.contains("\"volume\" is the scene's `volume:`"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `graphs/multi/`: a label table file binds the `LabelTable` input, with a note for the map's
+/// values it does not name and one for the labels it names that the map lacks; only the visible
+/// label shows; a float volume that is no label map is an error naming a voxel.
+#[test]
+fn a_label_table_file_colours_the_map_and_says_what_it_lacks() {
+    let dir = scratch("tables");
+    // The liver shown, the kidneys, spleen and aorta hidden (alpha 0), the vertebra (6) unnamed.
+    let table = "1 liver 255 0 0 255\n2 k 0 0 0 0\n3 k 0 0 0 0\n4 s 0 0 0 0\n5 a 0 0 0 0\n9 nothing 0 0 255 255\n";
+    std::fs::write(dir.join("liver.txt"), table).expect("table");
+    let inside = |table: &str| {
+        let table = format!("label_table={table}");
+        let args = [
+            "render",
+            "multi/ct_inside_labels",
+            "--volume",
+            "volume=organs32",
+            "--volume",
+            "labels=organs_labels32",
+            "--tf",
+            &table,
+            "--size",
+            "64x64",
+            "-o",
+            "inside.exr",
+        ];
+        let (ok, err) = volgraph(&args, &dir);
+        assert!(ok, "{err}");
+        (pixels(&dir.join("inside.exr")).iter().filter(|p| p[3] > 0.01).count(), err)
+    };
+    let (liver, err) = inside("liver.txt");
+    assert!(err.contains("1 label value(s) of organs_labels_32 have no entry in liver.txt (6)"), "{err}");
+    assert!(err.contains("liver.txt names 1 label(s) that organs_labels_32 does not hold (9)"), "{err}");
+    // Every organ in the default palette shows more of the scan than the liver alone.
+    let (all, _) = inside("default");
+    assert!(liver > 20 && all > liver + 20, "liver {liver} pixels, all organs {all}");
+    let (ok, err) = volgraph(&["render", "multi/labels", "--volume", "mlf32", "-o", "x.png"], &dir);
+    assert!(!ok);
+    assert!(err.contains("--tf label_table: ") && err.contains("is not a label map: voxel ("), "{err}");
+}
+
+/// Two DICOM series of different frames of reference (FrameOfReferenceUID) are refused, naming
+/// both UIDs and the flag; `--allow-frame-mismatch` shows them as placed, with a warning.
+#[test]
+fn dicom_series_of_different_frames_of_reference_are_refused_unless_allowed() {
+    let dir = scratch("frames");
+    let mut ct = volgraph_accel::organs::organs_ct(16);
+    ct.meta.frame_of_reference = Some("1.2.3.4".into());
+    volgraph_accel::load::dicom::write_ct_series(&dir.join("ct"), &ct).expect("series");
+    ct.meta.frame_of_reference = Some("1.2.3.5".into());
+    volgraph_accel::load::dicom::write_ct_series(&dir.join("pet"), &ct).expect("series");
+    let mut args = vec![
+        "render",
+        "multi/pet_ct",
+        "--volume",
+        "volume=ct",
+        "--volume",
+        "pet=pet",
+        "--size",
+        "32x32",
+        "-o",
+        "x.png",
+    ];
+    let (ok, err) = volgraph(&args, &dir);
+    assert!(!ok);
+    assert!(
+        err.contains("--volume pet=…: ")
+            && err.contains("different DICOM frames of reference (1.2.3.4 and 1.2.3.5)")
+            && err.contains("--allow-frame-mismatch"),
+        "{err}"
+    );
+    args.push("--allow-frame-mismatch");
+    let (ok, err) = volgraph(&args, &dir);
+    assert!(ok, "{err}");
+    assert!(err.contains("warning: --volume pet=…: ") && err.contains("shown as placed"), "{err}");
 }

@@ -54,6 +54,9 @@ enum BenchCommand {
     /// Crop boxes and clip planes: ms/frame of crops to an eighth and a half and of a clip
     /// plane beside the whole volume (the engine with modern/fastest by default).
     Cuts(crate::cuts::CutsArgs),
+    /// Several volumes in one march: a CT with a 117-label map (tinted, inside) against the CT
+    /// alone, a label's visibility toggled → frame, smooth vs nearest label boundaries at 4× zoom.
+    Multi(crate::multi::MultiArgs),
     /// The viewer as a workbench: TF edit → frame on a 256³ volume at 800x600, and the frame
     /// time while the camera moves for every shipped graph.
     Workbench(crate::workbench::WorkbenchArgs),
@@ -109,6 +112,9 @@ fn run(cli: BenchCli) -> anyhow::Result<()> {
         BenchCli::Bench { which: BenchCommand::Load(args) } => crate::load::run(&args).context("bench load").map(drop),
         BenchCli::Bench { which: BenchCommand::Workbench(args) } => {
             crate::workbench::run(&args).context("bench workbench").map(drop)
+        }
+        BenchCli::Bench { which: BenchCommand::Multi(args) } => {
+            crate::multi::run(&args).context("bench multi").map(drop)
         }
         BenchCli::Bench { which: BenchCommand::Cuts(args) } => crate::cuts::run(&args).context("bench cuts").map(drop),
         BenchCli::Bench { which: BenchCommand::Fetch(args) } => {

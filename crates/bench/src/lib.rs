@@ -20,6 +20,7 @@ pub mod fetch;
 pub mod graphs;
 pub mod live;
 pub mod load;
+pub mod multi;
 pub mod report_files;
 pub mod sweep;
 pub mod workbench;

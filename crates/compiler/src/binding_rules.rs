@@ -95,6 +95,7 @@ pub fn port_infos(plan: &Plan, step: &crate::plan::Step, specs: &[crate::decl::P
                 (Some(_), _) => None,
                 (None, Some(PortKind::Target { .. })) => Some(wgpu::TextureViewDimension::D2),
                 (None, Some(PortKind::TransferFunction)) => Some(wgpu::TextureViewDimension::D1),
+                (None, Some(PortKind::LabelTable)) => Some(wgpu::TextureViewDimension::D2),
                 (None, Some(PortKind::Volume)) => Some(wgpu::TextureViewDimension::D3),
                 _ => None,
             };

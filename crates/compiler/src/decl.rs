@@ -51,6 +51,8 @@ pub enum PortKind {
     VolumeVoxels,
     /// The transfer-function LUT (a graph input).
     TransferFunction,
+    /// A label map's table (a graph input of kind `LabelTable`): a 2D texture, 256 labels per row.
+    LabelTable,
     /// A resource a pass owns and shares by name, e.g. `"minmax_grid"` (a 3D texture built from
     /// the volume): producer and consumer must name the same type.
     Owned(&'static str),
@@ -86,6 +88,7 @@ impl PortKind {
             }
             PortKind::Volume | PortKind::VolumeVoxels => "the volume".to_string(),
             PortKind::TransferFunction => "the transfer function".to_string(),
+            PortKind::LabelTable => "a label table".to_string(),
             PortKind::Owned(t) => format!("a {t}"),
         }
     }

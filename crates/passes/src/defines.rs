@@ -40,6 +40,18 @@ pub const FIRST_VISIBLE: &str = "FIRST_VISIBLE";
 /// Count the samples a perfect start estimate would leap over (a bypass's measure).
 pub const COUNT_LEAPABLE: &str = "COUNT_LEAPABLE";
 
+// Several volumes in one march (`fusion.rs`, `shaders/common/fusion.wgsl`).
+/// Samples classify several volumes (`fusion` set).
+pub const FUSION: &str = "FUSION";
+/// … the frame volume is a label map (`fusion: "labels"`).
+pub const FUSION_LABELS: &str = "FUSION_LABELS";
+/// … the second volume is a label map (`tint`, `inside`).
+pub const FUSION_LABEL_MAP: &str = "FUSION_LABEL_MAP";
+/// … the second volume is scalar, with its own TF (`fuse`, `add`).
+pub const FUSION_SCALAR: &str = "FUSION_SCALAR";
+/// Label maps read at the nearest voxel (`label_filter: "nearest"`).
+pub const LABELS_NEAREST: &str = "LABELS_NEAREST";
+
 // Other passes.
 /// The compute raycaster classifies through the pre-corrected TF table (`raycast_compute.rs`).
 pub const CORRECTED_TABLE: &str = "CORRECTED_TABLE";
@@ -55,7 +67,7 @@ pub const SEGMENTS: &str = "SEGMENTS";
 pub const SCATTER: &str = "SCATTER";
 
 /// Every `#if` name of the built-in passes.
-pub const BUILT_IN: [&str; 21] = [
+pub const BUILT_IN: [&str; 26] = [
     SHADING,
     PREINTEGRATION,
     TRICUBIC,
@@ -77,4 +89,9 @@ pub const BUILT_IN: [&str; 21] = [
     COLOR_F32,
     SEGMENTS,
     SCATTER,
+    FUSION,
+    FUSION_LABELS,
+    FUSION_LABEL_MAP,
+    FUSION_SCALAR,
+    LABELS_NEAREST,
 ];

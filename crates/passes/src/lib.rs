@@ -20,6 +20,7 @@ pub mod empty_distance;
 pub mod empty_space;
 pub mod entry_points;
 pub mod fetch_probe;
+pub mod fusion;
 #[cfg(feature = "gpu")]
 pub mod grid_tap;
 pub mod hole_fill;

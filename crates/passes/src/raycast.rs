@@ -45,6 +45,7 @@ pub(crate) fn raycast_ports(params: &Params, color: &[TargetFormat], hit: &[Targ
     let mut ports = march_ports(params);
     ports.push(PortSpec::read("volume", PortKind::Volume));
     ports.push(PortSpec::read("tf", PortKind::TransferFunction));
+    ports.extend(crate::fusion::FusionSettings::of(params).ports());
     ports.push(PortSpec::write("color", PortKind::target(color)));
     if is_iso(params) {
         ports.push(PortSpec::write("hit", PortKind::target(hit)));
@@ -75,7 +76,7 @@ impl PassDecl for Raycast {
         // leap switch changes the entry point, the ports or the `#if`s (a rebuild).
         [
             raycast_blocks(OnChange::InPlace),
-            vec![effect_block()],
+            vec![effect_block(), crate::fusion::fusion_block()],
             march_blocks(),
             vec![RaycastOwn::block(OnChange::InPlace).with_defines(own_defines)],
         ]
@@ -134,10 +135,13 @@ fn own_defines(params: &Params) -> Vec<&'static str> {
 /// The march's entry point for `params` (DVR or iso, leap hits or not) and what it binds,
 /// declared once for `shaders()` and `create`.
 fn march_shader(params: &Params) -> ShaderUse {
-    ShaderUse::new("raycast.wgsl", fragment_entry(params))
-        .binds(&["preintegrated"])
-        .uniform(RaycastParamsGpu::bound("params"))
-        .uniform(BlockSize::bound_as("blocks"))
+    crate::fusion::with_fusion_uniform(
+        ShaderUse::new("raycast.wgsl", fragment_entry(params))
+            .binds(&["preintegrated", "label_blocks"])
+            .uniform(RaycastParamsGpu::bound("params"))
+            .uniform(BlockSize::bound_as("blocks")),
+        params,
+    )
 }
 
 #[cfg(feature = "gpu")]
@@ -174,7 +178,9 @@ impl PassPlugin for Raycast {
         let settings = gpu_block(ctx.params);
         let params = ctx.uniform_from_bytes("params", &settings.uniform_bytes());
         let effects = EffectState::new(ctx)?;
+        let fusion = crate::fusion::FusionState::new(ctx)?;
         Ok(Box::new(RaycastNode {
+            fusion,
             pipeline,
             without_start,
             params,
@@ -253,6 +259,7 @@ struct RaycastNode {
     without_start: Option<RenderPassPipeline>,
     params: wgpu::Buffer,
     effects: EffectState,
+    fusion: crate::fusion::FusionState,
     leaping: Leaping,
     /// What `params` holds (the conservative step back is filled in per volume).
     settings: RaycastParamsGpu,
@@ -283,9 +290,11 @@ impl PassNode for RaycastNode {
         }
         self.leaping.check(ctx)?;
         self.effects.update(ctx, &self.params, self.settings.step_voxels as f64)?;
+        self.fusion.update(ctx)?;
         let mut extra = vec![("params", self.params.as_entire_binding())];
         extra.extend(self.leaping.bindings());
         extra.extend(self.effects.bindings());
+        extra.extend(self.fusion.bindings());
         let pipeline = match &self.without_start {
             Some(without) if START_PORTS.iter().any(|&p| ctx.reads_zeros(p)) => without,
             _ => &self.pipeline,

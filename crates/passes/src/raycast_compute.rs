@@ -72,9 +72,12 @@ fn entry(params: &Params) -> &'static str {
     if is_iso(params) { "cs_iso" } else { "cs_dvr" }
 }
 
-/// Whether the pass classifies through the corrected table (pre-integration has its own).
+/// Whether the pass classifies through the corrected table (pre-integration has its own;
+/// fusion classifies each volume through its own TF).
 fn uses_table(params: &Params) -> bool {
-    ComputeOwn::from_params(params).classify == Classify::Table && !EffectFlags::of(params).preintegration
+    ComputeOwn::from_params(params).classify == Classify::Table
+        && !EffectFlags::of(params).preintegration
+        && crate::fusion::FusionSettings::of(params).combine().is_none()
 }
 
 impl PassDecl for RaycastCompute {
@@ -99,7 +102,7 @@ impl PassDecl for RaycastCompute {
         // The workgroup, the sample loop and the classification shape the pipeline.
         [
             raycast_blocks(OnChange::InPlace),
-            vec![effect_block()],
+            vec![effect_block(), crate::fusion::fusion_block()],
             march_blocks(),
             vec![
                 ComputeOwn::block(OnChange::Rebuild)
@@ -144,10 +147,13 @@ impl PassDecl for RaycastCompute {
 /// The march's entry point for `params` and what it binds, declared once for `shaders()` and
 /// `create`.
 fn march_shader(params: &Params) -> ShaderUse {
-    ShaderUse::new("raycast_compute.wgsl", entry(params))
-        .binds(&["corrected", "preintegrated"])
-        .uniform(RaycastParamsGpu::bound("params"))
-        .uniform(BlockSize::bound_as("blocks"))
+    crate::fusion::with_fusion_uniform(
+        ShaderUse::new("raycast_compute.wgsl", entry(params))
+            .binds(&["corrected", "preintegrated", "label_blocks"])
+            .uniform(RaycastParamsGpu::bound("params"))
+            .uniform(BlockSize::bound_as("blocks")),
+        params,
+    )
 }
 
 #[cfg(feature = "gpu")]
@@ -182,7 +188,9 @@ impl PassPlugin for RaycastCompute {
         let half_step = (exact && sampling.step_voxels == 0.5).then(|| variant(true)).transpose()?;
         let params = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());
         let effects = EffectState::new(ctx)?;
+        let fusion = crate::fusion::FusionState::new(ctx)?;
         Ok(Box::new(RaycastComputeNode {
+            fusion,
             pipeline,
             half_step,
             params,
@@ -207,6 +215,7 @@ struct RaycastComputeNode {
     table: Option<TfTable>,
     leaping: Leaping,
     effects: EffectState,
+    fusion: crate::fusion::FusionState,
     step_voxels: f64,
 }
 
@@ -221,12 +230,14 @@ impl PassNode for RaycastComputeNode {
             table.fill(ctx, &self.params)?;
         }
         self.effects.update(ctx, &self.params, self.step_voxels)?;
+        self.fusion.update(ctx)?;
         let mut extra = vec![("params", self.params.as_entire_binding())];
         if let Some(t) = &self.table {
             extra.push(("corrected", wgpu::BindingResource::TextureView(&t.view)));
         }
         extra.extend(self.leaping.bindings());
         extra.extend(self.effects.bindings());
+        extra.extend(self.fusion.bindings());
         let unit = ctx.frame.volume.map_or(1.0, |v| v.opacity_unit_voxels);
         let pipeline = match &self.half_step {
             Some(half) if self.step_voxels / unit == 0.5 => half,

@@ -58,8 +58,14 @@ fn bindings(module: &naga::Module) -> Vec<(String, u32, u32)> {
 
 /// `#if` combinations the raycasters compile (crates/passes/src/march.rs): leaping over block
 /// flags or the distance map, start estimates with leap hits.
-const SETTINGS: &[&[&str]] =
-    &[&["LEAP", "LEAP_BLOCKS"], &["LEAP", "LEAP_CUBES"], &["START", "LEAP_HITS", "FIRST_VISIBLE"]];
+const SETTINGS: &[&[&str]] = &[
+    &["LEAP", "LEAP_BLOCKS"],
+    &["LEAP", "LEAP_CUBES"],
+    &["START", "LEAP_HITS", "FIRST_VISIBLE"],
+    &["FUSION", "FUSION_LABELS"],
+    &["FUSION", "FUSION_LABEL_MAP"],
+    &["FUSION", "FUSION_SCALAR"],
+];
 
 #[test]
 fn every_shader_validates() {

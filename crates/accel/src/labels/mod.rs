@@ -175,6 +175,20 @@ impl LabelTable {
         if itksnap::looks_like(text) { itksnap::parse(file, text) } else { slicer::parse(file, text) }
     }
 
+    /// The table as a LUT by label value for values `0..len`: straight colour (the bytes / 255)
+    /// and opacity, 0 where a label is hidden; values without an entry take [`default_label`].
+    /// What a graph's `LabelTable` input holds (the GPU reads texel `v`; opacity is per voxel
+    /// unit of the frame volume, like a TF's).
+    pub fn lut(&self, len: usize) -> Vec<[f32; 4]> {
+        (0..len as u32)
+            .map(|v| {
+                let l = self.label(v);
+                let a = if l.visible { l.opacity.clamp(0.0, 1.0) } else { 0.0 };
+                [l.rgb[0] as f32 / 255.0, l.rgb[1] as f32 / 255.0, l.rgb[2] as f32 / 255.0, a]
+            })
+            .collect()
+    }
+
     /// Values the table names that `present` (a map's census) lacks, for the one note a caller
     /// gives ("the table names labels the map lacks").
     pub fn missing_from(&self, present: &[u32]) -> Vec<u32> {

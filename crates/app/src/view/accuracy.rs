@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::cuts::Cuts;
-use volgraph_accel::reference::{RaycastSettings, reference_pixel};
+use volgraph_accel::reference::RaycastSettings;
 use volgraph_accel::volume::Volume;
 
 /// The converged reference's step, in voxels (as `volgraph sweep`'s reference).
@@ -63,6 +63,9 @@ pub struct Job {
     pub settings: RaycastSettings,
     /// The cuts.
     pub cuts: Cuts,
+    /// A label map coloured by its table (`fusion: "labels"`): the table by label value and how
+    /// labels are sampled.
+    pub labels: Option<(Vec<[f32; 4]>, volgraph_accel::labels::sample::LabelFilter)>,
 }
 
 /// Compares on the calling thread.
@@ -82,7 +85,21 @@ pub fn measure(job: &Job) -> Accuracy {
     let (mut sum, mut max, mut n) = (0.0, 0.0f64, 0usize);
     for y in (stride / 2..h).step_by(stride as usize) {
         for x in (stride / 2..w).step_by(stride as usize) {
-            let (reference, _, _) = reference_pixel(&job.volume, &job.lut, &job.camera, &frame, (x, y), &settings);
+            let fusion = job.labels.as_ref().map(|(table, filter)| volgraph_accel::fusion::Fusion {
+                combine: volgraph_accel::fusion::Combine::Labels,
+                label_lut: table,
+                filter: *filter,
+                second: None,
+            });
+            let (reference, _, _) = volgraph_accel::reference::fused_pixel(
+                &job.volume,
+                &job.lut,
+                fusion.as_ref(),
+                &job.camera,
+                &frame,
+                (x, y),
+                &settings,
+            );
             let gpu = job.image[(y * w + x) as usize];
             for c in 0..4 {
                 let d = (gpu[c] - reference[c]).abs();

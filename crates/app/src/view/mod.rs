@@ -6,6 +6,7 @@
 
 pub mod accuracy;
 pub mod graph_picture;
+pub mod label_list;
 pub mod lod;
 pub mod orbit;
 pub mod panel;

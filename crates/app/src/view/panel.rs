@@ -33,6 +33,10 @@ pub enum Action {
     TransferFunction(super::tf_editor::TfAction),
     /// Set a value typed as `PASS.PARAM=VALUE` or `input.NAME=VALUE`.
     Assign(String),
+    /// The label list's edit.
+    Labels(super::label_list::LabelEdit),
+    /// The label list's search text.
+    LabelSearch(String),
     /// Time every pass on its own (`Runtime::set_step_profiling`) or not.
     TimeEachPass(bool),
     /// Level of detail while moving: on or off, and the frame rate to hold.
@@ -222,13 +226,26 @@ pub fn show(
                     }
                 });
             }
-            if plan.inputs.values().any(|k| *k == InputKind::TransferFunction) {
+            // A label map is coloured by its label list, not by the TF.
+            if plan.inputs.values().any(|k| *k == InputKind::TransferFunction) && session.labels().is_none() {
                 egui::CollapsingHeader::new("Transfer function").default_open(true).show(ui, |ui| {
                     let model = &session.workbench().tf;
                     let (histogram, range) = model.histogram();
                     let (tf, presets) = (model.transfer_function(), model.presets());
                     if let Some(a) = super::tf_editor::show(ui, tf, histogram, range, presets, model.save_on_change) {
                         actions.push(Action::TransferFunction(a));
+                    }
+                });
+            }
+            if let Some(list) = session.labels() {
+                egui::CollapsingHeader::new(format!("Labels ({})", list.rows.len())).default_open(true).show(ui, |ui| {
+                    let mut list = list.clone();
+                    let search = list.search.clone();
+                    if let Some(edit) = super::label_list::show(ui, &mut list) {
+                        actions.push(Action::Labels(edit));
+                    }
+                    if list.search != search {
+                        actions.push(Action::LabelSearch(list.search));
                     }
                 });
             }

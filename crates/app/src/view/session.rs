@@ -21,6 +21,7 @@ use volgraph_core::{CompileOptions, Plan};
 use super::workbench::{LodTarget, StepRequest, Workbench};
 use crate::inputs;
 
+mod labels;
 mod measure;
 mod open;
 mod tf;
@@ -163,6 +164,8 @@ pub struct LiveSession {
     volume_options: volgraph_accel::load::LoadOptions<'static>,
     /// What the TF's opacity is per (the scene's).
     opacity_reference: volgraph_core::runtime::OpacityReference,
+    /// The label list, when the graph reads a label table (the volume is its label map).
+    labels: Option<super::label_list::LabelList>,
 }
 
 impl LiveSession {
@@ -210,6 +213,7 @@ impl LiveSession {
     fn compile_and_apply(&mut self, source: &str, options: &CompileOptions) -> Result<ApplyReport, String> {
         let plan = self.bench.graph.plan_for(source, options)?;
         self.runtime.bind_scene(&plan.inputs, &self.volume, &self.lut).map_err(|e| e.to_string())?;
+        bind_label_list(&mut self.runtime, &plan.inputs, self.labels.as_ref()).map_err(|e| e.to_string())?;
         self.runtime.apply(plan, self.bench.graph.registry()).map_err(|e| e.to_string())
     }
 
@@ -493,4 +497,22 @@ impl LodTarget for LiveSession {
     fn next_frame_index(&self) -> u64 {
         self.runtime.next_frame_index()
     }
+}
+
+/// Binds the label list's table to every `LabelTable` input of `inputs` (what `bind_scene` bound
+/// there is the default palette).
+pub(super) fn bind_label_list(
+    runtime: &mut Runtime,
+    inputs: &std::collections::BTreeMap<String, volgraph_core::graph::ast::InputKind>,
+    list: Option<&super::label_list::LabelList>,
+) -> Result<bool, volgraph_core::runtime::RuntimeError> {
+    let Some(list) = list else { return Ok(false) };
+    let lut = list.lut();
+    let mut uploaded = false;
+    for (name, kind) in inputs {
+        if *kind == volgraph_core::graph::ast::InputKind::LabelTable {
+            uploaded |= runtime.bind_label_table(name, &lut)?;
+        }
+    }
+    Ok(uploaded)
 }

@@ -2,7 +2,8 @@
 //! viewer changes it (file edits, sliders, features, resizes), with its events and images checked.
 //! Here: the helpers, and the panel's edits (parameters, write-back, the "set" field, the probe,
 //! the live error, a resize, the level of detail's step); `tests/reload.rs`: file edits (graph,
-//! shaders, transfer function); `tests/gpu_errors.rs`: frames the GPU rejects.
+//! shaders, transfer function); `tests/gpu_errors.rs`: frames the GPU rejects; `tests/labels.rs`:
+//! the label list.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -86,6 +87,7 @@ fn open_with_tf_copy(name: &str) -> (Scratch, LiveSession, PathBuf) {
 }
 
 mod gpu_errors;
+mod labels;
 mod reload;
 
 #[test]

@@ -170,6 +170,11 @@ impl Viewer {
                 Action::Scalar(name, value) => session.set_scalar(&name, value),
                 Action::Feature(name, on) => session.set_feature(&name, on),
                 Action::Cuts(cuts) => session.set_cuts(cuts),
+                Action::Labels(edit) => session.edit_labels(&edit),
+                Action::LabelSearch(text) => {
+                    session.set_label_search(text);
+                    Vec::new()
+                }
                 Action::Assign(text) => session.assign(&text),
                 Action::TimeEachPass(on) => {
                     session.runtime.set_step_profiling(on);

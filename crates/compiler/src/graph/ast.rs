@@ -158,6 +158,11 @@ pub enum InputKind {
     Volume,
     /// The transfer function, bound as a 1D LUT texture (`texture_1d<f32>`, N RGBA texels).
     TransferFunction,
+    /// A label map's table: colour and opacity per label value (0 where hidden), bound as a 2D
+    /// texture of 256 texels per row, label `v` at `(v % 256, v / 256)` (`texture_2d<f32>`), so
+    /// every u16 value has its entry. Filled from an ITK-SNAP or 3D Slicer table, a
+    /// `.seg.nrrd`'s segments or the default palette.
+    LabelTable,
     /// A scene scalar with its default value (repeat counts, thresholds).
     Scalar(f64),
     /// A value in the data's units (HU for CT), or `Auto`: what the data suggests — for an
@@ -176,6 +181,7 @@ impl InputKind {
         match self {
             InputKind::Volume => "Volume".to_string(),
             InputKind::TransferFunction => "TransferFunction".to_string(),
+            InputKind::LabelTable => "LabelTable".to_string(),
             InputKind::Scalar(v) => format!("Scalar = {v}"),
             InputKind::Data(DataValue::Auto) => "Data(Auto)".to_string(),
             InputKind::Data(DataValue::Value(v)) => format!("Data({v})"),

@@ -206,6 +206,22 @@ impl InputStore {
         Ok(true)
     }
 
+    /// Binds a label table (RGBA by label value) to input `name` as its 2D texture
+    /// ([`super::upload::upload_label_table`]); uploads only when it differs from what is bound.
+    pub fn bind_label_table(&mut self, gpu: &Gpu, name: &str, table: &[[f32; 4]]) -> Result<bool, GpuFault> {
+        let content = content_hash(|h| {
+            "label table".hash(h);
+            table.iter().flatten().map(|x| x.to_bits()).for_each(|b| b.hash(h))
+        });
+        if self.inputs.get(name).is_some_and(|i| i.content == content) {
+            return Ok(false);
+        }
+        let texture = super::upload::upload_label_table(gpu, "label table", table)?;
+        self.insert(name, texture, content);
+        self.tables.insert(name.to_string(), Arc::new(table.to_vec()));
+        Ok(true)
+    }
+
     /// Binds a texture the application made to input `name` (always counts as new content).
     pub fn bind_texture(&mut self, name: &str, texture: wgpu::Texture) {
         let content = self.uploads.wrapping_add(0x9e37_79b9_7f4a_7c15);

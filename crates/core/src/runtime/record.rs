@@ -20,7 +20,7 @@ pub(crate) struct BoundPort<'a> {
     /// Version of a graph input's content or of an Owned resource (equal content, equal
     /// version); `None` for targets, which change every frame.
     pub version: Option<u64>,
-    /// A volume input's voxels (ports of kind VolumeVoxels).
+    /// A volume input's voxels (ports of kind Volume and VolumeVoxels).
     pub voxels: Option<&'a std::sync::Arc<volgraph_accel::volume::Volume>>,
     /// A transfer-function input's LUT on the CPU.
     pub table: Option<&'a std::sync::Arc<Vec<[f32; 4]>>>,
@@ -149,7 +149,7 @@ impl<'a> RecordContext<'a> {
     }
 
     /// The voxels of the volume bound to `port` (a port of kind
-    /// [`crate::plugin::PortKind::VolumeVoxels`]), on the CPU.
+    /// [`crate::plugin::PortKind::VolumeVoxels`], or `Volume`: its texture's voxels), on the CPU.
     pub fn voxels(&self, port: &str) -> Result<&'a std::sync::Arc<volgraph_accel::volume::Volume>, PassError> {
         self.port(port)
             .and_then(|p| p.voxels)

@@ -86,6 +86,7 @@ impl StepRecorder<'_> {
                     }
                     Binding::Input(name) => {
                         table = inputs.table(name);
+                        voxels = inputs.voxels(name);
                         (inputs.get(name).map(|t| &t.view), None)
                     }
                     Binding::InputVoxels(name) => {

@@ -26,6 +26,12 @@ impl Runtime {
         Ok(self.inputs.bind_lut(&self.gpu, name, lut)?)
     }
 
+    /// Binds a label table (RGBA by label value: `volgraph_accel::labels::LabelTable::lut`) to
+    /// graph input `name`, a `LabelTable` (uploads only new content).
+    pub fn bind_label_table(&mut self, name: &str, table: &[[f32; 4]]) -> Result<bool, RuntimeError> {
+        Ok(self.inputs.bind_label_table(&self.gpu, name, table)?)
+    }
+
     /// Binds an application-made texture to graph input `name` (a transfer function's is 1D,
     /// one RGBA texel per LUT entry, as `bind_lut` uploads it; a volume's is 3D).
     pub fn bind_texture(&mut self, name: &str, texture: wgpu::Texture) {
@@ -50,6 +56,16 @@ impl Runtime {
             match kind {
                 InputKind::Volume => uploaded |= self.bind_volume(name, volume)?,
                 InputKind::TransferFunction => uploaded |= self.bind_lut(name, lut)?,
+                // The volume's own labels in the default palette (a label map bound as the scene's
+                // volume; anything else leaves a table the caller binds).
+                InputKind::LabelTable => {
+                    if let Ok(census) = volgraph_accel::labels::census::census(volume) {
+                        let values = census.values();
+                        let len = values.last().map_or(1, |v| *v as usize + 1);
+                        let table = volgraph_accel::labels::LabelTable::default_for(values).lut(len);
+                        uploaded |= self.bind_label_table(name, &table)?;
+                    }
+                }
                 InputKind::Scalar(_) | InputKind::Data(_) => {}
             }
         }

@@ -152,6 +152,7 @@ impl Runtime {
                 let (kind, hint) = match kind {
                     InputKind::Volume => ("Volume", "bind it with Runtime::bind_volume"),
                     InputKind::TransferFunction => ("TransferFunction", "bind the LUT with Runtime::bind_lut"),
+                    InputKind::LabelTable => ("LabelTable", "bind the table with Runtime::bind_label_table"),
                     InputKind::Scalar(_) | InputKind::Data(_) => ("Scalar", "scalars are compile-time scene values"),
                 };
                 return Err(RuntimeError::UnboundInput {

@@ -205,6 +205,31 @@ pub fn upload_volume(
 /// when the second has weight 0, bench/one-march.md).
 pub fn upload_lut(gpu: &Gpu, label: &str, rgba: &[[f32; 4]]) -> Result<wgpu::Texture, GpuFault> {
     let width = rgba.len().max(1) as u32;
+    upload_rgba(gpu, ("transfer-function LUT", label), rgba, (width, 1), wgpu::TextureDimension::D1)
+}
+
+/// Texels per row of a label table's texture: label `v` is texel `(v % 256, v / 256)`.
+pub const LABEL_TABLE_ROW: u32 = 256;
+
+/// Uploads a label table (RGBA by label value, `volgraph_accel::labels::LabelTable::lut`) as the
+/// 2D texture a `LabelTable` input binds: [`LABEL_TABLE_ROW`] labels per row, the last row
+/// padded with hidden labels. Read with `textureLoad` (no filtering between labels).
+pub fn upload_label_table(gpu: &Gpu, label: &str, rgba: &[[f32; 4]]) -> Result<wgpu::Texture, GpuFault> {
+    let rows = (rgba.len() as u32).div_ceil(LABEL_TABLE_ROW).max(1);
+    let mut padded = rgba.to_vec();
+    padded.resize((rows * LABEL_TABLE_ROW) as usize, [0.0; 4]);
+    upload_rgba(gpu, ("label table", label), &padded, (LABEL_TABLE_ROW, rows), wgpu::TextureDimension::D2)
+}
+
+/// `rgba` as a `width × height` texture of `dimension` (1D: height 1), in f32 where the device
+/// filters it, else f16; `(what, label)` name it in a fault.
+fn upload_rgba(
+    gpu: &Gpu,
+    (what, label): (&str, &str),
+    rgba: &[[f32; 4]],
+    (width, height): (u32, u32),
+    dimension: wgpu::TextureDimension,
+) -> Result<wgpu::Texture, GpuFault> {
     let (format, bytes): (wgpu::TextureFormat, Vec<u8>) = if gpu.float32_filterable {
         (wgpu::TextureFormat::Rgba32Float, bytemuck::cast_slice(rgba).to_vec())
     } else {
@@ -212,16 +237,16 @@ pub fn upload_lut(gpu: &Gpu, label: &str, rgba: &[[f32; 4]]) -> Result<wgpu::Tex
         (wgpu::TextureFormat::Rgba16Float, bytemuck::cast_slice(&halves).to_vec())
     };
     let bpp = format.block_copy_size(None).unwrap_or(16);
-    let size = wgpu::Extent3d { width, height: 1, depth_or_array_layers: 1 };
+    let size = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
     gpu.checked(
-        || format!("uploading the transfer-function LUT \"{label}\" ({width} entries)"),
+        || format!("uploading the {what} \"{label}\" ({} entries)", rgba.len()),
         || {
             let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
                 size,
                 mip_level_count: 1,
                 sample_count: 1,
-                dimension: wgpu::TextureDimension::D1,
+                dimension,
                 format,
                 usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
                 view_formats: &[],
@@ -234,7 +259,11 @@ pub fn upload_lut(gpu: &Gpu, label: &str, rgba: &[[f32; 4]]) -> Result<wgpu::Tex
                     aspect: wgpu::TextureAspect::All,
                 },
                 &bytes,
-                wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(width * bpp), rows_per_image: Some(1) },
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(width * bpp),
+                    rows_per_image: Some(height),
+                },
                 size,
             );
             texture

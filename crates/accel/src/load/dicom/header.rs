@@ -43,6 +43,8 @@ pub struct FileHeader {
     pub description: String,
     /// Modality.
     pub modality: String,
+    /// FrameOfReferenceUID ("" when absent).
+    pub frame_of_reference: String,
     /// SamplesPerPixel (1 for grey images).
     pub samples_per_pixel: u16,
     /// BitsAllocated.
@@ -436,6 +438,7 @@ impl FileHeader {
             series_number: number(object, tags::SERIES_NUMBER).map(|n| n as i64),
             description: text(object, tags::SERIES_DESCRIPTION).unwrap_or_default(),
             modality: text(object, tags::MODALITY).unwrap_or_default(),
+            frame_of_reference: text(object, tags::FRAME_OF_REFERENCE_UID).unwrap_or_default(),
             samples_per_pixel: samples_per_pixel as u16,
             bits_allocated: bits_allocated as u16,
             photometric,

@@ -320,6 +320,7 @@ fn series_meta(first: &FileHeader, origin: glam::DVec3) -> VolumeMeta {
         frame: WorldFrame::Lps,
         origin: Some(origin),
         description: (!first.description.is_empty()).then(|| first.description.clone()),
+        frame_of_reference: (!first.frame_of_reference.is_empty()).then(|| first.frame_of_reference.clone()),
     }
 }
 

@@ -32,6 +32,8 @@ pub fn write_ct_series(dir: &Path, volume: &Volume) -> Result<Vec<PathBuf>, Load
     let (nx, ny) = (volume.dims.x as usize, volume.dims.y as usize);
     let s = volume.spacing;
     let series_uid = "2.25.316470861183412903012545620470592143071";
+    // The volume's frame of reference where it has one (tests write series in two frames).
+    let frame_uid = volume.meta.frame_of_reference.clone().unwrap_or_else(|| format!("{series_uid}.0"));
     (0..volume.dims.z as usize)
         .map(|z| {
             let pixels: Vec<i16> = values[z * nx * ny..(z + 1) * nx * ny].to_vec();
@@ -44,6 +46,7 @@ pub fn write_ct_series(dir: &Path, volume: &Volume) -> Result<Vec<PathBuf>, Load
                 DataElement::new(tags::SERIES_DESCRIPTION, VR::LO, text(volume.name.as_str())),
                 DataElement::new(tags::SERIES_INSTANCE_UID, VR::UI, text(series_uid)),
                 DataElement::new(tags::SERIES_NUMBER, VR::IS, text("1")),
+                DataElement::new(tags::FRAME_OF_REFERENCE_UID, VR::UI, text(frame_uid.as_str())),
                 DataElement::new(tags::INSTANCE_NUMBER, VR::IS, text((z + 1).to_string().as_str())),
                 DataElement::new(tags::IMAGE_POSITION_PATIENT, VR::DS, ds(&[0.0, 0.0, z as f64 * s.z])),
                 DataElement::new(tags::IMAGE_ORIENTATION_PATIENT, VR::DS, ds(&[1.0, 0.0, 0.0, 0.0, 1.0, 0.0])),

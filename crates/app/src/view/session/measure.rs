@@ -17,10 +17,19 @@ impl LiveSession {
         }
         let pixel = (cursor.0 as u32, cursor.1 as u32);
         let cuts = self.runtime.cuts();
-        let p = volgraph_accel::probe::first_visible(&self.volume, &self.lut, camera, (w, h), pixel, 0.5, &cuts)?;
+        // A label map is seen through its label table: the probe's LUT over its normalized values.
+        let lut = match self.labels() {
+            Some(list) => label_probe_lut(&self.volume, &list.lut()),
+            None => self.lut.clone(),
+        };
+        let p = volgraph_accel::probe::first_visible(&self.volume, &lut, camera, (w, h), pixel, 0.5, &cuts)?;
         let units = self.volume.meta.units.as_deref().map_or(String::new(), |u| format!(" {u}"));
+        let label = self.labels().map_or(String::new(), |list| {
+            let value = p.value.round().max(0.0) as u32;
+            list.name_of(value).map_or(String::new(), |name| format!(", label {value} \"{name}\""))
+        });
         Some(format!(
-            "under the cursor: {:.4}{units} at voxel ({:.1}, {:.1}, {:.1}), α {:.2}",
+            "under the cursor: {:.4}{units}{label} at voxel ({:.1}, {:.1}, {:.1}), α {:.2}",
             p.value, p.voxel.x, p.voxel.y, p.voxel.z, p.alpha
         ))
     }
@@ -31,6 +40,24 @@ impl LiveSession {
     pub fn accuracy_job(&mut self, camera: &OrbitCamera) -> Option<crate::view::accuracy::Job> {
         let plan = self.plan()?;
         let march = plan.steps.iter().find(|s| s.pass_id == "march" && s.params.declares("step_voxels"))?;
+        // Several volumes: the viewer binds one, so only a label map coloured by its table (the
+        // volume itself) has a reference to compare with.
+        let fusion = volgraph_passes::fusion::FusionSettings::of(&march.params);
+        let labels = match fusion.combine() {
+            None => None,
+            Some(volgraph_accel::fusion::Combine::Labels) => {
+                let filter = match fusion.label_filter {
+                    volgraph_passes::fusion::LabelFilterChoice::Smooth => {
+                        volgraph_accel::labels::sample::LabelFilter::Smooth
+                    }
+                    volgraph_passes::fusion::LabelFilterChoice::Nearest => {
+                        volgraph_accel::labels::sample::LabelFilter::Nearest
+                    }
+                };
+                Some((self.labels()?.lut(), filter))
+            }
+            Some(_) => return None,
+        };
         let mut settings = volgraph_passes::raycast_params::reference_settings(&march.params);
         settings.opacity_unit_voxels = match self.opacity_reference {
             volgraph_core::runtime::OpacityReference::World => 1.0 / self.volume.unit_step_world(),
@@ -49,6 +76,19 @@ impl LiveSession {
             camera: *camera,
             settings,
             cuts: self.runtime.cuts(),
+            labels,
         })
     }
+}
+
+/// A label table (RGBA by label value) as a LUT over the map's normalized values, for the probe:
+/// entry i is the table's entry of the label nearest to the value it stands for.
+fn label_probe_lut(map: &volgraph_accel::volume::Volume, table: &[[f32; 4]]) -> Vec<[f32; 4]> {
+    const N: usize = 4096;
+    (0..N)
+        .map(|i| {
+            let value = map.data_value((i as f64 + 0.5) / N as f64).round().max(0.0) as usize;
+            table.get(value).copied().unwrap_or([0.0; 4])
+        })
+        .collect()
 }

@@ -104,6 +104,20 @@ impl LiveSession {
         };
         let loaded = format!("{}, {shaders}", summary(&plan));
         runtime.bind_scene(&plan.inputs, &volume, &lut).map_err(|e| crate::cli::CliError::Other(anyhow!(e)))?;
+        // A graph that reads a label table shows the volume as a label map: its list, named by
+        // its own file (.seg.nrrd) or the default palette, bound over bind_scene's palette.
+        let labels = if plan.inputs.values().any(|k| *k == volgraph_core::graph::ast::InputKind::LabelTable) {
+            let map_path = args.volume.first().map(PathBuf::as_path);
+            let (table, _, notes) = crate::label_tables::label_table(&volume, map_path, None, "the label table")?;
+            for note in notes {
+                crate::stdout::eprintln_escaped!("{note}");
+            }
+            let list = crate::view::label_list::LabelList::of(&volume, &table).map_err(|e| anyhow!(e))?;
+            super::bind_label_list(&mut runtime, &plan.inputs, Some(&list)).map_err(|e| anyhow!(e))?;
+            Some(list)
+        } else {
+            None
+        };
         runtime.apply(plan, graph.registry()).map_err(|e| crate::cli::CliError::Other(anyhow!(e)))?;
         graph.set_options(options);
         let graph_name = graph.name().to_string();
@@ -119,6 +133,7 @@ impl LiveSession {
             volume_source: shown.source,
             volume_options: shown.options,
             opacity_reference: args.scene.as_ref().map(|s| s.opacity_reference).unwrap_or_default(),
+            labels,
         };
         let ms = start.elapsed().as_secs_f64() * 1e3;
         Ok((session, Event::Loaded { graph: graph_name, ms, summary: loaded }))

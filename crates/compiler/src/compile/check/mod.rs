@@ -38,6 +38,7 @@ pub(crate) enum ValueDesc {
     Owned(String),
     Volume,
     TransferFunction,
+    LabelTable,
     Scalar,
 }
 
@@ -49,6 +50,7 @@ impl ValueDesc {
             ValueDesc::Owned(t) => format!("a {t}"),
             ValueDesc::Volume => "the volume".to_string(),
             ValueDesc::TransferFunction => "the transfer function".to_string(),
+            ValueDesc::LabelTable => "a label table".to_string(),
             ValueDesc::Scalar => "a scalar".to_string(),
         }
     }

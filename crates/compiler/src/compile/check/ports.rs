@@ -100,6 +100,7 @@ impl Checker<'_> {
                 PortKind::Owned(t) => ValueDesc::Owned((*t).to_string()),
                 PortKind::Volume | PortKind::VolumeVoxels => ValueDesc::Volume,
                 PortKind::TransferFunction => ValueDesc::TransferFunction,
+                PortKind::LabelTable => ValueDesc::LabelTable,
             };
             out.insert(port.name.to_string(), desc);
         }

@@ -156,6 +156,7 @@ impl Checker<'_> {
             Ref::Input(n) => match self.doc.inputs.get(n)? {
                 InputKind::Volume => Some(ValueDesc::Volume),
                 InputKind::TransferFunction => Some(ValueDesc::TransferFunction),
+                InputKind::LabelTable => Some(ValueDesc::LabelTable),
                 InputKind::Scalar(_) | InputKind::Data(_) => Some(ValueDesc::Scalar),
             },
             Ref::History(n) => {
@@ -428,7 +429,8 @@ impl Checker<'_> {
                 return;
             }
             (PortKind::Volume | PortKind::VolumeVoxels, ValueDesc::Volume)
-            | (PortKind::TransferFunction, ValueDesc::TransferFunction) => true,
+            | (PortKind::TransferFunction, ValueDesc::TransferFunction)
+            | (PortKind::LabelTable, ValueDesc::LabelTable) => true,
             (PortKind::Owned(a), ValueDesc::Owned(b)) => a == b,
             (PortKind::Buffer { .. }, ValueDesc::Buffer { .. }) => true,
             _ => false,
@@ -448,6 +450,9 @@ impl Checker<'_> {
                     }
                     PortKind::TransferFunction => {
                         "declare inputs: {\"tf\": TransferFunction} and read \"input.tf\"".to_string()
+                    }
+                    PortKind::LabelTable => {
+                        "declare inputs: {\"label_table\": LabelTable} and read \"input.label_table\"".to_string()
                     }
                     PortKind::Target { .. } => "read \"<pass>.<output>\" of a pass that writes a target".to_string(),
                     PortKind::Owned(t) => format!("read the output of a pass that makes a {t}"),

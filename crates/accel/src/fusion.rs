@@ -1,0 +1,281 @@
+//! Several volumes in one march (issue "several volumes", items 2 and 3): how a sample of the
+//! frame's volume finds the same point in a second volume on another grid of the patient frame,
+//! and how the two are classified and combined at that sample — the f64 model the GPU's
+//! `shaders/common/fusion.wgsl` follows (`docs/rendering_model.md`, "Several volumes").
+//!
+//! Rays are marched in the frame volume's texture space (an affine image of the patient frame:
+//! axes along LPS, voxel `i`'s centre at `origin + i · spacing`), so a second volume's texture
+//! point is `u · scale + offset` per axis ([`TextureMap`]): a PET at 4 mm over a CT at 0.7 mm,
+//! shifted by half a voxel, is sampled where it lies. Outside its box a second volume adds
+//! nothing (a label map reads background 0).
+//!
+//! [`Combine`] says what one sample is:
+//! - `Labels`: the frame volume is a label map; each sample is its label's colour and opacity
+//!   (the label table), sampled without mixing label numbers ([`crate::labels::sample`]).
+//! - `Tint`: the scan by its TF, its colour replaced by the label's where a visible label lies
+//!   (the label's opacity is how strongly: 1 replaces it).
+//! - `Inside`: the scan by its TF, only where a visible label lies ("this organ and its vessels").
+//! - `Fuse`: two scalar volumes, each classified by its own TF, combined per sample as two
+//!   media in one place: `α = 1 − (1 − α₁)(1 − α₂)`, colour the opacity-weighted mean.
+//! - `Add`: channels (napari's and Fiji's additive blending): colours add (no clamp: where
+//!   channels overlap the image may exceed 1, as a display saturates it), `α` as in `Fuse`.
+//!
+//! Every opacity is corrected for the step in the frame volume's voxels, as one volume's is.
+
+use glam::DVec3;
+
+use crate::labels::sample::{LabelFilter, sample_label};
+use crate::reference::{corrected_alpha, lut_sample};
+use crate::volume::Volume;
+
+/// Where the frame volume's texture point `u` lies in another volume's texture space:
+/// `u · scale + offset` per axis (both grids' axes lie along the patient frame's).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TextureMap {
+    /// Per-axis scale.
+    pub scale: DVec3,
+    /// Per-axis offset.
+    pub offset: DVec3,
+}
+
+/// Two volumes that cannot be placed in one frame.
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[error(
+    "{first} lies in {first_frame} and {second} in {second_frame}: where one lies in the other is unknown; give \
+     files in one frame (a scan and its segmentation from one series)"
+)]
+pub struct FrameMismatch {
+    /// The frame volume's name.
+    pub first: String,
+    /// Its frame, described.
+    pub first_frame: String,
+    /// The other volume's name.
+    pub second: String,
+    /// Its frame, described.
+    pub second_frame: String,
+}
+
+/// Two DICOM series whose FrameOfReferenceUIDs differ: both say LPS, but of two patient
+/// positions (two scans, a patient who moved), so one does not lie where the other says.
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[error(
+    "{first} and {second} lie in different DICOM frames of reference ({first_uid} and {second_uid}): their \
+     positions do not line up unless registered; register them, or pass --allow-frame-mismatch to show them as \
+     their files place them"
+)]
+pub struct FrameOfReferenceMismatch {
+    /// The frame volume's name.
+    pub first: String,
+    /// Its FrameOfReferenceUID.
+    pub first_uid: String,
+    /// The other volume's name.
+    pub second: String,
+    /// Its FrameOfReferenceUID.
+    pub second_uid: String,
+}
+
+/// Whether `a` and `b` lie in one DICOM frame of reference: an error where both name one and
+/// the two differ (a volume without one — NIfTI, NRRD — is taken at its word).
+pub fn same_frame_of_reference(a: &Volume, b: &Volume) -> Result<(), FrameOfReferenceMismatch> {
+    match (&a.meta.frame_of_reference, &b.meta.frame_of_reference) {
+        (Some(x), Some(y)) if x != y => Err(FrameOfReferenceMismatch {
+            first: a.name.clone(),
+            first_uid: x.clone(),
+            second: b.name.clone(),
+            second_uid: y.clone(),
+        }),
+        _ => Ok(()),
+    }
+}
+
+impl TextureMap {
+    /// The identity (one grid).
+    pub const IDENTITY: Self = Self { scale: DVec3::ONE, offset: DVec3::ZERO };
+
+    /// The map from `from`'s texture space to `to`'s: the texture point `u` of `from` is the
+    /// patient point `origin + (u · n − ½) · spacing`, which is `to`'s texture point
+    /// `(p − origin' ) / spacing' + ½) / n'`. Files without an origin sit at 0 (voxel 0's centre).
+    pub fn between(from: &Volume, to: &Volume) -> Result<Self, FrameMismatch> {
+        if from.meta.frame != to.meta.frame {
+            return Err(FrameMismatch {
+                first: from.name.clone(),
+                first_frame: from.meta.frame.describe(),
+                second: to.name.clone(),
+                second_frame: to.meta.frame.describe(),
+            });
+        }
+        let corner = |v: &Volume| v.meta.origin.unwrap_or(DVec3::ZERO) - 0.5 * v.spacing;
+        let size = |v: &Volume| v.dims.as_dvec3() * v.spacing;
+        let scale = size(from) / size(to);
+        let offset = (corner(from) - corner(to)) / size(to);
+        Ok(Self { scale, offset })
+    }
+
+    /// `u` in the other volume's texture space.
+    pub fn apply(&self, u: DVec3) -> DVec3 {
+        u * self.scale + self.offset
+    }
+}
+
+/// Whether texture point `u` lies in the box (voxel centres ± half a voxel).
+pub fn in_box(u: DVec3) -> bool {
+    u.cmpge(DVec3::ZERO).all() && u.cmple(DVec3::ONE).all()
+}
+
+/// What one sample of several volumes is (module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Combine {
+    /// The frame volume is a label map, coloured by its table.
+    #[default]
+    Labels,
+    /// The scan by its TF, coloured by a visible label.
+    Tint,
+    /// The scan by its TF, only inside visible labels.
+    Inside,
+    /// Two scalar volumes, each by its TF, as two media in one place.
+    Fuse,
+    /// Two scalar volumes (channels), colours added.
+    Add,
+}
+
+impl Combine {
+    /// Whether the second volume is a label map (read through a label table).
+    pub fn second_is_labels(self) -> bool {
+        matches!(self, Combine::Tint | Combine::Inside)
+    }
+
+    /// Whether a sample's opacity is at most the frame volume's through its TF, so that the
+    /// frame volume's empty space is empty for the combination too (its leap is lossless).
+    pub fn bounded_by_first(self) -> bool {
+        matches!(self, Combine::Tint | Combine::Inside)
+    }
+}
+
+/// A second volume and how samples combine, for the reference ([`crate::reference`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Fusion<'a> {
+    /// What a sample is.
+    pub combine: Combine,
+    /// The label table as a LUT by label value ([`crate::labels::LabelTable::lut`]); for `Labels`,
+    /// `Tint` and `Inside`.
+    pub label_lut: &'a [[f32; 4]],
+    /// How label maps are sampled.
+    pub filter: LabelFilter,
+    /// The second volume and its TF (`Tint`, `Inside`: its label map; `Fuse`, `Add`: the second
+    /// scalar volume and its TF), with the map into its texture space.
+    pub second: Option<(&'a Volume, &'a [[f32; 4]], TextureMap)>,
+}
+
+/// The label table's entry at `label` (zero past its end: hidden).
+pub fn label_entry(label_lut: &[[f32; 4]], label: u32) -> [f64; 4] {
+    label_lut.get(label as usize).map_or([0.0; 4], |e| e.map(f64::from))
+}
+
+impl Fusion<'_> {
+    /// The premultiplied, opacity-corrected colour of the sample at the frame volume's texture
+    /// point `u`, where the frame volume's field is `s` and its TF `lut`; `exponent` is the
+    /// correction's (step over opacity unit). Shading, when on, is applied by the caller.
+    pub fn classify(&self, first: &Volume, lut: &[[f32; 4]], u: DVec3, s: f64, exponent: f64) -> [f64; 4] {
+        let premultiplied = |c: [f64; 3], a: f64| [c[0] * a, c[1] * a, c[2] * a, a];
+        let through = |lut: &[[f32; 4]], s: f64| {
+            let c = lut_sample(lut, s);
+            ([c[0], c[1], c[2]], corrected_alpha(c[3], exponent))
+        };
+        if self.combine == Combine::Labels {
+            let (label, _) = sample_label(first, u, self.filter);
+            let e = label_entry(self.label_lut, label);
+            return premultiplied([e[0], e[1], e[2]], corrected_alpha(e[3], exponent));
+        }
+        let (c1, a1) = through(lut, s);
+        let Some((second, second_lut, map)) = self.second else { return premultiplied(c1, a1) };
+        let u2 = map.apply(u);
+        let inside = in_box(u2);
+        match self.combine {
+            Combine::Labels => unreachable!("handled above"),
+            Combine::Tint | Combine::Inside => {
+                let label = if inside { sample_label(second, u2, self.filter).0 } else { 0 };
+                let e = label_entry(self.label_lut, label);
+                let visible = e[3] > 0.0;
+                match self.combine {
+                    Combine::Inside => premultiplied(c1, if visible { a1 } else { 0.0 }),
+                    _ if visible => {
+                        let w = e[3].min(1.0);
+                        premultiplied(std::array::from_fn(|i| c1[i] + (e[i] - c1[i]) * w), a1)
+                    }
+                    _ => premultiplied(c1, a1),
+                }
+            }
+            Combine::Fuse | Combine::Add => {
+                let (c2, a2) = if inside { through(second_lut, second.sample_trilinear(u2)) } else { ([0.0; 3], 0.0) };
+                fuse_media(self.combine, premultiplied(c1, a1), premultiplied(c2, a2))
+            }
+        }
+    }
+}
+
+/// Two premultiplied samples in one place: opacity `1 − (1 − α₁)(1 − α₂)`; colour the
+/// opacity-weighted mean (`Fuse`) or the sum (`Add`: each channel's light adds, so an image may
+/// exceed 1 where channels overlap, as additive blending saturates on display).
+pub fn fuse_media(combine: Combine, p1: [f64; 4], p2: [f64; 4]) -> [f64; 4] {
+    let a = 1.0 - (1.0 - p1[3]) * (1.0 - p2[3]);
+    let weight = p1[3] + p2[3];
+    if combine == Combine::Add {
+        return [p1[0] + p2[0], p1[1] + p2[1], p1[2] + p2[2], a];
+    }
+    if weight <= 0.0 {
+        return [0.0; 4];
+    }
+    let k = a / weight;
+    [(p1[0] + p2[0]) * k, (p1[1] + p2[1]) * k, (p1[2] + p2[2]) * k, a]
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::UVec3;
+
+    use super::*;
+    use crate::volume::VoxelData;
+    use crate::volume_meta::WorldFrame;
+
+    fn grid(n: u32, spacing: f64, origin: DVec3) -> Volume {
+        let mut v =
+            Volume::new("v", UVec3::splat(n), DVec3::splat(spacing), VoxelData::U8(vec![0; (n * n * n) as usize]));
+        v.meta.frame = WorldFrame::Lps;
+        v.meta.origin = Some(origin);
+        v
+    }
+
+    #[test]
+    fn a_voxel_centre_maps_to_the_same_patient_point() {
+        // CT: 64 voxels of 0.7 mm from (10, 20, 30); PET: 12 of 4 mm, shifted by half a PET voxel.
+        let ct = grid(64, 0.7, DVec3::new(10.0, 20.0, 30.0));
+        let pet = grid(12, 4.0, DVec3::new(10.0 - 2.0, 20.0 + 2.0, 30.0));
+        let map = TextureMap::between(&ct, &pet).expect("one frame");
+        let patient =
+            |v: &Volume, u: DVec3| v.meta.origin.expect("an origin") + (u * v.dims.as_dvec3() - 0.5) * v.spacing;
+        for i in [0.0, 17.0, 63.0] {
+            let u = (DVec3::new(i, 5.0, 40.0) + 0.5) / 64.0;
+            let a = patient(&ct, u);
+            let b = patient(&pet, map.apply(u));
+            assert!((a - b).length() < 1e-9, "{a} vs {b}");
+        }
+        assert_eq!(TextureMap::between(&ct, &ct).expect("same"), TextureMap::IDENTITY);
+        let mut elsewhere = pet.clone();
+        elsewhere.meta.frame = WorldFrame::IndexAxes;
+        assert!(TextureMap::between(&ct, &elsewhere).expect_err("frames").to_string().contains("index axes"));
+    }
+
+    #[test]
+    fn two_media_in_one_place() {
+        let red = [0.5, 0.0, 0.0, 0.5];
+        let blue = [0.0, 0.0, 0.25, 0.25];
+        let f = fuse_media(Combine::Fuse, red, blue);
+        assert!((f[3] - (1.0 - 0.5 * 0.75)).abs() < 1e-12);
+        // Straight colours: red's weight 0.5, blue's 0.25 of 0.75.
+        assert!((f[0] / f[3] - 2.0 / 3.0).abs() < 1e-12 && (f[2] / f[3] - 1.0 / 3.0).abs() < 1e-12);
+        assert_eq!(fuse_media(Combine::Fuse, red, [0.0; 4]), red);
+        assert_eq!(fuse_media(Combine::Fuse, [0.0; 4], [0.0; 4]), [0.0; 4]);
+        let added = fuse_media(Combine::Add, red, blue);
+        assert_eq!([added[0], added[2]], [0.5, 0.25]);
+    }
+}

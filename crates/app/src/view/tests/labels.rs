@@ -1,0 +1,55 @@
+//! The label list on a live session (issue "several volumes", item 5): a label map opened with
+//! `multi/labels` lists its labels by the names its file gives; showing one label alone is a
+//! table upload — the plan and its pipelines stay — and the next frame shows only it; the value
+//! under the cursor names its label.
+
+use std::sync::Arc;
+
+use volgraph_accel::camera::OrbitCamera;
+use volgraph_core::runtime::Gpu;
+
+use super::{frame, scratch};
+use crate::view::label_list::LabelEdit;
+use crate::view::session::{Event, LiveSession, SessionArgs};
+
+#[test]
+fn a_label_shown_alone_is_a_table_upload_and_the_cursor_names_it() {
+    let s = scratch("labels", "graphs/multi/labels.ron");
+    let gpu = Arc::new(Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)"));
+    let args = SessionArgs {
+        scene: None,
+        graph: s.graph.clone(),
+        volume: vec!["organs_labels32".into()],
+        raw: Default::default(),
+        tf: None,
+        tf_map: None,
+        viewport: (48, 48),
+        features: Vec::new(),
+        shaders: Some(s.shaders.clone()),
+        gpu_memory_mb: None,
+        cuts: Default::default(),
+    };
+    let (mut session, _) = LiveSession::open(gpu, &args).unwrap_or_else(|_| panic!("multi/labels opens"));
+    let list = session.labels().expect("a label list");
+    let names: Vec<&str> = list.rows.iter().map(|r| r.name.as_str()).collect();
+    assert_eq!(names, ["liver", "left kidney", "right kidney", "spleen", "aorta", "vertebra"]);
+    let all = frame(&mut session);
+    let covered = |image: &[f32]| image.chunks(4).filter(|p| p[3] > 0.01).count();
+    let plan = session.plan().map(|p| p.to_text());
+    let events = session.edit_labels(&LabelEdit::ShowOnly(6));
+    let [Event::Reloaded { what, detail, .. }] = events.as_slice() else { panic!("{events:?}") };
+    assert_eq!((what.as_str(), detail.as_str()), ("label table", "uploaded (no recompile)"));
+    assert_eq!(session.plan().map(|p| p.to_text()), plan, "the plan stays");
+    let vertebra = frame(&mut session);
+    assert!(
+        covered(&vertebra) > 0 && covered(&vertebra) < covered(&all),
+        "{} of {}",
+        covered(&vertebra),
+        covered(&all)
+    );
+    session.edit_labels(&LabelEdit::ShowAll);
+    assert_eq!(frame(&mut session), all, "every label again: the first image");
+    // The centre of the view lies on an organ, which the probe names.
+    let line = session.probe_line(&OrbitCamera::default(), (24.0, 24.0)).expect("something under the cursor");
+    assert!(line.contains(", label "), "{line}");
+}

@@ -1,0 +1,291 @@
+//! Several volumes in one march (issue "several volumes"): the single-pass raycasters
+//! (`raycast`, `raycast_compute`) classify each sample from the frame volume and, with `fusion`
+//! set, a second volume sampled at the same patient-frame point — a segmentation over its scan, a
+//! PET over a CT on another grid, a second channel — and combine them per sample, not as images
+//! composited afterwards (wrong wherever semi-transparent volumes interleave). Label maps are
+//! sampled without mixing label numbers (nearest, or each label's indicator interpolated) and
+//! coloured through a `LabelTable` input. The model, in f64, is `volgraph_accel::fusion`; the
+//! shader is `shaders/common/fusion.wgsl`, compiled in only when `fusion` is set.
+//!
+//! Leaping over the frame volume's empty space stays lossless where a sample's opacity is at
+//! most the frame volume's (`tint`, `inside`); elsewhere a wired leap is refused.
+
+use volgraph_accel::fusion::Combine;
+use volgraph_compiler::declare::ParamChoice;
+use volgraph_compiler::{Params, PortKind, PortSpec};
+#[cfg(feature = "gpu")]
+use volgraph_core::runtime::{CreateContext, PassError, RecordContext};
+
+use crate::defines;
+use crate::raycast_params::is_iso;
+
+volgraph_compiler::param_choice! {
+    /// What one sample of several volumes is (`volgraph_accel::fusion::Combine`).
+    pub enum FusionMode {
+        /// One volume.
+        None = "none",
+        /// The frame volume is a label map, coloured through `label_table`.
+        Labels = "labels",
+        /// The scan by its TF, coloured by the visible label of `second` (a label map).
+        Tint = "tint",
+        /// The scan by its TF, only inside the visible labels of `second`.
+        Inside = "inside",
+        /// Two scalar volumes, each by its TF, as two media in one place.
+        Fuse = "fuse",
+        /// Two scalar volumes (channels), colours added.
+        Add = "add",
+    }
+}
+
+volgraph_compiler::param_choice! {
+    /// How a label map is sampled between voxel centres.
+    pub enum LabelFilterChoice {
+        /// Each label's indicator interpolated; the largest wins (round boundaries).
+        Smooth = "smooth",
+        /// The nearest voxel's label (voxel stairs).
+        Nearest = "nearest",
+    }
+}
+
+volgraph_compiler::pass_params! {
+    /// The fusion of several volumes; a change rebuilds (ports and `#if`s change).
+    pub struct FusionSettings {
+        fusion: FusionMode = None,
+            "none: one volume; labels: the volume is a label map coloured by `label_table`; tint: the scan by its TF, \
+             coloured by the visible label of `second`; inside: the scan only inside the visible labels of `second`; \
+             fuse: `second` by `second_tf` and the volume by `tf` as two media in one place; add: their colours added \
+             (channels)";
+        label_filter: LabelFilterChoice = Smooth,
+            "smooth: each label's indicator interpolated, the largest wins (round boundaries); nearest: the nearest \
+             voxel's label";
+    }
+}
+
+impl FusionSettings {
+    /// The settings of `params` (no fusion for a kind without the block, or in mode iso).
+    pub fn of(params: &Params) -> Self {
+        let settings = Self::try_from_params(params)
+            .unwrap_or(Self { fusion: FusionMode::None, label_filter: LabelFilterChoice::Smooth });
+        if is_iso(params) { Self { fusion: FusionMode::None, ..settings } } else { settings }
+    }
+
+    /// The model's combination, `None` for one volume.
+    pub fn combine(&self) -> Option<Combine> {
+        Some(match self.fusion {
+            FusionMode::None => return None,
+            FusionMode::Labels => Combine::Labels,
+            FusionMode::Tint => Combine::Tint,
+            FusionMode::Inside => Combine::Inside,
+            FusionMode::Fuse => Combine::Fuse,
+            FusionMode::Add => Combine::Add,
+        })
+    }
+
+    /// The `#if` names: FUSION and what the volumes are.
+    pub fn defines(&self) -> Vec<&'static str> {
+        let Some(combine) = self.combine() else { return Vec::new() };
+        let mut out = vec![defines::FUSION];
+        out.push(match combine {
+            Combine::Labels => defines::FUSION_LABELS,
+            Combine::Tint | Combine::Inside => defines::FUSION_LABEL_MAP,
+            Combine::Fuse | Combine::Add => defines::FUSION_SCALAR,
+        });
+        if combine != Combine::Fuse && combine != Combine::Add && self.label_filter == LabelFilterChoice::Nearest {
+            out.push(defines::LABELS_NEAREST);
+        }
+        out
+    }
+
+    /// The ports fusion adds: `second` (and `second_tf` for a scalar one), `label_table`.
+    pub fn ports(&self) -> Vec<PortSpec> {
+        let Some(combine) = self.combine() else { return Vec::new() };
+        let mut ports = Vec::new();
+        if combine != Combine::Labels {
+            ports.push(PortSpec::read("second", PortKind::Volume));
+        }
+        match combine {
+            Combine::Fuse | Combine::Add => ports.push(PortSpec::read("second_tf", PortKind::TransferFunction)),
+            _ => ports.push(PortSpec::read("label_table", PortKind::LabelTable)),
+        }
+        ports
+    }
+}
+
+/// `use` with the `fusion` uniform declared when `params` set fusion (the march's shader use).
+pub fn with_fusion_uniform(use_: volgraph_compiler::ShaderUse, params: &Params) -> volgraph_compiler::ShaderUse {
+    if FusionSettings::of(params).combine().is_some() { use_.uniform(FusionMap::layout()) } else { use_ }
+}
+
+/// The fusion block (a rebuild: ports and `#if`s).
+pub fn fusion_block() -> volgraph_compiler::block::ParamBlock {
+    FusionSettings::block(volgraph_compiler::block::OnChange::Rebuild).with_defines(|p| FusionSettings::of(p).defines())
+}
+
+volgraph_compiler::pass_params! {
+    /// The `fusion` uniform of `shaders/common/fusion.wgsl`, computed from the bound volumes each
+    /// frame ([`FusionMap::of_volumes`]).
+    pub struct FusionMap {
+        second_scale: [f32; 4] = computed, "xyz: the second volume's texture point is u · scale + offset.";
+        second_offset: [f32; 4] = computed, "xyz: see second_scale.";
+        first_labels: [f32; 4] = computed, "x, y: a label of the frame volume is round(x + texel · y).";
+        second_labels: [f32; 4] = computed, "x, y: a label of the second volume is round(x + texel · y).";
+        combine: u32 = computed, "1 labels, 2 tint, 3 inside, 4 fuse, 5 add.";
+    }
+}
+
+impl FusionMap {
+    /// The block as the march's shader use declares it (bound as `fusion`); the node writes it.
+    pub fn layout() -> volgraph_compiler::UniformLayout {
+        Self::bound_as_with("fusion", Vec::new(), |_| Self::identity(Combine::Labels).uniform_bytes())
+    }
+
+    fn identity(combine: Combine) -> Self {
+        Self {
+            second_scale: [1.0; 4],
+            second_offset: [0.0; 4],
+            first_labels: [0.0, 255.0, 0.0, 0.0],
+            second_labels: [0.0, 255.0, 0.0, 0.0],
+            combine: combine as u32 + 1,
+        }
+    }
+
+    /// From the frame volume `first` and the `second` (when there is one).
+    pub fn of_volumes(
+        combine: Combine,
+        first: &volgraph_accel::volume::Volume,
+        second: Option<&volgraph_accel::volume::Volume>,
+    ) -> Result<Self, volgraph_accel::fusion::FrameMismatch> {
+        // A texel holds (v - lo) / (hi - lo) (`Volume::normalized`), so v = lo + texel · (hi - lo).
+        let decode = |v: &volgraph_accel::volume::Volume| {
+            let (lo, hi) = v.value_range;
+            [lo as f32, (hi - lo) as f32, 0.0, 0.0]
+        };
+        let mut map = Self { first_labels: decode(first), ..Self::identity(combine) };
+        if let Some(second) = second {
+            let m = volgraph_accel::fusion::TextureMap::between(first, second)?;
+            map.second_scale = [m.scale.x as f32, m.scale.y as f32, m.scale.z as f32, 0.0];
+            map.second_offset = [m.offset.x as f32, m.offset.y as f32, m.offset.z as f32, 0.0];
+            map.second_labels = decode(second);
+        }
+        Ok(map)
+    }
+}
+
+#[cfg(feature = "gpu")]
+/// What a raycaster node keeps for fusion: the `fusion` uniform, written when a bound volume
+/// changes.
+pub struct FusionState {
+    combine: Option<Combine>,
+    buffer: Option<wgpu::Buffer>,
+    versions: Option<(Option<u64>, Option<u64>)>,
+    /// Smooth label sampling: the label map's uniform blocks (`label_blocks`), and the version
+    /// of the map they were made from.
+    blocks: Option<(wgpu::TextureView, Option<u64>)>,
+    smooth: bool,
+}
+
+#[cfg(feature = "gpu")]
+impl FusionState {
+    /// From the node's parameters; a leap over the frame volume's empty space is refused where
+    /// the combination can be visible where the frame volume is empty.
+    pub fn new(ctx: &CreateContext<'_>) -> Result<Self, PassError> {
+        let combine = FusionSettings::of(ctx.params).combine();
+        let wired = ctx.wired();
+        if let Some(c) = combine
+            && !c.bounded_by_first()
+            && (wired.contains(&"empty") || wired.contains(&"distance"))
+        {
+            return Err(PassError {
+                pass: ctx.pass_id.to_string(),
+                message: format!(
+                    "fusion \"{}\" can be visible where the volume is empty, so leaping over the volume's empty \
+                     space would lose it; unwire \"empty\"/\"distance\" (tint and inside leap losslessly)",
+                    FusionSettings::of(ctx.params).fusion.name()
+                ),
+            });
+        }
+        let buffer = combine.map(|c| ctx.uniform_from_bytes("fusion", &FusionMap::identity(c).uniform_bytes()));
+        let smooth = FusionSettings::of(ctx.params).label_filter == LabelFilterChoice::Smooth;
+        Ok(Self { combine, buffer, versions: None, blocks: None, smooth })
+    }
+
+    /// The port of the label map, when smooth label sampling reads its uniform blocks.
+    fn label_map_port(&self) -> Option<&'static str> {
+        match self.combine? {
+            Combine::Labels if self.smooth => Some("volume"),
+            Combine::Tint | Combine::Inside if self.smooth => Some("second"),
+            _ => None,
+        }
+    }
+
+    /// Makes the `label_blocks` texture of the label map on `port` when it changed.
+    fn update_blocks(&mut self, ctx: &RecordContext<'_>, port: &str) -> Result<(), PassError> {
+        let version = ctx.input_version(port);
+        if self.blocks.as_ref().is_some_and(|(_, v)| *v == version) {
+            return Ok(());
+        }
+        let (dims, values) = volgraph_accel::labels::sample::uniform_blocks(ctx.voxels(port)?);
+        let size = wgpu::Extent3d { width: dims.x, height: dims.y, depth_or_array_layers: dims.z };
+        let gpu = ctx.gpu;
+        let texture = gpu
+            .checked(
+                || format!("{}: the label map's uniform blocks ({}x{}x{})", ctx.label, dims.x, dims.y, dims.z),
+                || {
+                    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+                        label: Some("label_blocks"),
+                        size,
+                        mip_level_count: 1,
+                        sample_count: 1,
+                        dimension: wgpu::TextureDimension::D3,
+                        format: wgpu::TextureFormat::R32Uint,
+                        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                        view_formats: &[],
+                    });
+                    gpu.queue.write_texture(
+                        wgpu::TexelCopyTextureInfo {
+                            texture: &texture,
+                            mip_level: 0,
+                            origin: wgpu::Origin3d::ZERO,
+                            aspect: wgpu::TextureAspect::All,
+                        },
+                        bytemuck::cast_slice(&values),
+                        wgpu::TexelCopyBufferLayout {
+                            offset: 0,
+                            bytes_per_row: Some(4 * dims.x),
+                            rows_per_image: Some(dims.y),
+                        },
+                        size,
+                    );
+                    texture
+                },
+            )
+            .map_err(|e| PassError { pass: ctx.label.to_string(), message: e.to_string() })?;
+        self.blocks = Some((texture.create_view(&wgpu::TextureViewDescriptor::default()), version));
+        Ok(())
+    }
+
+    /// Writes the uniform when the bound volumes changed.
+    pub fn update(&mut self, ctx: &RecordContext<'_>) -> Result<(), PassError> {
+        if let Some(port) = self.label_map_port() {
+            self.update_blocks(ctx, port)?;
+        }
+        let (Some(combine), Some(buffer)) = (self.combine, &self.buffer) else { return Ok(()) };
+        let versions = (ctx.input_version("volume"), ctx.input_version("second"));
+        if self.versions == Some(versions) {
+            return Ok(());
+        }
+        let first = ctx.voxels("volume")?;
+        let second = if combine == Combine::Labels { None } else { Some(ctx.voxels("second")?) };
+        let map = FusionMap::of_volumes(combine, first, second.map(|v| v.as_ref()))
+            .map_err(|e| PassError { pass: ctx.label.to_string(), message: e.to_string() })?;
+        ctx.write_buffer(buffer, 0, &map.uniform_bytes());
+        self.versions = Some(versions);
+        Ok(())
+    }
+
+    /// The `fusion` binding.
+    pub fn bindings(&self) -> Vec<(&'static str, wgpu::BindingResource<'_>)> {
+        let blocks = self.blocks.iter().map(|(view, _)| ("label_blocks", wgpu::BindingResource::TextureView(view)));
+        self.buffer.iter().map(|b| ("fusion", b.as_entire_binding())).chain(blocks).collect()
+    }
+}

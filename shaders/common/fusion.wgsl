@@ -1,0 +1,226 @@
+// Several volumes in one march (crates/passes/src/fusion.rs; the f64 model is
+// volgraph_accel::fusion, docs/rendering_model.md "Several volumes"): each sample of the frame
+// volume is classified with a second volume sampled at the same patient-frame point, or, with
+// FUSION_LABELS, the frame volume is itself a label map. Compiled in only with FUSION:
+// - FUSION_LABELS: the frame volume's label, coloured through `label_table`;
+// - FUSION_LABEL_MAP: `second` is a label map: `tint` colours the scan by the visible label,
+//   `inside` keeps the scan only inside visible labels;
+// - FUSION_SCALAR: `second` is scalar with its own `second_tf`: `fuse` (two media in one place)
+//   or `add` (channels);
+// - LABELS_NEAREST: labels at the nearest voxel, else each label's indicator interpolated and
+//   the largest taken (a tie to the smaller label), so no label number is ever blended.
+
+// Declared once: `FusionMap` (pass_params!) in crates/passes/src/fusion.rs.
+#import "params/FusionMap.wgsl"
+
+@group(0) @binding(auto) var<uniform> fusion: FusionMap;
+
+const COMBINE_INSIDE: u32 = 3u;
+const COMBINE_ADD: u32 = 5u;
+
+// The uniform's values, read once per ray (`begin_fusion`, from `begin_ray`): on llvmpipe a
+// uniform read inside the sample loop is repeated every sample, one lane at a time.
+var<private> fusion_scale: vec3<f32>;
+var<private> fusion_offset: vec3<f32>;
+var<private> fusion_decode: vec2<f32>;
+var<private> fusion_combine: u32;
+
+fn begin_fusion() {
+    fusion_scale = fusion.second_scale.xyz;
+    fusion_offset = fusion.second_offset.xyz;
+    fusion_combine = fusion.combine;
+#if FUSION_LABELS
+    fusion_decode = fusion.first_labels.xy;
+#else
+    fusion_decode = fusion.second_labels.xy;
+#endif
+}
+
+#if FUSION_LABEL_MAP
+// The second volume (a label map), normalized texels.
+@group(0) @binding(auto) var second: texture_3d<f32>;
+#endif
+#if FUSION_SCALAR
+// The second scalar volume and its transfer function.
+@group(0) @binding(auto) var second: texture_3d<f32>;
+@group(0) @binding(auto) var second_tf: texture_1d<f32>;
+#endif
+
+#if FUSION_LABELS
+// Colour and opacity per label value: label v at texel (v % 256, v / 256); 0 where hidden.
+@group(0) @binding(auto) var label_table: texture_2d<f32>;
+
+// The label map is the frame volume.
+fn label_texel(i: vec3<i32>) -> f32 {
+    return textureLoad(volume, i, 0).r;
+}
+fn label_dims() -> vec3<i32> {
+    return vec3<i32>(textureDimensions(volume));
+}
+#endif
+#if FUSION_LABEL_MAP
+@group(0) @binding(auto) var label_table: texture_2d<f32>;
+
+// The label map is the second volume.
+fn label_texel(i: vec3<i32>) -> f32 {
+    return textureLoad(second, i, 0).r;
+}
+fn label_dims() -> vec3<i32> {
+    return vec3<i32>(textureDimensions(second));
+}
+#endif
+
+#if FUSION_SCALAR
+#else
+#if LABELS_NEAREST
+#else
+// Per block of UNIFORM_BLOCK³ voxels of the label map: its label + 1 where the block and a
+// one-voxel apron hold one label, else 0 (volgraph_accel::labels::sample::uniform_blocks).
+@group(0) @binding(auto) var label_blocks: texture_3d<u32>;
+const UNIFORM_BLOCK: i32 = 4;
+#endif
+
+// The label value of voxel `i`: a texel holds (v - lo) / (hi - lo), so v = lo + texel · (hi - lo).
+fn label_at(i: vec3<i32>) -> u32 {
+    let d = fusion_decode;
+    return u32(max(round(d.x + label_texel(i) * d.y), 0.0));
+}
+
+// The label at the label map's texture point `u` (volgraph_accel::labels::sample_label).
+fn sample_label(u: vec3<f32>) -> u32 {
+    let n = label_dims();
+    let p = u * vec3<f32>(n) - vec3<f32>(0.5);
+    let top = n - vec3<i32>(1);
+#if LABELS_NEAREST
+    return label_at(clamp(vec3<i32>(floor(p + vec3<f32>(0.5))), vec3<i32>(0), top));
+#else
+    // Inside one structure (or the background) the 8 corners hold one label: one read.
+    let nearest = clamp(vec3<i32>(floor(p + vec3<f32>(0.5))), vec3<i32>(0), top);
+    let uniform = textureLoad(label_blocks, nearest / UNIFORM_BLOCK, 0).r;
+    if (uniform != 0u) {
+        return uniform - 1u;
+    }
+    let base = floor(p);
+    let f = p - base;
+    let g = vec3<f32>(1.0) - f;
+    let b = vec3<i32>(base);
+    // The 8 corners' labels and trilinear weights, corner (x, y, z) at x + 2y + 4z: vectors, not
+    // arrays (a private array costs every sample on llvmpipe, taken or not).
+    let la = vec4<u32>(corner_label(b, 0, 0, 0), corner_label(b, 1, 0, 0), corner_label(b, 0, 1, 0), corner_label(b, 1, 1, 0));
+    let lb = vec4<u32>(corner_label(b, 0, 0, 1), corner_label(b, 1, 0, 1), corner_label(b, 0, 1, 1), corner_label(b, 1, 1, 1));
+    let wa = vec4<f32>(g.x * g.y, f.x * g.y, g.x * f.y, f.x * f.y) * g.z;
+    let wb = vec4<f32>(g.x * g.y, f.x * g.y, g.x * f.y, f.x * f.y) * f.z;
+    // The nearest voxel's label holds the largest single weight: with more than half of the
+    // weight it wins outright (the common case on a boundary between two labels).
+    let o = vec3<u32>(f >= vec3<f32>(0.5));
+    let k = o.x + 2u * o.y;
+    let nearest_label = select(la[k], lb[k], o.z == 1u);
+    var best = nearest_label;
+    var best_w = label_weight(nearest_label, la, lb, wa, wb);
+    if (best_w > 0.5) {
+        return best;
+    }
+    // Else every corner's label by its summed weight; a tie goes to the smaller label.
+    for (var i = 0u; i < 4u; i++) {
+        let wi = label_weight(la[i], la, lb, wa, wb);
+        if (wi > best_w || (wi == best_w && la[i] < best)) {
+            best = la[i];
+            best_w = wi;
+        }
+        let wj = label_weight(lb[i], la, lb, wa, wb);
+        if (wj > best_w || (wj == best_w && lb[i] < best)) {
+            best = lb[i];
+            best_w = wj;
+        }
+    }
+    return best;
+#endif
+}
+
+#if LABELS_NEAREST
+#else
+// The label of corner `b + (x, y, z)`, clamped to the map.
+fn corner_label(b: vec3<i32>, x: i32, y: i32, z: i32) -> u32 {
+    return label_at(clamp(b + vec3<i32>(x, y, z), vec3<i32>(0), label_dims() - vec3<i32>(1)));
+}
+
+// The summed weight of `label` over the corners (labels `la`, `lb`, weights `wa`, `wb`).
+fn label_weight(label: u32, la: vec4<u32>, lb: vec4<u32>, wa: vec4<f32>, wb: vec4<f32>) -> f32 {
+    let one = vec4<f32>(1.0);
+    return dot(select(vec4<f32>(0.0), wa, la == vec4<u32>(label)), one) + dot(select(vec4<f32>(0.0), wb, lb == vec4<u32>(label)), one);
+}
+#endif
+
+// The table's colour and opacity of `label` (hidden past its end).
+fn label_entry(label: u32) -> vec4<f32> {
+    let at = vec2<u32>(label % 256u, label / 256u);
+    if (at.y >= textureDimensions(label_table).y) {
+        return vec4<f32>(0.0);
+    }
+    return textureLoad(label_table, vec2<i32>(at), 0);
+}
+#endif
+
+// Straight colour `c` with the corrected opacity of `a_tf`, premultiplied.
+fn premultiplied(c: vec3<f32>, a_tf: f32) -> vec4<f32> {
+    let a = corrected_alpha(a_tf);
+    return vec4<f32>(c * a, a);
+}
+
+// Whether the texture point `u` lies in the box (voxel centres ± half a voxel).
+fn in_box(u: vec3<f32>) -> bool {
+    return all(u >= vec3<f32>(0.0)) && all(u <= vec3<f32>(1.0));
+}
+
+// The premultiplied, opacity-corrected colour of the sample at the frame volume's texture point
+// `u`, whose field is `s` (volgraph_accel::fusion::Fusion::classify).
+fn fused_sample(u: vec3<f32>, s: f32) -> vec4<f32> {
+#if FUSION_LABELS
+    let e = label_entry(sample_label(u));
+    return premultiplied(e.rgb, e.a);
+#else
+    let c = sample_tf(s);
+    let u2 = u * fusion_scale + fusion_offset;
+    let inside = in_box(u2);
+#if FUSION_LABEL_MAP
+    // Where the scan is clear the label changes nothing (tint and inside keep its opacity).
+    if (!(c.a > 0.0)) {
+        return vec4<f32>(0.0);
+    }
+    var label = 0u;
+    if (inside) {
+        label = sample_label(u2);
+    }
+    let e = label_entry(label);
+    let visible = e.a > 0.0;
+    if (fusion_combine == COMBINE_INSIDE) {
+        return premultiplied(c.rgb, select(0.0, c.a, visible));
+    }
+    var rgb = c.rgb;
+    if (visible) {
+        rgb = mix(c.rgb, e.rgb, min(e.a, 1.0));
+    }
+    return premultiplied(rgb, c.a);
+#endif
+#if FUSION_SCALAR
+    let p1 = premultiplied(c.rgb, c.a);
+    var p2 = vec4<f32>(0.0);
+    if (inside) {
+        let s2 = textureSampleLevel(second, linear_clamp, u2, 0.0).r;
+        let c2 = textureSampleLevel(second_tf, linear_clamp, s2, 0.0);
+        p2 = premultiplied(c2.rgb, c2.a);
+    }
+    // Two media in one place: opacity 1 - (1 - a1)(1 - a2); colour the opacity-weighted mean,
+    // or (channels) the sum.
+    let a = 1.0 - (1.0 - p1.a) * (1.0 - p2.a);
+    if (fusion_combine == COMBINE_ADD) {
+        return vec4<f32>(p1.rgb + p2.rgb, a);
+    }
+    let weight = p1.a + p2.a;
+    if (!(weight > 0.0)) {
+        return vec4<f32>(0.0);
+    }
+    return vec4<f32>((p1.rgb + p2.rgb) * (a / weight), a);
+#endif
+#endif
+}

@@ -26,6 +26,32 @@ fn split_unless(arg: &Path, exists: &dyn Fn(&Path) -> bool) -> Option<(String, P
     (identifier && !rest.is_empty() && !exists(arg)).then(|| (name.to_string(), PathBuf::from(rest)))
 }
 
+/// A named volume's path and the volume of a 4D file it asks for: `cells.nii.gz#1` is volume 1
+/// (from 0) of `cells.nii.gz` — a microscope's channels, bound one per input — unless a file
+/// of that very name exists. `raw` comes back with that frame set.
+pub fn path_and_frame(
+    path: &Path,
+    raw: &volgraph_accel::load::LoadOptions<'static>,
+) -> (PathBuf, volgraph_accel::load::LoadOptions<'static>) {
+    path_and_frame_unless(path, raw, &|p| p.exists())
+}
+
+fn path_and_frame_unless(
+    path: &Path,
+    raw: &volgraph_accel::load::LoadOptions<'static>,
+    exists: &dyn Fn(&Path) -> bool,
+) -> (PathBuf, volgraph_accel::load::LoadOptions<'static>) {
+    let split = path.to_str().filter(|_| !exists(path)).and_then(|text| {
+        let (file, frame) = text.rsplit_once('#')?;
+        let frame: u64 = frame.parse().ok().filter(|_| frame.bytes().all(|b| b.is_ascii_digit()))?;
+        (!file.is_empty()).then(|| (PathBuf::from(file), frame))
+    });
+    match split {
+        Some((file, frame)) => (file, volgraph_accel::load::LoadOptions { frame: Some(frame), ..raw.clone() }),
+        None => (path.to_path_buf(), raw.clone()),
+    }
+}
+
 /// The named `--volume`s, in the order given (empty when none is named). When one is named,
 /// every one must be: several plain paths are one volume's DICOM slices, which a name cannot
 /// split.
@@ -259,6 +285,19 @@ mod tests {
         assert!(
             split_tfs(&args(&["a.ron", "b.ron"])).expect_err("two plain").to_string().contains("twice without a name")
         );
+    }
+
+    #[test]
+    fn a_frame_suffix_picks_a_volume_of_a_4d_file_unless_the_file_is_so_named() {
+        let raw = volgraph_accel::load::LoadOptions::default();
+        let none = |_: &Path| false;
+        let (file, options) = path_and_frame_unless(Path::new("cells.nii.gz#1"), &raw, &none);
+        assert_eq!((file, options.frame), (PathBuf::from("cells.nii.gz"), Some(1)));
+        for plain in ["cells.nii.gz", "#1", "a#b", "a#-1", "a#+1"] {
+            assert_eq!(path_and_frame_unless(Path::new(plain), &raw, &none).1.frame, None, "{plain}");
+        }
+        let so_named = |p: &Path| p == Path::new("odd#2");
+        assert_eq!(path_and_frame_unless(Path::new("odd#2"), &raw, &so_named).1.frame, None, "the file wins");
     }
 
     #[test]

@@ -111,7 +111,15 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
         Some((_, path)) if !scene_named => vec![path.clone()],
         _ => args.inputs.volume.clone(),
     };
-    let shown = crate::scene::load_shown_volume(&shown_paths, scene.as_ref(), &raw)?;
+    // A named volume may pick one volume of a 4D file (`cells.nii#1`: channels bound by name).
+    let (shown_paths, primary_raw) = match shown_paths.as_slice() {
+        [one] if !named.is_empty() => {
+            let (file, options) = crate::named_inputs::path_and_frame(one, &raw);
+            (vec![file], options)
+        }
+        _ => (shown_paths, raw.clone()),
+    };
+    let shown = crate::scene::load_shown_volume(&shown_paths, scene.as_ref(), &primary_raw)?;
     let (volume, generated, mut notes) = (shown.volume, shown.marschner_lobb_tf, shown.notes);
     let (tf, tf_notes) = match (&plain_tf, &scene) {
         (None, Some(scene)) => {
@@ -126,13 +134,14 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     let mut others = Vec::new();
     for (i, (name, path)) in named.iter().enumerate() {
         if i != primary {
+            let (file, options) = crate::named_inputs::path_and_frame(path, &raw);
             let shown =
-                crate::scene::load_shown_volume(std::slice::from_ref(path), None, &raw).map_err(|e| {
-                    match scene.as_ref().filter(|_| scene_named) {
+                crate::scene::load_shown_volume(std::slice::from_ref(&file), None, &options).map_err(
+                    |e| match scene.as_ref().filter(|_| scene_named) {
                         Some(scene) => anyhow!("{}: volumes: \"{name}\": {e:#}", scene.path.display()),
                         None => anyhow!("--volume {name}=…: {e:#}"),
-                    }
-                })?;
+                    },
+                )?;
             notes.extend(shown.notes);
             others.push((name.clone(), shown.volume));
         }
@@ -148,7 +157,7 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
         &plan,
         (&named, primary, frame_path),
         others,
-        &named_tfs,
+        (&named_tfs, plain_tf.as_ref()),
         &volume,
         args.inputs.tf_map.as_deref(),
     )?;
@@ -217,7 +226,7 @@ fn named_bindings(
     plan: &volgraph_core::Plan,
     (named, primary, frame_path): (&[(String, PathBuf)], usize, Option<&Path>),
     others: Vec<(String, volgraph_accel::volume::Volume)>,
-    named_tfs: &[(String, PathBuf)],
+    (named_tfs, plain_tf): (&[(String, PathBuf)], Option<&PathBuf>),
     volume: &volgraph_accel::volume::Volume,
     tf_map: Option<&str>,
 ) -> anyhow::Result<Option<(NamedBindings, Vec<String>)>> {
@@ -235,6 +244,18 @@ fn named_bindings(
         let base = name.strip_suffix("_tf").and_then(by_name).unwrap_or(volume);
         let (tf, tf_notes) =
             inputs::transfer_function(Some(path), tf_map, base, false).map_err(|e| anyhow!("--tf {name}=…: {e:#}"))?;
+        notes.extend(tf_notes);
+        luts.push((name.clone(), tf.to_lut_for(base, inputs::LUT_SIZE)));
+    }
+    // An unnamed TF input X_tf of another volume X takes the plain --tf (or the default) fitted
+    // to X: the frame volume's LUT would read X's normalized values in the frame volume's range.
+    for name in plan.inputs.iter().filter(|(_, k)| **k == InputKind::TransferFunction).map(|(n, _)| n) {
+        let Some(base) = name.strip_suffix("_tf").and_then(by_name) else { continue };
+        if named_tfs.iter().any(|(n, _)| n == name) {
+            continue;
+        }
+        let (tf, tf_notes) =
+            inputs::transfer_function(plain_tf, tf_map, base, false).map_err(|e| anyhow!("{name}: {e:#}"))?;
         notes.extend(tf_notes);
         luts.push((name.clone(), tf.to_lut_for(base, inputs::LUT_SIZE)));
     }

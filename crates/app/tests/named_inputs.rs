@@ -259,3 +259,46 @@ fn dicom_series_of_different_frames_of_reference_are_refused_unless_allowed() {
     assert!(ok, "{err}");
     assert!(err.contains("warning: --volume pet=…: ") && err.contains("shown as placed"), "{err}");
 }
+
+/// A 4D NIfTI's volumes as channels: `--volume volume=cells.nii#0 --volume channel2=cells.nii#1`
+/// binds volume 0 and volume 1 of one file to `multi/channels`; the two frames differ (the
+/// second holds the first's values halved; one TF in data units), so binding frame 0 twice gives
+/// another image; a frame the file lacks is an error naming the input.
+#[test]
+fn a_4d_files_volumes_bind_as_channels() {
+    let dir = scratch("channels");
+    support::write_nifti_4d(&dir.join("cells.nii"), &support::ct(20, "cells"));
+    // One TF in data units for both channels, so the halved frame looks fainter.
+    let tf = "TransferFunction(domain: (-1000.0, 1000.0), points: [(value: -200.0, color: (0.0, 1.0, 0.0), \
+              alpha: 0.0), (value: 1000.0, color: (0.0, 1.0, 0.0), alpha: 0.6)])";
+    std::fs::write(dir.join("green.ron"), tf).expect("tf");
+    let render = |second: &str, out: &str| {
+        let second = format!("channel2=cells.nii#{second}");
+        let args = [
+            "render",
+            "multi/channels",
+            "--volume",
+            "volume=cells.nii#0",
+            "--volume",
+            &second,
+            "--tf",
+            "green.ron",
+            "--tf",
+            "channel2_tf=green.ron",
+            "--size",
+            "48x48",
+            "-o",
+            out,
+        ];
+        volgraph(&args, &dir)
+    };
+    let (ok, err) = render("1", "both.exr");
+    assert!(ok, "{err}");
+    let (ok, err) = render("0", "same.exr");
+    assert!(ok, "{err}");
+    let (both, same) = (pixels(&dir.join("both.exr")), pixels(&dir.join("same.exr")));
+    assert!(both.iter().any(|p| p[3] > 0.01), "the channels show");
+    assert!(both.iter().zip(&same).any(|(a, b)| (a[3] - b[3]).abs() > 1e-3), "frame 1 is not frame 0");
+    let (ok, err) = render("7", "none.exr");
+    assert!(!ok && err.contains("--volume channel2=…: "), "{err}");
+}

@@ -225,40 +225,7 @@ impl FusionState {
             return Ok(());
         }
         let (dims, values) = volgraph_accel::labels::sample::uniform_blocks(ctx.voxels(port)?);
-        let size = wgpu::Extent3d { width: dims.x, height: dims.y, depth_or_array_layers: dims.z };
-        let gpu = ctx.gpu;
-        let texture = gpu
-            .checked(
-                || format!("{}: the label map's uniform blocks ({}x{}x{})", ctx.label, dims.x, dims.y, dims.z),
-                || {
-                    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-                        label: Some("label_blocks"),
-                        size,
-                        mip_level_count: 1,
-                        sample_count: 1,
-                        dimension: wgpu::TextureDimension::D3,
-                        format: wgpu::TextureFormat::R32Uint,
-                        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                        view_formats: &[],
-                    });
-                    gpu.queue.write_texture(
-                        wgpu::TexelCopyTextureInfo {
-                            texture: &texture,
-                            mip_level: 0,
-                            origin: wgpu::Origin3d::ZERO,
-                            aspect: wgpu::TextureAspect::All,
-                        },
-                        bytemuck::cast_slice(&values),
-                        wgpu::TexelCopyBufferLayout {
-                            offset: 0,
-                            bytes_per_row: Some(4 * dims.x),
-                            rows_per_image: Some(dims.y),
-                        },
-                        size,
-                    );
-                    texture
-                },
-            )
+        let texture = volgraph_core::runtime::upload::upload_u32_3d(ctx.gpu, "label_blocks", dims.to_array(), &values)
             .map_err(|e| PassError { pass: ctx.label.to_string(), message: e.to_string() })?;
         self.blocks = Some((texture.create_view(&wgpu::TextureViewDescriptor::default()), version));
         Ok(())

@@ -41,3 +41,28 @@ pub fn read_exr(path: &std::path::Path) -> (usize, usize, Vec<[f32; 4]>) {
     let size = image.layer_data.size;
     (size.width(), size.height(), image.layer_data.channel_data.pixels.1)
 }
+
+/// A NIfTI-1 file (written byte by byte from nifti1.h) of two int16 volumes: `ct`, then `ct`
+/// with its values halved, so the frames differ.
+pub fn write_nifti_4d(path: &std::path::Path, ct: &Volume) {
+    let VoxelData::I16(values) = &ct.data else { panic!("int16") };
+    let mut header = vec![0u8; 352];
+    header[0..4].copy_from_slice(&348i32.to_le_bytes());
+    let dims = [4i16, ct.dims.x as i16, ct.dims.y as i16, ct.dims.z as i16, 2, 1, 1, 1];
+    for (i, d) in dims.iter().enumerate() {
+        header[40 + 2 * i..42 + 2 * i].copy_from_slice(&d.to_le_bytes());
+    }
+    header[70..72].copy_from_slice(&4i16.to_le_bytes()); // DT_INT16
+    header[72..74].copy_from_slice(&16i16.to_le_bytes());
+    let pixdim = [1.0f32, ct.spacing.x as f32, ct.spacing.y as f32, ct.spacing.z as f32, 1.0, 1.0, 1.0, 1.0];
+    for (i, p) in pixdim.iter().enumerate() {
+        header[76 + 4 * i..80 + 4 * i].copy_from_slice(&p.to_le_bytes());
+    }
+    header[108..112].copy_from_slice(&352f32.to_le_bytes());
+    header[112..116].copy_from_slice(&1f32.to_le_bytes());
+    header[344..348].copy_from_slice(b"n+1\0");
+    let mut bytes = header;
+    bytes.extend(values.iter().flat_map(|v| v.to_le_bytes()));
+    bytes.extend(values.iter().flat_map(|v| (v / 2).to_le_bytes()));
+    std::fs::write(path, bytes).expect("nifti written");
+}

@@ -271,6 +271,43 @@ fn upload_rgba(
     )
 }
 
+/// `values` (x fastest) as an `R32Uint` 3D texture of `dims`, read with `textureLoad`: per-block
+/// tables a pass derives from a volume (a label map's uniform blocks).
+pub fn upload_u32_3d(gpu: &Gpu, label: &str, dims: [u32; 3], values: &[u32]) -> Result<wgpu::Texture, GpuFault> {
+    let size = wgpu::Extent3d { width: dims[0], height: dims[1], depth_or_array_layers: dims[2] };
+    gpu.checked(
+        || format!("uploading \"{label}\" ({}x{}x{} u32)", dims[0], dims[1], dims[2]),
+        || {
+            let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D3,
+                format: wgpu::TextureFormat::R32Uint,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            });
+            gpu.queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d::ZERO,
+                    aspect: wgpu::TextureAspect::All,
+                },
+                bytemuck::cast_slice(values),
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(4 * dims[0]),
+                    rows_per_image: Some(dims[1]),
+                },
+                size,
+            );
+            texture
+        },
+    )
+}
+
 /// IEEE single → half, round to nearest even (for the f16 LUT fallback).
 pub fn f32_to_f16(v: f32) -> u16 {
     let bits = v.to_bits();

@@ -131,21 +131,8 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     };
     notes.extend(tf_notes);
     let lut = tf.to_lut_for(&volume, inputs::LUT_SIZE);
-    let mut others = Vec::new();
-    for (i, (name, path)) in named.iter().enumerate() {
-        if i != primary {
-            let (file, options) = crate::named_inputs::path_and_frame(path, &raw);
-            let shown =
-                crate::scene::load_shown_volume(std::slice::from_ref(&file), None, &options).map_err(
-                    |e| match scene.as_ref().filter(|_| scene_named) {
-                        Some(scene) => anyhow!("{}: volumes: \"{name}\": {e:#}", scene.path.display()),
-                        None => anyhow!("--volume {name}=…: {e:#}"),
-                    },
-                )?;
-            notes.extend(shown.notes);
-            others.push((name.clone(), shown.volume));
-        }
-    }
+    let scene_path = scene.as_ref().filter(|_| scene_named).map(|s| s.path.as_path());
+    let others = load_other_volumes(&named, primary, &raw, scene_path, &mut notes)?;
     let registry = crate::program::registry();
     let file = display_name(&graph);
     let opacity = scene.as_ref().map(|s| s.opacity_reference).unwrap_or_default();
@@ -222,7 +209,7 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
 /// or, for a `LabelTable` input, a label table, and every label table the graph reads (the
 /// map's own names or the default palette where none is named). `None` when nothing is named
 /// and the graph reads no label table.
-fn named_bindings(
+pub(crate) fn named_bindings(
     plan: &volgraph_core::Plan,
     (named, primary, frame_path): (&[(String, PathBuf)], usize, Option<&Path>),
     others: Vec<(String, volgraph_accel::volume::Volume)>,
@@ -278,8 +265,35 @@ fn named_bindings(
     Ok(Some((NamedBindings { primary, others, luts, tables, allow_frame_mismatch: false }, notes)))
 }
 
+/// The named volumes but the frame volume (`named[primary]`), loaded (a `#N` suffix picks a
+/// volume of a 4D file); their notes go to `notes`. An error names the input (and the scene
+/// file `scene_path` whose `volumes:` gave it).
+pub(crate) fn load_other_volumes(
+    named: &[(String, PathBuf)],
+    primary: usize,
+    raw: &volgraph_accel::load::LoadOptions<'static>,
+    scene_path: Option<&Path>,
+    notes: &mut Vec<String>,
+) -> anyhow::Result<Vec<(String, volgraph_accel::volume::Volume)>> {
+    let mut others = Vec::new();
+    for (i, (name, path)) in named.iter().enumerate() {
+        if i != primary {
+            let (file, options) = crate::named_inputs::path_and_frame(path, raw);
+            let shown = crate::scene::load_shown_volume(std::slice::from_ref(&file), None, &options).map_err(|e| {
+                match scene_path {
+                    Some(scene) => anyhow!("{}: volumes: \"{name}\": {e:#}", scene.display()),
+                    None => anyhow!("--volume {name}=…: {e:#}"),
+                }
+            })?;
+            notes.extend(shown.notes);
+            others.push((name.clone(), shown.volume));
+        }
+    }
+    Ok(others)
+}
+
 /// The graph's volume inputs, by name.
-fn volume_input_names(plan: &volgraph_core::Plan) -> Vec<&str> {
+pub(crate) fn volume_input_names(plan: &volgraph_core::Plan) -> Vec<&str> {
     let volume = volgraph_core::graph::ast::InputKind::Volume;
     plan.inputs.iter().filter(|(_, k)| **k == volume).map(|(n, _)| n.as_str()).collect()
 }

@@ -54,6 +54,8 @@ fn open(graph: &Path, volume: &[PathBuf], raw: LoadOptions<'static>, tf: Option<
         shaders: None,
         gpu_memory_mb: None,
         cuts: Default::default(),
+        named: Vec::new(),
+        named_tfs: Vec::new(),
     };
     match LiveSession::open(gpu, &args) {
         Ok((session, _)) => session,

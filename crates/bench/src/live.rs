@@ -255,6 +255,8 @@ pub fn run(args: &LiveArgs) -> anyhow::Result<()> {
                 shaders: Some(dir.join("shaders")),
                 gpu_memory_mb: None,
                 cuts: Default::default(),
+                named: Vec::new(),
+                named_tfs: Vec::new(),
             },
         )
         .map(|(s, _)| s)

@@ -60,6 +60,8 @@ fn open(gpu: &Arc<Gpu>, graph: PathBuf, volume: &std::path::Path, viewport: (u32
         gpu_memory_mb: None,
         scene: None,
         cuts: Default::default(),
+        named: Vec::new(),
+        named_tfs: Vec::new(),
     };
     LiveSession::open(gpu.clone(), &args).map(|(s, _)| s).map_err(|e| anyhow!("{}", volgraph_app::cli::error_text(&e)))
 }

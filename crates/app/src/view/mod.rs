@@ -118,12 +118,26 @@ pub fn run(args: ViewArgs) -> Result<(), CliError> {
             )));
         }
     }
-    let tf = args.inputs.single_tf("volgraph view")?;
+    // Inputs by name, as `render` binds them: the frame volume (`volume`, else the first named)
+    // is the one shown, probed and saved.
+    let (tf, named_tfs) = crate::named_inputs::split_tfs(&args.inputs.tf)?;
+    let named = crate::named_inputs::named_volumes(&args.inputs.volume)?;
+    let mut raw = inputs::raw_options(&args.inputs.raw)?;
+    let volume = match named.get(crate::named_inputs::NamedBindings::primary_index(&named)) {
+        Some((_, path)) => {
+            let (file, options) = crate::named_inputs::path_and_frame(path, &raw);
+            raw = options;
+            vec![file]
+        }
+        None => args.inputs.volume,
+    };
     let session_args = session::SessionArgs {
         graph: resolved.graph,
         scene: resolved.scene,
-        volume: args.inputs.volume,
-        raw: inputs::raw_options(&args.inputs.raw)?,
+        volume,
+        raw,
+        named,
+        named_tfs,
         tf,
         tf_map: args.inputs.tf_map,
         viewport,

@@ -226,8 +226,8 @@ pub fn show(
                     }
                 });
             }
-            // A label map is coloured by its label list, not by the TF.
-            if plan.inputs.values().any(|k| *k == InputKind::TransferFunction) && session.labels().is_none() {
+            // A label map shown alone is coloured by its label list, not by the TF.
+            if plan.inputs.values().any(|k| *k == InputKind::TransferFunction) && session.shows_transfer_function() {
                 egui::CollapsingHeader::new("Transfer function").default_open(true).show(ui, |ui| {
                     let model = &session.workbench().tf;
                     let (histogram, range) = model.histogram();

@@ -139,6 +139,10 @@ pub struct SessionArgs {
     pub scene: Option<crate::scene::Scene>,
     /// The crop box and clip planes at start (`--crop`/`--clip` over the scene's).
     pub cuts: Cuts,
+    /// Volumes bound by name (`--volume NAME=PATH`); `volume` is then the frame volume's path.
+    pub named: Vec<(String, PathBuf)>,
+    /// Transfer functions and label tables bound by name (`--tf NAME=FILE`).
+    pub named_tfs: Vec<(String, PathBuf)>,
 }
 
 /// A graph running on a runtime, with everything that can change it.
@@ -164,8 +168,12 @@ pub struct LiveSession {
     volume_options: volgraph_accel::load::LoadOptions<'static>,
     /// What the TF's opacity is per (the scene's).
     opacity_reference: volgraph_core::runtime::OpacityReference,
-    /// The label list, when the graph reads a label table (the volume is its label map).
+    /// The label list, when the graph reads a label table.
     labels: Option<super::label_list::LabelList>,
+    /// The label map is the frame volume (`multi/labels`): its TF is not what is seen.
+    labels_are_the_volume: bool,
+    /// Inputs bound by name (`--volume NAME=PATH`, `--tf NAME=…`): rebound on every apply.
+    bindings: Option<crate::named_inputs::NamedBindings>,
 }
 
 impl LiveSession {
@@ -212,7 +220,11 @@ impl LiveSession {
     /// Compiles `source` with `options` and applies it; the report, or the error message.
     fn compile_and_apply(&mut self, source: &str, options: &CompileOptions) -> Result<ApplyReport, String> {
         let plan = self.bench.graph.plan_for(source, options)?;
-        self.runtime.bind_scene(&plan.inputs, &self.volume, &self.lut).map_err(|e| e.to_string())?;
+        match &self.bindings {
+            Some(b) => b.bind(&mut self.runtime, &plan, &self.volume, &self.lut),
+            None => self.runtime.bind_scene(&plan.inputs, &self.volume, &self.lut),
+        }
+        .map_err(|e| e.to_string())?;
         bind_label_list(&mut self.runtime, &plan.inputs, self.labels.as_ref()).map_err(|e| e.to_string())?;
         self.runtime.apply(plan, self.bench.graph.registry()).map_err(|e| e.to_string())
     }

@@ -59,6 +59,8 @@ fn open(s: &Scratch, tf: Option<PathBuf>) -> LiveSession {
         shaders: Some(s.shaders.clone()),
         gpu_memory_mb: None,
         cuts: Default::default(),
+        named: Vec::new(),
+        named_tfs: Vec::new(),
     };
     let (session, loaded) = LiveSession::open(gpu, &args).unwrap_or_else(|_| panic!("the scratch graph loads"));
     assert!(matches!(loaded, Event::Loaded { .. }), "{loaded}");

@@ -17,6 +17,12 @@ impl LiveSession {
         self.labels.as_ref()
     }
 
+    /// Whether the TF editor edits what is seen: not where the volume is a label map coloured by
+    /// its table.
+    pub fn shows_transfer_function(&self) -> bool {
+        !self.labels_are_the_volume
+    }
+
     /// Sets the label list's search text.
     pub fn set_label_search(&mut self, text: String) {
         if let Some(list) = &mut self.labels {

@@ -103,16 +103,55 @@ impl LiveSession {
             ),
         };
         let loaded = format!("{}, {shaders}", summary(&plan));
-        runtime.bind_scene(&plan.inputs, &volume, &lut).map_err(|e| crate::cli::CliError::Other(anyhow!(e)))?;
-        // A graph that reads a label table shows the volume as a label map: its list, named by
-        // its own file (.seg.nrrd) or the default palette, bound over bind_scene's palette.
-        let labels = if plan.inputs.values().any(|k| *k == volgraph_core::graph::ast::InputKind::LabelTable) {
-            let map_path = args.volume.first().map(PathBuf::as_path);
-            let (table, _, notes) = crate::label_tables::label_table(&volume, map_path, None, "the label table")?;
+        // Inputs bound by name, as `render` binds them (the others loaded, checked for one frame).
+        let bindings = if args.named.is_empty() && args.named_tfs.is_empty() {
+            None
+        } else {
+            let primary = crate::named_inputs::NamedBindings::primary_index(&args.named);
+            let mut notes = Vec::new();
+            let others = crate::render::load_other_volumes(&args.named, primary, &args.raw, None, &mut notes)?;
+            let frame_path = args.volume.first().map(PathBuf::as_path);
+            let named = (args.named.as_slice(), primary, frame_path);
+            let tfs = (args.named_tfs.as_slice(), args.tf.as_ref());
+            let found = crate::render::named_bindings(&plan, named, others, tfs, &volume, args.tf_map.as_deref())?;
+            found
+                .map(|(bindings, binding_notes)| {
+                    notes.extend(binding_notes);
+                    let file = graph.path().display().to_string();
+                    notes.extend(bindings.check(&plan, &file, graph.source(), &volume)?);
+                    for note in &notes {
+                        crate::stdout::eprintln_escaped!("{note}");
+                    }
+                    anyhow::Ok(bindings)
+                })
+                .transpose()?
+        };
+        match &bindings {
+            Some(b) => b.bind(&mut runtime, &plan, &volume, &lut),
+            None => runtime.bind_scene(&plan.inputs, &volume, &lut),
+        }
+        .map_err(|e| crate::cli::CliError::Other(anyhow!(e)))?;
+        // A graph that reads a label table shows its label map's list: the volume input the
+        // table colours (`label_tables::map_input_of`), else the frame volume; named by the
+        // table given, the map's own file (.seg.nrrd) or the default palette.
+        let table_input = plan.inputs.iter().find(|(_, k)| **k == volgraph_core::graph::ast::InputKind::LabelTable);
+        let map_name = table_input
+            .and_then(|(t, _)| crate::label_tables::map_input_of(t, &crate::render::volume_input_names(&plan)));
+        let labels_are_the_volume = table_input.is_some() && map_name.is_none();
+        let labels = if let Some((table_name, _)) = table_input {
+            let other = |name: &str| bindings.as_ref().and_then(|b| b.others.iter().find(|(n, _)| n == name));
+            let map = map_name.as_deref().and_then(other).map_or(&volume, |(_, v)| v);
+            let map_path = match map_name.as_deref().and_then(|m| args.named.iter().find(|(n, _)| n == m)) {
+                Some((_, path)) => Some(path.as_path()),
+                None => args.volume.first().map(PathBuf::as_path),
+            };
+            let given = args.named_tfs.iter().find(|(n, _)| n == table_name).map(|(_, p)| p.as_path());
+            let flag = format!("--tf {table_name}");
+            let (table, _, notes) = crate::label_tables::label_table(map, map_path, given, &flag)?;
             for note in notes {
                 crate::stdout::eprintln_escaped!("{note}");
             }
-            let list = crate::view::label_list::LabelList::of(&volume, &table).map_err(|e| anyhow!(e))?;
+            let list = crate::view::label_list::LabelList::of(map, &table).map_err(|e| anyhow!(e))?;
             super::bind_label_list(&mut runtime, &plan.inputs, Some(&list)).map_err(|e| anyhow!(e))?;
             Some(list)
         } else {
@@ -134,6 +173,8 @@ impl LiveSession {
             volume_options: shown.options,
             opacity_reference: args.scene.as_ref().map(|s| s.opacity_reference).unwrap_or_default(),
             labels,
+            labels_are_the_volume,
+            bindings,
         };
         let ms = start.elapsed().as_secs_f64() * 1e3;
         Ok((session, Event::Loaded { graph: graph_name, ms, summary: loaded }))

@@ -78,8 +78,10 @@ impl LiveSession {
         // Only the TF inputs: re-binding the volume would hash all its voxels to find it unchanged
         // (~4 ms of every edit on a 256³ volume).
         let inputs = self.plan().map(|p| p.inputs.clone()).unwrap_or_default();
+        // The TF editor edits the frame volume's TF: inputs bound by name keep their own.
+        let named = |name: &str| self.bindings.as_ref().is_some_and(|b| b.luts.iter().any(|(n, _)| n == name));
         for (name, kind) in &inputs {
-            if matches!(kind, volgraph_core::graph::ast::InputKind::TransferFunction) {
+            if matches!(kind, volgraph_core::graph::ast::InputKind::TransferFunction) && !named(name) {
                 self.runtime.bind_lut(name, &self.lut).map_err(|e| anyhow!(e))?;
             }
         }
@@ -96,6 +98,14 @@ impl LiveSession {
         camera: &volgraph_accel::camera::OrbitCamera,
         viewport: (u32, u32),
     ) -> anyhow::Result<crate::scene::SavedView> {
+        if let Some(b) = self.bindings.as_ref().filter(|b| !b.others.is_empty()) {
+            let names: Vec<&str> = b.others.iter().map(|(n, _)| n.as_str()).collect();
+            return Err(anyhow!(
+                "save view keeps one volume, and this view binds others by name ({}); give them to `volgraph render \
+                 --scene` with a `volumes:` map, or view one volume",
+                names.join(", ")
+            ));
+        }
         Ok(crate::scene::SavedView {
             graph: self.bench.graph.path().to_path_buf(),
             volume: self.volume_source.clone().map_err(|why| anyhow!("{why}"))?,

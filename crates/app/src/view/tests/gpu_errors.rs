@@ -82,6 +82,8 @@ fn a_frame_the_gpu_rejects_puts_the_last_good_graph_back() {
         shaders: Some(s.shaders.clone()),
         gpu_memory_mb: None,
         cuts: Default::default(),
+        named: Vec::new(),
+        named_tfs: Vec::new(),
     };
     let (mut session, _) = LiveSession::open_with(gpu, &args, registry).unwrap_or_else(|_| panic!("loads"));
     let camera = OrbitCamera::default();

@@ -28,6 +28,8 @@ fn a_label_shown_alone_is_a_table_upload_and_the_cursor_names_it() {
         shaders: Some(s.shaders.clone()),
         gpu_memory_mb: None,
         cuts: Default::default(),
+        named: Vec::new(),
+        named_tfs: Vec::new(),
     };
     let (mut session, _) = LiveSession::open(gpu, &args).unwrap_or_else(|_| panic!("multi/labels opens"));
     let list = session.labels().expect("a label list");
@@ -52,4 +54,42 @@ fn a_label_shown_alone_is_a_table_upload_and_the_cursor_names_it() {
     // The centre of the view lies on an organ, which the probe names.
     let line = session.probe_line(&OrbitCamera::default(), (24.0, 24.0)).expect("something under the cursor");
     assert!(line.contains(", label "), "{line}");
+}
+
+/// `view multi/ct_with_labels --volume volume=… --volume labels=…`: the viewer binds inputs by
+/// name as `render` does; the label list is the `labels` volume's (the organ phantom's names),
+/// and a TF edit leaves a named TF alone.
+#[test]
+fn the_viewer_binds_volumes_by_name_and_lists_the_label_maps_labels() {
+    let s = scratch("named", "graphs/multi/ct_with_labels.ron");
+    let gpu = Arc::new(Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)"));
+    let args = SessionArgs {
+        scene: None,
+        graph: s.graph.clone(),
+        volume: vec!["organs32".into()],
+        raw: Default::default(),
+        tf: Some("ct-soft-tissue".into()),
+        tf_map: None,
+        viewport: (48, 48),
+        features: Vec::new(),
+        shaders: Some(s.shaders.clone()),
+        gpu_memory_mb: None,
+        cuts: Default::default(),
+        named: vec![("volume".into(), "organs32".into()), ("labels".into(), "organs_labels32".into())],
+        named_tfs: Vec::new(),
+    };
+    let (mut session, _) = LiveSession::open(gpu, &args).unwrap_or_else(|_| panic!("ct_with_labels opens"));
+    let list = session.labels().expect("the labels volume's list");
+    assert_eq!(list.rows.first().map(|r| r.name.as_str()), Some("liver"));
+    let tinted = frame(&mut session);
+    assert!(tinted.chunks(4).any(|p| p[3] > 0.01), "the scan shows");
+    // Every label hidden: the scan alone, in its own colours.
+    for value in 1..=6 {
+        session.edit_labels(&LabelEdit::Visible(value, false));
+    }
+    let plain = frame(&mut session);
+    assert_ne!(plain, tinted, "the labels tinted the scan");
+    // A saved view holds one volume: refused with what to do instead.
+    let err = session.saved_view(&OrbitCamera::default(), (48, 48)).map(drop).expect_err("several volumes");
+    assert!(err.to_string().contains("binds others by name (labels)"), "{err}");
 }

@@ -170,11 +170,6 @@ fn a_scene_names_its_inputs_too() {
         .expect("scene");
     let (ok, err) = volgraph(&["render", "two_volumes.ron", "--scene", "bad.ron", "-o", "x.png"], &dir);
     assert!(!ok && err.contains("volumes") && err.contains("\"2nd\" is no input name"), "{err}");
-    let (ok, err) = volgraph(&["view", "--scene", "both.ron"], &dir);
-    assert!(
-        !ok && err.contains("both.ron: volumes/tfs name graph inputs, which `volgraph render --scene` binds"),
-        "{err}"
-    );
     std::fs::write(dir.join("twice.ron"), "Scene(volume: Generated(\"ml32\"), volumes: {\"volume\": \"ml32\"})")
         .expect("scene");
     let (ok, err) = volgraph(&["render", "two_volumes.ron", "--scene", "twice.ron", "-o", "x.png"], &dir);

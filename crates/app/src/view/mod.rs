@@ -94,18 +94,32 @@ pub fn emit(event: &session::Event) {
     let _ = out.flush();
 }
 
+/// A scene's named inputs, as `render --scene` takes them: where the command line names no
+/// volume, the scene's `volume:` is the input `volume` (an empty path: loaded from the scene) and
+/// its `volumes:` the others; its `tfs:` under the command line's of the same name.
+fn with_scene_names(
+    scene: Option<&crate::scene::Scene>,
+    cli_volumes: &[PathBuf],
+    mut named: Vec<(String, PathBuf)>,
+    mut named_tfs: Vec<(String, PathBuf)>,
+) -> (Vec<(String, PathBuf)>, Vec<(String, PathBuf)>) {
+    let Some(scene) = scene else { return (named, named_tfs) };
+    if cli_volumes.is_empty() && !scene.volumes.is_empty() {
+        named = std::iter::once((volgraph_core::runtime::inputs::PRIMARY_VOLUME.to_string(), PathBuf::new()))
+            .chain(scene.volumes.iter().cloned())
+            .collect();
+    }
+    for (name, path) in &scene.tfs {
+        if !named_tfs.iter().any(|(n, _)| n == name) {
+            named_tfs.push((name.clone(), path.clone()));
+        }
+    }
+    (named, named_tfs)
+}
+
 /// Runs `volgraph view`.
 pub fn run(args: ViewArgs) -> Result<(), CliError> {
     let resolved = args.inputs.resolve("volgraph view GRAPH", "800x600")?;
-    // The viewer binds one volume and one transfer function: a scene that names inputs would
-    // show the wrong one in them.
-    if let Some(scene) = resolved.scene.as_ref().filter(|s| !s.volumes.is_empty() || !s.tfs.is_empty()) {
-        return Err(CliError::Other(anyhow::anyhow!(
-            "{}: volumes/tfs name graph inputs, which `volgraph render --scene` binds; the viewer binds one volume \
-             and one transfer function for now (remove volumes and tfs to view the scene's volume)",
-            scene.path.display()
-        )));
-    }
     let viewport = inputs::parse_size(&resolved.size)?;
     let camera = resolved.camera.at(0);
     if let Some(path) = &args.screenshot {
@@ -122,8 +136,11 @@ pub fn run(args: ViewArgs) -> Result<(), CliError> {
     // is the one shown, probed and saved.
     let (tf, named_tfs) = crate::named_inputs::split_tfs(&args.inputs.tf)?;
     let named = crate::named_inputs::named_volumes(&args.inputs.volume)?;
+    let (named, named_tfs) = with_scene_names(resolved.scene.as_ref(), &args.inputs.volume, named, named_tfs);
     let mut raw = inputs::raw_options(&args.inputs.raw)?;
     let volume = match named.get(crate::named_inputs::NamedBindings::primary_index(&named)) {
+        // The scene's `volume:` (with_scene_names): loaded from the scene.
+        Some((_, path)) if path.as_os_str().is_empty() => Vec::new(),
         Some((_, path)) => {
             let (file, options) = crate::named_inputs::path_and_frame(path, &raw);
             raw = options;
@@ -167,4 +184,30 @@ pub fn run(args: ViewArgs) -> Result<(), CliError> {
         rx
     });
     window::run(session_args, view, script).map_err(|e| CliError::Other(anyhow::anyhow!(e)))
+}
+
+#[cfg(test)]
+mod scene_names {
+    use std::path::{Path, PathBuf};
+
+    use super::with_scene_names;
+
+    /// A scene's `volumes:` and `tfs:` reach the viewer as `render --scene` takes them: its
+    /// `volume:` is the input `volume`, the command line's names win.
+    #[test]
+    fn a_scenes_named_inputs_are_the_viewers() {
+        let text = "Scene(graph: \"g.ron\", volume: Generated(\"organs32\"), volumes: {\"labels\": \"organs_labels32\"}, \
+                    tfs: {\"label_table\": \"t.txt\", \"tf\": \"ct-bone\"})";
+        let scene = crate::scene::Scene::from_str(text, Path::new("/scenes/s.ron")).expect("scene");
+        let (named, tfs) = with_scene_names(Some(&scene), &[], Vec::new(), vec![("tf".into(), "ct-lung".into())]);
+        let names: Vec<&str> = named.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, ["volume", "labels"]);
+        assert_eq!(named[0].1, PathBuf::new(), "the scene's volume: loaded from the scene");
+        let tf = tfs.iter().find(|(n, _)| n == "tf").map(|(_, p)| p.clone());
+        assert_eq!(tf, Some(PathBuf::from("ct-lung")), "the command line's TF wins");
+        assert!(tfs.iter().any(|(n, _)| n == "label_table"));
+        // Volumes on the command line: the scene's names are not used.
+        let (named, _) = with_scene_names(Some(&scene), &[PathBuf::from("ct.nii")], Vec::new(), Vec::new());
+        assert!(named.is_empty());
+    }
 }

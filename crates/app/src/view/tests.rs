@@ -45,12 +45,13 @@ fn scratch(name: &str, graph: &str) -> Scratch {
     Scratch { shaders: dir.join("shaders"), graph: graph_path, dir }
 }
 
-fn open(s: &Scratch, tf: Option<PathBuf>) -> LiveSession {
-    let gpu = Arc::new(Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)"));
-    let args = SessionArgs {
+/// The session arguments of a scratch graph: its shaders, a 48×48 viewport, `volume` (empty:
+/// the generated default) and `tf`; nothing named.
+fn session_args(s: &Scratch, volume: &[&str], tf: Option<PathBuf>) -> SessionArgs {
+    SessionArgs {
         scene: None,
         graph: s.graph.clone(),
-        volume: Vec::new(),
+        volume: volume.iter().map(PathBuf::from).collect(),
         raw: Default::default(),
         tf,
         tf_map: None,
@@ -61,8 +62,17 @@ fn open(s: &Scratch, tf: Option<PathBuf>) -> LiveSession {
         cuts: Default::default(),
         named: Vec::new(),
         named_tfs: Vec::new(),
-    };
-    let (session, loaded) = LiveSession::open(gpu, &args).unwrap_or_else(|_| panic!("the scratch graph loads"));
+    }
+}
+
+/// The headless GPU.
+fn gpu() -> Arc<Gpu> {
+    Arc::new(Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)"))
+}
+
+fn open(s: &Scratch, tf: Option<PathBuf>) -> LiveSession {
+    let (session, loaded) =
+        LiveSession::open(gpu(), &session_args(s, &[], tf)).unwrap_or_else(|_| panic!("the scratch graph loads"));
     assert!(matches!(loaded, Event::Loaded { .. }), "{loaded}");
     session
 }

@@ -164,37 +164,11 @@ pub fn upload_volume(
     }
     let format = volume_format_for(gpu, texels);
     let bytes = texel_bytes(texels, format);
-    let size = wgpu::Extent3d { width: dims[0], height: dims[1], depth_or_array_layers: dims[2] };
-    let texture = gpu.checked(
+    let texture = texture_with(
+        gpu,
         || format!("uploading volume \"{label}\" ({}x{}x{} {format:?})", dims[0], dims[1], dims[2]),
-        || {
-            let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D3,
-                format: format.wgpu(),
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                view_formats: &[],
-            });
-            gpu.queue.write_texture(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &texture,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                &bytes,
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(dims[0] * format.bytes()),
-                    rows_per_image: Some(dims[1]),
-                },
-                size,
-            );
-            texture
-        },
+        (label, dims, wgpu::TextureDimension::D3, format.wgpu()),
+        &bytes,
     )?;
     Ok(UploadedVolume { texture, format })
 }
@@ -236,76 +210,64 @@ fn upload_rgba(
         let halves: Vec<u16> = rgba.iter().flatten().map(|v| f32_to_f16(*v)).collect();
         (wgpu::TextureFormat::Rgba16Float, bytemuck::cast_slice(&halves).to_vec())
     };
-    let bpp = format.block_copy_size(None).unwrap_or(16);
-    let size = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
-    gpu.checked(
+    texture_with(
+        gpu,
         || format!("uploading the {what} \"{label}\" ({} entries)", rgba.len()),
-        || {
-            let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension,
-                format,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                view_formats: &[],
-            });
-            gpu.queue.write_texture(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &texture,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                &bytes,
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(width * bpp),
-                    rows_per_image: Some(height),
-                },
-                size,
-            );
-            texture
-        },
+        (label, [width, height, 1], dimension, format),
+        &bytes,
     )
 }
 
 /// `values` (x fastest) as an `R32Uint` 3D texture of `dims`, read with `textureLoad`: per-block
 /// tables a pass derives from a volume (a label map's uniform blocks).
 pub fn upload_u32_3d(gpu: &Gpu, label: &str, dims: [u32; 3], values: &[u32]) -> Result<wgpu::Texture, GpuFault> {
-    let size = wgpu::Extent3d { width: dims[0], height: dims[1], depth_or_array_layers: dims[2] };
-    gpu.checked(
+    texture_with(
+        gpu,
         || format!("uploading \"{label}\" ({}x{}x{} u32)", dims[0], dims[1], dims[2]),
-        || {
-            let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D3,
-                format: wgpu::TextureFormat::R32Uint,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-                view_formats: &[],
-            });
-            gpu.queue.write_texture(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &texture,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                bytemuck::cast_slice(values),
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(4 * dims[0]),
-                    rows_per_image: Some(dims[1]),
-                },
-                size,
-            );
-            texture
-        },
+        (label, dims, wgpu::TextureDimension::D3, wgpu::TextureFormat::R32Uint),
+        bytemuck::cast_slice(values),
     )
+}
+
+/// The one way a sampled input texture is made: `(label, dims, dimension, format)` created and
+/// `bytes` (x fastest, tightly packed rows) written, a GPU error coming back as a fault named by
+/// `what`.
+fn texture_with(
+    gpu: &Gpu,
+    what: impl Fn() -> String,
+    (label, dims, dimension, format): (&str, [u32; 3], wgpu::TextureDimension, wgpu::TextureFormat),
+    bytes: &[u8],
+) -> Result<wgpu::Texture, GpuFault> {
+    let size = wgpu::Extent3d { width: dims[0], height: dims[1], depth_or_array_layers: dims[2] };
+    let texel = format.block_copy_size(None).unwrap_or(4);
+    gpu.checked(what, || {
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        gpu.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            bytes,
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(dims[0] * texel),
+                rows_per_image: Some(dims[1]),
+            },
+            size,
+        );
+        texture
+    })
 }
 
 /// IEEE single → half, round to nearest even (for the f16 LUT fallback).

@@ -67,25 +67,10 @@ impl volgraph_core::PassPlugin for BadDraw {
 #[test]
 fn a_frame_the_gpu_rejects_puts_the_last_good_graph_back() {
     let s = scratch("frame-error", "graphs/basic/fragment_raycast.ron");
-    let gpu = Arc::new(Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)"));
     let mut registry = volgraph_passes::builtin_registry();
     registry.register(BadDraw);
-    let args = SessionArgs {
-        scene: None,
-        graph: s.graph.clone(),
-        volume: Vec::new(),
-        raw: Default::default(),
-        tf: None,
-        tf_map: None,
-        viewport: (48, 48),
-        features: Vec::new(),
-        shaders: Some(s.shaders.clone()),
-        gpu_memory_mb: None,
-        cuts: Default::default(),
-        named: Vec::new(),
-        named_tfs: Vec::new(),
-    };
-    let (mut session, _) = LiveSession::open_with(gpu, &args, registry).unwrap_or_else(|_| panic!("loads"));
+    let args = session_args(&s, &[], None);
+    let (mut session, _) = LiveSession::open_with(gpu(), &args, registry).unwrap_or_else(|_| panic!("loads"));
     let camera = OrbitCamera::default();
     assert!(session.frame(&camera, None).expect("a good frame").is_empty());
     session.runtime.finish();

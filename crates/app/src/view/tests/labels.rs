@@ -3,35 +3,17 @@
 //! table upload — the plan and its pipelines stay — and the next frame shows only it; the value
 //! under the cursor names its label.
 
-use std::sync::Arc;
-
 use volgraph_accel::camera::OrbitCamera;
-use volgraph_core::runtime::Gpu;
 
-use super::{frame, scratch};
+use super::{frame, gpu, scratch, session_args};
 use crate::view::label_list::LabelEdit;
 use crate::view::session::{Event, LiveSession, SessionArgs};
 
 #[test]
 fn a_label_shown_alone_is_a_table_upload_and_the_cursor_names_it() {
     let s = scratch("labels", "graphs/multi/labels.ron");
-    let gpu = Arc::new(Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)"));
-    let args = SessionArgs {
-        scene: None,
-        graph: s.graph.clone(),
-        volume: vec!["organs_labels32".into()],
-        raw: Default::default(),
-        tf: None,
-        tf_map: None,
-        viewport: (48, 48),
-        features: Vec::new(),
-        shaders: Some(s.shaders.clone()),
-        gpu_memory_mb: None,
-        cuts: Default::default(),
-        named: Vec::new(),
-        named_tfs: Vec::new(),
-    };
-    let (mut session, _) = LiveSession::open(gpu, &args).unwrap_or_else(|_| panic!("multi/labels opens"));
+    let args = session_args(&s, &["organs_labels32"], None);
+    let (mut session, _) = LiveSession::open(gpu(), &args).unwrap_or_else(|_| panic!("multi/labels opens"));
     let list = session.labels().expect("a label list");
     let names: Vec<&str> = list.rows.iter().map(|r| r.name.as_str()).collect();
     assert_eq!(names, ["liver", "left kidney", "right kidney", "spleen", "aorta", "vertebra"]);
@@ -62,23 +44,11 @@ fn a_label_shown_alone_is_a_table_upload_and_the_cursor_names_it() {
 #[test]
 fn the_viewer_binds_volumes_by_name_and_lists_the_label_maps_labels() {
     let s = scratch("named", "graphs/multi/ct_with_labels.ron");
-    let gpu = Arc::new(Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)"));
     let args = SessionArgs {
-        scene: None,
-        graph: s.graph.clone(),
-        volume: vec!["organs32".into()],
-        raw: Default::default(),
-        tf: Some("ct-soft-tissue".into()),
-        tf_map: None,
-        viewport: (48, 48),
-        features: Vec::new(),
-        shaders: Some(s.shaders.clone()),
-        gpu_memory_mb: None,
-        cuts: Default::default(),
         named: vec![("volume".into(), "organs32".into()), ("labels".into(), "organs_labels32".into())],
-        named_tfs: Vec::new(),
+        ..session_args(&s, &["organs32"], Some("ct-soft-tissue".into()))
     };
-    let (mut session, _) = LiveSession::open(gpu, &args).unwrap_or_else(|_| panic!("ct_with_labels opens"));
+    let (mut session, _) = LiveSession::open(gpu(), &args).unwrap_or_else(|_| panic!("ct_with_labels opens"));
     let list = session.labels().expect("the labels volume's list");
     assert_eq!(list.rows.first().map(|r| r.name.as_str()), Some("liver"));
     let tinted = frame(&mut session);

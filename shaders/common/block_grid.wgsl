@@ -8,10 +8,9 @@
 #import "common/frame.wgsl"
 
 // The grids are read through the non-filtering sampler at texel centres (`block_texel`) rather
-// than with `textureLoad`: llvmpipe's texel fetch takes a level per lane and reads every
-// level's size and strides lane by lane, and was 1.7× the time of this lookup (8.7 against
-// 5.0 % of a `fastest` frame on hydrogen; bench/one-march-final.md, "llvmpipe profile").
-@group(0) @binding(auto) var nearest_clamp: sampler;
+// than with `textureLoad`: 1.7× less time for this lookup (8.7 against 5.0 % of a `fastest`
+// frame on hydrogen; bench/one-march-final.md, "llvmpipe profile").
+#import "common/nearest_clamp.wgsl"
 
 // The constants of block look-ups, read once per leap (common/leap_empty.wgsl's `LeapGrid`).
 struct BlockGrid {

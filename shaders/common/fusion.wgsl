@@ -12,18 +12,27 @@
 
 // Declared once: `FusionMap` (pass_params!) in crates/passes/src/fusion.rs.
 #import "params/FusionMap.wgsl"
+#import "common/nearest_clamp.wgsl"
 
 @group(0) @binding(auto) var<uniform> fusion: FusionMap;
 
 const COMBINE_INSIDE: u32 = 3u;
 const COMBINE_ADD: u32 = 5u;
 
-// The uniform's values, read once per ray (`begin_fusion`, from `begin_ray`): on llvmpipe a
-// uniform read inside the sample loop is repeated every sample, one lane at a time.
+// The uniform's values and the textures' sizes, read once per ray (`begin_fusion`, from
+// `begin_ray`): on llvmpipe a uniform or texture-size read inside the sample loop is repeated
+// every sample, one lane at a time.
 var<private> fusion_scale: vec3<f32>;
 var<private> fusion_offset: vec3<f32>;
 var<private> fusion_decode: vec2<f32>;
 var<private> fusion_combine: u32;
+#if FUSION_SCALAR
+#else
+// The label map's voxels per axis, their inverse, and the label table's texel size.
+var<private> label_n: vec3<f32>;
+var<private> label_inv_n: vec3<f32>;
+var<private> label_table_texel: vec2<f32>;
+#endif
 
 fn begin_fusion() {
     fusion_scale = fusion.second_scale.xyz;
@@ -33,6 +42,12 @@ fn begin_fusion() {
     fusion_decode = fusion.first_labels.xy;
 #else
     fusion_decode = fusion.second_labels.xy;
+#endif
+#if FUSION_SCALAR
+#else
+    label_n = vec3<f32>(label_dims());
+    label_inv_n = vec3<f32>(1.0) / label_n;
+    label_table_texel = vec2<f32>(1.0) / vec2<f32>(textureDimensions(label_table));
 #endif
 }
 
@@ -51,8 +66,8 @@ fn begin_fusion() {
 @group(0) @binding(auto) var label_table: texture_2d<f32>;
 
 // The label map is the frame volume.
-fn label_texel(i: vec3<i32>) -> f32 {
-    return textureLoad(volume, i, 0).r;
+fn label_texel(at: vec3<f32>) -> f32 {
+    return textureSampleLevel(volume, nearest_clamp, at, 0.0).r;
 }
 fn label_dims() -> vec3<i32> {
     return vec3<i32>(textureDimensions(volume));
@@ -62,8 +77,8 @@ fn label_dims() -> vec3<i32> {
 @group(0) @binding(auto) var label_table: texture_2d<f32>;
 
 // The label map is the second volume.
-fn label_texel(i: vec3<i32>) -> f32 {
-    return textureLoad(second, i, 0).r;
+fn label_texel(at: vec3<f32>) -> f32 {
+    return textureSampleLevel(second, nearest_clamp, at, 0.0).r;
 }
 fn label_dims() -> vec3<i32> {
     return vec3<i32>(textureDimensions(second));
@@ -80,21 +95,23 @@ fn label_dims() -> vec3<i32> {
 const UNIFORM_BLOCK: i32 = 4;
 #endif
 
-// The label value of voxel `i`: a texel holds (v - lo) / (hi - lo), so v = lo + texel · (hi - lo).
-fn label_at(i: vec3<i32>) -> u32 {
+// The label value of the voxel whose centre is at texture point `at` (the sampler clamps to the
+// map's edge): a texel holds (v - lo) / (hi - lo), so v = lo + texel · (hi - lo).
+fn label_at(at: vec3<f32>) -> u32 {
     let d = fusion_decode;
-    return u32(max(round(d.x + label_texel(i) * d.y), 0.0));
+    return u32(max(round(d.x + label_texel(at) * d.y), 0.0));
 }
 
 // The label at the label map's texture point `u` (volgraph_accel::labels::sample_label).
 fn sample_label(u: vec3<f32>) -> u32 {
-    let n = label_dims();
-    let p = u * vec3<f32>(n) - vec3<f32>(0.5);
-    let top = n - vec3<i32>(1);
+    let p = u * label_n - vec3<f32>(0.5);
 #if LABELS_NEAREST
-    return label_at(clamp(vec3<i32>(floor(p + vec3<f32>(0.5))), vec3<i32>(0), top));
+    return label_at((floor(p + vec3<f32>(0.5)) + vec3<f32>(0.5)) * label_inv_n);
 #else
-    // Inside one structure (or the background) the 8 corners hold one label: one read.
+    // Inside one structure (or the background) the 8 corners hold one label: one read. (A GPU
+    // skips the 8 reads below for a warp that is all inside; llvmpipe runs both sides of every
+    // branch, masked, so there the reads' count and cost decide: bench/multi.md.)
+    let top = vec3<i32>(label_n) - vec3<i32>(1);
     let nearest = clamp(vec3<i32>(floor(p + vec3<f32>(0.5))), vec3<i32>(0), top);
     let uniform = textureLoad(label_blocks, nearest / UNIFORM_BLOCK, 0).r;
     if (uniform != 0u) {
@@ -103,11 +120,23 @@ fn sample_label(u: vec3<f32>) -> u32 {
     let base = floor(p);
     let f = p - base;
     let g = vec3<f32>(1.0) - f;
-    let b = vec3<i32>(base);
+    // Corner (0, 0, 0)'s centre; the others one texel further along each axis.
+    let c = (base + vec3<f32>(0.5)) * label_inv_n;
+    let t = label_inv_n;
     // The 8 corners' labels and trilinear weights, corner (x, y, z) at x + 2y + 4z: vectors, not
     // arrays (a private array costs every sample on llvmpipe, taken or not).
-    let la = vec4<u32>(corner_label(b, 0, 0, 0), corner_label(b, 1, 0, 0), corner_label(b, 0, 1, 0), corner_label(b, 1, 1, 0));
-    let lb = vec4<u32>(corner_label(b, 0, 0, 1), corner_label(b, 1, 0, 1), corner_label(b, 0, 1, 1), corner_label(b, 1, 1, 1));
+    let la = vec4<u32>(
+        label_at(c),
+        label_at(c + vec3<f32>(t.x, 0.0, 0.0)),
+        label_at(c + vec3<f32>(0.0, t.y, 0.0)),
+        label_at(c + vec3<f32>(t.x, t.y, 0.0)),
+    );
+    let lb = vec4<u32>(
+        label_at(c + vec3<f32>(0.0, 0.0, t.z)),
+        label_at(c + vec3<f32>(t.x, 0.0, t.z)),
+        label_at(c + vec3<f32>(0.0, t.y, t.z)),
+        label_at(c + t),
+    );
     let wa = vec4<f32>(g.x * g.y, f.x * g.y, g.x * f.y, f.x * f.y) * g.z;
     let wb = vec4<f32>(g.x * g.y, f.x * g.y, g.x * f.y, f.x * f.y) * f.z;
     // The nearest voxel's label holds the largest single weight: with more than half of the
@@ -139,11 +168,6 @@ fn sample_label(u: vec3<f32>) -> u32 {
 
 #if LABELS_NEAREST
 #else
-// The label of corner `b + (x, y, z)`, clamped to the map.
-fn corner_label(b: vec3<i32>, x: i32, y: i32, z: i32) -> u32 {
-    return label_at(clamp(b + vec3<i32>(x, y, z), vec3<i32>(0), label_dims() - vec3<i32>(1)));
-}
-
 // The summed weight of `label` over the corners (labels `la`, `lb`, weights `wa`, `wb`).
 fn label_weight(label: u32, la: vec4<u32>, lb: vec4<u32>, wa: vec4<f32>, wb: vec4<f32>) -> f32 {
     let one = vec4<f32>(1.0);
@@ -151,13 +175,13 @@ fn label_weight(label: u32, la: vec4<u32>, lb: vec4<u32>, wa: vec4<f32>, wb: vec
 }
 #endif
 
-// The table's colour and opacity of `label` (hidden past its end).
+// The table's colour and opacity of `label` (hidden past its end), read at its texel's centre.
 fn label_entry(label: u32) -> vec4<f32> {
-    let at = vec2<u32>(label % 256u, label / 256u);
-    if (at.y >= textureDimensions(label_table).y) {
+    let at = (vec2<f32>(f32(label % 256u), f32(label / 256u)) + vec2<f32>(0.5)) * label_table_texel;
+    if (at.y >= 1.0) {
         return vec4<f32>(0.0);
     }
-    return textureLoad(label_table, vec2<i32>(at), 0);
+    return textureSampleLevel(label_table, nearest_clamp, at, 0.0);
 }
 #endif
 

@@ -1,5 +1,5 @@
 //! The DICOM fuzzer (issue 47): valid small files (native 16-bit, multi-frame, RLE Lossless,
-//! JPEG 2000, Float Pixel Data, with and without the preamble) with attributes replaced by
+//! JPEG 2000, Float Pixel Data, a BINARY segmentation, with and without the preamble) with attributes replaced by
 //! hostile values (sizes 0 and 2³²−1, NumberOfFrames 10⁸, NaN, inf, 1e300, junk text, wrong
 //! value counts, PALETTE COLOR, newlines), RLE headers and segments made of junk, bytes flipped
 //! and the file cut short; some cases load a folder of it and a second slice with its own
@@ -56,6 +56,9 @@ const FIELDS: &[(Tag, VR)] = &[
     (tags::WINDOW_WIDTH, VR::DS),
     (tags::DOSE_GRID_SCALING, VR::DS),
     (tags::PLANAR_CONFIGURATION, VR::IS),
+    (tags::MODALITY, VR::CS),
+    (tags::SEGMENTATION_TYPE, VR::CS),
+    (tags::MAXIMUM_FRACTIONAL_VALUE, VR::US),
 ];
 
 /// Hostile values.
@@ -97,6 +100,10 @@ const VALUES: &[&str] = &[
     "MONOCHROME1",
     "RGB",
     "axial\nerror: fake",
+    "SEG",
+    "BINARY",
+    "FRACTIONAL",
+    "LABELMAP",
     "\u{1b}]0;x\u{7}",
 ];
 
@@ -108,6 +115,8 @@ enum Base {
     Rle,
     Jpeg2000,
     Float,
+    /// A BINARY DICOM SEG (`write_segmentation`) of two segments over three slices.
+    Segmentation,
 }
 
 /// One fuzz case.
@@ -144,8 +153,28 @@ impl Case {
     }
 
     fn bytes(&self) -> Vec<u8> {
+        let mut bytes = match self.base {
+            Base::Segmentation => segmentation_bytes(&self.edits),
+            _ => self.image_bytes(),
+        };
+        if self.no_preamble {
+            bytes.drain(..128);
+        }
+        let len = bytes.len();
+        for &(at, xor) in &self.flips {
+            bytes[at % len] ^= xor;
+        }
+        if let Some(keep) = self.cut {
+            bytes.truncate(len * usize::from(keep) / 1000);
+        }
+        bytes
+    }
+
+    /// The image bases' bytes, with the case's pixels and edits.
+    fn image_bytes(&self) -> Vec<u8> {
         let mut image = Image::default();
         match self.base {
+            Base::Segmentation => unreachable!("segmentation_bytes"),
             Base::Native => {}
             Base::MultiFrame => {
                 let values: Vec<u16> = (0..90).map(|i| i * 7).collect();
@@ -176,19 +205,32 @@ impl Case {
             let (tag, vr) = FIELDS[field % FIELDS.len()];
             image = image.with(tag, vr, VALUES[value % VALUES.len()]);
         }
-        let mut bytes = image.bytes();
-        if self.no_preamble {
-            bytes.drain(..128);
-        }
-        let len = bytes.len();
-        for &(at, xor) in &self.flips {
-            bytes[at % len] ^= xor;
-        }
-        if let Some(keep) = self.cut {
-            bytes.truncate(len * usize::from(keep) / 1000);
-        }
-        bytes
+        image.bytes()
     }
+}
+
+/// The SEG base: a 6×5×3 map of labels 1 and 2 written by `write_segmentation`, with `edits`
+/// put into its data set (numbers for US, text otherwise).
+fn segmentation_bytes(edits: &[(usize, usize)]) -> Vec<u8> {
+    use volgraph_accel::volume::{Volume, VoxelData};
+    let values: Vec<u8> = (0..90u32).map(|i| [0, 1, 1, 2, 0][(i % 5) as usize]).collect();
+    let map = Volume::new("seg", glam::UVec3::new(6, 5, 3), glam::DVec3::new(0.5, 0.5, 2.0), VoxelData::U8(values));
+    let path = scratch_file().with_file_name("segmentation_base.dcm");
+    volgraph_accel::load::dicom::write_segmentation(&path, &map, &[(1, "one", [255, 0, 0]), (2, "two", [0, 0, 255])])
+        .expect("the SEG base");
+    let mut object = dicom_object::open_file(&path).expect("reads back");
+    for &(field, value) in edits {
+        let (tag, vr) = FIELDS[field % FIELDS.len()];
+        let v = VALUES[value % VALUES.len()];
+        let value = match vr {
+            VR::US => PrimitiveValue::from(v.parse::<u16>().unwrap_or(0)),
+            _ => PrimitiveValue::from(v),
+        };
+        object.put(DataElement::new(tag, vr, value));
+    }
+    let mut bytes = Vec::new();
+    object.write_all(&mut bytes).expect("written");
+    bytes
 }
 
 fn case() -> impl Strategy<Value = Case> {
@@ -197,7 +239,8 @@ fn case() -> impl Strategy<Value = Case> {
         Just(Base::MultiFrame),
         Just(Base::Rle),
         Just(Base::Jpeg2000),
-        Just(Base::Float)
+        Just(Base::Float),
+        Just(Base::Segmentation)
     ];
     let count = prop_oneof![0u32..20, Just(0xFFFF_FFFFu32), any::<u32>()];
     let rle = proptest::option::weighted(
@@ -238,14 +281,14 @@ fn scratch_file() -> PathBuf {
 #[test]
 fn valid_fuzz_bases_load() {
     let path = scratch_file().with_file_name("base.dcm");
-    for base in [Base::Native, Base::MultiFrame, Base::Rle, Base::Float] {
+    for base in [Base::Native, Base::MultiFrame, Base::Rle, Base::Float, Base::Segmentation] {
         for no_preamble in [false, true] {
             let case =
                 Case { base, edits: Vec::new(), rle: None, flips: Vec::new(), cut: None, no_preamble, neighbour: None };
             std::fs::write(&path, case.bytes()).expect("written");
             let loaded = load_volumes(std::slice::from_ref(&path), &LoadOptions::default())
                 .unwrap_or_else(|e| panic!("{case:?}: {e}"));
-            let want = if matches!(base, Base::MultiFrame) { 90 } else { 30 };
+            let want = if matches!(base, Base::MultiFrame | Base::Segmentation) { 90 } else { 30 };
             assert_eq!(loaded.volume.voxel_count(), want, "{case:?}");
         }
     }

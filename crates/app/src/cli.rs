@@ -88,7 +88,7 @@ enum Command {
         labels: bool,
         /// The label map's names and colours: an ITK-SNAP label description file, a 3D Slicer
         /// colour table (.ctbl, .txt) or segmentation (.seg.nrrd, whose header names its
-        /// segments; a .seg.nrrd given as the volume names its own). Implies --labels.
+        /// segments, or a DICOM SEG; either given as the volume names its own). Implies --labels.
         #[arg(long, value_name = "TABLE")]
         label_table: Option<PathBuf>,
         /// How to read a headerless raw volume.

@@ -47,11 +47,9 @@ pub fn run(paths: &[PathBuf], options: &LoadOptions<'static>, labels: Option<&La
     let name = paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(" ");
     out.push_str(&describe(Path::new(&name), &volume));
     if let Some(labels) = labels {
-        // A 3D Slicer segmentation names its own segments.
+        // A 3D Slicer or DICOM segmentation names its own segments.
         let own = match (&labels.table, paths) {
-            (None, [one]) if volgraph_accel::labels::slicer_seg::is_seg_nrrd(one) => {
-                Labels { table: Some(one.clone()) }
-            }
+            (None, [one]) if volgraph_accel::labels::names_its_labels(one) => Labels { table: Some(one.clone()) },
             _ => labels.clone(),
         };
         out.push_str(&label_report(&volume, &own)?);

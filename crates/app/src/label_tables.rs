@@ -1,7 +1,7 @@
 //! The label tables a graph's `LabelTable` inputs are bound to (issue "several volumes", item 3):
-//! `--tf NAME=FILE` (an ITK-SNAP label description, a 3D Slicer colour table, a `.seg.nrrd`
+//! `--tf NAME=FILE` (an ITK-SNAP label description, a 3D Slicer colour table, a `.seg.nrrd` or DICOM SEG
 //! whose segments name their values) or `--tf NAME=default`; without one, the label map's own
-//! names where its file has them (`.seg.nrrd`), else the default palette. Which map a table
+//! names where its file has them (`.seg.nrrd`, DICOM SEG), else the default palette. Which map a table
 //! colours: input `X_table` colours volume input `X`; `label_table` the volume input `labels`,
 //! else the frame's volume.
 
@@ -10,7 +10,7 @@ use std::path::Path;
 use anyhow::anyhow;
 use volgraph_accel::labels::LabelTable;
 use volgraph_accel::labels::census::census;
-use volgraph_accel::labels::slicer_seg::is_seg_nrrd;
+use volgraph_accel::labels::names_its_labels;
 use volgraph_accel::volume::Volume;
 
 /// Label values a table texture holds at most (256 per row, 8192 rows: wgpu's least 2D limit).
@@ -56,7 +56,7 @@ pub fn label_table(
     let table_file = match given {
         Some(p) if p.as_os_str() == "default" => None,
         Some(p) => Some(p),
-        None => map_path.filter(|p| is_seg_nrrd(p)),
+        None => map_path.filter(|p| names_its_labels(p)),
     };
     let table = match table_file {
         // The generated organ phantom's map comes with its organs' names and colours.

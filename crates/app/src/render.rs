@@ -251,7 +251,7 @@ pub(crate) fn named_bindings(
     for name in table_inputs {
         let map_name = crate::label_tables::map_input_of(name, &volume_inputs);
         let map = map_name.as_deref().and_then(by_name).unwrap_or(volume);
-        // The map's file (a .seg.nrrd names its own labels): a named one's, or the frame volume's.
+        // The map's file (a .seg.nrrd or DICOM SEG names its own labels): a named one's, or the frame volume's.
         let map_path = match map_name.as_deref().and_then(|m| named.iter().find(|(n, _)| n == m)) {
             Some((_, path)) => Some(path.as_path()),
             None => frame_path,

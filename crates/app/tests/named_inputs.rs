@@ -295,3 +295,57 @@ fn a_4d_files_volumes_bind_as_channels() {
     let (ok, err) = render("7", "none.exr");
     assert!(!ok && err.contains("--volume channel2=…: "), "{err}");
 }
+
+/// A DICOM SEG over its scan (issue "several volumes", item 3): the phantom's label map written
+/// as a BINARY SEG (`write_segmentation`, its organs as segments with their names and colours)
+/// binds as `--volume labels=seg.dcm` and names its own labels — the image is the one the
+/// generated map with the phantom's table gives, within the one step of 255 that colours take
+/// through DICOM's 16-bit CIELab; `info --labels` lists its segments by name.
+#[test]
+fn a_dicom_seg_binds_as_the_label_map_it_holds_with_its_own_names() {
+    let dir = scratch("dicom-seg");
+    let labels = volgraph_accel::organs::organs_labels(32);
+    let names: Vec<(u8, String, [u8; 3])> =
+        volgraph_accel::organs::label_table().labels.iter().map(|(v, l)| (*v as u8, l.name.clone(), l.rgb)).collect();
+    let names: Vec<(u8, &str, [u8; 3])> = names.iter().map(|(v, n, c)| (*v, n.as_str(), *c)).collect();
+    volgraph_accel::load::dicom::write_segmentation(&dir.join("seg.dcm"), &labels, &names).expect("SEG");
+    let render = |map: &str, out: &str| {
+        let map = format!("labels={map}");
+        let args = [
+            "render",
+            "multi/ct_with_labels",
+            "--volume",
+            "volume=organs32",
+            "--volume",
+            &map,
+            "--size",
+            "64x64",
+            "-o",
+            out,
+        ];
+        let (ok, err) = volgraph(&args, &dir);
+        assert!(ok, "{err}");
+        pixels(&dir.join(out))
+    };
+    let from_seg = render("seg.dcm", "seg.exr");
+    let generated = render("organs_labels32", "generated.exr");
+    let worst = from_seg
+        .iter()
+        .zip(&generated)
+        .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
+        .fold(0.0f32, f32::max);
+    let tinted = from_seg.iter().filter(|p| p[3] > 0.05).count();
+    assert!(tinted > 200, "the scan shows ({tinted} pixels)");
+    assert!(worst <= 1.5 / 255.0, "largest difference {} / 255", worst * 255.0);
+
+    let out = Command::new(env!("CARGO_BIN_EXE_volgraph"))
+        .args(["info", "seg.dcm", "--labels"])
+        .current_dir(&dir)
+        .output()
+        .expect("runs");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    for (_, name, _) in &names {
+        assert!(text.contains(name), "{name} missing from:\n{text}");
+    }
+}

@@ -133,6 +133,12 @@ fn hsv_bytes(hue: f64, s: f64, v: f64) -> [u8; 3] {
     [r, g, b].map(|t| ((t + m) * 255.0).round().clamp(0.0, 255.0) as u8)
 }
 
+/// Whether the volume file `path` names its own labels (a 3D Slicer `.seg.nrrd`, a DICOM SEG
+/// file): its table is read from it where no other is given.
+pub fn names_its_labels(path: &Path) -> bool {
+    slicer_seg::is_seg_nrrd(path) || crate::load::dicom::seg::is_seg_file(path)
+}
+
 impl LabelTable {
     /// The default palette for the values `values` (a map's census), each [`default_label`].
     pub fn default_for(values: impl IntoIterator<Item = u32>) -> Self {
@@ -149,10 +155,16 @@ impl LabelTable {
 
     /// Reads a table file, its format told by its text: ITK-SNAP's (entries with a quoted
     /// label, or its header comment) or 3D Slicer's colour table (`value name R G B A`); or the
-    /// segments a 3D Slicer segmentation (`.seg.nrrd`) names in its header. Notes (segments
+    /// segments a segmentation names: a 3D Slicer `.seg.nrrd`'s header, a DICOM SEG's
+    /// SegmentSequence ([`names_its_labels`]). Notes (segments
     /// left out) come back beside the table.
     pub fn read(path: &Path) -> Result<(Self, Vec<String>), LabelTableError> {
         let file = path.display().to_string();
+        if crate::load::dicom::seg::is_seg_file(path) {
+            let segments = crate::load::dicom::seg::segments(path)
+                .map_err(|e| LabelTableError::File { file: file.clone(), message: e.to_string() })?;
+            return Ok((crate::load::dicom::seg::table(path, &segments), Vec::new()));
+        }
         if slicer_seg::is_seg_nrrd(path) {
             let pairs = crate::load::nrrd_key_values(path).map_err(|e| LabelTableError::File {
                 file: file.clone(),

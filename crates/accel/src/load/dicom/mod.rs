@@ -11,9 +11,10 @@ mod geometry;
 mod header;
 mod lengths;
 mod pixels;
+pub mod seg;
 mod write;
 
-pub use write::write_ct_series;
+pub use write::{write_ct_series, write_segmentation};
 
 use std::path::{Path, PathBuf};
 
@@ -277,7 +278,11 @@ pub fn load(
     options: &DicomOptions,
     progress: Option<Progress<'_>>,
 ) -> Result<LoadedVolume, LoadError> {
-    let Stacked { series, ordered, stack, file_dims, mut notes } = stack_series(paths, options.series.as_deref())?;
+    let (series, notes) = pick_series(paths, options.series.as_deref())?;
+    if seg::is_segmentation(&series[0]) {
+        return seg::load(&series[0], notes);
+    }
+    let Stacked { series, ordered, stack, file_dims, mut notes } = stack_picked(series, notes)?;
     notes.extend(stack.notes.iter().cloned());
     let first = series[0].clone();
     let (voxels, pixel_notes) = pixels::read(&series, &ordered, file_dims, progress)?;
@@ -335,12 +340,15 @@ struct Stacked {
     notes: Vec<String>,
 }
 
-/// Scans `paths`, picks the series (`wanted`, or the only one), checks its pixels can be read
-/// and orders its frames along the slice normal.
-fn stack_series(paths: &[PathBuf], wanted: Option<&str>) -> Result<Stacked, LoadError> {
+/// Scans `paths` and picks the series (`wanted`, or the only one), with the scan's notes.
+fn pick_series(paths: &[PathBuf], wanted: Option<&str>) -> Result<(Vec<FileHeader>, Vec<String>), LoadError> {
     let place = paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
-    let (groups, mut notes) = scan(paths)?;
-    let series = choose(&place, groups, wanted)?;
+    let (groups, notes) = scan(paths)?;
+    Ok((choose(&place, groups, wanted)?, notes))
+}
+
+/// Checks the pixels of `series` can be read and orders its frames along the slice normal.
+fn stack_picked(series: Vec<FileHeader>, mut notes: Vec<String>) -> Result<Stacked, LoadError> {
     let first = series[0].clone();
     let series_name = if first.description.is_empty() {
         format!("series {}", first.series_number.map_or(first.series_uid.clone(), |n| n.to_string()))
@@ -415,7 +423,11 @@ pub struct SeriesSlices {
 impl SeriesSlices {
     /// The series in `paths` (`wanted`, or the only one; its slices along the patient axes).
     pub fn open(paths: &[PathBuf], wanted: Option<&str>) -> Result<Self, LoadError> {
-        let Stacked { series, ordered, stack, file_dims, .. } = stack_series(paths, wanted)?;
+        let (series, notes) = pick_series(paths, wanted)?;
+        if seg::is_segmentation(&series[0]) {
+            return Err(LoadError::NoBoxRead { path: series[0].path.clone(), format: "DICOM segmentation" });
+        }
+        let Stacked { series, ordered, stack, file_dims, .. } = stack_picked(series, notes)?;
         let first = &series[0];
         let at = Location::file(&first.path);
         let (orientation, spacing) =

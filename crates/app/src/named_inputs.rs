@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::anyhow;
+use volgraph_accel::transfer_function::TransferFunction;
 use volgraph_accel::volume::Volume;
 use volgraph_core::graph::ast::InputKind;
 
@@ -122,8 +123,8 @@ pub struct NamedBindings {
     pub primary: Option<String>,
     /// The other named volumes, `(input, volume)`, in the order given.
     pub others: Vec<(String, Volume)>,
-    /// `(input, LUT)`.
-    pub luts: Vec<(String, Vec<[f32; 4]>)>,
+    /// The transfer functions bound by name, or fitted to another volume (`X_tf` of `X`).
+    pub tfs: Vec<NamedTf>,
     /// `(input, label table by label value)` for the graph's `LabelTable` inputs.
     pub tables: Vec<(String, Vec<[f32; 4]>)>,
     /// Volumes of different DICOM frames of reference are shown as their files place them
@@ -131,7 +132,38 @@ pub struct NamedBindings {
     pub allow_frame_mismatch: bool,
 }
 
+/// A transfer-function input bound by name (`--tf pet_tf=hot.ron`), or one of another volume
+/// (`pet_tf` of `pet`) fitted to it: what the viewer's editor of that input edits.
+pub struct NamedTf {
+    /// The graph input.
+    pub input: String,
+    /// The volume input whose values it classifies (`X` for `X_tf`); `None`: the frame volume.
+    pub base: Option<String>,
+    /// The transfer function.
+    pub tf: TransferFunction,
+    /// What `--tf NAME=` gave (a file, a preset's name); `None`: the plain `--tf` or the fit.
+    pub given: Option<PathBuf>,
+    /// Its LUT over the base volume's range.
+    pub lut: Vec<[f32; 4]>,
+}
+
 impl NamedBindings {
+    /// The volume named TF `tf` classifies: its base, else `frame`.
+    pub fn base_of<'a>(&'a self, tf: &NamedTf, frame: &'a Volume) -> &'a Volume {
+        tf.base.as_deref().and_then(|b| self.others.iter().find(|(n, _)| n == b)).map_or(frame, |(_, v)| v)
+    }
+
+    /// Sets the named TF `input` to `tf` (its LUT made over its base volume, `frame` where it has
+    /// none); returns the LUT to upload, `None` if no such input is bound by name.
+    pub fn set_tf(&mut self, input: &str, tf: TransferFunction, frame: &Volume) -> Option<&[[f32; 4]]> {
+        let i = self.tfs.iter().position(|t| t.input == input)?;
+        let lut = tf.to_lut_for(self.base_of(&self.tfs[i], frame), crate::inputs::LUT_SIZE);
+        let named = &mut self.tfs[i];
+        named.tf = tf;
+        named.lut = lut;
+        Some(&named.lut)
+    }
+
     /// The index in `named` of the frame's volume: the input named `volume`, else the first.
     pub fn primary_index(named: &[(String, PathBuf)]) -> usize {
         named.iter().position(|(n, _)| n == volgraph_core::runtime::inputs::PRIMARY_VOLUME).unwrap_or(0)
@@ -168,7 +200,7 @@ impl NamedBindings {
                 return Err(unknown("--volume", name, &InputKind::Volume, "volume"));
             }
         }
-        for (name, _) in &self.luts {
+        for name in self.tfs.iter().map(|t| &t.input) {
             if plan.inputs.get(name) != Some(&InputKind::TransferFunction) {
                 return Err(unknown("--tf", name, &InputKind::TransferFunction, "transfer-function"));
             }
@@ -226,7 +258,7 @@ impl NamedBindings {
                     None => runtime.bind_volume(name, volume)?,
                 },
                 InputKind::TransferFunction => {
-                    let named = self.luts.iter().find(|(n, _)| n == name).map(|(_, l)| l.as_slice());
+                    let named = self.tfs.iter().find(|t| &t.input == name).map(|t| t.lut.as_slice());
                     runtime.bind_lut(name, named.unwrap_or(lut))?
                 }
                 InputKind::LabelTable => match self.tables.iter().find(|(n, _)| n == name) {

@@ -13,7 +13,7 @@ use volgraph_core::runtime::{CameraData, Gpu, Runtime, ShaderLibrary, VolumeDesc
 use crate::cli::{CliError, check_user_names, compile_options, display_name, warning_lines};
 use crate::image_out::{self, ImageKind};
 use crate::inputs;
-use crate::named_inputs::NamedBindings;
+use crate::named_inputs::{NamedBindings, NamedTf};
 use crate::scene::{CameraSpec, Scene};
 use crate::scene_args::{Resolved, SceneArgs};
 use volgraph_core::runtime::OpacityReference;
@@ -225,14 +225,17 @@ pub(crate) fn named_bindings(
     }
     let mut notes = Vec::new();
     let by_name = |n: &str| others.iter().find(|(o, _)| o == n).map(|(_, v)| v);
-    let mut luts = Vec::new();
+    let mut tfs = Vec::new();
+    // The volume input a TF input classifies: `X` for `X_tf` where X is bound by name.
+    let base_name = |name: &str| name.strip_suffix("_tf").filter(|b| by_name(b).is_some()).map(str::to_string);
     for (name, path) in named_tfs.iter().filter(|(n, _)| !table_inputs.contains(&n)) {
         // A TF named NAME_tf is fitted to (and its presets read in the units of) volume NAME.
         let base = name.strip_suffix("_tf").and_then(by_name).unwrap_or(volume);
         let (tf, tf_notes) =
             inputs::transfer_function(Some(path), tf_map, base, false).map_err(|e| anyhow!("--tf {name}=…: {e:#}"))?;
         notes.extend(tf_notes);
-        luts.push((name.clone(), tf.to_lut_for(base, inputs::LUT_SIZE)));
+        let lut = tf.to_lut_for(base, inputs::LUT_SIZE);
+        tfs.push(NamedTf { input: name.clone(), base: base_name(name), tf, given: Some(path.clone()), lut });
     }
     // An unnamed TF input X_tf of another volume X takes the plain --tf (or the default) fitted
     // to X: the frame volume's LUT would read X's normalized values in the frame volume's range.
@@ -244,7 +247,10 @@ pub(crate) fn named_bindings(
         let (tf, tf_notes) =
             inputs::transfer_function(plain_tf, tf_map, base, false).map_err(|e| anyhow!("{name}: {e:#}"))?;
         notes.extend(tf_notes);
-        luts.push((name.clone(), tf.to_lut_for(base, inputs::LUT_SIZE)));
+        let lut = tf.to_lut_for(base, inputs::LUT_SIZE);
+        // Not the plain --tf's file: that is the frame volume's, which "save TF" of this one must
+        // not overwrite.
+        tfs.push(NamedTf { input: name.clone(), base: base_name(name), tf, given: None, lut });
     }
     let volume_inputs = volume_input_names(plan);
     let mut tables = Vec::new();
@@ -262,7 +268,7 @@ pub(crate) fn named_bindings(
         tables.push((name.clone(), lut));
     }
     let primary = named.get(primary).map(|(n, _)| n.clone());
-    Ok(Some((NamedBindings { primary, others, luts, tables, allow_frame_mismatch: false }, notes)))
+    Ok(Some((NamedBindings { primary, others, tfs, tables, allow_frame_mismatch: false }, notes)))
 }
 
 /// The named volumes but the frame volume (`named[primary]`), loaded (a `#N` suffix picks a

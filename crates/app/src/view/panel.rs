@@ -31,6 +31,8 @@ pub enum Action {
     SaveScene(std::path::PathBuf),
     /// The TF editor's action.
     TransferFunction(super::tf_editor::TfAction),
+    /// The TF editor edits this named TF input (`None`: the frame volume's).
+    TfTarget(Option<String>),
     /// Set a value typed as `PASS.PARAM=VALUE` or `input.NAME=VALUE`.
     Assign(String),
     /// The label list's edit.
@@ -229,7 +231,22 @@ pub fn show(
             // A label map shown alone is coloured by its label list, not by the TF.
             if plan.inputs.values().any(|k| *k == InputKind::TransferFunction) && session.shows_transfer_function() {
                 egui::CollapsingHeader::new("Transfer function").default_open(true).show(ui, |ui| {
-                    let model = &session.workbench().tf;
+                    // One editor per scalar volume: which TF input it edits.
+                    let targets = session.transfer_function_targets();
+                    if targets.len() > 1 {
+                        let current = session.workbench().tf_target.clone();
+                        let label = |t: &Option<String>| {
+                            targets.iter().find(|(i, _)| i == t).map_or(String::new(), |(_, l)| l.clone())
+                        };
+                        egui::ComboBox::from_label("edits").selected_text(label(&current)).show_ui(ui, |ui| {
+                            for (input, text) in &targets {
+                                if ui.selectable_label(*input == current, text).clicked() && *input != current {
+                                    actions.push(Action::TfTarget(input.clone()));
+                                }
+                            }
+                        });
+                    }
+                    let model = session.workbench().edited_tf();
                     let (histogram, range) = model.histogram();
                     let (tf, presets) = (model.transfer_function(), model.presets());
                     if let Some(a) = super::tf_editor::show(ui, tf, histogram, range, presets, model.save_on_change) {

@@ -35,10 +35,13 @@ pub enum ScriptCommand {
     TfPoint(ControlPoint),
     /// `tf-save`: the TF editor's "save TF".
     TfSave,
+    /// `tf-edit INPUT`: the TF editor edits the transfer-function input INPUT (`pet_tf`: one
+    /// editor per scalar volume).
+    TfEdit(String),
 }
 
 /// What the script accepts, for messages.
-pub const USAGE: &str = "quit, screenshot PATH, param PASS.NAME VALUE, write, crop X0,Y0,Z0,X1,Y1,Z1|off, clip NX,NY,NZ,D|off, save-scene PATH, tf-point VALUE R,G,B,A, tf-save";
+pub const USAGE: &str = "quit, screenshot PATH, param PASS.NAME VALUE, write, crop X0,Y0,Z0,X1,Y1,Z1|off, clip NX,NY,NZ,D|off, save-scene PATH, tf-point VALUE R,G,B,A, tf-save, tf-edit INPUT";
 
 /// Parses one line: `Ok(None)` for a blank line, `Err` naming what is wrong.
 pub fn parse_line(line: &str) -> Result<Option<ScriptCommand>, String> {
@@ -65,6 +68,10 @@ pub fn parse_line(line: &str) -> Result<Option<ScriptCommand>, String> {
         }
         "tf-save" if rest.is_empty() => Ok(Some(ScriptCommand::TfSave)),
         "tf-save" => Err(format!("\"{line}\": tf-save takes nothing after it (found \"{rest}\")")),
+        "tf-edit" if rest.is_empty() || rest.contains(char::is_whitespace) => {
+            Err(format!("\"{line}\": write tf-edit INPUT (a transfer-function input of the graph, e.g. pet_tf)"))
+        }
+        "tf-edit" => Ok(Some(ScriptCommand::TfEdit(rest.to_string()))),
         "tf-point" => {
             let bad =
                 || format!("\"{line}\": write tf-point VALUE R,G,B,A (data value; linear colour and opacity in 0..1)");

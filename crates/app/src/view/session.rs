@@ -213,6 +213,7 @@ impl LiveSession {
     pub fn watched_files(&self) -> Vec<PathBuf> {
         let mut files = vec![self.bench.graph.path().to_path_buf()];
         files.extend(self.bench.tf.path().map(Path::to_path_buf));
+        files.extend(self.bench.named_tfs.iter().filter_map(|(_, e)| e.path().map(Path::to_path_buf)));
         files.extend(self.runtime.shaders().watched_files());
         files
     }
@@ -316,6 +317,7 @@ impl LiveSession {
         if self.bench.tf.needs_reload(changed) {
             events.extend(self.reload_transfer_function());
         }
+        events.extend(self.reload_named_transfer_functions(changed));
         let shaders: Vec<PathBuf> =
             changed.iter().filter(|c| c.extension().is_some_and(|e| e == "wgsl")).cloned().collect();
         if !shaders.is_empty() {

@@ -3,7 +3,7 @@
 //! Here: the helpers, and the panel's edits (parameters, write-back, the "set" field, the probe,
 //! the live error, a resize, the level of detail's step); `tests/reload.rs`: file edits (graph,
 //! shaders, transfer function); `tests/gpu_errors.rs`: frames the GPU rejects; `tests/labels.rs`:
-//! the label list.
+//! the label list; `tests/named_tfs.rs`: one TF editor per scalar volume.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -100,6 +100,7 @@ fn open_with_tf_copy(name: &str) -> (Scratch, LiveSession, PathBuf) {
 
 mod gpu_errors;
 mod labels;
+mod named_tfs;
 mod reload;
 
 #[test]

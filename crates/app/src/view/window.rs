@@ -190,8 +190,12 @@ impl Viewer {
                     session.edit_transfer_function(tf)
                 }
                 Action::TransferFunction(TfAction::Save) => session.save_transfer_function_events(),
+                Action::TfTarget(target) => {
+                    session.workbench_mut().tf_target = target;
+                    Vec::new()
+                }
                 Action::TransferFunction(TfAction::SaveOnChange(on)) => {
-                    session.workbench_mut().tf.save_on_change = on;
+                    session.workbench_mut().edited_tf_mut().save_on_change = on;
                     Vec::new()
                 }
                 Action::SaveScene(path) => {
@@ -264,7 +268,7 @@ impl Viewer {
                 Ok(Some(ScriptCommand::SaveScene(path))) => self.apply_actions(vec![Action::SaveScene(path)]),
                 Ok(Some(ScriptCommand::TfPoint(point))) => {
                     let Some(session) = self.session.as_ref() else { continue };
-                    if let Err(message) = session.workbench().tf.check_value(point.value) {
+                    if let Err(message) = session.workbench().edited_tf().check_value(point.value) {
                         crate::stdout::eprintln_escaped!("script: tf-point {message}");
                         continue;
                     }
@@ -272,6 +276,12 @@ impl Viewer {
                     self.apply_actions(vec![Action::TransferFunction(TfAction::Edit(tf))]);
                 }
                 Ok(Some(ScriptCommand::TfSave)) => self.apply_actions(vec![Action::TransferFunction(TfAction::Save)]),
+                Ok(Some(ScriptCommand::TfEdit(input))) => {
+                    let Some(session) = self.session.as_mut() else { continue };
+                    if let Err(message) = session.select_transfer_function(&input) {
+                        crate::stdout::eprintln_escaped!("script: tf-edit {message}");
+                    }
+                }
                 Ok(Some(ScriptCommand::Crop(crop))) => {
                     let Some(session) = self.session.as_ref() else { continue };
                     let planes: Vec<_> = session.runtime.cuts().planes().copied().collect();

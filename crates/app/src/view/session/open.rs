@@ -41,20 +41,12 @@ impl LiveSession {
             }
             (tf, _) => {
                 let (t, notes) = inputs::transfer_function(tf.as_ref(), args.tf_map.as_deref(), &volume, generated)?;
-                // A preset's or a built-in TF's name is no file: nothing to watch, and "save TF"
-                // writes elsewhere.
-                let file =
-                    |p: &PathBuf| scanner_preset_named(p).is_none() && crate::builtin_graphs::find_tf(p).is_none();
-                (t, tf.clone().filter(file), notes)
+                (t, tf_file_and_source(tf.as_ref()).0, notes)
             }
         };
         let tf_source = match (&args.tf, &args.scene) {
             (None, Some(scene)) => scene.transfer_function.clone(),
-            (None, None) => None,
-            (Some(p), _) => Some(match scanner_preset_named(p) {
-                Some(name) => crate::scene::TfSource::Preset(name.to_string()),
-                None => crate::scene::TfSource::File(p.display().to_string()),
-            }),
+            (tf, _) => tf_file_and_source(tf.as_ref()).1,
         };
         for note in tf_notes {
             crate::stdout::eprintln_escaped!("note: {note}");
@@ -157,12 +149,31 @@ impl LiveSession {
         } else {
             None
         };
+        // One TF editor per scalar volume: each TF bound by name or of another volume; the
+        // editor starts on the frame volume's unless every TF input is named.
+        let named_tfs: Vec<(String, TfEdits)> = bindings.as_ref().map_or_else(Vec::new, |b| {
+            b.tfs
+                .iter()
+                .map(|t| {
+                    let (path, source) = tf_file_and_source(t.given.as_ref());
+                    let edits =
+                        TfEdits::new(t.tf.clone(), path, args.tf_map.clone(), source, b.base_of(t, &volume), false);
+                    (t.input.clone(), edits.for_input(&t.input))
+                })
+                .collect()
+        });
+        let every_tf_named = plan
+            .inputs
+            .iter()
+            .filter(|(_, k)| **k == volgraph_core::graph::ast::InputKind::TransferFunction)
+            .all(|(n, _)| named_tfs.iter().any(|(t, _)| t == n));
+        let tf_target = if every_tf_named { named_tfs.first().map(|(n, _)| n.clone()) } else { None };
         runtime.apply(plan, graph.registry()).map_err(|e| crate::cli::CliError::Other(anyhow!(e)))?;
         graph.set_options(options);
         let graph_name = graph.name().to_string();
         let session = Self {
             runtime,
-            bench: Workbench { graph, tf },
+            bench: Workbench { graph, tf, named_tfs, tf_target },
             volume,
             lut,
             shader_dirs,
@@ -179,4 +190,17 @@ impl LiveSession {
         let ms = start.elapsed().as_secs_f64() * 1e3;
         Ok((session, Event::Loaded { graph: graph_name, ms, summary: loaded }))
     }
+}
+
+/// What `--tf` gave (`given`), as the TF editor keeps it: the file to watch — none for a
+/// preset's or a built-in TF's name, which "save TF" writes elsewhere — and where the TF came
+/// from, for "save view" (`None`: fitted to the data).
+fn tf_file_and_source(given: Option<&PathBuf>) -> (Option<PathBuf>, Option<crate::scene::TfSource>) {
+    let Some(p) = given else { return (None, None) };
+    let file = scanner_preset_named(p).is_none() && crate::builtin_graphs::find_tf(p).is_none();
+    let source = match scanner_preset_named(p) {
+        Some(name) => crate::scene::TfSource::Preset(name.to_string()),
+        None => crate::scene::TfSource::File(p.display().to_string()),
+    };
+    (file.then(|| p.clone()), Some(source))
 }

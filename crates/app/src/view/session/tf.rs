@@ -31,55 +31,157 @@ impl LiveSession {
         self.outcome("transfer function".to_string(), start, result)
     }
 
-    /// The transfer function on screen.
+    /// The transfer function the editor edits (on screen).
     pub fn transfer_function(&self) -> &TransferFunction {
-        self.bench.tf.transfer_function()
+        self.bench.edited_tf().transfer_function()
     }
 
-    /// The TF editor's edit: checked, uploaded at once (only what reads the TF reruns: the
-    /// classification, distance map and pre-integration table, by input version), and saved
-    /// when "save on change" is on.
+    /// The TF editor's edit of the TF it edits ([`Self::select_transfer_function`]): checked,
+    /// uploaded at once (only what reads the TF reruns: the classification, distance map and
+    /// pre-integration table, by input version), and saved when "save on change" is on.
     pub fn edit_transfer_function(&mut self, tf: TransferFunction) -> Vec<Event> {
         let start = Instant::now();
-        let result = self
-            .bench
-            .tf
-            .validate(&tf)
-            .and_then(|()| self.set_transfer_function(&tf).map_err(|e| format!("{e:#}")))
-            .map(|()| {
-                self.bench.tf.set(tf);
-                "LUT uploaded".to_string()
-            });
-        let mut events = self.outcome("transfer function edit".to_string(), start, result);
-        if self.bench.tf.save_on_change && self.error.is_none() {
+        let target = self.bench.tf_target.clone();
+        let result = self.bench.edited_tf().validate(&tf).and_then(|()| {
+            match &target {
+                None => self.set_transfer_function(&tf),
+                Some(input) => self.set_named_transfer_function(input, tf.clone()),
+            }
+            .map_err(|e| format!("{e:#}"))
+        });
+        let result = result.map(|()| {
+            self.bench.edited_tf_mut().set(tf);
+            "LUT uploaded".to_string()
+        });
+        let what = match &target {
+            None => "transfer function edit".to_string(),
+            Some(input) => format!("transfer function edit ({input})"),
+        };
+        let mut events = self.outcome(what, start, result);
+        if self.bench.edited_tf().save_on_change && self.error.is_none() {
             events.extend(self.save_transfer_function_events());
         }
         events
     }
 
-    /// Saves the TF to its file as it came (RON, or ParaView JSON with the file's other maps
-    /// kept), or where [`TfEdits::save_path`](crate::view::workbench::TfEdits::save_path) says for
-    /// a preset or a fitted TF (which the viewer then watches); atomic.
+    /// Which transfer function the editor edits, by the graph input it feeds: a TF input bound
+    /// by name or of another volume (`pet_tf`), or any other TF input (the frame volume's).
+    pub fn select_transfer_function(&mut self, input: &str) -> Result<(), String> {
+        if self.bench.named_tfs.iter().any(|(n, _)| n == input) {
+            self.bench.tf_target = Some(input.to_string());
+            return Ok(());
+        }
+        let inputs = self.plan().map(|p| p.inputs.clone()).unwrap_or_default();
+        let tf_inputs: Vec<&String> = inputs
+            .iter()
+            .filter(|(_, k)| matches!(k, volgraph_core::graph::ast::InputKind::TransferFunction))
+            .map(|(n, _)| n)
+            .collect();
+        if tf_inputs.iter().any(|n| n.as_str() == input) {
+            self.bench.tf_target = None;
+            return Ok(());
+        }
+        Err(format!(
+            "\"{input}\" is no transfer-function input of this graph; its inputs are: {}",
+            tf_inputs.iter().map(|n| n.as_str()).collect::<Vec<_>>().join(", ")
+        ))
+    }
+
+    /// The editors the panel offers: `(input, label)`, the frame volume's first (`None` where
+    /// every TF input is bound by name), then each named one with the volume it classifies.
+    pub fn transfer_function_targets(&self) -> Vec<(Option<String>, String)> {
+        let Some(b) = &self.bindings else { return Vec::new() };
+        let mut out = Vec::new();
+        let inputs = self.plan().map(|p| p.inputs.clone()).unwrap_or_default();
+        let frame_inputs: Vec<&String> = inputs
+            .iter()
+            .filter(|(n, k)| {
+                matches!(k, volgraph_core::graph::ast::InputKind::TransferFunction)
+                    && !b.tfs.iter().any(|t| &t.input == *n)
+            })
+            .map(|(n, _)| n)
+            .collect();
+        if !frame_inputs.is_empty() {
+            let names: Vec<&str> = frame_inputs.iter().map(|n| n.as_str()).collect();
+            out.push((None, format!("{} ({})", names.join(", "), self.volume.name)));
+        }
+        for t in &b.tfs {
+            out.push((Some(t.input.clone()), format!("{} ({})", t.input, b.base_of(t, &self.volume).name)));
+        }
+        out
+    }
+
+    /// Sets the named transfer-function input `input` to `tf` and uploads its LUT.
+    fn set_named_transfer_function(&mut self, input: &str, tf: TransferFunction) -> anyhow::Result<()> {
+        let bindings = self.bindings.as_mut().ok_or_else(|| anyhow!("no transfer function is bound by name"))?;
+        let lut = bindings
+            .set_tf(input, tf, &self.volume)
+            .ok_or_else(|| anyhow!("\"{input}\" is not bound by name"))?
+            .to_vec();
+        self.runtime.bind_lut(input, &lut).map_err(|e| anyhow!(e))?;
+        self.runtime.invalidate_history();
+        Ok(())
+    }
+
+    /// The named TF files that changed on disk (`changed`): each read again over its volume and
+    /// uploaded.
+    pub(super) fn reload_named_transfer_functions(&mut self, changed: &[PathBuf]) -> Vec<Event> {
+        let stale: Vec<String> =
+            self.bench.named_tfs.iter().filter(|(_, e)| e.needs_reload(changed)).map(|(n, _)| n.clone()).collect();
+        let mut events = Vec::new();
+        for input in stale {
+            let start = Instant::now();
+            let volume = self.named_tf_volume(&input).clone();
+            let Some(at) = self.bench.named_tfs.iter().position(|(n, _)| *n == input) else { continue };
+            let result = self.bench.named_tfs[at].1.read(&volume).map_err(|e| format!("{e:#}")).and_then(|tf| {
+                self.set_named_transfer_function(&input, tf.clone()).map_err(|e| format!("{e:#}"))?;
+                self.bench.named_tfs[at].1.reloaded(tf);
+                Ok("LUT uploaded, history restarted".to_string())
+            });
+            events.extend(self.outcome(format!("transfer function ({input})"), start, result));
+        }
+        events
+    }
+
+    /// The volume the named TF `input` classifies (the frame volume where it has no other).
+    fn named_tf_volume(&self, input: &str) -> &volgraph_accel::volume::Volume {
+        let named = self.bindings.as_ref().and_then(|b| b.tfs.iter().find(|t| t.input == input).map(|t| (b, t)));
+        named.map_or(&self.volume, |(b, t)| b.base_of(t, &self.volume))
+    }
+
+    /// Saves the edited TF ([`Self::select_transfer_function`]) to its file as it came (RON, or
+    /// ParaView JSON with the file's other maps kept), or where
+    /// [`TfEdits::save_path`](crate::view::workbench::TfEdits::save_path) says for a preset or a
+    /// fitted TF (which the viewer then watches); atomic.
     pub fn save_transfer_function(&mut self) -> anyhow::Result<PathBuf> {
-        self.bench.tf.save(&self.volume)
+        let volume = match self.bench.tf_target.clone() {
+            Some(input) => self.named_tf_volume(&input).clone(),
+            None => return self.bench.tf.save(&self.volume),
+        };
+        self.bench.edited_tf_mut().save(&volume)
     }
 
     /// [`Self::save_transfer_function`] as events.
     pub fn save_transfer_function_events(&mut self) -> Vec<Event> {
+        let what = match &self.bench.tf_target {
+            None => "transfer function".to_string(),
+            Some(input) => format!("transfer function ({input})"),
+        };
         match self.save_transfer_function() {
-            Ok(path) => vec![Event::Saved { what: "transfer function".to_string(), path }],
-            Err(e) => vec![Event::NotSaved { what: "transfer function".to_string(), message: format!("{e:#}") }],
+            Ok(path) => vec![Event::Saved { what, path }],
+            Err(e) => vec![Event::NotSaved { what, message: format!("{e:#}") }],
         }
     }
 
-    /// Uploads `tf` as the LUT of every transfer-function input.
+    /// Uploads `tf` as the LUT of every transfer-function input not bound by name (the frame
+    /// volume's).
     pub fn set_transfer_function(&mut self, tf: &TransferFunction) -> anyhow::Result<()> {
         self.lut = tf.to_lut_for(&self.volume, inputs::LUT_SIZE);
         // Only the TF inputs: re-binding the volume would hash all its voxels to find it unchanged
         // (~4 ms of every edit on a 256³ volume).
         let inputs = self.plan().map(|p| p.inputs.clone()).unwrap_or_default();
-        // The TF editor edits the frame volume's TF: inputs bound by name keep their own.
-        let named = |name: &str| self.bindings.as_ref().is_some_and(|b| b.luts.iter().any(|(n, _)| n == name));
+        // Inputs bound by name keep their own (their editors are the named ones).
+        let named = |name: &str| self.bindings.as_ref().is_some_and(|b| b.tfs.iter().any(|t| t.input == name));
         for (name, kind) in &inputs {
             if matches!(kind, volgraph_core::graph::ast::InputKind::TransferFunction) && !named(name) {
                 self.runtime.bind_lut(name, &self.lut).map_err(|e| anyhow!(e))?;

@@ -38,6 +38,9 @@ pub struct TfEdits {
     written: Option<String>,
     /// Save the TF file after every edit (the panel's toggle).
     pub save_on_change: bool,
+    /// Where "save TF" writes a TF that came from no file: [`SAVED_TF`], or a named input's own
+    /// (`view.pet_tf.tf.ron`).
+    fitted_file: String,
     /// Voxels per bin of the volume's normalized values (the TF editor's histogram).
     histogram: Vec<u64>,
     /// The data values the histogram's ends stand for.
@@ -66,10 +69,18 @@ impl TfEdits {
             generated,
             written: None,
             save_on_change: false,
+            fitted_file: SAVED_TF.to_string(),
             histogram: volgraph_accel::histogram::Histogram::of(volume, HISTOGRAM_BINS).counts,
             value_range: volume.value_range,
             presets: presets_for(volume),
         }
+    }
+
+    /// This TF saved, where it came from no file, as `view.INPUT.tf.ron` (a named input's, so two
+    /// editors never write one file).
+    pub fn for_input(mut self, input: &str) -> Self {
+        self.fitted_file = format!("view.{input}.tf.ron");
+        self
     }
 
     /// The transfer function on screen.
@@ -152,7 +163,7 @@ impl TfEdits {
 
     /// Where "save TF" writes: the TF's file; for a scanner preset (`--tf ct-bone`)
     /// `NAME.tf.ron` in the current folder (a name `--tf NAME` never reads in the preset's place);
-    /// for a fitted TF `view.tf.ron` there. The TF's own file is returned as `--tf` gave it
+    /// for a fitted TF `view.tf.ron` (a named input's `view.INPUT.tf.ron`) there. The TF's own file is returned as `--tf` gave it
     /// (relative to the current folder where it was given so, the path the viewer watches); the
     /// preset's and the fitted TF's new files are made absolute, so the "saved" line says where
     /// they went.
@@ -164,7 +175,7 @@ impl TfEdits {
                 let stem = Path::new(name).file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned());
                 PathBuf::from(format!("{}.tf.ron", stem.strip_suffix(".ron").unwrap_or(&stem)))
             }
-            (None, _) => PathBuf::from(SAVED_TF),
+            (None, _) => PathBuf::from(&self.fitted_file),
         };
         std::env::current_dir().map_or(path.clone(), |dir| dir.join(path))
     }

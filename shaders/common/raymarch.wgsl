@@ -120,12 +120,15 @@ fn lookup_preintegrated(s_front: f32, s_back: f32) -> vec4<f32> {
 // Per-ray state of the effects: the unit world view direction (SHADING) and the scalar of the
 // previous sample, the front of the next segment (PREINTEGRATION).
 var<private> ray_view_world: vec3<f32>;
+// The unit world direction toward the light along this ray (`light_toward`), set once per ray.
+var<private> ray_light_world: vec3<f32>;
 var<private> ray_prev_scalar: f32;
 
 // Starts marching `s` at sample k0: the view direction, and the front value of sample k0's
 // segment (the field one step before it).
 fn begin_ray(s: Samples, k0: u32) {
     ray_view_world = normalize(s.delta * 2.0 * frame.half_extent.xyz);
+    ray_light_world = light_toward(ray_view_world);
 #if FUSION
     begin_fusion();
 #endif
@@ -171,7 +174,7 @@ fn classify_value(u: vec3<f32>, s: f32) -> vec4<f32> {
 #endif
 #if SHADING
     if (p.a > 0.0) {
-        let light = headlight(u, ray_view_world);
+        let light = lighting(u, ray_view_world, ray_light_world);
         p = vec4<f32>(p.rgb * light.x + vec3<f32>(p.a * light.y), p.a);
     }
 #endif
@@ -283,11 +286,19 @@ fn volume_position(u: vec3<f32>) -> vec3<f32> {
     return u * sampled_scale + sampled_offset;
 }
 
-// Blinn–Phong headlight at texture-space point `u` seen along the unit world direction `d_world`
-// (docs/rendering_model.md "First-hit isosurface", "Effects"): (ambient + diffuse·|n·l|, the
-// white specular term), n from the central-difference gradient of the reconstructed field, the
-// light facing the eye where the gradient vanishes (constant regions: no NaN).
-fn headlight(u: vec3<f32>, d_world: vec3<f32>) -> vec2<f32> {
+// The unit world direction toward the scene's light for a ray along `d_world`: a directional
+// light's (frame.light_world, w = 1), else the headlight's -d_world (volgraph_accel::light).
+fn light_toward(d_world: vec3<f32>) -> vec3<f32> {
+    return select(-d_world, frame.light_world.xyz, frame.light_world.w != 0.0);
+}
+
+// Blinn–Phong at texture-space point `u` seen along the unit world direction `d_world`, lit from
+// the unit world direction `l` (`light_toward`; docs/rendering_model.md "First-hit isosurface",
+// "Effects"): (ambient + diffuse·|n·l|, the white specular term |n·h|^shininess), n from the
+// central-difference gradient of the reconstructed field, facing the light where the gradient
+// vanishes (constant regions: no NaN); h = normalize(l + v), exactly l for the headlight (l = v),
+// no highlight where light and eye are opposite (volgraph_accel::light::blinn_phong_terms).
+fn lighting(u: vec3<f32>, d_world: vec3<f32>, l: vec3<f32>) -> vec2<f32> {
     // One voxel of the texture sampled: the volume, or a brick atlas (raycast_bricks.wgsl),
     // whose slots hold the brick's neighbours on every side.
     let off = 1.0 / vec3<f32>(textureDimensions(volume));
@@ -296,7 +307,7 @@ fn headlight(u: vec3<f32>, d_world: vec3<f32>) -> vec2<f32> {
         sample_volume(u + vec3<f32>(0.0, off.y, 0.0)) - sample_volume(u - vec3<f32>(0.0, off.y, 0.0)),
         sample_volume(u + vec3<f32>(0.0, 0.0, off.z)) - sample_volume(u - vec3<f32>(0.0, 0.0, off.z)),
     );
-    let l = -d_world;
+    let v = -d_world;
     var n = l;
     if (length(g) >= 1e-6) {
         // g spans two voxels per axis: the world gradient is g / (2 · voxel_world) with
@@ -307,18 +318,24 @@ fn headlight(u: vec3<f32>, d_world: vec3<f32>) -> vec2<f32> {
 #if CUTS
     n = cap_normal(volume_position(u), d_world, n);
 #endif
-    // Headlight: l = v = -d, so h = normalize(l + v) = l.
     let n_dot_l = abs(dot(n, l));
+    let lv = l + v;
+    var n_dot_h = 0.0;
+    if (all(l == v)) {
+        n_dot_h = n_dot_l;
+    } else if (length(lv) > 1e-6) {
+        n_dot_h = abs(dot(n, lv / length(lv)));
+    }
     var spec = 0.0;
     if (n_dot_l > 0.0) {
-        spec = params.specular * pow(n_dot_l, params.shininess);
+        spec = params.specular * pow(n_dot_h, params.shininess);
     }
     return vec2<f32>(params.ambient + params.diffuse * n_dot_l, spec);
 }
 
 // The shaded colour of the isosurface at `u`.
 fn shade_iso(u: vec3<f32>, d_world: vec3<f32>) -> vec3<f32> {
-    let light = headlight(u, d_world);
+    let light = lighting(u, d_world, light_toward(d_world));
     let base = sample_tf(params.iso_value).rgb;
     return clamp(base * light.x + vec3<f32>(light.y), vec3<f32>(0.0), vec3<f32>(1.0));
 }

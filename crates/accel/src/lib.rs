@@ -18,6 +18,7 @@ pub mod histogram;
 pub mod image_diff;
 pub mod kd_split;
 pub mod labels;
+pub mod light;
 pub mod load;
 pub mod minmax;
 pub mod mip;

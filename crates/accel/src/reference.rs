@@ -99,6 +99,9 @@ pub struct RaycastSettings {
     /// stays the uncut ray's ([`crate::cuts`], `docs/rendering_model.md` "Cuts").
     #[serde(skip)]
     pub cuts: Cuts,
+    /// The scene's light: the headlight, or a directional one ([`crate::light`]).
+    #[serde(default)]
+    pub light: crate::light::Light,
 }
 
 impl Default for RaycastSettings {
@@ -113,6 +116,7 @@ impl Default for RaycastSettings {
             dvr_shading: Phong::default(),
             opacity_unit_voxels: 1.0,
             cuts: Cuts::NONE,
+            light: crate::light::Light::Headlight,
         }
     }
 }
@@ -360,8 +364,9 @@ impl<'a> March<'a> {
         (acc, (k - self.k0.min(k)) as u64)
     }
 
-    /// The headlight's factors at `u`: `ambient + diffuse·|n·l|` and the white specular term,
-    /// `n` from the gradient (facing the eye where the gradient vanishes).
+    /// The light's factors at `u`: `ambient + diffuse·|n·l|` and the white specular term
+    /// `|n·h|^shininess`, `n` from the gradient (facing the light where the gradient vanishes);
+    /// `l` the scene's light ([`crate::light::Light`]), the headlight's `l = v` by default.
     fn lighting(&self, u: DVec3, p: &Phong) -> (f64, f64) {
         let dims = self.volume.dims.as_dvec3();
         let off = 1.0 / dims;
@@ -371,15 +376,16 @@ impl<'a> March<'a> {
             s(u + DVec3::new(0.0, off.y, 0.0)) - s(u - DVec3::new(0.0, off.y, 0.0)),
             s(u + DVec3::new(0.0, 0.0, off.z)) - s(u - DVec3::new(0.0, 0.0, off.z)),
         );
-        let l = -self.seg.dir_world;
+        let v = -self.seg.dir_world;
+        let l = self.settings.light.toward().unwrap_or(v);
         let half = self.volume.half_extent_world();
         let mut n = if g.length() >= ZERO_GRADIENT { -(g * dims / half).normalize() } else { l };
         if !self.settings.cuts.is_none() {
             // A cut face shows the plane it was cut along ("capping", crate::cuts).
             n = self.settings.cuts.cap_normal(u, self.seg.u0, self.seg.d_tex, n, dims, half);
         }
-        let n_dot_l = n.dot(l).abs();
-        let spec = if n_dot_l > 0.0 { p.specular * n_dot_l.powf(p.shininess) } else { 0.0 };
+        let (n_dot_l, n_dot_h) = crate::light::blinn_phong_terms(n, l, v);
+        let spec = if n_dot_l > 0.0 { p.specular * n_dot_h.powf(p.shininess) } else { 0.0 };
         (p.ambient + p.diffuse * n_dot_l, spec)
     }
 

@@ -64,6 +64,8 @@ pub struct Prepared {
     frames: u32,
     opacity: OpacityReference,
     cuts: volgraph_accel::cuts::Cuts,
+    /// The scene's light.
+    light: volgraph_accel::light::Light,
     volume: volgraph_accel::volume::Volume,
     lut: Vec<[f32; 4]>,
     /// Inputs bound by name (`--volume NAME=PATH`, `--tf NAME=…`), if any.
@@ -77,7 +79,7 @@ pub struct Prepared {
 /// Reads and checks every input of `volgraph render`; touches no GPU, prints nothing.
 pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     let kind = ImageKind::from_path("-o", &args.out)?;
-    let Resolved { scene, graph, size, camera, cuts } =
+    let Resolved { scene, graph, size, camera, cuts, light } =
         args.inputs.resolve("volgraph render GRAPH -o out.png", "512x512")?;
     let source = inputs::read_graph(&graph)?;
     let mut features = scene.as_ref().map(|s| s.effects.clone()).unwrap_or_default();
@@ -201,7 +203,7 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     {
         notes.push(note);
     }
-    Ok(Prepared { args, graph, kind, camera, frames, opacity, cuts, volume, lut, bindings, plan, output, notes })
+    Ok(Prepared { args, graph, kind, camera, frames, opacity, cuts, light, volume, lut, bindings, plan, output, notes })
 }
 
 /// The inputs bound by name, with the notes their reading gave: the named volumes (`others`,
@@ -320,8 +322,9 @@ pub fn budget_note(plan: &volgraph_core::Plan, registry: &volgraph_core::Registr
 
 /// Opens the GPU, renders the frames and writes the image.
 pub fn execute(prepared: Prepared) -> Result<(), CliError> {
-    let Prepared { args, graph, kind, camera, frames, opacity, cuts, volume, lut, bindings, plan, output, .. } =
-        prepared;
+    let Prepared {
+        args, graph, kind, camera, frames, opacity, cuts, light, volume, lut, bindings, plan, output, ..
+    } = prepared;
     let registry = crate::program::registry();
     let viewport = plan.viewport;
     let gpu = Arc::new(Gpu::new_headless().map_err(|e| anyhow!(e))?);
@@ -329,6 +332,7 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
     let mut runtime = Runtime::new(gpu, ShaderLibrary::new(sources));
     runtime.set_opacity_reference(opacity);
     runtime.set_cuts(cuts);
+    runtime.set_light(light);
     runtime.set_gpu_memory_budget(args.inputs.gpu_memory_mb.map(|mb| mb << 20));
     match &bindings {
         Some(bindings) => bindings.bind(&mut runtime, &plan, &volume, &lut),

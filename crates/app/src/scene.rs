@@ -176,6 +176,8 @@ struct SceneDoc {
     volumes: std::collections::BTreeMap<String, String>,
     #[serde(default)]
     tfs: std::collections::BTreeMap<String, String>,
+    #[serde(default)]
+    lights: Vec<volgraph_accel::light::Light>,
 }
 
 /// A scene read and checked, its paths resolved against the scene file's folder.
@@ -212,6 +214,9 @@ pub struct Scene {
     /// Transfer-function inputs by name (`tfs: {"mask_tf": "mask.ron"}`): a file beside the
     /// scene, a preset's or a built-in TF's name, as `--tf NAME=…` takes it.
     pub tfs: Vec<(String, PathBuf)>,
+    /// The light (`lights: [Directional(azimuth_deg: 35, elevation_deg: 25)]`; none: the
+    /// headlight).
+    pub light: volgraph_accel::light::Light,
 }
 
 /// Why a scene could not be read.
@@ -332,6 +337,22 @@ impl Scene {
             })
             .collect::<Result<Vec<_>, _>>()?;
         let cuts = Cuts::new(crop, &planes).map_err(|e| field("clip", e.to_string()))?;
+        let light = match doc.lights.as_slice() {
+            [] => volgraph_accel::light::Light::Headlight,
+            [one] => {
+                one.check().map_err(|e| field("lights", e))?;
+                *one
+            }
+            more => {
+                return Err(field(
+                    "lights",
+                    format!(
+                        "{} lights: a scene has one light for now (the headlight, or one Directional(azimuth_deg: AZ,                          elevation_deg: EL)); keep one",
+                        more.len()
+                    ),
+                ));
+            }
+        };
         if let Some(TfSource::Data(name)) = &doc.transfer_function {
             check_data_name(name).map_err(|m| field("transfer_function", m))?;
         }
@@ -398,6 +419,7 @@ impl Scene {
             volume_options: doc.volume_options,
             volumes,
             tfs,
+            light,
         })
     }
 

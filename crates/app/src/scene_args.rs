@@ -73,6 +73,10 @@ pub struct SceneArgs {
     /// planes].
     #[arg(long, value_parser = ClipPlane::parse, allow_hyphen_values = true)]
     pub clip: Vec<ClipPlane>,
+    /// The light: AZ,EL in degrees (a directional light where an orbit camera at those angles
+    /// would stand; elevation -90..90), or headlight [default: the scene's, else the headlight].
+    #[arg(long, value_parser = volgraph_accel::light::Light::parse, allow_hyphen_values = true)]
+    pub light: Option<volgraph_accel::light::Light>,
 }
 
 /// What the command line and the scene say together: flags win over the scene.
@@ -87,6 +91,8 @@ pub struct Resolved {
     pub camera: CameraSpec,
     /// The crop box and clip planes: `--crop` and `--clip` win over the scene's.
     pub cuts: Cuts,
+    /// The light: `--light` wins over the scene's.
+    pub light: volgraph_accel::light::Light,
 }
 
 impl SceneArgs {
@@ -144,7 +150,8 @@ impl SceneArgs {
         let planes: Vec<ClipPlane> =
             if self.clip.is_empty() { scene_cuts.planes().copied().collect() } else { self.clip.clone() };
         let cuts = Cuts::new(crop, &planes).map_err(|e| anyhow!("--clip: {e}"))?;
-        Ok(Resolved { scene, graph, size, camera, cuts })
+        let light = self.light.or(scene.as_ref().map(|s| s.light)).unwrap_or_default();
+        Ok(Resolved { scene, graph, size, camera, cuts, light })
     }
 }
 

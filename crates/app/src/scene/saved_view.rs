@@ -34,6 +34,8 @@ pub struct SavedView {
     pub opacity_reference: OpacityReference,
     /// The crop box and clip planes.
     pub cuts: Cuts,
+    /// The light.
+    pub light: volgraph_accel::light::Light,
 }
 
 impl SavedView {
@@ -114,6 +116,11 @@ impl SavedView {
         if !planes.is_empty() {
             out += &format!("    clip: [{}],\n", planes.join(", "));
         }
+        if let volgraph_accel::light::Light::Directional { azimuth_deg, elevation_deg } = self.light {
+            out += &format!(
+                "    lights: [Directional(azimuth_deg: {azimuth_deg:?}, elevation_deg: {elevation_deg:?})],\n"
+            );
+        }
         out += ")\n";
         out
     }
@@ -133,8 +140,8 @@ mod saved_view_tests {
     use glam::DVec3;
     use volgraph_accel::cuts::{ClipPlane, CropBox};
 
-    /// "Save view" writes a scene that reads back to the same camera, cuts and effects, to the
-    /// last bit of every f64.
+    /// "Save view" writes a scene that reads back to the same camera, cuts, light and effects,
+    /// to the last bit of every f64.
     #[test]
     fn a_saved_view_reads_back_exactly() {
         let cuts = Cuts::new(
@@ -160,9 +167,11 @@ mod saved_view_tests {
             precision: Some(Precision::F16),
             opacity_reference: OpacityReference::World,
             cuts,
+            light: volgraph_accel::light::Light::Directional { azimuth_deg: -33.3, elevation_deg: 1.0 / 7.0 },
         };
         let scene = Scene::from_str(&view.to_ron(), Path::new("/tmp/x.scene.ron")).expect("reads back");
         assert_eq!(scene.cuts, cuts);
+        assert_eq!(scene.light, view.light);
         assert_eq!(scene.volume_options.spacing, Some((1.0, 0.1, 1.0 / 3.0)));
         assert_eq!(scene.viewport, Some((320, 200)));
         assert_eq!(scene.effects, vec!["shading".to_string()]);

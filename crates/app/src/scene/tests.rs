@@ -146,3 +146,22 @@ fn volume_options_are_checked_like_the_flags() {
         assert!(err.contains(expected), "{options}: {err}");
     }
 }
+
+/// `lights:` (issue "light that scatters", item 1): one Directional light, checked like
+/// `--light`; none is the headlight; two, or an elevation past 90°, name the field and the fix.
+#[test]
+fn a_scene_has_one_light_checked_like_the_flag() {
+    use volgraph_accel::light::Light;
+    let s = parse("Scene(volume: Generated(\"ml32\"))").expect("parses");
+    assert_eq!(s.light, Light::Headlight);
+    let s = parse("Scene(volume: Generated(\"ml32\"), lights: [Directional(azimuth_deg: 30, elevation_deg: 45)])")
+        .expect("parses");
+    assert_eq!(s.light, Light::Directional { azimuth_deg: 30.0, elevation_deg: 45.0 });
+    let two = "Scene(volume: Generated(\"ml32\"), lights: [Headlight, Directional(azimuth_deg: 0, elevation_deg: 0)])";
+    let e = parse(two).expect_err("two lights").to_string();
+    assert!(e.contains("lights: 2 lights: a scene has one light for now"), "{e}");
+    let e = parse("Scene(volume: Generated(\"ml32\"), lights: [Directional(azimuth_deg: 0, elevation_deg: 95)])")
+        .expect_err("95°")
+        .to_string();
+    assert!(e.contains("lights: a light's elevation is -90..90 degrees, not 95"), "{e}");
+}

@@ -7,6 +7,7 @@
 pub mod accuracy;
 pub mod graph_picture;
 pub mod label_list;
+pub mod light_control;
 pub mod lod;
 pub mod orbit;
 pub mod panel;
@@ -162,6 +163,7 @@ pub fn run(args: ViewArgs) -> Result<(), CliError> {
         shaders: args.inputs.shaders,
         gpu_memory_mb: args.inputs.gpu_memory_mb,
         cuts: resolved.cuts,
+        light: resolved.light,
     };
     let view = ViewOptions {
         camera,

@@ -33,6 +33,8 @@ pub enum Action {
     TransferFunction(super::tf_editor::TfAction),
     /// The TF editor edits this named TF input (`None`: the frame volume's).
     TfTarget(Option<String>),
+    /// The scene's light.
+    Light(volgraph_accel::light::Light),
     /// Set a value typed as `PASS.PARAM=VALUE` or `input.NAME=VALUE`.
     Assign(String),
     /// The label list's edit.
@@ -268,6 +270,9 @@ pub fn show(
             }
             if let Some(cuts) = cuts_section(ui, session.runtime.cuts()) {
                 actions.push(Action::Cuts(cuts));
+            }
+            if let Some(light) = super::light_control::light_section(ui, session.runtime.light()) {
+                actions.push(Action::Light(light));
             }
             let scalars: BTreeMap<&String, f64> = plan
                 .inputs

@@ -38,10 +38,12 @@ pub enum ScriptCommand {
     /// `tf-edit INPUT`: the TF editor edits the transfer-function input INPUT (`pet_tf`: one
     /// editor per scalar volume).
     TfEdit(String),
+    /// `light AZ,EL` or `light headlight`: the panel's light.
+    Light(volgraph_accel::light::Light),
 }
 
 /// What the script accepts, for messages.
-pub const USAGE: &str = "quit, screenshot PATH, param PASS.NAME VALUE, write, crop X0,Y0,Z0,X1,Y1,Z1|off, clip NX,NY,NZ,D|off, save-scene PATH, tf-point VALUE R,G,B,A, tf-save, tf-edit INPUT";
+pub const USAGE: &str = "quit, screenshot PATH, param PASS.NAME VALUE, write, crop X0,Y0,Z0,X1,Y1,Z1|off, clip NX,NY,NZ,D|off, save-scene PATH, tf-point VALUE R,G,B,A, tf-save, tf-edit INPUT, light AZ,EL|headlight";
 
 /// Parses one line: `Ok(None)` for a blank line, `Err` naming what is wrong.
 pub fn parse_line(line: &str) -> Result<Option<ScriptCommand>, String> {
@@ -72,6 +74,9 @@ pub fn parse_line(line: &str) -> Result<Option<ScriptCommand>, String> {
             Err(format!("\"{line}\": write tf-edit INPUT (a transfer-function input of the graph, e.g. pet_tf)"))
         }
         "tf-edit" => Ok(Some(ScriptCommand::TfEdit(rest.to_string()))),
+        "light" => volgraph_accel::light::Light::parse(rest)
+            .map(|l| Some(ScriptCommand::Light(l)))
+            .map_err(|e| format!("\"{line}\": {e}")),
         "tf-point" => {
             let bad =
                 || format!("\"{line}\": write tf-point VALUE R,G,B,A (data value; linear colour and opacity in 0..1)");

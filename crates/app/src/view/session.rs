@@ -139,6 +139,8 @@ pub struct SessionArgs {
     pub scene: Option<crate::scene::Scene>,
     /// The crop box and clip planes at start (`--crop`/`--clip` over the scene's).
     pub cuts: Cuts,
+    /// The light at start (`--light` over the scene's).
+    pub light: volgraph_accel::light::Light,
     /// Volumes bound by name (`--volume NAME=PATH`); `volume` is then the frame volume's path.
     pub named: Vec<(String, PathBuf)>,
     /// Transfer functions and label tables bound by name (`--tf NAME=FILE`).

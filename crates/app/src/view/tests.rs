@@ -60,6 +60,7 @@ fn session_args(s: &Scratch, volume: &[&str], tf: Option<PathBuf>) -> SessionArg
         shaders: Some(s.shaders.clone()),
         gpu_memory_mb: None,
         cuts: Default::default(),
+        light: Default::default(),
         named: Vec::new(),
         named_tfs: Vec::new(),
     }

@@ -170,6 +170,10 @@ impl Viewer {
                 Action::Scalar(name, value) => session.set_scalar(&name, value),
                 Action::Feature(name, on) => session.set_feature(&name, on),
                 Action::Cuts(cuts) => session.set_cuts(cuts),
+                Action::Light(light) => {
+                    session.runtime.set_light(light);
+                    Vec::new()
+                }
                 Action::Labels(edit) => session.edit_labels(&edit),
                 Action::LabelSearch(text) => {
                     session.set_label_search(text);
@@ -276,6 +280,7 @@ impl Viewer {
                     self.apply_actions(vec![Action::TransferFunction(TfAction::Edit(tf))]);
                 }
                 Ok(Some(ScriptCommand::TfSave)) => self.apply_actions(vec![Action::TransferFunction(TfAction::Save)]),
+                Ok(Some(ScriptCommand::Light(light))) => self.apply_actions(vec![Action::Light(light)]),
                 Ok(Some(ScriptCommand::TfEdit(input))) => {
                     let Some(session) = self.session.as_mut() else { continue };
                     if let Err(message) = session.select_transfer_function(&input) {

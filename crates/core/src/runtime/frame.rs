@@ -240,6 +240,8 @@ pub struct FrameData {
     pub gpu_memory_budget: Option<u64>,
     /// The scene's crop box and clip planes (volume fractions of the whole volume).
     pub cuts: Cuts,
+    /// The scene's light (`volgraph_accel::light`).
+    pub light: volgraph_accel::light::Light,
 }
 
 /// The pixel rays of a camera in texture space: pixel centre (x, y) (pixels, row 0 at the top)
@@ -337,9 +339,12 @@ pub struct FrameUniforms {
     pub footprint_vertices: u32,
     /// Padding to 16 bytes.
     pub _pad_footprint: [u32; 3],
+    /// The unit world direction toward a directional light (xyz); w = 1 for one, 0 for the
+    /// headlight (each ray's own `-direction`).
+    pub light_world: [f32; 4],
 }
 
-const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 656);
+const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 672);
 
 /// [`FrameUniforms::footprint_vertices`] of a footprint draw that covers the whole viewport.
 pub const FOOTPRINT_WHOLE: u32 = u32::MAX;
@@ -410,6 +415,7 @@ impl FrameUniforms {
             footprint: [[0.0; 4]; FAN_VERTICES / 2],
             footprint_vertices: FOOTPRINT_WHOLE,
             _pad_footprint: [0; 3],
+            light_world: frame.light.toward().map_or([0.0; 4], |l| with_w(l, 1.0)),
         }
         .with_cuts(&frame.cuts, grid)
     }

@@ -157,6 +157,8 @@ pub struct Runtime {
     window: Option<VolumeWindow>,
     /// The scene's crop box and clip planes.
     cuts: Cuts,
+    /// The scene's light (`set_light`).
+    light: volgraph_accel::light::Light,
     /// GPU memory passes that stream data may use (`--gpu-memory-mb`); `None`: the adapter's.
     gpu_memory_budget: Option<u64>,
     /// Submit and time every step on its own ([`Runtime::set_step_profiling`]).
@@ -188,6 +190,7 @@ impl Runtime {
             opacity_reference: OpacityReference::default(),
             window: None,
             cuts: Cuts::NONE,
+            light: volgraph_accel::light::Light::Headlight,
             gpu_memory_budget: None,
             profile_steps: false,
             bypasses: bypass::Bypasses::default(),

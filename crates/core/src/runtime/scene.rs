@@ -121,6 +121,20 @@ impl Runtime {
         self.cuts
     }
 
+    /// Sets the scene's light (`volgraph_accel::light`): the next frame is shaded by it, and
+    /// accumulated history restarts when it moved.
+    pub fn set_light(&mut self, light: volgraph_accel::light::Light) {
+        if self.light != light {
+            self.light = light;
+            self.invalidate_history();
+        }
+    }
+
+    /// The scene's light.
+    pub fn light(&self) -> volgraph_accel::light::Light {
+        self.light
+    }
+
     /// The bound volume as the frame contract describes it (windowed when a window is set).
     pub(super) fn volume_desc(&self) -> Option<VolumeDesc> {
         let (desc, _) = self.inputs.volume()?;

@@ -27,6 +27,7 @@ impl Runtime {
             volume: self.volume_desc(),
             gpu_memory_budget: self.gpu_memory_budget,
             cuts: self.cuts,
+            light: self.light,
         })
     }
 

@@ -63,6 +63,7 @@ impl LiveSession {
             .with_features(args.features.iter().filter(|f| !f.is_empty()).cloned());
         options.features.extend(cut_effects::features_of(&args.cuts));
         runtime.set_cuts(args.cuts);
+        runtime.set_light(args.light);
         if let Some(scene) = &args.scene {
             options.features.extend(scene.effects.iter().cloned());
             options.precision = scene.precision;

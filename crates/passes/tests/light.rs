@@ -1,0 +1,112 @@
+//! The scene's light (issue "light that scatters", item 1; `volgraph_accel::light`): a
+//! directional light fixed in the world shades every raycaster family as the f64 reference
+//! shades with the same light — Blinn–Phong with `h` halfway between light and eye — and moves
+//! the picture away from the headlight's.
+//!
+//! Tolerances, per channel of premultiplied linear RGBA, as `cuts.rs` bounds shaded images (f32
+//! on the GPU, f64 on the CPU; the gradient's central differences and the specular power
+//! amplify rounding where the normal is ill-conditioned): at most 0.5 % of pixels over 2/255,
+//! mean under 0.5/255.
+
+use volgraph_accel::camera::OrbitCamera;
+use volgraph_accel::image_diff::{fraction_over, image_diff};
+use volgraph_accel::light::Light;
+use volgraph_accel::reference::{RaycastSettings, render_reference};
+use volgraph_accel::transfer_function::{Preset, TransferFunction};
+use volgraph_accel::volume::Volume;
+use volgraph_core::runtime::{CameraData, Image, VolumeDesc, scene_values_of};
+use volgraph_core::{CompileOptions, compile};
+use volgraph_passes::builtin_registry;
+use volgraph_passes::raycast_params::reference_settings;
+
+mod support;
+
+use support::{gpu, graph_source};
+
+const SIZE: u32 = 96;
+
+/// `graph` rendered with the scene's `light` and `features`, and the reference settings of its
+/// "march" pass with that light.
+fn render_lit(
+    gpu: &std::sync::Arc<volgraph_core::runtime::Gpu>,
+    graph: &str,
+    (volume, lut): (&Volume, &[[f32; 4]]),
+    camera: &OrbitCamera,
+    light: Light,
+    features: &[&str],
+) -> (Image, RaycastSettings) {
+    let registry = builtin_registry();
+    let source = graph_source(graph);
+    let mut options =
+        CompileOptions::new(SIZE, SIZE).with_features(features.iter().map(|f| f.to_string()).collect::<Vec<_>>());
+    options.scene = scene_values_of(&VolumeDesc::of(volume));
+    let plan = compile(graph, &source, &registry, &options).unwrap_or_else(|d| panic!("{graph}: {d}"));
+    let march = plan.steps.iter().find(|s| s.pass_id == "march").expect("a march step");
+    let settings = RaycastSettings { light, ..reference_settings(&march.params) };
+    let mut runtime = support::runtime(gpu);
+    runtime.set_light(light);
+    runtime.bind_scene(&plan.inputs, volume, lut).expect("binds");
+    runtime.apply(plan.clone(), &registry).unwrap_or_else(|e| panic!("{graph}: {e}"));
+    runtime.render(CameraData::from_orbit(camera, plan.viewport)).unwrap_or_else(|e| panic!("{graph}: {e}"));
+    (runtime.read_output("image").expect("image"), settings)
+}
+
+#[test]
+fn a_directional_light_shades_every_family_like_the_reference() {
+    let gpu = gpu();
+    let volume = volgraph_accel::generate::marschner_lobb_f32(64);
+    // Opaque material: what shows is the shaded surface the light falls on.
+    let lut = TransferFunction::preset(Preset::Opaque, volume.value_range).to_lut_for(&volume, 256);
+    let camera = OrbitCamera { azimuth_deg: 25.0, elevation_deg: 15.0, ..OrbitCamera::default() };
+    let light = Light::Directional { azimuth_deg: -70.0, elevation_deg: 40.0 };
+    for (graph, features) in [
+        ("basic/fragment_raycast.ron", &["shading"][..]),
+        ("modern/fastest.ron", &["shading"][..]),
+        ("ruijters_vilanova_2006/bricks_octree_ert.ron", &["shading"][..]),
+        ("basic/isosurface.ron", &[][..]),
+        ("klein_2005/leap_iso.ron", &[][..]),
+    ] {
+        let (image, settings) = render_lit(&gpu, graph, (&volume, &lut), &camera, light, features);
+        let reference = render_reference(&volume, &lut, &camera, SIZE, SIZE, &settings);
+        let headlight = RaycastSettings { light: Light::Headlight, ..settings };
+        let headlit = render_reference(&volume, &lut, &camera, SIZE, SIZE, &headlight);
+        let got = image.to_rgba_f64();
+        let diff = image_diff(&got, &reference.color).expect("same size");
+        let over = fraction_over(&got, &reference.color, 2.0 / 255.0).expect("same size");
+        // The light moved the picture: a test that passes with the headlight proves nothing.
+        let moved = fraction_over(&headlit.color, &reference.color, 8.0 / 255.0).expect("same size");
+        eprintln!(
+            "{graph}: max {:.2}/255 mean {:.3}/255, {:.2}% over 2/255; the light moved {:.0}% of pixels",
+            diff.max_abs * 255.0,
+            diff.mean_abs * 255.0,
+            over * 100.0,
+            moved * 100.0
+        );
+        assert!(moved > 0.1, "{graph}: the light must change the image ({:.1}%)", moved * 100.0);
+        assert!(over <= 0.005, "{graph}: {:.2}% of pixels over 2/255", over * 100.0);
+        assert!(diff.mean_abs <= 0.5 / 255.0, "{graph}: mean {:.3}/255", diff.mean_abs * 255.0);
+    }
+}
+
+/// The headlight is the default and draws what it always drew: a runtime whose light was set
+/// and reset renders the same bytes as one never given a light.
+#[test]
+fn the_headlight_is_the_default_light() {
+    let gpu = gpu();
+    let volume = volgraph_accel::generate::marschner_lobb_f32(32);
+    let lut = TransferFunction::preset(Preset::Opaque, volume.value_range).to_lut_for(&volume, 256);
+    let camera = OrbitCamera::default();
+    let (plain, _) = render_lit(&gpu, "basic/isosurface.ron", (&volume, &lut), &camera, Light::default(), &[]);
+    let registry = builtin_registry();
+    let source = graph_source("basic/isosurface.ron");
+    let mut options = CompileOptions::new(SIZE, SIZE);
+    options.scene = scene_values_of(&VolumeDesc::of(&volume));
+    let plan = compile("basic/isosurface.ron", &source, &registry, &options).expect("compiles");
+    let mut runtime = support::runtime(&gpu);
+    runtime.set_light(Light::Directional { azimuth_deg: 10.0, elevation_deg: 10.0 });
+    runtime.set_light(Light::Headlight);
+    runtime.bind_scene(&plan.inputs, &volume, &lut).expect("binds");
+    runtime.apply(plan.clone(), &registry).expect("applies");
+    runtime.render(CameraData::from_orbit(&camera, plan.viewport)).expect("renders");
+    assert_eq!(runtime.read_output("image").expect("image").data, plain.data);
+}

@@ -255,6 +255,7 @@ pub fn run(args: &LiveArgs) -> anyhow::Result<()> {
                 shaders: Some(dir.join("shaders")),
                 gpu_memory_mb: None,
                 cuts: Default::default(),
+                light: Default::default(),
                 named: Vec::new(),
                 named_tfs: Vec::new(),
             },

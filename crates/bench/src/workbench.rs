@@ -60,6 +60,7 @@ fn open(gpu: &Arc<Gpu>, graph: PathBuf, volume: &std::path::Path, viewport: (u32
         gpu_memory_mb: None,
         scene: None,
         cuts: Default::default(),
+        light: Default::default(),
         named: Vec::new(),
         named_tfs: Vec::new(),
     };

@@ -128,7 +128,9 @@ var<private> ray_prev_scalar: f32;
 // segment (the field one step before it).
 fn begin_ray(s: Samples, k0: u32) {
     ray_view_world = normalize(s.delta * 2.0 * frame.half_extent.xyz);
+#if SHADING
     ray_light_world = light_toward(ray_view_world);
+#endif
 #if FUSION
     begin_fusion();
 #endif
@@ -151,6 +153,9 @@ fn classify_sample(u: vec3<f32>) -> vec4<f32> {
 
 #if FUSION
 #import "common/fusion.wgsl"
+#endif
+#if SHADOWS
+#import "common/shadows.wgsl"
 #endif
 
 // `classify_sample` of the scalar `s` already fetched at `u`.
@@ -177,6 +182,14 @@ fn classify_value(u: vec3<f32>, s: f32) -> vec4<f32> {
         let light = lighting(u, ray_view_world, ray_light_world);
         p = vec4<f32>(p.rgb * light.x + vec3<f32>(p.a * light.y), p.a);
     }
+#else
+#if SHADOWS
+    // Unshaded: the light reaching the sample scales its colour down to the ambient.
+    if (p.a > 0.0) {
+        let lit = params.ambient + (1.0 - params.ambient) * light_transmittance(u);
+        p = vec4<f32>(p.rgb * lit, p.a);
+    }
+#endif
 #endif
     return p;
 }
@@ -330,7 +343,13 @@ fn lighting(u: vec3<f32>, d_world: vec3<f32>, l: vec3<f32>) -> vec2<f32> {
     if (n_dot_l > 0.0) {
         spec = params.specular * pow(n_dot_h, params.shininess);
     }
+#if SHADOWS
+    // Shadows: only the light that gets through reaches the diffuse and specular terms.
+    let t = light_transmittance(u);
+    return vec2<f32>(params.ambient + t * params.diffuse * n_dot_l, t * spec);
+#else
     return vec2<f32>(params.ambient + params.diffuse * n_dot_l, spec);
+#endif
 }
 
 // The shaded colour of the isosurface at `u`.

@@ -69,6 +69,11 @@ pub struct Effects {
     pub preintegration: bool,
     /// Tricubic B-spline reconstruction ([`Volume::sample_tricubic`]) instead of trilinear.
     pub tricubic: bool,
+    /// Shadows (Behrens & Ratering 1998): the light reaching a sample through the volume, from
+    /// the light grid ([`crate::light::LightGrid`]), scales its lit terms — with shading the
+    /// diffuse and specular ones, without it the colour by `ambient + (1 − ambient)·T`.
+    #[serde(default)]
+    pub shadows: bool,
 }
 
 /// Raycasting settings shared by the reference and the GPU raycasters (WGSL twin:
@@ -271,6 +276,8 @@ struct March<'a> {
     k0: u32,
     /// Where the cuts end the ray (texture-space distance from `seg.u0`; `seg.len_tex` uncut).
     end_tex: f64,
+    /// The light grid of the `shadows` effect.
+    light_grid: Option<&'a crate::light::LightGrid>,
 }
 
 impl<'a> March<'a> {
@@ -290,7 +297,7 @@ impl<'a> March<'a> {
         let offset = 0.5 + jitter;
         let k0 = if begin < end { ((begin / step_tex - offset).ceil()).clamp(0.0, u32::MAX as f64) as u32 } else { 0 };
         let end_tex = if begin < end { end } else { 0.0 };
-        Self { volume, lut, fusion, settings, seg, step_tex, jitter, k0, end_tex }
+        Self { volume, lut, fusion, settings, seg, step_tex, jitter, k0, end_tex, light_grid: None }
     }
 
     fn t(&self, k: u32) -> f64 {
@@ -328,6 +335,14 @@ impl<'a> March<'a> {
             }
             for i in 0..3 {
                 p[i] += p[3] * specular;
+            }
+        }
+        if self.settings.effects.shadows && !self.settings.effects.shading && p[3] > 0.0 {
+            // Unshaded: the light reaching the sample scales its colour down to the ambient.
+            let ambient = self.settings.dvr_shading.ambient;
+            let lit = ambient + (1.0 - ambient) * self.transmittance(self.seg.u0 + t * self.seg.d_tex);
+            for c in p.iter_mut().take(3) {
+                *c *= lit;
             }
         }
         p
@@ -386,7 +401,14 @@ impl<'a> March<'a> {
         }
         let (n_dot_l, n_dot_h) = crate::light::blinn_phong_terms(n, l, v);
         let spec = if n_dot_l > 0.0 { p.specular * n_dot_h.powf(p.shininess) } else { 0.0 };
-        (p.ambient + p.diffuse * n_dot_l, spec)
+        // Shadows: only the light that gets through reaches the diffuse and specular terms.
+        let t = if self.settings.effects.shadows { self.transmittance(u) } else { 1.0 };
+        (p.ambient + t * p.diffuse * n_dot_l, t * spec)
+    }
+
+    /// The light reaching texture point `u` (1 without a light grid).
+    fn transmittance(&self, u: DVec3) -> f64 {
+        self.light_grid.map_or(1.0, |g| g.sample(u))
     }
 
     /// First hit of `s >= iso`, refined linearly; returns colour, hit and samples taken.
@@ -498,6 +520,7 @@ pub fn render_fused_reference(
         return ReferenceImage { width, height, color, hit, samples: 0 };
     }
     let frame = camera.frame(width, height);
+    let grid = shadow_grid(volume, lut, &frame, settings);
     let row_len = width as usize;
     let samples = color
         .par_chunks_mut(row_len)
@@ -506,7 +529,8 @@ pub fn render_fused_reference(
         .map(|(y, (color_row, hit_row))| {
             let mut row_samples = 0;
             for x in 0..width {
-                let (c, h, n) = fused_pixel(volume, lut, fusion, camera, &frame, (x, y as u32), settings);
+                let (c, h, n) =
+                    fused_pixel_lit(volume, lut, (fusion, grid.as_ref()), camera, &frame, (x, y as u32), settings);
                 color_row[x as usize] = c;
                 hit_row[x as usize] = h;
                 row_samples += n;
@@ -531,11 +555,45 @@ pub fn reference_pixel(
     fused_pixel(volume, lut, None, camera, frame, (x, y), settings)
 }
 
-/// [`reference_pixel`] of several volumes (`crate::fusion`).
+/// [`reference_pixel`] of several volumes (`crate::fusion`). With the `shadows` effect it
+/// computes the light grid for this one pixel: for many, compute it once ([`shadow_grid`]) and
+/// call [`fused_pixel_lit`].
 pub fn fused_pixel(
     volume: &Volume,
     lut: &[[f32; 4]],
     fusion: Option<&Fusion<'_>>,
+    camera: &OrbitCamera,
+    frame: &CameraFrame,
+    (x, y): (u32, u32),
+    settings: &RaycastSettings,
+) -> ([f64; 4], [f64; 4], u64) {
+    let grid = shadow_grid(volume, lut, frame, settings);
+    fused_pixel_lit(volume, lut, (fusion, grid.as_ref()), camera, frame, (x, y), settings)
+}
+
+/// The light grid the `shadows` effect reads (`None` without it): lit from the scene's light,
+/// or with the headlight from the eye along the camera's forward axis (one direction for the
+/// whole grid), as the GPU computes it.
+pub fn shadow_grid(
+    volume: &Volume,
+    lut: &[[f32; 4]],
+    frame: &CameraFrame,
+    settings: &RaycastSettings,
+) -> Option<crate::light::LightGrid> {
+    if !settings.effects.shadows {
+        return None;
+    }
+    let toward = settings.light.toward().unwrap_or(-frame.forward);
+    let tricubic = settings.effects.tricubic;
+    let field = |u: DVec3| if tricubic { volume.sample_tricubic(u) } else { volume.sample_trilinear(u) };
+    Some(crate::light::LightGrid::compute(volume, lut, toward, settings.opacity_unit_voxels, &field))
+}
+
+/// [`fused_pixel`] with the light grid of the `shadows` effect given ([`shadow_grid`]).
+pub fn fused_pixel_lit(
+    volume: &Volume,
+    lut: &[[f32; 4]],
+    (fusion, light_grid): (Option<&Fusion<'_>>, Option<&crate::light::LightGrid>),
     camera: &OrbitCamera,
     frame: &CameraFrame,
     (x, y): (u32, u32),
@@ -549,7 +607,7 @@ pub fn fused_pixel(
         return ([0.0; 4], [0.0; 4], 0);
     }
     let jitter = if settings.jitter { pixel_jitter(x, y, frame.width) } else { 0.0 };
-    let march = March::new(volume, lut, fusion, settings, seg, step_tex, jitter);
+    let march = March { light_grid, ..March::new(volume, lut, fusion, settings, seg, step_tex, jitter) };
     match settings.mode {
         RenderMode::Dvr => {
             let (c, n) = march.dvr();

@@ -95,7 +95,7 @@ fn ray_block(p: &Params) -> RaycastParamsGpu {
 /// Its pipeline for these parameters.
 fn shader(params: &Params) -> ShaderUse {
     ShaderUse::new("antialias.wgsl", if is_iso(params) { "fs_aa_iso" } else { "fs_aa_dvr" })
-        .binds(&["preintegrated"])
+        .binds(&["preintegrated", "light_volume"])
         .uniform(aa_layout())
         .uniform(RaycastParamsGpu::bound("params"))
 }

@@ -11,6 +11,8 @@ pub const SHADING: &str = "SHADING";
 pub const PREINTEGRATION: &str = "PREINTEGRATION";
 /// Tricubic B-spline reconstruction (`effects::EffectFlags::tricubic`; the min/max grid's apron).
 pub const TRICUBIC: &str = "TRICUBIC";
+/// Shadows from the light volume (`effects::EffectFlags::shadows`, `shadows.rs`).
+pub const SHADOWS: &str = "SHADOWS";
 /// A per-pixel sample offset (`raycast_params::Sampling::jitter`).
 pub const JITTER: &str = "JITTER";
 /// The offset changes every frame (`Sampling::jitter_per_frame`).
@@ -67,10 +69,11 @@ pub const SEGMENTS: &str = "SEGMENTS";
 pub const SCATTER: &str = "SCATTER";
 
 /// Every `#if` name of the built-in passes.
-pub const BUILT_IN: [&str; 26] = [
+pub const BUILT_IN: [&str; 27] = [
     SHADING,
     PREINTEGRATION,
     TRICUBIC,
+    SHADOWS,
     JITTER,
     JITTER_PER_FRAME,
     ANALYTIC,

@@ -1,6 +1,7 @@
 //! The scene effects a DVR raycaster specializes for (issue "effects a scene asks for"):
 //! `shading` (Blinn–Phong of every sample with the gradient), `preintegration` (Engel et al.
-//! 2001's segment table), `tricubic` (B-spline reconstruction from 8 trilinear fetches). Each is
+//! 2001's segment table), `tricubic` (B-spline reconstruction from 8 trilinear fetches),
+//! `shadows` (the light reaching each sample, from a light volume: `shadows.rs`). Each is
 //! a boolean parameter a graph wires to a scene feature — `"shading": "feature.shading"` — and
 //! an `#if NAME` in the shaders, so a scene that leaves an effect off compiles none of its code
 //! (`tests/effects_not_compiled.rs`) and builds none of its tables. Jitter is the existing
@@ -19,7 +20,7 @@ use crate::raycast_params::Sampling;
 /// The scene effects the built-in raycasters compile in, each a boolean parameter a graph wires
 /// to `"feature.NAME"`: every kind that marches with the shared core declares them
 /// (`PassDecl::scene_effects`), and a scene may ask for what some registered kind declares.
-pub const SCENE_EFFECTS: [&str; 4] = ["shading", "preintegration", "tricubic", "jitter"];
+pub const SCENE_EFFECTS: [&str; 5] = ["shading", "preintegration", "tricubic", "jitter", "shadows"];
 
 volgraph_compiler::pass_params! {
     /// The effect switches, declared once (all off by default); each is an `#if` of the same
@@ -29,12 +30,14 @@ volgraph_compiler::pass_params! {
         preintegration: bool = false,
             "pre-integrated classification of the segment between samples (Engel et al. 2001), table rebuilt when the TF changes";
         tricubic: bool = false, "tricubic B-spline reconstruction from 8 trilinear fetches instead of trilinear";
+        shadows: bool = false,
+            "shadows: the light reaching each sample through the volume (a light volume, rebuilt when the volume, TF or light changes) scales its lit terms";
     }
 }
 
 impl EffectFlags {
     /// Every effect off (a kind that declares none).
-    pub const OFF: Self = Self { shading: false, preintegration: false, tricubic: false };
+    pub const OFF: Self = Self { shading: false, preintegration: false, tricubic: false, shadows: false };
 
     /// The effects of `params` (all off for a kind that does not declare them).
     pub fn of(params: &Params) -> Self {
@@ -47,6 +50,7 @@ impl EffectFlags {
             (self.shading, defines::SHADING),
             (self.preintegration, defines::PREINTEGRATION),
             (self.tricubic, defines::TRICUBIC),
+            (self.shadows, defines::SHADOWS),
         ]
         .into_iter()
         .filter_map(|(on, define)| on.then_some(define))
@@ -82,17 +86,21 @@ pub fn jitter_defines(params: &Params) -> Vec<&'static str> {
 }
 
 #[cfg(feature = "gpu")]
-/// What a raycaster node keeps for its effects: the pre-integration table when that effect is on.
+/// What a raycaster node keeps for its effects: the pre-integration table and the light volume
+/// when those effects are on.
 pub struct EffectState {
     table: Option<PreintegrationTable>,
+    light: Option<crate::shadows::LightVolume>,
 }
 
 #[cfg(feature = "gpu")]
 impl EffectState {
     /// Builds what the effects in `ctx.params` need.
     pub fn new(ctx: &CreateContext<'_>) -> Result<Self, PassError> {
-        let table = EffectFlags::of(ctx.params).preintegration.then(|| PreintegrationTable::new(ctx)).transpose()?;
-        Ok(Self { table })
+        let flags = EffectFlags::of(ctx.params);
+        let table = flags.preintegration.then(|| PreintegrationTable::new(ctx)).transpose()?;
+        let light = flags.shadows.then(|| crate::shadows::LightVolume::new(flags.tricubic));
+        Ok(Self { table, light })
     }
 
     /// Brings derived data up to date before the raycaster records (the table after a TF or step
@@ -103,15 +111,26 @@ impl EffectState {
         params: &wgpu::Buffer,
         step_voxels: f64,
     ) -> Result<(), PassError> {
+        if let Some(light) = &mut self.light {
+            light.update(ctx)?;
+        }
         match &mut self.table {
             Some(t) => t.update(ctx, params, step_voxels),
             None => Ok(()),
         }
     }
 
-    /// The bindings the effects add (`preintegrated`).
+    /// The bindings the effects add (`preintegrated`, `light_volume`).
     pub fn bindings(&self) -> Vec<(&'static str, wgpu::BindingResource<'_>)> {
-        self.table.iter().map(|t| ("preintegrated", wgpu::BindingResource::TextureView(&t.table.view))).collect()
+        let table = self.table.iter().map(|t| ("preintegrated", wgpu::BindingResource::TextureView(&t.table.view)));
+        let light =
+            self.light.iter().filter_map(|l| l.view()).map(|v| ("light_volume", wgpu::BindingResource::TextureView(v)));
+        table.chain(light).collect()
+    }
+
+    /// Light-volume builds so far (0 without shadows).
+    pub fn light_builds(&self) -> u64 {
+        self.light.as_ref().map_or(0, |l| l.builds)
     }
 
     /// Table builds so far (0 without pre-integration).

@@ -38,6 +38,7 @@ pub mod raycast_segment;
 pub mod reprojection_splat;
 pub mod reprojection_tiles;
 pub mod segment_init;
+pub mod shadows;
 pub mod shared;
 pub mod slice_render;
 pub mod termination_test;

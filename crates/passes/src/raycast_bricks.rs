@@ -165,7 +165,7 @@ impl PassDecl for RaycastBricks {
 /// The brick march's entry point and what it binds, declared once for `shaders()` and `create`.
 fn march_shader() -> ShaderUse {
     ShaderUse::new("raycast_bricks.wgsl", "cs_main")
-        .binds(&["table", "leaf_words", "acc", "volume", "preintegrated"])
+        .binds(&["table", "leaf_words", "acc", "volume", "preintegrated", "light_volume"])
         .uniform(RaycastParamsGpu::bound("params"))
         .uniform(brick_layout())
 }

@@ -256,6 +256,7 @@ pub fn reference_settings(p: &Params) -> RaycastSettings {
             shading: effects.shading,
             preintegration: effects.preintegration,
             tricubic: effects.tricubic,
+            shadows: effects.shadows,
         },
         dvr_shading: phong,
         opacity_unit_voxels: 1.0,

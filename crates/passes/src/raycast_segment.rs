@@ -191,8 +191,11 @@ impl PassDecl for RaycastSegment {
         let (file, entry_point) = self.entry(params);
         // The counting variant (a bench tool's) binds the invocation counter too.
         // The pre-integration table's (an effect's), and the counting variant's counter.
-        let binds: &'static [&'static str] =
-            if self.counts() { &["invocations", "preintegrated"] } else { &["preintegrated"] };
+        let binds: &'static [&'static str] = if self.counts() {
+            &["invocations", "preintegrated", "light_volume"]
+        } else {
+            &["preintegrated", "light_volume"]
+        };
         let mut uses = [ShaderUse::new(file, "vs_segment"), ShaderUse::new(file, entry_point)]
             .map(|u| u.binds(binds).uniform(RaycastParamsGpu::bound("params")).uniform(SegmentParams::layout()))
             .to_vec();

@@ -77,8 +77,9 @@ fn march_code(graph: &str, options: CompileOptions) -> BTreeSet<String> {
 }
 
 /// Each scene effect and a function only its code calls.
-const EFFECT_MARKERS: [(&str, &str); 4] = [
-    ("shading", "headlight"),
+const EFFECT_MARKERS: [(&str, &str); 5] = [
+    ("shading", "lighting"),
+    ("shadows", "light_transmittance"),
     ("preintegration", "lookup_preintegrated"),
     ("tricubic", "sample_tricubic"),
     ("jitter", "pcg_hash"),
@@ -149,7 +150,7 @@ fn a_cut_is_compiled_only_when_the_scene_cuts() {
     // Capping (the cut faces' flat shading) comes with shading and a cut, and only then.
     for graph in ["basic/fragment_raycast.ron", "modern/fastest.ron"] {
         let shaded = pass_code_with_cuts(graph, "march", CompileOptions::new(64, 64).with_features(["shading"]));
-        assert!(shaded.contains("headlight") && !shaded.contains("cap_normal"), "{graph}: {shaded:?}");
+        assert!(shaded.contains("lighting") && !shaded.contains("cap_normal"), "{graph}: {shaded:?}");
         for cut in ["crop", "clip"] {
             let capped =
                 pass_code_with_cuts(graph, "march", CompileOptions::new(64, 64).with_features(["shading", cut]));

@@ -3,6 +3,13 @@
 //! shades with the same light — Blinn–Phong with `h` halfway between light and eye — and moves
 //! the picture away from the headlight's.
 //!
+//! With the `shadows` effect (Behrens & Ratering 1998) every family reads the light volume —
+//! the transmittance toward the light on a grid of up to 64³, `volgraph_accel::light::LightGrid`,
+//! which the reference computes with the same function — and matches the reference within the
+//! same bounds: the grid is uploaded as f16 (T within 2⁻¹¹) and filtered by the sampler, whose
+//! weights carry 8 fractional bits on llvmpipe, so across a shadow's edge (T from 0 to 1 between
+//! two grid voxels) T may differ by 1/256: about one 255th of colour.
+//!
 //! Tolerances, per channel of premultiplied linear RGBA, as `cuts.rs` bounds shaded images (f32
 //! on the GPU, f64 on the CPU; the gradient's central differences and the specular power
 //! amplify rounding where the normal is ill-conditioned): at most 0.5 % of pixels over 2/255,
@@ -41,6 +48,15 @@ fn render_lit(
         CompileOptions::new(SIZE, SIZE).with_features(features.iter().map(|f| f.to_string()).collect::<Vec<_>>());
     options.scene = scene_values_of(&VolumeDesc::of(volume));
     let plan = compile(graph, &source, &registry, &options).unwrap_or_else(|d| panic!("{graph}: {d}"));
+    // Krüger–Westermann's termination test stops between segments, the reference per sample:
+    // compared lossless (T = 1), as tests/kruger_westermann.rs compares them.
+    let plan = match plan.steps.iter().find(|s| s.pass_id == "terminate") {
+        Some(_) => {
+            options = options.with_param("terminate", "threshold", 1.0).with_param("march", "threshold", 1.0);
+            compile(graph, &source, &registry, &options).unwrap_or_else(|d| panic!("{graph}: {d}"))
+        }
+        None => plan,
+    };
     let march = plan.steps.iter().find(|s| s.pass_id == "march").expect("a march step");
     let settings = RaycastSettings { light, ..reference_settings(&march.params) };
     let mut runtime = support::runtime(gpu);
@@ -109,4 +125,44 @@ fn the_headlight_is_the_default_light() {
     runtime.apply(plan.clone(), &registry).expect("applies");
     runtime.render(CameraData::from_orbit(&camera, plan.viewport)).expect("renders");
     assert_eq!(runtime.read_output("image").expect("image").data, plain.data);
+}
+
+#[test]
+fn shadows_darken_what_the_light_cannot_reach_like_the_reference() {
+    let gpu = gpu();
+    let volume = volgraph_accel::generate::marschner_lobb_f32(32);
+    // Dense enough that the rings shadow one another, clear enough that the shadows show.
+    let lut = TransferFunction::preset(Preset::Opaque, volume.value_range).to_lut_for(&volume, 256);
+    let camera = OrbitCamera { azimuth_deg: 25.0, elevation_deg: 15.0, ..OrbitCamera::default() };
+    let light = Light::Directional { azimuth_deg: -80.0, elevation_deg: 50.0 };
+    for (graph, features) in [
+        ("basic/fragment_raycast.ron", &["shading", "shadows"][..]),
+        ("basic/fragment_raycast.ron", &["shadows"][..]),
+        ("modern/fastest.ron", &["shading", "shadows"][..]),
+        ("kruger_westermann_2003/rc_b.ron", &["shading", "shadows"][..]),
+        ("ruijters_vilanova_2006/bricks_octree_ert.ron", &["shading", "shadows"][..]),
+    ] {
+        let (image, settings) = render_lit(&gpu, graph, (&volume, &lut), &camera, light, features);
+        assert!(settings.effects.shadows, "{graph}: shadows reach the reference settings");
+        let reference = render_reference(&volume, &lut, &camera, SIZE, SIZE, &settings);
+        let unshadowed = RaycastSettings {
+            effects: volgraph_accel::reference::Effects { shadows: false, ..settings.effects },
+            ..settings
+        };
+        let lit = render_reference(&volume, &lut, &camera, SIZE, SIZE, &unshadowed);
+        let got = image.to_rgba_f64();
+        let diff = image_diff(&got, &reference.color).expect("same size");
+        let over = fraction_over(&got, &reference.color, 2.0 / 255.0).expect("same size");
+        let shadowed = fraction_over(&lit.color, &reference.color, 8.0 / 255.0).expect("same size");
+        eprintln!(
+            "{graph} {features:?}: max {:.2}/255 mean {:.3}/255, {:.2}% over 2/255; shadows moved {:.0}% of pixels",
+            diff.max_abs * 255.0,
+            diff.mean_abs * 255.0,
+            over * 100.0,
+            shadowed * 100.0
+        );
+        assert!(shadowed > 0.05, "{graph}: the shadows must change the image ({:.1}%)", shadowed * 100.0);
+        assert!(over <= 0.005, "{graph}: {:.2}% of pixels over 2/255", over * 100.0);
+        assert!(diff.mean_abs <= 0.5 / 255.0, "{graph}: mean {:.3}/255", diff.mean_abs * 255.0);
+    }
 }

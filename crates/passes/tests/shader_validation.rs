@@ -57,7 +57,7 @@ fn bindings(module: &naga::Module) -> Vec<(String, u32, u32)> {
 }
 
 /// `#if` combinations the raycasters compile (crates/passes/src/march.rs): leaping over block
-/// flags or the distance map, start estimates with leap hits.
+/// flags or the distance map, start estimates with leap hits, several volumes, shadows.
 const SETTINGS: &[&[&str]] = &[
     &["LEAP", "LEAP_BLOCKS"],
     &["LEAP", "LEAP_CUBES"],
@@ -65,6 +65,8 @@ const SETTINGS: &[&[&str]] = &[
     &["FUSION", "FUSION_LABELS"],
     &["FUSION", "FUSION_LABEL_MAP"],
     &["FUSION", "FUSION_SCALAR"],
+    &["SHADOWS"],
+    &["SHADOWS", "SHADING"],
 ];
 
 #[test]

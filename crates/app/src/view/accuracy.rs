@@ -82,6 +82,8 @@ pub fn measure(job: &Job) -> Accuracy {
         ..job.settings
     };
     let frame = job.camera.frame(w, h);
+    // The shadows' light grid once for the whole view, not once per pixel.
+    let grid = volgraph_accel::reference::shadow_grid(&job.volume, &job.lut, &frame, &settings);
     let (mut sum, mut max, mut n) = (0.0, 0.0f64, 0usize);
     for y in (stride / 2..h).step_by(stride as usize) {
         for x in (stride / 2..w).step_by(stride as usize) {
@@ -91,10 +93,10 @@ pub fn measure(job: &Job) -> Accuracy {
                 filter: *filter,
                 second: None,
             });
-            let (reference, _, _) = volgraph_accel::reference::fused_pixel(
+            let (reference, _, _) = volgraph_accel::reference::fused_pixel_lit(
                 &job.volume,
                 &job.lut,
-                fusion.as_ref(),
+                (fusion.as_ref(), grid.as_ref()),
                 &job.camera,
                 &frame,
                 (x, y),

@@ -229,6 +229,18 @@ pub fn upload_u32_3d(gpu: &Gpu, label: &str, dims: [u32; 3], values: &[u32]) -> 
     )
 }
 
+/// `values` (x fastest) as a filterable `R16Float` 3D texture: a derived field in \[0, 1\] whose
+/// f16 step (≤ 2⁻¹¹ there) is below a 255th (the `shadows` effect's light volume).
+pub fn upload_f16_3d(gpu: &Gpu, label: &str, dims: [u32; 3], values: &[f32]) -> Result<wgpu::Texture, GpuFault> {
+    let halves: Vec<u16> = values.iter().map(|v| f32_to_f16(*v)).collect();
+    texture_with(
+        gpu,
+        || format!("uploading \"{label}\" ({}x{}x{} f16)", dims[0], dims[1], dims[2]),
+        (label, dims, wgpu::TextureDimension::D3, wgpu::TextureFormat::R16Float),
+        bytemuck::cast_slice(&halves),
+    )
+}
+
 /// The one way a sampled input texture is made: `(label, dims, dimension, format)` created and
 /// `bytes` (x fastest, tightly packed rows) written, a GPU error coming back as a fault named by
 /// `what`.

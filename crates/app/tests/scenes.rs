@@ -87,8 +87,8 @@ fn a_broken_scene_names_the_file_and_the_line_or_field() {
         ),
         (
             "effect.ron",
-            "Scene(volume: Generated(\"ml16\"), effects: [\"shadows\"])\n",
-            "effects: \"shadows\" is not an effect",
+            "Scene(volume: Generated(\"ml16\"), effects: [\"scattering\"])\n",
+            "effects: \"scattering\" is not an effect",
             graph,
         ),
         (

@@ -10,13 +10,11 @@
 //! weights carry 8 fractional bits on llvmpipe, so across a shadow's edge (T from 0 to 1 between
 //! two grid voxels) T may differ by 1/256: about one 255th of colour.
 //!
-//! Tolerances, per channel of premultiplied linear RGBA, as `cuts.rs` bounds shaded images (f32
-//! on the GPU, f64 on the CPU; the gradient's central differences and the specular power
-//! amplify rounding where the normal is ill-conditioned): at most 0.5 % of pixels over 2/255,
-//! mean under 0.5/255.
+//! Tolerances: `support::assert_shaded_like_reference`, the bounds of shaded images (at most
+//! 0.5 % of pixels over 2/255, mean under 0.5/255 per channel of premultiplied linear RGBA).
 
 use volgraph_accel::camera::OrbitCamera;
-use volgraph_accel::image_diff::{fraction_over, image_diff};
+use volgraph_accel::image_diff::fraction_over;
 use volgraph_accel::light::Light;
 use volgraph_accel::reference::{RaycastSettings, render_reference};
 use volgraph_accel::transfer_function::{Preset, TransferFunction};
@@ -28,7 +26,7 @@ use volgraph_passes::raycast_params::reference_settings;
 
 mod support;
 
-use support::{gpu, graph_source};
+use support::{assert_shaded_like_reference, gpu, graph_source};
 
 const SIZE: u32 = 96;
 
@@ -86,21 +84,11 @@ fn a_directional_light_shades_every_family_like_the_reference() {
         let reference = render_reference(&volume, &lut, &camera, SIZE, SIZE, &settings);
         let headlight = RaycastSettings { light: Light::Headlight, ..settings };
         let headlit = render_reference(&volume, &lut, &camera, SIZE, SIZE, &headlight);
-        let got = image.to_rgba_f64();
-        let diff = image_diff(&got, &reference.color).expect("same size");
-        let over = fraction_over(&got, &reference.color, 2.0 / 255.0).expect("same size");
         // The light moved the picture: a test that passes with the headlight proves nothing.
         let moved = fraction_over(&headlit.color, &reference.color, 8.0 / 255.0).expect("same size");
-        eprintln!(
-            "{graph}: max {:.2}/255 mean {:.3}/255, {:.2}% over 2/255; the light moved {:.0}% of pixels",
-            diff.max_abs * 255.0,
-            diff.mean_abs * 255.0,
-            over * 100.0,
-            moved * 100.0
-        );
+        let extra = format!("; the light moved {:.0}% of pixels", moved * 100.0);
+        assert_shaded_like_reference(graph, &image.to_rgba_f64(), &reference.color, &extra);
         assert!(moved > 0.1, "{graph}: the light must change the image ({:.1}%)", moved * 100.0);
-        assert!(over <= 0.005, "{graph}: {:.2}% of pixels over 2/255", over * 100.0);
-        assert!(diff.mean_abs <= 0.5 / 255.0, "{graph}: mean {:.3}/255", diff.mean_abs * 255.0);
     }
 }
 
@@ -150,19 +138,9 @@ fn shadows_darken_what_the_light_cannot_reach_like_the_reference() {
             ..settings
         };
         let lit = render_reference(&volume, &lut, &camera, SIZE, SIZE, &unshadowed);
-        let got = image.to_rgba_f64();
-        let diff = image_diff(&got, &reference.color).expect("same size");
-        let over = fraction_over(&got, &reference.color, 2.0 / 255.0).expect("same size");
         let shadowed = fraction_over(&lit.color, &reference.color, 8.0 / 255.0).expect("same size");
-        eprintln!(
-            "{graph} {features:?}: max {:.2}/255 mean {:.3}/255, {:.2}% over 2/255; shadows moved {:.0}% of pixels",
-            diff.max_abs * 255.0,
-            diff.mean_abs * 255.0,
-            over * 100.0,
-            shadowed * 100.0
-        );
+        let extra = format!("; shadows moved {:.0}% of pixels", shadowed * 100.0);
+        assert_shaded_like_reference(&format!("{graph} {features:?}"), &image.to_rgba_f64(), &reference.color, &extra);
         assert!(shadowed > 0.05, "{graph}: the shadows must change the image ({:.1}%)", shadowed * 100.0);
-        assert!(over <= 0.005, "{graph}: {:.2}% of pixels over 2/255", over * 100.0);
-        assert!(diff.mean_abs <= 0.5 / 255.0, "{graph}: mean {:.3}/255", diff.mean_abs * 255.0);
     }
 }

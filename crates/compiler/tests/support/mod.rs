@@ -73,6 +73,7 @@ fn raycast_params() -> Vec<ParamSpec> {
         ParamSpec::boolean("shading", false, "gradient shading"),
         ParamSpec::boolean("preintegration", false, "pre-integrated classification"),
         ParamSpec::boolean("tricubic", false, "tricubic reconstruction"),
+        ParamSpec::boolean("shadows", false, "light volume shadows"),
     ]
 }
 

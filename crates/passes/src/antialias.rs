@@ -134,7 +134,7 @@ impl PassDecl for Antialias {
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        [vec![shader(params)], effect_shader_uses(params)].concat()
+        [vec![shader(params)], effect_shader_uses(params, true)].concat()
     }
 }
 
@@ -148,7 +148,7 @@ impl PassPlugin for Antialias {
         })?;
         let params = ctx.uniform_from_bytes("params", &ray_block(ctx.params).uniform_bytes());
         let aa = ctx.uniform_from_bytes("aa", &AaParams::of(ctx.params).uniform_bytes());
-        let effects = EffectState::new(ctx)?;
+        let effects = EffectState::new(ctx, true)?;
         let step_voxels = Sampling::from_params(ctx.params).step_voxels;
         Ok(Box::new(AntialiasNode { pipeline, params, aa, effects, step_voxels }))
     }

@@ -65,13 +65,19 @@ pub fn effect_block() -> volgraph_compiler::block::ParamBlock {
 }
 
 /// The shader uses the effects add to a raycaster's own: the pre-integration table's compute
-/// pipelines when `preintegration` is on (one of the two is built, by what the device filters).
-pub fn effect_shader_uses(params: &Params) -> Vec<volgraph_compiler::ShaderUse> {
-    if EffectFlags::of(params).preintegration {
-        crate::preintegration::table_shader_uses().to_vec()
-    } else {
-        Vec::new()
+/// pipelines when `preintegration` is on (one of the two is built, by what the device filters),
+/// the light volume's when `shadows` is on and the pass's volume is a texture
+/// (`volume_texture`; the brick raycaster computes it on the CPU).
+pub fn effect_shader_uses(params: &Params, volume_texture: bool) -> Vec<volgraph_compiler::ShaderUse> {
+    let flags = EffectFlags::of(params);
+    let mut uses = Vec::new();
+    if flags.preintegration {
+        uses.extend(crate::preintegration::table_shader_uses());
     }
+    if flags.shadows && volume_texture {
+        uses.push(crate::shadows::light_shader_use());
+    }
+    uses
 }
 
 /// `JITTER` when the `jitter` parameter is on: the `#if`s of the sampling block
@@ -95,11 +101,13 @@ pub struct EffectState {
 
 #[cfg(feature = "gpu")]
 impl EffectState {
-    /// Builds what the effects in `ctx.params` need.
-    pub fn new(ctx: &CreateContext<'_>) -> Result<Self, PassError> {
+    /// Builds what the effects in `ctx.params` need; `volume_texture`: the pass's `volume` port
+    /// is the volume's texture (not voxels on the CPU, as the brick raycaster's).
+    pub fn new(ctx: &CreateContext<'_>, volume_texture: bool) -> Result<Self, PassError> {
         let flags = EffectFlags::of(ctx.params);
         let table = flags.preintegration.then(|| PreintegrationTable::new(ctx)).transpose()?;
-        let light = flags.shadows.then(|| crate::shadows::LightVolume::new(flags.tricubic));
+        let light =
+            flags.shadows.then(|| crate::shadows::LightVolume::new(ctx, flags.tricubic, volume_texture)).transpose()?;
         Ok(Self { table, light })
     }
 

@@ -115,7 +115,7 @@ impl PassDecl for Raycast {
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        [vec![march_shader(params)], crate::effects::effect_shader_uses(params)].concat()
+        [vec![march_shader(params)], crate::effects::effect_shader_uses(params, true)].concat()
     }
 }
 
@@ -177,7 +177,7 @@ impl PassPlugin for Raycast {
         let own = RaycastOwn::from_params(ctx.params);
         let settings = gpu_block(ctx.params);
         let params = ctx.uniform_from_bytes("params", &settings.uniform_bytes());
-        let effects = EffectState::new(ctx)?;
+        let effects = EffectState::new(ctx, true)?;
         let fusion = crate::fusion::FusionState::new(ctx)?;
         Ok(Box::new(RaycastNode {
             fusion,

@@ -158,7 +158,7 @@ impl PassDecl for RaycastBricks {
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        [vec![march_shader()], effect_shader_uses(params)].concat()
+        [vec![march_shader()], effect_shader_uses(params, false)].concat()
     }
 }
 
@@ -214,7 +214,7 @@ impl PassPlugin for RaycastBricks {
                 message: format!("rank {rank} is not below ranks {ranks}; ranks are numbered 0..ranks"),
             });
         }
-        let effects = EffectState::new(ctx)?;
+        let effects = EffectState::new(ctx, false)?;
         Ok(Box::new(RaycastBricksNode {
             effects,
             step_voxels: Sampling::from_params(ctx.params).step_voxels,

@@ -132,7 +132,7 @@ impl PassDecl for RaycastCompute {
         if uses_table(params) {
             uses.extend(table_shader_uses());
         }
-        uses.extend(crate::effects::effect_shader_uses(params));
+        uses.extend(crate::effects::effect_shader_uses(params, true));
         uses
     }
 
@@ -187,7 +187,7 @@ impl PassPlugin for RaycastCompute {
         let exact = table.is_none() && !EffectFlags::of(ctx.params).preintegration && !is_iso(ctx.params);
         let half_step = (exact && sampling.step_voxels == 0.5).then(|| variant(true)).transpose()?;
         let params = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());
-        let effects = EffectState::new(ctx)?;
+        let effects = EffectState::new(ctx, true)?;
         let fusion = crate::fusion::FusionState::new(ctx)?;
         Ok(Box::new(RaycastComputeNode {
             fusion,

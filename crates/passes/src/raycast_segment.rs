@@ -199,7 +199,7 @@ impl PassDecl for RaycastSegment {
         let mut uses = [ShaderUse::new(file, "vs_segment"), ShaderUse::new(file, entry_point)]
             .map(|u| u.binds(binds).uniform(RaycastParamsGpu::bound("params")).uniform(SegmentParams::layout()))
             .to_vec();
-        uses.extend(effect_shader_uses(params));
+        uses.extend(effect_shader_uses(params, true));
         uses
     }
 
@@ -282,7 +282,7 @@ impl PassPlugin for RaycastSegment {
             }
             None => None,
         };
-        let effects = EffectState::new(ctx)?;
+        let effects = EffectState::new(ctx, true)?;
         let step_voxels = Sampling::from_params(ctx.params).step_voxels;
         Ok(Box::new(RaycastSegmentNode { free, early_z, params, segment, invocations, effects, step_voxels }))
     }

@@ -8,19 +8,29 @@
 //! reconstruction change. With the headlight the light comes from the eye along the camera's
 //! forward axis, so the volume follows the camera.
 //!
-//! The grid is computed on the CPU (rayon) from the voxels and LUT the runtime keeps for every
-//! bound volume and TF, and uploaded as `R16Float` (filterable everywhere; T ∈ \[0, 1\] in f16 is
-//! within 2⁻¹¹). That reaches every family at once — the brick raycaster's GPU volume is an
-//! atlas of resident bricks, not the volume — at 64³ × (up to ~110 steps) trilinear samples per
-//! rebuild.
+//! The grid is computed on the GPU (`shaders/light_volume.wgsl`, one compute dispatch, written
+//! as `Rgba16Float`: T ∈ \[0, 1\] in f16 is within 2⁻¹¹) where the pass's volume is a texture;
+//! the brick raycaster's GPU volume is an atlas of resident bricks, not the volume, so there it
+//! is computed on the CPU (rayon) from the voxels and LUT the runtime keeps for every bound
+//! volume and TF — by `LightGrid::compute`, the reference's own function — and uploaded as
+//! `R16Float`.
+
+use volgraph_compiler::ShaderUse;
+
+/// The light volume's compute entry point, declared by the raycasters whose volume is a texture.
+pub fn light_shader_use() -> ShaderUse {
+    ShaderUse::new("light_volume.wgsl", "cs_light_volume").binds(&["light_out"])
+}
 
 #[cfg(feature = "gpu")]
-use volgraph_core::runtime::{PassError, RecordContext};
+use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
 
 #[cfg(feature = "gpu")]
 /// A raycaster's light volume and what it was built for.
 pub struct LightVolume {
     view: Option<wgpu::TextureView>,
+    /// Where the pass's volume is a texture: the compute pipeline that writes the grid.
+    gpu: Option<ComputePassPipeline>,
     /// (volume version, TF version, light direction, opacity unit) of the last build.
     built_for: Option<(Option<u64>, Option<u64>, [u64; 3], u64)>,
     /// The field is the tricubic B-spline (the `tricubic` effect), as the march reconstructs it.
@@ -31,9 +41,17 @@ pub struct LightVolume {
 
 #[cfg(feature = "gpu")]
 impl LightVolume {
-    /// Not built yet; `tricubic`: reconstruct the field as the march does.
-    pub fn new(tricubic: bool) -> Self {
-        Self { view: None, built_for: None, tricubic, builds: 0 }
+    /// Not built yet; `tricubic`: reconstruct the field as the march does. On the GPU where the
+    /// pass's `volume` port is the volume's texture (`volume_texture`), else on the CPU.
+    pub fn new(ctx: &CreateContext<'_>, tricubic: bool, volume_texture: bool) -> Result<Self, PassError> {
+        let gpu = if volume_texture {
+            let declared = light_shader_use();
+            let defines: &[&str] = if tricubic { &[crate::defines::TRICUBIC] } else { &[] };
+            Some(ctx.compute_pipeline(&ComputePipelineSpec { defines, ..ComputePipelineSpec::of(&declared) })?)
+        } else {
+            None
+        };
+        Ok(Self { view: None, gpu, built_for: None, tricubic, builds: 0 })
     }
 
     /// The light volume, once built.
@@ -43,13 +61,47 @@ impl LightVolume {
 
     /// Rebuilds from the pass's `volume` and `tf` ports when they, the light or the opacity unit
     /// changed since the last build.
-    pub fn update(&mut self, ctx: &RecordContext<'_>) -> Result<(), PassError> {
+    pub fn update(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let frame = ctx.frame;
         let toward = frame.light.toward().unwrap_or(-frame.camera.forward);
         let unit = frame.volume.map_or(1.0, |v| v.opacity_unit_voxels);
         let key =
             (ctx.input_version("volume"), ctx.input_version("tf"), toward.to_array().map(f64::to_bits), unit.to_bits());
         if self.built_for == Some(key) && self.view.is_some() {
+            return Ok(());
+        }
+        let dims = volgraph_accel::light::light_grid_dims(ctx.voxels("volume")?.dims);
+        if let Some(pipeline) = &self.gpu {
+            // The grid's texture, made anew when the volume's size changed.
+            let size = wgpu::Extent3d { width: dims.x, height: dims.y, depth_or_array_layers: dims.z };
+            let view = match &self.view {
+                Some(v) if v.texture().size() == size && v.texture().format() == wgpu::TextureFormat::Rgba16Float => {
+                    v.clone()
+                }
+                _ => ctx
+                    .gpu
+                    .device
+                    .create_texture(&wgpu::TextureDescriptor {
+                        label: Some(&format!("{} light volume", ctx.label)),
+                        size,
+                        mip_level_count: 1,
+                        sample_count: 1,
+                        dimension: wgpu::TextureDimension::D3,
+                        format: wgpu::TextureFormat::Rgba16Float,
+                        usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+                        view_formats: &[],
+                    })
+                    .create_view(&wgpu::TextureViewDescriptor::default()),
+            };
+            let bg = ctx.bind_group(pipeline, &[("light_out", wgpu::BindingResource::TextureView(&view))])?;
+            let mut pass = ctx.begin_compute_pass();
+            pass.set_pipeline(&pipeline.pipeline);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups(dims.x.div_ceil(4), dims.y.div_ceil(4), dims.z.div_ceil(4));
+            drop(pass);
+            self.view = Some(view);
+            self.built_for = Some(key);
+            self.builds += 1;
             return Ok(());
         }
         let volume = ctx.voxels("volume")?.clone();

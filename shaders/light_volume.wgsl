@@ -1,12 +1,15 @@
-// The `shadows` effect's light volume on the GPU (crates/passes/src/shadows.rs; Behrens &
-// Ratering 1998's shadow volume, computed per voxel; the f64 model is
-// volgraph_accel::light::LightGrid, which the reference calls): at each voxel centre
-// u0 = (i + 0.5) / m of a grid of m voxels per axis (the volume's, up to 64), the transmittance
-// toward the light T = Π_{k≥1} (1 − α_tf(s(u0 + k·Δ)))^e, Δ one unit_world toward the light in
-// texture space, k up to the last step inside the box, e = 1 / opacity unit, the sample at u0
-// itself left out (a surface does not shadow itself); below 1/1024 the light is out. Built by the
-// raycaster that reads it when the volume, TF, light or opacity unit change, into `light_out`
-// (Rgba16Float, T in .r).
+// The illumination volume of the `shadows` and `ambient_occlusion` effects on the GPU
+// (crates/passes/src/shadows.rs; the f64 model is volgraph_accel::light::LightGrid, which the
+// reference calls). At each voxel centre u0 = (i + 0.5) / m of a grid of m voxels per axis (the
+// volume's, up to 64):
+// - SHADOWS (Behrens & Ratering 1998's shadow volume, per voxel): the transmittance toward the
+//   light T = Π_{k≥1} (1 − α_tf(s(u0 + k·Δ)))^e, Δ one unit_world toward the light in texture
+//   space, k up to the last step inside the box, e = 1 / opacity unit, the sample at u0 itself
+//   left out (a surface does not shadow itself); below 1/1024 the light is out;
+// - AMBIENT_OCCLUSION (Hernell et al. 2010, cones reduced to rays): the mean transmittance along
+//   14 directions (the axes and the diagonals) over 8 steps each (fewer where the box ends).
+// Built by the raycaster that reads it when the volume, TF, light or opacity unit change, into
+// `light_out` (Rgba16Float: T in .r, AO in .g; 1 for an effect that is off).
 
 #import "common/raymarch.wgsl"
 
@@ -14,6 +17,9 @@
 
 // volgraph_accel::light::MIN_TRANSMITTANCE.
 const MIN_TRANSMITTANCE: f32 = 1.0 / 1024.0;
+
+// volgraph_accel::light::OCCLUSION_STEPS.
+const OCCLUSION_STEPS: u32 = 8u;
 
 // Whole steps `step` from `u0` that stay inside the texture box (light::steps_to_exit).
 fn steps_to_exit(u0: vec3<f32>, step: vec3<f32>) -> u32 {
@@ -28,6 +34,29 @@ fn steps_to_exit(u0: vec3<f32>, step: vec3<f32>) -> u32 {
     return u32(clamp(floor(t), 0.0, 1e6));
 }
 
+// The transmittance from `u0` along `step` over at most `max_steps` steps (light::LightGrid's
+// `along`).
+fn transmittance_along(u0: vec3<f32>, step: vec3<f32>, max_steps: u32, exponent: f32) -> f32 {
+    let steps = min(steps_to_exit(u0, step), max_steps);
+    var t = 1.0;
+    for (var k = 1u; k <= steps; k++) {
+        let a = clamp(sample_tf(sample_volume(u0 + f32(k) * step)).a, 0.0, 1.0);
+        if (a >= 1.0) {
+            return 0.0;
+        }
+        t *= pow(1.0 - a, exponent);
+        if (t < MIN_TRANSMITTANCE) {
+            return 0.0;
+        }
+    }
+    return t;
+}
+
+// One unit_world along the unit world direction `d`, in texture space (light::light_step_tex).
+fn unit_step_toward(d: vec3<f32>) -> vec3<f32> {
+    return d * frame.half_extent.w / (2.0 * frame.half_extent.xyz);
+}
+
 @compute @workgroup_size(4, 4, 4)
 fn cs_light_volume(@builtin(global_invocation_id) id: vec3<u32>) {
     let m = textureDimensions(light_out);
@@ -35,23 +64,29 @@ fn cs_light_volume(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let u0 = (vec3<f32>(id) + vec3<f32>(0.5)) / vec3<f32>(m);
+    let exponent = 1.0 / frame.volume_dims.w;
+    var t = 1.0;
+#if SHADOWS
     // Toward the light: a directional light's, else the eye's along the camera's forward axis.
     let toward = select(-frame.camera_forward.xyz, frame.light_world.xyz, frame.light_world.w != 0.0);
-    let step = toward * frame.half_extent.w / (2.0 * frame.half_extent.xyz);
-    let exponent = 1.0 / frame.volume_dims.w;
-    let steps = steps_to_exit(u0, step);
-    var t = 1.0;
-    for (var k = 1u; k <= steps; k++) {
-        let a = clamp(sample_tf(sample_volume(u0 + f32(k) * step)).a, 0.0, 1.0);
-        if (a >= 1.0) {
-            t = 0.0;
-            break;
+    t = transmittance_along(u0, unit_step_toward(toward), 0xffffffffu, exponent);
+#endif
+    var ao = 1.0;
+#if AMBIENT_OCCLUSION
+    // The 6 axes, then the 8 diagonals (light::OCCLUSION_DIRECTIONS, in that order).
+    var sum = 0.0;
+    for (var j = 0u; j < 14u; j++) {
+        var d: vec3<f32>;
+        if (j < 6u) {
+            d = vec3<f32>(0.0);
+            d[j / 2u] = select(1.0, -1.0, (j & 1u) == 1u);
+        } else {
+            let c = j - 6u;
+            d = normalize(vec3<f32>(select(1.0, -1.0, c >= 4u), select(1.0, -1.0, (c & 2u) != 0u), select(1.0, -1.0, (c & 1u) != 0u)));
         }
-        t *= pow(1.0 - a, exponent);
-        if (t < MIN_TRANSMITTANCE) {
-            t = 0.0;
-            break;
-        }
+        sum += transmittance_along(u0, unit_step_toward(d), OCCLUSION_STEPS, exponent);
     }
-    textureStore(light_out, id, vec4<f32>(t, 0.0, 0.0, 1.0));
+    ao = sum / 14.0;
+#endif
+    textureStore(light_out, id, vec4<f32>(t, ao, 0.0, 1.0));
 }

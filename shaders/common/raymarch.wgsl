@@ -156,6 +156,10 @@ fn classify_sample(u: vec3<f32>) -> vec4<f32> {
 #endif
 #if SHADOWS
 #import "common/shadows.wgsl"
+#else
+#if AMBIENT_OCCLUSION
+#import "common/shadows.wgsl"
+#endif
 #endif
 
 // `classify_sample` of the scalar `s` already fetched at `u`.
@@ -184,14 +188,44 @@ fn classify_value(u: vec3<f32>, s: f32) -> vec4<f32> {
     }
 #else
 #if SHADOWS
-    // Unshaded: the light reaching the sample scales its colour down to the ambient.
-    if (p.a > 0.0) {
-        let lit = params.ambient + (1.0 - params.ambient) * light_transmittance(u);
-        p = vec4<f32>(p.rgb * lit, p.a);
-    }
+    p = unshaded_lit(u, p);
+#else
+#if AMBIENT_OCCLUSION
+    p = unshaded_lit(u, p);
+#endif
 #endif
 #endif
     return p;
+}
+
+// The ambient light reaching `u`: the ambient term, scaled by its unoccluded share with
+// AMBIENT_OCCLUSION.
+fn ambient_at(u: vec3<f32>) -> f32 {
+#if AMBIENT_OCCLUSION
+    return params.ambient * ambient_occlusion(u);
+#else
+    return params.ambient;
+#endif
+}
+
+// The scene light reaching `u`: its transmittance with SHADOWS, else all of it.
+fn direct_at(u: vec3<f32>) -> f32 {
+#if SHADOWS
+    return light_transmittance(u);
+#else
+    return 1.0;
+#endif
+}
+
+// An unshaded sample `p` at `u` lit by the illumination volume: its colour scaled by the ambient
+// light reaching it and the rest of the light by what gets through
+// (volgraph_accel::reference: `ambient·AO + (1 − ambient)·T`).
+fn unshaded_lit(u: vec3<f32>, p: vec4<f32>) -> vec4<f32> {
+    if (!(p.a > 0.0)) {
+        return p;
+    }
+    let lit = ambient_at(u) + (1.0 - params.ambient) * direct_at(u);
+    return vec4<f32>(p.rgb * lit, p.a);
 }
 
 // The samples of a pixel's ray (`count` 0 when there is no ray to march): step and jitter of
@@ -343,13 +377,10 @@ fn lighting(u: vec3<f32>, d_world: vec3<f32>, l: vec3<f32>) -> vec2<f32> {
     if (n_dot_l > 0.0) {
         spec = params.specular * pow(n_dot_h, params.shininess);
     }
-#if SHADOWS
-    // Shadows: only the light that gets through reaches the diffuse and specular terms.
-    let t = light_transmittance(u);
-    return vec2<f32>(params.ambient + t * params.diffuse * n_dot_l, t * spec);
-#else
-    return vec2<f32>(params.ambient + params.diffuse * n_dot_l, spec);
-#endif
+    // Shadows: only the light that gets through reaches the diffuse and specular terms;
+    // ambient occlusion: only the unoccluded share of the ambient light.
+    let t = direct_at(u);
+    return vec2<f32>(ambient_at(u) + t * params.diffuse * n_dot_l, t * spec);
 }
 
 // The shaded colour of the isosurface at `u`.

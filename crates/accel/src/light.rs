@@ -106,60 +106,119 @@ pub fn light_grid_dims(dims: glam::UVec3) -> glam::UVec3 {
     dims.min(glam::UVec3::splat(LIGHT_GRID_MAX)).max(glam::UVec3::ONE)
 }
 
-/// The `shadows` effect's light volume (Behrens & Ratering 1998's shadow volume, computed per
-/// voxel by marching toward the light): at each grid voxel's centre `u0`, the transmittance toward the light
-/// `T = Π_{k≥1} (1 − α_tf(s(u0 + k·Δ)))^(1/opacity_unit)`, `Δ` one `unit_world` toward the light
-/// in texture space, up to the box's face — the light reaching `u0` through everything between
-/// it and the light (its own sample excluded, so a surface does not shadow itself).
+/// The illumination grid of the `shadows` and `ambient_occlusion` effects, on a grid of the
+/// volume's voxels up to [`LIGHT_GRID_MAX`] per axis, at each grid voxel's centre `u0`:
+/// - shadows (Behrens & Ratering 1998's shadow volume, computed per voxel by marching toward the
+///   light): the transmittance toward the light `T = Π_{k≥1} (1 − α_tf(s(u0 + k·Δ)))^e`, `Δ` one
+///   `unit_world` toward the light in texture space, up to the box's face — the light reaching
+///   `u0` through everything between it and the light (its own sample excluded, so a surface
+///   does not shadow itself); `e = 1 / opacity_unit_voxels`;
+/// - ambient occlusion (Hernell et al. 2010's local ambient occlusion, with cone samples reduced
+///   to rays): the mean over [`OCCLUSION_DIRECTIONS`] of the transmittance along each over
+///   [`OCCLUSION_STEPS`] steps of one `unit_world` (fewer where the box ends: outside is empty).
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightGrid {
     /// Voxels per axis.
     pub dims: glam::UVec3,
-    /// Transmittance per voxel, x fastest.
+    /// Transmittance toward the light per voxel, x fastest (empty without shadows).
     pub transmittance: Vec<f64>,
+    /// Ambient occlusion (the unoccluded share, 1 in the open) per voxel (empty without it).
+    pub occlusion: Vec<f64>,
 }
 
+/// Steps of one `unit_world` each ambient-occlusion ray takes: the neighbourhood whose material
+/// darkens a point (Hernell et al. 2010 use a few voxels' radius too).
+pub const OCCLUSION_STEPS: u32 = 8;
+
+/// The ambient-occlusion rays: the 6 axes and the 8 diagonals, each normalized in world space.
+pub const OCCLUSION_DIRECTIONS: [[f64; 3]; 14] = [
+    [1.0, 0.0, 0.0],
+    [-1.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, -1.0, 0.0],
+    [0.0, 0.0, 1.0],
+    [0.0, 0.0, -1.0],
+    [1.0, 1.0, 1.0],
+    [1.0, 1.0, -1.0],
+    [1.0, -1.0, 1.0],
+    [1.0, -1.0, -1.0],
+    [-1.0, 1.0, 1.0],
+    [-1.0, 1.0, -1.0],
+    [-1.0, -1.0, 1.0],
+    [-1.0, -1.0, -1.0],
+];
+
 impl LightGrid {
-    /// The grid of `volume` classified by `lut` (alpha per `opacity_unit_voxels`), lit from the
-    /// unit world direction `toward`; `field` reconstructs the volume at a texture point
-    /// (trilinear, or the tricubic B-spline).
+    /// The grid of `volume` classified by `lut` (alpha per `opacity_unit_voxels`): transmittance
+    /// toward the unit world direction `toward` where given (shadows), ambient occlusion where
+    /// `occlusion`; `field` reconstructs the volume at a texture point (trilinear, or the
+    /// tricubic B-spline).
     pub fn compute(
         volume: &crate::volume::Volume,
         lut: &[[f32; 4]],
-        toward: DVec3,
+        (toward, occlusion): (Option<DVec3>, bool),
         opacity_unit_voxels: f64,
         field: &(dyn Fn(DVec3) -> f64 + Sync),
     ) -> Self {
         use rayon::prelude::*;
         let dims = light_grid_dims(volume.dims);
-        let step = light_step_tex(volume, toward);
         let exponent = 1.0 / opacity_unit_voxels;
         let m = dims.as_dvec3();
-        let transmittance = (0..(dims.x * dims.y * dims.z) as usize)
-            .into_par_iter()
-            .map(|i| {
-                let i = i as u32;
-                let id = glam::UVec3::new(i % dims.x, (i / dims.x) % dims.y, i / (dims.x * dims.y));
-                let u0 = (id.as_dvec3() + 0.5) / m;
-                // Optical depth in opacity units: T = exp(exponent · Σ ln(1 − α)).
-                let mut depth = 0.0;
-                for k in 1..=steps_to_exit(u0, step) {
-                    let s = field(u0 + k as f64 * step);
-                    let a = crate::reference::lut_sample(lut, s)[3].clamp(0.0, 1.0);
-                    depth += (1.0 - a).ln();
-                    if exponent * depth < MIN_TRANSMITTANCE.ln() {
-                        return 0.0;
-                    }
+        let centre = |i: usize| {
+            let i = i as u32;
+            (glam::UVec3::new(i % dims.x, (i / dims.x) % dims.y, i / (dims.x * dims.y)).as_dvec3() + 0.5) / m
+        };
+        // The transmittance from `u0` along `step` over at most `max` steps.
+        let along = |u0: DVec3, step: DVec3, max: u32| {
+            // Optical depth in opacity units: T = exp(exponent · Σ ln(1 − α)).
+            let mut depth = 0.0;
+            for k in 1..=steps_to_exit(u0, step).min(max) {
+                let s = field(u0 + k as f64 * step);
+                let a = crate::reference::lut_sample(lut, s)[3].clamp(0.0, 1.0);
+                depth += (1.0 - a).ln();
+                if exponent * depth < MIN_TRANSMITTANCE.ln() {
+                    return 0.0;
                 }
-                (exponent * depth).exp()
-            })
-            .collect();
-        Self { dims, transmittance }
+            }
+            (exponent * depth).exp()
+        };
+        let count = (dims.x * dims.y * dims.z) as usize;
+        let transmittance = match toward {
+            Some(toward) => {
+                let step = light_step_tex(volume, toward);
+                (0..count).into_par_iter().map(|i| along(centre(i), step, u32::MAX)).collect()
+            }
+            None => Vec::new(),
+        };
+        let occlusion = if occlusion {
+            let steps: Vec<DVec3> = OCCLUSION_DIRECTIONS
+                .iter()
+                .map(|d| light_step_tex(volume, DVec3::from_array(*d).normalize()))
+                .collect();
+            (0..count)
+                .into_par_iter()
+                .map(|i| {
+                    let u0 = centre(i);
+                    steps.iter().map(|&step| along(u0, step, OCCLUSION_STEPS)).sum::<f64>() / steps.len() as f64
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        Self { dims, transmittance, occlusion }
     }
 
-    /// The transmittance at texture point `u`: trilinear between the grid's voxel centres,
-    /// clamped to the edge (as the GPU samples the light volume).
-    pub fn sample(&self, u: DVec3) -> f64 {
+    /// The transmittance toward the light and the ambient occlusion at texture point `u`, each
+    /// trilinear between the grid's voxel centres, clamped to the edge (as the GPU samples the
+    /// light volume); 1 for a channel the grid does not hold.
+    pub fn sample(&self, u: DVec3) -> (f64, f64) {
+        (self.sample_channel(&self.transmittance, u), self.sample_channel(&self.occlusion, u))
+    }
+
+    fn sample_channel(&self, values: &[f64], u: DVec3) -> f64 {
+        if values.is_empty() {
+            return 1.0;
+        }
         let n = self.dims.as_dvec3();
         let p = (u * n - 0.5).clamp(DVec3::ZERO, n - 1.0);
         let i = p.floor();
@@ -167,7 +226,7 @@ impl LightGrid {
         let top = self.dims.as_ivec3() - 1;
         let at = |dx: i32, dy: i32, dz: i32| {
             let c = (i.as_ivec3() + glam::IVec3::new(dx, dy, dz)).min(top);
-            self.transmittance[(c.x + self.dims.x as i32 * (c.y + self.dims.y as i32 * c.z)) as usize]
+            values[(c.x + self.dims.x as i32 * (c.y + self.dims.y as i32 * c.z)) as usize]
         };
         let lerp = |a: f64, b: f64, t: f64| a + (b - a) * t;
         let x00 = lerp(at(0, 0, 0), at(1, 0, 0), f.x);
@@ -233,14 +292,20 @@ mod tests {
         // Opaque above 0.5, clear below.
         let lut: Vec<[f32; 4]> = (0..256).map(|i| if i >= 128 { [1.0; 4] } else { [0.0; 4] }).collect();
         let toward = DVec3::Z; // light at +z
-        let grid = LightGrid::compute(&volume, &lut, toward, 1.0, &|u| volume.sample_trilinear(u));
+        let grid = LightGrid::compute(&volume, &lut, (Some(toward), true), 1.0, &|u| volume.sample_trilinear(u));
         assert_eq!(grid.dims, glam::UVec3::splat(n));
         let at = |z: u32| grid.transmittance[(8 + n * (8 + n * z)) as usize];
         assert_eq!(at(2), 0.0, "behind the slab");
         assert_eq!(at(12), 1.0, "on the light's side");
         assert_eq!(at(15), 1.0, "the last voxel toward the light");
-        let mid = grid.sample(DVec3::new(0.5, 0.5, 12.5 / 16.0));
+        let (mid, _) = grid.sample(DVec3::new(0.5, 0.5, 12.5 / 16.0));
         assert_eq!(mid, 1.0);
+        // Ambient occlusion: one voxel above the slab (z = 10) 5 of the 14 rays (−z and the four
+        // diagonals with −z) run into it within their 8 steps; six voxels above (z = 15) only
+        // −z reaches it, the diagonals end 10.4 voxels up.
+        let ao = |z: u32| grid.occlusion[(8 + n * (8 + n * z)) as usize];
+        assert!((ao(10) - 9.0 / 14.0).abs() < 1e-12, "beside the slab: {}", ao(10));
+        assert!((ao(15) - 13.0 / 14.0).abs() < 1e-12, "six voxels above: {}", ao(15));
         assert_eq!(steps_to_exit(DVec3::splat(0.5), DVec3::new(0.0, 0.0, 0.1)), 5);
         assert_eq!(steps_to_exit(DVec3::splat(0.5), DVec3::ZERO), 0);
     }

@@ -71,9 +71,13 @@ pub struct Effects {
     pub tricubic: bool,
     /// Shadows (Behrens & Ratering 1998): the light reaching a sample through the volume, from
     /// the light grid ([`crate::light::LightGrid`]), scales its lit terms — with shading the
-    /// diffuse and specular ones, without it the colour by `ambient + (1 − ambient)·T`.
+    /// diffuse and specular ones, without it the colour by `ambient·AO + (1 − ambient)·T`.
     #[serde(default)]
     pub shadows: bool,
+    /// Ambient occlusion (Hernell et al. 2010): the unoccluded share `AO` of a sample's
+    /// neighbourhood, from the light grid, scales its ambient term.
+    #[serde(default)]
+    pub ambient_occlusion: bool,
 }
 
 /// Raycasting settings shared by the reference and the GPU raycasters (WGSL twin:
@@ -337,10 +341,13 @@ impl<'a> March<'a> {
                 p[i] += p[3] * specular;
             }
         }
-        if self.settings.effects.shadows && !self.settings.effects.shading && p[3] > 0.0 {
-            // Unshaded: the light reaching the sample scales its colour down to the ambient.
+        let lit_by_grid = self.settings.effects.shadows || self.settings.effects.ambient_occlusion;
+        if lit_by_grid && !self.settings.effects.shading && p[3] > 0.0 {
+            // Unshaded: the light reaching the sample (and its share of the ambient light)
+            // scales its colour.
             let ambient = self.settings.dvr_shading.ambient;
-            let lit = ambient + (1.0 - ambient) * self.transmittance(self.seg.u0 + t * self.seg.d_tex);
+            let (light, ao) = self.illumination(self.seg.u0 + t * self.seg.d_tex);
+            let lit = ambient * ao + (1.0 - ambient) * light;
             for c in p.iter_mut().take(3) {
                 *c *= lit;
             }
@@ -401,14 +408,16 @@ impl<'a> March<'a> {
         }
         let (n_dot_l, n_dot_h) = crate::light::blinn_phong_terms(n, l, v);
         let spec = if n_dot_l > 0.0 { p.specular * n_dot_h.powf(p.shininess) } else { 0.0 };
-        // Shadows: only the light that gets through reaches the diffuse and specular terms.
-        let t = if self.settings.effects.shadows { self.transmittance(u) } else { 1.0 };
-        (p.ambient + t * p.diffuse * n_dot_l, t * spec)
+        // Shadows: only the light that gets through reaches the diffuse and specular terms;
+        // ambient occlusion: only the unoccluded share of the ambient light.
+        let (t, ao) = self.illumination(u);
+        (p.ambient * ao + t * p.diffuse * n_dot_l, t * spec)
     }
 
-    /// The light reaching texture point `u` (1 without a light grid).
-    fn transmittance(&self, u: DVec3) -> f64 {
-        self.light_grid.map_or(1.0, |g| g.sample(u))
+    /// The light reaching texture point `u` from the light and the ambient light's unoccluded
+    /// share there (1, 1 without a light grid).
+    fn illumination(&self, u: DVec3) -> (f64, f64) {
+        self.light_grid.map_or((1.0, 1.0), |g| g.sample(u))
     }
 
     /// First hit of `s >= iso`, refined linearly; returns colour, hit and samples taken.
@@ -571,22 +580,23 @@ pub fn fused_pixel(
     fused_pixel_lit(volume, lut, (fusion, grid.as_ref()), camera, frame, (x, y), settings)
 }
 
-/// The light grid the `shadows` effect reads (`None` without it): lit from the scene's light,
-/// or with the headlight from the eye along the camera's forward axis (one direction for the
-/// whole grid), as the GPU computes it.
+/// The light grid the `shadows` and `ambient_occlusion` effects read (`None` without them): lit
+/// from the scene's light, or with the headlight from the eye along the camera's forward axis
+/// (one direction for the whole grid), as the GPU computes it.
 pub fn shadow_grid(
     volume: &Volume,
     lut: &[[f32; 4]],
     frame: &CameraFrame,
     settings: &RaycastSettings,
 ) -> Option<crate::light::LightGrid> {
-    if !settings.effects.shadows {
+    if !(settings.effects.shadows || settings.effects.ambient_occlusion) {
         return None;
     }
-    let toward = settings.light.toward().unwrap_or(-frame.forward);
+    let toward = settings.effects.shadows.then(|| settings.light.toward().unwrap_or(-frame.forward));
     let tricubic = settings.effects.tricubic;
     let field = |u: DVec3| if tricubic { volume.sample_tricubic(u) } else { volume.sample_trilinear(u) };
-    Some(crate::light::LightGrid::compute(volume, lut, toward, settings.opacity_unit_voxels, &field))
+    let occlusion = settings.effects.ambient_occlusion;
+    Some(crate::light::LightGrid::compute(volume, lut, (toward, occlusion), settings.opacity_unit_voxels, &field))
 }
 
 /// [`fused_pixel`] with the light grid of the `shadows` effect given ([`shadow_grid`]).

@@ -52,7 +52,7 @@ pub const MAX_FRAMES: u32 = 100_000;
 /// The effects a scene may ask for: those the built-in raycasters declare
 /// (`volgraph_passes::effects::SCENE_EFFECTS`, `PassDecl::scene_effects`); graphs read them as
 /// `"feature.NAME"`.
-pub const EFFECTS: [&str; 5] = volgraph_passes::effects::SCENE_EFFECTS;
+pub const EFFECTS: [&str; 6] = volgraph_passes::effects::SCENE_EFFECTS;
 
 /// Where a scene's volume comes from.
 #[derive(Clone, Debug, Deserialize, PartialEq)]

@@ -11,8 +11,10 @@ pub const SHADING: &str = "SHADING";
 pub const PREINTEGRATION: &str = "PREINTEGRATION";
 /// Tricubic B-spline reconstruction (`effects::EffectFlags::tricubic`; the min/max grid's apron).
 pub const TRICUBIC: &str = "TRICUBIC";
-/// Shadows from the light volume (`effects::EffectFlags::shadows`, `shadows.rs`).
+/// Shadows from the illumination volume (`effects::EffectFlags::shadows`, `shadows.rs`).
 pub const SHADOWS: &str = "SHADOWS";
+/// Ambient occlusion from the illumination volume (`effects::EffectFlags::ambient_occlusion`).
+pub const AMBIENT_OCCLUSION: &str = "AMBIENT_OCCLUSION";
 /// A per-pixel sample offset (`raycast_params::Sampling::jitter`).
 pub const JITTER: &str = "JITTER";
 /// The offset changes every frame (`Sampling::jitter_per_frame`).
@@ -69,11 +71,12 @@ pub const SEGMENTS: &str = "SEGMENTS";
 pub const SCATTER: &str = "SCATTER";
 
 /// Every `#if` name of the built-in passes.
-pub const BUILT_IN: [&str; 27] = [
+pub const BUILT_IN: [&str; 28] = [
     SHADING,
     PREINTEGRATION,
     TRICUBIC,
     SHADOWS,
+    AMBIENT_OCCLUSION,
     JITTER,
     JITTER_PER_FRAME,
     ANALYTIC,

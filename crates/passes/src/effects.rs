@@ -1,7 +1,8 @@
 //! The scene effects a DVR raycaster specializes for (issue "effects a scene asks for"):
 //! `shading` (Blinn–Phong of every sample with the gradient), `preintegration` (Engel et al.
 //! 2001's segment table), `tricubic` (B-spline reconstruction from 8 trilinear fetches),
-//! `shadows` (the light reaching each sample, from a light volume: `shadows.rs`). Each is
+//! `shadows` and `ambient_occlusion` (the light reaching each sample and its ambient share, from
+//! an illumination volume: `shadows.rs`). Each is
 //! a boolean parameter a graph wires to a scene feature — `"shading": "feature.shading"` — and
 //! an `#if NAME` in the shaders, so a scene that leaves an effect off compiles none of its code
 //! (`tests/effects_not_compiled.rs`) and builds none of its tables. Jitter is the existing
@@ -20,7 +21,8 @@ use crate::raycast_params::Sampling;
 /// The scene effects the built-in raycasters compile in, each a boolean parameter a graph wires
 /// to `"feature.NAME"`: every kind that marches with the shared core declares them
 /// (`PassDecl::scene_effects`), and a scene may ask for what some registered kind declares.
-pub const SCENE_EFFECTS: [&str; 5] = ["shading", "preintegration", "tricubic", "jitter", "shadows"];
+pub const SCENE_EFFECTS: [&str; 6] =
+    ["shading", "preintegration", "tricubic", "jitter", "shadows", "ambient_occlusion"];
 
 volgraph_compiler::pass_params! {
     /// The effect switches, declared once (all off by default); each is an `#if` of the same
@@ -32,12 +34,15 @@ volgraph_compiler::pass_params! {
         tricubic: bool = false, "tricubic B-spline reconstruction from 8 trilinear fetches instead of trilinear";
         shadows: bool = false,
             "shadows: the light reaching each sample through the volume (a light volume, rebuilt when the volume, TF or light changes) scales its lit terms";
+        ambient_occlusion: bool = false,
+            "ambient occlusion: the unoccluded share of each sample's neighbourhood (14 rays of 8 voxels, in the light volume) scales its ambient light";
     }
 }
 
 impl EffectFlags {
     /// Every effect off (a kind that declares none).
-    pub const OFF: Self = Self { shading: false, preintegration: false, tricubic: false, shadows: false };
+    pub const OFF: Self =
+        Self { shading: false, preintegration: false, tricubic: false, shadows: false, ambient_occlusion: false };
 
     /// The effects of `params` (all off for a kind that does not declare them).
     pub fn of(params: &Params) -> Self {
@@ -51,6 +56,7 @@ impl EffectFlags {
             (self.preintegration, defines::PREINTEGRATION),
             (self.tricubic, defines::TRICUBIC),
             (self.shadows, defines::SHADOWS),
+            (self.ambient_occlusion, defines::AMBIENT_OCCLUSION),
         ]
         .into_iter()
         .filter_map(|(on, define)| on.then_some(define))
@@ -74,7 +80,7 @@ pub fn effect_shader_uses(params: &Params, volume_texture: bool) -> Vec<volgraph
     if flags.preintegration {
         uses.extend(crate::preintegration::table_shader_uses());
     }
-    if flags.shadows && volume_texture {
+    if (flags.shadows || flags.ambient_occlusion) && volume_texture {
         uses.push(crate::shadows::light_shader_use());
     }
     uses
@@ -106,8 +112,9 @@ impl EffectState {
     pub fn new(ctx: &CreateContext<'_>, volume_texture: bool) -> Result<Self, PassError> {
         let flags = EffectFlags::of(ctx.params);
         let table = flags.preintegration.then(|| PreintegrationTable::new(ctx)).transpose()?;
-        let light =
-            flags.shadows.then(|| crate::shadows::LightVolume::new(ctx, flags.tricubic, volume_texture)).transpose()?;
+        let light = (flags.shadows || flags.ambient_occlusion)
+            .then(|| crate::shadows::LightVolume::new(ctx, &flags, volume_texture))
+            .transpose()?;
         Ok(Self { table, light })
     }
 

@@ -257,6 +257,7 @@ pub fn reference_settings(p: &Params) -> RaycastSettings {
             preintegration: effects.preintegration,
             tricubic: effects.tricubic,
             shadows: effects.shadows,
+            ambient_occlusion: effects.ambient_occlusion,
         },
         dvr_shading: phong,
         opacity_unit_voxels: 1.0,

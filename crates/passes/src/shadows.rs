@@ -31,10 +31,13 @@ pub struct LightVolume {
     view: Option<wgpu::TextureView>,
     /// Where the pass's volume is a texture: the compute pipeline that writes the grid.
     gpu: Option<ComputePassPipeline>,
-    /// (volume version, TF version, light direction, opacity unit) of the last build.
+    /// (volume version, TF version, light direction (shadows only), opacity unit) of the last build.
     built_for: Option<(Option<u64>, Option<u64>, [u64; 3], u64)>,
     /// The field is the tricubic B-spline (the `tricubic` effect), as the march reconstructs it.
     tricubic: bool,
+    /// Which channels: transmittance toward the light (`shadows`), ambient occlusion.
+    shadows: bool,
+    occlusion: bool,
     /// Builds so far (tests, the viewer).
     pub builds: u64,
 }
@@ -43,15 +46,36 @@ pub struct LightVolume {
 impl LightVolume {
     /// Not built yet; `tricubic`: reconstruct the field as the march does. On the GPU where the
     /// pass's `volume` port is the volume's texture (`volume_texture`), else on the CPU.
-    pub fn new(ctx: &CreateContext<'_>, tricubic: bool, volume_texture: bool) -> Result<Self, PassError> {
+    pub fn new(
+        ctx: &CreateContext<'_>,
+        flags: &crate::effects::EffectFlags,
+        volume_texture: bool,
+    ) -> Result<Self, PassError> {
         let gpu = if volume_texture {
             let declared = light_shader_use();
-            let defines: &[&str] = if tricubic { &[crate::defines::TRICUBIC] } else { &[] };
-            Some(ctx.compute_pipeline(&ComputePipelineSpec { defines, ..ComputePipelineSpec::of(&declared) })?)
+            let defines: Vec<&str> = [
+                (flags.tricubic, crate::defines::TRICUBIC),
+                (flags.shadows, crate::defines::SHADOWS),
+                (flags.ambient_occlusion, crate::defines::AMBIENT_OCCLUSION),
+            ]
+            .into_iter()
+            .filter_map(|(on, d)| on.then_some(d))
+            .collect();
+            Some(
+                ctx.compute_pipeline(&ComputePipelineSpec { defines: &defines, ..ComputePipelineSpec::of(&declared) })?,
+            )
         } else {
             None
         };
-        Ok(Self { view: None, gpu, built_for: None, tricubic, builds: 0 })
+        Ok(Self {
+            view: None,
+            gpu,
+            built_for: None,
+            tricubic: flags.tricubic,
+            shadows: flags.shadows,
+            occlusion: flags.ambient_occlusion,
+            builds: 0,
+        })
     }
 
     /// The light volume, once built.
@@ -63,10 +87,15 @@ impl LightVolume {
     /// changed since the last build.
     pub fn update(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let frame = ctx.frame;
-        let toward = frame.light.toward().unwrap_or(-frame.camera.forward);
+        // Only shadows depend on the light (ambient occlusion does not follow the camera).
+        let toward = self.shadows.then(|| frame.light.toward().unwrap_or(-frame.camera.forward));
         let unit = frame.volume.map_or(1.0, |v| v.opacity_unit_voxels);
-        let key =
-            (ctx.input_version("volume"), ctx.input_version("tf"), toward.to_array().map(f64::to_bits), unit.to_bits());
+        let key = (
+            ctx.input_version("volume"),
+            ctx.input_version("tf"),
+            toward.unwrap_or_default().to_array().map(f64::to_bits),
+            unit.to_bits(),
+        );
         if self.built_for == Some(key) && self.view.is_some() {
             return Ok(());
         }
@@ -108,10 +137,14 @@ impl LightVolume {
         let lut = ctx.table("tf")?.clone();
         let tricubic = self.tricubic;
         let field = |u: glam::DVec3| if tricubic { volume.sample_tricubic(u) } else { volume.sample_trilinear(u) };
-        let grid = volgraph_accel::light::LightGrid::compute(&volume, &lut, toward, unit, &field);
-        let values: Vec<f32> = grid.transmittance.iter().map(|&t| t as f32).collect();
+        let grid = volgraph_accel::light::LightGrid::compute(&volume, &lut, (toward, self.occlusion), unit, &field);
+        // The GPU's layout: T in .r, AO in .g, 1 for a channel that is off.
+        let channel = |values: &[f64], i: usize| values.get(i).map_or(1.0, |&v| v as f32);
+        let texels: Vec<[f32; 4]> = (0..(grid.dims.x * grid.dims.y * grid.dims.z) as usize)
+            .map(|i| [channel(&grid.transmittance, i), channel(&grid.occlusion, i), 0.0, 1.0])
+            .collect();
         let texture =
-            volgraph_core::runtime::upload::upload_f16_3d(ctx.gpu, "light_volume", grid.dims.to_array(), &values)
+            volgraph_core::runtime::upload::upload_rgba16f_3d(ctx.gpu, "light_volume", grid.dims.to_array(), &texels)
                 .map_err(|e| PassError { pass: ctx.label.to_string(), message: e.to_string() })?;
         self.view = Some(texture.create_view(&wgpu::TextureViewDescriptor::default()));
         self.built_for = Some(key);

@@ -77,9 +77,10 @@ fn march_code(graph: &str, options: CompileOptions) -> BTreeSet<String> {
 }
 
 /// Each scene effect and a function only its code calls.
-const EFFECT_MARKERS: [(&str, &str); 5] = [
+const EFFECT_MARKERS: [(&str, &str); 6] = [
     ("shading", "lighting"),
     ("shadows", "light_transmittance"),
+    ("ambient_occlusion", "ambient_occlusion"),
     ("preintegration", "lookup_preintegrated"),
     ("tricubic", "sample_tricubic"),
     ("jitter", "pcg_hash"),

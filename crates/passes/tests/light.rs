@@ -144,3 +144,34 @@ fn shadows_darken_what_the_light_cannot_reach_like_the_reference() {
         assert!(shadowed > 0.05, "{graph}: the shadows must change the image ({:.1}%)", shadowed * 100.0);
     }
 }
+
+/// Ambient occlusion (Hernell et al. 2010, cones reduced to 14 rays of 8 voxels): every family
+/// that computes the illumination volume on the GPU, and the brick raycaster on the CPU, darkens
+/// the ambient light of occluded samples as the reference does, alone and with shadows.
+#[test]
+fn ambient_occlusion_darkens_the_ambient_light_like_the_reference() {
+    let gpu = gpu();
+    let volume = volgraph_accel::generate::marschner_lobb_f32(32);
+    let lut = TransferFunction::preset(Preset::Opaque, volume.value_range).to_lut_for(&volume, 256);
+    let camera = OrbitCamera { azimuth_deg: 25.0, elevation_deg: 15.0, ..OrbitCamera::default() };
+    let light = Light::Directional { azimuth_deg: -80.0, elevation_deg: 50.0 };
+    for (graph, features) in [
+        ("basic/fragment_raycast.ron", &["shading", "ambient_occlusion"][..]),
+        ("basic/fragment_raycast.ron", &["ambient_occlusion"][..]),
+        ("modern/fastest.ron", &["shading", "shadows", "ambient_occlusion"][..]),
+        ("ruijters_vilanova_2006/bricks_octree_ert.ron", &["shading", "ambient_occlusion"][..]),
+    ] {
+        let (image, settings) = render_lit(&gpu, graph, (&volume, &lut), &camera, light, features);
+        assert!(settings.effects.ambient_occlusion, "{graph}: the effect reaches the reference settings");
+        let reference = render_reference(&volume, &lut, &camera, SIZE, SIZE, &settings);
+        let open = RaycastSettings {
+            effects: volgraph_accel::reference::Effects { ambient_occlusion: false, ..settings.effects },
+            ..settings
+        };
+        let unoccluded = render_reference(&volume, &lut, &camera, SIZE, SIZE, &open);
+        let occluded = fraction_over(&unoccluded.color, &reference.color, 2.0 / 255.0).expect("same size");
+        let extra = format!("; occlusion moved {:.0}% of pixels over 2/255", occluded * 100.0);
+        assert_shaded_like_reference(&format!("{graph} {features:?}"), &image.to_rgba_f64(), &reference.color, &extra);
+        assert!(occluded > 0.05, "{graph}: the occlusion must change the image ({:.1}%)", occluded * 100.0);
+    }
+}

@@ -67,6 +67,9 @@ const SETTINGS: &[&[&str]] = &[
     &["FUSION", "FUSION_SCALAR"],
     &["SHADOWS"],
     &["SHADOWS", "SHADING"],
+    &["AMBIENT_OCCLUSION"],
+    &["AMBIENT_OCCLUSION", "SHADING"],
+    &["AMBIENT_OCCLUSION", "SHADOWS", "SHADING"],
 ];
 
 #[test]

@@ -74,6 +74,7 @@ fn raycast_params() -> Vec<ParamSpec> {
         ParamSpec::boolean("preintegration", false, "pre-integrated classification"),
         ParamSpec::boolean("tricubic", false, "tricubic reconstruction"),
         ParamSpec::boolean("shadows", false, "light volume shadows"),
+        ParamSpec::boolean("ambient_occlusion", false, "ambient occlusion"),
     ]
 }
 

@@ -229,14 +229,20 @@ pub fn upload_u32_3d(gpu: &Gpu, label: &str, dims: [u32; 3], values: &[u32]) -> 
     )
 }
 
-/// `values` (x fastest) as a filterable `R16Float` 3D texture: a derived field in \[0, 1\] whose
-/// f16 step (≤ 2⁻¹¹ there) is below a 255th (the `shadows` effect's light volume).
-pub fn upload_f16_3d(gpu: &Gpu, label: &str, dims: [u32; 3], values: &[f32]) -> Result<wgpu::Texture, GpuFault> {
-    let halves: Vec<u16> = values.iter().map(|v| f32_to_f16(*v)).collect();
+/// `texels` (x fastest) as a filterable `Rgba16Float` 3D texture: derived fields in \[0, 1\] whose
+/// f16 step (≤ 2⁻¹¹ there) is below a 255th (the illumination volume of the `shadows` and
+/// `ambient_occlusion` effects, as the GPU's own dispatch writes it).
+pub fn upload_rgba16f_3d(
+    gpu: &Gpu,
+    label: &str,
+    dims: [u32; 3],
+    texels: &[[f32; 4]],
+) -> Result<wgpu::Texture, GpuFault> {
+    let halves: Vec<u16> = texels.iter().flatten().map(|v| f32_to_f16(*v)).collect();
     texture_with(
         gpu,
-        || format!("uploading \"{label}\" ({}x{}x{} f16)", dims[0], dims[1], dims[2]),
-        (label, dims, wgpu::TextureDimension::D3, wgpu::TextureFormat::R16Float),
+        || format!("uploading \"{label}\" ({}x{}x{} rgba16float)", dims[0], dims[1], dims[2]),
+        (label, dims, wgpu::TextureDimension::D3, wgpu::TextureFormat::Rgba16Float),
         bytemuck::cast_slice(&halves),
     )
 }

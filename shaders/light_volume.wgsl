@@ -35,11 +35,16 @@ fn steps_to_exit(u0: vec3<f32>, step: vec3<f32>) -> u32 {
 }
 
 // The transmittance from `u0` along `step` over at most `max_steps` steps (light::LightGrid's
-// `along`).
+// `along`); what the scene's crop and clip planes cut away casts no shadow (samples k in the
+// kept [begin, end) of common/ray_box.wgsl's cut_segment, the identity without cuts).
 fn transmittance_along(u0: vec3<f32>, step: vec3<f32>, max_steps: u32, exponent: f32) -> f32 {
     let steps = min(steps_to_exit(u0, step), max_steps);
+    let kept = cut_segment(u0, step, 0.0, 3.0e38);
     var t = 1.0;
     for (var k = 1u; k <= steps; k++) {
+        if (!(f32(k) >= kept.x && f32(k) < kept.y)) {
+            continue;
+        }
         let a = clamp(sample_tf(sample_volume(u0 + f32(k) * step)).a, 0.0, 1.0);
         if (a >= 1.0) {
             return 0.0;

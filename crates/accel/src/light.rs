@@ -157,7 +157,7 @@ impl LightGrid {
         volume: &crate::volume::Volume,
         lut: &[[f32; 4]],
         (toward, occlusion): (Option<DVec3>, bool),
-        opacity_unit_voxels: f64,
+        (opacity_unit_voxels, cuts): (f64, &crate::cuts::Cuts),
         field: &(dyn Fn(DVec3) -> f64 + Sync),
     ) -> Self {
         use rayon::prelude::*;
@@ -168,11 +168,16 @@ impl LightGrid {
             let i = i as u32;
             (glam::UVec3::new(i % dims.x, (i / dims.x) % dims.y, i / (dims.x * dims.y)).as_dvec3() + 0.5) / m
         };
-        // The transmittance from `u0` along `step` over at most `max` steps.
+        // The transmittance from `u0` along `step` over at most `max` steps; what the scene's
+        // crop and clip planes cut away casts no shadow (samples k in the kept [begin, end)).
         let along = |u0: DVec3, step: DVec3, max: u32| {
+            let (begin, end) = cuts.keeps_interval(u0, step, 0.0, f64::MAX);
             // Optical depth in opacity units: T = exp(exponent · Σ ln(1 − α)).
             let mut depth = 0.0;
             for k in 1..=steps_to_exit(u0, step).min(max) {
+                if !((k as f64) >= begin && (k as f64) < end) {
+                    continue;
+                }
                 let s = field(u0 + k as f64 * step);
                 let a = crate::reference::lut_sample(lut, s)[3].clamp(0.0, 1.0);
                 depth += (1.0 - a).ln();
@@ -292,7 +297,9 @@ mod tests {
         // Opaque above 0.5, clear below.
         let lut: Vec<[f32; 4]> = (0..256).map(|i| if i >= 128 { [1.0; 4] } else { [0.0; 4] }).collect();
         let toward = DVec3::Z; // light at +z
-        let grid = LightGrid::compute(&volume, &lut, (Some(toward), true), 1.0, &|u| volume.sample_trilinear(u));
+        let grid = LightGrid::compute(&volume, &lut, (Some(toward), true), (1.0, &crate::cuts::Cuts::NONE), &|u| {
+            volume.sample_trilinear(u)
+        });
         assert_eq!(grid.dims, glam::UVec3::splat(n));
         let at = |z: u32| grid.transmittance[(8 + n * (8 + n * z)) as usize];
         assert_eq!(at(2), 0.0, "behind the slab");
@@ -307,6 +314,12 @@ mod tests {
         assert!((ao(10) - 9.0 / 14.0).abs() < 1e-12, "beside the slab: {}", ao(10));
         assert!((ao(15) - 13.0 / 14.0).abs() < 1e-12, "six voxels above: {}", ao(15));
         assert_eq!(steps_to_exit(DVec3::splat(0.5), DVec3::new(0.0, 0.0, 0.1)), 5);
+        // A clip plane keeping z < 0.3 removes the slab: nothing shadows the voxel behind it.
+        let keep_low = crate::cuts::ClipPlane::new(DVec3::new(0.0, 0.0, -1.0), -0.3).expect("plane");
+        let cuts = crate::cuts::Cuts::new(None, &[keep_low]).expect("cuts");
+        let cut =
+            LightGrid::compute(&volume, &lut, (Some(toward), false), (1.0, &cuts), &|u| volume.sample_trilinear(u));
+        assert_eq!(cut.transmittance[(8 + n * (8 + n * 2)) as usize], 1.0, "the cut-away slab casts no shadow");
         assert_eq!(steps_to_exit(DVec3::splat(0.5), DVec3::ZERO), 0);
     }
 

@@ -596,7 +596,8 @@ pub fn shadow_grid(
     let tricubic = settings.effects.tricubic;
     let field = |u: DVec3| if tricubic { volume.sample_tricubic(u) } else { volume.sample_trilinear(u) };
     let occlusion = settings.effects.ambient_occlusion;
-    Some(crate::light::LightGrid::compute(volume, lut, (toward, occlusion), settings.opacity_unit_voxels, &field))
+    let unit = (settings.opacity_unit_voxels, &settings.cuts);
+    Some(crate::light::LightGrid::compute(volume, lut, (toward, occlusion), unit, &field))
 }
 
 /// [`fused_pixel`] with the light grid of the `shadows` effect given ([`shadow_grid`]).

@@ -31,8 +31,9 @@ pub struct LightVolume {
     view: Option<wgpu::TextureView>,
     /// Where the pass's volume is a texture: the compute pipeline that writes the grid.
     gpu: Option<ComputePassPipeline>,
-    /// (volume version, TF version, light direction (shadows only), opacity unit) of the last build.
-    built_for: Option<(Option<u64>, Option<u64>, [u64; 3], u64)>,
+    /// (volume version, TF version, light direction (shadows only), opacity unit, cuts) of the
+    /// last build.
+    built_for: Option<(Option<u64>, Option<u64>, [u64; 3], u64, volgraph_accel::cuts::Cuts)>,
     /// The field is the tricubic B-spline (the `tricubic` effect), as the march reconstructs it.
     tricubic: bool,
     /// Which channels: transmittance toward the light (`shadows`), ambient occlusion.
@@ -95,6 +96,8 @@ impl LightVolume {
             ctx.input_version("tf"),
             toward.unwrap_or_default().to_array().map(f64::to_bits),
             unit.to_bits(),
+            // What the cuts keep (cut-away material casts no shadow).
+            frame.cuts,
         );
         if self.built_for == Some(key) && self.view.is_some() {
             return Ok(());
@@ -137,7 +140,9 @@ impl LightVolume {
         let lut = ctx.table("tf")?.clone();
         let tricubic = self.tricubic;
         let field = |u: glam::DVec3| if tricubic { volume.sample_tricubic(u) } else { volume.sample_trilinear(u) };
-        let grid = volgraph_accel::light::LightGrid::compute(&volume, &lut, (toward, self.occlusion), unit, &field);
+        let cuts = frame.cuts;
+        let grid =
+            volgraph_accel::light::LightGrid::compute(&volume, &lut, (toward, self.occlusion), (unit, &cuts), &field);
         // The GPU's layout: T in .r, AO in .g, 1 for a channel that is off.
         let channel = |values: &[f64], i: usize| values.get(i).map_or(1.0, |&v| v as f32);
         let texels: Vec<[f32; 4]> = (0..(grid.dims.x * grid.dims.y * grid.dims.z) as usize)

@@ -14,6 +14,7 @@
 //! 0.5 % of pixels over 2/255, mean under 0.5/255 per channel of premultiplied linear RGBA).
 
 use volgraph_accel::camera::OrbitCamera;
+use volgraph_accel::cuts::{ClipPlane, Cuts};
 use volgraph_accel::image_diff::fraction_over;
 use volgraph_accel::light::Light;
 use volgraph_accel::reference::{RaycastSettings, render_reference};
@@ -37,13 +38,14 @@ fn render_lit(
     graph: &str,
     (volume, lut): (&Volume, &[[f32; 4]]),
     camera: &OrbitCamera,
-    light: Light,
+    (light, cuts): (Light, Cuts),
     features: &[&str],
 ) -> (Image, RaycastSettings) {
     let registry = builtin_registry();
     let source = graph_source(graph);
-    let mut options =
-        CompileOptions::new(SIZE, SIZE).with_features(features.iter().map(|f| f.to_string()).collect::<Vec<_>>());
+    let mut all = volgraph_core::cut_effects::features_of(&cuts);
+    all.extend(features.iter().map(|f| f.to_string()));
+    let mut options = CompileOptions::new(SIZE, SIZE).with_features(all);
     options.scene = scene_values_of(&VolumeDesc::of(volume));
     let plan = compile(graph, &source, &registry, &options).unwrap_or_else(|d| panic!("{graph}: {d}"));
     // Krüger–Westermann's termination test stops between segments, the reference per sample:
@@ -56,9 +58,10 @@ fn render_lit(
         None => plan,
     };
     let march = plan.steps.iter().find(|s| s.pass_id == "march").expect("a march step");
-    let settings = RaycastSettings { light, ..reference_settings(&march.params) };
+    let settings = RaycastSettings { light, cuts, ..reference_settings(&march.params) };
     let mut runtime = support::runtime(gpu);
     runtime.set_light(light);
+    runtime.set_cuts(cuts);
     runtime.bind_scene(&plan.inputs, volume, lut).expect("binds");
     runtime.apply(plan.clone(), &registry).unwrap_or_else(|e| panic!("{graph}: {e}"));
     runtime.render(CameraData::from_orbit(camera, plan.viewport)).unwrap_or_else(|e| panic!("{graph}: {e}"));
@@ -80,7 +83,7 @@ fn a_directional_light_shades_every_family_like_the_reference() {
         ("basic/isosurface.ron", &[][..]),
         ("klein_2005/leap_iso.ron", &[][..]),
     ] {
-        let (image, settings) = render_lit(&gpu, graph, (&volume, &lut), &camera, light, features);
+        let (image, settings) = render_lit(&gpu, graph, (&volume, &lut), &camera, (light, Cuts::NONE), features);
         let reference = render_reference(&volume, &lut, &camera, SIZE, SIZE, &settings);
         let headlight = RaycastSettings { light: Light::Headlight, ..settings };
         let headlit = render_reference(&volume, &lut, &camera, SIZE, SIZE, &headlight);
@@ -100,7 +103,8 @@ fn the_headlight_is_the_default_light() {
     let volume = volgraph_accel::generate::marschner_lobb_f32(32);
     let lut = TransferFunction::preset(Preset::Opaque, volume.value_range).to_lut_for(&volume, 256);
     let camera = OrbitCamera::default();
-    let (plain, _) = render_lit(&gpu, "basic/isosurface.ron", (&volume, &lut), &camera, Light::default(), &[]);
+    let (plain, _) =
+        render_lit(&gpu, "basic/isosurface.ron", (&volume, &lut), &camera, (Light::default(), Cuts::NONE), &[]);
     let registry = builtin_registry();
     let source = graph_source("basic/isosurface.ron");
     let mut options = CompileOptions::new(SIZE, SIZE);
@@ -130,7 +134,7 @@ fn shadows_darken_what_the_light_cannot_reach_like_the_reference() {
         ("kruger_westermann_2003/rc_b.ron", &["shading", "shadows"][..]),
         ("ruijters_vilanova_2006/bricks_octree_ert.ron", &["shading", "shadows"][..]),
     ] {
-        let (image, settings) = render_lit(&gpu, graph, (&volume, &lut), &camera, light, features);
+        let (image, settings) = render_lit(&gpu, graph, (&volume, &lut), &camera, (light, Cuts::NONE), features);
         assert!(settings.effects.shadows, "{graph}: shadows reach the reference settings");
         let reference = render_reference(&volume, &lut, &camera, SIZE, SIZE, &settings);
         let unshadowed = RaycastSettings {
@@ -161,7 +165,7 @@ fn ambient_occlusion_darkens_the_ambient_light_like_the_reference() {
         ("modern/fastest.ron", &["shading", "shadows", "ambient_occlusion"][..]),
         ("ruijters_vilanova_2006/bricks_octree_ert.ron", &["shading", "ambient_occlusion"][..]),
     ] {
-        let (image, settings) = render_lit(&gpu, graph, (&volume, &lut), &camera, light, features);
+        let (image, settings) = render_lit(&gpu, graph, (&volume, &lut), &camera, (light, Cuts::NONE), features);
         assert!(settings.effects.ambient_occlusion, "{graph}: the effect reaches the reference settings");
         let reference = render_reference(&volume, &lut, &camera, SIZE, SIZE, &settings);
         let open = RaycastSettings {
@@ -174,4 +178,38 @@ fn ambient_occlusion_darkens_the_ambient_light_like_the_reference() {
         assert_shaded_like_reference(&format!("{graph} {features:?}"), &image.to_rgba_f64(), &reference.color, &extra);
         assert!(occluded > 0.05, "{graph}: the occlusion must change the image ({:.1}%)", occluded * 100.0);
     }
+}
+
+/// Shadows with a cut (issue "light that scatters": effects compose with crop/clip): what the
+/// clip plane cuts away casts no shadow on what it keeps, on the GPU as in the reference, and a
+/// cut face is lit by the light.
+#[test]
+fn what_a_cut_removes_casts_no_shadow() {
+    let gpu = gpu();
+    let volume = volgraph_accel::generate::marschner_lobb_f32(32);
+    let lut = TransferFunction::preset(Preset::Opaque, volume.value_range).to_lut_for(&volume, 256);
+    let camera = OrbitCamera { azimuth_deg: 25.0, elevation_deg: 15.0, ..OrbitCamera::default() };
+    let light = Light::Directional { azimuth_deg: -80.0, elevation_deg: 50.0 };
+    let cuts =
+        Cuts::new(None, &[ClipPlane::new(glam::DVec3::new(0.0, -1.0, 0.0), -0.55).expect("plane")]).expect("cuts");
+    for graph in ["basic/fragment_raycast.ron", "modern/fastest.ron"] {
+        let features = &["shading", "shadows", "ambient_occlusion"][..];
+        let (image, settings) = render_lit(&gpu, graph, (&volume, &lut), &camera, (light, cuts), features);
+        assert_eq!(settings.cuts, cuts);
+        let reference = render_reference(&volume, &lut, &camera, SIZE, SIZE, &settings);
+        assert_shaded_like_reference(&format!("{graph} cut"), &image.to_rgba_f64(), &reference.color, "");
+    }
+    // In the reference's own grid: a point under the cut-away top, in the light's path through
+    // it, is lit once the top is cut away.
+    let frame = camera.frame(SIZE, SIZE);
+    let settings = RaycastSettings {
+        light,
+        effects: volgraph_accel::reference::Effects { shadows: true, ..Default::default() },
+        ..Default::default()
+    };
+    let whole = volgraph_accel::reference::shadow_grid(&volume, &lut, &frame, &settings).expect("a grid");
+    let cut = volgraph_accel::reference::shadow_grid(&volume, &lut, &frame, &RaycastSettings { cuts, ..settings })
+        .expect("a grid");
+    let lit_more = whole.transmittance.iter().zip(&cut.transmittance).filter(|(w, c)| **c > **w + 0.1).count();
+    assert!(lit_more > 100, "{lit_more} grid voxels lit more once the top is cut away");
 }

@@ -87,6 +87,10 @@ pub struct GraphsArgs {
     /// Step of the converged CPU reference, in voxels.
     #[arg(long, default_value_t = 0.1)]
     pub reference_step: f64,
+    /// The scene's light for every case: AZ,EL in degrees (a directional light fixed in the
+    /// world while the camera turns), or headlight [default: the headlight].
+    #[arg(long, value_parser = volgraph_accel::light::Light::parse, allow_hyphen_values = true)]
+    pub light: Option<volgraph_accel::light::Light>,
     /// Longest side of the CPU reference image whose sample count gives samples/pixel
     /// (0: do not count samples).
     #[arg(long, default_value_t = 128)]
@@ -153,6 +157,8 @@ pub struct BenchConfig {
     pub gpu_count: bool,
     /// The brick pool's budget in bytes (`--gpu-memory-mb`).
     pub gpu_memory_budget: Option<u64>,
+    /// The scene's light (`--light`), on the GPU and in the reference.
+    pub light: volgraph_accel::light::Light,
     /// Run the preset's peer.
     pub peer: bool,
     /// A shader folder read before the built-in shaders.
@@ -407,6 +413,7 @@ impl GraphsArgs {
             spp_size: self.spp_size,
             gpu_count: !self.no_gpu_count,
             gpu_memory_budget: self.gpu_memory_mb.map(|mb| mb << 20),
+            light: self.light.unwrap_or_default(),
             peer: !self.no_peer && preset.is_some_and(|p| p.peer.is_some()),
             shaders: self.shaders.clone(),
             json: self.json.clone(),

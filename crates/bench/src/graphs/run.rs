@@ -33,6 +33,7 @@ pub fn run(gpu: std::sync::Arc<Gpu>, config: &BenchConfig) -> anyhow::Result<Gra
         ceiling_cache: HashMap::new(),
     };
     ctx.runtime.set_gpu_memory_budget(config.gpu_memory_budget);
+    ctx.runtime.set_light(config.light);
     let graphs: Vec<GraphFile> = config
         .graphs
         .iter()

@@ -86,6 +86,10 @@ impl<R: Read + Seek> Walk<R> {
             if group == 0xFFFE {
                 let Some(l) = self.bytes::<4>()? else { return Ok(()) };
                 match element {
+                    // A delimiter ends the item or sequence it closes; at the top level it
+                    // closes nothing, and dicom-rs reads on past it, so the walk does too (a
+                    // flipped length landing on one once hid a 4 GB length after it).
+                    0xE00D | 0xE0DD if depth == 0 => continue,
                     0xE00D | 0xE0DD => return Ok(()),
                     _ => {
                         let l = u32_of(l);

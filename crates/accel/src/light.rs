@@ -70,7 +70,13 @@ impl Light {
                     ));
                 }
                 if !(-90.0..=90.0).contains(&elevation_deg) {
-                    return Err(format!("a light's elevation is -90..90 degrees, not {elevation_deg}"));
+                    // Short, where a header-sized number would print 40 digits (1e39).
+                    let shown = if elevation_deg.abs() < 1e6 {
+                        format!("{elevation_deg}")
+                    } else {
+                        format!("{elevation_deg:e}")
+                    };
+                    return Err(format!("a light's elevation is -90..90 degrees, not {shown}"));
                 }
                 Ok(())
             }
@@ -279,6 +285,7 @@ mod tests {
 
     #[test]
     fn bad_lights_say_what_to_write() {
+        assert!(Light::parse("0,1e39").expect_err("1e39").ends_with("not 1e39"));
         for text in ["", "35", "a,b", "NaN,0", "0,inf", "0,91", "1,2,3"] {
             let e = Light::parse(text).expect_err(text);
             assert!(e.contains(&format!("\"{}\"", text.trim())), "{text}: {e}");

@@ -23,9 +23,8 @@ use volgraph_accel::reference::{ray_segment, render_reference};
 use volgraph_accel::transfer_function::{Preset, TransferFunction};
 use volgraph_accel::volume::{Volume, VoxelData};
 use volgraph_core::runtime::{CameraData, Image, VolumeDesc, VolumeWindow, scene_values_of};
-use volgraph_core::{CompileOptions, compile, cut_effects};
+use volgraph_core::{CompileOptions, compile};
 use volgraph_passes::builtin_registry;
-use volgraph_passes::raycast_params::reference_settings;
 
 mod support;
 
@@ -33,8 +32,8 @@ use support::{gpu, graph_source};
 
 const SIZE: u32 = 96;
 
-/// `graph` rendered on the GPU with `cuts` and scene `features`, and the reference settings of
-/// its "march" pass.
+/// `graph` rendered on the GPU with `cuts` and scene `features` under the headlight, and the
+/// reference settings of its "march" pass (`support::render_in_scene`).
 fn render_cut(
     gpu: &std::sync::Arc<volgraph_core::runtime::Gpu>,
     graph: &str,
@@ -44,31 +43,8 @@ fn render_cut(
     cuts: Cuts,
     features: &[&str],
 ) -> (Image, volgraph_accel::reference::RaycastSettings) {
-    let registry = builtin_registry();
-    let source = graph_source(graph);
-    let mut all = cut_effects::features_of(&cuts);
-    all.extend(features.iter().map(|f| f.to_string()));
-    let mut options = CompileOptions::new(SIZE, SIZE).with_features(all);
-    options.scene = scene_values_of(&VolumeDesc::of(volume));
-    let plan = compile(graph, &source, &registry, &options).unwrap_or_else(|d| panic!("{graph}: {d}"));
-    // Krüger–Westermann's termination test stops between segments, the reference per sample:
-    // compared lossless (T = 1), as tests/kruger_westermann.rs compares them.
-    let plan = match plan.steps.iter().find(|s| s.pass_id == "terminate") {
-        Some(_) => {
-            options = options.with_param("terminate", "threshold", 1.0).with_param("march", "threshold", 1.0);
-            compile(graph, &source, &registry, &options).unwrap_or_else(|d| panic!("{graph}: {d}"))
-        }
-        None => plan,
-    };
-    let march = plan.steps.iter().find(|s| s.pass_id == "march").expect("a march step");
-    let mut settings = reference_settings(&march.params);
-    settings.cuts = cuts;
-    let mut runtime = support::runtime(gpu);
-    runtime.set_cuts(cuts);
-    runtime.bind_scene(&plan.inputs, volume, lut).expect("binds");
-    runtime.apply(plan.clone(), &registry).unwrap_or_else(|e| panic!("{graph}: {e}"));
-    runtime.render(CameraData::from_orbit(camera, plan.viewport)).unwrap_or_else(|e| panic!("{graph}: {e}"));
-    (runtime.read_output("image").expect("image"), settings)
+    let scene = (volgraph_accel::light::Light::Headlight, cuts);
+    support::render_in_scene(gpu, (graph, SIZE), (volume, lut), camera, scene, features)
 }
 
 fn cuts_to_test() -> Vec<(&'static str, Cuts)> {

@@ -17,13 +17,12 @@ use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::cuts::{ClipPlane, Cuts};
 use volgraph_accel::image_diff::fraction_over;
 use volgraph_accel::light::Light;
-use volgraph_accel::reference::{RaycastSettings, render_reference};
+use volgraph_accel::reference::{Effects, RaycastSettings, render_reference};
 use volgraph_accel::transfer_function::{Preset, TransferFunction};
 use volgraph_accel::volume::Volume;
 use volgraph_core::runtime::{CameraData, Image, VolumeDesc, scene_values_of};
 use volgraph_core::{CompileOptions, compile};
 use volgraph_passes::builtin_registry;
-use volgraph_passes::raycast_params::reference_settings;
 
 mod support;
 
@@ -31,41 +30,44 @@ use support::{assert_shaded_like_reference, gpu, graph_source};
 
 const SIZE: u32 = 96;
 
-/// `graph` rendered with the scene's `light` and `features`, and the reference settings of its
-/// "march" pass with that light.
+/// `graph` rendered with the scene's light and cuts and `features`, and the reference settings
+/// of its "march" pass with them (`support::render_in_scene`).
 fn render_lit(
     gpu: &std::sync::Arc<volgraph_core::runtime::Gpu>,
     graph: &str,
-    (volume, lut): (&Volume, &[[f32; 4]]),
+    scene: (&Volume, &[[f32; 4]]),
     camera: &OrbitCamera,
-    (light, cuts): (Light, Cuts),
+    light_and_cuts: (Light, Cuts),
     features: &[&str],
 ) -> (Image, RaycastSettings) {
-    let registry = builtin_registry();
-    let source = graph_source(graph);
-    let mut all = volgraph_core::cut_effects::features_of(&cuts);
-    all.extend(features.iter().map(|f| f.to_string()));
-    let mut options = CompileOptions::new(SIZE, SIZE).with_features(all);
-    options.scene = scene_values_of(&VolumeDesc::of(volume));
-    let plan = compile(graph, &source, &registry, &options).unwrap_or_else(|d| panic!("{graph}: {d}"));
-    // Krüger–Westermann's termination test stops between segments, the reference per sample:
-    // compared lossless (T = 1), as tests/kruger_westermann.rs compares them.
-    let plan = match plan.steps.iter().find(|s| s.pass_id == "terminate") {
-        Some(_) => {
-            options = options.with_param("terminate", "threshold", 1.0).with_param("march", "threshold", 1.0);
-            compile(graph, &source, &registry, &options).unwrap_or_else(|d| panic!("{graph}: {d}"))
-        }
-        None => plan,
-    };
-    let march = plan.steps.iter().find(|s| s.pass_id == "march").expect("a march step");
-    let settings = RaycastSettings { light, cuts, ..reference_settings(&march.params) };
-    let mut runtime = support::runtime(gpu);
-    runtime.set_light(light);
-    runtime.set_cuts(cuts);
-    runtime.bind_scene(&plan.inputs, volume, lut).expect("binds");
-    runtime.apply(plan.clone(), &registry).unwrap_or_else(|e| panic!("{graph}: {e}"));
-    runtime.render(CameraData::from_orbit(camera, plan.viewport)).unwrap_or_else(|e| panic!("{graph}: {e}"));
-    (runtime.read_output("image").expect("image"), settings)
+    support::render_in_scene(gpu, (graph, SIZE), scene, camera, light_and_cuts, features)
+}
+
+/// Each (graph, features) rendered with `light` on ML 32³ (opaque) against the reference of the
+/// same effects, and the reference without the effect `off` takes away: the effect must move
+/// more than 5 % of pixels by more than `moved` (a test that passes without it proves nothing).
+fn effect_like_reference(
+    cases: &[(&str, &[&str])],
+    light: Light,
+    (what, off): (&str, fn(Effects) -> Effects),
+    moved: f64,
+) {
+    let gpu = gpu();
+    let volume = volgraph_accel::generate::marschner_lobb_f32(32);
+    // Opaque material: what shows is the shaded surface the light falls on.
+    let lut = TransferFunction::preset(Preset::Opaque, volume.value_range).to_lut_for(&volume, 256);
+    let camera = OrbitCamera { azimuth_deg: 25.0, elevation_deg: 15.0, ..OrbitCamera::default() };
+    for &(graph, features) in cases {
+        let (image, settings) = render_lit(&gpu, graph, (&volume, &lut), &camera, (light, Cuts::NONE), features);
+        assert_ne!(off(settings.effects), settings.effects, "{graph}: {what} reaches the reference settings");
+        let reference = render_reference(&volume, &lut, &camera, SIZE, SIZE, &settings);
+        let without = RaycastSettings { effects: off(settings.effects), ..settings };
+        let without = render_reference(&volume, &lut, &camera, SIZE, SIZE, &without);
+        let changed = fraction_over(&without.color, &reference.color, moved).expect("same size");
+        let extra = format!("; {what} moved {:.0}% of pixels", changed * 100.0);
+        assert_shaded_like_reference(&format!("{graph} {features:?}"), &image.to_rgba_f64(), &reference.color, &extra);
+        assert!(changed > 0.05, "{graph}: {what} must change the image ({:.1}%)", changed * 100.0);
+    }
 }
 
 #[test]
@@ -121,32 +123,15 @@ fn the_headlight_is_the_default_light() {
 
 #[test]
 fn shadows_darken_what_the_light_cannot_reach_like_the_reference() {
-    let gpu = gpu();
-    let volume = volgraph_accel::generate::marschner_lobb_f32(32);
-    // Dense enough that the rings shadow one another, clear enough that the shadows show.
-    let lut = TransferFunction::preset(Preset::Opaque, volume.value_range).to_lut_for(&volume, 256);
-    let camera = OrbitCamera { azimuth_deg: 25.0, elevation_deg: 15.0, ..OrbitCamera::default() };
+    let cases: [(&str, &[&str]); 5] = [
+        ("basic/fragment_raycast.ron", &["shading", "shadows"]),
+        ("basic/fragment_raycast.ron", &["shadows"]),
+        ("modern/fastest.ron", &["shading", "shadows"]),
+        ("kruger_westermann_2003/rc_b.ron", &["shading", "shadows"]),
+        ("ruijters_vilanova_2006/bricks_octree_ert.ron", &["shading", "shadows"]),
+    ];
     let light = Light::Directional { azimuth_deg: -80.0, elevation_deg: 50.0 };
-    for (graph, features) in [
-        ("basic/fragment_raycast.ron", &["shading", "shadows"][..]),
-        ("basic/fragment_raycast.ron", &["shadows"][..]),
-        ("modern/fastest.ron", &["shading", "shadows"][..]),
-        ("kruger_westermann_2003/rc_b.ron", &["shading", "shadows"][..]),
-        ("ruijters_vilanova_2006/bricks_octree_ert.ron", &["shading", "shadows"][..]),
-    ] {
-        let (image, settings) = render_lit(&gpu, graph, (&volume, &lut), &camera, (light, Cuts::NONE), features);
-        assert!(settings.effects.shadows, "{graph}: shadows reach the reference settings");
-        let reference = render_reference(&volume, &lut, &camera, SIZE, SIZE, &settings);
-        let unshadowed = RaycastSettings {
-            effects: volgraph_accel::reference::Effects { shadows: false, ..settings.effects },
-            ..settings
-        };
-        let lit = render_reference(&volume, &lut, &camera, SIZE, SIZE, &unshadowed);
-        let shadowed = fraction_over(&lit.color, &reference.color, 8.0 / 255.0).expect("same size");
-        let extra = format!("; shadows moved {:.0}% of pixels", shadowed * 100.0);
-        assert_shaded_like_reference(&format!("{graph} {features:?}"), &image.to_rgba_f64(), &reference.color, &extra);
-        assert!(shadowed > 0.05, "{graph}: the shadows must change the image ({:.1}%)", shadowed * 100.0);
-    }
+    effect_like_reference(&cases, light, ("shadows", |e| Effects { shadows: false, ..e }), 8.0 / 255.0);
 }
 
 /// Ambient occlusion (Hernell et al. 2010, cones reduced to 14 rays of 8 voxels): every family
@@ -154,30 +139,16 @@ fn shadows_darken_what_the_light_cannot_reach_like_the_reference() {
 /// the ambient light of occluded samples as the reference does, alone and with shadows.
 #[test]
 fn ambient_occlusion_darkens_the_ambient_light_like_the_reference() {
-    let gpu = gpu();
-    let volume = volgraph_accel::generate::marschner_lobb_f32(32);
-    let lut = TransferFunction::preset(Preset::Opaque, volume.value_range).to_lut_for(&volume, 256);
-    let camera = OrbitCamera { azimuth_deg: 25.0, elevation_deg: 15.0, ..OrbitCamera::default() };
+    let cases: [(&str, &[&str]); 4] = [
+        ("basic/fragment_raycast.ron", &["shading", "ambient_occlusion"]),
+        ("basic/fragment_raycast.ron", &["ambient_occlusion"]),
+        ("modern/fastest.ron", &["shading", "shadows", "ambient_occlusion"]),
+        ("ruijters_vilanova_2006/bricks_octree_ert.ron", &["shading", "ambient_occlusion"]),
+    ];
     let light = Light::Directional { azimuth_deg: -80.0, elevation_deg: 50.0 };
-    for (graph, features) in [
-        ("basic/fragment_raycast.ron", &["shading", "ambient_occlusion"][..]),
-        ("basic/fragment_raycast.ron", &["ambient_occlusion"][..]),
-        ("modern/fastest.ron", &["shading", "shadows", "ambient_occlusion"][..]),
-        ("ruijters_vilanova_2006/bricks_octree_ert.ron", &["shading", "ambient_occlusion"][..]),
-    ] {
-        let (image, settings) = render_lit(&gpu, graph, (&volume, &lut), &camera, (light, Cuts::NONE), features);
-        assert!(settings.effects.ambient_occlusion, "{graph}: the effect reaches the reference settings");
-        let reference = render_reference(&volume, &lut, &camera, SIZE, SIZE, &settings);
-        let open = RaycastSettings {
-            effects: volgraph_accel::reference::Effects { ambient_occlusion: false, ..settings.effects },
-            ..settings
-        };
-        let unoccluded = render_reference(&volume, &lut, &camera, SIZE, SIZE, &open);
-        let occluded = fraction_over(&unoccluded.color, &reference.color, 2.0 / 255.0).expect("same size");
-        let extra = format!("; occlusion moved {:.0}% of pixels over 2/255", occluded * 100.0);
-        assert_shaded_like_reference(&format!("{graph} {features:?}"), &image.to_rgba_f64(), &reference.color, &extra);
-        assert!(occluded > 0.05, "{graph}: the occlusion must change the image ({:.1}%)", occluded * 100.0);
-    }
+    // The ambient term is 0.15 of the light: occlusion moves pixels by a few 255ths.
+    let off = |e: Effects| Effects { ambient_occlusion: false, ..e };
+    effect_like_reference(&cases, light, ("occlusion", off), 2.0 / 255.0);
 }
 
 /// Shadows with a cut (issue "light that scatters": effects compose with crop/clip): what the

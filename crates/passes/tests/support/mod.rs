@@ -81,6 +81,46 @@ pub fn assert_shaded_like_reference(what: &str, got: &[[f64; 4]], reference: &[[
     assert!(diff.mean_abs <= 0.5 / 255.0, "{what}: mean {:.3}/255", diff.mean_abs * 255.0);
 }
 
+/// `graph` (under `graphs/`) rendered at `size`² on a fresh runtime with the scene's `light`,
+/// `cuts` and `features`, and the reference settings of its "march" pass with the same light
+/// and cuts. Krüger–Westermann's termination test stops between segments, the reference per
+/// sample: those graphs are compared lossless (T = 1), as tests/kruger_westermann.rs compares
+/// them.
+pub fn render_in_scene(
+    gpu: &Arc<Gpu>,
+    (graph, size): (&str, u32),
+    (volume, lut): (&Volume, &[[f32; 4]]),
+    camera: &OrbitCamera,
+    (light, cuts): (volgraph_accel::light::Light, volgraph_accel::cuts::Cuts),
+    features: &[&str],
+) -> (Image, volgraph_accel::reference::RaycastSettings) {
+    let registry = volgraph_passes::builtin_registry();
+    let source = graph_source(graph);
+    let mut all = volgraph_core::cut_effects::features_of(&cuts);
+    all.extend(features.iter().map(|f| f.to_string()));
+    let mut options = CompileOptions::new(size, size).with_features(all);
+    options.scene = volgraph_core::runtime::scene_values_of(&volgraph_core::runtime::VolumeDesc::of(volume));
+    let mut plan =
+        volgraph_core::compile(graph, &source, &registry, &options).unwrap_or_else(|d| panic!("{graph}: {d}"));
+    if plan.steps.iter().any(|s| s.pass_id == "terminate") {
+        options = options.with_param("terminate", "threshold", 1.0).with_param("march", "threshold", 1.0);
+        plan = volgraph_core::compile(graph, &source, &registry, &options).unwrap_or_else(|d| panic!("{graph}: {d}"));
+    }
+    let march = plan.steps.iter().find(|s| s.pass_id == "march").expect("a march step");
+    let settings = volgraph_accel::reference::RaycastSettings {
+        light,
+        cuts,
+        ..volgraph_passes::raycast_params::reference_settings(&march.params)
+    };
+    let mut runtime = runtime(gpu);
+    runtime.set_light(light);
+    runtime.set_cuts(cuts);
+    runtime.bind_scene(&plan.inputs, volume, lut).expect("binds");
+    runtime.apply(plan.clone(), &registry).unwrap_or_else(|e| panic!("{graph}: {e}"));
+    runtime.render(CameraData::from_orbit(camera, plan.viewport)).unwrap_or_else(|e| panic!("{graph}: {e}"));
+    (runtime.read_output("image").expect("image"), settings)
+}
+
 /// `graphs/<name>` in the workspace.
 pub fn graph_path(name: &str) -> PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../graphs").join(name)

@@ -28,6 +28,11 @@ pub struct RenderArgs {
     /// follows the scene's camera path [default: the scene's, else 1].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     pub frames: Option<u32>,
+    /// Samples per pixel a progressive graph (`graphs/cinematic/path_traced.ron`) accumulates at
+    /// one camera: this many frames with the camera still, each adding a sample to the running
+    /// mean.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65_536), conflicts_with = "frames")]
+    pub spp: Option<u32>,
     /// The graph output to write; default: "display" for PNG when the graph has it, else "image".
     #[arg(long)]
     pub output: Option<String>,
@@ -62,6 +67,8 @@ pub struct Prepared {
     kind: ImageKind,
     camera: CameraSpec,
     frames: u32,
+    /// `--spp`: every frame from the first frame's camera.
+    still: bool,
     opacity: OpacityReference,
     cuts: volgraph_accel::cuts::Cuts,
     /// The scene's light.
@@ -88,7 +95,8 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     features.extend(volgraph_core::cut_effects::features_of(&cuts));
     let mut options = compile_options(&size, &features, &[])?;
     options.precision = scene.as_ref().and_then(|s| s.precision);
-    let frames = args.frames.or(scene.as_ref().map(Scene::frame_count)).unwrap_or(1);
+    let frames = args.spp.or(args.frames).or(scene.as_ref().map(Scene::frame_count)).unwrap_or(1);
+    let still = args.spp.is_some();
     let raw = inputs::raw_options(&args.inputs.raw)?;
     // `--volume NAME=PATH` / `--tf NAME=…` bind inputs by name; the frame's volume is the one
     // bound to `volume`, else the first named (crate::named_inputs).
@@ -141,6 +149,16 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     options.scene = scene_values_of(&VolumeDesc::of(&volume));
     options.scene.extend(crate::inputs::data_scene_values(&volume));
     let plan = compile(&file, &source, &registry, &options).map_err(CliError::Graph)?;
+    if let Some(spp) = args.spp
+        && !accumulates(&plan)
+    {
+        return Err(CliError::Other(anyhow!(
+            "--spp {spp}: {} keeps no running mean to add samples to (no history entry with \
+             `while_camera_still: true`); use a progressive graph such as graphs/cinematic/path_traced.ron, or \
+             --frames N for frames that turn the camera",
+            graph.display()
+        )));
+    }
     let frame_path = shown_paths.first().map(PathBuf::as_path);
     let bindings = named_bindings(
         &plan,
@@ -203,7 +221,23 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     {
         notes.push(note);
     }
-    Ok(Prepared { args, graph, kind, camera, frames, opacity, cuts, light, volume, lut, bindings, plan, output, notes })
+    Ok(Prepared {
+        args,
+        graph,
+        kind,
+        camera,
+        frames,
+        still,
+        opacity,
+        cuts,
+        light,
+        volume,
+        lut,
+        bindings,
+        plan,
+        output,
+        notes,
+    })
 }
 
 /// The inputs bound by name, with the notes their reading gave: the named volumes (`others`,
@@ -323,7 +357,7 @@ pub fn budget_note(plan: &volgraph_core::Plan, registry: &volgraph_core::Registr
 /// Opens the GPU, renders the frames and writes the image.
 pub fn execute(prepared: Prepared) -> Result<(), CliError> {
     let Prepared {
-        args, graph, kind, camera, frames, opacity, cuts, light, volume, lut, bindings, plan, output, ..
+        args, graph, kind, camera, frames, still, opacity, cuts, light, volume, lut, bindings, plan, output, ..
     } = prepared;
     let registry = crate::program::registry();
     let viewport = plan.viewport;
@@ -350,7 +384,8 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
     // Frames one at a time, so each has its own time (the first includes pipeline JIT).
     let mut stats = Vec::new();
     for f in 0..frames {
-        stats.push(runtime.render(CameraData::from_orbit(&camera.at(f), viewport)).map_err(|e| anyhow!(e))?);
+        let at = if still { 0 } else { f };
+        stats.push(runtime.render(CameraData::from_orbit(&camera.at(at), viewport)).map_err(|e| anyhow!(e))?);
     }
     let warm: Vec<f64> = stats.iter().skip(1).map(|s| s.frame_ms).collect();
     let last = stats.pop();
@@ -406,6 +441,11 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
         for b in runtime.bypass_status() {
             crate::stdout::eprintln_escaped!("  {}", bypass_line(&b));
         }
+        if accumulates(plan) {
+            // The mean holds the frames since history last started over.
+            let samples = runtime.history_stats().run + 1;
+            crate::stdout::eprintln_escaped!("  {samples} samples per pixel accumulated");
+        }
     }
     Ok(())
 }
@@ -446,6 +486,11 @@ pub fn counter_lines(counters: &[(String, &'static str, f64)]) -> Vec<String> {
             }
         })
         .collect()
+}
+
+/// Whether `plan` keeps a running mean over still frames (a progressive graph: `--spp` adds to it).
+pub fn accumulates(plan: &volgraph_core::Plan) -> bool {
+    plan.history.values().any(|h| h.while_camera_still)
 }
 
 /// One line saying what a graph's bypass did over the frames rendered.

@@ -253,6 +253,8 @@ pub struct History {
     pub reset_on_params_of: Vec<String>,
     /// The largest camera turn between frames (degrees) this history survives.
     pub max_camera_degrees: Option<f64>,
+    /// Restarts whenever the camera moves at all (progressive accumulation).
+    pub while_camera_still: bool,
 }
 
 /// Transient memory figures.

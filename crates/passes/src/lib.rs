@@ -27,6 +27,7 @@ pub mod hole_fill;
 pub mod march;
 pub mod minmax_grid;
 pub mod opacity_lut;
+pub mod path_trace;
 pub mod preintegration;
 pub mod present;
 pub mod ray_directions;
@@ -85,6 +86,7 @@ macro_rules! builtin_kinds {
             .register(hole_fill::HoleFill)
             .register(reprojection_tiles::ReprojectionTiles)
             .register(antialias::Antialias)
+            .register(path_trace::PathTrace)
             .register(raycast_bricks::RaycastBricks)
             .register(present::Present)
     };

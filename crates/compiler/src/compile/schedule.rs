@@ -71,6 +71,7 @@ pub(crate) fn schedule(doc: &GraphDoc, c: Checked, options: &CompileOptions) -> 
         if let Some(declared) = doc.history.get(name) {
             h.reset_on_params_of = declared.reset_on_params_of.clone();
             h.max_camera_degrees = declared.max_camera_degrees;
+            h.while_camera_still = declared.while_camera_still;
         }
     }
     let bypass = c.bypass.iter().filter_map(|b| bypass_in_plan(&c, b, &steps, &resources)).collect();
@@ -494,6 +495,7 @@ fn keep_results(
                     initial: initial.clone(),
                     reset_on_params_of: Vec::new(),
                     max_camera_degrees: None,
+                    while_camera_still: false,
                 },
             );
         }

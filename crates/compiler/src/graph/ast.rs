@@ -222,6 +222,10 @@ pub struct HistoryDoc {
     /// is thrown away (a camera jump: Klein et al. 2005 §4.1). Unbounded when absent.
     #[serde(default)]
     pub max_camera_degrees: Option<f64>,
+    /// The kept value is thrown away whenever the camera moves at all — turns, zooms or pans:
+    /// progressive accumulation (a path tracer's running mean), which holds only for one view.
+    #[serde(default)]
+    pub while_camera_still: bool,
 }
 
 /// What a history target holds when there is no previous frame.

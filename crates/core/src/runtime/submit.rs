@@ -167,11 +167,15 @@ impl Runtime {
     }
 
     /// Whether `camera` turned further from the last frame's than some history entry allows
-    /// (`max_camera_degrees`): a camera jump starts that history over (Klein et al. 2005 §4.1).
+    /// (`max_camera_degrees`): a camera jump starts that history over (Klein et al. 2005 §4.1);
+    /// or moved at all where an entry accumulates (`while_camera_still`).
     fn camera_jumped(&self, camera: &CameraData) -> bool {
         let (Some(plan), Some((last, _))) = (self.plan(), self.last_camera) else { return false };
         let turned = last.forward.angle_between(camera.forward).to_degrees();
-        plan.history.values().any(|h| h.max_camera_degrees.is_some_and(|bound| turned > bound))
+        let moved = last.clip_from_world != camera.clip_from_world || last.eye != camera.eye;
+        plan.history
+            .values()
+            .any(|h| h.max_camera_degrees.is_some_and(|bound| turned > bound) || (h.while_camera_still && moved))
     }
 
     /// Forgets history: the next frame reads every entry's initial value (resize, transfer

@@ -1,0 +1,298 @@
+// A progressive volumetric path tracer, one path per pixel per frame, averaged into a running
+// mean while the view rests (crates/passes/src/path_trace.rs; graphs/cinematic/path_traced.ron).
+//
+// The medium: the TF's opacity α per opacity unit L (frame.half_extent.w · frame.volume_dims.w
+// world units) is an extinction coefficient σ(x) = −ln(1 − α(s(x))) / L — the continuous form of
+// the raycasters' opacity correction, so the emission–absorption case (albedo 0, emission 1) is
+// the DVR integral ∫ T(t) σ(t) c(t) dt that they march, estimated instead of stepped. At an
+// interaction a path scatters with probability `albedo` (tinted by the TF colour) and is
+// otherwise absorbed, emitting `emission` × the TF colour.
+//
+// - Free paths by delta (Woodcock) tracking against the majorant σ̄ = σ(max α of the TF), the
+//   tightest bound one number can give (Novák et al. 2014 §3);
+// - light toward the directional light (or the headlight) by ratio tracking (Novák et al. 2014
+//   §5.2), with Russian roulette once the transmittance is small;
+// - scattering by the Henyey–Greenstein phase function, or where the field has a gradient, with
+//   probability `surface` · (1 − e^(−20 |∇s|)), off a Lambertian surface whose normal is the
+//   gradient (Kroes et al. 2012, "Exposure Render", §4.3's hybrid scattering);
+// - paths that leave the box see the environment (a generated sky, or a uniform one); a
+//   primary ray that meets nothing is transparent, as in the raycasters (`present` draws the
+//   background), and its alpha is the probability of an interaction: 1 − T of the ray.
+//
+// Accumulation: `previous` is last frame's mean (history, cleared on any change of the camera,
+// TF, volume, light, cuts or this pass's parameters), frame.history_age the samples it holds;
+// the new mean is written in f32 (an f16 mean stops moving once 1/(n+1) is below its ulp: after
+// about 2048 samples at 1.0, far fewer for a dim pixel).
+
+#import "common/frame.wgsl"
+#import "common/volume.wgsl"
+#import "common/ray_box.wgsl"
+
+// Declared once: `PathTraceParams` (pass_params!) in crates/passes/src/path_trace.rs, which
+// generates the struct imported here.
+#import "params/PathTraceParams.wgsl"
+
+@group(0) @binding(auto) var<uniform> trace: PathTraceParams;
+// Last frame's running mean (premultiplied linear RGBA); zeros when history restarted.
+@group(0) @binding(auto) var previous: texture_2d<f32>;
+@group(0) @binding(auto) var color: texture_storage_2d<rgba32float, write>;
+
+// α is capped below 1 so σ stays finite: a unit of length then lets 10⁻⁶ through, which no
+// 8-bit image tells from opaque.
+const MAX_ALPHA: f32 = 0.999999;
+// No path takes more tentative collisions than this (a guard against a NaN majorant; a ray
+// across the 256³ engine box at σ̄ takes a few hundred).
+const MAX_TRACKING_STEPS: u32 = 65536u;
+const PI: f32 = 3.14159265358979;
+
+// ---- random numbers: PCG (O'Neill 2014), one stream per pixel and sample --------------------
+
+var<private> rng: u32;
+
+fn pcg_next(v: u32) -> u32 {
+    let state = v * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+fn seed_rng(pixel: vec2<u32>, sample_index: u32) {
+    rng = pcg_next(pixel.x ^ pcg_next(pixel.y ^ pcg_next(sample_index ^ pcg_next(trace.seed))));
+}
+
+// Uniform in [0, 1): 24 random bits.
+fn random() -> f32 {
+    rng = rng * 747796405u + 2891336453u;
+    let word = ((rng >> ((rng >> 28u) + 4u)) ^ rng) * 277803737u;
+    return f32(((word >> 22u) ^ word) >> 8u) * (1.0 / 16777216.0);
+}
+
+// An exponential free path of rate `sigma`: −ln(1 − ξ) / σ, ξ < 1 so the log is finite.
+fn free_path(sigma: f32) -> f32 {
+    return -log(1.0 - random()) / sigma;
+}
+
+// ---- the medium ------------------------------------------------------------------------------
+
+// World length of the TF's opacity unit.
+fn opacity_unit_world() -> f32 {
+    return frame.half_extent.w * frame.volume_dims.w;
+}
+
+fn extinction_of(alpha: f32) -> f32 {
+    return -log(1.0 - clamp(alpha, 0.0, MAX_ALPHA)) / opacity_unit_world();
+}
+
+// σ and the TF colour at world point `p`.
+fn medium_at(p: vec3<f32>) -> vec4<f32> {
+    let c = sample_tf(sample_volume(texture_from_world(p)));
+    return vec4<f32>(c.rgb, extinction_of(c.a));
+}
+
+fn majorant() -> f32 {
+    return extinction_of(trace.max_alpha);
+}
+
+// The part [t0, t1) of the world ray p + t·w inside the box and kept by the scene's cuts.
+fn world_segment(p: vec3<f32>, w: vec3<f32>) -> vec2<f32> {
+    let half = frame.half_extent.xyz;
+    let span = box_span(p, w, -half, half);
+    let kept = cut_segment(texture_from_world(p), w / (2.0 * half), max(span.x, 0.0), span.y);
+    return select(vec2<f32>(0.0, 0.0), kept, kept.x < kept.y);
+}
+
+// Delta tracking: the distance to the first real interaction in [t0, t1), or −1 when the path
+// leaves.
+fn delta_track(p: vec3<f32>, w: vec3<f32>, span: vec2<f32>) -> f32 {
+    let bound = majorant();
+    if (!(bound > 0.0) || span.x >= span.y) {
+        return -1.0;
+    }
+    var t = span.x;
+    for (var i = 0u; i < MAX_TRACKING_STEPS; i += 1u) {
+        t += free_path(bound);
+        if (t >= span.y) {
+            return -1.0;
+        }
+        if (random() * bound < medium_at(p + t * w).a) {
+            return t;
+        }
+    }
+    return -1.0;
+}
+
+// Ratio tracking: an unbiased estimate of the transmittance along [t0, t1).
+fn ratio_track(p: vec3<f32>, w: vec3<f32>, span: vec2<f32>) -> f32 {
+    let bound = majorant();
+    if (!(bound > 0.0) || span.x >= span.y) {
+        return 1.0;
+    }
+    var t = span.x;
+    var transmittance = 1.0;
+    for (var i = 0u; i < MAX_TRACKING_STEPS; i += 1u) {
+        t += free_path(bound);
+        if (t >= span.y) {
+            return transmittance;
+        }
+        transmittance *= max(1.0 - medium_at(p + t * w).a / bound, 0.0);
+        // Russian roulette: a small estimate survives with probability ½, doubled.
+        if (transmittance < 0.1) {
+            if (random() < 0.5) {
+                return 0.0;
+            }
+            transmittance *= 2.0;
+        }
+    }
+    return 0.0;
+}
+
+// ---- light -----------------------------------------------------------------------------------
+
+// The unit world direction toward the light: the scene's directional light, else the headlight
+// (from the eye, along the camera's forward axis).
+fn toward_light() -> vec3<f32> {
+    if (frame.light_world.w > 0.0) {
+        return frame.light_world.xyz;
+    }
+    return -frame.camera_forward.xyz;
+}
+
+// What a path leaving along `w` sees: world +y is up (the orbit camera's up).
+fn environment(w: vec3<f32>) -> vec3<f32> {
+    if (trace.environment == 1u) {
+        return vec3<f32>(trace.environment_intensity);
+    }
+    let ground = vec3<f32>(0.32, 0.30, 0.28);
+    let horizon = vec3<f32>(0.85, 0.85, 0.82);
+    let zenith = vec3<f32>(0.35, 0.55, 0.95);
+    let up = w.y;
+    let sky = select(mix(horizon, ground, smoothstep(0.0, 0.3, -up)), mix(horizon, zenith, smoothstep(0.0, 0.6, up)), up >= 0.0);
+    return sky * trace.environment_intensity;
+}
+
+// ---- scattering ------------------------------------------------------------------------------
+
+// Henyey–Greenstein for the cosine between the path's direction and the outgoing one.
+fn henyey_greenstein(cos_theta: f32, g: f32) -> f32 {
+    let d = 1.0 + g * g - 2.0 * g * cos_theta;
+    return (1.0 - g * g) / (4.0 * PI * d * sqrt(max(d, 1e-12)));
+}
+
+// Any unit vector perpendicular to unit `n`, and the third of a frame (Duff et al. 2017).
+fn basis(n: vec3<f32>) -> mat3x3<f32> {
+    let s = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (s + n.z);
+    let b = n.x * n.y * a;
+    let t = vec3<f32>(1.0 + s * n.x * n.x * a, s * b, -s * n.x);
+    let u = vec3<f32>(b, s + n.y * n.y * a, -n.y);
+    return mat3x3<f32>(t, u, n);
+}
+
+// A direction from the HG lobe around `w`.
+fn sample_henyey_greenstein(w: vec3<f32>, g: f32) -> vec3<f32> {
+    let xi = random();
+    var cos_theta = 1.0 - 2.0 * xi;
+    if (abs(g) > 1e-3) {
+        let q = (1.0 - g * g) / (1.0 - g + 2.0 * g * xi);
+        cos_theta = clamp((1.0 + g * g - q * q) / (2.0 * g), -1.0, 1.0);
+    }
+    let sin_theta = sqrt(max(0.0, 1.0 - cos_theta * cos_theta));
+    let phi = 2.0 * PI * random();
+    return normalize(basis(w) * vec3<f32>(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta));
+}
+
+// A cosine-weighted direction about unit `n`.
+fn sample_cosine(n: vec3<f32>) -> vec3<f32> {
+    let r = sqrt(random());
+    let phi = 2.0 * PI * random();
+    return normalize(basis(n) * vec3<f32>(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - r * r))));
+}
+
+// The field's world gradient at `p` by central differences one voxel apart (scalar per voxel).
+fn voxel_gradient(p: vec3<f32>) -> vec3<f32> {
+    let u = texture_from_world(p);
+    let h = 1.0 / frame.volume_dims.xyz;
+    let dx = sample_volume(u + vec3<f32>(h.x, 0.0, 0.0)) - sample_volume(u - vec3<f32>(h.x, 0.0, 0.0));
+    let dy = sample_volume(u + vec3<f32>(0.0, h.y, 0.0)) - sample_volume(u - vec3<f32>(0.0, h.y, 0.0));
+    let dz = sample_volume(u + vec3<f32>(0.0, 0.0, h.z)) - sample_volume(u - vec3<f32>(0.0, 0.0, h.z));
+    // Per voxel along each axis; world directions scale by the voxel's world size per axis.
+    let voxel_world = 2.0 * frame.half_extent.xyz / frame.volume_dims.xyz;
+    return 0.5 * vec3<f32>(dx, dy, dz) * (frame.half_extent.w / voxel_world);
+}
+
+// ---- one path --------------------------------------------------------------------------------
+
+// One path's estimate for the pixel's ray: premultiplied RGB and alpha (1 when the primary ray
+// interacted).
+fn trace_pixel(pixel: vec2<u32>) -> vec4<f32> {
+    let ray = analytic_ray(pixel);
+    if (!(ray.len > ray.begin)) {
+        return vec4<f32>(0.0);
+    }
+    let world_per_tex = length(ray.d * 2.0 * frame.half_extent.xyz);
+    var p = world_from_texture(ray.u0);
+    var w = normalize(ray.d * 2.0 * frame.half_extent.xyz);
+    var span = vec2<f32>(ray.begin, ray.len) * world_per_tex;
+    let l = toward_light();
+    var radiance = vec3<f32>(0.0);
+    var throughput = vec3<f32>(1.0);
+    var alpha = 0.0;
+    for (var bounce = 0u; bounce <= trace.bounces; bounce += 1u) {
+        let t = delta_track(p, w, span);
+        if (t < 0.0) {
+            if (bounce > 0u) {
+                radiance += throughput * environment(w);
+            }
+            break;
+        }
+        if (bounce == 0u) {
+            alpha = 1.0;
+        }
+        p = p + t * w;
+        let medium = medium_at(p);
+        if (random() >= trace.albedo) {
+            // Absorbed: what the medium emits there.
+            radiance += throughput * trace.emission * medium.rgb;
+            break;
+        }
+        throughput *= medium.rgb;
+        if (bounce == trace.bounces) {
+            break;
+        }
+        let g = voxel_gradient(p);
+        let strength = length(g);
+        let surface = trace.surface * (1.0 - exp(-20.0 * strength));
+        let to_light = ratio_track(p, l, world_segment(p, l)) * trace.light_intensity;
+        if (strength > 1e-6 && random() < surface) {
+            // Off a Lambertian surface facing the incoming path: light × cos / π, and a
+            // cosine-weighted bounce (its weight f·cos/pdf is 1).
+            var n = -g / strength;
+            if (dot(n, w) > 0.0) {
+                n = -n;
+            }
+            radiance += throughput * to_light * max(dot(n, l), 0.0) / PI;
+            w = sample_cosine(n);
+        } else {
+            radiance += throughput * to_light * henyey_greenstein(dot(w, l), trace.anisotropy);
+            // Importance-sampled: the phase function's weight p/pdf is 1.
+            w = sample_henyey_greenstein(w, trace.anisotropy);
+        }
+        span = world_segment(p, w);
+    }
+    return vec4<f32>(radiance, alpha);
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_path_trace(@builtin(global_invocation_id) id: vec3<u32>) {
+    let pixel = id.xy;
+    if (!in_viewport(pixel)) {
+        return;
+    }
+    let n = f32(frame.history_age);
+    seed_rng(pixel, frame.history_age);
+    let sample = trace_pixel(pixel);
+    let before = textureLoad(previous, vec2<i32>(pixel), 0);
+    // The running mean over n + 1 samples; a NaN sample (none should occur) is dropped rather
+    // than poisoning the mean for good.
+    let safe = select(vec4<f32>(before), sample, all(sample == sample));
+    textureStore(color, vec2<i32>(pixel), before + (safe - before) / (n + 1.0));
+}

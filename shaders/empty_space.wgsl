@@ -1,9 +1,7 @@
 // Krüger & Westermann 2003 §2.3's classification ("CT": is anything in [min, max] visible after
 // the transfer function?) evaluated per block on the GPU, mirroring
-// `volgraph_accel::classify::OpacityClassifier`: with a LUT of N texels sampled linearly between
-// texel centres (i+0.5)/N and clamped at the ends, [lo, hi] may be visible iff some texel
-// i ∈ [ceil(lo·N − 1.5), floor(hi·N + 0.5)] (clamped to the LUT) has alpha > 0 (or NaN), the
-// range first widened by VALUE_MARGIN. That test is one subtraction of `visible_before`, the
+// `volgraph_accel::classify::OpacityClassifier`: [lo, hi] may be visible iff some texel it
+// interpolates (common/lut_range.wgsl) has alpha > 0 (or NaN). That test is one subtraction of `visible_before`, the
 // count of such texels before each texel (built by the pass from the LUT it uploads), so a
 // block costs the same whatever its range (a loop over the range's texels took ~10 ms of a TF
 // edit on the engine's 64³ blocks under lavapipe). Rerun when the grid or the TF changes.
@@ -11,15 +9,13 @@
 // Entry point: `cs_classify` → `empty` (R32Float 3D: 1 = empty, 0 = may be visible).
 
 #import "common/volume.wgsl"
+#import "common/lut_range.wgsl"
 
 // The min/max grid of minmax_grid.wgsl (r = min, g = max).
 @group(0) @binding(auto) var grid: texture_3d<f32>;
 @group(0) @binding(auto) var empty: texture_storage_3d<r32float, write>;
 // visible_before[i]: how many texels j < i of the LUT have alpha > 0 or NaN (N + 1 entries).
 @group(0) @binding(auto) var<storage, read> visible_before: array<u32>;
-
-// `volgraph_accel::classify::VALUE_MARGIN`: covers f32 rounding of interpolated values.
-const VALUE_MARGIN: f32 = 1e-6;
 
 @compute @workgroup_size(4, 4, 4)
 fn cs_classify(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -47,17 +43,9 @@ fn cs_classify(@builtin(global_invocation_id) id: vec3<u32>) {
     let range = textureLoad(grid, vec3<i32>(id), 0).rg;
     let unknown = false;
 #endif
-    let texels = i32(textureDimensions(tf));
-    let n = f32(texels);
-    var first = 0;
-    var last = texels - 1;
-    // NaN bounds widen to the whole LUT (the conservative choice).
-    if (!unknown && range.x == range.x && range.y == range.y) {
-        let lo = min(range.x, range.y) - VALUE_MARGIN;
-        let hi = max(range.x, range.y) + VALUE_MARGIN;
-        first = clamp(i32(clamp(ceil(lo * n - 1.5), -1.0, n)), 0, texels - 1);
-        last = clamp(i32(clamp(floor(hi * n + 0.5), -1.0, n)), 0, texels - 1);
-    }
+    let texels = lut_texels_of(range, unknown, i32(textureDimensions(tf)));
+    let first = texels.x;
+    let last = texels.y;
     let visible = visible_before[last + 1] > visible_before[first];
     textureStore(empty, vec3<i32>(id), vec4<f32>(select(1.0, 0.0, visible), 0.0, 0.0, 0.0));
 }

@@ -8,8 +8,9 @@
 // interaction a path scatters with probability `albedo` (tinted by the TF colour) and is
 // otherwise absorbed, emitting `emission` × the TF colour.
 //
-// - Free paths by delta (Woodcock) tracking against the majorant σ̄ = σ(max α of the TF), the
-//   tightest bound one number can give (Novák et al. 2014 §3);
+// - free paths by delta (Woodcock) tracking against a majorant: σ(max α of the TF), or with
+//   BLOCK_MAJORANTS one per block of the min/max grid (majorant_grid.wgsl), stepping block by
+//   block (Novák et al. 2014 §3: tight majorants are what make it fast);
 // - light toward the directional light (or the headlight) by ratio tracking (Novák et al. 2014
 //   §5.2), with Russian roulette once the transmittance is small;
 // - scattering by the Henyey–Greenstein phase function, or where the field has a gradient, with
@@ -88,9 +89,37 @@ fn medium_at(p: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(c.rgb, extinction_of(c.a));
 }
 
-fn majorant() -> f32 {
-    return extinction_of(trace.max_alpha);
+// The majorant σ̄ over the path from distance `t` on, and where it stops holding (`end`).
+struct MajorantSpan {
+    sigma: f32,
+    end: f32,
 }
+
+#if BLOCK_MAJORANTS
+#import "common/block_grid.wgsl"
+
+// The largest opacity per block of the min/max grid (majorant_grid.wgsl).
+@group(0) @binding(auto) var majorants: texture_3d<f32>;
+
+// The block the path p + t·w is in at `t` — looked up a hundredth of a voxel ahead, so a path
+// on a face takes the block it enters (the grid's one-voxel apron covers the difference) — its
+// majorant and where the path leaves it, capped at `limit`; at least that hundredth of a voxel
+// on, so rounding at a face never stalls a path.
+fn majorant_span(p: vec3<f32>, w: vec3<f32>, t: f32, limit: f32) -> MajorantSpan {
+    let grid = block_grid(textureDimensions(majorants), trace.block_size);
+    let w_tex = w / (2.0 * frame.half_extent.xyz);
+    let ahead = 0.01 * frame.half_extent.w;
+    let b = block_at(texture_from_world(p + (t + ahead) * w), grid);
+    let leaves = box_span(texture_from_world(p), w_tex, blocks_box_lo(b, grid), blocks_box_hi(b, grid)).y;
+    let alpha = textureLoad(majorants, b, 0).r;
+    return MajorantSpan(extinction_of(alpha), min(max(leaves, t + ahead), limit));
+}
+#else
+// One majorant for the whole volume: the TF's most opaque value's.
+fn majorant_span(p: vec3<f32>, w: vec3<f32>, t: f32, limit: f32) -> MajorantSpan {
+    return MajorantSpan(extinction_of(trace.max_alpha), limit);
+}
+#endif
 
 // The part [t0, t1) of the world ray p + t·w inside the box and kept by the scene's cuts.
 fn world_segment(p: vec3<f32>, w: vec3<f32>) -> vec2<f32> {
@@ -101,19 +130,28 @@ fn world_segment(p: vec3<f32>, w: vec3<f32>) -> vec2<f32> {
 }
 
 // Delta tracking: the distance to the first real interaction in [t0, t1), or −1 when the path
-// leaves.
+// leaves. Within a majorant's span free paths are exponential at its rate; a path that reaches
+// the span's end restarts there (the exponential has no memory).
 fn delta_track(p: vec3<f32>, w: vec3<f32>, span: vec2<f32>) -> f32 {
-    let bound = majorant();
-    if (!(bound > 0.0) || span.x >= span.y) {
-        return -1.0;
-    }
     var t = span.x;
+    var m = majorant_span(p, w, t, span.y);
     for (var i = 0u; i < MAX_TRACKING_STEPS; i += 1u) {
-        t += free_path(bound);
         if (t >= span.y) {
             return -1.0;
         }
-        if (random() * bound < medium_at(p + t * w).a) {
+        if (!(m.sigma > 0.0)) {
+            t = m.end;
+            m = majorant_span(p, w, t, span.y);
+            continue;
+        }
+        let next = t + free_path(m.sigma);
+        if (next >= m.end) {
+            t = m.end;
+            m = majorant_span(p, w, t, span.y);
+            continue;
+        }
+        t = next;
+        if (random() * m.sigma < medium_at(p + t * w).a) {
             return t;
         }
     }
@@ -122,18 +160,26 @@ fn delta_track(p: vec3<f32>, w: vec3<f32>, span: vec2<f32>) -> f32 {
 
 // Ratio tracking: an unbiased estimate of the transmittance along [t0, t1).
 fn ratio_track(p: vec3<f32>, w: vec3<f32>, span: vec2<f32>) -> f32 {
-    let bound = majorant();
-    if (!(bound > 0.0) || span.x >= span.y) {
-        return 1.0;
-    }
     var t = span.x;
+    var m = majorant_span(p, w, t, span.y);
     var transmittance = 1.0;
     for (var i = 0u; i < MAX_TRACKING_STEPS; i += 1u) {
-        t += free_path(bound);
         if (t >= span.y) {
             return transmittance;
         }
-        transmittance *= max(1.0 - medium_at(p + t * w).a / bound, 0.0);
+        if (!(m.sigma > 0.0)) {
+            t = m.end;
+            m = majorant_span(p, w, t, span.y);
+            continue;
+        }
+        let next = t + free_path(m.sigma);
+        if (next >= m.end) {
+            t = m.end;
+            m = majorant_span(p, w, t, span.y);
+            continue;
+        }
+        t = next;
+        transmittance *= max(1.0 - medium_at(p + t * w).a / m.sigma, 0.0);
         // Russian roulette: a small estimate survives with probability ½, doubled.
         if (transmittance < 0.1) {
             if (random() < 0.5) {

@@ -36,6 +36,10 @@ pub const START: &str = "START";
 /// Rays start at per-tile depth bounds (`start_tiles`, `reprojection_tiles`).
 pub const START_TILES: &str = "START_TILES";
 
+// The path tracer's choices (`path_trace.rs`).
+/// Delta and ratio tracking block by block against per-block majorants (`majorant_grid`).
+pub const BLOCK_MAJORANTS: &str = "BLOCK_MAJORANTS";
+
 // The fragment raycaster's Klein variant (`raycast.rs`).
 /// Write `leap_hit`, where the next frame's ray starts.
 pub const LEAP_HITS: &str = "LEAP_HITS";
@@ -71,7 +75,7 @@ pub const SEGMENTS: &str = "SEGMENTS";
 pub const SCATTER: &str = "SCATTER";
 
 /// Every `#if` name of the built-in passes.
-pub const BUILT_IN: [&str; 28] = [
+pub const BUILT_IN: [&str; 29] = [
     SHADING,
     PREINTEGRATION,
     TRICUBIC,
@@ -100,4 +104,5 @@ pub const BUILT_IN: [&str; 28] = [
     FUSION_LABEL_MAP,
     FUSION_SCALAR,
     LABELS_NEAREST,
+    BLOCK_MAJORANTS,
 ];

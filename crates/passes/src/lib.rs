@@ -24,6 +24,7 @@ pub mod fusion;
 #[cfg(feature = "gpu")]
 pub mod grid_tap;
 pub mod hole_fill;
+pub mod majorant_grid;
 pub mod march;
 pub mod minmax_grid;
 pub mod opacity_lut;
@@ -86,6 +87,7 @@ macro_rules! builtin_kinds {
             .register(hole_fill::HoleFill)
             .register(reprojection_tiles::ReprojectionTiles)
             .register(antialias::Antialias)
+            .register(majorant_grid::MajorantGrid)
             .register(path_trace::PathTrace)
             .register(raycast_bricks::RaycastBricks)
             .register(present::Present)

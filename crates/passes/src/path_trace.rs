@@ -40,6 +40,16 @@ volgraph_compiler::param_choice! {
     }
 }
 
+volgraph_compiler::param_choice! {
+    /// What free paths are sampled against.
+    pub enum Majorant {
+        /// The TF's most opaque value's extinction, everywhere.
+        Global = "global",
+        /// Each block's own, from a wired `majorants` grid (`majorant_grid`).
+        Blocks = "blocks",
+    }
+}
+
 volgraph_compiler::pass_params! {
     /// The parameters, declared once: spec, typed values and `PathTraceParams` of
     /// `shaders/path_trace.wgsl` (`max_alpha` the node computes from the TF).
@@ -56,8 +66,16 @@ volgraph_compiler::pass_params! {
         environment: Environment = Sky, "what paths leaving the volume see: a generated sky or a uniform radiance";
         environment_intensity: f32 = 0.6, 0.0..=1000.0, "radiance scale of the environment";
         seed: u32 = 0, 0..=4294967295, "seed of the random sequence (each frame and pixel draws its own stream)";
+        majorant: Majorant = Global,
+            "free paths against the TF's largest extinction (global) or each block's (blocks: wire `majorants`)";
+        block_size: u32 = 8, 1..=256, "with majorant blocks: the minmax_grid pass's block size";
         max_alpha: f32 = computed, "the TF's largest opacity: the majorant's";
     }
+}
+
+/// Whether free paths step block by block (`majorant: "blocks"`).
+fn by_blocks(params: &Params) -> bool {
+    PathTraceParams::from_params(params).majorant == Majorant::Blocks
 }
 
 /// Its one pipeline, declared once.
@@ -86,17 +104,28 @@ impl PassDecl for PathTrace {
     }
 
     fn blocks(&self) -> Vec<ParamBlock> {
-        // Every value is a uniform; a change restarts the accumulation (the graph's history).
-        vec![PathTraceParams::block(OnChange::InPlace)]
+        // Every value is a uniform (a change restarts the accumulation: the graph's history);
+        // block majorants add a port and a define.
+        vec![PathTraceParams::block(OnChange::InPlace).with_defines(|p| {
+            if by_blocks(p) { vec![crate::defines::BLOCK_MAJORANTS] } else { Vec::new() }
+        })]
     }
 
-    fn ports(&self, _params: &Params) -> Vec<PortSpec> {
-        vec![
+    fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
+        by_blocks(old) == by_blocks(new)
+    }
+
+    fn ports(&self, params: &Params) -> Vec<PortSpec> {
+        let mut ports = vec![
             PortSpec::read("volume", PortKind::Volume),
             PortSpec::read("tf", PortKind::TransferFunction),
             PortSpec::read("previous", PortKind::target(&[TargetFormat::Rgba32Float])),
             PortSpec::write("color", PortKind::target(&[TargetFormat::Rgba32Float])),
-        ]
+        ];
+        if by_blocks(params) {
+            ports.push(PortSpec::read("majorants", PortKind::Owned(crate::majorant_grid::MAJORANT_GRID)));
+        }
+        ports
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
@@ -107,7 +136,9 @@ impl PassDecl for PathTrace {
 #[cfg(feature = "gpu")]
 impl PassPlugin for PathTrace {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec::of(&shader()))?;
+        let defines = self.shader_defines(ctx.params);
+        let pipeline =
+            ctx.compute_pipeline(&ComputePipelineSpec { defines: &defines, ..ComputePipelineSpec::of(&shader()) })?;
         let settings = PathTraceParams::from_params(ctx.params);
         let uniform = ctx.uniform_from_bytes("trace", &settings.uniform_bytes());
         Ok(Box::new(PathTraceNode { pipeline, uniform, settings, written: None }))
@@ -126,6 +157,10 @@ struct PathTraceNode {
 #[cfg(feature = "gpu")]
 impl PassNode for PathTraceNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
+        if self.settings.majorant == Majorant::Blocks {
+            let dims = ctx.voxels("volume")?.dims;
+            crate::empty_space::check_block_grid(ctx, "majorants", self.settings.block_size, dims.to_array())?;
+        }
         let version = ctx.input_version("tf");
         if self.written.as_ref().is_none_or(|(_, v)| *v != version) {
             let block = PathTraceParams { max_alpha: max_alpha(ctx.table("tf")?), ..self.settings };

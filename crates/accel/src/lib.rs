@@ -23,6 +23,7 @@ pub mod load;
 pub mod minmax;
 pub mod mip;
 pub mod octree;
+pub mod path_trace;
 pub mod organs;
 pub mod probe;
 pub mod reference;

@@ -245,3 +245,53 @@ fn the_running_mean_starts_over_when_the_camera_or_light_moves() {
     live.frame(&OrbitCamera { distance: camera().distance * 1.01, ..camera() });
     assert_eq!(live.runtime.history_stats().run, 0, "a new light starts over");
 }
+
+#[test]
+fn the_gpu_mean_agrees_with_an_independent_f64_path_tracer() {
+    use volgraph_accel::path_trace::{PathTraceSettings, render_path_traced};
+    // Everything on: multiple scattering (4 bounces), the gradient-surface term, a directional
+    // light, the generated sky — the graph's defaults. The CPU tracer (f64, its own random
+    // streams, delta-tracked light visibility instead of ratio tracking) is another unbiased
+    // estimator of the same pixel values.
+    let volume = volgraph_accel::generate::marschner_lobb_f32(32);
+    let lut = ramp_lut();
+    let light = volgraph_accel::light::Light::Directional { azimuth_deg: -60.0, elevation_deg: 35.0 };
+    let size = 24;
+    let spp = 512;
+    let gpu = gpu();
+    let mut live =
+        Live::new(&gpu, &builtin_registry(), GRAPH, &volume, &lut, &CompileOptions::new(size, size));
+    live.runtime.set_light(light);
+    let mut image = None;
+    for _ in 0..spp {
+        image = Some(live.frame(&camera()));
+    }
+    let got = image.expect("frames").to_rgba_f64();
+    let settings = PathTraceSettings { light, ..PathTraceSettings::default() };
+    let cpu = render_path_traced(&volume, &lut, &camera(), (size, size), &settings, (spp, 99));
+    // Per pixel and channel, z = (GPU − CPU) / √(2 s² / n) with s² the CPU's sample variance
+    // (the GPU's is the same distribution's). Two agreeing estimators put |z| > 3 on 0.3 % of
+    // values (the means of 512 paths are near normal); a wrong light direction, phase function
+    // or majorant moves whole regions by tens of standard errors.
+    let n = f64::from(spp);
+    let (mut over, mut counted, mut sum_z) = (0usize, 0usize, 0.0);
+    for (g, c) in got.iter().zip(&cpu) {
+        for k in 0..4 {
+            // At least one unit event in n samples: a pixel the CPU's paths never interacted
+            // in (zero sample variance) may still see one GPU path do so.
+            let se = (2.0 * c.variance[k] / n).sqrt().max(1.0 / n);
+            let z = (g[k] - c.mean[k]) / se;
+            sum_z += z;
+            counted += 1;
+            over += usize::from(z.abs() > 3.0);
+        }
+    }
+    let fraction = over as f64 / counted as f64;
+    let mean_z = sum_z / counted as f64;
+    eprintln!("{counted} values: {:.2} % beyond 3 standard errors, mean z {mean_z:+.3}", fraction * 100.0);
+    assert!(counted > 500, "the medium covers the image");
+    assert!(fraction < 0.02, "{:.2} % of values beyond 3 standard errors", fraction * 100.0);
+    // No systematic offset: the mean of `counted` z's has standard deviation 1/√counted (the
+    // channels of a pixel are correlated, so allow 6 of those).
+    assert!(mean_z.abs() < 6.0 / (counted as f64).sqrt(), "mean z {mean_z}: one is biased");
+}

@@ -191,6 +191,16 @@ fn ratio_track(p: vec3<f32>, w: vec3<f32>, span: vec2<f32>) -> f32 {
     return 0.0;
 }
 
+// The transmittance from `p` toward the light: ratio tracking's estimate, or delta tracking's
+// 0 or 1 (`shadow_rays: "delta"`, the cheaper, noisier estimator bench cinematic compares).
+fn light_transmittance(p: vec3<f32>, l: vec3<f32>) -> f32 {
+    let span = world_segment(p, l);
+    if (trace.shadow_rays == 1u) {
+        return select(0.0, 1.0, delta_track(p, l, span) < 0.0);
+    }
+    return ratio_track(p, l, span);
+}
+
 // ---- light -----------------------------------------------------------------------------------
 
 // The unit world direction toward the light: the scene's directional light, else the headlight
@@ -307,7 +317,7 @@ fn trace_pixel(pixel: vec2<u32>) -> vec4<f32> {
         let g = voxel_gradient(p);
         let strength = length(g);
         let surface = trace.surface * (1.0 - exp(-20.0 * strength));
-        let to_light = ratio_track(p, l, world_segment(p, l)) * trace.light_intensity;
+        let to_light = light_transmittance(p, l) * trace.light_intensity;
         if (strength > 1e-6 && random() < surface) {
             // Off a Lambertian surface facing the incoming path: light × cos / π, and a
             // cosine-weighted bounce (its weight f·cos/pdf is 1).

@@ -51,6 +51,10 @@ enum BenchCommand {
     /// Sort-last rendering under mpirun: compositing alone (direct-send vs radix-k, 256² …
     /// 2048², beside the memory-copy bound) and whole frames with 1, 2, 4 ranks.
     Distributed(crate::distributed::DistributedArgs),
+    /// Light that scatters: the path tracer's RMSE against a converged image vs seconds of
+    /// accumulation, with one or block majorants and ratio- or delta-tracked shadow rays, and the
+    /// light-volume shadows effect beside it (the engine at 256² by default).
+    Cinematic(crate::cinematic::CinematicArgs),
     /// Crop boxes and clip planes: ms/frame of crops to an eighth and a half and of a clip
     /// plane beside the whole volume (the engine with modern/fastest by default).
     Cuts(crate::cuts::CutsArgs),
@@ -115,6 +119,9 @@ fn run(cli: BenchCli) -> anyhow::Result<()> {
         }
         BenchCli::Bench { which: BenchCommand::Multi(args) } => {
             crate::multi::run(&args).context("bench multi").map(drop)
+        }
+        BenchCli::Bench { which: BenchCommand::Cinematic(args) } => {
+            crate::cinematic::run(&args).context("bench cinematic").map(drop)
         }
         BenchCli::Bench { which: BenchCommand::Cuts(args) } => crate::cuts::run(&args).context("bench cuts").map(drop),
         BenchCli::Bench { which: BenchCommand::Fetch(args) } => {

@@ -4,7 +4,8 @@
 //!
 //! - Free paths by delta (Woodcock) tracking against a majorant — the extinction of the TF's
 //!   largest opacity, recomputed when the TF changes — and the transmittance toward the light by
-//!   ratio tracking (Novák et al. 2014, §3 and §5.2);
+//!   ratio tracking, or delta tracking's 0-or-1 visibility (`shadow_rays`; Novák et al. 2014, §3
+//!   and §5.2);
 //! - single and multiple scattering (`bounces`) with a Henyey–Greenstein phase function
 //!   (`anisotropy`), or off a Lambertian surface with probability `surface` · (1 − e^(−20 |∇s|))
 //!   (Kroes et al. 2012, "Exposure Render", §4.3's hybrid scattering);
@@ -50,6 +51,16 @@ volgraph_compiler::param_choice! {
     }
 }
 
+volgraph_compiler::param_choice! {
+    /// How a path estimates the light's transmittance (Novák et al. 2014 §5).
+    pub enum ShadowRays {
+        /// Ratio tracking: the product of (1 − σ/σ̄) over tentative collisions.
+        Ratio = "ratio",
+        /// Delta tracking: 1 if the shadow ray reaches the light, else 0.
+        Delta = "delta",
+    }
+}
+
 volgraph_compiler::pass_params! {
     /// The parameters, declared once: spec, typed values and `PathTraceParams` of
     /// `shaders/path_trace.wgsl` (`max_alpha` the node computes from the TF).
@@ -69,6 +80,8 @@ volgraph_compiler::pass_params! {
         majorant: Majorant = Global,
             "free paths against the TF's largest extinction (global) or each block's (blocks: wire `majorants`)";
         block_size: u32 = 8, 1..=256, "with majorant blocks: the minmax_grid pass's block size";
+        shadow_rays: ShadowRays = Ratio,
+            "the light's transmittance by ratio tracking (smooth) or delta tracking (0 or 1: cheaper, noisier)";
         max_alpha: f32 = computed, "the TF's largest opacity: the majorant's";
     }
 }

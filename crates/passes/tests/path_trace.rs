@@ -140,7 +140,7 @@ fn converges_to(graph: &str, volume: &Volume, lut: &[[f32; 4]], reference: &[[f6
 }
 
 #[test]
-fn block_majorants_light_the_medium_as_the_global_majorant_does() {
+fn block_majorants_and_delta_shadow_rays_light_the_medium_as_the_global_majorant_does() {
     // Single scattering of a directional light through the medium: the light's transmittance
     // comes from ratio tracking, block by block or against the one majorant. Both are unbiased,
     // so their means agree within the noise of two independent estimates: the signed mean
@@ -159,12 +159,18 @@ fn block_majorants_light_the_medium_as_the_global_majorant_does() {
     let spp = 128;
     let global = accumulate_with(GRAPH, &volume, &lut, &params, spp).to_rgba_f64();
     let blocks = accumulate_with(GRAPH_BLOCKS, &volume, &lut, &params, spp).to_rgba_f64();
+    // And delta-tracked shadow rays (a 0-or-1 visibility): the same mean again.
+    let mut delta_params = params.to_vec();
+    delta_params.push(("shadow_rays", Value::from("delta")));
+    let delta = accumulate_with(GRAPH_BLOCKS, &volume, &lut, &delta_params, spp).to_rgba_f64();
     let n = global.len() as f64;
     let standard_error = (2.0 * 0.16f64.powi(2) / 4.0 / f64::from(spp) / n).sqrt();
-    for c in 0..4 {
-        let diff: f64 = global.iter().zip(&blocks).map(|(a, b)| a[c] - b[c]).sum::<f64>() / n;
-        eprintln!("channel {c}: global − blocks {diff:+.5} (standard error {standard_error:.5})");
-        assert!(diff.abs() <= 4.0 * standard_error, "channel {c}: the majorants disagree by {diff}");
+    for (what, other) in [("blocks", &blocks), ("delta-tracked shadow rays", &delta)] {
+        for c in 0..4 {
+            let diff: f64 = global.iter().zip(other).map(|(a, b)| a[c] - b[c]).sum::<f64>() / n;
+            eprintln!("channel {c}: global − {what} {diff:+.5} (standard error {standard_error:.5})");
+            assert!(diff.abs() <= 4.0 * standard_error, "channel {c}: {what} disagree by {diff}");
+        }
     }
     assert!(global.iter().any(|p| p[0] > 0.02), "the light reaches the medium");
 }

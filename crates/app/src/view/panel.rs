@@ -135,6 +135,16 @@ pub fn history_line(stats: &volgraph_core::runtime::HistoryStats) -> String {
     )
 }
 
+/// A progressive graph's samples per pixel (a path tracer's running mean: its noise falls as
+/// 1/√spp while the view rests).
+pub fn samples_line(stats: &volgraph_core::runtime::HistoryStats) -> String {
+    format!(
+        "{} samples per pixel (noise ∝ 1/√spp; any change of view, TF, light or cuts starts over; {} restarts)",
+        stats.run + 1,
+        stats.restarts
+    )
+}
+
 /// Draws the panel; returns what the user changed.
 pub fn show(
     root: &mut egui::Ui,
@@ -177,7 +187,9 @@ pub fn show(
                 ui.add(egui::Label::new(egui::RichText::new(message).monospace().small()).wrap());
             });
         }
-        if !plan.history.is_empty() {
+        if crate::render::accumulates(plan) {
+            ui.label(samples_line(&session.runtime.history_stats()));
+        } else if !plan.history.is_empty() {
             ui.label(history_line(&session.runtime.history_stats()));
         }
         // What the graph's bypasses did (Klein's reprojection left out where it cannot pay).

@@ -16,7 +16,8 @@
 // - scattering by the Henyey–Greenstein phase function, or where the field has a gradient, with
 //   probability `surface` · (1 − e^(−20 |∇s|)), off a Lambertian surface whose normal is the
 //   gradient (Kroes et al. 2012, "Exposure Render", §4.3's hybrid scattering);
-// - paths that leave the box see the environment (a generated sky, or a uniform one); a
+// - paths that leave the box see the environment (the scene's map, a generated sky, or a
+//   uniform one); a
 //   primary ray that meets nothing is transparent, as in the raycasters (`present` draws the
 //   background), and its alpha is the probability of an interaction: 1 − T of the ray.
 //
@@ -212,10 +213,27 @@ fn toward_light() -> vec3<f32> {
     return -frame.camera_forward.xyz;
 }
 
+// The scene's environment map (volgraph_accel::environment): equirectangular, row 0 up, the
+// column at u = atan2(x, −z) / 2π + ½; 1×1 black when the scene has none.
+@group(0) @binding(auto) var environment_map: texture_2d<f32>;
+
+// The map's radiance along unit `w`, nearest texel (EnvironmentMap::radiance).
+fn environment_radiance(w: vec3<f32>) -> vec3<f32> {
+    let size = vec2<i32>(textureDimensions(environment_map));
+    let u = atan2(w.x, -w.z) / (2.0 * PI) + 0.5;
+    let v = acos(clamp(w.y, -1.0, 1.0)) / PI;
+    let x = ((i32(floor(u * f32(size.x))) % size.x) + size.x) % size.x;
+    let y = clamp(i32(floor(v * f32(size.y))), 0, size.y - 1);
+    return textureLoad(environment_map, vec2<i32>(x, y), 0).rgb;
+}
+
 // What a path leaving along `w` sees: world +y is up (the orbit camera's up).
 fn environment(w: vec3<f32>) -> vec3<f32> {
     if (trace.environment == 1u) {
         return vec3<f32>(trace.environment_intensity);
+    }
+    if (trace.environment_map == 1u) {
+        return environment_radiance(w) * trace.environment_intensity;
     }
     let ground = vec3<f32>(0.32, 0.30, 0.28);
     let horizon = vec3<f32>(0.85, 0.85, 0.82);

@@ -12,6 +12,7 @@ pub mod camera;
 pub mod chebyshev;
 pub mod classify;
 pub mod data_dir;
+pub mod environment;
 pub mod fusion;
 pub mod generate;
 pub mod histogram;

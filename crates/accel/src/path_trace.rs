@@ -18,16 +18,18 @@ use crate::reference::{intersect_box, lut_sample, ray_segment};
 use crate::volume::Volume;
 
 /// What a path leaving the volume sees (`path_trace`'s `environment`).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Environment {
     /// The generated sky along world +y.
     Sky,
     /// The same radiance everywhere.
     Uniform,
+    /// The scene's map (`Runtime::set_environment`), scaled by `environment_intensity`.
+    Map(std::sync::Arc<crate::environment::EnvironmentMap>),
 }
 
 /// The medium's and the light's parameters, as `path_trace`'s (its `PathTraceParams`).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct PathTraceSettings {
     /// Probability that an interaction scatters.
     pub albedo: f64,
@@ -148,8 +150,10 @@ impl Medium<'_> {
 
     fn environment(&self, w: DVec3) -> DVec3 {
         let k = self.settings.environment_intensity;
-        if self.settings.environment == Environment::Uniform {
-            return DVec3::splat(k);
+        match &self.settings.environment {
+            Environment::Uniform => return DVec3::splat(k),
+            Environment::Map(map) => return map.radiance(w) * k,
+            Environment::Sky => {}
         }
         let ground = DVec3::new(0.32, 0.30, 0.28);
         let horizon = DVec3::new(0.85, 0.85, 0.82);
@@ -288,7 +292,7 @@ pub fn render_path_traced(
     let mut medium = Medium {
         volume,
         lut,
-        settings: *settings,
+        settings: settings.clone(),
         half: volume.half_extent_world(),
         unit_world: volume.unit_step_world(),
         majorant: 0.0,

@@ -11,6 +11,7 @@ pub mod cli;
 #[cfg(test)]
 mod cli_fuzz;
 pub mod distributed;
+pub mod environment_file;
 pub mod forward;
 #[cfg(test)]
 mod fuzz_runner;

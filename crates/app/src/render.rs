@@ -73,6 +73,8 @@ pub struct Prepared {
     cuts: volgraph_accel::cuts::Cuts,
     /// The scene's light.
     light: volgraph_accel::light::Light,
+    /// The scene's environment map, read and checked.
+    environment: Option<Arc<volgraph_accel::environment::EnvironmentMap>>,
     volume: volgraph_accel::volume::Volume,
     lut: Vec<[f32; 4]>,
     /// Inputs bound by name (`--volume NAME=PATH`, `--tf NAME=…`), if any.
@@ -86,7 +88,7 @@ pub struct Prepared {
 /// Reads and checks every input of `volgraph render`; touches no GPU, prints nothing.
 pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     let kind = ImageKind::from_path("-o", &args.out)?;
-    let Resolved { scene, graph, size, camera, cuts, light } =
+    let Resolved { scene, graph, size, camera, cuts, light, environment } =
         args.inputs.resolve("volgraph render GRAPH -o out.png", "512x512")?;
     let source = inputs::read_graph(&graph)?;
     let mut features = scene.as_ref().map(|s| s.effects.clone()).unwrap_or_default();
@@ -149,6 +151,7 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     options.scene = scene_values_of(&VolumeDesc::of(&volume));
     options.scene.extend(crate::inputs::data_scene_values(&volume));
     let plan = compile(&file, &source, &registry, &options).map_err(CliError::Graph)?;
+    let environment = environment.as_deref().map(crate::environment_file::load_environment).transpose()?.map(Arc::new);
     if let Some(spp) = args.spp
         && !accumulates(&plan)
     {
@@ -231,6 +234,7 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
         opacity,
         cuts,
         light,
+        environment,
         volume,
         lut,
         bindings,
@@ -357,7 +361,22 @@ pub fn budget_note(plan: &volgraph_core::Plan, registry: &volgraph_core::Registr
 /// Opens the GPU, renders the frames and writes the image.
 pub fn execute(prepared: Prepared) -> Result<(), CliError> {
     let Prepared {
-        args, graph, kind, camera, frames, still, opacity, cuts, light, volume, lut, bindings, plan, output, ..
+        args,
+        graph,
+        kind,
+        camera,
+        frames,
+        still,
+        opacity,
+        cuts,
+        light,
+        environment,
+        volume,
+        lut,
+        bindings,
+        plan,
+        output,
+        ..
     } = prepared;
     let registry = crate::program::registry();
     let viewport = plan.viewport;
@@ -367,6 +386,7 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
     runtime.set_opacity_reference(opacity);
     runtime.set_cuts(cuts);
     runtime.set_light(light);
+    runtime.set_environment(environment);
     runtime.set_gpu_memory_budget(args.inputs.gpu_memory_mb.map(|mb| mb << 20));
     match &bindings {
         Some(bindings) => bindings.bind(&mut runtime, &plan, &volume, &lut),

@@ -178,6 +178,8 @@ struct SceneDoc {
     tfs: std::collections::BTreeMap<String, String>,
     #[serde(default)]
     lights: Vec<volgraph_accel::light::Light>,
+    #[serde(default)]
+    environment: Option<String>,
 }
 
 /// A scene read and checked, its paths resolved against the scene file's folder.
@@ -217,6 +219,9 @@ pub struct Scene {
     /// The light (`lights: [Directional(azimuth_deg: 35, elevation_deg: 25)]`; none: the
     /// headlight).
     pub light: volgraph_accel::light::Light,
+    /// The environment map a path tracer's paths see (`environment: "sky.exr"`, beside the
+    /// scene); none: the path tracer's own sky.
+    pub environment: Option<PathBuf>,
 }
 
 /// Why a scene could not be read.
@@ -420,6 +425,7 @@ impl Scene {
             volumes,
             tfs,
             light,
+            environment: doc.environment.as_deref().map(resolve),
         })
     }
 

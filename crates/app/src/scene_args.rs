@@ -77,6 +77,10 @@ pub struct SceneArgs {
     /// would stand; elevation -90..90), or headlight [default: the scene's, else the headlight].
     #[arg(long, value_parser = volgraph_accel::light::Light::parse, allow_hyphen_values = true)]
     pub light: Option<volgraph_accel::light::Light>,
+    /// An environment map (OpenEXR, equirectangular linear radiance) that a path tracer's paths
+    /// see when they leave the volume [default: the scene's, else the path tracer's own sky].
+    #[arg(long)]
+    pub environment: Option<PathBuf>,
 }
 
 /// What the command line and the scene say together: flags win over the scene.
@@ -93,6 +97,8 @@ pub struct Resolved {
     pub cuts: Cuts,
     /// The light: `--light` wins over the scene's.
     pub light: volgraph_accel::light::Light,
+    /// The environment map's file: `--environment` wins over the scene's.
+    pub environment: Option<PathBuf>,
 }
 
 impl SceneArgs {
@@ -151,7 +157,8 @@ impl SceneArgs {
             if self.clip.is_empty() { scene_cuts.planes().copied().collect() } else { self.clip.clone() };
         let cuts = Cuts::new(crop, &planes).map_err(|e| anyhow!("--clip: {e}"))?;
         let light = self.light.or(scene.as_ref().map(|s| s.light)).unwrap_or_default();
-        Ok(Resolved { scene, graph, size, camera, cuts, light })
+        let environment = self.environment.clone().or_else(|| scene.as_ref().and_then(|s| s.environment.clone()));
+        Ok(Resolved { scene, graph, size, camera, cuts, light, environment })
     }
 }
 

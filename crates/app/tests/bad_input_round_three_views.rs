@@ -43,6 +43,7 @@ fn open(graph: &Path, volume: &[PathBuf], raw: LoadOptions<'static>, tf: Option<
             .expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)"),
     );
     let args = SessionArgs {
+        environment: None,
         scene: None,
         graph: graph.to_path_buf(),
         volume: volume.to_vec(),

@@ -49,6 +49,7 @@ pub struct WorkbenchArgs {
 
 fn open(gpu: &Arc<Gpu>, graph: PathBuf, volume: &std::path::Path, viewport: (u32, u32)) -> anyhow::Result<LiveSession> {
     let args = SessionArgs {
+        environment: None,
         graph,
         volume: vec![volume.to_path_buf()],
         raw: Default::default(),

@@ -9,16 +9,18 @@ use crate::decl::{Access, PortKind};
 use crate::plan::{Binding, Plan, ResourceDesc, ResourceId};
 use crate::reflect::{BindingKind, ReflectedBinding};
 
-/// Names the runtime binds itself, in every pass that declares them.
-pub const SYSTEM_BINDINGS: [&str; 3] = ["frame", "linear_clamp", "nearest_clamp"];
+/// Names the runtime binds itself, in every pass that declares them: the frame uniforms, the
+/// two samplers and the scene's environment map (`Runtime::set_environment`).
+pub const SYSTEM_BINDINGS: [&str; 4] = ["frame", "linear_clamp", "nearest_clamp", "environment_map"];
 
-/// Whether the system sampler `name` filters: `linear_clamp` does; `nearest_clamp` binds as
+/// Whether the system binding `name` filters: `linear_clamp` does; `nearest_clamp` binds as
 /// non-filtering, so a shader may read any float texture through it, filterable or not (the
-/// empty-space grids by texel centre, common/block_grid.wgsl). `None` for other names.
+/// empty-space grids by texel centre, common/block_grid.wgsl); `environment_map` is an
+/// `Rgba32Float` texture read with `textureLoad`, bound as unfilterable. `None` for other names.
 pub fn system_sampler_filters(name: &str) -> Option<bool> {
     match name {
         "linear_clamp" => Some(true),
-        "nearest_clamp" => Some(false),
+        "nearest_clamp" | "environment_map" => Some(false),
         _ => None,
     }
 }

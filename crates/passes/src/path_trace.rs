@@ -9,7 +9,8 @@
 //! - single and multiple scattering (`bounces`) with a Henyey–Greenstein phase function
 //!   (`anisotropy`), or off a Lambertian surface with probability `surface` · (1 − e^(−20 |∇s|))
 //!   (Kroes et al. 2012, "Exposure Render", §4.3's hybrid scattering);
-//! - the scene's directional light (or the headlight) and an environment: a generated sky, or a
+//! - the scene's directional light (or the headlight) and an environment: the scene's map
+//!   (`Runtime::set_environment`, bound as `environment_map`), else a generated sky, or a
 //!   uniform one (the white furnace);
 //! - an interaction scatters with probability `albedo`, tinted by the TF colour, and otherwise
 //!   absorbs, emitting `emission` × the TF colour: with albedo 0 and emission 1 the estimate is
@@ -34,7 +35,8 @@ pub struct PathTrace;
 volgraph_compiler::param_choice! {
     /// What a path that leaves the volume sees.
     pub enum Environment {
-        /// A generated sky: ground, horizon and zenith along world +y.
+        /// The scene's environment map where it has one (`--environment sky.exr`), else a
+        /// generated sky: ground, horizon and zenith along world +y.
         Sky = "sky",
         /// The same radiance from every direction (the white furnace).
         Uniform = "uniform",
@@ -83,6 +85,7 @@ volgraph_compiler::pass_params! {
         shadow_rays: ShadowRays = Ratio,
             "the light's transmittance by ratio tracking (smooth) or delta tracking (0 or 1: cheaper, noisier)";
         max_alpha: f32 = computed, "the TF's largest opacity: the majorant's";
+        environment_map: u32 = computed, "1: paths leaving see the scene's environment map (bound as environment_map)";
     }
 }
 
@@ -163,8 +166,9 @@ struct PathTraceNode {
     pipeline: ComputePassPipeline,
     uniform: wgpu::Buffer,
     settings: PathTraceParams,
-    /// The block last written, with the TF version its majorant came from.
-    written: Option<(PathTraceParams, Option<u64>)>,
+    /// The block last written, with the TF version its majorant came from and whether the
+    /// scene had an environment map.
+    written: Option<(PathTraceParams, (Option<u64>, bool))>,
 }
 
 #[cfg(feature = "gpu")]
@@ -174,9 +178,11 @@ impl PassNode for PathTraceNode {
             let dims = ctx.voxels("volume")?.dims;
             crate::empty_space::check_block_grid(ctx, "majorants", self.settings.block_size, dims.to_array())?;
         }
-        let version = ctx.input_version("tf");
+        let version = (ctx.input_version("tf"), ctx.frame.environment);
         if self.written.as_ref().is_none_or(|(_, v)| *v != version) {
-            let block = PathTraceParams { max_alpha: max_alpha(ctx.table("tf")?), ..self.settings };
+            // The scene's map stands in for the generated sky (a uniform environment stays one).
+            let environment_map = u32::from(ctx.frame.environment && self.settings.environment == Environment::Sky);
+            let block = PathTraceParams { max_alpha: max_alpha(ctx.table("tf")?), environment_map, ..self.settings };
             ctx.write_buffer(&self.uniform, 0, &block.uniform_bytes());
             self.written = Some((block, version));
         }

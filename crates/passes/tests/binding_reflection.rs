@@ -135,7 +135,7 @@ fn shader_global_without_a_port_is_named() {
     assert_eq!(
         msg,
         "pass \"march\": raycast.wgsl: global \"dir\" is neither a port of this pass (ports: entry, direction, volume, tf, color) \
-         nor a system binding (frame, linear_clamp, nearest_clamp) nor one the pass binds itself (params); \
+         nor a system binding (frame, linear_clamp, nearest_clamp, environment_map) nor one the pass binds itself (params); \
          rename it to the port it stands for, or, when the node binds it itself, declare it in the pass's \
          ShaderUse (`.uniform(..)` for a uniform block, else `.binds(&[\"dir\"])`)"
     );

@@ -36,6 +36,8 @@ pub struct SavedView {
     pub cuts: Cuts,
     /// The light.
     pub light: volgraph_accel::light::Light,
+    /// The environment map's file.
+    pub environment: Option<PathBuf>,
 }
 
 impl SavedView {
@@ -121,6 +123,9 @@ impl SavedView {
                 "    lights: [Directional(azimuth_deg: {azimuth_deg:?}, elevation_deg: {elevation_deg:?})],\n"
             );
         }
+        if let Some(path) = &self.environment {
+            out += &format!("    environment: {},\n", quote(path));
+        }
         out += ")\n";
         out
     }
@@ -140,7 +145,8 @@ mod saved_view_tests {
     use glam::DVec3;
     use volgraph_accel::cuts::{ClipPlane, CropBox};
 
-    /// "Save view" writes a scene that reads back to the same camera, cuts, light and effects,
+    /// "Save view" writes a scene that reads back to the same camera, cuts, light, environment
+    /// map and effects,
     /// to the last bit of every f64.
     #[test]
     fn a_saved_view_reads_back_exactly() {
@@ -168,10 +174,12 @@ mod saved_view_tests {
             opacity_reference: OpacityReference::World,
             cuts,
             light: volgraph_accel::light::Light::Directional { azimuth_deg: -33.3, elevation_deg: 1.0 / 7.0 },
+            environment: Some(PathBuf::from("/nonexistent/sky.exr")),
         };
         let scene = Scene::from_str(&view.to_ron(), Path::new("/tmp/x.scene.ron")).expect("reads back");
         assert_eq!(scene.cuts, cuts);
         assert_eq!(scene.light, view.light);
+        assert_eq!(scene.environment, view.environment);
         assert_eq!(scene.volume_options.spacing, Some((1.0, 0.1, 1.0 / 3.0)));
         assert_eq!(scene.viewport, Some((320, 200)));
         assert_eq!(scene.effects, vec!["shading".to_string()]);

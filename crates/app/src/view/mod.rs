@@ -164,6 +164,7 @@ pub fn run(args: ViewArgs) -> Result<(), CliError> {
         gpu_memory_mb: args.inputs.gpu_memory_mb,
         cuts: resolved.cuts,
         light: resolved.light,
+        environment: resolved.environment,
     };
     let view = ViewOptions {
         camera,

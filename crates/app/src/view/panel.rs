@@ -139,7 +139,7 @@ pub fn history_line(stats: &volgraph_core::runtime::HistoryStats) -> String {
 /// 1/√spp while the view rests).
 pub fn samples_line(stats: &volgraph_core::runtime::HistoryStats) -> String {
     format!(
-        "{} samples per pixel (noise ∝ 1/√spp; any change of view, TF, light or cuts starts over; {} restarts)",
+        "{} samples per pixel (noise falls as 1/sqrt(spp); any change of view, TF, light or cuts starts over; {} restarts)",
         stats.run + 1,
         stats.restarts
     )

@@ -141,6 +141,8 @@ pub struct SessionArgs {
     pub cuts: Cuts,
     /// The light at start (`--light` over the scene's).
     pub light: volgraph_accel::light::Light,
+    /// The environment map's file (`--environment` over the scene's).
+    pub environment: Option<PathBuf>,
     /// Volumes bound by name (`--volume NAME=PATH`); `volume` is then the frame volume's path.
     pub named: Vec<(String, PathBuf)>,
     /// Transfer functions and label tables bound by name (`--tf NAME=FILE`).
@@ -176,6 +178,8 @@ pub struct LiveSession {
     labels_are_the_volume: bool,
     /// Inputs bound by name (`--volume NAME=PATH`, `--tf NAME=…`): rebound on every apply.
     bindings: Option<crate::named_inputs::NamedBindings>,
+    /// The environment map's file, for "save view".
+    environment: Option<PathBuf>,
 }
 
 impl LiveSession {

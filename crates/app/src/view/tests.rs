@@ -49,6 +49,7 @@ fn scratch(name: &str, graph: &str) -> Scratch {
 /// the generated default) and `tf`; nothing named.
 fn session_args(s: &Scratch, volume: &[&str], tf: Option<PathBuf>) -> SessionArgs {
     SessionArgs {
+        environment: None,
         scene: None,
         graph: s.graph.clone(),
         volume: volume.iter().map(PathBuf::from).collect(),

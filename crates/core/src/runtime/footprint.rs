@@ -249,6 +249,7 @@ mod tests {
             gpu_memory_budget: None,
             cuts: Default::default(),
             light: Default::default(),
+            environment: false,
         }
     }
 

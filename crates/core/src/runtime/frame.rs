@@ -242,6 +242,8 @@ pub struct FrameData {
     pub cuts: Cuts,
     /// The scene's light (`volgraph_accel::light`).
     pub light: volgraph_accel::light::Light,
+    /// Whether the scene has an environment map (bound as `environment_map`).
+    pub environment: bool,
 }
 
 /// The pixel rays of a camera in texture space: pixel centre (x, y) (pixels, row 0 at the top)

@@ -159,6 +159,8 @@ pub struct Runtime {
     cuts: Cuts,
     /// The scene's light (`set_light`).
     light: volgraph_accel::light::Light,
+    /// The scene's environment map (`set_environment`).
+    environment: Option<Arc<volgraph_accel::environment::EnvironmentMap>>,
     /// GPU memory passes that stream data may use (`--gpu-memory-mb`); `None`: the adapter's.
     gpu_memory_budget: Option<u64>,
     /// Submit and time every step on its own ([`Runtime::set_step_profiling`]).
@@ -191,6 +193,7 @@ impl Runtime {
             window: None,
             cuts: Cuts::NONE,
             light: volgraph_accel::light::Light::Headlight,
+            environment: None,
             gpu_memory_budget: None,
             profile_steps: false,
             bypasses: bypass::Bypasses::default(),

@@ -36,6 +36,31 @@ pub struct SystemBindings {
     pub linear_clamp: wgpu::Sampler,
     /// `nearest_clamp`.
     pub nearest_clamp: wgpu::Sampler,
+    /// `environment_map`: the scene's environment (`Runtime::set_environment`), 1×1 black
+    /// without one.
+    pub environment_map: wgpu::TextureView,
+}
+
+/// An environment map as an `Rgba32Float` 2D texture (read with `textureLoad`).
+pub(crate) fn environment_view(gpu: &Gpu, map: &volgraph_accel::environment::EnvironmentMap) -> wgpu::TextureView {
+    use wgpu::util::DeviceExt as _;
+    gpu.device
+        .create_texture_with_data(
+            &gpu.queue,
+            &wgpu::TextureDescriptor {
+                label: Some("environment map"),
+                size: wgpu::Extent3d { width: map.width, height: map.height, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba32Float,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            bytemuck::cast_slice(&map.texels),
+        )
+        .create_view(&wgpu::TextureViewDescriptor::default())
 }
 
 impl SystemBindings {
@@ -60,6 +85,7 @@ impl SystemBindings {
             }),
             linear_clamp: sampler("linear_clamp", wgpu::FilterMode::Linear),
             nearest_clamp: sampler("nearest_clamp", wgpu::FilterMode::Nearest),
+            environment_map: environment_view(gpu, &volgraph_accel::environment::EnvironmentMap::uniform([0.0; 3])),
         }
     }
 }
@@ -219,6 +245,7 @@ impl<'a> RecordContext<'a> {
                 "frame" => self.system.frame.as_entire_binding(),
                 "linear_clamp" => wgpu::BindingResource::Sampler(&self.system.linear_clamp),
                 "nearest_clamp" => wgpu::BindingResource::Sampler(&self.system.nearest_clamp),
+                "environment_map" => wgpu::BindingResource::TextureView(&self.system.environment_map),
                 name => match extra.iter().find(|(n, _)| *n == name) {
                     Some((_, r)) => r.clone(),
                     None => match self.port(name).and_then(|p| p.buffer) {

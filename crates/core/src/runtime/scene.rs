@@ -4,6 +4,7 @@
 //! the scene values and the volume description the frame contract sees.
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 use volgraph_accel::cuts::Cuts;
 
@@ -128,6 +129,25 @@ impl Runtime {
             self.light = light;
             self.invalidate_history();
         }
+    }
+
+    /// Sets the scene's environment map (what a path tracer's paths see when they leave the
+    /// volume; `None`: the pass's own generated sky): uploaded once, bound by name
+    /// (`environment_map`) to every pass that declares it. Accumulated history restarts.
+    pub fn set_environment(&mut self, map: Option<Arc<volgraph_accel::environment::EnvironmentMap>>) {
+        if self.environment != map {
+            self.system.environment_map = super::record::environment_view(
+                &self.gpu,
+                map.as_deref().unwrap_or(&volgraph_accel::environment::EnvironmentMap::uniform([0.0; 3])),
+            );
+            self.environment = map;
+            self.invalidate_history();
+        }
+    }
+
+    /// The scene's environment map, if any.
+    pub fn environment(&self) -> Option<&Arc<volgraph_accel::environment::EnvironmentMap>> {
+        self.environment.as_ref()
     }
 
     /// The scene's light.

@@ -28,6 +28,7 @@ impl Runtime {
             gpu_memory_budget: self.gpu_memory_budget,
             cuts: self.cuts,
             light: self.light,
+            environment: self.environment.is_some(),
         })
     }
 

@@ -64,6 +64,9 @@ impl LiveSession {
         options.features.extend(cut_effects::features_of(&args.cuts));
         runtime.set_cuts(args.cuts);
         runtime.set_light(args.light);
+        if let Some(path) = &args.environment {
+            runtime.set_environment(Some(std::sync::Arc::new(crate::environment_file::load_environment(path)?)));
+        }
         if let Some(scene) = &args.scene {
             options.features.extend(scene.effects.iter().cloned());
             options.precision = scene.precision;
@@ -187,6 +190,7 @@ impl LiveSession {
             labels,
             labels_are_the_volume,
             bindings,
+            environment: args.environment.clone(),
         };
         let ms = start.elapsed().as_secs_f64() * 1e3;
         Ok((session, Event::Loaded { graph: graph_name, ms, summary: loaded }))

@@ -220,6 +220,7 @@ impl LiveSession {
             opacity_reference: self.opacity_reference,
             cuts: self.runtime.cuts(),
             light: self.runtime.light(),
+            environment: self.environment.clone(),
         })
     }
 

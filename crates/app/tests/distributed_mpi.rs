@@ -45,7 +45,15 @@ fn mpirun(ranks: usize, args: &[&str], contexts: &[(&str, &[&str])]) -> Run {
     for (env, extra) in contexts {
         cmd.args([":", "-n", "1", "-x", env, exe, "render"]).args(*extra);
     }
-    let out = cmd.env("XDG_RUNTIME_DIR", xdg()).output().expect("mpirun starts");
+    // Each mpirun gets its own session folder: two started at once by parallel tests raced to
+    // create the shared /tmp/ompi.HOST.UID ("mkdir … File exists", orte_init failed; seen once
+    // in CI on 2026-12-06).
+    static CALLS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let session = scratch(&format!("ompi-{}-{call}", std::process::id()));
+    std::fs::create_dir_all(&session).expect("an MPI session folder");
+    let out = cmd.env("XDG_RUNTIME_DIR", xdg()).env("TMPDIR", &session).output().expect("mpirun starts");
+    let _ = std::fs::remove_dir_all(&session);
     let run = Run { code: out.status.code().unwrap_or(-1), stderr: String::from_utf8_lossy(&out.stderr).into_owned() };
     assert_ne!(run.code, 124, "mpirun hung (killed after 300 s):\n{}", run.stderr);
     run

@@ -57,6 +57,11 @@ fn transmittance_along(u0: vec3<f32>, step: vec3<f32>, max_steps: u32, exponent:
     return t;
 }
 
+// Whole steps of unit_world toward a point light `distance` away (light::steps_to_light).
+fn steps_to_light(distance: f32) -> u32 {
+    return u32(clamp(floor(distance / frame.half_extent.w), 0.0, 1e6));
+}
+
 // One unit_world along the unit world direction `d`, in texture space (light::light_step_tex).
 fn unit_step_toward(d: vec3<f32>) -> vec3<f32> {
     return d * frame.half_extent.w / (2.0 * frame.half_extent.xyz);
@@ -72,9 +77,17 @@ fn cs_light_volume(@builtin(global_invocation_id) id: vec3<u32>) {
     let exponent = 1.0 / frame.volume_dims.w;
     var t = 1.0;
 #if SHADOWS
-    // Toward the light: a directional light's, else the eye's along the camera's forward axis.
-    let toward = select(-frame.camera_forward.xyz, frame.light_world.xyz, frame.light_world.w != 0.0);
-    t = transmittance_along(u0, unit_step_toward(toward), 0xffffffffu, exponent);
+    // Toward the light: a directional light's, else the eye's along the camera's forward axis;
+    // toward a point light (w = 2) this voxel's own direction, up to the light (light::Toward).
+    var toward = select(-frame.camera_forward.xyz, frame.light_world.xyz, frame.light_world.w == 1.0);
+    var steps = 0xffffffffu;
+    if (frame.light_world.w == 2.0) {
+        let d = frame.light_world.xyz - world_from_texture(u0);
+        let r = length(d);
+        toward = select(vec3<f32>(0.0, 1.0, 0.0), d / r, r > 1e-12);
+        steps = steps_to_light(r);
+    }
+    t = transmittance_along(u0, unit_step_toward(toward), steps, exponent);
 #endif
     var ao = 1.0;
 #if AMBIENT_OCCLUSION

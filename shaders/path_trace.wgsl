@@ -194,8 +194,10 @@ fn ratio_track(p: vec3<f32>, w: vec3<f32>, span: vec2<f32>) -> f32 {
 
 // The transmittance from `p` toward the light: ratio tracking's estimate, or delta tracking's
 // 0 or 1 (`shadow_rays: "delta"`, the cheaper, noisier estimator bench cinematic compares).
-fn light_transmittance(p: vec3<f32>, l: vec3<f32>) -> f32 {
-    let span = world_segment(p, l);
+fn light_transmittance(p: vec3<f32>, l: vec3<f32>, distance: f32) -> f32 {
+    let whole = world_segment(p, l);
+    // Material beyond a point light casts no shadow.
+    let span = vec2<f32>(whole.x, min(whole.y, distance));
     if (trace.shadow_rays == 1u) {
         return select(0.0, 1.0, delta_track(p, l, span) < 0.0);
     }
@@ -204,13 +206,19 @@ fn light_transmittance(p: vec3<f32>, l: vec3<f32>) -> f32 {
 
 // ---- light -----------------------------------------------------------------------------------
 
-// The unit world direction toward the light: the scene's directional light, else the headlight
-// (from the eye, along the camera's forward axis).
-fn toward_light() -> vec3<f32> {
-    if (frame.light_world.w > 0.0) {
-        return frame.light_world.xyz;
+// The unit world direction toward the light from world point `p` (xyz) and the distance to it
+// (w; 3e38 for a distant light): the scene's directional light, a point light (w = 2), else the
+// headlight (from the eye, along the camera's forward axis). volgraph_accel::light::Toward.
+fn toward_light(p: vec3<f32>) -> vec4<f32> {
+    if (frame.light_world.w == 2.0) {
+        let d = frame.light_world.xyz - p;
+        let r = length(d);
+        return vec4<f32>(select(vec3<f32>(0.0, 1.0, 0.0), d / r, r > 1e-12), r);
     }
-    return -frame.camera_forward.xyz;
+    if (frame.light_world.w == 1.0) {
+        return vec4<f32>(frame.light_world.xyz, 3.0e38);
+    }
+    return vec4<f32>(-frame.camera_forward.xyz, 3.0e38);
 }
 
 // The scene's environment map (volgraph_accel::environment): equirectangular, row 0 up, the
@@ -306,7 +314,6 @@ fn trace_pixel(pixel: vec2<u32>) -> vec4<f32> {
     var p = world_from_texture(ray.u0);
     var w = normalize(ray.d * 2.0 * frame.half_extent.xyz);
     var span = vec2<f32>(ray.begin, ray.len) * world_per_tex;
-    let l = toward_light();
     var radiance = vec3<f32>(0.0);
     var throughput = vec3<f32>(1.0);
     var alpha = 0.0;
@@ -335,7 +342,11 @@ fn trace_pixel(pixel: vec2<u32>) -> vec4<f32> {
         let g = voxel_gradient(p);
         let strength = length(g);
         let surface = trace.surface * (1.0 - exp(-20.0 * strength));
-        let to_light = light_transmittance(p, l) * trace.light_intensity;
+        // A point light's irradiance falls as 1/r² (light_intensity at one world unit).
+        let light = toward_light(p);
+        let l = light.xyz;
+        let falloff = select(1.0, 1.0 / max(light.w * light.w, 1e-12), light.w < 1.0e38);
+        let to_light = light_transmittance(p, l, light.w) * trace.light_intensity * falloff;
         if (strength > 1e-6 && random() < surface) {
             // Off a Lambertian surface facing the incoming path: light × cos / π, and a
             // cosine-weighted bounce (its weight f·cos/pdf is 1).

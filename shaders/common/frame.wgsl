@@ -56,8 +56,9 @@ struct Frame {
     _pad2: u32,
     _pad3: u32,
     _pad4: u32,
-    // xyz: the unit world direction toward a directional light; w: 1 for one, 0 for the
-    // headlight (each ray's own -direction). volgraph_accel::light.
+    // w = 1: xyz the unit world direction toward a directional light; w = 2: xyz a point
+    // light's world position (the bound box's own world); w = 0: the headlight (each ray's own
+    // -direction). volgraph_accel::light.
     light_world: vec4<f32>,
 }
 

@@ -183,7 +183,7 @@ fn classify_value(u: vec3<f32>, s: f32) -> vec4<f32> {
 #endif
 #if SHADING
     if (p.a > 0.0) {
-        let light = lighting(u, ray_view_world, ray_light_world);
+        let light = lighting(u, ray_view_world, light_at(u, ray_light_world));
         p = vec4<f32>(p.rgb * light.x + vec3<f32>(p.a * light.y), p.a);
     }
 #else
@@ -334,9 +334,22 @@ fn volume_position(u: vec3<f32>) -> vec3<f32> {
 }
 
 // The unit world direction toward the scene's light for a ray along `d_world`: a directional
-// light's (frame.light_world, w = 1), else the headlight's -d_world (volgraph_accel::light).
+// light's (frame.light_world, w = 1), else the headlight's -d_world (volgraph_accel::light); a
+// point light's (w = 2) depends on the sample: `light_at`.
 fn light_toward(d_world: vec3<f32>) -> vec3<f32> {
-    return select(-d_world, frame.light_world.xyz, frame.light_world.w != 0.0);
+    return select(-d_world, frame.light_world.xyz, frame.light_world.w == 1.0);
+}
+
+// The unit world direction toward the light from texture point `u` (of the texture sampled:
+// `volume_position` maps a brick atlas back): a point light's (frame.light_world.xyz, w = 2)
+// from u's world point, else the ray's `ray_light` (`light_toward`). One uniform branch a sample.
+fn light_at(u: vec3<f32>, ray_light: vec3<f32>) -> vec3<f32> {
+    if (frame.light_world.w == 2.0) {
+        let d = frame.light_world.xyz - world_from_texture(volume_position(u));
+        let r = length(d);
+        return select(vec3<f32>(0.0, 1.0, 0.0), d / r, r > 1e-12);
+    }
+    return ray_light;
 }
 
 // Blinn–Phong at texture-space point `u` seen along the unit world direction `d_world`, lit from
@@ -385,7 +398,7 @@ fn lighting(u: vec3<f32>, d_world: vec3<f32>, l: vec3<f32>) -> vec2<f32> {
 
 // The shaded colour of the isosurface at `u`.
 fn shade_iso(u: vec3<f32>, d_world: vec3<f32>) -> vec3<f32> {
-    let light = lighting(u, d_world, light_toward(d_world));
+    let light = lighting(u, d_world, light_at(u, light_toward(d_world)));
     let base = sample_tf(params.iso_value).rgb;
     return clamp(base * light.x + vec3<f32>(light.y), vec3<f32>(0.0), vec3<f32>(1.0));
 }

@@ -75,7 +75,8 @@ mod tests {
         let wide = EnvironmentMap::new(4, 2, vec![[0.0; 4]; 8]).expect("valid");
         assert_eq!(wide.texel_of(DVec3::Y).1, 0);
         assert_eq!(wide.texel_of(-DVec3::Y).1, 1);
-        let columns: Vec<u32> = [-DVec3::Z, DVec3::X, DVec3::Z, -DVec3::X].iter().map(|w| wide.texel_of(*w).0).collect();
+        let columns: Vec<u32> =
+            [-DVec3::Z, DVec3::X, DVec3::Z, -DVec3::X].iter().map(|w| wide.texel_of(*w).0).collect();
         assert_eq!(columns, [2, 3, 0, 1]);
     }
 

@@ -24,14 +24,51 @@ pub enum Light {
         /// Degrees above the xz plane, toward +y (−90..90).
         elevation_deg: f64,
     },
+    /// A point light at a world position (the volume's box is centred on the origin, its
+    /// longest side 2 world units): the direction toward it changes from sample to sample.
+    /// Blinn–Phong takes its direction only (no fall-off, as a directional light's irradiance is
+    /// constant); the path tracer's `light_intensity` is its irradiance one world unit away,
+    /// falling as 1/r².
+    Point {
+        /// World x.
+        x: f64,
+        /// World y (up).
+        y: f64,
+        /// World z.
+        z: f64,
+    },
+}
+
+/// Where light reaches a point from: one direction for every point, or a position.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Toward {
+    /// The unit world direction toward a distant light (the headlight's resolved).
+    Direction(DVec3),
+    /// A point light's world position.
+    Point(DVec3),
+}
+
+impl Toward {
+    /// The unit direction toward the light from world point `p`, and the distance to it
+    /// (infinite for a distant light; 0 at the light itself, whose direction is then +y).
+    pub fn from(&self, p: DVec3) -> (DVec3, f64) {
+        match *self {
+            Toward::Direction(d) => (d, f64::INFINITY),
+            Toward::Point(at) => {
+                let d = at - p;
+                let r = d.length();
+                if r > 1e-12 { (d / r, r) } else { (DVec3::Y, 0.0) }
+            }
+        }
+    }
 }
 
 impl Light {
-    /// The unit world direction toward the light; `None` for the headlight (it is each ray's
-    /// own `-direction`).
+    /// The unit world direction toward a distant light; `None` for the headlight (it is each
+    /// ray's own `-direction`) and for a point light (see [`Light::toward_with`]).
     pub fn toward(&self) -> Option<DVec3> {
         match *self {
-            Light::Headlight => None,
+            Light::Headlight | Light::Point { .. } => None,
             Light::Directional { azimuth_deg, elevation_deg } => {
                 let (az, el) = (azimuth_deg.to_radians(), elevation_deg.to_radians());
                 Some(DVec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos()))
@@ -39,16 +76,40 @@ impl Light {
         }
     }
 
-    /// Reads `--light`: `headlight`, or `AZ,EL` in degrees (finite; elevation within −90..90).
+    /// Where the light comes from, with `headlight` (a unit world direction toward the eye) for
+    /// the headlight.
+    pub fn toward_with(&self, headlight: DVec3) -> Toward {
+        match *self {
+            Light::Point { x, y, z } => Toward::Point(DVec3::new(x, y, z)),
+            _ => Toward::Direction(self.toward().unwrap_or(headlight)),
+        }
+    }
+
+    /// Reads `--light`: `headlight`, `AZ,EL` in degrees (finite; elevation within −90..90), or
+    /// `point:X,Y,Z` in world units (finite).
     pub fn parse(text: &str) -> Result<Self, String> {
         let text = text.trim();
         if text.eq_ignore_ascii_case("headlight") {
             return Ok(Light::Headlight);
         }
+        if let Some(at) = text.strip_prefix("point:").or_else(|| text.strip_prefix("POINT:")) {
+            let bad = || {
+                format!(
+                    "\"{text}\" is no point light: write point:X,Y,Z in world units (the volume's box is centred on \
+                     the origin, its longest side 2), e.g. point:0,2,1"
+                )
+            };
+            let values: Vec<f64> =
+                at.split(',').map(|v| v.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|_| bad())?;
+            let [x, y, z] = values[..] else { return Err(bad()) };
+            let light = Light::Point { x, y, z };
+            light.check().map_err(|e| format!("\"{text}\": {e}"))?;
+            return Ok(light);
+        }
         let bad = || {
             format!(
                 "\"{text}\" is no light: write AZ,EL in degrees (azimuth about the vertical axis, elevation -90..90, \
-                 e.g. 35,25) or headlight"
+                 e.g. 35,25), point:X,Y,Z or headlight"
             )
         };
         let (az, el) = text.split_once(',').ok_or_else(bad)?;
@@ -63,6 +124,13 @@ impl Light {
     pub fn check(&self) -> Result<(), String> {
         match *self {
             Light::Headlight => Ok(()),
+            Light::Point { x, y, z } => {
+                if [x, y, z].iter().all(|v| v.is_finite()) {
+                    Ok(())
+                } else {
+                    Err(format!("a point light's position must be finite world units, not ({x}, {y}, {z})"))
+                }
+            }
             Light::Directional { azimuth_deg, elevation_deg } => {
                 if !(azimuth_deg.is_finite() && elevation_deg.is_finite()) {
                     return Err(format!(
@@ -100,6 +168,12 @@ pub fn blinn_phong_terms(n: DVec3, l: DVec3, v: DVec3) -> (f64, f64) {
         0.0
     };
     (n_dot_l, n_dot_h)
+}
+
+/// Whole steps of `unit_world` a light ray may take toward a light `distance` away (all of them
+/// toward a distant light): the GPU's `steps_to_light` (light_volume.wgsl).
+pub fn steps_to_light(distance: f64, unit_world: f64) -> u32 {
+    if distance.is_finite() { (distance / unit_world).floor().clamp(0.0, 1e6) as u32 } else { u32::MAX }
 }
 
 /// Light-grid voxels per axis at most: transmittance toward the light varies slowly (it is an
@@ -162,7 +236,7 @@ impl LightGrid {
     pub fn compute(
         volume: &crate::volume::Volume,
         lut: &[[f32; 4]],
-        (toward, occlusion): (Option<DVec3>, bool),
+        (toward, occlusion): (Option<Toward>, bool),
         (opacity_unit_voxels, cuts): (f64, &crate::cuts::Cuts),
         field: &(dyn Fn(DVec3) -> f64 + Sync),
     ) -> Self {
@@ -195,9 +269,23 @@ impl LightGrid {
         };
         let count = (dims.x * dims.y * dims.z) as usize;
         let transmittance = match toward {
-            Some(toward) => {
+            Some(Toward::Direction(toward)) => {
                 let step = light_step_tex(volume, toward);
                 (0..count).into_par_iter().map(|i| along(centre(i), step, u32::MAX)).collect()
+            }
+            Some(point @ Toward::Point(_)) => {
+                // Toward a point light: each voxel's own direction, up to the light (material
+                // beyond it casts no shadow); whole steps of one unit_world, as the GPU takes.
+                let half = volume.half_extent_world();
+                let unit = volume.unit_step_world();
+                (0..count)
+                    .into_par_iter()
+                    .map(|i| {
+                        let u0 = centre(i);
+                        let (d, r) = point.from((u0 - 0.5) * 2.0 * half);
+                        along(u0, light_step_tex(volume, d), steps_to_light(r, unit))
+                    })
+                    .collect()
             }
             None => Vec::new(),
         };
@@ -283,6 +371,22 @@ mod tests {
         assert_eq!(Light::parse("HEADLIGHT"), Ok(Light::Headlight));
     }
 
+    /// `point:X,Y,Z` is a point light in world units; its direction and distance from a point
+    /// come from where it is; bad positions say what to write.
+    #[test]
+    fn a_point_light_is_where_it_is_put() {
+        let light = Light::parse("point: 0, 2,1").expect("parses");
+        assert_eq!(light, Light::Point { x: 0.0, y: 2.0, z: 1.0 });
+        let (d, r) = light.toward_with(DVec3::Z).from(DVec3::new(0.0, 0.0, 1.0));
+        assert_eq!((d, r), (DVec3::Y, 2.0));
+        assert_eq!(light.toward(), None);
+        for text in ["point:1,2", "point:a,b,c", "point:inf,0,0", "point:1,2,3,4"] {
+            let e = Light::parse(text).expect_err(text);
+            assert!(e.contains(&format!("\"{text}\"")), "{text}: {e}");
+        }
+        assert!(Light::parse("point:nan,0,0").expect_err("NaN").contains("finite"));
+    }
+
     #[test]
     fn bad_lights_say_what_to_write() {
         assert!(Light::parse("0,1e39").expect_err("1e39").ends_with("not 1e39"));
@@ -304,9 +408,13 @@ mod tests {
         // Opaque above 0.5, clear below.
         let lut: Vec<[f32; 4]> = (0..256).map(|i| if i >= 128 { [1.0; 4] } else { [0.0; 4] }).collect();
         let toward = DVec3::Z; // light at +z
-        let grid = LightGrid::compute(&volume, &lut, (Some(toward), true), (1.0, &crate::cuts::Cuts::NONE), &|u| {
-            volume.sample_trilinear(u)
-        });
+        let grid = LightGrid::compute(
+            &volume,
+            &lut,
+            (Some(Toward::Direction(toward)), true),
+            (1.0, &crate::cuts::Cuts::NONE),
+            &|u| volume.sample_trilinear(u),
+        );
         assert_eq!(grid.dims, glam::UVec3::splat(n));
         let at = |z: u32| grid.transmittance[(8 + n * (8 + n * z)) as usize];
         assert_eq!(at(2), 0.0, "behind the slab");
@@ -324,8 +432,9 @@ mod tests {
         // A clip plane keeping z < 0.3 removes the slab: nothing shadows the voxel behind it.
         let keep_low = crate::cuts::ClipPlane::new(DVec3::new(0.0, 0.0, -1.0), -0.3).expect("plane");
         let cuts = crate::cuts::Cuts::new(None, &[keep_low]).expect("cuts");
-        let cut =
-            LightGrid::compute(&volume, &lut, (Some(toward), false), (1.0, &cuts), &|u| volume.sample_trilinear(u));
+        let cut = LightGrid::compute(&volume, &lut, (Some(Toward::Direction(toward)), false), (1.0, &cuts), &|u| {
+            volume.sample_trilinear(u)
+        });
         assert_eq!(cut.transmittance[(8 + n * (8 + n * 2)) as usize], 1.0, "the cut-away slab casts no shadow");
         assert_eq!(steps_to_exit(DVec3::splat(0.5), DVec3::ZERO), 0);
     }

@@ -107,7 +107,7 @@ struct Medium<'a> {
     half: DVec3,
     unit_world: f64,
     majorant: f64,
-    toward_light: DVec3,
+    toward_light: crate::light::Toward,
 }
 
 impl Medium<'_> {
@@ -133,7 +133,7 @@ impl Medium<'_> {
 
     /// Delta tracking: the first real interaction in [t0, t1), if any.
     fn delta_track(&self, p: DVec3, w: DVec3, (t0, t1): (f64, f64), rng: &mut SplitMix64) -> Option<f64> {
-        if !(self.majorant > 0.0) {
+        if self.majorant.is_nan() || self.majorant <= 0.0 {
             return None;
         }
         let mut t = t0;
@@ -187,7 +187,6 @@ impl Medium<'_> {
     /// One path from `p` along `w` over `span` (a pixel's ray in the box).
     fn trace(&self, mut p: DVec3, mut w: DVec3, mut span: (f64, f64), rng: &mut SplitMix64) -> [f64; 4] {
         let s = &self.settings;
-        let l = self.toward_light;
         let mut radiance = DVec3::ZERO;
         let mut throughput = DVec3::ONE;
         let mut alpha = 0.0;
@@ -214,12 +213,15 @@ impl Medium<'_> {
             let g = self.gradient(p);
             let strength = g.length();
             let surface = s.surface * (1.0 - (-20.0 * strength).exp());
-            // The light's visibility by delta tracking: reached (1) or not (0).
+            // Toward the light (a point light's direction from here, its irradiance falling as
+            // 1/r²); its visibility by delta tracking up to it: reached (1) or not (0).
+            let (l, r) = self.toward_light.from(p);
             let lit = match self.span(p, l) {
-                Some(to_light) => self.delta_track(p, l, to_light, rng).is_none(),
+                Some((t0, t1)) => t0 >= t1.min(r) || self.delta_track(p, l, (t0, t1.min(r)), rng).is_none(),
                 None => true,
             };
-            let to_light = if lit { s.light_intensity } else { 0.0 };
+            let irradiance = if r.is_finite() { s.light_intensity / (r * r).max(1e-12) } else { s.light_intensity };
+            let to_light = if lit { irradiance } else { 0.0 };
             if strength > 1e-6 && rng.uniform() < surface {
                 let mut n = -g / strength;
                 if n.dot(w) > 0.0 {
@@ -288,7 +290,8 @@ pub fn render_path_traced(
     (spp, seed): (u32, u64),
 ) -> Vec<PixelEstimate> {
     let frame = camera.frame(width, height);
-    let max_alpha = lut.iter().map(|t| if t[3].is_nan() { 1.0 } else { f64::from(t[3]).clamp(0.0, 1.0) }).fold(0.0, f64::max);
+    let max_alpha =
+        lut.iter().map(|t| if t[3].is_nan() { 1.0 } else { f64::from(t[3]).clamp(0.0, 1.0) }).fold(0.0, f64::max);
     let mut medium = Medium {
         volume,
         lut,
@@ -296,7 +299,7 @@ pub fn render_path_traced(
         half: volume.half_extent_world(),
         unit_world: volume.unit_step_world(),
         majorant: 0.0,
-        toward_light: settings.light.toward().unwrap_or(-frame.forward),
+        toward_light: settings.light.toward_with(-frame.forward),
     };
     medium.majorant = medium.extinction_of(max_alpha);
     (0..height)
@@ -312,7 +315,8 @@ pub fn render_path_traced(
                 let p1 = (ray.u0 + ray.d_tex * ray.len_tex - 0.5) * 2.0 * medium.half;
                 let length = (p1 - p0).length();
                 let w = (p1 - p0) / length;
-                let mut rng = SplitMix64(seed ^ (u64::from(y) << 32 | u64::from(x)).wrapping_mul(0x2545_f491_4f6c_dd1d));
+                let mut rng =
+                    SplitMix64(seed ^ (u64::from(y) << 32 | u64::from(x)).wrapping_mul(0x2545_f491_4f6c_dd1d));
                 let (mut sum, mut squares) = ([0.0; 4], [0.0; 4]);
                 for _ in 0..spp {
                     let sample = medium.trace(p0, w, (0.0, length), &mut rng);
@@ -356,14 +360,8 @@ mod tests {
     fn an_empty_medium_renders_nothing() {
         let volume = crate::generate::marschner_lobb_f32(16);
         let lut = vec![[1.0, 1.0, 1.0, 0.0]; 16];
-        let image = render_path_traced(
-            &volume,
-            &lut,
-            &OrbitCamera::default(),
-            (8, 8),
-            &PathTraceSettings::default(),
-            (16, 1),
-        );
+        let image =
+            render_path_traced(&volume, &lut, &OrbitCamera::default(), (8, 8), &PathTraceSettings::default(), (16, 1));
         assert!(image.iter().all(|p| *p == PixelEstimate::default()));
     }
 }

@@ -399,8 +399,9 @@ impl<'a> March<'a> {
             s(u + DVec3::new(0.0, 0.0, off.z)) - s(u - DVec3::new(0.0, 0.0, off.z)),
         );
         let v = -self.seg.dir_world;
-        let l = self.settings.light.toward().unwrap_or(v);
         let half = self.volume.half_extent_world();
+        // A point light's direction from this sample's world point (the volume's own space).
+        let l = self.settings.light.toward_with(v).from((u - 0.5) * 2.0 * half).0;
         let mut n = if g.length() >= ZERO_GRADIENT { -(g * dims / half).normalize() } else { l };
         if !self.settings.cuts.is_none() {
             // A cut face shows the plane it was cut along ("capping", crate::cuts).
@@ -592,7 +593,7 @@ pub fn shadow_grid(
     if !(settings.effects.shadows || settings.effects.ambient_occlusion) {
         return None;
     }
-    let toward = settings.effects.shadows.then(|| settings.light.toward().unwrap_or(-frame.forward));
+    let toward = settings.effects.shadows.then(|| settings.light.toward_with(-frame.forward));
     let tricubic = settings.effects.tricubic;
     let field = |u: DVec3| if tricubic { volume.sample_tricubic(u) } else { volume.sample_trilinear(u) };
     let occlusion = settings.effects.ambient_occlusion;

@@ -26,7 +26,8 @@ pub fn load_environment(path: &Path) -> anyhow::Result<EnvironmentMap> {
     // The header first: a map too large is refused before its pixels are decoded.
     let header = exr::meta::MetaData::read_from_file(path, false)
         .map_err(|e| anyhow!("environment map {shown}: not a readable OpenEXR file ({e})"))?;
-    let size = header.headers.first().map(|h| h.layer_size).ok_or_else(|| anyhow!("environment map {shown}: no layer"))?;
+    let size =
+        header.headers.first().map(|h| h.layer_size).ok_or_else(|| anyhow!("environment map {shown}: no layer"))?;
     if size.0 == 0 || size.1 == 0 || size.0 > MAX_SIDE as usize || size.1 > MAX_SIDE as usize {
         bail!("environment map {shown}: {}×{} pixels; an environment map's sides are 1..={MAX_SIDE}", size.0, size.1);
     }

@@ -352,7 +352,8 @@ impl Scene {
                 return Err(field(
                     "lights",
                     format!(
-                        "{} lights: a scene has one light for now (the headlight, or one Directional(azimuth_deg: AZ,                          elevation_deg: EL)); keep one",
+                        "{} lights: a scene has one light for now (the headlight, one Directional(azimuth_deg: AZ, \
+                         elevation_deg: EL) or one Point(x: X, y: Y, z: Z)); keep one",
                         more.len()
                     ),
                 ));

@@ -74,7 +74,9 @@ pub struct SceneArgs {
     #[arg(long, value_parser = ClipPlane::parse, allow_hyphen_values = true)]
     pub clip: Vec<ClipPlane>,
     /// The light: AZ,EL in degrees (a directional light where an orbit camera at those angles
-    /// would stand; elevation -90..90), or headlight [default: the scene's, else the headlight].
+    /// would stand; elevation -90..90), point:X,Y,Z (a point light in world units: the volume's
+    /// box is centred on the origin, its longest side 2), or headlight [default: the scene's,
+    /// else the headlight].
     #[arg(long, value_parser = volgraph_accel::light::Light::parse, allow_hyphen_values = true)]
     pub light: Option<volgraph_accel::light::Light>,
     /// An environment map (OpenEXR, equirectangular linear radiance) that a path tracer's paths

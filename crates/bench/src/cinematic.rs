@@ -62,16 +62,8 @@ struct Case {
 }
 
 const CASES: [Case; 3] = [
-    Case {
-        name: "one majorant, ratio-tracked shadow rays",
-        graph: "cinematic/path_traced",
-        overrides: &[],
-    },
-    Case {
-        name: "block majorants, ratio-tracked shadow rays",
-        graph: "cinematic/path_traced_blocks",
-        overrides: &[],
-    },
+    Case { name: "one majorant, ratio-tracked shadow rays", graph: "cinematic/path_traced", overrides: &[] },
+    Case { name: "block majorants, ratio-tracked shadow rays", graph: "cinematic/path_traced_blocks", overrides: &[] },
     Case {
         name: "block majorants, delta-tracked shadow rays",
         graph: "cinematic/path_traced_blocks",
@@ -189,14 +181,8 @@ pub fn run(args: &CinematicArgs) -> anyhow::Result<serde_json::Value> {
     let mut runtime = Runtime::new(gpu, ShaderLibrary::new(volgraph_passes::builtin_shaders()));
     runtime.set_light(light);
     let camera = OrbitCamera { azimuth_deg: 30.0, elevation_deg: 20.0, distance: 3.2, ..OrbitCamera::default() };
-    let mut bench = Bench {
-        runtime,
-        registry: volgraph_app::program::registry(),
-        volume,
-        lut,
-        size: args.size.clone(),
-        camera,
-    };
+    let mut bench =
+        Bench { runtime, registry: volgraph_app::program::registry(), volume, lut, size: args.size.clone(), camera };
     let k = args.reference_spp;
     eprintln!("converging the reference: {k} samples per pixel …");
     let reference = bench.converged(k)?;
@@ -228,11 +214,7 @@ pub fn run(args: &CinematicArgs) -> anyhow::Result<serde_json::Value> {
         });
         let needed = (sigma / target).powi(2).ceil().max(1.0);
         let seconds = needed * c.ms_per_sample / 1e3;
-        summary.push_str(&format!(
-            "| {} | {:.1} | {needed:.0} | {seconds:.1} |\n",
-            c.name,
-            sigma * 255.0
-        ));
+        summary.push_str(&format!("| {} | {:.1} | {needed:.0} | {seconds:.1} |\n", c.name, sigma * 255.0));
         json_curves.push(serde_json::json!({
             "case": c.name, "ms_per_sample": c.ms_per_sample,
             "points": c.points.iter().map(|(n, s, e)| serde_json::json!({"spp": n, "seconds": s, "rmse": e})).collect::<Vec<_>>(),

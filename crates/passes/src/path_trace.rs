@@ -122,9 +122,10 @@ impl PassDecl for PathTrace {
     fn blocks(&self) -> Vec<ParamBlock> {
         // Every value is a uniform (a change restarts the accumulation: the graph's history);
         // block majorants add a port and a define.
-        vec![PathTraceParams::block(OnChange::InPlace).with_defines(|p| {
-            if by_blocks(p) { vec![crate::defines::BLOCK_MAJORANTS] } else { Vec::new() }
-        })]
+        vec![
+            PathTraceParams::block(OnChange::InPlace)
+                .with_defines(|p| if by_blocks(p) { vec![crate::defines::BLOCK_MAJORANTS] } else { Vec::new() }),
+        ]
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {

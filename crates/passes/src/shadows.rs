@@ -25,15 +25,20 @@ pub fn light_shader_use() -> ShaderUse {
 #[cfg(feature = "gpu")]
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
 
+/// What a light volume was built for: the volume's and TF's versions, the light's direction or
+/// a point light's position (with `true`), the opacity unit's bits and the cuts.
+#[cfg(feature = "gpu")]
+type BuildKey = (Option<u64>, Option<u64>, ([u64; 3], bool), u64, volgraph_accel::cuts::Cuts);
+
 #[cfg(feature = "gpu")]
 /// A raycaster's light volume and what it was built for.
 pub struct LightVolume {
     view: Option<wgpu::TextureView>,
     /// Where the pass's volume is a texture: the compute pipeline that writes the grid.
     gpu: Option<ComputePassPipeline>,
-    /// (volume version, TF version, light direction (shadows only), opacity unit, cuts) of the
-    /// last build.
-    built_for: Option<(Option<u64>, Option<u64>, [u64; 3], u64, volgraph_accel::cuts::Cuts)>,
+    /// (volume version, TF version, light direction or point light position (shadows only),
+    /// opacity unit, cuts) of the last build.
+    built_for: Option<BuildKey>,
     /// The field is the tricubic B-spline (the `tricubic` effect), as the march reconstructs it.
     tricubic: bool,
     /// Which channels: transmittance toward the light (`shadows`), ambient occlusion.
@@ -88,13 +93,23 @@ impl LightVolume {
     /// changed since the last build.
     pub fn update(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let frame = ctx.frame;
-        // Only shadows depend on the light (ambient occlusion does not follow the camera).
-        let toward = self.shadows.then(|| frame.light.toward().unwrap_or(-frame.camera.forward));
+        // Only shadows depend on the light (ambient occlusion does not follow the camera). A
+        // point light in the bound box's own world (a sort-last window centres it on its origin).
+        let window_centre = frame.volume.and_then(|v| v.window).map_or(glam::DVec3::ZERO, |w| w.centre_world);
+        let toward = self.shadows.then(|| match frame.light.toward_with(-frame.camera.forward) {
+            volgraph_accel::light::Toward::Point(at) => volgraph_accel::light::Toward::Point(at - window_centre),
+            direction => direction,
+        });
+        let (toward_key, is_point) = match toward {
+            Some(volgraph_accel::light::Toward::Direction(d)) => (d, false),
+            Some(volgraph_accel::light::Toward::Point(at)) => (at, true),
+            None => (glam::DVec3::ZERO, false),
+        };
         let unit = frame.volume.map_or(1.0, |v| v.opacity_unit_voxels);
         let key = (
             ctx.input_version("volume"),
             ctx.input_version("tf"),
-            toward.unwrap_or_default().to_array().map(f64::to_bits),
+            (toward_key.to_array().map(f64::to_bits), is_point),
             unit.to_bits(),
             // What the cuts keep (cut-away material casts no shadow).
             frame.cuts,

@@ -97,6 +97,53 @@ fn a_directional_light_shades_every_family_like_the_reference() {
     }
 }
 
+/// A point light (its direction changes from sample to sample) shades every family as the
+/// reference does — a fragment raycaster, the compute path, the brick atlas (whose samples map
+/// back to the volume by `volume_position`), a first-hit isosurface and Klein's leaping march —
+/// and moves the picture away from a directional light from the same side.
+#[test]
+fn a_point_light_shades_every_family_like_the_reference() {
+    let gpu = gpu();
+    let volume = volgraph_accel::generate::marschner_lobb_f32(64);
+    let lut = TransferFunction::preset(Preset::Opaque, volume.value_range).to_lut_for(&volume, 256);
+    let camera = OrbitCamera { azimuth_deg: 25.0, elevation_deg: 15.0, ..OrbitCamera::default() };
+    // Just outside the box's corner: directions across the volume differ by up to ~90°.
+    let light = Light::Point { x: 1.2, y: 1.0, z: 1.1 };
+    let from_afar = Light::Directional { azimuth_deg: 47.5, elevation_deg: 35.0 };
+    for (graph, features) in [
+        ("basic/fragment_raycast.ron", &["shading"][..]),
+        ("modern/fastest.ron", &["shading"][..]),
+        ("ruijters_vilanova_2006/bricks_octree_ert.ron", &["shading"][..]),
+        ("basic/isosurface.ron", &[][..]),
+        ("klein_2005/leap_iso.ron", &[][..]),
+    ] {
+        let (image, settings) = render_lit(&gpu, graph, (&volume, &lut), &camera, (light, Cuts::NONE), features);
+        let reference = render_reference(&volume, &lut, &camera, SIZE, SIZE, &settings);
+        let distant =
+            render_reference(&volume, &lut, &camera, SIZE, SIZE, &RaycastSettings { light: from_afar, ..settings });
+        let moved = fraction_over(&distant.color, &reference.color, 8.0 / 255.0).expect("same size");
+        let extra = format!("; a point light moved {:.0}% of pixels from the distant one", moved * 100.0);
+        assert_shaded_like_reference(graph, &image.to_rgba_f64(), &reference.color, &extra);
+        assert!(moved > 0.05, "{graph}: the point light must differ from a distant one ({:.1}%)", moved * 100.0);
+    }
+}
+
+/// Shadows toward a point light: each light-volume voxel looks toward the light from where it
+/// is, and material beyond the light casts no shadow — on the GPU (fragment, compute) and on
+/// the CPU (the brick raycaster's grid) as in the reference.
+#[test]
+fn shadows_toward_a_point_light_are_the_references() {
+    let cases: [(&str, &[&str]); 3] = [
+        ("basic/fragment_raycast.ron", &["shading", "shadows"]),
+        ("modern/fastest.ron", &["shadows"]),
+        ("ruijters_vilanova_2006/bricks_octree_ert.ron", &["shading", "shadows"]),
+    ];
+    // Inside the box, above its centre: material above the light casts no shadow on what is
+    // below it.
+    let light = Light::Point { x: 0.1, y: 0.35, z: 0.2 };
+    effect_like_reference(&cases, light, ("shadows", |e| Effects { shadows: false, ..e }), 8.0 / 255.0);
+}
+
 /// The headlight is the default and draws what it always drew: a runtime whose light was set
 /// and reset renders the same bytes as one never given a light.
 #[test]

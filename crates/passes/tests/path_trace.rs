@@ -10,12 +10,12 @@
 //!
 //! Every image is 48² on Marschner–Lobb 32³ (a few seconds of lavapipe for hundreds of samples).
 
+use ron::Value;
 use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::reference::{RaycastSettings, render_reference};
 use volgraph_accel::volume::Volume;
-use volgraph_core::runtime::Image;
-use ron::Value;
 use volgraph_core::CompileOptions;
+use volgraph_core::runtime::Image;
 use volgraph_passes::builtin_registry;
 
 mod support;
@@ -82,12 +82,7 @@ fn accumulate_with(graph: &str, volume: &Volume, lut: &[[f32; 4]], params: &[(&s
 
 /// Emission–absorption: albedo 0, emission 1, no light, no bounces.
 fn emission_absorption(seed: u32) -> Vec<(&'static str, Value)> {
-    vec![
-        ("albedo", f(0.0)),
-        ("emission", f(1.0)),
-        ("bounces", u(0)),
-        ("seed", u(seed)),
-    ]
+    vec![("albedo", f(0.0)), ("emission", f(1.0)), ("bounces", u(0)), ("seed", u(seed))]
 }
 
 /// The f64 reference of the same integral, marched at an eighth of a voxel: its step error is
@@ -265,8 +260,7 @@ fn the_gpu_mean_agrees_with_an_independent_f64_path_tracer() {
     let size = 24;
     let spp = 512;
     let gpu = gpu();
-    let mut live =
-        Live::new(&gpu, &builtin_registry(), GRAPH, &volume, &lut, &CompileOptions::new(size, size));
+    let mut live = Live::new(&gpu, &builtin_registry(), GRAPH, &volume, &lut, &CompileOptions::new(size, size));
     live.runtime.set_light(light);
     let mut image = None;
     for _ in 0..spp {
@@ -378,4 +372,56 @@ fn an_environment_map_lights_the_medium_as_the_f64_tracer_sees_it() {
 /// The furnace's parameters with the scene's map in place of the generated sky.
 fn furnace_map_params() -> Vec<(&'static str, Value)> {
     furnace_params().into_iter().filter(|(name, _)| *name != "environment").collect()
+}
+
+#[test]
+fn a_point_light_lights_the_medium_as_the_f64_tracer_sees_it() {
+    use volgraph_accel::path_trace::{PathTraceSettings, render_path_traced};
+    // A point light inside the box: the direction toward it changes from vertex to vertex, its
+    // irradiance falls as 1/r², and material beyond it casts no shadow — single scattering, so
+    // the light is all there is to see.
+    let volume = volgraph_accel::generate::marschner_lobb_f32(32);
+    let lut = ramp_lut();
+    let light = volgraph_accel::light::Light::Point { x: 0.3, y: 0.4, z: -0.2 };
+    let (size, spp) = (24, 256);
+    let params =
+        [("bounces", u(1)), ("surface", f(0.0)), ("light_intensity", f(0.5)), ("environment_intensity", f(0.0))];
+    let mut options = CompileOptions::new(size, size);
+    for (name, value) in &params {
+        options = options.with_param("trace", name, value.clone());
+    }
+    let gpu = gpu();
+    let mut live = Live::new(&gpu, &builtin_registry(), GRAPH, &volume, &lut, &options);
+    live.runtime.set_light(light);
+    let mut image = None;
+    for _ in 0..spp {
+        image = Some(live.frame(&camera()));
+    }
+    let got = image.expect("frames").to_rgba_f64();
+    let settings = PathTraceSettings {
+        light,
+        bounces: 1,
+        surface: 0.0,
+        light_intensity: 0.5,
+        environment_intensity: 0.0,
+        ..PathTraceSettings::default()
+    };
+    let cpu = render_path_traced(&volume, &lut, &camera(), (size, size), &settings, (spp, 17));
+    let n = f64::from(spp);
+    let (mut over, mut counted, mut sum_z) = (0usize, 0usize, 0.0);
+    for (g, c) in got.iter().zip(&cpu) {
+        for k in 0..4 {
+            let se = (2.0 * c.variance[k] / n).sqrt().max(1.0 / n);
+            let z = (g[k] - c.mean[k]) / se;
+            sum_z += z;
+            counted += 1;
+            over += usize::from(z.abs() > 3.0);
+        }
+    }
+    let fraction = over as f64 / counted as f64;
+    let mean_z = sum_z / counted as f64;
+    eprintln!("point light: {:.2} % beyond 3 standard errors, mean z {mean_z:+.3}", fraction * 100.0);
+    assert!(fraction < 0.02, "{:.2} % of values beyond 3 standard errors", fraction * 100.0);
+    assert!(mean_z.abs() < 6.0 / (counted as f64).sqrt(), "mean z {mean_z}");
+    assert!(got.iter().any(|p| p[0] > 0.05), "the point light reaches the medium");
 }

@@ -118,10 +118,16 @@ impl SavedView {
         if !planes.is_empty() {
             out += &format!("    clip: [{}],\n", planes.join(", "));
         }
-        if let volgraph_accel::light::Light::Directional { azimuth_deg, elevation_deg } = self.light {
-            out += &format!(
-                "    lights: [Directional(azimuth_deg: {azimuth_deg:?}, elevation_deg: {elevation_deg:?})],\n"
-            );
+        match self.light {
+            volgraph_accel::light::Light::Directional { azimuth_deg, elevation_deg } => {
+                out += &format!(
+                    "    lights: [Directional(azimuth_deg: {azimuth_deg:?}, elevation_deg: {elevation_deg:?})],\n"
+                );
+            }
+            volgraph_accel::light::Light::Point { x, y, z } => {
+                out += &format!("    lights: [Point(x: {x:?}, y: {y:?}, z: {z:?})],\n");
+            }
+            volgraph_accel::light::Light::Headlight => {}
         }
         if let Some(path) = &self.environment {
             out += &format!("    environment: {},\n", quote(path));
@@ -180,6 +186,11 @@ mod saved_view_tests {
         assert_eq!(scene.cuts, cuts);
         assert_eq!(scene.light, view.light);
         assert_eq!(scene.environment, view.environment);
+        // A point light is written back as one.
+        let point =
+            SavedView { light: volgraph_accel::light::Light::Point { x: 0.25, y: 1.0 / 3.0, z: -2.0 }, ..view.clone() };
+        let scene = Scene::from_str(&point.to_ron(), Path::new("/tmp/x.scene.ron")).expect("reads back");
+        assert_eq!(scene.light, point.light);
         assert_eq!(scene.volume_options.spacing, Some((1.0, 0.1, 1.0 / 3.0)));
         assert_eq!(scene.viewport, Some((320, 200)));
         assert_eq!(scene.effects, vec!["shading".to_string()]);

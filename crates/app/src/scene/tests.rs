@@ -157,6 +157,9 @@ fn a_scene_has_one_light_checked_like_the_flag() {
     let s = parse("Scene(volume: Generated(\"ml32\"), lights: [Directional(azimuth_deg: 30, elevation_deg: 45)])")
         .expect("parses");
     assert_eq!(s.light, Light::Directional { azimuth_deg: 30.0, elevation_deg: 45.0 });
+    let point =
+        parse("Scene(volume: Generated(\"ml32\"), lights: [Point(x: 0.5, y: 2, z: -1)])").expect("a point light");
+    assert_eq!(point.light, Light::Point { x: 0.5, y: 2.0, z: -1.0 });
     let two = "Scene(volume: Generated(\"ml32\"), lights: [Headlight, Directional(azimuth_deg: 0, elevation_deg: 0)])";
     let e = parse(two).expect_err("two lights").to_string();
     assert!(e.contains("lights: 2 lights: a scene has one light for now"), "{e}");

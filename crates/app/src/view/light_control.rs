@@ -16,12 +16,27 @@ pub fn light_section(ui: &mut egui::Ui, light: Light) -> Option<Light> {
         if ui.checkbox(&mut headlight, "headlight (from the eye)").changed() {
             next = if headlight { Light::Headlight } else { FIRST_DIRECTIONAL };
         }
-        if let Light::Directional { mut azimuth_deg, mut elevation_deg } = next {
-            let az = ui.add(egui::Slider::new(&mut azimuth_deg, -180.0..=180.0).text("azimuth °"));
-            let el = ui.add(egui::Slider::new(&mut elevation_deg, -90.0..=90.0).text("elevation °"));
-            if az.changed() || el.changed() {
-                next = Light::Directional { azimuth_deg, elevation_deg };
+        match next {
+            Light::Directional { mut azimuth_deg, mut elevation_deg } => {
+                let az = ui.add(egui::Slider::new(&mut azimuth_deg, -180.0..=180.0).text("azimuth °"));
+                let el = ui.add(egui::Slider::new(&mut elevation_deg, -90.0..=90.0).text("elevation °"));
+                if az.changed() || el.changed() {
+                    next = Light::Directional { azimuth_deg, elevation_deg };
+                }
             }
+            Light::Point { mut x, mut y, mut z } => {
+                // World units: the volume's box is centred on the origin, its longest side 2.
+                let moved = [("x", &mut x), ("y", &mut y), ("z", &mut z)]
+                    .into_iter()
+                    .map(|(name, v)| {
+                        ui.add(egui::Slider::new(v, -4.0..=4.0).text(format!("point light {name}"))).changed()
+                    })
+                    .fold(false, |a, b| a | b);
+                if moved {
+                    next = Light::Point { x, y, z };
+                }
+            }
+            Light::Headlight => {}
         }
     });
     (next != light).then_some(next)

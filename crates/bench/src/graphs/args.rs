@@ -88,7 +88,7 @@ pub struct GraphsArgs {
     #[arg(long, default_value_t = 0.1)]
     pub reference_step: f64,
     /// The scene's light for every case: AZ,EL in degrees (a directional light fixed in the
-    /// world while the camera turns), or headlight [default: the headlight].
+    /// world while the camera turns), point:X,Y,Z, or headlight [default: the headlight].
     #[arg(long, value_parser = volgraph_accel::light::Light::parse, allow_hyphen_values = true)]
     pub light: Option<volgraph_accel::light::Light>,
     /// Longest side of the CPU reference image whose sample count gives samples/pixel

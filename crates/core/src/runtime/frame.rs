@@ -417,7 +417,7 @@ impl FrameUniforms {
             footprint: [[0.0; 4]; FAN_VERTICES / 2],
             footprint_vertices: FOOTPRINT_WHOLE,
             _pad_footprint: [0; 3],
-            light_world: frame.light.toward().map_or([0.0; 4], |l| with_w(l, 1.0)),
+            light_world: light_world(&frame.light, window.map(|w| w.centre_world)),
         }
         .with_cuts(&frame.cuts, grid)
     }
@@ -461,6 +461,18 @@ impl FrameUniforms {
             *slot = with_w(n, (p.offset + n.dot(lo)) as f32);
         }
         self
+    }
+}
+
+/// The frame block's `light_world`: (0, 0, 0, 0) for the headlight, the unit direction toward a
+/// directional light with w = 1, a point light's position with w = 2 — in the bound box's own
+/// world, which a sort-last window centres on its own origin (`window_centre`).
+fn light_world(light: &volgraph_accel::light::Light, window_centre: Option<DVec3>) -> [f32; 4] {
+    match *light {
+        volgraph_accel::light::Light::Point { x, y, z } => {
+            with_w(DVec3::new(x, y, z) - window_centre.unwrap_or(DVec3::ZERO), 2.0)
+        }
+        _ => light.toward().map_or([0.0; 4], |l| with_w(l, 1.0)),
     }
 }
 

@@ -247,38 +247,50 @@ fn the_running_mean_starts_over_when_the_camera_or_light_moves() {
     assert_eq!(live.runtime.history_stats().run, 0, "a new light starts over");
 }
 
-#[test]
-fn the_gpu_mean_agrees_with_an_independent_f64_path_tracer() {
-    use volgraph_accel::path_trace::{PathTraceSettings, render_path_traced};
-    // Everything on: multiple scattering (4 bounces), the gradient-surface term, a directional
-    // light, the generated sky — the graph's defaults. The CPU tracer (f64, its own random
-    // streams, delta-tracked light visibility instead of ratio tracking) is another unbiased
-    // estimator of the same pixel values.
+/// The GPU path tracer with the scene's `light` and `environment`, `params` over the graph's,
+/// at 24² after `spp` samples, against the independent f64 tracer with `settings` (the same
+/// medium, light and environment): its mean agrees within the tracers' confidence interval.
+///
+/// Per pixel and channel, z = (GPU − CPU) / √(2 s² / n) with s² the CPU's sample variance (the
+/// GPU's is the same distribution's), and at least one unit event in n samples (a pixel the
+/// CPU's paths never interacted in may still see one GPU path do so). Two agreeing estimators
+/// put |z| > 3 on 0.3 % of values (the means of hundreds of paths are near normal): at most 2 %
+/// is allowed; a wrong light direction, phase function, majorant or map moves whole regions by
+/// tens of standard errors. No systematic offset: the mean of the z's has standard deviation
+/// 1/√count (a pixel's channels are correlated, so 6 of those are allowed).
+fn agrees_with_the_f64_tracer(
+    what: &str,
+    (light, environment): (
+        volgraph_accel::light::Light,
+        Option<std::sync::Arc<volgraph_accel::environment::EnvironmentMap>>,
+    ),
+    params: &[(&str, Value)],
+    settings: &volgraph_accel::path_trace::PathTraceSettings,
+    (spp, seed): (u32, u64),
+) {
     let volume = volgraph_accel::generate::marschner_lobb_f32(32);
     let lut = ramp_lut();
-    let light = volgraph_accel::light::Light::Directional { azimuth_deg: -60.0, elevation_deg: 35.0 };
     let size = 24;
-    let spp = 512;
+    let mut options = CompileOptions::new(size, size);
+    for (name, value) in params {
+        options = options.with_param("trace", name, value.clone());
+    }
     let gpu = gpu();
-    let mut live = Live::new(&gpu, &builtin_registry(), GRAPH, &volume, &lut, &CompileOptions::new(size, size));
+    let mut live = Live::new(&gpu, &builtin_registry(), GRAPH, &volume, &lut, &options);
     live.runtime.set_light(light);
+    live.runtime.set_environment(environment);
     let mut image = None;
     for _ in 0..spp {
         image = Some(live.frame(&camera()));
     }
     let got = image.expect("frames").to_rgba_f64();
-    let settings = PathTraceSettings { light, ..PathTraceSettings::default() };
-    let cpu = render_path_traced(&volume, &lut, &camera(), (size, size), &settings, (spp, 99));
-    // Per pixel and channel, z = (GPU − CPU) / √(2 s² / n) with s² the CPU's sample variance
-    // (the GPU's is the same distribution's). Two agreeing estimators put |z| > 3 on 0.3 % of
-    // values (the means of 512 paths are near normal); a wrong light direction, phase function
-    // or majorant moves whole regions by tens of standard errors.
+    let settings = volgraph_accel::path_trace::PathTraceSettings { light, ..settings.clone() };
+    let cpu =
+        volgraph_accel::path_trace::render_path_traced(&volume, &lut, &camera(), (size, size), &settings, (spp, seed));
     let n = f64::from(spp);
     let (mut over, mut counted, mut sum_z) = (0usize, 0usize, 0.0);
     for (g, c) in got.iter().zip(&cpu) {
         for k in 0..4 {
-            // At least one unit event in n samples: a pixel the CPU's paths never interacted
-            // in (zero sample variance) may still see one GPU path do so.
             let se = (2.0 * c.variance[k] / n).sqrt().max(1.0 / n);
             let z = (g[k] - c.mean[k]) / se;
             sum_z += z;
@@ -288,19 +300,31 @@ fn the_gpu_mean_agrees_with_an_independent_f64_path_tracer() {
     }
     let fraction = over as f64 / counted as f64;
     let mean_z = sum_z / counted as f64;
-    eprintln!("{counted} values: {:.2} % beyond 3 standard errors, mean z {mean_z:+.3}", fraction * 100.0);
-    assert!(counted > 500, "the medium covers the image");
-    assert!(fraction < 0.02, "{:.2} % of values beyond 3 standard errors", fraction * 100.0);
-    // No systematic offset: the mean of `counted` z's has standard deviation 1/√counted (the
-    // channels of a pixel are correlated, so allow 6 of those).
-    assert!(mean_z.abs() < 6.0 / (counted as f64).sqrt(), "mean z {mean_z}: one is biased");
+    eprintln!("{what}: {counted} values, {:.2} % beyond 3 standard errors, mean z {mean_z:+.3}", fraction * 100.0);
+    assert!(fraction < 0.02, "{what}: {:.2} % of values beyond 3 standard errors", fraction * 100.0);
+    assert!(mean_z.abs() < 6.0 / (counted as f64).sqrt(), "{what}: mean z {mean_z}: one is biased");
+    // A comparison of two black images proves nothing: the medium is lit.
+    assert!(got.iter().filter(|p| p[3] > 0.05).count() > got.len() / 4, "{what}: the medium covers the image");
+    assert!(got.iter().any(|p| p[0] > 0.02), "{what}: light reaches the medium");
+}
+
+#[test]
+fn the_gpu_mean_agrees_with_an_independent_f64_path_tracer() {
+    // Everything on: multiple scattering (4 bounces), the gradient-surface term, a directional
+    // light, the generated sky — the graph's defaults. The CPU tracer (f64, its own random
+    // streams, delta-tracked light visibility instead of ratio tracking) is another unbiased
+    // estimator of the same pixel values.
+    let light = volgraph_accel::light::Light::Directional { azimuth_deg: -60.0, elevation_deg: 35.0 };
+    let settings = volgraph_accel::path_trace::PathTraceSettings::default();
+    agrees_with_the_f64_tracer("defaults, directional light", (light, None), &[], &settings, (512, 99));
 }
 
 #[test]
 fn an_environment_map_lights_the_medium_as_the_f64_tracer_sees_it() {
     use std::sync::Arc;
     use volgraph_accel::environment::EnvironmentMap;
-    use volgraph_accel::path_trace::{Environment, PathTraceSettings, render_path_traced};
+    use volgraph_accel::light::Light;
+    use volgraph_accel::path_trace::{Environment, PathTraceSettings};
     let volume = volgraph_accel::generate::marschner_lobb_f32(32);
     let gpu = gpu();
     // A map of radiance 1 everywhere is the white furnace: colour = alpha, as with `uniform`.
@@ -325,48 +349,23 @@ fn an_environment_map_lights_the_medium_as_the_f64_tracer_sees_it() {
         })
         .collect();
     let map = Arc::new(EnvironmentMap::new(w, h, texels).expect("valid"));
-    let lut = ramp_lut();
-    let size = 24;
-    let spp = 256;
     let params = [("albedo", f(1.0)), ("light_intensity", f(0.0)), ("environment_intensity", f(1.0))];
-    let mut options = CompileOptions::new(size, size);
-    for (name, value) in &params {
-        options = options.with_param("trace", name, value.clone());
-    }
-    let mut live = Live::new(&gpu, &builtin_registry(), GRAPH, &volume, &lut, &options);
-    live.runtime.set_environment(Some(map.clone()));
-    let mut image = None;
-    for _ in 0..spp {
-        image = Some(live.frame(&camera()));
-    }
-    let got = image.expect("frames").to_rgba_f64();
     let settings = PathTraceSettings {
         albedo: 1.0,
         light_intensity: 0.0,
-        environment: Environment::Map(map),
+        environment: Environment::Map(map.clone()),
         environment_intensity: 1.0,
         ..PathTraceSettings::default()
     };
-    let cpu = render_path_traced(&volume, &lut, &camera(), (size, size), &settings, (spp, 5));
-    let n = f64::from(spp);
-    let (mut over, mut counted, mut sum_z) = (0usize, 0usize, 0.0);
-    for (g, c) in got.iter().zip(&cpu) {
-        for k in 0..4 {
-            let se = (2.0 * c.variance[k] / n).sqrt().max(1.0 / n);
-            let z = (g[k] - c.mean[k]) / se;
-            sum_z += z;
-            counted += 1;
-            over += usize::from(z.abs() > 3.0);
-        }
-    }
-    let fraction = over as f64 / counted as f64;
-    let mean_z = sum_z / counted as f64;
-    eprintln!("environment map: {:.2} % beyond 3 standard errors, mean z {mean_z:+.3}", fraction * 100.0);
-    assert!(fraction < 0.02, "{:.2} % of values beyond 3 standard errors", fraction * 100.0);
-    assert!(mean_z.abs() < 6.0 / (counted as f64).sqrt(), "mean z {mean_z}");
     // (Had the GPU drawn its generated sky, the CPU's map would set it tens of standard errors
-    // apart.) The medium covers the image.
-    assert!(got.iter().filter(|p| p[3] > 0.05).count() > got.len() / 4);
+    // apart.)
+    agrees_with_the_f64_tracer(
+        "a coloured environment map",
+        (Light::Headlight, Some(map)),
+        &params,
+        &settings,
+        (256, 5),
+    );
 }
 
 /// The furnace's parameters with the scene's map in place of the generated sky.
@@ -376,52 +375,18 @@ fn furnace_map_params() -> Vec<(&'static str, Value)> {
 
 #[test]
 fn a_point_light_lights_the_medium_as_the_f64_tracer_sees_it() {
-    use volgraph_accel::path_trace::{PathTraceSettings, render_path_traced};
     // A point light inside the box: the direction toward it changes from vertex to vertex, its
-    // irradiance falls as 1/r², and material beyond it casts no shadow — single scattering, so
-    // the light is all there is to see.
-    let volume = volgraph_accel::generate::marschner_lobb_f32(32);
-    let lut = ramp_lut();
+    // irradiance falls as 1/r², and material beyond it casts no shadow — single scattering and
+    // no environment, so the light is all there is to see.
     let light = volgraph_accel::light::Light::Point { x: 0.3, y: 0.4, z: -0.2 };
-    let (size, spp) = (24, 256);
     let params =
         [("bounces", u(1)), ("surface", f(0.0)), ("light_intensity", f(0.5)), ("environment_intensity", f(0.0))];
-    let mut options = CompileOptions::new(size, size);
-    for (name, value) in &params {
-        options = options.with_param("trace", name, value.clone());
-    }
-    let gpu = gpu();
-    let mut live = Live::new(&gpu, &builtin_registry(), GRAPH, &volume, &lut, &options);
-    live.runtime.set_light(light);
-    let mut image = None;
-    for _ in 0..spp {
-        image = Some(live.frame(&camera()));
-    }
-    let got = image.expect("frames").to_rgba_f64();
-    let settings = PathTraceSettings {
-        light,
+    let settings = volgraph_accel::path_trace::PathTraceSettings {
         bounces: 1,
         surface: 0.0,
         light_intensity: 0.5,
         environment_intensity: 0.0,
-        ..PathTraceSettings::default()
+        ..Default::default()
     };
-    let cpu = render_path_traced(&volume, &lut, &camera(), (size, size), &settings, (spp, 17));
-    let n = f64::from(spp);
-    let (mut over, mut counted, mut sum_z) = (0usize, 0usize, 0.0);
-    for (g, c) in got.iter().zip(&cpu) {
-        for k in 0..4 {
-            let se = (2.0 * c.variance[k] / n).sqrt().max(1.0 / n);
-            let z = (g[k] - c.mean[k]) / se;
-            sum_z += z;
-            counted += 1;
-            over += usize::from(z.abs() > 3.0);
-        }
-    }
-    let fraction = over as f64 / counted as f64;
-    let mean_z = sum_z / counted as f64;
-    eprintln!("point light: {:.2} % beyond 3 standard errors, mean z {mean_z:+.3}", fraction * 100.0);
-    assert!(fraction < 0.02, "{:.2} % of values beyond 3 standard errors", fraction * 100.0);
-    assert!(mean_z.abs() < 6.0 / (counted as f64).sqrt(), "mean z {mean_z}");
-    assert!(got.iter().any(|p| p[0] > 0.05), "the point light reaches the medium");
+    agrees_with_the_f64_tracer("a point light", (light, None), &params, &settings, (256, 17));
 }

@@ -303,6 +303,11 @@ fn voxel_gradient(p: vec3<f32>) -> vec3<f32> {
 
 // ---- one path --------------------------------------------------------------------------------
 
+// Where this frame's path first interacted along the pixel's ray (world), and whether it did:
+// the point a REPROJECT pass finds the pixel's last-frame mean by.
+var<private> first_point: vec3<f32>;
+var<private> first_hit: bool;
+
 // One path's estimate for the pixel's ray: premultiplied RGB and alpha (1 when the primary ray
 // interacted).
 fn trace_pixel(pixel: vec2<u32>) -> vec4<f32> {
@@ -325,10 +330,12 @@ fn trace_pixel(pixel: vec2<u32>) -> vec4<f32> {
             }
             break;
         }
+        p = p + t * w;
         if (bounce == 0u) {
             alpha = 1.0;
+            first_point = p;
+            first_hit = true;
         }
-        p = p + t * w;
         let medium = medium_at(p);
         if (random() >= trace.albedo) {
             // Absorbed: what the medium emits there.
@@ -366,16 +373,94 @@ fn trace_pixel(pixel: vec2<u32>) -> vec4<f32> {
     return vec4<f32>(radiance, alpha);
 }
 
+#if REPROJECT
+// Martschinke et al. 2019's idea for path-traced volumes (and Klein et al. 2005's for hits):
+// when the camera moves, a pixel keeps the mean of where its surface was last frame. `aux` is
+// per pixel: x = the samples its mean holds, yzw = the mean world point of its paths' first
+// interactions. A pixel's surface point this frame is its path's first interaction (else its
+// last-frame mean point's depth along this frame's ray); projected with last frame's camera it
+// lands on the pixel whose mean it continues, when that pixel's mean point lies within
+// `reproject_tolerance` voxels of it (else the pixel starts over: a disocclusion). After a move
+// a pixel keeps at most `reproject_keep` samples, so light of the old view fades.
+@group(0) @binding(auto) var previous_aux: texture_2d<f32>;
+@group(0) @binding(auto) var aux: texture_storage_2d<rgba32float, write>;
+
+// Whether the camera moved since last frame (history restarts set last frame's camera to this
+// frame's).
+fn camera_moved() -> bool {
+    let a = frame.clip_from_world;
+    let b = frame.prev_clip_from_world;
+    return any(a[0] != b[0]) || any(a[1] != b[1]) || any(a[2] != b[2]) || any(a[3] != b[3]);
+}
+
+struct Continued {
+    mean: vec4<f32>,
+    aux: vec4<f32>,
+}
+
+// The last-frame mean and aux this pixel continues: its own while the camera rests; where its
+// surface point was seen last frame after a move; nothing (zeros) where that does not hold.
+fn continued(pixel: vec2<u32>) -> Continued {
+    let none = Continued(vec4<f32>(0.0), vec4<f32>(0.0));
+    let here = vec2<i32>(pixel);
+    if (!camera_moved()) {
+        return Continued(textureLoad(previous, here, 0), textureLoad(previous_aux, here, 0));
+    }
+    var point = first_point;
+    if (!first_hit) {
+        // No interaction this sample: the depth of last frame's mean point at this pixel, along
+        // this frame's ray.
+        let own = textureLoad(previous_aux, here, 0);
+        if (!(own.x > 0.0)) {
+            return none;
+        }
+        let dir = pixel_ray_dir(vec2<f32>(pixel) + vec2<f32>(0.5));
+        point = frame.eye_world.xyz + dir * length(own.yzw - frame.eye_world.xyz);
+    }
+    let clip = frame.prev_clip_from_world * vec4<f32>(point, 1.0);
+    if (!(clip.w > 0.0)) {
+        return none;
+    }
+    let ndc = clip.xy / clip.w;
+    let at = vec2<f32>((ndc.x + 1.0) * 0.5 * frame.viewport.x, (1.0 - ndc.y) * 0.5 * frame.viewport.y);
+    if (any(at < vec2<f32>(0.0)) || any(at >= frame.viewport.xy)) {
+        return none;
+    }
+    let there = vec2<i32>(floor(at));
+    let was = textureLoad(previous_aux, there, 0);
+    let voxel = frame.half_extent.w;
+    if (!(was.x > 0.0) || distance(was.yzw, point) > trace.reproject_tolerance * voxel) {
+        return none;
+    }
+    let kept = min(was.x, f32(trace.reproject_keep));
+    return Continued(textureLoad(previous, there, 0), vec4<f32>(kept, was.yzw));
+}
+#endif
+
 @compute @workgroup_size(8, 8)
 fn cs_path_trace(@builtin(global_invocation_id) id: vec3<u32>) {
     let pixel = id.xy;
     if (!in_viewport(pixel)) {
         return;
     }
-    let n = f32(frame.history_age);
     seed_rng(pixel, frame.history_age);
+    first_hit = false;
     let sample = trace_pixel(pixel);
+#if REPROJECT
+    let from_last = continued(pixel);
+    let before = from_last.mean;
+    let n = from_last.aux.x;
+    // The mean first-interaction point over the samples that had one (a running mean weighted
+    // like the colour's: exact while every sample interacts, a fair depth otherwise).
+    var point = from_last.aux.yzw;
+    if (first_hit) {
+        point = select(first_point, point + (first_point - point) / (n + 1.0), n > 0.0);
+    }
+    textureStore(aux, vec2<i32>(pixel), vec4<f32>(n + 1.0, point));
+#else
+    let n = f32(frame.history_age);
     let before = textureLoad(previous, vec2<i32>(pixel), 0);
+#endif
     // The running mean over n + 1 samples; a NaN sample (none should occur) is dropped rather
     // than poisoning the mean for good.
     let safe = select(vec4<f32>(before), sample, all(sample == sample));

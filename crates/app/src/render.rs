@@ -508,9 +508,15 @@ pub fn counter_lines(counters: &[(String, &'static str, f64)]) -> Vec<String> {
         .collect()
 }
 
-/// Whether `plan` keeps a running mean over still frames (a progressive graph: `--spp` adds to it).
+/// Whether `plan` keeps a running mean over still frames (a progressive graph: `--spp` adds to
+/// it): a history that restarts on any camera move, or a path tracer that reprojects its mean
+/// (its still frames accumulate too).
 pub fn accumulates(plan: &volgraph_core::Plan) -> bool {
     plan.history.values().any(|h| h.while_camera_still)
+        || plan
+            .steps
+            .iter()
+            .any(|s| s.kind == "path_trace" && s.params.declares("reproject") && s.params.boolean("reproject"))
 }
 
 /// One line saying what a graph's bypass did over the frames rendered.

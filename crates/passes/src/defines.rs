@@ -39,6 +39,8 @@ pub const START_TILES: &str = "START_TILES";
 // The path tracer's choices (`path_trace.rs`).
 /// Delta and ratio tracking block by block against per-block majorants (`majorant_grid`).
 pub const BLOCK_MAJORANTS: &str = "BLOCK_MAJORANTS";
+/// Each pixel's mean continued across camera moves where its surface was (`reproject`).
+pub const REPROJECT: &str = "REPROJECT";
 
 // The fragment raycaster's Klein variant (`raycast.rs`).
 /// Write `leap_hit`, where the next frame's ray starts.
@@ -75,7 +77,7 @@ pub const SEGMENTS: &str = "SEGMENTS";
 pub const SCATTER: &str = "SCATTER";
 
 /// Every `#if` name of the built-in passes.
-pub const BUILT_IN: [&str; 29] = [
+pub const BUILT_IN: [&str; 30] = [
     SHADING,
     PREINTEGRATION,
     TRICUBIC,
@@ -105,4 +107,5 @@ pub const BUILT_IN: [&str; 29] = [
     FUSION_SCALAR,
     LABELS_NEAREST,
     BLOCK_MAJORANTS,
+    REPROJECT,
 ];

@@ -82,6 +82,11 @@ volgraph_compiler::pass_params! {
         majorant: Majorant = Global,
             "free paths against the TF's largest extinction (global) or each block's (blocks: wire `majorants`)";
         block_size: u32 = 8, 1..=256, "with majorant blocks: the minmax_grid pass's block size";
+        reproject: bool = false,
+            "keep each pixel's mean across camera moves, found where its surface was last frame (wire previous_aux/aux)";
+        reproject_keep: u32 = 32, 1..=65536, "after a camera move, a reprojected pixel keeps at most this many samples";
+        reproject_tolerance: f32 = 2.0, 0.0..=1000.0,
+            "voxels between this frame's surface point and last frame's mean point for a pixel to continue its mean";
         shadow_rays: ShadowRays = Ratio,
             "the light's transmittance by ratio tracking (smooth) or delta tracking (0 or 1: cheaper, noisier)";
         max_alpha: f32 = computed, "the TF's largest opacity: the majorant's";
@@ -92,6 +97,11 @@ volgraph_compiler::pass_params! {
 /// Whether free paths step block by block (`majorant: "blocks"`).
 fn by_blocks(params: &Params) -> bool {
     PathTraceParams::from_params(params).majorant == Majorant::Blocks
+}
+
+/// Whether each pixel's mean follows its surface across camera moves (`reproject`).
+fn reprojects(params: &Params) -> bool {
+    PathTraceParams::from_params(params).reproject
 }
 
 /// Its one pipeline, declared once.
@@ -122,14 +132,20 @@ impl PassDecl for PathTrace {
     fn blocks(&self) -> Vec<ParamBlock> {
         // Every value is a uniform (a change restarts the accumulation: the graph's history);
         // block majorants add a port and a define.
-        vec![
-            PathTraceParams::block(OnChange::InPlace)
-                .with_defines(|p| if by_blocks(p) { vec![crate::defines::BLOCK_MAJORANTS] } else { Vec::new() }),
-        ]
+        vec![PathTraceParams::block(OnChange::InPlace).with_defines(|p| {
+            let mut defines = Vec::new();
+            if by_blocks(p) {
+                defines.push(crate::defines::BLOCK_MAJORANTS);
+            }
+            if reprojects(p) {
+                defines.push(crate::defines::REPROJECT);
+            }
+            defines
+        })]
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        by_blocks(old) == by_blocks(new)
+        by_blocks(old) == by_blocks(new) && reprojects(old) == reprojects(new)
     }
 
     fn ports(&self, params: &Params) -> Vec<PortSpec> {
@@ -141,6 +157,10 @@ impl PassDecl for PathTrace {
         ];
         if by_blocks(params) {
             ports.push(PortSpec::read("majorants", PortKind::Owned(crate::majorant_grid::MAJORANT_GRID)));
+        }
+        if reprojects(params) {
+            ports.push(PortSpec::read("previous_aux", PortKind::target(&[TargetFormat::Rgba32Float])));
+            ports.push(PortSpec::write("aux", PortKind::target(&[TargetFormat::Rgba32Float])));
         }
         ports
     }

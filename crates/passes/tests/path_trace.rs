@@ -26,6 +26,8 @@ const SIZE: u32 = 48;
 const GRAPH: &str = "cinematic/path_traced.ron";
 /// The same estimator stepping block by block against per-block majorants.
 const GRAPH_BLOCKS: &str = "cinematic/path_traced_blocks.ron";
+/// That one with each pixel's mean reprojected across camera moves.
+const GRAPH_MOVING: &str = "cinematic/path_traced_moving.ron";
 
 /// A semi-transparent ramp: colour from blue to orange with the value, opacity up to 0.12 per
 /// voxel, so rays see through (the interesting case for a Monte Carlo estimate of alpha).
@@ -389,4 +391,60 @@ fn a_point_light_lights_the_medium_as_the_f64_tracer_sees_it() {
         ..Default::default()
     };
     agrees_with_the_f64_tracer("a point light", (light, None), &params, &settings, (256, 17));
+}
+
+/// Reprojection (item 3) with the camera at rest is the plain running mean: the same seeds, the
+/// same samples, each pixel continuing its own mean.
+#[test]
+fn with_the_camera_still_reprojection_is_the_plain_running_mean() {
+    let volume = volgraph_accel::generate::marschner_lobb_f32(32);
+    let lut = ramp_lut();
+    let plain = accumulate_with(GRAPH_BLOCKS, &volume, &lut, &[], 8).to_rgba_f64();
+    let moving = accumulate_with(GRAPH_MOVING, &volume, &lut, &[], 8).to_rgba_f64();
+    let worst =
+        plain.iter().zip(&moving).flat_map(|(a, b)| (0..4).map(move |c| (a[c] - b[c]).abs())).fold(0.0, f64::max);
+    assert!(worst < 1e-6, "a resting camera must not change the mean: {worst}");
+}
+
+/// After 64 samples the camera turns 1°: the next frame continues each pixel's mean where its
+/// surface was, so it is far closer to the converged image of the new view than one fresh
+/// sample (and than the mean left where it was); pixels newly in view start over.
+#[test]
+fn a_turned_camera_keeps_the_converged_look() {
+    let volume = volgraph_accel::generate::marschner_lobb_f32(32);
+    // Opaque above 0.45: surfaces, whose points reprojection follows.
+    let lut: Vec<[f32; 4]> = (0..256)
+        .map(|i| {
+            let s = i as f32 / 255.0;
+            [0.9, 0.7 + 0.2 * s, 0.5, if s > 0.45 { 1.0 } else { 0.0 }]
+        })
+        .collect();
+    let gpu = gpu();
+    let turned = OrbitCamera { azimuth_deg: camera().azimuth_deg + 1.0, ..camera() };
+    let mut live = Live::new(&gpu, &builtin_registry(), GRAPH_MOVING, &volume, &lut, &options(&[]));
+    for _ in 0..64 {
+        live.frame(&camera());
+    }
+    let before_turn = live.runtime.read_output("image").expect("image").to_rgba_f64();
+    let reprojected = live.frame(&turned).to_rgba_f64();
+    // The converged image of the turned view and one fresh sample of it.
+    let converged = {
+        let mut live = Live::new(&gpu, &builtin_registry(), GRAPH_BLOCKS, &volume, &lut, &options(&[("seed", u(3))]));
+        let mut image = None;
+        for _ in 0..256 {
+            image = Some(live.frame(&turned));
+        }
+        image.expect("frames").to_rgba_f64()
+    };
+    let fresh =
+        Live::new(&gpu, &builtin_registry(), GRAPH_BLOCKS, &volume, &lut, &options(&[])).frame(&turned).to_rgba_f64();
+    let (kept, one, stale) = (rmse(&reprojected, &converged), rmse(&fresh, &converged), rmse(&before_turn, &converged));
+    eprintln!(
+        "after a 1° turn: reprojected {:.2}/255, one fresh sample {:.2}/255, the old view's mean {:.2}/255",
+        kept * 255.0,
+        one * 255.0,
+        stale * 255.0
+    );
+    assert!(kept < 0.5 * one, "reprojection must keep most of the convergence: {kept} vs {one}");
+    assert!(kept < stale, "the reprojected mean must follow the view: {kept} vs {stale}");
 }

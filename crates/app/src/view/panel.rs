@@ -187,8 +187,17 @@ pub fn show(
                 ui.add(egui::Label::new(egui::RichText::new(message).monospace().small()).wrap());
             });
         }
-        if crate::render::accumulates(plan) {
+        if plan.history.values().any(|h| h.while_camera_still) {
             ui.label(samples_line(&session.runtime.history_stats()));
+        } else if crate::render::accumulates(plan) {
+            // A reprojecting path tracer: each pixel's count is its own after a camera move.
+            let stats = session.runtime.history_stats();
+            ui.label(format!(
+                "{} frames since the last restart; each pixel's mean follows the view (reprojected), keeping its own \
+                 count ({} restarts)",
+                stats.run + 1,
+                stats.restarts
+            ));
         } else if !plan.history.is_empty() {
             ui.label(history_line(&session.runtime.history_stats()));
         }

@@ -368,6 +368,17 @@ fn trace_pixel(pixel: vec2<u32>) -> vec4<f32> {
             // Importance-sampled: the phase function's weight p/pdf is 1.
             w = sample_henyey_greenstein(w, trace.anisotropy);
         }
+        // Russian roulette from the second scattering on (unbiased): the path goes on with
+        // probability q, its largest throughput channel (at least 1/20), and its throughput is
+        // divided by q — dim paths end early, and no channel's throughput exceeds 1, so the
+        // furnace and energy bounds hold sample by sample.
+        if (bounce >= 1u && trace.russian_roulette == 1u) {
+            let q = clamp(max(throughput.r, max(throughput.g, throughput.b)), 0.05, 1.0);
+            if (random() >= q) {
+                break;
+            }
+            throughput /= q;
+        }
         span = world_segment(p, w);
     }
     return vec4<f32>(radiance, alpha);

@@ -54,20 +54,26 @@ pub struct CinematicArgs {
     pub markdown: Option<PathBuf>,
 }
 
-/// A path-traced case: its name, graph and parameter overrides of the `trace` pass.
+/// A path-traced case: its name, graph and parameter overrides of the `trace` pass (values in
+/// RON: `false`, `"delta"`).
 struct Case {
     name: &'static str,
     graph: &'static str,
     overrides: &'static [(&'static str, &'static str)],
 }
 
-const CASES: [Case; 3] = [
+const CASES: [Case; 4] = [
     Case { name: "one majorant, ratio-tracked shadow rays", graph: "cinematic/path_traced", overrides: &[] },
     Case { name: "block majorants, ratio-tracked shadow rays", graph: "cinematic/path_traced_blocks", overrides: &[] },
     Case {
+        name: "block majorants, ratio-tracked, no Russian roulette",
+        graph: "cinematic/path_traced_blocks",
+        overrides: &[("russian_roulette", "false")],
+    },
+    Case {
         name: "block majorants, delta-tracked shadow rays",
         graph: "cinematic/path_traced_blocks",
-        overrides: &[("shadow_rays", "delta")],
+        overrides: &[("shadow_rays", "\"delta\"")],
     },
 ];
 
@@ -112,7 +118,8 @@ impl Bench {
         options.scene = scene_values_of(&VolumeDesc::of(&self.volume));
         options.scene.extend(volgraph_app::inputs::data_scene_values(&self.volume));
         for (name, value) in overrides {
-            options = options.with_param("trace", name, *value);
+            let value: ron::Value = ron::from_str(value).map_err(|e| anyhow!("override {name} = {value}: {e}"))?;
+            options = options.with_param("trace", name, value);
         }
         if let Some(seed) = seed {
             options = options.with_param("trace", "seed", seed);

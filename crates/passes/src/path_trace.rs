@@ -75,6 +75,8 @@ volgraph_compiler::pass_params! {
         surface: f32 = 0.5, 0.0..=1.0,
             "how much a strong gradient scatters as a Lambertian surface instead of the phase function (Kroes et al. 2012)";
         bounces: u32 = 4, 0..=64, "scattering events a path may take before it ends";
+        russian_roulette: bool = true,
+            "from the second scattering on, end a path with probability 1 − its largest throughput channel (unbiased)";
         light_intensity: f32 = 2.0, 0.0..=1000.0, "irradiance of the scene's light (directional, or the headlight)";
         environment: Environment = Sky, "what paths leaving the volume see: a generated sky or a uniform radiance";
         environment_intensity: f32 = 0.6, 0.0..=1000.0, "radiance scale of the environment";

@@ -177,9 +177,30 @@ struct SceneDoc {
     #[serde(default)]
     tfs: std::collections::BTreeMap<String, String>,
     #[serde(default)]
-    lights: Vec<volgraph_accel::light::Light>,
+    lights: Vec<SceneLight>,
     #[serde(default)]
     environment: Option<String>,
+}
+
+/// An entry of a scene's `lights:`: the light (`Headlight`, `Directional(…)`, `Point(…)`), or
+/// what the path tracer's paths see when they leave the volume (`Environment(File("sky.exr"))`,
+/// `Environment(Sky)` for its generated sky; the same as `environment:`).
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+enum SceneLight {
+    Headlight,
+    Directional { azimuth_deg: f64, elevation_deg: f64 },
+    Point { x: f64, y: f64, z: f64 },
+    Environment(EnvironmentSource),
+}
+
+/// Where an `Environment(…)` light comes from.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+enum EnvironmentSource {
+    /// An OpenEXR map beside the scene (or an absolute path).
+    File(String),
+    /// The path tracer's generated sky.
+    Sky,
 }
 
 /// A scene read and checked, its paths resolved against the scene file's folder.
@@ -342,8 +363,20 @@ impl Scene {
             })
             .collect::<Result<Vec<_>, _>>()?;
         let cuts = Cuts::new(crop, &planes).map_err(|e| field("clip", e.to_string()))?;
-        let light = match doc.lights.as_slice() {
-            [] => volgraph_accel::light::Light::Headlight,
+        use volgraph_accel::light::Light;
+        let (mut lights, mut environments) = (Vec::new(), Vec::new());
+        for entry in &doc.lights {
+            match entry {
+                SceneLight::Headlight => lights.push(Light::Headlight),
+                &SceneLight::Directional { azimuth_deg, elevation_deg } => {
+                    lights.push(Light::Directional { azimuth_deg, elevation_deg })
+                }
+                &SceneLight::Point { x, y, z } => lights.push(Light::Point { x, y, z }),
+                SceneLight::Environment(source) => environments.push(source),
+            }
+        }
+        let light = match lights.as_slice() {
+            [] => Light::Headlight,
             [one] => {
                 one.check().map_err(|e| field("lights", e))?;
                 *one
@@ -353,9 +386,21 @@ impl Scene {
                     "lights",
                     format!(
                         "{} lights: a scene has one light for now (the headlight, one Directional(azimuth_deg: AZ, \
-                         elevation_deg: EL) or one Point(x: X, y: Y, z: Z)); keep one",
+                         elevation_deg: EL) or one Point(x: X, y: Y, z: Z)) besides an Environment(…); keep one",
                         more.len()
                     ),
+                ));
+            }
+        };
+        let environment = match (environments.as_slice(), &doc.environment) {
+            ([], None) | ([EnvironmentSource::Sky], None) => None,
+            ([], Some(file)) | ([EnvironmentSource::File(file)], None) => Some(resolve(file)),
+            _ => {
+                return Err(field(
+                    "lights",
+                    "a scene has one environment: one Environment(File(\"sky.exr\")) in lights:, or environment: \
+                     \"sky.exr\", not both or two"
+                        .to_string(),
                 ));
             }
         };
@@ -426,7 +471,7 @@ impl Scene {
             volumes,
             tfs,
             light,
-            environment: doc.environment.as_deref().map(resolve),
+            environment,
         })
     }
 

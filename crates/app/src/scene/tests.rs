@@ -157,6 +157,21 @@ fn a_scene_has_one_light_checked_like_the_flag() {
     let s = parse("Scene(volume: Generated(\"ml32\"), lights: [Directional(azimuth_deg: 30, elevation_deg: 45)])")
         .expect("parses");
     assert_eq!(s.light, Light::Directional { azimuth_deg: 30.0, elevation_deg: 45.0 });
+    // The issue's spelling of an environment map: an Environment(…) entry beside the light.
+    let lit = parse(
+        "Scene(volume: Generated(\"ml32\"), lights: [Directional(azimuth_deg: 30, elevation_deg: 45), \
+         Environment(File(\"sky.exr\"))])",
+    )
+    .expect("a light and an environment");
+    assert_eq!(lit.light, Light::Directional { azimuth_deg: 30.0, elevation_deg: 45.0 });
+    assert!(lit.environment.as_ref().is_some_and(|p| p.ends_with("sky.exr")), "{:?}", lit.environment);
+    let sky = parse("Scene(volume: Generated(\"ml32\"), lights: [Environment(Sky)])").expect("the generated sky");
+    assert_eq!((sky.light, sky.environment), (Light::Headlight, None));
+    let both = "Scene(volume: Generated(\"ml32\"), environment: \"a.exr\", lights: [Environment(File(\"b.exr\"))])";
+    let e = parse(both).expect_err("two environments").to_string();
+    assert!(e.contains("lights: a scene has one environment"), "{e}");
+    let typo = "Scene(volume: Generated(\"ml32\"), lights: [Directional(azimuth: 30, elevation_deg: 45)])";
+    assert!(parse(typo).is_err(), "an unknown field of a light is an error");
     let point =
         parse("Scene(volume: Generated(\"ml32\"), lights: [Point(x: 0.5, y: 2, z: -1)])").expect("a point light");
     assert_eq!(point.light, Light::Point { x: 0.5, y: 2.0, z: -1.0 });

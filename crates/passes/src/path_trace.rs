@@ -78,7 +78,8 @@ volgraph_compiler::pass_params! {
         russian_roulette: bool = true,
             "from the second scattering on, end a path with probability 1 − its largest throughput channel (unbiased)";
         light_intensity: f32 = 2.0, 0.0..=1000.0, "irradiance of the scene's light (directional, or the headlight)";
-        environment: Environment = Sky, "what paths leaving the volume see: a generated sky or a uniform radiance";
+        environment: Environment = Sky,
+            "what paths leaving the volume see: the scene's environment map where it has one, else a generated sky; or a uniform radiance";
         environment_intensity: f32 = 0.6, 0.0..=1000.0, "radiance scale of the environment";
         seed: u32 = 0, 0..=4294967295, "seed of the random sequence (each frame and pixel draws its own stream)";
         majorant: Majorant = Global,

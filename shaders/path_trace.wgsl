@@ -404,6 +404,9 @@ fn camera_moved() -> bool {
     return any(a[0] != b[0]) || any(a[1] != b[1]) || any(a[2] != b[2]) || any(a[3] != b[3]);
 }
 
+// The mean point of a pixel none of whose paths has interacted: far from every surface.
+const NO_POINT: f32 = 1.0e30;
+
 struct Continued {
     mean: vec4<f32>,
     aux: vec4<f32>,
@@ -422,7 +425,7 @@ fn continued(pixel: vec2<u32>) -> Continued {
         // No interaction this sample: the depth of last frame's mean point at this pixel, along
         // this frame's ray.
         let own = textureLoad(previous_aux, here, 0);
-        if (!(own.x > 0.0)) {
+        if (!(own.x > 0.0) || own.y == NO_POINT) {
             return none;
         }
         let dir = pixel_ray_dir(vec2<f32>(pixel) + vec2<f32>(0.5));
@@ -437,14 +440,33 @@ fn continued(pixel: vec2<u32>) -> Continued {
     if (any(at < vec2<f32>(0.0)) || any(at >= frame.viewport.xy)) {
         return none;
     }
-    let there = vec2<i32>(floor(at));
-    let was = textureLoad(previous_aux, there, 0);
-    let voxel = frame.half_extent.w;
-    if (!(was.x > 0.0) || distance(was.yzw, point) > trace.reproject_tolerance * voxel) {
-        return none;
+    // The pixel the point lands in, where its mean point is near enough; else, of the 2×2 pixels
+    // whose centres surround the point, the one whose mean point lies nearest (at an edge the
+    // pixel it lands in may hold the mean of a neighbouring, farther surface).
+    let size = vec2<i32>(frame.viewport.xy);
+    let tolerance = trace.reproject_tolerance * frame.half_extent.w;
+    var best = vec2<i32>(floor(at));
+    let own = textureLoad(previous_aux, best, 0);
+    if (!(own.x > 0.0 && distance(own.yzw, point) <= tolerance)) {
+        best = vec2<i32>(-1);
+        var best_distance = tolerance;
+        let corner = vec2<i32>(floor(at - vec2<f32>(0.5)));
+        for (var i = 0; i < 4; i += 1) {
+            let q = clamp(corner + vec2<i32>(i & 1, i >> 1u), vec2<i32>(0), size - vec2<i32>(1));
+            let was = textureLoad(previous_aux, q, 0);
+            let d = distance(was.yzw, point);
+            if (was.x > 0.0 && d <= best_distance) {
+                best = q;
+                best_distance = d;
+            }
+        }
+        if (best.x < 0) {
+            return none;
+        }
     }
+    let was = textureLoad(previous_aux, best, 0);
     let kept = min(was.x, f32(trace.reproject_keep));
-    return Continued(textureLoad(previous, there, 0), vec4<f32>(kept, was.yzw));
+    return Continued(textureLoad(previous, best, 0), vec4<f32>(kept, was.yzw));
 }
 #endif
 
@@ -463,9 +485,10 @@ fn cs_path_trace(@builtin(global_invocation_id) id: vec3<u32>) {
     let n = from_last.aux.x;
     // The mean first-interaction point over the samples that had one (a running mean weighted
     // like the colour's: exact while every sample interacts, a fair depth otherwise).
-    var point = from_last.aux.yzw;
+    // A pixel none of whose paths has interacted yet keeps a point no surface is near (1e30).
+    var point = select(vec3<f32>(NO_POINT), from_last.aux.yzw, n > 0.0);
     if (first_hit) {
-        point = select(first_point, point + (first_point - point) / (n + 1.0), n > 0.0);
+        point = select(first_point, point + (first_point - point) / (n + 1.0), n > 0.0 && point.x != NO_POINT);
     }
     textureStore(aux, vec2<i32>(pixel), vec4<f32>(n + 1.0, point));
 #else

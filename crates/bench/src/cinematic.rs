@@ -52,6 +52,9 @@ pub struct CinematicArgs {
     /// Write the table as Markdown here.
     #[arg(long)]
     pub markdown: Option<PathBuf>,
+    /// Draw RMSE against seconds of accumulation, one line per case (PNG).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
 }
 
 /// A path-traced case: its name, graph and parameter overrides of the `trace` pass (values in
@@ -253,7 +256,52 @@ pub fn run(args: &CinematicArgs) -> anyhow::Result<serde_json::Value> {
         "light_volume_shadows": {"graph": "modern/fastest", "ms_per_frame": shadows.0, "rmse_vs_reference": shadows.1},
     });
     crate::report_files::write_markdown_and_json((args.markdown.as_deref(), &table), (args.json.as_deref(), &value))?;
+    if let Some(path) = &args.plot {
+        write_plot(path, &curves, target, &adapter)
+            .map_err(|e| anyhow!("--plot {}: cannot draw the plot: {e}", path.display()))?;
+    }
     Ok(value)
+}
+
+/// RMSE (/255) against seconds of accumulation, both on log scales (a path tracer's error is a
+/// line of slope −½ there), one line per case, and the target as a dashed level.
+fn write_plot(
+    path: &std::path::Path,
+    curves: &[Curve],
+    target: f64,
+    adapter: &str,
+) -> Result<(), Box<dyn std::error::Error>> {
+    use plotters::prelude::*;
+    let points: Vec<(f64, f64)> =
+        curves.iter().flat_map(|c| c.points.iter().map(|&(_, s, e)| (s, e * 255.0))).collect();
+    let (x_min, x_max) = points.iter().fold((f64::MAX, 0.0f64), |(lo, hi), p| (lo.min(p.0), hi.max(p.0)));
+    let (y_min, y_max) = points.iter().fold((target * 255.0, 0.0f64), |(lo, hi), p| (lo.min(p.1), hi.max(p.1)));
+    let root = BitMapBackend::new(path, (960, 600)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(format!("path tracer: RMSE against seconds of accumulation, {adapter}"), ("sans-serif", 18))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d((x_min * 0.8..x_max * 1.25).log_scale(), (y_min * 0.8..y_max * 1.25).log_scale())?;
+    chart.configure_mesh().x_desc("seconds of accumulation").y_desc("RMSE (1/255)").draw()?;
+    for (i, c) in curves.iter().enumerate() {
+        let color = crate::graphs::plot::palette(i);
+        let line: Vec<(f64, f64)> = c.points.iter().map(|&(_, s, e)| (s, e * 255.0)).collect();
+        chart
+            .draw_series(LineSeries::new(line.clone(), color.stroke_width(2)))?
+            .label(c.name)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
+        chart.draw_series(line.into_iter().map(|p| Circle::new(p, 3, color.filled())))?;
+    }
+    let level = target * 255.0;
+    chart
+        .draw_series(DashedLineSeries::new(vec![(x_min * 0.8, level), (x_max * 1.25, level)], 6, 4, BLACK.into()))?
+        .label(format!("target {level:.0}/255"))
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLACK));
+    chart.configure_series_labels().background_style(WHITE.mix(0.85)).border_style(BLACK).draw()?;
+    root.present()?;
+    Ok(())
 }
 
 /// `modern/fastest` with the `shadows` effect: median ms of 8 frames after a warm-up, and the

@@ -12,7 +12,7 @@ use super::report::{GraphBenchReport, Row};
 
 const SIZE: (u32, u32) = (1280, 720);
 
-fn palette(i: usize) -> RGBColor {
+pub(crate) fn palette(i: usize) -> RGBColor {
     const COLORS: [RGBColor; 8] = [
         RGBColor(31, 119, 180),
         RGBColor(255, 127, 14),

@@ -130,28 +130,38 @@ fn world_segment(p: vec3<f32>, w: vec3<f32>) -> vec2<f32> {
     return select(vec2<f32>(0.0, 0.0), kept, kept.x < kept.y);
 }
 
+// The next tentative collision after `t` on p + t·w before `limit`: free paths at the rate of
+// the majorant `m` holds; a path that reaches a majorant's end restarts there at the next one's
+// rate (the exponential has no memory), and one of rate 0 (an empty block) is crossed at once.
+// `limit` when the path leaves; `m` is left holding the result's majorant.
+fn next_tentative(p: vec3<f32>, w: vec3<f32>, t0: f32, m: ptr<function, MajorantSpan>, limit: f32) -> f32 {
+    var t = t0;
+    for (var i = 0u; i < MAX_TRACKING_STEPS; i += 1u) {
+        if (t >= limit) {
+            return limit;
+        }
+        if ((*m).sigma > 0.0) {
+            let next = t + free_path((*m).sigma);
+            if (next < (*m).end) {
+                return next;
+            }
+        }
+        t = (*m).end;
+        *m = majorant_span(p, w, t, limit);
+    }
+    return limit;
+}
+
 // Delta tracking: the distance to the first real interaction in [t0, t1), or −1 when the path
-// leaves. Within a majorant's span free paths are exponential at its rate; a path that reaches
-// the span's end restarts there (the exponential has no memory).
+// leaves: a tentative collision is real with probability σ/σ̄.
 fn delta_track(p: vec3<f32>, w: vec3<f32>, span: vec2<f32>) -> f32 {
     var t = span.x;
     var m = majorant_span(p, w, t, span.y);
     for (var i = 0u; i < MAX_TRACKING_STEPS; i += 1u) {
+        t = next_tentative(p, w, t, &m, span.y);
         if (t >= span.y) {
             return -1.0;
         }
-        if (!(m.sigma > 0.0)) {
-            t = m.end;
-            m = majorant_span(p, w, t, span.y);
-            continue;
-        }
-        let next = t + free_path(m.sigma);
-        if (next >= m.end) {
-            t = m.end;
-            m = majorant_span(p, w, t, span.y);
-            continue;
-        }
-        t = next;
         if (random() * m.sigma < medium_at(p + t * w).a) {
             return t;
         }
@@ -159,27 +169,17 @@ fn delta_track(p: vec3<f32>, w: vec3<f32>, span: vec2<f32>) -> f32 {
     return -1.0;
 }
 
-// Ratio tracking: an unbiased estimate of the transmittance along [t0, t1).
+// Ratio tracking: an unbiased estimate of the transmittance along [t0, t1), the product of
+// (1 − σ/σ̄) over the tentative collisions.
 fn ratio_track(p: vec3<f32>, w: vec3<f32>, span: vec2<f32>) -> f32 {
     var t = span.x;
     var m = majorant_span(p, w, t, span.y);
     var transmittance = 1.0;
     for (var i = 0u; i < MAX_TRACKING_STEPS; i += 1u) {
+        t = next_tentative(p, w, t, &m, span.y);
         if (t >= span.y) {
             return transmittance;
         }
-        if (!(m.sigma > 0.0)) {
-            t = m.end;
-            m = majorant_span(p, w, t, span.y);
-            continue;
-        }
-        let next = t + free_path(m.sigma);
-        if (next >= m.end) {
-            t = m.end;
-            m = majorant_span(p, w, t, span.y);
-            continue;
-        }
-        t = next;
         transmittance *= max(1.0 - medium_at(p + t * w).a / m.sigma, 0.0);
         // Russian roulette: a small estimate survives with probability ½, doubled.
         if (transmittance < 0.1) {

@@ -39,6 +39,10 @@ pub enum Light {
     },
 }
 
+/// How far from the origin a point light may be, per coordinate, in world units (the volume's
+/// box is 2 across): its squared distance stays far inside f32.
+pub const MAX_POINT_DISTANCE: f64 = 1e6;
+
 /// Where light reaches a point from: one direction for every point, or a position.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Toward {
@@ -125,11 +129,18 @@ impl Light {
         match *self {
             Light::Headlight => Ok(()),
             Light::Point { x, y, z } => {
-                if [x, y, z].iter().all(|v| v.is_finite()) {
-                    Ok(())
-                } else {
-                    Err(format!("a point light's position must be finite world units, not ({x}, {y}, {z})"))
+                if !([x, y, z].iter().all(|v| v.is_finite())) {
+                    return Err(format!("a point light's position must be finite world units, not ({x}, {y}, {z})"));
                 }
+                // The GPU holds it in f32 and squares its distance: far beyond the box a point
+                // light is a directional one, which is what to write.
+                if [x, y, z].iter().any(|v| v.abs() > MAX_POINT_DISTANCE) {
+                    return Err(format!(
+                        "a point light's position is within ±{MAX_POINT_DISTANCE:e} world units (the box is 2 across), \
+                         not ({x:e}, {y:e}, {z:e}); for a light that far write its direction as AZ,EL"
+                    ));
+                }
+                Ok(())
             }
             Light::Directional { azimuth_deg, elevation_deg } => {
                 if !(azimuth_deg.is_finite() && elevation_deg.is_finite()) {
@@ -385,6 +396,9 @@ mod tests {
             assert!(e.contains(&format!("\"{text}\"")), "{text}: {e}");
         }
         assert!(Light::parse("point:nan,0,0").expect_err("NaN").contains("finite"));
+        // 1e39 is finite in f64 but infinite on the GPU (it drew a black image): refused.
+        assert!(Light::parse("point:1e39,0,0").expect_err("1e39").contains("AZ,EL"));
+        assert!(Light::parse("point:-1,0,-1e6").is_ok());
     }
 
     #[test]

@@ -27,6 +27,7 @@ pub mod octree;
 pub mod organs;
 pub mod path_trace;
 pub mod probe;
+pub mod progressive_error;
 pub mod reference;
 pub mod srgb;
 pub mod stats;

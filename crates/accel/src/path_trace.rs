@@ -51,6 +51,9 @@ pub struct PathTraceSettings {
     pub light: Light,
     /// The TF's opacity is per this many voxels (1: per voxel).
     pub opacity_unit_voxels: f64,
+    /// The scene's crop box and clip planes: paths, primary and scattered, and the light's
+    /// visibility see only the region they keep (`cut_segment` of ray_box.wgsl).
+    pub cuts: crate::cuts::Cuts,
 }
 
 impl Default for PathTraceSettings {
@@ -67,6 +70,7 @@ impl Default for PathTraceSettings {
             environment_intensity: 0.6,
             light: Light::Headlight,
             opacity_unit_voxels: 1.0,
+            cuts: crate::cuts::Cuts::default(),
         }
     }
 }
@@ -125,10 +129,18 @@ impl Medium<'_> {
         ([c[0], c[1], c[2]], self.extinction_of(c[3]))
     }
 
-    /// Where along p + t·w the box begins and ends (from t ≥ 0).
+    /// Where along p + t·w the box begins and ends (from t ≥ 0), cut to what the scene's cuts
+    /// keep.
     fn span(&self, p: DVec3, w: DVec3) -> Option<(f64, f64)> {
         let (t0, t1) = intersect_box(p, w, self.half)?;
-        (t1 > t0.max(0.0)).then_some((t0.max(0.0), t1))
+        self.kept(p, w, (t0.max(0.0), t1))
+    }
+
+    /// The part of [t0, t1) on p + t·w the cuts keep (they are in texture coordinates, where the
+    /// ray is texture(p) + t · w / (2 · half)), if any.
+    fn kept(&self, p: DVec3, w: DVec3, (t0, t1): (f64, f64)) -> Option<(f64, f64)> {
+        let (t0, t1) = self.settings.cuts.keeps_interval(self.texture(p), w / (2.0 * self.half), t0, t1);
+        (t1 > t0).then_some((t0, t1))
     }
 
     /// Delta tracking: the first real interaction in [t0, t1), if any.
@@ -315,11 +327,14 @@ pub fn render_path_traced(
                 let p1 = (ray.u0 + ray.d_tex * ray.len_tex - 0.5) * 2.0 * medium.half;
                 let length = (p1 - p0).length();
                 let w = (p1 - p0) / length;
+                let Some(span) = medium.kept(p0, w, (0.0, length)) else {
+                    return PixelEstimate::default();
+                };
                 let mut rng =
                     SplitMix64(seed ^ (u64::from(y) << 32 | u64::from(x)).wrapping_mul(0x2545_f491_4f6c_dd1d));
                 let (mut sum, mut squares) = ([0.0; 4], [0.0; 4]);
                 for _ in 0..spp {
-                    let sample = medium.trace(p0, w, (0.0, length), &mut rng);
+                    let sample = medium.trace(p0, w, span, &mut rng);
                     for c in 0..4 {
                         sum[c] += sample[c];
                         squares[c] += sample[c] * sample[c];

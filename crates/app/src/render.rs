@@ -403,9 +403,21 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
     runtime.set_step_profiling(args.time_each_pass);
     // Frames one at a time, so each has its own time (the first includes pipeline JIT).
     let mut stats = Vec::new();
+    // `--spp N`: the mean's error, estimated from the `image` at the powers of two of samples
+    // (read after the frame, outside its time). The camera never moves, so a reprojecting path
+    // tracer's mean is the plain running mean too.
+    let has_image = runtime.plan().is_some_and(|p| p.outputs.contains_key("image"));
+    let mut noise = (still && has_image).then(volgraph_accel::progressive_error::ErrorTracker::default);
     for f in 0..frames {
         let at = if still { 0 } else { f };
         stats.push(runtime.render(CameraData::from_orbit(&camera.at(at), viewport)).map_err(|e| anyhow!(e))?);
+        if let Some(tracker) = noise.as_mut() {
+            let history = runtime.history_stats();
+            if tracker.wants(history.run + 1) {
+                let image = runtime.read_output("image").map_err(|e| anyhow!(e))?;
+                tracker.offer(history.restarts, history.run + 1, image.to_rgba_f64());
+            }
+        }
     }
     let warm: Vec<f64> = stats.iter().skip(1).map(|s| s.frame_ms).collect();
     let last = stats.pop();
@@ -463,8 +475,12 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
         }
         if accumulates(plan) {
             // The mean holds the frames since history last started over.
-            let samples = runtime.history_stats().run + 1;
+            let history = runtime.history_stats();
+            let samples = history.run + 1;
             crate::stdout::eprintln_escaped!("  {samples} samples per pixel accumulated");
+            if let Some(estimate) = noise.as_ref().and_then(|t| t.last(history.restarts)) {
+                crate::stdout::eprintln_escaped!("  {}", estimate.line(samples));
+            }
         }
     }
     Ok(())
@@ -517,6 +533,14 @@ pub fn accumulates(plan: &volgraph_core::Plan) -> bool {
             .steps
             .iter()
             .any(|s| s.kind == "path_trace" && s.params.declares("reproject") && s.params.boolean("reproject"))
+}
+
+/// Whether the view's error of `plan` can be estimated from its own `image` at powers of two of
+/// samples (`volgraph_accel::progressive_error`): a running mean of independent samples per
+/// pixel, started over on any change (`while_camera_still`) — a reprojected mean holds its own
+/// count per pixel after a move, which the doubling estimate does not know.
+pub fn estimates_noise(plan: Option<&volgraph_core::Plan>) -> bool {
+    plan.is_some_and(|p| p.history.values().any(|h| h.while_camera_still) && p.outputs.contains_key("image"))
 }
 
 /// One line saying what a graph's bypass did over the frames rendered.

@@ -16,6 +16,7 @@ use std::time::Instant;
 use anyhow::{Context as _, anyhow};
 use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::light::Light;
+use volgraph_accel::progressive_error::{ErrorTracker, rmse};
 use volgraph_core::runtime::{CameraData, Gpu, Runtime, ShaderLibrary, VolumeDesc, scene_values_of};
 use volgraph_core::{CompileOptions, compile};
 
@@ -83,17 +84,13 @@ const CASES: [Case; 4] = [
 /// The seed of the converged image (no case uses it).
 const REFERENCE_SEED: u64 = 0x5eed;
 
-/// One case's curve: (samples, seconds of accumulation, RMSE) at each power of two.
+/// One case's curve: (samples, seconds of accumulation, RMSE) at each power of two, and the
+/// error the viewer would estimate there from the images at n/2 and n alone.
 struct Curve {
     name: &'static str,
     ms_per_sample: f64,
     points: Vec<(u32, f64, f64)>,
-}
-
-/// Root-mean-square difference over every channel of two premultiplied RGBA images.
-fn rmse(a: &[[f64; 4]], b: &[[f64; 4]]) -> f64 {
-    let sum: f64 = a.iter().zip(b).flat_map(|(x, y)| (0..4).map(move |c| (x[c] - y[c]).powi(2))).sum();
-    (sum / (a.len().max(1) * 4) as f64).sqrt()
+    estimated: Vec<Option<f64>>,
 }
 
 /// Everything the cases share.
@@ -160,21 +157,25 @@ impl Bench {
         let plan = self.apply(case.graph, case.overrides, None, &[])?;
         let warm = OrbitCamera { azimuth_deg: self.camera.azimuth_deg + 90.0, ..self.camera };
         self.runtime.render(CameraData::from_orbit(&warm, plan.viewport)).map_err(|e| anyhow!(e))?;
-        let (mut spent, mut times, mut points) = (0.0, Vec::new(), Vec::new());
+        let (mut spent, mut times, mut points, mut estimated) = (0.0, Vec::new(), Vec::new(), Vec::new());
+        let mut tracker = ErrorTracker::default();
         let mut next = 1;
         for n in 1..=most {
             let ms = self.frame(plan.viewport)?;
             spent += ms;
             times.push(ms);
             if n == next {
-                points.push((n, spent / 1e3, rmse(&self.image()?, reference)));
+                let image = self.image()?;
+                points.push((n, spent / 1e3, rmse(&image, reference)));
+                tracker.offer(0, u64::from(n), image);
+                estimated.push(tracker.last(0).filter(|e| e.spp == u64::from(n)).map(|e| e.rmse));
                 if spent / 1e3 > seconds {
                     break;
                 }
                 next *= 2;
             }
         }
-        Ok(Curve { name: case.name, ms_per_sample: median(&times), points })
+        Ok(Curve { name: case.name, ms_per_sample: median(&times), points, estimated })
     }
 }
 
@@ -205,8 +206,10 @@ pub fn run(args: &CinematicArgs) -> anyhow::Result<serde_json::Value> {
     let mut table = format!(
         "# Cinematic light: error against time\n\n{} ({}×{}×{} voxels) at {}, light {}, measured side by side in one \
          run on {adapter}. RMSE over premultiplied linear RGBA against the block-majorant path tracer at {k} samples \
-         per pixel (another seed); wall-clock ms per sample after a warm-up frame.\n\n\
-         | path tracer | ms/sample | samples | seconds | RMSE (/255) |\n|---|---:|---:|---:|---:|\n",
+         per pixel (another seed); wall-clock ms per sample after a warm-up frame. \"estimated\" is what the viewer \
+         and `render --spp` report with no reference: the RMS difference of the means at n/2 and n samples \
+         (volgraph_accel::progressive_error); the measured RMSE² also holds the reference's own noise².\n\n\
+         | path tracer | ms/sample | samples | seconds | RMSE (/255) | estimated (/255) |\n|---|---:|---:|---:|---:|---:|\n",
         args.dataset, bench.volume.dims.x, bench.volume.dims.y, bench.volume.dims.z, args.size, args.light
     );
     let mut json_curves = Vec::new();
@@ -214,8 +217,14 @@ pub fn run(args: &CinematicArgs) -> anyhow::Result<serde_json::Value> {
         "\n| path tracer | σ of one sample (/255) | samples to reach the target | seconds to reach it |\n|---|---:|---:|---:|\n",
     );
     for c in &curves {
-        for (n, s, e) in &c.points {
-            table.push_str(&format!("| {} | {:.1} | {n} | {s:.2} | {:.2} |\n", c.name, c.ms_per_sample, e * 255.0));
+        for ((n, s, e), estimate) in c.points.iter().zip(&c.estimated) {
+            let estimate = estimate.map_or("–".to_string(), |x| format!("{:.2}", x * 255.0));
+            table.push_str(&format!(
+                "| {} | {:.1} | {n} | {s:.2} | {:.2} | {estimate} |\n",
+                c.name,
+                c.ms_per_sample,
+                e * 255.0
+            ));
         }
         // RMSE² at n samples ≈ σ²/n + σ²/K (the reference's own noise): σ from the first point.
         let sigma = c.points.first().map_or(0.0, |(n, _, e)| {
@@ -227,7 +236,7 @@ pub fn run(args: &CinematicArgs) -> anyhow::Result<serde_json::Value> {
         summary.push_str(&format!("| {} | {:.1} | {needed:.0} | {seconds:.1} |\n", c.name, sigma * 255.0));
         json_curves.push(serde_json::json!({
             "case": c.name, "ms_per_sample": c.ms_per_sample,
-            "points": c.points.iter().map(|(n, s, e)| serde_json::json!({"spp": n, "seconds": s, "rmse": e})).collect::<Vec<_>>(),
+            "points": c.points.iter().zip(&c.estimated).map(|((n, s, e), estimate)| serde_json::json!({"spp": n, "seconds": s, "rmse": e, "estimated_rmse": estimate})).collect::<Vec<_>>(),
             "sigma_one_sample": sigma, "spp_to_target": needed, "seconds_to_target": seconds,
         }));
     }

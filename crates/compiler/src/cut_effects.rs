@@ -3,8 +3,8 @@
 //! `shaders/common/ray_box.wgsl` compiles its cut into, and `CUTS` with either (code every cut
 //! needs, such as capping's shading normal). Unlike the DVR effects, which a graph
 //! wires per pass (`"shading": "feature.shading"`), a cut belongs to the frame: every pass that
-//! honours a sub-box of the volume ([`crate::decl::PassDecl::honours_volume_window`]) takes it
-//! without the graph saying so, and a scene without cuts compiles none of their code.
+//! takes cuts ([`crate::decl::PassDecl::takes_cuts`]) takes it without the graph saying so, and
+//! a scene without cuts compiles none of their code.
 
 use std::collections::BTreeSet;
 
@@ -66,12 +66,17 @@ pub fn cuts_among(defines: &[&str]) -> bool {
     defines.iter().any(|d| *d != WINDOW)
 }
 
-/// The cut `#if` names pass `decl` is compiled with when `cut_defines` are the frame's: all of
-/// them for a pass that honours a sub-box of the volume, none for any other (a plan with cuts
-/// and such a pass is refused, `compile::passes_that_cannot_cut`). The one rule the plan check,
-/// the runtime's node creation and the tests share.
+/// The frame `#if` names pass `decl` is compiled with when `cut_defines` are the frame's: the
+/// cuts' for a pass that takes cuts, [`WINDOW`] for one that honours a sub-box of the volume,
+/// none for any other (a plan with cuts and a pass that cannot take them is refused,
+/// `compile::passes_that_cannot_cut`; a distributed render refuses a pass that cannot split).
+/// The one rule the plan check, the runtime's node creation and the tests share.
 pub fn defines_for_pass<D: PassDecl + ?Sized>(decl: &D, cut_defines: &[&'static str]) -> Vec<&'static str> {
-    if decl.honours_volume_window() { cut_defines.to_vec() } else { Vec::new() }
+    cut_defines
+        .iter()
+        .copied()
+        .filter(|d| if *d == WINDOW { decl.honours_volume_window() } else { decl.takes_cuts() })
+        .collect()
 }
 
 /// Whether `feature` is a cut (always known to the compiler, whatever the graph declares).

@@ -277,11 +277,21 @@ pub trait PassDecl: Send + Sync {
     /// ranks' images composite to the single-process one. `render --distributed` refuses a graph
     /// with any other pass (slice-based rendering, a maximum-intensity projection) rather than
     /// composite a wrong image. The same property makes a scene's crop box and clip planes
-    /// right (`crate::cut_effects`: samples are dropped through the same `own_segment`): such a
-    /// pass's modules are compiled with `#if CROP`/`#if CLIP` when the scene cuts, and a graph
-    /// with a pass that is not is refused with a cut. Default: false.
+    /// right (`crate::cut_effects`: samples are dropped through the same `own_segment`), so it
+    /// is [`Self::takes_cuts`]'s default. Default: false.
     fn honours_volume_window(&self) -> bool {
         false
+    }
+
+    /// True when the pass takes only what a scene's crop box and clip planes keep
+    /// (`crate::cut_effects`): its modules are compiled with `#if CROP`/`#if CLIP` when the
+    /// scene cuts, and a graph with a pass that does not is refused with a cut. Default:
+    /// [`Self::honours_volume_window`] — a pass right in a rank's box is right in the kept
+    /// region through the same `own_segment`. A pass may take cuts without splitting between
+    /// ranks: a path tracer's light crosses every rank's box, but the region the cuts keep is
+    /// convex, so each path segment is cut like a primary ray (`cut_segment`).
+    fn takes_cuts(&self) -> bool {
+        self.honours_volume_window()
     }
 
     /// True for passes that hold what they stream within the runtime's GPU memory budget

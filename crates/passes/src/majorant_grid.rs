@@ -28,6 +28,12 @@ fn shader() -> ShaderUse {
 }
 
 impl PassDecl for MajorantGrid {
+    /// A bound per block of the TF's opacity over the block's range: still a bound wherever a
+    /// window or the cuts keep part of the block (the path tracer cuts its paths itself).
+    fn honours_volume_window(&self) -> bool {
+        true
+    }
+
     fn kind(&self) -> &'static str {
         "majorant_grid"
     }

@@ -122,6 +122,14 @@ pub fn max_alpha(lut: &[[f32; 4]]) -> f32 {
 }
 
 impl PassDecl for PathTrace {
+    /// Paths are cut like the raycasters' rays (`world_segment` → `cut_segment`): the primary
+    /// ray's, each scattered path's and each shadow ray's (material cut away casts no shadow).
+    /// The kept region is convex, so a path from inside leaves it once. No sort-last window:
+    /// scattered light crosses every rank's box.
+    fn takes_cuts(&self) -> bool {
+        true
+    }
+
     fn kind(&self) -> &'static str {
         "path_trace"
     }

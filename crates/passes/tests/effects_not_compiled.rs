@@ -113,7 +113,7 @@ fn pass_code_with_cuts(graph: &str, pass: &str, options: CompileOptions) -> BTre
     let plan = compile(graph, &source, &registry, &options).expect("compiles");
     let step = plan.steps.iter().find(|s| s.pass_id == pass).expect("the step");
     let plugin = registry.get(&step.kind).expect("registered");
-    assert!(plugin.honours_volume_window(), "{}: the raycasters take cuts", step.kind);
+    assert!(plugin.takes_cuts(), "{}: the raycasters take cuts", step.kind);
     let cuts = volgraph_core::cut_effects::defines_of(&plan.features);
     let mut defines = plugin.shader_defines(&step.params);
     defines.extend(volgraph_core::cut_effects::defines_for_pass(plugin.as_ref(), &cuts));

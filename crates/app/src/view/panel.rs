@@ -189,6 +189,7 @@ pub fn show(
         }
         if plan.history.values().any(|h| h.while_camera_still) {
             ui.label(samples_line(&session.runtime.history_stats()));
+            ui.label(session.noise_line().unwrap_or_else(|| "estimated error: from the second sample on".to_string()));
         } else if crate::render::accumulates(plan) {
             // A reprojecting path tracer: each pixel's count is its own after a camera move.
             let stats = session.runtime.history_stats();

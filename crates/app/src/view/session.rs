@@ -180,6 +180,8 @@ pub struct LiveSession {
     bindings: Option<crate::named_inputs::NamedBindings>,
     /// The environment map's file, for "save view".
     environment: Option<PathBuf>,
+    /// A path tracer's error, estimated from its own image at powers of two of samples.
+    noise: volgraph_accel::progressive_error::ErrorTracker,
 }
 
 impl LiveSession {
@@ -456,6 +458,7 @@ impl LiveSession {
     ) -> Result<Vec<Event>, volgraph_core::runtime::RuntimeError> {
         match self.submit(camera, target) {
             Ok(_) => {
+                self.track_noise();
                 if self.unproven {
                     self.unproven = false;
                     let graph = &self.bench.graph;

@@ -194,6 +194,38 @@ fn the_live_error_follows_the_step() {
     let _ = std::fs::remove_dir_all(&s.dir);
 }
 
+/// A path tracer's panel shows the view's estimated error (issue "light that scatters", item
+/// 3): from the second sample on, it follows 1/√spp, and a moved camera starts it over.
+#[test]
+fn the_path_tracer_shows_its_estimated_error() {
+    let s = scratch("noise", "graphs/cinematic/path_traced.ron");
+    let mut session = open(&s, None);
+    let camera = OrbitCamera::default();
+    let mut frames = |session: &mut LiveSession, n: u32, camera: &OrbitCamera| {
+        for _ in 0..n {
+            session.frame(camera, None).expect("a frame");
+        }
+        session.runtime.finish();
+    };
+    frames(&mut session, 1, &camera);
+    assert_eq!(session.noise_line(), None, "one sample has no estimate");
+    frames(&mut session, 15, &camera);
+    let at_16 = session.noise_line().expect("an estimate at 16 spp");
+    assert!(at_16.contains("at 16 spp") && at_16.contains("means at 8 and 16 spp"), "{at_16}");
+    frames(&mut session, 48, &camera);
+    let at_64 = session.noise_line().expect("an estimate at 64 spp");
+    let value = |line: &str| -> f64 {
+        let after = line.split("estimated error ").nth(1).expect("a figure");
+        after.split('/').next().expect("a figure").parse().expect("a number")
+    };
+    // 4× the samples halve the noise (1.5–2.7×: two estimates of an RMS over 2,304 pixels).
+    let ratio = value(&at_16) / value(&at_64);
+    assert!((1.5..=2.7).contains(&ratio), "{at_16} → {at_64}");
+    frames(&mut session, 1, &OrbitCamera { azimuth_deg: camera.azimuth_deg + 5.0, ..camera });
+    assert_eq!(session.noise_line(), None, "a moved camera starts the mean, and its estimate, over");
+    let _ = std::fs::remove_dir_all(&s.dir);
+}
+
 #[test]
 fn a_resize_rebuilds_no_pipeline() {
     let s = scratch("resize", "graphs/basic/fragment_raycast.ron");

@@ -122,7 +122,7 @@ pub fn compile(
 }
 
 /// A scene that crops or clips (`crate::cut_effects`) needs every pass to take only the samples
-/// the cuts keep: a pass that does not (`PassDecl::honours_volume_window`) would draw the
+/// the cuts keep: a pass that does not (`PassDecl::takes_cuts`) would draw the
 /// cut-away part — a silent wrong image — so it is an error naming the pass.
 fn passes_that_cannot_cut(plan: &Plan, registry: &dyn KindLookup) -> Vec<crate::diagnostic::Diagnostic> {
     use crate::diagnostic::{Diagnostic, Location};
@@ -134,7 +134,7 @@ fn passes_that_cannot_cut(plan: &Plan, registry: &dyn KindLookup) -> Vec<crate::
     plan.steps
         .iter()
         .filter(|s| seen.insert(s.pass_id.clone()))
-        .filter(|s| registry.decl(&s.kind).is_some_and(|d| !d.honours_volume_window()))
+        .filter(|s| registry.decl(&s.kind).is_some_and(|d| !d.takes_cuts()))
         .map(|s| {
             let names: Vec<&str> = cuts.iter().map(|f| f.as_str()).collect();
             Diagnostic::new(
@@ -142,7 +142,7 @@ fn passes_that_cannot_cut(plan: &Plan, registry: &dyn KindLookup) -> Vec<crate::
                 format!("pass \"{}\" ({}) cannot {}: it samples the volume its own way", s.pass_id, s.kind, names.join(" or ")),
             )
             .with_help(
-                "crop boxes and clip planes work with the raycasters (raycast, raycast_compute, raycast_segment, raycast_bricks); render this graph without --crop/--clip"
+                "crop boxes and clip planes work with the raycasters (raycast, raycast_compute, raycast_segment, raycast_bricks) and the path tracer (path_trace); render this graph without --crop/--clip"
                     .to_string(),
             )
         })

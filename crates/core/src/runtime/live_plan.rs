@@ -201,7 +201,7 @@ pub(crate) fn build(
         // samples they keep (the compiler refused a plan with a cut and any other pass; a
         // distributed render refuses a graph with one).
         let frame_defines = crate::cut_effects::defines_for_pass(plugin.as_ref(), cut_defines);
-        if crate::cut_effects::cuts_among(cut_defines) && !plugin.honours_volume_window() {
+        if crate::cut_effects::cuts_among(cut_defines) && !plugin.takes_cuts() {
             return Err((ApplyError::CannotCut { pass: step.pass_id.clone(), kind: step.kind.clone() }, old));
         }
         let previous = old.as_ref().and_then(|o| o.nodes.get(&step.pass_id));

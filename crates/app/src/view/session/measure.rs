@@ -7,6 +7,32 @@ use volgraph_accel::camera::OrbitCamera;
 use super::LiveSession;
 
 impl LiveSession {
+    /// After a frame of a path tracer whose mean starts over on any change: its image at each
+    /// power of two of samples, for the estimate of the view's error
+    /// (`volgraph_accel::progressive_error`; one read-back per doubling).
+    pub(super) fn track_noise(&mut self) {
+        if !crate::render::estimates_noise(self.runtime.plan()) {
+            return;
+        }
+        let history = self.runtime.history_stats();
+        let spp = history.run + 1;
+        if self.noise.wants(spp)
+            && let Ok(image) = self.runtime.read_output("image")
+        {
+            self.noise.offer(history.restarts, spp, image.to_rgba_f64());
+        }
+    }
+
+    /// The view's estimated error at the samples it holds now (from the last doubling), for
+    /// the panel: `None` before the second sample or for a graph it is not made for.
+    pub fn noise_line(&self) -> Option<String> {
+        if !crate::render::estimates_noise(self.runtime.plan()) {
+            return None;
+        }
+        let history = self.runtime.history_stats();
+        self.noise.last(history.restarts).map(|e| e.line(history.run + 1))
+    }
+
     /// What lies under window pixel `cursor` (physical pixels) seen by `camera`: the first
     /// visible point along its ray (the TF, the crop and clip planes as drawn) and the data value
     /// there, as a line for the panel in the data's units; `None` off the volume.

@@ -191,6 +191,7 @@ impl LiveSession {
             labels_are_the_volume,
             bindings,
             environment: args.environment.clone(),
+            noise: Default::default(),
         };
         let ms = start.elapsed().as_secs_f64() * 1e3;
         Ok((session, Event::Loaded { graph: graph_name, ms, summary: loaded }))

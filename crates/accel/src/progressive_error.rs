@@ -67,7 +67,7 @@ impl ErrorEstimate {
 /// Keeps the image at each power of two of samples of one accumulation and estimates the error
 /// at the next. The accumulation is named by a key that changes when it starts over (the
 /// runtime's restart count): a new key forgets what was kept.
-#[derive(Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct ErrorTracker {
     key: u64,
     kept: Option<(u64, Vec<[f64; 4]>)>,

@@ -102,17 +102,41 @@ struct MajorantSpan {
 // The largest opacity per block of the min/max grid (majorant_grid.wgsl).
 @group(0) @binding(auto) var majorants: texture_3d<f32>;
 
+#if MAJORANT_LEAP
+// The Chebyshev distance map over the same blocks (empty_distance.wgsl): an empty block's
+// distance says how large a cube of empty blocks lies around it. A block is empty there exactly
+// when its majorant is 0 (both: no LUT texel of its range has α > 0 or NaN).
+fn block_edge() -> u32 {
+    return trace.block_size;
+}
+#import "common/empty_cubes.wgsl"
+#endif
+
 // The block the path p + t·w is in at `t` — looked up a hundredth of a voxel ahead, so a path
 // on a face takes the block it enters (the grid's one-voxel apron covers the difference) — its
 // majorant and where the path leaves it, capped at `limit`; at least that hundredth of a voxel
-// on, so rounding at a face never stalls a path.
+// on, so rounding at a face never stalls a path. With MAJORANT_LEAP a path in an empty block
+// leaves the largest cube of empty blocks around it instead: one step where one per block took
+// dozens.
 fn majorant_span(p: vec3<f32>, w: vec3<f32>, t: f32, limit: f32) -> MajorantSpan {
     let grid = block_grid(textureDimensions(majorants), trace.block_size);
     let w_tex = w / (2.0 * frame.half_extent.xyz);
     let ahead = 0.01 * frame.half_extent.w;
-    let b = block_at(texture_from_world(p + (t + ahead) * w), grid);
-    let leaves = box_span(texture_from_world(p), w_tex, blocks_box_lo(b, grid), blocks_box_hi(b, grid)).y;
-    let alpha = textureLoad(majorants, b, 0).r;
+    let u = texture_from_world(p + (t + ahead) * w);
+    let b = block_at(u, grid);
+    var lo = blocks_box_lo(b, grid);
+    var hi = blocks_box_hi(b, grid);
+    let alpha = textureSampleLevel(majorants, nearest_clamp, block_texel(b, grid), 0.0).r;
+#if MAJORANT_LEAP
+    if (alpha == 0.0) {
+        let region = empty_region_at(u, leap_grid());
+        if (region.empty) {
+            lo = region.lo;
+            hi = region.hi;
+        }
+    }
+#endif
+    let leaves = box_span(texture_from_world(p), w_tex, lo, hi).y;
     return MajorantSpan(extinction_of(alpha), min(max(leaves, t + ahead), limit));
 }
 #else
@@ -440,6 +464,7 @@ fn continued(pixel: vec2<u32>) -> Continued {
     if (any(at < vec2<f32>(0.0)) || any(at >= frame.viewport.xy)) {
         return none;
     }
+    // (Lengths of differences: with MAJORANT_LEAP `distance` names the distance map.)
     // The pixel the point lands in, where its mean point is near enough; else, of the 2×2 pixels
     // whose centres surround the point, the one whose mean point lies nearest (at an edge the
     // pixel it lands in may hold the mean of a neighbouring, farther surface).
@@ -447,14 +472,14 @@ fn continued(pixel: vec2<u32>) -> Continued {
     let tolerance = trace.reproject_tolerance * frame.half_extent.w;
     var best = vec2<i32>(floor(at));
     let own = textureLoad(previous_aux, best, 0);
-    if (!(own.x > 0.0 && distance(own.yzw, point) <= tolerance)) {
+    if (!(own.x > 0.0 && length(own.yzw - point) <= tolerance)) {
         best = vec2<i32>(-1);
         var best_distance = tolerance;
         let corner = vec2<i32>(floor(at - vec2<f32>(0.5)));
         for (var i = 0; i < 4; i += 1) {
             let q = clamp(corner + vec2<i32>(i & 1, i >> 1u), vec2<i32>(0), size - vec2<i32>(1));
             let was = textureLoad(previous_aux, q, 0);
-            let d = distance(was.yzw, point);
+            let d = length(was.yzw - point);
             if (was.x > 0.0 && d <= best_distance) {
                 best = q;
                 best_distance = d;

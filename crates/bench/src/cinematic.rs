@@ -1,8 +1,9 @@
 //! `volgraph bench cinematic`: what light costs (issue "light that scatters", item 5). The
 //! progressive path tracer's error against a converged image as it accumulates, against the
-//! milliseconds it took — with one majorant and with block majorants, with ratio-tracked and
-//! delta-tracked shadow rays — and the light-volume `shadows` effect of the raycasters beside
-//! it (its error against its own f64 reference). One run, one runtime, side by side.
+//! milliseconds it took — with one majorant and with block majorants, leaping over empty cubes
+//! by the distance map or not, with ratio-tracked and delta-tracked shadow rays — and the
+//! light-volume `shadows` effect of the raycasters beside it (its error against its own f64
+//! reference). One run, one runtime, side by side.
 //!
 //! The converged image is the block-majorant path tracer at `--reference-spp` samples with a
 //! seed no case uses; its own noise (σ/√K) is printed as the floor under every RMSE. A path
@@ -66,7 +67,7 @@ struct Case {
     overrides: &'static [(&'static str, &'static str)],
 }
 
-const CASES: [Case; 4] = [
+const CASES: [Case; 5] = [
     Case { name: "one majorant, ratio-tracked shadow rays", graph: "cinematic/path_traced", overrides: &[] },
     Case { name: "block majorants, ratio-tracked shadow rays", graph: "cinematic/path_traced_blocks", overrides: &[] },
     Case {
@@ -78,6 +79,11 @@ const CASES: [Case; 4] = [
         name: "block majorants, delta-tracked shadow rays",
         graph: "cinematic/path_traced_blocks",
         overrides: &[("shadow_rays", "\"delta\"")],
+    },
+    Case {
+        name: "block majorants, leaping over empty cubes (distance map)",
+        graph: "cinematic/path_traced_distance",
+        overrides: &[],
     },
 ];
 

@@ -41,6 +41,8 @@ pub const START_TILES: &str = "START_TILES";
 pub const BLOCK_MAJORANTS: &str = "BLOCK_MAJORANTS";
 /// Each pixel's mean continued across camera moves where its surface was (`reproject`).
 pub const REPROJECT: &str = "REPROJECT";
+/// Empty blocks crossed a cube at a time by the Chebyshev distance map (`leap`).
+pub const MAJORANT_LEAP: &str = "MAJORANT_LEAP";
 
 // The fragment raycaster's Klein variant (`raycast.rs`).
 /// Write `leap_hit`, where the next frame's ray starts.
@@ -77,7 +79,7 @@ pub const SEGMENTS: &str = "SEGMENTS";
 pub const SCATTER: &str = "SCATTER";
 
 /// Every `#if` name of the built-in passes.
-pub const BUILT_IN: [&str; 30] = [
+pub const BUILT_IN: [&str; 31] = [
     SHADING,
     PREINTEGRATION,
     TRICUBIC,
@@ -108,4 +110,5 @@ pub const BUILT_IN: [&str; 30] = [
     LABELS_NEAREST,
     BLOCK_MAJORANTS,
     REPROJECT,
+    MAJORANT_LEAP,
 ];

@@ -85,6 +85,8 @@ volgraph_compiler::pass_params! {
         majorant: Majorant = Global,
             "free paths against the TF's largest extinction (global) or each block's (blocks: wire `majorants`)";
         block_size: u32 = 8, 1..=256, "with majorant blocks: the minmax_grid pass's block size";
+        leap: bool = false,
+            "with majorant blocks: cross the largest cube of empty blocks around a path at once, by the Chebyshev distance map (wire `distance` from empty_distance)";
         reproject: bool = false,
             "keep each pixel's mean across camera moves, found where its surface was last frame (wire previous_aux/aux)";
         reproject_keep: u32 = 32, 1..=65536, "after a camera move, a reprojected pixel keeps at most this many samples";
@@ -100,6 +102,11 @@ volgraph_compiler::pass_params! {
 /// Whether free paths step block by block (`majorant: "blocks"`).
 fn by_blocks(params: &Params) -> bool {
     PathTraceParams::from_params(params).majorant == Majorant::Blocks
+}
+
+/// Whether free paths cross cubes of empty blocks at once (`leap`, with block majorants).
+fn leaps(params: &Params) -> bool {
+    by_blocks(params) && PathTraceParams::from_params(params).leap
 }
 
 /// Whether each pixel's mean follows its surface across camera moves (`reproject`).
@@ -148,6 +155,9 @@ impl PassDecl for PathTrace {
             if by_blocks(p) {
                 defines.push(crate::defines::BLOCK_MAJORANTS);
             }
+            if leaps(p) {
+                defines.push(crate::defines::MAJORANT_LEAP);
+            }
             if reprojects(p) {
                 defines.push(crate::defines::REPROJECT);
             }
@@ -156,7 +166,7 @@ impl PassDecl for PathTrace {
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        by_blocks(old) == by_blocks(new) && reprojects(old) == reprojects(new)
+        by_blocks(old) == by_blocks(new) && leaps(old) == leaps(new) && reprojects(old) == reprojects(new)
     }
 
     fn ports(&self, params: &Params) -> Vec<PortSpec> {
@@ -168,6 +178,9 @@ impl PassDecl for PathTrace {
         ];
         if by_blocks(params) {
             ports.push(PortSpec::read("majorants", PortKind::Owned(crate::majorant_grid::MAJORANT_GRID)));
+        }
+        if leaps(params) {
+            ports.push(PortSpec::read("distance", PortKind::Owned(crate::empty_distance::EMPTY_DISTANCE)));
         }
         if reprojects(params) {
             ports.push(PortSpec::read("previous_aux", PortKind::target(&[TargetFormat::Rgba32Float])));
@@ -209,6 +222,9 @@ impl PassNode for PathTraceNode {
         if self.settings.majorant == Majorant::Blocks {
             let dims = ctx.voxels("volume")?.dims;
             crate::empty_space::check_block_grid(ctx, "majorants", self.settings.block_size, dims.to_array())?;
+            if self.settings.leap {
+                crate::empty_space::check_block_grid(ctx, "distance", self.settings.block_size, dims.to_array())?;
+            }
         }
         let version = (ctx.input_version("tf"), ctx.frame.environment);
         if self.written.as_ref().is_none_or(|(_, v)| *v != version) {

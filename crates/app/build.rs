@@ -1,6 +1,8 @@
 //! Compiles every graph of the workspace's `graphs/` folder (not the transfer functions of
 //! `graphs/tf/`) into the binary (`crate::builtin_graphs::EMBEDDED_GRAPHS`), so an installed
-//! `volgraph` renders them by name from any folder: `volgraph render kruger_westermann_2003/rc_b`.
+//! `volgraph` renders them by name from any folder: `volgraph render kruger_westermann_2003/rc_b`;
+//! and the shipped scenes of `scenes/` (`EMBEDDED_SCENES`): `volgraph render --scene
+//! engine_cut_open`.
 
 use std::path::{Path, PathBuf};
 
@@ -46,6 +48,24 @@ fn main() {
         .unwrap_or_default();
     tfs.sort();
     for path in tfs.iter().filter(|p| p.extension().is_some_and(|e| e == "ron")) {
+        println!("cargo:rerun-if-changed={}", path.display());
+        let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let absolute = path.canonicalize().unwrap_or_else(|_| path.clone());
+        code.push_str(&format!("    ({stem:?}, include_str!({:?})),\n", absolute.display().to_string()));
+    }
+    code.push_str("];\n");
+    // The shipped scenes of `scenes/`, which name their graphs and TFs as built-ins.
+    code.push_str(
+        "/// Every scene of the workspace's `scenes/` folder: `(stem, text)`.\n\
+         pub static EMBEDDED_SCENES: &[(&str, &str)] = &[\n",
+    );
+    let scenes_dir = Path::new(&manifest).join("../../scenes");
+    println!("cargo:rerun-if-changed={}", scenes_dir.display());
+    let mut scenes: Vec<PathBuf> = std::fs::read_dir(&scenes_dir)
+        .map(|entries| entries.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    scenes.sort();
+    for path in scenes.iter().filter(|p| p.extension().is_some_and(|e| e == "ron")) {
         println!("cargo:rerun-if-changed={}", path.display());
         let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         let absolute = path.canonicalize().unwrap_or_else(|_| path.clone());

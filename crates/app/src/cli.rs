@@ -97,7 +97,25 @@ enum Command {
     },
     /// List the graphs built into the binary (name, paper, description): every one can be given
     /// by name where a graph file is asked for (`volgraph render klein_2005/leap_iso -o x.png`).
-    Graphs,
+    /// `--export NAME [DIR]` writes one out to edit (DIR/NAME.ron, e.g. ./modern/fastest.ron).
+    Graphs {
+        /// Write this built-in graph to DIR/NAME.ron (never over an existing file).
+        #[arg(long, value_name = "NAME")]
+        export: Option<String>,
+        /// The folder --export writes into (created when missing).
+        #[arg(requires = "export", default_value = ".")]
+        dir: PathBuf,
+    },
+    /// List the scenes built into the binary (name, graph, effects): `--scene NAME` renders one
+    /// from any folder; `--export NAME [DIR]` writes one out to edit.
+    Scenes {
+        /// Write this built-in scene to DIR/NAME.ron (never over an existing file).
+        #[arg(long, value_name = "NAME")]
+        export: Option<String>,
+        /// The folder --export writes into (created when missing).
+        #[arg(requires = "export", default_value = ".")]
+        dir: PathBuf,
+    },
     /// Write values into a graph file at their place (only the values' text changes; comments,
     /// order and layout stay): `volgraph set graph.ron march.step_voxels=0.25 input.threshold=0.99`.
     /// The edited graph is compiled first; a bad value or unknown name leaves the file untouched.
@@ -265,13 +283,21 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
         Command::Render(args) => Ok(Checked::Render(Box::new(crate::render::prepare(args)?))),
         Command::View(_)
         | Command::Passes { .. }
-        | Command::Graphs
+        | Command::Graphs { .. }
+        | Command::Scenes { .. }
         | Command::Info { .. }
         | Command::Set { .. }
         | Command::CompositeBench(_) => {
             Err(CliError::Other(anyhow!("only plan and render are checked ahead of running")))
         }
     }
+}
+
+/// `graphs --export` / `scenes --export`: writes the built-in out and says where.
+fn export_builtin(kind: crate::builtin_scenes::Builtin, name: &str, dir: &Path) -> Result<(), CliError> {
+    let path = crate::builtin_scenes::export(kind, name, dir)?;
+    crate::stdout::println_escaped!("wrote {}", path.display());
+    Ok(())
 }
 
 /// Runs a parsed command line.
@@ -299,9 +325,19 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
             crate::stdout::write_stdout(&crate::set_cmd::run(&graph, &assignments)?)?;
             Ok(())
         }
-        Command::Graphs => {
+        Command::Graphs { export: None, .. } => {
             crate::stdout::write_stdout(&crate::builtin_graphs::listing())?;
             Ok(())
+        }
+        Command::Scenes { export: None, .. } => {
+            crate::stdout::write_stdout(&crate::builtin_scenes::listing())?;
+            Ok(())
+        }
+        Command::Graphs { export: Some(name), dir } => {
+            export_builtin(crate::builtin_scenes::Builtin::Graph, &name, &dir)
+        }
+        Command::Scenes { export: Some(name), dir } => {
+            export_builtin(crate::builtin_scenes::Builtin::Scene, &name, &dir)
         }
         Command::Info { volume, labels, label_table, raw } => {
             let labels = (labels || label_table.is_some()).then_some(crate::info_cmd::Labels { table: label_table });

@@ -263,10 +263,12 @@ pub fn transfer_function_fitted(
             }
             preset.fitted(values)
         }
-        // `graphs/tf/NAME.ron` where no such file exists: the copy compiled into the program.
-        Some(p) => match crate::builtin_graphs::find_tf(p) {
-            Some((_, text)) => TransferFunction::from_ron_str(text, p).map_err(|e| anyhow!("{e}"))?,
-            None => TransferFunction::load(p).map_err(|e| tf_read_error(p, e))?,
+        // `graphs/tf/NAME.ron` where no such file exists: the copy compiled into the program;
+        // a plain name (`engine_opaque`) of the data folder's tf/ (a scene's `Data("…")`).
+        Some(p) => match (crate::builtin_graphs::find_tf(p), data_folder_tf(p)) {
+            (Some((_, text)), _) => TransferFunction::from_ron_str(text, p).map_err(|e| anyhow!("{e}"))?,
+            (None, Some(file)) => TransferFunction::load(&file).map_err(|e| anyhow!("{e}"))?,
+            (None, None) => TransferFunction::load(p).map_err(|e| tf_read_error(p, e))?,
         },
     };
     if let Some(p) = path
@@ -275,6 +277,21 @@ pub fn transfer_function_fitted(
         notes.push(format!("{}: {note}", p.display()));
     }
     Ok((tf, notes))
+}
+
+/// The transfer function of the data folder's `tf/` a `--tf` argument names where no file of
+/// that name exists: a plain name (no folder, no extension) with `tf/NAME.ron` there, as a
+/// scene's `Data("NAME")` reads it (`--tf engine_opaque`, the peer benchmark's).
+fn data_folder_tf(path: &Path) -> Option<PathBuf> {
+    if path.symlink_metadata().is_ok() || path.components().count() != 1 || path.extension().is_some() {
+        return None;
+    }
+    let name = path.to_str()?;
+    if name.chars().any(volgraph_core::terminal::is_unsafe) || name == "." || name == ".." {
+        return None;
+    }
+    let file = volgraph_accel::data_dir::data_dir().join("tf").join(format!("{name}.ron"));
+    file.is_file().then_some(file)
 }
 
 /// A `--tf` file that cannot be read; where no such file exists, the preset it may have meant
@@ -293,7 +310,11 @@ fn tf_read_error(path: &Path, error: volgraph_accel::transfer_function::TfError)
             ScannerPreset::names()
         ),
         None if path.components().count() == 1 && path.extension().is_none() => {
-            anyhow!("{error}; nor is it a built-in preset: they are {}", ScannerPreset::names())
+            anyhow!(
+                "{error}; nor is it a built-in preset (they are {}) or a transfer function of the data folder ({})",
+                ScannerPreset::names(),
+                volgraph_accel::data_dir::data_dir().join("tf").display()
+            )
         }
         None => anyhow!("{error}"),
     }

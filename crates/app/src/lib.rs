@@ -7,6 +7,7 @@
 
 pub mod atomic_write;
 pub mod builtin_graphs;
+pub mod builtin_scenes;
 pub mod cli;
 #[cfg(test)]
 mod cli_fuzz;

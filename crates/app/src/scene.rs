@@ -7,9 +7,9 @@
 //!
 //! ```ron
 //! Scene(
-//!     graph: "../graphs/modern/fastest.ron",
+//!     graph: "modern/fastest.ron",
 //!     volume: Dataset("hydrogen_atom"),          // or File("path.raw"), Generated("ml64")
-//!     transfer_function: File("../graphs/tf/default.ron"),   // or Preset("sparse"), Data("engine_opaque")
+//!     transfer_function: File("tf/default.ron"),   // or Preset("sparse"), Data("engine_opaque")
 //!     camera: Orbit(azimuth: 30, elevation: 20, distance: 3.2),
 //!     viewport: (512, 512),
 //!     effects: ["shading", "jitter"],
@@ -276,6 +276,15 @@ pub enum SceneError {
 }
 
 impl Scene {
+    /// The scene a `--scene` argument names: the file at `argument` (a dangling link too: the
+    /// user's), else a shipped scene of that name (`engine_cut_open`; `crate::builtin_scenes`).
+    pub fn load_named(argument: &Path) -> Result<Scene, SceneError> {
+        match crate::builtin_scenes::find(argument) {
+            Some((name, text)) => Scene::from_str(text, &crate::builtin_scenes::virtual_path(name)),
+            None => Scene::load(argument),
+        }
+    }
+
     /// Reads and checks the scene file `path`.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let text = volgraph_accel::input_file::read_text(path, "scene file")?;
@@ -323,10 +332,7 @@ impl Scene {
             check_camera(camera).map_err(|m| field("camera", m))?;
         }
         if doc.graph.as_deref().is_some_and(|g| g.trim().is_empty()) {
-            return Err(field(
-                "graph",
-                "is empty; name the graph file, e.g. graph: \"../graphs/modern/fastest.ron\"".into(),
-            ));
+            return Err(field("graph", "is empty; name the graph file, e.g. graph: \"modern/fastest.ron\"".into()));
         }
         for (name, path) in [
             (

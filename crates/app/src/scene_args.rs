@@ -33,7 +33,8 @@ pub struct SceneArgs {
     pub raw: RawArgs,
     /// Transfer function (RON, or ParaView color-map .json; the viewer watches it for edits), or
     /// a built-in preset for scanner data: ct-bone, ct-soft-tissue, ct-lung, ct-angio (in HU),
-    /// mr-default (percentiles); default: for a generated 8-bit Marschner–Lobb volume (the
+    /// mr-default (percentiles), or a transfer function of the data folder's tf/ by name
+    /// (`engine_opaque`, as a scene's Data("…")); default: for a generated 8-bit Marschner–Lobb volume (the
     /// default volume, `ml64`, `ml32`) the band that shows its rings (graphs/tf/marschner_lobb.ron),
     /// else one fitted to the data (transparent up to its background of air or noise; see
     /// `volgraph info`). `--tf NAME=FILE|PRESET` (repeat for each) binds the graph's
@@ -132,14 +133,14 @@ impl SceneArgs {
                 dir.display()
             ));
         }
-        let scene = self.scene.as_deref().map(Scene::load).transpose().map_err(|e| anyhow!(e))?;
+        let scene = self.scene.as_deref().map(Scene::load_named).transpose().map_err(|e| anyhow!(e))?;
         let graph = match (&self.graph, scene.as_ref().and_then(|s| s.graph.clone())) {
             (Some(g), _) => g.clone(),
             (None, Some(g)) => g,
             (None, None) => {
                 return Err(anyhow!(
                     "no graph: give a graph file ({usage}), or a --scene whose file names one \
-                     (graph: \"../graphs/modern/fastest.ron\")"
+                     (graph: \"modern/fastest.ron\")"
                 ));
             }
         };

@@ -20,9 +20,10 @@ use crate::cli::{CliError, compile_options, display_name};
 pub fn run(graph: &Path, assignments: &[String]) -> Result<String, CliError> {
     if graph.symlink_metadata().is_err() && crate::builtin_graphs::find(graph).is_some() {
         return Err(CliError::Other(anyhow!(
-            "{}: is a built-in graph (compiled into volgraph), not a file: `set` edits a graph file; copy it from \
-             graphs/ in the source tree and give that path",
-            graph.display()
+            "{}: is a built-in graph (compiled into volgraph), not a file: `set` edits a graph file; write it out \
+             with `volgraph graphs --export {}` and give the path it prints",
+            graph.display(),
+            crate::builtin_graphs::normalized(graph)
         )));
     }
     let source = volgraph_accel::input_file::read_text(graph, "graph file").map_err(|e| anyhow!("{e}"))?;

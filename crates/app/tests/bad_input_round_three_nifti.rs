@@ -247,5 +247,6 @@ fn misspelt_tf_presets_get_a_did_you_mean_not_just_no_such_file() {
     }
     let run = volgraph(&["render", "graphs/basic/fragment_raycast.ron", "--tf", "zzz", "-o", &out]);
     assert_eq!(run.code, 1, "{}", run.stderr);
-    assert!(run.stderr.contains("nor is it a built-in preset: they are ct-bone, ct-soft-tissue"), "{}", run.stderr);
+    assert!(run.stderr.contains("nor is it a built-in preset (they are ct-bone, ct-soft-tissue"), "{}", run.stderr);
+    assert!(run.stderr.contains("or a transfer function of the data folder"), "{}", run.stderr);
 }

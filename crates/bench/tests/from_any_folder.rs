@@ -5,75 +5,11 @@
 //! beside `volgraph-bench` (always under `cargo test --workspace`), its `bench` and `sweep`
 //! are run too: they hand over to the copied `volgraph-bench`.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
 
-/// A fresh folder under the system's temporary folder.
-fn fresh(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("volgraph-anywhere-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
+mod support;
 
-/// The binaries copied into `bin/`, the working folder `work/` and the data folder `data/`;
-/// removed when dropped (the copies are hundreds of MB).
-struct Sandbox {
-    root: PathBuf,
-    bench: PathBuf,
-    stock: Option<PathBuf>,
-    work: PathBuf,
-    data: PathBuf,
-}
-
-fn sandbox(name: &str) -> Sandbox {
-    let root = fresh(name);
-    let (bin, work, data) = (root.join("bin"), root.join("work"), root.join("data"));
-    for d in [&bin, &work, &data] {
-        std::fs::create_dir_all(d).expect("folders");
-    }
-    let built = PathBuf::from(env!("CARGO_BIN_EXE_volgraph-bench"));
-    let bench = bin.join(built.file_name().expect("a file name"));
-    std::fs::copy(&built, &bench).expect("copy volgraph-bench");
-    let stock_built = built.with_file_name(format!("volgraph{}", std::env::consts::EXE_SUFFIX));
-    let stock = stock_built.is_file().then(|| {
-        let to = bin.join(stock_built.file_name().expect("a file name"));
-        std::fs::copy(&stock_built, &to).expect("copy volgraph");
-        to
-    });
-    if stock.is_none() && std::env::var_os("CI").is_some() {
-        panic!("{} was not built beside volgraph-bench; CI runs cargo test --workspace", stock_built.display());
-    }
-    Sandbox { root, bench, stock, work, data }
-}
-
-impl Drop for Sandbox {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.root);
-    }
-}
-
-impl Sandbox {
-    /// Runs `program` in the working folder with the empty data folder, no VOLGRAPH_DATA.
-    fn run(&self, program: &Path, args: &[&str]) -> Output {
-        let output = Command::new(program)
-            .current_dir(&self.work)
-            .env_remove("VOLGRAPH_DATA")
-            .arg("--data")
-            .arg(&self.data)
-            .args(args)
-            .output()
-            .expect("runs");
-        assert!(
-            output.status.success(),
-            "{} {args:?} failed ({}):\n{}",
-            program.display(),
-            output.status,
-            String::from_utf8_lossy(&output.stderr)
-        );
-        output
-    }
-}
+use support::sandbox;
 
 fn json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).expect("the JSON was written")).expect("JSON")

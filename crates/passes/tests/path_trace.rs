@@ -147,8 +147,11 @@ fn leaping_over_empty_cubes_draws_the_block_tracers_image() {
     // A sparse vessel tree, its background (below 0.3) transparent: most blocks a path crosses
     // are empty.
     let volume = volgraph_accel::vessels::vessel_tree(48, 1);
-    let lut: Vec<[f32; 4]> =
-        ramp_lut().into_iter().enumerate().map(|(i, [r, g, b, a])| [r, g, b, if i < 77 { 0.0 } else { 4.0 * a }]).collect();
+    let lut: Vec<[f32; 4]> = ramp_lut()
+        .into_iter()
+        .enumerate()
+        .map(|(i, [r, g, b, a])| [r, g, b, if i < 77 { 0.0 } else { 4.0 * a }])
+        .collect();
     let blocks = accumulate_with(GRAPH_BLOCKS, &volume, &lut, &[], 8).to_rgba_f64();
     let leaping = accumulate_with(GRAPH_DISTANCE, &volume, &lut, &[], 8).to_rgba_f64();
     let values = blocks.len() * 4;

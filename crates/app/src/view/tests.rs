@@ -201,7 +201,7 @@ fn the_path_tracer_shows_its_estimated_error() {
     let s = scratch("noise", "graphs/cinematic/path_traced.ron");
     let mut session = open(&s, None);
     let camera = OrbitCamera::default();
-    let mut frames = |session: &mut LiveSession, n: u32, camera: &OrbitCamera| {
+    let frames = |session: &mut LiveSession, n: u32, camera: &OrbitCamera| {
         for _ in 0..n {
             session.frame(camera, None).expect("a frame");
         }

@@ -1,5 +1,6 @@
-//! The histogram of a volume's normalized values, and the background it shows: the peak that
-//! air, or a scanner's noise floor, makes at the low end. A default transfer function that
+//! The histogram of a volume's normalized values, and the background it shows: the low peak
+//! that air or a scanner's noise floor makes, at or below the median (a CT's padding outside
+//! the field of view, below −1024 HU and apart from every measured value, left out). A default transfer function that
 //! starts above it shows the object instead of a box of noise (3D Slicer's and ParaView's
 //! presets do the same by starting their ramps above air), and `volgraph info` reports it.
 
@@ -17,13 +18,28 @@ pub struct Histogram {
 /// The background peak of a histogram ([`Histogram::background`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Background {
-    /// The normalized value of the peak (the histogram's mode).
+    /// The normalized value of the peak (its highest bin).
     pub mode: f64,
     /// The normalized value where the peak's upper flank has fallen to 1% of its height: what
     /// lies below is background.
     pub ceiling: f64,
-    /// The share of voxels at or below the ceiling.
+    /// The normalized value where the peak's share begins: 0, or above a CT's padding.
+    pub floor: f64,
+    /// The share of all voxels in the peak: from `floor` up to `ceiling` (its own, not what
+    /// lies below it).
     pub fraction: f64,
+}
+
+/// Values apart from every other at the bottom of the histogram ([`ValueSummary::padding`]):
+/// a CT's padding outside the scanner's field of view.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Padding {
+    /// The normalized value of its bin.
+    pub value: f64,
+    /// The share of voxels it holds.
+    pub fraction: f64,
+    /// The first bin above it that holds a value (where the measured values begin).
+    pub next_bin: usize,
 }
 
 /// A mode holding less than this share of the voxels is not a background.
@@ -62,36 +78,69 @@ impl Histogram {
         1.0
     }
 
-    /// The background: the histogram's mode — the densest window of 5 bins, so noise spread
-    /// over neighbouring values counts as one peak — when it lies in the lower half of the
-    /// values and holds at least a tenth of the voxels, up to where the counts fall below 1%
-    /// of the peak's highest bin. `None` for a volume without one (a peak in the upper half, a
-    /// flat histogram, or a peak with nothing above it).
+    /// The background ([`Self::background_from`] bin 0, any mode).
     pub fn background(&self) -> Option<Background> {
+        self.background_from(0, |_| true)
+    }
+
+    /// The background among the bins from `start` on: the densest window of 5 bins (so noise
+    /// spread over neighbouring values counts as one peak) holding at least a tenth of the
+    /// voxels, whose highest bin lies in the lower half of the values from `start`, at or below
+    /// the median
+    /// and where `allowed` (the data's units: a CT's air) says a background may be — a denser
+    /// window that is not is tissue, and the search goes on below it — up to where the counts
+    /// above that bin fall below 1% of its height. Its share is its own: from `start` (above a
+    /// CT's padding) to that ceiling. `None` for a volume without one (no low peak, a flat
+    /// histogram, or a peak with nothing above it).
+    ///
+    /// At or below the median: an MR's noise floor spread over many low values (half the
+    /// voxels below 12) is the background even where a narrower tissue peak above it (at 68)
+    /// holds more voxels per bin.
+    pub fn background_from(&self, start: usize, allowed: impl Fn(f64) -> bool) -> Option<Background> {
         let n = self.counts.len();
-        let around = |i: usize| i.saturating_sub(2)..(i + 3).min(n);
+        if self.total == 0 || start >= n {
+            return None;
+        }
+        let median = self.percentile(0.5);
+        // The lower half of the values above `start` (a CT's padding stretches the range).
+        let half = (start as f64 / n as f64 + 1.0) / 2.0;
+        let around = |i: usize| i.saturating_sub(2).max(start)..(i + 3).min(n);
         let window = |i: usize| self.counts[around(i)].iter().sum::<u64>();
-        let densest = (0..n).max_by_key(|&i| (window(i), std::cmp::Reverse(i)))?;
-        if self.total == 0 || (window(densest) as f64) < MIN_BACKGROUND_SHARE * self.total as f64 {
-            return None;
+        let mut limit = n;
+        while limit > start {
+            let densest = (start..limit).max_by_key(|&i| (window(i), std::cmp::Reverse(i)))?;
+            if (window(densest) as f64) < MIN_BACKGROUND_SHARE * self.total as f64 {
+                return None;
+            }
+            let mode = around(densest).max_by_key(|&i| (self.counts[i], std::cmp::Reverse(i)))?;
+            let centre = self.bin_centre(mode);
+            if centre < half && centre <= median && allowed(centre) {
+                let flank = (self.counts[mode] as f64 * FLANK).max(1.0);
+                let end = (mode..n).find(|&i| (self.counts[i] as f64) < flank)?;
+                let own: u64 = self.counts[start..end].iter().sum();
+                let below: u64 = self.counts[..end].iter().sum();
+                if below == self.total || own == 0 {
+                    return None;
+                }
+                return Some(Background {
+                    mode: centre,
+                    ceiling: end as f64 / n as f64,
+                    floor: start as f64 / n as f64,
+                    fraction: own as f64 / self.total as f64,
+                });
+            }
+            // Tissue, not background: look below its window.
+            limit = around(densest).start;
         }
-        // The peak is the window's highest bin; the background ends where the counts above it
-        // fall below 1% of its height.
-        let mode = around(densest).max_by_key(|&i| (self.counts[i], std::cmp::Reverse(i)))?;
-        if self.bin_centre(mode) >= 0.5 {
-            return None;
-        }
-        let floor = (self.counts[mode] as f64 * FLANK).max(1.0);
-        let end = (mode..n).find(|&i| (self.counts[i] as f64) < floor)?;
-        let below: u64 = self.counts[..end].iter().sum();
-        if below == self.total || below == 0 {
-            return None;
-        }
-        Some(Background {
-            mode: self.bin_centre(mode),
-            ceiling: end as f64 / n as f64,
-            fraction: below as f64 / self.total as f64,
-        })
+        None
+    }
+
+    /// The lowest occupied bin when the n/32 bins above it are empty — values apart from all
+    /// others — with the first occupied bin above it.
+    pub fn isolated_lowest(&self) -> Option<(usize, usize)> {
+        let first = self.counts.iter().position(|&c| c > 0)?;
+        let next = (first + 1..self.counts.len()).find(|&i| self.counts[i] > 0)?;
+        (next - first > (self.counts.len() / 32).max(2)).then_some((first, next))
     }
 }
 
@@ -142,6 +191,10 @@ impl Histogram {
 /// about −700); a CT peak above it is tissue, not background.
 const CT_AIR_BELOW_HU: f64 = -500.0;
 
+/// The floor of the Hounsfield scale (dcm2niix and most scanners clamp air there): a value
+/// below it is no measurement but padding outside the field of view (−2000, −3024, −32768).
+const HU_FLOOR: f64 = -1024.0;
+
 /// Bins of [`ValueSummary::histogram`]: the finest any fitted default reads (the MR preset's
 /// percentiles); coarser histograms are exact sums of its bins.
 pub const FIT_BINS: usize = 1024;
@@ -186,6 +239,30 @@ impl ValueSummary {
         let (lo, hi) = self.value_range;
         lo + s * (hi - lo)
     }
+
+    /// Whether the values are Hounsfield units: the file says so (a DICOM CT), or they reach
+    /// −1024, the scale's floor, which no MR, microscope or 8/16-bit unsigned file reaches — so
+    /// a NIfTI written from a CT series, which names no units, is read as the series is.
+    pub fn hounsfield(&self) -> bool {
+        self.ct_hu || self.value_range.0 <= HU_FLOOR
+    }
+
+    /// A CT's padding in the 256-bin histogram: the lowest values when they lie below −1024
+    /// (below air on the Hounsfield scale: no measurement) and apart from every other value
+    /// ([`Histogram::isolated_lowest`]). Read from the values alone — a DICOM series and the
+    /// NIfTI written from it (which says no units) find the same. `None` for any other volume:
+    /// an MR's masked zeros are its background, not padding.
+    pub fn padding(&self) -> Option<Padding> {
+        let h = self.binned(256);
+        let (first, next) = h.isolated_lowest()?;
+        // The bin's upper edge: every value in it lies below the floor.
+        let top = self.data_value((first + 1) as f64 / 256.0);
+        (top < HU_FLOOR && self.value_range.0 < HU_FLOOR).then(|| Padding {
+            value: h.bin_centre(first),
+            fraction: h.counts[first] as f64 / h.total.max(1) as f64,
+            next_bin: next,
+        })
+    }
 }
 
 /// The background of `volume` ([`background_in`] of its summary).
@@ -193,15 +270,14 @@ pub fn background_of(volume: &Volume) -> Option<Background> {
     background_in(&ValueSummary::of(volume))
 }
 
-/// The background ([`Histogram::background`] of the 256-bin histogram), where the data's units
-/// allow it: in CT (values in HU) only a peak of air counts — a field of view filled with soft
-/// tissue has no background, however common its values.
+/// The background ([`Histogram::background_from`] of the 256-bin histogram, above a CT's
+/// padding), where the data's units allow it: in CT (values in HU, said by the file or read
+/// from the values: [`ValueSummary::hounsfield`]) only a peak of air counts — a field of view
+/// filled with soft tissue has no background, however common its values.
 pub fn background_in(values: &ValueSummary) -> Option<Background> {
-    let b = values.binned(256).background()?;
-    if values.ct_hu && values.data_value(b.mode) > CT_AIR_BELOW_HU {
-        return None;
-    }
-    Some(b)
+    let start = values.padding().map_or(0, |p| p.next_bin);
+    let hu = values.hounsfield();
+    values.binned(256).background_from(start, |mode| !hu || values.data_value(mode) <= CT_AIR_BELOW_HU)
 }
 
 /// The iso value a graph gets for `Data(Auto)` ([`auto_iso_in`] of `volume`'s summary).
@@ -271,6 +347,62 @@ mod tests {
         // A constant volume: nothing above the peak.
         let flat = Volume::new("flat", UVec3::splat(4), DVec3::ONE, VoxelData::U8(vec![30; 64]));
         assert_eq!(Histogram::of(&flat, 256).background(), None);
+    }
+
+    /// A volume of i16 values drawn from `(value, count)` runs, in order.
+    fn of_runs(runs: &[(i16, usize)]) -> ValueSummary {
+        let values: Vec<i16> = runs.iter().flat_map(|&(v, n)| std::iter::repeat_n(v, n)).collect();
+        let n = values.len() as u32;
+        let mut v = Volume::new("runs", UVec3::new(n, 1, 1), DVec3::ONE, VoxelData::I16(values));
+        v.fit_range_to_data();
+        ValueSummary::of(&v)
+    }
+
+    /// An MR head: half the voxels a noise floor spread over 0..24, a narrow tissue peak at 68
+    /// denser per bin than any part of the floor, a tail to 255. The background is the floor
+    /// (at or below the median), not the tissue peak (the issue's "a peak at 68.2 holding
+    /// 94.2 % of the voxels" with a median of 12).
+    #[test]
+    fn an_mr_noise_floor_below_the_median_is_the_background_not_a_denser_tissue_peak() {
+        let mut runs: Vec<(i16, usize)> = (0..24).map(|v| (v, 2000)).collect();
+        runs.extend([(67, 9000), (68, 12000), (69, 9000)]);
+        runs.extend((70..256).map(|v| (v as i16, 40)));
+        let values = of_runs(&runs);
+        let median = values.data_value(values.histogram.percentile(0.5));
+        let b = background_in(&values).expect("a background");
+        let (mode, ceiling) = (values.data_value(b.mode), values.data_value(b.ceiling));
+        assert!(mode < 24.0 && mode <= median, "mode {mode}, median {median}");
+        assert!(ceiling <= 30.0, "the floor ends before the tissue: {ceiling}");
+        assert!((b.fraction - 48_000.0 / 85_440.0).abs() < 0.02, "its own share: {b:?}");
+    }
+
+    /// A CT with padding outside the field of view (−3024, a fifth of the voxels), air at
+    /// −1000, a narrow soft-tissue peak and bone: the padding is apart, the background is air
+    /// with its own share, whether the file says HU (DICOM) or not (a NIfTI of it: its values
+    /// reach −1024).
+    #[test]
+    fn a_ct_background_is_air_above_its_padding_with_or_without_units() {
+        let mut runs = vec![(-3024, 20_000)];
+        runs.extend((-1010..=-990).map(|v| (v, 1_400)));
+        runs.extend([(39, 13_000), (40, 14_000), (41, 13_000)]);
+        runs.extend((300..1300).step_by(10).map(|v| (v, 100)));
+        for ct_hu in [true, false] {
+            let mut values = of_runs(&runs);
+            values.ct_hu = ct_hu;
+            assert!(values.hounsfield());
+            let padding = values.padding().expect("padding");
+            assert!(
+                values.data_value(padding.value) < -3000.0 && (padding.fraction - 20_000.0 / 99_400.0).abs() < 1e-9
+            );
+            let b = background_in(&values).expect("air");
+            let mode = values.data_value(b.mode);
+            assert!((-1030.0..=-970.0).contains(&mode), "ct_hu {ct_hu}: mode {mode}");
+            assert!((b.fraction - 29_400.0 / 99_400.0).abs() < 0.01, "air's own share: {b:?}");
+            assert!(values.data_value(b.ceiling) < 0.0, "the tissue is not background: {b:?}");
+        }
+        // Masked MR zeros are not padding (0 is no value below the HU floor).
+        let mr = of_runs(&[(0, 5000), (400, 3000), (401, 3000), (900, 100)]);
+        assert_eq!(mr.padding(), None);
     }
 
     #[test]

@@ -261,19 +261,34 @@ pub fn describe(path: &Path, volume: &Volume) -> String {
         data(h.percentile(0.5)),
         data(h.percentile(0.99))
     );
-    match volgraph_accel::histogram::background_of(volume) {
+    let values = volgraph_accel::histogram::ValueSummary::of(volume);
+    if let Some(p) = values.padding() {
+        let _ = writeln!(
+            out,
+            "  padding      {:.1} % of the voxels at {:.4}{units}, below the Hounsfield scale's floor and apart from every \
+             other value (outside the scanner's field of view): hidden, and left out of the background",
+            100.0 * p.fraction,
+            data(p.value)
+        );
+    }
+    match volgraph_accel::histogram::background_in(&values) {
         Some(b) => {
             let _ = writeln!(
                 out,
-                "  background   a peak at {:.4} holding {:.1} % of the voxels, up to {:.4} (air or the scanner's noise \
-                 floor)",
+                "  background   the histogram's low mode at {:.4}{units}: {:.1} % of the voxels lie in it, from {:.4} to \
+                 {:.4}{units} (air or the scanner's noise floor)",
                 data(b.mode),
                 100.0 * b.fraction,
+                data(b.floor),
                 data(b.ceiling)
             );
         }
         None => {
-            let _ = writeln!(out, "  background   none (no low peak holding a tenth of the voxels)");
+            let _ = writeln!(
+                out,
+                "  background   none (no mode at or below the median holding a tenth of the voxels{})",
+                if values.hounsfield() { ", below -500 HU" } else { "" }
+            );
         }
     }
     // Where the fitted default (`TransferFunction::default_for`) stops being transparent: the

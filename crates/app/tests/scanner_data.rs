@@ -135,3 +135,55 @@ fn an_automatic_isovalue_finds_the_body_not_the_box() {
     // more than twice as much.
     assert!(lit > 60 && lit < 350, "{lit} pixels hit a surface");
 }
+
+/// Issue 45 item 5: `info` says what it measured, alike for a DICOM series and the NIfTI written
+/// from it (which names no units): a head CT with padding outside the scanner's circular field
+/// of view (−3024 HU, a fifth of the voxels) — the padding reported apart, the background air
+/// with its own share, the same fitted TF and automatic isovalue from both.
+#[test]
+fn a_dicom_series_and_its_nifti_twin_find_the_same_background() {
+    let dir = scratch("twin");
+    let mut head = ct(40, "head");
+    let dims = head.dims;
+    if let volgraph_accel::volume::VoxelData::I16(values) = &mut head.data {
+        for (i, v) in values.iter_mut().enumerate() {
+            let (x, y) = ((i as u32 % dims.x) as f64, ((i as u32 / dims.x) % dims.y) as f64);
+            let r = ((x + 0.5) / dims.x as f64 - 0.5).hypot((y + 0.5) / dims.y as f64 - 0.5);
+            if r > 0.5 {
+                *v = -3024;
+            }
+        }
+    }
+    write(&dir.join("series"), &head);
+    let nifti = dir.join("head.nii");
+    support::write_nifti(&nifti, &head);
+    let mut reports = Vec::new();
+    for path in [dir.join("series"), nifti] {
+        let info = volgraph(&["info", &path.display().to_string()]);
+        assert_eq!(info.code, 0, "{}", info.stderr);
+        // The lines of what was measured, in the values' numbers (the DICOM's say HU).
+        let measured: Vec<String> = info
+            .stdout
+            .lines()
+            .filter(|l| ["  padding", "  background", "  default TF", "  auto iso"].iter().any(|p| l.starts_with(p)))
+            .map(|l| l.replace(" HU", ""))
+            .collect();
+        reports.push((info.stdout.clone(), measured));
+    }
+    let (dicom, nifti) = (&reports[0], &reports[1]);
+    assert_eq!(dicom.1, nifti.1, "DICOM:\n{}\nNIfTI:\n{}", dicom.0, nifti.0);
+    let background = dicom.1.iter().find(|l| l.starts_with("  background")).expect("a background line");
+    let mode: f64 = background
+        .split("low mode at ")
+        .nth(1)
+        .and_then(|t| t.split(':').next())
+        .and_then(|t| t.parse().ok())
+        .expect("the mode");
+    assert!((-1020.0..=-980.0).contains(&mode), "air is the background: {background}");
+    let padding = dicom.1.iter().find(|l| l.starts_with("  padding")).expect("padding found");
+    assert!(padding.contains("at -30") && padding.contains("outside the scanner's field of view"), "{padding}");
+    // Air's own share (58 % here), not everything below its ceiling (80 %, the padding too).
+    let share: f64 =
+        background.split(": ").nth(1).and_then(|t| t.split(' ').next()).and_then(|t| t.parse().ok()).expect("a share");
+    assert!((50.0..65.0).contains(&share), "the share is air's own: {background}");
+}

@@ -46,9 +46,22 @@ pub fn read_exr(path: &std::path::Path) -> (usize, usize, Vec<[f32; 4]>) {
 /// with its values halved, so the frames differ.
 pub fn write_nifti_4d(path: &std::path::Path, ct: &Volume) {
     let VoxelData::I16(values) = &ct.data else { panic!("int16") };
+    let halved: Vec<i16> = values.iter().map(|v| v / 2).collect();
+    write_nifti_frames(path, ct, &[values, &halved]);
+}
+
+/// A NIfTI-1 file of the int16 volume `ct` alone (3D, no orientation: index axes).
+pub fn write_nifti(path: &std::path::Path, ct: &Volume) {
+    let VoxelData::I16(values) = &ct.data else { panic!("int16") };
+    write_nifti_frames(path, ct, &[values]);
+}
+
+/// A NIfTI-1 file of `frames`, each an int16 volume of `ct`'s size and spacing.
+fn write_nifti_frames(path: &std::path::Path, ct: &Volume, frames: &[&[i16]]) {
     let mut header = vec![0u8; 352];
     header[0..4].copy_from_slice(&348i32.to_le_bytes());
-    let dims = [4i16, ct.dims.x as i16, ct.dims.y as i16, ct.dims.z as i16, 2, 1, 1, 1];
+    let rank = if frames.len() > 1 { 4i16 } else { 3 };
+    let dims = [rank, ct.dims.x as i16, ct.dims.y as i16, ct.dims.z as i16, frames.len() as i16, 1, 1, 1];
     for (i, d) in dims.iter().enumerate() {
         header[40 + 2 * i..42 + 2 * i].copy_from_slice(&d.to_le_bytes());
     }
@@ -62,7 +75,8 @@ pub fn write_nifti_4d(path: &std::path::Path, ct: &Volume) {
     header[112..116].copy_from_slice(&1f32.to_le_bytes());
     header[344..348].copy_from_slice(b"n+1\0");
     let mut bytes = header;
-    bytes.extend(values.iter().flat_map(|v| v.to_le_bytes()));
-    bytes.extend(values.iter().flat_map(|v| (v / 2).to_le_bytes()));
+    for frame in frames {
+        bytes.extend(frame.iter().flat_map(|v| v.to_le_bytes()));
+    }
     std::fs::write(path, bytes).expect("nifti written");
 }

@@ -154,240 +154,268 @@ pub fn show(
     under_cursor: Option<&str>,
     lod: &super::lod::Lod,
     accuracy: &str,
-) -> Vec<Action> {
+) -> Shown {
     let mut actions = Vec::new();
-    egui::Panel::right("volgraph").default_size(320.0).show(root, |ui| {
+    let panel = egui::Panel::right("volgraph").default_size(320.0).show(root, |ui| {
         let Some(plan) = session.plan() else { return };
-        ui.heading(&plan.name);
-        let clock = match (timings.serialised, timings.wall_fallback) {
-            (true, _) => "wall, passes one by one",
-            (false, true) => "wall",
-            (false, false) => "GPU",
-        };
-        ui.label(format!(
-            "{:.2} ms/frame {clock} ({:.0} fps) · {}x{} · {adapter}",
-            timings.frame_ms,
-            1000.0 / timings.frame_ms.max(1e-3),
-            plan.viewport.0,
-            plan.viewport.1
-        ));
-        match session.shader_dirs() {
-            [] => ui.small("shaders: built into the binary"),
-            dirs => ui.small(format!(
-                "shaders: {} (watched)",
-                dirs.iter().map(|d| d.display().to_string()).collect::<Vec<_>>().join(", ")
-            )),
-        };
-        if let Some((what, message)) = session.error() {
-            ui.colored_label(
-                egui::Color32::from_rgb(255, 110, 110),
-                format!("error in {what} (keeping the last good graph):"),
-            );
-            egui::ScrollArea::vertical().id_salt("error").max_height(160.0).show(ui, |ui| {
-                ui.add(egui::Label::new(egui::RichText::new(message).monospace().small()).wrap());
-            });
-        }
-        if plan.history.values().any(|h| h.while_camera_still) {
-            ui.label(samples_line(&session.runtime.history_stats()));
-            ui.label(session.noise_line().unwrap_or_else(|| "estimated error: from the second sample on".to_string()));
-        } else if crate::render::accumulates(plan) {
-            // A reprojecting path tracer: each pixel's count is its own after a camera move.
-            let stats = session.runtime.history_stats();
+        // The buttons first, at the panel's foot: always in reach, whatever the window's height.
+        egui::Panel::bottom("volgraph actions").show(ui, |ui| {
+            ui.add_space(4.0);
+            action_buttons(ui, &mut actions);
+            ui.small(HELP);
+        });
+        // Everything else scrolls (the wheel over the panel), above them.
+        egui::ScrollArea::vertical().id_salt("panel").auto_shrink([false, false]).show(ui, |ui| {
+            ui.heading(&plan.name);
+            let clock = match (timings.serialised, timings.wall_fallback) {
+                (true, _) => "wall, passes one by one",
+                (false, true) => "wall",
+                (false, false) => "GPU",
+            };
             ui.label(format!(
+                "{:.2} ms/frame {clock} ({:.0} fps) · {}x{} · {adapter}",
+                timings.frame_ms,
+                1000.0 / timings.frame_ms.max(1e-3),
+                plan.viewport.0,
+                plan.viewport.1
+            ));
+            match session.shader_dirs() {
+                [] => ui.small("shaders: built into the binary"),
+                dirs => ui.small(format!(
+                    "shaders: {} (watched)",
+                    dirs.iter().map(|d| d.display().to_string()).collect::<Vec<_>>().join(", ")
+                )),
+            };
+            if let Some((what, message)) = session.error() {
+                ui.colored_label(
+                    egui::Color32::from_rgb(255, 110, 110),
+                    format!("error in {what} (keeping the last good graph):"),
+                );
+                egui::ScrollArea::vertical().id_salt("error").max_height(160.0).show(ui, |ui| {
+                    ui.add(egui::Label::new(egui::RichText::new(message).monospace().small()).wrap());
+                });
+            }
+            if plan.history.values().any(|h| h.while_camera_still) {
+                ui.label(samples_line(&session.runtime.history_stats()));
+                ui.label(
+                    session.noise_line().unwrap_or_else(|| "estimated error: from the second sample on".to_string()),
+                );
+            } else if crate::render::accumulates(plan) {
+                // A reprojecting path tracer: each pixel's count is its own after a camera move.
+                let stats = session.runtime.history_stats();
+                ui.label(format!(
                 "{} frames since the last restart; each pixel's mean follows the view (reprojected), keeping its own \
                  count ({} restarts)",
                 stats.run + 1,
                 stats.restarts
             ));
-        } else if !plan.history.is_empty() {
-            ui.label(history_line(&session.runtime.history_stats()));
-        }
-        // What the graph's bypasses did (Klein's reprojection left out where it cannot pay).
-        for b in session.runtime.bypass_status() {
-            ui.label(crate::render::bypass_line(&b));
-        }
-        ui.small(under_cursor.unwrap_or("under the cursor: nothing visible"));
-        ui.horizontal(|ui| {
-            let (mut enabled, mut fps) = (lod.enabled, 1000.0 / lod.target_ms);
-            let toggled = ui.checkbox(&mut enabled, "coarser while moving, target").changed();
-            let moved = ui.add(egui::DragValue::new(&mut fps).range(1.0..=120.0).speed(0.5).suffix(" fps")).changed();
-            if toggled || moved {
-                actions.push(Action::Lod { enabled, target_fps: fps });
+            } else if !plan.history.is_empty() {
+                ui.label(history_line(&session.runtime.history_stats()));
             }
-        });
-        ui.small(lod.line());
-        ui.small(accuracy);
-        // What passes report about the last frame (a brick pool's uploads and occupancy).
-        for line in crate::render::counter_lines(&session.runtime.pass_counters()) {
-            ui.label(egui::RichText::new(line).small());
-        }
-        ui.separator();
-        let mut each = session.runtime.step_profiling();
-        let hint = "Submit and wait for every pass on its own, so each one's time is measured even where GPU \
-                    timestamps miss compute work (lavapipe); frames get slower";
-        if ui.checkbox(&mut each, "time each pass").on_hover_text(hint).changed() {
-            actions.push(Action::TimeEachPass(each));
-        }
-        let max = timings.per_pass.iter().map(|(_, ms)| *ms).fold(1e-6, f64::max);
-        egui::Grid::new("passes").num_columns(3).show(ui, |ui| {
-            for (pass, ms) in &timings.per_pass {
-                ui.label(pass);
-                ui.add(egui::ProgressBar::new((ms / max) as f32).desired_width(120.0));
-                ui.label(format!("{ms:.2} ms"));
-                ui.end_row();
+            // What the graph's bypasses did (Klein's reprojection left out where it cannot pay).
+            for b in session.runtime.bypass_status() {
+                ui.label(crate::render::bypass_line(&b));
             }
-        });
-        ui.separator();
-        egui::ScrollArea::vertical().show(ui, |ui| {
-            // Crop and clip have their own section below.
-            let known: Vec<&String> =
-                plan.known_features.iter().filter(|f| !volgraph_core::cut_effects::is_cut_feature(f)).collect();
-            if !known.is_empty() {
-                ui.collapsing("Features", |ui| {
-                    for f in known {
-                        let mut on = plan.features.contains(f);
-                        if ui.checkbox(&mut on, f.as_str()).changed() {
-                            actions.push(Action::Feature(f.clone(), on));
-                        }
-                    }
-                });
-            }
-            // A label map shown alone is coloured by its label list, not by the TF.
-            if plan.inputs.values().any(|k| *k == InputKind::TransferFunction) && session.shows_transfer_function() {
-                egui::CollapsingHeader::new("Transfer function").default_open(true).show(ui, |ui| {
-                    // One editor per scalar volume: which TF input it edits.
-                    let targets = session.transfer_function_targets();
-                    if targets.len() > 1 {
-                        let current = session.workbench().tf_target.clone();
-                        let label = |t: &Option<String>| {
-                            targets.iter().find(|(i, _)| i == t).map_or(String::new(), |(_, l)| l.clone())
-                        };
-                        egui::ComboBox::from_label("edits").selected_text(label(&current)).show_ui(ui, |ui| {
-                            for (input, text) in &targets {
-                                if ui.selectable_label(*input == current, text).clicked() && *input != current {
-                                    actions.push(Action::TfTarget(input.clone()));
-                                }
-                            }
-                        });
-                    }
-                    let model = session.workbench().edited_tf();
-                    let (histogram, range) = model.histogram();
-                    let (tf, presets) = (model.transfer_function(), model.presets());
-                    if let Some(a) = super::tf_editor::show(ui, tf, histogram, range, presets, model.save_on_change) {
-                        actions.push(Action::TransferFunction(a));
-                    }
-                });
-            }
-            if let Some(list) = session.labels() {
-                egui::CollapsingHeader::new(format!("Labels ({})", list.rows.len())).default_open(true).show(ui, |ui| {
-                    let mut list = list.clone();
-                    let search = list.search.clone();
-                    if let Some(edit) = super::label_list::show(ui, &mut list) {
-                        actions.push(Action::Labels(edit));
-                    }
-                    if list.search != search {
-                        actions.push(Action::LabelSearch(list.search));
-                    }
-                });
-            }
-            if let Some(cuts) = cuts_section(ui, session.runtime.cuts()) {
-                actions.push(Action::Cuts(cuts));
-            }
-            if let Some(light) = super::light_control::light_section(ui, session.runtime.light()) {
-                actions.push(Action::Light(light));
-            }
-            let scalars: BTreeMap<&String, f64> = plan
-                .inputs
-                .iter()
-                .filter_map(|(n, k)| match k {
-                    InputKind::Scalar(default) => {
-                        Some((n, session.options().scalars.get(n).copied().unwrap_or(*default)))
-                    }
-                    // A value in data units: the panel edits it only once the user set one.
-                    InputKind::Data(_) => session.options().scalars.get(n).map(|v| (n, *v)),
-                    _ => None,
-                })
-                .collect();
-            if !scalars.is_empty() {
-                ui.collapsing("Scalars", |ui| {
-                    for (name, value) in scalars {
-                        let mut v = value;
-                        let r = ui.add(
-                            egui::DragValue::new(&mut v)
-                                .speed((value.abs() * 0.01).max(0.001))
-                                .prefix(format!("{name} = ")),
-                        );
-                        if r.drag_stopped() || (r.changed() && !r.dragged()) {
-                            actions.push(Action::Scalar(name.clone(), v));
-                        }
-                    }
-                });
-            }
-            ui.collapsing("Parameters", |ui| {
-                if let Some(text) = assign_field(ui) {
-                    actions.push(Action::Assign(text));
+            ui.small(under_cursor.unwrap_or("under the cursor: nothing visible"));
+            ui.horizontal(|ui| {
+                let (mut enabled, mut fps) = (lod.enabled, 1000.0 / lod.target_ms);
+                let toggled = ui.checkbox(&mut enabled, "coarser while moving, target").changed();
+                let moved =
+                    ui.add(egui::DragValue::new(&mut fps).range(1.0..=120.0).speed(0.5).suffix(" fps")).changed();
+                if toggled || moved {
+                    actions.push(Action::Lod { enabled, target_fps: fps });
                 }
-                // The graph's own WGSL-only kinds have parameters too.
-                let registry = volgraph_core::wgsl_pass::with_graph_kinds(session.workbench().graph.registry(), &plan.kinds);
-                let mut seen = Vec::new();
-                for step in &plan.steps {
-                    if seen.contains(&step.pass_id) {
-                        continue;
-                    }
-                    seen.push(step.pass_id.clone());
-                    let Some(plugin) = registry.get(&step.kind) else { continue };
-                    let specs = plugin.params();
-                    if specs.is_empty() {
-                        continue;
-                    }
-                    ui.collapsing(format!("{} [{}]", step.pass_id, step.kind), |ui| {
-                        for spec in specs {
-                            let Some((_, value)) = step.params.iter().find(|(n, _)| *n == spec.name) else { continue };
-                            if let Some(v) = param_widget(ui, spec.name, &spec.kind, value) {
-                                actions.push(Action::Param(step.pass_id.clone(), spec.name.to_string(), v));
+            });
+            ui.small(lod.line());
+            ui.small(accuracy);
+            // What passes report about the last frame (a brick pool's uploads and occupancy).
+            for line in crate::render::counter_lines(&session.runtime.pass_counters()) {
+                ui.label(egui::RichText::new(line).small());
+            }
+            ui.separator();
+            let mut each = session.runtime.step_profiling();
+            let hint = "Submit and wait for every pass on its own, so each one's time is measured even where GPU \
+                    timestamps miss compute work (lavapipe); frames get slower";
+            if ui.checkbox(&mut each, "time each pass").on_hover_text(hint).changed() {
+                actions.push(Action::TimeEachPass(each));
+            }
+            let max = timings.per_pass.iter().map(|(_, ms)| *ms).fold(1e-6, f64::max);
+            egui::Grid::new("passes").num_columns(3).show(ui, |ui| {
+                for (pass, ms) in &timings.per_pass {
+                    ui.label(pass);
+                    ui.add(egui::ProgressBar::new((ms / max) as f32).desired_width(120.0));
+                    ui.label(format!("{ms:.2} ms"));
+                    ui.end_row();
+                }
+            });
+            ui.separator();
+            {
+                // Crop and clip have their own section below.
+                let known: Vec<&String> =
+                    plan.known_features.iter().filter(|f| !volgraph_core::cut_effects::is_cut_feature(f)).collect();
+                if !known.is_empty() {
+                    ui.collapsing("Features", |ui| {
+                        for f in known {
+                            let mut on = plan.features.contains(f);
+                            if ui.checkbox(&mut on, f.as_str()).changed() {
+                                actions.push(Action::Feature(f.clone(), on));
                             }
                         }
                     });
                 }
-            });
-            egui::CollapsingHeader::new("Graph").default_open(true).show(ui, |ui| {
-                egui::ScrollArea::both().id_salt("graph").max_height(320.0).show(ui, |ui| {
-                    super::graph_picture::show(ui, plan);
+                // A label map shown alone is coloured by its label list, not by the TF.
+                if plan.inputs.values().any(|k| *k == InputKind::TransferFunction) && session.shows_transfer_function()
+                {
+                    egui::CollapsingHeader::new("Transfer function").default_open(true).show(ui, |ui| {
+                        // One editor per scalar volume: which TF input it edits.
+                        let targets = session.transfer_function_targets();
+                        if targets.len() > 1 {
+                            let current = session.workbench().tf_target.clone();
+                            let label = |t: &Option<String>| {
+                                targets.iter().find(|(i, _)| i == t).map_or(String::new(), |(_, l)| l.clone())
+                            };
+                            egui::ComboBox::from_label("edits").selected_text(label(&current)).show_ui(ui, |ui| {
+                                for (input, text) in &targets {
+                                    if ui.selectable_label(*input == current, text).clicked() && *input != current {
+                                        actions.push(Action::TfTarget(input.clone()));
+                                    }
+                                }
+                            });
+                        }
+                        let model = session.workbench().edited_tf();
+                        let (histogram, range) = model.histogram();
+                        let (tf, presets) = (model.transfer_function(), model.presets());
+                        if let Some(a) = super::tf_editor::show(ui, tf, histogram, range, presets, model.save_on_change)
+                        {
+                            actions.push(Action::TransferFunction(a));
+                        }
+                    });
+                }
+                if let Some(list) = session.labels() {
+                    egui::CollapsingHeader::new(format!("Labels ({})", list.rows.len())).default_open(true).show(
+                        ui,
+                        |ui| {
+                            let mut list = list.clone();
+                            let search = list.search.clone();
+                            if let Some(edit) = super::label_list::show(ui, &mut list) {
+                                actions.push(Action::Labels(edit));
+                            }
+                            if list.search != search {
+                                actions.push(Action::LabelSearch(list.search));
+                            }
+                        },
+                    );
+                }
+                if let Some(cuts) = cuts_section(ui, session.runtime.cuts()) {
+                    actions.push(Action::Cuts(cuts));
+                }
+                if let Some(light) = super::light_control::light_section(ui, session.runtime.light()) {
+                    actions.push(Action::Light(light));
+                }
+                let scalars: BTreeMap<&String, f64> = plan
+                    .inputs
+                    .iter()
+                    .filter_map(|(n, k)| match k {
+                        InputKind::Scalar(default) => {
+                            Some((n, session.options().scalars.get(n).copied().unwrap_or(*default)))
+                        }
+                        // A value in data units: the panel edits it only once the user set one.
+                        InputKind::Data(_) => session.options().scalars.get(n).map(|v| (n, *v)),
+                        _ => None,
+                    })
+                    .collect();
+                if !scalars.is_empty() {
+                    ui.collapsing("Scalars", |ui| {
+                        for (name, value) in scalars {
+                            let mut v = value;
+                            let r = ui.add(
+                                egui::DragValue::new(&mut v)
+                                    .speed((value.abs() * 0.01).max(0.001))
+                                    .prefix(format!("{name} = ")),
+                            );
+                            if r.drag_stopped() || (r.changed() && !r.dragged()) {
+                                actions.push(Action::Scalar(name.clone(), v));
+                            }
+                        }
+                    });
+                }
+                ui.collapsing("Parameters", |ui| {
+                    if let Some(text) = assign_field(ui) {
+                        actions.push(Action::Assign(text));
+                    }
+                    // The graph's own WGSL-only kinds have parameters too.
+                    let registry =
+                        volgraph_core::wgsl_pass::with_graph_kinds(session.workbench().graph.registry(), &plan.kinds);
+                    let mut seen = Vec::new();
+                    for step in &plan.steps {
+                        if seen.contains(&step.pass_id) {
+                            continue;
+                        }
+                        seen.push(step.pass_id.clone());
+                        let Some(plugin) = registry.get(&step.kind) else { continue };
+                        let specs = plugin.params();
+                        if specs.is_empty() {
+                            continue;
+                        }
+                        ui.collapsing(format!("{} [{}]", step.pass_id, step.kind), |ui| {
+                            for spec in specs {
+                                let Some((_, value)) = step.params.iter().find(|(n, _)| *n == spec.name) else {
+                                    continue;
+                                };
+                                if let Some(v) = param_widget(ui, spec.name, &spec.kind, value) {
+                                    actions.push(Action::Param(step.pass_id.clone(), spec.name.to_string(), v));
+                                }
+                            }
+                        });
+                    }
                 });
-            });
-            ui.collapsing("Plan", |ui| {
-                ui.add(egui::Label::new(egui::RichText::new(plan.to_text()).monospace().small()).extend());
-            });
-        });
-        ui.separator();
-        ui.horizontal(|ui| {
-            if ui.button("screenshot").clicked() {
-                actions.push(Action::Screenshot);
-            }
-            if ui.button("reset camera").clicked() {
-                actions.push(Action::ResetCamera);
-            }
-            if ui
-                .button("write to graph file")
-                .on_hover_text("the values changed here, written at their place")
-                .clicked()
-            {
-                actions.push(Action::WriteBack);
-            }
-            if ui
-                .button("save view")
-                .on_hover_text(format!(
-                    "graph, volume, camera, crop, clip, TF and effects to {SAVED_SCENE} (an edited TF beside it): render \
-                     --scene draws it again"
-                ))
-                .clicked()
-            {
-                actions.push(Action::SaveScene(SAVED_SCENE.into()));
+                egui::CollapsingHeader::new("Graph").default_open(true).show(ui, |ui| {
+                    egui::ScrollArea::both().id_salt("graph").max_height(320.0).show(ui, |ui| {
+                        super::graph_picture::show(ui, plan);
+                    });
+                });
+                ui.collapsing("Plan", |ui| {
+                    ui.add(egui::Label::new(egui::RichText::new(plan.to_text()).monospace().small()).extend());
+                });
             }
         });
-        ui.small(HELP);
     });
-    actions
+    Shown { actions, width: panel.response.rect.width() }
+}
+
+/// What [`show`] drew: what the user changed, and the panel's width in points (the image is
+/// drawn beside it, never under it).
+pub struct Shown {
+    /// What the user changed.
+    pub actions: Vec<Action>,
+    /// The panel's width, points.
+    pub width: f32,
+}
+
+/// The panel's buttons: screenshot, reset camera, write to graph file, save view (wrapping onto
+/// more rows in a narrow panel).
+fn action_buttons(ui: &mut egui::Ui, actions: &mut Vec<Action>) {
+    ui.horizontal_wrapped(|ui| {
+        if ui.button("screenshot").clicked() {
+            actions.push(Action::Screenshot);
+        }
+        if ui.button("reset camera").clicked() {
+            actions.push(Action::ResetCamera);
+        }
+        if ui.button("write to graph file").on_hover_text("the values changed here, written at their place").clicked() {
+            actions.push(Action::WriteBack);
+        }
+        if ui
+            .button("save view")
+            .on_hover_text(format!(
+                "graph, volume, camera, crop, clip, TF and effects to {SAVED_SCENE} (an edited TF beside it): render \
+                 --scene draws it again"
+            ))
+            .clicked()
+        {
+            actions.push(Action::SaveScene(SAVED_SCENE.into()));
+        }
+    });
 }
 
 /// Where the panel's "save view" writes (the current folder).

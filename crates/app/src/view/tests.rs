@@ -226,6 +226,54 @@ fn the_path_tracer_shows_its_estimated_error() {
     let _ = std::fs::remove_dir_all(&s.dir);
 }
 
+/// The panel at 800×600 (issue 45 item 3), through egui's test harness: it takes a side of the
+/// window, not half of it (the image is drawn in the rest, `window::image_size`), its buttons
+/// stay in the window whatever the sections above them hold, and what does not fit scrolls into
+/// view.
+#[test]
+fn the_panel_leaves_the_image_its_side_and_keeps_its_buttons_in_reach_at_800_by_600() {
+    use egui_kittest::Harness;
+    use egui_kittest::kittest::Queryable as _;
+
+    let s = scratch("layout", "graphs/basic/fragment_raycast.ron");
+    let mut session = open(&s, None);
+    frame(&mut session);
+    let window = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::Vec2::new(800.0, 600.0));
+    let timings = super::panel::Timings::default();
+    let lod = super::lod::Lod::default();
+    let mut h = Harness::builder().with_size(window.size()).build_ui_state(
+        |ui, width: &mut f32| {
+            let shown = super::panel::show(ui, &session, &timings, "lavapipe", None, &lod, "");
+            *width = shown.width;
+        },
+        0.0f32,
+    );
+    h.run();
+    let width = *h.state();
+    assert!(width > 100.0 && width <= 400.0, "the panel is {width} points of 800");
+    // Open every section the tall way: the parameters of every pass, the plan's text.
+    h.get_by_label("Parameters").click();
+    h.run();
+    h.get_by_label("Plan").click();
+    h.run();
+    for button in ["screenshot", "reset camera", "write to graph file", "save view"] {
+        let rect = h.get_by_label(button).rect();
+        assert!(window.contains_rect(rect), "\"{button}\" at {rect:?} is outside the window");
+        assert!(rect.min.x >= 800.0 - width - 1.0, "\"{button}\" is in the panel");
+    }
+    // The sections scroll (the wheel over the panel): the plan's header moves up, toward the
+    // text below it that did not fit.
+    let before = h.get_by_label("Plan").rect();
+    for _ in 0..3 {
+        h.get_by_label("Plan").scroll_down();
+        h.run();
+    }
+    let after = h.get_by_label("Plan").rect();
+    assert!(after.min.y < before.min.y - 100.0, "the panel scrolled: {before:?} → {after:?}");
+    assert!(h.get_by_label("save view").rect().max.y <= window.max.y, "the buttons stay put");
+    let _ = std::fs::remove_dir_all(&s.dir);
+}
+
 #[test]
 fn a_resize_rebuilds_no_pipeline() {
     let s = scratch("resize", "graphs/basic/fragment_raycast.ron");

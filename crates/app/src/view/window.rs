@@ -44,6 +44,9 @@ pub struct Viewer {
     timings: Timings,
     modifiers: ModifiersState,
     panel_open: bool,
+    /// The panel's width as last drawn, physical pixels (0 while it is closed): the image is
+    /// drawn beside it, in the rest of the window, never under it.
+    panel_px: u32,
     /// The pointer's last position in the window (physical pixels), for "under the cursor".
     cursor: Option<(f64, f64)>,
     /// Coarser frames while the camera moves, and when to measure the view's accuracy.
@@ -62,6 +65,8 @@ impl Viewer {
         let orbit = Orbit::new(view.camera);
         Self {
             panel_open: view.panel,
+            // Until the panel is first drawn: its default width (320 points) at one pixel a point.
+            panel_px: if view.panel { 320 } else { 0 },
             session_args,
             view,
             script,
@@ -203,8 +208,12 @@ impl Viewer {
                     Vec::new()
                 }
                 Action::SaveScene(path) => {
-                    let window =
-                        self.gfx.as_ref().map_or(session.options().viewport, |g| (g.config.width, g.config.height));
+                    // The image as the window shows it (beside the panel), which the screenshot
+                    // saves too: `render --scene` draws the same picture.
+                    let panel_px = self.panel_px;
+                    let window = self.gfx.as_ref().map_or(session.options().viewport, |g| {
+                        image_size((g.config.width, g.config.height), panel_px)
+                    });
                     match session.save_view(&self.orbit.camera, window, &path) {
                         Ok(tf_file) => {
                             crate::stdout::println_escaped!("saved scene {}", path.display());
@@ -316,7 +325,8 @@ impl Viewer {
         super::screenshot_target(path)?;
         let (Some(session), Some(gfx)) = (self.session.as_mut(), self.gfx.as_ref()) else { return Ok(()) };
         let output = session.shown_output();
-        let (w, h) = (gfx.config.width, gfx.config.height);
+        // The image as the window shows it beside the panel (not stretched over the window).
+        let (w, h) = image_size((gfx.config.width, gfx.config.height), self.panel_px);
         let bytes = session.runtime.capture(output, gfx.config.format, (w, h)).map_err(|e| e.to_string())?;
         let bgra = matches!(gfx.config.format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb);
         let mut rgba = bytes;
@@ -343,7 +353,8 @@ impl Viewer {
         // Level of detail: fewer pixels while the camera moves, the full image once it rests.
         let mut lod_events = Vec::new();
         if let (Some(session), Some(gfx)) = (self.session.as_mut(), self.gfx.as_ref()) {
-            lod_events = self.frames.apply_lod((gfx.config.width, gfx.config.height), session);
+            let image = image_size((gfx.config.width, gfx.config.height), self.panel_px);
+            lod_events = self.frames.apply_lod(image, session);
         }
         self.handle(lod_events);
         let Some(session) = self.session.as_mut() else { return };
@@ -362,7 +373,14 @@ impl Viewer {
         };
         let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
         let size = (gfx.config.width, gfx.config.height);
-        let target = PresentTarget { view: &view, format: gfx.config.format, size, output: session.shown_output() };
+        let image = image_size(size, self.panel_px);
+        let target = PresentTarget {
+            view: &view,
+            format: gfx.config.format,
+            size,
+            output: session.shown_output(),
+            region: Some([0, 0, image.0, image.1]),
+        };
         if let Some(turn) = self.view.turn_degrees {
             self.orbit.turn(turn);
             self.frames.changed();
@@ -403,8 +421,9 @@ impl Viewer {
                 }
             }
             let accuracy_line = self.frames.accuracy_line(self.accuracy.last.as_ref(), self.accuracy.busy());
+            let mut panel_points = 0.0;
             let output = ctx.run_ui(raw, |ui| {
-                actions = panel::show(
+                let shown = panel::show(
                     ui,
                     session,
                     &self.timings,
@@ -413,8 +432,11 @@ impl Viewer {
                     self.frames.lod(),
                     &accuracy_line,
                 );
+                (actions, panel_points) = (shown.actions, shown.width);
             });
             let egui::FullOutput { platform_output, mut textures_delta, shapes, pixels_per_point, .. } = output;
+            // The next frame's image fits beside the panel as drawn now.
+            self.panel_px = (panel_points * pixels_per_point).ceil().max(0.0) as u32;
             gfx.egui.handle_platform_output(&gfx.window, platform_output);
             let jobs = ctx.tessellate(shapes, pixels_per_point);
             for (id, deltas) in textures_delta.set.drain() {
@@ -494,7 +516,8 @@ impl ApplicationHandler for Viewer {
                     gfx.surface.configure(&gfx.gpu.device, &gfx.config);
                 }
                 if let Some(session) = self.session.as_mut() {
-                    let events = session.resize(size.width, size.height);
+                    let (w, h) = image_size((size.width, size.height), self.panel_px);
+                    let events = session.resize(w, h);
                     self.handle(events);
                 }
             }
@@ -503,7 +526,14 @@ impl ApplicationHandler for Viewer {
             WindowEvent::KeyboardInput { event, .. } if !consumed && event.state == ElementState::Pressed => {
                 match event.logical_key {
                     Key::Named(NamedKey::Escape) => event_loop.exit(),
-                    Key::Named(NamedKey::F1) => self.panel_open = !self.panel_open,
+                    Key::Named(NamedKey::F1) => {
+                        self.panel_open = !self.panel_open;
+                        // Closed, the image takes the whole window; open, the panel's width as
+                        // last drawn (the next frame fits it).
+                        if !self.panel_open {
+                            self.panel_px = 0;
+                        }
+                    }
                     Key::Character(c) if c.eq_ignore_ascii_case("r") => self.orbit.reset(),
                     Key::Character(c) if c.eq_ignore_ascii_case("s") => {
                         self.apply_actions(vec![Action::Screenshot]);
@@ -564,4 +594,11 @@ pub fn run(session_args: SessionArgs, view: ViewOptions, script: Option<Receiver
         Some(e) => Err(e),
         None => Ok(()),
     }
+}
+
+/// The image's size in a window of `surface` pixels with a panel `panel_px` wide at its right:
+/// the rest of the window (at least a quarter of its width and a pixel).
+fn image_size(surface: (u32, u32), panel_px: u32) -> (u32, u32) {
+    let (w, h) = surface;
+    (w.saturating_sub(panel_px).max(w / 4).max(1), h.max(1))
 }

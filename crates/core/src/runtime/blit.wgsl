@@ -1,15 +1,17 @@
 // Presenting a graph output on a window surface, sRGB-correct: the output is either linear
 // colour (a raycaster's float `image`) or already sRGB-encoded 8-bit (`present`'s `display`);
 // the surface either encodes in hardware (an *Srgb format) or expects encoded values.
-// The output is scaled to the surface with nearest sampling (equal sizes in steady state).
+// The output is scaled to its region of the surface (the whole surface, or the viewer's image
+// beside its panel; the pass's viewport) with nearest sampling (equal sizes in steady state).
 
 struct BlitParams {
     // 1: the source holds sRGB-encoded values.
     source_encoded: u32,
     // 1: the surface format is not sRGB, so the shader must write encoded values.
     surface_wants_encoded: u32,
-    // Surface size in pixels.
-    surface_size: vec2<f32>,
+    // The region's corner and size on the surface, pixels.
+    region_origin: vec2<f32>,
+    region_size: vec2<f32>,
 }
 
 @group(0) @binding(0) var source: texture_2d<f32>;
@@ -33,7 +35,7 @@ fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
 @fragment
 fn fs_blit(@builtin(position) p: vec4<f32>) -> @location(0) vec4<f32> {
     let size = vec2<f32>(textureDimensions(source));
-    let texel = vec2<i32>(clamp(floor(p.xy / params.surface_size * size), vec2<f32>(0.0), size - 1.0));
+    let texel = vec2<i32>(clamp(floor((p.xy - params.region_origin) / params.region_size * size), vec2<f32>(0.0), size - 1.0));
     var rgb = textureLoad(source, texel, 0).rgb;
     if (params.source_encoded == 1u && params.surface_wants_encoded == 0u) {
         rgb = srgb_to_linear(rgb);

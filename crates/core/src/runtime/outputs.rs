@@ -92,7 +92,7 @@ impl Runtime {
             },
         )?;
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
-        let target = PresentTarget { view: &view, format, size, output };
+        let target = PresentTarget { view: &view, format, size, output, region: None };
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("capture") });
         self.blitter.record(&self.gpu, &mut encoder, &source, encoded, &target)?;

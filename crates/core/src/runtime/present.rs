@@ -16,6 +16,9 @@ pub struct PresentTarget<'a> {
     pub size: (u32, u32),
     /// The graph output to show (`display` when the graph has it).
     pub output: &'a str,
+    /// Where on the surface the output goes, (x, y, width, height) in pixels (the viewer's image
+    /// beside its panel); `None`: the whole surface.
+    pub region: Option<[u32; 4]>,
 }
 
 #[repr(C)]
@@ -23,7 +26,9 @@ pub struct PresentTarget<'a> {
 struct BlitParams {
     source_encoded: u32,
     surface_wants_encoded: u32,
-    surface_size: [f32; 2],
+    region_origin: [f32; 2],
+    region_size: [f32; 2],
+    _pad: [f32; 2],
 }
 
 struct BlitPipeline {
@@ -128,10 +133,18 @@ impl Blitter {
         target: &PresentTarget<'_>,
     ) -> Result<(), GpuFault> {
         let blit = self.pipeline(gpu, target.format)?;
+        // The region, kept on the surface and at least a pixel.
+        let (w, h) = (target.size.0.max(1), target.size.1.max(1));
+        let region = target.region.map_or([0, 0, w, h], |[x, y, rw, rh]| {
+            let (x, y) = (x.min(w - 1), y.min(h - 1));
+            [x, y, rw.clamp(1, w - x), rh.clamp(1, h - y)]
+        });
         let params = BlitParams {
             source_encoded: source_encoded as u32,
             surface_wants_encoded: (!target.format.is_srgb()) as u32,
-            surface_size: [target.size.0.max(1) as f32, target.size.1.max(1) as f32],
+            region_origin: [region[0] as f32, region[1] as f32],
+            region_size: [region[2] as f32, region[3] as f32],
+            _pad: [0.0; 2],
         };
         gpu.queue.write_buffer(&blit.params, 0, bytemuck::bytes_of(&params));
         let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -154,6 +167,7 @@ impl Blitter {
         });
         pass.set_pipeline(&blit.pipeline);
         pass.set_bind_group(0, &group, &[]);
+        pass.set_viewport(region[0] as f32, region[1] as f32, region[2] as f32, region[3] as f32, 0.0, 1.0);
         pass.draw(0..3, 0..1);
         Ok(())
     }

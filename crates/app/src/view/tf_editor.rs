@@ -2,8 +2,10 @@
 //! Slicer's volume-rendering module and Inviwo's TF property offer): the volume's histogram on a
 //! log scale in the data's units, the TF's opacity curve and control points over it. Click empty
 //! space to add a point, drag a point to move it (value and opacity), right-click to delete it;
-//! the selected point's colour, opacity and value are edited below, and the built-in presets
-//! replace the whole function. Every change comes back as a new [`TransferFunction`] for the
+//! the selected point's colour, opacity and value are edited below (drag the numbers, or
+//! double-click to type one), "shift" moves the whole function along the data axis and "width"
+//! stretches it about its centre (3D Slicer's shift slider: a CT preset moved along the HU axis in
+//! one motion), and the built-in presets replace the whole function. Every change comes back as a new [`TransferFunction`] for the
 //! session to upload at once.
 
 use egui::{Color32, Pos2, Rect, Sense, Stroke, Vec2};
@@ -178,6 +180,19 @@ pub fn show(
             action = Some(TfAction::Edit(widen(next)));
         }
     }
+    // The whole function: each frame's drag (or a typed amount) applied once, from 0 and ×1.
+    ui.horizontal(|ui| {
+        let (mut shift, mut width) = (0.0, 1.0);
+        let label = ui.label("shift");
+        let moved = ui.add(egui::DragValue::new(&mut shift).speed((hi - lo) / 500.0)).labelled_by(label.id);
+        let label = ui.label("width ×");
+        let stretched = ui.add(egui::DragValue::new(&mut width).speed(0.005).range(0.01..=100.0)).labelled_by(label.id);
+        if moved.changed() && shift != 0.0 && action.is_none() {
+            action = Some(TfAction::Edit(shifted(tf, shift)));
+        } else if stretched.changed() && width != 1.0 && action.is_none() {
+            action = Some(TfAction::Edit(stretched_by(tf, width)));
+        }
+    });
     ui.horizontal(|ui| {
         egui::ComboBox::from_label("preset").selected_text("replace with…").show_ui(ui, |ui| {
             for (name, preset) in presets {
@@ -205,6 +220,28 @@ pub fn with_point(tf: &TransferFunction, point: ControlPoint) -> TransferFunctio
     next.points.retain(|p| p.value != point.value);
     let at = next.points.partition_point(|p| p.value <= point.value);
     next.points.insert(at, point);
+    widen(next)
+}
+
+/// `tf` moved by `delta` data units along the value axis, its domain with it: every point keeps
+/// its colour and opacity.
+pub fn shifted(tf: &TransferFunction, delta: f64) -> TransferFunction {
+    let mut next = tf.clone();
+    next.points.iter_mut().for_each(|p| p.value += delta);
+    next.domain = (tf.domain.0 + delta, tf.domain.1 + delta);
+    next
+}
+
+/// `tf` stretched by `factor` about the centre of its points' values (the domain widened over
+/// them): a ramp made `factor` times as wide, where it was.
+pub fn stretched_by(tf: &TransferFunction, factor: f64) -> TransferFunction {
+    let (first, last) = match (tf.points.first(), tf.points.last()) {
+        (Some(a), Some(b)) => (a.value, b.value),
+        _ => return tf.clone(),
+    };
+    let centre = 0.5 * (first + last);
+    let mut next = tf.clone();
+    next.points.iter_mut().for_each(|p| p.value = centre + (p.value - centre) * factor);
     widen(next)
 }
 
@@ -310,6 +347,26 @@ mod tests {
         assert!((p.value - 30.0).abs() < 1.0 && (p.alpha - 0.8).abs() < 0.02, "moved to {p:?}");
         assert_eq!(p.color, [1.0, 0.0, 0.0], "the colour stays with the point");
         assert!(h.state().edits >= 1);
+    }
+
+    /// "shift" moves every point by the amount typed (or dragged), "width ×" stretches them about
+    /// their centre; colours and opacities stay.
+    #[test]
+    fn shift_and_width_move_and_stretch_the_whole_function() {
+        use egui_kittest::kittest::Queryable as _;
+        let mut h = harness();
+        h.get_by_label("shift").set_value_accesskit(20.0);
+        h.run();
+        let values: Vec<f64> = h.state().tf.points.iter().map(|p| p.value).collect();
+        assert_eq!(values, [20.0, 70.0, 120.0], "shifted by 20");
+        assert_eq!(h.state().tf.domain, (20.0, 120.0));
+        let alphas: Vec<f64> = h.state().tf.points.iter().map(|p| p.alpha).collect();
+        assert_eq!(alphas, [0.0, 0.5, 1.0], "opacities stay");
+        h.get_by_label("width ×").set_value_accesskit(0.5);
+        h.run();
+        let values: Vec<f64> = h.state().tf.points.iter().map(|p| p.value).collect();
+        assert_eq!(values, [45.0, 70.0, 95.0], "half as wide about 70");
+        assert_eq!(h.state().tf.points[1].color, [1.0, 0.0, 0.0], "colours stay");
     }
 
     #[test]

@@ -251,6 +251,14 @@ pub enum SceneError {
     /// The file cannot be read (missing, not a regular file, too large, not text).
     #[error(transparent)]
     Read(#[from] volgraph_accel::input_file::InputFileError),
+    /// No file at the path, and no built-in scene of that name.
+    #[error("{}: no such scene file, nor a built-in scene of that name (`volgraph scenes` lists them: {builtin})", .path.display())]
+    Missing {
+        /// The path given.
+        path: PathBuf,
+        /// The built-in scenes' names.
+        builtin: String,
+    },
     /// The RON does not parse into a scene.
     #[error("{}:{line}:{col}: {message}; see scenes/README.md (or crates/app/src/scene.rs) for the format", .path.display())]
     Ron {
@@ -281,6 +289,10 @@ impl Scene {
     pub fn load_named(argument: &Path) -> Result<Scene, SceneError> {
         match crate::builtin_scenes::find(argument) {
             Some((name, text)) => Scene::from_str(text, &crate::builtin_scenes::virtual_path(name)),
+            None if argument.symlink_metadata().is_err() => Err(SceneError::Missing {
+                path: argument.to_path_buf(),
+                builtin: crate::builtin_graphs::EMBEDDED_SCENES.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "),
+            }),
             None => Scene::load(argument),
         }
     }

@@ -275,8 +275,13 @@ fn a_memory_budget_for_a_graph_without_a_pool_is_named() {
 #[test]
 fn an_os_error_is_printed_once() {
     let dir = temp_dir();
+    let tf = s(&dir.join("no_such_tf.ron"));
+    let run = volgraph(&["render", "basic/fragment_raycast", "--tf", &tf, "-o", &s(&dir.join("x.png"))]);
+    assert_fails_with(&run, 1, "no_such_tf.ron: cannot read the transfer function: No such file or directory", "tf");
+    assert_eq!(run.stderr.matches("No such file or directory").count(), 1, "{}", run.stderr);
+    // A missing scene names the built-in scenes instead of an OS error.
     let scene = s(&dir.join("no_such_scene.ron"));
     let run = volgraph(&["render", "--scene", &scene, "-o", &s(&dir.join("x.png"))]);
-    assert_fails_with(&run, 1, "no_such_scene.ron: cannot read the scene file: No such file or directory", "scene");
-    assert_eq!(run.stderr.matches("No such file or directory").count(), 1, "{}", run.stderr);
+    assert_fails_with(&run, 1, "no_such_scene.ron: no such scene file, nor a built-in scene", "scene");
+    assert!(run.stderr.contains("engine_cut_open"), "{}", run.stderr);
 }

@@ -38,42 +38,31 @@ fn main() {
         code.push_str(&format!("    ({name:?}, include_str!({:?})),\n", absolute.display().to_string()));
     }
     code.push_str("];\n");
-    // The transfer functions of `graphs/tf/`, which presets and scenes name.
-    code.push_str(
-        "/// Every transfer function of the workspace's `graphs/tf/` folder: `(stem, text)`.\n\
-         pub static EMBEDDED_TFS: &[(&str, &str)] = &[\n",
-    );
-    let mut tfs: Vec<PathBuf> = std::fs::read_dir(root.join("tf"))
-        .map(|entries| entries.filter_map(|e| e.ok().map(|e| e.path())).collect())
-        .unwrap_or_default();
-    tfs.sort();
-    for path in tfs.iter().filter(|p| p.extension().is_some_and(|e| e == "ron")) {
-        println!("cargo:rerun-if-changed={}", path.display());
-        let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-        let absolute = path.canonicalize().unwrap_or_else(|_| path.clone());
-        code.push_str(&format!("    ({stem:?}, include_str!({:?})),\n", absolute.display().to_string()));
-    }
-    code.push_str("];\n");
-    // The shipped scenes of `scenes/`, which name their graphs and TFs as built-ins.
-    code.push_str(
-        "/// Every scene of the workspace's `scenes/` folder: `(stem, text)`.\n\
-         pub static EMBEDDED_SCENES: &[(&str, &str)] = &[\n",
-    );
-    let scenes_dir = Path::new(&manifest).join("../../scenes");
-    println!("cargo:rerun-if-changed={}", scenes_dir.display());
-    let mut scenes: Vec<PathBuf> = std::fs::read_dir(&scenes_dir)
-        .map(|entries| entries.filter_map(|e| e.ok().map(|e| e.path())).collect())
-        .unwrap_or_default();
-    scenes.sort();
-    for path in scenes.iter().filter(|p| p.extension().is_some_and(|e| e == "ron")) {
-        println!("cargo:rerun-if-changed={}", path.display());
-        let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-        let absolute = path.canonicalize().unwrap_or_else(|_| path.clone());
-        code.push_str(&format!("    ({stem:?}, include_str!({:?})),\n", absolute.display().to_string()));
-    }
-    code.push_str("];\n");
+    // The transfer functions of `graphs/tf/`, which presets and scenes name, and the shipped
+    // scenes of `scenes/`, which name their graphs and TFs as built-ins.
+    embed_folder(&mut code, "EMBEDDED_TFS", "transfer function of the workspace's `graphs/tf/`", &root.join("tf"));
+    let scenes = Path::new(&manifest).join("../../scenes");
+    embed_folder(&mut code, "EMBEDDED_SCENES", "scene of the workspace's `scenes/`", &scenes);
     let out = PathBuf::from(std::env::var("OUT_DIR").unwrap_or_else(|_| ".".to_string())).join("embedded_graphs.rs");
     if let Err(e) = std::fs::write(&out, code) {
         panic!("cannot write {}: {e}", out.display());
     }
+}
+
+/// Appends `pub static NAME: &[(&str, &str)]`: `(stem, text)` of every `.ron` file of `dir` (not
+/// below it), in name order; `what` documents it.
+fn embed_folder(code: &mut String, name: &str, what: &str, dir: &Path) {
+    println!("cargo:rerun-if-changed={}", dir.display());
+    code.push_str(&format!("/// Every {what} folder: `(stem, text)`.\npub static {name}: &[(&str, &str)] = &[\n"));
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|entries| entries.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    files.sort();
+    for path in files.iter().filter(|p| p.extension().is_some_and(|e| e == "ron")) {
+        println!("cargo:rerun-if-changed={}", path.display());
+        let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let absolute = path.canonicalize().unwrap_or_else(|_| path.clone());
+        code.push_str(&format!("    ({stem:?}, include_str!({:?})),\n", absolute.display().to_string()));
+    }
+    code.push_str("];\n");
 }

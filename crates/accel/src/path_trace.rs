@@ -90,10 +90,10 @@ pub struct PixelEstimate {
 
 /// SplitMix64 (Steele et al. 2014): a small, well-mixed generator; uniform in [0, 1) from its
 /// top 53 bits.
-struct SplitMix64(u64);
+pub(crate) struct SplitMix64(pub(crate) u64);
 
 impl SplitMix64 {
-    fn uniform(&mut self) -> f64 {
+    pub(crate) fn uniform(&mut self) -> f64 {
         self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);

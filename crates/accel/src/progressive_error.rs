@@ -111,20 +111,12 @@ impl ErrorTracker {
 mod tests {
     use super::*;
 
-    /// A tiny deterministic generator of standard normal values (Box–Muller over SplitMix64).
-    struct Normal(u64);
+    /// Standard normal values (Box–Muller over the f64 path tracer's SplitMix64).
+    struct Normal(crate::path_trace::SplitMix64);
 
     impl Normal {
-        fn uniform(&mut self) -> f64 {
-            self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-        }
-
         fn next(&mut self) -> f64 {
-            let (u, v) = (1.0 - self.uniform(), self.uniform());
+            let (u, v) = (1.0 - self.0.uniform(), self.0.uniform());
             (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
         }
     }
@@ -134,7 +126,7 @@ mod tests {
     /// 64 within a few percent (over 4,096 values the RMS of either has a spread of ~2 %).
     #[test]
     fn the_doubling_estimate_is_the_true_error() {
-        let mut rng = Normal(7);
+        let mut rng = Normal(crate::path_trace::SplitMix64(7));
         let pixels = 1024;
         let truth: Vec<[f64; 4]> = (0..pixels).map(|i| [i as f64 / pixels as f64; 4]).collect();
         let sigma: Vec<f64> = (0..pixels).map(|i| 0.5 * ((i * 37) % pixels) as f64 / pixels as f64).collect();

@@ -62,4 +62,43 @@ impl VolumeMeta {
     pub fn is_ct_hu(&self) -> bool {
         self.units.as_deref() == Some("HU")
     }
+
+    /// The patient point (LPS, mm) of a point in voxel coordinates (voxel centres at integer +
+    /// 0.5, as `probe::Probe::voxel`): the loaders lay an LPS volume's axes along L, P and S, so
+    /// it is the origin (voxel (0, 0, 0)'s centre) plus the index times the spacing. `None` for
+    /// a volume outside the patient frame or without an origin.
+    pub fn patient_point(&self, voxel: DVec3, spacing: DVec3) -> Option<DVec3> {
+        match (&self.frame, self.origin) {
+            (WorldFrame::Lps, Some(origin)) => Some(origin + (voxel - DVec3::splat(0.5)) * spacing),
+            _ => None,
+        }
+    }
+}
+
+/// A patient point (LPS, mm) as the clinical tools write it: each axis by the side it lies
+/// toward — R/L, A/P, I/S — and its distance from the origin, `R 12.5 · P 40.0 · S 7.0 mm`.
+pub fn patient_label(point: DVec3) -> String {
+    let side = |v: f64, negative: char, positive: char| {
+        let v = if v.abs() < 0.05 { 0.0 } else { v };
+        format!("{} {:.1}", if v < 0.0 { negative } else { positive }, v.abs())
+    };
+    format!("{} · {} · {} mm", side(point.x, 'R', 'L'), side(point.y, 'A', 'P'), side(point.z, 'I', 'S'))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// LPS: +x left, +y posterior, +z superior; a negative coordinate is the opposite side.
+    #[test]
+    fn patient_points_are_labelled_by_side() {
+        let meta =
+            VolumeMeta { frame: WorldFrame::Lps, origin: Some(DVec3::new(-100.0, 20.0, -5.0)), ..Default::default() };
+        // The centre of voxel (10, 0, 4) with 0.5 × 1 × 2.5 mm voxels.
+        let p = meta.patient_point(DVec3::new(10.5, 0.5, 4.5), DVec3::new(0.5, 1.0, 2.5)).expect("in LPS");
+        assert_eq!(p, DVec3::new(-95.0, 20.0, 5.0));
+        assert_eq!(patient_label(p), "R 95.0 · P 20.0 · S 5.0 mm");
+        assert_eq!(patient_label(DVec3::new(12.5, -40.0, -7.0)), "L 12.5 · A 40.0 · I 7.0 mm");
+        assert_eq!(VolumeMeta::default().patient_point(DVec3::ZERO, DVec3::ONE), None, "index axes have no patient");
+    }
 }

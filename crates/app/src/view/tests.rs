@@ -167,6 +167,40 @@ fn the_value_under_the_cursor_is_where_the_ray_first_becomes_visible() {
     let _ = std::fs::remove_dir_all(&s.dir);
 }
 
+/// Issue 45 item 3: in the patient frame the cursor's readout says where in the patient, in mm
+/// by side (R/L, A/P, I/S); a volume in index axes says no such thing.
+#[test]
+fn the_cursor_readout_gives_the_patient_point_in_mm() {
+    use volgraph_accel::volume::{Volume, VoxelData};
+    let s = scratch("patient", "graphs/basic/fragment_raycast.ron");
+    // A 24³ CT in HU: a soft-tissue ball in air, written as a DICOM series (LPS, with an origin).
+    let n = 24u32;
+    let values: Vec<i16> = (0..n * n * n)
+        .map(|i| {
+            let p = glam::DVec3::new((i % n) as f64, ((i / n) % n) as f64, (i / (n * n)) as f64) + 0.5;
+            if (p / n as f64 - 0.5).length() < 0.35 { 40 } else { -1000 }
+        })
+        .collect();
+    let ct = Volume::new("ball", glam::UVec3::splat(n), glam::DVec3::new(0.8, 0.8, 2.0), VoxelData::I16(values));
+    let series = s.dir.join("series");
+    volgraph_accel::load::dicom::write_ct_series(&series, &ct).expect("written");
+    let series = series.display().to_string();
+    let (mut session, _) =
+        LiveSession::open(gpu(), &session_args(&s, &[series.as_str()], None)).unwrap_or_else(|_| panic!("opens"));
+    frame(&mut session);
+    let camera = OrbitCamera { azimuth_deg: 0.0, elevation_deg: 0.0, distance: 3.2, ..Default::default() };
+    let line = session.probe_line(&camera, (24.0, 24.0)).expect("the ball is under the centre");
+    assert!(line.contains(" mm") && [" L ", " R "].iter().any(|side| line.contains(side)), "{line}");
+    assert!(
+        ["P ", "A "].iter().any(|side| line.contains(side)) && ["S ", "I "].iter().any(|s| line.contains(s)),
+        "{line}"
+    );
+    // The generated default volume lies in index axes: no patient point.
+    let plain = open(&s, None).probe_line(&camera, (24.0, 24.0)).expect("the volume is under the centre");
+    assert!(!plain.contains(" mm"), "{plain}");
+    let _ = std::fs::remove_dir_all(&s.dir);
+}
+
 /// Issue 24 §5: the view's error against the converged reference, as the panel shows it: a
 /// coarser step costs accuracy, a finer one gains it back.
 #[test]

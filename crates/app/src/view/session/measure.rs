@@ -54,8 +54,14 @@ impl LiveSession {
             let value = p.value.round().max(0.0) as u32;
             list.name_of(value).map_or(String::new(), |name| format!(", label {value} \"{name}\""))
         });
+        // In the patient frame, where that is in mm, as the clinical tools say it.
+        let patient = self
+            .volume
+            .meta
+            .patient_point(p.voxel, self.volume.spacing)
+            .map_or(String::new(), |mm| format!(", {}", volgraph_accel::volume_meta::patient_label(mm)));
         Some(format!(
-            "under the cursor: {:.4}{units}{label} at voxel ({:.1}, {:.1}, {:.1}), α {:.2}",
+            "under the cursor: {:.4}{units}{label} at voxel ({:.1}, {:.1}, {:.1}){patient}, α {:.2}",
             p.value, p.voxel.x, p.voxel.y, p.voxel.z, p.alpha
         ))
     }

@@ -10,6 +10,11 @@
 //! any σ per pixel. Between powers of two the error falls as 1/√n: the estimate at n scales by
 //! √(n/m) to m samples. It sees the noise only: a biased estimator's bias (none here: delta and
 //! ratio tracking are unbiased) is invisible to it.
+//!
+//! Where each pixel holds its own count (a reprojected mean: n₁ samples in the first image, n₂
+//! in the second, after the frames between added n₂ − n₁), the difference has variance
+//! σ²(1/n₁ − 1/n₂) = σ²(n₂ − n₁)/(n₁n₂), so d²·n₁/(n₂ − n₁) estimates σ²/n₂ pixel by pixel
+//! ([`estimated_rmse_counted`]); with n₁ = n/2, n₂ = n that is the plain estimate.
 
 /// Root-mean-square difference over every channel of two premultiplied RGBA images (the
 /// project's RMSE: `bench cinematic`'s and the path tracer's tests').
@@ -21,6 +26,23 @@ pub fn rmse(a: &[[f64; 4]], b: &[[f64; 4]]) -> f64 {
 /// The estimated RMSE of `mean` (n samples per pixel) from the image at n/2, `half_mean`.
 pub fn estimated_rmse(half_mean: &[[f64; 4]], mean: &[[f64; 4]]) -> f64 {
     rmse(half_mean, mean)
+}
+
+/// The estimated RMSE of `mean`, whose pixels hold `counts` samples (`.x` of a graph's `samples`
+/// output), from `earlier` with `earlier_counts`: per pixel d²·n₁/(n₂ − n₁); a pixel that took
+/// no sample between the two (or started over: fewer now) counts as its own mean's noise
+/// unknown and is left out.
+pub fn estimated_rmse_counted(earlier: (&[[f64; 4]], &[f64]), now: (&[[f64; 4]], &[f64])) -> f64 {
+    let (mut sum, mut values) = (0.0, 0usize);
+    for ((a, &n1), (b, &n2)) in earlier.0.iter().zip(earlier.1).zip(now.0.iter().zip(now.1)) {
+        if !(n2 > n1 && n1 > 0.0) {
+            continue;
+        }
+        let weight = n1 / (n2 - n1);
+        sum += (0..4).map(|c| (a[c] - b[c]).powi(2) * weight).sum::<f64>();
+        values += 4;
+    }
+    (sum / values.max(1) as f64).sqrt()
 }
 
 /// An estimate at `spp` samples per pixel.
@@ -47,6 +69,18 @@ impl ErrorEstimate {
         (n < u64::MAX as f64).then_some(n as u64)
     }
 
+    /// A panel's line for a mean whose pixels keep their own counts (a reprojected one), made
+    /// `self.spp` frames after the view came to rest: not scaled, since a pixel's count is not
+    /// the frames.
+    pub fn line_resting(&self) -> String {
+        format!(
+            "estimated error {:.2}/255 RMS (noise from the images {} and {} frames after the view rested)",
+            self.rmse * 255.0,
+            self.spp / 2,
+            self.spp
+        )
+    }
+
     /// A panel's or a log's line, at `spp` samples now.
     pub fn line(&self, spp: u64) -> String {
         let target = 2.0 / 255.0;
@@ -70,8 +104,16 @@ impl ErrorEstimate {
 #[derive(Clone, Debug, Default)]
 pub struct ErrorTracker {
     key: u64,
-    kept: Option<(u64, Vec<[f64; 4]>)>,
+    kept: Option<Kept>,
     last: Option<ErrorEstimate>,
+}
+
+/// The image kept at a power of two, with its per-pixel counts where the graph has them.
+#[derive(Clone, Debug)]
+struct Kept {
+    step: u64,
+    mean: Vec<[f64; 4]>,
+    counts: Option<Vec<f64>>,
 }
 
 impl ErrorTracker {
@@ -84,16 +126,28 @@ impl ErrorTracker {
     /// [`Self::wants`] said so); estimates the error when the image at `spp / 2` was kept.
     /// A count that does not grow is taken as an accumulation that started over unseen.
     pub fn offer(&mut self, key: u64, spp: u64, mean: Vec<[f64; 4]>) {
-        if key != self.key || self.kept.as_ref().is_some_and(|(kept_spp, _)| spp <= *kept_spp) {
+        self.offer_counted(key, spp, mean, None);
+    }
+
+    /// [`Self::offer`] where `spp` counts frames and each pixel holds its own count of samples
+    /// (`counts`, a reprojected mean's): estimated with [`estimated_rmse_counted`].
+    pub fn offer_counted(&mut self, key: u64, spp: u64, mean: Vec<[f64; 4]>, counts: Option<Vec<f64>>) {
+        if key != self.key || self.kept.as_ref().is_some_and(|k| spp <= k.step) {
             self.restart(key);
         }
-        if let Some((kept_spp, kept)) = &self.kept
-            && *kept_spp * 2 == spp
-            && kept.len() == mean.len()
+        if let Some(kept) = &self.kept
+            && kept.step * 2 == spp
+            && kept.mean.len() == mean.len()
         {
-            self.last = Some(ErrorEstimate { spp, rmse: estimated_rmse(kept, &mean) });
+            let rmse = match (&kept.counts, &counts) {
+                (Some(n1), Some(n2)) if n1.len() == mean.len() && n2.len() == mean.len() => {
+                    estimated_rmse_counted((&kept.mean, n1), (&mean, n2))
+                }
+                _ => estimated_rmse(&kept.mean, &mean),
+            };
+            self.last = Some(ErrorEstimate { spp, rmse });
         }
-        self.kept = Some((spp, mean));
+        self.kept = Some(Kept { step: spp, mean, counts });
     }
 
     /// Forgets the accumulation: a new one, `key`, began.
@@ -173,6 +227,44 @@ mod tests {
         // A count that went back started over: the last estimate was another accumulation's.
         tracker.offer(2, 1, vec![[0.5; 4]]);
         assert_eq!(tracker.last(2), None);
+    }
+
+    /// Pixels that kept 32 samples from before the view rested and then took k more: the plain
+    /// doubling estimate undershoots (the difference holds only the new samples' share), the
+    /// counted one is the true error.
+    #[test]
+    fn with_per_pixel_counts_the_estimate_is_the_true_error() {
+        let mut rng = Normal(crate::path_trace::SplitMix64(11));
+        let pixels = 2048;
+        let truth = vec![[0.5; 4]; pixels];
+        let sigma = 0.2;
+        let kept = 32.0;
+        let mut sum: Vec<[f64; 4]> = vec![[0.0; 4]; pixels];
+        let mut draw = |sum: &mut Vec<[f64; 4]>, n: usize| {
+            for s in sum.iter_mut() {
+                for _ in 0..n {
+                    for c in s.iter_mut() {
+                        *c += 0.5 + sigma * rng.next();
+                    }
+                }
+            }
+        };
+        let mean = |sum: &[[f64; 4]], n: f64| sum.iter().map(|s| s.map(|v| v / n)).collect::<Vec<_>>();
+        draw(&mut sum, kept as usize + 16);
+        let first = mean(&sum, kept + 16.0);
+        draw(&mut sum, 16);
+        let second = mean(&sum, kept + 32.0);
+        let actual = rmse(&second, &truth);
+        let counted =
+            estimated_rmse_counted((&first, &vec![kept + 16.0; pixels]), (&second, &vec![kept + 32.0; pixels]));
+        let plain = estimated_rmse(&first, &second);
+        assert!((counted / actual - 1.0).abs() < 0.1, "counted {counted} against {actual}");
+        assert!(plain < 0.8 * actual, "the plain estimate undershoots: {plain} against {actual}");
+        // Through the tracker, keyed by frames since the view rested (16, 32).
+        let mut tracker = ErrorTracker::default();
+        tracker.offer_counted(5, 16, first, Some(vec![kept + 16.0; pixels]));
+        tracker.offer_counted(5, 32, second, Some(vec![kept + 32.0; pixels]));
+        assert_eq!(tracker.last(5).map(|e| e.rmse), Some(counted));
     }
 
     #[test]

@@ -525,15 +525,15 @@ pub fn counter_lines(counters: &[(String, &'static str, f64)]) -> Vec<String> {
 }
 
 /// Whether `plan` keeps a running mean over still frames (a progressive graph: `--spp` adds to
-/// it): a history that restarts on any camera move, or a path tracer that reprojects its mean
-/// (its still frames accumulate too).
+/// it): a history that restarts on any camera move, or a `samples` output — each pixel's own
+/// sample count in `.x`, which a mean that follows the view across moves (a reprojecting path
+/// tracer) keeps (docs/graph_format.md, "Outputs").
 pub fn accumulates(plan: &volgraph_core::Plan) -> bool {
-    plan.history.values().any(|h| h.while_camera_still)
-        || plan
-            .steps
-            .iter()
-            .any(|s| s.kind == "path_trace" && s.params.declares("reproject") && s.params.boolean("reproject"))
+    plan.history.values().any(|h| h.while_camera_still) || plan.outputs.contains_key(SAMPLES_OUTPUT)
 }
+
+/// The output of a progressive graph whose pixels keep their own sample counts (in `.x`).
+pub const SAMPLES_OUTPUT: &str = "samples";
 
 /// Whether the view's error of `plan` can be estimated from its own `image` at powers of two of
 /// samples (`volgraph_accel::progressive_error`): a running mean of independent samples per

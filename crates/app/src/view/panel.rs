@@ -209,6 +209,11 @@ pub fn show(
                 stats.run + 1,
                 stats.restarts
             ));
+                ui.label(
+                    session
+                        .noise_line()
+                        .unwrap_or_else(|| "estimated error: from the second frame at rest on".to_string()),
+                );
             } else if !plan.history.is_empty() {
                 ui.label(history_line(&session.runtime.history_stats()));
             }

@@ -182,6 +182,16 @@ pub struct LiveSession {
     environment: Option<PathBuf>,
     /// A path tracer's error, estimated from its own image at powers of two of samples.
     noise: volgraph_accel::progressive_error::ErrorTracker,
+    /// Since when the camera rests (a reprojecting path tracer's estimate counts from there).
+    resting: Resting,
+}
+
+/// The camera of the last frame, the frames it has rested, and how often it moved.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Resting {
+    camera: Option<volgraph_accel::camera::OrbitCamera>,
+    frames: u64,
+    moves: u64,
 }
 
 impl LiveSession {
@@ -458,7 +468,7 @@ impl LiveSession {
     ) -> Result<Vec<Event>, volgraph_core::runtime::RuntimeError> {
         match self.submit(camera, target) {
             Ok(_) => {
-                self.track_noise();
+                self.track_noise(camera);
                 if self.unproven {
                     self.unproven = false;
                     let graph = &self.bench.graph;

@@ -260,6 +260,39 @@ fn the_path_tracer_shows_its_estimated_error() {
     let _ = std::fs::remove_dir_all(&s.dir);
 }
 
+/// The reprojecting path tracer (its `samples` output: each pixel's own count) shows an
+/// estimated error too, counted from when the view came to rest, each pixel weighted by its
+/// counts; a move starts it over.
+#[test]
+fn the_reprojecting_path_tracer_estimates_its_error_once_the_view_rests() {
+    let s = scratch("noise_moving", "graphs/cinematic/path_traced_moving.ron");
+    let mut session = open(&s, None);
+    let camera = OrbitCamera::default();
+    let frames = |session: &mut LiveSession, n: u32, camera: &OrbitCamera| {
+        for _ in 0..n {
+            session.frame(camera, None).expect("a frame");
+        }
+        session.runtime.finish();
+    };
+    frames(&mut session, 16, &camera);
+    let rested = session.noise_line().expect("an estimate 16 frames at rest");
+    assert!(rested.contains("8 and 16 frames after the view rested"), "{rested}");
+    let turned = OrbitCamera { azimuth_deg: camera.azimuth_deg + 2.0, ..camera };
+    frames(&mut session, 1, &turned);
+    assert_eq!(session.noise_line(), None, "a move starts the estimate over");
+    frames(&mut session, 31, &turned);
+    let again = session.noise_line().expect("an estimate after the move");
+    assert!(again.contains("16 and 32 frames after the view rested"), "{again}");
+    let value: f64 = again
+        .split("estimated error ")
+        .nth(1)
+        .and_then(|t| t.split('/').next())
+        .and_then(|t| t.parse().ok())
+        .expect("a figure");
+    assert!(value > 0.0 && value < 255.0, "{again}");
+    let _ = std::fs::remove_dir_all(&s.dir);
+}
+
 /// The panel at 800×600 (issue 45 item 3), through egui's test harness: it takes a side of the
 /// window, not half of it (the image is drawn in the rest, `window::image_size`), its buttons
 /// stay in the window whatever the sections above them hold, and what does not fit scrolls into

@@ -4,33 +4,58 @@
 
 use volgraph_accel::camera::OrbitCamera;
 
-use super::LiveSession;
+use super::{LiveSession, Resting};
 
 impl LiveSession {
     /// After a frame of a path tracer whose mean starts over on any change: its image at each
     /// power of two of samples, for the estimate of the view's error
     /// (`volgraph_accel::progressive_error`; one read-back per doubling).
-    pub(super) fn track_noise(&mut self) {
-        if !crate::render::estimates_noise(self.runtime.plan()) {
+    ///
+    /// A graph whose pixels keep their own counts (a `samples` output: a reprojecting path
+    /// tracer) is estimated over the frames since the camera last moved, each pixel weighted by
+    /// its counts (`estimated_rmse_counted`).
+    pub(super) fn track_noise(&mut self, camera: &OrbitCamera) {
+        let history = self.runtime.history_stats();
+        if crate::render::estimates_noise(self.runtime.plan()) {
+            let spp = history.run + 1;
+            if self.noise.wants(spp)
+                && let Ok(image) = self.runtime.read_output("image")
+            {
+                self.noise.offer(history.restarts, spp, image.to_rgba_f64());
+            }
             return;
         }
-        let history = self.runtime.history_stats();
-        let spp = history.run + 1;
-        if self.noise.wants(spp)
-            && let Ok(image) = self.runtime.read_output("image")
-        {
-            self.noise.offer(history.restarts, spp, image.to_rgba_f64());
+        if !self.runtime.plan().is_some_and(|p| p.outputs.contains_key(crate::render::SAMPLES_OUTPUT)) {
+            return;
         }
+        if self.resting.camera != Some(*camera) {
+            self.resting = Resting { camera: Some(*camera), frames: 0, moves: self.resting.moves + 1 };
+        }
+        self.resting.frames += 1;
+        let frames = self.resting.frames;
+        if self.noise.wants(frames)
+            && let (Ok(image), Ok(counts)) =
+                (self.runtime.read_output("image"), self.runtime.read_output(crate::render::SAMPLES_OUTPUT))
+        {
+            let counts = counts.to_rgba_f64().iter().map(|p| p[0]).collect();
+            self.noise.offer_counted(self.resting_key(), frames, image.to_rgba_f64(), Some(counts));
+        }
+    }
+
+    /// What names one accumulation of a graph with per-pixel counts: the history's restarts
+    /// and the camera's moves.
+    fn resting_key(&self) -> u64 {
+        (self.runtime.history_stats().restarts << 32) ^ self.resting.moves
     }
 
     /// The view's estimated error at the samples it holds now (from the last doubling), for
     /// the panel: `None` before the second sample or for a graph it is not made for.
     pub fn noise_line(&self) -> Option<String> {
-        if !crate::render::estimates_noise(self.runtime.plan()) {
-            return None;
-        }
         let history = self.runtime.history_stats();
-        self.noise.last(history.restarts).map(|e| e.line(history.run + 1))
+        if crate::render::estimates_noise(self.runtime.plan()) {
+            return self.noise.last(history.restarts).map(|e| e.line(history.run + 1));
+        }
+        self.noise.last(self.resting_key()).map(|e| e.line_resting())
     }
 
     /// What lies under window pixel `cursor` (physical pixels) seen by `camera`: the first

@@ -192,6 +192,7 @@ impl LiveSession {
             bindings,
             environment: args.environment.clone(),
             noise: Default::default(),
+            resting: Default::default(),
         };
         let ms = start.elapsed().as_secs_f64() * 1e3;
         Ok((session, Event::Loaded { graph: graph_name, ms, summary: loaded }))

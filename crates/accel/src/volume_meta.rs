@@ -78,11 +78,28 @@ impl VolumeMeta {
 /// A patient point (LPS, mm) as the clinical tools write it: each axis by the side it lies
 /// toward — R/L, A/P, I/S — and its distance from the origin, `R 12.5 · P 40.0 · S 7.0 mm`.
 pub fn patient_label(point: DVec3) -> String {
-    let side = |v: f64, negative: char, positive: char| {
-        let v = if v.abs() < 0.05 { 0.0 } else { v };
-        format!("{} {:.1}", if v < 0.0 { negative } else { positive }, v.abs())
-    };
-    format!("{} · {} · {} mm", side(point.x, 'R', 'L'), side(point.y, 'A', 'P'), side(point.z, 'I', 'S'))
+    format!("{} · {} · {} mm", side_label(0, point.x), side_label(1, point.y), side_label(2, point.z))
+}
+
+/// The sides of LPS axis `axis` (0, 1, 2): toward negative and positive values.
+pub const SIDES: [(char, char); 3] = [('R', 'L'), ('A', 'P'), ('I', 'S')];
+
+/// A coordinate `mm` along LPS axis `axis` by its side: `R 12.5`, `S 7.0`.
+pub fn side_label(axis: usize, mm: f64) -> String {
+    let (negative, positive) = SIDES[axis.min(2)];
+    let v = if mm.abs() < 0.05 { 0.0 } else { mm };
+    format!("{} {:.1}", if v < 0.0 { negative } else { positive }, v.abs())
+}
+
+impl VolumeMeta {
+    /// The patient box of a volume in the patient frame: the LPS position (mm) of its low
+    /// corner (voxel (0, 0, 0)'s outer face) and its extent along L, P and S (`dims` ×
+    /// `spacing`); `None` outside the patient frame. A volume fraction f along axis a lies at
+    /// `corner[a] + f · extent[a]`, which the viewer's crop sliders show.
+    pub fn patient_box(&self, dims: DVec3, spacing: DVec3) -> Option<(DVec3, DVec3)> {
+        let corner = self.patient_point(DVec3::ZERO, spacing)?;
+        Some((corner, dims * spacing))
+    }
 }
 
 #[cfg(test)]
@@ -100,5 +117,9 @@ mod tests {
         assert_eq!(patient_label(p), "R 95.0 · P 20.0 · S 5.0 mm");
         assert_eq!(patient_label(DVec3::new(12.5, -40.0, -7.0)), "L 12.5 · A 40.0 · I 7.0 mm");
         assert_eq!(VolumeMeta::default().patient_point(DVec3::ZERO, DVec3::ONE), None, "index axes have no patient");
+        // The box: voxel (0, 0, 0)'s outer corner and dims × spacing.
+        let (corner, extent) =
+            meta.patient_box(DVec3::new(10.0, 20.0, 4.0), DVec3::new(0.5, 1.0, 2.5)).expect("in LPS");
+        assert_eq!((corner, extent), (DVec3::new(-100.25, 19.5, -6.25), DVec3::new(5.0, 20.0, 10.0)));
     }
 }

@@ -311,7 +311,7 @@ pub fn show(
                         },
                     );
                 }
-                if let Some(cuts) = cuts_section(ui, session.runtime.cuts()) {
+                if let Some(cuts) = cuts_section(ui, session.runtime.cuts(), session.patient_box()) {
                     actions.push(Action::Cuts(cuts));
                 }
                 if let Some(light) = super::light_control::light_section(ui, session.runtime.light()) {
@@ -452,7 +452,10 @@ pub fn assign_field(ui: &mut egui::Ui) -> Option<String> {
     (submitted && !text.trim().is_empty()).then_some(text)
 }
 
-fn cuts_section(ui: &mut egui::Ui, cuts: Cuts) -> Option<Cuts> {
+///
+/// With `patient` (the volume's LPS corner and extent in mm, `VolumeMeta::patient_box`) each crop
+/// slider also says where it cuts in the patient, by side: `x from · R 30.0 mm`.
+fn cuts_section(ui: &mut egui::Ui, cuts: Cuts, patient: Option<(glam::DVec3, glam::DVec3)>) -> Option<Cuts> {
     let mut crop = cuts.crop();
     let mut planes: Vec<ClipPlane> = cuts.planes().copied().collect();
     let mut changed = false;
@@ -465,8 +468,18 @@ fn cuts_section(ui: &mut egui::Ui, cuts: Cuts) -> Option<Cuts> {
         if let Some(c) = crop.as_mut() {
             for (axis, name) in ["x", "y", "z"].into_iter().enumerate() {
                 let (mut lo, mut hi) = (c.lo[axis], c.hi[axis]);
-                changed |= ui.add(egui::Slider::new(&mut lo, 0.0..=0.99).text(format!("{name} from"))).changed();
-                changed |= ui.add(egui::Slider::new(&mut hi, 0.01..=1.0).text(format!("{name} to"))).changed();
+                // Where a fraction cuts in the patient: by side, in mm.
+                let at = |f: f64| {
+                    patient.map_or(String::new(), |(corner, extent)| {
+                        format!(
+                            " · {} mm",
+                            volgraph_accel::volume_meta::side_label(axis, corner[axis] + f * extent[axis])
+                        )
+                    })
+                };
+                let (lo_text, hi_text) = (format!("{name} from{}", at(lo)), format!("{name} to{}", at(hi)));
+                changed |= ui.add(egui::Slider::new(&mut lo, 0.0..=0.99).text(lo_text)).changed();
+                changed |= ui.add(egui::Slider::new(&mut hi, 0.01..=1.0).text(hi_text)).changed();
                 // The box stays a box: the high end at least a hundredth past the low one.
                 c.lo[axis] = lo.min(0.99);
                 c.hi[axis] = hi.max(c.lo[axis] + 0.01).min(1.0);
@@ -506,11 +519,32 @@ mod tests {
     use egui_kittest::Harness;
     use egui_kittest::kittest::Queryable as _;
 
+    /// In the patient frame each crop slider says where it cuts, by side, in mm.
+    #[test]
+    fn crop_sliders_say_where_they_cut_in_the_patient() {
+        let patient = Some((glam::DVec3::new(-100.0, -50.0, 10.0), glam::DVec3::new(200.0, 100.0, 50.0)));
+        let crop = CropBox::new(glam::DVec3::ZERO, glam::DVec3::new(0.5, 1.0, 1.0)).expect("box");
+        let mut h = Harness::builder().with_size(egui::Vec2::new(360.0, 420.0)).build_ui_state(
+            |ui, cuts: &mut Cuts| {
+                if let Some(next) = cuts_section(ui, *cuts, patient) {
+                    *cuts = next;
+                }
+            },
+            Cuts::new(Some(crop), &[]).expect("cuts"),
+        );
+        h.run();
+        h.get_by_label("Crop and clip").click();
+        h.run();
+        for label in ["x from · R 100.0 mm", "x to · L 0.0 mm", "y from · A 50.0 mm", "z to · S 60.0 mm"] {
+            assert!(h.query_all_by_label(label).next().is_some(), "no slider \"{label}\"");
+        }
+    }
+
     #[test]
     fn the_crop_checkbox_and_sliders_set_the_cuts() {
         let mut h = Harness::builder().with_size(egui::Vec2::new(360.0, 420.0)).build_ui_state(
             |ui, cuts: &mut Cuts| {
-                if let Some(next) = cuts_section(ui, *cuts) {
+                if let Some(next) = cuts_section(ui, *cuts, None) {
                     *cuts = next;
                 }
             },

@@ -42,6 +42,12 @@ impl LiveSession {
         }
     }
 
+    /// The volume's patient box (LPS corner and extent, mm) when it lies in the patient frame:
+    /// the crop sliders say where they cut in mm.
+    pub fn patient_box(&self) -> Option<(glam::DVec3, glam::DVec3)> {
+        self.volume.meta.patient_box(self.volume.dims.as_dvec3(), self.volume.spacing)
+    }
+
     /// What names one accumulation of a graph with per-pixel counts: the history's restarts
     /// and the camera's moves.
     fn resting_key(&self) -> u64 {

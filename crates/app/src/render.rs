@@ -133,6 +133,7 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     };
     let shown = crate::scene::load_shown_volume(&shown_paths, scene.as_ref(), &primary_raw)?;
     let (volume, generated, mut notes) = (shown.volume, shown.marschner_lobb_tf, shown.notes);
+    crate::scene_args::check_view_frame(args.inputs.view.as_deref(), &volume)?;
     let (tf, tf_notes) = match (&plain_tf, &scene) {
         (None, Some(scene)) => {
             let (tf, _, notes) =

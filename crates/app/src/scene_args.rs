@@ -52,6 +52,11 @@ pub struct SceneArgs {
     /// scene's first camera, else 30,20,3.2].
     #[arg(long)]
     pub camera: Option<String>,
+    /// A standard view of a volume in the patient frame (DICOM, NIfTI, an anatomical NRRD):
+    /// anterior, posterior, left, right, superior or inferior — superior up, as the clinical
+    /// tools show them (from above or below: anterior up). The viewer's keys 1–6 give the same.
+    #[arg(long, conflicts_with = "camera")]
+    pub view: Option<String>,
     /// Scene features (effects) that are on, comma separated: shading, preintegration,
     /// jitter, tricubic (added to the scene's; the viewer's panel toggles them).
     #[arg(long, value_delimiter = ',')]
@@ -150,6 +155,7 @@ impl SceneArgs {
             .or_else(|| scene.as_ref().and_then(|s| s.viewport).map(|(w, h)| format!("{w}x{h}")))
             .unwrap_or_else(|| default_size.to_string());
         let camera = match (&self.camera, scene.as_ref().and_then(|s| s.camera.clone())) {
+            _ if self.view.is_some() => patient_view(self.view.as_deref().unwrap_or_default())?,
             (Some(text), _) => orbit(text)?,
             (None, Some(spec)) => spec,
             (None, None) => orbit("30,20,3.2")?,
@@ -165,8 +171,44 @@ impl SceneArgs {
     }
 }
 
+/// The camera of `--view NAME`, 3.2 away: superior up.
+fn patient_view(name: &str) -> anyhow::Result<CameraSpec> {
+    use volgraph_accel::camera::PatientView;
+    let view = PatientView::from_name(name).ok_or_else(|| {
+        anyhow!("--view {name}: not a view; the views are {} (a volume in the patient frame)", PatientView::names())
+    })?;
+    let c = view.camera(3.2);
+    Ok(CameraSpec::Orbit {
+        azimuth: c.azimuth_deg,
+        elevation: c.elevation_deg,
+        distance: c.distance,
+        target: None,
+        up: c.up,
+    })
+}
+
+/// `--view` needs a volume whose axes lie in the patient (LPS): named views of index axes would
+/// name sides the file never gave.
+pub fn check_view_frame(view: Option<&str>, volume: &volgraph_accel::volume::Volume) -> anyhow::Result<()> {
+    match view {
+        Some(name) if volume.meta.frame != volgraph_accel::volume_meta::WorldFrame::Lps => Err(anyhow!(
+            "--view {name}: {} lies in {}; the patient views need a volume in the patient frame (DICOM, NIfTI, an \
+             anatomical NRRD); use --camera AZIMUTH,ELEVATION,DISTANCE",
+            volume.name,
+            volume.meta.frame.describe()
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// The orbit camera of `AZIMUTH,ELEVATION,DISTANCE`.
 fn orbit(text: &str) -> anyhow::Result<CameraSpec> {
     let c = inputs::parse_camera(text)?;
-    Ok(CameraSpec::Orbit { azimuth: c.azimuth_deg, elevation: c.elevation_deg, distance: c.distance, target: None })
+    Ok(CameraSpec::Orbit {
+        azimuth: c.azimuth_deg,
+        elevation: c.elevation_deg,
+        distance: c.distance,
+        target: None,
+        up: volgraph_accel::camera::CameraUp::Y,
+    })
 }

@@ -187,3 +187,89 @@ fn a_dicom_series_and_its_nifti_twin_find_the_same_background() {
         background.split(": ").nth(1).and_then(|t| t.split(' ').next()).and_then(|t| t.parse().ok()).expect("a share");
     assert!((50.0..65.0).contains(&share), "the share is air's own: {background}");
 }
+
+/// Issue 45 item 1 (in part): `--view` gives the clinical tools' standard views of a volume in
+/// the patient frame (superior up); left and right are mirror views of each other; a volume in
+/// index axes, an unknown view and `--camera` with `--view` are refused by name.
+#[test]
+fn patient_views_render_a_dicom_series_and_are_refused_without_a_patient_frame() {
+    let dir = scratch("views");
+    // A head with a bony nose toward anterior (−y) above the middle: no mirror symmetry
+    // between its left and right views.
+    let mut head = ct(32, "head");
+    let dims = head.dims;
+    if let volgraph_accel::volume::VoxelData::I16(values) = &mut head.data {
+        for (i, v) in values.iter_mut().enumerate() {
+            let i = i as u32;
+            let (x, y, z) = (i % dims.x, (i / dims.x) % dims.y, i / (dims.x * dims.y));
+            if (14..18).contains(&x) && (3..10).contains(&y) && (16..22).contains(&z) {
+                *v = 900;
+            }
+        }
+    }
+    write(&dir.join("series"), &head);
+    let series = dir.join("series").display().to_string();
+    let out = |name: &str| dir.join(format!("{name}.png")).display().to_string();
+    let mut images = Vec::new();
+    for view in ["anterior", "left", "right", "superior"] {
+        let run = volgraph(&[
+            "render",
+            "basic/fragment_raycast",
+            "--volume",
+            &series,
+            "--tf",
+            "ct-bone",
+            "--size",
+            "48x48",
+            "--view",
+            view,
+            "-o",
+            &out(view),
+        ]);
+        assert_eq!(run.code, 0, "--view {view}: {}", run.stderr);
+        images.push(image::open(out(view)).expect("a PNG").to_rgba8());
+    }
+    let lit = |i: &image::RgbaImage| i.pixels().filter(|p| p[0] > 10 || p[1] > 10 || p[2] > 10).count();
+    assert!(images.iter().all(|i| lit(i) > 48 * 48 / 20), "every view shows the head");
+    // Left and right look at the same head from opposite sides: each is the other mirrored
+    // (to a pixel's rounding at the silhouette).
+    let (left, right) = (&images[1], &images[2]);
+    let on = |p: &image::Rgba<u8>| p[0] > 10 || p[1] > 10 || p[2] > 10;
+    let differ = |flip: bool| {
+        left.enumerate_pixels()
+            .filter(|(x, y, p)| on(p) != on(right.get_pixel(if flip { 47 - x } else { *x }, *y)))
+            .count()
+    };
+    let (mirrored, unmirrored) = (differ(true), differ(false));
+    eprintln!("left vs right: {mirrored} pixels differ mirrored, {unmirrored} as they are");
+    assert!(mirrored < 48 * 48 / 50, "left and right are mirror silhouettes: {mirrored} pixels differ");
+    assert!(unmirrored > 2 * mirrored.max(10), "the head is not symmetric, so the mirror matters: {unmirrored}");
+    let generated =
+        volgraph(&["render", "basic/fragment_raycast", "--volume", "ml32", "--view", "anterior", "-o", &out("ml")]);
+    assert_eq!(generated.code, 1);
+    assert!(
+        generated.stderr.contains("--view anterior") && generated.stderr.contains("patient frame"),
+        "{}",
+        generated.stderr
+    );
+    let typo =
+        volgraph(&["render", "basic/fragment_raycast", "--volume", &series, "--view", "lateral", "-o", &out("t")]);
+    assert!(
+        typo.code != 0 && typo.stderr.contains("anterior, posterior, left, right, superior, inferior"),
+        "{}",
+        typo.stderr
+    );
+    let both = volgraph(&[
+        "render",
+        "basic/fragment_raycast",
+        "--volume",
+        &series,
+        "--view",
+        "left",
+        "--camera",
+        "0,0,3",
+        "-o",
+        &out("b"),
+    ]);
+    assert_eq!(both.code, 2, "{}", both.stderr);
+}

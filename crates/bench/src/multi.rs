@@ -65,6 +65,7 @@ const CAMERA: OrbitCamera = OrbitCamera {
     near: 0.01,
     far: 100.0,
     target: [0.0; 3],
+    up: volgraph_accel::camera::CameraUp::Y,
 };
 
 /// A label map of `labels` regions over the body of `ct` (HU > −500): each body voxel takes the

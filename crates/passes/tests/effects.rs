@@ -30,6 +30,7 @@ const CAMERA: OrbitCamera = OrbitCamera {
     near: 0.01,
     far: 100.0,
     target: [0.0; 3],
+    up: volgraph_accel::camera::CameraUp::Y,
 };
 
 /// The graphs the effects are rendered with (one per raycaster family).

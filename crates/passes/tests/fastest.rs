@@ -44,6 +44,7 @@ const CAMERAS: [OrbitCamera; 3] = [
         near: 0.01,
         far: 100.0,
         target: [0.0; 3],
+        up: volgraph_accel::camera::CameraUp::Y,
     },
     OrbitCamera {
         azimuth_deg: 35.0,
@@ -53,6 +54,7 @@ const CAMERAS: [OrbitCamera; 3] = [
         near: 0.01,
         far: 100.0,
         target: [0.0; 3],
+        up: volgraph_accel::camera::CameraUp::Y,
     },
     OrbitCamera {
         azimuth_deg: 200.0,
@@ -62,6 +64,7 @@ const CAMERAS: [OrbitCamera; 3] = [
         near: 0.05,
         far: 100.0,
         target: [0.0; 3],
+        up: volgraph_accel::camera::CameraUp::Y,
     },
 ];
 

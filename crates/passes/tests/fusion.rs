@@ -34,6 +34,7 @@ const CAMERA: OrbitCamera = OrbitCamera {
     near: 0.01,
     far: 100.0,
     target: [0.0; 3],
+    up: volgraph_accel::camera::CameraUp::Y,
 };
 
 /// A TF over `domain` from `(value, r, g, b, alpha)` points.

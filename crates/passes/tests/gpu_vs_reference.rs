@@ -115,6 +115,7 @@ const CAMERA: OrbitCamera = OrbitCamera {
     near: 0.01,
     far: 100.0,
     target: [0.0; 3],
+    up: volgraph_accel::camera::CameraUp::Y,
 };
 
 #[test]

@@ -29,6 +29,7 @@ const CAMERA: OrbitCamera = OrbitCamera {
     near: 0.01,
     far: 100.0,
     target: [0.0; 3],
+    up: volgraph_accel::camera::CameraUp::Y,
 };
 
 /// Renders `graph` and returns (GPU image, reference of the march pass's own settings).

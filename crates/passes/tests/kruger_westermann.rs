@@ -147,6 +147,7 @@ const CAMERA: OrbitCamera = OrbitCamera {
     near: 0.01,
     far: 100.0,
     target: [0.0; 3],
+    up: volgraph_accel::camera::CameraUp::Y,
 };
 
 fn ml() -> Volume {
@@ -458,6 +459,7 @@ fn camera_inside_the_volume_with_multipass_segments() {
         near: 0.01,
         far: 100.0,
         target: [0.0; 3],
+        up: volgraph_accel::camera::CameraUp::Y,
     };
     let opts = options(&v);
     for graph in ["kruger_westermann_2003/rc.ron", "kruger_westermann_2003/rc_b.ron"] {
@@ -481,6 +483,7 @@ fn axis_aligned_view_with_multipass_segments() {
         near: 0.01,
         far: 100.0,
         target: [0.0; 3],
+        up: volgraph_accel::camera::CameraUp::Y,
     };
     let opts = options(&v);
     for graph in ["kruger_westermann_2003/rc.ron", "kruger_westermann_2003/rc_b.ron", "modern/single_pass_ess_ert.ron"]

@@ -2,7 +2,7 @@
 //! checked as the command line's `--camera` is checked, and the orbit camera of each frame.
 
 use serde::Deserialize;
-use volgraph_accel::camera::OrbitCamera;
+use volgraph_accel::camera::{CameraUp, OrbitCamera};
 
 use super::MAX_FRAMES;
 
@@ -34,6 +34,10 @@ pub enum CameraSpec {
         /// The point it orbits (world units; default the volume's centre): a viewer's pan.
         #[serde(default)]
         target: Option<(f64, f64, f64)>,
+        /// Which way is up: `Y` (default), or `Patient` — superior up, azimuth 0 from the front
+        /// (`--view`; a volume in the patient frame).
+        #[serde(default)]
+        up: CameraUp,
     },
     /// Keyframes, interpolated linearly in azimuth, elevation and distance.
     Path {
@@ -72,7 +76,7 @@ pub const MAX_DISTANCE: f64 = 1e6;
 
 pub(super) fn check_camera(camera: &CameraSpec) -> Result<(), String> {
     match camera {
-        CameraSpec::Orbit { azimuth, elevation, distance, target } => {
+        CameraSpec::Orbit { azimuth, elevation, distance, target, .. } => {
             check_orbit(*azimuth, *elevation, *distance)?;
             if target.is_some_and(|(x, y, z)| !(x.is_finite() && y.is_finite() && z.is_finite())) {
                 return Err("target must be three finite numbers (world units)".into());
@@ -110,11 +114,12 @@ impl CameraSpec {
     /// --frames`); a path interpolates its keyframes linearly and holds the ends.
     pub fn at(&self, index: u32) -> OrbitCamera {
         match self {
-            CameraSpec::Orbit { azimuth, elevation, distance, target } => OrbitCamera {
+            CameraSpec::Orbit { azimuth, elevation, distance, target, up } => OrbitCamera {
                 azimuth_deg: azimuth + index as f64,
                 elevation_deg: *elevation,
                 distance: *distance,
                 target: target.map_or([0.0; 3], |(x, y, z)| [x, y, z]),
+                up: *up,
                 ..OrbitCamera::default()
             },
             CameraSpec::Path { keyframes } => {

@@ -94,8 +94,12 @@ impl SavedView {
         }
         let c = &self.camera;
         // Rust's shortest round-trip formatting: the file reads back the same f64.
+        let up = match c.up {
+            volgraph_accel::camera::CameraUp::Y => "",
+            volgraph_accel::camera::CameraUp::Patient => ", up: Patient",
+        };
         out += &format!(
-            "    camera: Orbit(azimuth: {:?}, elevation: {:?}, distance: {:?}, target: ({:?}, {:?}, {:?})),\n",
+            "    camera: Orbit(azimuth: {:?}, elevation: {:?}, distance: {:?}, target: ({:?}, {:?}, {:?}){up}),\n",
             c.azimuth_deg, c.elevation_deg, c.distance, c.target[0], c.target[1], c.target[2]
         );
         out += &format!("    viewport: ({}, {}),\n", self.viewport.0, self.viewport.1);
@@ -201,5 +205,15 @@ mod saved_view_tests {
             (back.azimuth_deg, back.elevation_deg, back.distance, back.target),
             (37.123456789, -12.5, 2.0 / 3.0, [0.1, -0.2, 0.3])
         );
+        assert_eq!(back.up, volgraph_accel::camera::CameraUp::Y);
+        // A patient view (superior up) is written back as one.
+        let patient = SavedView {
+            camera: OrbitCamera { up: volgraph_accel::camera::CameraUp::Patient, ..camera },
+            ..view.clone()
+        };
+        let text = patient.to_ron();
+        assert!(text.contains("up: Patient"), "{text}");
+        let scene = Scene::from_str(&text, Path::new("/tmp/x.scene.ron")).expect("reads back");
+        assert_eq!(scene.camera.expect("a camera").at(0), patient.camera);
     }
 }

@@ -57,7 +57,7 @@ impl Orbit {
             } else if self.panning {
                 let frame = self.camera.frame(1, 1);
                 let forward = frame.forward;
-                let right = forward.cross(DVec3::Y).normalize_or(DVec3::X);
+                let right = forward.cross(self.camera.up_vector()).normalize_or(DVec3::X);
                 let up = right.cross(forward);
                 // One window height of drag moves the target by the visible height at its distance.
                 let scale =

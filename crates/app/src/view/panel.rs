@@ -23,6 +23,8 @@ pub enum Action {
     Screenshot,
     /// Reset the camera.
     ResetCamera,
+    /// A standard view of a volume in the patient frame (keys 1–6, the panel's A P L R S I).
+    PatientView(volgraph_accel::camera::PatientView),
     /// Write the parameters and inputs changed here into the graph file.
     WriteBack,
     /// Set the crop box and clip planes.
@@ -407,6 +409,13 @@ fn action_buttons(ui: &mut egui::Ui, actions: &mut Vec<Action>) {
         if ui.button("reset camera").clicked() {
             actions.push(Action::ResetCamera);
         }
+        // The patient views, superior up (keys 1–6).
+        for (name, view) in volgraph_accel::camera::PatientView::ALL {
+            let letter = name[..1].to_uppercase();
+            if ui.button(&letter).on_hover_text(format!("the {name} view, superior up")).clicked() {
+                actions.push(Action::PatientView(view));
+            }
+        }
         if ui.button("write to graph file").on_hover_text("the values changed here, written at their place").clicked() {
             actions.push(Action::WriteBack);
         }
@@ -518,6 +527,29 @@ mod tests {
     use super::*;
     use egui_kittest::Harness;
     use egui_kittest::kittest::Queryable as _;
+
+    /// The panel's A P L R S I buttons ask for the patient views (as keys 1–6 do).
+    #[test]
+    fn the_view_buttons_ask_for_the_patient_views() {
+        use volgraph_accel::camera::PatientView;
+        let mut h = Harness::builder().with_size(egui::Vec2::new(480.0, 120.0)).build_ui_state(
+            |ui, asked: &mut Vec<PatientView>| {
+                let mut actions = Vec::new();
+                action_buttons(ui, &mut actions);
+                asked.extend(actions.into_iter().filter_map(|a| match a {
+                    Action::PatientView(v) => Some(v),
+                    _ => None,
+                }));
+            },
+            Vec::new(),
+        );
+        h.run();
+        for letter in ["L", "S"] {
+            h.get_by_label(letter).click();
+            h.run();
+        }
+        assert_eq!(h.state().as_slice(), [PatientView::Left, PatientView::Superior]);
+    }
 
     /// In the patient frame each crop slider says where it cuts, by side, in mm.
     #[test]

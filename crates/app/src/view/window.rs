@@ -247,6 +247,19 @@ impl Viewer {
                     self.orbit.reset();
                     Vec::new()
                 }
+                Action::PatientView(view) => {
+                    self.orbit.camera = volgraph_accel::camera::OrbitCamera {
+                        target: self.orbit.camera.target,
+                        ..view.camera(self.orbit.camera.distance)
+                    };
+                    if !session.in_patient_frame() {
+                        crate::stdout::eprintln_escaped!(
+                            "note: the {view:?} view names a patient side, but this volume lies in index axes (+z up, \
+                             seen from -y)"
+                        );
+                    }
+                    Vec::new()
+                }
                 Action::WriteBack => match session.write_back() {
                     Ok(lines) => {
                         for line in lines {
@@ -535,6 +548,13 @@ impl ApplicationHandler for Viewer {
                         }
                     }
                     Key::Character(c) if c.eq_ignore_ascii_case("r") => self.orbit.reset(),
+                    // 1–6: the patient views (anterior, posterior, left, right, superior,
+                    // inferior), superior up, at the current distance.
+                    Key::Character(c) if matches!(c.as_str(), "1" | "2" | "3" | "4" | "5" | "6") => {
+                        let index = c.as_str().parse::<usize>().unwrap_or(1) - 1;
+                        let (_, view) = volgraph_accel::camera::PatientView::ALL[index];
+                        self.apply_actions(vec![Action::PatientView(view)]);
+                    }
                     Key::Character(c) if c.eq_ignore_ascii_case("s") => {
                         self.apply_actions(vec![Action::Screenshot]);
                     }

@@ -42,6 +42,11 @@ impl LiveSession {
         }
     }
 
+    /// Whether the volume's axes lie in the patient (LPS): the patient views name its sides.
+    pub fn in_patient_frame(&self) -> bool {
+        self.volume.meta.frame == volgraph_accel::volume_meta::WorldFrame::Lps
+    }
+
     /// The volume's patient box (LPS corner and extent, mm) when it lies in the patient frame:
     /// the crop sliders say where they cut in mm.
     pub fn patient_box(&self) -> Option<(glam::DVec3, glam::DVec3)> {

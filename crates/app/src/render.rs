@@ -88,7 +88,7 @@ pub struct Prepared {
 /// Reads and checks every input of `volgraph render`; touches no GPU, prints nothing.
 pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     let kind = ImageKind::from_path("-o", &args.out)?;
-    let Resolved { scene, graph, size, camera, cuts, light, environment } =
+    let Resolved { scene, graph, size, camera, camera_is_default, cuts, light, environment } =
         args.inputs.resolve("volgraph render GRAPH -o out.png", "512x512")?;
     let source = inputs::read_graph(&graph)?;
     let mut features = scene.as_ref().map(|s| s.effects.clone()).unwrap_or_default();
@@ -134,6 +134,7 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     let shown = crate::scene::load_shown_volume(&shown_paths, scene.as_ref(), &primary_raw)?;
     let (volume, generated, mut notes) = (shown.volume, shown.marschner_lobb_tf, shown.notes);
     crate::scene_args::check_view_frame(args.inputs.view.as_deref(), &volume)?;
+    let camera = Resolved::camera_for(camera, camera_is_default, &volume);
     let (tf, tf_notes) = match (&plain_tf, &scene) {
         (None, Some(scene)) => {
             let (tf, _, notes) =

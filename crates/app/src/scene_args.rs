@@ -101,6 +101,9 @@ pub struct Resolved {
     pub size: String,
     /// The camera (an orbit, or the scene's path).
     pub camera: CameraSpec,
+    /// True when nothing chose the camera (no `--camera`, `--view` or scene camera): a volume in
+    /// the patient frame is then seen from the front, superior up ([`Resolved::camera_for`]).
+    pub camera_is_default: bool,
     /// The crop box and clip planes: `--crop` and `--clip` win over the scene's.
     pub cuts: Cuts,
     /// The light: `--light` wins over the scene's.
@@ -154,6 +157,8 @@ impl SceneArgs {
             .clone()
             .or_else(|| scene.as_ref().and_then(|s| s.viewport).map(|(w, h)| format!("{w}x{h}")))
             .unwrap_or_else(|| default_size.to_string());
+        let camera_is_default =
+            self.view.is_none() && self.camera.is_none() && scene.as_ref().is_none_or(|s| s.camera.is_none());
         let camera = match (&self.camera, scene.as_ref().and_then(|s| s.camera.clone())) {
             _ if self.view.is_some() => patient_view(self.view.as_deref().unwrap_or_default())?,
             (Some(text), _) => orbit(text)?,
@@ -167,7 +172,24 @@ impl SceneArgs {
         let cuts = Cuts::new(crop, &planes).map_err(|e| anyhow!("--clip: {e}"))?;
         let light = self.light.or(scene.as_ref().map(|s| s.light)).unwrap_or_default();
         let environment = self.environment.clone().or_else(|| scene.as_ref().and_then(|s| s.environment.clone()));
-        Ok(Resolved { scene, graph, size, camera, cuts, light, environment })
+        Ok(Resolved { scene, graph, size, camera, camera_is_default, cuts, light, environment })
+    }
+}
+
+impl Resolved {
+    /// The camera for `volume`: the one chosen, else — for a volume in the patient frame — the
+    /// anterior view, superior up, as the clinical tools open a scan (the generated and raw
+    /// volumes, in index axes, keep the 30°, 20° orbit).
+    pub fn camera_for(
+        camera: CameraSpec,
+        camera_is_default: bool,
+        volume: &volgraph_accel::volume::Volume,
+    ) -> CameraSpec {
+        if camera_is_default && volume.meta.frame == volgraph_accel::volume_meta::WorldFrame::Lps {
+            patient_view("anterior").unwrap_or(camera)
+        } else {
+            camera
+        }
     }
 }
 

@@ -244,6 +244,34 @@ fn patient_views_render_a_dicom_series_and_are_refused_without_a_patient_frame()
     eprintln!("left vs right: {mirrored} pixels differ mirrored, {unmirrored} as they are");
     assert!(mirrored < 48 * 48 / 50, "left and right are mirror silhouettes: {mirrored} pixels differ");
     assert!(unmirrored > 2 * mirrored.max(10), "the head is not symmetric, so the mirror matters: {unmirrored}");
+    // Nothing choosing the camera, a volume in the patient frame opens from the front (as
+    // --view anterior), a generated one in the 30°, 20° orbit as before.
+    let default = volgraph(&[
+        "render",
+        "basic/fragment_raycast",
+        "--volume",
+        &series,
+        "--tf",
+        "ct-bone",
+        "--size",
+        "48x48",
+        "-o",
+        &out("default"),
+    ]);
+    assert_eq!(default.code, 0, "{}", default.stderr);
+    assert_eq!(image::open(out("default")).expect("a PNG").to_rgba8(), images[0], "the default is the anterior view");
+    for (name, camera) in [("ml_default", None), ("ml_orbit", Some("30,20,3.2"))] {
+        let mut args = vec!["render", "basic/fragment_raycast", "--volume", "ml32", "--size", "48x48"];
+        args.extend(camera.map(|c| ["--camera", c]).into_iter().flatten());
+        let path = out(name);
+        args.extend(["-o", path.as_str()]);
+        assert_eq!(volgraph(&args).code, 0);
+    }
+    assert_eq!(
+        image::open(out("ml_default")).expect("a PNG").to_rgba8(),
+        image::open(out("ml_orbit")).expect("a PNG").to_rgba8(),
+        "index axes keep the 30, 20 orbit"
+    );
     let generated =
         volgraph(&["render", "basic/fragment_raycast", "--volume", "ml32", "--view", "anterior", "-o", &out("ml")]);
     assert_eq!(generated.code, 1);

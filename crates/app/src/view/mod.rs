@@ -78,6 +78,10 @@ pub fn screenshot_target(path: &std::path::Path) -> Result<(), String> {
 pub struct ViewOptions {
     /// The start camera.
     pub camera: OrbitCamera,
+    /// Nothing chose the camera: a volume in the patient frame opens in the anterior view.
+    pub camera_is_default: bool,
+    /// `--view NAME`: refused once the volume shows it lies outside the patient frame.
+    pub patient_view: Option<String>,
     /// Exit after this many frames.
     pub frames: Option<u64>,
     /// Screenshot path on exit.
@@ -168,6 +172,8 @@ pub fn run(args: ViewArgs) -> Result<(), CliError> {
     };
     let view = ViewOptions {
         camera,
+        camera_is_default: resolved.camera_is_default,
+        patient_view: args.inputs.view.clone(),
         frames: args.frames,
         screenshot: args.screenshot,
         panel: !args.no_panel,

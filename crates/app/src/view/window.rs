@@ -140,6 +140,14 @@ impl Viewer {
         let mut watch = FileWatch::new().map_err(|e| format!("cannot watch files: {e}"))?;
         watch.set_files(&session.watched_files());
         self.watch = Some(watch);
+        // The camera for this volume: `--view` needs the patient frame; a volume in it opens
+        // from the front, superior up, when nothing chose the camera (as `render` does).
+        crate::scene_args::check_view_frame(self.view.patient_view.as_deref(), session.volume())
+            .map_err(|e| format!("{e:#}"))?;
+        if self.view.camera_is_default && session.in_patient_frame() {
+            let anterior = volgraph_accel::camera::PatientView::Anterior.camera(self.view.camera.distance);
+            self.orbit = Orbit::new(anterior);
+        }
         self.session = Some(session);
         self.gfx = Some(Gfx { window, surface, config, gpu, egui, renderer });
         // Only now: an edit made as soon as this line appears is seen by the watcher.

@@ -42,6 +42,11 @@ impl LiveSession {
         }
     }
 
+    /// The frame volume.
+    pub fn volume(&self) -> &volgraph_accel::volume::Volume {
+        &self.volume
+    }
+
     /// Whether the volume's axes lie in the patient (LPS): the patient views name its sides.
     pub fn in_patient_frame(&self) -> bool {
         self.volume.meta.frame == volgraph_accel::volume_meta::WorldFrame::Lps

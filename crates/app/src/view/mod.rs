@@ -10,6 +10,7 @@ pub mod label_list;
 pub mod light_control;
 pub mod lod;
 pub mod orbit;
+pub mod orientation;
 pub mod panel;
 pub mod script;
 pub mod session;

@@ -158,10 +158,7 @@ pub fn show(
     accuracy: &str,
 ) -> Shown {
     let mut actions = Vec::new();
-    // At most 45 % of the window: the image keeps the larger side (a narrow window scrolls the
-    // panel instead).
-    let widest = (root.available_width() * 0.45).max(160.0);
-    let panel = egui::Panel::right("volgraph").default_size(320.0_f32.min(widest)).max_size(widest).show(root, |ui| {
+    let panel = egui::Panel::right("volgraph").default_size(320.0).show(root, |ui| {
         let Some(plan) = session.plan() else { return };
         // The buttons first, at the panel's foot: always in reach, whatever the window's height.
         egui::Panel::bottom("volgraph actions").show(ui, |ui| {

@@ -443,7 +443,19 @@ impl Viewer {
             }
             let accuracy_line = self.frames.accuracy_line(self.accuracy.last.as_ref(), self.accuracy.busy());
             let mut panel_points = 0.0;
+            // The orientation marker, for a volume in the patient frame, in the image's corner.
+            let marker = session.in_patient_frame().then(|| {
+                let (w, h) = image_size(size, self.panel_px);
+                let ppp = ctx.pixels_per_point();
+                (
+                    egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(w as f32 / ppp, h as f32 / ppp)),
+                    self.orbit.camera,
+                )
+            });
             let output = ctx.run_ui(raw, |ui| {
+                if let Some((image, camera)) = &marker {
+                    super::orientation::draw(ui.ctx(), *image, camera);
+                }
                 let shown = panel::show(
                     ui,
                     session,

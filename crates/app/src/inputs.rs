@@ -290,8 +290,9 @@ fn data_folder_tf(path: &Path) -> Option<PathBuf> {
     if name.chars().any(volgraph_core::terminal::is_unsafe) || name == "." || name == ".." {
         return None;
     }
+    // Anything of that name (a FIFO, a folder) is handed on, and the loader refuses it by kind.
     let file = volgraph_accel::data_dir::data_dir().join("tf").join(format!("{name}.ron"));
-    file.is_file().then_some(file)
+    file.symlink_metadata().is_ok().then_some(file)
 }
 
 /// A `--tf` file that cannot be read; where no such file exists, the preset it may have meant

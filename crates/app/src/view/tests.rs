@@ -85,6 +85,15 @@ fn frame(session: &mut LiveSession) -> Vec<f32> {
     session.runtime.read_output("image").expect("image").data
 }
 
+/// `n` frames seen by `camera` through the session's own frame path (what the window calls,
+/// estimates and reverts included), waited for.
+fn frames(session: &mut LiveSession, n: u32, camera: &OrbitCamera) {
+    for _ in 0..n {
+        session.frame(camera, None).expect("a frame");
+    }
+    session.runtime.finish();
+}
+
 fn edit(path: &Path, from: &str, to: &str) {
     let text = std::fs::read_to_string(path).expect("readable");
     assert!(text.contains(from), "{} has no {from:?}", path.display());
@@ -235,12 +244,6 @@ fn the_path_tracer_shows_its_estimated_error() {
     let s = scratch("noise", "graphs/cinematic/path_traced.ron");
     let mut session = open(&s, None);
     let camera = OrbitCamera::default();
-    let frames = |session: &mut LiveSession, n: u32, camera: &OrbitCamera| {
-        for _ in 0..n {
-            session.frame(camera, None).expect("a frame");
-        }
-        session.runtime.finish();
-    };
     frames(&mut session, 1, &camera);
     assert_eq!(session.noise_line(), None, "one sample has no estimate");
     frames(&mut session, 15, &camera);
@@ -268,12 +271,6 @@ fn the_reprojecting_path_tracer_estimates_its_error_once_the_view_rests() {
     let s = scratch("noise_moving", "graphs/cinematic/path_traced_moving.ron");
     let mut session = open(&s, None);
     let camera = OrbitCamera::default();
-    let frames = |session: &mut LiveSession, n: u32, camera: &OrbitCamera| {
-        for _ in 0..n {
-            session.frame(camera, None).expect("a frame");
-        }
-        session.runtime.finish();
-    };
     frames(&mut session, 16, &camera);
     let rested = session.noise_line().expect("an estimate 16 frames at rest");
     assert!(rested.contains("8 and 16 frames after the view rested"), "{rested}");
@@ -317,12 +314,16 @@ fn the_panel_leaves_the_image_its_side_and_keeps_its_buttons_in_reach_at_800_by_
     );
     h.run();
     let width = *h.state();
+    // At most half the window (the image keeps the other half, `window::image_size`); its
+    // natural width is ~320–380 points.
     assert!(width > 100.0 && width <= 400.0, "the panel is {width} points of 800");
     // Open every section the tall way: the parameters of every pass, the plan's text.
     h.get_by_label("Parameters").click();
     h.run();
     h.get_by_label("Plan").click();
     h.run();
+    // (With the buttons after the sections, as before this foot, "screenshot" lay at y 593–613:
+    // outside.)
     for button in ["screenshot", "reset camera", "write to graph file", "save view"] {
         let rect = h.get_by_label(button).rect();
         assert!(window.contains_rect(rect), "\"{button}\" at {rect:?} is outside the window");

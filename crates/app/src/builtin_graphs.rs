@@ -30,6 +30,7 @@ fn paper_of(folder: &str) -> &'static str {
         "modern" => "all four papers combined",
         "bench" => "benchmarks",
         "basic" => "basic raycasters",
+        "clinical" => "clinical viewer",
         _ => "",
     }
 }

@@ -61,6 +61,9 @@ enum BenchCommand {
     /// Several volumes in one march: a CT with a 117-label map (tinted, inside) against the CT
     /// alone, a label's visibility toggled → frame, smooth vs nearest label boundaries at 4× zoom.
     Multi(crate::multi::MultiArgs),
+    /// The clinical viewer's slice panes: the update when the crosshair moves (512² panes) and
+    /// the 3D view's frame with the panes open vs without.
+    Slices(crate::slices::SlicesArgs),
     /// The viewer as a workbench: TF edit → frame on a 256³ volume at 800x600, and the frame
     /// time while the camera moves for every shipped graph.
     Workbench(crate::workbench::WorkbenchArgs),
@@ -116,6 +119,9 @@ fn run(cli: BenchCli) -> anyhow::Result<()> {
         BenchCli::Bench { which: BenchCommand::Load(args) } => crate::load::run(&args).context("bench load").map(drop),
         BenchCli::Bench { which: BenchCommand::Workbench(args) } => {
             crate::workbench::run(&args).context("bench workbench").map(drop)
+        }
+        BenchCli::Bench { which: BenchCommand::Slices(args) } => {
+            crate::slices::run(&args).context("bench slices").map(drop)
         }
         BenchCli::Bench { which: BenchCommand::Multi(args) } => {
             crate::multi::run(&args).context("bench multi").map(drop)

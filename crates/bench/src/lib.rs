@@ -23,6 +23,7 @@ pub mod live;
 pub mod load;
 pub mod multi;
 pub mod report_files;
+pub mod slices;
 pub mod sweep;
 pub mod workbench;
 

@@ -39,6 +39,7 @@ pub mod raycast_params;
 pub mod raycast_segment;
 pub mod reprojection_splat;
 pub mod reprojection_tiles;
+pub mod reslice;
 pub mod segment_init;
 pub mod shadows;
 pub mod shared;
@@ -91,6 +92,7 @@ macro_rules! builtin_kinds {
             .register(path_trace::PathTrace)
             .register(raycast_bricks::RaycastBricks)
             .register(present::Present)
+            .register(reslice::Reslice)
     };
 }
 

@@ -84,7 +84,7 @@ fn from_rgba16(golden: &image::ImageBuffer<image::Rgba<u16>, Vec<u16>>) -> Vec<[
     golden.pixels().map(|p| p.0.map(|c| c as f64 / 65535.0)).collect()
 }
 
-/// The graph's second frame.
+/// The graph's second frame: its `image` output, else its first (the slice panes' `axial`).
 fn render(gpu: &std::sync::Arc<volgraph_core::runtime::Gpu>, name: &str, path: &Path) -> Result<Image, String> {
     let volume = volgraph_accel::data_dir::load_dataset("neghip").map_err(|e| e.to_string())?.volume;
     let tf = TransferFunction::default_for(&volume);
@@ -94,7 +94,12 @@ fn render(gpu: &std::sync::Arc<volgraph_core::runtime::Gpu>, name: &str, path: &
     let options = CompileOptions::new(SIZE, SIZE);
     let (mut runtime, plan) = render_once(gpu, &registry, name, &source, &options, &volume, &lut, &camera(30.0))?;
     runtime.render(CameraData::from_orbit(&camera(38.0), plan.viewport)).map_err(|e| e.to_string())?;
-    runtime.read_output("image").map_err(|e| e.to_string())
+    let output = match plan.outputs.keys().next() {
+        _ if plan.outputs.contains_key("image") => "image",
+        Some(first) => first.as_str(),
+        None => return Err("the graph has no output".to_string()),
+    };
+    runtime.read_output(output).map_err(|e| e.to_string())
 }
 
 #[test]

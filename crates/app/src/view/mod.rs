@@ -14,6 +14,8 @@ pub mod orientation;
 pub mod panel;
 pub mod script;
 pub mod session;
+pub mod slice_panes;
+pub mod slice_section;
 pub mod tf_editor;
 pub mod watch;
 pub mod window;
@@ -48,6 +50,9 @@ pub struct ViewArgs {
     /// Start without the overlay panel (F1 toggles it).
     #[arg(long)]
     pub no_panel: bool,
+    /// Open the axial, coronal and sagittal slice panes beside the 3D view (M toggles them).
+    #[arg(long)]
+    pub slices: bool,
     /// Read script lines from stdin: `quit`, `screenshot PATH`, `param PASS.NAME VALUE`, `write` (the
     /// panel's "write to graph file").
     #[arg(long)]
@@ -91,6 +96,8 @@ pub struct ViewOptions {
     pub panel: bool,
     /// Degrees per frame.
     pub turn_degrees: Option<f64>,
+    /// The slice panes open at start.
+    pub slices: bool,
 }
 
 /// Writes one event line to stdout, flushed (tests read it as it happens).
@@ -179,6 +186,7 @@ pub fn run(args: ViewArgs) -> Result<(), CliError> {
         screenshot: args.screenshot,
         panel: !args.no_panel,
         turn_degrees: args.turn,
+        slices: args.slices,
     };
     let script = args.script.then(|| {
         let (tx, rx) = std::sync::mpsc::channel();

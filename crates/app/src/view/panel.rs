@@ -45,6 +45,10 @@ pub enum Action {
     LabelSearch(String),
     /// Time every pass on its own (`Runtime::set_step_profiling`) or not.
     TimeEachPass(bool),
+    /// Open or close the slice panes.
+    SlicePanes(bool),
+    /// The slice panes' window (data units).
+    SliceWindow(volgraph_accel::volume_meta::Window),
     /// Level of detail while moving: on or off, and the frame rate to hold.
     Lod {
         /// Render coarser while moving.
@@ -87,8 +91,8 @@ impl Timings {
 }
 
 /// The help line.
-pub const HELP: &str =
-    "drag: rotate · wheel: zoom · shift/middle-drag: pan · R: reset camera · S: screenshot · F1: panel · Esc: quit";
+pub const HELP: &str = "drag: rotate · wheel: zoom · shift/middle-drag: pan · R: reset camera · 1–6: patient views · M: slice panes \
+     (click: crosshair, wheel: slice) · S: screenshot · F1: panel · Esc: quit";
 
 fn param_widget(ui: &mut egui::Ui, name: &str, kind: &ParamKind, value: &ParamValue) -> Option<ron::Value> {
     match (kind, value) {
@@ -313,6 +317,14 @@ pub fn show(
                         },
                     );
                 }
+                let slice_info = super::slice_section::SliceInfo {
+                    panes: session.slices(),
+                    hounsfield: session.volume().meta.is_ct_hu(),
+                    patient: session.slices().and_then(|p| {
+                        session.volume().meta.patient_point(p.crosshair_voxel(), session.volume().spacing)
+                    }),
+                };
+                actions.extend(super::slice_section::section(ui, &slice_info));
                 if let Some(cuts) = cuts_section(ui, session.runtime.cuts(), session.patient_box()) {
                     actions.push(Action::Cuts(cuts));
                 }

@@ -40,10 +40,18 @@ pub enum ScriptCommand {
     TfEdit(String),
     /// `light AZ,EL` or `light headlight`: the panel's light.
     Light(volgraph_accel::light::Light),
+    /// `slices on|off`: open or close the slice panes.
+    Slices(bool),
+    /// `window CENTER,WIDTH`: the slice panes' window in data units.
+    SliceWindow(volgraph_accel::volume_meta::Window),
+    /// `click X Y`: a left click at window pixel (X, Y).
+    Click(f64, f64),
+    /// `wheel X Y LINES`: the wheel turned LINES notches at window pixel (X, Y).
+    Wheel(f64, f64, f64),
 }
 
 /// What the script accepts, for messages.
-pub const USAGE: &str = "quit, screenshot PATH, param PASS.NAME VALUE, write, crop X0,Y0,Z0,X1,Y1,Z1|off, clip NX,NY,NZ,D|off, save-scene PATH, tf-point VALUE R,G,B,A, tf-save, tf-edit INPUT, light AZ,EL|headlight";
+pub const USAGE: &str = "quit, screenshot PATH, param PASS.NAME VALUE, write, crop X0,Y0,Z0,X1,Y1,Z1|off, clip NX,NY,NZ,D|off, save-scene PATH, tf-point VALUE R,G,B,A, tf-save, tf-edit INPUT, light AZ,EL|headlight, slices on|off, window CENTER,WIDTH, click X Y, wheel X Y LINES";
 
 /// Parses one line: `Ok(None)` for a blank line, `Err` naming what is wrong.
 pub fn parse_line(line: &str) -> Result<Option<ScriptCommand>, String> {
@@ -91,6 +99,32 @@ pub fn parse_line(line: &str) -> Result<Option<ScriptCommand>, String> {
                 _ => Err(bad()),
             }
         }
+        "slices" => match rest {
+            "on" => Ok(Some(ScriptCommand::Slices(true))),
+            "off" => Ok(Some(ScriptCommand::Slices(false))),
+            _ => Err(format!("\"{line}\": write slices on or slices off")),
+        },
+        "window" => {
+            let bad = || format!("\"{line}\": write window CENTER,WIDTH (data units, width > 0), e.g. window 40,400");
+            let parts = finite_numbers(rest, ',').ok_or_else(bad)?;
+            match parts.as_slice() {
+                [center, width] if *width > 0.0 => {
+                    Ok(Some(ScriptCommand::SliceWindow(volgraph_accel::volume_meta::Window {
+                        center: *center,
+                        width: *width,
+                    })))
+                }
+                _ => Err(bad()),
+            }
+        }
+        "click" => match finite_numbers(rest, ' ').as_deref() {
+            Some([x, y]) => Ok(Some(ScriptCommand::Click(*x, *y))),
+            _ => Err(format!("\"{line}\": write click X Y (window pixels)")),
+        },
+        "wheel" => match finite_numbers(rest, ' ').as_deref() {
+            Some([x, y, lines]) => Ok(Some(ScriptCommand::Wheel(*x, *y, *lines))),
+            _ => Err(format!("\"{line}\": write wheel X Y LINES (window pixels, notches: + up)")),
+        },
         "save-scene" if rest.is_empty() => Err(format!("\"{line}\": write save-scene PATH")),
         "save-scene" => Ok(Some(ScriptCommand::SaveScene(PathBuf::from(rest)))),
         "crop" if rest == "off" => Ok(Some(ScriptCommand::Crop(None))),
@@ -105,6 +139,16 @@ pub fn parse_line(line: &str) -> Result<Option<ScriptCommand>, String> {
     }
 }
 
+/// `text` split at `separator` (runs of spaces count once) as finite numbers; `None` if any is
+/// not one.
+fn finite_numbers(text: &str, separator: char) -> Option<Vec<f64>> {
+    text.split(separator)
+        .map(str::trim)
+        .filter(|p| !(separator == ' ' && p.is_empty()))
+        .map(|p| p.parse::<f64>().ok().filter(|v| v.is_finite()))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -117,6 +161,11 @@ mod tests {
         assert_eq!(parse_line("crop off"), Ok(Some(ScriptCommand::Crop(None))));
         assert!(matches!(parse_line("clip 1,0,0,0.5"), Ok(Some(ScriptCommand::Clip(Some(_))))));
         assert!(parse_line("write now").is_err());
+        assert_eq!(parse_line("slices on"), Ok(Some(ScriptCommand::Slices(true))));
+        assert_eq!(parse_line("click 410  20.5"), Ok(Some(ScriptCommand::Click(410.0, 20.5))));
+        assert_eq!(parse_line("wheel 410 20 -3"), Ok(Some(ScriptCommand::Wheel(410.0, 20.0, -3.0))));
+        let bone = volgraph_accel::volume_meta::Window { center: 400.0, width: 1800.0 };
+        assert_eq!(parse_line("window 400, 1800"), Ok(Some(ScriptCommand::SliceWindow(bone))));
         assert_eq!(
             parse_line("screenshot my shots/a.png"),
             Ok(Some(ScriptCommand::Screenshot(PathBuf::from("my shots/a.png"))))
@@ -140,6 +189,12 @@ mod tests {
             ("param march 0.5", "\"march\" is not PASS.NAME"),
             ("screenshot", "write screenshot PATH"),
             ("qiut", "unknown command \"qiut\""),
+            ("slices maybe", "write slices on or slices off"),
+            ("window 40", "write window CENTER,WIDTH"),
+            ("window 40,-1", "write window CENTER,WIDTH"),
+            ("window NaN,400", "write window CENTER,WIDTH"),
+            ("click 10", "write click X Y"),
+            ("wheel 1 2 inf", "write wheel X Y LINES"),
             ("crop 0,0,0,1,1", "got 5"),
             ("tf-point 40 1,0,0", "write tf-point VALUE R,G,B,A"),
             ("tf-point 40 1,0,0,2", "write tf-point VALUE R,G,B,A"),

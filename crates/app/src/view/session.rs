@@ -24,6 +24,7 @@ use crate::inputs;
 mod labels;
 mod measure;
 mod open;
+mod slices;
 mod tf;
 
 pub use super::workbench::SAVED_TF;
@@ -184,6 +185,8 @@ pub struct LiveSession {
     noise: volgraph_accel::progressive_error::ErrorTracker,
     /// Since when the camera rests (a reprojecting path tracer's estimate counts from there).
     resting: Resting,
+    /// The axial, coronal and sagittal panes beside the 3D view, while open.
+    slices: Option<crate::view::slice_panes::SlicePanes>,
 }
 
 /// The camera of the last frame, the frames it has rested, and how often it moved.

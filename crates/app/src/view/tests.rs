@@ -113,6 +113,7 @@ mod gpu_errors;
 mod labels;
 mod named_tfs;
 mod reload;
+mod slices;
 
 #[test]
 fn a_parameter_edit_is_written_in_place_and_changes_the_image() {

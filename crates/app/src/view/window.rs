@@ -18,6 +18,7 @@ use super::orbit::Orbit;
 use super::panel::{self, Action, Timings};
 use super::script::ScriptCommand;
 use super::session::{Event, LiveSession, SessionArgs};
+use super::slice_panes::FourUp;
 use super::tf_editor::TfAction;
 use super::watch::FileWatch;
 use super::workbench::FramePolicy;
@@ -53,6 +54,8 @@ pub struct Viewer {
     frames: FramePolicy,
     /// The view's error against the converged reference, measured once it rests.
     accuracy: super::accuracy::LiveAccuracy,
+    /// The slice pane a left-button drag moves the crosshair in.
+    slice_drag: Option<volgraph_accel::reslice::SliceAxis>,
     /// Screenshots asked for since the last frame, each written (in order) after it.
     screenshots_now: Vec<PathBuf>,
     quit: bool,
@@ -79,6 +82,7 @@ impl Viewer {
             cursor: None,
             frames: FramePolicy::default(),
             accuracy: Default::default(),
+            slice_drag: None,
             screenshots_now: Vec::new(),
             quit: false,
             failure: None,
@@ -148,8 +152,11 @@ impl Viewer {
             let anterior = volgraph_accel::camera::PatientView::Anterior.camera(self.view.camera.distance);
             self.orbit = Orbit::new(anterior);
         }
+        let mut session = session;
+        let slice_events = if self.view.slices { session.set_slice_panes(true) } else { Vec::new() };
         self.session = Some(session);
         self.gfx = Some(Gfx { window, surface, config, gpu, egui, renderer });
+        self.handle(slice_events);
         // Only now: an edit made as soon as this line appears is seen by the watcher.
         emit(&loaded);
         Ok(())
@@ -197,6 +204,13 @@ impl Viewer {
                     session.runtime.set_step_profiling(on);
                     Vec::new()
                 }
+                Action::SlicePanes(open) => session.set_slice_panes(open),
+                Action::SliceWindow(window) => {
+                    if let Some(panes) = session.slices_mut() {
+                        panes.view.window = window;
+                    }
+                    Vec::new()
+                }
                 Action::Lod { enabled, target_fps } => {
                     self.frames.set_lod(enabled, target_fps);
                     Vec::new()
@@ -218,9 +232,9 @@ impl Viewer {
                 Action::SaveScene(path) => {
                     // The image as the window shows it (beside the panel), which the screenshot
                     // saves too: `render --scene` draws the same picture.
-                    let panel_px = self.panel_px;
+                    let (panel_px, slices) = (self.panel_px, session.slices().is_some());
                     let window = self.gfx.as_ref().map_or(session.options().viewport, |g| {
-                        image_size((g.config.width, g.config.height), panel_px)
+                        view_size((g.config.width, g.config.height), panel_px, slices)
                     });
                     match session.save_view(&self.orbit.camera, window, &path) {
                         Ok(tf_file) => {
@@ -309,6 +323,18 @@ impl Viewer {
                     let tf = super::tf_editor::with_point(session.transfer_function(), point);
                     self.apply_actions(vec![Action::TransferFunction(TfAction::Edit(tf))]);
                 }
+                Ok(Some(ScriptCommand::Slices(open))) => self.apply_actions(vec![Action::SlicePanes(open)]),
+                Ok(Some(ScriptCommand::SliceWindow(window))) => self.apply_actions(vec![Action::SliceWindow(window)]),
+                Ok(Some(ScriptCommand::Click(x, y))) => {
+                    // A left click there, as the window's events would give it.
+                    self.cursor = Some((x, y));
+                    self.mouse_button(MouseButton::Left, true);
+                    self.mouse_button(MouseButton::Left, false);
+                }
+                Ok(Some(ScriptCommand::Wheel(x, y, lines))) => {
+                    self.cursor = Some((x, y));
+                    self.mouse_wheel(lines);
+                }
                 Ok(Some(ScriptCommand::TfSave)) => self.apply_actions(vec![Action::TransferFunction(TfAction::Save)]),
                 Ok(Some(ScriptCommand::Light(light))) => self.apply_actions(vec![Action::Light(light)]),
                 Ok(Some(ScriptCommand::TfEdit(input))) => {
@@ -339,6 +365,59 @@ impl Viewer {
         }
     }
 
+    /// A mouse button at the pointer: on a slice pane the left button moves the crosshair (and
+    /// drags it); elsewhere left and middle turn and pan the camera.
+    fn mouse_button(&mut self, button: MouseButton, pressed: bool) {
+        let on_pane = self.pane_under_cursor();
+        let slice_click = pressed && on_pane.is_some() || !pressed && self.slice_drag.is_some();
+        if button == MouseButton::Left && slice_click {
+            self.slice_drag = on_pane.filter(|_| pressed).map(|(axis, _)| axis);
+            if pressed {
+                self.move_crosshair();
+            }
+        } else if matches!(button, MouseButton::Left | MouseButton::Middle) {
+            let pan = button == MouseButton::Middle || self.modifiers.shift_key();
+            self.orbit.button(pressed, pan);
+        }
+    }
+
+    /// The wheel at the pointer: over a slice pane it steps through its slices (a notch a slice,
+    /// up toward the higher index); elsewhere it zooms.
+    fn mouse_wheel(&mut self, lines: f64) {
+        if let Some((axis, _)) = self.pane_under_cursor() {
+            if let Some(panes) = self.session.as_mut().and_then(LiveSession::slices_mut) {
+                panes.scroll(axis, lines.signum() as i32 * lines.abs().ceil().max(1.0) as i32);
+            }
+        } else {
+            self.orbit.wheel(lines);
+            self.frames.moved();
+        }
+    }
+
+    /// The four-up layout while the slice panes are open.
+    fn four_up(&self) -> Option<FourUp> {
+        let gfx = self.gfx.as_ref()?;
+        self.session.as_ref()?.slices()?;
+        Some(FourUp::of(image_size((gfx.config.width, gfx.config.height), self.panel_px)))
+    }
+
+    /// The slice pane under the pointer and the pointer's point in it (pixels).
+    fn pane_under_cursor(&self) -> Option<(volgraph_accel::reslice::SliceAxis, glam::DVec2)> {
+        let (x, y) = self.cursor?;
+        self.four_up()?.pane_at(glam::DVec2::new(x, y))
+    }
+
+    /// Moves the crosshair to the pointer in the pane being dragged in (clamped to its slice).
+    fn move_crosshair(&mut self) {
+        let (Some(axis), Some(layout), Some((x, y))) = (self.slice_drag, self.four_up(), self.cursor) else { return };
+        let index = volgraph_accel::reslice::SliceAxis::ALL.iter().position(|a| *a == axis).unwrap_or(0);
+        let [px, py, _, _] = layout.panes[index];
+        let local = glam::DVec2::new(x - f64::from(px), y - f64::from(py));
+        if let Some(panes) = self.session.as_mut().and_then(LiveSession::slices_mut) {
+            panes.click(axis, layout.pane(), local);
+        }
+    }
+
     fn save_screenshot(&mut self, path: &PathBuf) -> Result<(), String> {
         // A FIFO here would block the window for good: refused now with the screenshot's own
         // message, and the PNG is written with `write_bytes_atomically`, which never opens the
@@ -347,7 +426,8 @@ impl Viewer {
         let (Some(session), Some(gfx)) = (self.session.as_mut(), self.gfx.as_ref()) else { return Ok(()) };
         let output = session.shown_output();
         // The image as the window shows it beside the panel (not stretched over the window).
-        let (w, h) = image_size((gfx.config.width, gfx.config.height), self.panel_px);
+        let slices = session.slices().is_some();
+        let (w, h) = view_size((gfx.config.width, gfx.config.height), self.panel_px, slices);
         let bytes = session.runtime.capture(output, gfx.config.format, (w, h)).map_err(|e| e.to_string())?;
         let bgra = matches!(gfx.config.format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb);
         let mut rgba = bytes;
@@ -374,7 +454,7 @@ impl Viewer {
         // Level of detail: fewer pixels while the camera moves, the full image once it rests.
         let mut lod_events = Vec::new();
         if let (Some(session), Some(gfx)) = (self.session.as_mut(), self.gfx.as_ref()) {
-            let image = image_size((gfx.config.width, gfx.config.height), self.panel_px);
+            let image = view_size((gfx.config.width, gfx.config.height), self.panel_px, session.slices().is_some());
             lod_events = self.frames.apply_lod(image, session);
         }
         self.handle(lod_events);
@@ -394,13 +474,15 @@ impl Viewer {
         };
         let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
         let size = (gfx.config.width, gfx.config.height);
-        let image = image_size(size, self.panel_px);
+        let four_up = session.slices().is_some().then(|| FourUp::of(image_size(size, self.panel_px)));
+        let image = view_size(size, self.panel_px, four_up.is_some());
         let target = PresentTarget {
             view: &view,
             format: gfx.config.format,
             size,
             output: session.shown_output(),
             region: Some([0, 0, image.0, image.1]),
+            load: false,
         };
         if let Some(turn) = self.view.turn_degrees {
             self.orbit.turn(turn);
@@ -419,6 +501,20 @@ impl Viewer {
         if reverted {
             // This frame's surface texture was not drawn: show the next one.
             return;
+        }
+        let Some(session) = self.session.as_mut() else { return };
+        let Some(gfx) = self.gfx.as_mut() else { return };
+        // The slice panes beside the 3D view: rendered again only when the crosshair, the window
+        // or the pane size changed, drawn every frame.
+        if let (Some(layout), Some(panes)) = (four_up, session.slices_mut()) {
+            let drawn =
+                panes.update(layout.pane()).and_then(|_| panes.present(&view, gfx.config.format, size, &layout.panes));
+            if let Err(message) = drawn {
+                let events = session.set_slice_panes(false);
+                let error = Event::Error { what: "slice panes".to_string(), message };
+                self.handle(events.into_iter().chain([error]).collect());
+                return;
+            }
         }
         let Some(session) = self.session.as_mut() else { return };
         let Some(gfx) = self.gfx.as_mut() else { return };
@@ -445,7 +541,7 @@ impl Viewer {
             let mut panel_points = 0.0;
             // The orientation marker, for a volume in the patient frame, in the image's corner.
             let marker = session.in_patient_frame().then(|| {
-                let (w, h) = image_size(size, self.panel_px);
+                let (w, h) = view_size(size, self.panel_px, four_up.is_some());
                 let ppp = ctx.pixels_per_point();
                 (
                     egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(w as f32 / ppp, h as f32 / ppp)),
@@ -455,6 +551,11 @@ impl Viewer {
             let output = ctx.run_ui(raw, |ui| {
                 if let Some((image, camera)) = &marker {
                     super::orientation::draw(ui.ctx(), *image, camera);
+                }
+                if let (Some(layout), Some(panes)) = (&four_up, session.slices()) {
+                    let patient = session.in_patient_frame();
+                    let ppp = ui.ctx().pixels_per_point();
+                    super::slice_section::draw_overlay(ui.ctx(), layout, ppp, panes, &self.orbit.camera, patient);
                 }
                 let shown = panel::show(
                     ui,
@@ -549,7 +650,8 @@ impl ApplicationHandler for Viewer {
                     gfx.surface.configure(&gfx.gpu.device, &gfx.config);
                 }
                 if let Some(session) = self.session.as_mut() {
-                    let (w, h) = image_size((size.width, size.height), self.panel_px);
+                    let slices = session.slices().is_some();
+                    let (w, h) = view_size((size.width, size.height), self.panel_px, slices);
                     let events = session.resize(w, h);
                     self.handle(events);
                 }
@@ -575,6 +677,10 @@ impl ApplicationHandler for Viewer {
                         let (_, view) = volgraph_accel::camera::PatientView::ALL[index];
                         self.apply_actions(vec![Action::PatientView(view)]);
                     }
+                    Key::Character(c) if c.eq_ignore_ascii_case("m") => {
+                        let open = self.session.as_ref().is_some_and(|s| s.slices().is_some());
+                        self.apply_actions(vec![Action::SlicePanes(!open)]);
+                    }
                     Key::Character(c) if c.eq_ignore_ascii_case("s") => {
                         self.apply_actions(vec![Action::Screenshot]);
                     }
@@ -582,13 +688,14 @@ impl ApplicationHandler for Viewer {
                 }
             }
             WindowEvent::MouseInput { state, button, .. } if !consumed => {
-                let pan = button == MouseButton::Middle || self.modifiers.shift_key();
-                if matches!(button, MouseButton::Left | MouseButton::Middle) {
-                    self.orbit.button(state == ElementState::Pressed, pan);
-                }
+                self.mouse_button(button, state == ElementState::Pressed);
             }
             WindowEvent::CursorMoved { position, .. } => {
                 self.cursor = Some((position.x, position.y));
+                if self.slice_drag.is_some() {
+                    self.move_crosshair();
+                    return;
+                }
                 if self.orbit.is_dragging() {
                     self.frames.moved();
                 }
@@ -600,8 +707,7 @@ impl ApplicationHandler for Viewer {
                     MouseScrollDelta::LineDelta(_, y) => y as f64,
                     MouseScrollDelta::PixelDelta(p) => p.y / 40.0,
                 };
-                self.orbit.wheel(lines);
-                self.frames.moved();
+                self.mouse_wheel(lines);
             }
             _ => {}
         }
@@ -634,6 +740,13 @@ pub fn run(session_args: SessionArgs, view: ViewOptions, script: Option<Receiver
         Some(e) => Err(e),
         None => Ok(()),
     }
+}
+
+/// The 3D view's size: the image beside the panel, or its top-left quarter with the slice panes
+/// open (`FourUp`).
+fn view_size(surface: (u32, u32), panel_px: u32, slices: bool) -> (u32, u32) {
+    let image = image_size(surface, panel_px);
+    if slices { FourUp::of(image).pane() } else { image }
 }
 
 /// The image's size in a window of `surface` pixels with a panel `panel_px` wide at its right:

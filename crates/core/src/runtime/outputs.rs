@@ -64,6 +64,20 @@ impl Runtime {
         }
     }
 
+    /// Draws `target.output` as the last frame left it onto `target` (a window's surface), in a
+    /// command buffer of its own after that frame's: a second graph's outputs beside the first's
+    /// (`load: true`), without rendering it again. Does not wait.
+    pub fn present(&mut self, target: &PresentTarget<'_>) -> Result<(), RuntimeError> {
+        let live = self.live.as_ref().ok_or(RuntimeError::NoPlan)?;
+        let (source, encoded) = output_view(live, &self.history, target.output)?;
+        let mut encoder =
+            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("present") });
+        self.blitter.record(&self.gpu, &mut encoder, &source, encoded, target)?;
+        self.gpu
+            .checked(|| format!("presenting \"{}\"", target.output), || self.gpu.queue.submit([encoder.finish()]))?;
+        Ok(())
+    }
+
     /// What a window of `format` and `size` shows of `output` after the last frame: the same
     /// blit, drawn into an offscreen texture and read back as `format`'s bytes (a screenshot
     /// without the overlay). Waits for the frame.
@@ -92,7 +106,7 @@ impl Runtime {
             },
         )?;
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
-        let target = PresentTarget { view: &view, format, size, output, region: None };
+        let target = PresentTarget { view: &view, format, size, output, region: None, load: false };
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("capture") });
         self.blitter.record(&self.gpu, &mut encoder, &source, encoded, &target)?;

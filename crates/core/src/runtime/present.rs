@@ -19,6 +19,9 @@ pub struct PresentTarget<'a> {
     /// Where on the surface the output goes, (x, y, width, height) in pixels (the viewer's image
     /// beside its panel); `None`: the whole surface.
     pub region: Option<[u32; 4]>,
+    /// Draw over what the surface holds (a second output beside the first, the viewer's slice
+    /// panes) instead of clearing it to black first.
+    pub load: bool,
 }
 
 #[repr(C)]
@@ -161,7 +164,10 @@ impl Blitter {
                 view: target.view,
                 depth_slice: None,
                 resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
+                ops: wgpu::Operations {
+                    load: if target.load { wgpu::LoadOp::Load } else { wgpu::LoadOp::Clear(wgpu::Color::BLACK) },
+                    store: wgpu::StoreOp::Store,
+                },
             })],
             ..Default::default()
         });

@@ -193,6 +193,7 @@ impl LiveSession {
             environment: args.environment.clone(),
             noise: Default::default(),
             resting: Default::default(),
+            slices: None,
         };
         let ms = start.elapsed().as_secs_f64() * 1e3;
         Ok((session, Event::Loaded { graph: graph_name, ms, summary: loaded }))

@@ -1,0 +1,171 @@
+//! The slice panes in the window: the panel's "Slices" section (open/close, window and level
+//! with the CT presets, where the crosshair is) and the overlay over the panes (each pane's
+//! crosshair, its name, slice and side letters) and the 3D view (the crosshair's point).
+
+use glam::{DVec2, DVec4};
+use volgraph_accel::camera::OrbitCamera;
+use volgraph_accel::reslice::SliceAxis;
+use volgraph_accel::volume_meta::{Window, side_label};
+
+use super::panel::Action;
+use super::slice_panes::{FourUp, SlicePanes};
+
+/// The CT windows every viewer offers (center, width in HU), as radiology reads them.
+pub const CT_WINDOWS: [(&str, f64, f64); 4] =
+    [("brain", 40.0, 80.0), ("soft tissue", 40.0, 400.0), ("lung", -600.0, 1500.0), ("bone", 400.0, 1800.0)];
+
+/// What the panel's section shows of the panes.
+pub struct SliceInfo<'a> {
+    /// The panes, when open.
+    pub panes: Option<&'a SlicePanes>,
+    /// The volume is CT in HU: the CT presets apply.
+    pub hounsfield: bool,
+    /// The crosshair's patient point (LPS mm), for a volume in the patient frame.
+    pub patient: Option<glam::DVec3>,
+}
+
+/// The "Slices" section; returns what the user did.
+pub fn section(ui: &mut egui::Ui, info: &SliceInfo<'_>) -> Vec<Action> {
+    let mut actions = Vec::new();
+    egui::CollapsingHeader::new("Slices").default_open(info.panes.is_some()).show(ui, |ui| {
+        let mut open = info.panes.is_some();
+        if ui.checkbox(&mut open, "axial, coronal, sagittal panes (M)").changed() {
+            actions.push(Action::SlicePanes(open));
+        }
+        let Some(panes) = info.panes else {
+            ui.small("the clinical four-up: click a slice to move the crosshair, the wheel steps through slices");
+            return;
+        };
+        let window = panes.view.window;
+        ui.horizontal_wrapped(|ui| {
+            ui.label("window:");
+            if ui.button("file").on_hover_text("the file's window, else the value range").clicked() {
+                actions.push(Action::SliceWindow(panes.file_window()));
+            }
+            if info.hounsfield {
+                for (name, center, width) in CT_WINDOWS {
+                    if ui.button(name).on_hover_text(format!("{center} / {width} HU")).clicked() {
+                        actions.push(Action::SliceWindow(Window { center, width }));
+                    }
+                }
+            }
+        });
+        let (mut center, mut width) = (window.center, window.width);
+        let speed = (panes.file_window().width / 200.0).max(1e-3);
+        let changed = ui
+            .horizontal(|ui| {
+                let c = ui.add(egui::DragValue::new(&mut center).speed(speed).prefix("level ")).changed();
+                let w =
+                    ui.add(egui::DragValue::new(&mut width).speed(speed).range(1e-6..=1e9).prefix("width ")).changed();
+                c || w
+            })
+            .inner;
+        if changed {
+            actions.push(Action::SliceWindow(Window { center, width }));
+        }
+        for axis in SliceAxis::ALL {
+            ui.small(format!("{}: slice {} of {}", axis.name(), panes.slice_index(axis) + 1, panes.slice_count(axis)));
+        }
+        if let Some(p) = info.patient {
+            ui.small(format!("crosshair: {}", volgraph_accel::volume_meta::patient_label(p)));
+        }
+        if let Some(ms) = panes.last_update_ms {
+            ui.small(format!("last slice update: {ms:.1} ms (three panes, rendered and waited for)"));
+        }
+    });
+    actions
+}
+
+/// Draws each pane's crosshair, name, slice and side letters over the panes, and the crosshair's
+/// point over the 3D view seen by `camera`. `layout` is in physical pixels; `ppp` pixels per point.
+pub fn draw_overlay(
+    ctx: &egui::Context,
+    layout: &FourUp,
+    ppp: f32,
+    panes: &SlicePanes,
+    camera: &OrbitCamera,
+    patient: bool,
+) {
+    let painter = ctx.layer_painter(egui::LayerId::new(egui::Order::Background, egui::Id::unique("slice overlay")));
+    let to_points = |x: f64, y: f64| egui::pos2(x as f32 / ppp, y as f32 / ppp);
+    let pane = layout.pane();
+    let yellow = egui::Color32::from_rgb(240, 200, 40);
+    for (axis, [x, y, w, h]) in SliceAxis::ALL.into_iter().zip(layout.panes) {
+        let (x0, y0) = (f64::from(x), f64::from(y));
+        let rect = egui::Rect::from_min_max(to_points(x0, y0), to_points(x0 + f64::from(w), y0 + f64::from(h)));
+        let c = panes.crosshair_in(axis, pane) + DVec2::new(x0, y0);
+        let stroke = egui::Stroke::new(1.0, yellow.gamma_multiply(0.8));
+        painter.line_segment(
+            [egui::pos2(rect.left(), c.y as f32 / ppp), egui::pos2(rect.right(), c.y as f32 / ppp)],
+            stroke,
+        );
+        painter.line_segment(
+            [egui::pos2(c.x as f32 / ppp, rect.top()), egui::pos2(c.x as f32 / ppp, rect.bottom())],
+            stroke,
+        );
+        painter.rect_stroke(rect, 0.0, egui::Stroke::new(1.0, egui::Color32::from_gray(70)), egui::StrokeKind::Inside);
+        let font = egui::FontId::proportional(12.0);
+        let name = format!("{} {}/{}", axis.name(), panes.slice_index(axis) + 1, panes.slice_count(axis));
+        painter.text(
+            rect.left_top() + egui::vec2(4.0, 2.0),
+            egui::Align2::LEFT_TOP,
+            name,
+            font.clone(),
+            egui::Color32::WHITE,
+        );
+        // The sides at the pane's edges (the patient frame's letters; index axes otherwise).
+        let [(c_axis, c_back), (r_axis, r_back)] = axis.pane_axes();
+        let letter = |a: usize, toward_plus: bool| edge_letter(a, toward_plus, patient);
+        let edges = [
+            (rect.left_center() + egui::vec2(3.0, 0.0), egui::Align2::LEFT_CENTER, letter(c_axis, c_back)),
+            (rect.right_center() - egui::vec2(3.0, 0.0), egui::Align2::RIGHT_CENTER, letter(c_axis, !c_back)),
+            (rect.center_top() + egui::vec2(0.0, 16.0), egui::Align2::CENTER_TOP, letter(r_axis, r_back)),
+            (rect.center_bottom() - egui::vec2(0.0, 3.0), egui::Align2::CENTER_BOTTOM, letter(r_axis, !r_back)),
+        ];
+        for (at, align, text) in edges {
+            painter.text(at, align, text, font.clone(), yellow);
+        }
+    }
+    // The crosshair in the 3D view: where the three planes meet, projected by the camera.
+    let [x, y, w, h] = layout.view;
+    let frame = camera.frame(w, h);
+    let clip = frame.clip_from_world * DVec4::from((panes.crosshair_world(), 1.0));
+    if clip.w > 0.0 {
+        let ndc = clip.truncate() / clip.w;
+        let px = f64::from(x) + (ndc.x + 1.0) * 0.5 * f64::from(w);
+        let py = f64::from(y) + (1.0 - ndc.y) * 0.5 * f64::from(h);
+        let at = to_points(px, py);
+        painter.circle_stroke(at, 5.0, egui::Stroke::new(1.5, yellow));
+        painter.circle_filled(at, 1.5, yellow);
+    }
+}
+
+/// The letter of the pane edge that axis `a`'s values grow toward (`toward_plus`) or away from:
+/// L/R, P/A, S/I in the patient frame (LPS), else +x/−x and so on.
+fn edge_letter(a: usize, toward_plus: bool, patient: bool) -> String {
+    if patient {
+        // side_label of a positive or negative distance names the side; keep its letter.
+        side_label(a, if toward_plus { 1.0 } else { -1.0 }).chars().next().unwrap_or('?').to_string()
+    } else {
+        format!("{}{}", if toward_plus { "+" } else { "−" }, ["x", "y", "z"][a])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pane_edges_carry_the_patient_sides_the_clinical_tools_show() {
+        // Axial: the patient's right on the left edge, left on the right, anterior at the top.
+        let [(c, c_back), (r, r_back)] = SliceAxis::Axial.pane_axes();
+        assert_eq!(edge_letter(c, c_back, true), "R");
+        assert_eq!(edge_letter(c, !c_back, true), "L");
+        assert_eq!(edge_letter(r, r_back, true), "A");
+        // Sagittal: anterior on the left, superior at the top.
+        let [(c, c_back), (r, r_back)] = SliceAxis::Sagittal.pane_axes();
+        assert_eq!(edge_letter(c, c_back, true), "A");
+        assert_eq!(edge_letter(r, r_back, true), "S");
+        assert_eq!(edge_letter(2, true, false), "+z");
+    }
+}

@@ -1,0 +1,91 @@
+//! The slice panes through the session, as the window drives them: opened on the session's
+//! volume, a click on a pane moves the crosshair within its plane, the wheel steps one slice a
+//! notch, a window preset — and every pane rendered is its f64 slice
+//! (`volgraph_accel::reslice`), within the 8-bit rounding of the target.
+
+use glam::DVec2;
+use volgraph_accel::reslice::{SliceAxis, reslice};
+use volgraph_accel::volume_meta::Window;
+
+use super::super::slice_panes::{FourUp, SlicePanes};
+use super::{LiveSession, gpu, scratch, session_args};
+
+/// Each pane against the f64 slice through the same crosshair: half a code of rounding and the
+/// f32 filter's error (crates/passes/tests/reslice.rs measures 0.51 codes at worst).
+fn assert_panes_match(session: &mut LiveSession, pane: (u32, u32)) {
+    let volume = session.volume().clone();
+    let panes = session.slices_mut().expect("open");
+    assert!(panes.update(pane).expect("renders"), "a change renders");
+    assert!(!panes.update(pane).expect("renders"), "nothing changed: nothing rendered");
+    for axis in SliceAxis::ALL {
+        let expected = reslice(&volume, panes.plane(axis), panes.view.window, pane);
+        let image = panes.read(axis).expect("a pane");
+        let worst = expected
+            .iter()
+            .enumerate()
+            .map(|(i, e)| {
+                let got = image.rgba(i as u32 % pane.0, i as u32 / pane.0);
+                e.map_or(f64::from(got[3]), |grey| (f64::from(got[0]) - grey).abs() * 255.0)
+            })
+            .fold(0.0, f64::max);
+        assert!(worst <= 0.75, "{}: {worst:.2} codes from the f64 slice", axis.name());
+    }
+}
+
+#[test]
+fn a_click_moves_the_crosshair_the_wheel_steps_a_slice_and_the_panes_stay_their_f64_slices() {
+    let s = scratch("slices", "graphs/basic/fragment_raycast.ron");
+    let (mut session, _) =
+        LiveSession::open(gpu(), &session_args(&s, &["organs48"], None)).unwrap_or_else(|_| panic!("opens"));
+    assert!(session.set_slice_panes(true).is_empty());
+    let layout = FourUp::of((200, 160));
+    let pane = layout.pane();
+    assert_eq!(pane, (100, 80));
+    assert_panes_match(&mut session, pane);
+
+    let panes = session.slices_mut().expect("open");
+    let start = panes.view.crosshair;
+    // The central voxel: 48 × 48 × 24 voxels, the crosshair on voxel centres.
+    assert_eq!(panes.crosshair_voxel().to_array(), [24.5, 24.5, 12.5]);
+    // A click on the coronal pane at its slice's upper-left quarter point: x and z move, y
+    // (the coronal plane's own position) stays.
+    let fit = panes.fit(SliceAxis::Coronal, pane);
+    panes.click(SliceAxis::Coronal, pane, fit.point(DVec2::new(0.25, 0.25)));
+    let moved = panes.view.crosshair;
+    assert!((moved.x - 0.25).abs() < 1e-9 && (moved.z - 0.75).abs() < 1e-9, "{moved}");
+    assert_eq!(moved.y, start.y);
+    // The crosshair shows in the other panes where it was put.
+    let axial = panes.crosshair_in(SliceAxis::Axial, pane);
+    let axial_fit = panes.fit(SliceAxis::Axial, pane);
+    assert!((axial_fit.fractions(axial).x - 0.25).abs() < 1e-9);
+    // Three notches up on the axial pane: three slices up, onto voxel centres.
+    let before = panes.slice_index(SliceAxis::Axial);
+    panes.scroll(SliceAxis::Axial, 3);
+    assert_eq!(panes.slice_index(SliceAxis::Axial), before + 3);
+    // Past the last slice it stops there.
+    panes.scroll(SliceAxis::Axial, 1000);
+    assert_eq!(panes.slice_index(SliceAxis::Axial), 23);
+    panes.scroll(SliceAxis::Axial, -5);
+    // The bone window, as the panel's preset gives it.
+    panes.view.window = Window { center: 400.0, width: 1800.0 };
+    assert_panes_match(&mut session, pane);
+
+    // Closed, the panes' runtime is gone; opened again, the crosshair starts at the centre.
+    assert!(session.set_slice_panes(false).is_empty());
+    assert!(session.slices().is_none());
+    session.set_slice_panes(true);
+    assert_eq!(session.slices().map(|p| p.crosshair_voxel().to_array()), Some([24.5, 24.5, 12.5]));
+    let _ = std::fs::remove_dir_all(&s.dir);
+}
+
+#[test]
+fn the_panes_open_on_the_files_window_else_the_value_range() {
+    let mut ct = volgraph_accel::organs::organs_ct(32);
+    ct.meta.window = Some(Window { center: 40.0, width: 400.0 });
+    let panes = SlicePanes::new(gpu(), &ct).expect("opens");
+    assert_eq!(panes.view.window, Window { center: 40.0, width: 400.0 });
+    ct.meta.window = None;
+    let panes = SlicePanes::new(gpu(), &ct).expect("opens");
+    let (lo, hi) = ct.value_range;
+    assert_eq!(panes.view.window, Window { center: 0.5 * (lo + hi), width: hi - lo });
+}

@@ -91,6 +91,37 @@ pub fn side_label(axis: usize, mm: f64) -> String {
     format!("{} {:.1}", if v < 0.0 { negative } else { positive }, v.abs())
 }
 
+/// A clip plane of the volume's fractions — it keeps the points `f` with `n · f ≥ d` — as the
+/// patient frame sees it, for a volume whose patient box has its low corner at `corner` and its
+/// extent `extent` (mm, [`VolumeMeta::patient_box`]): the plane's unit normal in LPS, pointing
+/// to the side it keeps, and its signed distance (mm) from the patient origin along that normal.
+/// `None` for a zero normal. (With `f = (p − corner) / extent` the plane is `m · p = d + Σ nₐcₐ/eₐ`,
+/// `m = n / extent`.)
+pub fn patient_plane(normal: DVec3, offset: f64, corner: DVec3, extent: DVec3) -> Option<(DVec3, f64)> {
+    let m = normal / extent;
+    let length = m.length();
+    (length > 0.0 && length.is_finite())
+        .then(|| (m / length, (offset + (normal * corner / extent).element_sum()) / length))
+}
+
+/// A direction by the sides it points to, its largest components first: `L 0.71 · S 0.71`;
+/// components under 0.005 are left out, a direction along one axis is its side alone (`S`).
+pub fn direction_label(direction: DVec3) -> String {
+    let mut parts: Vec<(f64, String)> = (0..3)
+        .filter(|&a| direction[a].abs() >= 0.005)
+        .map(|a| {
+            let side = side_label(a, direction[a]);
+            let letter = side.split(' ').next().unwrap_or_default().to_string();
+            (direction[a].abs(), format!("{letter} {:.2}", direction[a].abs()))
+        })
+        .collect();
+    parts.sort_by(|a, b| b.0.total_cmp(&a.0));
+    match parts.as_slice() {
+        [(_, one)] => one.split(' ').next().unwrap_or_default().to_string(),
+        _ => parts.into_iter().map(|(_, p)| p).collect::<Vec<_>>().join(" · "),
+    }
+}
+
 impl VolumeMeta {
     /// The patient box of a volume in the patient frame: the LPS position (mm) of its low
     /// corner (voxel (0, 0, 0)'s outer face) and its extent along L, P and S (`dims` ×
@@ -105,6 +136,28 @@ impl VolumeMeta {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_clip_plane_of_fractions_is_a_patient_plane_in_mm() {
+        // A box from R 100 · A 50 · I 20 mm, 200 × 100 × 40 mm.
+        let (corner, extent) = (DVec3::new(-100.0, -50.0, -20.0), DVec3::new(200.0, 100.0, 40.0));
+        // Keep x fraction ≥ 0.6: toward L of x = −100 + 0.6 · 200 = L 20 mm.
+        let (n, d) = patient_plane(DVec3::X, 0.6, corner, extent).expect("a plane");
+        assert!((n - DVec3::X).length() < 1e-12 && (d - 20.0).abs() < 1e-9, "{n} {d}");
+        assert_eq!(direction_label(n), "L");
+        // Keep −z ≥ −0.25, z fraction ≤ 0.25: toward I of z = −20 + 10 = I 10 mm; the distance
+        // along the inferior normal is +10.
+        let (n, d) = patient_plane(-DVec3::Z, -0.25, corner, extent).expect("a plane");
+        assert!((n + DVec3::Z).length() < 1e-12 && (d - 10.0).abs() < 1e-9, "{n} {d}");
+        assert_eq!(direction_label(n), "I");
+        // An oblique plane of fractions is oblique in mm too, turned by the box's aspect; every
+        // point of it satisfies both forms.
+        let (n, d) = patient_plane(DVec3::new(1.0, 0.0, 1.0), 1.0, corner, extent).expect("a plane");
+        let f = DVec3::new(0.3, 0.5, 0.7); // on the fraction plane: 0.3 + 0.7 = 1
+        assert!((n.dot(corner + f * extent) - d).abs() < 1e-9);
+        assert_eq!(direction_label(n), "S 0.98 · L 0.20");
+        assert_eq!(patient_plane(DVec3::ZERO, 0.5, corner, extent), None);
+    }
 
     /// LPS: +x left, +y posterior, +z superior; a negative coordinate is the opposite side.
     #[test]

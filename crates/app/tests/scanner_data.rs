@@ -265,3 +265,43 @@ fn patient_views_render_a_dicom_series_and_are_refused_without_a_patient_frame()
     let both = render_bone(&series, &["--view", "left", "--camera", "0,0,3"], &out("b"));
     assert_eq!(both.code, 2, "{}", both.stderr);
 }
+
+/// Issue 45 item 1: a DICOM head and the NIfTI a converter writes from it — voxels in the same
+/// order with an RAS sform, or rows stored bottom up as dcm2niix stores them — render alike from
+/// `--view anterior` (and from the left, which a turn of 180° about any axis would change): the
+/// loaders put both in LPS. Without an orientation (no sform or qform) the NIfTI lies in index
+/// axes and `--view` is refused by name.
+#[test]
+fn a_dicom_head_and_its_nifti_twins_render_alike_from_the_same_view() {
+    let dir = scratch("nifti_views");
+    // The bony nose toward anterior (−y) above the middle, as in the views test.
+    let head = painted(ct(32, "head"), |x, y, z| {
+        ((14..18).contains(&x) && (3..10).contains(&y) && (16..22).contains(&z)).then_some(900)
+    });
+    write(&dir.join("series"), &head);
+    support::write_nifti_from_dicom(&dir.join("same_order.nii"), &head, false);
+    support::write_nifti_from_dicom(&dir.join("rows_flipped.nii"), &head, true);
+    support::write_nifti(&dir.join("unoriented.nii"), &head);
+    let sources = ["series", "same_order.nii", "rows_flipped.nii"];
+    for view in ["anterior", "left"] {
+        let images: Vec<image::RgbaImage> = sources
+            .iter()
+            .map(|source| {
+                let png = dir.join(format!("{source}_{view}.png")).display().to_string();
+                let run = render_bone(&dir.join(source).display().to_string(), &["--view", view], &png);
+                assert_eq!(run.code, 0, "{source} --view {view}: {}", run.stderr);
+                image::open(&png).expect("a PNG").to_rgba8()
+            })
+            .collect();
+        // The same voxels at the same patient points through the same preset: the same image
+        // to the 8-bit code (a turned head would differ in hundreds of pixels).
+        for (source, image) in sources.iter().zip(&images).skip(1) {
+            let differ = image.pixels().zip(images[0].pixels()).filter(|(a, b)| a != b).count();
+            assert_eq!(differ, 0, "--view {view}: {source} differs from the DICOM series in {differ} pixels");
+        }
+    }
+    let unoriented = dir.join("unoriented.nii").display().to_string();
+    let refused = render_bone(&unoriented, &["--view", "anterior"], &dir.join("u.png").display().to_string());
+    assert_eq!(refused.code, 1, "{}", refused.stderr);
+    assert!(refused.stderr.contains("patient frame"), "{}", refused.stderr);
+}

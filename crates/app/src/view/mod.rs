@@ -12,6 +12,7 @@ pub mod lod;
 pub mod orbit;
 pub mod orientation;
 pub mod panel;
+pub mod save_section;
 pub mod script;
 pub mod session;
 pub mod slice_panes;

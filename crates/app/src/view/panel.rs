@@ -12,6 +12,7 @@ use volgraph_core::params::{ParamKind, ParamValue};
 use super::session::LiveSession;
 
 /// A change asked for in the panel.
+#[derive(Debug)]
 pub enum Action {
     /// Set a pass parameter.
     Param(String, String, ron::Value),
@@ -29,6 +30,13 @@ pub enum Action {
     WriteBack,
     /// Set the crop box and clip planes.
     Cuts(Cuts),
+    /// Render the view again at `size` pixels and save it to `path` (PNG).
+    SaveImage {
+        /// The PNG to write.
+        path: std::path::PathBuf,
+        /// Width and height in pixels.
+        size: (u32, u32),
+    },
     /// Save the view (camera, crop, clip, TF, effects) to a scene file.
     SaveScene(std::path::PathBuf),
     /// The TF editor's action.
@@ -47,6 +55,8 @@ pub enum Action {
     TimeEachPass(bool),
     /// Open or close the slice panes.
     SlicePanes(bool),
+    /// Draw the slice planes' outlines in the 3D view or not.
+    SlicePlanesIn3d(bool),
     /// The slice panes' window (data units).
     SliceWindow(volgraph_accel::volume_meta::Window),
     /// Level of detail while moving: on or off, and the frame rate to hold.
@@ -331,6 +341,7 @@ pub fn show(
                 if let Some(light) = super::light_control::light_section(ui, session.runtime.light()) {
                     actions.push(Action::Light(light));
                 }
+                actions.extend(super::save_section::section(ui));
                 let scalars: BTreeMap<&String, f64> = plan
                     .inputs
                     .iter()
@@ -476,6 +487,24 @@ pub fn assign_field(ui: &mut egui::Ui) -> Option<String> {
 ///
 /// With `patient` (the volume's LPS corner and extent in mm, `VolumeMeta::patient_box`) each crop
 /// slider also says where it cuts in the patient, by side: `x from · R 30.0 mm`.
+/// The patient sides a clip plane can keep: letter, LPS axis, the normal's sign along it.
+const CLIP_SIDES: [(&str, usize, f64); 6] =
+    [("R", 0, -1.0), ("L", 0, 1.0), ("A", 1, -1.0), ("P", 1, 1.0), ("I", 2, -1.0), ("S", 2, 1.0)];
+
+/// Where clip plane `p` lies in the patient frame of a box at `corner` with `extent` (mm): along
+/// one axis, the side it keeps and its position (`d · keeps L of L 20.0 mm`); oblique, its
+/// normal by sides and its distance from the origin.
+fn clip_plane_text(p: &ClipPlane, corner: glam::DVec3, extent: glam::DVec3) -> String {
+    use volgraph_accel::volume_meta::{direction_label, patient_plane, side_label};
+    let Some((n, d)) = patient_plane(p.normal, p.offset, corner, extent) else { return "d".to_string() };
+    let keeps = direction_label(n);
+    match (0..3).find(|&a| n[a].abs() > 1.0 - 1e-9) {
+        // n = ±eₐ: the plane is pₐ = d · nₐ.
+        Some(a) => format!("d · keeps {keeps} of {} mm", side_label(a, d * n[a])),
+        None => format!("d · keeps {keeps}, {d:.1} mm from the origin"),
+    }
+}
+
 fn cuts_section(ui: &mut egui::Ui, cuts: Cuts, patient: Option<(glam::DVec3, glam::DVec3)>) -> Option<Cuts> {
     let mut crop = cuts.crop();
     let mut planes: Vec<ClipPlane> = cuts.planes().copied().collect();
@@ -512,11 +541,29 @@ fn cuts_section(ui: &mut egui::Ui, cuts: Cuts, patient: Option<(glam::DVec3, gla
             changed = true;
         }
         if let Some(p) = planes.first_mut() {
+            // In the patient frame: a plane through the box's centre keeping one side, and where
+            // the plane lies in mm.
+            if patient.is_some() {
+                ui.horizontal(|ui| {
+                    ui.label("keep toward");
+                    for (letter, axis, sign) in CLIP_SIDES {
+                        let hint = format!("a plane through the centre keeping the patient's {letter} half");
+                        if ui.small_button(letter).on_hover_text(hint).clicked() {
+                            let mut n = glam::DVec3::ZERO;
+                            n[axis] = sign;
+                            *p = ClipPlane { normal: n, offset: 0.5 * sign };
+                            changed = true;
+                        }
+                    }
+                });
+            }
             let mut n = p.normal;
             for (axis, name) in ["n.x", "n.y", "n.z"].into_iter().enumerate() {
                 changed |= ui.add(egui::Slider::new(&mut n[axis], -1.0..=1.0).text(name)).changed();
             }
-            changed |= ui.add(egui::Slider::new(&mut p.offset, -3.0..=3.0).text("d")).changed();
+            let where_text =
+                patient.map_or_else(|| "d".to_string(), |(corner, extent)| clip_plane_text(p, corner, extent));
+            changed |= ui.add(egui::Slider::new(&mut p.offset, -3.0..=3.0).text(where_text)).changed();
             // A zero normal keeps nothing meaningful: the slider cannot leave one.
             if n != glam::DVec3::ZERO {
                 p.normal = n;
@@ -539,6 +586,17 @@ mod tests {
     use super::*;
     use egui_kittest::Harness;
     use egui_kittest::kittest::Queryable as _;
+
+    #[test]
+    fn a_clip_plane_says_where_it_cuts_the_patient() {
+        let (corner, extent) = (glam::DVec3::new(-100.0, -50.0, -20.0), glam::DVec3::new(200.0, 100.0, 40.0));
+        let right_half = ClipPlane { normal: -glam::DVec3::X, offset: -0.5 };
+        assert_eq!(clip_plane_text(&right_half, corner, extent), "d · keeps R of L 0.0 mm");
+        let above = ClipPlane { normal: glam::DVec3::Z, offset: 0.75 };
+        assert_eq!(clip_plane_text(&above, corner, extent), "d · keeps S of S 10.0 mm");
+        let oblique = ClipPlane { normal: glam::DVec3::new(1.0, 0.0, 1.0), offset: 1.0 };
+        assert!(clip_plane_text(&oblique, corner, extent).starts_with("d · keeps S 0.98 · L 0.20, "));
+    }
 
     /// The panel's A P L R S I buttons ask for the patient views (as keys 1–6 do).
     #[test]

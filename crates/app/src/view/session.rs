@@ -24,10 +24,12 @@ use crate::inputs;
 mod labels;
 mod measure;
 mod open;
+mod save_image;
 mod slices;
 mod tf;
 
 pub use super::workbench::SAVED_TF;
+pub use save_image::MAX_SAVED_SIDE;
 pub use tf::SavedTf;
 
 /// What the session reports, one line each on stdout.

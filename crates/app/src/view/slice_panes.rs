@@ -43,6 +43,8 @@ pub struct SlicePanes {
     file_window: Window,
     /// What the panes should show.
     pub view: SliceView,
+    /// The three planes' outlines drawn in the 3D view.
+    pub planes_in_3d: bool,
     /// What they show now, and at which pane size.
     rendered: Option<(SliceView, (u32, u32))>,
     /// Milliseconds of the last update: compile, apply, render and wait.
@@ -67,6 +69,7 @@ impl SlicePanes {
             half_extent: volume.half_extent_world(),
             file_window,
             view: SliceView { crosshair: centre / volume.dims.as_dvec3(), window: file_window },
+            planes_in_3d: true,
             rendered: None,
             last_update_ms: None,
         })
@@ -125,6 +128,18 @@ impl SlicePanes {
     /// The crosshair in world space, where the 3D view draws its point.
     pub fn crosshair_world(&self) -> DVec3 {
         (self.view.crosshair - 0.5) * 2.0 * self.half_extent
+    }
+
+    /// The corners of `axis`'s plane where it cuts the volume box, in world space, in order
+    /// around it: the outline the 3D view draws.
+    pub fn plane_corners_world(&self, axis: SliceAxis) -> [DVec3; 4] {
+        let [(c, _), (r, _)] = axis.pane_axes();
+        [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)].map(|(a, b)| {
+            let mut u = self.view.crosshair;
+            u[c] = a;
+            u[r] = b;
+            (u - 0.5) * 2.0 * self.half_extent
+        })
     }
 
     /// The voxel coordinate of the crosshair (voxel centres at integer + 0.5, as

@@ -14,6 +14,15 @@ use super::slice_panes::{FourUp, SlicePanes};
 pub const CT_WINDOWS: [(&str, f64, f64); 4] =
     [("brain", 40.0, 80.0), ("soft tissue", 40.0, 400.0), ("lung", -600.0, 1500.0), ("bone", 400.0, 1800.0)];
 
+/// Each plane's colour, as 3D Slicer marks its views: axial red, coronal green, sagittal yellow.
+pub fn plane_colour(axis: SliceAxis) -> egui::Color32 {
+    match axis {
+        SliceAxis::Axial => egui::Color32::from_rgb(230, 80, 70),
+        SliceAxis::Coronal => egui::Color32::from_rgb(90, 200, 90),
+        SliceAxis::Sagittal => egui::Color32::from_rgb(235, 200, 60),
+    }
+}
+
 /// What the panel's section shows of the panes.
 pub struct SliceInfo<'a> {
     /// The panes, when open.
@@ -36,6 +45,10 @@ pub fn section(ui: &mut egui::Ui, info: &SliceInfo<'_>) -> Vec<Action> {
             ui.small("the clinical four-up: click a slice to move the crosshair, the wheel steps through slices");
             return;
         };
+        let mut planes = panes.planes_in_3d;
+        if ui.checkbox(&mut planes, "the planes in the 3D view").changed() {
+            actions.push(Action::SlicePlanesIn3d(planes));
+        }
         let window = panes.view.window;
         ui.horizontal_wrapped(|ui| {
             ui.label("window:");
@@ -103,7 +116,7 @@ pub fn draw_overlay(
             [egui::pos2(c.x as f32 / ppp, rect.top()), egui::pos2(c.x as f32 / ppp, rect.bottom())],
             stroke,
         );
-        painter.rect_stroke(rect, 0.0, egui::Stroke::new(1.0, egui::Color32::from_gray(70)), egui::StrokeKind::Inside);
+        painter.rect_stroke(rect, 0.0, egui::Stroke::new(1.5, plane_colour(axis)), egui::StrokeKind::Inside);
         let font = egui::FontId::proportional(12.0);
         let name = format!("{} {}/{}", axis.name(), panes.slice_index(axis) + 1, panes.slice_count(axis));
         painter.text(
@@ -126,15 +139,33 @@ pub fn draw_overlay(
             painter.text(at, align, text, font.clone(), yellow);
         }
     }
-    // The crosshair in the 3D view: where the three planes meet, projected by the camera.
+    // The crosshair in the 3D view, where the three planes meet, and the planes' outlines,
+    // projected by the camera.
     let [x, y, w, h] = layout.view;
     let frame = camera.frame(w, h);
-    let clip = frame.clip_from_world * DVec4::from((panes.crosshair_world(), 1.0));
-    if clip.w > 0.0 {
-        let ndc = clip.truncate() / clip.w;
-        let px = f64::from(x) + (ndc.x + 1.0) * 0.5 * f64::from(w);
-        let py = f64::from(y) + (1.0 - ndc.y) * 0.5 * f64::from(h);
-        let at = to_points(px, py);
+    let project = |world: glam::DVec3| {
+        let clip = frame.clip_from_world * DVec4::from((world, 1.0));
+        (clip.w > 0.0).then(|| {
+            let ndc = clip.truncate() / clip.w;
+            to_points(
+                f64::from(x) + (ndc.x + 1.0) * 0.5 * f64::from(w),
+                f64::from(y) + (1.0 - ndc.y) * 0.5 * f64::from(h),
+            )
+        })
+    };
+    let view_rect =
+        egui::Rect::from_min_max(to_points(f64::from(x), f64::from(y)), to_points(f64::from(x + w), f64::from(y + h)));
+    let painter = painter.with_clip_rect(view_rect);
+    if panes.planes_in_3d {
+        for axis in SliceAxis::ALL {
+            let corners: Option<Vec<egui::Pos2>> = panes.plane_corners_world(axis).into_iter().map(project).collect();
+            if let Some(mut outline) = corners {
+                outline.push(outline[0]);
+                painter.add(egui::Shape::line(outline, egui::Stroke::new(1.5, plane_colour(axis))));
+            }
+        }
+    }
+    if let Some(at) = project(panes.crosshair_world()) {
         painter.circle_stroke(at, 5.0, egui::Stroke::new(1.5, yellow));
         painter.circle_filled(at, 1.5, yellow);
     }

@@ -464,3 +464,38 @@ fn a_bad_value_typed_into_the_set_field_is_refused_with_its_message() {
     assert_ne!(frame(&mut session), before, "a good value applies");
     let _ = std::fs::remove_dir_all(&s.dir);
 }
+
+/// Issue 45 item 3: "save image…" renders the view again at the size asked for (not the
+/// window's image stretched), at full quality, and gives the window its viewport back; a size
+/// of 0 or a FIFO as the file is refused by name.
+#[test]
+fn save_image_renders_the_view_at_the_size_asked_for_and_restores_the_window() {
+    let s = scratch("save-image", "graphs/basic/fragment_raycast.ron");
+    let mut session = open(&s, None);
+    frame(&mut session);
+    let camera = OrbitCamera::default();
+    let path = s.dir.join("big.png");
+    session.save_image(&camera, (96, 64), &path).expect("saved");
+    let saved = image::open(&path).expect("a PNG").to_rgba8();
+    assert_eq!(saved.dimensions(), (96, 64));
+    assert_eq!(session.options().viewport, (48, 48), "the window's viewport is back");
+    // The same view rendered at 96×64 by `render`'s own path: the same pixels.
+    session.resize(96, 64);
+    frame(&mut session);
+    let direct = session.runtime.read_output(session.shown_output()).expect("image");
+    let expected = s.dir.join("direct.png");
+    crate::image_out::write_png(&expected, &direct, session.shown_output() == "display").expect("written");
+    assert_eq!(saved, image::open(&expected).expect("a PNG").to_rgba8(), "the saved image is a render at its size");
+    session.resize(48, 48);
+    let zero = session.save_image(&camera, (0, 64), &s.dir.join("zero.png")).expect_err("refused");
+    assert!(format!("{zero:#}").contains("1 to 16384 pixels"), "{zero:#}");
+    #[cfg(unix)]
+    {
+        let fifo = s.dir.join("fifo.png");
+        assert!(std::process::Command::new("mkfifo").arg(&fifo).status().is_ok_and(|st| st.success()));
+        let refused = session.save_image(&camera, (32, 32), &fifo).expect_err("a FIFO is no file");
+        assert!(format!("{refused:#}").contains("FIFO") || format!("{refused:#}").contains("fifo"), "{refused:#}");
+    }
+    assert_eq!(session.options().viewport, (48, 48));
+    let _ = std::fs::remove_dir_all(&s.dir);
+}

@@ -17,6 +17,7 @@ const HEIGHT: f32 = 130.0;
 const GRAB: f32 = 8.0;
 
 /// What the editor asks of the session.
+#[derive(Debug)]
 pub enum TfAction {
     /// Use this function.
     Edit(TransferFunction),

@@ -205,6 +205,12 @@ impl Viewer {
                     Vec::new()
                 }
                 Action::SlicePanes(open) => session.set_slice_panes(open),
+                Action::SlicePlanesIn3d(on) => {
+                    if let Some(panes) = session.slices_mut() {
+                        panes.planes_in_3d = on;
+                    }
+                    Vec::new()
+                }
                 Action::SliceWindow(window) => {
                     if let Some(panes) = session.slices_mut() {
                         panes.view.window = window;
@@ -260,6 +266,15 @@ impl Viewer {
                         }
                     }
                 }
+                Action::SaveImage { path, size } => match session.save_image(&self.orbit.camera, size, &path) {
+                    Ok(()) => {
+                        crate::stdout::println_escaped!("saved image {} ({}x{})", path.display(), size.0, size.1);
+                        Vec::new()
+                    }
+                    Err(e) => {
+                        vec![super::session::Event::NotSaved { what: "image".to_string(), message: format!("{e:#}") }]
+                    }
+                },
                 Action::Screenshot => {
                     self.screenshots_now
                         .push(self.view.screenshot.clone().unwrap_or_else(|| PathBuf::from("volgraph.png")));

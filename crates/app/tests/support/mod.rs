@@ -56,8 +56,34 @@ pub fn write_nifti(path: &std::path::Path, ct: &Volume) {
     write_nifti_frames(path, ct, &[values]);
 }
 
+/// The NIfTI-1 file a converter writes from the DICOM series of `ct` (LPS axes, voxel
+/// (0, 0, 0) at the origin, as `write_ct_series` lays it): the same voxels with an sform in RAS
+/// (x and y negated); with `flip_rows`, the rows stored bottom up as dcm2niix stores them, the
+/// sform's y column and offset saying so.
+pub fn write_nifti_from_dicom(path: &std::path::Path, ct: &Volume, flip_rows: bool) {
+    let VoxelData::I16(values) = &ct.data else { panic!("int16") };
+    let (nx, ny) = (ct.dims.x as usize, ct.dims.y as usize);
+    let s = ct.spacing;
+    let (stored, y_column, y_offset): (Vec<i16>, f64, f64) = if flip_rows {
+        let flipped = values
+            .chunks(nx * ny)
+            .flat_map(|slice| slice.chunks(nx).rev().flatten().copied().collect::<Vec<_>>())
+            .collect();
+        (flipped, s.y, -((ny - 1) as f64) * s.y)
+    } else {
+        (values.clone(), -s.y, 0.0)
+    };
+    let srow = [[-s.x, 0.0, 0.0, 0.0], [0.0, y_column, 0.0, y_offset], [0.0, 0.0, s.z, 0.0]];
+    write_nifti_with(path, ct, &[&stored], Some(srow));
+}
+
 /// A NIfTI-1 file of `frames`, each an int16 volume of `ct`'s size and spacing.
 fn write_nifti_frames(path: &std::path::Path, ct: &Volume, frames: &[&[i16]]) {
+    write_nifti_with(path, ct, frames, None);
+}
+
+/// [`write_nifti_frames`] with an sform (rows x, y, z of the RAS affine; sform_code 1) or none.
+fn write_nifti_with(path: &std::path::Path, ct: &Volume, frames: &[&[i16]], srow: Option<[[f64; 4]; 3]>) {
     let mut header = vec![0u8; 352];
     header[0..4].copy_from_slice(&348i32.to_le_bytes());
     let rank = if frames.len() > 1 { 4i16 } else { 3 };
@@ -73,6 +99,15 @@ fn write_nifti_frames(path: &std::path::Path, ct: &Volume, frames: &[&[i16]]) {
     }
     header[108..112].copy_from_slice(&352f32.to_le_bytes());
     header[112..116].copy_from_slice(&1f32.to_le_bytes());
+    if let Some(rows) = srow {
+        header[254..256].copy_from_slice(&1i16.to_le_bytes()); // sform_code: scanner
+        for (r, row) in rows.iter().enumerate() {
+            for (c, v) in row.iter().enumerate() {
+                let at = 280 + 16 * r + 4 * c;
+                header[at..at + 4].copy_from_slice(&(*v as f32).to_le_bytes());
+            }
+        }
+    }
     header[344..348].copy_from_slice(b"n+1\0");
     let mut bytes = header;
     for frame in frames {

@@ -89,3 +89,55 @@ fn the_panes_open_on_the_files_window_else_the_value_range() {
     let (lo, hi) = ct.value_range;
     assert_eq!(panes.view.window, Window { center: 0.5 * (lo + hi), width: hi - lo });
 }
+
+/// The panel's Slices and Save image sections at 800×600, driven with egui's test harness: the
+/// CT presets, the planes-in-3D and panes checkboxes, a size preset and "save image" ask for
+/// what they say, and the foot's buttons stay in the window.
+#[test]
+fn the_slices_and_save_image_sections_ask_for_what_they_say() {
+    use super::super::panel::{Action, Timings, show};
+    use egui_kittest::Harness;
+    use egui_kittest::kittest::Queryable as _;
+
+    let s = scratch("slices-panel", "graphs/basic/fragment_raycast.ron");
+    let (mut session, _) =
+        LiveSession::open(gpu(), &session_args(&s, &["organs32"], None)).unwrap_or_else(|_| panic!("opens"));
+    assert!(session.set_slice_panes(true).is_empty());
+    let window = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::Vec2::new(800.0, 600.0));
+    let (timings, lod) = (Timings::default(), super::super::lod::Lod::default());
+    let mut h = Harness::builder().with_size(window.size()).build_ui_state(
+        |ui, asked: &mut Vec<Action>| {
+            asked.extend(show(ui, &session, &timings, "lavapipe", None, &lod, "").actions);
+        },
+        Vec::new(),
+    );
+    h.run();
+    // Scrolled into view first (the sections lie below the TF editor), then clicked where it
+    // is, as a user would.
+    let clicked = |h: &mut Harness<'_, Vec<Action>>, label: &str| {
+        h.get_by_label(label).scroll_to_me();
+        h.run();
+        h.state_mut().clear();
+        h.get_by_label(label).click();
+        h.run();
+        std::mem::take(h.state_mut())
+    };
+    let bone = clicked(&mut h, "bone");
+    assert!(matches!(bone.as_slice(), [Action::SliceWindow(w)] if (w.center, w.width) == (400.0, 1800.0)), "{bone:?}");
+    let planes = clicked(&mut h, "the planes in the 3D view");
+    assert!(matches!(planes.as_slice(), [Action::SlicePlanesIn3d(false)]), "{planes:?}");
+    let close = clicked(&mut h, "axial, coronal, sagittal panes (M)");
+    assert!(matches!(close.as_slice(), [Action::SlicePanes(false)]), "{close:?}");
+    clicked(&mut h, "Save image");
+    clicked(&mut h, "4K");
+    let save = clicked(&mut h, "save image");
+    assert!(
+        matches!(save.as_slice(), [Action::SaveImage { size: (3840, 2160), path }] if path.ends_with("volgraph_image.png")),
+        "{save:?}"
+    );
+    for button in ["screenshot", "save view"] {
+        let rect = h.get_by_label(button).rect();
+        assert!(window.contains_rect(rect), "\"{button}\" at {rect:?} is outside the window");
+    }
+    let _ = std::fs::remove_dir_all(&s.dir);
+}

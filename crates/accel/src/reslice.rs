@@ -15,6 +15,8 @@
 
 use glam::{DVec2, DVec3};
 
+use crate::fusion::{FrameMismatch, TextureMap, in_box};
+use crate::labels::sample::{LabelFilter, sample_label};
 use crate::volume::Volume;
 use crate::volume_meta::Window;
 
@@ -183,6 +185,61 @@ pub fn reslice(volume: &Volume, plane: SlicePlane, window: Window, pane: (u32, u
         .collect()
 }
 
+/// A label map over a slice: the map (in the slice volume's patient frame, on any grid of it),
+/// its table as a graph's `LabelTable` input holds it (colour and opacity by label value, 0
+/// where hidden; `LabelTable::lut`) and how strongly a label's colour covers the grey.
+pub struct LabelOverlay<'a> {
+    /// The label map.
+    pub labels: &'a Volume,
+    /// Colour (the table's bytes / 255, display values) and opacity by label value.
+    pub table: &'a [[f32; 4]],
+    /// The cover of a label of opacity 1.
+    pub opacity: f64,
+}
+
+impl LabelOverlay<'_> {
+    /// The colour at slice volume texture point `u` through `map` (the slice volume's texture
+    /// space to the map's): the nearest voxel's label — clinical viewers show a segmentation's
+    /// voxels as they are — and its table colour with the cover `opacity × its opacity`;
+    /// `None` outside the map or where its label is hidden or beyond the table.
+    pub fn colour(&self, map: &TextureMap, u: DVec3) -> Option<([f64; 3], f64)> {
+        let v = map.apply(u);
+        if !in_box(v) {
+            return None;
+        }
+        let (label, _) = sample_label(self.labels, v, LabelFilter::Nearest);
+        let [r, g, b, a] = *self.table.get(label as usize)?;
+        let cover = self.opacity * f64::from(a);
+        (cover > 0.0).then_some(([f64::from(r), f64::from(g), f64::from(b)], cover))
+    }
+}
+
+/// [`reslice`] with a label map over it: per pixel the grey (as a colour) with the label's
+/// colour blended over it, `None` beside the slice.
+pub fn reslice_with_labels(
+    volume: &Volume,
+    plane: SlicePlane,
+    window: Window,
+    pane: (u32, u32),
+    overlay: &LabelOverlay<'_>,
+) -> Result<Vec<Option<[f64; 3]>>, FrameMismatch> {
+    let map = TextureMap::between(volume, overlay.labels)?;
+    let fit = PaneFit::of(plane.axis, volume.dims, volume.spacing, pane);
+    let window = NormalizedWindow::of(window, volume);
+    let (w, h) = pane;
+    Ok((0..h)
+        .flat_map(|y| (0..w).map(move |x| DVec2::new(x as f64 + 0.5, y as f64 + 0.5)))
+        .map(|p| {
+            let u = plane.texture_point(&fit, p)?;
+            let grey = window.grey(volume.sample_trilinear(u));
+            Some(match overlay.colour(&map, u) {
+                Some((c, a)) => c.map(|c| grey * (1.0 - a) + c * a),
+                None => [grey; 3],
+            })
+        })
+        .collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -203,6 +260,32 @@ mod tests {
         let mut v = Volume::new("ramp", dims, DVec3::new(1.0, 2.0, 3.0), VoxelData::U16(data));
         v.value_range = (0.0, 1000.0);
         v
+    }
+
+    #[test]
+    fn a_label_map_colours_its_voxels_over_the_grey() {
+        let v = ramp();
+        // Labels on the same grid: 2 where x ≥ 2, else 0 (background, hidden).
+        let mut labels = v.clone();
+        let dims = v.dims;
+        labels.data =
+            VoxelData::U16((0..dims.x * dims.y * dims.z).map(|i| if i % dims.x >= 2 { 2 } else { 0 }).collect());
+        labels.value_range = (0.0, 65535.0);
+        let table = [[0.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 1.0], [1.0, 0.0, 0.0, 1.0]];
+        let overlay = LabelOverlay { labels: &labels, table: &table, opacity: 0.5 };
+        let plane = SlicePlane { axis: SliceAxis::Axial, position: 2.5 / 6.0 };
+        let window = Window { center: 500.0, width: 1000.0 };
+        let plain = reslice(&v, plane, window, (4, 10));
+        let with = reslice_with_labels(&v, plane, window, (4, 10), &overlay).expect("one frame");
+        for (i, (g, c)) in plain.iter().zip(&with).enumerate() {
+            let (g, c) = (g.expect("on the slice"), c.expect("on the slice"));
+            if i % 4 >= 2 {
+                // Half red over the grey.
+                assert!((c[0] - (0.5 * g + 0.5)).abs() < 1e-12 && (c[1] - 0.5 * g).abs() < 1e-12, "{i}: {c:?}");
+            } else {
+                assert_eq!(c, [g; 3], "{i}: the background is hidden");
+            }
+        }
     }
 
     #[test]

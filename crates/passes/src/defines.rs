@@ -77,9 +77,11 @@ pub const COLOR_F32: &str = "COLOR_F32";
 pub const SEGMENTS: &str = "SEGMENTS";
 /// The splats written by a compute scatter (`reprojection_splat.rs`).
 pub const SCATTER: &str = "SCATTER";
+/// A slice with a label map over it (`reslice.rs`, `labels: true`).
+pub const RESLICE_LABELS: &str = "RESLICE_LABELS";
 
 /// Every `#if` name of the built-in passes.
-pub const BUILT_IN: [&str; 31] = [
+pub const BUILT_IN: [&str; 32] = [
     SHADING,
     PREINTEGRATION,
     TRICUBIC,
@@ -111,4 +113,5 @@ pub const BUILT_IN: [&str; 31] = [
     BLOCK_MAJORANTS,
     REPROJECT,
     MAJORANT_LEAP,
+    RESLICE_LABELS,
 ];

@@ -54,6 +54,17 @@ volgraph_compiler::pass_params! {
         window_width: f32 = 0.0, 0.0..=1000000000.0,
             "the window's width in data units; 0: the file's window (DICOM WindowCenter/Width, NIfTI cal_min/cal_max), \
              else the whole value range";
+        label_opacity: f32 = 0.5, 0.0..=1.0,
+            "with labels: how strongly a label's colour covers the grey (times its opacity in the table)";
+    }
+}
+
+volgraph_compiler::pass_params! {
+    /// Whether a label map lies over the slice; a change rebuilds (ports and `#if`s change).
+    pub struct ResliceLabels {
+        labels: bool = false,
+            "overlay the label map `labels` (the volume's patient frame, any grid of it) coloured by `label_table`: \
+             each pixel the nearest voxel's label";
     }
 }
 
@@ -66,6 +77,9 @@ volgraph_compiler::pass_params! {
         per_row: [f32; 4] = computed, "xyz: the texture point's change per pixel down.";
         fit: [f32; 4] = computed, "the slice's rectangle in the pane, pixels: x0, y0, x1, y1.";
         window: [f32; 4] = computed, "x: the normalized value shown black; y: 1 / (white − black).";
+        label_scale: [f32; 4] = computed, "xyz: the label map's texture point is u · scale + offset.";
+        label_offset: [f32; 4] = computed, "xyz: see label_scale.";
+        label_decode: [f32; 4] = computed, "x, y: a label is round(x + texel · y); z: the labels' cover.";
     }
 }
 
@@ -76,7 +90,16 @@ impl SliceMap {
     }
 
     fn zeroed() -> Self {
-        Self { origin: [0.0; 4], per_column: [0.0; 4], per_row: [0.0; 4], fit: [0.0; 4], window: [0.0, 1.0, 0.0, 0.0] }
+        Self {
+            origin: [0.0; 4],
+            per_column: [0.0; 4],
+            per_row: [0.0; 4],
+            fit: [0.0; 4],
+            window: [0.0, 1.0, 0.0, 0.0],
+            label_scale: [1.0; 4],
+            label_offset: [0.0; 4],
+            label_decode: [0.0, 255.0, 0.0, 0.0],
+        }
     }
 
     /// The map of `settings` for `volume` in a pane of `pane` pixels: the same fit, orientation
@@ -108,8 +131,33 @@ impl SliceMap {
             per_row: v4(per_row),
             fit: [fit.origin.x as f32, fit.origin.y as f32, end.x as f32, end.y as f32],
             window: [window.low as f32, (1.0 / (window.high - window.low)) as f32, 0.0, 0.0],
+            ..Self::zeroed()
         }
     }
+
+    /// With `labels` over the slice: where the map's texture point of `volume`'s lies and how
+    /// its texels decode to label values (`volgraph_accel::reslice::LabelOverlay`).
+    pub fn with_labels(
+        self,
+        settings: &ResliceSettings,
+        volume: &volgraph_accel::volume::Volume,
+        labels: &volgraph_accel::volume::Volume,
+    ) -> Result<Self, volgraph_accel::fusion::FrameMismatch> {
+        let m = volgraph_accel::fusion::TextureMap::between(volume, labels)?;
+        // A texel holds (v − lo) / (hi − lo) (`Volume::normalized`), so v = lo + texel · (hi − lo).
+        let (lo, hi) = labels.value_range;
+        Ok(Self {
+            label_scale: [m.scale.x as f32, m.scale.y as f32, m.scale.z as f32, 0.0],
+            label_offset: [m.offset.x as f32, m.offset.y as f32, m.offset.z as f32, 0.0],
+            label_decode: [lo as f32, (hi - lo) as f32, settings.label_opacity, 0.0],
+            ..self
+        })
+    }
+}
+
+/// Whether the pass lays a label map over its slice.
+fn labelled(params: &Params) -> bool {
+    ResliceLabels::try_from_params(params).is_some_and(|l| l.labels)
 }
 
 /// Its one pipeline, declared once.
@@ -129,14 +177,23 @@ impl PassDecl for Reslice {
 
     fn blocks(&self) -> Vec<ParamBlock> {
         // Every value goes into the uniform the node computes: an edit is written in place.
-        vec![ResliceSettings::block(OnChange::InPlace)]
+        vec![
+            ResliceSettings::block(OnChange::InPlace),
+            ResliceLabels::block(OnChange::Rebuild)
+                .with_defines(|p| if labelled(p) { vec![crate::defines::RESLICE_LABELS] } else { Vec::new() }),
+        ]
     }
 
-    fn ports(&self, _params: &Params) -> Vec<PortSpec> {
-        vec![
+    fn ports(&self, params: &Params) -> Vec<PortSpec> {
+        let mut ports = vec![
             PortSpec::read("volume", PortKind::Volume),
             PortSpec::write("slice", PortKind::target(&[TargetFormat::Rgba8Unorm])),
-        ]
+        ];
+        if labelled(params) {
+            ports.push(PortSpec::read("labels", PortKind::Volume));
+            ports.push(PortSpec::read("label_table", PortKind::LabelTable));
+        }
+        ports
     }
 
     fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
@@ -147,12 +204,16 @@ impl PassDecl for Reslice {
 #[cfg(feature = "gpu")]
 impl PassPlugin for Reslice {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec::of(&shader()))?;
+        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
+            defines: &self.shader_defines(ctx.params),
+            ..ComputePipelineSpec::of(&shader())
+        })?;
         let buffer = ctx.uniform_from_bytes("slice_map", &SliceMap::zeroed().uniform_bytes());
         Ok(Box::new(ResliceNode {
             pipeline,
             buffer,
             settings: ResliceSettings::from_params(ctx.params),
+            labelled: labelled(ctx.params),
             written: None,
         }))
     }
@@ -163,21 +224,30 @@ struct ResliceNode {
     pipeline: ComputePassPipeline,
     buffer: wgpu::Buffer,
     settings: ResliceSettings,
-    /// What the uniform holds: the map and the volume version and pane it was computed for.
-    written: Option<(Vec<u8>, Option<u64>, (u32, u32))>,
+    labelled: bool,
+    /// What the uniform holds: the map, and the versions of the volume and label map and the
+    /// pane it was computed for.
+    written: Option<(Vec<u8>, [Option<u64>; 2], (u32, u32))>,
 }
 
 #[cfg(feature = "gpu")]
 impl PassNode for ResliceNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let pane = ctx.extent("slice");
-        let version = ctx.input_version("volume");
-        let stale = self.written.as_ref().is_none_or(|(_, v, p)| *v != version || *p != pane);
+        let versions = [ctx.input_version("volume"), self.labelled.then(|| ctx.input_version("labels")).flatten()];
+        let stale = self.written.as_ref().is_none_or(|(_, v, p)| *v != versions || *p != pane);
         if stale {
             let volume = ctx.voxels("volume")?;
-            let bytes = SliceMap::of(&self.settings, volume, pane).uniform_bytes();
+            let mut map = SliceMap::of(&self.settings, volume, pane);
+            if self.labelled {
+                let labels = ctx.voxels("labels")?;
+                map = map
+                    .with_labels(&self.settings, volume, labels)
+                    .map_err(|e| PassError { pass: ctx.label.to_string(), message: e.to_string() })?;
+            }
+            let bytes = map.uniform_bytes();
             ctx.write_buffer(&self.buffer, 0, &bytes);
-            self.written = Some((bytes, version, pane));
+            self.written = Some((bytes, versions, pane));
         }
         ctx.dispatch_over(&self.pipeline, &[("slice_map", self.buffer.as_entire_binding())], "slice", (8, 8))
     }

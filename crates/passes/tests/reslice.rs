@@ -135,3 +135,74 @@ fn a_window_in_hu_and_a_crosshair_move_are_written_in_place() {
         .count();
     assert!(changed > 100, "another slice shows other tissue ({changed} pixels changed)");
 }
+
+/// `clinical/slices_labels` rendered with `labels` over `volume` (the organ phantom's table).
+fn render_with_labels(volume: &Volume, labels: &Volume, table: &[[f32; 4]], position: f32) -> Runtime {
+    const LABELLED: &str = "clinical/slices_labels.ron";
+    let registry = builtin_registry();
+    let overrides: Vec<(String, ron::Value)> =
+        SliceAxis::ALL.iter().map(|a| (format!("{}.position", a.name()), ron::Value::from(position))).collect();
+    let overrides: Vec<(&str, ron::Value)> = overrides.iter().map(|(k, v)| (k.as_str(), v.clone())).collect();
+    let plan = volgraph_core::compile(LABELLED, &graph_source(LABELLED), &registry, &options(&overrides))
+        .expect("the labelled slice graph compiles");
+    let mut runtime = support::runtime(&gpu());
+    runtime.bind_volume("volume", volume).expect("volume");
+    runtime.bind_volume("labels", labels).expect("labels");
+    runtime.bind_label_table("label_table", table).expect("table");
+    runtime.apply(plan, &registry).expect("applies");
+    runtime.render(CameraData::from_orbit(&OrbitCamera::default(), PANE)).expect("renders");
+    runtime
+}
+
+/// A segmentation over the slices, on the scan's grid and on one of half its resolution (the
+/// same box): each pane is its f64 twin (`reslice_with_labels`). Grey and label colours blend
+/// in f32 and round to 8 bits (≤ 0.75 codes, as the grey alone); where a pixel centre lies on a
+/// boundary between two label voxels (exactly, in f64) f32 may take the other voxel — such
+/// pixels are counted and must stay under 0.5 % of the pane.
+#[test]
+fn a_label_map_over_the_panes_is_its_f64_twin_on_its_own_grid_or_a_coarser_one() {
+    use volgraph_accel::reslice::{LabelOverlay, reslice_with_labels};
+    let volume = ct();
+    let table = volgraph_accel::organs::label_table().lut(256);
+    let same = volgraph_accel::organs::organs_labels(64);
+    // Half the resolution over the same box: voxels twice the size, voxel (0,0,0)'s centre half a
+    // (coarse) voxel in from the scan's corner.
+    let mut coarse = volgraph_accel::organs::organs_labels(32);
+    coarse.spacing *= 2.0;
+    coarse.meta.origin = Some(glam::DVec3::new(0.5, 0.5, 1.0));
+    let mut scan = volume.clone();
+    scan.meta.origin = Some(glam::DVec3::ZERO);
+    let position = 0.437f32;
+    for (name, labels, volume) in [("same grid", &same, &volume), ("half resolution", &coarse, &scan)] {
+        let mut runtime = render_with_labels(volume, labels, &table, position);
+        let overlay = LabelOverlay { labels, table: &table, opacity: 0.5 };
+        let window = Window { center: 40.0, width: 400.0 };
+        for axis in SliceAxis::ALL {
+            let pane = runtime.read_output(axis.name()).expect("a pane");
+            let plane = SlicePlane { axis, position: f64::from(position) };
+            let expected = reslice_with_labels(volume, plane, window, PANE, &overlay).expect("one frame");
+            let (mut coloured, mut ties, mut worst) = (0usize, 0usize, 0.0f64);
+            for (i, e) in expected.iter().enumerate() {
+                let got = pane.rgba(i as u32 % PANE.0, i as u32 / PANE.0);
+                let Some(e) = e else {
+                    assert_eq!(got, [0.0; 4], "{name} {axis:?} {i}: beside the slice");
+                    continue;
+                };
+                coloured += usize::from(e[0] != e[1] || e[1] != e[2]);
+                let off = (0..3).map(|c| (f64::from(got[c]) - e[c]).abs() * 255.0).fold(0.0, f64::max);
+                if off > 0.75 {
+                    ties += 1;
+                } else {
+                    worst = worst.max(off);
+                }
+            }
+            eprintln!(
+                "{name} {}: {coloured} labelled pixels, {ties} boundary ties, worst {worst:.2} codes",
+                axis.name()
+            );
+            // The organs (the body itself is label 0, hidden) cover a few hundred pixels a pane.
+            assert!(coloured > 100, "{name} {axis:?}: the organs show ({coloured} pixels)");
+            assert!(ties * 200 < expected.len(), "{name} {axis:?}: {ties} pixels differ by more than 0.75 codes");
+        }
+    }
+}

@@ -330,9 +330,7 @@ pub fn show(
                 let slice_info = super::slice_section::SliceInfo {
                     panes: session.slices(),
                     hounsfield: session.volume().meta.is_ct_hu(),
-                    patient: session.slices().and_then(|p| {
-                        session.volume().meta.patient_point(p.crosshair_voxel(), session.volume().spacing)
-                    }),
+                    crosshair: session.crosshair_line(),
                 };
                 actions.extend(super::slice_section::section(ui, &slice_info));
                 if let Some(cuts) = cuts_section(ui, session.runtime.cuts(), session.patient_box()) {

@@ -179,6 +179,8 @@ pub struct LiveSession {
     labels: Option<super::label_list::LabelList>,
     /// The label map is the frame volume (`multi/labels`): its TF is not what is seen.
     labels_are_the_volume: bool,
+    /// The named volume input holding the label map (`None`: the frame volume).
+    label_map_input: Option<String>,
     /// Inputs bound by name (`--volume NAME=PATH`, `--tf NAME=…`): rebound on every apply.
     bindings: Option<crate::named_inputs::NamedBindings>,
     /// The environment map's file, for "save view".

@@ -19,6 +19,16 @@ use volgraph_core::{CompileOptions, Registry};
 
 /// The built-in graph the panes run.
 pub const SLICES_GRAPH: &str = "clinical/slices";
+/// … and with a label map over them.
+pub const LABELLED_SLICES_GRAPH: &str = "clinical/slices_labels";
+
+/// A label map to lay over the panes: the map and its table (`LabelTable::lut`).
+pub struct PaneLabels<'a> {
+    /// The label map, in the volume's patient frame.
+    pub map: &'a Volume,
+    /// Colour and opacity by label value, 0 where hidden.
+    pub table: Vec<[f32; 4]>,
+}
 
 /// What the panes show: the crosshair (a texture point of the volume, `[0, 1]³`) and the
 /// window, in data units.
@@ -34,7 +44,8 @@ pub struct SliceView {
 pub struct SlicePanes {
     runtime: Runtime,
     registry: Registry,
-    source: &'static str,
+    /// The graph's name and text (with or without labels).
+    graph: (&'static str, &'static str),
     dims: UVec3,
     spacing: DVec3,
     /// Half the volume box in world units (`Volume::half_extent_world`).
@@ -52,18 +63,25 @@ pub struct SlicePanes {
 }
 
 impl SlicePanes {
-    /// The panes of `volume` on `gpu`: the crosshair at the central voxel, the file's window.
-    pub fn new(gpu: Arc<Gpu>, volume: &Volume) -> Result<Self, String> {
-        let (_, source) = crate::builtin_graphs::find(std::path::Path::new(SLICES_GRAPH))
-            .ok_or_else(|| format!("the built-in graph {SLICES_GRAPH} is missing from this build"))?;
+    /// The panes of `volume` on `gpu`, with `labels` over them when given: the crosshair at the
+    /// central voxel, the file's window.
+    pub fn new(gpu: Arc<Gpu>, volume: &Volume, labels: Option<PaneLabels<'_>>) -> Result<Self, String> {
+        let name = if labels.is_some() { LABELLED_SLICES_GRAPH } else { SLICES_GRAPH };
+        let graph = crate::builtin_graphs::find(std::path::Path::new(name))
+            .ok_or_else(|| format!("the built-in graph {name} is missing from this build"))?;
         let mut runtime = Runtime::new(gpu, ShaderLibrary::new(volgraph_passes::builtin_shaders()));
-        runtime.bind_volume("volume", volume).map_err(|e| format!("the slice panes: {e}"))?;
+        let bound = |e: volgraph_core::runtime::RuntimeError| format!("the slice panes: {e}");
+        runtime.bind_volume("volume", volume).map_err(bound)?;
+        if let Some(labels) = &labels {
+            runtime.bind_volume("labels", labels.map).map_err(bound)?;
+            runtime.bind_label_table("label_table", &labels.table).map_err(bound)?;
+        }
         let file_window = default_window(volume);
         let centre = (volume.dims / 2).as_dvec3() + 0.5;
         Ok(Self {
             runtime,
             registry: volgraph_passes::builtin_registry(),
-            source,
+            graph,
             dims: volume.dims,
             spacing: volume.spacing,
             half_extent: volume.half_extent_world(),
@@ -166,7 +184,7 @@ impl SlicePanes {
             set(&mut options, "window_center", self.view.window.center);
             set(&mut options, "window_width", self.view.window.width.max(1e-6));
         }
-        let plan = volgraph_core::compile(SLICES_GRAPH, self.source, &self.registry, &options)
+        let plan = volgraph_core::compile(self.graph.0, self.graph.1, &self.registry, &options)
             .map_err(|d| format!("the slice panes' graph: {d}"))?;
         self.runtime.apply(plan, &self.registry).map_err(|e| format!("the slice panes: {e}"))?;
         self.runtime
@@ -175,6 +193,23 @@ impl SlicePanes {
         self.rendered = Some((self.view, pane));
         self.last_update_ms = Some(start.elapsed().as_secs_f64() * 1e3);
         Ok(true)
+    }
+
+    /// Whether a label map lies over the panes.
+    pub fn labelled(&self) -> bool {
+        self.graph.0 == LABELLED_SLICES_GRAPH
+    }
+
+    /// A new table for the label map over the panes (a label hidden or recoloured in the list):
+    /// one upload, the panes rendered again at the next update.
+    pub fn set_label_table(&mut self, table: &[[f32; 4]]) -> Result<(), String> {
+        if !self.labelled() {
+            return Ok(());
+        }
+        if self.runtime.bind_label_table("label_table", table).map_err(|e| format!("the slice panes: {e}"))? {
+            self.rendered = None;
+        }
+        Ok(())
     }
 
     /// Draws the three panes as last rendered onto a window's surface, each in its region

@@ -29,8 +29,8 @@ pub struct SliceInfo<'a> {
     pub panes: Option<&'a SlicePanes>,
     /// The volume is CT in HU: the CT presets apply.
     pub hounsfield: bool,
-    /// The crosshair's patient point (LPS mm), for a volume in the patient frame.
-    pub patient: Option<glam::DVec3>,
+    /// What lies at the crosshair: value, label, where (`LiveSession::crosshair_line`).
+    pub crosshair: Option<String>,
 }
 
 /// The "Slices" section; returns what the user did.
@@ -79,8 +79,8 @@ pub fn section(ui: &mut egui::Ui, info: &SliceInfo<'_>) -> Vec<Action> {
         for axis in SliceAxis::ALL {
             ui.small(format!("{}: slice {} of {}", axis.name(), panes.slice_index(axis) + 1, panes.slice_count(axis)));
         }
-        if let Some(p) = info.patient {
-            ui.small(format!("crosshair: {}", volgraph_accel::volume_meta::patient_label(p)));
+        if let Some(line) = &info.crosshair {
+            ui.small(line);
         }
         if let Some(ms) = panes.last_update_ms {
             ui.small(format!("last slice update: {ms:.1} ms (three panes, rendered and waited for)"));

@@ -46,13 +46,15 @@ impl LiveSession {
             return Vec::new();
         }
         let inputs = self.plan().map(|p| p.inputs.clone()).unwrap_or_default();
-        match bind_label_list(&mut self.runtime, &inputs, self.labels.as_ref()) {
+        let mut events = match bind_label_list(&mut self.runtime, &inputs, self.labels.as_ref()) {
             Ok(_) => vec![Event::Reloaded {
                 what: "label table".to_string(),
                 detail: "uploaded (no recompile)".to_string(),
                 ms: start.elapsed().as_secs_f64() * 1e3,
             }],
             Err(e) => vec![Event::Error { what: "label table".to_string(), message: e.to_string() }],
-        }
+        };
+        events.extend(self.label_table_to_slices());
+        events
     }
 }

@@ -91,10 +91,15 @@ impl LiveSession {
         };
         let p = volgraph_accel::probe::first_visible(&self.volume, &lut, camera, (w, h), pixel, 0.5, &cuts)?;
         let units = self.volume.meta.units.as_deref().map_or(String::new(), |u| format!(" {u}"));
-        let label = self.labels().map_or(String::new(), |list| {
-            let value = p.value.round().max(0.0) as u32;
-            list.name_of(value).map_or(String::new(), |name| format!(", label {value} \"{name}\""))
-        });
+        // The label there: the volume's own value where it is the label map, else the map's
+        // voxel at that patient point (a segmentation over its scan).
+        let label = match (self.labels(), self.labels_are_the_volume) {
+            (Some(list), true) => {
+                let value = p.value.round().max(0.0) as u32;
+                list.name_of(value).map_or(String::new(), |name| format!(", label {value} \"{name}\""))
+            }
+            _ => self.label_line(p.voxel / self.volume.dims.as_dvec3()),
+        };
         // In the patient frame, where that is in mm, as the clinical tools say it.
         let patient = self
             .volume
@@ -105,6 +110,28 @@ impl LiveSession {
             "under the cursor: {:.4}{units}{label} at voxel ({:.1}, {:.1}, {:.1}){patient}, α {:.2}",
             p.value, p.voxel.x, p.voxel.y, p.voxel.z, p.alpha
         ))
+    }
+
+    /// `, label V "NAME"` for the label map's voxel at the frame volume's texture point `u` (the
+    /// same patient point on the map's own grid, its nearest voxel), or nothing where there is
+    /// no label map, the point lies outside it or its label is unnamed.
+    pub(super) fn label_line(&self, u: glam::DVec3) -> String {
+        let Some(list) = self.labels() else { return String::new() };
+        let map = match &self.label_map_input {
+            None => Some(&self.volume),
+            Some(input) => {
+                self.bindings.as_ref().and_then(|b| b.others.iter().find(|(n, _)| n == input)).map(|(_, v)| v)
+            }
+        };
+        let Some(map) = map else { return String::new() };
+        let Ok(to_map) = volgraph_accel::fusion::TextureMap::between(&self.volume, map) else { return String::new() };
+        let v = to_map.apply(u);
+        if !volgraph_accel::fusion::in_box(v) {
+            return String::new();
+        }
+        let (value, _) =
+            volgraph_accel::labels::sample::sample_label(map, v, volgraph_accel::labels::sample::LabelFilter::Nearest);
+        list.name_of(value).map_or(String::new(), |name| format!(", label {value} \"{name}\""))
     }
 
     /// A comparison of the view on screen (the last frame's `image`) with the converged

@@ -189,6 +189,7 @@ impl LiveSession {
             opacity_reference: args.scene.as_ref().map(|s| s.opacity_reference).unwrap_or_default(),
             labels,
             labels_are_the_volume,
+            label_map_input: map_name,
             bindings,
             environment: args.environment.clone(),
             noise: Default::default(),

@@ -8,7 +8,7 @@ use volgraph_accel::reslice::{SliceAxis, reslice};
 use volgraph_accel::volume_meta::Window;
 
 use super::super::slice_panes::{FourUp, SlicePanes};
-use super::{LiveSession, gpu, scratch, session_args};
+use super::{LiveSession, SessionArgs, gpu, scratch, session_args};
 
 /// Each pane against the f64 slice through the same crosshair: half a code of rounding and the
 /// f32 filter's error (crates/passes/tests/reslice.rs measures 0.51 codes at worst).
@@ -82,10 +82,10 @@ fn a_click_moves_the_crosshair_the_wheel_steps_a_slice_and_the_panes_stay_their_
 fn the_panes_open_on_the_files_window_else_the_value_range() {
     let mut ct = volgraph_accel::organs::organs_ct(32);
     ct.meta.window = Some(Window { center: 40.0, width: 400.0 });
-    let panes = SlicePanes::new(gpu(), &ct).expect("opens");
+    let panes = SlicePanes::new(gpu(), &ct, None).expect("opens");
     assert_eq!(panes.view.window, Window { center: 40.0, width: 400.0 });
     ct.meta.window = None;
-    let panes = SlicePanes::new(gpu(), &ct).expect("opens");
+    let panes = SlicePanes::new(gpu(), &ct, None).expect("opens");
     let (lo, hi) = ct.value_range;
     assert_eq!(panes.view.window, Window { center: 0.5 * (lo + hi), width: hi - lo });
 }
@@ -139,5 +139,50 @@ fn the_slices_and_save_image_sections_ask_for_what_they_say() {
         let rect = h.get_by_label(button).rect();
         assert!(window.contains_rect(rect), "\"{button}\" at {rect:?} is outside the window");
     }
+    let _ = std::fs::remove_dir_all(&s.dir);
+}
+
+/// A graph with a segmentation over its scan (`multi/ct_with_labels`): the panes show the label
+/// map too, coloured as the label list says; hiding every label but one (the list's "show only")
+/// takes the others off the panes as well — one table upload, the panes rendered again.
+#[test]
+fn the_panes_show_the_label_map_as_the_label_list_colours_it() {
+    use super::super::label_list::LabelEdit;
+    let s = scratch("slices-labels", "graphs/multi/ct_with_labels.ron");
+    let args = SessionArgs {
+        named: vec![("volume".into(), "organs48".into()), ("labels".into(), "organs_labels48".into())],
+        ..session_args(&s, &["organs48"], Some("ct-soft-tissue".into()))
+    };
+    let (mut session, _) = LiveSession::open(gpu(), &args).unwrap_or_else(|_| panic!("opens"));
+    assert!(session.set_slice_panes(true).is_empty());
+    let pane = (96, 72);
+    let coloured = |session: &mut LiveSession| {
+        let panes = session.slices_mut().expect("open");
+        assert!(panes.labelled(), "the label map lies over the panes");
+        panes.update(pane).expect("renders");
+        let image = panes.read(SliceAxis::Coronal).expect("a pane");
+        image.data.chunks(4).filter(|p| (p[0] - p[1]).abs() > 0.02 || (p[1] - p[2]).abs() > 0.02).count()
+    };
+    let all = coloured(&mut session);
+    assert!(all > 200, "the organs show in colour ({all} pixels)");
+    let shown = session.labels().expect("a label list").rows.iter().map(|r| r.value).min().expect("labels");
+    let events = session.edit_labels(&LabelEdit::ShowOnly(shown));
+    assert!(events.iter().all(|e| !matches!(e, super::Event::Error { .. })), "{events:?}");
+    let one = coloured(&mut session);
+    assert!(one < all, "only label {shown} keeps its colour ({one} of {all} pixels)");
+    // The crosshair on a voxel of that organ: the panel's line names it, with the value in HU
+    // and the place (the generated phantom has no origin, so by voxel rather than in mm).
+    let map = volgraph_accel::organs::organs_labels(48);
+    let i = (0..map.voxel_count()).find(|&i| map.raw_value(i) as u32 == shown).expect("the organ's voxels");
+    let d = map.dims;
+    let voxel =
+        glam::DVec3::new((i as u32 % d.x) as f64, ((i as u32 / d.x) % d.y) as f64, (i as u32 / (d.x * d.y)) as f64);
+    session.slices_mut().expect("open").view.crosshair = (voxel + 0.5) / d.as_dvec3();
+    let line = session.crosshair_line().expect("a line");
+    let name = session.labels().and_then(|l| l.name_of(shown)).expect("named").to_string();
+    assert!(
+        line.contains(&format!("label {shown} \"{name}\"")) && line.contains(" HU") && line.contains("at voxel (13.5"),
+        "{line}"
+    );
     let _ = std::fs::remove_dir_all(&s.dir);
 }

@@ -187,7 +187,12 @@ fn hot_reload_in_a_window_keeps_the_last_good_graph_and_matches_the_headless_ren
     let tf_after = std::fs::read_to_string(&tf).expect("tf");
     assert_ne!(tf_before, tf_after, "the edit was saved");
     assert!(tf_after.contains("150.0"), "{tf_after}");
-    // 11. "Save view": the camera, crop, clip, TF and effects to a scene file, which `render
+    // 11. Issue 45 item 3: an edit after "save TF", then "save view": the scene must hold the TF
+    // on screen (written beside it), not the file saved before the edit — `render --scene` of a
+    // view saved so drew a pink fog box for a skull once. The TF's own file keeps the save.
+    writeln!(stdin, "tf-point 60 0.1,0.3,1,0.5").expect("script line");
+    expect_line(&lines, "reloaded transfer function edit in", &mut log);
+    // "Save view": the camera, crop, clip, TF and effects to a scene file, which `render
     // --scene` must draw as the window shows it (checked below).
     let saved = dir.join("saved view.scene.ron");
     writeln!(stdin, "save-scene {}", saved.display()).expect("script line");
@@ -244,9 +249,13 @@ fn hot_reload_in_a_window_keeps_the_last_good_graph_and_matches_the_headless_ren
         a.pixels().zip(b.pixels()).flat_map(|(p, q)| (0..3).map(move |c| p[c].abs_diff(q[c]))).max().unwrap_or(0)
     };
     let window = read_rgba(&shots);
-    // The same graph rendered headless, with the cuts and TF set in the viewer.
+    assert_eq!(std::fs::read_to_string(&tf).expect("tf"), tf_after, "save view left the TF's file as saved");
+    // The same graph rendered headless, with the cuts and the TF on screen (the edit after the
+    // save, which "save view" wrote beside the scene).
+    let on_screen = dir.join("saved view.scene.tf.ron");
+    assert!(on_screen.is_file(), "the edited TF is written beside the scene:\n{}", log.join("\n"));
     let graph_arg = graph.display().to_string();
-    let tf_arg = tf.display().to_string();
+    let tf_arg = on_screen.display().to_string();
     let headless = render(
         &[&graph_arg, "--size", "96x96", "--crop", "0,0,0,0.6,1,1", "--clip", "0,1,1,0.9", "--tf", &tf_arg],
         "headless.png",

@@ -5,6 +5,7 @@
 //! binary hands `bench` and `sweep` to it ([`forward`]). This crate is the one that talks to a
 //! user: inputs are read and checked here, before any GPU work.
 
+pub mod api;
 pub mod atomic_write;
 pub mod builtin_graphs;
 pub mod builtin_scenes;

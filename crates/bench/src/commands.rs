@@ -61,6 +61,9 @@ enum BenchCommand {
     /// Several volumes in one march: a CT with a 117-label map (tinted, inside) against the CT
     /// alone, a label's visibility toggled → frame, smooth vs nearest label boundaries at 4× zoom.
     Multi(crate::multi::MultiArgs),
+    /// One frame through the library API the Python package wraps (render, wait, read back):
+    /// the baseline of the Python layer's cost.
+    Api(crate::api::ApiArgs),
     /// The clinical viewer's slice panes: the update when the crosshair moves (512² panes) and
     /// the 3D view's frame with the panes open vs without.
     Slices(crate::slices::SlicesArgs),
@@ -120,6 +123,7 @@ fn run(cli: BenchCli) -> anyhow::Result<()> {
         BenchCli::Bench { which: BenchCommand::Workbench(args) } => {
             crate::workbench::run(&args).context("bench workbench").map(drop)
         }
+        BenchCli::Bench { which: BenchCommand::Api(args) } => crate::api::run(&args).context("bench api").map(drop),
         BenchCli::Bench { which: BenchCommand::Slices(args) } => {
             crate::slices::run(&args).context("bench slices").map(drop)
         }

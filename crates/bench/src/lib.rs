@@ -12,6 +12,7 @@
 //! - `sweep` ([`sweep`]): every quality knob against the converged f64 reference.
 
 pub mod accel;
+pub mod api;
 pub mod cinematic;
 mod commands;
 pub mod compile_time;

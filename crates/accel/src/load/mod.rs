@@ -160,6 +160,27 @@ pub fn load_volumes(paths: &[PathBuf], options: &LoadOptions<'_>) -> Result<Load
     Ok(loaded)
 }
 
+/// A volume handed over in memory (an array from Python, `volgraph_app::api`) read as a raw file
+/// of the same voxels is: its size checked against `dims`, non-finite floats replaced, then what
+/// every loaded volume passes ([`finish_loaded`]: the spacing checked, a constant volume's range
+/// and note). `name` stands for the file in messages.
+pub fn from_memory(name: &str, dims: UVec3, spacing: DVec3, data: VoxelData) -> Result<LoadedVolume, LoadError> {
+    let path = PathBuf::from(name);
+    let expected = dims.x as u64 * dims.y as u64 * dims.z as u64;
+    if expected == 0 || data.len() as u64 != expected {
+        return Err(LoadError::NotAFile {
+            path,
+            what: "an array whose voxel count is its dimensions' product, none of them 0",
+        });
+    }
+    let mut volume = Volume::new(name, dims, spacing, data);
+    let mut report = LoadReport::new(VolumeFormat::Raw, &path);
+    (report.nan_replaced, report.pos_inf_replaced, report.neg_inf_replaced) = sanitize_volume(&mut volume);
+    let mut loaded = LoadedVolume { volume, report };
+    finish_loaded(&path, None, &mut loaded)?;
+    Ok(loaded)
+}
+
 /// The largest ratio of the longest voxel side to the shortest: the box is scaled to its longest
 /// side in f32, and beyond this the shortest side falls below f32's resolution and the volume
 /// renders black. `--spacing` and every header's spacing are held to it.

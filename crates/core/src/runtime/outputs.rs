@@ -19,9 +19,37 @@ impl Runtime {
         self.read_resource(rid)
     }
 
+    /// Reads back an 8-bit RGBA output of the last frame (`present`'s `display`: sRGB-encoded
+    /// values) as its bytes, rows from the top: `(width, height, bytes)`, without the float
+    /// conversion of [`Self::read_output`] (the Python package's images). Waits for the frame.
+    pub fn read_output_rgba8(&mut self, name: &str) -> Result<(u32, u32, Vec<u8>), RuntimeError> {
+        let live = self.live.as_ref().ok_or(RuntimeError::NoPlan)?;
+        let Some(&rid) = live.plan.outputs.get(name) else {
+            return Err(RuntimeError::UnknownOutput {
+                name: name.to_string(),
+                known: live.plan.outputs.keys().cloned().collect::<Vec<_>>().join(", "),
+            });
+        };
+        let (texture, format, extent) = self.resource_texture(rid)?;
+        if format != crate::format::TargetFormat::Rgba8Unorm {
+            return Err(RuntimeError::Readback(format!("output \"{name}\" is {format:?}, not Rgba8Unorm")));
+        }
+        let bytes = readback::read_texture_bytes(&self.gpu, &texture).map_err(RuntimeError::Readback)?;
+        Ok((extent.0, extent.1, bytes))
+    }
+
     /// Reads back any target resource of the last frame (valid while its slot was not reused
     /// later in the frame: outputs and the last holder of a slot).
     pub fn read_resource(&mut self, rid: usize) -> Result<Image, RuntimeError> {
+        let (texture, format, extent) = self.resource_texture(rid)?;
+        readback::read_texture(&self.gpu, &texture, format, extent).map_err(RuntimeError::Readback)
+    }
+
+    /// The texture, format and extent of target resource `rid` after the last frame (waited for).
+    fn resource_texture(
+        &mut self,
+        rid: usize,
+    ) -> Result<(wgpu::Texture, crate::format::TargetFormat, (u32, u32)), RuntimeError> {
         let _ = self.frames.finish(&self.gpu);
         let live = self.live.as_ref().ok_or(RuntimeError::NoPlan)?;
         let r = &live.plan.resources[rid];
@@ -37,7 +65,7 @@ impl Runtime {
                 .map(|e| e.current().texture.clone())
                 .ok_or_else(|| RuntimeError::Readback(format!("history \"{name}\" is gone")))?,
         };
-        readback::read_texture(&self.gpu, &texture, *format, *extent).map_err(RuntimeError::Readback)
+        Ok((texture, *format, *extent))
     }
 
     /// Reads back the bytes of a buffer output of the last frame (waits for it).

@@ -17,7 +17,7 @@ use anyhow::{Context as _, anyhow};
 use glam::DVec2;
 use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::reslice::SliceAxis;
-use volgraph_app::view::session::{LiveSession, SessionArgs};
+use volgraph_app::view::session::LiveSession;
 use volgraph_app::view::slice_panes::FourUp;
 use volgraph_core::runtime::Gpu;
 
@@ -44,29 +44,6 @@ pub struct SlicesArgs {
     /// Write the tables as Markdown here.
     #[arg(long)]
     pub markdown: Option<PathBuf>,
-}
-
-fn open(gpu: &Arc<Gpu>, args: &SlicesArgs, viewport: (u32, u32)) -> anyhow::Result<LiveSession> {
-    let session_args = SessionArgs {
-        environment: None,
-        graph: args.graph.clone(),
-        volume: vec![args.volume.clone()],
-        raw: Default::default(),
-        tf: None,
-        tf_map: None,
-        viewport,
-        features: Vec::new(),
-        shaders: None,
-        gpu_memory_mb: None,
-        scene: None,
-        cuts: Default::default(),
-        light: Default::default(),
-        named: Vec::new(),
-        named_tfs: Vec::new(),
-    };
-    LiveSession::open(gpu.clone(), &session_args)
-        .map(|(s, _)| s)
-        .map_err(|e| anyhow!("{}", volgraph_app::cli::error_text(&e)))
 }
 
 /// A crosshair move of case `i`: a click on the coronal pane at a point that walks across it
@@ -125,7 +102,7 @@ pub fn run(args: &SlicesArgs) -> anyhow::Result<serde_json::Value> {
     let gpu = Arc::new(Gpu::new_headless().map_err(|e| anyhow!(e))?);
     let adapter = gpu.adapter_name.clone();
     let camera = OrbitCamera { azimuth_deg: 30.0, elevation_deg: 20.0, distance: 3.2, ..OrbitCamera::default() };
-    let mut session = open(&gpu, args, image)?;
+    let mut session = crate::workbench::open(&gpu, args.graph.clone(), &args.volume, image)?;
     let volume = session.volume();
     let volume_text = format!("{} ({}×{}×{})", volume.name, volume.dims.x, volume.dims.y, volume.dims.z);
 

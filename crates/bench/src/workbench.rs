@@ -47,7 +47,14 @@ pub struct WorkbenchArgs {
     pub markdown: Option<PathBuf>,
 }
 
-fn open(gpu: &Arc<Gpu>, graph: PathBuf, volume: &std::path::Path, viewport: (u32, u32)) -> anyhow::Result<LiveSession> {
+/// The viewer's session (no window) of `graph` on `volume` at `viewport`, as `volgraph view`
+/// opens it with nothing else given (the benchmarks of the viewer share it).
+pub(crate) fn open(
+    gpu: &Arc<Gpu>,
+    graph: PathBuf,
+    volume: &std::path::Path,
+    viewport: (u32, u32),
+) -> anyhow::Result<LiveSession> {
     let args = SessionArgs {
         environment: None,
         graph,

@@ -42,10 +42,11 @@ class Volume:
 class Renderer:
     """A graph kept on the GPU: set a volume, a transfer function and parameters; render."""
     def __init__(self, graph: str | PathLike[str], size: tuple[int, int] = (512, 512)) -> None: ...
+    # Write-only attributes (setters): `r.volume = v` and `r.tf = "ct-bone"`.
     volume: Any
-    """Set a Volume or a [z, y, x] array (spacing 1, 1, 1; use set_volume for another)."""
+    """Write-only: a Volume or a [z, y, x] array (spacing 1, 1, 1; set_volume takes another)."""
     tf: str | PathLike[str] | None
-    """A preset ("ct-bone"), a TF file, a data-folder TF's name, or None (fitted to the data)."""
+    """Write-only: a preset ("ct-bone"), a TF file, a data-folder TF's name, or None (fitted)."""
     def set_volume(
         self, volume: Any, spacing: tuple[float, float, float] | None = None, axes: Literal["zyx", "xyz"] = "zyx"
     ) -> None: ...

@@ -173,6 +173,25 @@ def test_a_renderer_keeps_its_gpu_state_and_renders_floats_and_png():
     assert "modern/fastest" in names and "clinical/slices" in names
 
 
+def test_renderers_in_threads_render_what_they_render_alone():
+    from concurrent.futures import ThreadPoolExecutor
+
+    a = ramp_volume()
+    cameras = [(40 * k, 20, 3.2) for k in range(4)]
+    alone = [volgraph.render("basic/fragment_raycast", a, size=(40, 40), camera=c) for c in cameras]
+
+    def work(camera):
+        # A Renderer belongs to the thread that made it; the GIL is released while it renders.
+        r = volgraph.Renderer("basic/fragment_raycast", size=(40, 40))
+        r.volume = a
+        return [r.render(camera=camera) for _ in range(3)]
+
+    with ThreadPoolExecutor(4) as pool:
+        results = list(pool.map(work, cameras))
+    for want, frames in zip(alone, results):
+        assert all(np.array_equal(want, got) for got in frames)
+
+
 def test_a_thousand_renders_do_not_grow_memory():
     def rss_kib():
         for line in Path("/proc/self/status").read_text().splitlines():

@@ -179,6 +179,7 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
         notes.extend(binding_notes.iter().cloned());
         notes.extend(bindings.check(&plan, &file, &source, &volume)?);
     }
+    notes.extend(unnamed_volume_notes(&plan, &named));
     let bindings = bindings.map(|(b, _)| b);
     // A scene's effect the graph does not offer is a note (the scene may be shown with another
     // graph); a --features name it does not know is the user's typo: an error.
@@ -311,6 +312,29 @@ pub(crate) fn named_bindings(
     }
     let primary = named.get(primary).map(|(n, _)| n.clone());
     Ok(Some((NamedBindings { primary, others, tfs, tables, allow_frame_mismatch: false }, notes)))
+}
+
+/// With no volume named, a graph reading several volume inputs gets the one volume in each (a
+/// label map would be the scan itself): a note per other input, saying how to name them.
+pub(crate) fn unnamed_volume_notes(plan: &volgraph_core::Plan, named: &[(String, PathBuf)]) -> Vec<String> {
+    let inputs = volume_input_names(plan);
+    if !named.is_empty() || inputs.len() < 2 {
+        return Vec::new();
+    }
+    let frame = volgraph_core::runtime::inputs::PRIMARY_VOLUME;
+    let frame = if inputs.contains(&frame) { frame } else { inputs[0] };
+    inputs
+        .iter()
+        .filter(|n| **n != frame)
+        .map(|n| {
+            format!(
+                "note: graph \"{}\" reads the volume input \"{n}\" too, and no --volume {n}=PATH names it: the one \
+                 volume given is bound to it as well; give each by name (--volume {frame}=scan.nii.gz --volume \
+                 {n}=other.nii.gz)",
+                plan.name
+            )
+        })
+        .collect()
 }
 
 /// The named volumes but the frame volume (`named[primary]`), loaded (a `#N` suffix picks a

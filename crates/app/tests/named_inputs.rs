@@ -349,3 +349,34 @@ fn a_dicom_seg_binds_as_the_label_map_it_holds_with_its_own_names() {
         assert!(text.contains(name), "{name} missing from:\n{text}");
     }
 }
+
+/// A graph of several volume inputs given one volume: each other input gets it too (a CT as its
+/// own PET), said in a note naming the input and how to name each, never silently.
+#[test]
+fn one_volume_for_a_graph_of_several_says_it_is_bound_to_each() {
+    let dir = scratch("one_for_several");
+    let out = dir.join("one.png").display().to_string();
+    let (ok, stderr) =
+        volgraph(&["render", "multi/pet_ct", "--volume", "organs32", "--size", "32x32", "-o", &out], &dir);
+    assert!(ok, "{stderr}");
+    assert!(
+        stderr.contains("reads the volume input \"pet\" too") && stderr.contains("--volume pet=other.nii.gz"),
+        "{stderr}"
+    );
+    let (ok, stderr) = volgraph(
+        &[
+            "render",
+            "multi/ct_with_labels",
+            "--volume",
+            "volume=organs32",
+            "--volume",
+            "labels=organs_labels32",
+            "--size",
+            "32x32",
+            "-o",
+            &out,
+        ],
+        &dir,
+    );
+    assert!(ok && !stderr.contains("too, and no --volume"), "{stderr}");
+}

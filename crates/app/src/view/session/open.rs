@@ -99,6 +99,9 @@ impl LiveSession {
             ),
         };
         let loaded = format!("{}, {shaders}", summary(&plan));
+        for note in crate::render::unnamed_volume_notes(&plan, &args.named) {
+            crate::stdout::eprintln_escaped!("{note}");
+        }
         // Inputs bound by name, as `render` binds them (the others loaded, checked for one frame).
         let bindings = if args.named.is_empty() && args.named_tfs.is_empty() {
             None

@@ -349,6 +349,36 @@ fn graphs(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
     Ok(list)
 }
 
+/// What `graph` compiles to at `size` (no GPU): its name, viewport, features, inputs, steps in
+/// order (label, pass, kind), the passes culled and the outputs — `volgraph plan` as a dict.
+/// A broken graph raises `GraphError`.
+#[pyfunction]
+#[pyo3(signature = (graph, size = (1920, 1080)))]
+fn plan<'py>(py: Python<'py>, graph: PathBuf, size: (u32, u32)) -> PyResult<Bound<'py, PyDict>> {
+    let source = volgraph_app::inputs::read_graph(&graph).map_err(|e| VolumeError::new_err(format!("{e:#}")))?;
+    let file = volgraph_app::cli::display_name(&graph);
+    let options = volgraph_core::CompileOptions::new(size.0, size.1);
+    let plan = volgraph_core::compile(&file, &source, &volgraph_app::program::registry(), &options)
+        .map_err(|d| raise(CliError::Graph(d), value_error))?;
+    let d = PyDict::new(py);
+    d.set_item("name", &plan.name)?;
+    d.set_item("viewport", plan.viewport)?;
+    d.set_item("features", plan.features.iter().cloned().collect::<Vec<_>>())?;
+    d.set_item("inputs", plan.inputs.keys().cloned().collect::<Vec<_>>())?;
+    let steps = PyList::empty(py);
+    for step in &plan.steps {
+        let s = PyDict::new(py);
+        s.set_item("label", &step.label)?;
+        s.set_item("pass", &step.pass_id)?;
+        s.set_item("kind", &step.kind)?;
+        steps.append(s)?;
+    }
+    d.set_item("steps", steps)?;
+    d.set_item("culled", plan.culled.clone())?;
+    d.set_item("outputs", plan.outputs.keys().cloned().collect::<Vec<_>>())?;
+    Ok(d)
+}
+
 /// The extension module.
 #[pymodule]
 fn _volgraph(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -357,6 +387,7 @@ fn _volgraph(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add_function(wrap_pyfunction!(graphs, m)?)?;
+    m.add_function(wrap_pyfunction!(plan, m)?)?;
     m.add("GraphError", m.py().get_type::<GraphError>())?;
     m.add("VolumeError", m.py().get_type::<VolumeError>())?;
     m.add("GpuError", m.py().get_type::<GpuError>())?;

@@ -171,6 +171,9 @@ def test_a_renderer_keeps_its_gpu_state_and_renders_floats_and_png():
     assert r._repr_png_()[:8] == b"\x89PNG\r\n\x1a\n"
     names = [g["name"] for g in volgraph.graphs()]
     assert "modern/fastest" in names and "clinical/slices" in names
+    p = volgraph.plan("clinical/slices", size=(64, 48))
+    assert p["viewport"] == (64, 48) and [s["kind"] for s in p["steps"]] == ["reslice"] * 3
+    assert p["outputs"] == ["axial", "coronal", "sagittal"] and p["inputs"] == ["volume"]
 
 
 def test_renderers_in_threads_render_what_they_render_alone():

@@ -27,7 +27,8 @@ from ._volgraph import (
     VolumeError,
     graphs,
     load,
+    plan,
     render,
 )
 
-__all__ = ["GpuError", "GraphError", "Renderer", "Volume", "VolumeError", "graphs", "load", "render"]
+__all__ = ["GpuError", "GraphError", "Renderer", "Volume", "VolumeError", "graphs", "load", "plan", "render"]

@@ -75,3 +75,6 @@ def render(
 
 def graphs() -> list[dict[str, str]]:
     """The built-in graphs: name, paper, description."""
+
+def plan(graph: str | PathLike[str], size: tuple[int, int] = (1920, 1080)) -> dict[str, Any]:
+    """What a graph compiles to (no GPU): name, viewport, features, inputs, steps, culled, outputs."""

@@ -42,7 +42,7 @@ fn raise(e: CliError, fallback: fn(String) -> PyErr) -> PyErr {
         CliError::Graph(diagnostics) => {
             let problem = GraphProblem::of(&diagnostics);
             Python::attach(|py| {
-                let err = GraphError::new_err(problem.message.clone());
+                let err = GraphError::new_err(escaped(problem.message.clone()));
                 let value = err.value(py);
                 let set = |name: &str, v: Py<PyAny>| value.setattr(name, v);
                 let _ = set("path", problem.path.into_pyobject(py).map(|o| o.into_any().unbind()).unwrap_or(py.None()));
@@ -52,12 +52,18 @@ fn raise(e: CliError, fallback: fn(String) -> PyErr) -> PyErr {
                 err
             })
         }
-        CliError::Other(e) => fallback(format!("{e:#}")),
+        CliError::Other(e) => fallback(escaped(format!("{e:#}"))),
     }
 }
 
 fn value_error(message: String) -> PyErr {
     PyValueError::new_err(message)
+}
+
+/// A message as an exception may carry it: control characters of a path or name escaped
+/// (`\x1b`), as the command line prints them, so printing the exception never drives a terminal.
+fn escaped(message: String) -> String {
+    volgraph_core::terminal::escape_controls(&message).into_owned()
 }
 
 /// A volume: voxels, spacing and what the file says of them.
@@ -302,7 +308,7 @@ fn png_bytes(rendered: Rendered) -> PyResult<Vec<u8>> {
 fn load(py: Python<'_>, path: PathBuf) -> PyResult<Volume> {
     let shown = py
         .detach(|| volgraph_app::scene::load_shown_volume(&[path], None, &volgraph_accel::load::LoadOptions::default()))
-        .map_err(|e| VolumeError::new_err(format!("{e:#}")))?;
+        .map_err(|e| VolumeError::new_err(escaped(format!("{e:#}"))))?;
     Ok(Volume { inner: Arc::new(shown.volume), ring_tf: shown.marschner_lobb_tf })
 }
 
@@ -355,7 +361,7 @@ fn graphs(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
 #[pyfunction]
 #[pyo3(signature = (graph, size = (1920, 1080)))]
 fn plan<'py>(py: Python<'py>, graph: PathBuf, size: (u32, u32)) -> PyResult<Bound<'py, PyDict>> {
-    let source = volgraph_app::inputs::read_graph(&graph).map_err(|e| VolumeError::new_err(format!("{e:#}")))?;
+    let source = volgraph_app::inputs::read_graph(&graph).map_err(|e| raise(CliError::Other(e), value_error))?;
     let file = volgraph_app::cli::display_name(&graph);
     let options = volgraph_core::CompileOptions::new(size.0, size.1);
     let plan = volgraph_core::compile(&file, &source, &volgraph_app::program::registry(), &options)

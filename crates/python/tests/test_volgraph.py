@@ -158,6 +158,14 @@ def test_bad_arrays_and_arguments_are_value_errors_naming_the_problem():
         volgraph.render("basic/fragment_raycast", ramp_volume(), size=(16, 16), camera="anterior")
     with pytest.raises(volgraph.VolumeError, match="No such file"):
         volgraph.load("/nonexistent/volume.nrrd")
+    # A control character in a name comes back escaped, never sent to a terminal raw.
+    with pytest.raises(volgraph.VolumeError) as e:
+        volgraph.load("bad\x1b[31mname.nrrd")
+    assert "\x1b" not in str(e.value) and "\\x1b" in str(e.value)
+    with pytest.raises(ValueError, match="1 to 16384 pixels"):
+        volgraph.render("basic/fragment_raycast", ramp_volume(), size=(0, 16))
+    with pytest.raises(ValueError, match="not a graph file"):
+        volgraph.plan(Path("/"))
 
 
 def test_a_renderer_keeps_its_gpu_state_and_renders_floats_and_png():

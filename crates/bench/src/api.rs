@@ -36,13 +36,13 @@ pub fn run(args: &ApiArgs) -> anyhow::Result<f64> {
         None,
         &volgraph_accel::load::LoadOptions::default(),
     )?;
-    let mut r = Renderer::new(&args.graph, size).map_err(|e| anyhow!("{}", volgraph_app::cli::error_text(&e)))?;
+    let mut r = Renderer::new(&args.graph, size).map_err(|e| anyhow!("{e}"))?;
     r.set_volume(shown.volume, shown.marschner_lobb_tf);
     let camera = Camera::Orbit(30.0, 20.0, 3.2);
     let mut times = Vec::new();
     for i in 0..=args.frames {
         let t0 = Instant::now();
-        r.render(&camera, None).map_err(|e| anyhow!("{}", volgraph_app::cli::error_text(&e)))?;
+        r.render(&camera, None).map_err(|e| anyhow!("{e}"))?;
         if i > 0 {
             times.push(t0.elapsed().as_secs_f64() * 1e3);
         }

@@ -1,5 +1,5 @@
-//! The Python package's tests (`tests/test_volgraph.py`) in the README's test command: a virtual
-//! environment under the target folder (made once, with maturin, numpy and pytest from PyPI), the
+//! The Python package's tests (`tests/test_*.py`) in the README's test command: a virtual
+//! environment under the target folder (made once, with [`REQUIREMENTS`] from PyPI), the
 //! package built into it by `maturin develop` (the dev profile, sharing the workspace's target
 //! folder), then pytest, with `VOLGRAPH_BIN` the workspace's `volgraph` binary for the
 //! comparisons with the command line. Without Python 3 it says so and passes — except under CI,
@@ -7,6 +7,22 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+/// What the tests need besides the package: the build, the test runner, the notebook's kernel
+/// and plots, the widget's frame buffer, and the libraries users' NIfTI and DICOM files come from.
+const REQUIREMENTS: &[&str] = &[
+    "maturin>=1.5,<2",
+    "numpy",
+    "pytest",
+    "jupyter_rfb",
+    "ipywidgets",
+    "nbclient",
+    "nbformat",
+    "ipykernel",
+    "matplotlib",
+    "nibabel",
+    "pydicom",
+];
 
 fn run(what: &str, command: &mut Command) {
     let status = command.status().unwrap_or_else(|e| panic!("{what}: cannot run: {e}"));
@@ -32,12 +48,18 @@ fn the_python_package_passes_its_tests() {
     let profile = target_profile_dir();
     let venv = profile.join("python-venv");
     let bin = venv.join("bin");
-    if !bin.join("maturin").exists() || !bin.join("pytest").exists() {
-        run("python3 -m venv", Command::new(&python).args(["-m", "venv"]).arg(&venv));
+    // The list installed is written beside the venv: a changed list installs again.
+    let installed = venv.join("volgraph-requirements.txt");
+    let wanted = REQUIREMENTS.join("\n");
+    if std::fs::read_to_string(&installed).ok().as_deref() != Some(wanted.as_str()) {
+        if !bin.join("python").exists() {
+            run("python3 -m venv", Command::new(&python).args(["-m", "venv"]).arg(&venv));
+        }
         run(
-            "pip install maturin numpy pytest",
-            Command::new(bin.join("python")).args(["-m", "pip", "install", "-q", "maturin>=1.5,<2", "numpy", "pytest"]),
+            "pip install (the tests' requirements)",
+            Command::new(bin.join("python")).args(["-m", "pip", "install", "-q"]).args(REQUIREMENTS),
         );
+        std::fs::write(&installed, &wanted).expect("write the venv's requirements list");
     }
     let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
     run(

@@ -2,77 +2,13 @@
 README's test command, or by hand: `pip install ./crates/python pytest && pytest crates/python/tests`.
 The `volgraph` binary the comparisons run is $VOLGRAPH_BIN (the test runner gives the workspace's)."""
 
-import os
-import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import cli, ramp_volume, read_png
 
 import volgraph
-
-BIN = os.environ.get("VOLGRAPH_BIN", "volgraph")
-
-
-def cli(*args, cwd):
-    out = subprocess.run([BIN, *map(str, args)], cwd=cwd, capture_output=True, text=True)
-    assert out.returncode == 0, out.stderr
-    return out
-
-
-def read_png(path):
-    """A PNG's pixels as (H, W, 4) uint8, with a PNG decoder of the standard library alone."""
-    import struct
-    import zlib
-
-    data = Path(path).read_bytes()
-    assert data[:8] == b"\x89PNG\r\n\x1a\n"
-    pos, chunks, width, height = 8, [], 0, 0
-    while pos < len(data):
-        (length,) = struct.unpack(">I", data[pos : pos + 4])
-        kind = data[pos + 4 : pos + 8]
-        body = data[pos + 8 : pos + 8 + length]
-        if kind == b"IHDR":
-            width, height, depth, colour = struct.unpack(">IIBB", body[:10])
-            assert (depth, colour) == (8, 6), "8-bit RGBA"
-        elif kind == b"IDAT":
-            chunks.append(body)
-        pos += 12 + length
-    raw = zlib.decompress(b"".join(chunks))
-    stride = width * 4
-    out = np.zeros((height, stride), np.int32)
-    prev = np.zeros(stride, np.int32)
-    for y in range(height):
-        f = raw[y * (stride + 1)]
-        line = np.frombuffer(raw, np.uint8, stride, y * (stride + 1) + 1).astype(np.int32)
-        cur = np.zeros(stride, np.int32)
-        for x in range(stride):
-            a = cur[x - 4] if x >= 4 else 0
-            b = prev[x]
-            c = prev[x - 4] if x >= 4 else 0
-            if f == 0:
-                p = 0
-            elif f == 1:
-                p = a
-            elif f == 2:
-                p = b
-            elif f == 3:
-                p = (a + b) // 2
-            else:
-                pa, pb, pc = abs(b - c), abs(a - c), abs(a + b - 2 * c)
-                p = a if pa <= pb and pa <= pc else (b if pb <= pc else c)
-            cur[x] = (line[x] + p) & 0xFF
-        out[y] = cur
-        prev = cur
-    return out.reshape(height, width, 4).astype(np.uint8)
-
-
-def ramp_volume():
-    """A 24×20×16 uint16 volume, [z, y, x]: a ball of rising values in a noisy floor."""
-    z, y, x = np.mgrid[0:16, 0:20, 0:24]
-    r = np.sqrt(((x - 11.5) / 12) ** 2 + ((y - 9.5) / 10) ** 2 + ((z - 7.5) / 8) ** 2)
-    rng = np.random.default_rng(7)
-    return (np.clip(1.0 - r, 0, 1) * 60000 + rng.integers(0, 400, r.shape)).astype(np.uint16)
 
 
 def test_a_numpy_render_equals_the_cli_render_of_the_same_raw_file(tmp_path):
@@ -192,7 +128,7 @@ def test_renderers_in_threads_render_what_they_render_alone():
     alone = [volgraph.render("basic/fragment_raycast", a, size=(40, 40), camera=c) for c in cameras]
 
     def work(camera):
-        # A Renderer belongs to the thread that made it; the GIL is released while it renders.
+        # A renderer per thread; the GIL is released while each renders.
         r = volgraph.Renderer("basic/fragment_raycast", size=(40, 40))
         r.volume = a
         return [r.render(camera=camera) for _ in range(3)]
@@ -201,6 +137,12 @@ def test_renderers_in_threads_render_what_they_render_alone():
         results = list(pool.map(work, cameras))
     for want, frames in zip(alone, results):
         assert all(np.array_equal(want, got) for got in frames)
+    # One renderer shared by four threads: calls take turns, each frame is its camera's.
+    shared = volgraph.Renderer("basic/fragment_raycast", size=(40, 40))
+    shared.volume = a
+    with ThreadPoolExecutor(4) as pool:
+        frames = list(pool.map(lambda c: shared.render(camera=c), cameras * 3))
+    assert all(np.array_equal(alone[i % 4], got) for i, got in enumerate(frames))
 
 
 def test_a_thousand_renders_do_not_grow_memory():

@@ -6,6 +6,9 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
+Light = Literal["headlight"] | str | tuple[float, float] | tuple[Literal["point"], float, float, float]
+Crop = tuple[float, float, float, float, float, float]
+Clip = tuple[float, float, float, float] | list[tuple[float, float, float, float]]
 Camera = tuple[float, float, float] | Literal["anterior", "posterior", "left", "right", "superior", "inferior"] | None
 VolumeLike = "Volume | npt.NDArray[np.uint8] | npt.NDArray[np.uint16] | npt.NDArray[np.int16] | npt.NDArray[np.float32]"
 
@@ -21,11 +24,35 @@ class VolumeError(Exception):
 class GpuError(Exception):
     """No GPU adapter, or the GPU refused the work."""
 
+class TransferFunction:
+    """A piecewise-linear transfer function: control points (value, (r, g, b), alpha)."""
+    @staticmethod
+    def from_points(
+        points: list[tuple[float, tuple[float, float, float], float] | tuple[float, float, float, float, float]],
+        domain: tuple[float, float] | None = None,
+    ) -> TransferFunction:
+        """Points sorted by data value; colour linear RGB in 0..1, alpha the opacity per voxel."""
+    @staticmethod
+    def load(path: str | PathLike[str]) -> TransferFunction:
+        """A TF file: RON, or a ParaView colour map .json."""
+    @property
+    def points(self) -> list[tuple[float, tuple[float, float, float], float]]: ...
+    @property
+    def domain(self) -> tuple[float, float]: ...
+    def hidden_below(self, value: float) -> TransferFunction:
+        """Transparent below `value` (a step there), unchanged above."""
+    def __call__(self, value: float) -> tuple[float, float, float, float]: ...
+    def to_ron(self) -> str:
+        """The text of a TF file (`volgraph render --tf FILE`)."""
+
 class Volume:
     """A volume: voxels, spacing and what the file says of them."""
     @property
     def array(self) -> npt.NDArray[Any]:
-        """The voxels indexed [z, y, x] (a copy)."""
+        """The voxels indexed [z, y, x]: a read-only view of the loaded buffer (no copy)."""
+    @property
+    def world_from_volume(self) -> npt.NDArray[np.float64]:
+        """4×4: voxel index (x, y, z, 1) to the world (LPS mm in the patient frame)."""
     @property
     def spacing(self) -> tuple[float, float, float]:
         """Voxel spacing (x, y, z)."""
@@ -40,35 +67,80 @@ class Volume:
         """modality, units, window (center, width), frame, origin (LPS mm), description."""
 
 class Renderer:
-    """A graph kept on the GPU: set a volume, a transfer function and parameters; render."""
-    def __init__(self, graph: str | PathLike[str], size: tuple[int, int] = (512, 512)) -> None: ...
-    # Write-only attributes (setters): `r.volume = v` and `r.tf = "ct-bone"`.
+    """A graph kept on the GPU: set a volume, a transfer function, parameters, effects, cuts
+    and the light; render. Made and used in one thread."""
+    def __init__(
+        self,
+        graph: str | PathLike[str] | None = None,
+        size: tuple[int, int] | None = None,
+        *,
+        scene: str | PathLike[str] | None = None,
+    ) -> None:
+        """A graph's name or file, and/or a scene file (its graph, size, volume, TF, camera,
+        effects, cuts and light where nothing else gives them); size default 512×512."""
     volume: Any
     """Write-only: a Volume or a [z, y, x] array (spacing 1, 1, 1; set_volume takes another)."""
-    tf: str | PathLike[str] | None
-    """Write-only: a preset ("ct-bone"), a TF file, a data-folder TF's name, or None (fitted)."""
+    @property
+    def tf(self) -> TransferFunction:
+        """The TF the next frame classifies with (fitted to the volume unless one was set)."""
+    @tf.setter
+    def tf(self, tf: str | PathLike[str] | TransferFunction | None) -> None: ...
+    effects: list[str] | str | None
+    """Write-only: effects on besides the scene's (as --features): ["shading", "jitter"]."""
+    light: Light
+    """Write-only: "headlight", (azimuth, elevation) or ("point", x, y, z) (as --light)."""
+    @property
+    def value_range(self) -> tuple[float, float] | None: ...
+    @property
+    def default_camera(self) -> tuple[float, float, float]: ...
+    @property
+    def size(self) -> tuple[int, int]: ...
+    @property
+    def notes(self) -> list[str]:
+        """Notes of the last compile (what the CLI prints on stderr)."""
+    def set_cuts(self, crop: Crop | None = None, clip: Clip | None = None) -> None:
+        """Crop box and clip planes in volume fractions (as --crop, --clip); none: no cuts."""
+    def reference(self, camera: Camera = None, step_voxels: float = 0.1) -> npt.NDArray[np.float64]:
+        """The converged f64 image of the graph's raycast model: compare with render(output="image")."""
+    def widget(self, camera: tuple[float, float, float] | None = None, threshold: bool = True) -> Any:
+        """An interactive view in Jupyter (jupyter_rfb): drag rotates, wheel zooms, a slider thresholds."""
     def set_volume(
-        self, volume: Any, spacing: tuple[float, float, float] | None = None, axes: Literal["zyx", "xyz"] = "zyx"
-    ) -> None: ...
+        self,
+        volume: Any,
+        spacing: tuple[float, float, float] | None = None,
+        axes: Literal["zyx", "xyz"] = "zyx",
+        name: str | None = None,
+    ) -> None:
+        """A Volume or array; `name` binds another volume input of the graph ("pet"), as --volume NAME=…."""
+    def set_named_tf(self, name: str, tf: str | PathLike[str]) -> None:
+        """Binds a TF or label-table input by name ("pet_tf"), as --tf NAME=…."""
     def set(self, key: str, value: bool | int | float | str) -> None:
         """Sets "PASS.PARAM" or "input.NAME"; checked (range, name) at the next render."""
     def render(self, camera: Camera = None, output: str | None = None) -> npt.NDArray[Any]:
         """(H, W, 4) uint8 sRGB of `display`, or float32 linear of another output ("image")."""
     def _repr_png_(self) -> bytes: ...
 
-def load(path: str | PathLike[str]) -> Volume:
-    """A file, a DICOM folder, a dataset of the data folder by name, or a generated volume (ml64)."""
+def load(path: str | PathLike[str], *, series: str | None = None, frame: int | None = None) -> Volume:
+    """A file, a DICOM folder, a dataset of the data folder by name, or a generated volume (ml64);
+    `series` picks a DICOM series of a folder, `frame` a volume of a 4D NIfTI."""
 
 def render(
-    graph: str | PathLike[str],
-    volume: Any,
+    graph: str | PathLike[str] | None = None,
+    volume: Any = None,
     *,
+    scene: str | PathLike[str] | None = None,
     spacing: tuple[float, float, float] | None = None,
     axes: Literal["zyx", "xyz"] = "zyx",
-    tf: str | PathLike[str] | None = None,
-    size: tuple[int, int] = (512, 512),
+    tf: str | PathLike[str] | TransferFunction | None = None,
+    size: tuple[int, int] | None = None,
     camera: Camera = None,
     output: str | None = None,
+    effects: list[str] | str | None = None,
+    crop: Crop | None = None,
+    clip: Clip | None = None,
+    light: Light | None = None,
+    volumes: dict[str, Any] | None = None,
+    tfs: dict[str, str | PathLike[str]] | None = None,
     params: dict[str, bool | int | float | str] | None = None,
 ) -> npt.NDArray[Any]:
     """Renders once: (H, W, 4) uint8 sRGB, or float32 linear for output="image"."""

@@ -1,0 +1,290 @@
+//! `volgraph.Renderer`: a graph kept on the GPU (`volgraph_app::api::Renderer`), with the
+//! volume, transfer function, parameters, effects, cuts, light and scene as attributes; frames
+//! rendered with the GIL released.
+
+use std::path::PathBuf;
+use std::sync::{Mutex, PoisonError};
+
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use volgraph_app::api::{Camera, Rendered, TfChoice};
+
+use crate::errors::{raise, value_error};
+use crate::tf::TransferFunction;
+
+/// `camera`: None, (azimuth, elevation, distance) or a patient view's name.
+pub fn camera_of(camera: Option<&Bound<'_, PyAny>>) -> PyResult<Camera> {
+    let Some(c) = camera.filter(|c| !c.is_none()) else { return Ok(Camera::Default) };
+    if let Ok(name) = c.extract::<String>() {
+        return Ok(Camera::View(name));
+    }
+    let (a, e, d) = c.extract::<(f64, f64, f64)>().map_err(|_| {
+        PyValueError::new_err("camera: (azimuth, elevation, distance) in degrees and world units, or a view's name")
+    })?;
+    Ok(Camera::Orbit(a, e, d))
+}
+
+/// A rendered output as numpy: (H, W, 4) uint8 sRGB for `display` (its bytes as read back,
+/// what the CLI's PNG holds), float32 linear otherwise.
+fn image_array<'py>(py: Python<'py>, rendered: Rendered) -> PyResult<Bound<'py, PyAny>> {
+    match rendered {
+        Rendered::Srgb8 { width, height, bytes } => {
+            Ok(PyArray1::from_vec(py, bytes).reshape([height as usize, width as usize, 4])?.into_any())
+        }
+        Rendered::Linear(image) => {
+            let shape = [image.height as usize, image.width as usize, image.channels as usize];
+            Ok(PyArray1::from_vec(py, image.data).reshape(shape)?.into_any())
+        }
+    }
+}
+
+/// A Python value as a graph parameter's RON value.
+fn ron_value(value: &Bound<'_, PyAny>) -> PyResult<ron::Value> {
+    if let Ok(b) = value.extract::<bool>() {
+        return Ok(ron::Value::Bool(b));
+    }
+    if let Ok(i) = value.extract::<i64>() {
+        return Ok(ron::Value::from(i));
+    }
+    if let Ok(f) = value.extract::<f64>() {
+        return Ok(ron::Value::from(f));
+    }
+    if let Ok(s) = value.extract::<String>() {
+        return Ok(ron::Value::String(s));
+    }
+    Err(PyValueError::new_err("a parameter is a bool, a number or a string"))
+}
+
+/// A transfer function argument: None (fitted, or the scene's), a name or file, or a
+/// `TransferFunction`.
+fn tf_choice(tf: Option<&Bound<'_, PyAny>>) -> PyResult<TfChoice> {
+    let Some(tf) = tf.filter(|t| !t.is_none()) else { return Ok(TfChoice::Fitted) };
+    if let Ok(f) = tf.cast::<TransferFunction>() {
+        return Ok(TfChoice::Function(f.get().inner.clone()));
+    }
+    tf.extract::<PathBuf>().map(TfChoice::Named).map_err(|_| {
+        PyValueError::new_err(
+            "tf: a preset (\"ct-bone\"), a TF file, a data-folder TF's name, a TransferFunction or None",
+        )
+    })
+}
+
+/// A graph kept on the GPU: set a volume, a transfer function, parameters, effects, cuts and the
+/// light; render frames. Any thread may use it; calls from several threads take turns, and
+/// several renderers render in parallel.
+#[pyclass(module = "volgraph", subclass)]
+pub struct Renderer {
+    inner: Mutex<volgraph_app::api::Renderer>,
+}
+
+impl Renderer {
+    /// Runs `f` on the library's renderer with the GIL released: the lock is taken and given
+    /// back while the GIL is not held, so a thread waiting for it never holds the GIL the
+    /// renderer's thread needs.
+    fn with<R: Send>(&self, py: Python<'_>, f: impl FnOnce(&mut volgraph_app::api::Renderer) -> R + Send) -> R {
+        py.detach(|| f(&mut self.inner.lock().unwrap_or_else(PoisonError::into_inner)))
+    }
+}
+
+#[pymethods]
+impl Renderer {
+    /// `graph`: a built-in name (`modern/fastest`) or a graph file; `scene`: a scene file (or a
+    /// built-in scene's name) giving the graph, size, volume, TF, camera, effects, cuts and light
+    /// that nothing else gives. `size`: (width, height), default the scene's, else 512×512.
+    #[new]
+    #[pyo3(signature = (graph = None, size = None, *, scene = None))]
+    pub fn new(graph: Option<PathBuf>, size: Option<(u32, u32)>, scene: Option<PathBuf>) -> PyResult<Self> {
+        let gpu = crate::gpu()?;
+        let inner = match (scene, graph) {
+            (Some(scene), graph) => volgraph_app::api::Renderer::from_scene(gpu, &scene, graph.as_deref(), size),
+            (None, Some(graph)) => volgraph_app::api::Renderer::on(gpu, &graph, size.unwrap_or((512, 512))),
+            (None, None) => return Err(PyValueError::new_err("Renderer: give a graph (\"modern/fastest\") or scene=")),
+        };
+        Ok(Self { inner: Mutex::new(inner.map_err(|e| raise(e, value_error))?) })
+    }
+
+    /// The volume: a `Volume`, or an array with `set_volume` for its spacing.
+    #[setter(volume)]
+    fn set_volume_attr(&self, volume: &Bound<'_, PyAny>) -> PyResult<()> {
+        self.set_volume(volume, None, "zyx", None)
+    }
+
+    /// The volume: a `Volume` or an array ([z, y, x], or [x, y, z] with axes="xyz"), its voxel
+    /// spacing (x, y, z). `name`: the graph's volume input it binds (`pet` of `multi/pet_ct`,
+    /// as `--volume pet=PATH`); default the input `volume`.
+    #[pyo3(signature = (volume, spacing = None, axes = "zyx", name = None))]
+    pub fn set_volume(
+        &self,
+        volume: &Bound<'_, PyAny>,
+        spacing: Option<(f64, f64, f64)>,
+        axes: &str,
+        name: Option<String>,
+    ) -> PyResult<()> {
+        let (v, ring_tf) = crate::volume::volume_of(volume, spacing, axes)?;
+        match name.filter(|n| n != volgraph_core::runtime::inputs::PRIMARY_VOLUME) {
+            Some(name) => self.with(volume.py(), |r| r.set_named_volume(&name, v)),
+            None => self.with(volume.py(), |r| r.set_volume(v, ring_tf)),
+        }
+        Ok(())
+    }
+
+    /// Binds the transfer-function or label-table input `name` (`pet_tf`, `label_table`) to a
+    /// preset, a file or a data-folder TF's name, as `--tf NAME=…`.
+    pub fn set_named_tf(&self, py: Python<'_>, name: String, tf: PathBuf) {
+        self.with(py, |r| r.set_named_tf(&name, tf));
+    }
+
+    /// The transfer function: a preset ("ct-bone"), a file, a data-folder TF's name, a
+    /// `TransferFunction`, or None for the scene's or the one fitted to the data.
+    #[setter(tf)]
+    pub fn set_tf(&self, py: Python<'_>, tf: Option<&Bound<'_, PyAny>>) -> PyResult<()> {
+        let tf = tf_choice(tf)?;
+        self.with(py, |r| r.set_tf(tf));
+        Ok(())
+    }
+
+    /// The transfer function the next frame classifies with (fitted to the volume if none was
+    /// given), as a `TransferFunction`.
+    #[getter(tf)]
+    fn get_tf(&self, py: Python<'_>) -> PyResult<TransferFunction> {
+        let tf = self.with(py, |r| r.transfer_function()).map_err(|e| raise(e, value_error))?;
+        Ok(TransferFunction { inner: tf })
+    }
+
+    /// Effects that are on, besides the scene's: a list of names or "shading,jitter" (as
+    /// `--features`; a name the graph lacks is an error at the next frame, naming its effects).
+    #[setter]
+    pub fn set_effects(&self, effects: &Bound<'_, PyAny>) -> PyResult<()> {
+        let features = if effects.is_none() { Vec::new() } else { crate::look::effects(effects)? };
+        self.with(effects.py(), |r| r.set_features(features));
+        Ok(())
+    }
+
+    /// The crop box and clip planes in volume fractions (as `--crop` and `--clip`; they replace
+    /// the scene's): `crop` (x0, y0, z0, x1, y1, z1), `clip` a plane (nx, ny, nz, d) or a list.
+    #[pyo3(signature = (crop = None, clip = None))]
+    pub fn set_cuts(
+        &self,
+        py: Python<'_>,
+        crop: Option<&Bound<'_, PyAny>>,
+        clip: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let cuts = crate::look::cuts(crop, clip)?;
+        self.with(py, |r| r.set_cuts(cuts));
+        Ok(())
+    }
+
+    /// The light (as `--light`): "headlight", (azimuth, elevation) or ("point", x, y, z).
+    #[setter]
+    pub fn set_light(&self, light: &Bound<'_, PyAny>) -> PyResult<()> {
+        let parsed = crate::look::light(light)?;
+        self.with(light.py(), |r| r.set_light(parsed));
+        Ok(())
+    }
+
+    /// Sets "PASS.PARAM" (a pass's parameter) or "input.NAME" (a Scalar input).
+    pub fn set(&self, key: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        let parsed = ron_value(value)?;
+        self.with(value.py(), |r| r.set(key, parsed)).map_err(|e| raise(e, value_error))
+    }
+
+    /// The volume's data values that map to 0 and 1 (a TF slider's range); None before a volume.
+    #[getter]
+    fn value_range(&self, py: Python<'_>) -> Option<(f64, f64)> {
+        self.with(py, |r| r.volume().map(|v| v.value_range))
+    }
+
+    /// (azimuth, elevation, distance) of the default camera: the scene's, the anterior view for
+    /// a volume in the patient frame, else 30°, 20°, 3.2.
+    #[getter]
+    fn default_camera(&self, py: Python<'_>) -> PyResult<(f64, f64, f64)> {
+        let c = self.with(py, |r| r.default_camera()).map_err(|e| raise(e, value_error))?;
+        Ok((c.azimuth_deg, c.elevation_deg, c.distance))
+    }
+
+    /// The notes of the last frame's compile (an effect the graph lacks, a TF repaired, a volume
+    /// the TF hides): what the command line prints on stderr.
+    #[getter]
+    fn notes(&self, py: Python<'_>) -> Vec<String> {
+        self.with(py, |r| r.notes().to_vec())
+    }
+
+    /// Renders one frame: (H, W, 4) uint8 sRGB of `display`, or float32 linear of another output
+    /// ("image"). The GIL is released while the GPU works.
+    #[pyo3(signature = (camera = None, output = None))]
+    pub fn render<'py>(
+        &self,
+        py: Python<'py>,
+        camera: Option<&Bound<'py, PyAny>>,
+        output: Option<String>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let camera = camera_of(camera)?;
+        let rendered = self.with(py, |r| r.render(&camera, output.as_deref()));
+        image_array(py, rendered.map_err(|e| raise(e, value_error))?)
+    }
+
+    /// The converged f64 reference of the frame `camera` shows: the graph's raycast model
+    /// (mode, effects, cuts, light) at `step_voxels` with lossless termination and no jitter —
+    /// premultiplied linear RGBA, float64 (H, W, 4), to compare with `render(output="image")`
+    /// (what `volgraph sweep` measures). Computed on the CPU (all cores), the GIL released.
+    #[pyo3(signature = (camera = None, step_voxels = 0.1))]
+    fn reference<'py>(
+        &self,
+        py: Python<'py>,
+        camera: Option<&Bound<'py, PyAny>>,
+        step_voxels: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let camera = camera_of(camera)?;
+        let (image, (w, h)) = self
+            .with(py, |r| r.reference(&camera, step_voxels).map(|image| (image, r.size())))
+            .map_err(|e| raise(e, value_error))?;
+        let flat: Vec<f64> = image.into_iter().flatten().collect();
+        Ok(PyArray1::from_vec(py, flat).reshape([h as usize, w as usize, 4])?.into_any())
+    }
+
+    /// The default view as PNG bytes, so a notebook shows a renderer as its image.
+    fn _repr_png_(&self, py: Python<'_>) -> PyResult<Vec<u8>> {
+        let rendered = self.with(py, |r| r.render(&Camera::Default, None)).map_err(|e| raise(e, value_error))?;
+        png_bytes(rendered)
+    }
+
+    /// (width, height) in pixels.
+    #[getter]
+    fn size(&self, py: Python<'_>) -> (u32, u32) {
+        self.with(py, |r| r.size())
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> String {
+        let (w, h) = self.size(py);
+        format!("volgraph.Renderer({w}×{h})")
+    }
+}
+
+/// `rendered` as an opaque PNG, as the CLI writes one: sRGB bytes as read back, linear colour
+/// encoded.
+pub fn png_bytes(rendered: Rendered) -> PyResult<Vec<u8>> {
+    let (width, height, bytes) = match rendered {
+        Rendered::Srgb8 { width, height, mut bytes } => {
+            bytes.chunks_exact_mut(4).for_each(|p| p[3] = 255);
+            (width, height, bytes)
+        }
+        Rendered::Linear(image) => {
+            let mut bytes = Vec::with_capacity((image.width * image.height * 4) as usize);
+            for y in 0..image.height {
+                for x in 0..image.width {
+                    let p = image.rgba(x, y);
+                    let encode =
+                        |v: f32| (volgraph_accel::srgb::encode(f64::from(v)).clamp(0.0, 1.0) * 255.0).round() as u8;
+                    bytes.extend([encode(p[0]), encode(p[1]), encode(p[2]), 255]);
+                }
+            }
+            (image.width, image.height, bytes)
+        }
+    };
+    let buffer = image::RgbaImage::from_raw(width, height, bytes)
+        .ok_or_else(|| PyValueError::new_err("internal: image size mismatch"))?;
+    let mut png = std::io::Cursor::new(Vec::new());
+    buffer.write_to(&mut png, image::ImageFormat::Png).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(png.into_inner())
+}

@@ -3,7 +3,9 @@
 //! rendered with the GIL released.
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Mutex, PoisonError};
+use std::time::Instant;
 
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -76,6 +78,8 @@ fn tf_choice(tf: Option<&Bound<'_, PyAny>>) -> PyResult<TfChoice> {
 #[pyclass(module = "volgraph", subclass)]
 pub struct Renderer {
     inner: Mutex<volgraph_app::api::Renderer>,
+    /// Seconds the library took for the last frame (`f64` bits): the frame without this layer.
+    last_frame_seconds: AtomicU64,
 }
 
 impl Renderer {
@@ -101,7 +105,7 @@ impl Renderer {
             (None, Some(graph)) => volgraph_app::api::Renderer::on(gpu, &graph, size.unwrap_or((512, 512))),
             (None, None) => return Err(PyValueError::new_err("Renderer: give a graph (\"modern/fastest\") or scene=")),
         };
-        Ok(Self { inner: Mutex::new(inner.map_err(|e| raise(e, value_error))?) })
+        Ok(Self { inner: Mutex::new(inner.map_err(|e| raise(e, value_error))?), last_frame_seconds: AtomicU64::new(0) })
     }
 
     /// The volume: a `Volume`, or an array with `set_volume` for its spacing.
@@ -220,8 +224,20 @@ impl Renderer {
         output: Option<String>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let camera = camera_of(camera)?;
-        let rendered = self.with(py, |r| r.render(&camera, output.as_deref()));
+        let rendered = self.with(py, |r| {
+            let start = Instant::now();
+            let rendered = r.render(&camera, output.as_deref());
+            self.last_frame_seconds.store(start.elapsed().as_secs_f64().to_bits(), Ordering::Relaxed);
+            rendered
+        });
         image_array(py, rendered.map_err(|e| raise(e, value_error))?)
+    }
+
+    /// Milliseconds the library took for the last `render` (render, wait, read back), without
+    /// the Python layer around it: a script's wall clock minus this is what Python adds.
+    #[getter]
+    fn last_frame_ms(&self) -> f64 {
+        f64::from_bits(self.last_frame_seconds.load(Ordering::Relaxed)) * 1e3
     }
 
     /// The converged f64 reference of the frame `camera` shows: the graph's raycast model

@@ -15,13 +15,23 @@ pub struct TransferFunction {
     pub inner: Tf,
 }
 
-/// A point as `(value, (r, g, b), alpha)` or `(value, r, g, b, alpha)`.
+/// A point as `(value, (r, g, b), alpha)` or `(value, r, g, b, alpha)`, its value finite.
 fn point(index: usize, p: &Bound<'_, PyAny>) -> PyResult<ControlPoint> {
-    if let Ok((value, color, alpha)) = p.extract::<(f64, [f64; 3], f64)>() {
-        return Ok(ControlPoint { value, color, alpha });
-    }
-    if let Ok((value, r, g, b, alpha)) = p.extract::<(f64, f64, f64, f64, f64)>() {
-        return Ok(ControlPoint { value, color: [r, g, b], alpha });
+    let point = if let Ok((value, color, alpha)) = p.extract::<(f64, [f64; 3], f64)>() {
+        Some(ControlPoint { value, color, alpha })
+    } else if let Ok((value, r, g, b, alpha)) = p.extract::<(f64, f64, f64, f64, f64)>() {
+        Some(ControlPoint { value, color: [r, g, b], alpha })
+    } else {
+        None
+    };
+    if let Some(point) = point {
+        if !point.value.is_finite() {
+            return Err(PyValueError::new_err(format!(
+                "points[{index}].value = {}: a control point sits at a finite data value",
+                point.value
+            )));
+        }
+        return Ok(point);
     }
     Err(PyValueError::new_err(format!(
         "points[{index}]: (value, (r, g, b), alpha) or (value, r, g, b, alpha): a data value, linear RGB in 0..1 and \

@@ -103,6 +103,8 @@ def test_a_transfer_function_made_in_python_equals_its_file(tmp_path):
         volgraph.TransferFunction.from_points([(0, (0, 0, 0), 0), "red"])
     with pytest.raises(ValueError):
         volgraph.TransferFunction.from_points([])
+    with pytest.raises(ValueError, match=r"points\[0\]\.value = NaN"):
+        volgraph.TransferFunction.from_points([(float("nan"), (1, 1, 1), 0.5)])
 
 
 def test_the_reference_converges_and_the_gpu_follows_it():
@@ -127,7 +129,7 @@ def test_the_reference_converges_and_the_gpu_follows_it():
         r.reference(step_voxels=0)
     slices = volgraph.Renderer("clinical/slices", size=(32, 32))
     slices.volume = ramp_volume()
-    with pytest.raises(ValueError, match="marches no rays"):
+    with pytest.raises(ValueError, match="no raycast step"):
         slices.reference()
 
 

@@ -421,7 +421,8 @@ impl Renderer {
         let plan = self.prepare()?;
         let Some(march) = plan.steps.iter().find(|s| s.params.declares("step_voxels")) else {
             return Err(ApiError::Input(anyhow!(
-                "graph \"{}\" marches no rays (no step has a step_voxels parameter): there is no integral to converge",
+                "graph \"{}\" has no raycast step (none declares step_voxels), so there is no ray integral to converge; \
+                 a reference is made for the raycasters (modern/fastest, basic/fragment_raycast, the papers' graphs)",
                 plan.name
             )));
         };

@@ -96,6 +96,9 @@ class Renderer:
     @property
     def size(self) -> tuple[int, int]: ...
     @property
+    def last_frame_ms(self) -> float:
+        """The library's time of the last render, without the Python layer."""
+    @property
     def notes(self) -> list[str]:
         """Notes of the last compile (what the CLI prints on stderr)."""
     def set_cuts(self, crop: Crop | None = None, clip: Clip | None = None) -> None:

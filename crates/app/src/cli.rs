@@ -95,6 +95,10 @@ enum Command {
         #[command(flatten)]
         raw: RawArgs,
     },
+    /// Write a volume as an OME-Zarr pyramid (NGFF 0.5, zstd): levels halving to 64³, every
+    /// chunk's value range beside it, with a progress bar. The input is anything --volume
+    /// takes (a file, a DICOM folder, a dataset or a generated volume by name: `vessels512`).
+    Convert(crate::convert_cmd::ConvertArgs),
     /// List the graphs built into the binary (name, paper, description): every one can be given
     /// by name where a graph file is asked for (`volgraph render klein_2005/leap_iso -o x.png`).
     /// `--export NAME [DIR]` writes one out to edit (DIR/NAME.ron, e.g. ./modern/fastest.ron).
@@ -286,6 +290,7 @@ pub fn check(cli: Cli) -> Result<Checked, CliError> {
         | Command::Graphs { .. }
         | Command::Scenes { .. }
         | Command::Info { .. }
+        | Command::Convert(_)
         | Command::Set { .. }
         | Command::CompositeBench(_) => {
             Err(CliError::Other(anyhow!("only plan and render are checked ahead of running")))
@@ -342,6 +347,10 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Info { volume, labels, label_table, raw } => {
             let labels = (labels || label_table.is_some()).then_some(crate::info_cmd::Labels { table: label_table });
             crate::stdout::write_stdout(&crate::info_cmd::run(&volume, &inputs::raw_options(&raw)?, labels.as_ref())?)?;
+            Ok(())
+        }
+        Command::Convert(args) => {
+            crate::stdout::write_stdout(&crate::convert_cmd::run(&args)?)?;
             Ok(())
         }
         Command::Passes { kind, graph } => {

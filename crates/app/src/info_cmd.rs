@@ -28,6 +28,11 @@ pub fn run(paths: &[PathBuf], options: &LoadOptions<'static>, labels: Option<&La
     if !named.is_empty() {
         return several(&named, options, labels);
     }
+    if let [one] = paths
+        && volgraph_zarr::is_zarr(one)
+    {
+        return crate::zarr_input::describe(one);
+    }
     let mut out = String::new();
     if dicom::is_dicom_input(paths) {
         let series = dicom::list_series(paths).map_err(|e| anyhow!("{e}"))?;

@@ -115,6 +115,11 @@ pub fn volume(paths: &[PathBuf], options: &LoadOptions<'_>) -> anyhow::Result<(V
 /// is a path relative to the scene).
 pub fn volume_files(paths: &[PathBuf], options: &LoadOptions<'_>) -> anyhow::Result<(Volume, Vec<String>)> {
     let Some(p) = paths.first() else { bail!("no volume file given") };
+    if let [one] = paths
+        && volgraph_zarr::is_zarr(one)
+    {
+        return crate::zarr_input::read(one, options);
+    }
     let loaded = crate::load_progress::load_with_progress(paths, options).map_err(|e| anyhow!("{e}"))?;
     Ok((loaded.volume, load_notes(&p.display().to_string(), &loaded.report)))
 }

@@ -12,6 +12,7 @@ pub mod builtin_scenes;
 pub mod cli;
 #[cfg(test)]
 mod cli_fuzz;
+pub mod convert_cmd;
 pub mod distributed;
 pub mod environment_file;
 pub mod forward;
@@ -37,5 +38,6 @@ mod set_fuzz;
 pub mod shader_dir;
 pub mod stdout;
 pub mod view;
+pub mod zarr_input;
 
 pub use program::{Commands, Extension, main_with, registry, shaders};

@@ -21,6 +21,8 @@ pub struct Volume {
     /// A generated Marschner–Lobb volume: its default TF is the band that shows its rings (as
     /// the command line's).
     ring_tf: bool,
+    /// The voxels' type (the header's data is empty).
+    voxel_type: volgraph_accel::volume::VoxelType,
 }
 
 impl Volume {
@@ -28,6 +30,7 @@ impl Volume {
     pub fn new(py: Python<'_>, mut volume: volgraph_accel::volume::Volume, ring_tf: bool) -> PyResult<Self> {
         let d = volume.dims;
         let shape = [d.z as usize, d.y as usize, d.x as usize];
+        let voxel_type = volume.data.voxel_type();
         let data = std::mem::replace(&mut volume.data, VoxelData::U8(Vec::new()));
         let array = match data {
             VoxelData::U8(v) => PyArray1::from_vec(py, v).reshape(shape)?.into_any(),
@@ -37,7 +40,7 @@ impl Volume {
         };
         // Read-only: the metadata (value range, window) describes these values.
         array.getattr("flags")?.setattr("writeable", false)?;
-        Ok(Self { header: volume, array: array.unbind(), ring_tf })
+        Ok(Self { header: volume, array: array.unbind(), ring_tf, voxel_type })
     }
 
     /// The library's volume with its voxels (one copy, out of the numpy array), and whether its
@@ -111,7 +114,7 @@ impl Volume {
             d.x,
             d.y,
             d.z,
-            self.header.data.voxel_type()
+            self.voxel_type
         )
     }
 }

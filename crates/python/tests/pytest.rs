@@ -9,7 +9,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// What the tests need besides the package: the build, the test runner, the notebook's kernel
-/// and plots, the widget's frame buffer, and the libraries users' NIfTI and DICOM files come from.
+/// and plots, the widget's frame buffer, and the libraries users' NIfTI, DICOM and OME-Zarr files
+/// come from.
 const REQUIREMENTS: &[&str] = &[
     "maturin>=1.5,<2",
     "numpy",
@@ -22,6 +23,7 @@ const REQUIREMENTS: &[&str] = &[
     "matplotlib",
     "nibabel",
     "pydicom",
+    "ome-zarr",
 ];
 
 fn run(what: &str, command: &mut Command) {

@@ -1,0 +1,79 @@
+"""OME-Zarr against ome-zarr-py, the library users' stores come from (issue 48): a store that
+`volgraph convert` wrote reads in ome-zarr-py with the same levels, scales and voxels, and a store
+ome-zarr-py wrote renders in volgraph like the array it was written from."""
+
+import numpy as np
+from helpers import cli, ramp_volume
+
+import volgraph
+
+
+def test_a_converted_store_reads_in_ome_zarr_py(tmp_path):
+    from ome_zarr.io import parse_url
+    from ome_zarr.reader import Reader
+
+    a = ramp_volume()  # [z, y, x] uint16, 24×20×16
+    raw = tmp_path / "ball_24x20x16_uint16.raw"
+    a.tofile(raw)
+    out = tmp_path / "ball.ome.zarr"
+    cli("convert", raw, out, "--chunk", "8", "--spacing", "0.8,0.8,1.5", cwd=tmp_path)
+    node = list(Reader(parse_url(str(out)))())[0]
+    levels = [np.asarray(level) for level in node.data]
+    assert [level.shape for level in levels] == [(16, 20, 24)]  # 24 ≤ 64: one level
+    assert np.array_equal(levels[0], a)
+    axes = node.metadata["axes"]
+    assert [x["name"] for x in axes] == ["z", "y", "x"]
+    scale = node.metadata["coordinateTransformations"][0][0]["scale"]
+    assert scale == [1.5, 0.8, 0.8]
+
+
+def test_a_store_from_ome_zarr_py_renders_like_its_array(tmp_path):
+    import zarr
+    from ome_zarr.io import parse_url
+    from ome_zarr.writer import write_image
+
+    a = ramp_volume()
+    path = tmp_path / "from_py.ome.zarr"
+    root = zarr.group(store=parse_url(str(path), mode="w").store)
+    write_image(a, root, axes="zyx", scale={"z": 1.5, "y": 0.8, "x": 0.8})  # levels halving y and x
+    v = volgraph.load(path)
+    assert v.dims == (24, 20, 16) and v.spacing == (0.8, 0.8, 1.5)
+    assert np.array_equal(v.array, a)
+    assert np.array_equal(volgraph.render("basic/fragment_raycast", v, size=(48, 40)),
+                          volgraph.render("basic/fragment_raycast", a, spacing=(0.8, 0.8, 1.5), size=(48, 40)))
+
+
+def test_an_ngff_0_4_store_on_zarr_v2_reads(tmp_path):
+    import zarr
+    from ome_zarr.format import FormatV04
+    from ome_zarr.io import parse_url
+    from ome_zarr.writer import write_image
+
+    a = ramp_volume()
+    path = tmp_path / "v04.ome.zarr"
+    root = zarr.group(store=parse_url(str(path), mode="w", fmt=FormatV04()).store, zarr_format=2)
+    write_image(a, root, axes="zyx", fmt=FormatV04(), scale={"z": 2.0, "y": 0.5, "x": 0.5})
+    assert (path / ".zattrs").is_file() and not (path / "zarr.json").exists()
+    v = volgraph.load(path)
+    assert v.spacing == (0.5, 0.5, 2.0) and np.array_equal(v.array, a)
+    assert "uint16" in repr(v.array.dtype) and "U16" in repr(v)
+    info = cli("info", path, cwd=tmp_path).stdout
+    assert "OME-Zarr (NGFF 0.4)" in info and "5 levels" in info
+
+
+def test_a_nifti_converted_renders_like_the_nifti(tmp_path):
+    import nibabel as nib
+
+    data = ramp_volume().astype(np.int16).transpose(2, 1, 0)  # nibabel's [x, y, z]
+    affine = np.diag([0.8, 0.9, 1.5, 1.0])
+    affine[:3, 3] = (-10.0, 20.0, 5.0)
+    nifti = tmp_path / "ball.nii.gz"
+    nib.save(nib.Nifti1Image(data, affine), nifti)
+    out = tmp_path / "ball.ome.zarr"
+    cli("convert", nifti, out, "--chunk", "8", cwd=tmp_path)
+    store, original = volgraph.load(out), volgraph.load(nifti)
+    assert np.array_equal(store.array, original.array) and store.spacing == original.spacing
+    assert store.meta["frame"] == original.meta["frame"] and store.meta["origin"] == original.meta["origin"]
+    # The patient frame kept: the default camera is the anterior view of both.
+    assert np.array_equal(volgraph.render("basic/fragment_raycast", store, size=(48, 40)),
+                          volgraph.render("basic/fragment_raycast", original, size=(48, 40)))

@@ -238,6 +238,29 @@ pub enum NamedVolumeError {
         /// The name.
         name: String,
     },
+    /// The edge of a vessel tree made a slab at a time is out of range.
+    #[error("\"{name}\": a vessel tree written a slab at a time has an edge of 2..={MAX_STREAMED_EDGE} voxels")]
+    StreamedEdge {
+        /// The name.
+        name: String,
+    },
+}
+
+/// The largest edge of a vessel tree made a slab at a time ([`streamed_vessels`]): 8192³ is
+/// 512 GiB.
+pub const MAX_STREAMED_EDGE: u32 = 8192;
+
+/// The vessel tree `vessels<N>` names, to be made a slab at a time (any N up to
+/// [`MAX_STREAMED_EDGE`], beyond what [`by_name`] makes in memory); `None` for another name.
+pub fn streamed_vessels(name: &str) -> Option<Result<crate::vessels::VesselTree, NamedVolumeError>> {
+    let digits = name.strip_prefix("vessels")?;
+    if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    Some(match digits.parse::<u32>() {
+        Ok(edge) if (2..=MAX_STREAMED_EDGE).contains(&edge) => Ok(crate::vessels::VesselTree::new(edge, 1)),
+        _ => Err(NamedVolumeError::StreamedEdge { name: name.to_string() }),
+    })
 }
 
 /// The generated volume a name asks for: `ml64` (Marschner–Lobb, 64³ u8), `mlf64` (f32),

@@ -84,16 +84,43 @@ fn distance_to_segment(p: DVec3, a: DVec3, b: DVec3) -> f64 {
     (p - (a + t * ab)).length()
 }
 
-/// A branching vessel tree in an `n³` `uint8` volume (module docs), named
-/// `vessels_<n>_seed<seed>`. The same `(n, seed)` gives the same volume on every platform.
-pub fn vessel_tree(n: u32, seed: u64) -> Volume {
-    let segments = tree(n, seed);
-    let slice = n as usize * n as usize;
-    let mut data = vec![BACKGROUND; slice * n as usize];
-    // Per z slice: the segments whose (wall-padded) bounding box meets it.
-    data.par_chunks_mut(slice.max(1)).enumerate().for_each(|(z, chunk)| {
+/// The tree of an `n³` volume, to fill any of its planes: a volume far larger than memory is
+/// made a slab at a time (`volgraph convert vessels4096 …` writes 64 GiB this way).
+pub struct VesselTree {
+    n: u32,
+    seed: u64,
+    segments: Vec<Segment>,
+}
+
+impl VesselTree {
+    /// The tree of an `n³` volume with `seed`.
+    pub fn new(n: u32, seed: u64) -> Self {
+        Self { n, seed, segments: tree(n, seed) }
+    }
+
+    /// Voxels per axis.
+    pub fn dims(&self) -> UVec3 {
+        UVec3::splat(self.n)
+    }
+
+    /// The volume's name, `vessels_<n>_seed<seed>`.
+    pub fn name(&self) -> String {
+        format!("vessels_{}_seed{}", self.n, self.seed)
+    }
+
+    /// The planes `z` of the volume, x fastest (each plane on its own rayon task).
+    pub fn planes(&self, z: std::ops::Range<u32>) -> Vec<u8> {
+        let slice = self.n as usize * self.n as usize;
+        let mut data = vec![BACKGROUND; slice * z.len()];
+        data.par_chunks_mut(slice.max(1)).enumerate().for_each(|(i, plane)| self.fill_plane(z.start + i as u32, plane));
+        data
+    }
+
+    /// Plane `z`: the segments whose (wall-padded) bounding box meets it.
+    fn fill_plane(&self, z: u32, plane: &mut [u8]) {
+        let n = self.n;
         let zc = z as f64;
-        for s in &segments {
+        for s in &self.segments {
             let pad = s.radius + 1.0;
             let lo = s.a.min(s.b) - DVec3::splat(pad);
             let hi = s.a.max(s.b) + DVec3::splat(pad);
@@ -113,13 +140,19 @@ pub fn vessel_tree(n: u32, seed: u64) -> Volume {
                     // 1 inside the wall, 0 two voxels outside it.
                     let w = ((s.radius + 1.0 - d) / 2.0).clamp(0.0, 1.0);
                     let v = (BACKGROUND as f64 + w * (VESSEL - BACKGROUND) as f64).round() as u8;
-                    let cell = &mut chunk[y as usize * n as usize + x as usize];
+                    let cell = &mut plane[y as usize * n as usize + x as usize];
                     *cell = (*cell).max(v);
                 }
             }
         }
-    });
-    Volume::new(format!("vessels_{n}_seed{seed}"), UVec3::splat(n), DVec3::ONE, VoxelData::U8(data))
+    }
+}
+
+/// A branching vessel tree in an `n³` `uint8` volume (module docs), named
+/// `vessels_<n>_seed<seed>`. The same `(n, seed)` gives the same volume on every platform.
+pub fn vessel_tree(n: u32, seed: u64) -> Volume {
+    let tree = VesselTree::new(n, seed);
+    Volume::new(tree.name(), tree.dims(), DVec3::ONE, VoxelData::U8(tree.planes(0..n)))
 }
 
 /// Control points `(value, rgb, alpha)` of the vessel transfer function on the 0..255 domain:

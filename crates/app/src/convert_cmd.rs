@@ -31,14 +31,11 @@ pub struct ConvertArgs {
 pub fn run(args: &ConvertArgs) -> anyhow::Result<String> {
     let start = Instant::now();
     let options = crate::inputs::raw_options(&args.raw)?;
-    let shown = crate::scene::load_shown_volume(std::slice::from_ref(&args.input), None, &options)?;
-    for note in &shown.notes {
-        crate::stdout::eprintln_escaped!("note: {note}");
-    }
-    let volume = shown.volume;
-    let read_s = start.elapsed().as_secs_f64();
+    let (mut source, how) = source(args, &options)?;
+    let open_s = start.elapsed().as_secs_f64();
     let write = volgraph_zarr::WriteOptions { chunk: args.chunk, ..Default::default() };
-    let total = volgraph_zarr::write::chunk_count(volume.dims, &write);
+    let dims = source.dims();
+    let total = volgraph_zarr::write::chunk_count(dims, &write);
     let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
     bar.set_style(
         ProgressStyle::with_template("writing {msg} {bar:40} {pos}/{len} chunks ({eta} left)")
@@ -46,18 +43,16 @@ pub fn run(args: &ConvertArgs) -> anyhow::Result<String> {
     );
     bar.set_message(args.output.display().to_string());
     let report =
-        volgraph_zarr::write_pyramid(&mut volgraph_zarr::InMemory(&volume), &args.output, &write, &mut |done, _| {
-            bar.set_position(done)
-        })
-        .map_err(|e| anyhow!("{e}"));
+        volgraph_zarr::write_pyramid(source.as_mut(), &args.output, &write, &mut |done, _| bar.set_position(done))
+            .map_err(|e| anyhow!("{e}"));
     bar.finish_and_clear();
     let report = report?;
     let bytes = folder_bytes(&args.output);
-    let raw = volume.data.len() as u64 * volume.data.voxel_type().size_bytes() as u64;
+    let raw = dims.x as u64 * dims.y as u64 * dims.z as u64 * source.voxel_type().size_bytes() as u64;
     let levels: Vec<String> = report.levels.iter().map(|d| format!("{}×{}×{}", d.x, d.y, d.z)).collect();
     Ok(format!(
-        "wrote {}: {} levels ({}), chunks {}³: {} written, {} empty (not stored); {:.1} MiB on disk for {:.1} MiB \
-         of voxels ({:.2}×); read {:.2} s, written {:.2} s\n",
+        "wrote {} ({how}): {} levels ({}), chunks {}³: {} written, {} empty (not stored); {:.1} MiB on disk for \
+         {:.1} MiB of voxels ({:.2}×); opened in {:.2} s, written in {:.2} s\n",
         args.output.display(),
         report.levels.len(),
         levels.join(", "),
@@ -67,9 +62,33 @@ pub fn run(args: &ConvertArgs) -> anyhow::Result<String> {
         bytes as f64 / (1 << 20) as f64,
         raw as f64 / (1 << 20) as f64,
         raw as f64 / bytes.max(1) as f64,
-        read_s,
-        start.elapsed().as_secs_f64() - read_s
+        open_s,
+        start.elapsed().as_secs_f64() - open_s
     ))
+}
+
+/// The input as a slab source, and how it is read.
+fn source(
+    args: &ConvertArgs,
+    options: &volgraph_accel::load::LoadOptions<'static>,
+) -> anyhow::Result<(Box<dyn volgraph_zarr::SlabSource>, &'static str)> {
+    use crate::convert_sources::{FileSlabs, VesselSlabs, WholeVolume};
+    let name = args.input.to_string_lossy();
+    if !args.input.exists()
+        && let Some(tree) = volgraph_accel::generate::streamed_vessels(&name)
+    {
+        return Ok((Box::new(VesselSlabs(tree.map_err(|e| anyhow!("{e}"))?)), "generated a slab at a time"));
+    }
+    if args.input.is_file()
+        && let Some(file) = FileSlabs::open(&args.input, options)
+    {
+        return Ok((Box::new(file?), "read a slab at a time"));
+    }
+    let shown = crate::scene::load_shown_volume(std::slice::from_ref(&args.input), None, options)?;
+    for note in &shown.notes {
+        crate::stdout::eprintln_escaped!("note: {note}");
+    }
+    Ok((Box::new(WholeVolume(shown.volume)), "read whole"))
 }
 
 /// Bytes of the files under `dir`.

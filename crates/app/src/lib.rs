@@ -13,6 +13,7 @@ pub mod cli;
 #[cfg(test)]
 mod cli_fuzz;
 pub mod convert_cmd;
+pub mod convert_sources;
 pub mod distributed;
 pub mod environment_file;
 pub mod forward;

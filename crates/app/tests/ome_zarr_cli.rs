@@ -63,3 +63,41 @@ fn bad_conversions_say_why() {
         assert!(!ok && err.contains(want), "{args:?}: {err}");
     }
 }
+
+#[test]
+fn raw_files_convert_a_slab_at_a_time_and_render_as_the_file() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    let (nx, ny, nz) = (40u32, 30u32, 21u32);
+    let mut u16s = Vec::new();
+    let mut f32s = Vec::new();
+    for z in 0..nz {
+        for y in 0..ny {
+            for x in 0..nx {
+                let r = ((x as f32 - 20.0).powi(2) + (y as f32 - 15.0).powi(2) + (z as f32 - 10.0).powi(2)).sqrt();
+                u16s.extend(((60_000.0 * (1.0 - r / 20.0).max(0.0)) as u16).to_le_bytes());
+                // A float file with a NaN: its range is surveyed, the NaN replaced as the loader does.
+                let v = if (x, y, z) == (1, 1, 1) { f32::NAN } else { 3.5 - r / 6.0 };
+                f32s.extend(v.to_le_bytes());
+            }
+        }
+    }
+    std::fs::write(d.join("ball_40x30x21_uint16.raw"), u16s).expect("write");
+    std::fs::write(d.join("ballf_40x30x21_float32.raw"), f32s).expect("write");
+    for (raw, store) in [("ball_40x30x21_uint16.raw", "u.ome.zarr"), ("ballf_40x30x21_float32.raw", "f.ome.zarr")] {
+        let (ok, out, err) = volgraph(&["convert", raw, store, "--chunk", "8", "--spacing", "1,1,2"], d);
+        assert!(ok, "{err}");
+        assert!(out.contains("(read a slab at a time)") && out.contains("1 levels (40×30×21)"), "{out}");
+        let mut images = Vec::new();
+        for volume in [raw, store] {
+            let png = format!("{volume}.png");
+            let spacing: &[&str] = if volume == raw { &["--spacing", "1,1,2"] } else { &[] };
+            let mut args = vec!["render", "modern/fastest", "--volume", volume, "--size", "48x48", "-o", &png];
+            args.extend(spacing);
+            let (ok, _, err) = volgraph(&args, d);
+            assert!(ok, "{err}");
+            images.push(std::fs::read(d.join(&png)).expect("png"));
+        }
+        assert!(images[0] == images[1], "{store} renders unlike {raw}");
+    }
+}

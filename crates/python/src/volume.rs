@@ -108,14 +108,7 @@ impl Volume {
 
     fn __repr__(&self) -> String {
         let d = self.header.dims;
-        format!(
-            "volgraph.Volume(\"{}\", {}×{}×{}, {:?})",
-            self.header.name,
-            d.x,
-            d.y,
-            d.z,
-            self.voxel_type
-        )
+        format!("volgraph.Volume(\"{}\", {}×{}×{}, {:?})", self.header.name, d.x, d.y, d.z, self.voxel_type)
     }
 }
 

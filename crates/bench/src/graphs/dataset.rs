@@ -48,7 +48,9 @@ pub fn load_or_stand_in(name: &str) -> anyhow::Result<BenchVolume> {
 pub fn load(name: &str) -> anyhow::Result<Volume> {
     match generate::by_name(name) {
         Ok(volume) => Ok(volume),
-        Err(e @ generate::NamedVolumeError::Edge { .. }) => Err(anyhow!("--datasets {name}: {e}")),
+        Err(e @ (generate::NamedVolumeError::Edge { .. } | generate::NamedVolumeError::StreamedEdge { .. })) => {
+            Err(anyhow!("--datasets {name}: {e}"))
+        }
         Err(generate::NamedVolumeError::Unknown { .. }) => {
             let loaded = volgraph_accel::data_dir::load_dataset(name)
                 .map_err(|e| anyhow!("--datasets {name}: {e} (generated volumes: {})", generate::NAMED_GENERATORS))?;

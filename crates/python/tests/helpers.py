@@ -77,3 +77,15 @@ def ramp_volume():
     return (np.clip(1.0 - r, 0, 1) * 60000 + rng.integers(0, 400, r.shape)).astype(np.uint16)
 
 
+
+
+def ball_nifti(path):
+    """`ramp_volume` as int16 written by nibabel at `path` (RAS, 0.8 × 0.9 × 1.5 mm, origin
+    (-10, 20, 5)); returns nibabel's [x, y, z] array."""
+    import nibabel as nib
+
+    data = ramp_volume().astype(np.int16).transpose(2, 1, 0)
+    affine = np.diag([0.8, 0.9, 1.5, 1.0])
+    affine[:3, 3] = (-10.0, 20.0, 5.0)
+    nib.save(nib.Nifti1Image(data, affine), path)
+    return data

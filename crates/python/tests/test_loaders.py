@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers import cli, ramp_volume, read_png
+from helpers import ball_nifti, cli, ramp_volume, read_png
 
 import volgraph
 
@@ -37,12 +37,8 @@ def test_a_loaded_volumes_array_is_a_read_only_view_of_its_voxels(tmp_path):
 
 
 def test_nifti_from_nibabel_reads_as_the_cli_reads_it(tmp_path):
-    import nibabel as nib
-    data = ramp_volume().astype(np.int16).transpose(2, 1, 0)  # nibabel's [x, y, z]
-    affine = np.diag([0.8, 0.9, 1.5, 1.0])
-    affine[:3, 3] = (-10.0, 20.0, 5.0)
     path = tmp_path / "ball.nii.gz"
-    nib.save(nib.Nifti1Image(data, affine), path)
+    data = ball_nifti(path)  # nibabel's [x, y, z]
     v = volgraph.load(path)
     assert v.dims == (24, 20, 16) and v.spacing == pytest.approx((0.8, 0.9, 1.5))
     assert v.meta["frame"].startswith("LPS")

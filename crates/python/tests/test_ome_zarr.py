@@ -3,7 +3,7 @@
 ome-zarr-py wrote renders in volgraph like the array it was written from."""
 
 import numpy as np
-from helpers import cli, ramp_volume
+from helpers import ball_nifti, cli, ramp_volume
 
 import volgraph
 
@@ -62,13 +62,8 @@ def test_an_ngff_0_4_store_on_zarr_v2_reads(tmp_path):
 
 
 def test_a_nifti_converted_renders_like_the_nifti(tmp_path):
-    import nibabel as nib
-
-    data = ramp_volume().astype(np.int16).transpose(2, 1, 0)  # nibabel's [x, y, z]
-    affine = np.diag([0.8, 0.9, 1.5, 1.0])
-    affine[:3, 3] = (-10.0, 20.0, 5.0)
     nifti = tmp_path / "ball.nii.gz"
-    nib.save(nib.Nifti1Image(data, affine), nifti)
+    ball_nifti(nifti)
     out = tmp_path / "ball.ome.zarr"
     cli("convert", nifti, out, "--chunk", "8", cwd=tmp_path)
     store, original = volgraph.load(out), volgraph.load(nifti)

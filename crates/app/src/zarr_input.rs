@@ -1,7 +1,10 @@
 //! `--volume image.ome.zarr` and `volgraph info image.ome.zarr`: an OME-Zarr pyramid
 //! (`volgraph_zarr`) read in core — the finest level whose voxels fit in
-//! [`IN_CORE_LIMIT_BYTES`], the time point `--frame` picks, channel 0 — with notes saying which
-//! level was read and what the reader met (missing or undecodable chunks, named).
+//! [`IN_CORE_LIMIT_BYTES`], the volume `--frame N` (or `image.ome.zarr#N`, one per named input)
+//! picks — with notes saying which level was read and what the reader met (missing or
+//! undecodable chunks, named). The image's volumes are counted as a 4D NIfTI's are: channels
+//! fastest within each time point, N = t·C + c, so a store of channels binds as
+//! `--volume volume=cells.ome.zarr#0 --volume second=cells.ome.zarr#1`.
 
 use std::path::Path;
 
@@ -22,7 +25,20 @@ pub fn read(path: &Path, options: &LoadOptions<'_>) -> anyhow::Result<(Volume, V
             path.display()
         ));
     }
-    let pick = Pick { time: options.frame.unwrap_or(0), channel: 0 };
+    let volumes = image.times * image.channels;
+    let n = options.frame.unwrap_or(0);
+    if n >= volumes {
+        return Err(anyhow!(
+            "{}: volume {n} asked for (--frame or #N); the image holds {volumes} ({} time point{} × {} channel{}, \
+             counted t·C + c from 0)",
+            path.display(),
+            image.times,
+            if image.times == 1 { "" } else { "s" },
+            image.channels,
+            if image.channels == 1 { "" } else { "s" }
+        ));
+    }
+    let pick = Pick { time: n / image.channels, channel: n % image.channels };
     let index = image.finest_within(IN_CORE_LIMIT_BYTES).unwrap_or(image.levels.len() - 1);
     let read = image.read_level(index, pick, IN_CORE_LIMIT_BYTES).map_err(|e| anyhow!("{e}"))?;
     let mut notes = read.notes;
@@ -44,11 +60,15 @@ pub fn read(path: &Path, options: &LoadOptions<'_>) -> anyhow::Result<(Volume, V
             fine.dims.z
         ));
     }
-    if image.channels > 1 {
-        notes.push(format!("{}: channel 0 of {} is shown", path.display(), image.channels));
-    }
-    if image.times > 1 && options.frame.is_none() {
-        notes.push(format!("{}: time point 0 of {} is shown; --frame N picks another", path.display(), image.times));
+    if volumes > 1 && options.frame.is_none() {
+        notes.push(format!(
+            "{}: the image holds {volumes} volumes ({} time points × {} channels); volume 0 is shown: --frame N or \
+             {}#N picks N = t·C + c",
+            path.display(),
+            image.times,
+            image.channels,
+            path.display()
+        ));
     }
     let mut volume = read.volume;
     if let Some(spacing) = options.raw.spacing {

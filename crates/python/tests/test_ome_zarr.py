@@ -1,9 +1,11 @@
 """OME-Zarr against ome-zarr-py, the library users' stores come from (issue 48): a store that
 `volgraph convert` wrote reads in ome-zarr-py with the same levels, scales and voxels, and a store
-ome-zarr-py wrote renders in volgraph like the array it was written from."""
+ome-zarr-py wrote renders in volgraph like the array it was written from; its channels are its
+volumes, bound one per input."""
 
 import numpy as np
-from helpers import ball_nifti, cli, ramp_volume
+import pytest
+from helpers import ball_nifti, cli, ramp_volume, read_png
 
 import volgraph
 
@@ -72,3 +74,26 @@ def test_a_nifti_converted_renders_like_the_nifti(tmp_path):
     # The patient frame kept: the default camera is the anterior view of both.
     assert np.array_equal(volgraph.render("basic/fragment_raycast", store, size=(48, 40)),
                           volgraph.render("basic/fragment_raycast", original, size=(48, 40)))
+
+
+def test_the_channels_of_a_store_are_its_volumes(tmp_path):
+    import zarr
+    from ome_zarr.io import parse_url
+    from ome_zarr.writer import write_image
+
+    a = ramp_volume()
+    b = np.ascontiguousarray((a // 2)[::-1])
+    path = tmp_path / "two.ome.zarr"
+    root = zarr.group(store=parse_url(str(path), mode="w").store)
+    write_image(np.stack([a, b]), root, axes="czyx", scale={"c": 1.0, "z": 1.5, "y": 0.8, "x": 0.8})
+    assert np.array_equal(volgraph.load(path).array, a)
+    assert np.array_equal(volgraph.load(path, frame=1).array, b)
+    with pytest.raises(volgraph.VolumeError, match="holds 2"):
+        volgraph.load(path, frame=2)
+    # Bound one channel per input, as a 4D NIfTI's volumes are (`#N`).
+    png = tmp_path / "cli.png"
+    cli("render", "multi/pet_ct", "--volume", f"volume={path}#0", "--volume", f"pet={path}#1", "--size", "48x40",
+        "-o", png, cwd=tmp_path)
+    ours = volgraph.render("multi/pet_ct", volgraph.load(path), volumes={"pet": volgraph.load(path, frame=1)},
+                           size=(48, 40))
+    assert np.array_equal(ours[..., :3], read_png(png)[..., :3])

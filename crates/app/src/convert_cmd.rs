@@ -72,7 +72,7 @@ fn source(
     args: &ConvertArgs,
     options: &volgraph_accel::load::LoadOptions<'static>,
 ) -> anyhow::Result<(Box<dyn volgraph_zarr::SlabSource>, &'static str)> {
-    use crate::convert_sources::{FileSlabs, VesselSlabs, WholeVolume};
+    use crate::convert_sources::{FileSlabs, VesselSlabs};
     let name = args.input.to_string_lossy();
     if !args.input.exists()
         && let Some(tree) = volgraph_accel::generate::streamed_vessels(&name)
@@ -88,7 +88,7 @@ fn source(
     for note in &shown.notes {
         crate::stdout::eprintln_escaped!("note: {note}");
     }
-    Ok((Box::new(WholeVolume(shown.volume)), "read whole"))
+    Ok((Box::new(volgraph_zarr::InMemory(shown.volume)), "read whole"))
 }
 
 /// Bytes of the files under `dir`.

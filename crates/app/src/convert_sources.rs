@@ -2,7 +2,8 @@
 //! so a volume larger than memory converts: a generated vessel tree of any size up to 8192³
 //! (`vessels4096`: 64 GiB) made plane by plane; a headerless raw file, raw-encoded NRRD or
 //! uncompressed MetaImage read by seeking (`VolumeHeader::read_box`). Anything else (NIfTI,
-//! compressed files, DICOM, datasets and other generated volumes) is read whole, as `--volume`.
+//! compressed files, DICOM, datasets and other generated volumes) is read whole, as `--volume`
+//! reads it, and written from memory (`volgraph_zarr::InMemory`).
 
 use std::ops::Range;
 use std::path::Path;
@@ -13,7 +14,7 @@ use volgraph_accel::kd_split::VoxelBox;
 use volgraph_accel::load::LoadOptions;
 use volgraph_accel::load::VolumeHeader;
 use volgraph_accel::vessels::VesselTree;
-use volgraph_accel::volume::{Volume, VoxelData, VoxelType};
+use volgraph_accel::volume::{VoxelData, VoxelType};
 use volgraph_accel::volume_meta::VolumeMeta;
 use volgraph_zarr::SlabSource;
 
@@ -58,30 +59,16 @@ impl FileSlabs {
         let header = VolumeHeader::read(path, options).ok()?;
         let value_range = match header.type_range() {
             Some(range) => range,
-            None => match survey(&header) {
-                Ok(range) => range,
-                Err(e) => return Some(Err(e)),
+            None => match header.finite_range(0..header.dims.z) {
+                Ok((lo, hi)) if lo < hi => (lo, hi),
+                // A constant file (or none finite): a range around its value, as the loader gives.
+                Ok((lo, _)) if lo.is_finite() => (lo, lo + 1.0),
+                Ok(_) => (0.0, 1.0),
+                Err(e) => return Some(Err(anyhow!("{e}"))),
             },
         };
         Some(Ok(Self { header, value_range }))
     }
-}
-
-/// The finite (min, max) of a file's values, read a slab at a time.
-fn survey(header: &VolumeHeader) -> anyhow::Result<(f64, f64)> {
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    header
-        .for_each_slab(0..header.dims.z, 16, (0.0, 1.0), |_, slab| {
-            for i in 0..slab.voxel_count() {
-                let v = slab.raw_value(i);
-                if v.is_finite() {
-                    lo = lo.min(v);
-                    hi = hi.max(v);
-                }
-            }
-        })
-        .map_err(|e| anyhow!("{e}"))?;
-    if lo < hi { Ok((lo, hi)) } else { Ok((lo.min(0.0), lo.max(0.0) + 1.0)) }
 }
 
 impl SlabSource for FileSlabs {
@@ -107,32 +94,5 @@ impl SlabSource for FileSlabs {
         let d = self.header.dims;
         let slab = VoxelBox::new(UVec3::new(0, 0, z.start), UVec3::new(d.x, d.y, z.end));
         self.header.read_box(slab, self.value_range).map(|v| v.data).map_err(|e| e.to_string())
-    }
-}
-
-/// A volume read whole.
-pub struct WholeVolume(pub Volume);
-
-impl SlabSource for WholeVolume {
-    fn dims(&self) -> UVec3 {
-        volgraph_zarr::InMemory(&self.0).dims()
-    }
-    fn voxel_type(&self) -> VoxelType {
-        self.0.data.voxel_type()
-    }
-    fn spacing(&self) -> DVec3 {
-        self.0.spacing
-    }
-    fn origin(&self) -> DVec3 {
-        volgraph_zarr::InMemory(&self.0).origin()
-    }
-    fn meta(&self) -> VolumeMeta {
-        self.0.meta.clone()
-    }
-    fn value_range(&self) -> (f64, f64) {
-        self.0.value_range
-    }
-    fn read_slab(&mut self, z: Range<u32>) -> Result<VoxelData, String> {
-        volgraph_zarr::InMemory(&self.0).read_slab(z)
     }
 }

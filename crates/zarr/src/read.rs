@@ -141,7 +141,12 @@ impl OmeZarr {
                     let shape = level.array.chunk_shape(&index).map_err(|e| chunk_error(e.to_string()))?;
                     let shape: Vec<u64> = shape.iter().map(|s| s.get()).collect();
                     let origin = origin_of(&index).map_err(|e| chunk_error(e.to_string()))?;
-                    let elements = match level.array.retrieve_chunk_if_exists::<Vec<T>>(&index) {
+                    // A FIFO or device in a chunk's place would block the read: an undecodable chunk.
+                    let file = self.path.join(level.array.chunk_key(&index).as_str());
+                    let read = crate::store::check_file(&file)
+                        .map_err(zarrs::array::ArrayError::Other)
+                        .and_then(|()| level.array.retrieve_chunk_if_exists::<Vec<T>>(&index));
+                    let elements = match read {
                         Ok(Some(elements)) => elements,
                         Ok(None) => {
                             let i = ((cz * grid[ay] + cy) * grid[ax] + cx) as usize * 2;
@@ -225,6 +230,17 @@ impl OmeZarr {
     fn chunk_ranges(&self, level: &Level) -> Option<Vec<f32>> {
         self.attributes.get("volgraph")?.get("chunk_ranges")?;
         let path = format!("/chunk_ranges/{}", level.path);
+        // Only regular files: a FIFO among them would block the read (the ranges are then unused).
+        let mut stack = vec![self.path.join("chunk_ranges").join(&level.path)];
+        while let Some(dir) = stack.pop() {
+            for entry in std::fs::read_dir(&dir).ok()?.flatten() {
+                let kind = entry.file_type().ok()?;
+                match kind.is_dir() {
+                    true => stack.push(entry.path()),
+                    false => crate::store::check_file(&entry.path()).ok()?,
+                }
+            }
+        }
         let ranges = zarrs::array::Array::open(level.array.storage(), &path).ok()?;
         let grid = level.array.chunk_grid_shape();
         (ranges.shape() == [grid[0], grid[1], grid[2], 2].as_slice()).then_some(())?;

@@ -54,6 +54,20 @@ pub struct OmeZarr {
     pub channels: u64,
 }
 
+/// A file the store would read, refused unless it is a regular file (or absent): a FIFO or a
+/// device would block the read or never end it.
+pub(crate) fn check_file(path: &Path) -> Result<(), String> {
+    match volgraph_accel::input_file::special_kind(path) {
+        Ok(Some(what)) => Err(format!("{} is {what}, not a file; a store holds files and folders", path.display())),
+        _ => Ok(()),
+    }
+}
+
+/// [`check_file`] of every metadata file Zarr v2 or v3 keeps in folder `dir`.
+fn check_metadata_files(dir: &Path) -> Result<(), String> {
+    ["zarr.json", ".zgroup", ".zarray", ".zattrs"].iter().try_for_each(|name| check_file(&dir.join(name)))
+}
+
 /// The data type of an array's metadata, if volgraph renders it.
 fn voxel_type(metadata: &Value) -> Result<VoxelType, String> {
     // v3: "data_type": "uint16"; v2: "dtype": "<u2".
@@ -109,6 +123,11 @@ impl OmeZarr {
         if !path.join("zarr.json").is_file() && !path.join(".zgroup").is_file() {
             return Err(ZarrError::NotZarr { path: path.to_path_buf() });
         }
+        check_metadata_files(path).map_err(|problem| ZarrError::Metadata {
+            path: path.to_path_buf(),
+            field: "the root group".into(),
+            problem,
+        })?;
         let store = Arc::new(FilesystemStore::new(path).map_err(|e| ZarrError::Level {
             path: path.to_path_buf(),
             level: "/".into(),
@@ -127,6 +146,7 @@ impl OmeZarr {
         for meta in &multiscale.levels {
             let level_error =
                 |problem: String| ZarrError::Level { path: path.to_path_buf(), level: meta.path.clone(), problem };
+            check_metadata_files(&path.join(&meta.path)).map_err(&level_error)?;
             let array =
                 Array::open(store.clone(), &format!("/{}", meta.path)).map_err(|e| level_error(e.to_string()))?;
             let json = serde_json::to_value(array.metadata()).unwrap_or(Value::Null);

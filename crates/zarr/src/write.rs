@@ -41,9 +41,9 @@ pub trait SlabSource {
 }
 
 /// A volume in memory as a source.
-pub struct InMemory<'a>(pub &'a Volume);
+pub struct InMemory(pub Volume);
 
-impl SlabSource for InMemory<'_> {
+impl SlabSource for InMemory {
     fn dims(&self) -> UVec3 {
         self.0.dims
     }

@@ -14,7 +14,7 @@ fn store(dir: &Path) -> PathBuf {
     let out = dir.join("full.ome.zarr");
     let source = Volume::new("full", UVec3::splat(32), DVec3::ONE, VoxelData::U8(vec![200; 32 * 32 * 32]));
     write_pyramid(
-        &mut InMemory(&source),
+        &mut InMemory(source.clone()),
         &out,
         &WriteOptions { chunk: 16, coarsest: 16, zstd_level: 1 },
         &mut |_, _| {},
@@ -106,4 +106,40 @@ fn a_level_over_the_limit_is_refused_naming_the_coarser_ones() {
     assert!(e.contains("level \"0\"") && e.contains("coarser levels: 1"), "{e}");
     let e = image.read_level(0, Pick { time: 2, channel: 0 }, 1 << 30).err().expect("refused").to_string();
     assert!(e.contains("time point 2") && e.contains("no time point axis"), "{e}");
+}
+
+/// Replaces `path` by a FIFO (a read of it would block for ever).
+fn fifo_at(path: &Path) {
+    std::fs::remove_file(path).expect("a file to replace");
+    let made = std::process::Command::new("mkfifo").arg(path).status().expect("mkfifo runs");
+    assert!(made.success(), "mkfifo {}", path.display());
+}
+
+#[test]
+fn a_fifo_in_a_store_is_refused_never_read() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    // In a level's metadata: the store does not open.
+    let meta = dir.path().join("meta");
+    std::fs::create_dir(&meta).expect("dir");
+    let out = store(&meta);
+    fifo_at(&out.join("0/zarr.json"));
+    let e = open_error(&out);
+    assert!(e.contains("level \"0\"") && e.contains("FIFO"), "{e}");
+    // In a chunk's place: that chunk is an error line, the rest reads.
+    let chunk = dir.path().join("chunk");
+    std::fs::create_dir(&chunk).expect("dir");
+    let out = store(&chunk);
+    fifo_at(&out.join("0/c/0/0/0"));
+    let read = OmeZarr::open(&out).and_then(|i| i.read_level(0, Pick::default(), 1 << 30)).expect("read");
+    assert!(
+        read.notes.len() == 1 && read.notes[0].contains("0/0/0") && read.notes[0].contains("FIFO"),
+        "{:?}",
+        read.notes
+    );
+    // Among the chunk ranges: they are left unused (the missing-chunk warnings fall back to a note).
+    let ranges = dir.path().join("ranges");
+    std::fs::create_dir(&ranges).expect("dir");
+    let out = store(&ranges);
+    fifo_at(&out.join("chunk_ranges/0/c/0/0/0/0"));
+    assert!(OmeZarr::open(&out).and_then(|i| i.read_level(0, Pick::default(), 1 << 30)).is_ok());
 }

@@ -25,6 +25,12 @@ fn ramp() -> Volume {
     v
 }
 
+/// Writes `source` at `out` with cubes of `chunk` voxels, levels halving until ≤ `coarsest`.
+fn write(source: &Volume, out: &std::path::Path, chunk: u32, coarsest: u32) {
+    let options = WriteOptions { chunk, coarsest, zstd_level: 1 };
+    write_pyramid(&mut InMemory(source.clone()), out, &options, &mut |_, _| {}).expect("written");
+}
+
 fn voxels(v: &Volume) -> Vec<u16> {
     match &v.data {
         VoxelData::U16(d) => d.clone(),
@@ -62,7 +68,7 @@ fn a_pyramid_reads_back_exactly() {
     let source = ramp();
     let options = WriteOptions { chunk: 16, coarsest: 16, zstd_level: 3 };
     let mut calls = 0;
-    let report = write_pyramid(&mut InMemory(&source), &out, &options, &mut |_, _| calls += 1).expect("written");
+    let report = write_pyramid(&mut InMemory(source.clone()), &out, &options, &mut |_, _| calls += 1).expect("written");
     assert_eq!(
         report.levels,
         vec![UVec3::new(70, 50, 37), UVec3::new(35, 25, 19), UVec3::new(18, 13, 10), UVec3::new(9, 7, 5)]
@@ -100,13 +106,7 @@ fn every_chunks_range_is_stored_beside_it() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("ramp.ome.zarr");
     let source = ramp();
-    write_pyramid(
-        &mut InMemory(&source),
-        &out,
-        &WriteOptions { chunk: 16, coarsest: 64, zstd_level: 1 },
-        &mut |_, _| {},
-    )
-    .expect("written");
+    write(&source, &out, 16, 64);
     let store = std::sync::Arc::new(zarrs::filesystem::FilesystemStore::new(&out).expect("store"));
     let ranges = zarrs::array::Array::open(store, "/chunk_ranges/0").expect("ranges");
     assert_eq!(ranges.shape(), &[3, 4, 5, 2]);
@@ -144,13 +144,7 @@ fn float_and_signed_volumes_round_trip() {
     ] {
         let source = Volume::new(name, d, DVec3::ONE, data);
         let out = dir.path().join(format!("{name}.ome.zarr"));
-        write_pyramid(
-            &mut InMemory(&source),
-            &out,
-            &WriteOptions { chunk: 8, coarsest: 8, zstd_level: 1 },
-            &mut |_, _| {},
-        )
-        .expect("written");
+        write(&source, &out, 8, 8);
         let read = OmeZarr::open(&out).and_then(|i| i.read_level(0, Pick::default(), 1 << 30)).expect("read");
         assert_eq!(read.volume.data, source.data, "{name}");
     }

@@ -194,6 +194,23 @@ impl VolumeHeader {
     }
 }
 
+impl VolumeHeader {
+    /// The finite (min, max) of the values in planes `z`, read a slab at a time (a float file's
+    /// range, which no type fixes); `(+∞, −∞)` when none is finite.
+    pub fn finite_range(&self, z: std::ops::Range<u32>) -> Result<(f64, f64), LoadError> {
+        let mut lo_hi = (f64::INFINITY, f64::NEG_INFINITY);
+        self.for_each_slab(z, 8, (0.0, 1.0), |_, slab| {
+            for i in 0..slab.voxel_count() {
+                let v = slab.raw_value(i);
+                if v.is_finite() {
+                    lo_hi = (lo_hi.0.min(v), lo_hi.1.max(v));
+                }
+            }
+        })?;
+        Ok(lo_hi)
+    }
+}
+
 /// The first MiB of `path`: enough for any header volgraph reads.
 fn read_head(path: &Path) -> Result<Vec<u8>, LoadError> {
     // A FIFO or device would block the open or never end: refused by name first.

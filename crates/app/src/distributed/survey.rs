@@ -101,15 +101,9 @@ pub fn survey<E: Exchange + ?Sized>(ex: &mut E, header: &VolumeHeader, brick: u3
     let value_range = match header.type_range() {
         Some(range) => range,
         None => {
-            let mut lo_hi = (f64::INFINITY, f64::NEG_INFINITY);
-            let read = header.for_each_slab(z.clone(), 8, (0.0, 1.0), |_, v| {
-                if let VoxelData::F32(values) = &v.data {
-                    for x in values.iter().filter(|x| x.is_finite()) {
-                        lo_hi = (lo_hi.0.min(*x as f64), lo_hi.1.max(*x as f64));
-                    }
-                }
-            });
-            agree(ex, read.map_err(|e| e.to_string())).map_err(fail)?;
+            let read = header.finite_range(z.clone());
+            let lo_hi = *read.as_ref().unwrap_or(&(f64::INFINITY, f64::NEG_INFINITY));
+            agree(ex, read.map(drop).map_err(|e| e.to_string())).map_err(fail)?;
             let mine = [lo_hi.0, lo_hi.1].iter().flat_map(|v| v.to_le_bytes()).collect();
             let all = all_gather(ex, mine).map_err(fail)?;
             let (lo, hi) = all.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), m| {

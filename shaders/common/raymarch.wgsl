@@ -79,8 +79,18 @@ fn ray_is_valid(u0: vec3<f32>, d_tex: vec3<f32>, len_tex: f32) -> bool {
 
 // The opacity-correction exponent of one step: step_voxels over the TF's opacity unit in voxels
 // (frame.volume_dims.w: 1 for opacity per voxel, 1/unit_world for opacity per world unit).
+#if LEVEL_STEPS
+// raycast_stream.wgsl: a run through a brick of level l takes every 2^l-th sample of the grid;
+// its opacity is corrected for that step.
+var<private> step_multiple: f32 = 1.0;
+#endif
+
 fn step_exponent() -> f32 {
+#if LEVEL_STEPS
+    return step_multiple * params.step_voxels / frame.volume_dims.w;
+#else
     return params.step_voxels / frame.volume_dims.w;
+#endif
 }
 
 // Opacity correction from the LUT's per-unit alpha to this step: 1 - (1 - a)^step_exponent.

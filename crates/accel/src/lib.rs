@@ -28,6 +28,7 @@ pub mod organs;
 pub mod path_trace;
 pub mod probe;
 pub mod progressive_error;
+pub mod pyramid;
 pub mod reference;
 pub mod reslice;
 pub mod srgb;

@@ -38,6 +38,7 @@ pub mod set_cmd;
 mod set_fuzz;
 pub mod shader_dir;
 pub mod stdout;
+pub mod stream_progress;
 pub mod view;
 pub mod zarr_input;
 

@@ -2,6 +2,7 @@
 //! sizes, the output file's kind) before the GPU is opened, then frames are drawn and the last
 //! one is written. A scene (`--scene`) supplies what flags do not.
 
+use crate::stream_progress::StreamProgress;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -47,6 +48,11 @@ pub struct RenderArgs {
     /// How --distributed ranks composite their images.
     #[arg(long, value_enum, default_value = "radix-k", requires = "distributed")]
     pub composite: crate::distributed::CompositeAlgorithm,
+    /// With a streaming graph (graphs/streaming/ray_guided.ron): stop refining after this many
+    /// milliseconds from the first frame and write what is drawn (bricks still being read are
+    /// drawn from a coarser level) [default: wait for the full image].
+    #[arg(long, value_parser = clap::value_parser!(u64).range(0..=86_400_000))]
+    pub time_budget_ms: Option<u64>,
     /// Time every pass by wall clock, each submitted on its own and waited for: per-pass costs
     /// where GPU timestamps do not cover compute work (lavapipe). The frames get slower.
     #[arg(long)]
@@ -79,6 +85,8 @@ pub struct Prepared {
     lut: Vec<[f32; 4]>,
     /// Inputs bound by name (`--volume NAME=PATH`, `--tf NAME=…`), if any.
     bindings: Option<NamedBindings>,
+    /// The store a streaming graph reads brick by brick (then `volume` is its coarsest level).
+    streamed: Option<Arc<volgraph_zarr::ZarrPyramid>>,
     plan: volgraph_core::Plan,
     output: String,
     /// Notes and warnings for stderr (repairs, choices made, capped counts, invisible data).
@@ -131,8 +139,21 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
         }
         _ => (shown_paths, raw.clone()),
     };
-    let shown = crate::scene::load_shown_volume(&shown_paths, scene.as_ref(), &primary_raw)?;
-    let (volume, generated, mut notes) = (shown.volume, shown.marschner_lobb_tf, shown.notes);
+    // An OME-Zarr store shown by a streaming graph is read brick by brick, never whole: what is
+    // loaded here is its coarsest level (the TF's fit, the camera's frame).
+    let streamed = match shown_paths.as_slice() {
+        [one] if volgraph_zarr::is_zarr(one) && crate::zarr_input::graph_streams(&source) => {
+            Some(crate::zarr_input::stream(one, &primary_raw, args.inputs.memory_mb)?)
+        }
+        _ => None,
+    };
+    let (volume, generated, mut notes) = match &streamed {
+        Some(s) => (s.coarsest.clone(), false, s.notes.clone()),
+        None => {
+            let shown = crate::scene::load_shown_volume(&shown_paths, scene.as_ref(), &primary_raw)?;
+            (shown.volume, shown.marschner_lobb_tf, shown.notes)
+        }
+    };
     crate::scene_args::check_view_frame(args.inputs.view.as_deref(), &volume)?;
     let camera = Resolved::camera_for(camera, camera_is_default, &volume);
     let (tf, tf_notes) = match (&plain_tf, &scene) {
@@ -150,7 +171,13 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     let registry = crate::program::registry();
     let file = display_name(&graph);
     let opacity = scene.as_ref().map(|s| s.opacity_reference).unwrap_or_default();
-    options.scene = scene_values_of(&VolumeDesc::of(&volume));
+    options.scene = scene_values_of(&match &streamed {
+        Some(s) => {
+            let source = volgraph_accel::pyramid::PyramidSource::levels(s.source.as_ref())[0];
+            VolumeDesc::of_box(source.dims, volgraph_accel::pyramid::PyramidSource::spacing(s.source.as_ref()))
+        }
+        None => VolumeDesc::of(&volume),
+    });
     options.scene.extend(crate::inputs::data_scene_values(&volume));
     let plan = compile(&file, &source, &registry, &options).map_err(CliError::Graph)?;
     let environment = environment.as_deref().map(crate::environment_file::load_environment).transpose()?.map(Arc::new);
@@ -241,6 +268,7 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
         volume,
         lut,
         bindings,
+        streamed: streamed.map(|s| s.source),
         plan,
         output,
         notes,
@@ -400,6 +428,7 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
         volume,
         lut,
         bindings,
+        streamed,
         plan,
         output,
         ..
@@ -419,6 +448,9 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
         None => runtime.bind_scene(&plan.inputs, &volume, &lut),
     }
     .map_err(|e| anyhow!(e))?;
+    if let Some(source) = &streamed {
+        runtime.bind_pyramid(volgraph_core::runtime::inputs::PRIMARY_VOLUME, source.clone());
+    }
     if runtime.volume().is_some_and(|(_, f)| f == VolumeFormat::R16Float) && !matches!(volume.data, VoxelData::U8(_)) {
         crate::stdout::eprintln_escaped!(
             "note: this GPU filters neither 16-bit normalized nor 32-bit float textures; the volume is sampled as \
@@ -434,6 +466,7 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
     // tracer's mean is the plain running mean too.
     let has_image = runtime.plan().is_some_and(|p| p.outputs.contains_key("image"));
     let mut noise = (still && has_image).then(volgraph_accel::progressive_error::ErrorTracker::default);
+    let started = std::time::Instant::now();
     for f in 0..frames {
         let at = if still { 0 } else { f };
         stats.push(runtime.render(CameraData::from_orbit(&camera.at(at), viewport)).map_err(|e| anyhow!(e))?);
@@ -444,6 +477,38 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
                 tracker.offer(history.restarts, history.run + 1, image.to_rgba_f64());
             }
         }
+    }
+    // A streaming graph: frames at the last camera until the rays lack nothing (or the budget
+    // is spent); the first frame was drawn from what was resident.
+    let streaming = StreamProgress::of(&runtime.pass_counters());
+    if !streaming.is_empty() {
+        let last_camera = CameraData::from_orbit(&camera.at(if still { 0 } else { frames - 1 }), viewport);
+        let budget = args.time_budget_ms.map(std::time::Duration::from_millis);
+        let runtime_cell = std::cell::RefCell::new(&mut runtime);
+        let (complete, progress) = crate::stream_progress::refine(
+            started,
+            budget,
+            || {
+                let mut runtime = runtime_cell.borrow_mut();
+                stats.push(runtime.render(last_camera).map_err(|e| anyhow!(e))?);
+                Ok(StreamProgress::of(&runtime.pass_counters()))
+            },
+            |timeout| runtime_cell.borrow().wait_for_background(timeout),
+            streaming,
+        )?;
+        if !complete {
+            let pending: f64 = progress.iter().map(|p| p.pending + p.requested).sum();
+            crate::stdout::eprintln_escaped!(
+                "note: --time-budget-ms {}: {pending} bricks were still wanted; they are drawn from a coarser level",
+                args.time_budget_ms.unwrap_or(0)
+            );
+        }
+        crate::stdout::eprintln_escaped!(
+            "  {} frames, {:.0} ms from the first frame to the {} image",
+            stats.len(),
+            started.elapsed().as_secs_f64() * 1e3,
+            if complete { "full" } else { "last" }
+        );
     }
     let warm: Vec<f64> = stats.iter().skip(1).map(|s| s.frame_ms).collect();
     let last = stats.pop();
@@ -493,6 +558,11 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
             };
             crate::stdout::eprintln_escaped!("  per pass (ms){caveat}: {}", list.join(", "));
         }
+        if let Some(source) = &streamed {
+            for line in volgraph_accel::pyramid::PyramidSource::notes(source.as_ref()) {
+                crate::stdout::eprintln_escaped!("{line}");
+            }
+        }
         for line in crate::render::counter_lines(&runtime.pass_counters()) {
             crate::stdout::eprintln_escaped!("  {line}");
         }
@@ -518,9 +588,13 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
 pub fn counter_lines(counters: &[(String, &'static str, f64)]) -> Vec<String> {
     let mut passes: Vec<&str> = counters.iter().map(|(p, _, _)| p.as_str()).collect();
     passes.dedup();
+    let streaming = StreamProgress::of(counters);
     passes
         .into_iter()
         .map(|pass| {
+            if let Some(progress) = streaming.iter().find(|p| p.pass == pass) {
+                return progress.line();
+            }
             let get = |name: &str| counters.iter().find(|(p, n, _)| p == pass && *n == name).map(|c| c.2);
             let mib = |b: f64| b / (1024.0 * 1024.0);
             match (get("uploaded_bytes"), get("pool_slots")) {

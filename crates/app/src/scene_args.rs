@@ -70,6 +70,10 @@ pub struct SceneArgs {
     /// [default: 2048, bounded by the adapter's 3D texture limit].
     #[arg(long = "gpu-memory-mb", value_parser = clap::value_parser!(u64).range(1..=1 << 24))]
     pub gpu_memory_mb: Option<u64>,
+    /// Host memory, in MiB, a volume streamed from an OME-Zarr store may hold in decoded chunks
+    /// (graphs/streaming/ray_guided.ron reads it brick by brick) [default: 512].
+    #[arg(long = "memory-mb", value_parser = clap::value_parser!(u64).range(16..=1 << 24))]
+    pub memory_mb: Option<u64>,
     /// Crop box X0,Y0,Z0,X1,Y1,Z1 in fractions of the volume (0..1 per axis): only what lies
     /// inside is drawn [default: the scene's crop, else none].
     #[arg(long, value_parser = CropBox::parse, allow_hyphen_values = true)]

@@ -16,9 +16,61 @@ use volgraph_zarr::{OmeZarr, Pick};
 /// The most voxel bytes one level read in core may hold (2 GiB).
 pub const IN_CORE_LIMIT_BYTES: u64 = 2 << 30;
 
-/// The volume `path` (an OME-Zarr image) shows, and notes for stderr.
-pub fn read(path: &Path, options: &LoadOptions<'_>) -> anyhow::Result<(Volume, Vec<String>)> {
+/// Decoded chunks a streamed store keeps in memory when `--memory-mb` does not say (512 MiB).
+pub const DEFAULT_CHUNK_CACHE_MB: u64 = 512;
+
+/// An OME-Zarr image bound as a pyramid, read brick by brick by a streaming graph.
+pub struct Streamed {
+    /// The source the streaming pass reads.
+    pub source: std::sync::Arc<volgraph_zarr::ZarrPyramid>,
+    /// Its coarsest level, whole: what the transfer function is fitted to and the camera framed
+    /// on (the same box as the finest).
+    pub coarsest: Volume,
+    /// Notes for stderr.
+    pub notes: Vec<String>,
+}
+
+/// Whether graph `source` draws its `volume` input brick by brick (a `raycast_stream` pass):
+/// then an OME-Zarr store is streamed, never read a level whole.
+pub fn graph_streams(source: &str) -> bool {
+    use volgraph_core::graph::ast::NodeDoc;
+    volgraph_core::graph::parse_graph(source).is_ok_and(|doc| {
+        doc.passes.iter().any(|node| match node {
+            NodeDoc::Pass(p) => p.kind == "raycast_stream",
+            NodeDoc::Repeat(r) => r.body.iter().any(|p| p.kind == "raycast_stream"),
+        })
+    })
+}
+
+/// The store `path` as a streamed pyramid (the volume `--frame N` picks), its decoded chunks
+/// held within `memory_mb` MiB.
+pub fn stream(path: &Path, options: &LoadOptions<'_>, memory_mb: Option<u64>) -> anyhow::Result<Streamed> {
     let image = OmeZarr::open(path).map_err(|e| anyhow!("{e}"))?;
+    let pick = pick_of(path, &image, options)?;
+    let levels = image.levels.len();
+    let (fine, coarse) = (image.levels[0].dims, image.levels[levels - 1].dims);
+    let cache = memory_mb.unwrap_or(DEFAULT_CHUNK_CACHE_MB) << 20;
+    let mut source = volgraph_zarr::ZarrPyramid::new(image, pick, cache).map_err(|e| anyhow!("{e}"))?;
+    if let Some(spacing) = options.raw.spacing {
+        source.set_spacing(spacing);
+    }
+    let coarsest = volgraph_accel::pyramid::PyramidSource::coarsest(&source).map_err(|e| anyhow!(e))?;
+    let notes = vec![format!(
+        "{}: streamed brick by brick from {levels} levels ({}×{}×{} … {}×{}×{}), decoded chunks within {} MiB",
+        path.display(),
+        fine.x,
+        fine.y,
+        fine.z,
+        coarse.x,
+        coarse.y,
+        coarse.z,
+        cache >> 20
+    )];
+    Ok(Streamed { source: std::sync::Arc::new(source), coarsest, notes })
+}
+
+/// The volume `--frame N` (or `#N`) picks of `image`: N = t·C + c.
+fn pick_of(path: &Path, image: &OmeZarr, options: &LoadOptions<'_>) -> anyhow::Result<Pick> {
     if options.series.is_some() || options.raw.dims.is_some() || options.raw.dtype.is_some() {
         return Err(anyhow!(
             "{}: an OME-Zarr image says its own layout; --series, --dims and --dtype are for DICOM and raw files",
@@ -38,7 +90,14 @@ pub fn read(path: &Path, options: &LoadOptions<'_>) -> anyhow::Result<(Volume, V
             if image.channels == 1 { "" } else { "s" }
         ));
     }
-    let pick = Pick { time: n / image.channels, channel: n % image.channels };
+    Ok(Pick { time: n / image.channels, channel: n % image.channels })
+}
+
+/// The volume `path` (an OME-Zarr image) shows, and notes for stderr.
+pub fn read(path: &Path, options: &LoadOptions<'_>) -> anyhow::Result<(Volume, Vec<String>)> {
+    let image = OmeZarr::open(path).map_err(|e| anyhow!("{e}"))?;
+    let pick = pick_of(path, &image, options)?;
+    let volumes = image.times * image.channels;
     let index = image.finest_within(IN_CORE_LIMIT_BYTES).unwrap_or(image.levels.len() - 1);
     let read = image.read_level(index, pick, IN_CORE_LIMIT_BYTES).map_err(|e| anyhow!("{e}"))?;
     let mut notes = read.notes;

@@ -61,6 +61,10 @@ enum BenchCommand {
     /// Several volumes in one march: a CT with a 117-label map (tinted, inside) against the CT
     /// alone, a label's visibility toggled → frame, smooth vs nearest label boundaries at 4× zoom.
     Multi(crate::multi::MultiArgs),
+    /// Volumes beyond memory: a generated 4096³ vessel tree converted to OME-Zarr and streamed
+    /// ray-guided at 800x600 (time to the first image, frames while moving, time to the full
+    /// image, peak memory, bricks read), and a 512³ store streamed against in core.
+    Stream(crate::stream::StreamArgs),
     /// One frame through the library API the Python package wraps (render, wait, read back):
     /// the baseline of the Python layer's cost.
     Api(crate::api::ApiArgs),
@@ -132,6 +136,9 @@ fn run(cli: BenchCli) -> anyhow::Result<()> {
         }
         BenchCli::Bench { which: BenchCommand::Cinematic(args) } => {
             crate::cinematic::run(&args).context("bench cinematic").map(drop)
+        }
+        BenchCli::Bench { which: BenchCommand::Stream(args) } => {
+            crate::stream::run(&args).context("bench stream").map(drop)
         }
         BenchCli::Bench { which: BenchCommand::Cuts(args) } => crate::cuts::run(&args).context("bench cuts").map(drop),
         BenchCli::Bench { which: BenchCommand::Fetch(args) } => {

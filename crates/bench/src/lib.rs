@@ -25,6 +25,7 @@ pub mod load;
 pub mod multi;
 pub mod report_files;
 pub mod slices;
+pub mod stream;
 pub mod sweep;
 pub mod workbench;
 

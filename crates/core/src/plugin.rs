@@ -44,6 +44,13 @@ pub trait PassNode: Send {
     fn counters(&self) -> Vec<(&'static str, f64)> {
         Vec::new()
     }
+
+    /// Waits, up to `timeout`, for work the node has in flight off the GPU — bricks being read
+    /// from disk by a streaming raycaster — so a caller that refines an image (`volgraph render`
+    /// waiting for the full image) draws its next frame when there is more to show, instead of
+    /// drawing frames that take the cores the readers need. Returns at once when nothing is in
+    /// flight (the default).
+    fn wait_for_background(&self, _timeout: std::time::Duration) {}
 }
 
 /// Maps kind names to plugins.

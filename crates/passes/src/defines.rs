@@ -36,6 +36,10 @@ pub const START: &str = "START";
 /// Rays start at per-tile depth bounds (`start_tiles`, `reprojection_tiles`).
 pub const START_TILES: &str = "START_TILES";
 
+// The streaming raycaster (`raycast_stream.rs`).
+/// A run's opacity is corrected for its level's step (`step_multiple`, common/raymarch.wgsl).
+pub const LEVEL_STEPS: &str = "LEVEL_STEPS";
+
 // The path tracer's choices (`path_trace.rs`).
 /// Delta and ratio tracking block by block against per-block majorants (`majorant_grid`).
 pub const BLOCK_MAJORANTS: &str = "BLOCK_MAJORANTS";
@@ -81,7 +85,7 @@ pub const SCATTER: &str = "SCATTER";
 pub const RESLICE_LABELS: &str = "RESLICE_LABELS";
 
 /// Every `#if` name of the built-in passes.
-pub const BUILT_IN: [&str; 32] = [
+pub const BUILT_IN: [&str; 33] = [
     SHADING,
     PREINTEGRATION,
     TRICUBIC,
@@ -96,6 +100,7 @@ pub const BUILT_IN: [&str; 32] = [
     LEAP_CUBES,
     START,
     START_TILES,
+    LEVEL_STEPS,
     LEAP_HITS,
     FIRST_VISIBLE,
     COUNT_LEAPABLE,

@@ -37,6 +37,7 @@ pub mod raycast_bricks;
 pub mod raycast_compute;
 pub mod raycast_params;
 pub mod raycast_segment;
+pub mod raycast_stream;
 pub mod reprojection_splat;
 pub mod reprojection_tiles;
 pub mod reslice;
@@ -44,6 +45,8 @@ pub mod segment_init;
 pub mod shadows;
 pub mod shared;
 pub mod slice_render;
+pub mod stream_cache;
+pub mod stream_loader;
 pub mod termination_test;
 pub mod tf_table;
 
@@ -91,6 +94,7 @@ macro_rules! builtin_kinds {
             .register(majorant_grid::MajorantGrid)
             .register(path_trace::PathTrace)
             .register(raycast_bricks::RaycastBricks)
+            .register(raycast_stream::RaycastStream)
             .register(present::Present)
             .register(reslice::Reslice)
     };

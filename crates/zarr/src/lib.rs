@@ -9,16 +9,20 @@
 //!   the fill value with a warning naming it, an undecodable one with an error line, the rest
 //!   still read ([`read`]);
 //! - [`write_pyramid`]: any volume, streamed a slab at a time, as a pyramid halving to 64³ with
-//!   every chunk's value range beside it, for skipping empty chunks unread ([`write`]).
+//!   every chunk's value range beside it, for skipping empty chunks unread ([`write`]);
+//! - [`ZarrPyramid`]: the image as a `volgraph_accel::pyramid::PyramidSource`, read brick by
+//!   brick through a bounded chunk cache for the ray-guided streaming raycaster ([`pyramid`]).
 
 mod error;
 pub mod ngff;
+pub mod pyramid;
 pub mod read;
 mod sample;
 pub mod store;
 pub mod write;
 
 pub use error::ZarrError;
+pub use pyramid::ZarrPyramid;
 pub use read::{Pick, ReadLevel};
 pub use store::{Level, OmeZarr};
 pub use write::{InMemory, SlabSource, WriteOptions, WriteReport, write_pyramid};

@@ -227,7 +227,7 @@ impl OmeZarr {
 
     /// The value range `volgraph convert` stored for each chunk of `level` (`chunk_ranges/<level>`,
     /// [gz, gy, gx, 2]), if this store has them.
-    fn chunk_ranges(&self, level: &Level) -> Option<Vec<f32>> {
+    pub(crate) fn chunk_ranges(&self, level: &Level) -> Option<Vec<f32>> {
         self.attributes.get("volgraph")?.get("chunk_ranges")?;
         let path = format!("/chunk_ranges/{}", level.path);
         // Only regular files: a FIFO among them would block the read (the ranges are then unused).

@@ -139,6 +139,20 @@ impl VolumeDesc {
         }
     }
 
+    /// The description of a volume of `dims` voxels of `spacing` that is not in memory (a
+    /// pyramid streamed brick by brick), as [`VolumeDesc::of`] gives it for one that is.
+    pub fn of_box(dims: UVec3, spacing: DVec3) -> Self {
+        let extent = dims.as_dvec3() * spacing;
+        let longest = extent.max_element();
+        Self {
+            dims,
+            half_extent: extent / (2.0 * longest),
+            unit_step: (spacing / longest).min_element(),
+            opacity_unit_voxels: 1.0,
+            window: None,
+        }
+    }
+
     /// The description of `dims` bound voxels that are `window` of a larger volume: world sizes
     /// are the whole volume's (its longest side 1), the boxes are in the bound texture's
     /// coordinates.

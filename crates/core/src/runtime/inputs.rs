@@ -12,6 +12,7 @@ use std::collections::BTreeMap;
 use std::hash::{Hash, Hasher};
 use std::sync::Arc;
 
+use volgraph_accel::pyramid::{PyramidSource, TexelKind};
 use volgraph_accel::volume::{Volume, VoxelData};
 
 use super::frame::VolumeDesc;
@@ -36,6 +37,14 @@ struct BoundVoxels {
     content: u64,
 }
 
+/// A volume bound as a resolution pyramid read brick by brick (an OME-Zarr store larger than
+/// memory): only a pass that streams it ([`volgraph_accel::pyramid::PyramidSource`], the
+/// `raycast_stream` raycaster) reads it; no texture or CPU copy of it is ever made.
+struct BoundPyramid {
+    source: Arc<dyn PyramidSource>,
+    content: u64,
+}
+
 /// The volume input whose description the frame carries when several are bound.
 pub const PRIMARY_VOLUME: &str = "volume";
 
@@ -46,6 +55,8 @@ pub struct InputStore {
     inputs: BTreeMap<String, BoundInput>,
     /// Bound volumes on the CPU (their texture, once made, is in `inputs`).
     volumes: BTreeMap<String, BoundVoxels>,
+    /// Volumes bound as pyramids, streamed by the passes that read them.
+    pyramids: BTreeMap<String, BoundPyramid>,
     /// Bound LUTs on the CPU (for passes that classify bricks with them).
     tables: BTreeMap<String, Arc<Vec<[f32; 4]>>>,
     /// Each bound volume input's description and texture format, by name.
@@ -156,9 +167,38 @@ impl InputStore {
             return Err(UploadError::Size { label: volume.name.clone(), given: volume.data.len(), expected });
         }
         self.inputs.remove(name);
+        self.pyramids.remove(name);
         self.volumes.insert(name.to_string(), BoundVoxels { voxels: Arc::new(volume.clone()), content });
         self.descs.insert(name.to_string(), (desc, format));
         Ok(true)
+    }
+
+    /// Binds a pyramid to volume input `name` (a volume read brick by brick by the pass that
+    /// streams it); the frame's volume description is its finest level's. Binding the same
+    /// source again (the same `Arc`) is no new content.
+    pub fn bind_pyramid(&mut self, gpu: &Gpu, name: &str, source: Arc<dyn PyramidSource>) {
+        let level = source.levels()[0];
+        let content = content_hash(|h| {
+            "pyramid".hash(h);
+            (Arc::as_ptr(&source) as *const () as usize).hash(h);
+        });
+        let format = volume_format_for(
+            gpu,
+            &match source.texel_kind() {
+                TexelKind::Unorm8 => VolumeTexels::Unorm8(&[]),
+                TexelKind::Unorm16 => VolumeTexels::Unorm16(&[]),
+                TexelKind::Float => VolumeTexels::Float(&[]),
+            },
+        );
+        self.descs.insert(name.to_string(), (VolumeDesc::of_box(level.dims, source.spacing()), format));
+        self.inputs.remove(name);
+        self.volumes.remove(name);
+        self.pyramids.insert(name.to_string(), BoundPyramid { source, content });
+    }
+
+    /// The pyramid bound to volume input `name`, if one is (not a volume in memory).
+    pub fn pyramid(&self, name: &str) -> Option<&Arc<dyn PyramidSource>> {
+        self.pyramids.get(name).map(|p| &p.source)
     }
 
     /// Makes the 3D texture of volume input `name` if it has none yet (a pass reads it as a
@@ -186,12 +226,16 @@ impl InputStore {
 
     /// The content version of input `name` (texture or CPU volume).
     pub fn version(&self, name: &str) -> Option<u64> {
-        self.inputs.get(name).map(|i| i.content).or_else(|| self.volumes.get(name).map(|v| v.content))
+        self.inputs
+            .get(name)
+            .map(|i| i.content)
+            .or_else(|| self.volumes.get(name).map(|v| v.content))
+            .or_else(|| self.pyramids.get(name).map(|p| p.content))
     }
 
     /// Whether input `name` is bound (as a texture or as a volume on the CPU).
     pub fn is_bound(&self, name: &str) -> bool {
-        self.inputs.contains_key(name) || self.volumes.contains_key(name)
+        self.inputs.contains_key(name) || self.volumes.contains_key(name) || self.pyramids.contains_key(name)
     }
 
     /// Binds an RGBA LUT to input `name`; uploads only when it differs from what is bound.

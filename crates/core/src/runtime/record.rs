@@ -22,6 +22,8 @@ pub(crate) struct BoundPort<'a> {
     pub version: Option<u64>,
     /// A volume input's voxels (ports of kind Volume and VolumeVoxels).
     pub voxels: Option<&'a std::sync::Arc<volgraph_accel::volume::Volume>>,
+    /// A volume input bound as a pyramid (streamed brick by brick), instead of `voxels`.
+    pub pyramid: Option<&'a std::sync::Arc<dyn volgraph_accel::pyramid::PyramidSource>>,
     /// A transfer-function input's LUT on the CPU.
     pub table: Option<&'a std::sync::Arc<Vec<[f32; 4]>>>,
     /// A graph's bypass left out this input's producer: it holds zeros this frame.
@@ -180,6 +182,12 @@ impl<'a> RecordContext<'a> {
         self.port(port)
             .and_then(|p| p.voxels)
             .ok_or_else(|| self.error(format!("port \"{port}\" is not bound to a volume's voxels")))
+    }
+
+    /// The pyramid bound to volume port `port`, when the application bound one (a volume
+    /// larger than memory) instead of voxels; `None` for voxels or nothing.
+    pub fn pyramid(&self, port: &str) -> Option<&'a std::sync::Arc<dyn volgraph_accel::pyramid::PyramidSource>> {
+        self.port(port).and_then(|p| p.pyramid)
     }
 
     /// The transfer-function LUT bound to `port`, on the CPU (classifying bricks).

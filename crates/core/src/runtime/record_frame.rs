@@ -55,7 +55,7 @@ impl StepRecorder<'_> {
             let mut ports = Vec::with_capacity(step.ports.len());
             for bp in &step.ports {
                 let mut buffer = None;
-                let (mut voxels, mut table) = (None, None);
+                let (mut voxels, mut table, mut pyramid) = (None, None, None);
                 let version = match &bp.binding {
                     Binding::Input(name) | Binding::InputVoxels(name) => inputs.version(name),
                     Binding::Resource { id, .. } if matches!(plan.resources[*id].desc, ResourceDesc::Owned(_)) => {
@@ -91,6 +91,7 @@ impl StepRecorder<'_> {
                     }
                     Binding::InputVoxels(name) => {
                         voxels = inputs.voxels(name);
+                        pyramid = inputs.pyramid(name);
                         (None, None)
                     }
                     Binding::History(name) => (history.get(name).map(|e| &e.previous().view), None),
@@ -108,6 +109,7 @@ impl StepRecorder<'_> {
                     extent,
                     version,
                     voxels,
+                    pyramid,
                     table,
                 });
             }

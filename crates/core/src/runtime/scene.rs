@@ -22,6 +22,12 @@ impl Runtime {
         Ok(self.inputs.bind_volume(&self.gpu, name, volume)?)
     }
 
+    /// Binds a volume read brick by brick to graph input `name`: only a pass that streams it
+    /// (`raycast_stream`) can draw it; the frame's volume box is its finest level's.
+    pub fn bind_pyramid(&mut self, name: &str, source: Arc<dyn volgraph_accel::pyramid::PyramidSource>) {
+        self.inputs.bind_pyramid(&self.gpu, name, source);
+    }
+
     /// Binds a transfer-function LUT to graph input `name` (uploads only new content).
     pub fn bind_lut(&mut self, name: &str, lut: &[[f32; 4]]) -> Result<bool, RuntimeError> {
         Ok(self.inputs.bind_lut(&self.gpu, name, lut)?)

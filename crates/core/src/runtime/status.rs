@@ -29,6 +29,16 @@ impl Runtime {
         self.gpu_memory_budget = bytes;
     }
 
+    /// Waits, up to `timeout` in all, for the work the applied plan's passes have in flight off
+    /// the GPU ([`crate::plugin::PassNode::wait_for_background`]: bricks being read).
+    pub fn wait_for_background(&self, timeout: std::time::Duration) {
+        let Some(live) = &self.live else { return };
+        let deadline = std::time::Instant::now() + timeout;
+        for entry in live.nodes.values() {
+            entry.node.wait_for_background(deadline.saturating_duration_since(std::time::Instant::now()));
+        }
+    }
+
     /// Figures the applied plan's passes report about their last frame ([`crate::plugin::PassNode::counters`]),
     /// as `(pass id, name, value)` in step order.
     pub fn pass_counters(&self) -> Vec<(String, &'static str, f64)> {

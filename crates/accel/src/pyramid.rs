@@ -110,13 +110,14 @@ pub trait PyramidSource: Send + Sync {
 }
 
 /// A [`Volume`] held in memory as a pyramid of 2×2×2 means (odd edges averaged with
-/// themselves), halving until every axis is at most `coarsest_edge`: the in-core twin of an
-/// OME-Zarr store written by `volgraph convert`, so the streaming raycaster renders any volume
-/// and its tests need no store.
+/// themselves, integer types rounded to the nearest as `volgraph convert` writes them),
+/// halving until every axis is at most `coarsest_edge`: the in-core twin of an OME-Zarr store
+/// the converter wrote, texel for texel, so the streaming raycaster renders any volume and its
+/// tests need no store.
 pub struct InCorePyramid {
     volume: std::sync::Arc<Volume>,
     levels: Vec<PyramidLevel>,
-    /// Levels 1.. as normalized f32 means (level 0 is the volume).
+    /// Levels 1.. as stored values (level 0 is the volume).
     coarse: Vec<Vec<f32>>,
     kind: TexelKind,
 }
@@ -125,17 +126,20 @@ impl InCorePyramid {
     /// The pyramid of `volume`, halving until every axis is at most `coarsest_edge` (≥ 1).
     pub fn new(volume: std::sync::Arc<Volume>, coarsest_edge: u32) -> Self {
         let edge = coarsest_edge.max(1);
+        let integer = !matches!(volume.data, VoxelData::F32(_));
         let mut levels = vec![PyramidLevel { dims: volume.dims, factor: DVec3::ONE }];
         let mut coarse: Vec<Vec<f32>> = Vec::new();
-        let mut fine: Vec<f32> = volume.normalized_f32();
         let mut dims = volume.dims;
         while dims.max_element() > edge {
             let half = (dims + 1) / 2;
-            fine = halve_f32(&fine, dims);
+            let next = match coarse.last() {
+                Some(fine) => halve(|i| f64::from(fine[i]), dims, integer),
+                None => halve(|i| volume.raw_value(i), dims, integer),
+            };
+            coarse.push(next);
             dims = half;
             let factor = levels.last().map_or(DVec3::ONE, |l| l.factor * 2.0);
             levels.push(PyramidLevel { dims, factor });
-            coarse.push(fine.clone());
         }
         let kind = match volume.data {
             VoxelData::U8(_) => TexelKind::Unorm8,
@@ -145,19 +149,20 @@ impl InCorePyramid {
         Self { volume, levels, coarse, kind }
     }
 
-    /// Normalized voxel `i` of `level`.
-    fn value(&self, level: usize, i: usize) -> f32 {
+    /// Stored value of voxel `i` of `level`.
+    fn raw(&self, level: usize, i: usize) -> f64 {
         match level {
-            0 => self.volume.normalized(i) as f32,
-            l => self.coarse[l - 1][i],
+            0 => self.volume.raw_value(i),
+            l => f64::from(self.coarse[l - 1][i]),
         }
     }
 }
 
-/// The 2×2×2 means of `data` (`dims` voxels, x fastest), odd edges averaged with themselves.
-pub fn halve_f32(data: &[f32], dims: UVec3) -> Vec<f32> {
+/// The 2×2×2 means of `value` over `dims` voxels (x fastest), odd edges averaged with
+/// themselves; rounded to the nearest integer for integer types.
+fn halve(value: impl Fn(usize) -> f64, dims: UVec3, integer: bool) -> Vec<f32> {
     let half = (dims + 1) / 2;
-    let at = |x: u32, y: u32, z: u32| f64::from(data[((z * dims.y + y) * dims.x + x) as usize]);
+    let at = |x: u32, y: u32, z: u32| value(((z * dims.y + y) * dims.x + x) as usize);
     let mut out = Vec::with_capacity(half.element_product() as usize);
     for z in 0..half.z {
         let zs = [2 * z, (2 * z + 1).min(dims.z - 1)];
@@ -173,7 +178,8 @@ pub fn halve_f32(data: &[f32], dims: UVec3) -> Vec<f32> {
                         }
                     }
                 }
-                out.push((sum / 8.0) as f32);
+                let mean = sum / 8.0;
+                out.push(if integer { mean.round() } else { mean } as f32);
             }
         }
     }
@@ -213,14 +219,22 @@ impl PyramidSource for InCorePyramid {
     fn read_box(&self, level: usize, lo: IVec3, dims: UVec3) -> Result<BoxTexels, String> {
         let level_dims = self.levels.get(level).ok_or_else(|| format!("no level {level}"))?.dims;
         let indices = clamped_indices(level_dims, lo, dims);
+        let v = &self.volume;
+        // As the whole volume's texture holds it (`upload_volume_texture`): bytes as stored, the
+        // 16-bit type range as stored, anything else normalized over the value range.
         Ok(match self.kind {
-            TexelKind::Unorm8 => {
-                BoxTexels::Unorm8(indices.map(|i| (self.value(level, i) * 255.0).round() as u8).collect())
+            TexelKind::Unorm8 => BoxTexels::Unorm8(indices.map(|i| self.raw(level, i) as u8).collect()),
+            TexelKind::Unorm16 if v.value_range == (0.0, 65535.0) && matches!(v.data, VoxelData::U16(_)) => {
+                BoxTexels::Unorm16(indices.map(|i| self.raw(level, i) as u16).collect())
             }
-            TexelKind::Unorm16 => {
-                BoxTexels::Unorm16(indices.map(|i| (self.value(level, i) * 65535.0).round() as u16).collect())
+            TexelKind::Unorm16 => BoxTexels::Unorm16(
+                indices
+                    .map(|i| (v.normalize_value(self.raw(level, i)).clamp(0.0, 1.0) * 65535.0).round() as u16)
+                    .collect(),
+            ),
+            TexelKind::Float => {
+                BoxTexels::Float(indices.map(|i| v.normalize_value(self.raw(level, i)) as f32).collect())
             }
-            TexelKind::Float => BoxTexels::Float(indices.map(|i| self.value(level, i)).collect()),
         })
     }
 
@@ -230,10 +244,8 @@ impl PyramidSource for InCorePyramid {
             return Ok((*self.volume).clone());
         }
         let level = self.levels[last];
-        let (lo, hi) = self.volume.value_range;
-        let data = self.coarse[last - 1].iter().map(|v| (lo + f64::from(*v) * (hi - lo)) as f32).collect();
-        let mut v =
-            Volume::new(self.volume.name.clone(), level.dims, self.volume.spacing * level.factor, VoxelData::F32(data));
+        let data = VoxelData::F32(self.coarse[last - 1].clone());
+        let mut v = Volume::new(self.volume.name.clone(), level.dims, self.volume.spacing * level.factor, data);
         v.value_range = self.volume.value_range;
         v.meta = self.volume.meta.clone();
         Ok(v)
@@ -259,7 +271,7 @@ mod tests {
     }
 
     /// Level 0 reads back the volume's own voxels (clamped past the faces); a coarse voxel is
-    /// the mean of the eight below it.
+    /// the mean of the eight below it, rounded as the converter rounds a byte's.
     #[test]
     fn boxes_read_back_the_voxels_and_the_means_clamped_at_faces() {
         let v = ramp(UVec3::new(8, 6, 4));
@@ -276,7 +288,7 @@ mod tests {
             .map(|&(x, y, z)| f64::from(at(x, y, z)))
             .sum::<f64>()
             / 8.0;
-        assert_eq!(coarse.value(0), (mean.round() / 255.0) as f32);
+        assert_eq!(coarse, BoxTexels::Unorm8(vec![mean.round() as u8]));
         assert_eq!(p.coarsest().unwrap().dims, p.levels().last().unwrap().dims);
     }
 }

@@ -248,9 +248,9 @@ impl ZarrPyramid {
     fn texels(&self, values: impl Iterator<Item = f64>) -> BoxTexels {
         let n = self.normalize;
         match n.kind {
-            // Bytes and the type's own 16-bit range are uploaded as they are stored.
-            TexelKind::Unorm8 if (n.lo, n.hi) == (0.0, 255.0) => BoxTexels::Unorm8(values.map(|v| v as u8).collect()),
-            TexelKind::Unorm8 => BoxTexels::Unorm8(values.map(|v| (n.unit(v) * 255.0).round() as u8).collect()),
+            // Bytes and the type's own 16-bit range are uploaded as they are stored, as a whole
+            // volume's texture holds them (`upload_volume_texture`).
+            TexelKind::Unorm8 => BoxTexels::Unorm8(values.map(|v| v as u8).collect()),
             TexelKind::Unorm16 if (n.lo, n.hi) == (0.0, 65535.0) => {
                 BoxTexels::Unorm16(values.map(|v| v as u16).collect())
             }

@@ -191,12 +191,14 @@ impl RaycastStreamNode {
         let budget = self.budget(ctx);
         let most = (budget / slot_bytes).min(u64::from(per_axis).pow(3)).min(u64::from(layout.entries()));
         let coarsest = layout.level_entries(layout.levels.len() - 1).len() as u64;
-        if most < coarsest + 1 {
+        // The coarsest level, pinned, and room for one finer brick where there are any.
+        let needed = (coarsest + 1).min(u64::from(layout.entries()));
+        if most < needed {
             return Err(pass_error(
                 ctx,
                 format!(
                     "the brick pool's budget of {} MiB holds {most} bricks of {slot_bytes} bytes, fewer than the \
-                     coarsest level's {coarsest} and one more; raise --gpu-memory-mb (or pool_mb)",
+                     {needed} it needs (the coarsest level's {coarsest}, and one more where there are finer levels); raise --gpu-memory-mb (or pool_mb)",
                     budget >> 20
                 ),
             ));

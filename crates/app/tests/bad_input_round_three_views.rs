@@ -54,6 +54,7 @@ fn open(graph: &Path, volume: &[PathBuf], raw: LoadOptions<'static>, tf: Option<
         features: Vec::new(),
         shaders: None,
         gpu_memory_mb: None,
+        memory_mb: None,
         cuts: Default::default(),
         light: Default::default(),
         named: Vec::new(),

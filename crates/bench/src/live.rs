@@ -254,6 +254,7 @@ pub fn run(args: &LiveArgs) -> anyhow::Result<()> {
                 features: Vec::new(),
                 shaders: Some(dir.join("shaders")),
                 gpu_memory_mb: None,
+                memory_mb: None,
                 cuts: Default::default(),
                 light: Default::default(),
                 environment: None,

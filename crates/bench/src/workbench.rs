@@ -66,6 +66,7 @@ pub(crate) fn open(
         features: Vec::new(),
         shaders: None,
         gpu_memory_mb: None,
+        memory_mb: None,
         scene: None,
         cuts: Default::default(),
         light: Default::default(),

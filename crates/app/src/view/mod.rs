@@ -175,6 +175,7 @@ pub fn run(args: ViewArgs) -> Result<(), CliError> {
         features: args.inputs.features,
         shaders: args.inputs.shaders,
         gpu_memory_mb: args.inputs.gpu_memory_mb,
+        memory_mb: args.inputs.memory_mb,
         cuts: resolved.cuts,
         light: resolved.light,
         environment: resolved.environment,

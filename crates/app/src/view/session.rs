@@ -137,6 +137,8 @@ pub struct SessionArgs {
     pub shaders: Option<PathBuf>,
     /// GPU memory (MiB) a brick pool may hold; None: 2 GiB, bounded by the adapter's 3D texture limit.
     pub gpu_memory_mb: Option<u64>,
+    /// Host memory for a streamed store's decoded chunks (`--memory-mb`).
+    pub memory_mb: Option<u64>,
     /// A scene supplying the volume and transfer function where `volume` and `tf` are not
     /// given, and its precision and opacity reference.
     pub scene: Option<crate::scene::Scene>,
@@ -159,6 +161,8 @@ pub struct LiveSession {
     /// The graph and transfer function being edited.
     bench: Workbench,
     volume: Volume,
+    /// The store a streaming graph reads brick by brick (then `volume` is its coarsest level).
+    pyramid: Option<std::sync::Arc<dyn volgraph_accel::pyramid::PyramidSource>>,
     /// The LUT of the transfer function on screen.
     lut: Vec<[f32; 4]>,
     shader_dirs: Vec<PathBuf>,
@@ -251,6 +255,9 @@ impl LiveSession {
             None => self.runtime.bind_scene(&plan.inputs, &self.volume, &self.lut),
         }
         .map_err(|e| e.to_string())?;
+        if let Some(p) = &self.pyramid {
+            self.runtime.bind_pyramid(volgraph_core::runtime::inputs::PRIMARY_VOLUME, p.clone());
+        }
         bind_label_list(&mut self.runtime, &plan.inputs, self.labels.as_ref()).map_err(|e| e.to_string())?;
         self.runtime.apply(plan, self.bench.graph.registry()).map_err(|e| e.to_string())
     }

@@ -60,6 +60,7 @@ fn session_args(s: &Scratch, volume: &[&str], tf: Option<PathBuf>) -> SessionArg
         features: Vec::new(),
         shaders: Some(s.shaders.clone()),
         gpu_memory_mb: None,
+        memory_mb: None,
         cuts: Default::default(),
         light: Default::default(),
         named: Vec::new(),
@@ -114,6 +115,7 @@ mod labels;
 mod named_tfs;
 mod reload;
 mod slices;
+mod streaming;
 
 #[test]
 fn a_parameter_edit_is_written_in_place_and_changes_the_image() {

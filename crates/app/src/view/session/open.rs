@@ -30,7 +30,26 @@ impl LiveSession {
     ) -> Result<(Self, Event), crate::cli::CliError> {
         let start = Instant::now();
         let source = inputs::read_graph(&args.graph)?;
-        let shown = crate::scene::load_shown_volume(&args.volume, args.scene.as_ref(), &args.raw)?;
+        // An OME-Zarr store shown by a streaming graph is read brick by brick as frames go on
+        // (the panel counts the bricks pending); the session holds its coarsest level.
+        let streamed = match args.volume.as_slice() {
+            [one] if volgraph_zarr::is_zarr(one) && crate::zarr_input::graph_streams(&source) => {
+                Some((one.clone(), crate::zarr_input::stream(one, &args.raw, args.memory_mb)?))
+            }
+            _ => None,
+        };
+        let shown = match &streamed {
+            Some((path, s)) => crate::scene::ShownVolume {
+                volume: s.coarsest.clone(),
+                source: Ok(crate::scene::VolumeSource::File(path.display().to_string())),
+                options: args.raw.clone(),
+                marschner_lobb_tf: false,
+                notes: s.notes.clone(),
+            },
+            None => crate::scene::load_shown_volume(&args.volume, args.scene.as_ref(), &args.raw)?,
+        };
+        let pyramid: Option<Arc<dyn volgraph_accel::pyramid::PyramidSource>> =
+            streamed.map(|(_, s)| s.source as Arc<dyn volgraph_accel::pyramid::PyramidSource>);
         let (volume, generated, notes) = (shown.volume, shown.marschner_lobb_tf, shown.notes);
         for note in notes {
             crate::stdout::eprintln_escaped!("note: {note}");
@@ -73,6 +92,9 @@ impl LiveSession {
             runtime.set_opacity_reference(scene.opacity_reference);
         }
         let mut graph = GraphEdits::new(&args.graph, source, options.clone(), registry, &volume);
+        if let Some(p) = &pyramid {
+            graph.set_volume_box(&volgraph_core::runtime::VolumeDesc::of_box(p.levels()[0].dims, p.spacing()));
+        }
         let plan = graph.compile(graph.source(), &options).map_err(crate::cli::CliError::Graph)?;
         // A scene's effect the graph does not offer is left out with a note; a --features typo is
         // an error.
@@ -130,6 +152,9 @@ impl LiveSession {
             None => runtime.bind_scene(&plan.inputs, &volume, &lut),
         }
         .map_err(|e| crate::cli::CliError::Other(anyhow!(e)))?;
+        if let Some(p) = &pyramid {
+            runtime.bind_pyramid(volgraph_core::runtime::inputs::PRIMARY_VOLUME, p.clone());
+        }
         // A graph that reads a label table shows its label map's list: the volume input the
         // table colours (`label_tables::map_input_of`), else the frame volume; named by the
         // table given, the map's own file (.seg.nrrd) or the default palette.
@@ -182,6 +207,7 @@ impl LiveSession {
             runtime,
             bench: Workbench { graph, tf, named_tfs, tf_target },
             volume,
+            pyramid,
             lut,
             shader_dirs,
             error: None,

@@ -50,6 +50,12 @@ impl GraphEdits {
         }
     }
 
+    /// The volume is streamed: its box is `desc`'s (the finest level), not the coarsest level's
+    /// the session holds in memory — rays are as long as the finest level's voxels count them.
+    pub fn set_volume_box(&mut self, desc: &volgraph_core::runtime::VolumeDesc) {
+        self.scene_values.extend(volgraph_core::runtime::scene_values_of(desc));
+    }
+
     /// The graph file.
     pub fn path(&self) -> &Path {
         &self.path

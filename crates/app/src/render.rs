@@ -145,6 +145,10 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
         [one] if volgraph_zarr::is_zarr(one) && crate::zarr_input::graph_streams(&source) => {
             Some(crate::zarr_input::stream(one, &primary_raw, args.inputs.memory_mb)?)
         }
+        [one] if crate::zarr_input::graph_streams(&source) => {
+            crate::zarr_input::refuse_large_file(one, &primary_raw)?;
+            None
+        }
         _ => None,
     };
     let (volume, generated, mut notes) = match &streamed {

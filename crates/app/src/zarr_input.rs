@@ -42,6 +42,25 @@ pub fn graph_streams(source: &str) -> bool {
     })
 }
 
+/// For a streaming graph shown a file instead of a store: a raw, NRRD or MetaImage file larger
+/// than [`IN_CORE_LIMIT_BYTES`] is refused before it is read whole, with the way to stream it.
+pub fn refuse_large_file(path: &Path, options: &LoadOptions<'_>) -> anyhow::Result<()> {
+    let Ok(header) = volgraph_accel::load::VolumeHeader::read(path, options) else { return Ok(()) };
+    let bytes = header.dims.as_u64vec3().element_product() * header.dtype.size_bytes() as u64;
+    if bytes <= IN_CORE_LIMIT_BYTES {
+        return Ok(());
+    }
+    Err(anyhow!(
+        "{}: {:.1} GiB of voxels, more than the {} GiB a volume is read into memory with; the streaming graph reads \
+         OME-Zarr stores brick by brick: `volgraph convert {} OUT.ome.zarr` writes one a slab at a time (it never \
+         holds the file), then `--volume OUT.ome.zarr`",
+        path.display(),
+        bytes as f64 / f64::from(1u32 << 30),
+        IN_CORE_LIMIT_BYTES >> 30,
+        path.display()
+    ))
+}
+
 /// The store `path` as a streamed pyramid (the volume `--frame N` picks), its decoded chunks
 /// held within `memory_mb` MiB.
 pub fn stream(path: &Path, options: &LoadOptions<'_>, memory_mb: Option<u64>) -> anyhow::Result<Streamed> {

@@ -155,3 +155,19 @@ fn a_store_streams_brick_by_brick_as_the_volume_in_memory_does() {
     let most = first.as_raw().iter().zip(images[1].as_raw()).map(|(a, b)| a.abs_diff(*b)).max();
     assert!(most.is_some_and(|m| m > 8), "the first frame is drawn coarser than the full image: {most:?}/255");
 }
+
+/// A raw file larger than a volume is read into memory with, shown by the streaming graph, is
+/// refused before a byte of it is read, with the way to stream it (a sparse 3 GiB file: no disk).
+#[test]
+fn a_file_too_large_for_memory_is_refused_with_the_way_to_stream_it() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let d = dir.path();
+    let file = std::fs::File::create(d.join("big_1536x1024x2048_uint8.raw")).expect("create");
+    file.set_len(3 << 30).expect("a sparse file");
+    let graph = concat!(env!("CARGO_MANIFEST_DIR"), "/../../graphs/streaming/ray_guided.ron");
+    let (ok, _, err) = volgraph(&["render", graph, "--volume", "big_1536x1024x2048_uint8.raw", "-o", "x.png"], d);
+    assert!(
+        !ok && err.contains("3.0 GiB of voxels") && err.contains("volgraph convert big_1536x1024x2048_uint8.raw"),
+        "{err}"
+    );
+}

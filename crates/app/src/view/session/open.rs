@@ -36,6 +36,10 @@ impl LiveSession {
             [one] if volgraph_zarr::is_zarr(one) && crate::zarr_input::graph_streams(&source) => {
                 Some((one.clone(), crate::zarr_input::stream(one, &args.raw, args.memory_mb)?))
             }
+            [one] if crate::zarr_input::graph_streams(&source) => {
+                crate::zarr_input::refuse_large_file(one, &args.raw)?;
+                None
+            }
             _ => None,
         };
         let shown = match &streamed {

@@ -99,7 +99,11 @@ fn march_groups(s: Samples, k: u32, count: u32, m: u32, scale: vec3<f32>, shift:
     let inv_atlas = ray_leap_grid.inv_atlas;
     let centre = sample_at(s, k) + s.delta * (0.5 * f32(m - 1u));
     let run = Samples((centre * scale + shift) * inv_atlas, s.delta * f32(m) * scale * inv_atlas, count, s.step * f32(m), s.offset, s.cut);
+    // The pass always compiles LEVEL_STEPS (crates/passes/src/raycast_stream/node.rs); the
+    // guard lets the file validate on its own.
+#if LEVEL_STEPS
     step_multiple = f32(m);
+#endif
     return march_dvr(run, 0u, count, start);
 }
 

@@ -125,11 +125,42 @@ impl Renderer {
         axes: &str,
         name: Option<String>,
     ) -> PyResult<()> {
+        // A path: read as `--volume PATH` reads it (an OME-Zarr store streamed by a streaming
+        // graph, anything else loaded whole).
+        if name.is_none()
+            && spacing.is_none()
+            && !volume.is_instance_of::<pyo3::types::PyList>()
+            && let Ok(path) = volume.extract::<PathBuf>()
+        {
+            return self
+                .with(volume.py(), |r| r.set_volume_path(&path, None))
+                .map_err(|e| raise(e, crate::errors::volume_error));
+        }
         let (v, ring_tf) = crate::volume::volume_of(volume, spacing, axes)?;
         match name.filter(|n| n != volgraph_core::runtime::inputs::PRIMARY_VOLUME) {
             Some(name) => self.with(volume.py(), |r| r.set_named_volume(&name, v)),
             None => self.with(volume.py(), |r| r.set_volume(v, ring_tf)),
         }
+        Ok(())
+    }
+
+    /// Streams the OME-Zarr store `path` brick by brick (a streaming graph such as
+    /// `streaming/ray_guided`): `frame` picks the volume N = t·C + c, `memory_mb` bounds the
+    /// decoded chunks held (default 512). A render waits for the full image, or for
+    /// `time_budget_ms`.
+    #[pyo3(signature = (path, *, frame = None, memory_mb = None))]
+    pub fn stream(&self, py: Python<'_>, path: PathBuf, frame: Option<u64>, memory_mb: Option<u64>) -> PyResult<()> {
+        self.with(py, |r| r.stream(&path, frame, memory_mb)).map_err(|e| raise(e, value_error))
+    }
+
+    /// Milliseconds a render of a streaming graph may refine before it returns what it drew
+    /// (bricks still being read drawn from a coarser level); None: until the image is complete.
+    #[setter(time_budget_ms)]
+    fn set_time_budget_ms(&self, py: Python<'_>, ms: Option<f64>) -> PyResult<()> {
+        if ms.is_some_and(|m| !(m.is_finite() && m >= 0.0)) {
+            return Err(PyValueError::new_err("time_budget_ms: a number of milliseconds ≥ 0, or None"));
+        }
+        self.with(py, |r| r.set_time_budget(ms.map(|m| std::time::Duration::from_secs_f64(m / 1e3))));
         Ok(())
     }
 

@@ -39,6 +39,12 @@ pub struct Renderer {
     size: (u32, u32),
     runtime: Runtime,
     volume: Option<Volume>,
+    /// A store a streaming graph reads brick by brick ([`Self::stream`]); `volume` is then its
+    /// coarsest level.
+    pyramid: Option<Arc<dyn volgraph_accel::pyramid::PyramidSource>>,
+    /// How long a frame of a streaming graph may refine before it is returned (`None`: until
+    /// the rays lack nothing).
+    time_budget: Option<std::time::Duration>,
     /// A generated Marschner–Lobb volume: the default TF is the band showing its rings.
     ring_tf: bool,
     tf: TfChoice,
@@ -88,6 +94,8 @@ impl Renderer {
             size,
             runtime,
             volume: None,
+            pyramid: None,
+            time_budget: None,
             ring_tf: false,
             tf: TfChoice::Fitted,
             lut: None,
@@ -143,10 +151,56 @@ impl Renderer {
     /// `marschner_lobb_tf`: a generated Marschner–Lobb volume, whose default TF is the band that
     /// shows its rings (`scene::ShownVolume::marschner_lobb_tf`).
     pub fn set_volume(&mut self, volume: Volume, marschner_lobb_tf: bool) {
+        self.pyramid = None;
         self.volume = Some(volume);
         self.ring_tf = marschner_lobb_tf;
         self.lut = None;
         self.plan = None;
+    }
+
+    /// The OME-Zarr store `path` (the volume `frame` picks, N = t·C + c), read brick by brick
+    /// by a streaming graph (`streaming/ray_guided`) as `volgraph render` reads it: decoded
+    /// chunks held within `memory_mb` MiB (default 512); a render waits for the full image (or
+    /// [`Self::set_time_budget`]). Another graph is an error saying to load the store in core.
+    pub fn stream(&mut self, path: &Path, frame: Option<u64>, memory_mb: Option<u64>) -> Result<(), ApiError> {
+        if !crate::zarr_input::graph_streams(&self.source) {
+            return Err(ApiError::Input(anyhow!(
+                "{}: graph \"{}\" reads its volume whole; a store is streamed brick by brick by streaming/ray_guided \
+                 (or load it in core: volgraph.load)",
+                path.display(),
+                self.graph.display()
+            )));
+        }
+        if !volgraph_zarr::is_zarr(path) {
+            return Err(ApiError::Input(anyhow!(
+                "{}: not an OME-Zarr store (a folder with zarr.json or .zgroup)",
+                path.display()
+            )));
+        }
+        let options = volgraph_accel::load::LoadOptions { frame, ..Default::default() };
+        let streamed = crate::zarr_input::stream(path, &options, memory_mb)?;
+        self.notes.extend(streamed.notes);
+        self.set_volume(streamed.coarsest, false);
+        self.pyramid = Some(streamed.source);
+        Ok(())
+    }
+
+    /// The volume file, folder or name `path`, as `--volume PATH` reads it: an OME-Zarr store
+    /// is streamed where the graph streams ([`Self::stream`]), anything else is loaded whole.
+    pub fn set_volume_path(&mut self, path: &Path, frame: Option<u64>) -> Result<(), ApiError> {
+        if volgraph_zarr::is_zarr(path) && crate::zarr_input::graph_streams(&self.source) {
+            return self.stream(path, frame, None);
+        }
+        let options = volgraph_accel::load::LoadOptions { frame, ..Default::default() };
+        let shown = crate::scene::load_shown_volume(&[path.to_path_buf()], None, &options)?;
+        self.notes.extend(shown.notes);
+        self.set_volume(shown.volume, shown.marschner_lobb_tf);
+        Ok(())
+    }
+
+    /// How long a render of a streaming graph may go on refining (`None`: until complete).
+    pub fn set_time_budget(&mut self, budget: Option<std::time::Duration>) {
+        self.time_budget = budget;
     }
 
     /// Binds the graph's volume input `name` (`--volume NAME=PATH`: `pet` of `multi/pet_ct`,
@@ -236,7 +290,10 @@ impl Renderer {
         options.precision = self.scene.as_ref().and_then(|s| s.precision);
         options.scalars = self.scalars.clone();
         options.param_overrides = self.overrides.clone();
-        options.scene = scene_values_of(&VolumeDesc::of(volume));
+        options.scene = scene_values_of(&match &self.pyramid {
+            Some(p) => VolumeDesc::of_box(p.levels()[0].dims, p.spacing()),
+            None => VolumeDesc::of(volume),
+        });
         options.scene.extend(crate::inputs::data_scene_values(volume));
         let file = crate::cli::display_name(&self.graph);
         let plan = volgraph_core::compile(&file, &self.source, &self.registry, &options)
@@ -372,6 +429,9 @@ impl Renderer {
             None => self.runtime.bind_scene(&plan.inputs, volume, &lut),
         }
         .map_err(ApiError::gpu)?;
+        if let Some(p) = &self.pyramid {
+            self.runtime.bind_pyramid(volgraph_core::runtime::inputs::PRIMARY_VOLUME, p.clone());
+        }
         Ok(())
     }
 
@@ -401,7 +461,26 @@ impl Renderer {
         );
         let viewport = plan.viewport;
         let orbit = self.orbit(camera)?;
+        let started = std::time::Instant::now();
         self.runtime.render(CameraData::from_orbit(&orbit, viewport)).map_err(ApiError::gpu)?;
+        // A streaming graph: frames at this camera until the rays lack nothing (or the budget).
+        let streaming = crate::stream_progress::StreamProgress::of(&self.runtime.pass_counters());
+        if !streaming.is_empty() {
+            let runtime = std::cell::RefCell::new(&mut self.runtime);
+            let camera = CameraData::from_orbit(&orbit, viewport);
+            crate::stream_progress::refine(
+                started,
+                self.time_budget,
+                || {
+                    let mut runtime = runtime.borrow_mut();
+                    runtime.render(camera).map_err(|e| anyhow!(e))?;
+                    Ok(crate::stream_progress::StreamProgress::of(&runtime.pass_counters()))
+                },
+                |timeout| runtime.borrow().wait_for_background(timeout),
+                streaming,
+            )
+            .map_err(ApiError::gpu)?;
+        }
         if srgb {
             let (width, height, bytes) = self.runtime.read_output_rgba8(&output).map_err(ApiError::gpu)?;
             return Ok(Rendered::Srgb8 { width, height, bytes });

@@ -88,6 +88,18 @@ pub fn stream(path: &Path, options: &LoadOptions<'_>, memory_mb: Option<u64>) ->
     Ok(Streamed { source: std::sync::Arc::new(source), coarsest, notes })
 }
 
+/// The header of store `path`'s finest level at the volume `--frame N` picks, read box by box
+/// (`render --distributed`: each rank reads its kd-tree box, chunk by chunk).
+pub fn store_header(path: &Path, options: &LoadOptions<'_>) -> anyhow::Result<volgraph_accel::load::VolumeHeader> {
+    let image = OmeZarr::open(path).map_err(|e| anyhow!("{e}"))?;
+    let pick = pick_of(path, &image, options)?;
+    let mut header = volgraph_zarr::StoreBoxes::header(image, pick);
+    if let Some(spacing) = options.raw.spacing {
+        header.spacing = spacing;
+    }
+    Ok(header)
+}
+
 /// The volume `--frame N` (or `#N`) picks of `image`: N = t·C + c.
 fn pick_of(path: &Path, image: &OmeZarr, options: &LoadOptions<'_>) -> anyhow::Result<Pick> {
     if options.series.is_some() || options.raw.dims.is_some() || options.raw.dtype.is_some() {

@@ -263,3 +263,22 @@ fn soft_tissue_ct() -> volgraph_accel::volume::Volume {
         volgraph_accel::volume::VoxelData::I16(values),
     )
 }
+
+/// Issue 48 item 6 (its first half): ranks read their kd-tree boxes of an OME-Zarr store chunk
+/// by chunk (`volgraph_zarr::StoreBoxes`), no rank holding the volume, and the composited image
+/// equals the single-process render of the store (read in core) within the bounds above.
+#[test]
+fn ranks_read_their_boxes_of_an_ome_zarr_store() {
+    let Some(volume) = dataset("hydrogen_atom") else { return };
+    let store = scratch("hydrogen.ome.zarr");
+    let _ = std::fs::remove_dir_all(&store);
+    let convert =
+        ["volgraph", "convert", volume.to_str().expect("utf-8"), store.to_str().expect("utf-8"), "--chunk", "16"];
+    volgraph_app::cli::run(Cli::try_parse_from(convert).expect("cli"))
+        .unwrap_or_else(|e| panic!("convert: {}", volgraph_app::cli::error_text(&e)));
+    let tf = volgraph_accel::data_dir::data_dir().join("tf/hydrogen.ron");
+    let (s, t) = (store.to_str().expect("utf-8"), tf.to_str().expect("utf-8"));
+    let args = ["modern/fastest", "--volume", s, "--tf", t, "--size", "96x80", "--camera", "30,20,3.2"];
+    compare("fastest_store", &args, 2, "direct-send");
+    compare("fastest_store", &args, 4, "radix-k");
+}

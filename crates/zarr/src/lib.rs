@@ -13,6 +13,7 @@
 //! - [`ZarrPyramid`]: the image as a `volgraph_accel::pyramid::PyramidSource`, read brick by
 //!   brick through a bounded chunk cache for the ray-guided streaming raycaster ([`pyramid`]).
 
+pub mod boxes;
 mod error;
 pub mod ngff;
 pub mod pyramid;
@@ -21,6 +22,7 @@ mod sample;
 pub mod store;
 pub mod write;
 
+pub use boxes::StoreBoxes;
 pub use error::ZarrError;
 pub use pyramid::ZarrPyramid;
 pub use read::{Pick, ReadLevel};

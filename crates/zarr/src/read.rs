@@ -198,7 +198,7 @@ impl OmeZarr {
 impl OmeZarr {
     /// The metadata `volgraph convert` kept (patient frame, modality, units, window); empty for
     /// another writer's store.
-    fn volgraph_meta(&self) -> volgraph_accel::volume_meta::VolumeMeta {
+    pub(crate) fn volgraph_meta(&self) -> volgraph_accel::volume_meta::VolumeMeta {
         use volgraph_accel::volume_meta::{VolumeMeta, Window, WorldFrame};
         let Some(v) = self.attributes.get("volgraph") else { return VolumeMeta::default() };
         let text = |key: &str| v.get(key).and_then(serde_json::Value::as_str).map(str::to_string);

@@ -57,6 +57,15 @@ pub enum LoadError {
         format: &'static str,
     },
 
+    /// A box of a chunked store (an OME-Zarr image) could not be read.
+    #[error("{}: {problem}", .path.display())]
+    StoreBox {
+        /// The store.
+        path: PathBuf,
+        /// What went wrong, naming the level or chunk.
+        problem: String,
+    },
+
     /// The path is a directory, a FIFO, a socket or a device rather than a file.
     #[error("{}: is {what}, not a volume file; give the path of a .raw, .nrrd, .nhdr, .mhd, .mha, .nii or .nii.gz file, or a folder of DICOM slices", .path.display())]
     NotAFile {

@@ -37,7 +37,7 @@ use glam::{DVec3, UVec3};
 pub use error::{LoadError, Location};
 pub use orientation::AxisOrientation;
 pub use raw::parse_raw_name;
-pub use region::VolumeHeader;
+pub use region::{RawBoxes, VolumeHeader};
 
 use crate::volume::{Volume, VoxelData, VoxelType, finite_range};
 

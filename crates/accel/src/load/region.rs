@@ -33,9 +33,18 @@ pub struct VolumeHeader {
     source: Source,
 }
 
+/// A volume stored in chunks (an OME-Zarr image's finest level) read a box at a time, in its
+/// stored type, x fastest: how sort-last ranks read their boxes of a store.
+pub trait RawBoxes: Send + Sync + std::fmt::Debug {
+    /// The voxels of `bx` (within the volume), as stored.
+    fn read_raw(&self, bx: VoxelBox) -> Result<VoxelData, LoadError>;
+}
+
 /// Where the voxels are.
 #[derive(Clone, Debug)]
 enum Source {
+    /// In a chunked store, read through its reader.
+    Boxes(std::sync::Arc<dyn RawBoxes>),
     /// In one file from `offset`, x fastest.
     File { path: PathBuf, offset: u64 },
     /// In the slices of a DICOM series (read as rescaled f32).
@@ -101,10 +110,12 @@ impl VolumeHeader {
         })
     }
 
-    /// The file the voxels are read from (a DICOM series: the path it was opened by).
+    /// The file the voxels are read from (a DICOM series: the path it was opened by; a store:
+    /// its name).
     pub fn data_path(&self) -> &Path {
         match &self.source {
             Source::File { path, .. } | Source::Dicom { path, .. } => path,
+            Source::Boxes(_) => Path::new(&self.name),
         }
     }
 
@@ -115,7 +126,26 @@ impl VolumeHeader {
     pub fn type_range(&self) -> Option<(f64, f64)> {
         match &self.source {
             Source::Dicom { slices, .. } => slices.eight_bit.then_some((0.0, 255.0)),
-            Source::File { .. } => self.dtype.integer_range(),
+            Source::File { .. } | Source::Boxes(_) => self.dtype.integer_range(),
+        }
+    }
+
+    /// The header of a volume held in a chunked store: `dims` voxels of `dtype` and `spacing`,
+    /// read box by box through `boxes`.
+    pub fn from_boxes(
+        name: &str,
+        (dims, dtype, spacing): (UVec3, VoxelType, DVec3),
+        meta: VolumeMeta,
+        boxes: std::sync::Arc<dyn RawBoxes>,
+    ) -> Self {
+        Self {
+            name: name.to_string(),
+            dims,
+            dtype,
+            order: Endianness::Little,
+            spacing,
+            meta,
+            source: Source::Boxes(boxes),
         }
     }
 
@@ -126,6 +156,10 @@ impl VolumeHeader {
     pub fn read_box(&self, bx: VoxelBox, value_range: (f64, f64)) -> Result<Volume, LoadError> {
         let (data_path, data_offset) = match &self.source {
             Source::File { path, offset } => (path, *offset),
+            Source::Boxes(boxes) => {
+                let data = boxes.read_raw(bx)?;
+                return Ok(self.volume_of(bx.size(), data, value_range));
+            }
             Source::Dicom { slices, .. } => {
                 // Whole slices of the box's z-range, then its rows and columns.
                 let all = slices.read_slices(bx.lo.z..bx.hi.z)?;
@@ -158,7 +192,12 @@ impl VolumeHeader {
                 at += row;
             }
         }
-        let mut data = decode(&bytes, self.dtype, self.order);
+        Ok(self.volume_of(size, decode(&bytes, self.dtype, self.order), value_range))
+    }
+
+    /// A box's voxels as a volume: non-finite floats replaced as the loaders do (NaN and −∞ by
+    /// the range's low end, +∞ by its high end), normalized over `value_range`.
+    fn volume_of(&self, size: UVec3, mut data: VoxelData, value_range: (f64, f64)) -> Volume {
         if let VoxelData::F32(values) = &mut data {
             for v in values.iter_mut() {
                 if v.is_nan() || *v == f32::NEG_INFINITY {
@@ -171,7 +210,7 @@ impl VolumeHeader {
         let mut volume = Volume::new(self.name.clone(), size, self.spacing, data);
         volume.value_range = value_range;
         volume.meta = self.meta.clone();
-        Ok(volume)
+        volume
     }
 
     /// Reads the slabs of whole z slices `z.start..z.end`, `slices` at a time, and gives each to

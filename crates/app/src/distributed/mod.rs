@@ -1,7 +1,8 @@
 //! `volgraph render --distributed`: sort-last rendering over MPI (`docs/scaling.md`).
 //!
 //! Rank 0's command line is the job (it is broadcast, so ranks cannot disagree). Then:
-//! 1. every rank reads the file's header, and the file is surveyed once in total, a z-slab per
+//! 1. every rank reads the file's header (an OME-Zarr store's finest level: its boxes are read
+//!    chunk by chunk, `volgraph_zarr::StoreBoxes`), and the file is surveyed once in total, a z-slab per
 //!    rank ([`survey`]): value range, a preview for the default transfer function, per-brick
 //!    histograms;
 //! 2. every rank builds the same kd-tree over the bricks, balanced by voxels visible under the
@@ -338,7 +339,12 @@ impl Job {
                 &dataset_file
             }
         };
-        let header = VolumeHeader::read(path, &raw).map_err(|e| anyhow!("{e}"))?;
+        // An OME-Zarr store: each rank reads its box of the finest level, chunk by chunk.
+        let header = if volgraph_zarr::is_zarr(path) {
+            crate::zarr_input::store_header(path, &raw)?
+        } else {
+            VolumeHeader::read(path, &raw).map_err(|e| anyhow!("{e}"))?
+        };
         let source = inputs::read_graph(&resolved.graph)?;
         let mut options = compile_options(&resolved.size, &args.inputs.features, &[])?;
         options.features.extend(volgraph_core::cut_effects::features_of(&resolved.cuts));

@@ -91,8 +91,8 @@ fn source(
     Ok((Box::new(volgraph_zarr::InMemory(shown.volume)), "read whole"))
 }
 
-/// Bytes of the files under `dir`.
-fn folder_bytes(dir: &std::path::Path) -> u64 {
+/// Bytes of the files under `dir` (a store's size on disk, before block rounding).
+pub fn folder_bytes(dir: &std::path::Path) -> u64 {
     let mut total = 0;
     let mut stack = vec![dir.to_path_buf()];
     while let Some(d) = stack.pop() {

@@ -86,21 +86,6 @@ fn reset_peak_rss() {
     let _ = std::fs::write("/proc/self/clear_refs", "5");
 }
 
-fn dir_bytes(path: &Path) -> u64 {
-    let mut total = 0;
-    let mut stack = vec![path.to_path_buf()];
-    while let Some(dir) = stack.pop() {
-        for entry in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
-            match entry.file_type() {
-                Ok(t) if t.is_dir() => stack.push(entry.path()),
-                Ok(_) => total += entry.metadata().map_or(0, |m| m.len()),
-                Err(_) => {}
-            }
-        }
-    }
-    total
-}
-
 /// `volgraph convert name out` in a child process: wall seconds and its peak resident memory
 /// (its VmHWM, polled).
 fn convert(name: &str, out: &Path) -> anyhow::Result<(f64, u64)> {
@@ -218,7 +203,7 @@ pub fn run(args: &StreamArgs) -> anyhow::Result<serde_json::Value> {
             (out, Some((seconds, peak)))
         }
     };
-    let on_disk = dir_bytes(&store);
+    let on_disk = volgraph_app::convert_cmd::folder_bytes(&store);
     let gpu = Arc::new(Gpu::new_headless().map_err(|e| anyhow!(e))?);
 
     // The big store, streamed.

@@ -28,7 +28,7 @@ use volgraph_passes::raycast_params::reference_settings;
 
 mod support;
 
-use support::{as_reference, diff_reference, gpu, graph_source, render_once, save_images};
+use support::{as_reference, coverage, diff_reference, gpu, graph_source, render_once, save_images};
 
 const SIZE: u32 = 128;
 const T: f64 = 1.0 - 1.0 / 255.0;
@@ -154,11 +154,6 @@ fn differing_pixels(got: &Image, want: &Image) -> usize {
         .flat_map(|y| (0..got.width).map(move |x| (x, y)))
         .filter(|&(x, y)| got.rgba(x, y) != want.rgba(x, y))
         .count()
-}
-
-fn coverage(image: &Image) -> f64 {
-    let covered = (0..image.height).flat_map(|y| (0..image.width).map(move |x| (x, y)));
-    covered.filter(|&(x, y)| image.rgba(x, y)[3] > 0.0).count() as f64 / (image.width * image.height) as f64
 }
 
 #[test]

@@ -18,7 +18,7 @@ use volgraph_passes::builtin_registry;
 
 mod support;
 
-use support::{as_reference, diff_reference, save_images};
+use support::{as_reference, coverage, diff_reference, save_images};
 
 const SIZE: u32 = 96;
 const GRAPH: &str = "streaming/ray_guided.ron";
@@ -77,15 +77,6 @@ fn render_until_complete(runtime: &mut Runtime, viewport: (u32, u32), camera: &O
 fn render_once(runtime: &mut Runtime, viewport: (u32, u32), camera: &OrbitCamera) -> Image {
     runtime.render(CameraData::from_orbit(camera, viewport)).unwrap_or_else(|e| panic!("{e}"));
     runtime.read_output("image").expect("image")
-}
-
-fn coverage(image: &Image) -> f64 {
-    let n = (image.width * image.height) as f64;
-    (0..image.height)
-        .flat_map(|y| (0..image.width).map(move |x| (x, y)))
-        .filter(|&(x, y)| image.rgba(x, y)[3] > 0.0)
-        .count() as f64
-        / n
 }
 
 fn max_diff(name: &str, got: &Image, want: &Image) -> f64 {

@@ -19,7 +19,7 @@ use volgraph_passes::builtin_registry;
 
 mod support;
 
-use support::{Live, as_reference, diff_reference, save_images};
+use support::{Live, as_reference, coverage, diff_reference, save_images};
 
 const SIZE: u32 = 96;
 
@@ -43,15 +43,6 @@ fn live(
 
 fn camera(azimuth: f64, distance: f64) -> OrbitCamera {
     OrbitCamera { azimuth_deg: azimuth, elevation_deg: 25.0, distance, ..OrbitCamera::default() }
-}
-
-fn coverage(image: &Image) -> f64 {
-    let n = (image.width * image.height) as f64;
-    (0..image.height)
-        .flat_map(|y| (0..image.width).map(move |x| (x, y)))
-        .filter(|&(x, y)| image.rgba(x, y)[3] > 0.0)
-        .count() as f64
-        / n
 }
 
 /// Bricking changes no pixel beyond rounding: 1/255 covers the f16 colour target's rounding of

@@ -224,3 +224,9 @@ impl Live {
         counters.iter().find(|(_, n, _)| *n == name).unwrap_or_else(|| panic!("no counter {name}: {counters:?}")).2
     }
 }
+
+/// The fraction of `image`'s pixels with any opacity: a test's check that the volume is in view.
+pub fn coverage(image: &Image) -> f64 {
+    let covered = (0..image.height).flat_map(|y| (0..image.width).map(move |x| (x, y)));
+    covered.filter(|&(x, y)| image.rgba(x, y)[3] > 0.0).count() as f64 / (image.width * image.height) as f64
+}

@@ -236,3 +236,30 @@ fn a_pool_too_small_draws_coarser_and_counts_the_refused_bricks() {
     assert!(counter(&stream, "resident_bricks") <= counter(&stream, "pool_slots"));
     assert!(coverage(&image) > 0.2, "what found no slot is drawn coarser, not left out");
 }
+
+/// The ray's grid counts level-0 steps however coarse the levels it draws from: a ray through
+/// 2400 voxels at half a voxel a step takes 4800 grid steps, more than `max_steps`' default
+/// 4096, and must still reach the volume's far end (the pass raises the bound to the longest
+/// ray's steps). A 64×64×2400 column seen end-on from just outside its near face, whose only
+/// content is a slab at the far end.
+#[test]
+fn a_ray_longer_than_max_steps_reaches_the_far_end() {
+    let gpu = support::gpu();
+    let registry = builtin_registry();
+    let dims = UVec3::new(64, 64, 2400);
+    let data: Vec<u8> = (0..dims.element_product()).map(|i| if i / (dims.x * dims.y) < 40 { 200 } else { 0 }).collect();
+    let volume = Volume::new("column", dims, DVec3::ONE, VoxelData::U8(data));
+    // Exactly transparent below 50 (the LUT's first texels too), so 2400 voxels of zeros add nothing.
+    let tf = tf_points(
+        (0.0, 255.0),
+        &[(0.0, [0.0; 3], 0.0), (50.0, [0.0; 3], 0.0), (100.0, [1.0; 3], 0.5), (255.0, [1.0; 3], 0.5)],
+    );
+    let lut = tf.to_lut_for(&volume, 256);
+    let options = CompileOptions::new(32, 32).with_param("march", "lod", 0.125);
+    let (mut stream, viewport) = runtime_for(&gpu, &registry, GRAPH, (&volume, &lut), &options, Cuts::NONE);
+    // Azimuth 0: the eye on +z, looking down the column toward z = 0, where the slab is.
+    let end_on = OrbitCamera { azimuth_deg: 0.0, elevation_deg: 0.0, distance: 1.05, ..OrbitCamera::default() };
+    let (image, _) = render_until_complete(&mut stream, viewport, &end_on);
+    let centre = image.rgba(16, 16);
+    assert!(centre[3] > 0.4, "the far slab is seen through 2400 voxels: {centre:?}");
+}

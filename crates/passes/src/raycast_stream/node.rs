@@ -125,6 +125,17 @@ struct RaycastStreamNode {
     counters: Counters,
 }
 
+/// The raycasting uniform, its `max_steps` raised to the level-0 steps of the longest ray: the
+/// grid is counted in level-0 steps however coarse the levels a ray draws from, so a 4096³
+/// volume's rays need 14 000 steps where coarse runs take a few hundred samples — a smaller
+/// bound would cut every ray short of the volume's back.
+fn params_bytes(params: &volgraph_compiler::Params, longest_ray_voxels: f64) -> Vec<u8> {
+    let mut gpu = RaycastParamsGpu::of(params);
+    let needed = (longest_ray_voxels / f64::from(gpu.step_voxels)).ceil() + 2.0;
+    gpu.max_steps = gpu.max_steps.max(needed.min(f64::from(u32::MAX)) as u32);
+    gpu.uniform_bytes()
+}
+
 fn pass_error(ctx: &RecordContext<'_>, message: String) -> PassError {
     PassError { pass: ctx.label.to_string(), message }
 }
@@ -442,6 +453,8 @@ impl PassNode for RaycastStreamNode {
             lod: [lod, 0.0, 0.0, 0.0],
         };
         ctx.write_buffer(&self.uniform, 0, &uniform.uniform_bytes());
+        let longest = ctx.frame.volume.map_or(0.0, |v| v.longest_ray_voxels());
+        ctx.write_buffer(&self.params, 0, &params_bytes(ctx.params, longest));
         ctx.encoder.clear_buffer(&state.feedback, 0, None);
         let extra = [
             ("params", self.params.as_entire_binding()),

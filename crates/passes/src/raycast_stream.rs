@@ -48,7 +48,7 @@ volgraph_compiler::pass_params! {
         brick_cells: u32 = 64, 4..=256, "voxels per brick side at every level (an OME-Zarr store reads best at its chunk size)";
         lod: f32 = 1.0, 0.125..=64.0,
             "level of detail at rest: a sample takes the coarsest level whose voxel is at most this many pixels wide (0.125..1: finer than a pixel)";
-        lod_moving: f32 = 2.0, 0.125..=64.0, "the same while the camera moves (coarser: faster frames)";
+        lod_moving: f32 = 4.0, 0.125..=64.0, "the same while the camera moves (coarser: faster frames)";
         pool_mb: u32 = 0, 0..=1048576,
             "brick pool budget in MiB (0: the runtime's --gpu-memory-mb, else 1 GiB), at most what every brick of every level needs";
         readers: u32 = 0, 0..=64, "threads reading bricks (0: one per core, at least 2)";

@@ -48,6 +48,32 @@ def test_a_store_from_ome_zarr_py_renders_like_its_array(tmp_path):
                           volgraph.render("basic/fragment_raycast", a, spacing=(0.8, 0.8, 1.5), size=(48, 40)))
 
 
+def test_a_store_from_ome_zarr_py_streams_like_its_array(tmp_path):
+    """A third-party store (ome-zarr-py's levels: halving y and x only, dims rounded down, no chunk
+    ranges) streamed brick by brick renders, fully loaded at level 0, as its array does (held in
+    memory as a pyramid): within 1/255, bricks of 8 so the rays cross many."""
+    import zarr
+    from ome_zarr.io import parse_url
+    from ome_zarr.writer import write_image
+
+    a = ramp_volume()
+    path = tmp_path / "from_py.ome.zarr"
+    root = zarr.group(store=parse_url(str(path), mode="w").store)
+    write_image(a, root, axes="zyx", scale={"z": 1.5, "y": 0.8, "x": 0.8})
+    images = []
+    for volume in (path, a):
+        r = volgraph.Renderer("streaming/ray_guided", size=(48, 40))
+        r.set("input.brick_cells", 8)
+        r.set("march.lod", 0.5)
+        if volume is path:
+            r.stream(path)
+        else:
+            r.set_volume(a, spacing=(0.8, 0.8, 1.5))
+        images.append(r.render(camera=(30, 20, 2.4), output="image"))
+        assert images[-1][..., 3].max() > 0.1
+    assert np.abs(images[0] - images[1]).max() <= 1.5 / 255
+
+
 def test_an_ngff_0_4_store_on_zarr_v2_reads(tmp_path):
     import zarr
     from ome_zarr.format import FormatV04

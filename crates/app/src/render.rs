@@ -488,22 +488,12 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
     if !streaming.is_empty() {
         let last_camera = CameraData::from_orbit(&camera.at(if still { 0 } else { frames - 1 }), viewport);
         let budget = args.time_budget_ms.map(std::time::Duration::from_millis);
-        let runtime_cell = std::cell::RefCell::new(&mut runtime);
-        let (complete, progress) = crate::stream_progress::refine(
-            started,
-            budget,
-            || {
-                let mut runtime = runtime_cell.borrow_mut();
-                stats.push(runtime.render(last_camera).map_err(|e| anyhow!(e))?);
-                Ok(StreamProgress::of(&runtime.pass_counters()))
-            },
-            |timeout| runtime_cell.borrow().wait_for_background(timeout),
-            streaming,
-        )?;
+        let (complete, progress) =
+            crate::stream_progress::refine_runtime(&mut runtime, last_camera, started, budget, |s| stats.push(s))?;
         if !complete {
-            let pending: f64 = progress.iter().map(|p| p.pending + p.requested).sum();
+            let missing: f64 = progress.iter().map(|p| p.missing).sum();
             crate::stdout::eprintln_escaped!(
-                "note: --time-budget-ms {}: {pending} bricks were still wanted; they are drawn from a coarser level",
+                "note: --time-budget-ms {}: the last frame lacked {missing} bricks; they are drawn from a coarser level",
                 args.time_budget_ms.unwrap_or(0)
             );
         }

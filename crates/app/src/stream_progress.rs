@@ -130,6 +130,33 @@ pub fn refine(
     }
 }
 
+/// [`refine`] on `runtime` at `camera`: frames until every streaming pass is complete or
+/// `budget` has passed since `started`, waiting for the readers between frames
+/// (`Runtime::wait_for_background`); `on_frame` sees each frame's stats. What `volgraph render`,
+/// the Python API and `bench stream` run after a first frame.
+pub fn refine_runtime(
+    runtime: &mut volgraph_core::runtime::Runtime,
+    camera: volgraph_core::runtime::CameraData,
+    started: Instant,
+    budget: Option<Duration>,
+    mut on_frame: impl FnMut(volgraph_core::runtime::FrameStats),
+) -> Result<(bool, Vec<StreamProgress>), anyhow::Error> {
+    let progress = StreamProgress::of(&runtime.pass_counters());
+    // The two closures take turns with the runtime: one draws, the other waits.
+    let runtime = std::cell::RefCell::new(runtime);
+    refine(
+        started,
+        budget,
+        || {
+            let mut runtime = runtime.borrow_mut();
+            on_frame(runtime.render(camera).map_err(|e| anyhow::anyhow!(e))?);
+            Ok(StreamProgress::of(&runtime.pass_counters()))
+        },
+        |timeout| runtime.borrow().wait_for_background(timeout),
+        progress,
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -161,21 +161,18 @@ fn counter(runtime: &Runtime, name: &str) -> f64 {
     runtime.pass_counters().iter().find(|(_, n, _)| *n == name).map_or(0.0, |c| c.2)
 }
 
-fn complete(runtime: &Runtime) -> bool {
-    counter(runtime, "feedback_read") == 1.0 && counter(runtime, "missing_bricks") == 0.0
-}
-
-/// Frames at `cam` until complete: (frames, ms).
+/// A first frame at `cam`, then frames until complete (`volgraph render`'s refinement): the
+/// frames and ms.
 fn refine(runtime: &mut Runtime, viewport: (u32, u32), cam: &OrbitCamera) -> anyhow::Result<(u32, f64)> {
     let started = Instant::now();
-    for frame in 1..=100_000 {
-        runtime.render(CameraData::from_orbit(cam, viewport)).map_err(|e| anyhow!(e))?;
-        if complete(runtime) {
-            return Ok((frame, started.elapsed().as_secs_f64() * 1e3));
-        }
-        runtime.wait_for_background(Duration::from_secs(10));
+    let camera = CameraData::from_orbit(cam, viewport);
+    runtime.render(camera).map_err(|e| anyhow!(e))?;
+    let mut frames = 1;
+    let (complete, _) = volgraph_app::stream_progress::refine_runtime(runtime, camera, started, None, |_| frames += 1)?;
+    if !complete {
+        return Err(anyhow!("the stream did not complete"));
     }
-    Err(anyhow!("the stream did not complete in 100000 frames"))
+    Ok((frames, started.elapsed().as_secs_f64() * 1e3))
 }
 
 fn max_diff(a: &Image, b: &Image) -> f64 {

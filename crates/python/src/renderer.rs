@@ -157,10 +157,17 @@ impl Renderer {
     /// (bricks still being read drawn from a coarser level); None: until the image is complete.
     #[setter(time_budget_ms)]
     fn set_time_budget_ms(&self, py: Python<'_>, ms: Option<f64>) -> PyResult<()> {
-        if ms.is_some_and(|m| !(m.is_finite() && m >= 0.0)) {
-            return Err(PyValueError::new_err("time_budget_ms: a number of milliseconds ≥ 0, or None"));
-        }
-        self.with(py, |r| r.set_time_budget(ms.map(|m| std::time::Duration::from_secs_f64(m / 1e3))));
+        // At most a day, as `--time-budget-ms`; NaN, negatives and 1e39 are refused, not panics.
+        let budget = match ms {
+            None => None,
+            Some(m) if (0.0..=86_400_000.0).contains(&m) => Some(std::time::Duration::from_secs_f64(m / 1e3)),
+            Some(m) => {
+                return Err(PyValueError::new_err(format!(
+                    "time_budget_ms {m}: milliseconds from 0 to 86400000 (a day), or None"
+                )));
+            }
+        };
+        self.with(py, |r| r.set_time_budget(budget));
         Ok(())
     }
 

@@ -155,3 +155,10 @@ def test_a_store_streams_brick_by_brick_as_the_cli_streams_it(tmp_path):
     assert np.abs(r2.render(camera=(30, 20, 1.8), output="image") - streamed).max() > 8 / 255
     with pytest.raises(ValueError, match="streamed brick by brick by streaming/ray_guided"):
         volgraph.Renderer("modern/fastest", size=(32, 32)).stream(store)
+    for bad in (float("nan"), -1, 1e39):
+        with pytest.raises(ValueError, match="time_budget_ms"):
+            r2.time_budget_ms = bad
+    with pytest.raises(ValueError, match="not an OME-Zarr store"):
+        r2.stream(tmp_path)
+    with pytest.raises(ValueError, match="memory_mb 0"):
+        r2.stream(store, memory_mb=0)

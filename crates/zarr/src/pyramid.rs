@@ -19,6 +19,10 @@ use crate::ngff::AxisKind;
 use crate::read::Pick;
 use crate::store::{Level, OmeZarr};
 
+/// The most bytes of voxels the coarsest level may hold: it is read whole (the first image, the
+/// transfer function's fit), so a store without a small level is refused, not read into memory.
+pub const COARSEST_LIMIT_BYTES: u64 = 256 << 20;
+
 /// Chunk lines noted at most per kind (missing, undecodable); the rest are counted.
 const NOTED_CHUNKS: usize = 8;
 
@@ -76,7 +80,24 @@ impl ZarrPyramid {
     /// level whole (for the value range, the transfer function's fit and a first image).
     pub fn new(image: OmeZarr, pick: Pick, cache_bytes: u64) -> Result<Self, ZarrError> {
         let last = image.levels.len() - 1;
-        let coarsest = image.read_level(last, pick, u64::MAX)?.volume;
+        let level = &image.levels[last];
+        let bytes = crate::read::level_bytes(level);
+        if bytes > COARSEST_LIMIT_BYTES {
+            return Err(ZarrError::Level {
+                path: image.path.clone(),
+                level: level.path.clone(),
+                problem: format!(
+                    "the coarsest level is {}×{}×{} ({} MiB); streaming reads the coarsest level whole, at most {} MiB: \
+                     write the store with levels down to 64³ (`volgraph convert STORE OUT.ome.zarr`)",
+                    level.dims.x,
+                    level.dims.y,
+                    level.dims.z,
+                    bytes >> 20,
+                    COARSEST_LIMIT_BYTES >> 20
+                ),
+            });
+        }
+        let coarsest = image.read_level(last, pick, COARSEST_LIMIT_BYTES)?.volume;
         let mm = image.millimetres_per_unit().unwrap_or(1.0);
         let fine = &image.levels[0];
         let levels: Vec<PyramidLevel> =

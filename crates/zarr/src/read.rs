@@ -288,7 +288,7 @@ fn copy_chunk<T: Copy>(
 }
 
 /// Bytes of one volume of `level`.
-fn level_bytes(level: &Level) -> u64 {
+pub(crate) fn level_bytes(level: &Level) -> u64 {
     let per = match level.voxel_type {
         VoxelType::U8 => 1,
         VoxelType::U16 | VoxelType::I16 => 2,

@@ -74,3 +74,26 @@ fn a_lost_chunk_is_named_once_and_an_undecodable_one_as_an_error() {
     assert_eq!(notes.iter().filter(|n| n.contains("chunk (z, y, x) 1/1/2 is missing")).count(), 1, "{notes:?}");
     assert!(notes.iter().any(|n| n.starts_with("error:") && n.contains("2/1/2")), "{notes:?}");
 }
+
+/// A store whose coarsest level is large (one level of 1024³ bytes, written as metadata with no
+/// chunks) is refused before a voxel is read: streaming holds only the coarsest level whole.
+#[test]
+fn a_store_without_a_small_level_is_refused_before_reading() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("big.ome.zarr");
+    let big = Volume::new("big", UVec3::new(1024, 1024, 1), DVec3::ONE, VoxelData::U8(vec![0; 1 << 20]));
+    let options = WriteOptions { chunk: 64, coarsest: 1024, zstd_level: 1 };
+    write_pyramid(&mut InMemory(big), &path, &options, &mut |_, _| {}).expect("written");
+    // The level's metadata says 1024³: rewrite its shape, as a store of one big level would.
+    let meta_path = path.join("0/zarr.json");
+    let meta = std::fs::read_to_string(&meta_path).expect("metadata");
+    std::fs::write(
+        &meta_path,
+        meta.replacen("[\n    1,\n    1024,\n    1024\n  ]", "[\n    1024,\n    1024,\n    1024\n  ]", 1),
+    )
+    .expect("rewritten");
+    let image = OmeZarr::open(&path).expect("opens");
+    assert_eq!(image.levels[0].dims, UVec3::splat(1024), "the shape was rewritten");
+    let err = ZarrPyramid::new(image, Pick::default(), 1 << 20).err().expect("refused").to_string();
+    assert!(err.contains("1024×1024×1024 (1024 MiB)") && err.contains("at most 256 MiB"), "{err}");
+}

@@ -177,6 +177,9 @@ impl Renderer {
                 path.display()
             )));
         }
+        if let Some(mb) = memory_mb.filter(|mb| !(16..=1 << 24).contains(mb)) {
+            return Err(ApiError::Input(anyhow!("memory_mb {mb}: 16 to 16777216 MiB, as --memory-mb")));
+        }
         let options = volgraph_accel::load::LoadOptions { frame, ..Default::default() };
         let streamed = crate::zarr_input::stream(path, &options, memory_mb)?;
         self.notes.extend(streamed.notes);
@@ -464,22 +467,10 @@ impl Renderer {
         let started = std::time::Instant::now();
         self.runtime.render(CameraData::from_orbit(&orbit, viewport)).map_err(ApiError::gpu)?;
         // A streaming graph: frames at this camera until the rays lack nothing (or the budget).
-        let streaming = crate::stream_progress::StreamProgress::of(&self.runtime.pass_counters());
-        if !streaming.is_empty() {
-            let runtime = std::cell::RefCell::new(&mut self.runtime);
+        if !crate::stream_progress::StreamProgress::of(&self.runtime.pass_counters()).is_empty() {
             let camera = CameraData::from_orbit(&orbit, viewport);
-            crate::stream_progress::refine(
-                started,
-                self.time_budget,
-                || {
-                    let mut runtime = runtime.borrow_mut();
-                    runtime.render(camera).map_err(|e| anyhow!(e))?;
-                    Ok(crate::stream_progress::StreamProgress::of(&runtime.pass_counters()))
-                },
-                |timeout| runtime.borrow().wait_for_background(timeout),
-                streaming,
-            )
-            .map_err(ApiError::gpu)?;
+            crate::stream_progress::refine_runtime(&mut self.runtime, camera, started, self.time_budget, |_| ())
+                .map_err(ApiError::gpu)?;
         }
         if srgb {
             let (width, height, bytes) = self.runtime.read_output_rgba8(&output).map_err(ApiError::gpu)?;

@@ -35,10 +35,25 @@ pub trait Exchange {
     fn rank(&self) -> usize;
     /// The number of processes.
     fn size(&self) -> usize;
-    /// Sends each `(to, bytes)` of `outgoing` and receives one message from each rank of
-    /// `from`, returned in that order. Every process of a round must call it with matching
-    /// sends and receives; sends never wait for the matching receive to start.
-    fn exchange(&mut self, outgoing: Vec<(usize, Vec<u8>)>, from: &[usize]) -> Result<Vec<Vec<u8>>, ExchangeError>;
+    /// Sends each `(to, bytes)` of `outgoing` and receives one message from each `(from,
+    /// buffer)` of `incoming` into its buffer (resized to the message; its capacity reused, so
+    /// a caller that keeps its buffers allocates nothing from frame to frame). Every process of
+    /// a round must call it with matching sends and receives; sends never wait for the matching
+    /// receive to start.
+    fn exchange_into(
+        &mut self,
+        outgoing: &[(usize, &[u8])],
+        incoming: &mut [(usize, Vec<u8>)],
+    ) -> Result<(), ExchangeError>;
+
+    /// [`Exchange::exchange_into`] with new buffers: the messages from each rank of `from`, in
+    /// that order.
+    fn exchange(&mut self, outgoing: Vec<(usize, Vec<u8>)>, from: &[usize]) -> Result<Vec<Vec<u8>>, ExchangeError> {
+        let sends: Vec<(usize, &[u8])> = outgoing.iter().map(|(to, bytes)| (*to, bytes.as_slice())).collect();
+        let mut incoming: Vec<(usize, Vec<u8>)> = from.iter().map(|&r| (r, Vec::new())).collect();
+        self.exchange_into(&sends, &mut incoming)?;
+        Ok(incoming.into_iter().map(|(_, bytes)| bytes).collect())
+    }
 }
 
 /// Every process's `mine`, by rank.
@@ -131,11 +146,18 @@ impl Exchange for LocalGroup {
         self.size
     }
 
-    fn exchange(&mut self, outgoing: Vec<(usize, Vec<u8>)>, from: &[usize]) -> Result<Vec<Vec<u8>>, ExchangeError> {
-        for (to, bytes) in outgoing {
-            self.to[to].send(bytes).map_err(|_| ExchangeError::PeerGone(to))?;
+    fn exchange_into(
+        &mut self,
+        outgoing: &[(usize, &[u8])],
+        incoming: &mut [(usize, Vec<u8>)],
+    ) -> Result<(), ExchangeError> {
+        for &(to, bytes) in outgoing {
+            self.to[to].send(bytes.to_vec()).map_err(|_| ExchangeError::PeerGone(to))?;
         }
-        from.iter().map(|&r| self.from[r].recv().map_err(|_| ExchangeError::PeerGone(r))).collect()
+        for (from, buffer) in incoming {
+            *buffer = self.from[*from].recv().map_err(|_| ExchangeError::PeerGone(*from))?;
+        }
+        Ok(())
     }
 }
 

@@ -1,8 +1,5 @@
 //! Premultiplied RGBA images and pieces of them, and the over operator.
 
-use crate::exchange::{Exchange, ExchangeError};
-use crate::spans;
-
 /// A premultiplied linear RGBA f32 image, row-major, row 0 at the top.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Layer {
@@ -32,7 +29,7 @@ impl Layer {
 }
 
 /// A range of pixel indices `[start, end)` of a row-major image.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PixelRange {
     /// First pixel.
     pub start: usize,
@@ -59,41 +56,9 @@ impl PixelRange {
     }
 }
 
-/// The part of the final image one process holds after compositing.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Piece {
-    /// Which pixels.
-    pub range: PixelRange,
-    /// Their values.
-    pub pixels: Vec<[f32; 4]>,
-}
-
 /// `front` over `back`, premultiplied: `front + (1 − α_front)·back`.
 #[inline]
 pub fn over_front_to_back(front: [f32; 4], back: [f32; 4]) -> [f32; 4] {
     let t = 1.0 - front[3];
     [front[0] + t * back[0], front[1] + t * back[1], front[2] + t * back[2], front[3] + t * back[3]]
-}
-
-/// Collects every process's piece on rank 0, which gets the whole `width × height` image;
-/// the others get `None`. Only non-empty spans travel.
-pub fn gather<E: Exchange + ?Sized>(
-    ex: &mut E,
-    piece: &Piece,
-    width: u32,
-    height: u32,
-) -> Result<Option<Layer>, ExchangeError> {
-    let encoded = spans::encode(&piece.pixels, piece.range.start);
-    if ex.rank() != 0 {
-        ex.exchange(vec![(0, encoded)], &[])?;
-        return Ok(None);
-    }
-    let others: Vec<usize> = (1..ex.size()).collect();
-    let received = ex.exchange(Vec::new(), &others)?;
-    let mut image = Layer::transparent(width, height);
-    image.pixels[piece.range.start..piece.range.end].copy_from_slice(&piece.pixels);
-    for message in &received {
-        spans::decode_into(message, &mut image.pixels, 0, |dst, src| *dst = src)?;
-    }
-    Ok(Some(image))
 }

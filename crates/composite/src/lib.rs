@@ -2,17 +2,19 @@
 //! premultiplied RGBA image, and the images are combined with the *over* operator in the
 //! visibility order of the boxes. Two algorithms, as IceT offers them:
 //!
-//! - [`direct_send`]: every process owns an equal tile of the image and receives from each
+//! - [`Compositor::direct_send`]: every process owns an equal tile of the image and receives from each
 //!   other process that process's pixels in the tile — one round, N − 1 messages per process;
-//! - [`radix_k`] (Peterka et al. 2009): rounds over a factorization N = k₁·k₂·…; in a round,
+//! - [`Compositor::radix_k`] (Peterka et al. 2009): rounds over a factorization N = k₁·k₂·…; in a round,
 //!   groups of kᵢ processes split the part of the image they share into kᵢ pieces and each
 //!   composites one — fewer, larger messages than direct-send at scale (binary swap for k = 2).
 //!
 //! Both send only the non-empty pixel spans of an image ([`spans`]), and both finish with every
-//! process holding one piece of the final image, which [`gather`] collects on rank 0. The
+//! process holding one piece of the final image, which [`Compositor::gather`] collects on rank 0;
+//! a [`Compositor`] keeps every buffer from frame to frame. The
 //! transport is a trait ([`Exchange`]): threads in one process ([`LocalGroup`], for tests) or MPI
 //! (`mpi` feature, [`mpi_exchange`]).
 
+pub mod compositor;
 pub mod direct_send;
 pub mod exchange;
 pub mod image;
@@ -21,10 +23,9 @@ pub mod mpi_exchange;
 pub mod radix_k;
 pub mod spans;
 
-pub use direct_send::direct_send;
+pub use compositor::Compositor;
 pub use exchange::{Exchange, ExchangeError, LocalGroup, agree, all_gather, broadcast_from_root};
-pub use image::{Layer, Piece, PixelRange, gather, over_front_to_back};
-pub use radix_k::radix_k;
+pub use image::{Layer, PixelRange, over_front_to_back};
 
 /// What one process's compositing cost.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

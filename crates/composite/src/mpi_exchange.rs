@@ -1,7 +1,7 @@
 //! [`Exchange`] over MPI (rsmpi over the system's Open MPI): the transport of
 //! `volgraph render --distributed` under `mpirun`.
 
-use mpi::traits::{Communicator, Destination, Source};
+use mpi::traits::{Communicator, Destination, Equivalence, Source};
 
 use crate::exchange::{Exchange, ExchangeError};
 
@@ -41,20 +41,33 @@ impl Exchange for MpiExchange {
         self.world.size() as usize
     }
 
-    fn exchange(&mut self, outgoing: Vec<(usize, Vec<u8>)>, from: &[usize]) -> Result<Vec<Vec<u8>>, ExchangeError> {
+    fn exchange_into(
+        &mut self,
+        outgoing: &[(usize, &[u8])],
+        incoming: &mut [(usize, Vec<u8>)],
+    ) -> Result<(), ExchangeError> {
         let world = &self.world;
-        let received = mpi::request::scope(|scope| {
+        mpi::request::scope(|scope| {
             let requests: Vec<_> = outgoing
                 .iter()
-                .map(|(to, bytes)| world.process_at_rank(*to as i32).immediate_send(scope, &bytes[..]))
+                .map(|&(to, bytes)| world.process_at_rank(to as i32).immediate_send(scope, bytes))
                 .collect();
-            let received: Vec<Vec<u8>> =
-                from.iter().map(|&r| world.process_at_rank(r as i32).receive_vec::<u8>().0).collect();
+            for (from, buffer) in incoming.iter_mut() {
+                // Probe for the length, then receive into the kept buffer: growing it is the
+                // only allocation, and a buffer that shrinks keeps its pages.
+                let (message, status) = world.process_at_rank(*from as i32).matched_probe();
+                let len = status.count(u8::equivalent_datatype()) as usize;
+                if buffer.len() < len {
+                    buffer.resize(len, 0);
+                } else {
+                    buffer.truncate(len);
+                }
+                message.matched_receive_into(&mut buffer[..]);
+            }
             for request in requests {
                 request.wait();
             }
-            received
         });
-        Ok(received)
+        Ok(())
     }
 }

@@ -9,71 +9,74 @@
 //! combines the children of one tree node, which are contiguous in every visibility order, so
 //! compositing each group in its children's order gives the single-process image.
 
+use crate::compositor::{Compositor, Fragment, composite_in_place};
 use crate::exchange::{Exchange, ExchangeError};
-use crate::image::{Layer, Piece, PixelRange, over_front_to_back};
+use crate::image::{Layer, PixelRange};
 use crate::{CompositeStats, spans};
 
-/// Composites `image` over `factors.len()` rounds. `factors[i]` is the group size of round i
-/// (bottom of the kd-tree first; their product is the number of processes, rank digits as in
-/// `kd_split::rank_digits`), and `orders[i]` the front-to-back order of this process's group's
-/// members in round i, as digits (the kd-tree node's children order for the eye). Returns
-/// this process's piece of the final image.
-pub fn radix_k<E: Exchange + ?Sized>(
-    ex: &mut E,
-    image: &Layer,
-    factors: &[usize],
-    orders: &[Vec<usize>],
-) -> Result<(Piece, CompositeStats), ExchangeError> {
-    let rank = ex.rank();
-    // What this process holds of the image: all of it at first, then its piece of each round.
-    let mut range = PixelRange { start: 0, end: image.len() };
-    let mut held: Option<Vec<[f32; 4]>> = None;
-    let mut stats = CompositeStats::default();
-    let mut stride = 1;
-    for (round, &k) in factors.iter().enumerate() {
-        if k == 1 {
-            continue;
-        }
-        let current: &[[f32; 4]] = held.as_deref().unwrap_or(&image.pixels);
-        let local = |p: PixelRange| (p.start - range.start)..(p.end - range.start);
-        let digit = (rank / stride) % k;
-        let base = rank - digit * stride;
-        let member = |c: usize| base + c * stride;
-        let mut outgoing = Vec::with_capacity(k - 1);
-        for c in (0..k).filter(|&c| c != digit) {
-            let piece = range.part(c, k);
-            let message = spans::encode(&current[local(piece)], piece.start);
-            stats.bytes_sent += message.len() as u64;
-            stats.messages += 1;
-            outgoing.push((member(c), message));
-        }
-        let from: Vec<usize> = (0..k).filter(|&c| c != digit).map(member).collect();
-        let received = ex.exchange(outgoing, &from)?;
-        let mine = range.part(digit, k);
-        let mut acc = vec![[0.0f32; 4]; mine.len()];
-        for &c in &orders[round] {
-            if c == digit {
-                for (a, p) in acc.iter_mut().zip(&current[local(mine)]) {
-                    *a = over_front_to_back(*a, *p);
-                }
+impl Compositor {
+    /// Composites `image` over `factors.len()` rounds. `factors[i]` is the group size of round
+    /// i (bottom of the kd-tree first; their product is the number of processes, rank digits as
+    /// in `kd_split::rank_digits`), and `orders[i]` the front-to-back order of this process's
+    /// group's members in round i, as digits (the kd-tree node's children order for the eye).
+    /// Leaves this process's piece of the final image in place, in `image`'s pixels
+    /// [`Compositor::piece`]; each round's piece lies inside the round before's.
+    pub fn radix_k<E: Exchange + ?Sized>(
+        &mut self,
+        ex: &mut E,
+        image: &mut Layer,
+        factors: &[usize],
+        orders: &[Vec<usize>],
+    ) -> Result<CompositeStats, ExchangeError> {
+        let rank = ex.rank();
+        // What this process holds of the image: all of it at first, then its piece of each
+        // round.
+        let mut range = PixelRange { start: 0, end: image.len() };
+        let mut stats = CompositeStats::default();
+        let mut stride = 1;
+        for (round, &k) in factors.iter().enumerate() {
+            if k == 1 {
                 continue;
             }
-            let i = if c < digit { c } else { c - 1 };
-            spans::decode_into(&received[i], &mut acc, mine.start, |a, p| *a = over_front_to_back(*a, p))?;
+            let digit = (rank / stride) % k;
+            let base = rank - digit * stride;
+            let member = |c: usize| base + c * stride;
+            self.outgoing.resize_with(k - 1, Default::default);
+            self.incoming.resize_with(k - 1, Default::default);
+            let others = (0..k).filter(|&c| c != digit);
+            for ((out, inc), c) in self.outgoing.iter_mut().zip(&mut self.incoming).zip(others) {
+                let piece = range.part(c, k);
+                out.0 = member(c);
+                spans::encode_into(&mut out.1, &image.pixels[piece.start..piece.end], piece.start);
+                stats.bytes_sent += out.1.len() as u64;
+                stats.messages += 1;
+                inc.0 = member(c);
+            }
+            let sends: Vec<(usize, &[u8])> = self.outgoing.iter().map(|(r, m)| (*r, m.as_slice())).collect();
+            ex.exchange_into(&sends, &mut self.incoming)?;
+            let mine = range.part(digit, k);
+            let incoming = &self.incoming;
+            let fragments = orders[round].iter().map(|&c| {
+                if c == digit {
+                    Fragment::Own
+                } else {
+                    Fragment::Received(&incoming[if c < digit { c } else { c - 1 }].1)
+                }
+            });
+            composite_in_place(&mut image.pixels[mine.start..mine.end], mine, fragments)?;
+            range = mine;
+            stride *= k;
+            stats.rounds += 1;
         }
-        held = Some(acc);
-        range = mine;
-        stride *= k;
-        stats.rounds += 1;
+        self.piece = range;
+        Ok(stats)
     }
-    let pixels = held.unwrap_or_else(|| image.pixels.clone());
-    Ok((Piece { range, pixels }, stats))
 }
 
 #[cfg(test)]
 mod tests {
-    use super::*;
-    use crate::{LocalGroup, direct_send, gather};
+    use crate::image::over_front_to_back;
+    use crate::{Compositor, Exchange, Layer, LocalGroup};
 
     /// N random layers composited by both algorithms equal the sequential front-to-back over.
     fn check(factors: &[usize], order_of: impl Fn(usize) -> Vec<usize> + Sync) {
@@ -109,13 +112,21 @@ mod tests {
                     .map(|(mut ex, layer)| {
                         let order = &order;
                         s.spawn(move || {
-                            let (piece, _) = if algorithm == "direct" {
-                                direct_send(&mut ex, layer, 0..h, order).expect("direct")
-                            } else {
-                                let orders = round_orders(factors, order, ex.rank());
-                                radix_k(&mut ex, layer, factors, &orders).expect("radix")
-                            };
-                            gather(&mut ex, &piece, w, h).expect("gather")
+                            let mut compositor = Compositor::new();
+                            let mut image = layer.clone();
+                            // Twice: the second frame reuses the first one's buffers.
+                            let mut whole = false;
+                            for _ in 0..2 {
+                                image.clone_from(layer);
+                                if algorithm == "direct" {
+                                    compositor.direct_send(&mut ex, &mut image, 0..h, order).expect("direct");
+                                } else {
+                                    let orders = round_orders(factors, order, ex.rank());
+                                    compositor.radix_k(&mut ex, &mut image, factors, &orders).expect("radix");
+                                }
+                                whole = compositor.gather(&mut ex, &mut image).expect("gather");
+                            }
+                            whole.then_some(image)
                         })
                     })
                     .collect();

@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use anyhow::anyhow;
 use serde::{Deserialize, Serialize};
-use volgraph_composite::{Exchange, Layer, agree, all_gather, direct_send, gather, radix_k};
+use volgraph_composite::{Compositor, Exchange, Layer, agree, all_gather};
 
 use super::CompositeAlgorithm;
 use crate::cli::CliError;
@@ -97,22 +97,28 @@ pub fn run<E: Exchange + ?Sized>(ex: &mut E, args: &CompositeBenchArgs) -> Resul
     let mut times = Vec::new();
     let mut sent = 0;
     let mut round_count = 0;
+    // One compositor for every repeat, as a renderer keeps one from frame to frame: the warm-up
+    // allocates its buffers.
+    // Compositing works in the rank's image, as a renderer's freshly read frame: each repeat
+    // starts from a copy, made before the clock starts.
+    let mut compositor = Compositor::new();
+    let mut image = layer.clone();
     for repeat in 0..=args.repeats {
+        image.clone_from(&layer);
         agree(ex, Ok(())).map_err(fail)?;
         let started = Instant::now();
-        let (piece, stats) = match args.composite {
-            CompositeAlgorithm::DirectSend => direct_send(ex, &layer, 0..args.size, &order),
-            CompositeAlgorithm::RadixK => radix_k(ex, &layer, &rounds, &orders),
+        let stats = match args.composite {
+            CompositeAlgorithm::DirectSend => compositor.direct_send(ex, &mut image, 0..args.size, &order),
+            CompositeAlgorithm::RadixK => compositor.radix_k(ex, &mut image, &rounds, &orders),
         }
         .map_err(fail)?;
-        let image = gather(ex, &piece, args.size, args.size).map_err(fail)?;
+        compositor.gather(ex, &mut image).map_err(fail)?;
         let ms = started.elapsed().as_secs_f64() * 1e3;
         if repeat > 0 {
             times.push(ms);
         }
-        sent = stats.bytes_sent + volgraph_composite::spans::encode(&piece.pixels, piece.range.start).len() as u64;
+        sent = stats.bytes_sent + compositor.gathered_bytes();
         round_count = stats.rounds;
-        drop(image);
     }
     let all = all_gather(ex, sent.to_le_bytes().to_vec()).map_err(fail)?;
     let bytes = all.iter().map(|b| u64::from_le_bytes(b.as_slice().try_into().unwrap_or([0; 8]))).sum();

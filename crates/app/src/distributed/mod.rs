@@ -27,7 +27,7 @@ use anyhow::anyhow;
 use glam::{DVec3, DVec4, UVec3};
 use volgraph_accel::kd_split::{KdTree, VoxelBox, radix_factors};
 use volgraph_accel::load::VolumeHeader;
-use volgraph_composite::{CompositeStats, Exchange, ExchangeError, Layer, agree, direct_send, gather, radix_k};
+use volgraph_composite::{CompositeStats, Compositor, Exchange, ExchangeError, Layer, agree};
 use volgraph_core::runtime::{CameraData, Gpu, Runtime, ShaderLibrary, VolumeDesc, VolumeWindow, scene_values_of};
 use volgraph_core::{TargetFormat, compile};
 
@@ -191,6 +191,7 @@ pub fn run<E: Exchange + ?Sized>(ex: &mut E, args: &RenderArgs) -> Result<RankRe
         job.header.dims,
         &VolumeWindow::new(job.header.dims, job.header.spacing, UVec3::ZERO, UVec3::ZERO, job.header.dims),
     );
+    let mut compositor = Compositor::new();
     let mut last = None;
     for frame in 0..job.frames {
         let orbit = job.camera.at(frame);
@@ -199,7 +200,7 @@ pub fn run<E: Exchange + ?Sized>(ex: &mut E, args: &RenderArgs) -> Result<RankRe
         let rendered = runtime.render(camera).and_then(|_| runtime.read_output("image")).map_err(|e| anyhow!(e));
         let image = step(ex, rendered)?;
         report.render_ms = started.elapsed().as_secs_f64() * 1e3;
-        let layer = Layer {
+        let mut layer = Layer {
             width: image.width,
             height: image.height,
             pixels: image.data.chunks_exact(4).map(|p| [p[0], p[1], p[2], p[3]]).collect(),
@@ -207,20 +208,22 @@ pub fn run<E: Exchange + ?Sized>(ex: &mut E, args: &RenderArgs) -> Result<RankRe
         let eye_voxels = (camera.eye / (2.0 * whole.half_extent) + DVec3::splat(0.5)) * job.header.dims.as_dvec3();
         let rows = screen_rows(&camera, viewport, &whole, job.header.dims, &own);
         let started = Instant::now();
-        let (piece, stats) = match job.algorithm {
-            CompositeAlgorithm::DirectSend => direct_send(ex, &layer, rows, &tree.visibility_order(eye_voxels)),
+        let stats = match job.algorithm {
+            CompositeAlgorithm::DirectSend => {
+                compositor.direct_send(ex, &mut layer, rows, &tree.visibility_order(eye_voxels))
+            }
             CompositeAlgorithm::RadixK => {
                 let rounds: Vec<usize> = tree.factors.iter().rev().copied().collect();
                 let orders: Vec<Vec<usize>> =
                     (0..rounds.len()).map(|round| tree.children_order(rank, round, eye_voxels)).collect();
-                radix_k(ex, &layer, &rounds, &orders)
+                compositor.radix_k(ex, &mut layer, &rounds, &orders)
             }
         }
         .map_err(other)?;
-        let gathered = gather(ex, &piece, viewport.0, viewport.1).map_err(other)?;
+        let whole = compositor.gather(ex, &mut layer).map_err(other)?;
         report.composite_ms = started.elapsed().as_secs_f64() * 1e3;
         report.composite = stats;
-        last = gathered;
+        last = whole.then_some(layer);
     }
     let written = match (&last, rank) {
         (Some(image), 0) => job.write(image, background),

@@ -50,7 +50,8 @@ pub struct BrickWeights {
     pub dims: UVec3,
     /// The brick edge in voxels (the split planes lie on brick faces).
     pub brick: u32,
-    /// One weight per brick, x fastest: the voxels visible under the transfer function.
+    /// One weight per brick, x fastest: what the split balances (`render --distributed`: the
+    /// voxels of the bricks the view needs).
     pub weight: Vec<u64>,
 }
 

@@ -70,6 +70,10 @@ struct FrameRow {
     render_ms: Vec<f64>,
     composite_ms: Vec<f64>,
     voxel_bytes: Vec<u64>,
+    /// The bytes of the bricks the view needs (every rank's line says the same).
+    needed_bytes: u64,
+    /// The most any rank holds, as a share of `needed_bytes` (the issue's goal: ≤ 1.3/N).
+    largest_share: f64,
 }
 
 #[derive(Serialize)]
@@ -186,8 +190,8 @@ pub fn run(args: &DistributedArgs) -> anyhow::Result<()> {
         args.frames
     );
     println!(
-        "{:>5} {:>10} {:>22} {:>22} {:>16}",
-        "ranks", "frame ms", "render ms (per rank)", "composite ms", "MiB voxels/rank"
+        "{:>5} {:>10} {:>22} {:>22} {:>22} {:>16}",
+        "ranks", "frame ms", "render ms (per rank)", "composite ms", "MiB voxels/rank", "most held/needed"
     );
     let out_png = std::env::temp_dir().join(format!("volgraph-bench-distributed-{}.png", std::process::id()));
     let mut frames = Vec::new();
@@ -210,7 +214,7 @@ pub fn run(args: &DistributedArgs) -> anyhow::Result<()> {
             ],
         )?;
         let stderr = String::from_utf8_lossy(&out.stderr);
-        let mut per_rank: Vec<(usize, u64, f64, f64)> = stderr.lines().filter_map(parse_rank_line).collect();
+        let mut per_rank: Vec<(usize, u64, f64, f64, u64)> = stderr.lines().filter_map(parse_rank_line).collect();
         per_rank.sort_by_key(|r| r.0);
         if per_rank.len() != ranks {
             bail!("expected {ranks} rank lines, got:\n{stderr}");
@@ -221,10 +225,12 @@ pub fn run(args: &DistributedArgs) -> anyhow::Result<()> {
             render_ms: per_rank.iter().map(|r| r.2).collect(),
             composite_ms: per_rank.iter().map(|r| r.3).collect(),
             voxel_bytes: per_rank.iter().map(|r| r.1).collect(),
+            needed_bytes: per_rank[0].4,
+            largest_share: per_rank.iter().map(|r| r.1).max().unwrap_or(0) as f64 / per_rank[0].4.max(1) as f64,
         };
         let list = |v: &[f64]| v.iter().map(|x| format!("{x:.1}")).collect::<Vec<_>>().join(" ");
         println!(
-            "{:>5} {:>10.1} {:>22} {:>22} {:>16}",
+            "{:>5} {:>10.1} {:>22} {:>22} {:>22} {:>16}",
             ranks,
             row.frame_ms,
             list(&row.render_ms),
@@ -233,7 +239,8 @@ pub fn run(args: &DistributedArgs) -> anyhow::Result<()> {
                 .iter()
                 .map(|b| format!("{:.1}", *b as f64 / (1 << 20) as f64))
                 .collect::<Vec<_>>()
-                .join(" ")
+                .join(" "),
+            format!("{:.1} % (1.3/N {:.1} %)", 100.0 * row.largest_share, 130.0 / ranks as f64)
         );
         frames.push(row);
     }
@@ -253,15 +260,18 @@ pub fn run(args: &DistributedArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// `rank R of N holds B bytes of voxels, rendered in X ms, composited in Y ms`.
-fn parse_rank_line(line: &str) -> Option<(usize, u64, f64, f64)> {
+/// `rank R of N holds B bytes of voxels (P % of the V bytes the view needs), rendered in X ms,
+/// composited in Y ms`: (R, B, X, Y, V).
+fn parse_rank_line(line: &str) -> Option<(usize, u64, f64, f64, u64)> {
     let rest = line.strip_prefix("rank ")?;
     let (rank, rest) = rest.split_once(" of ")?;
     let (_, rest) = rest.split_once(" holds ")?;
-    let (bytes, rest) = rest.split_once(" bytes of voxels, rendered in ")?;
+    let (bytes, rest) = rest.split_once(" bytes of voxels (")?;
+    let (_, rest) = rest.split_once(" % of the ")?;
+    let (needed, rest) = rest.split_once(" bytes the view needs), rendered in ")?;
     let (render, rest) = rest.split_once(" ms, composited in ")?;
     let composite = rest.strip_suffix(" ms")?;
-    Some((rank.parse().ok()?, bytes.parse().ok()?, render.parse().ok()?, composite.parse().ok()?))
+    Some((rank.parse().ok()?, bytes.parse().ok()?, render.parse().ok()?, composite.parse().ok()?, needed.parse().ok()?))
 }
 
 #[cfg(test)]
@@ -270,9 +280,10 @@ mod tests {
     fn rank_lines_parse() {
         assert_eq!(
             super::parse_rank_line(
-                "rank 2 of 4 holds 591872 bytes of voxels, rendered in 75.85 ms, composited in 0.16 ms"
+                "rank 2 of 4 holds 591872 bytes of voxels (21.3 % of the 2778112 bytes the view needs), rendered in \
+                 75.85 ms, composited in 0.16 ms"
             ),
-            Some((2, 591872, 75.85, 0.16))
+            Some((2, 591872, 75.85, 0.16, 2778112))
         );
     }
 }

@@ -6,8 +6,9 @@
 //!    rank ([`survey`]): value range, a preview for the default transfer function, per-brick
 //!    histograms;
 //! 2. every rank builds the same kd-tree over the bricks, balanced by voxels visible under the
-//!    transfer function (`volgraph_accel::kd_split`), and reads only its box plus an apron of
-//!    [`APRON`] voxels;
+//!    transfer function (`volgraph_accel::kd_split`), and reads only the part of its box the
+//!    view needs (the bounding box of its bricks that can show anything, [`need`]) plus an
+//!    apron of [`APRON`] voxels ([`APRON_TRILINEAR`] without tricubic filtering);
 //! 3. every rank renders its box with the same graph and camera into premultiplied RGBA f32 —
 //!    rays meet the whole volume's box, so samples lie on the single-process step grid, and
 //!    each rank takes only the samples in its own box (`Runtime::set_volume_window`);
@@ -18,6 +19,7 @@
 //! one rank ends every rank with that rank's message and a non-zero exit, never a hang.
 
 pub mod bench;
+pub mod need;
 pub mod survey;
 
 use std::sync::Arc;
@@ -36,9 +38,19 @@ use crate::image_out::{self, ImageKind};
 use crate::inputs;
 use crate::render::RenderArgs;
 
-/// Voxels each rank holds beyond its box on every side: trilinear filtering reaches 1, central
-/// differences for shading 1 more, the tricubic B-spline 2 — 4 covers them all.
+/// Voxels each rank holds beyond its box on every side when a march filters tricubically:
+/// trilinear filtering reaches 1, central differences for shading 1 more, the tricubic B-spline
+/// 2 — 4 covers them all.
 pub const APRON: u32 = 4;
+/// The apron of a graph without tricubic filtering: trilinear 1, central differences 1.
+pub const APRON_TRILINEAR: u32 = 2;
+
+/// The apron `plan`'s marches need ([`APRON`] or [`APRON_TRILINEAR`]): at a fifth of a 100-voxel
+/// box's bytes, the apron is most of what a rank holds beyond what the view needs.
+fn apron_of(plan: &volgraph_core::Plan) -> u32 {
+    let tricubic = plan.steps.iter().any(|s| s.params.declares("tricubic") && s.params.boolean("tricubic"));
+    if tricubic { APRON } else { APRON_TRILINEAR }
+}
 
 /// How ranks composite their images.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize)]
@@ -58,6 +70,8 @@ pub struct RankReport {
     pub ranks: usize,
     /// Bytes of voxels this rank holds (its box and apron).
     pub voxel_bytes: u64,
+    /// Bytes of the bricks the view needs, over all ranks (`need::Needed::bytes`).
+    pub needed_bytes: u64,
     /// The box it owns.
     pub own: Option<VoxelBox>,
     /// The box it holds: its own and the apron.
@@ -71,11 +85,19 @@ pub struct RankReport {
 }
 
 impl RankReport {
-    /// `rank R of N holds B bytes of voxels, rendered in X ms, composited in Y ms`.
+    /// `rank R of N holds B bytes of voxels (P % of the V bytes the view needs), rendered in X
+    /// ms, composited in Y ms`.
     pub fn line(&self) -> String {
         format!(
-            "rank {} of {} holds {} bytes of voxels, rendered in {:.2} ms, composited in {:.2} ms",
-            self.rank, self.ranks, self.voxel_bytes, self.render_ms, self.composite_ms
+            "rank {} of {} holds {} bytes of voxels ({:.1} % of the {} bytes the view needs), rendered in {:.2} ms, \
+             composited in {:.2} ms",
+            self.rank,
+            self.ranks,
+            self.voxel_bytes,
+            100.0 * self.voxel_bytes as f64 / self.needed_bytes.max(1) as f64,
+            self.needed_bytes,
+            self.render_ms,
+            self.composite_ms
         )
     }
 }
@@ -170,15 +192,18 @@ pub fn run<E: Exchange + ?Sized>(ex: &mut E, args: &RenderArgs) -> Result<RankRe
             1.0 - threshold
         );
     }
-    let weights = survey.weights(job.header.dims, &lut);
-    let tree = step(ex, KdTree::balanced(&weights, &factors).map_err(|e| anyhow!("{e}")))?;
-    let own = tree.boxes[rank];
-    let held = own.with_apron(APRON, job.header.dims);
+    // The tree balances the bytes the view needs, and each rank holds and marches only the part
+    // of its box the view needs (`need`).
+    let needed = need::Needed::of(&survey, job.header.dims, &need::shown_bins(&plan, &lut));
+    let tree = step(ex, KdTree::balanced(&needed.weights(), &factors).map_err(|e| anyhow!("{e}")))?;
+    let own = needed.tight(tree.boxes[rank]);
+    let held = own.with_apron(apron_of(&plan), job.header.dims);
     let volume = step(ex, job.header.read_box(held, survey.value_range).map_err(|e| anyhow!("{e}")))?;
     let mut report = RankReport {
         rank,
         ranks,
         voxel_bytes: volume.voxel_count() as u64 * job.header.dtype.size_bytes() as u64,
+        needed_bytes: needed.bytes(job.header.dtype.size_bytes() as u64),
         own: Some(own),
         held: Some(held),
         ..Default::default()

@@ -2,8 +2,8 @@
 //! between the processes, for what every process must agree on before it knows its box — the
 //! value range of float data, the whole volume's histogram (what the default transfer function
 //! and the data's automatic values are fitted to, as one process fits them), a subsampled
-//! preview, and per-brick histograms (what the kd-tree balances:
-//! the voxels visible under the transfer function).
+//! preview, and per-brick histograms (what `need` finds the bricks the view needs in, which the
+//! kd-tree balances).
 
 use glam::UVec3;
 use volgraph_accel::histogram::{FIT_BINS, Histogram, ValueSummary};
@@ -41,22 +41,17 @@ pub struct Survey {
     pub bytes_read: u64,
 }
 
+#[cfg(test)]
 impl Survey {
-    /// The per-brick weights under `lut`: the voxels whose bin (or a neighbour, which linear
-    /// filtering blends in) has non-zero opacity.
-    pub fn weights(&self, dims: UVec3, lut: &[[f32; 4]]) -> BrickWeights {
-        let mut weights = BrickWeights::zeros(dims, self.brick);
-        let visible: Vec<bool> = (0..BINS)
-            .map(|b| {
-                let texel = |i: usize| lut.get(i * lut.len() / BINS).is_some_and(|t| t[3] > 0.0);
-                texel(b) || (b > 0 && texel(b - 1)) || texel(b + 1)
-            })
-            .collect();
-        for (brick, w) in weights.weight.iter_mut().enumerate() {
-            let counts = &self.bins[brick * BINS..(brick + 1) * BINS];
-            *w = counts.iter().zip(&visible).filter(|(_, v)| **v).map(|(c, _)| *c).sum();
-        }
-        weights
+    /// A survey of only per-brick histograms (`bins`, brick-major), for tests of what uses them.
+    pub fn for_tests(brick: u32, bins: Vec<u64>) -> Self {
+        let preview = Volume::new("test", UVec3::ONE, glam::DVec3::ONE, VoxelData::U8(vec![0]));
+        let values = ValueSummary {
+            histogram: Histogram { total: 0, counts: vec![0; FIT_BINS] },
+            value_range: (0.0, 255.0),
+            ct_hu: false,
+        };
+        Self { value_range: (0.0, 255.0), preview, brick, bins, values, bytes_read: 0 }
     }
 }
 

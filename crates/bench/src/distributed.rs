@@ -267,8 +267,11 @@ fn parse_rank_line(line: &str) -> Option<(usize, u64, f64, f64, u64)> {
     let (rank, rest) = rest.split_once(" of ")?;
     let (_, rest) = rest.split_once(" holds ")?;
     let (bytes, rest) = rest.split_once(" bytes of voxels (")?;
-    let (_, rest) = rest.split_once(" % of the ")?;
-    let (needed, rest) = rest.split_once(" bytes the view needs), rendered in ")?;
+    let (share, rest) = rest.split_once("), rendered in ")?;
+    let needed = match share.split_once(" % of the ") {
+        Some((_, needed)) => needed.strip_suffix(" bytes the view needs")?,
+        None => "0",
+    };
     let (render, rest) = rest.split_once(" ms, composited in ")?;
     let composite = rest.strip_suffix(" ms")?;
     Some((rank.parse().ok()?, bytes.parse().ok()?, render.parse().ok()?, composite.parse().ok()?, needed.parse().ok()?))
@@ -284,6 +287,12 @@ mod tests {
                  75.85 ms, composited in 0.16 ms"
             ),
             Some((2, 591872, 75.85, 0.16, 2778112))
+        );
+        assert_eq!(
+            super::parse_rank_line(
+                "rank 0 of 2 holds 27 bytes of voxels (the view needs none), rendered in 5.00 ms, composited in 0.10 ms"
+            ),
+            Some((0, 27, 5.0, 0.1, 0))
         );
     }
 }

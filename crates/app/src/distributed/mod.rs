@@ -87,17 +87,18 @@ pub struct RankReport {
 impl RankReport {
     /// `rank R of N holds B bytes of voxels (P % of the V bytes the view needs), rendered in X
     /// ms, composited in Y ms`.
+    /// When the view needs nothing (a transfer function that shows nothing):
+    /// `… bytes of voxels (the view needs none), …`.
     pub fn line(&self) -> String {
+        let share = match self.needed_bytes {
+            0 => "the view needs none".to_string(),
+            needed => {
+                format!("{:.1} % of the {needed} bytes the view needs", 100.0 * self.voxel_bytes as f64 / needed as f64)
+            }
+        };
         format!(
-            "rank {} of {} holds {} bytes of voxels ({:.1} % of the {} bytes the view needs), rendered in {:.2} ms, \
-             composited in {:.2} ms",
-            self.rank,
-            self.ranks,
-            self.voxel_bytes,
-            100.0 * self.voxel_bytes as f64 / self.needed_bytes.max(1) as f64,
-            self.needed_bytes,
-            self.render_ms,
-            self.composite_ms
+            "rank {} of {} holds {} bytes of voxels ({share}), rendered in {:.2} ms, composited in {:.2} ms",
+            self.rank, self.ranks, self.voxel_bytes, self.render_ms, self.composite_ms
         )
     }
 }

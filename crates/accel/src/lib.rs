@@ -29,6 +29,7 @@ pub mod path_trace;
 pub mod probe;
 pub mod progressive_error;
 pub mod pyramid;
+pub mod pyramid_file;
 pub mod reference;
 pub mod reslice;
 pub mod srgb;

@@ -125,27 +125,17 @@ pub struct InCorePyramid {
 impl InCorePyramid {
     /// The pyramid of `volume`, halving until every axis is at most `coarsest_edge` (≥ 1).
     pub fn new(volume: std::sync::Arc<Volume>, coarsest_edge: u32) -> Self {
-        let edge = coarsest_edge.max(1);
         let integer = !matches!(volume.data, VoxelData::F32(_));
-        let mut levels = vec![PyramidLevel { dims: volume.dims, factor: DVec3::ONE }];
+        let levels = pyramid_levels(volume.dims, coarsest_edge);
         let mut coarse: Vec<Vec<f32>> = Vec::new();
-        let mut dims = volume.dims;
-        while dims.max_element() > edge {
-            let half = (dims + 1) / 2;
+        for fine in &levels[..levels.len() - 1] {
             let next = match coarse.last() {
-                Some(fine) => halve(|i| f64::from(fine[i]), dims, integer),
-                None => halve(|i| volume.raw_value(i), dims, integer),
+                Some(values) => halve(|i| f64::from(values[i]), fine.dims, integer),
+                None => halve(|i| volume.raw_value(i), fine.dims, integer),
             };
             coarse.push(next);
-            dims = half;
-            let factor = levels.last().map_or(DVec3::ONE, |l| l.factor * 2.0);
-            levels.push(PyramidLevel { dims, factor });
         }
-        let kind = match volume.data {
-            VoxelData::U8(_) => TexelKind::Unorm8,
-            VoxelData::U16(_) | VoxelData::I16(_) => TexelKind::Unorm16,
-            VoxelData::F32(_) => TexelKind::Float,
-        };
+        let kind = texel_kind_of(&volume);
         Self { volume, levels, coarse, kind }
     }
 
@@ -156,6 +146,71 @@ impl InCorePyramid {
             l => f64::from(self.coarse[l - 1][i]),
         }
     }
+}
+
+/// The texel kind of `volume`'s type (one for every level of its pyramid).
+pub fn texel_kind_of(volume: &Volume) -> TexelKind {
+    match volume.data {
+        VoxelData::U8(_) => TexelKind::Unorm8,
+        VoxelData::U16(_) | VoxelData::I16(_) => TexelKind::Unorm16,
+        VoxelData::F32(_) => TexelKind::Float,
+    }
+}
+
+/// Stored values of a pyramid of `volume` (its type, value range) as the whole volume's texture
+/// holds them (`upload_volume_texture`): bytes as stored, the 16-bit type range as stored,
+/// anything else normalized over the value range. `volume` may hold no voxels: only its type
+/// and range are read.
+pub fn texels_of(volume: &Volume, kind: TexelKind, values: impl Iterator<Item = f64>) -> BoxTexels {
+    match kind {
+        TexelKind::Unorm8 => BoxTexels::Unorm8(values.map(|v| v as u8).collect()),
+        TexelKind::Unorm16 if volume.value_range == (0.0, 65535.0) && matches!(volume.data, VoxelData::U16(_)) => {
+            BoxTexels::Unorm16(values.map(|v| v as u16).collect())
+        }
+        TexelKind::Unorm16 => BoxTexels::Unorm16(
+            values.map(|v| (volume.normalize_value(v).clamp(0.0, 1.0) * 65535.0).round() as u16).collect(),
+        ),
+        TexelKind::Float => BoxTexels::Float(values.map(|v| volume.normalize_value(v) as f32).collect()),
+    }
+}
+
+/// The dims of each level of a pyramid of `dims` halving until every axis is at most `edge`,
+/// finest first, with their factors.
+pub fn pyramid_levels(dims: UVec3, edge: u32) -> Vec<PyramidLevel> {
+    let edge = edge.max(1);
+    let mut levels = vec![PyramidLevel { dims, factor: DVec3::ONE }];
+    let mut at = dims;
+    while at.max_element() > edge {
+        at = (at + 1) / 2;
+        let factor = levels.last().map_or(DVec3::ONE, |l| l.factor * 2.0);
+        levels.push(PyramidLevel { dims: at, factor });
+    }
+    levels
+}
+
+/// The 2×2×2 mean of voxel `(x, y)` of the half-resolution slice made from slices `a` and `b`
+/// of a level of `dims` (x fastest; `b` is `a` again at an odd last slice), summed in the order
+/// [`halve`] sums (so both give the same bits), rounded for integer types.
+pub fn halve_pair(a: &[f32], b: &[f32], dims: UVec3, integer: bool) -> Vec<f32> {
+    let half = (dims + 1) / 2;
+    let mut out = Vec::with_capacity((half.x * half.y) as usize);
+    for y in 0..half.y {
+        let ys = [2 * y, (2 * y + 1).min(dims.y - 1)];
+        for x in 0..half.x {
+            let xs = [2 * x, (2 * x + 1).min(dims.x - 1)];
+            let mut sum = 0.0f64;
+            for slice in [a, b] {
+                for yy in ys {
+                    for xx in xs {
+                        sum += f64::from(slice[(yy * dims.x + xx) as usize]);
+                    }
+                }
+            }
+            let mean = sum / 8.0;
+            out.push(if integer { mean.round() } else { mean } as f32);
+        }
+    }
+    out
 }
 
 /// The 2×2×2 means of `value` over `dims` voxels (x fastest), odd edges averaged with
@@ -219,23 +274,7 @@ impl PyramidSource for InCorePyramid {
     fn read_box(&self, level: usize, lo: IVec3, dims: UVec3) -> Result<BoxTexels, String> {
         let level_dims = self.levels.get(level).ok_or_else(|| format!("no level {level}"))?.dims;
         let indices = clamped_indices(level_dims, lo, dims);
-        let v = &self.volume;
-        // As the whole volume's texture holds it (`upload_volume_texture`): bytes as stored, the
-        // 16-bit type range as stored, anything else normalized over the value range.
-        Ok(match self.kind {
-            TexelKind::Unorm8 => BoxTexels::Unorm8(indices.map(|i| self.raw(level, i) as u8).collect()),
-            TexelKind::Unorm16 if v.value_range == (0.0, 65535.0) && matches!(v.data, VoxelData::U16(_)) => {
-                BoxTexels::Unorm16(indices.map(|i| self.raw(level, i) as u16).collect())
-            }
-            TexelKind::Unorm16 => BoxTexels::Unorm16(
-                indices
-                    .map(|i| (v.normalize_value(self.raw(level, i)).clamp(0.0, 1.0) * 65535.0).round() as u16)
-                    .collect(),
-            ),
-            TexelKind::Float => {
-                BoxTexels::Float(indices.map(|i| v.normalize_value(self.raw(level, i)) as f32).collect())
-            }
-        })
+        Ok(texels_of(&self.volume, self.kind, indices.map(|i| self.raw(level, i))))
     }
 
     fn coarsest(&self) -> Result<Volume, String> {

@@ -85,8 +85,8 @@ pub struct Prepared {
     lut: Vec<[f32; 4]>,
     /// Inputs bound by name (`--volume NAME=PATH`, `--tf NAME=…`), if any.
     bindings: Option<NamedBindings>,
-    /// The store a streaming graph reads brick by brick (then `volume` is its coarsest level).
-    streamed: Option<Arc<volgraph_zarr::ZarrPyramid>>,
+    /// The store or large file a streaming graph reads brick by brick (then `volume` is its coarsest level).
+    streamed: Option<Arc<dyn volgraph_accel::pyramid::PyramidSource>>,
     plan: volgraph_core::Plan,
     output: String,
     /// Notes and warnings for stderr (repairs, choices made, capped counts, invisible data).
@@ -139,13 +139,17 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
         }
         _ => (shown_paths, raw.clone()),
     };
-    // An OME-Zarr store shown by a streaming graph is read brick by brick, never whole: what is
-    // loaded here is its coarsest level (the TF's fit, the camera's frame).
+    // An OME-Zarr store, or a file over the memory budget, shown by a streaming graph is read
+    // brick by brick, never whole: what is loaded here is its coarsest level (the TF's fit, the
+    // camera's frame). Another graph refuses a file too large to read whole.
     let streamed = match shown_paths.as_slice() {
         [one] if volgraph_zarr::is_zarr(one) && crate::zarr_input::graph_streams(&source) => {
             Some(crate::zarr_input::stream(one, &primary_raw, args.inputs.memory_mb)?)
         }
         [one] if crate::zarr_input::graph_streams(&source) => {
+            crate::zarr_input::stream_file(one, &primary_raw, args.inputs.memory_mb)?
+        }
+        [one] => {
             crate::zarr_input::refuse_large_file(one, &primary_raw)?;
             None
         }

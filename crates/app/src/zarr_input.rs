@@ -19,10 +19,11 @@ pub const IN_CORE_LIMIT_BYTES: u64 = 2 << 30;
 /// Decoded chunks a streamed store keeps in memory when `--memory-mb` does not say (512 MiB).
 pub const DEFAULT_CHUNK_CACHE_MB: u64 = 512;
 
-/// An OME-Zarr image bound as a pyramid, read brick by brick by a streaming graph.
+/// A volume bound as a pyramid, read brick by brick by a streaming graph: an OME-Zarr image,
+/// or a volume file larger than the memory budget ([`stream_file`]).
 pub struct Streamed {
     /// The source the streaming pass reads.
-    pub source: std::sync::Arc<volgraph_zarr::ZarrPyramid>,
+    pub source: std::sync::Arc<dyn volgraph_accel::pyramid::PyramidSource>,
     /// Its coarsest level, whole: what the transfer function is fitted to and the camera framed
     /// on (the same box as the finest).
     pub coarsest: Volume,
@@ -42,8 +43,60 @@ pub fn graph_streams(source: &str) -> bool {
     })
 }
 
-/// For a streaming graph shown a file instead of a store: a raw, NRRD or MetaImage file larger
-/// than [`IN_CORE_LIMIT_BYTES`] is refused before it is read whole, with the way to stream it.
+/// The coarsest level's largest edge of a pyramid built from a file (what `volgraph convert`
+/// writes).
+const FILE_PYRAMID_EDGE: u32 = 64;
+
+/// For a streaming graph shown a raw, NRRD or MetaImage file (or a DICOM series): one whose
+/// voxels exceed the memory budget (`memory_mb`, default [`DEFAULT_CHUNK_CACHE_MB`]) is streamed
+/// from the file brick by brick (`volgraph_accel::pyramid_file::FilePyramid`: one pass builds
+/// the coarse levels, a quarter of the budget holds them), never read whole; `None` for a
+/// smaller one (read in core) or a format read only whole (NIfTI, compressed).
+pub fn stream_file(path: &Path, options: &LoadOptions<'_>, memory_mb: Option<u64>) -> anyhow::Result<Option<Streamed>> {
+    let Ok(mut header) = volgraph_accel::load::VolumeHeader::read(path, options) else { return Ok(None) };
+    let budget = memory_mb.unwrap_or(DEFAULT_CHUNK_CACHE_MB) << 20;
+    let bytes = header.dims.as_u64vec3().element_product() * header.dtype.size_bytes() as u64;
+    if bytes <= budget {
+        return Ok(None);
+    }
+    if let Some(spacing) = options.raw.spacing {
+        header.spacing = spacing;
+    }
+    // The pass takes a while on a big file (about 6 s a GiB here): say so before it starts.
+    crate::stdout::eprintln_escaped!(
+        "note: {}: more than --memory-mb {}: reading it once to build its coarse levels, then brick by brick",
+        path.display(),
+        budget >> 20
+    );
+    let started = std::time::Instant::now();
+    let source = volgraph_accel::pyramid_file::FilePyramid::open(header, FILE_PYRAMID_EDGE, budget / 4)
+        .map_err(|e| anyhow!("{e}"))?;
+    let coarsest = volgraph_accel::pyramid::PyramidSource::coarsest(&source).map_err(|e| anyhow!(e))?;
+    let levels = volgraph_accel::pyramid::PyramidSource::levels(&source);
+    let notes = vec![format!(
+        "{}: {} of voxels, more than --memory-mb {}: streamed brick by brick from the file ({} levels down to \
+         {}×{}×{}); building the coarse levels read it once in {:.1} s (`volgraph convert {} OUT.ome.zarr` writes a \
+         store that opens at once)",
+        path.display(),
+        if bytes >= 1 << 30 {
+            format!("{:.1} GiB", bytes as f64 / f64::from(1u32 << 30))
+        } else {
+            format!("{} MiB", bytes >> 20)
+        },
+        budget >> 20,
+        levels.len(),
+        coarsest.dims.x,
+        coarsest.dims.y,
+        coarsest.dims.z,
+        started.elapsed().as_secs_f64(),
+        path.display()
+    )];
+    Ok(Some(Streamed { source: std::sync::Arc::new(source), coarsest, notes }))
+}
+
+/// For a graph that holds its volume whole, shown a raw, NRRD or MetaImage file larger than
+/// [`IN_CORE_LIMIT_BYTES`]: refused before it is read, naming the streaming graph that reads it
+/// brick by brick.
 pub fn refuse_large_file(path: &Path, options: &LoadOptions<'_>) -> anyhow::Result<()> {
     let Ok(header) = volgraph_accel::load::VolumeHeader::read(path, options) else { return Ok(()) };
     let bytes = header.dims.as_u64vec3().element_product() * header.dtype.size_bytes() as u64;
@@ -51,9 +104,8 @@ pub fn refuse_large_file(path: &Path, options: &LoadOptions<'_>) -> anyhow::Resu
         return Ok(());
     }
     Err(anyhow!(
-        "{}: {:.1} GiB of voxels, more than the {} GiB a volume is read into memory with; the streaming graph reads \
-         OME-Zarr stores brick by brick: `volgraph convert {} OUT.ome.zarr` writes one a slab at a time (it never \
-         holds the file), then `--volume OUT.ome.zarr`",
+        "{}: {:.1} GiB of voxels, more than the {} GiB a graph that holds its volume whole reads into memory; \
+         streaming/ray_guided reads it brick by brick: `volgraph render streaming/ray_guided --volume {}`",
         path.display(),
         bytes as f64 / f64::from(1u32 << 30),
         IN_CORE_LIMIT_BYTES >> 30,

@@ -57,6 +57,9 @@ struct Noted {
     lines: Vec<String>,
     missing: usize,
     broken: usize,
+    /// The chunks noted, by (level, z, y, x): two readers decoding one chunk at once, or a
+    /// chunk decoded again after the cache let it go, are named once.
+    chunks: std::collections::HashSet<(String, [u64; 3])>,
 }
 
 /// An OME-Zarr image read brick by brick.
@@ -238,7 +241,10 @@ impl ZarrPyramid {
     fn fill(&self, c: [u64; 3], problem: Option<String>, level: &Level) -> BoxTexels {
         if let Some(problem) = problem {
             let mut noted = self.noted.lock().unwrap_or_else(|e| e.into_inner());
-            let (count, line) = if problem.is_empty() {
+            let first_time = noted.chunks.insert((level.path.clone(), c));
+            let (count, line) = if !first_time {
+                (usize::MAX, String::new())
+            } else if problem.is_empty() {
                 noted.missing += 1;
                 (
                     noted.missing,

@@ -188,13 +188,26 @@ impl Renderer {
         Ok(())
     }
 
-    /// The volume file, folder or name `path`, as `--volume PATH` reads it: an OME-Zarr store
-    /// is streamed where the graph streams ([`Self::stream`]), anything else is loaded whole.
+    /// The volume file, folder or name `path`, as `--volume PATH` reads it: an OME-Zarr store,
+    /// or a file over the default memory budget, is streamed where the graph streams
+    /// ([`Self::stream`], `zarr_input::stream_file`), anything else is loaded whole.
     pub fn set_volume_path(&mut self, path: &Path, frame: Option<u64>) -> Result<(), ApiError> {
-        if volgraph_zarr::is_zarr(path) && crate::zarr_input::graph_streams(&self.source) {
+        let streams = crate::zarr_input::graph_streams(&self.source);
+        if volgraph_zarr::is_zarr(path) && streams {
             return self.stream(path, frame, None);
         }
         let options = volgraph_accel::load::LoadOptions { frame, ..Default::default() };
+        // A file over the memory budget is streamed from the file, as `--volume` does; a graph
+        // that holds its volume whole refuses one too large to read.
+        if streams && let Some(streamed) = crate::zarr_input::stream_file(path, &options, None)? {
+            self.notes.extend(streamed.notes);
+            self.set_volume(streamed.coarsest, false);
+            self.pyramid = Some(streamed.source);
+            return Ok(());
+        }
+        if !streams {
+            crate::zarr_input::refuse_large_file(path, &options)?;
+        }
         let shown = crate::scene::load_shown_volume(&[path.to_path_buf()], None, &options)?;
         self.notes.extend(shown.notes);
         self.set_volume(shown.volume, shown.marschner_lobb_tf);

@@ -37,6 +37,9 @@ impl LiveSession {
                 Some((one.clone(), crate::zarr_input::stream(one, &args.raw, args.memory_mb)?))
             }
             [one] if crate::zarr_input::graph_streams(&source) => {
+                crate::zarr_input::stream_file(one, &args.raw, args.memory_mb)?.map(|s| (one.clone(), s))
+            }
+            [one] => {
                 crate::zarr_input::refuse_large_file(one, &args.raw)?;
                 None
             }
@@ -52,8 +55,7 @@ impl LiveSession {
             },
             None => crate::scene::load_shown_volume(&args.volume, args.scene.as_ref(), &args.raw)?,
         };
-        let pyramid: Option<Arc<dyn volgraph_accel::pyramid::PyramidSource>> =
-            streamed.map(|(_, s)| s.source as Arc<dyn volgraph_accel::pyramid::PyramidSource>);
+        let pyramid: Option<Arc<dyn volgraph_accel::pyramid::PyramidSource>> = streamed.map(|(_, s)| s.source);
         let (volume, generated, notes) = (shown.volume, shown.marschner_lobb_tf, shown.notes);
         for note in notes {
             crate::stdout::eprintln_escaped!("note: {note}");

@@ -1,0 +1,388 @@
+//! A volume file larger than memory as a pyramid ([`FilePyramid`]): a raw, NRRD or MetaImage
+//! file (any [`VolumeHeader`] that reads boxes) streamed by `raycast_stream` without an OME-Zarr
+//! store and without ever being in memory whole.
+//!
+//! Opening reads the file once, a few slices at a time, through a cascade of 2×2×2 means: each
+//! pair of slices of a level makes one slice of the next, so every level is built while only
+//! two slices per level are held. The coarse levels that fit in the budget are kept; the finer
+//! ones are read when a brick of them is asked for — level 0 straight from the file (a row per
+//! seek), a level in between from the level-0 box beneath it, halved as the cascade halves —
+//! and the pass also keeps each 32³ block's value range, so bricks the transfer function leaves
+//! transparent are never read. Every level holds, bit for bit, what [`InCorePyramid`] holds for
+//! the whole volume (and what `volgraph convert` writes): the same sums in the same order.
+//!
+//! [`InCorePyramid`]: crate::pyramid::InCorePyramid
+
+use glam::{DVec3, IVec3, UVec3};
+
+use crate::kd_split::VoxelBox;
+use crate::load::{LoadError, VolumeHeader};
+use crate::pyramid::{
+    BoxTexels, PyramidLevel, PyramidSource, TexelKind, clamped_indices, halve_pair, pyramid_levels, texel_kind_of,
+    texels_of,
+};
+use crate::volume::{Volume, VoxelData, VoxelType};
+
+/// The edge of the blocks whose value ranges the opening pass keeps.
+const RANGE_BLOCK: u32 = 32;
+/// Bytes of slices read at once by the opening pass.
+const PASS_SLAB_BYTES: u64 = 64 << 20;
+
+/// A volume file read as a pyramid: see the module.
+pub struct FilePyramid {
+    header: VolumeHeader,
+    /// The volume's type, value range, name, spacing and metadata, with no voxels: how values
+    /// become texels.
+    template: Volume,
+    levels: Vec<PyramidLevel>,
+    kind: TexelKind,
+    integer: bool,
+    /// Levels `held_from..` in memory, as stored values.
+    held_from: usize,
+    held: Vec<Vec<f32>>,
+    /// Level-0 (min, max) stored value of each [`RANGE_BLOCK`]³ block, x fastest.
+    block_ranges: Vec<(f32, f32)>,
+    blocks: UVec3,
+}
+
+impl FilePyramid {
+    /// Opens `header`'s file as a pyramid halving until every axis is at most `coarsest_edge`,
+    /// keeping in memory the coarse levels whose stored values fit in `held_bytes` (the
+    /// coarsest always). Reads the file once (twice for float data: its finite range first).
+    pub fn open(header: VolumeHeader, coarsest_edge: u32, held_bytes: u64) -> Result<Self, LoadError> {
+        let dims = header.dims;
+        let value_range = match header.type_range() {
+            Some(range) => range,
+            None => {
+                let (lo, hi) = header.finite_range(0..dims.z)?;
+                if lo <= hi { (lo, hi) } else { (0.0, 0.0) }
+            }
+        };
+        let empty = match header.dtype {
+            VoxelType::U8 => VoxelData::U8(Vec::new()),
+            VoxelType::U16 => VoxelData::U16(Vec::new()),
+            VoxelType::I16 => VoxelData::I16(Vec::new()),
+            VoxelType::F32 => VoxelData::F32(Vec::new()),
+        };
+        let mut template = Volume::new(header.name.clone(), UVec3::ZERO, header.spacing, empty);
+        template.value_range = value_range;
+        template.meta = header.meta.clone();
+        let levels = pyramid_levels(dims, coarsest_edge);
+        let last = levels.len() - 1;
+        // The coarse levels kept: from the coarsest up while they fit (the coarsest always).
+        let mut held_from = levels.len().max(2) - 1;
+        let mut bytes = 0u64;
+        for l in (1..levels.len()).rev() {
+            bytes += levels[l].dims.as_u64vec3().element_product() * 4;
+            if bytes > held_bytes && l < last {
+                break;
+            }
+            held_from = l;
+        }
+        let mut pyramid = Self {
+            kind: texel_kind_of(&template),
+            integer: header.dtype != VoxelType::F32,
+            template,
+            levels,
+            held_from,
+            held: Vec::new(),
+            block_ranges: Vec::new(),
+            blocks: (dims + (RANGE_BLOCK - 1)) / RANGE_BLOCK,
+            header,
+        };
+        pyramid.cascade(value_range)?;
+        Ok(pyramid)
+    }
+
+    /// The opening pass: every slice of the file through the cascade of means, the kept levels
+    /// gathered and each block's range taken.
+    fn cascade(&mut self, value_range: (f64, f64)) -> Result<(), LoadError> {
+        let dims = self.header.dims;
+        let slice_voxels = (dims.x * dims.y) as usize;
+        self.held = (self.held_from..self.levels.len())
+            .map(|l| Vec::with_capacity(self.levels[l].dims.as_uvec3_product()))
+            .collect();
+        self.block_ranges = vec![(f32::INFINITY, f32::NEG_INFINITY); self.blocks.as_uvec3_product()];
+        let mut pending: Vec<Option<Vec<f32>>> = vec![None; self.levels.len()];
+        let slice_bytes = (slice_voxels * self.header.dtype.size_bytes()) as u64;
+        let slices = (PASS_SLAB_BYTES / slice_bytes.max(1)).clamp(1, u64::from(dims.z)) as u32;
+        let header = self.header.clone();
+        header.for_each_slab(0..dims.z, slices, value_range, |z0, slab| {
+            for lz in 0..slab.dims.z {
+                let first = lz as usize * slice_voxels;
+                let slice: Vec<f32> = (first..first + slice_voxels).map(|i| slab.raw_value(i) as f32).collect();
+                self.take_ranges(&slice, z0 + lz);
+                self.feed(0, slice, z0 + lz, &mut pending);
+            }
+        })
+    }
+
+    /// Widens the range of the blocks slice `z` crosses.
+    fn take_ranges(&mut self, slice: &[f32], z: u32) {
+        let dims = self.header.dims;
+        let bz = z / RANGE_BLOCK;
+        for y in 0..dims.y {
+            let row = &slice[(y * dims.x) as usize..((y + 1) * dims.x) as usize];
+            let base = (bz * self.blocks.y + y / RANGE_BLOCK) * self.blocks.x;
+            for (bx, chunk) in row.chunks(RANGE_BLOCK as usize).enumerate() {
+                let r = &mut self.block_ranges[base as usize + bx];
+                for &v in chunk {
+                    *r = (r.0.min(v), r.1.max(v));
+                }
+            }
+        }
+    }
+
+    /// Slice `z` of `level` made: kept if the level is, and paired with the one before into
+    /// the next level's slice `z / 2` (an odd last slice pairs with itself).
+    fn feed(&mut self, level: usize, slice: Vec<f32>, z: u32, pending: &mut [Option<Vec<f32>>]) {
+        if level >= self.held_from {
+            self.held[level - self.held_from].extend_from_slice(&slice);
+        }
+        if level + 1 >= self.levels.len() {
+            return;
+        }
+        let dims = self.levels[level].dims;
+        let next = if z.is_multiple_of(2) {
+            if z + 1 < dims.z {
+                pending[level] = Some(slice);
+                return;
+            }
+            halve_pair(&slice, &slice, dims, self.integer)
+        } else {
+            let first = pending[level].take().unwrap_or_else(|| slice.clone());
+            halve_pair(&first, &slice, dims, self.integer)
+        };
+        self.feed(level + 1, next, z / 2, pending);
+    }
+
+    /// Stored values of voxels `[lo, hi)` of `level` (within it), x fastest: from the file at
+    /// level 0, from memory at a kept level, else halved up from the level-0 box beneath.
+    fn values(&self, level: usize, lo: UVec3, hi: UVec3) -> Result<Vec<f32>, String> {
+        // The box at each level down to 0: children 2x and min(2x + 1, dims − 1).
+        let mut boxes = vec![(lo, hi)];
+        for l in (0..level).rev() {
+            let (a, b) = boxes[boxes.len() - 1];
+            boxes.push((a * 2, (b * 2).min(self.levels[l].dims)));
+        }
+        let (a0, b0) = boxes[boxes.len() - 1];
+        let read = self
+            .header
+            .read_box(VoxelBox::new(a0, b0), self.template.value_range)
+            .map_err(|e| format!("{}: {e}", self.header.name))?;
+        let mut values: Vec<f32> = (0..read.voxel_count()).map(|i| read.raw_value(i) as f32).collect();
+        for l in 1..=level {
+            let (fa, fb) = boxes[level - l + 1];
+            let (a, b) = boxes[level - l];
+            values = halve_box(&values, fa, fb, self.levels[l - 1].dims, a, b, self.integer);
+        }
+        Ok(values)
+    }
+
+    fn block_range(&self, lo: UVec3, hi: UVec3) -> (f32, f32) {
+        let (blo, bhi) = (lo / RANGE_BLOCK, ((hi + (RANGE_BLOCK - 1)) / RANGE_BLOCK).min(self.blocks));
+        let mut range = (f32::INFINITY, f32::NEG_INFINITY);
+        for z in blo.z..bhi.z {
+            for y in blo.y..bhi.y {
+                for x in blo.x..bhi.x {
+                    let r = self.block_ranges[((z * self.blocks.y + y) * self.blocks.x + x) as usize];
+                    range = (range.0.min(r.0), range.1.max(r.1));
+                }
+            }
+        }
+        range
+    }
+}
+
+/// Voxels `[a, b)` of the level above a box `[fa, fb)` of a level of `dims` (whose values are
+/// `fine`, x fastest): each the mean of its children `2x`, `min(2x + 1, dims − 1)`, summed as
+/// [`halve_pair`] sums.
+fn halve_box(fine: &[f32], fa: UVec3, fb: UVec3, dims: UVec3, a: UVec3, b: UVec3, integer: bool) -> Vec<f32> {
+    let size = fb - fa;
+    let at = |x: u32, y: u32, z: u32| fine[(((z - fa.z) * size.y + (y - fa.y)) * size.x + (x - fa.x)) as usize];
+    let mut out = Vec::with_capacity((b - a).as_uvec3_product());
+    for z in a.z..b.z {
+        let zs = [2 * z, (2 * z + 1).min(dims.z - 1)];
+        for y in a.y..b.y {
+            let ys = [2 * y, (2 * y + 1).min(dims.y - 1)];
+            for x in a.x..b.x {
+                let xs = [2 * x, (2 * x + 1).min(dims.x - 1)];
+                let mut sum = 0.0f64;
+                for zz in zs {
+                    for yy in ys {
+                        for xx in xs {
+                            sum += f64::from(at(xx, yy, zz));
+                        }
+                    }
+                }
+                let mean = sum / 8.0;
+                out.push(if integer { mean.round() } else { mean } as f32);
+            }
+        }
+    }
+    out
+}
+
+/// Voxel counts of boxes, as `usize`.
+trait Product {
+    fn as_uvec3_product(&self) -> usize;
+}
+
+impl Product for UVec3 {
+    fn as_uvec3_product(&self) -> usize {
+        self.x as usize * self.y as usize * self.z as usize
+    }
+}
+
+impl PyramidSource for FilePyramid {
+    fn name(&self) -> &str {
+        &self.header.name
+    }
+
+    fn levels(&self) -> &[PyramidLevel] {
+        &self.levels
+    }
+
+    fn spacing(&self) -> DVec3 {
+        self.header.spacing
+    }
+
+    fn texel_kind(&self) -> TexelKind {
+        self.kind
+    }
+
+    fn read_box(&self, level: usize, lo: IVec3, dims: UVec3) -> Result<BoxTexels, String> {
+        let level_dims = self.levels.get(level).ok_or_else(|| format!("no level {level}"))?.dims;
+        if level >= self.held_from {
+            let held = &self.held[level - self.held_from];
+            let values = clamped_indices(level_dims, lo, dims).map(|i| f64::from(held[i]));
+            return Ok(texels_of(&self.template, self.kind, values));
+        }
+        // The box clamped to the level, read once; the asked voxels repeat its faces.
+        let n = level_dims.as_ivec3() - 1;
+        let clo = lo.clamp(IVec3::ZERO, n).as_uvec3();
+        let chi = (lo + dims.as_ivec3() - 1).clamp(IVec3::ZERO, n).as_uvec3() + 1;
+        let values = self.values(level, clo, chi)?;
+        let size = chi - clo;
+        let local = clamped_indices(level_dims, lo, dims).map(|i| {
+            let (x, y, z) = (
+                i as u32 % level_dims.x,
+                i as u32 / level_dims.x % level_dims.y,
+                i as u32 / (level_dims.x * level_dims.y),
+            );
+            f64::from(values[(((z - clo.z) * size.y + (y - clo.y)) * size.x + (x - clo.x)) as usize])
+        });
+        Ok(texels_of(&self.template, self.kind, local))
+    }
+
+    fn box_range(&self, level: usize, lo: IVec3, hi: IVec3) -> Option<(f32, f32)> {
+        let level = self.levels.get(level)?;
+        let n = level.dims.as_ivec3() - 1;
+        let (clo, chi) = (lo.clamp(IVec3::ZERO, n).as_uvec3(), (hi - 1).clamp(IVec3::ZERO, n).as_uvec3() + 1);
+        // A mean lies within its level-0 voxels' range; the box's level-0 voxels lie in blocks.
+        let f = level.factor.as_uvec3();
+        let (lo0, hi0) = (clo * f, (chi * f).min(self.header.dims));
+        let (lo_v, hi_v) = self.block_range(lo0, hi0);
+        if lo_v > hi_v {
+            return None;
+        }
+        let normalized = |v: f32| self.template.normalize_value(f64::from(v)).clamp(0.0, 1.0) as f32;
+        // A 16-bit texel rounds to the nearest 65535th: widened by one.
+        let slack = if self.kind == TexelKind::Unorm16 { 1.0 / 65535.0 } else { 0.0 };
+        Some(((normalized(lo_v) - slack).max(0.0), (normalized(hi_v) + slack).min(1.0)))
+    }
+
+    fn coarsest(&self) -> Result<Volume, String> {
+        let last = self.levels.len() - 1;
+        let level = self.levels[last];
+        let values = match self.held.last() {
+            Some(values) if last >= self.held_from => values.clone(),
+            _ => self.values(last, UVec3::ZERO, level.dims)?,
+        };
+        let mut v = Volume::new(
+            self.header.name.clone(),
+            level.dims,
+            self.header.spacing * level.factor,
+            VoxelData::F32(values),
+        );
+        v.value_range = self.template.value_range;
+        v.meta = self.template.meta.clone();
+        Ok(v)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::path::PathBuf;
+    use std::sync::Arc;
+
+    use super::*;
+    use crate::load::{LoadOptions, RawOptions, load_volume};
+    use crate::pyramid::InCorePyramid;
+
+    fn write_raw(name: &str, bytes: &[u8]) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("volgraph-pyramid-file-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).expect("write raw");
+        path
+    }
+
+    /// Every box of every level (faces, past faces, whole levels) equals the in-memory
+    /// pyramid's, whichever levels are kept, and each box's known range holds its texels.
+    fn check(path: &std::path::Path, edge: u32) {
+        let whole = Arc::new(load_volume(path, &RawOptions::default()).expect("loads").volume);
+        let memory = InCorePyramid::new(whole.clone(), edge);
+        for held in [0, 1 << 30] {
+            let header = VolumeHeader::read(path, &LoadOptions::default()).expect("header");
+            let file = FilePyramid::open(header, edge, held).expect("opens");
+            assert_eq!(file.levels(), memory.levels());
+            assert_eq!(file.texel_kind(), memory.texel_kind());
+            assert!(held > 0 || file.held_from == file.levels().len() - 1, "only the coarsest kept");
+            for (level, l) in file.levels().iter().enumerate() {
+                let d = l.dims.as_ivec3();
+                let boxes = [
+                    (IVec3::ZERO, l.dims),
+                    (IVec3::new(-2, -1, -3), UVec3::new(5, 4, 6)),
+                    (d - 3, UVec3::new(6, 5, 4)),
+                    (d / 2 - 1, UVec3::new(3, 3, 3)),
+                ];
+                for (lo, dims) in boxes {
+                    let a = file.read_box(level, lo, dims).expect("reads");
+                    let b = memory.read_box(level, lo, dims).expect("reads");
+                    assert_eq!(a, b, "level {level} box {lo} + {dims}, held {held}");
+                    let (lo_v, hi_v) = file.box_range(level, lo, lo + dims.as_ivec3()).expect("ranges known");
+                    let (min, max) = a.range().expect("not empty");
+                    assert!(lo_v <= min && max <= hi_v, "level {level}: {min}..{max} outside {lo_v}..{hi_v}");
+                }
+            }
+            assert_eq!(file.coarsest().expect("coarsest").data, memory.coarsest().expect("coarsest").data);
+        }
+    }
+
+    #[test]
+    fn a_16_bit_file_of_odd_dims_is_the_in_memory_pyramid_at_every_level() {
+        let dims = UVec3::new(37, 29, 23);
+        let bytes: Vec<u8> = (0..dims.element_product())
+            .flat_map(|i| {
+                let (x, y, z) = (i % 37, i / 37 % 29, i / (37 * 29));
+                (((x * 1733 + y * 977 + z * 4099) % 60000) as u16 + 7).to_le_bytes()
+            })
+            .collect();
+        check(&write_raw("odd_37x29x23_uint16.raw", &bytes), 4);
+    }
+
+    #[test]
+    fn an_8_bit_and_a_float_file_are_the_in_memory_pyramid_at_every_level() {
+        let dims = UVec3::new(40, 33, 18);
+        let bytes: Vec<u8> = (0..dims.element_product()).map(|i| ((i * 37 + i / 40 * 11) % 251) as u8).collect();
+        check(&write_raw("bytes_40x33x18_uint8.raw", &bytes), 3);
+        let floats: Vec<u8> = (0..dims.element_product())
+            .flat_map(|i| {
+                let v = if i % 97 == 0 { f32::NAN } else { (i as f32 * 0.37).sin() * 120.5 - 3.0 };
+                v.to_le_bytes()
+            })
+            .collect();
+        check(&write_raw("floats_40x33x18_float32.raw", &floats), 5);
+    }
+}

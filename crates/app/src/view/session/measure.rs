@@ -138,6 +138,12 @@ impl LiveSession {
     /// reference, for a worker thread; `None` for a graph without a float `image` output or a
     /// raycaster (`march`) to take the settings from.
     pub fn accuracy_job(&mut self, camera: &OrbitCamera) -> Option<crate::view::accuracy::Job> {
+        // A streamed volume (a store, a file over the memory budget): the session holds only its
+        // coarsest level, and a reference over that would be compared with the full-resolution
+        // image (it showed "max 253/255" for a correct image).
+        if self.pyramid.is_some() {
+            return None;
+        }
         let plan = self.plan()?;
         let march = plan.steps.iter().find(|s| s.pass_id == "march" && s.params.declares("step_voxels"))?;
         // Several volumes: the viewer binds one, so only a label map coloured by its table (the

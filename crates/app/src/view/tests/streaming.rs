@@ -1,7 +1,8 @@
 //! The viewer on an OME-Zarr store with the streaming graph (issue 48 item 3): the session
 //! holds the coarsest level only, binds the store as a pyramid, and frames refine as bricks
 //! arrive — the panel's line counts them down to none pending; a graph edit re-applied keeps
-//! the store streamed (the pass keeps its pool).
+//! the store streamed (the pass keeps its pool); the live accuracy measure, which would compare
+//! the full image with the coarsest level, is not taken.
 
 use super::*;
 
@@ -38,6 +39,9 @@ fn the_viewer_streams_a_store_and_refines_as_bricks_arrive() {
         }
     }
     assert!(done && line(&session).contains("0 pending"), "{}", line(&session));
+    // The session holds the coarsest level only: no reference to compare the full image with
+    // (one over the coarsest level said "max 253/255" of a right image).
+    assert!(session.accuracy_job(&camera).is_none(), "no accuracy measure of a streamed volume");
     let read_before = crate::stream_progress::StreamProgress::of(&session.runtime.pass_counters())[0].read;
     assert!(read_before > 1.0, "finer bricks were read");
     // A graph edit (the step) re-applies the plan: the store stays bound, its bricks stay.

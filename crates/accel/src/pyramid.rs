@@ -129,9 +129,12 @@ impl InCorePyramid {
         let levels = pyramid_levels(volume.dims, coarsest_edge);
         let mut coarse: Vec<Vec<f32>> = Vec::new();
         for fine in &levels[..levels.len() - 1] {
+            let d = fine.dims;
+            let index = |v: UVec3| ((v.z * d.y + v.y) * d.x + v.x) as usize;
+            let half = (d + 1) / 2;
             let next = match coarse.last() {
-                Some(values) => halve(|i| f64::from(values[i]), fine.dims, integer),
-                None => halve(|i| volume.raw_value(i), fine.dims, integer),
+                Some(values) => halve_box(|v| f64::from(values[index(v)]), d, UVec3::ZERO, half, integer),
+                None => halve_box(|v| volume.raw_value(index(v)), d, UVec3::ZERO, half, integer),
             };
             coarse.push(next);
         }
@@ -188,48 +191,25 @@ pub fn pyramid_levels(dims: UVec3, edge: u32) -> Vec<PyramidLevel> {
     levels
 }
 
-/// The 2×2×2 mean of voxel `(x, y)` of the half-resolution slice made from slices `a` and `b`
-/// of a level of `dims` (x fastest; `b` is `a` again at an odd last slice), summed in the order
-/// [`halve`] sums (so both give the same bits), rounded for integer types.
-pub fn halve_pair(a: &[f32], b: &[f32], dims: UVec3, integer: bool) -> Vec<f32> {
-    let half = (dims + 1) / 2;
-    let mut out = Vec::with_capacity((half.x * half.y) as usize);
-    for y in 0..half.y {
-        let ys = [2 * y, (2 * y + 1).min(dims.y - 1)];
-        for x in 0..half.x {
-            let xs = [2 * x, (2 * x + 1).min(dims.x - 1)];
-            let mut sum = 0.0f64;
-            for slice in [a, b] {
-                for yy in ys {
-                    for xx in xs {
-                        sum += f64::from(slice[(yy * dims.x + xx) as usize]);
-                    }
-                }
-            }
-            let mean = sum / 8.0;
-            out.push(if integer { mean.round() } else { mean } as f32);
-        }
-    }
-    out
-}
-
-/// The 2×2×2 means of `value` over `dims` voxels (x fastest), odd edges averaged with
-/// themselves; rounded to the nearest integer for integer types.
-fn halve(value: impl Fn(usize) -> f64, dims: UVec3, integer: bool) -> Vec<f32> {
-    let half = (dims + 1) / 2;
-    let at = |x: u32, y: u32, z: u32| value(((z * dims.y + y) * dims.x + x) as usize);
-    let mut out = Vec::with_capacity(half.element_product() as usize);
-    for z in 0..half.z {
+/// Voxels `[a, b)` of the level above a level of `dims` voxels whose stored values `value`
+/// gives (by level voxel): each the 2×2×2 mean of its children `2x` and `min(2x + 1, dims − 1)`
+/// per axis (odd edges averaged with themselves), summed z, y, x outermost first — one order
+/// for every caller, so the in-memory pyramid, a file's cascade and its bricks agree bit for
+/// bit — and rounded to the nearest for integer types.
+pub fn halve_box(value: impl Fn(UVec3) -> f64, dims: UVec3, a: UVec3, b: UVec3, integer: bool) -> Vec<f32> {
+    let size = b.saturating_sub(a);
+    let mut out = Vec::with_capacity(size.x as usize * size.y as usize * size.z as usize);
+    for z in a.z..b.z {
         let zs = [2 * z, (2 * z + 1).min(dims.z - 1)];
-        for y in 0..half.y {
+        for y in a.y..b.y {
             let ys = [2 * y, (2 * y + 1).min(dims.y - 1)];
-            for x in 0..half.x {
+            for x in a.x..b.x {
                 let xs = [2 * x, (2 * x + 1).min(dims.x - 1)];
                 let mut sum = 0.0;
                 for zz in zs {
                     for yy in ys {
                         for xx in xs {
-                            sum += at(xx, yy, zz);
+                            sum += value(UVec3::new(xx, yy, zz));
                         }
                     }
                 }

@@ -18,7 +18,7 @@ use glam::{DVec3, IVec3, UVec3};
 use crate::kd_split::VoxelBox;
 use crate::load::{LoadError, VolumeHeader};
 use crate::pyramid::{
-    BoxTexels, PyramidLevel, PyramidSource, TexelKind, clamped_indices, halve_pair, pyramid_levels, texel_kind_of,
+    BoxTexels, PyramidLevel, PyramidSource, TexelKind, clamped_indices, halve_box, pyramid_levels, texel_kind_of,
     texels_of,
 };
 use crate::volume::{Volume, VoxelData, VoxelType};
@@ -143,17 +143,20 @@ impl FilePyramid {
             return;
         }
         let dims = self.levels[level].dims;
-        let next = if z.is_multiple_of(2) {
-            if z + 1 < dims.z {
-                pending[level] = Some(slice);
-                return;
-            }
-            halve_pair(&slice, &slice, dims, self.integer)
-        } else {
-            let first = pending[level].take().unwrap_or_else(|| slice.clone());
-            halve_pair(&first, &slice, dims, self.integer)
+        if z.is_multiple_of(2) && z + 1 < dims.z {
+            pending[level] = Some(slice);
+            return;
+        }
+        // Slice z/2 of the next level from slices 2·(z/2) (held) and z (an odd last one: itself).
+        let first = if z.is_multiple_of(2) { None } else { pending[level].take() };
+        let out = z / 2;
+        let value = |v: UVec3| {
+            let from = if v.z == 2 * out { first.as_deref().unwrap_or(&slice) } else { &slice };
+            f64::from(from[(v.y * dims.x + v.x) as usize])
         };
-        self.feed(level + 1, next, z / 2, pending);
+        let half = (dims + 1) / 2;
+        let next = halve_box(value, dims, UVec3::new(0, 0, out), UVec3::new(half.x, half.y, out + 1), self.integer);
+        self.feed(level + 1, next, out, pending);
     }
 
     /// Stored values of voxels `[lo, hi)` of `level` (within it), x fastest: from the file at
@@ -174,7 +177,12 @@ impl FilePyramid {
         for l in 1..=level {
             let (fa, fb) = boxes[level - l + 1];
             let (a, b) = boxes[level - l];
-            values = halve_box(&values, fa, fb, self.levels[l - 1].dims, a, b, self.integer);
+            let size = fb - fa;
+            let local = |v: UVec3| {
+                let v = v - fa;
+                f64::from(values[((v.z * size.y + v.y) * size.x + v.x) as usize])
+            };
+            values = halve_box(local, self.levels[l - 1].dims, a, b, self.integer);
         }
         Ok(values)
     }
@@ -192,35 +200,6 @@ impl FilePyramid {
         }
         range
     }
-}
-
-/// Voxels `[a, b)` of the level above a box `[fa, fb)` of a level of `dims` (whose values are
-/// `fine`, x fastest): each the mean of its children `2x`, `min(2x + 1, dims − 1)`, summed as
-/// [`halve_pair`] sums.
-fn halve_box(fine: &[f32], fa: UVec3, fb: UVec3, dims: UVec3, a: UVec3, b: UVec3, integer: bool) -> Vec<f32> {
-    let size = fb - fa;
-    let at = |x: u32, y: u32, z: u32| fine[(((z - fa.z) * size.y + (y - fa.y)) * size.x + (x - fa.x)) as usize];
-    let mut out = Vec::with_capacity((b - a).as_uvec3_product());
-    for z in a.z..b.z {
-        let zs = [2 * z, (2 * z + 1).min(dims.z - 1)];
-        for y in a.y..b.y {
-            let ys = [2 * y, (2 * y + 1).min(dims.y - 1)];
-            for x in a.x..b.x {
-                let xs = [2 * x, (2 * x + 1).min(dims.x - 1)];
-                let mut sum = 0.0f64;
-                for zz in zs {
-                    for yy in ys {
-                        for xx in xs {
-                            sum += f64::from(at(xx, yy, zz));
-                        }
-                    }
-                }
-                let mean = sum / 8.0;
-                out.push(if integer { mean.round() } else { mean } as f32);
-            }
-        }
-    }
-    out
 }
 
 /// Voxel counts of boxes, as `usize`.

@@ -43,6 +43,8 @@ pub struct FilePyramid {
     /// Level-0 (min, max) stored value of each [`RANGE_BLOCK`]³ block, x fastest.
     block_ranges: Vec<(f32, f32)>,
     blocks: UVec3,
+    /// Non-finite voxels of a float file, read as the range's ends.
+    non_finite: u64,
 }
 
 impl FilePyramid {
@@ -51,11 +53,25 @@ impl FilePyramid {
     /// coarsest always). Reads the file once (twice for float data: its finite range first).
     pub fn open(header: VolumeHeader, coarsest_edge: u32, held_bytes: u64) -> Result<Self, LoadError> {
         let dims = header.dims;
+        // Float data: the finite range first (what NaN and ±∞ are replaced by, as the loaders
+        // replace them), counting what is replaced.
+        let mut non_finite = 0u64;
         let value_range = match header.type_range() {
             Some(range) => range,
             None => {
-                let (lo, hi) = header.finite_range(0..dims.z)?;
-                if lo <= hi { (lo, hi) } else { (0.0, 0.0) }
+                let mut lo_hi = (f64::INFINITY, f64::NEG_INFINITY);
+                // A range of NaN leaves NaN and ±∞ as NaN, not replaced by a range's ends.
+                header.for_each_slab(0..dims.z, 8, (f64::NAN, f64::NAN), |_, slab| {
+                    for i in 0..slab.voxel_count() {
+                        let v = slab.raw_value(i);
+                        if v.is_finite() {
+                            lo_hi = (lo_hi.0.min(v), lo_hi.1.max(v));
+                        } else {
+                            non_finite += 1;
+                        }
+                    }
+                })?;
+                if lo_hi.0 <= lo_hi.1 { lo_hi } else { (0.0, 0.0) }
             }
         };
         let empty = match header.dtype {
@@ -88,10 +104,17 @@ impl FilePyramid {
             held: Vec::new(),
             block_ranges: Vec::new(),
             blocks: (dims + (RANGE_BLOCK - 1)) / RANGE_BLOCK,
+            non_finite,
             header,
         };
         pyramid.cascade(value_range)?;
         Ok(pyramid)
+    }
+
+    /// How many voxels of a float file were NaN or infinite (read as the finite range's low
+    /// end for NaN and −∞, its high end for +∞, as the loaders replace them).
+    pub fn non_finite_replaced(&self) -> u64 {
+        self.non_finite
     }
 
     /// The opening pass: every slice of the file through the cascade of means, the kept levels
@@ -358,10 +381,18 @@ mod tests {
         check(&write_raw("bytes_40x33x18_uint8.raw", &bytes), 3);
         let floats: Vec<u8> = (0..dims.element_product())
             .flat_map(|i| {
-                let v = if i % 97 == 0 { f32::NAN } else { (i as f32 * 0.37).sin() * 120.5 - 3.0 };
+                // Positive: a NaN read as 0 would widen the range (it once did).
+                let v = if i % 97 == 0 { f32::NAN } else { (i as f32 * 0.37).sin() * 120.5 + 200.0 };
                 v.to_le_bytes()
             })
             .collect();
-        check(&write_raw("floats_40x33x18_float32.raw", &floats), 5);
+        let path = write_raw("floats_40x33x18_float32.raw", &floats);
+        check(&path, 5);
+        let header = VolumeHeader::read(&path, &LoadOptions::default()).expect("header");
+        let nan = (0..dims.element_product()).filter(|i| i % 97 == 0).count() as u64;
+        // The header's own range survey (`render --distributed`'s) skips the NaN too.
+        let (lo, hi) = header.finite_range(0..dims.z).expect("surveyed");
+        assert!(lo > 79.0 && hi < 321.0, "a NaN widened the range to {lo}..{hi}");
+        assert_eq!(FilePyramid::open(header, 5, 0).expect("opens").non_finite_replaced(), nan);
     }
 }

@@ -73,7 +73,7 @@ pub fn stream_file(path: &Path, options: &LoadOptions<'_>, memory_mb: Option<u64
         .map_err(|e| anyhow!("{e}"))?;
     let coarsest = volgraph_accel::pyramid::PyramidSource::coarsest(&source).map_err(|e| anyhow!(e))?;
     let levels = volgraph_accel::pyramid::PyramidSource::levels(&source);
-    let notes = vec![format!(
+    let mut notes = vec![format!(
         "{}: {} of voxels, more than --memory-mb {}: streamed brick by brick from the file ({} levels down to \
          {}×{}×{}); building the coarse levels read it once in {:.1} s (`volgraph convert {} OUT.ome.zarr` writes a \
          store that opens at once)",
@@ -91,6 +91,9 @@ pub fn stream_file(path: &Path, options: &LoadOptions<'_>, memory_mb: Option<u64
         started.elapsed().as_secs_f64(),
         path.display()
     )];
+    if source.non_finite_replaced() > 0 {
+        notes.push(format!("{}: replaced {} NaN/Inf voxels", path.display(), source.non_finite_replaced()));
+    }
     Ok(Some(Streamed { source: std::sync::Arc::new(source), coarsest, notes }))
 }
 

@@ -255,7 +255,9 @@ impl VolumeHeader {
     /// range, which no type fixes); `(+∞, −∞)` when none is finite.
     pub fn finite_range(&self, z: std::ops::Range<u32>) -> Result<(f64, f64), LoadError> {
         let mut lo_hi = (f64::INFINITY, f64::NEG_INFINITY);
-        self.for_each_slab(z, 8, (0.0, 1.0), |_, slab| {
+        // A range of NaN leaves NaN and ±∞ as NaN: with (0, 1) they were read as 0 and 1, and a
+        // float file with a NaN got a range reaching 0.
+        self.for_each_slab(z, 8, (f64::NAN, f64::NAN), |_, slab| {
             for i in 0..slab.voxel_count() {
                 let v = slab.raw_value(i);
                 if v.is_finite() {

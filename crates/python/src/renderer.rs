@@ -146,8 +146,9 @@ impl Renderer {
 
     /// Streams the OME-Zarr store `path` brick by brick (a streaming graph such as
     /// `streaming/ray_guided`): `frame` picks the volume N = t·C + c, `memory_mb` bounds the
-    /// decoded chunks held (default 512). A render waits for the full image, or for
-    /// `time_budget_ms`.
+    /// decoded chunks held (default 512). A raw, NRRD or MetaImage file larger than `memory_mb`
+    /// streams from the file itself; a smaller one is read in core. A render waits for the full
+    /// image, or for `time_budget_ms`.
     #[pyo3(signature = (path, *, frame = None, memory_mb = None))]
     pub fn stream(&self, py: Python<'_>, path: PathBuf, frame: Option<u64>, memory_mb: Option<u64>) -> PyResult<()> {
         self.with(py, |r| r.stream(&path, frame, memory_mb)).map_err(|e| raise(e, value_error))

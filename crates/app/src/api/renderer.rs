@@ -161,7 +161,9 @@ impl Renderer {
     /// The OME-Zarr store `path` (the volume `frame` picks, N = t·C + c), read brick by brick
     /// by a streaming graph (`streaming/ray_guided`) as `volgraph render` reads it: decoded
     /// chunks held within `memory_mb` MiB (default 512); a render waits for the full image (or
-    /// [`Self::set_time_budget`]). Another graph is an error saying to load the store in core.
+    /// [`Self::set_time_budget`]). A volume file larger than `memory_mb` is streamed from the
+    /// file (`zarr_input::stream_file`), a smaller one read in core. Another graph is an error
+    /// saying to load the store in core.
     pub fn stream(&mut self, path: &Path, frame: Option<u64>, memory_mb: Option<u64>) -> Result<(), ApiError> {
         if !crate::zarr_input::graph_streams(&self.source) {
             return Err(ApiError::Input(anyhow!(
@@ -171,7 +173,7 @@ impl Renderer {
                 self.graph.display()
             )));
         }
-        if !volgraph_zarr::is_zarr(path) {
+        if path.is_dir() && !volgraph_zarr::is_zarr(path) {
             return Err(ApiError::Input(anyhow!(
                 "{}: not an OME-Zarr store (a folder with zarr.json or .zgroup)",
                 path.display()
@@ -181,7 +183,22 @@ impl Renderer {
             return Err(ApiError::Input(anyhow!("memory_mb {mb}: 16 to 16777216 MiB, as --memory-mb")));
         }
         let options = volgraph_accel::load::LoadOptions { frame, ..Default::default() };
-        let streamed = crate::zarr_input::stream(path, &options, memory_mb)?;
+        let streamed = if volgraph_zarr::is_zarr(path) {
+            crate::zarr_input::stream(path, &options, memory_mb)?
+        } else {
+            // A volume file: streamed from the file when its voxels exceed the budget, else
+            // read in core as `volume = path` reads it (it fits).
+            match crate::zarr_input::stream_file(path, &options, memory_mb)? {
+                Some(streamed) => streamed,
+                None => {
+                    let shown = crate::scene::load_shown_volume(&[path.to_path_buf()], None, &options)?;
+                    self.notes.extend(shown.notes);
+                    self.notes.push(format!("{}: fits in memory_mb: read in core", path.display()));
+                    self.set_volume(shown.volume, shown.marschner_lobb_tf);
+                    return Ok(());
+                }
+            }
+        };
         self.notes.extend(streamed.notes);
         self.set_volume(streamed.coarsest, false);
         self.pyramid = Some(streamed.source);

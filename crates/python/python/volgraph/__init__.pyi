@@ -80,12 +80,15 @@ class Renderer:
         effects, cuts and light where nothing else gives them); size default 512×512."""
     volume: Any
     """Write-only: a Volume, a [z, y, x] array (spacing 1, 1, 1; set_volume takes another) or a
-    path read as --volume reads it (an OME-Zarr store is streamed by a streaming graph)."""
+    path read as --volume reads it (an OME-Zarr store, or a file over 512 MiB, is streamed by a
+    streaming graph)."""
     time_budget_ms: float | None
     """Write-only: how long a render of a streaming graph refines; None: until complete."""
     def stream(self, path: str | PathLike[str], *, frame: int | None = None, memory_mb: int | None = None) -> None:
         """Streams an OME-Zarr store brick by brick (graph streaming/ray_guided): frame picks
-        N = t·C + c, memory_mb bounds the decoded chunks held (default 512)."""
+        N = t·C + c, memory_mb bounds the decoded chunks held (default 512). A raw, NRRD or
+        MetaImage file larger than memory_mb streams from the file itself; a smaller one is read
+        in core."""
     @property
     def tf(self) -> TransferFunction:
         """The TF the next frame classifies with (fitted to the volume unless one was set)."""

@@ -4,12 +4,15 @@
 //!
 //! Opening reads the file once, a few slices at a time, through a cascade of 2×2×2 means: each
 //! pair of slices of a level makes one slice of the next, so every level is built while only
-//! two slices per level are held. The coarse levels that fit in the budget are kept; the finer
-//! ones are read when a brick of them is asked for — level 0 straight from the file (a row per
-//! seek), a level in between from the level-0 box beneath it, halved as the cascade halves —
-//! and the pass also keeps each 32³ block's value range, so bricks the transfer function leaves
-//! transparent are never read. Every level holds, bit for bit, what [`InCorePyramid`] holds for
-//! the whole volume (and what `volgraph convert` writes): the same sums in the same order.
+//! two slices per level are held. The coarse levels that fit in the budget are kept in memory;
+//! the levels between them and the file are written, as they are made, to scratch raw files in
+//! the temporary folder (`TMPDIR`; about a seventh of the file's bytes, removed when the pyramid
+//! is dropped), and a brick of any level is then one box read — level 0 from the file, the
+//! others from their scratch file (a plane of the box's rows per read). The pass also keeps each
+//! 32³ block's value range, so bricks the transfer function leaves transparent are never read.
+//! Every level holds, bit for bit, what [`InCorePyramid`] holds for the whole volume (and what
+//! `volgraph convert` writes): the same sums in the same order, one function
+//! ([`halve_box`]) for both.
 //!
 //! [`InCorePyramid`]: crate::pyramid::InCorePyramid
 
@@ -45,6 +48,23 @@ pub struct FilePyramid {
     blocks: UVec3,
     /// Non-finite voxels of a float file, read as the range's ends.
     non_finite: u64,
+    /// Levels `1..held_from`: their scratch files, written by the pass, read box by box.
+    scratch: Vec<Scratch>,
+}
+
+/// A level written to a scratch raw file (`name_XxYxZ_type.raw`, little-endian, the file's
+/// type): while the pass runs, its writer; then its header, to read boxes.
+struct Scratch {
+    path: std::path::PathBuf,
+    writer: Option<std::io::BufWriter<std::fs::File>>,
+    header: Option<VolumeHeader>,
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        self.writer = None;
+        let _ = std::fs::remove_file(&self.path);
+    }
 }
 
 impl FilePyramid {
@@ -105,9 +125,12 @@ impl FilePyramid {
             block_ranges: Vec::new(),
             blocks: (dims + (RANGE_BLOCK - 1)) / RANGE_BLOCK,
             non_finite,
+            scratch: Vec::new(),
             header,
         };
+        pyramid.open_scratch()?;
         pyramid.cascade(value_range)?;
+        pyramid.close_scratch()?;
         Ok(pyramid)
     }
 
@@ -115,6 +138,41 @@ impl FilePyramid {
     /// end for NaN and −∞, its high end for +∞, as the loaders replace them).
     pub fn non_finite_replaced(&self) -> u64 {
         self.non_finite
+    }
+
+    /// Creates the scratch files of levels `1..held_from`.
+    fn open_scratch(&mut self) -> Result<(), LoadError> {
+        static OPENED: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let n = OPENED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        for level in 1..self.held_from {
+            let d = self.levels[level].dims;
+            let name = format!(
+                "volgraph-pyramid-{}-{n}-level{level}_{}x{}x{}_{}.raw",
+                std::process::id(),
+                d.x,
+                d.y,
+                d.z,
+                self.header.dtype.name()
+            );
+            let path = std::env::temp_dir().join(name);
+            let io = |source| LoadError::Io { path: path.clone(), source };
+            let file = std::fs::OpenOptions::new().write(true).create_new(true).open(&path).map_err(io)?;
+            self.scratch.push(Scratch { writer: Some(std::io::BufWriter::new(file)), header: None, path });
+        }
+        Ok(())
+    }
+
+    /// Flushes the scratch files and opens them for box reads.
+    fn close_scratch(&mut self) -> Result<(), LoadError> {
+        use std::io::Write as _;
+        for scratch in &mut self.scratch {
+            let path = scratch.path.clone();
+            if let Some(mut writer) = scratch.writer.take() {
+                writer.flush().map_err(|source| LoadError::Io { path: path.clone(), source })?;
+            }
+            scratch.header = Some(VolumeHeader::read(&path, &crate::load::LoadOptions::default())?);
+        }
+        Ok(())
     }
 
     /// The opening pass: every slice of the file through the cascade of means, the kept levels
@@ -130,14 +188,18 @@ impl FilePyramid {
         let slice_bytes = (slice_voxels * self.header.dtype.size_bytes()) as u64;
         let slices = (PASS_SLAB_BYTES / slice_bytes.max(1)).clamp(1, u64::from(dims.z)) as u32;
         let header = self.header.clone();
+        let mut written = Ok(());
         header.for_each_slab(0..dims.z, slices, value_range, |z0, slab| {
             for lz in 0..slab.dims.z {
                 let first = lz as usize * slice_voxels;
                 let slice: Vec<f32> = (first..first + slice_voxels).map(|i| slab.raw_value(i) as f32).collect();
                 self.take_ranges(&slice, z0 + lz);
-                self.feed(0, slice, z0 + lz, &mut pending);
+                if written.is_ok() {
+                    written = self.feed(0, slice, z0 + lz, &mut pending);
+                }
             }
-        })
+        })?;
+        written
     }
 
     /// Widens the range of the blocks slice `z` crosses.
@@ -158,17 +220,25 @@ impl FilePyramid {
 
     /// Slice `z` of `level` made: kept if the level is, and paired with the one before into
     /// the next level's slice `z / 2` (an odd last slice pairs with itself).
-    fn feed(&mut self, level: usize, slice: Vec<f32>, z: u32, pending: &mut [Option<Vec<f32>>]) {
+    fn feed(
+        &mut self,
+        level: usize,
+        slice: Vec<f32>,
+        z: u32,
+        pending: &mut [Option<Vec<f32>>],
+    ) -> Result<(), LoadError> {
         if level >= self.held_from {
             self.held[level - self.held_from].extend_from_slice(&slice);
+        } else if level > 0 {
+            self.write_scratch(level, &slice)?;
         }
         if level + 1 >= self.levels.len() {
-            return;
+            return Ok(());
         }
         let dims = self.levels[level].dims;
         if z.is_multiple_of(2) && z + 1 < dims.z {
             pending[level] = Some(slice);
-            return;
+            return Ok(());
         }
         // Slice z/2 of the next level from slices 2·(z/2) (held) and z (an odd last one: itself).
         let first = if z.is_multiple_of(2) { None } else { pending[level].take() };
@@ -179,35 +249,52 @@ impl FilePyramid {
         };
         let half = (dims + 1) / 2;
         let next = halve_box(value, dims, UVec3::new(0, 0, out), UVec3::new(half.x, half.y, out + 1), self.integer);
-        self.feed(level + 1, next, out, pending);
+        self.feed(level + 1, next, out, pending)
     }
 
-    /// Stored values of voxels `[lo, hi)` of `level` (within it), x fastest: from the file at
-    /// level 0, from memory at a kept level, else halved up from the level-0 box beneath.
+    /// Appends a slice of `level` to its scratch file, in the file's type (a mean of integers is
+    /// rounded to one, so it fits).
+    fn write_scratch(&mut self, level: usize, slice: &[f32]) -> Result<(), LoadError> {
+        use std::io::Write as _;
+        let dtype = self.header.dtype;
+        let scratch = &mut self.scratch[level - 1];
+        let io = |source| LoadError::Io { path: scratch.path.clone(), source };
+        let Some(writer) = scratch.writer.as_mut() else { return Ok(()) };
+        let bytes: Vec<u8> = match dtype {
+            VoxelType::U8 => slice.iter().map(|&v| v as u8).collect(),
+            VoxelType::U16 => slice.iter().flat_map(|&v| (v as u16).to_le_bytes()).collect(),
+            VoxelType::I16 => slice.iter().flat_map(|&v| (v as i16).to_le_bytes()).collect(),
+            VoxelType::F32 => slice.iter().flat_map(|&v| v.to_le_bytes()).collect(),
+        };
+        writer.write_all(&bytes).map_err(io)
+    }
+
+    /// Stored values of voxels `[lo, hi)` of `level` (within it), x fastest: one box read, from
+    /// the file at level 0, from the level's scratch file above it, from memory at a kept level.
     fn values(&self, level: usize, lo: UVec3, hi: UVec3) -> Result<Vec<f32>, String> {
-        // The box at each level down to 0: children 2x and min(2x + 1, dims − 1).
-        let mut boxes = vec![(lo, hi)];
-        for l in (0..level).rev() {
-            let (a, b) = boxes[boxes.len() - 1];
-            boxes.push((a * 2, (b * 2).min(self.levels[l].dims)));
+        if level >= self.held_from {
+            let d = self.levels[level].dims;
+            let held = &self.held[level - self.held_from];
+            let mut out = Vec::with_capacity((hi - lo).as_uvec3_product());
+            for z in lo.z..hi.z {
+                for y in lo.y..hi.y {
+                    let row = ((z * d.y + y) * d.x) as usize;
+                    out.extend_from_slice(&held[row + lo.x as usize..row + hi.x as usize]);
+                }
+            }
+            return Ok(out);
         }
-        let (a0, b0) = boxes[boxes.len() - 1];
-        let read = self
-            .header
-            .read_box(VoxelBox::new(a0, b0), self.template.value_range)
+        let header = match level {
+            0 => &self.header,
+            l => self.scratch[l - 1]
+                .header
+                .as_ref()
+                .ok_or_else(|| "internal: a scratch level not written".to_string())?,
+        };
+        let read = header
+            .read_box(VoxelBox::new(lo, hi), self.template.value_range)
             .map_err(|e| format!("{}: {e}", self.header.name))?;
-        let mut values: Vec<f32> = (0..read.voxel_count()).map(|i| read.raw_value(i) as f32).collect();
-        for l in 1..=level {
-            let (fa, fb) = boxes[level - l + 1];
-            let (a, b) = boxes[level - l];
-            let size = fb - fa;
-            let local = |v: UVec3| {
-                let v = v - fa;
-                f64::from(values[((v.z * size.y + v.y) * size.x + v.x) as usize])
-            };
-            values = halve_box(local, self.levels[l - 1].dims, a, b, self.integer);
-        }
-        Ok(values)
+        Ok((0..read.voxel_count()).map(|i| read.raw_value(i) as f32).collect())
     }
 
     fn block_range(&self, lo: UVec3, hi: UVec3) -> (f32, f32) {
@@ -359,7 +446,15 @@ mod tests {
                 }
             }
             assert_eq!(file.coarsest().expect("coarsest").data, memory.coarsest().expect("coarsest").data);
+            // The levels between the file and the kept ones live in scratch files until the
+            // pyramid is dropped.
+            let scratch: Vec<std::path::PathBuf> = file.scratch.iter().map(|s| s.path.clone()).collect();
+            assert_eq!(scratch.len(), file.held_from - 1);
+            assert!(scratch.iter().all(|p| p.exists()));
+            drop(file);
+            assert!(scratch.iter().all(|p| !p.exists()), "scratch files removed");
         }
+        std::fs::remove_file(path).ok();
     }
 
     #[test]
@@ -387,12 +482,12 @@ mod tests {
             })
             .collect();
         let path = write_raw("floats_40x33x18_float32.raw", &floats);
-        check(&path, 5);
         let header = VolumeHeader::read(&path, &LoadOptions::default()).expect("header");
         let nan = (0..dims.element_product()).filter(|i| i % 97 == 0).count() as u64;
         // The header's own range survey (`render --distributed`'s) skips the NaN too.
         let (lo, hi) = header.finite_range(0..dims.z).expect("surveyed");
         assert!(lo > 79.0 && hi < 321.0, "a NaN widened the range to {lo}..{hi}");
         assert_eq!(FilePyramid::open(header, 5, 0).expect("opens").non_finite_replaced(), nan);
+        check(&path, 5);
     }
 }

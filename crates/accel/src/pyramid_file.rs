@@ -76,23 +76,11 @@ impl FilePyramid {
         let dims = header.dims;
         // Float data: the finite range first (what NaN and ±∞ are replaced by, as the loaders
         // replace them), counting what is replaced.
-        let mut non_finite = 0u64;
-        let value_range = match header.type_range() {
-            Some(range) => range,
+        let (value_range, non_finite) = match header.type_range() {
+            Some(range) => (range, 0),
             None => {
-                let mut lo_hi = (f64::INFINITY, f64::NEG_INFINITY);
-                // A range of NaN leaves NaN and ±∞ as NaN, not replaced by a range's ends.
-                header.for_each_slab(0..dims.z, 8, (f64::NAN, f64::NAN), |_, slab| {
-                    for i in 0..slab.voxel_count() {
-                        let v = slab.raw_value(i);
-                        if v.is_finite() {
-                            lo_hi = (lo_hi.0.min(v), lo_hi.1.max(v));
-                        } else {
-                            non_finite += 1;
-                        }
-                    }
-                })?;
-                if lo_hi.0 <= lo_hi.1 { lo_hi } else { (0.0, 0.0) }
+                let (lo_hi, non_finite) = header.finite_survey(0..dims.z)?;
+                (if lo_hi.0 <= lo_hi.1 { lo_hi } else { (0.0, 0.0) }, non_finite)
             }
         };
         let empty = match header.dtype {
@@ -182,9 +170,10 @@ impl FilePyramid {
         let dims = self.header.dims;
         let slice_voxels = (dims.x * dims.y) as usize;
         self.held = (self.held_from..self.levels.len())
-            .map(|l| Vec::with_capacity(self.levels[l].dims.as_uvec3_product()))
+            .map(|l| Vec::with_capacity(self.levels[l].dims.as_u64vec3().element_product() as usize))
             .collect();
-        self.block_ranges = vec![(f32::INFINITY, f32::NEG_INFINITY); self.blocks.as_uvec3_product()];
+        self.block_ranges =
+            vec![(f32::INFINITY, f32::NEG_INFINITY); self.blocks.as_u64vec3().element_product() as usize];
         let mut pending: Vec<Option<Vec<f32>>> = vec![None; self.levels.len()];
         let slice_bytes = (slice_voxels * self.header.dtype.size_bytes()) as u64;
         let slices = (PASS_SLAB_BYTES / slice_bytes.max(1)).clamp(1, u64::from(dims.z)) as u32;
@@ -282,7 +271,7 @@ impl FilePyramid {
         if level >= self.held_from {
             let d = self.levels[level].dims;
             let held = &self.held[level - self.held_from];
-            let mut out = Vec::with_capacity((hi - lo).as_uvec3_product());
+            let mut out = Vec::with_capacity((hi - lo).as_u64vec3().element_product() as usize);
             for z in lo.z..hi.z {
                 for y in lo.y..hi.y {
                     let row = ((z * d.y + y) * d.x) as usize;
@@ -319,17 +308,6 @@ impl FilePyramid {
     }
 }
 
-/// Voxel counts of boxes, as `usize`.
-trait Product {
-    fn as_uvec3_product(&self) -> usize;
-}
-
-impl Product for UVec3 {
-    fn as_uvec3_product(&self) -> usize {
-        self.x as usize * self.y as usize * self.z as usize
-    }
-}
-
 impl PyramidSource for FilePyramid {
     fn name(&self) -> &str {
         &self.header.name
@@ -349,25 +327,13 @@ impl PyramidSource for FilePyramid {
 
     fn read_box(&self, level: usize, lo: IVec3, dims: UVec3) -> Result<BoxTexels, String> {
         let level_dims = self.levels.get(level).ok_or_else(|| format!("no level {level}"))?.dims;
-        if level >= self.held_from {
-            let held = &self.held[level - self.held_from];
-            let values = clamped_indices(level_dims, lo, dims).map(|i| f64::from(held[i]));
-            return Ok(texels_of(&self.template, self.kind, values));
-        }
-        // The box clamped to the level, read once; the asked voxels repeat its faces.
+        // The box clamped to the level, read once; the asked voxels repeat its faces, which is
+        // clamping the same indices to the read box.
         let n = level_dims.as_ivec3() - 1;
-        let clo = lo.clamp(IVec3::ZERO, n).as_uvec3();
-        let chi = (lo + dims.as_ivec3() - 1).clamp(IVec3::ZERO, n).as_uvec3() + 1;
-        let values = self.values(level, clo, chi)?;
-        let size = chi - clo;
-        let local = clamped_indices(level_dims, lo, dims).map(|i| {
-            let (x, y, z) = (
-                i as u32 % level_dims.x,
-                i as u32 / level_dims.x % level_dims.y,
-                i as u32 / (level_dims.x * level_dims.y),
-            );
-            f64::from(values[(((z - clo.z) * size.y + (y - clo.y)) * size.x + (x - clo.x)) as usize])
-        });
+        let clo = lo.clamp(IVec3::ZERO, n);
+        let chi = (lo + dims.as_ivec3() - 1).clamp(IVec3::ZERO, n) + 1;
+        let values = self.values(level, clo.as_uvec3(), chi.as_uvec3())?;
+        let local = clamped_indices((chi - clo).as_uvec3(), lo - clo, dims).map(|i| f64::from(values[i]));
         Ok(texels_of(&self.template, self.kind, local))
     }
 

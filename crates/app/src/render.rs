@@ -147,7 +147,9 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
             Some(crate::zarr_input::stream(one, &primary_raw, args.inputs.memory_mb)?)
         }
         [one] if crate::zarr_input::graph_streams(&source) => {
-            crate::zarr_input::stream_file(one, &primary_raw, args.inputs.memory_mb)?
+            crate::zarr_input::stream_file(one, &primary_raw, args.inputs.memory_mb, |line| {
+                crate::stdout::eprintln_escaped!("{line}")
+            })?
         }
         [one] => {
             crate::zarr_input::refuse_large_file(one, &primary_raw)?;

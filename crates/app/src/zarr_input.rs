@@ -51,8 +51,15 @@ const FILE_PYRAMID_EDGE: u32 = 64;
 /// voxels exceed the memory budget (`memory_mb`, default [`DEFAULT_CHUNK_CACHE_MB`]) is streamed
 /// from the file brick by brick (`volgraph_accel::pyramid_file::FilePyramid`: one pass builds
 /// the coarse levels, a quarter of the budget holds them), never read whole; `None` for a
-/// smaller one (read in core) or a format read only whole (NIfTI, compressed).
-pub fn stream_file(path: &Path, options: &LoadOptions<'_>, memory_mb: Option<u64>) -> anyhow::Result<Option<Streamed>> {
+/// smaller one (read in core) or a format read only whole (NIfTI, compressed). `announce` is
+/// told, before the opening pass, that it starts (the command line prints it: the pass takes a
+/// while on a big file; the Python API stays quiet).
+pub fn stream_file(
+    path: &Path,
+    options: &LoadOptions<'_>,
+    memory_mb: Option<u64>,
+    announce: impl FnOnce(&str),
+) -> anyhow::Result<Option<Streamed>> {
     let Ok(mut header) = volgraph_accel::load::VolumeHeader::read(path, options) else { return Ok(None) };
     let budget = memory_mb.unwrap_or(DEFAULT_CHUNK_CACHE_MB) << 20;
     let bytes = header.dims.as_u64vec3().element_product() * header.dtype.size_bytes() as u64;
@@ -62,12 +69,12 @@ pub fn stream_file(path: &Path, options: &LoadOptions<'_>, memory_mb: Option<u64
     if let Some(spacing) = options.raw.spacing {
         header.spacing = spacing;
     }
-    // The pass takes a while on a big file (about 6 s a GiB here): say so before it starts.
-    crate::stdout::eprintln_escaped!(
-        "note: {}: more than --memory-mb {}: reading it once to build its coarse levels, then brick by brick",
+    // The pass takes a while on a big file (about 4 s a GiB here): say so before it starts.
+    announce(&format!(
+        "{}: more than --memory-mb {}: reading it once to build its coarse levels, then brick by brick",
         path.display(),
         budget >> 20
-    );
+    ));
     let started = std::time::Instant::now();
     let source = volgraph_accel::pyramid_file::FilePyramid::open(header, FILE_PYRAMID_EDGE, budget / 4)
         .map_err(|e| anyhow!("{e}"))?;

@@ -2,8 +2,9 @@
 //! front-to-back combination of one piece's fragments, and the gather onto rank 0.
 //!
 //! A frame's compositing touches a few times the image's bytes, so every copy shows. Allocating
-//! messages and pieces anew each frame made the kernel fault in and zero every page (about half
-//! the time of a 1024² composite); a [`Compositor`] keeps its messages. And the pieces are
+//! messages and pieces anew each frame made the kernel fault in and zero every page (2 ranks at
+//! 1024²: 23 ms with fresh buffers, 5.6 with kept ones, under perf); a [`Compositor`] keeps its
+//! messages. And the pieces are
 //! composited in place, in the caller's own image: this process's pixels stay where they are,
 //! messages in front of them are laid over them and messages behind under them (over is
 //! associative), and rank 0's image becomes the final one when the others' pieces arrive.

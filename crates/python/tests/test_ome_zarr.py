@@ -166,8 +166,10 @@ def test_a_store_streams_brick_by_brick_as_the_cli_streams_it(tmp_path):
 
 def test_a_raw_file_over_memory_mb_streams_from_the_file(tmp_path):
     """Issue 48 item 4 from Python: `Renderer.stream` of a raw file larger than memory_mb
-    streams it from the file (no store), and the image equals the file read in core (within
-    1/255 linear: bricks land in whichever atlas slot is free, as between a store and memory)."""
+    streams it from the file (no store), and the image equals the file read in core: within
+    1.5/255 linear, the bound of the store test above — a brick lands in whichever atlas slot is
+    free when its read finishes, and lavapipe's fixed-point filter weights follow the atlas
+    position (0 measured in three runs here; a brick of the wrong level or place is far over)."""
     z, y, x = np.mgrid[0:256, 0:256, 0:288].astype(np.float32)
     shell = np.abs(np.sqrt((x - 140) ** 2 + (y - 128) ** 2 + (z - 120) ** 2) - 80)
     voxels = (255 * np.clip(1 - shell / 6, 0, None)).astype(np.uint8)

@@ -254,7 +254,14 @@ impl VolumeHeader {
     /// The finite (min, max) of the values in planes `z`, read a slab at a time (a float file's
     /// range, which no type fixes); `(+∞, −∞)` when none is finite.
     pub fn finite_range(&self, z: std::ops::Range<u32>) -> Result<(f64, f64), LoadError> {
+        self.finite_survey(z).map(|(range, _)| range)
+    }
+
+    /// [`Self::finite_range`] and how many values are NaN or infinite (what a reader replaces
+    /// by the range's ends, as the loaders do).
+    pub fn finite_survey(&self, z: std::ops::Range<u32>) -> Result<((f64, f64), u64), LoadError> {
         let mut lo_hi = (f64::INFINITY, f64::NEG_INFINITY);
+        let mut non_finite = 0u64;
         // A range of NaN leaves NaN and ±∞ as NaN: with (0, 1) they were read as 0 and 1, and a
         // float file with a NaN got a range reaching 0.
         self.for_each_slab(z, 8, (f64::NAN, f64::NAN), |_, slab| {
@@ -262,10 +269,12 @@ impl VolumeHeader {
                 let v = slab.raw_value(i);
                 if v.is_finite() {
                     lo_hi = (lo_hi.0.min(v), lo_hi.1.max(v));
+                } else {
+                    non_finite += 1;
                 }
             }
         })?;
-        Ok(lo_hi)
+        Ok((lo_hi, non_finite))
     }
 }
 

@@ -188,7 +188,7 @@ impl Renderer {
         } else {
             // A volume file: streamed from the file when its voxels exceed the budget, else
             // read in core as `volume = path` reads it (it fits).
-            match crate::zarr_input::stream_file(path, &options, memory_mb)? {
+            match crate::zarr_input::stream_file(path, &options, memory_mb, |_| ())? {
                 Some(streamed) => streamed,
                 None => {
                     let shown = crate::scene::load_shown_volume(&[path.to_path_buf()], None, &options)?;
@@ -216,7 +216,7 @@ impl Renderer {
         let options = volgraph_accel::load::LoadOptions { frame, ..Default::default() };
         // A file over the memory budget is streamed from the file, as `--volume` does; a graph
         // that holds its volume whole refuses one too large to read.
-        if streams && let Some(streamed) = crate::zarr_input::stream_file(path, &options, None)? {
+        if streams && let Some(streamed) = crate::zarr_input::stream_file(path, &options, None, |_| ())? {
             self.notes.extend(streamed.notes);
             self.set_volume(streamed.coarsest, false);
             self.pyramid = Some(streamed.source);

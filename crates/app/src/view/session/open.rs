@@ -37,7 +37,10 @@ impl LiveSession {
                 Some((one.clone(), crate::zarr_input::stream(one, &args.raw, args.memory_mb)?))
             }
             [one] if crate::zarr_input::graph_streams(&source) => {
-                crate::zarr_input::stream_file(one, &args.raw, args.memory_mb)?.map(|s| (one.clone(), s))
+                crate::zarr_input::stream_file(one, &args.raw, args.memory_mb, |line| {
+                    crate::stdout::eprintln_escaped!("{line}")
+                })?
+                .map(|s| (one.clone(), s))
             }
             [one] => {
                 crate::zarr_input::refuse_large_file(one, &args.raw)?;

@@ -1,7 +1,8 @@
 //! Sort-last decomposition (`docs/scaling.md`): a kd-tree over the brick grid splits a volume
-//! into one box per process, balanced by the voxels visible under the transfer function, and
-//! gives, for any eye position, an order of the boxes in which every ray from the eye meets them
-//! front to back — the order their images composite in with the *over* operator.
+//! into one box per process, balanced by the voxels visible under the transfer function (at the
+//! last level, by the bounding boxes of those a process holds), and gives, for any eye position,
+//! an order of the boxes in which every ray from the eye meets them front to back — the order
+//! their images composite in with the *over* operator.
 //!
 //! The tree is k-ary where radix-k compositing (Peterka et al. 2009) wants it: a node splits
 //! into `factors[level]` slabs along one axis, so each compositing round combines the images of
@@ -147,8 +148,10 @@ impl KdTree {
     /// Splits the volume of `weights` into `factors.iter().product()` boxes: the top node into
     /// `factors[0]` slabs along its longest axis that can be split, each of those into
     /// `factors[1]`, and so on; every plane lies on a brick face and is placed so that the
-    /// slabs' weights are as equal as the bricks allow. A node with no weight splits by voxel
-    /// count (equal volume). Ranks are numbered in tree order, so the ranks of any node are
+    /// slabs' weights are as equal as the bricks allow — at the last level, whose slabs are
+    /// processes' boxes, so that the largest bounding box of weighted bricks a slab holds is
+    /// smallest (a process holds that box). A node with no weight splits by voxel count (equal
+    /// volume). Ranks are numbered in tree order, so the ranks of any node are
     /// consecutive.
     pub fn balanced(weights: &BrickWeights, factors: &[usize]) -> Result<Self, SplitError> {
         if factors.contains(&0) || factors.is_empty() {
@@ -204,24 +207,31 @@ impl KdTree {
             let b = slab(lo, hi);
             if total_visible > 0 { weights.weight_of(&b) as f64 } else { b.voxels() as f64 }
         };
-        let total = weight(bx.lo[axis], bx.hi[axis]);
-        // Greedy planes: each at the face whose weight below best matches its share, leaving at
-        // least one face for every plane still to place.
-        let mut at = Vec::with_capacity(parts - 1);
-        let mut from = 0usize;
-        for i in 1..parts {
-            let target = total * i as f64 / parts as f64;
-            let last = candidates.len() - (parts - 1 - i) - 1;
-            let best = (from..=last)
-                .min_by(|&a, &b| {
-                    let da = (weight(bx.lo[axis], candidates[a]) - target).abs();
-                    let db = (weight(bx.lo[axis], candidates[b]) - target).abs();
-                    da.total_cmp(&db)
-                })
-                .unwrap_or(from);
-            at.push(candidates[best]);
-            from = best + 1;
-        }
+        let at = if total_visible > 0 && level + 1 == self.factors.len() {
+            // The children are processes' boxes, and a process holds the bounding box of its
+            // weighted bricks: balance those boxes, not the weights inside them.
+            HeldBoxes::along(weights, bx, axis).planes(&candidates, parts)
+        } else {
+            let total = weight(bx.lo[axis], bx.hi[axis]);
+            // Greedy planes: each at the face whose weight below best matches its share, leaving
+            // at least one face for every plane still to place.
+            let mut at = Vec::with_capacity(parts - 1);
+            let mut from = 0usize;
+            for i in 1..parts {
+                let target = total * i as f64 / parts as f64;
+                let last = candidates.len() - (parts - 1 - i) - 1;
+                let best = (from..=last)
+                    .min_by(|&a, &b| {
+                        let da = (weight(bx.lo[axis], candidates[a]) - target).abs();
+                        let db = (weight(bx.lo[axis], candidates[b]) - target).abs();
+                        da.total_cmp(&db)
+                    })
+                    .unwrap_or(from);
+                at.push(candidates[best]);
+                from = best + 1;
+            }
+            at
+        };
         let mut children = Vec::with_capacity(parts);
         let mut lo = bx.lo[axis];
         for i in 0..parts {
@@ -278,6 +288,104 @@ impl KdTree {
             Node::Split { axis, at, .. } => slab_order(eye_voxels[*axis], at),
             Node::Leaf { .. } => vec![0],
         }
+    }
+}
+
+/// The bounding boxes of the weighted bricks of a box's slabs along one axis: what a process
+/// whose box is such a slab holds (`render --distributed` holds only the bricks the view needs,
+/// and their bounding box is what it reads). One record per brick layer of the box along the
+/// axis, so the box of any slab is a union over its layers.
+struct HeldBoxes {
+    bx: VoxelBox,
+    axis: usize,
+    brick: u32,
+    dims: UVec3,
+    /// Per brick layer along `axis` (from `bx.lo`), the weighted bricks' bounding box in the
+    /// layer, in bricks (`None`: no weighted brick).
+    layers: Vec<Option<(UVec3, UVec3)>>,
+}
+
+impl HeldBoxes {
+    fn along(weights: &BrickWeights, bx: VoxelBox, axis: usize) -> Self {
+        let brick = weights.brick;
+        let n = BrickWeights::bricks(weights.dims, brick);
+        let (lo, hi) = (bx.lo / brick, ((bx.hi + UVec3::splat(brick - 1)) / brick).min(n));
+        let mut layers = vec![None::<(UVec3, UVec3)>; (hi[axis] - lo[axis]) as usize];
+        for z in lo.z..hi.z {
+            for y in lo.y..hi.y {
+                for x in lo.x..hi.x {
+                    if weights.weight[(x + n.x * (y + n.y * z)) as usize] == 0 {
+                        continue;
+                    }
+                    let b = UVec3::new(x, y, z);
+                    let layer = &mut layers[(b[axis] - lo[axis]) as usize];
+                    *layer = Some(match *layer {
+                        Some((l, h)) => (l.min(b), h.max(b + UVec3::ONE)),
+                        None => (b, b + UVec3::ONE),
+                    });
+                }
+            }
+        }
+        Self { bx, axis, brick, dims: weights.dims, layers }
+    }
+
+    /// The brick layer holding voxel plane `p` along the axis (a brick face or the box's end).
+    fn layer_at(&self, p: u32) -> usize {
+        (p.div_ceil(self.brick) - self.bx.lo[self.axis] / self.brick) as usize
+    }
+
+    /// The voxels of the bounding box of the weighted bricks between planes `from` and `to`,
+    /// within the slab.
+    fn held(&self, from: u32, to: u32) -> u64 {
+        let (a, b) = (self.layer_at(from).min(self.layers.len()), self.layer_at(to).min(self.layers.len()));
+        let bound = self.layers[a..b].iter().flatten().copied().reduce(|(l0, h0), (l1, h1)| (l0.min(l1), h0.max(h1)));
+        let Some((l, h)) = bound else { return 0 };
+        let mut slab = self.bx;
+        slab.lo[self.axis] = from;
+        slab.hi[self.axis] = to;
+        VoxelBox::new((l * self.brick).max(slab.lo), (h * self.brick).min(self.dims).min(slab.hi)).voxels()
+    }
+
+    /// The `parts - 1` planes among `candidates` (increasing) that make the largest slab's held
+    /// box smallest (then their sum): exact, by dynamic programming over the planes.
+    fn planes(&self, candidates: &[u32], parts: usize) -> Vec<u32> {
+        // Plane positions: the box's start, the candidates, its end.
+        let mut p = Vec::with_capacity(candidates.len() + 2);
+        p.push(self.bx.lo[self.axis]);
+        p.extend_from_slice(candidates);
+        p.push(self.bx.hi[self.axis]);
+        let m = p.len();
+        let held: Vec<Vec<u64>> =
+            (0..m).map(|i| (0..m).map(|j| if i < j { self.held(p[i], p[j]) } else { 0 }).collect()).collect();
+        // cost[k][j]: the best (largest, sum) of k slabs covering p[0]..p[j]; from[k][j] the
+        // start of the last of them.
+        let mut cost = vec![vec![(u64::MAX, u64::MAX); m]; parts + 1];
+        let mut from = vec![vec![0usize; m]; parts + 1];
+        cost[0][0] = (0, 0);
+        for k in 1..=parts {
+            for j in k..m {
+                for i in (k - 1)..j {
+                    let (largest, sum) = cost[k - 1][i];
+                    if largest == u64::MAX {
+                        continue;
+                    }
+                    let h = held[i][j];
+                    let c = (largest.max(h), sum + h);
+                    if c < cost[k][j] {
+                        cost[k][j] = c;
+                        from[k][j] = i;
+                    }
+                }
+            }
+        }
+        let mut at = Vec::with_capacity(parts - 1);
+        let mut j = m - 1;
+        for k in (2..=parts).rev() {
+            j = from[k][j];
+            at.push(p[j]);
+        }
+        at.reverse();
+        at
     }
 }
 
@@ -404,6 +512,33 @@ mod tests {
         }
         let tree = KdTree::balanced(&w, &[2]).expect("splits");
         assert_eq!(tree.boxes[0].hi.x, 32, "{:?}", tree.boxes);
+    }
+
+    /// A dense cluster at one end and two lone bricks further on: balancing the weights puts
+    /// the plane inside the cluster, and the other process's box must then reach from there to
+    /// the last lone brick. The processes hold the bounding boxes of their weighted bricks, so
+    /// the plane goes where the larger of those is smallest.
+    #[test]
+    fn the_split_balances_the_boxes_processes_hold() {
+        let dims = UVec3::new(256, 32, 32);
+        let mut w = BrickWeights::zeros(dims, 16);
+        for layer in [0, 1, 2, 3] {
+            for (y, z) in [(0, 0), (16, 0), (0, 16), (16, 16)] {
+                let i = w.brick_of(UVec3::new(layer * 16, y, z));
+                w.weight[i] = 16 * 16 * 16;
+            }
+        }
+        for layer in [8, 15] {
+            let i = w.brick_of(UVec3::new(layer * 16, 0, 0));
+            w.weight[i] = 16 * 16 * 16;
+        }
+        let tree = KdTree::balanced(&w, &[2]).expect("splits");
+        assert_tiles(&tree);
+        let layers = HeldBoxes::along(&w, VoxelBox::new(UVec3::ZERO, dims), 0);
+        let held: Vec<u64> = tree.boxes.iter().map(|b| layers.held(b.lo.x, b.hi.x)).collect();
+        // The best split: the cluster (64 × 32 × 32) on one side, the lone bricks (from 128 to
+        // 256, one brick across) on the other; balancing weights held 224 × 32 × 32.
+        assert_eq!(held, vec![64 * 32 * 32, 128 * 16 * 16], "{:?}", tree.boxes);
     }
 
     #[test]

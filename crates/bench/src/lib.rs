@@ -23,6 +23,7 @@ pub mod graphs;
 pub mod live;
 pub mod load;
 pub mod multi;
+pub mod multi_toggle;
 pub mod report_files;
 pub mod slices;
 pub mod stream;

@@ -347,6 +347,38 @@ fn a_new_transfer_function_reclassifies_the_blocks() {
     assert!(changed > 2.0 / 255.0, "the two TFs give visibly different images");
 }
 
+#[test]
+fn a_step_changed_in_place_draws_what_a_fresh_build_draws() {
+    // The viewer's level of detail doubles the step while the camera moves and restores it at
+    // rest. The node updates in place (a rebuilt node would remake what it derives from its
+    // inputs), keeping the half-voxel step's variant (the exact correction's square root) for
+    // the way back: each frame must equal a fresh build at its step, exactly.
+    let cases = cases();
+    let case = &cases[0];
+    let camera = &CAMERAS[1];
+    let registry = builtin_registry();
+    let source = graph_source("modern/fastest.ron");
+    let (half, mut runtime, _) = render_fastest(case, camera, &[]);
+    let mut options = CompileOptions::new(SIZE, SIZE);
+    options.param_overrides.insert("march.threshold".into(), ron::Value::from(T));
+    options.scene = volgraph_core::runtime::scene_values_of(&volgraph_core::runtime::VolumeDesc::of(&case.volume));
+    let mut frame_at = |step: f64| {
+        let mut options = options.clone();
+        options.param_overrides.insert("march.step_voxels".into(), ron::Value::from(step));
+        let plan = volgraph_core::compile("modern/fastest.ron", &source, &registry, &options).expect("compiles");
+        let report = runtime.apply(plan, &registry).expect("applies");
+        assert_eq!((report.nodes_created, report.pipelines_built), (0, 0), "step {step}: {report:?}");
+        runtime.render(CameraData::from_orbit(camera, (SIZE, SIZE))).expect("frame");
+        runtime.read_output("image").expect("image")
+    };
+    let coarse = frame_at(1.0);
+    let back = frame_at(0.5);
+    let (fresh_coarse, ..) = render_fastest(case, camera, &[("march.step_voxels", ron::Value::from(1.0))]);
+    assert_eq!(diff_reference(&coarse, &as_reference(&fresh_coarse)).0, 0.0, "step 1 in place");
+    assert_eq!(diff_reference(&back, &as_reference(&half)).0, 0.0, "back to step 0.5 in place");
+    assert!(diff_reference(&coarse, &as_reference(&half)).0 > 0.0, "the two steps draw different images");
+}
+
 /// `raycast_compute` maps consecutive invocations to 4×2 tiles where the workgroup's sides allow
 /// it (`invocation_pixel` in common/workgroup_pixel.wgsl, which `raycast_bricks` shares) and to
 /// rows otherwise: every shape, tiled or not, must write every pixel exactly once with its own

@@ -57,9 +57,11 @@ fn a_kind_that_takes_the_sampling_block_compiles_the_jitter_it_asks_for() {
 
 #[test]
 fn in_place_blocks_update_in_place_and_rebuild_blocks_rebuild() {
-    let cases: [(&str, &str, ParamValue, bool); 10] = [
+    let cases: [(&str, &str, ParamValue, bool); 11] = [
         // The raycasters' uniform values.
         ("raycast", "step_voxels", ParamValue::Float(0.25), true),
+        // The level of detail's doubled step: the node holds both correction variants.
+        ("raycast_compute", "step_voxels", ParamValue::Float(1.0), true),
         ("raycast_compute", "ambient", ParamValue::Float(0.3), true),
         ("raycast_bricks", "threshold", ParamValue::Float(0.9), true),
         ("antialias", "contrast", ParamValue::Float(0.2), true),

@@ -194,7 +194,14 @@ impl Viewer {
                     session.runtime.set_light(light);
                     Vec::new()
                 }
-                Action::Labels(edit) => session.edit_labels(&edit),
+                Action::Labels(edit) => {
+                    // A label shown, hidden or faded changes the picture as a TF edit does:
+                    // coarse frames until input rests, so the change shows at once.
+                    if edit != crate::view::label_list::LabelEdit::Save {
+                        self.frames.moved();
+                    }
+                    session.edit_labels(&edit)
+                }
                 Action::LabelSearch(text) => {
                     session.set_label_search(text);
                     Vec::new()

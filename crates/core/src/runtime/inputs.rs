@@ -149,12 +149,15 @@ impl InputStore {
             volume.spacing.to_array().map(f64::to_bits).hash(h);
             volume.value_range.0.to_bits().hash(h);
             volume.value_range.1.to_bits().hash(h);
-            match &volume.data {
-                VoxelData::U8(v) => v.hash(h),
-                VoxelData::U16(v) => v.hash(h),
-                VoxelData::I16(v) => v.hash(h),
-                VoxelData::F32(v) => v.iter().map(|x| x.to_bits()).for_each(|b| b.hash(h)),
-            }
+            let bytes: &[u8] = match &volume.data {
+                VoxelData::U8(v) => v,
+                VoxelData::U16(v) => bytemuck::cast_slice(v),
+                VoxelData::I16(v) => bytemuck::cast_slice(v),
+                VoxelData::F32(v) => bytemuck::cast_slice(v),
+            };
+            // The voxels by a fast fingerprint (every recompile binds them again), and their type.
+            std::mem::discriminant(&volume.data).hash(h);
+            super::fingerprint::fingerprint(bytes).hash(h);
         });
         let desc = VolumeDesc::of(volume);
         let format = volume_texture_format(gpu, volume);

@@ -27,6 +27,7 @@
 mod apply;
 mod bypass;
 pub mod create;
+mod fingerprint;
 pub use volgraph_compiler::reflect;
 pub mod footprint;
 pub mod frame;

@@ -137,3 +137,19 @@ fn fields_after_the_data_file_and_non_finite_matrices_are_named() {
     let err = load_volume(&dir.join("nan.mhd"), &RawOptions::default()).expect_err("NaN matrix").to_string();
     assert!(err.contains("nan.mhd:2:") && err.contains("nine finite numbers"), "{err}");
 }
+
+/// `Offset` is the first stored voxel's centre; the volume's origin is its world-lowest voxel's
+/// after the reorder (file axis 0 runs along −x here: it starts 2 mm further along x).
+#[test]
+fn the_offset_places_the_volume() {
+    let dir = common::temp_dir("mhd-offset");
+    std::fs::write(dir.join("f.raw"), [0u8; 8]).expect("write");
+    let header = "NDims = 3\nTransformMatrix = -1 0 0 0 1 0 0 0 1\nOffset = 10 20 30\nElementSpacing = 2 1 1\nDimSize = 2 2 2\nElementType = MET_UCHAR\nElementDataFile = f.raw\n";
+    std::fs::write(dir.join("f.mhd"), header).expect("write");
+    let loaded = load_volume(&dir.join("f.mhd"), &RawOptions::default()).expect("loads");
+    assert_eq!(loaded.volume.meta.origin, Some(DVec3::new(8.0, 20.0, 30.0)));
+    let bad = header.replace("Offset = 10 20 30", "Offset = 10 inf 30");
+    std::fs::write(dir.join("bad.mhd"), bad).expect("write");
+    let err = load_volume(&dir.join("bad.mhd"), &RawOptions::default()).expect_err("infinite offset").to_string();
+    assert!(err.contains("bad.mhd:3:") && err.contains("three finite numbers"), "{err}");
+}

@@ -275,3 +275,66 @@ fn an_ras_space_is_turned_into_lps() {
     assert_eq!(scanner.volume.data, volgraph_accel::volume::VoxelData::U8(data));
     assert_eq!(scanner.volume.meta.frame, WorldFrame::Named("scanner-xyz".into()));
 }
+
+/// `space origin` is the first stored voxel's centre; after the voxels are reordered into world
+/// order the volume's origin is its world-lowest voxel's centre (a flipped axis starts at its
+/// other end), in LPS for an anatomical space (RAS origins negate x and y).
+#[test]
+fn the_space_origin_places_the_volume_in_the_patient_frame() {
+    let dir = common::temp_dir("nrrd-origin");
+    let world = ramp(UVec3::new(4, 3, 2));
+    let stored = stored_flipped_and_swapped(&world);
+    let extra = "space directions: (0,-1.5,0) (1,0,0) (0,0,-2)\nspace origin: (10, 20, 30)\n";
+    let path = write_nrrd(&dir, &stored, false, false, false, extra);
+    let loaded = load_volume(&path, &RawOptions::default()).expect("load");
+    // y: 20 − 1.5 · (3 − 1); z: 30 − 2 · (2 − 1).
+    assert_eq!(loaded.volume.meta.origin, Some(DVec3::new(10.0, 17.0, 28.0)));
+
+    let ras = ramp(UVec3::new(4, 3, 2));
+    let text = std::fs::read(write_nrrd(
+        &dir,
+        &ras,
+        false,
+        false,
+        false,
+        "space directions: (1,0,0) (0,1,0) (0,0,1)\nspace origin: (5,6,7)\n",
+    ))
+    .expect("read");
+    let text = String::from_utf8_lossy(&text).replace("left-posterior-superior", "right-anterior-superior");
+    let ras_path = dir.join("ras.nrrd");
+    std::fs::write(&ras_path, text.as_bytes()).expect("write");
+    let loaded = load_volume(&ras_path, &RawOptions::default()).expect("load");
+    // LPS (−5, −6, 7); x and y run towards −LPS in the file: the lowest voxel is 3 and 2 away.
+    assert_eq!(loaded.volume.meta.origin, Some(DVec3::new(-8.0, -8.0, 7.0)));
+}
+
+/// A segmentation saved on a cropped grid (as 3D Slicer saves a `.seg.nrrd`: only the extent
+/// its segments cover) lands on its scan: the scan's voxel at the segmentation's origin maps to
+/// the segmentation's first voxel. Before `space origin` was read both sat at 0 and the
+/// segment drew 2 voxels off.
+#[test]
+fn a_segmentation_on_a_cropped_grid_lands_on_its_scan() {
+    let dir = common::temp_dir("nrrd-cropped-seg");
+    let mut scan = ramp(UVec3::splat(8));
+    scan.name = "scan".into();
+    let mut seg = ramp(UVec3::splat(4));
+    seg.name = "seg".into();
+    let directions = "space directions: (1,0,0) (0,1,0) (0,0,1)\n";
+    let scan = load_volume(
+        &write_nrrd(&dir, &scan, false, false, false, &format!("{directions}space origin: (-4,-4,-4)\n")),
+        &RawOptions::default(),
+    )
+    .expect("scan")
+    .volume;
+    let seg = load_volume(
+        &write_nrrd(&dir, &seg, false, false, false, &format!("{directions}space origin: (-2,-2,-2)\n")),
+        &RawOptions::default(),
+    )
+    .expect("seg")
+    .volume;
+    let map = volgraph_accel::fusion::TextureMap::between(&scan, &seg).expect("one frame");
+    // The scan's voxel (2, 2, 2) centre, in its texture space, is the segmentation's first.
+    let at_scan = (DVec3::splat(2.0) + 0.5) / 8.0;
+    let at_seg = map.apply(at_scan);
+    assert!((at_seg - DVec3::splat(0.5 / 4.0)).abs().max_element() < 1e-12, "{at_seg}");
+}

@@ -7,7 +7,9 @@
 //! `ElementNumberOfChannels` (must be 1), `TransformMatrix` (`Rotation`, `Orientation`: the
 //! direction of each file axis; flips and axis swaps are honoured by reordering the voxels,
 //! rotated or oblique directions are rejected, see [`super::AxisOrientation`]) and
-//! `ElementDataFile`, which must be the last field. Every other key (`ObjectType`, `Offset`,
+//! `ElementDataFile`, which must be the last field, and `Offset` (`Position`, `Origin`: the first
+//! voxel's centre, so two files on different grids — a scan and its segmentation, a PET on a
+//! CT — lie where their headers put them). Every other key (`ObjectType`,
 //! `AnatomicalOrientation`, …) is ignored: MetaImage headers carry free-form keys.
 
 use std::path::Path;
@@ -43,6 +45,8 @@ pub(super) fn load(path: &Path) -> Result<LoadedVolume, LoadError> {
 /// What a MetaImage header says: the layout and where and how the voxels are stored.
 struct Header {
     layout: Layout,
+    /// `Offset`: the first voxel's centre, in file order's world coordinates.
+    offset: Option<DVec3>,
     compressed: bool,
     header_size: i64,
     /// `ElementDataFile`: its value, where attached data starts, its line.
@@ -53,8 +57,9 @@ struct Header {
 }
 
 pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError> {
-    let Header { layout, compressed, header_size, data_name, data_start, data_line, mut notes } =
+    let Header { layout, offset, compressed, header_size, data_name, data_start, data_line, mut notes } =
         parse_header(path, bytes)?;
+    let origin = offset.map(|o| layout.orientation.world_origin(o, layout.dims, layout.spacing));
     let (dims, dtype) = (layout.dims, layout.dtype);
     let local = data_name.eq_ignore_ascii_case("LOCAL");
     let (data_path, stored) = if local {
@@ -79,7 +84,9 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
     };
     let mut report = LoadReport::new(VolumeFormat::MetaImage, &data_path);
     report.notes = notes;
-    finish(layout, &data, &data_path, report, HINT)
+    let mut loaded = finish(layout, &data, &data_path, report, HINT)?;
+    loaded.volume.meta.origin = origin;
+    Ok(loaded)
 }
 
 /// Where the voxels of MetaImage `path` lie when a box of them can be read by seeking: the
@@ -119,6 +126,7 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, LoadError> {
     let mut compressed = false;
     let mut data_file: Option<(String, usize, usize)> = None;
     let mut directions: Option<(usize, [DVec3; 3])> = None;
+    let mut offset: Option<DVec3> = None;
     let notes = Vec::new();
 
     for (number, text, end) in header_lines(bytes) {
@@ -207,6 +215,14 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, LoadError> {
                     }
                 }
             }
+            "offset" | "position" | "origin" => {
+                offset = Some(
+                    three(value)
+                        .filter(|o| o.iter().all(|v| v.is_finite()))
+                        .map(DVec3::from_array)
+                        .ok_or_else(|| bad("three finite numbers, e.g. `Offset = -120.5 -98 40`"))?,
+                );
+            }
             "compresseddata" => {
                 compressed = boolean(value).ok_or_else(|| bad("`True` or `False`"))?;
             }
@@ -279,5 +295,5 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, LoadError> {
     };
 
     let layout = Layout { name: stem(path), dims, dtype, order, spacing, orientation };
-    Ok(Header { layout, compressed, header_size, data_name, data_start, data_line, notes })
+    Ok(Header { layout, offset, compressed, header_size, data_name, data_start, data_line, notes })
 }

@@ -6,10 +6,11 @@
 //! directions are rejected: see [`super::AxisOrientation`]), `endian` (little when missing, noted in the report), `encoding`,
 //! `data file`, `byte skip` (≥ 0, or -1 with raw encoding: data at the end of the file) and
 //! `line skip: 0`, and `space`: an anatomical space (`right-anterior-superior`/`RAS`,
-//! `left-anterior-superior`, `left-posterior-superior`, …) turns the directions into the LPS
-//! patient frame as ITK does (`docs/rendering_model.md`, "Patient frame"); another space keeps
-//! its own axes. Ignored as harmless: comments, `key:=value` pairs, `content`,
-//! `space origin`, `kinds`, `labels`, `units`, `centers` and the other per-axis or range
+//! `left-anterior-superior`, `left-posterior-superior`, …) turns the directions and `space
+//! origin` (the first voxel's centre) into the LPS patient frame as ITK does
+//! (`docs/rendering_model.md`, "Patient frame"), so a segmentation saved on a cropped grid lands
+//! on its scan; another space keeps its own axes. Ignored as harmless: comments, `key:=value`
+//! pairs, `content`, `kinds`, `labels`, `units`, `centers` and the other per-axis or range
 //! annotations. Any other field is an error rather than a silent misreading.
 
 use std::path::Path;
@@ -32,7 +33,6 @@ const HINT: &str =
 /// Fields that do not change how the voxels are read.
 const IGNORED: &[&str] = &[
     "content",
-    "space origin",
     "space units",
     "space dimension",
     "labels",
@@ -88,11 +88,14 @@ pub(super) struct Header {
     notes: Vec<String>,
     frame: WorldFrame,
     oriented: bool,
+    /// `space origin` in the frame's coordinates (LPS for an anatomical space).
+    origin: Option<DVec3>,
 }
 
 pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError> {
-    let Header { layout, encoding, data_file, byte_skip, data_start, notes, frame, oriented } =
+    let Header { layout, encoding, data_file, byte_skip, data_start, notes, frame, oriented, origin } =
         parse_header(path, bytes)?;
+    let world_origin = origin.map(|o| layout.orientation.world_origin(o, layout.dims, layout.spacing));
     let (dims, dtype) = (layout.dims, layout.dtype);
     let missing = |field, example| LoadError::MissingField { path: path.to_path_buf(), field, example };
     let (data_path, stored) = match &data_file {
@@ -125,6 +128,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<LoadedVolume, LoadError
     report.notes = notes;
     let mut loaded = finish(layout, data, &data_path, report, HINT)?;
     loaded.volume.meta.frame = if oriented { frame } else { WorldFrame::IndexAxes };
+    loaded.volume.meta.origin = world_origin.filter(|_| oriented);
     Ok(loaded)
 }
 
@@ -167,6 +171,7 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, LoadError> {
     let mut spacing: Option<(usize, DVec3)> = None;
     let mut directions: Option<(Location, [DVec3; 3])> = None;
     let mut space: Option<String> = None;
+    let mut space_origin: Option<DVec3> = None;
     let mut order = None;
     let mut encoding = None;
     let mut data_file: Option<(String, usize)> = None;
@@ -300,6 +305,12 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, LoadError> {
             }
             "block size" | "blocksize" => {}
             "space" => space = Some(value.to_string()),
+            "space origin" => {
+                let parsed = parse_vector(value)
+                    .filter(|o| o.is_finite())
+                    .ok_or_else(|| bad("one vector of three finite numbers, e.g. `space origin: (-120.5,-98,40)`"))?;
+                space_origin = Some(parsed);
+            }
             f if IGNORED.contains(&f) => {}
             _ => {
                 return Err(LoadError::UnsupportedField {
@@ -343,6 +354,7 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, LoadError> {
     }
 
     let (frame, lps) = space.as_deref().map_or((WorldFrame::IndexAxes, None), anatomical_space);
+    let origin = space_origin.map(|o| lps.map_or(o, |flip| o * flip));
     let oriented = directions.is_some();
     let orientation = match directions {
         Some((at, d)) => {
@@ -355,7 +367,18 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header, LoadError> {
         None => super::AxisOrientation::default(),
     };
     let layout = Layout { name: stem(path), dims, dtype, order, spacing, orientation };
-    Ok(Header { layout, encoding, data_file, byte_skip, data_start, notes, frame, oriented })
+    Ok(Header { layout, encoding, data_file, byte_skip, data_start, notes, frame, oriented, origin })
+}
+
+/// The vector of a `space origin` value such as `(-120.5, -98, 40)`.
+fn parse_vector(value: &str) -> Option<DVec3> {
+    let compact: String = value.chars().filter(|c| !c.is_whitespace()).collect();
+    let components: Option<Vec<f64>> =
+        compact.strip_prefix('(')?.strip_suffix(')')?.split(',').map(|c| c.parse().ok()).collect();
+    match components.as_deref() {
+        Some(&[x, y, z]) => Some(DVec3::new(x, y, z)),
+        _ => None,
+    }
 }
 
 /// The frame of NRRD `space` value `name`, and for an anatomical space the per-axis signs that

@@ -100,6 +100,21 @@ impl AxisOrientation {
         w
     }
 
+    /// The patient-frame centre of the reordered volume's voxel (0, 0, 0) — the world-lowest
+    /// corner voxel — from the centre of the file's first voxel, `file_origin` (a header's
+    /// `space origin` or `Offset`), for a grid of `file_dims` at `spacing` (world order): a file
+    /// axis stored towards −world starts at the other end.
+    pub fn world_origin(&self, file_origin: DVec3, file_dims: UVec3, spacing: DVec3) -> DVec3 {
+        let mut origin = file_origin;
+        for i in 0..3 {
+            if self.flipped[i] {
+                let a = self.world_axis[i];
+                origin[a] -= spacing[a] * (file_dims[i].max(1) - 1) as f64;
+            }
+        }
+        origin
+    }
+
     /// Reorders voxels stored in file order (`file_dims`, file axis 0 fastest) into world order
     /// (x fastest, every axis ascending).
     pub fn reorder(&self, file_dims: UVec3, data: VoxelData) -> VoxelData {

@@ -7,7 +7,7 @@
 //! two slices per level are held. The coarse levels that fit in the budget are kept in memory;
 //! the levels between them and the file are written, as they are made, to scratch raw files in
 //! the temporary folder (`TMPDIR`; about a seventh of the file's bytes, removed when the pyramid
-//! is dropped), and a brick of any level is then one box read — level 0 from the file, the
+//! is dropped — or, where a killed process left them, by the next pyramid opened), and a brick of any level is then one box read — level 0 from the file, the
 //! others from their scratch file (a plane of the box's rows per read). The pass also keeps each
 //! 32³ block's value range, so bricks the transfer function leaves transparent are never read.
 //! Every level holds, bit for bit, what [`InCorePyramid`] holds for the whole volume (and what
@@ -66,6 +66,35 @@ impl Drop for Scratch {
         self.writer = None;
         let _ = std::fs::remove_file(&self.path);
     }
+}
+
+/// The prefix of every scratch file's name, then the owning process's id.
+const SCRATCH_PREFIX: &str = "volgraph-pyramid-";
+
+/// Removes the scratch files in `dir` whose process is gone: a process killed while streaming
+/// (no `Drop`) leaves its levels behind, up to a seventh of the file's bytes. A process is
+/// gone when the system lists no such process (`/proc/PID`; where there is no `/proc`, nothing
+/// is removed). Returns how many files were removed.
+fn remove_stale_scratch(dir: &std::path::Path) -> usize {
+    let proc = std::path::Path::new("/proc");
+    if !proc.join("self").exists() {
+        return 0;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else { return 0 };
+    let mut removed = 0;
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(pid) =
+            name.to_str().and_then(|n| n.strip_prefix(SCRATCH_PREFIX)).and_then(|rest| rest.split('-').next())
+        else {
+            continue;
+        };
+        let own = entry.file_type().is_ok_and(|t| t.is_file());
+        if own && pid.parse::<u32>().is_ok() && !proc.join(pid).exists() && std::fs::remove_file(entry.path()).is_ok() {
+            removed += 1;
+        }
+    }
+    removed
 }
 
 impl FilePyramid {
@@ -129,14 +158,16 @@ impl FilePyramid {
         self.non_finite
     }
 
-    /// Creates the scratch files of levels `1..held_from`.
+    /// Creates the scratch files of levels `1..held_from` (first removing those a killed
+    /// process left behind).
     fn open_scratch(&mut self) -> Result<(), LoadError> {
+        remove_stale_scratch(&std::env::temp_dir());
         static OPENED: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
         let n = OPENED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         for level in 1..self.held_from {
             let d = self.levels[level].dims;
             let name = format!(
-                "volgraph-pyramid-{}-{n}-level{level}_{}x{}x{}_{}.raw",
+                "{SCRATCH_PREFIX}{}-{n}-level{level}_{}x{}x{}_{}.raw",
                 std::process::id(),
                 d.x,
                 d.y,
@@ -462,5 +493,27 @@ mod tests {
         assert!(lo > 79.0 && hi < 321.0, "a NaN widened the range to {lo}..{hi}");
         assert_eq!(FilePyramid::open(header, 5, 0).expect("opens").non_finite_replaced(), nan);
         check(&path, 5);
+    }
+
+    /// A killed process's scratch files are removed by the next pyramid opened; a live
+    /// process's (this one's) and other files stay.
+    #[test]
+    fn scratch_files_of_a_gone_process_are_removed() {
+        let dir = std::env::temp_dir().join(format!("volgraph-stale-scratch-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        // Above any pid_max Linux allows (2²²): no such process.
+        let gone = dir.join(format!("{SCRATCH_PREFIX}4294967295-0-level1_2x2x2_uint8.raw"));
+        let live = dir.join(format!("{SCRATCH_PREFIX}{}-0-level1_2x2x2_uint8.raw", std::process::id()));
+        let other = dir.join(format!("{SCRATCH_PREFIX}notes.txt"));
+        for path in [&gone, &live, &other] {
+            std::fs::write(path, [0u8; 8]).expect("write");
+        }
+        let removed = remove_stale_scratch(&dir);
+        if std::path::Path::new("/proc/self").exists() {
+            assert_eq!(removed, 1);
+            assert!(!gone.exists(), "the gone process's level is removed");
+        }
+        assert!(live.exists() && other.exists(), "a live process's level and other files stay");
+        std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -6,7 +6,10 @@
 // - FUSION_LABEL_MAP: `second` is a label map: `tint` colours the scan by the visible label,
 //   `inside` keeps the scan only inside visible labels;
 // - FUSION_SCALAR: `second` is scalar with its own `second_tf`: `fuse` (two media in one place)
-//   or `add` (channels);
+//   or `add` (channels); with FUSION_OVERLAY a third volume, the label map `overlay`, lies over
+//   the pair (`tint` or `inside`, as a label map does to one scan);
+// - FUSION_LABEL_READS: one of the above samples a label map (the frame volume, `second` or
+//   `overlay`: "the label map" below);
 // - LABELS_NEAREST: labels at the nearest voxel, else each label's indicator interpolated and
 //   the largest taken (a tie to the smaller label), so no label number is ever blended.
 
@@ -26,12 +29,17 @@ var<private> fusion_scale: vec3<f32>;
 var<private> fusion_offset: vec3<f32>;
 var<private> fusion_decode: vec2<f32>;
 var<private> fusion_combine: u32;
-#if FUSION_SCALAR
-#else
+#if FUSION_LABEL_READS
 // The label map's voxels per axis, their inverse, and the label table's texel size.
 var<private> label_n: vec3<f32>;
 var<private> label_inv_n: vec3<f32>;
 var<private> label_table_texel: vec2<f32>;
+#endif
+#if FUSION_OVERLAY
+// Where the overlay lies, and what it does.
+var<private> overlay_scale: vec3<f32>;
+var<private> overlay_offset: vec3<f32>;
+var<private> overlay_combine: u32;
 #endif
 
 fn begin_fusion() {
@@ -43,8 +51,13 @@ fn begin_fusion() {
 #else
     fusion_decode = fusion.second_labels.xy;
 #endif
-#if FUSION_SCALAR
-#else
+#if FUSION_OVERLAY
+    fusion_decode = fusion.overlay_labels.xy;
+    overlay_scale = fusion.overlay_scale.xyz;
+    overlay_offset = fusion.overlay_offset.xyz;
+    overlay_combine = fusion.overlay_combine;
+#endif
+#if FUSION_LABEL_READS
     label_n = vec3<f32>(label_dims());
     label_inv_n = vec3<f32>(1.0) / label_n;
     label_table_texel = vec2<f32>(1.0) / vec2<f32>(textureDimensions(label_table));
@@ -84,9 +97,21 @@ fn label_dims() -> vec3<i32> {
     return vec3<i32>(textureDimensions(second));
 }
 #endif
+#if FUSION_OVERLAY
+@group(0) @binding(auto) var label_table: texture_2d<f32>;
+// The third volume, a label map over the scalar pair, normalized texels.
+@group(0) @binding(auto) var overlay: texture_3d<f32>;
 
-#if FUSION_SCALAR
-#else
+// The label map is the overlay.
+fn label_texel(at: vec3<f32>) -> f32 {
+    return textureSampleLevel(overlay, nearest_clamp, at, 0.0).r;
+}
+fn label_dims() -> vec3<i32> {
+    return vec3<i32>(textureDimensions(overlay));
+}
+#endif
+
+#if FUSION_LABEL_READS
 #if LABELS_NEAREST
 #else
 // Per block of UNIFORM_BLOCK³ voxels of the label map: its label + 1 where the block and a
@@ -237,14 +262,46 @@ fn fused_sample(u: vec3<f32>, s: f32) -> vec4<f32> {
     // Two media in one place: opacity 1 - (1 - a1)(1 - a2); colour the opacity-weighted mean,
     // or (channels) the sum.
     let a = 1.0 - (1.0 - p1.a) * (1.0 - p2.a);
-    if (fusion_combine == COMBINE_ADD) {
-        return vec4<f32>(p1.rgb + p2.rgb, a);
+    var fused = vec4<f32>(p1.rgb + p2.rgb, a);
+    if (fusion_combine != COMBINE_ADD) {
+        let weight = p1.a + p2.a;
+        if (!(weight > 0.0)) {
+            return vec4<f32>(0.0);
+        }
+        fused = vec4<f32>((p1.rgb + p2.rgb) * (a / weight), a);
     }
-    let weight = p1.a + p2.a;
-    if (!(weight > 0.0)) {
-        return vec4<f32>(0.0);
-    }
-    return vec4<f32>((p1.rgb + p2.rgb) * (a / weight), a);
+#if FUSION_OVERLAY
+    return overlaid(fused, u);
+#else
+    return fused;
+#endif
 #endif
 #endif
 }
+
+#if FUSION_OVERLAY
+// The premultiplied sample `fused` of the pair under the overlay at the frame volume's texture
+// point `u` (volgraph_accel::fusion::Fusion::overlaid): `inside` keeps it only where a visible
+// label lies; `tint` moves its colour towards the visible label's by the label's opacity.
+fn overlaid(fused: vec4<f32>, u: vec3<f32>) -> vec4<f32> {
+    let a = fused.a;
+    if (!(a > 0.0)) {
+        return vec4<f32>(0.0);
+    }
+    let u3 = u * overlay_scale + overlay_offset;
+    var label = 0u;
+    if (in_box(u3)) {
+        label = sample_label(u3);
+    }
+    let e = label_entry(label);
+    let visible = e.a > 0.0;
+    if (overlay_combine == COMBINE_INSIDE) {
+        return select(vec4<f32>(0.0), fused, visible);
+    }
+    if (!visible) {
+        return fused;
+    }
+    let straight = fused.rgb / a;
+    return vec4<f32>(mix(straight, e.rgb, min(e.a, 1.0)) * a, a);
+}
+#endif

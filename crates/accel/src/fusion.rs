@@ -20,6 +20,10 @@
 //! - `Add`: channels (napari's and Fiji's additive blending): colours add (no clamp: where
 //!   channels overlap the image may exceed 1, as a display saturates it), `α` as in `Fuse`.
 //!
+//! A third volume, a label map, may lie over a fused pair ([`Overlay`]: PET/CT and the organs
+//! segmented on the CT): the pair's sample tinted by the visible label, or kept only inside
+//! visible labels, as `Tint` and `Inside` do to one scan.
+//!
 //! Every opacity is corrected for the step in the frame volume's voxels, as one volume's is.
 
 use glam::DVec3;
@@ -151,6 +155,19 @@ impl Combine {
     }
 }
 
+/// A label map over a fused pair (`Fuse`, `Add`): what it does to the pair's sample (`Tint` or
+/// `Inside`, as to one scan), the map, and where a frame-volume texture point lies in it. Its
+/// labels are coloured by the fusion's `label_lut` and sampled with its `filter`.
+#[derive(Clone, Copy, Debug)]
+pub struct Overlay<'a> {
+    /// `Tint` or `Inside`.
+    pub combine: Combine,
+    /// The label map.
+    pub labels: &'a Volume,
+    /// The frame volume's texture space into the map's.
+    pub map: TextureMap,
+}
+
 /// A second volume and how samples combine, for the reference ([`crate::reference`]).
 #[derive(Clone, Copy, Debug)]
 pub struct Fusion<'a> {
@@ -164,6 +181,8 @@ pub struct Fusion<'a> {
     /// The second volume and its TF (`Tint`, `Inside`: its label map; `Fuse`, `Add`: the second
     /// scalar volume and its TF), with the map into its texture space.
     pub second: Option<(&'a Volume, &'a [[f32; 4]], TextureMap)>,
+    /// A label map over the fused pair (`Fuse`, `Add` only).
+    pub overlay: Option<Overlay<'a>>,
 }
 
 /// The label table's entry at `label` (zero past its end: hidden).
@@ -207,8 +226,39 @@ impl Fusion<'_> {
             }
             Combine::Fuse | Combine::Add => {
                 let (c2, a2) = if inside { through(second_lut, second.sample_trilinear(u2)) } else { ([0.0; 3], 0.0) };
-                fuse_media(self.combine, premultiplied(c1, a1), premultiplied(c2, a2))
+                let fused = fuse_media(self.combine, premultiplied(c1, a1), premultiplied(c2, a2));
+                match &self.overlay {
+                    Some(overlay) => self.overlaid(overlay, fused, u),
+                    None => fused,
+                }
             }
+        }
+    }
+
+    /// The premultiplied sample `fused` under the label map `overlay` at the frame volume's
+    /// texture point `u`: where no visible label lies, nothing (`Inside`) or itself (`Tint`);
+    /// where one does, itself (`Inside`) or its colour moved towards the label's by the label's
+    /// opacity, its own opacity kept (`Tint`).
+    fn overlaid(&self, overlay: &Overlay<'_>, fused: [f64; 4], u: DVec3) -> [f64; 4] {
+        let a = fused[3];
+        if !(a > 0.0) {
+            return [0.0; 4];
+        }
+        let u3 = overlay.map.apply(u);
+        let label = if in_box(u3) { sample_label(overlay.labels, u3, self.filter).0 } else { 0 };
+        let e = label_entry(self.label_lut, label);
+        let visible = e[3] > 0.0;
+        match overlay.combine {
+            Combine::Inside if !visible => [0.0; 4],
+            Combine::Tint if visible => {
+                let w = e[3].min(1.0);
+                let rgb: [f64; 3] = std::array::from_fn(|i| {
+                    let straight = fused[i] / a;
+                    (straight + (e[i] - straight) * w) * a
+                });
+                [rgb[0], rgb[1], rgb[2], a]
+            }
+            _ => fused,
         }
     }
 }

@@ -380,3 +380,43 @@ fn one_volume_for_a_graph_of_several_says_it_is_bound_to_each() {
     );
     assert!(ok && !stderr.contains("too, and no --volume"), "{stderr}");
 }
+
+/// Three volumes in one graph: `multi/pet_ct_inside_labels` binds the CT, a second scalar volume
+/// and a label map by name (each checked against the frame volume's frame), the label table
+/// given by name; the image shows only what lies inside the visible labels, so hiding them all
+/// (an ITK-SNAP table with every label invisible) leaves it empty.
+#[test]
+fn three_volumes_bind_by_name() {
+    let dir = scratch("three_volumes");
+    let render = |table: Option<&str>, out: &str| {
+        let mut args = vec![
+            "render",
+            "multi/pet_ct_inside_labels",
+            "--volume",
+            "volume=organs32",
+            "--volume",
+            "pet=organs32",
+            "--volume",
+            "labels=organs_labels32",
+            "--size",
+            "32x32",
+            "--output",
+            "image",
+            "-o",
+            out,
+        ];
+        if let Some(t) = table {
+            args.extend(["--tf", t]);
+        }
+        volgraph(&args, &dir)
+    };
+    let (ok, stderr) = render(None, "shown.exr");
+    assert!(ok && !stderr.contains("too, and no --volume"), "{stderr}");
+    let visible = |file: &str| support::read_exr(&dir.join(file)).2.iter().filter(|p| p[3] > 2.0 / 255.0).count();
+    assert!(visible("shown.exr") > 20, "the organs show inside their labels");
+    let hidden: String = (1..=6).map(|v| format!("{v} 255 0 0 1 0 1 \"label {v}\"\n")).collect();
+    std::fs::write(dir.join("hidden.txt"), hidden).expect("table");
+    let (ok, stderr) = render(Some("label_table=hidden.txt"), "hidden.exr");
+    assert!(ok, "{stderr}");
+    assert_eq!(visible("hidden.exr"), 0, "every label hidden: nothing inside");
+}

@@ -166,6 +166,7 @@ fn sparse_error(image: &Image, scene: &Scene<'_>, march: &Params, stride: u32) -
         label_lut: scene.table,
         filter,
         second: Some((scene.labels, scene.table, map)),
+        overlay: None,
     });
     let frame = CAMERA.frame(image.width, image.height);
     let pixels: Vec<(u32, u32)> = (0..image.height)
@@ -357,8 +358,13 @@ fn boundary_quality(bench: &mut Bench) -> anyhow::Result<(f64, f64)> {
         bench.runtime.render(CameraData::from_orbit(&zoomed, viewport)).map_err(|e| anyhow!(e))?;
         let image = bench.runtime.read_output("image").map_err(|e| anyhow!(e))?;
         let reference = converged.get_or_insert_with(|| {
-            let model =
-                Fusion { combine: Combine::Labels, label_lut: &table, filter: LabelFilter::Smooth, second: None };
+            let model = Fusion {
+                combine: Combine::Labels,
+                label_lut: &table,
+                filter: LabelFilter::Smooth,
+                second: None,
+                overlay: None,
+            };
             volgraph_accel::reference::render_fused_reference(
                 &fine,
                 &[[0.0; 4]; 2],

@@ -65,6 +65,10 @@ pub const FUSION_LABELS: &str = "FUSION_LABELS";
 pub const FUSION_LABEL_MAP: &str = "FUSION_LABEL_MAP";
 /// … the second volume is scalar, with its own TF (`fuse`, `add`).
 pub const FUSION_SCALAR: &str = "FUSION_SCALAR";
+/// … and a label map lies over the scalar pair (`overlay`: `tint`, `inside`).
+pub const FUSION_OVERLAY: &str = "FUSION_OVERLAY";
+/// A label map is sampled (`FUSION_LABELS`, `FUSION_LABEL_MAP` or `FUSION_OVERLAY`).
+pub const FUSION_LABEL_READS: &str = "FUSION_LABEL_READS";
 /// Label maps read at the nearest voxel (`label_filter: "nearest"`).
 pub const LABELS_NEAREST: &str = "LABELS_NEAREST";
 
@@ -85,7 +89,7 @@ pub const SCATTER: &str = "SCATTER";
 pub const RESLICE_LABELS: &str = "RESLICE_LABELS";
 
 /// Every `#if` name of the built-in passes.
-pub const BUILT_IN: [&str; 33] = [
+pub const BUILT_IN: [&str; 35] = [
     SHADING,
     PREINTEGRATION,
     TRICUBIC,
@@ -114,6 +118,8 @@ pub const BUILT_IN: [&str; 33] = [
     FUSION_LABELS,
     FUSION_LABEL_MAP,
     FUSION_SCALAR,
+    FUSION_OVERLAY,
+    FUSION_LABEL_READS,
     LABELS_NEAREST,
     BLOCK_MAJORANTS,
     REPROJECT,

@@ -38,6 +38,18 @@ volgraph_compiler::param_choice! {
 }
 
 volgraph_compiler::param_choice! {
+    /// A label map over a fused pair (`volgraph_accel::fusion::Overlay`).
+    pub enum OverlayMode {
+        /// None.
+        None = "none",
+        /// The pair's sample coloured by the visible label of `overlay`.
+        Tint = "tint",
+        /// The pair's sample only inside the visible labels of `overlay`.
+        Inside = "inside",
+    }
+}
+
+volgraph_compiler::param_choice! {
     /// How a label map is sampled between voxel centres.
     pub enum LabelFilterChoice {
         /// Each label's indicator interpolated; the largest wins (round boundaries).
@@ -58,14 +70,20 @@ volgraph_compiler::pass_params! {
         label_filter: LabelFilterChoice = Smooth,
             "smooth: each label's indicator interpolated, the largest wins (round boundaries); nearest: the nearest \
              voxel's label";
+        overlay: OverlayMode = None,
+            "with fusion fuse or add, a third volume: the label map `overlay` (through `label_table`) over the pair — \
+             tint: coloured by the visible label; inside: only inside the visible labels (PET/CT inside an organ)";
     }
 }
 
 impl FusionSettings {
     /// The settings of `params` (no fusion for a kind without the block, or in mode iso).
     pub fn of(params: &Params) -> Self {
-        let settings = Self::try_from_params(params)
-            .unwrap_or(Self { fusion: FusionMode::None, label_filter: LabelFilterChoice::Smooth });
+        let settings = Self::try_from_params(params).unwrap_or(Self {
+            fusion: FusionMode::None,
+            label_filter: LabelFilterChoice::Smooth,
+            overlay: OverlayMode::None,
+        });
         if is_iso(params) { Self { fusion: FusionMode::None, ..settings } } else { settings }
     }
 
@@ -81,6 +99,20 @@ impl FusionSettings {
         })
     }
 
+    /// The label map over a fused pair, `Tint` or `Inside` (only with `fuse` and `add`).
+    pub fn overlay(&self) -> Option<Combine> {
+        match (self.combine()?, self.overlay) {
+            (Combine::Fuse | Combine::Add, OverlayMode::Tint) => Some(Combine::Tint),
+            (Combine::Fuse | Combine::Add, OverlayMode::Inside) => Some(Combine::Inside),
+            _ => None,
+        }
+    }
+
+    /// Whether a label map is sampled (the frame volume, the second or the overlay).
+    fn reads_labels(&self) -> bool {
+        self.overlay().is_some() || self.combine().is_some_and(|c| !matches!(c, Combine::Fuse | Combine::Add))
+    }
+
     /// The `#if` names: FUSION and what the volumes are.
     pub fn defines(&self) -> Vec<&'static str> {
         let Some(combine) = self.combine() else { return Vec::new() };
@@ -90,22 +122,34 @@ impl FusionSettings {
             Combine::Tint | Combine::Inside => defines::FUSION_LABEL_MAP,
             Combine::Fuse | Combine::Add => defines::FUSION_SCALAR,
         });
-        if combine != Combine::Fuse && combine != Combine::Add && self.label_filter == LabelFilterChoice::Nearest {
-            out.push(defines::LABELS_NEAREST);
+        if self.overlay().is_some() {
+            out.push(defines::FUSION_OVERLAY);
+        }
+        if self.reads_labels() {
+            out.push(defines::FUSION_LABEL_READS);
+            if self.label_filter == LabelFilterChoice::Nearest {
+                out.push(defines::LABELS_NEAREST);
+            }
         }
         out
     }
 
-    /// The ports fusion adds: `second` (and `second_tf` for a scalar one), `label_table`.
+    /// The ports fusion adds: `second` (and `second_tf` for a scalar one), `label_table`, and
+    /// `overlay` for a label map over a scalar pair.
     pub fn ports(&self) -> Vec<PortSpec> {
         let Some(combine) = self.combine() else { return Vec::new() };
         let mut ports = Vec::new();
         if combine != Combine::Labels {
             ports.push(PortSpec::read("second", PortKind::Volume));
         }
-        match combine {
-            Combine::Fuse | Combine::Add => ports.push(PortSpec::read("second_tf", PortKind::TransferFunction)),
-            _ => ports.push(PortSpec::read("label_table", PortKind::LabelTable)),
+        if let Combine::Fuse | Combine::Add = combine {
+            ports.push(PortSpec::read("second_tf", PortKind::TransferFunction));
+        }
+        if self.overlay().is_some() {
+            ports.push(PortSpec::read("overlay", PortKind::Volume));
+        }
+        if self.reads_labels() {
+            ports.push(PortSpec::read("label_table", PortKind::LabelTable));
         }
         ports
     }
@@ -129,7 +173,11 @@ volgraph_compiler::pass_params! {
         second_offset: [f32; 4] = computed, "xyz: see second_scale.";
         first_labels: [f32; 4] = computed, "x, y: a label of the frame volume is round(x + texel · y).";
         second_labels: [f32; 4] = computed, "x, y: a label of the second volume is round(x + texel · y).";
+        overlay_scale: [f32; 4] = computed, "xyz: the overlay's texture point is u · scale + offset.";
+        overlay_offset: [f32; 4] = computed, "xyz: see overlay_scale.";
+        overlay_labels: [f32; 4] = computed, "x, y: a label of the overlay is round(x + texel · y).";
         combine: u32 = computed, "1 labels, 2 tint, 3 inside, 4 fuse, 5 add.";
+        overlay_combine: u32 = computed, "0 none, 2 tint, 3 inside.";
     }
 }
 
@@ -145,15 +193,21 @@ impl FusionMap {
             second_offset: [0.0; 4],
             first_labels: [0.0, 255.0, 0.0, 0.0],
             second_labels: [0.0, 255.0, 0.0, 0.0],
+            overlay_scale: [1.0; 4],
+            overlay_offset: [0.0; 4],
+            overlay_labels: [0.0, 255.0, 0.0, 0.0],
             combine: combine as u32 + 1,
+            overlay_combine: 0,
         }
     }
 
-    /// From the frame volume `first` and the `second` (when there is one).
+    /// From the frame volume `first`, the `second` (when there is one) and the label map over
+    /// them with what it does (when there is one).
     pub fn of_volumes(
         combine: Combine,
         first: &volgraph_accel::volume::Volume,
         second: Option<&volgraph_accel::volume::Volume>,
+        overlay: Option<(Combine, &volgraph_accel::volume::Volume)>,
     ) -> Result<Self, volgraph_accel::fusion::FrameMismatch> {
         // A texel holds (v - lo) / (hi - lo) (`Volume::normalized`), so v = lo + texel · (hi - lo).
         let decode = |v: &volgraph_accel::volume::Volume| {
@@ -167,6 +221,13 @@ impl FusionMap {
             map.second_offset = [m.offset.x as f32, m.offset.y as f32, m.offset.z as f32, 0.0];
             map.second_labels = decode(second);
         }
+        if let Some((what, labels)) = overlay {
+            let m = volgraph_accel::fusion::TextureMap::between(first, labels)?;
+            map.overlay_scale = [m.scale.x as f32, m.scale.y as f32, m.scale.z as f32, 0.0];
+            map.overlay_offset = [m.offset.x as f32, m.offset.y as f32, m.offset.z as f32, 0.0];
+            map.overlay_labels = decode(labels);
+            map.overlay_combine = what as u32 + 1;
+        }
         Ok(map)
     }
 }
@@ -176,8 +237,9 @@ impl FusionMap {
 /// changes.
 pub struct FusionState {
     combine: Option<Combine>,
+    overlay: Option<Combine>,
     buffer: Option<wgpu::Buffer>,
-    versions: Option<(Option<u64>, Option<u64>)>,
+    versions: Option<[Option<u64>; 3]>,
     /// Smooth label sampling: the label map's uniform blocks (`label_blocks`), and the version
     /// of the map they were made from.
     blocks: Option<(wgpu::TextureView, Option<u64>)>,
@@ -204,17 +266,30 @@ impl FusionState {
                 ),
             });
         }
+        let settings = FusionSettings::of(ctx.params);
+        if settings.overlay != OverlayMode::None && settings.overlay().is_none() {
+            return Err(PassError {
+                pass: ctx.pass_id.to_string(),
+                message: format!(
+                    "overlay \"{}\" lies a label map over two fused scalar volumes, so it needs fusion \"fuse\" or \
+                     \"add\" (here \"{}\"); for one scan and its label map use fusion \"tint\" or \"inside\"",
+                    settings.overlay.name(),
+                    settings.fusion.name()
+                ),
+            });
+        }
         let buffer = combine.map(|c| ctx.uniform_from_bytes("fusion", &FusionMap::identity(c).uniform_bytes()));
-        let smooth = FusionSettings::of(ctx.params).label_filter == LabelFilterChoice::Smooth;
-        Ok(Self { combine, buffer, versions: None, blocks: None, smooth })
+        let smooth = settings.label_filter == LabelFilterChoice::Smooth;
+        Ok(Self { combine, overlay: settings.overlay(), buffer, versions: None, blocks: None, smooth })
     }
 
     /// The port of the label map, when smooth label sampling reads its uniform blocks.
     fn label_map_port(&self) -> Option<&'static str> {
         match self.combine? {
-            Combine::Labels if self.smooth => Some("volume"),
-            Combine::Tint | Combine::Inside if self.smooth => Some("second"),
-            _ => None,
+            _ if !self.smooth => None,
+            Combine::Labels => Some("volume"),
+            Combine::Tint | Combine::Inside => Some("second"),
+            Combine::Fuse | Combine::Add => self.overlay.map(|_| "overlay"),
         }
     }
 
@@ -237,14 +312,23 @@ impl FusionState {
             self.update_blocks(ctx, port)?;
         }
         let (Some(combine), Some(buffer)) = (self.combine, &self.buffer) else { return Ok(()) };
-        let versions = (ctx.input_version("volume"), ctx.input_version("second"));
+        let versions = [ctx.input_version("volume"), ctx.input_version("second"), ctx.input_version("overlay")];
         if self.versions == Some(versions) {
             return Ok(());
         }
         let first = ctx.voxels("volume")?;
         let second = if combine == Combine::Labels { None } else { Some(ctx.voxels("second")?) };
-        let map = FusionMap::of_volumes(combine, first, second.map(|v| v.as_ref()))
-            .map_err(|e| PassError { pass: ctx.label.to_string(), message: e.to_string() })?;
+        let overlay = match self.overlay {
+            Some(what) => Some((what, ctx.voxels("overlay")?)),
+            None => None,
+        };
+        let map = FusionMap::of_volumes(
+            combine,
+            first,
+            second.as_ref().map(|v| v.as_ref()),
+            overlay.as_ref().map(|(what, v)| (*what, v.as_ref())),
+        )
+        .map_err(|e| PassError { pass: ctx.label.to_string(), message: e.to_string() })?;
         ctx.write_buffer(buffer, 0, &map.uniform_bytes());
         self.versions = Some(versions);
         Ok(())

@@ -1,12 +1,13 @@
 //! Several volumes in one march (issue "several volumes"): every graph of `graphs/multi/` rendered
 //! on the GPU against the f64 reference of the same model (`volgraph_accel::fusion`), on the
 //! generated organ phantom — a CT in Hounsfield units and its label map — and a coarse "PET" on a
-//! shifted grid; the scan inside a label against the scan with every voxel outside it set to
-//! air; a label map and its twin on a shifted grid. Failure images go to target/test-images.
+//! shifted grid, and the organs' label map over the PET/CT pair (three volumes, the map cropped
+//! to a grid of its own); the scan inside a label against the scan with every voxel outside it
+//! set to air; a label map and its twin on a shifted grid. Failure images go to target/test-images.
 
 use glam::{DVec3, UVec3};
 use volgraph_accel::camera::OrbitCamera;
-use volgraph_accel::fusion::{Fusion, TextureMap};
+use volgraph_accel::fusion::{Fusion, Overlay, TextureMap};
 use volgraph_accel::labels::sample::LabelFilter;
 use volgraph_accel::organs::{label_table, organs_ct, organs_labels};
 use volgraph_accel::reference::render_fused_reference;
@@ -105,13 +106,16 @@ fn coarse_pet(ct: &Volume) -> Volume {
     pet
 }
 
-/// What a graph binds: its frame volume and TF, the second volume and its TF or label table.
+/// What a graph binds: its frame volume and TF, the second volume and its TF or label table,
+/// and a label map over a fused pair (the input `labels` of a graph with an overlay).
+#[derive(Clone, Copy)]
 struct Scene<'a> {
     volume: &'a Volume,
     lut: &'a [[f32; 4]],
     second: Option<&'a Volume>,
     second_lut: &'a [[f32; 4]],
     table: &'a [[f32; 4]],
+    overlay: Option<&'a Volume>,
 }
 
 /// Renders `graph` with `scene` bound by input kind and name, lossless (threshold 1), with
@@ -130,6 +134,9 @@ fn render(graph: &str, scene: &Scene<'_>, features: &[&str], set: &[(&str, &str)
     for (name, kind) in &plan.inputs {
         match kind {
             InputKind::Volume if name == "volume" => runtime.bind_volume(name, scene.volume),
+            InputKind::Volume if name == "labels" && scene.overlay.is_some() => {
+                runtime.bind_volume(name, scene.overlay.expect("an overlay"))
+            }
             InputKind::Volume => runtime.bind_volume(name, scene.second.expect("a second volume")),
             InputKind::TransferFunction if name == "tf" => runtime.bind_lut(name, scene.lut),
             InputKind::TransferFunction => runtime.bind_lut(name, scene.second_lut),
@@ -154,7 +161,11 @@ fn reference(scene: &Scene<'_>, march: &volgraph_core::Params) -> Vec<[f64; 4]> 
     };
     let second_lut = if combine.second_is_labels() { scene.table } else { scene.second_lut };
     let second = scene.second.map(|v| (v, second_lut, TextureMap::between(scene.volume, v).expect("one frame")));
-    let fusion = Fusion { combine, label_lut: scene.table, filter, second };
+    let overlay = fusion.overlay().map(|combine| {
+        let labels = scene.overlay.expect("a graph with an overlay binds its label map");
+        Overlay { combine, labels, map: TextureMap::between(scene.volume, labels).expect("one frame") }
+    });
+    let fusion = Fusion { combine, label_lut: scene.table, filter, second, overlay };
     render_fused_reference(scene.volume, scene.lut, Some(&fusion), &CAMERA, SIZE, SIZE, &reference_settings(march))
         .color
 }
@@ -202,7 +213,8 @@ fn check(name: &str, scene: &Scene<'_>, graph: &str, features: &[&str], set: &[(
 fn a_label_map_alone_smooth_and_nearest_shaded() {
     let labels = organs_labels(N);
     let table = table();
-    let scene = Scene { volume: &labels, lut: &[[0.0; 4]; 2], second: None, second_lut: &[], table: &table };
+    let scene =
+        Scene { volume: &labels, lut: &[[0.0; 4]; 2], second: None, second_lut: &[], table: &table, overlay: None };
     check("labels_smooth", &scene, "multi/labels.ron", &[], &[]);
     check("labels_nearest_shaded", &scene, "multi/labels.ron", &["shading"], &[("label_filter", "nearest")]);
 }
@@ -211,7 +223,7 @@ fn a_label_map_alone_smooth_and_nearest_shaded() {
 fn the_scan_tinted_by_its_labels_and_inside_them() {
     let (ct, labels) = (organs_ct(N), organs_labels(N));
     let (lut, table) = (ct_lut(&ct), table());
-    let scene = Scene { volume: &ct, lut: &lut, second: Some(&labels), second_lut: &[], table: &table };
+    let scene = Scene { volume: &ct, lut: &lut, second: Some(&labels), second_lut: &[], table: &table, overlay: None };
     check("ct_with_labels", &scene, "multi/ct_with_labels.ron", &[], &[]);
     check("ct_with_labels_shaded_jitter", &scene, "multi/ct_with_labels.ron", &["shading", "jitter"], &[]);
     check("ct_inside_labels", &scene, "multi/ct_inside_labels.ron", &[], &[]);
@@ -222,7 +234,8 @@ fn pet_on_a_shifted_coarse_grid_and_channels() {
     let ct = organs_ct(N);
     let pet = coarse_pet(&ct);
     let (lut, second_lut) = (ct_lut(&ct), pet_lut(&pet));
-    let scene = Scene { volume: &ct, lut: &lut, second: Some(&pet), second_lut: &second_lut, table: &[] };
+    let scene =
+        Scene { volume: &ct, lut: &lut, second: Some(&pet), second_lut: &second_lut, table: &[], overlay: None };
     let fused = check("pet_ct", &scene, "multi/pet_ct.ron", &[], &[]);
     check("channels", &scene, "multi/channels.ron", &[], &[]);
     // The PET shows: the fused image differs from the CT alone where the PET is hot.
@@ -230,6 +243,96 @@ fn pet_on_a_shifted_coarse_grid_and_channels() {
     let (ct_only, _) = render("multi/pet_ct.ron", &alone, &[], &[]);
     let (_, mean) = diff_reference(&fused, &support::as_reference(&ct_only));
     assert!(mean > 1.0 / 255.0, "the PET changes the image (mean {:.3}/255)", mean * 255.0);
+}
+
+/// `map`'s voxels in `[lo, hi)`, on their own grid: its origin moved to voxel `lo`'s centre,
+/// as 3D Slicer saves a segmentation cropped to the box its segments cover.
+fn cropped(map: &Volume, lo: UVec3, hi: UVec3) -> Volume {
+    let dims = hi - lo;
+    let index = |x: u32, y: u32, z: u32| (x + map.dims.x * (y + map.dims.y * z)) as usize;
+    let mut values = Vec::with_capacity((dims.x * dims.y * dims.z) as usize);
+    for z in lo.z..hi.z {
+        for y in lo.y..hi.y {
+            for x in lo.x..hi.x {
+                values.push(map.raw_value(index(x, y, z)));
+            }
+        }
+    }
+    let data = match &map.data {
+        VoxelData::U8(_) => VoxelData::U8(values.iter().map(|&v| v as u8).collect()),
+        VoxelData::U16(_) => VoxelData::U16(values.iter().map(|&v| v as u16).collect()),
+        other => panic!("a label map is u8 or u16, not {other:?}"),
+    };
+    let mut out = Volume::new("cropped labels", dims, map.spacing, data);
+    out.value_range = map.value_range;
+    out.meta = map.meta.clone();
+    out.meta.origin = Some(map.meta.origin.unwrap_or_default() + lo.as_dvec3() * map.spacing);
+    out
+}
+
+/// Three volumes in one march: the PET/CT pair (the PET on a shifted coarse grid) with the
+/// organs' label map over it, cropped to a grid of its own — the pair inside the visible labels
+/// (the shipped graph), and tinted by them with shading — each against the f64 reference.
+#[test]
+fn pet_ct_inside_and_tinted_by_a_label_map_on_its_own_grid() {
+    let ct = organs_ct(N);
+    let pet = coarse_pet(&ct);
+    let labels = cropped(&organs_labels(N), UVec3::new(4, 6, 2), UVec3::new(N - 6, N - 4, N / 2 - 2));
+    let (lut, second_lut, table) = (ct_lut(&ct), pet_lut(&pet), table());
+    let scene = Scene {
+        volume: &ct,
+        lut: &lut,
+        second: Some(&pet),
+        second_lut: &second_lut,
+        table: &table,
+        overlay: Some(&labels),
+    };
+    let graph = "multi/pet_ct_inside_labels.ron";
+    let inside = check("pet_ct_inside_labels", &scene, graph, &[], &[]);
+    check("pet_ct_tinted_by_labels_shaded", &scene, graph, &["shading"], &[("overlay", "tint")]);
+    // The labels decide: every label hidden leaves nothing inside, and the pair alone (no
+    // overlay) shows more than the pair inside its visible labels.
+    let hidden = vec![[0.0f32; 4]; table.len()];
+    let (none_inside, _) = render(graph, &Scene { table: &hidden, ..scene }, &[], &[]);
+    let coverage = |image: &Image| (0..SIZE * SIZE).filter(|i| image.rgba(i % SIZE, i / SIZE)[3] > 2.0 / 255.0).count();
+    assert_eq!(coverage(&none_inside), 0, "every label hidden: nothing inside");
+    let (pair, _) = render("multi/pet_ct.ron", &scene, &[], &[]);
+    assert!(
+        coverage(&pair) > coverage(&inside) + 100,
+        "the pair alone covers {} pixels, inside the labels {}",
+        coverage(&pair),
+        coverage(&inside)
+    );
+}
+
+/// An overlay where there is no fused pair to lie over is refused with what to use instead,
+/// not drawn as something else.
+#[test]
+fn an_overlay_without_a_fused_pair_is_refused() {
+    let registry = builtin_registry();
+    let options = CompileOptions::new(SIZE, SIZE).with_param("march", "overlay", "inside");
+    let graph = "multi/ct_with_labels.ron";
+    let plan = volgraph_core::compile(graph, &graph_source(graph), &registry, &options).expect("compiles");
+    let (ct, labels) = (organs_ct(16), organs_labels(16));
+    let mut runtime = support::runtime(&gpu());
+    runtime.bind_volume("volume", &ct).expect("binds");
+    runtime.bind_volume("labels", &labels).expect("binds");
+    let err = runtime.apply(plan, &registry).expect_err("refused").to_string();
+    assert!(err.contains("overlay \"inside\"") && err.contains("needs fusion \"fuse\" or \"add\""), "{err}");
+    assert!(err.contains("use fusion \"tint\" or \"inside\""), "{err}");
+}
+
+/// A refused value of a parameter that picks the ports is the one error: the wiring it leaves
+/// unmatched (`overlay`, `label_table` at the default) is not reported on top of it.
+#[test]
+fn a_refused_overlay_value_is_one_error() {
+    let registry = builtin_registry();
+    let options = CompileOptions::new(SIZE, SIZE).with_param("march", "overlay", "tinted");
+    let graph = "multi/pet_ct_inside_labels.ron";
+    let err =
+        volgraph_core::compile(graph, &graph_source(graph), &registry, &options).expect_err("refused").to_string();
+    assert!(err.contains("\"tinted\", which is not a valid choice"), "{err}");
+    assert!(!err.contains("has no input"), "{err}");
 }
 
 /// The scan inside label 1 (the liver) equals the scan with every voxel outside the liver set to
@@ -241,7 +344,8 @@ fn the_scan_inside_a_label_is_the_scan_with_the_rest_set_to_air() {
     let lut = ct_lut(&ct);
     let only_liver: Vec<[f32; 4]> =
         table().iter().enumerate().map(|(v, e)| if v == 1 { *e } else { [0.0; 4] }).collect();
-    let scene = Scene { volume: &ct, lut: &lut, second: Some(&labels), second_lut: &[], table: &only_liver };
+    let scene =
+        Scene { volume: &ct, lut: &lut, second: Some(&labels), second_lut: &[], table: &only_liver, overlay: None };
     let (inside, _) = render("multi/ct_inside_labels.ron", &scene, &[], &[]);
     let mut masked = ct.clone();
     let VoxelData::I16(values) = &mut masked.data else { panic!("the phantom CT is i16") };
@@ -323,7 +427,7 @@ fn a_label_map_and_its_twin_on_a_shifted_grid_render_alike() {
     twin.meta = labels.meta.clone();
     twin.meta.origin = Some(labels.meta.origin.unwrap_or_default() - labels.spacing * pad as f64);
     let (lut, table) = (ct_lut(&ct), table());
-    let scene = Scene { volume: &ct, lut: &lut, second: Some(&labels), second_lut: &[], table: &table };
+    let scene = Scene { volume: &ct, lut: &lut, second: Some(&labels), second_lut: &[], table: &table, overlay: None };
     let (a, _) = render("multi/ct_with_labels.ron", &scene, &[], &[]);
     let (b, _) = render("multi/ct_with_labels.ron", &Scene { second: Some(&twin), ..scene }, &[], &[]);
     let (max, mean) = diff_reference(&a, &support::as_reference(&b));
@@ -352,7 +456,8 @@ fn a_map_of_labels_up_to_65535_renders_through_its_table() {
         l.opacity = 0.05;
     }
     let lut = table.lut(65_536);
-    let scene = Scene { volume: &labels, lut: &[[0.0; 4]; 2], second: None, second_lut: &[], table: &lut };
+    let scene =
+        Scene { volume: &labels, lut: &[[0.0; 4]; 2], second: None, second_lut: &[], table: &lut, overlay: None };
     check("labels_65535_nearest", &scene, "multi/labels.ron", &[], &[("label_filter", "nearest")]);
     // Every voxel its own label: smooth sampling takes the 8-corner path everywhere and, no two
     // corners alike, picks the nearest corner's (the same image, by another path).

@@ -255,7 +255,9 @@ impl Checker<'_> {
             self.passes.push(info);
             return idx;
         };
+        let errors_before = self.diags.len();
         info.params = self.check_params(p, path, plugin.as_ref());
+        let params_ok = self.diags.len() == errors_before;
         info.ports = plugin.ports(&info.params);
         for f in plugin.features() {
             if !info.needs.iter().any(|n| n == f) {
@@ -263,7 +265,11 @@ impl Checker<'_> {
             }
         }
         info.enabled = info.needs.iter().all(|f| self.options.features.contains(f));
-        self.check_port_names(p, path, &info);
+        // A parameter that picks the ports (`fusion`, `overlay`) and was refused leaves them at
+        // its default: the wiring's errors would only echo the parameter's.
+        if params_ok {
+            self.check_port_names(p, path, &info);
+        }
         info.outputs = self.output_descs(p, path, &info);
         self.passes.push(info);
         idx

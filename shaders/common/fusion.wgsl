@@ -6,7 +6,8 @@
 // - FUSION_LABEL_MAP: `second` is a label map: `tint` colours the scan by the visible label,
 //   `inside` keeps the scan only inside visible labels;
 // - FUSION_SCALAR: `second` is scalar with its own `second_tf`: `fuse` (two media in one place)
-//   or `add` (channels); with FUSION_OVERLAY a third volume, the label map `overlay`, lies over
+//   or `add` (channels); FUSION_THIRD and FUSION_FOURTH add `third`/`third_tf` and
+//   `fourth`/`fourth_tf` (up to four channels, all media in one place); with FUSION_OVERLAY a third volume, the label map `overlay`, lies over
 //   the pair (`tint` or `inside`, as a label map does to one scan);
 // - FUSION_LABEL_READS: one of the above samples a label map (the frame volume, `second` or
 //   `overlay`: "the label map" below);
@@ -72,6 +73,14 @@ fn begin_fusion() {
 // The second scalar volume and its transfer function.
 @group(0) @binding(auto) var second: texture_3d<f32>;
 @group(0) @binding(auto) var second_tf: texture_1d<f32>;
+#endif
+#if FUSION_THIRD
+@group(0) @binding(auto) var third: texture_3d<f32>;
+@group(0) @binding(auto) var third_tf: texture_1d<f32>;
+#endif
+#if FUSION_FOURTH
+@group(0) @binding(auto) var fourth: texture_3d<f32>;
+@group(0) @binding(auto) var fourth_tf: texture_1d<f32>;
 #endif
 
 #if FUSION_LABELS
@@ -259,16 +268,27 @@ fn fused_sample(u: vec3<f32>, s: f32) -> vec4<f32> {
         let c2 = textureSampleLevel(second_tf, linear_clamp, s2, 0.0);
         p2 = premultiplied(c2.rgb, c2.a);
     }
-    // Two media in one place: opacity 1 - (1 - a1)(1 - a2); colour the opacity-weighted mean,
-    // or (channels) the sum.
-    let a = 1.0 - (1.0 - p1.a) * (1.0 - p2.a);
-    var fused = vec4<f32>(p1.rgb + p2.rgb, a);
+    // Media in one place: opacity 1 - Π(1 - aᵢ); colour the opacity-weighted mean, or
+    // (channels) the sum. `sum` holds Σ premultiplied colours and Σ opacities.
+    var sum = p1 + p2;
+    var clear = (1.0 - p1.a) * (1.0 - p2.a);
+#if FUSION_THIRD
+    let p3 = scalar_medium(third, third_tf, u * fusion.third_scale.xyz + fusion.third_offset.xyz);
+    sum += p3;
+    clear *= 1.0 - p3.a;
+#endif
+#if FUSION_FOURTH
+    let p4 = scalar_medium(fourth, fourth_tf, u * fusion.fourth_scale.xyz + fusion.fourth_offset.xyz);
+    sum += p4;
+    clear *= 1.0 - p4.a;
+#endif
+    let a = 1.0 - clear;
+    var fused = vec4<f32>(sum.rgb, a);
     if (fusion_combine != COMBINE_ADD) {
-        let weight = p1.a + p2.a;
-        if (!(weight > 0.0)) {
+        if (!(sum.a > 0.0)) {
             return vec4<f32>(0.0);
         }
-        fused = vec4<f32>((p1.rgb + p2.rgb) * (a / weight), a);
+        fused = vec4<f32>(sum.rgb * (a / sum.a), a);
     }
 #if FUSION_OVERLAY
     return overlaid(fused, u);
@@ -278,6 +298,19 @@ fn fused_sample(u: vec3<f32>, s: f32) -> vec4<f32> {
 #endif
 #endif
 }
+
+#if FUSION_THIRD
+// The premultiplied, corrected sample of scalar volume `v` through its TF `tf` at its texture
+// point `at` (nothing outside its box).
+fn scalar_medium(v: texture_3d<f32>, tf: texture_1d<f32>, at: vec3<f32>) -> vec4<f32> {
+    if (!in_box(at)) {
+        return vec4<f32>(0.0);
+    }
+    let s = textureSampleLevel(v, linear_clamp, at, 0.0).r;
+    let c = textureSampleLevel(tf, linear_clamp, s, 0.0);
+    return premultiplied(c.rgb, c.a);
+}
+#endif
 
 #if FUSION_OVERLAY
 // The premultiplied sample `fused` of the pair under the overlay at the frame volume's texture

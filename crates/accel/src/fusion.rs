@@ -20,6 +20,8 @@
 //! - `Add`: channels (napari's and Fiji's additive blending): colours add (no clamp: where
 //!   channels overlap the image may exceed 1, as a display saturates it), `α` as in `Fuse`.
 //!
+//! `Fuse` and `Add` take up to four scalar volumes (a microscope's channels), each by its TF.
+//!
 //! A third volume, a label map, may lie over a fused pair ([`Overlay`]: PET/CT and the organs
 //! segmented on the CT): the pair's sample tinted by the visible label, or kept only inside
 //! visible labels, as `Tint` and `Inside` do to one scan.
@@ -181,6 +183,9 @@ pub struct Fusion<'a> {
     /// The second volume and its TF (`Tint`, `Inside`: its label map; `Fuse`, `Add`: the second
     /// scalar volume and its TF), with the map into its texture space.
     pub second: Option<(&'a Volume, &'a [[f32; 4]], TextureMap)>,
+    /// More scalar volumes with their TFs and maps (`Fuse`, `Add`: a third and fourth channel),
+    /// combined with the first two as more media in one place.
+    pub more: &'a [(&'a Volume, &'a [[f32; 4]], TextureMap)],
     /// A label map over the fused pair (`Fuse`, `Add` only).
     pub overlay: Option<Overlay<'a>>,
 }
@@ -225,8 +230,14 @@ impl Fusion<'_> {
                 }
             }
             Combine::Fuse | Combine::Add => {
-                let (c2, a2) = if inside { through(second_lut, second.sample_trilinear(u2)) } else { ([0.0; 3], 0.0) };
-                let fused = fuse_media(self.combine, premultiplied(c1, a1), premultiplied(c2, a2));
+                let medium = |volume: &Volume, lut: &[[f32; 4]], map: &TextureMap| {
+                    let at = map.apply(u);
+                    let (c, a) = if in_box(at) { through(lut, volume.sample_trilinear(at)) } else { ([0.0; 3], 0.0) };
+                    premultiplied(c, a)
+                };
+                let mut media = vec![premultiplied(c1, a1), medium(second, second_lut, &map)];
+                media.extend(self.more.iter().map(|(v, lut, map)| medium(v, lut, map)));
+                let fused = fuse_media(self.combine, &media);
                 match &self.overlay {
                     Some(overlay) => self.overlaid(overlay, fused, u),
                     None => fused,
@@ -263,20 +274,20 @@ impl Fusion<'_> {
     }
 }
 
-/// Two premultiplied samples in one place: opacity `1 − (1 − α₁)(1 − α₂)`; colour the
+/// Premultiplied samples of several media in one place: opacity `1 − Π(1 − αᵢ)`; colour the
 /// opacity-weighted mean (`Fuse`) or the sum (`Add`: each channel's light adds, so an image may
 /// exceed 1 where channels overlap, as additive blending saturates on display).
-pub fn fuse_media(combine: Combine, p1: [f64; 4], p2: [f64; 4]) -> [f64; 4] {
-    let a = 1.0 - (1.0 - p1[3]) * (1.0 - p2[3]);
-    let weight = p1[3] + p2[3];
+pub fn fuse_media(combine: Combine, media: &[[f64; 4]]) -> [f64; 4] {
+    let a = 1.0 - media.iter().map(|p| 1.0 - p[3]).product::<f64>();
+    let sum: [f64; 4] = std::array::from_fn(|i| media.iter().map(|p| p[i]).sum());
     if combine == Combine::Add {
-        return [p1[0] + p2[0], p1[1] + p2[1], p1[2] + p2[2], a];
+        return [sum[0], sum[1], sum[2], a];
     }
-    if weight <= 0.0 {
+    if sum[3] <= 0.0 {
         return [0.0; 4];
     }
-    let k = a / weight;
-    [(p1[0] + p2[0]) * k, (p1[1] + p2[1]) * k, (p1[2] + p2[2]) * k, a]
+    let k = a / sum[3];
+    [sum[0] * k, sum[1] * k, sum[2] * k, a]
 }
 
 #[cfg(test)]
@@ -319,13 +330,28 @@ mod tests {
     fn two_media_in_one_place() {
         let red = [0.5, 0.0, 0.0, 0.5];
         let blue = [0.0, 0.0, 0.25, 0.25];
-        let f = fuse_media(Combine::Fuse, red, blue);
+        let f = fuse_media(Combine::Fuse, &[red, blue]);
         assert!((f[3] - (1.0 - 0.5 * 0.75)).abs() < 1e-12);
         // Straight colours: red's weight 0.5, blue's 0.25 of 0.75.
         assert!((f[0] / f[3] - 2.0 / 3.0).abs() < 1e-12 && (f[2] / f[3] - 1.0 / 3.0).abs() < 1e-12);
-        assert_eq!(fuse_media(Combine::Fuse, red, [0.0; 4]), red);
-        assert_eq!(fuse_media(Combine::Fuse, [0.0; 4], [0.0; 4]), [0.0; 4]);
-        let added = fuse_media(Combine::Add, red, blue);
+        assert_eq!(fuse_media(Combine::Fuse, &[red, [0.0; 4]]), red);
+        assert_eq!(fuse_media(Combine::Fuse, &[[0.0; 4], [0.0; 4]]), [0.0; 4]);
+        let added = fuse_media(Combine::Add, &[red, blue]);
         assert_eq!([added[0], added[2]], [0.5, 0.25]);
+    }
+
+    /// Four channels: opacity `1 − Π(1 − αᵢ)`, colours added; the order of the media does not
+    /// matter (no channel is "in front" within one sample).
+    #[test]
+    fn four_media_in_one_place() {
+        let media = [[0.2, 0.0, 0.0, 0.2], [0.0, 0.3, 0.0, 0.3], [0.0, 0.0, 0.1, 0.1], [0.05, 0.05, 0.0, 0.1]];
+        let added = fuse_media(Combine::Add, &media);
+        let a = 1.0 - 0.8 * 0.7 * 0.9 * 0.9;
+        assert!((added[3] - a).abs() < 1e-12 && (added[0] - 0.25).abs() < 1e-12 && (added[1] - 0.35).abs() < 1e-12);
+        let mut reversed = media;
+        reversed.reverse();
+        let fused = fuse_media(Combine::Fuse, &media);
+        let again = fuse_media(Combine::Fuse, &reversed);
+        assert!((0..4).all(|i| (fused[i] - again[i]).abs() < 1e-12), "{fused:?} {again:?}");
     }
 }

@@ -296,6 +296,60 @@ fn a_4d_files_volumes_bind_as_channels() {
     assert!(!ok && err.contains("--volume channel2=…: "), "{err}");
 }
 
+/// Four channels of one 4D file: `multi/channels4` binds its four volumes by name, each with its
+/// own TF; every channel adds light (the fourth bound to frame 0 again gives another image); a
+/// channel left unbound is an error naming it.
+#[test]
+fn four_channels_of_a_4d_file_bind_by_name() {
+    let dir = scratch("channels4");
+    support::write_nifti_channels(&dir.join("cells.nii"), &support::ct(20, "cells"), 4);
+    for (name, (r, g, b)) in [("green", (0, 1, 0)), ("magenta", (1, 0, 1)), ("cyan", (0, 1, 1)), ("yellow", (1, 1, 0))]
+    {
+        let tf = format!(
+            "TransferFunction(domain: (-1000.0, 1000.0), points: [(value: -200.0, color: ({r}.0, {g}.0, {b}.0), \
+             alpha: 0.0), (value: 1000.0, color: ({r}.0, {g}.0, {b}.0), alpha: 0.5)])"
+        );
+        std::fs::write(dir.join(format!("{name}.ron")), tf).expect("tf");
+    }
+    let render = |fourth: Option<&str>, out: &str| {
+        let mut args = vec![
+            "render",
+            "multi/channels4",
+            "--volume",
+            "volume=cells.nii#0",
+            "--volume",
+            "channel2=cells.nii#1",
+            "--volume",
+            "channel3=cells.nii#2",
+            "--tf",
+            "green.ron",
+            "--tf",
+            "channel2_tf=magenta.ron",
+            "--tf",
+            "channel3_tf=cyan.ron",
+            "--tf",
+            "channel4_tf=yellow.ron",
+            "--size",
+            "48x48",
+            "-o",
+            out,
+        ];
+        if let Some(f) = fourth {
+            args.extend(["--volume", f]);
+        }
+        volgraph(&args, &dir)
+    };
+    let (ok, err) = render(Some("channel4=cells.nii#3"), "four.exr");
+    assert!(ok, "{err}");
+    let (ok, err) = render(Some("channel4=cells.nii#0"), "again.exr");
+    assert!(ok, "{err}");
+    let (four, again) = (pixels(&dir.join("four.exr")), pixels(&dir.join("again.exr")));
+    assert!(four.iter().any(|p| p[3] > 0.01), "the channels show");
+    assert!(four.iter().zip(&again).any(|(a, b)| (a[2] - b[2]).abs() > 1e-3), "frame 3 is not frame 0");
+    let (ok, err) = render(None, "three.exr");
+    assert!(!ok && err.contains("channel4"), "{err}");
+}
+
 /// A DICOM SEG over its scan (issue "several volumes", item 3): the phantom's label map written
 /// as a BINARY SEG (`write_segmentation`, its organs as segments with their names and colours)
 /// binds as `--volume labels=seg.dcm` and names its own labels — the image is the one the

@@ -166,6 +166,7 @@ fn sparse_error(image: &Image, scene: &Scene<'_>, march: &Params, stride: u32) -
         label_lut: scene.table,
         filter,
         second: Some((scene.labels, scene.table, map)),
+        more: &[],
         overlay: None,
     });
     let frame = CAMERA.frame(image.width, image.height);
@@ -363,6 +364,7 @@ fn boundary_quality(bench: &mut Bench) -> anyhow::Result<(f64, f64)> {
                 label_lut: &table,
                 filter: LabelFilter::Smooth,
                 second: None,
+                more: &[],
                 overlay: None,
             };
             volgraph_accel::reference::render_fused_reference(

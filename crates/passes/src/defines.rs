@@ -65,6 +65,10 @@ pub const FUSION_LABELS: &str = "FUSION_LABELS";
 pub const FUSION_LABEL_MAP: &str = "FUSION_LABEL_MAP";
 /// … the second volume is scalar, with its own TF (`fuse`, `add`).
 pub const FUSION_SCALAR: &str = "FUSION_SCALAR";
+/// … and a third scalar volume (`channels` 3 or 4).
+pub const FUSION_THIRD: &str = "FUSION_THIRD";
+/// … and a fourth (`channels` 4).
+pub const FUSION_FOURTH: &str = "FUSION_FOURTH";
 /// … and a label map lies over the scalar pair (`overlay`: `tint`, `inside`).
 pub const FUSION_OVERLAY: &str = "FUSION_OVERLAY";
 /// A label map is sampled (`FUSION_LABELS`, `FUSION_LABEL_MAP` or `FUSION_OVERLAY`).
@@ -89,7 +93,7 @@ pub const SCATTER: &str = "SCATTER";
 pub const RESLICE_LABELS: &str = "RESLICE_LABELS";
 
 /// Every `#if` name of the built-in passes.
-pub const BUILT_IN: [&str; 35] = [
+pub const BUILT_IN: [&str; 37] = [
     SHADING,
     PREINTEGRATION,
     TRICUBIC,
@@ -118,6 +122,8 @@ pub const BUILT_IN: [&str; 35] = [
     FUSION_LABELS,
     FUSION_LABEL_MAP,
     FUSION_SCALAR,
+    FUSION_THIRD,
+    FUSION_FOURTH,
     FUSION_OVERLAY,
     FUSION_LABEL_READS,
     LABELS_NEAREST,

@@ -70,6 +70,9 @@ volgraph_compiler::pass_params! {
         label_filter: LabelFilterChoice = Smooth,
             "smooth: each label's indicator interpolated, the largest wins (round boundaries); nearest: the nearest \
              voxel's label";
+        channels: u32 = 2, 2..=4,
+            "with fusion fuse or add, how many scalar volumes: the volume and `second`, then `third` and `fourth` \
+             (a microscope's channels), each by its own TF (`second_tf`, `third_tf`, `fourth_tf`)";
         overlay: OverlayMode = None,
             "with fusion fuse or add, a third volume: the label map `overlay` (through `label_table`) over the pair — \
              tint: coloured by the visible label; inside: only inside the visible labels (PET/CT inside an organ)";
@@ -82,6 +85,7 @@ impl FusionSettings {
         let settings = Self::try_from_params(params).unwrap_or(Self {
             fusion: FusionMode::None,
             label_filter: LabelFilterChoice::Smooth,
+            channels: 2,
             overlay: OverlayMode::None,
         });
         if is_iso(params) { Self { fusion: FusionMode::None, ..settings } } else { settings }
@@ -108,6 +112,15 @@ impl FusionSettings {
         }
     }
 
+    /// The scalar volumes beside the frame volume, by port and TF port (`fuse`, `add`).
+    pub fn scalar_partners(&self) -> &'static [(&'static str, &'static str)] {
+        const PARTNERS: [(&str, &str); 3] = [("second", "second_tf"), ("third", "third_tf"), ("fourth", "fourth_tf")];
+        match self.combine() {
+            Some(Combine::Fuse | Combine::Add) => &PARTNERS[..(self.channels.clamp(2, 4) - 1) as usize],
+            _ => &[],
+        }
+    }
+
     /// Whether a label map is sampled (the frame volume, the second or the overlay).
     fn reads_labels(&self) -> bool {
         self.overlay().is_some() || self.combine().is_some_and(|c| !matches!(c, Combine::Fuse | Combine::Add))
@@ -122,6 +135,13 @@ impl FusionSettings {
             Combine::Tint | Combine::Inside => defines::FUSION_LABEL_MAP,
             Combine::Fuse | Combine::Add => defines::FUSION_SCALAR,
         });
+        let partners = self.scalar_partners().len();
+        if partners >= 2 {
+            out.push(defines::FUSION_THIRD);
+        }
+        if partners >= 3 {
+            out.push(defines::FUSION_FOURTH);
+        }
         if self.overlay().is_some() {
             out.push(defines::FUSION_OVERLAY);
         }
@@ -139,11 +159,12 @@ impl FusionSettings {
     pub fn ports(&self) -> Vec<PortSpec> {
         let Some(combine) = self.combine() else { return Vec::new() };
         let mut ports = Vec::new();
-        if combine != Combine::Labels {
+        if let Combine::Tint | Combine::Inside = combine {
             ports.push(PortSpec::read("second", PortKind::Volume));
         }
-        if let Combine::Fuse | Combine::Add = combine {
-            ports.push(PortSpec::read("second_tf", PortKind::TransferFunction));
+        for (volume, tf) in self.scalar_partners() {
+            ports.push(PortSpec::read(volume, PortKind::Volume));
+            ports.push(PortSpec::read(tf, PortKind::TransferFunction));
         }
         if self.overlay().is_some() {
             ports.push(PortSpec::read("overlay", PortKind::Volume));
@@ -173,6 +194,10 @@ volgraph_compiler::pass_params! {
         second_offset: [f32; 4] = computed, "xyz: see second_scale.";
         first_labels: [f32; 4] = computed, "x, y: a label of the frame volume is round(x + texel · y).";
         second_labels: [f32; 4] = computed, "x, y: a label of the second volume is round(x + texel · y).";
+        third_scale: [f32; 4] = computed, "xyz: the third volume's texture point is u · scale + offset.";
+        third_offset: [f32; 4] = computed, "xyz: see third_scale.";
+        fourth_scale: [f32; 4] = computed, "xyz: the fourth volume's texture point is u · scale + offset.";
+        fourth_offset: [f32; 4] = computed, "xyz: see fourth_scale.";
         overlay_scale: [f32; 4] = computed, "xyz: the overlay's texture point is u · scale + offset.";
         overlay_offset: [f32; 4] = computed, "xyz: see overlay_scale.";
         overlay_labels: [f32; 4] = computed, "x, y: a label of the overlay is round(x + texel · y).";
@@ -193,6 +218,10 @@ impl FusionMap {
             second_offset: [0.0; 4],
             first_labels: [0.0, 255.0, 0.0, 0.0],
             second_labels: [0.0, 255.0, 0.0, 0.0],
+            third_scale: [1.0; 4],
+            third_offset: [0.0; 4],
+            fourth_scale: [1.0; 4],
+            fourth_offset: [0.0; 4],
             overlay_scale: [1.0; 4],
             overlay_offset: [0.0; 4],
             overlay_labels: [0.0, 255.0, 0.0, 0.0],
@@ -201,12 +230,14 @@ impl FusionMap {
         }
     }
 
-    /// From the frame volume `first`, the `second` (when there is one) and the label map over
-    /// them with what it does (when there is one).
+    /// From the frame volume `first`, the `second` (when there is one), the `more` scalar
+    /// volumes (a third and fourth channel) and the label map over them with what it does (when
+    /// there is one).
     pub fn of_volumes(
         combine: Combine,
         first: &volgraph_accel::volume::Volume,
         second: Option<&volgraph_accel::volume::Volume>,
+        more: &[&volgraph_accel::volume::Volume],
         overlay: Option<(Combine, &volgraph_accel::volume::Volume)>,
     ) -> Result<Self, volgraph_accel::fusion::FrameMismatch> {
         // A texel holds (v - lo) / (hi - lo) (`Volume::normalized`), so v = lo + texel · (hi - lo).
@@ -220,6 +251,20 @@ impl FusionMap {
             map.second_scale = [m.scale.x as f32, m.scale.y as f32, m.scale.z as f32, 0.0];
             map.second_offset = [m.offset.x as f32, m.offset.y as f32, m.offset.z as f32, 0.0];
             map.second_labels = decode(second);
+        }
+        let maps = more
+            .iter()
+            .map(|v| volgraph_accel::fusion::TextureMap::between(first, v))
+            .collect::<Result<Vec<_>, _>>()?;
+        let pair = |m: &volgraph_accel::fusion::TextureMap| {
+            let (s, o) = (m.scale.as_vec3(), m.offset.as_vec3());
+            ([s.x, s.y, s.z, 0.0], [o.x, o.y, o.z, 0.0])
+        };
+        if let Some(m) = maps.first() {
+            (map.third_scale, map.third_offset) = pair(m);
+        }
+        if let Some(m) = maps.get(1) {
+            (map.fourth_scale, map.fourth_offset) = pair(m);
         }
         if let Some((what, labels)) = overlay {
             let m = volgraph_accel::fusion::TextureMap::between(first, labels)?;
@@ -237,9 +282,11 @@ impl FusionMap {
 /// changes.
 pub struct FusionState {
     combine: Option<Combine>,
+    /// The ports of the scalar volumes past the second (`third`, `fourth`).
+    more: Vec<&'static str>,
     overlay: Option<Combine>,
     buffer: Option<wgpu::Buffer>,
-    versions: Option<[Option<u64>; 3]>,
+    versions: Option<Vec<Option<u64>>>,
     /// Smooth label sampling: the label map's uniform blocks (`label_blocks`), and the version
     /// of the map they were made from.
     blocks: Option<(wgpu::TextureView, Option<u64>)>,
@@ -280,7 +327,8 @@ impl FusionState {
         }
         let buffer = combine.map(|c| ctx.uniform_from_bytes("fusion", &FusionMap::identity(c).uniform_bytes()));
         let smooth = settings.label_filter == LabelFilterChoice::Smooth;
-        Ok(Self { combine, overlay: settings.overlay(), buffer, versions: None, blocks: None, smooth })
+        let more = settings.scalar_partners().iter().skip(1).map(|(port, _)| *port).collect();
+        Ok(Self { combine, more, overlay: settings.overlay(), buffer, versions: None, blocks: None, smooth })
     }
 
     /// The port of the label map, when smooth label sampling reads its uniform blocks.
@@ -312,12 +360,18 @@ impl FusionState {
             self.update_blocks(ctx, port)?;
         }
         let (Some(combine), Some(buffer)) = (self.combine, &self.buffer) else { return Ok(()) };
-        let versions = [ctx.input_version("volume"), ctx.input_version("second"), ctx.input_version("overlay")];
-        if self.versions == Some(versions) {
+        let versions: Vec<Option<u64>> = ["volume", "second", "overlay"]
+            .iter()
+            .chain(self.more.iter())
+            .map(|port| ctx.input_version(port))
+            .collect();
+        if self.versions.as_ref() == Some(&versions) {
             return Ok(());
         }
         let first = ctx.voxels("volume")?;
         let second = if combine == Combine::Labels { None } else { Some(ctx.voxels("second")?) };
+        let more = self.more.iter().map(|port| ctx.voxels(port)).collect::<Result<Vec<_>, _>>()?;
+        let more: Vec<&volgraph_accel::volume::Volume> = more.iter().map(|v| v.as_ref()).collect();
         let overlay = match self.overlay {
             Some(what) => Some((what, ctx.voxels("overlay")?)),
             None => None,
@@ -326,6 +380,7 @@ impl FusionState {
             combine,
             first,
             second.as_ref().map(|v| v.as_ref()),
+            &more,
             overlay.as_ref().map(|(what, v)| (*what, v.as_ref())),
         )
         .map_err(|e| PassError { pass: ctx.label.to_string(), message: e.to_string() })?;

@@ -116,6 +116,8 @@ struct Scene<'a> {
     second_lut: &'a [[f32; 4]],
     table: &'a [[f32; 4]],
     overlay: Option<&'a Volume>,
+    /// The third and fourth channels with their TFs (inputs `channel3`, `channel4`).
+    more: &'a [(&'a Volume, &'a [[f32; 4]])],
 }
 
 /// Renders `graph` with `scene` bound by input kind and name, lossless (threshold 1), with
@@ -137,6 +139,10 @@ fn render(graph: &str, scene: &Scene<'_>, features: &[&str], set: &[(&str, &str)
             InputKind::Volume if name == "labels" && scene.overlay.is_some() => {
                 runtime.bind_volume(name, scene.overlay.expect("an overlay"))
             }
+            InputKind::Volume if name == "channel3" => runtime.bind_volume(name, scene.more[0].0),
+            InputKind::Volume if name == "channel4" => runtime.bind_volume(name, scene.more[1].0),
+            InputKind::TransferFunction if name == "channel3_tf" => runtime.bind_lut(name, scene.more[0].1),
+            InputKind::TransferFunction if name == "channel4_tf" => runtime.bind_lut(name, scene.more[1].1),
             InputKind::Volume => runtime.bind_volume(name, scene.second.expect("a second volume")),
             InputKind::TransferFunction if name == "tf" => runtime.bind_lut(name, scene.lut),
             InputKind::TransferFunction => runtime.bind_lut(name, scene.second_lut),
@@ -165,7 +171,15 @@ fn reference(scene: &Scene<'_>, march: &volgraph_core::Params) -> Vec<[f64; 4]> 
         let labels = scene.overlay.expect("a graph with an overlay binds its label map");
         Overlay { combine, labels, map: TextureMap::between(scene.volume, labels).expect("one frame") }
     });
-    let fusion = Fusion { combine, label_lut: scene.table, filter, second, overlay };
+    // The graph's channels past the second, of those the scene has.
+    let channels = fusion.scalar_partners().len().saturating_sub(1);
+    let more: Vec<_> = scene
+        .more
+        .iter()
+        .take(channels)
+        .map(|(v, lut)| (*v, *lut, TextureMap::between(scene.volume, v).expect("one frame")))
+        .collect();
+    let fusion = Fusion { combine, label_lut: scene.table, filter, second, more: &more, overlay };
     render_fused_reference(scene.volume, scene.lut, Some(&fusion), &CAMERA, SIZE, SIZE, &reference_settings(march))
         .color
 }
@@ -213,8 +227,15 @@ fn check(name: &str, scene: &Scene<'_>, graph: &str, features: &[&str], set: &[(
 fn a_label_map_alone_smooth_and_nearest_shaded() {
     let labels = organs_labels(N);
     let table = table();
-    let scene =
-        Scene { volume: &labels, lut: &[[0.0; 4]; 2], second: None, second_lut: &[], table: &table, overlay: None };
+    let scene = Scene {
+        volume: &labels,
+        lut: &[[0.0; 4]; 2],
+        second: None,
+        second_lut: &[],
+        table: &table,
+        overlay: None,
+        more: &[],
+    };
     check("labels_smooth", &scene, "multi/labels.ron", &[], &[]);
     check("labels_nearest_shaded", &scene, "multi/labels.ron", &["shading"], &[("label_filter", "nearest")]);
 }
@@ -223,7 +244,15 @@ fn a_label_map_alone_smooth_and_nearest_shaded() {
 fn the_scan_tinted_by_its_labels_and_inside_them() {
     let (ct, labels) = (organs_ct(N), organs_labels(N));
     let (lut, table) = (ct_lut(&ct), table());
-    let scene = Scene { volume: &ct, lut: &lut, second: Some(&labels), second_lut: &[], table: &table, overlay: None };
+    let scene = Scene {
+        volume: &ct,
+        lut: &lut,
+        second: Some(&labels),
+        second_lut: &[],
+        table: &table,
+        overlay: None,
+        more: &[],
+    };
     check("ct_with_labels", &scene, "multi/ct_with_labels.ron", &[], &[]);
     check("ct_with_labels_shaded_jitter", &scene, "multi/ct_with_labels.ron", &["shading", "jitter"], &[]);
     check("ct_inside_labels", &scene, "multi/ct_inside_labels.ron", &[], &[]);
@@ -234,8 +263,15 @@ fn pet_on_a_shifted_coarse_grid_and_channels() {
     let ct = organs_ct(N);
     let pet = coarse_pet(&ct);
     let (lut, second_lut) = (ct_lut(&ct), pet_lut(&pet));
-    let scene =
-        Scene { volume: &ct, lut: &lut, second: Some(&pet), second_lut: &second_lut, table: &[], overlay: None };
+    let scene = Scene {
+        volume: &ct,
+        lut: &lut,
+        second: Some(&pet),
+        second_lut: &second_lut,
+        table: &[],
+        overlay: None,
+        more: &[],
+    };
     let fused = check("pet_ct", &scene, "multi/pet_ct.ron", &[], &[]);
     check("channels", &scene, "multi/channels.ron", &[], &[]);
     // The PET shows: the fused image differs from the CT alone where the PET is hot.
@@ -286,6 +322,7 @@ fn pet_ct_inside_and_tinted_by_a_label_map_on_its_own_grid() {
         second_lut: &second_lut,
         table: &table,
         overlay: Some(&labels),
+        more: &[],
     };
     let graph = "multi/pet_ct_inside_labels.ron";
     let inside = check("pet_ct_inside_labels", &scene, graph, &[], &[]);
@@ -303,6 +340,41 @@ fn pet_ct_inside_and_tinted_by_a_label_map_on_its_own_grid() {
         coverage(&pair),
         coverage(&inside)
     );
+}
+
+/// Three and four channels in one march, each on its own grid (the CT's, the coarse shifted
+/// "PET", the labels' cropped grid, a grid twice as fine) and by its own colour: GPU against the
+/// reference; each added channel changes the image.
+#[test]
+fn three_and_four_channels_on_their_own_grids() {
+    let ct = organs_ct(N);
+    let pet = coarse_pet(&ct);
+    // Two label maps as scalar channels (u8: texels v/255, the TFs over their values 0..6).
+    let third = cropped(&organs_labels(N), UVec3::new(4, 6, 2), UVec3::new(N - 6, N - 4, N / 2 - 2));
+    let fourth = organs_labels(N * 2);
+    let ramp =
+        |r: f64, g: f64, b: f64| tf((0.0, 255.0), &[(0.5, r, g, b, 0.0), (1.5, r, g, b, 0.2), (6.0, r, g, b, 0.3)]);
+    let (lut, second_lut) = (ct_lut(&ct), pet_lut(&pet));
+    let (third_lut, fourth_lut) =
+        (ramp(0.1, 0.9, 0.9).to_lut_for(&third, 256), ramp(0.9, 0.9, 0.1).to_lut_for(&fourth, 256));
+    let more = [(&third, third_lut.as_slice()), (&fourth, fourth_lut.as_slice())];
+    let scene = Scene {
+        volume: &ct,
+        lut: &lut,
+        second: Some(&pet),
+        second_lut: &second_lut,
+        table: &[],
+        overlay: None,
+        more: &more,
+    };
+    let two = check("channels_two", &scene, "multi/channels.ron", &[], &[]);
+    let three = check("channels_three", &scene, "multi/channels3.ron", &[], &[]);
+    check("channels_four_shaded", &scene, "multi/channels4.ron", &["shading"], &[]);
+    let (four_plain, _) = render("multi/channels4.ron", &scene, &[], &[]);
+    for (what, a, b) in [("the third", &two, &three), ("the fourth", &three, &four_plain)] {
+        let (_, mean) = diff_reference(a, &support::as_reference(b));
+        assert!(mean > 0.5 / 255.0, "{what} channel changes the image (mean {:.3}/255)", mean * 255.0);
+    }
 }
 
 /// An overlay where there is no fused pair to lie over is refused with what to use instead,
@@ -344,8 +416,15 @@ fn the_scan_inside_a_label_is_the_scan_with_the_rest_set_to_air() {
     let lut = ct_lut(&ct);
     let only_liver: Vec<[f32; 4]> =
         table().iter().enumerate().map(|(v, e)| if v == 1 { *e } else { [0.0; 4] }).collect();
-    let scene =
-        Scene { volume: &ct, lut: &lut, second: Some(&labels), second_lut: &[], table: &only_liver, overlay: None };
+    let scene = Scene {
+        volume: &ct,
+        lut: &lut,
+        second: Some(&labels),
+        second_lut: &[],
+        table: &only_liver,
+        overlay: None,
+        more: &[],
+    };
     let (inside, _) = render("multi/ct_inside_labels.ron", &scene, &[], &[]);
     let mut masked = ct.clone();
     let VoxelData::I16(values) = &mut masked.data else { panic!("the phantom CT is i16") };
@@ -427,7 +506,15 @@ fn a_label_map_and_its_twin_on_a_shifted_grid_render_alike() {
     twin.meta = labels.meta.clone();
     twin.meta.origin = Some(labels.meta.origin.unwrap_or_default() - labels.spacing * pad as f64);
     let (lut, table) = (ct_lut(&ct), table());
-    let scene = Scene { volume: &ct, lut: &lut, second: Some(&labels), second_lut: &[], table: &table, overlay: None };
+    let scene = Scene {
+        volume: &ct,
+        lut: &lut,
+        second: Some(&labels),
+        second_lut: &[],
+        table: &table,
+        overlay: None,
+        more: &[],
+    };
     let (a, _) = render("multi/ct_with_labels.ron", &scene, &[], &[]);
     let (b, _) = render("multi/ct_with_labels.ron", &Scene { second: Some(&twin), ..scene }, &[], &[]);
     let (max, mean) = diff_reference(&a, &support::as_reference(&b));
@@ -456,8 +543,15 @@ fn a_map_of_labels_up_to_65535_renders_through_its_table() {
         l.opacity = 0.05;
     }
     let lut = table.lut(65_536);
-    let scene =
-        Scene { volume: &labels, lut: &[[0.0; 4]; 2], second: None, second_lut: &[], table: &lut, overlay: None };
+    let scene = Scene {
+        volume: &labels,
+        lut: &[[0.0; 4]; 2],
+        second: None,
+        second_lut: &[],
+        table: &lut,
+        overlay: None,
+        more: &[],
+    };
     check("labels_65535_nearest", &scene, "multi/labels.ron", &[], &[("label_filter", "nearest")]);
     // Every voxel its own label: smooth sampling takes the 8-corner path everywhere and, no two
     // corners alike, picks the nearest corner's (the same image, by another path).

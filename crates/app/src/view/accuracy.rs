@@ -92,6 +92,7 @@ pub fn measure(job: &Job) -> Accuracy {
                 label_lut: table,
                 filter: *filter,
                 second: None,
+                more: &[],
                 overlay: None,
             });
             let (reference, _, _) = volgraph_accel::reference::fused_pixel_lit(

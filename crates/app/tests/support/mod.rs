@@ -50,6 +50,15 @@ pub fn write_nifti_4d(path: &std::path::Path, ct: &Volume) {
     write_nifti_frames(path, ct, &[values, &halved]);
 }
 
+/// A NIfTI-1 file of `n` int16 volumes: `ct`, then `ct` with its values divided by 2, 3, …
+/// (a microscope's channels, each fainter).
+pub fn write_nifti_channels(path: &std::path::Path, ct: &Volume, n: i16) {
+    let VoxelData::I16(values) = &ct.data else { panic!("int16") };
+    let frames: Vec<Vec<i16>> = (1..=n).map(|k| values.iter().map(|v| v / k).collect()).collect();
+    let refs: Vec<&[i16]> = frames.iter().map(Vec::as_slice).collect();
+    write_nifti_frames(path, ct, &refs);
+}
+
 /// A NIfTI-1 file of the int16 volume `ct` alone (3D, no orientation: index axes).
 pub fn write_nifti(path: &std::path::Path, ct: &Volume) {
     let VoxelData::I16(values) = &ct.data else { panic!("int16") };

@@ -238,7 +238,9 @@ fn fused_sample(u: vec3<f32>, s: f32) -> vec4<f32> {
     return premultiplied(e.rgb, e.a);
 #else
     let c = sample_tf(s);
-    let u2 = u * fusion_scale + fusion_offset;
+    // The frame volume's texture point (`u` is a brick atlas's in raycast_bricks).
+    let uv = volume_position(u);
+    let u2 = uv * fusion_scale + fusion_offset;
     let inside = in_box(u2);
 #if FUSION_LABEL_MAP
     // Where the scan is clear the label changes nothing (tint and inside keep its opacity).
@@ -273,12 +275,12 @@ fn fused_sample(u: vec3<f32>, s: f32) -> vec4<f32> {
     var sum = p1 + p2;
     var clear = (1.0 - p1.a) * (1.0 - p2.a);
 #if FUSION_THIRD
-    let p3 = scalar_medium(third, third_tf, u * fusion.third_scale.xyz + fusion.third_offset.xyz);
+    let p3 = scalar_medium(third, third_tf, uv * fusion.third_scale.xyz + fusion.third_offset.xyz);
     sum += p3;
     clear *= 1.0 - p3.a;
 #endif
 #if FUSION_FOURTH
-    let p4 = scalar_medium(fourth, fourth_tf, u * fusion.fourth_scale.xyz + fusion.fourth_offset.xyz);
+    let p4 = scalar_medium(fourth, fourth_tf, uv * fusion.fourth_scale.xyz + fusion.fourth_offset.xyz);
     sum += p4;
     clear *= 1.0 - p4.a;
 #endif
@@ -291,7 +293,7 @@ fn fused_sample(u: vec3<f32>, s: f32) -> vec4<f32> {
         fused = vec4<f32>(sum.rgb * (a / sum.a), a);
     }
 #if FUSION_OVERLAY
-    return overlaid(fused, u);
+    return overlaid(fused, uv);
 #else
     return fused;
 #endif
@@ -314,7 +316,7 @@ fn scalar_medium(v: texture_3d<f32>, tf: texture_1d<f32>, at: vec3<f32>) -> vec4
 
 #if FUSION_OVERLAY
 // The premultiplied sample `fused` of the pair under the overlay at the frame volume's texture
-// point `u` (volgraph_accel::fusion::Fusion::overlaid): `inside` keeps it only where a visible
+// point `u` (not an atlas's) (volgraph_accel::fusion::Fusion::overlaid): `inside` keeps it only where a visible
 // label lies; `tint` moves its colour towards the visible label's by the label's opacity.
 fn overlaid(fused: vec4<f32>, u: vec3<f32>) -> vec4<f32> {
     let a = fused.a;

@@ -38,6 +38,7 @@ use crate::raycast_params::sampling_block;
 use std::sync::Arc;
 use std::time::Instant;
 use volgraph_compiler::block::{OnChange, ParamBlock};
+use volgraph_compiler::declare::ParamChoice as _;
 
 use glam::{DVec3, UVec3};
 use volgraph_accel::brick_leaves::{SLOTS_PER_AXIS, classify_leaves, leaf_grid, owns, slot_coord, slot_word};
@@ -137,6 +138,7 @@ impl PassDecl for RaycastBricks {
             sampling_block(OnChange::InPlace),
             Termination::block(OnChange::InPlace),
             effect_block(),
+            crate::fusion::fusion_block(),
             // The headlight's coefficients, which the shading effect reads.
             Shading::block(OnChange::InPlace),
             BrickSettings::block(OnChange::Rebuild),
@@ -149,25 +151,28 @@ impl PassDecl for RaycastBricks {
         true
     }
 
-    fn ports(&self, _params: &Params) -> Vec<PortSpec> {
-        vec![
-            PortSpec::read("volume", PortKind::VolumeVoxels),
-            PortSpec::read("tf", PortKind::TransferFunction),
-            PortSpec::write("color", PortKind::target(&[TargetFormat::Rgba16Float, TargetFormat::Rgba32Float])),
-        ]
+    fn ports(&self, params: &Params) -> Vec<PortSpec> {
+        let mut ports =
+            vec![PortSpec::read("volume", PortKind::VolumeVoxels), PortSpec::read("tf", PortKind::TransferFunction)];
+        ports.extend(crate::fusion::FusionSettings::of(params).ports());
+        ports.push(PortSpec::write("color", PortKind::target(&[TargetFormat::Rgba16Float, TargetFormat::Rgba32Float])));
+        ports
     }
 
     fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
-        [vec![march_shader()], effect_shader_uses(params, false)].concat()
+        [vec![march_shader(params)], effect_shader_uses(params, false)].concat()
     }
 }
 
 /// The brick march's entry point and what it binds, declared once for `shaders()` and `create`.
-fn march_shader() -> ShaderUse {
-    ShaderUse::new("raycast_bricks.wgsl", "cs_main")
-        .binds(&["table", "leaf_words", "acc", "volume", "preintegrated", "light_volume"])
-        .uniform(RaycastParamsGpu::bound("params"))
-        .uniform(brick_layout())
+fn march_shader(params: &Params) -> ShaderUse {
+    crate::fusion::with_fusion_uniform(
+        ShaderUse::new("raycast_bricks.wgsl", "cs_main")
+            .binds(&["table", "leaf_words", "acc", "volume", "preintegrated", "light_volume", "label_blocks"])
+            .uniform(RaycastParamsGpu::bound("params"))
+            .uniform(brick_layout()),
+        params,
+    )
 }
 
 /// The `bricks` block, checked against the shader's struct when the graph is planned. The
@@ -189,7 +194,7 @@ impl PassPlugin for RaycastBricks {
         let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
             defines: &defines,
             constants: &[("WORKGROUP_X", wg.0 as f64), ("WORKGROUP_Y", wg.1 as f64)],
-            ..ComputePipelineSpec::of(&march_shader())
+            ..ComputePipelineSpec::of(&march_shader(ctx.params))
         })?;
         let params = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());
         let uniform = ctx.uniform_from_bytes("bricks", &BrickParams::EMPTY.uniform_bytes());
@@ -215,8 +220,26 @@ impl PassPlugin for RaycastBricks {
             });
         }
         let effects = EffectState::new(ctx, false)?;
+        let fusion = crate::fusion::FusionState::new(ctx)?;
+        // Only the frame volume's visible bricks are marched, and they are sampled through the
+        // atlas: a second volume that may show where the frame volume is empty, or a label map
+        // as the frame volume (its labels read voxel by voxel of the volume), is not drawn here.
+        if let Some(combine) = crate::fusion::FusionSettings::of(ctx.params).combine()
+            && !combine.bounded_by_first()
+        {
+            return Err(PassError {
+                pass: ctx.pass_id.to_string(),
+                message: format!(
+                    "fusion \"{}\" is not drawn through the brick pool (it marches only the volume's visible bricks, \
+                     sampled through its atlas): use fusion \"tint\" or \"inside\" here, or raycast_compute \
+                     (graphs/multi/) for \"{0}\"",
+                    crate::fusion::FusionSettings::of(ctx.params).fusion.name()
+                ),
+            });
+        }
         Ok(Box::new(RaycastBricksNode {
             effects,
+            fusion,
             step_voxels: Sampling::from_params(ctx.params).step_voxels,
             effects_on: EffectFlags::of(ctx.params),
             ranks: (rank, ranks),
@@ -305,6 +328,8 @@ fn range_apron(effects: EffectFlags) -> u32 {
 struct RaycastBricksNode {
     /// The pre-integration table when that effect is on.
     effects: EffectState,
+    /// Several volumes: the fusion uniform and a label map's uniform blocks.
+    fusion: crate::fusion::FusionState,
     step_voxels: f64,
     /// The effects compiled in ([`apron`], [`range_apron`]).
     effects_on: EffectFlags,
@@ -480,6 +505,7 @@ impl PassNode for RaycastBricksNode {
                 Some(VolumeState::new(ctx, voxels, version, self.brick_cells, self.node_cells, apron, range_apron)?);
         }
         self.effects.update(ctx, &self.params, self.step_voxels)?;
+        self.fusion.update(ctx)?;
         let tf_version = ctx.input_version("tf");
         let lut = ctx.table("tf")?.clone();
         let budget = self.budget(ctx);
@@ -552,6 +578,7 @@ impl PassNode for RaycastBricksNode {
                 ("volume", wgpu::BindingResource::TextureView(&atlas.view)),
             ];
             extra.extend(self.effects.bindings());
+            extra.extend(self.fusion.bindings());
             ctx.dispatch_over(&self.pipeline, &extra, "color", self.workgroup)?;
         }
         counters.batches = batches.len() as u64;

@@ -127,7 +127,11 @@ fn render(graph: &str, scene: &Scene<'_>, features: &[&str], set: &[(&str, &str)
     let mut options =
         CompileOptions::new(SIZE, SIZE).with_features(features.iter().copied()).with_param("march", "threshold", 1.0);
     for (name, value) in set {
-        options = options.with_param("march", name, *value);
+        // A whole number is a number (`brick_cells`), anything else a choice's name.
+        options = match value.parse::<u64>() {
+            Ok(n) => options.with_param("march", name, n),
+            Err(_) => options.with_param("march", name, *value),
+        };
     }
     options.scene = volgraph_core::runtime::scene_values_of(&volgraph_core::runtime::VolumeDesc::of(scene.volume));
     let plan = volgraph_core::compile(graph, &graph_source(graph), &registry, &options).expect("compiles");
@@ -375,6 +379,36 @@ fn three_and_four_channels_on_their_own_grids() {
         let (_, mean) = diff_reference(a, &support::as_reference(b));
         assert!(mean > 0.5 / 255.0, "{what} channel changes the image (mean {:.3}/255)", mean * 255.0);
     }
+}
+
+/// Fusion in the brick family: the brick pool's raycaster (samples through its atlas, only the
+/// scan's visible bricks) tints the scan by its labels and keeps it inside them as the f64
+/// reference does; a fusion the pool cannot draw losslessly is refused by name.
+#[test]
+fn the_brick_pool_tints_the_scan_by_its_labels() {
+    let (ct, labels) = (organs_ct(N), organs_labels(N));
+    let (lut, table) = (ct_lut(&ct), table());
+    let scene = Scene {
+        volume: &ct,
+        lut: &lut,
+        second: Some(&labels),
+        second_lut: &[],
+        table: &table,
+        overlay: None,
+        more: &[],
+    };
+    let graph = "ruijters_vilanova_2006/bricks_with_labels.ron";
+    check("bricks_tint", &scene, graph, &[], &[("brick_cells", "16")]);
+    check("bricks_inside_shaded", &scene, graph, &["shading"], &[("brick_cells", "16"), ("fusion", "inside")]);
+    let registry = builtin_registry();
+    let options = CompileOptions::new(SIZE, SIZE).with_param("march", "fusion", "fuse");
+    let source = graph_source(graph).replace(r#""label_table": "input.label_table","#, r#""second_tf": "input.tf","#);
+    let plan = volgraph_core::compile(graph, &source, &registry, &options).expect("compiles");
+    let mut runtime = support::runtime(&gpu());
+    runtime.bind_volume("volume", &ct).expect("binds");
+    runtime.bind_volume("labels", &labels).expect("binds");
+    let err = runtime.apply(plan, &registry).expect_err("refused").to_string();
+    assert!(err.contains("fusion \"fuse\" is not drawn through the brick pool"), "{err}");
 }
 
 /// An overlay where there is no fused pair to lie over is refused with what to use instead,

@@ -331,6 +331,27 @@ impl FusionState {
         Ok(Self { combine, more, overlay: settings.overlay(), buffer, versions: None, blocks: None, smooth })
     }
 
+    /// [`Self::new`] for a raycaster whose empty-space skipping reads the frame volume alone
+    /// (`skipping`: what skips, for the message): only a fusion never more opaque than the scan
+    /// (`tint`, `inside`) is drawn right there; the others are refused by name.
+    pub fn bounded_by_the_scan(ctx: &CreateContext<'_>, kind: &str, skipping: &str) -> Result<Self, PassError> {
+        let settings = FusionSettings::of(ctx.params);
+        if let Some(combine) = settings.combine()
+            && !combine.bounded_by_first()
+        {
+            return Err(PassError {
+                pass: ctx.pass_id.to_string(),
+                message: format!(
+                    "fusion \"{}\" is not drawn by {} ({skipping} the volume alone): use fusion \"tint\" or \"inside\" \
+                     here, or raycast_compute (graphs/multi/) for \"{0}\"",
+                    settings.fusion.name(),
+                    kind
+                ),
+            });
+        }
+        Self::new(ctx)
+    }
+
     /// The port of the label map, when smooth label sampling reads its uniform blocks.
     fn label_map_port(&self) -> Option<&'static str> {
         match self.combine? {

@@ -38,7 +38,6 @@ use crate::raycast_params::sampling_block;
 use std::sync::Arc;
 use std::time::Instant;
 use volgraph_compiler::block::{OnChange, ParamBlock};
-use volgraph_compiler::declare::ParamChoice as _;
 
 use glam::{DVec3, UVec3};
 use volgraph_accel::brick_leaves::{SLOTS_PER_AXIS, classify_leaves, leaf_grid, owns, slot_coord, slot_word};
@@ -220,23 +219,10 @@ impl PassPlugin for RaycastBricks {
             });
         }
         let effects = EffectState::new(ctx, false)?;
-        let fusion = crate::fusion::FusionState::new(ctx)?;
-        // Only the frame volume's visible bricks are marched, and they are sampled through the
-        // atlas: a second volume that may show where the frame volume is empty, or a label map
-        // as the frame volume (its labels read voxel by voxel of the volume), is not drawn here.
-        if let Some(combine) = crate::fusion::FusionSettings::of(ctx.params).combine()
-            && !combine.bounded_by_first()
-        {
-            return Err(PassError {
-                pass: ctx.pass_id.to_string(),
-                message: format!(
-                    "fusion \"{}\" is not drawn through the brick pool (it marches only the volume's visible bricks, \
-                     sampled through its atlas): use fusion \"tint\" or \"inside\" here, or raycast_compute \
-                     (graphs/multi/) for \"{0}\"",
-                    crate::fusion::FusionSettings::of(ctx.params).fusion.name()
-                ),
-            });
-        }
+        // Only the volume's visible bricks are marched (and a label map as the volume would be
+        // read through the atlas, voxel by voxel of the volume).
+        let fusion =
+            crate::fusion::FusionState::bounded_by_the_scan(ctx, self.kind(), "it marches only the visible bricks of")?;
         Ok(Box::new(RaycastBricksNode {
             effects,
             fusion,

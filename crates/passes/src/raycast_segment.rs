@@ -163,7 +163,12 @@ impl PassDecl for RaycastSegment {
         // The node writes its uniforms once, when built: every change rebuilds it.
         [
             raycast_blocks(OnChange::Rebuild),
-            vec![effect_block(), SegmentSteps::block(OnChange::Rebuild), BlockSize::block(OnChange::Rebuild)],
+            vec![
+                effect_block(),
+                crate::fusion::fusion_block(),
+                SegmentSteps::block(OnChange::Rebuild),
+                BlockSize::block(OnChange::Rebuild),
+            ],
         ]
         .concat()
     }
@@ -180,6 +185,7 @@ impl PassDecl for RaycastSegment {
             // samples (§2.3's skipping done in the segment instead of by the depth test).
             PortSpec::read("empty", PortKind::Owned(EMPTY_BLOCKS)).optional(),
         ];
+        ports.extend(crate::fusion::FusionSettings::of(params).ports());
         if is_iso(params) {
             // §2.2: the closest hit's texture-space position, blended like the colour.
             ports.push(PortSpec::modify("hit", PortKind::target(&HIT_FORMATS)));
@@ -192,12 +198,17 @@ impl PassDecl for RaycastSegment {
         // The counting variant (a bench tool's) binds the invocation counter too.
         // The pre-integration table's (an effect's), and the counting variant's counter.
         let binds: &'static [&'static str] = if self.counts() {
-            &["invocations", "preintegrated", "light_volume"]
+            &["invocations", "preintegrated", "light_volume", "label_blocks"]
         } else {
-            &["preintegrated", "light_volume"]
+            &["preintegrated", "light_volume", "label_blocks"]
         };
         let mut uses = [ShaderUse::new(file, "vs_segment"), ShaderUse::new(file, entry_point)]
-            .map(|u| u.binds(binds).uniform(RaycastParamsGpu::bound("params")).uniform(SegmentParams::layout()))
+            .map(|u| {
+                crate::fusion::with_fusion_uniform(
+                    u.binds(binds).uniform(RaycastParamsGpu::bound("params")).uniform(SegmentParams::layout()),
+                    params,
+                )
+            })
             .to_vec();
         uses.extend(effect_shader_uses(params, true));
         uses
@@ -283,8 +294,13 @@ impl PassPlugin for RaycastSegment {
             None => None,
         };
         let effects = EffectState::new(ctx, true)?;
+        let fusion = crate::fusion::FusionState::bounded_by_the_scan(
+            ctx,
+            self.kind(),
+            "the termination test and empty-space classification beside its segments read",
+        )?;
         let step_voxels = Sampling::from_params(ctx.params).step_voxels;
-        Ok(Box::new(RaycastSegmentNode { free, early_z, params, segment, invocations, effects, step_voxels }))
+        Ok(Box::new(RaycastSegmentNode { free, early_z, params, segment, invocations, effects, fusion, step_voxels }))
     }
 }
 
@@ -310,6 +326,8 @@ struct RaycastSegmentNode {
     invocations: Option<wgpu::Buffer>,
     /// The pre-integration table when that effect is on.
     effects: EffectState,
+    /// Several volumes: the fusion uniform and a label map's uniform blocks.
+    fusion: crate::fusion::FusionState,
     step_voxels: f64,
 }
 
@@ -319,9 +337,11 @@ impl PassNode for RaycastSegmentNode {
         let index = segment_index(ctx);
         let pipeline = if ctx.is_bound("depth") { &self.early_z } else { &self.free };
         self.effects.update(ctx, &self.params, self.step_voxels)?;
+        self.fusion.update(ctx)?;
         let mut extra =
             vec![("params", self.params.as_entire_binding()), ("segment", self.segment.as_entire_binding())];
         extra.extend(self.effects.bindings());
+        extra.extend(self.fusion.bindings());
         if let Some(counter) = &self.invocations {
             if index == 0 {
                 ctx.encoder.clear_buffer(counter, 0, None);

@@ -123,6 +123,17 @@ struct Scene<'a> {
 /// Renders `graph` with `scene` bound by input kind and name, lossless (threshold 1), with
 /// `features` and parameter overrides `set`; returns the image and the march's parameters.
 fn render(graph: &str, scene: &Scene<'_>, features: &[&str], set: &[(&str, &str)]) -> (Image, volgraph_core::Params) {
+    render_source(graph, &graph_source(graph), scene, features, set)
+}
+
+/// [`render`] of the graph text `source` (named `graph`).
+fn render_source(
+    graph: &str,
+    source: &str,
+    scene: &Scene<'_>,
+    features: &[&str],
+    set: &[(&str, &str)],
+) -> (Image, volgraph_core::Params) {
     let registry = builtin_registry();
     let mut options =
         CompileOptions::new(SIZE, SIZE).with_features(features.iter().copied()).with_param("march", "threshold", 1.0);
@@ -134,7 +145,7 @@ fn render(graph: &str, scene: &Scene<'_>, features: &[&str], set: &[(&str, &str)
         };
     }
     options.scene = volgraph_core::runtime::scene_values_of(&volgraph_core::runtime::VolumeDesc::of(scene.volume));
-    let plan = volgraph_core::compile(graph, &graph_source(graph), &registry, &options).expect("compiles");
+    let plan = volgraph_core::compile(graph, source, &registry, &options).expect("compiles");
     let gpu = gpu();
     let mut runtime = support::runtime(&gpu);
     for (name, kind) in &plan.inputs {
@@ -206,7 +217,19 @@ fn share_over(image: &Image, reference: &[[f64; 4]], tolerance: f64) -> f64 {
 /// opaque labels a whole pixel's colour. Measured: 0 % of pixels on the organ phantom,
 /// 0.011 % (one pixel) on the 65,535-label map; 1 % allowed.
 fn check(name: &str, scene: &Scene<'_>, graph: &str, features: &[&str], set: &[(&str, &str)]) -> Image {
-    let (image, march) = render(graph, scene, features, set);
+    check_source(name, scene, graph, &graph_source(graph), features, set)
+}
+
+/// [`check`] of the graph text `source` (named `graph`).
+fn check_source(
+    name: &str,
+    scene: &Scene<'_>,
+    graph: &str,
+    source: &str,
+    features: &[&str],
+    set: &[(&str, &str)],
+) -> Image {
+    let (image, march) = render_source(graph, source, scene, features, set);
     let reference = reference(scene, &march);
     let (max, mean) = diff_reference(&image, &reference);
     let over = share_over(&image, &reference, 2.0 / 255.0);
@@ -408,7 +431,50 @@ fn the_brick_pool_tints_the_scan_by_its_labels() {
     runtime.bind_volume("volume", &ct).expect("binds");
     runtime.bind_volume("labels", &labels).expect("binds");
     let err = runtime.apply(plan, &registry).expect_err("refused").to_string();
-    assert!(err.contains("fusion \"fuse\" is not drawn through the brick pool"), "{err}");
+    assert!(err.contains("fusion \"fuse\" is not drawn by raycast_bricks"), "{err}");
+}
+
+/// Fusion in the multipass family (Krüger & Westermann 2003's ray segments, blended pass after
+/// pass): `kruger_westermann_2003/rc.ron` with the scan tinted by its labels, and inside them
+/// with shading, against the reference; a fusion the termination test beside the segments could
+/// not follow is refused by name.
+#[test]
+fn ray_segments_tint_the_scan_by_its_labels() {
+    let (ct, labels) = (organs_ct(N), organs_labels(N));
+    let (lut, table) = (ct_lut(&ct), table());
+    let scene = Scene {
+        volume: &ct,
+        lut: &lut,
+        second: Some(&labels),
+        second_lut: &[],
+        table: &table,
+        overlay: None,
+        more: &[],
+    };
+    let graph = "kruger_westermann_2003/rc.ron";
+    let source = graph_source(graph)
+        .replace(
+            r#""tf": TransferFunction,"#,
+            r#""tf": TransferFunction, "labels": Volume, "label_table": LabelTable,"#,
+        )
+        .replace(r#""threshold": 1.0,"#, r#""threshold": 1.0, "fusion": "tint","#)
+        .replace(
+            r#""tf": "input.tf",
+                        "accum""#,
+            r#""tf": "input.tf", "second": "input.labels", "label_table": "input.label_table",
+                        "accum""#,
+        );
+    assert!(source.contains(r#""second": "input.labels""#), "the segment pass is wired to the label map");
+    check_source("segments_tint", &scene, graph, &source, &[], &[]);
+    check_source("segments_inside_shaded", &scene, graph, &source, &["shading"], &[("fusion", "inside")]);
+    let registry = builtin_registry();
+    let options = CompileOptions::new(SIZE, SIZE).with_param("march", "fusion", "labels");
+    let plan = volgraph_core::compile(graph, &source.replace(r#""second": "input.labels", "#, ""), &registry, &options)
+        .expect("compiles");
+    let mut runtime = support::runtime(&gpu());
+    runtime.bind_scene(&plan.inputs, &labels, &lut).expect("binds");
+    let err = runtime.apply(plan, &registry).expect_err("refused").to_string();
+    assert!(err.contains("fusion \"labels\" is not drawn by raycast_segment"), "{err}");
 }
 
 /// An overlay where there is no fused pair to lie over is refused with what to use instead,

@@ -190,10 +190,24 @@ impl Live {
         lut: &[[f32; 4]],
         options: &CompileOptions,
     ) -> Self {
+        Self::with_source(gpu, registry, (graph, &graph_source(graph)), volume, lut, options, |_| {})
+    }
+
+    /// [`Self::new`] of the graph text `source` (named `graph`); `bind` binds what the scene's
+    /// volume and TF do not (a second volume, a label table) before the plan is applied.
+    pub fn with_source(
+        gpu: &Arc<Gpu>,
+        registry: &Registry,
+        (graph, source): (&str, &str),
+        volume: &Volume,
+        lut: &[[f32; 4]],
+        options: &CompileOptions,
+        bind: impl FnOnce(&mut Runtime),
+    ) -> Self {
         let mut runtime = runtime(gpu);
-        let source = graph_source(graph);
-        let plan = runtime.compile(graph, &source, registry, options).unwrap_or_else(|d| panic!("{graph}:\n{d}"));
+        let plan = runtime.compile(graph, source, registry, options).unwrap_or_else(|d| panic!("{graph}:\n{d}"));
         runtime.bind_scene(&plan.inputs, volume, lut).expect("binds");
+        bind(&mut runtime);
         let viewport = plan.viewport;
         runtime.apply(plan, registry).unwrap_or_else(|e| panic!("{graph}: {e}"));
         Self { runtime, viewport }

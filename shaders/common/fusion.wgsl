@@ -263,7 +263,8 @@ fn fused_sample(u: vec3<f32>, s: f32) -> vec4<f32> {
     return premultiplied(rgb, c.a);
 #endif
 #if FUSION_SCALAR
-    let p1 = premultiplied(c.rgb, c.a);
+    // Past the frame volume's box (rays cross every scalar volume's) it adds nothing.
+    let p1 = select(vec4<f32>(0.0), premultiplied(c.rgb, c.a), in_box(uv));
     var p2 = vec4<f32>(0.0);
     if (inside) {
         let s2 = textureSampleLevel(second, linear_clamp, u2, 0.0).r;

@@ -164,6 +164,26 @@ fn cap_normal(u: vec3<f32>, d_world: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 }
 #endif
 
+// The box rays cross, in the bound texture's coordinates: the volume's [0,1]³; a sort-last
+// window's whole grid; or, with several scalar volumes (FUSION_SCALAR), the union of their
+// boxes (common/fusion.wgsl's `fusion.march_lo/hi`, volgraph_accel::fusion::march_box), so a
+// PET reaching past its CT is drawn where it lies.
+fn march_lo() -> vec3<f32> {
+#if FUSION_SCALAR
+    return select(fusion.march_lo.xyz, frame.grid_lo.xyz, is_window());
+#else
+    return select(vec3<f32>(0.0), frame.grid_lo.xyz, is_window());
+#endif
+}
+
+fn march_hi() -> vec3<f32> {
+#if FUSION_SCALAR
+    return select(fusion.march_hi.xyz, frame.grid_hi.xyz, is_window());
+#else
+    return select(vec3<f32>(1.0), frame.grid_hi.xyz, is_window());
+#endif
+}
+
 // The ray of pixel centre `pixel` clipped to the box and the near plane, as
 // `volgraph_accel::reference::ray_segment` clips it (slab test; start at max(t_in, t_near); the
 // ends clamped to [0,1]³; rays shorter than 1e-6 dropped), computed in texture space from the
@@ -189,8 +209,8 @@ fn analytic_ray_at(at: vec2<f32>) -> Ray {
 // clipped to the box and the near plane like `analytic_ray`.
 fn analytic_ray_along(dir: vec3<f32>) -> Ray {
     let eye = frame.eye_texture.xyz;
-    let lo = select(vec3<f32>(0.0), frame.grid_lo.xyz, is_window());
-    let hi = select(vec3<f32>(1.0), frame.grid_hi.xyz, is_window());
+    let lo = march_lo();
+    let hi = march_hi();
     let span = box_span(eye, dir, lo, hi);
     let t_in = span.x;
     let t_out = span.y;

@@ -65,8 +65,8 @@ fn ray_step_tex(d_tex: vec3<f32>) -> f32 {
 // In a sort-last window the box is the whole volume's (frame.grid_lo/hi), not [0,1]³.
 fn ray_is_valid(u0: vec3<f32>, d_tex: vec3<f32>, len_tex: f32) -> bool {
     let d_len = length(d_tex);
-    let lo = select(vec3<f32>(0.0), frame.grid_lo.xyz, is_window());
-    let size = select(vec3<f32>(1.0), frame.grid_hi.xyz - frame.grid_lo.xyz, is_window());
+    let lo = march_lo();
+    let size = march_hi() - lo;
     if (!(len_tex > 0.0) || !(len_tex < 4.0 * max(size.x, max(size.y, size.z))) || !(d_len > 0.5) || !(d_len < 1.5)) {
         return false;
     }

@@ -190,12 +190,34 @@ pub struct Fusion<'a> {
     pub overlay: Option<Overlay<'a>>,
 }
 
+/// The texture-space box (of the frame volume's texture space) rays cross: the frame volume's
+/// `[0,1]³`, grown to hold every scalar volume fused with it (`Fuse`, `Add`: a PET reaching past
+/// its CT is drawn where it lies); a label map (`Tint`, `Inside`, an overlay) shows only where
+/// the scan does, so it grows nothing.
+pub fn march_box(combine: Combine, scalar_maps: impl IntoIterator<Item = TextureMap>) -> (DVec3, DVec3) {
+    let (mut lo, mut hi) = (DVec3::ZERO, DVec3::ONE);
+    if matches!(combine, Combine::Fuse | Combine::Add) {
+        for m in scalar_maps {
+            // u₂ = u · scale + offset is the partner's [0,1] at u = −offset/scale … (1 − offset)/scale.
+            let (a, b) = (-m.offset / m.scale, (DVec3::ONE - m.offset) / m.scale);
+            (lo, hi) = (lo.min(a.min(b)), hi.max(a.max(b)));
+        }
+    }
+    (lo, hi)
+}
+
 /// The label table's entry at `label` (zero past its end: hidden).
 pub fn label_entry(label_lut: &[[f32; 4]], label: u32) -> [f64; 4] {
     label_lut.get(label as usize).map_or([0.0; 4], |e| e.map(f64::from))
 }
 
 impl Fusion<'_> {
+    /// The box rays cross ([`march_box`]).
+    pub fn march_box(&self) -> (DVec3, DVec3) {
+        let maps = self.second.iter().map(|(_, _, m)| *m).chain(self.more.iter().map(|(_, _, m)| *m));
+        march_box(self.combine, maps)
+    }
+
     /// The premultiplied, opacity-corrected colour of the sample at the frame volume's texture
     /// point `u`, where the frame volume's field is `s` and its TF `lut`; `exponent` is the
     /// correction's (step over opacity unit). Shading, when on, is applied by the caller.
@@ -235,7 +257,9 @@ impl Fusion<'_> {
                     let (c, a) = if in_box(at) { through(lut, volume.sample_trilinear(at)) } else { ([0.0; 3], 0.0) };
                     premultiplied(c, a)
                 };
-                let mut media = vec![premultiplied(c1, a1), medium(second, second_lut, &map)];
+                // Past the frame volume's box (rays cross every scalar volume's) it adds nothing.
+                let first = if in_box(u) { premultiplied(c1, a1) } else { [0.0; 4] };
+                let mut media = vec![first, medium(second, second_lut, &map)];
                 media.extend(self.more.iter().map(|(v, lut, map)| medium(v, lut, map)));
                 let fused = fuse_media(self.combine, &media);
                 match &self.overlay {

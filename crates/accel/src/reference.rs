@@ -205,15 +205,30 @@ pub fn intersect_box(origin: DVec3, dir: DVec3, half: DVec3) -> Option<(f64, f64
 /// ([`CameraFrame::pixel_ray`]), from `max(t_in, t_near)` to `t_out`; `None` when there is no
 /// ray (it misses, `t_out <= t0`, or the segment is shorter than [`MIN_RAY_LENGTH_TEX`]).
 pub fn ray_segment(volume: &Volume, camera: &OrbitCamera, frame: &CameraFrame, x: u32, y: u32) -> Option<RaySegment> {
+    ray_segment_in(volume, camera, frame, (x, y), (DVec3::ZERO, DVec3::ONE))
+}
+
+/// [`ray_segment`] through the texture-space box `[lo, hi]` instead of the volume's `[0,1]³`
+/// (several scalar volumes: the union of their boxes, [`crate::fusion::Fusion::march_box`]).
+pub fn ray_segment_in(
+    volume: &Volume,
+    camera: &OrbitCamera,
+    frame: &CameraFrame,
+    (x, y): (u32, u32),
+    (lo, hi): (DVec3, DVec3),
+) -> Option<RaySegment> {
     let half = volume.half_extent_world();
     let (eye, dir) = frame.pixel_ray(x, y);
-    let (t_in, t_out) = intersect_box(eye, dir, half)?;
+    // The box in world space, about its centre (0 and `half` for the volume's own).
+    let (wlo, whi) = ((lo - 0.5) * 2.0 * half, (hi - 0.5) * 2.0 * half);
+    let centre = (wlo + whi) * 0.5;
+    let (t_in, t_out) = intersect_box(eye - centre, dir, (whi - wlo) * 0.5)?;
     let t0 = t_in.max(frame.near_t(camera.near, dir));
     if t0.is_nan() || t_out <= t0 {
         return None;
     }
     // Clamped like the GPU's entry/exit targets, which clamp interpolation overshoot.
-    let texture = |t: f64| ((eye + t * dir) / (2.0 * half) + 0.5).clamp(DVec3::ZERO, DVec3::ONE);
+    let texture = |t: f64| ((eye + t * dir) / (2.0 * half) + 0.5).clamp(lo, hi);
     let (u0, u1) = (texture(t0), texture(t_out));
     let len_tex = (u1 - u0).length();
     if len_tex.is_nan() || len_tex < MIN_RAY_LENGTH_TEX {
@@ -611,7 +626,8 @@ pub fn fused_pixel_lit(
     (x, y): (u32, u32),
     settings: &RaycastSettings,
 ) -> ([f64; 4], [f64; 4], u64) {
-    let Some(seg) = ray_segment(volume, camera, frame, x, y) else {
+    let bounds = fusion.map_or((DVec3::ZERO, DVec3::ONE), |f| f.march_box());
+    let Some(seg) = ray_segment_in(volume, camera, frame, (x, y), bounds) else {
         return ([0.0; 4], [0.0; 4], 0);
     };
     let step_tex = step_tex(volume, seg.d_tex, settings.step_voxels);

@@ -198,6 +198,8 @@ volgraph_compiler::pass_params! {
         third_offset: [f32; 4] = computed, "xyz: see third_scale.";
         fourth_scale: [f32; 4] = computed, "xyz: the fourth volume's texture point is u · scale + offset.";
         fourth_offset: [f32; 4] = computed, "xyz: see fourth_scale.";
+        march_lo: [f32; 4] = computed, "xyz: the box rays cross, in the volume's texture space (fusion::march_box).";
+        march_hi: [f32; 4] = computed, "xyz: see march_lo.";
         overlay_scale: [f32; 4] = computed, "xyz: the overlay's texture point is u · scale + offset.";
         overlay_offset: [f32; 4] = computed, "xyz: see overlay_scale.";
         overlay_labels: [f32; 4] = computed, "x, y: a label of the overlay is round(x + texel · y).";
@@ -222,6 +224,8 @@ impl FusionMap {
             third_offset: [0.0; 4],
             fourth_scale: [1.0; 4],
             fourth_offset: [0.0; 4],
+            march_lo: [0.0; 4],
+            march_hi: [1.0; 4],
             overlay_scale: [1.0; 4],
             overlay_offset: [0.0; 4],
             overlay_labels: [0.0, 255.0, 0.0, 0.0],
@@ -246,8 +250,10 @@ impl FusionMap {
             [lo as f32, (hi - lo) as f32, 0.0, 0.0]
         };
         let mut map = Self { first_labels: decode(first), ..Self::identity(combine) };
+        let mut scalar_maps = Vec::new();
         if let Some(second) = second {
             let m = volgraph_accel::fusion::TextureMap::between(first, second)?;
+            scalar_maps.push(m);
             map.second_scale = [m.scale.x as f32, m.scale.y as f32, m.scale.z as f32, 0.0];
             map.second_offset = [m.offset.x as f32, m.offset.y as f32, m.offset.z as f32, 0.0];
             map.second_labels = decode(second);
@@ -260,6 +266,9 @@ impl FusionMap {
             let (s, o) = (m.scale.as_vec3(), m.offset.as_vec3());
             ([s.x, s.y, s.z, 0.0], [o.x, o.y, o.z, 0.0])
         };
+        scalar_maps.extend(maps.iter().copied());
+        let (lo, hi) = volgraph_accel::fusion::march_box(combine, scalar_maps);
+        (map.march_lo, map.march_hi) = (lo.as_vec3().extend(0.0).to_array(), hi.as_vec3().extend(0.0).to_array());
         if let Some(m) = maps.first() {
             (map.third_scale, map.third_offset) = pair(m);
         }

@@ -477,6 +477,76 @@ fn ray_segments_tint_the_scan_by_its_labels() {
     assert!(err.contains("fusion \"labels\" is not drawn by raycast_segment"), "{err}");
 }
 
+/// A PET-like volume whose grid reaches past the CT's box on every side (a whole-body PET over
+/// a cropped CT): the CT's values where the CT is, and a hot sphere beside the CT's box, in the
+/// part only the PET covers.
+fn wide_pet(ct: &Volume) -> Volume {
+    let spacing = ct.spacing * 4.0;
+    let margin = UVec3::new(6, 2, 3);
+    let dims = ct.dims / 4 + margin * 2;
+    let origin = ct.meta.origin.unwrap_or_default() - margin.as_dvec3() * spacing + DVec3::splat(0.5) * spacing;
+    let mut pet =
+        Volume::new("wide pet", dims, spacing, VoxelData::F32(vec![0.0; (dims.x * dims.y * dims.z) as usize]));
+    pet.meta.frame = ct.meta.frame.clone();
+    pet.meta.origin = Some(origin);
+    let to_ct = TextureMap::between(&pet, ct).expect("one frame");
+    // The hot sphere: beside the CT's high-x face (towards the test's camera), a fifth of the
+    // CT's width away.
+    let hot = DVec3::new(1.2, 0.5, 0.5);
+    let mut data = Vec::new();
+    for z in 0..dims.z {
+        for y in 0..dims.y {
+            for x in 0..dims.x {
+                let u = to_ct.apply((DVec3::new(x as f64, y as f64, z as f64) + 0.5) / dims.as_dvec3());
+                let inside = u.cmpge(DVec3::ZERO).all() && u.cmple(DVec3::ONE).all();
+                let value = if inside {
+                    ((ct.data_value(ct.sample_trilinear(u)) - 20.0) / 280.0).clamp(0.0, 1.0)
+                } else {
+                    (1.0 - ((u - hot) * DVec3::new(1.0, 0.5, 1.0)).length() / 0.2).clamp(0.0, 1.0)
+                };
+                data.push(value as f32);
+            }
+        }
+    }
+    pet.data = VoxelData::F32(data);
+    pet.value_range = (0.0, 1.0);
+    pet
+}
+
+/// A PET reaching past its CT is drawn where it lies: rays cross the union of the scalar
+/// volumes' boxes (the CT adds nothing outside its own), GPU against the reference, and the
+/// hot sphere beside the CT shows.
+#[test]
+fn a_pet_reaching_past_its_ct_is_drawn_where_it_lies() {
+    let ct = organs_ct(N);
+    let pet = wide_pet(&ct);
+    let (lut, second_lut) = (ct_lut(&ct), pet_lut(&pet));
+    let scene = Scene {
+        volume: &ct,
+        lut: &lut,
+        second: Some(&pet),
+        second_lut: &second_lut,
+        table: &[],
+        overlay: None,
+        more: &[],
+    };
+    let fused = check("pet_past_the_ct", &scene, "multi/pet_ct.ron", &[], &[]);
+    check("pet_past_the_ct_shaded", &scene, "multi/pet_ct.ron", &["shading"], &[]);
+    // The CT alone (its TF, the PET's transparent) covers less: the sphere lies outside its box.
+    let ct_only = Scene { second_lut: &[[0.0; 4]; 2], ..scene };
+    let (alone, _) = render("multi/pet_ct.ron", &ct_only, &[], &[]);
+    let covered = |image: &Image| (0..SIZE * SIZE).filter(|i| image.rgba(i % SIZE, i / SIZE)[3] > 2.0 / 255.0).count();
+    let outside = (0..SIZE * SIZE)
+        .filter(|i| alone.rgba(i % SIZE, i / SIZE)[3] <= 0.0 && fused.rgba(i % SIZE, i / SIZE)[3] > 2.0 / 255.0)
+        .count();
+    assert!(
+        outside > 30,
+        "the sphere beside the CT shows on {outside} pixels (CT {}, fused {})",
+        covered(&alone),
+        covered(&fused)
+    );
+}
+
 /// An overlay where there is no fused pair to lie over is refused with what to use instead,
 /// not drawn as something else.
 #[test]

@@ -45,7 +45,13 @@ fn transmittance_along(u0: vec3<f32>, step: vec3<f32>, max_steps: u32, exponent:
         if (!(f32(k) >= kept.x && f32(k) < kept.y)) {
             continue;
         }
-        let a = clamp(sample_tf(sample_volume(u0 + f32(k) * step)).a, 0.0, 1.0);
+        let p = u0 + f32(k) * step;
+#if FUSION
+        // Several volumes: their combined opacity (common/fusion.wgsl).
+        let a = clamp(fused_alpha(p, sample_volume(p)), 0.0, 1.0);
+#else
+        let a = clamp(sample_tf(sample_volume(p)).a, 0.0, 1.0);
+#endif
         if (a >= 1.0) {
             return 0.0;
         }
@@ -75,6 +81,9 @@ fn cs_light_volume(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let u0 = (vec3<f32>(id) + vec3<f32>(0.5)) / vec3<f32>(m);
     let exponent = 1.0 / frame.volume_dims.w;
+#if FUSION
+    begin_fusion();
+#endif
     var t = 1.0;
 #if SHADOWS
     // Toward the light: a directional light's, else the eye's along the camera's forward axis;

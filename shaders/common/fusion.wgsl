@@ -302,18 +302,71 @@ fn fused_sample(u: vec3<f32>, s: f32) -> vec4<f32> {
 #endif
 }
 
-#if FUSION_THIRD
-// The premultiplied, corrected sample of scalar volume `v` through its TF `tf` at its texture
-// point `at` (nothing outside its box).
-fn scalar_medium(v: texture_3d<f32>, tf: texture_1d<f32>, at: vec3<f32>) -> vec4<f32> {
+#if FUSION_SCALAR
+// Scalar volume `v` through its TF `tf` at its texture point `at` (straight colour and the TF's
+// opacity; nothing outside its box).
+fn scalar_tf_at(v: texture_3d<f32>, tf: texture_1d<f32>, at: vec3<f32>) -> vec4<f32> {
     if (!in_box(at)) {
         return vec4<f32>(0.0);
     }
     let s = textureSampleLevel(v, linear_clamp, at, 0.0).r;
-    let c = textureSampleLevel(tf, linear_clamp, s, 0.0);
+    return textureSampleLevel(tf, linear_clamp, s, 0.0);
+}
+#endif
+
+#if FUSION_THIRD
+// The premultiplied, corrected sample of scalar volume `v` through its TF `tf` at its texture
+// point `at` (nothing outside its box).
+fn scalar_medium(v: texture_3d<f32>, tf: texture_1d<f32>, at: vec3<f32>) -> vec4<f32> {
+    let c = scalar_tf_at(v, tf, at);
     return premultiplied(c.rgb, c.a);
 }
 #endif
+
+#if FUSION_LABEL_READS
+// Whether a visible label lies at the label map's texture point `at` (none outside its box).
+fn visible_label_at(at: vec3<f32>) -> bool {
+    var label = 0u;
+    if (in_box(at)) {
+        label = sample_label(at);
+    }
+    return label_entry(label).a > 0.0;
+}
+#endif
+
+// The opacity of the sample at `u` (the frame volume's field `s`) before the step's correction,
+// as the combination makes it (volgraph_accel::fusion::Fusion::alpha): what the light volume of
+// the `shadows` and `ambient_occlusion` effects attenuates by (light_volume.wgsl).
+fn fused_alpha(u: vec3<f32>, s: f32) -> f32 {
+#if FUSION_LABELS
+    return clamp(label_entry(sample_label(u)).a, 0.0, 1.0);
+#else
+    let a1 = clamp(sample_tf(s).a, 0.0, 1.0);
+    let uv = volume_position(u);
+    let u2 = uv * fusion_scale + fusion_offset;
+#if FUSION_LABEL_MAP
+    if (fusion_combine == COMBINE_INSIDE && !visible_label_at(u2)) {
+        return 0.0;
+    }
+    return a1;
+#endif
+#if FUSION_SCALAR
+    var clear = (1.0 - select(0.0, a1, in_box(uv))) * (1.0 - clamp(scalar_tf_at(second, second_tf, u2).a, 0.0, 1.0));
+#if FUSION_THIRD
+    clear *= 1.0 - clamp(scalar_tf_at(third, third_tf, uv * fusion.third_scale.xyz + fusion.third_offset.xyz).a, 0.0, 1.0);
+#endif
+#if FUSION_FOURTH
+    clear *= 1.0 - clamp(scalar_tf_at(fourth, fourth_tf, uv * fusion.fourth_scale.xyz + fusion.fourth_offset.xyz).a, 0.0, 1.0);
+#endif
+#if FUSION_OVERLAY
+    if (overlay_combine == COMBINE_INSIDE && !visible_label_at(uv * overlay_scale + overlay_offset)) {
+        return 0.0;
+    }
+#endif
+    return 1.0 - clear;
+#endif
+#endif
+}
 
 #if FUSION_OVERLAY
 // The premultiplied sample `fused` of the pair under the overlay at the frame volume's texture

@@ -270,6 +270,49 @@ impl Fusion<'_> {
         }
     }
 
+    /// The opacity of the sample at the frame volume's texture point `u` (its field `s`, its TF
+    /// `lut`) before the step's correction: what the light grid of the `shadows` and
+    /// `ambient_occlusion` effects attenuates by ([`crate::light::LightGrid::compute`]). The
+    /// combination's opacity as [`Self::classify`] makes it — the correction of several media's
+    /// `1 − Π(1 − αᵢ)` is the product of each one's.
+    pub fn alpha(&self, first: &Volume, lut: &[[f32; 4]], u: DVec3, s: f64) -> f64 {
+        let through = |lut: &[[f32; 4]], s: f64| lut_sample(lut, s)[3].clamp(0.0, 1.0);
+        let visible = |labels: &Volume, at: DVec3| {
+            let label = if in_box(at) { sample_label(labels, at, self.filter).0 } else { 0 };
+            label_entry(self.label_lut, label)[3] > 0.0
+        };
+        if self.combine == Combine::Labels {
+            return label_entry(self.label_lut, sample_label(first, u, self.filter).0)[3].clamp(0.0, 1.0);
+        }
+        let a1 = through(lut, s);
+        let Some((second, second_lut, map)) = self.second else { return a1 };
+        match self.combine {
+            Combine::Labels | Combine::Tint => a1,
+            Combine::Inside => {
+                if visible(second, map.apply(u)) {
+                    a1
+                } else {
+                    0.0
+                }
+            }
+            Combine::Fuse | Combine::Add => {
+                let medium = |volume: &Volume, lut: &[[f32; 4]], map: &TextureMap| {
+                    let at = map.apply(u);
+                    if in_box(at) { through(lut, volume.sample_trilinear(at)) } else { 0.0 }
+                };
+                let mut clear = 1.0 - if in_box(u) { a1 } else { 0.0 };
+                clear *= 1.0 - medium(second, second_lut, &map);
+                for (v, lut, map) in self.more {
+                    clear *= 1.0 - medium(v, lut, map);
+                }
+                match &self.overlay {
+                    Some(o) if o.combine == Combine::Inside && !visible(o.labels, o.map.apply(u)) => 0.0,
+                    _ => 1.0 - clear,
+                }
+            }
+        }
+    }
+
     /// The premultiplied sample `fused` under the label map `overlay` at the frame volume's
     /// texture point `u`: where no visible label lies, nothing (`Inside`) or itself (`Tint`);
     /// where one does, itself (`Inside`) or its colour moved towards the label's by the label's

@@ -240,16 +240,15 @@ pub const OCCLUSION_DIRECTIONS: [[f64; 3]; 14] = [
 ];
 
 impl LightGrid {
-    /// The grid of `volume` classified by `lut` (alpha per `opacity_unit_voxels`): transmittance
-    /// toward the unit world direction `toward` where given (shadows), ambient occlusion where
-    /// `occlusion`; `field` reconstructs the volume at a texture point (trilinear, or the
-    /// tricubic B-spline).
+    /// The grid over `volume` of the opacity `alpha` gives at a texture point (per
+    /// `opacity_unit_voxels`, before the step's correction: the TF's at the reconstructed field,
+    /// or several volumes' combined, `fusion::Fusion::alpha`): transmittance toward the unit
+    /// world direction `toward` where given (shadows), ambient occlusion where `occlusion`.
     pub fn compute(
         volume: &crate::volume::Volume,
-        lut: &[[f32; 4]],
         (toward, occlusion): (Option<Toward>, bool),
         (opacity_unit_voxels, cuts): (f64, &crate::cuts::Cuts),
-        field: &(dyn Fn(DVec3) -> f64 + Sync),
+        alpha: &(dyn Fn(DVec3) -> f64 + Sync),
     ) -> Self {
         use rayon::prelude::*;
         let dims = light_grid_dims(volume.dims);
@@ -269,8 +268,7 @@ impl LightGrid {
                 if !((k as f64) >= begin && (k as f64) < end) {
                     continue;
                 }
-                let s = field(u0 + k as f64 * step);
-                let a = crate::reference::lut_sample(lut, s)[3].clamp(0.0, 1.0);
+                let a = alpha(u0 + k as f64 * step).clamp(0.0, 1.0);
                 depth += (1.0 - a).ln();
                 if exponent * depth < MIN_TRANSMITTANCE.ln() {
                     return 0.0;
@@ -422,12 +420,12 @@ mod tests {
         // Opaque above 0.5, clear below.
         let lut: Vec<[f32; 4]> = (0..256).map(|i| if i >= 128 { [1.0; 4] } else { [0.0; 4] }).collect();
         let toward = DVec3::Z; // light at +z
+        let alpha = |u: DVec3| crate::reference::lut_sample(&lut, volume.sample_trilinear(u))[3];
         let grid = LightGrid::compute(
             &volume,
-            &lut,
             (Some(Toward::Direction(toward)), true),
             (1.0, &crate::cuts::Cuts::NONE),
-            &|u| volume.sample_trilinear(u),
+            &alpha,
         );
         assert_eq!(grid.dims, glam::UVec3::splat(n));
         let at = |z: u32| grid.transmittance[(8 + n * (8 + n * z)) as usize];
@@ -446,9 +444,7 @@ mod tests {
         // A clip plane keeping z < 0.3 removes the slab: nothing shadows the voxel behind it.
         let keep_low = crate::cuts::ClipPlane::new(DVec3::new(0.0, 0.0, -1.0), -0.3).expect("plane");
         let cuts = crate::cuts::Cuts::new(None, &[keep_low]).expect("cuts");
-        let cut = LightGrid::compute(&volume, &lut, (Some(Toward::Direction(toward)), false), (1.0, &cuts), &|u| {
-            volume.sample_trilinear(u)
-        });
+        let cut = LightGrid::compute(&volume, (Some(Toward::Direction(toward)), false), (1.0, &cuts), &alpha);
         assert_eq!(cut.transmittance[(8 + n * (8 + n * 2)) as usize], 1.0, "the cut-away slab casts no shadow");
         assert_eq!(steps_to_exit(DVec3::splat(0.5), DVec3::ZERO), 0);
     }

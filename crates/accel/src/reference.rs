@@ -545,7 +545,7 @@ pub fn render_fused_reference(
         return ReferenceImage { width, height, color, hit, samples: 0 };
     }
     let frame = camera.frame(width, height);
-    let grid = shadow_grid(volume, lut, &frame, settings);
+    let grid = shadow_grid(volume, lut, fusion, &frame, settings);
     let row_len = width as usize;
     let samples = color
         .par_chunks_mut(row_len)
@@ -592,16 +592,18 @@ pub fn fused_pixel(
     (x, y): (u32, u32),
     settings: &RaycastSettings,
 ) -> ([f64; 4], [f64; 4], u64) {
-    let grid = shadow_grid(volume, lut, frame, settings);
+    let grid = shadow_grid(volume, lut, fusion, frame, settings);
     fused_pixel_lit(volume, lut, (fusion, grid.as_ref()), camera, frame, (x, y), settings)
 }
 
 /// The light grid the `shadows` and `ambient_occlusion` effects read (`None` without them): lit
 /// from the scene's light, or with the headlight from the eye along the camera's forward axis
-/// (one direction for the whole grid), as the GPU computes it.
+/// (one direction for the whole grid), as the GPU computes it; with several volumes from their
+/// combined opacity (`Fusion::alpha`).
 pub fn shadow_grid(
     volume: &Volume,
     lut: &[[f32; 4]],
+    fusion: Option<&Fusion<'_>>,
     frame: &CameraFrame,
     settings: &RaycastSettings,
 ) -> Option<crate::light::LightGrid> {
@@ -611,9 +613,13 @@ pub fn shadow_grid(
     let toward = settings.effects.shadows.then(|| settings.light.toward_with(-frame.forward));
     let tricubic = settings.effects.tricubic;
     let field = |u: DVec3| if tricubic { volume.sample_tricubic(u) } else { volume.sample_trilinear(u) };
+    let alpha = |u: DVec3| match fusion {
+        Some(f) => f.alpha(volume, lut, u, field(u)),
+        None => lut_sample(lut, field(u))[3],
+    };
     let occlusion = settings.effects.ambient_occlusion;
     let unit = (settings.opacity_unit_voxels, &settings.cuts);
-    Some(crate::light::LightGrid::compute(volume, lut, (toward, occlusion), unit, &field))
+    Some(crate::light::LightGrid::compute(volume, (toward, occlusion), unit, &alpha))
 }
 
 /// [`fused_pixel`] with the light grid of the `shadows` effect given ([`shadow_grid`]).

@@ -167,7 +167,7 @@ struct AntialiasNode {
 #[cfg(feature = "gpu")]
 impl PassNode for AntialiasNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
-        self.effects.update(ctx, &self.params, self.step_voxels)?;
+        self.effects.update(ctx, &self.params, self.step_voxels, &[])?;
         let mut bindings = vec![("params", self.params.as_entire_binding()), ("aa", self.aa.as_entire_binding())];
         bindings.extend(self.effects.bindings());
         let bg = ctx.bind_group(&self.pipeline, &bindings)?;

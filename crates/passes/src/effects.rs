@@ -81,7 +81,7 @@ pub fn effect_shader_uses(params: &Params, volume_texture: bool) -> Vec<volgraph
         uses.extend(crate::preintegration::table_shader_uses());
     }
     if (flags.shadows || flags.ambient_occlusion) && volume_texture {
-        uses.push(crate::shadows::light_shader_use());
+        uses.push(crate::shadows::light_shader_use(params));
     }
     uses
 }
@@ -119,15 +119,17 @@ impl EffectState {
     }
 
     /// Brings derived data up to date before the raycaster records (the table after a TF or step
-    /// change); `params` is the raycaster's uniform buffer.
+    /// change); `params` is the raycaster's uniform buffer, `fusion` its fusion bindings
+    /// (`FusionState::bindings`, brought up to date first; empty for one volume).
     pub fn update(
         &mut self,
         ctx: &mut RecordContext<'_>,
         params: &wgpu::Buffer,
         step_voxels: f64,
+        fusion: &[(&'static str, wgpu::BindingResource<'_>)],
     ) -> Result<(), PassError> {
         if let Some(light) = &mut self.light {
-            light.update(ctx)?;
+            light.update(ctx, fusion)?;
         }
         match &mut self.table {
             Some(t) => t.update(ctx, params, step_voxels),

@@ -289,8 +289,8 @@ impl PassNode for RaycastNode {
             ctx.clear_buffer("leapable")?;
         }
         self.leaping.check(ctx)?;
-        self.effects.update(ctx, &self.params, self.settings.step_voxels as f64)?;
         self.fusion.update(ctx)?;
+        self.effects.update(ctx, &self.params, self.settings.step_voxels as f64, &self.fusion.bindings())?;
         let mut extra = vec![("params", self.params.as_entire_binding())];
         extra.extend(self.leaping.bindings());
         extra.extend(self.effects.bindings());

@@ -223,6 +223,20 @@ impl PassPlugin for RaycastBricks {
         // read through the atlas, voxel by voxel of the volume).
         let fusion =
             crate::fusion::FusionState::bounded_by_the_scan(ctx, self.kind(), "it marches only the visible bricks of")?;
+        // Its light volume is made on the CPU from the scan's opacity: the same as the tinted
+        // scan's, not the scan's inside the labels.
+        let flags = EffectFlags::of(ctx.params);
+        if (flags.shadows || flags.ambient_occlusion)
+            && crate::fusion::FusionSettings::of(ctx.params).combine() == Some(volgraph_accel::fusion::Combine::Inside)
+        {
+            return Err(PassError {
+                pass: ctx.pass_id.to_string(),
+                message: "shadows and ambient occlusion of the scan inside its labels are not made by the brick pool \
+                          (its light volume is the scan's alone): use fusion \"tint\" here, or raycast_compute \
+                          (graphs/multi/ct_inside_labels.ron)"
+                    .to_string(),
+            });
+        }
         Ok(Box::new(RaycastBricksNode {
             effects,
             fusion,
@@ -490,8 +504,8 @@ impl PassNode for RaycastBricksNode {
             self.volume =
                 Some(VolumeState::new(ctx, voxels, version, self.brick_cells, self.node_cells, apron, range_apron)?);
         }
-        self.effects.update(ctx, &self.params, self.step_voxels)?;
         self.fusion.update(ctx)?;
+        self.effects.update(ctx, &self.params, self.step_voxels, &self.fusion.bindings())?;
         let tf_version = ctx.input_version("tf");
         let lut = ctx.table("tf")?.clone();
         let budget = self.budget(ctx);

@@ -232,8 +232,8 @@ impl PassNode for RaycastComputeNode {
         if let Some(table) = &self.table {
             table.fill(ctx, &self.params)?;
         }
-        self.effects.update(ctx, &self.params, self.step_voxels)?;
         self.fusion.update(ctx)?;
+        self.effects.update(ctx, &self.params, self.step_voxels, &self.fusion.bindings())?;
         let mut extra = vec![("params", self.params.as_entire_binding())];
         if let Some(t) = &self.table {
             extra.push(("corrected", wgpu::BindingResource::TextureView(&t.view)));

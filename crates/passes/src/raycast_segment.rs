@@ -336,8 +336,8 @@ impl PassNode for RaycastSegmentNode {
     fn record(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
         let index = segment_index(ctx);
         let pipeline = if ctx.is_bound("depth") { &self.early_z } else { &self.free };
-        self.effects.update(ctx, &self.params, self.step_voxels)?;
         self.fusion.update(ctx)?;
+        self.effects.update(ctx, &self.params, self.step_voxels, &self.fusion.bindings())?;
         let mut extra =
             vec![("params", self.params.as_entire_binding()), ("segment", self.segment.as_entire_binding())];
         extra.extend(self.effects.bindings());

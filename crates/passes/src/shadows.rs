@@ -17,10 +17,20 @@
 
 use volgraph_compiler::ShaderUse;
 
-/// The light volume's compute entry point, declared by the raycasters whose volume is a texture.
-pub fn light_shader_use() -> ShaderUse {
-    ShaderUse::new("light_volume.wgsl", "cs_light_volume").binds(&["light_out"])
+/// The light volume's compute entry point, declared by the raycasters whose volume is a texture;
+/// with several volumes (`params` set fusion) it reads their combined opacity, through the
+/// raycaster's `fusion` uniform and label blocks.
+pub fn light_shader_use(params: &volgraph_compiler::Params) -> ShaderUse {
+    crate::fusion::with_fusion_uniform(
+        ShaderUse::new("light_volume.wgsl", "cs_light_volume").binds(&["light_out", "label_blocks"]),
+        params,
+    )
 }
+
+/// The ports whose versions rebuild the light volume of several volumes besides the volume and
+/// TF: the others' voxels and TFs, and the label table (a label hidden casts no shadow).
+const FUSION_INPUTS: [&str; 8] =
+    ["second", "second_tf", "third", "third_tf", "fourth", "fourth_tf", "overlay", "label_table"];
 
 #[cfg(feature = "gpu")]
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
@@ -28,7 +38,8 @@ use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateCon
 /// What a light volume was built for: the volume's and TF's versions, the light's direction or
 /// a point light's position (with `true`), the opacity unit's bits and the cuts.
 #[cfg(feature = "gpu")]
-type BuildKey = (Option<u64>, Option<u64>, ([u64; 3], bool), u64, volgraph_accel::cuts::Cuts);
+type BuildKey =
+    (Option<u64>, Option<u64>, ([u64; 3], bool), u64, volgraph_accel::cuts::Cuts, [Option<u64>; FUSION_INPUTS.len()]);
 
 #[cfg(feature = "gpu")]
 /// A raycaster's light volume and what it was built for.
@@ -58,8 +69,8 @@ impl LightVolume {
         volume_texture: bool,
     ) -> Result<Self, PassError> {
         let gpu = if volume_texture {
-            let declared = light_shader_use();
-            let defines: Vec<&str> = [
+            let declared = light_shader_use(ctx.params);
+            let mut defines: Vec<&str> = [
                 (flags.tricubic, crate::defines::TRICUBIC),
                 (flags.shadows, crate::defines::SHADOWS),
                 (flags.ambient_occlusion, crate::defines::AMBIENT_OCCLUSION),
@@ -67,6 +78,7 @@ impl LightVolume {
             .into_iter()
             .filter_map(|(on, d)| on.then_some(d))
             .collect();
+            defines.extend(crate::fusion::FusionSettings::of(ctx.params).defines());
             Some(
                 ctx.compute_pipeline(&ComputePipelineSpec { defines: &defines, ..ComputePipelineSpec::of(&declared) })?,
             )
@@ -91,7 +103,13 @@ impl LightVolume {
 
     /// Rebuilds from the pass's `volume` and `tf` ports when they, the light or the opacity unit
     /// changed since the last build.
-    pub fn update(&mut self, ctx: &mut RecordContext<'_>) -> Result<(), PassError> {
+    /// Rebuilds the volume when what it depends on changed; `fusion`: the raycaster's fusion
+    /// bindings (`FusionState::bindings`, written before), empty for one volume.
+    pub fn update(
+        &mut self,
+        ctx: &mut RecordContext<'_>,
+        fusion: &[(&'static str, wgpu::BindingResource<'_>)],
+    ) -> Result<(), PassError> {
         let frame = ctx.frame;
         // Only shadows depend on the light (ambient occlusion does not follow the camera). A
         // point light in the bound box's own world (a sort-last window centres it on its origin).
@@ -113,6 +131,7 @@ impl LightVolume {
             unit.to_bits(),
             // What the cuts keep (cut-away material casts no shadow).
             frame.cuts,
+            FUSION_INPUTS.map(|port| ctx.input_version(port)),
         );
         if self.built_for == Some(key) && self.view.is_some() {
             return Ok(());
@@ -140,7 +159,9 @@ impl LightVolume {
                     })
                     .create_view(&wgpu::TextureViewDescriptor::default()),
             };
-            let bg = ctx.bind_group(pipeline, &[("light_out", wgpu::BindingResource::TextureView(&view))])?;
+            let mut extra = vec![("light_out", wgpu::BindingResource::TextureView(&view))];
+            extra.extend(fusion.iter().cloned());
+            let bg = ctx.bind_group(pipeline, &extra)?;
             let mut pass = ctx.begin_compute_pass();
             pass.set_pipeline(&pipeline.pipeline);
             pass.set_bind_group(0, &bg, &[]);
@@ -155,9 +176,9 @@ impl LightVolume {
         let lut = ctx.table("tf")?.clone();
         let tricubic = self.tricubic;
         let field = |u: glam::DVec3| if tricubic { volume.sample_tricubic(u) } else { volume.sample_trilinear(u) };
+        let alpha = |u: glam::DVec3| volgraph_accel::reference::lut_sample(&lut, field(u))[3];
         let cuts = frame.cuts;
-        let grid =
-            volgraph_accel::light::LightGrid::compute(&volume, &lut, (toward, self.occlusion), (unit, &cuts), &field);
+        let grid = volgraph_accel::light::LightGrid::compute(&volume, (toward, self.occlusion), (unit, &cuts), &alpha);
         // The GPU's layout: T in .r, AO in .g, 1 for a channel that is off.
         let channel = |values: &[f64], i: usize| values.get(i).map_or(1.0, |&v| v as f32);
         let texels: Vec<[f32; 4]> = (0..(grid.dims.x * grid.dims.y * grid.dims.z) as usize)

@@ -432,6 +432,16 @@ fn the_brick_pool_tints_the_scan_by_its_labels() {
     runtime.bind_volume("labels", &labels).expect("binds");
     let err = runtime.apply(plan, &registry).expect_err("refused").to_string();
     assert!(err.contains("fusion \"fuse\" is not drawn by raycast_bricks"), "{err}");
+    // Its light volume is the scan's (made on the CPU): right for the tinted scan, not for the
+    // scan inside its labels, which is refused with shadows.
+    check("bricks_tint_shadows", &scene, graph, &["shading", "shadows"], &[("brick_cells", "16")]);
+    let options = CompileOptions::new(SIZE, SIZE).with_features(["shadows"]).with_param("march", "fusion", "inside");
+    let plan = volgraph_core::compile(graph, &graph_source(graph), &registry, &options).expect("compiles");
+    let mut runtime = support::runtime(&gpu());
+    runtime.bind_volume("volume", &ct).expect("binds");
+    runtime.bind_volume("labels", &labels).expect("binds");
+    let err = runtime.apply(plan, &registry).expect_err("refused").to_string();
+    assert!(err.contains("not made by the brick pool"), "{err}");
 }
 
 /// Fusion in the multipass family (Krüger & Westermann 2003's ray segments, blended pass after
@@ -545,6 +555,45 @@ fn a_pet_reaching_past_its_ct_is_drawn_where_it_lies() {
         covered(&alone),
         covered(&fused)
     );
+}
+
+/// Shadows and ambient occlusion of several volumes: the light volume attenuates by their
+/// combined opacity (`Fusion::alpha`) — the scan inside its labels shades only by what is shown,
+/// a PET adds its own shadow — GPU against the reference's own light grid.
+#[test]
+fn shadows_fall_from_what_the_volumes_show_together() {
+    let (ct, labels) = (organs_ct(N), organs_labels(N));
+    let pet = coarse_pet(&ct);
+    let (lut, table, second_lut) = (ct_lut(&ct), table(), pet_lut(&pet));
+    let inside = Scene {
+        volume: &ct,
+        lut: &lut,
+        second: Some(&labels),
+        second_lut: &[],
+        table: &table,
+        overlay: None,
+        more: &[],
+    };
+    let lit = check("inside_labels_shadows", &inside, "multi/ct_inside_labels.ron", &["shading", "shadows"], &[]);
+    check("inside_labels_occlusion", &inside, "multi/ct_inside_labels.ron", &["ambient_occlusion"], &[]);
+    let fused = Scene {
+        volume: &ct,
+        lut: &lut,
+        second: Some(&pet),
+        second_lut: &second_lut,
+        table: &[],
+        overlay: None,
+        more: &[],
+    };
+    check("pet_ct_shadows", &fused, "multi/pet_ct.ron", &["shading", "shadows"], &[]);
+    // Hiding a label changes the light the others get (the light volume follows the table).
+    let liver_hidden: Vec<[f32; 4]> =
+        table.iter().enumerate().map(|(v, e)| if v == 1 { [0.0; 4] } else { *e }).collect();
+    let hidden = Scene { table: &liver_hidden, ..inside };
+    let (changed, _) = render("multi/ct_inside_labels.ron", &hidden, &["shading", "shadows"], &[]);
+    let (_, mean) = diff_reference(&lit, &support::as_reference(&changed));
+    assert!(mean > 0.1 / 255.0, "hiding the liver changes the image (mean {:.3}/255)", mean * 255.0);
+    check("inside_labels_shadows_liver_hidden", &hidden, "multi/ct_inside_labels.ron", &["shading", "shadows"], &[]);
 }
 
 /// An overlay where there is no fused pair to lie over is refused with what to use instead,

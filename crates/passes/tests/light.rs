@@ -210,9 +210,10 @@ fn what_a_cut_removes_casts_no_shadow() {
         effects: volgraph_accel::reference::Effects { shadows: true, ..Default::default() },
         ..Default::default()
     };
-    let whole = volgraph_accel::reference::shadow_grid(&volume, &lut, &frame, &settings).expect("a grid");
-    let cut = volgraph_accel::reference::shadow_grid(&volume, &lut, &frame, &RaycastSettings { cuts, ..settings })
-        .expect("a grid");
+    let whole = volgraph_accel::reference::shadow_grid(&volume, &lut, None, &frame, &settings).expect("a grid");
+    let cut =
+        volgraph_accel::reference::shadow_grid(&volume, &lut, None, &frame, &RaycastSettings { cuts, ..settings })
+            .expect("a grid");
     let lit_more = whole.transmittance.iter().zip(&cut.transmittance).filter(|(w, c)| **c > **w + 0.1).count();
     assert!(lit_more > 100, "{lit_more} grid voxels lit more once the top is cut away");
 }

@@ -82,19 +82,19 @@ pub fn measure(job: &Job) -> Accuracy {
         ..job.settings
     };
     let frame = job.camera.frame(w, h);
+    let fusion = job.labels.as_ref().map(|(table, filter)| volgraph_accel::fusion::Fusion {
+        combine: volgraph_accel::fusion::Combine::Labels,
+        label_lut: table,
+        filter: *filter,
+        second: None,
+        more: &[],
+        overlay: None,
+    });
     // The shadows' light grid once for the whole view, not once per pixel.
-    let grid = volgraph_accel::reference::shadow_grid(&job.volume, &job.lut, &frame, &settings);
+    let grid = volgraph_accel::reference::shadow_grid(&job.volume, &job.lut, fusion.as_ref(), &frame, &settings);
     let (mut sum, mut max, mut n) = (0.0, 0.0f64, 0usize);
     for y in (stride / 2..h).step_by(stride as usize) {
         for x in (stride / 2..w).step_by(stride as usize) {
-            let fusion = job.labels.as_ref().map(|(table, filter)| volgraph_accel::fusion::Fusion {
-                combine: volgraph_accel::fusion::Combine::Labels,
-                label_lut: table,
-                filter: *filter,
-                second: None,
-                more: &[],
-                overlay: None,
-            });
             let (reference, _, _) = volgraph_accel::reference::fused_pixel_lit(
                 &job.volume,
                 &job.lut,

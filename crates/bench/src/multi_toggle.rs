@@ -57,23 +57,10 @@ pub fn time_in_viewer(
     let list = LabelList::of(labels, table).map_err(|e| anyhow!("{e}"))?;
     std::fs::write(&table_path, list.itk_snap_text()).context("writing the label table")?;
     let args = SessionArgs {
-        environment: None,
-        graph: PathBuf::from("multi/ct_with_labels"),
-        volume: vec![ct_path.clone()],
-        raw: Default::default(),
-        tf: None,
-        tf_map: None,
-        viewport,
-        features: Vec::new(),
-        shaders: None,
-        gpu_memory_mb: None,
-        memory_mb: None,
-        scene: None,
-        cuts: Default::default(),
-        light: Default::default(),
         // As `view --volume volume=ct.mha --volume labels=labels.mha` gives them.
-        named: vec![("volume".to_string(), ct_path), ("labels".to_string(), labels_path)],
+        named: vec![("volume".to_string(), ct_path.clone()), ("labels".to_string(), labels_path)],
         named_tfs: vec![("tf".to_string(), PathBuf::from("ct-soft-tissue")), ("label_table".to_string(), table_path)],
+        ..crate::workbench::session_args(PathBuf::from("multi/ct_with_labels"), &ct_path, viewport)
     };
     let (mut session, _) =
         LiveSession::open(gpu.clone(), &args).map_err(|e| anyhow!("{}", volgraph_app::cli::error_text(&e)))?;

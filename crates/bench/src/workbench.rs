@@ -55,7 +55,14 @@ pub(crate) fn open(
     volume: &std::path::Path,
     viewport: (u32, u32),
 ) -> anyhow::Result<LiveSession> {
-    let args = SessionArgs {
+    let args = session_args(graph, volume, viewport);
+    LiveSession::open(gpu.clone(), &args).map(|(s, _)| s).map_err(|e| anyhow!("{}", volgraph_app::cli::error_text(&e)))
+}
+
+/// What `volgraph view GRAPH --volume VOLUME --size W×H` starts its session with (nothing else
+/// given: the default TF, no scene, no features).
+pub(crate) fn session_args(graph: PathBuf, volume: &std::path::Path, viewport: (u32, u32)) -> SessionArgs {
+    SessionArgs {
         environment: None,
         graph,
         volume: vec![volume.to_path_buf()],
@@ -72,8 +79,7 @@ pub(crate) fn open(
         light: Default::default(),
         named: Vec::new(),
         named_tfs: Vec::new(),
-    };
-    LiveSession::open(gpu.clone(), &args).map(|(s, _)| s).map_err(|e| anyhow!("{}", volgraph_app::cli::error_text(&e)))
+    }
 }
 
 /// Submits a frame of `camera` and waits for it: wall ms.

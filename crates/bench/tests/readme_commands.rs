@@ -52,7 +52,7 @@ fn strip_comment(line: &str) -> &str {
 }
 
 /// Files the README names as the user's own (placeholders no data folder holds).
-const USERS_FILES: [&str; 12] = [
+const USERS_FILES: [&str; 13] = [
     "path/to/",
     "ct_series/",
     "seg.nii.gz",
@@ -65,6 +65,7 @@ const USERS_FILES: [&str; 12] = [
     "liver_only.txt",
     "hot.ron",
     "my_graph.ron",
+    "cells.nii",
 ];
 
 /// Why `command` cannot run from an empty folder here, if it cannot.

@@ -120,6 +120,23 @@ struct Scene<'a> {
     more: &'a [(&'a Volume, &'a [[f32; 4]])],
 }
 
+impl<'a> Scene<'a> {
+    /// A scan and a label map over it (`tint`, `inside`), coloured by `table`.
+    fn scan_and_labels(volume: &'a Volume, lut: &'a [[f32; 4]], labels: &'a Volume, table: &'a [[f32; 4]]) -> Self {
+        Self { volume, lut, second: Some(labels), second_lut: &[], table, overlay: None, more: &[] }
+    }
+
+    /// Two scalar volumes, each with its TF (`fuse`, `add`).
+    fn pair(volume: &'a Volume, lut: &'a [[f32; 4]], second: &'a Volume, second_lut: &'a [[f32; 4]]) -> Self {
+        Self { volume, lut, second: Some(second), second_lut, table: &[], overlay: None, more: &[] }
+    }
+
+    /// A label map alone (`labels`), coloured by `table`.
+    fn labels(labels: &'a Volume, table: &'a [[f32; 4]]) -> Self {
+        Self { volume: labels, lut: &[[0.0; 4]; 2], second: None, second_lut: &[], table, overlay: None, more: &[] }
+    }
+}
+
 /// Renders `graph` with `scene` bound by input kind and name, lossless (threshold 1), with
 /// `features` and parameter overrides `set`; returns the image and the march's parameters.
 fn render(graph: &str, scene: &Scene<'_>, features: &[&str], set: &[(&str, &str)]) -> (Image, volgraph_core::Params) {
@@ -254,15 +271,7 @@ fn check_source(
 fn a_label_map_alone_smooth_and_nearest_shaded() {
     let labels = organs_labels(N);
     let table = table();
-    let scene = Scene {
-        volume: &labels,
-        lut: &[[0.0; 4]; 2],
-        second: None,
-        second_lut: &[],
-        table: &table,
-        overlay: None,
-        more: &[],
-    };
+    let scene = Scene::labels(&labels, &table);
     check("labels_smooth", &scene, "multi/labels.ron", &[], &[]);
     check("labels_nearest_shaded", &scene, "multi/labels.ron", &["shading"], &[("label_filter", "nearest")]);
 }
@@ -271,15 +280,7 @@ fn a_label_map_alone_smooth_and_nearest_shaded() {
 fn the_scan_tinted_by_its_labels_and_inside_them() {
     let (ct, labels) = (organs_ct(N), organs_labels(N));
     let (lut, table) = (ct_lut(&ct), table());
-    let scene = Scene {
-        volume: &ct,
-        lut: &lut,
-        second: Some(&labels),
-        second_lut: &[],
-        table: &table,
-        overlay: None,
-        more: &[],
-    };
+    let scene = Scene::scan_and_labels(&ct, &lut, &labels, &table);
     check("ct_with_labels", &scene, "multi/ct_with_labels.ron", &[], &[]);
     check("ct_with_labels_shaded_jitter", &scene, "multi/ct_with_labels.ron", &["shading", "jitter"], &[]);
     check("ct_inside_labels", &scene, "multi/ct_inside_labels.ron", &[], &[]);
@@ -290,15 +291,7 @@ fn pet_on_a_shifted_coarse_grid_and_channels() {
     let ct = organs_ct(N);
     let pet = coarse_pet(&ct);
     let (lut, second_lut) = (ct_lut(&ct), pet_lut(&pet));
-    let scene = Scene {
-        volume: &ct,
-        lut: &lut,
-        second: Some(&pet),
-        second_lut: &second_lut,
-        table: &[],
-        overlay: None,
-        more: &[],
-    };
+    let scene = Scene::pair(&ct, &lut, &pet, &second_lut);
     let fused = check("pet_ct", &scene, "multi/pet_ct.ron", &[], &[]);
     check("channels", &scene, "multi/channels.ron", &[], &[]);
     // The PET shows: the fused image differs from the CT alone where the PET is hot.
@@ -411,15 +404,7 @@ fn three_and_four_channels_on_their_own_grids() {
 fn the_brick_pool_tints_the_scan_by_its_labels() {
     let (ct, labels) = (organs_ct(N), organs_labels(N));
     let (lut, table) = (ct_lut(&ct), table());
-    let scene = Scene {
-        volume: &ct,
-        lut: &lut,
-        second: Some(&labels),
-        second_lut: &[],
-        table: &table,
-        overlay: None,
-        more: &[],
-    };
+    let scene = Scene::scan_and_labels(&ct, &lut, &labels, &table);
     let graph = "ruijters_vilanova_2006/bricks_with_labels.ron";
     check("bricks_tint", &scene, graph, &[], &[("brick_cells", "16")]);
     check("bricks_inside_shaded", &scene, graph, &["shading"], &[("brick_cells", "16"), ("fusion", "inside")]);
@@ -452,15 +437,7 @@ fn the_brick_pool_tints_the_scan_by_its_labels() {
 fn ray_segments_tint_the_scan_by_its_labels() {
     let (ct, labels) = (organs_ct(N), organs_labels(N));
     let (lut, table) = (ct_lut(&ct), table());
-    let scene = Scene {
-        volume: &ct,
-        lut: &lut,
-        second: Some(&labels),
-        second_lut: &[],
-        table: &table,
-        overlay: None,
-        more: &[],
-    };
+    let scene = Scene::scan_and_labels(&ct, &lut, &labels, &table);
     let graph = "kruger_westermann_2003/rc.ron";
     let source = graph_source(graph)
         .replace(
@@ -531,15 +508,7 @@ fn a_pet_reaching_past_its_ct_is_drawn_where_it_lies() {
     let ct = organs_ct(N);
     let pet = wide_pet(&ct);
     let (lut, second_lut) = (ct_lut(&ct), pet_lut(&pet));
-    let scene = Scene {
-        volume: &ct,
-        lut: &lut,
-        second: Some(&pet),
-        second_lut: &second_lut,
-        table: &[],
-        overlay: None,
-        more: &[],
-    };
+    let scene = Scene::pair(&ct, &lut, &pet, &second_lut);
     let fused = check("pet_past_the_ct", &scene, "multi/pet_ct.ron", &[], &[]);
     check("pet_past_the_ct_shaded", &scene, "multi/pet_ct.ron", &["shading"], &[]);
     // The CT alone (its TF, the PET's transparent) covers less: the sphere lies outside its box.
@@ -565,26 +534,10 @@ fn shadows_fall_from_what_the_volumes_show_together() {
     let (ct, labels) = (organs_ct(N), organs_labels(N));
     let pet = coarse_pet(&ct);
     let (lut, table, second_lut) = (ct_lut(&ct), table(), pet_lut(&pet));
-    let inside = Scene {
-        volume: &ct,
-        lut: &lut,
-        second: Some(&labels),
-        second_lut: &[],
-        table: &table,
-        overlay: None,
-        more: &[],
-    };
+    let inside = Scene::scan_and_labels(&ct, &lut, &labels, &table);
     let lit = check("inside_labels_shadows", &inside, "multi/ct_inside_labels.ron", &["shading", "shadows"], &[]);
     check("inside_labels_occlusion", &inside, "multi/ct_inside_labels.ron", &["ambient_occlusion"], &[]);
-    let fused = Scene {
-        volume: &ct,
-        lut: &lut,
-        second: Some(&pet),
-        second_lut: &second_lut,
-        table: &[],
-        overlay: None,
-        more: &[],
-    };
+    let fused = Scene::pair(&ct, &lut, &pet, &second_lut);
     check("pet_ct_shadows", &fused, "multi/pet_ct.ron", &["shading", "shadows"], &[]);
     // Hiding a label changes the light the others get (the light volume follows the table).
     let liver_hidden: Vec<[f32; 4]> =
@@ -635,15 +588,7 @@ fn the_scan_inside_a_label_is_the_scan_with_the_rest_set_to_air() {
     let lut = ct_lut(&ct);
     let only_liver: Vec<[f32; 4]> =
         table().iter().enumerate().map(|(v, e)| if v == 1 { *e } else { [0.0; 4] }).collect();
-    let scene = Scene {
-        volume: &ct,
-        lut: &lut,
-        second: Some(&labels),
-        second_lut: &[],
-        table: &only_liver,
-        overlay: None,
-        more: &[],
-    };
+    let scene = Scene::scan_and_labels(&ct, &lut, &labels, &only_liver);
     let (inside, _) = render("multi/ct_inside_labels.ron", &scene, &[], &[]);
     let mut masked = ct.clone();
     let VoxelData::I16(values) = &mut masked.data else { panic!("the phantom CT is i16") };
@@ -725,15 +670,7 @@ fn a_label_map_and_its_twin_on_a_shifted_grid_render_alike() {
     twin.meta = labels.meta.clone();
     twin.meta.origin = Some(labels.meta.origin.unwrap_or_default() - labels.spacing * pad as f64);
     let (lut, table) = (ct_lut(&ct), table());
-    let scene = Scene {
-        volume: &ct,
-        lut: &lut,
-        second: Some(&labels),
-        second_lut: &[],
-        table: &table,
-        overlay: None,
-        more: &[],
-    };
+    let scene = Scene::scan_and_labels(&ct, &lut, &labels, &table);
     let (a, _) = render("multi/ct_with_labels.ron", &scene, &[], &[]);
     let (b, _) = render("multi/ct_with_labels.ron", &Scene { second: Some(&twin), ..scene }, &[], &[]);
     let (max, mean) = diff_reference(&a, &support::as_reference(&b));
@@ -762,15 +699,7 @@ fn a_map_of_labels_up_to_65535_renders_through_its_table() {
         l.opacity = 0.05;
     }
     let lut = table.lut(65_536);
-    let scene = Scene {
-        volume: &labels,
-        lut: &[[0.0; 4]; 2],
-        second: None,
-        second_lut: &[],
-        table: &lut,
-        overlay: None,
-        more: &[],
-    };
+    let scene = Scene::labels(&labels, &lut);
     check("labels_65535_nearest", &scene, "multi/labels.ron", &[], &[("label_filter", "nearest")]);
     // Every voxel its own label: smooth sampling takes the 8-corner path everywhere and, no two
     // corners alike, picks the nearest corner's (the same image, by another path).

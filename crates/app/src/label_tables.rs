@@ -29,6 +29,16 @@ pub fn map_input_of(table: &str, volume_inputs: &[&str]) -> Option<String> {
     None
 }
 
+/// The flag a message about label table input `table` and its map names: the table's `--tf`
+/// when one was given, else the map's `--volume` (a scan given as the label map is the map's
+/// fault, not a table's the user never named).
+pub fn blamed_flag(table: &str, table_given: bool, map_input: Option<&str>) -> String {
+    match map_input {
+        Some(map) if !table_given => format!("--volume {map}=…"),
+        _ => format!("--tf {table}"),
+    }
+}
+
 /// The LUT (RGBA by label value) of label map `map` (read from `map_path` when known) through
 /// the table `given` names (`default`, or a file), with the notes a user should see: values the
 /// map holds that the table does not name, labels the table names that the map lacks.

@@ -344,7 +344,8 @@ pub(crate) fn named_bindings(
             None => frame_path,
         };
         let given = named_tfs.iter().find(|(n, _)| n == name).map(|(_, p)| p.as_path());
-        let (lut, table_notes) = crate::label_tables::label_lut(map, map_path, given, &format!("--tf {name}"))?;
+        let flag = crate::label_tables::blamed_flag(name, given.is_some(), map_name.as_deref());
+        let (lut, table_notes) = crate::label_tables::label_lut(map, map_path, given, &flag)?;
         notes.extend(table_notes);
         tables.push((name.clone(), lut));
     }

@@ -466,6 +466,23 @@ fn three_volumes_bind_by_name() {
     };
     let (ok, stderr) = render(None, "shown.exr");
     assert!(ok && !stderr.contains("too, and no --volume"), "{stderr}");
+    // A scan given as the label map is the map's flag's fault, not a table's never given.
+    let (ok, stderr) = volgraph(
+        &[
+            "render",
+            "multi/pet_ct_inside_labels",
+            "--volume",
+            "volume=organs32",
+            "--volume",
+            "pet=organs32",
+            "--volume",
+            "labels=organs32",
+            "-o",
+            "scan.png",
+        ],
+        &dir,
+    );
+    assert!(!ok && stderr.contains("--volume labels=…: organs_32 is not a label map"), "{stderr}");
     let visible = |file: &str| support::read_exr(&dir.join(file)).2.iter().filter(|p| p[3] > 2.0 / 255.0).count();
     assert!(visible("shown.exr") > 20, "the organs show inside their labels");
     let hidden: String = (1..=6).map(|v| format!("{v} 255 0 0 1 0 1 \"label {v}\"\n")).collect();

@@ -179,7 +179,7 @@ impl LiveSession {
                 None => args.volume.first().map(PathBuf::as_path),
             };
             let given = args.named_tfs.iter().find(|(n, _)| n == table_name).map(|(_, p)| p.as_path());
-            let flag = format!("--tf {table_name}");
+            let flag = crate::label_tables::blamed_flag(table_name, given.is_some(), map_name.as_deref());
             let (table, _, notes) = crate::label_tables::label_table(map, map_path, given, &flag)?;
             for note in notes {
                 crate::stdout::eprintln_escaped!("{note}");

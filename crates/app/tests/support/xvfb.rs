@@ -53,6 +53,11 @@ fn in_use(n: u32) -> bool {
 /// Starts Xvfb with a `screen` (`WxHxD`) on the first free display of `displays`; `None` (a
 /// note) where Xvfb is not installed, which under CI is a failure.
 pub fn start_xvfb(displays: std::ops::Range<u32>, screen: &str) -> Option<Xvfb> {
+    // One start at a time in this process: two tests running at once both found display n free,
+    // and the second's clean-up of "stale" files removed the first server's lock, so both ran on
+    // one server and the first to finish killed it under the other ("XIO: fatal IO error 104").
+    static STARTING: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _one_at_a_time = STARTING.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     let found = Command::new("Xvfb").arg("-help").stdout(Stdio::null()).stderr(Stdio::null()).status().is_ok();
     if !found {
         assert!(
@@ -78,11 +83,12 @@ pub fn start_xvfb(displays: std::ops::Range<u32>, screen: &str) -> Option<Xvfb> 
         let mut server = Xvfb { child, number: n, display: format!(":{n}") };
         let start = Instant::now();
         while start.elapsed() < Duration::from_secs(10) {
-            if socket_path(n).exists() {
-                return Some(server);
-            }
+            // Its own socket: a server that has exited (another took the display) is not ours.
             if server.child.try_wait().ok().flatten().is_some() {
                 break;
+            }
+            if socket_path(n).exists() {
+                return Some(server);
             }
             std::thread::sleep(Duration::from_millis(50));
         }

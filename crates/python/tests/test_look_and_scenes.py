@@ -155,3 +155,25 @@ def test_several_volumes_bind_by_name_as_the_cli_binds_them(tmp_path):
     assert np.array_equal(r.render(), ours) and not any("pet" in n for n in r.notes)
     with pytest.raises(ValueError, match="petscan"):
         volgraph.render("multi/pet_ct", ct, volumes={"petscan": pet}, size=(16, 16))
+
+
+def test_four_channels_bind_by_name_as_the_cli_binds_them(tmp_path):
+    """Four volumes in one march (multi/channels4), from arrays and from files, alike."""
+    z, y, x = np.mgrid[0:16, 0:20, 0:24]
+    first = ramp_volume()
+    blobs = [(np.exp(-((x - cx) ** 2 + (y - cy) ** 2 + (z - cz) ** 2) / 12.0) * 1000).astype(np.float32)
+             for cx, cy, cz in [(6, 6, 5), (17, 12, 8), (12, 15, 11)]]
+    first.tofile(tmp_path / "c1_24x20x16_uint16.raw")
+    for k, blob in enumerate(blobs):
+        blob.tofile(tmp_path / f"c{k + 2}_24x20x16_float32.raw")
+    png = tmp_path / "cli.png"
+    cli("render", "multi/channels4", "--volume", "volume=c1_24x20x16_uint16.raw",
+        "--volume", "channel2=c2_24x20x16_float32.raw", "--volume", "channel3=c3_24x20x16_float32.raw",
+        "--volume", "channel4=c4_24x20x16_float32.raw", "--size", "56x48", "-o", png, cwd=tmp_path)
+    named = {f"channel{k + 2}": blob for k, blob in enumerate(blobs)}
+    ours = volgraph.render("multi/channels4", first, volumes=named, size=(56, 48))
+    assert np.array_equal(ours[..., :3], read_png(png)[..., :3])
+    three = dict(named)
+    three["channel4"] = np.zeros_like(blobs[2])
+    assert not np.array_equal(ours, volgraph.render("multi/channels4", first, volumes=three, size=(56, 48))), \
+        "the fourth channel shows"

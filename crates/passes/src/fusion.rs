@@ -334,6 +334,17 @@ impl FusionState {
                 ),
             });
         }
+        if settings.channels != 2 && settings.scalar_partners().is_empty() {
+            return Err(PassError {
+                pass: ctx.pass_id.to_string(),
+                message: format!(
+                    "channels {} are scalar volumes fused with the volume, so it needs fusion \"fuse\" or \"add\" \
+                     (here \"{}\"); leave channels at 2 otherwise",
+                    settings.channels,
+                    settings.fusion.name()
+                ),
+            });
+        }
         let buffer = combine.map(|c| ctx.uniform_from_bytes("fusion", &FusionMap::identity(c).uniform_bytes()));
         let smooth = settings.label_filter == LabelFilterChoice::Smooth;
         let more = settings.scalar_partners().iter().skip(1).map(|(port, _)| *port).collect();

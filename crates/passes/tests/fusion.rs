@@ -564,6 +564,14 @@ fn an_overlay_without_a_fused_pair_is_refused() {
     let err = runtime.apply(plan, &registry).expect_err("refused").to_string();
     assert!(err.contains("overlay \"inside\"") && err.contains("needs fusion \"fuse\" or \"add\""), "{err}");
     assert!(err.contains("use fusion \"tint\" or \"inside\""), "{err}");
+    // Channels likewise: more than two scalar volumes only with a fusion of scalar volumes.
+    let options = CompileOptions::new(SIZE, SIZE).with_param("march", "channels", 3u64);
+    let plan = volgraph_core::compile(graph, &graph_source(graph), &registry, &options).expect("compiles");
+    let mut runtime = support::runtime(&gpu());
+    runtime.bind_volume("volume", &ct).expect("binds");
+    runtime.bind_volume("labels", &labels).expect("binds");
+    let err = runtime.apply(plan, &registry).expect_err("refused").to_string();
+    assert!(err.contains("channels 3 are scalar volumes fused with the volume"), "{err}");
 }
 
 /// A refused value of a parameter that picks the ports is the one error: the wiring it leaves

@@ -301,7 +301,13 @@ struct ViewerRun {
 /// Runs `volgraph view ARGS --script` in `cwd` on `x`'s display; once it has loaded, writes the
 /// script `lines` and waits up to 60 s for it to end (killed after that).
 fn run_viewer(x: &Xvfb, cwd: &Path, args: &[&str], lines: &[&str]) -> ViewerRun {
-    run_viewer_with(x, cwd, args, |_, _| {}, lines)
+    run_viewer_with(x, cwd, args, |_, _| {}, lines, false)
+}
+
+/// [`run_viewer`], each `screenshot PATH` line waited for (the viewer printing that it wrote
+/// it) before the next line is written: the lines after it act on a later frame.
+fn run_viewer_paced(x: &Xvfb, cwd: &Path, args: &[&str], lines: &[&str]) -> ViewerRun {
+    run_viewer_with(x, cwd, args, |_, _| {}, lines, true)
 }
 
 /// [`run_viewer`], calling `during` with the event lines (and the list of those seen) once the
@@ -312,6 +318,7 @@ fn run_viewer_with(
     args: &[&str],
     during: impl FnOnce(&Receiver<String>, &mut Vec<String>),
     lines: &[&str],
+    pace_screenshots: bool,
 ) -> ViewerRun {
     let mut viewer = Command::new(env!("CARGO_BIN_EXE_volgraph"))
         .arg("view")
@@ -354,6 +361,17 @@ fn run_viewer_with(
     let mut stdin = viewer.stdin.take().expect("stdin");
     for line in lines {
         let _ = writeln!(stdin, "{line}");
+        // Paced: wait until the viewer says it wrote PATH, so the lines after it reach a later
+        // frame.
+        if let Some(path) = line.strip_prefix("screenshot ").filter(|_| pace_screenshots) {
+            let until = Instant::now() + Duration::from_secs(20);
+            while !seen.iter().any(|l| l == &format!("screenshot {path}")) {
+                match until.checked_duration_since(Instant::now()).map(|left| rx.recv_timeout(left)) {
+                    Some(Ok(l)) => seen.push(l),
+                    _ => break,
+                }
+            }
+        }
     }
     drop(stdin);
     let status = loop {
@@ -498,6 +516,7 @@ fn a_graph_whose_folder_was_deleted_and_made_again_still_reloads() {
             reloaded = wait_for(lines, seen, "reloaded graph");
         },
         &["quit"],
+        false,
     );
     assert!(run.status.is_some_and(|s| s.success()), "{}\n{}", run.stdout, run.stderr);
     assert!(deleted_seen, "the deleted graph is an error:\n{}", run.stdout);
@@ -624,4 +643,35 @@ fn a_screenshot_is_written_without_opening_its_path() {
     assert!(result.as_ref().is_err_and(|e| e.contains("FIFO")), "{result:?}");
     let names: Vec<_> = std::fs::read_dir(&dir).expect("dir").flatten().map(|e| e.file_name()).collect();
     assert_eq!(names.len(), 2, "no temporary file stays: {names:?}");
+}
+
+/// The label list's switches from a script (`label VALUE show|hide|only`, `label all`), as the
+/// panel's do: hiding the liver of the organ phantom changes the window's image, showing every
+/// label again changes it back from that.
+#[test]
+fn script_label_commands_hide_and_show_labels() {
+    let dir = scratch("label_script");
+    let Some(x) = start_xvfb() else { return };
+    let shot = |name: &str| dir.join(name);
+    let lines = [
+        format!("screenshot {}", shot("all.png").display()),
+        "label 1 hide".to_string(),
+        format!("screenshot {}", shot("no_liver.png").display()),
+        "label all".to_string(),
+        format!("screenshot {}", shot("again.png").display()),
+        "label 7 shown".to_string(),
+        "quit".to_string(),
+    ];
+    let lines: Vec<&str> = lines.iter().map(String::as_str).collect();
+    let run = run_viewer_paced(&x, &dir, &["multi/labels", "--volume", "organs_labels32"], &lines);
+    assert!(run.status.is_some_and(|s| s.success()), "{}\n{}", run.stdout, run.stderr);
+    let (all, no_liver, again) =
+        (read_rgba(&shot("all.png")), read_rgba(&shot("no_liver.png")), read_rgba(&shot("again.png")));
+    assert_ne!(all, no_liver, "hiding label 1 changes the image");
+    assert_ne!(no_liver, again, "showing every label changes it back");
+    assert!(
+        run.stderr.contains("label 7 shown") && run.stderr.contains("write label VALUE show|hide|only"),
+        "{}",
+        run.stderr
+    );
 }

@@ -48,10 +48,12 @@ pub enum ScriptCommand {
     Click(f64, f64),
     /// `wheel X Y LINES`: the wheel turned LINES notches at window pixel (X, Y).
     Wheel(f64, f64, f64),
+    /// `label VALUE show|hide|only` or `label all`: the label list's visibility switches.
+    Label(super::label_list::LabelEdit),
 }
 
 /// What the script accepts, for messages.
-pub const USAGE: &str = "quit, screenshot PATH, param PASS.NAME VALUE, write, crop X0,Y0,Z0,X1,Y1,Z1|off, clip NX,NY,NZ,D|off, save-scene PATH, tf-point VALUE R,G,B,A, tf-save, tf-edit INPUT, light AZ,EL|headlight, slices on|off, window CENTER,WIDTH, click X Y, wheel X Y LINES";
+pub const USAGE: &str = "quit, screenshot PATH, param PASS.NAME VALUE, write, crop X0,Y0,Z0,X1,Y1,Z1|off, clip NX,NY,NZ,D|off, save-scene PATH, tf-point VALUE R,G,B,A, tf-save, tf-edit INPUT, light AZ,EL|headlight, slices on|off, window CENTER,WIDTH, click X Y, wheel X Y LINES, label VALUE show|hide|only, label all";
 
 /// Parses one line: `Ok(None)` for a blank line, `Err` naming what is wrong.
 pub fn parse_line(line: &str) -> Result<Option<ScriptCommand>, String> {
@@ -135,6 +137,25 @@ pub fn parse_line(line: &str) -> Result<Option<ScriptCommand>, String> {
         "clip" => {
             ClipPlane::parse(rest).map(|p| Some(ScriptCommand::Clip(Some(p)))).map_err(|e| format!("\"{line}\": {e}"))
         }
+        "label" => {
+            use super::label_list::LabelEdit;
+            let words: Vec<&str> = rest.split_whitespace().collect();
+            match words.as_slice() {
+                ["all"] => Ok(Some(ScriptCommand::Label(LabelEdit::ShowAll))),
+                [value, what] => {
+                    let value: u32 = value.parse().map_err(|_| {
+                        format!("\"{line}\": the label value must be a whole number 0 to 4294967295, not \"{value}\"")
+                    })?;
+                    match *what {
+                        "show" => Ok(Some(ScriptCommand::Label(LabelEdit::Visible(value, true)))),
+                        "hide" => Ok(Some(ScriptCommand::Label(LabelEdit::Visible(value, false)))),
+                        "only" => Ok(Some(ScriptCommand::Label(LabelEdit::ShowOnly(value)))),
+                        _ => Err(format!("\"{line}\": write label VALUE show|hide|only, or label all")),
+                    }
+                }
+                _ => Err(format!("\"{line}\": write label VALUE show|hide|only, or label all")),
+            }
+        }
         other => Err(format!("\"{line}\": unknown command \"{other}\"; known: {USAGE}")),
     }
 }
@@ -162,6 +183,12 @@ mod tests {
         assert!(matches!(parse_line("clip 1,0,0,0.5"), Ok(Some(ScriptCommand::Clip(Some(_))))));
         assert!(parse_line("write now").is_err());
         assert_eq!(parse_line("slices on"), Ok(Some(ScriptCommand::Slices(true))));
+        use crate::view::label_list::LabelEdit;
+        assert_eq!(parse_line("label 3 hide"), Ok(Some(ScriptCommand::Label(LabelEdit::Visible(3, false)))));
+        assert_eq!(parse_line("label  7 only"), Ok(Some(ScriptCommand::Label(LabelEdit::ShowOnly(7)))));
+        assert_eq!(parse_line("label all"), Ok(Some(ScriptCommand::Label(LabelEdit::ShowAll))));
+        assert!(parse_line("label -1 hide").is_err() && parse_line("label 3 hidden").is_err());
+        assert!(parse_line("label 3 hide now").is_err() && parse_line("label").is_err());
         assert_eq!(parse_line("click 410  20.5"), Ok(Some(ScriptCommand::Click(410.0, 20.5))));
         assert_eq!(parse_line("wheel 410 20 -3"), Ok(Some(ScriptCommand::Wheel(410.0, 20.0, -3.0))));
         let bone = volgraph_accel::volume_meta::Window { center: 400.0, width: 1800.0 };

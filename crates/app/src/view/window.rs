@@ -359,6 +359,7 @@ impl Viewer {
                 }
                 Ok(Some(ScriptCommand::TfSave)) => self.apply_actions(vec![Action::TransferFunction(TfAction::Save)]),
                 Ok(Some(ScriptCommand::Light(light))) => self.apply_actions(vec![Action::Light(light)]),
+                Ok(Some(ScriptCommand::Label(edit))) => self.apply_actions(vec![Action::Labels(edit)]),
                 Ok(Some(ScriptCommand::TfEdit(input))) => {
                     let Some(session) = self.session.as_mut() else { continue };
                     if let Err(message) = session.select_transfer_function(&input) {

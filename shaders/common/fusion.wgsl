@@ -241,17 +241,12 @@ fn fused_sample(u: vec3<f32>, s: f32) -> vec4<f32> {
     // The frame volume's texture point (`u` is a brick atlas's in raycast_bricks).
     let uv = volume_position(u);
     let u2 = uv * fusion_scale + fusion_offset;
-    let inside = in_box(u2);
 #if FUSION_LABEL_MAP
     // Where the scan is clear the label changes nothing (tint and inside keep its opacity).
     if (!(c.a > 0.0)) {
         return vec4<f32>(0.0);
     }
-    var label = 0u;
-    if (inside) {
-        label = sample_label(u2);
-    }
-    let e = label_entry(label);
+    let e = label_entry_at(u2);
     let visible = e.a > 0.0;
     if (fusion_combine == COMBINE_INSIDE) {
         return premultiplied(c.rgb, select(0.0, c.a, visible));
@@ -265,12 +260,7 @@ fn fused_sample(u: vec3<f32>, s: f32) -> vec4<f32> {
 #if FUSION_SCALAR
     // Past the frame volume's box (rays cross every scalar volume's) it adds nothing.
     let p1 = select(vec4<f32>(0.0), premultiplied(c.rgb, c.a), in_box(uv));
-    var p2 = vec4<f32>(0.0);
-    if (inside) {
-        let s2 = textureSampleLevel(second, linear_clamp, u2, 0.0).r;
-        let c2 = textureSampleLevel(second_tf, linear_clamp, s2, 0.0);
-        p2 = premultiplied(c2.rgb, c2.a);
-    }
+    let p2 = scalar_medium(second, second_tf, u2);
     // Media in one place: opacity 1 - Π(1 - aᵢ); colour the opacity-weighted mean, or
     // (channels) the sum. `sum` holds Σ premultiplied colours and Σ opacities.
     var sum = p1 + p2;
@@ -312,9 +302,7 @@ fn scalar_tf_at(v: texture_3d<f32>, tf: texture_1d<f32>, at: vec3<f32>) -> vec4<
     let s = textureSampleLevel(v, linear_clamp, at, 0.0).r;
     return textureSampleLevel(tf, linear_clamp, s, 0.0);
 }
-#endif
 
-#if FUSION_THIRD
 // The premultiplied, corrected sample of scalar volume `v` through its TF `tf` at its texture
 // point `at` (nothing outside its box).
 fn scalar_medium(v: texture_3d<f32>, tf: texture_1d<f32>, at: vec3<f32>) -> vec4<f32> {
@@ -324,13 +312,19 @@ fn scalar_medium(v: texture_3d<f32>, tf: texture_1d<f32>, at: vec3<f32>) -> vec4
 #endif
 
 #if FUSION_LABEL_READS
-// Whether a visible label lies at the label map's texture point `at` (none outside its box).
-fn visible_label_at(at: vec3<f32>) -> bool {
+// The table's entry of the label at the label map's texture point `at` (hidden — zero —
+// outside its box, where it reads background 0; volgraph_accel::fusion's label_entry_at).
+fn label_entry_at(at: vec3<f32>) -> vec4<f32> {
     var label = 0u;
     if (in_box(at)) {
         label = sample_label(at);
     }
-    return label_entry(label).a > 0.0;
+    return label_entry(label);
+}
+
+// Whether a visible label lies at the label map's texture point `at`.
+fn visible_label_at(at: vec3<f32>) -> bool {
+    return label_entry_at(at).a > 0.0;
 }
 #endif
 
@@ -377,12 +371,7 @@ fn overlaid(fused: vec4<f32>, u: vec3<f32>) -> vec4<f32> {
     if (!(a > 0.0)) {
         return vec4<f32>(0.0);
     }
-    let u3 = u * overlay_scale + overlay_offset;
-    var label = 0u;
-    if (in_box(u3)) {
-        label = sample_label(u3);
-    }
-    let e = label_entry(label);
+    let e = label_entry_at(u * overlay_scale + overlay_offset);
     let visible = e.a > 0.0;
     if (overlay_combine == COMBINE_INSIDE) {
         return select(vec4<f32>(0.0), fused, visible);

@@ -193,18 +193,25 @@ pub struct Fusion<'a> {
 /// The texture-space box (of the frame volume's texture space) rays cross: the frame volume's
 /// `[0,1]³`, grown to hold every scalar volume fused with it (`Fuse`, `Add`: a PET reaching past
 /// its CT is drawn where it lies); a label map (`Tint`, `Inside`, an overlay) shows only where
-/// the scan does, so it grows nothing.
+/// the scan does, so it grows nothing. The box reaches at most [`MARCH_BOX_REACH`] frame-volume
+/// sizes past each face (what the camera, framed on the frame volume, can show): a header placing
+/// a volume 10³⁹ mm away grows the box no further, and it stays finite in the GPU's f32.
 pub fn march_box(combine: Combine, scalar_maps: impl IntoIterator<Item = TextureMap>) -> (DVec3, DVec3) {
     let (mut lo, mut hi) = (DVec3::ZERO, DVec3::ONE);
     if matches!(combine, Combine::Fuse | Combine::Add) {
         for m in scalar_maps {
             // u₂ = u · scale + offset is the partner's [0,1] at u = −offset/scale … (1 − offset)/scale.
             let (a, b) = (-m.offset / m.scale, (DVec3::ONE - m.offset) / m.scale);
-            (lo, hi) = (lo.min(a.min(b)), hi.max(a.max(b)));
+            if a.is_finite() && b.is_finite() {
+                (lo, hi) = (lo.min(a.min(b)), hi.max(a.max(b)));
+            }
         }
     }
-    (lo, hi)
+    (lo.max(DVec3::splat(-MARCH_BOX_REACH)), hi.min(DVec3::splat(1.0 + MARCH_BOX_REACH)))
 }
+
+/// How far, in frame-volume sizes, the box rays cross may reach past the frame volume's faces.
+pub const MARCH_BOX_REACH: f64 = 4.0;
 
 /// The label table's entry at `label` (zero past its end: hidden).
 pub fn label_entry(label_lut: &[[f32; 4]], label: u32) -> [f64; 4] {
@@ -212,6 +219,20 @@ pub fn label_entry(label_lut: &[[f32; 4]], label: u32) -> [f64; 4] {
 }
 
 impl Fusion<'_> {
+    /// The table's entry of the label map `labels` at its texture point `at` (hidden — zero —
+    /// outside its box, where it reads background 0).
+    fn label_entry_at(&self, labels: &Volume, at: DVec3) -> [f64; 4] {
+        let label = if in_box(at) { sample_label(labels, at, self.filter).0 } else { 0 };
+        label_entry(self.label_lut, label)
+    }
+
+    /// Scalar volume `volume` through its TF `lut` at the frame volume's texture point `u`
+    /// (`map` into its texture space): straight colour and the TF's opacity, zero outside its box.
+    fn medium_at(volume: &Volume, lut: &[[f32; 4]], map: &TextureMap, u: DVec3) -> [f64; 4] {
+        let at = map.apply(u);
+        if in_box(at) { lut_sample(lut, volume.sample_trilinear(at)) } else { [0.0; 4] }
+    }
+
     /// The box rays cross ([`march_box`]).
     pub fn march_box(&self) -> (DVec3, DVec3) {
         let maps = self.second.iter().map(|(_, _, m)| *m).chain(self.more.iter().map(|(_, _, m)| *m));
@@ -234,13 +255,10 @@ impl Fusion<'_> {
         }
         let (c1, a1) = through(lut, s);
         let Some((second, second_lut, map)) = self.second else { return premultiplied(c1, a1) };
-        let u2 = map.apply(u);
-        let inside = in_box(u2);
         match self.combine {
             Combine::Labels => unreachable!("handled above"),
             Combine::Tint | Combine::Inside => {
-                let label = if inside { sample_label(second, u2, self.filter).0 } else { 0 };
-                let e = label_entry(self.label_lut, label);
+                let e = self.label_entry_at(second, map.apply(u));
                 let visible = e[3] > 0.0;
                 match self.combine {
                     Combine::Inside => premultiplied(c1, if visible { a1 } else { 0.0 }),
@@ -253,9 +271,8 @@ impl Fusion<'_> {
             }
             Combine::Fuse | Combine::Add => {
                 let medium = |volume: &Volume, lut: &[[f32; 4]], map: &TextureMap| {
-                    let at = map.apply(u);
-                    let (c, a) = if in_box(at) { through(lut, volume.sample_trilinear(at)) } else { ([0.0; 3], 0.0) };
-                    premultiplied(c, a)
+                    let c = Self::medium_at(volume, lut, map, u);
+                    premultiplied([c[0], c[1], c[2]], corrected_alpha(c[3], exponent))
                 };
                 // Past the frame volume's box (rays cross every scalar volume's) it adds nothing.
                 let first = if in_box(u) { premultiplied(c1, a1) } else { [0.0; 4] };
@@ -276,15 +293,11 @@ impl Fusion<'_> {
     /// combination's opacity as [`Self::classify`] makes it — the correction of several media's
     /// `1 − Π(1 − αᵢ)` is the product of each one's.
     pub fn alpha(&self, first: &Volume, lut: &[[f32; 4]], u: DVec3, s: f64) -> f64 {
-        let through = |lut: &[[f32; 4]], s: f64| lut_sample(lut, s)[3].clamp(0.0, 1.0);
-        let visible = |labels: &Volume, at: DVec3| {
-            let label = if in_box(at) { sample_label(labels, at, self.filter).0 } else { 0 };
-            label_entry(self.label_lut, label)[3] > 0.0
-        };
+        let visible = |labels: &Volume, at: DVec3| self.label_entry_at(labels, at)[3] > 0.0;
         if self.combine == Combine::Labels {
             return label_entry(self.label_lut, sample_label(first, u, self.filter).0)[3].clamp(0.0, 1.0);
         }
-        let a1 = through(lut, s);
+        let a1 = lut_sample(lut, s)[3].clamp(0.0, 1.0);
         let Some((second, second_lut, map)) = self.second else { return a1 };
         match self.combine {
             Combine::Labels | Combine::Tint => a1,
@@ -297,8 +310,7 @@ impl Fusion<'_> {
             }
             Combine::Fuse | Combine::Add => {
                 let medium = |volume: &Volume, lut: &[[f32; 4]], map: &TextureMap| {
-                    let at = map.apply(u);
-                    if in_box(at) { through(lut, volume.sample_trilinear(at)) } else { 0.0 }
+                    Self::medium_at(volume, lut, map, u)[3].clamp(0.0, 1.0)
                 };
                 let mut clear = 1.0 - if in_box(u) { a1 } else { 0.0 };
                 clear *= 1.0 - medium(second, second_lut, &map);
@@ -322,9 +334,7 @@ impl Fusion<'_> {
         if !(a > 0.0) {
             return [0.0; 4];
         }
-        let u3 = overlay.map.apply(u);
-        let label = if in_box(u3) { sample_label(overlay.labels, u3, self.filter).0 } else { 0 };
-        let e = label_entry(self.label_lut, label);
+        let e = self.label_entry_at(overlay.labels, overlay.map.apply(u));
         let visible = e[3] > 0.0;
         match overlay.combine {
             Combine::Inside if !visible => [0.0; 4],
@@ -420,5 +430,19 @@ mod tests {
         let fused = fuse_media(Combine::Fuse, &media);
         let again = fuse_media(Combine::Fuse, &reversed);
         assert!((0..4).all(|i| (fused[i] - again[i]).abs() < 1e-12), "{fused:?} {again:?}");
+    }
+
+    /// Rays cross the union of the scalar volumes' boxes, a label map grows nothing, and a
+    /// partner placed absurdly far (a header's 10³⁹ mm) is cut at the reach, finite in f32.
+    #[test]
+    fn the_march_box_is_the_union_within_its_reach() {
+        // A partner twice the frame volume's size, centred on it: [−0.5, 1.5] in its texture space.
+        let wide = TextureMap { scale: DVec3::splat(0.5), offset: DVec3::splat(0.25) };
+        assert_eq!(march_box(Combine::Fuse, [wide]), (DVec3::splat(-0.5), DVec3::splat(1.5)));
+        assert_eq!(march_box(Combine::Tint, [wide]), (DVec3::ZERO, DVec3::ONE));
+        let far = TextureMap { scale: DVec3::ONE, offset: DVec3::splat(-1e39) };
+        let (lo, hi) = march_box(Combine::Add, [far]);
+        assert_eq!((lo, hi), (DVec3::ZERO, DVec3::splat(1.0 + MARCH_BOX_REACH)));
+        assert!(hi.as_vec3().is_finite());
     }
 }

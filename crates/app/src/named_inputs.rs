@@ -230,8 +230,10 @@ impl NamedBindings {
                 let (lo, hi) = (a.min(b).max(glam::DVec3::ZERO), a.max(b).min(glam::DVec3::ONE));
                 if lo.cmpge(hi).any() {
                     warnings.push(format!(
-                        "warning: --volume {name}=…: its box does not overlap {first_name}'s, so rays through \
-                         {first_name}'s box never meet it; {first_name} is {} and {name} is {}",
+                        "warning: --volume {name}=…: its box does not overlap {first_name}'s: a label map there \
+                         shows nothing, a scalar volume only where it lies within {}× {first_name}'s size of \
+                         it (the view is framed on {first_name}); {first_name} is {} and {name} is {}",
+                        volgraph_accel::fusion::MARCH_BOX_REACH,
                         grid_text(primary),
                         grid_text(volume)
                     ));

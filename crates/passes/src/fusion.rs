@@ -249,36 +249,28 @@ impl FusionMap {
             let (lo, hi) = v.value_range;
             [lo as f32, (hi - lo) as f32, 0.0, 0.0]
         };
+        // A texture map as the uniform's (scale, offset) pair.
+        let uniform = |m: volgraph_accel::fusion::TextureMap| {
+            (m.scale.as_vec3().extend(0.0).to_array(), m.offset.as_vec3().extend(0.0).to_array())
+        };
+        let between = |v: &volgraph_accel::volume::Volume| volgraph_accel::fusion::TextureMap::between(first, v);
         let mut map = Self { first_labels: decode(first), ..Self::identity(combine) };
-        let mut scalar_maps = Vec::new();
-        if let Some(second) = second {
-            let m = volgraph_accel::fusion::TextureMap::between(first, second)?;
-            scalar_maps.push(m);
-            map.second_scale = [m.scale.x as f32, m.scale.y as f32, m.scale.z as f32, 0.0];
-            map.second_offset = [m.offset.x as f32, m.offset.y as f32, m.offset.z as f32, 0.0];
+        let second_map = second.map(between).transpose()?;
+        let more_maps = more.iter().map(|v| between(v)).collect::<Result<Vec<_>, _>>()?;
+        if let (Some(second), Some(m)) = (second, second_map) {
+            (map.second_scale, map.second_offset) = uniform(m);
             map.second_labels = decode(second);
         }
-        let maps = more
-            .iter()
-            .map(|v| volgraph_accel::fusion::TextureMap::between(first, v))
-            .collect::<Result<Vec<_>, _>>()?;
-        let pair = |m: &volgraph_accel::fusion::TextureMap| {
-            let (s, o) = (m.scale.as_vec3(), m.offset.as_vec3());
-            ([s.x, s.y, s.z, 0.0], [o.x, o.y, o.z, 0.0])
-        };
-        scalar_maps.extend(maps.iter().copied());
-        let (lo, hi) = volgraph_accel::fusion::march_box(combine, scalar_maps);
+        if let Some(&m) = more_maps.first() {
+            (map.third_scale, map.third_offset) = uniform(m);
+        }
+        if let Some(&m) = more_maps.get(1) {
+            (map.fourth_scale, map.fourth_offset) = uniform(m);
+        }
+        let (lo, hi) = volgraph_accel::fusion::march_box(combine, second_map.into_iter().chain(more_maps));
         (map.march_lo, map.march_hi) = (lo.as_vec3().extend(0.0).to_array(), hi.as_vec3().extend(0.0).to_array());
-        if let Some(m) = maps.first() {
-            (map.third_scale, map.third_offset) = pair(m);
-        }
-        if let Some(m) = maps.get(1) {
-            (map.fourth_scale, map.fourth_offset) = pair(m);
-        }
         if let Some((what, labels)) = overlay {
-            let m = volgraph_accel::fusion::TextureMap::between(first, labels)?;
-            map.overlay_scale = [m.scale.x as f32, m.scale.y as f32, m.scale.z as f32, 0.0];
-            map.overlay_offset = [m.offset.x as f32, m.offset.y as f32, m.offset.z as f32, 0.0];
+            (map.overlay_scale, map.overlay_offset) = uniform(between(labels)?);
             map.overlay_labels = decode(labels);
             map.overlay_combine = what as u32 + 1;
         }

@@ -391,6 +391,8 @@ fn three_and_four_channels_on_their_own_grids() {
     let three = check("channels_three", &scene, "multi/channels3.ron", &[], &[]);
     check("channels_four_shaded", &scene, "multi/channels4.ron", &["shading"], &[]);
     let (four_plain, _) = render("multi/channels4.ron", &scene, &[], &[]);
+    // 0.5/255 on average: twice the largest GPU-vs-reference difference above (0.25/255), so a
+    // channel bound but not drawn fails.
     for (what, a, b) in [("the third", &two, &three), ("the fourth", &three, &four_plain)] {
         let (_, mean) = diff_reference(a, &support::as_reference(b));
         assert!(mean > 0.5 / 255.0, "{what} channel changes the image (mean {:.3}/255)", mean * 255.0);
@@ -518,6 +520,8 @@ fn a_pet_reaching_past_its_ct_is_drawn_where_it_lies() {
     let outside = (0..SIZE * SIZE)
         .filter(|i| alone.rgba(i % SIZE, i / SIZE)[3] <= 0.0 && fused.rgba(i % SIZE, i / SIZE)[3] > 2.0 / 255.0)
         .count();
+    // The sphere (radius 0.2 of the CT's width) is drawn beside the CT on more than 30 pixels of
+    // 96² (a sphere of radius 0.12, tried, showed on 22).
     assert!(
         outside > 30,
         "the sphere beside the CT shows on {outside} pixels (CT {}, fused {})",
@@ -545,6 +549,7 @@ fn shadows_fall_from_what_the_volumes_show_together() {
     let hidden = Scene { table: &liver_hidden, ..inside };
     let (changed, _) = render("multi/ct_inside_labels.ron", &hidden, &["shading", "shadows"], &[]);
     let (_, mean) = diff_reference(&lit, &support::as_reference(&changed));
+    // Above the GPU-vs-reference mean of these images (≤ 0.006/255), so "no change" fails.
     assert!(mean > 0.1 / 255.0, "hiding the liver changes the image (mean {:.3}/255)", mean * 255.0);
     check("inside_labels_shadows_liver_hidden", &hidden, "multi/ct_inside_labels.ron", &["shading", "shadows"], &[]);
 }

@@ -238,6 +238,7 @@ fn tile_bounds_stay_exact_with_a_label_map() {
             let cam = camera(10.0 + 3.0 * f as f64);
             let (b, l) = (base.frame(&cam), leap.frame(&cam));
             if f == 0 {
+                // A check of the scene, not of the march: the organs cover ~13 % of the image.
                 assert!(coverage(&b) > 0.02, "{fusion}: the labelled scan is in view");
             }
             let (off, max) = compare(&l, &b);

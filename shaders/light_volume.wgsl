@@ -2,14 +2,15 @@
 // (crates/passes/src/shadows.rs; the f64 model is volgraph_accel::light::LightGrid, which the
 // reference calls). At each voxel centre u0 = (i + 0.5) / m of a grid of m voxels per axis (the
 // volume's, up to 64):
-// - SHADOWS (Behrens & Ratering 1998's shadow volume, per voxel): the transmittance toward the
-//   light T = Π_{k≥1} (1 − α_tf(s(u0 + k·Δ)))^e, Δ one unit_world toward the light in texture
+// - SHADOWS (Behrens & Ratering 1998's shadow volume, per voxel): the transmittance toward each
+//   of the scene's lights T = Π_{k≥1} (1 − α_tf(s(u0 + k·Δ)))^e, Δ one unit_world toward the light in texture
 //   space, k up to the last step inside the box, e = 1 / opacity unit, the sample at u0 itself
 //   left out (a surface does not shadow itself); below 1/1024 the light is out;
 // - AMBIENT_OCCLUSION (Hernell et al. 2010, cones reduced to rays): the mean transmittance along
 //   14 directions (the axes and the diagonals) over 8 steps each (fewer where the box ends).
 // Built by the raycaster that reads it when the volume, TF, light or opacity unit change, into
-// `light_out` (Rgba16Float: T in .r, AO in .g; 1 for an effect that is off).
+// `light_out` (Rgba16Float: each light's T in .rgb in the scene's order, AO in .a; 1 for an
+// effect that is off and a light the scene does not have).
 
 #import "common/raymarch.wgsl"
 
@@ -73,34 +74,30 @@ fn unit_step_toward(d: vec3<f32>) -> vec3<f32> {
     return d * frame.half_extent.w / (2.0 * frame.half_extent.xyz);
 }
 
-@compute @workgroup_size(4, 4, 4)
-fn cs_light_volume(@builtin(global_invocation_id) id: vec3<u32>) {
-    let m = textureDimensions(light_out);
-    if (any(id >= m)) {
-        return;
+// The transmittance toward each of the scene's lights from `u0` (.rgb in the scene's order, 1
+// for a light it lacks): toward a directional light its direction, toward the headlight the
+// eye's along the camera's forward axis; toward a point light (w = 2) this voxel's own
+// direction, up to the light (light::Toward).
+fn transmittances_toward_lights(u0: vec3<f32>, exponent: f32) -> vec4<f32> {
+    var t = vec4<f32>(1.0);
+    for (var i = 0u; i < frame.light_count; i++) {
+        let light = frame.lights[i];
+        var toward = select(-frame.camera_forward.xyz, light.xyz, light.w == 1.0);
+        var steps = 0xffffffffu;
+        if (light.w == 2.0) {
+            let d = light.xyz - world_from_texture(u0);
+            let r = length(d);
+            toward = select(vec3<f32>(0.0, 1.0, 0.0), d / r, r > 1e-12);
+            steps = steps_to_light(r);
+        }
+        t[i] = transmittance_along(u0, unit_step_toward(toward), steps, exponent);
     }
-    let u0 = (vec3<f32>(id) + vec3<f32>(0.5)) / vec3<f32>(m);
-    let exponent = 1.0 / frame.volume_dims.w;
-#if FUSION
-    begin_fusion();
-#endif
-    var t = 1.0;
-#if SHADOWS
-    // Toward the light: a directional light's, else the eye's along the camera's forward axis;
-    // toward a point light (w = 2) this voxel's own direction, up to the light (light::Toward).
-    var toward = select(-frame.camera_forward.xyz, frame.light_world.xyz, frame.light_world.w == 1.0);
-    var steps = 0xffffffffu;
-    if (frame.light_world.w == 2.0) {
-        let d = frame.light_world.xyz - world_from_texture(u0);
-        let r = length(d);
-        toward = select(vec3<f32>(0.0, 1.0, 0.0), d / r, r > 1e-12);
-        steps = steps_to_light(r);
-    }
-    t = transmittance_along(u0, unit_step_toward(toward), steps, exponent);
-#endif
-    var ao = 1.0;
-#if AMBIENT_OCCLUSION
-    // The 6 axes, then the 8 diagonals (light::OCCLUSION_DIRECTIONS, in that order).
+    return t;
+}
+
+// The unoccluded share of the neighbourhood of `u0`: the mean transmittance along the 6 axes,
+// then the 8 diagonals (light::OCCLUSION_DIRECTIONS, in that order), OCCLUSION_STEPS each.
+fn occlusion_at(u0: vec3<f32>, exponent: f32) -> f32 {
     var sum = 0.0;
     for (var j = 0u; j < 14u; j++) {
         var d: vec3<f32>;
@@ -113,7 +110,27 @@ fn cs_light_volume(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         sum += transmittance_along(u0, unit_step_toward(d), OCCLUSION_STEPS, exponent);
     }
-    ao = sum / 14.0;
+    return sum / 14.0;
+}
+
+@compute @workgroup_size(4, 4, 4)
+fn cs_light_volume(@builtin(global_invocation_id) id: vec3<u32>) {
+    let m = textureDimensions(light_out);
+    if (any(id >= m)) {
+        return;
+    }
+    let u0 = (vec3<f32>(id) + vec3<f32>(0.5)) / vec3<f32>(m);
+    let exponent = 1.0 / frame.volume_dims.w;
+#if FUSION
+    begin_fusion();
 #endif
-    textureStore(light_out, id, vec4<f32>(t, ao, 0.0, 1.0));
+    var t = vec4<f32>(1.0);
+#if SHADOWS
+    t = transmittances_toward_lights(u0, exponent);
+#endif
+    var ao = 1.0;
+#if AMBIENT_OCCLUSION
+    ao = occlusion_at(u0, exponent);
+#endif
+    textureStore(light_out, id, vec4<f32>(t.rgb, ao));
 }

@@ -230,17 +230,19 @@ fn light_transmittance(p: vec3<f32>, l: vec3<f32>, distance: f32) -> f32 {
 
 // ---- light -----------------------------------------------------------------------------------
 
-// The unit world direction toward the light from world point `p` (xyz) and the distance to it
-// (w; 3e38 for a distant light): the scene's directional light, a point light (w = 2), else the
-// headlight (from the eye, along the camera's forward axis). volgraph_accel::light::Toward.
-fn toward_light(p: vec3<f32>) -> vec4<f32> {
-    if (frame.light_world.w == 2.0) {
-        let d = frame.light_world.xyz - p;
+// The unit world direction toward the scene's light `i` from world point `p` (xyz) and the
+// distance to it (w; 3e38 for a distant light): a directional light (w = 1), a point light
+// (w = 2), else the headlight (from the eye, along the camera's forward axis).
+// volgraph_accel::light::Toward.
+fn toward_light(p: vec3<f32>, i: u32) -> vec4<f32> {
+    let light = frame.lights[i];
+    if (light.w == 2.0) {
+        let d = light.xyz - p;
         let r = length(d);
         return vec4<f32>(select(vec3<f32>(0.0, 1.0, 0.0), d / r, r > 1e-12), r);
     }
-    if (frame.light_world.w == 1.0) {
-        return vec4<f32>(frame.light_world.xyz, 3.0e38);
+    if (light.w == 1.0) {
+        return vec4<f32>(light.xyz, 3.0e38);
     }
     return vec4<f32>(-frame.camera_forward.xyz, 3.0e38);
 }
@@ -373,11 +375,15 @@ fn trace_pixel(pixel: vec2<u32>) -> vec4<f32> {
         let g = voxel_gradient(p);
         let strength = length(g);
         let surface = trace.surface * (1.0 - exp(-20.0 * strength));
-        // A point light's irradiance falls as 1/r² (light_intensity at one world unit).
-        let light = toward_light(p);
-        let l = light.xyz;
-        let falloff = select(1.0, 1.0 / max(light.w * light.w, 1e-12), light.w < 1.0e38);
-        let to_light = light_transmittance(p, l, light.w) * trace.light_intensity * falloff;
+        // Next-event estimation toward every light: its direction (xyz) and the irradiance
+        // that reaches here (w). A point light's irradiance falls as 1/r² (light_intensity at
+        // one world unit).
+        var to_lights: array<vec4<f32>, MAX_LIGHTS>;
+        for (var i = 0u; i < frame.light_count; i++) {
+            let light = toward_light(p, i);
+            let falloff = select(1.0, 1.0 / max(light.w * light.w, 1e-12), light.w < 1.0e38);
+            to_lights[i] = vec4<f32>(light.xyz, light_transmittance(p, light.xyz, light.w) * trace.light_intensity * falloff);
+        }
         if (strength > 1e-6 && random() < surface) {
             // Off a Lambertian surface facing the incoming path: light × cos / π, and a
             // cosine-weighted bounce (its weight f·cos/pdf is 1).
@@ -385,10 +391,14 @@ fn trace_pixel(pixel: vec2<u32>) -> vec4<f32> {
             if (dot(n, w) > 0.0) {
                 n = -n;
             }
-            radiance += throughput * to_light * max(dot(n, l), 0.0) / PI;
+            for (var i = 0u; i < frame.light_count; i++) {
+                radiance += throughput * to_lights[i].w * max(dot(n, to_lights[i].xyz), 0.0) / PI;
+            }
             w = sample_cosine(n);
         } else {
-            radiance += throughput * to_light * henyey_greenstein(dot(w, l), trace.anisotropy);
+            for (var i = 0u; i < frame.light_count; i++) {
+                radiance += throughput * to_lights[i].w * henyey_greenstein(dot(w, to_lights[i].xyz), trace.anisotropy);
+            }
             // Importance-sampled: the phase function's weight p/pdf is 1.
             w = sample_henyey_greenstein(w, trace.anisotropy);
         }

@@ -53,14 +53,18 @@ struct Frame {
     // whole viewport.
     footprint: array<vec4<f32>, 6>,
     footprint_vertices: u32,
-    _pad2: u32,
+    // How many of `lights` the scene has (1 to MAX_LIGHTS).
+    light_count: u32,
     _pad3: u32,
     _pad4: u32,
-    // w = 1: xyz the unit world direction toward a directional light; w = 2: xyz a point
-    // light's world position (the bound box's own world); w = 0: the headlight (each ray's own
-    // -direction). volgraph_accel::light.
-    light_world: vec4<f32>,
+    // The scene's lights, the key light first. w = 1: xyz the unit world direction toward a
+    // directional light; w = 2: xyz a point light's world position (the bound box's own world);
+    // w = 0: the headlight (each ray's own -direction). volgraph_accel::light.
+    lights: array<vec4<f32>, MAX_LIGHTS>,
 }
+
+// volgraph_accel::light::MAX_LIGHTS.
+const MAX_LIGHTS: u32 = 3u;
 
 @group(0) @binding(auto) var<uniform> frame: Frame;
 

@@ -130,17 +130,12 @@ fn lookup_preintegrated(s_front: f32, s_back: f32) -> vec4<f32> {
 // Per-ray state of the effects: the unit world view direction (SHADING) and the scalar of the
 // previous sample, the front of the next segment (PREINTEGRATION).
 var<private> ray_view_world: vec3<f32>;
-// The unit world direction toward the light along this ray (`light_toward`), set once per ray.
-var<private> ray_light_world: vec3<f32>;
 var<private> ray_prev_scalar: f32;
 
 // Starts marching `s` at sample k0: the view direction, and the front value of sample k0's
 // segment (the field one step before it).
 fn begin_ray(s: Samples, k0: u32) {
     ray_view_world = normalize(s.delta * 2.0 * frame.half_extent.xyz);
-#if SHADING
-    ray_light_world = light_toward(ray_view_world);
-#endif
 #if FUSION
     begin_fusion();
 #endif
@@ -193,7 +188,7 @@ fn classify_value(u: vec3<f32>, s: f32) -> vec4<f32> {
 #endif
 #if SHADING
     if (p.a > 0.0) {
-        let light = lighting(u, ray_view_world, light_at(u, ray_light_world));
+        let light = lighting(u, ray_view_world);
         p = vec4<f32>(p.rgb * light.x + vec3<f32>(p.a * light.y), p.a);
     }
 #else
@@ -208,34 +203,34 @@ fn classify_value(u: vec3<f32>, s: f32) -> vec4<f32> {
     return p;
 }
 
-// The ambient light reaching `u`: the ambient term, scaled by its unoccluded share with
-// AMBIENT_OCCLUSION.
-fn ambient_at(u: vec3<f32>) -> f32 {
-#if AMBIENT_OCCLUSION
-    return params.ambient * ambient_occlusion(u);
-#else
-    return params.ambient;
-#endif
-}
-
-// The scene light reaching `u`: its transmittance with SHADOWS, else all of it.
-fn direct_at(u: vec3<f32>) -> f32 {
+// The light reaching `u`: the share of each light that gets through (.rgb, in the scene's
+// order) with SHADOWS and the ambient light's unoccluded share (.a) with AMBIENT_OCCLUSION, read
+// from the illumination volume; 1 for what is not simulated.
+fn illumination_at(u: vec3<f32>) -> vec4<f32> {
+    var lit = vec4<f32>(1.0);
 #if SHADOWS
-    return light_transmittance(u);
-#else
-    return 1.0;
+    lit = vec4<f32>(light_transmittance(u), 1.0);
 #endif
+#if AMBIENT_OCCLUSION
+    lit.a = ambient_occlusion(u);
+#endif
+    return lit;
 }
 
 // An unshaded sample `p` at `u` lit by the illumination volume: its colour scaled by the ambient
-// light reaching it and the rest of the light by what gets through
-// (volgraph_accel::reference: `ambient·AO + (1 − ambient)·T`).
+// light reaching it and the rest of the light by the share of the lights that gets through
+// (volgraph_accel::reference: `ambient·AO + (1 − ambient)·mean(T)`).
 fn unshaded_lit(u: vec3<f32>, p: vec4<f32>) -> vec4<f32> {
     if (!(p.a > 0.0)) {
         return p;
     }
-    let lit = ambient_at(u) + (1.0 - params.ambient) * direct_at(u);
-    return vec4<f32>(p.rgb * lit, p.a);
+    let lit = illumination_at(u);
+    var through = 0.0;
+    for (var i = 0u; i < frame.light_count; i++) {
+        through += lit[i];
+    }
+    let shade = params.ambient * lit.a + (1.0 - params.ambient) * through / f32(frame.light_count);
+    return vec4<f32>(p.rgb * shade, p.a);
 }
 
 // The samples of a pixel's ray (`count` 0 when there is no ray to march): step and jitter of
@@ -343,32 +338,28 @@ fn volume_position(u: vec3<f32>) -> vec3<f32> {
     return u * sampled_scale + sampled_offset;
 }
 
-// The unit world direction toward the scene's light for a ray along `d_world`: a directional
-// light's (frame.light_world, w = 1), else the headlight's -d_world (volgraph_accel::light); a
-// point light's (w = 2) depends on the sample: `light_at`.
-fn light_toward(d_world: vec3<f32>) -> vec3<f32> {
-    return select(-d_world, frame.light_world.xyz, frame.light_world.w == 1.0);
-}
-
-// The unit world direction toward the light from texture point `u` (of the texture sampled:
-// `volume_position` maps a brick atlas back): a point light's (frame.light_world.xyz, w = 2)
-// from u's world point, else the ray's `ray_light` (`light_toward`). One uniform branch a sample.
-fn light_at(u: vec3<f32>, ray_light: vec3<f32>) -> vec3<f32> {
-    if (frame.light_world.w == 2.0) {
-        let d = frame.light_world.xyz - world_from_texture(volume_position(u));
+// The unit world direction toward the scene's light `i` from texture point `u` (of the texture
+// sampled: `volume_position` maps a brick atlas back) on a ray along `d_world`: a directional
+// light's (frame.lights[i], w = 1), a point light's (w = 2) from u's world point, else the
+// headlight's -d_world (volgraph_accel::light::Toward). Uniform branches.
+fn light_at(u: vec3<f32>, d_world: vec3<f32>, i: u32) -> vec3<f32> {
+    let light = frame.lights[i];
+    if (light.w == 2.0) {
+        let d = light.xyz - world_from_texture(volume_position(u));
         let r = length(d);
         return select(vec3<f32>(0.0, 1.0, 0.0), d / r, r > 1e-12);
     }
-    return ray_light;
+    return select(-d_world, light.xyz, light.w == 1.0);
 }
 
-// Blinn–Phong at texture-space point `u` seen along the unit world direction `d_world`, lit from
-// the unit world direction `l` (`light_toward`; docs/rendering_model.md "First-hit isosurface",
-// "Effects"): (ambient + diffuse·|n·l|, the white specular term |n·h|^shininess), n from the
-// central-difference gradient of the reconstructed field, facing the light where the gradient
-// vanishes (constant regions: no NaN); h = normalize(l + v), exactly l for the headlight (l = v),
-// no highlight where light and eye are opposite (volgraph_accel::light::blinn_phong_terms).
-fn lighting(u: vec3<f32>, d_world: vec3<f32>, l: vec3<f32>) -> vec2<f32> {
+// Blinn–Phong at texture-space point `u` seen along the unit world direction `d_world`, lit by
+// each of the scene's lights from its unit world direction `l` (`light_at`;
+// docs/rendering_model.md "First-hit isosurface", "Effects"): (ambient + Σ diffuse·|n·l|, the
+// white specular term Σ |n·h|^shininess), n from the central-difference gradient of the
+// reconstructed field, facing the light where the gradient vanishes (constant regions: no NaN);
+// h = normalize(l + v), exactly l for the headlight (l = v), no highlight where light and eye
+// are opposite (volgraph_accel::light::blinn_phong_terms).
+fn lighting(u: vec3<f32>, d_world: vec3<f32>) -> vec2<f32> {
     // One voxel of the texture sampled: the volume, or a brick atlas (raycast_bricks.wgsl),
     // whose slots hold the brick's neighbours on every side.
     let off = 1.0 / vec3<f32>(textureDimensions(volume));
@@ -378,37 +369,43 @@ fn lighting(u: vec3<f32>, d_world: vec3<f32>, l: vec3<f32>) -> vec2<f32> {
         sample_volume(u + vec3<f32>(0.0, 0.0, off.z)) - sample_volume(u - vec3<f32>(0.0, 0.0, off.z)),
     );
     let v = -d_world;
-    var n = l;
-    if (length(g) >= 1e-6) {
-        // g spans two voxels per axis: the world gradient is g / (2 · voxel_world) with
-        // voxel_world = 2·half / dims, so its direction is that of g · dims / half.
-        n = -normalize(g * frame.volume_dims.xyz / frame.half_extent.xyz);
-    }
-    // A cut face shows the plane it was cut along (common/ray_box.wgsl).
-#if CUTS
-    n = cap_normal(volume_position(u), d_world, n);
-#endif
-    let n_dot_l = abs(dot(n, l));
-    let lv = l + v;
-    var n_dot_h = 0.0;
-    if (all(l == v)) {
-        n_dot_h = n_dot_l;
-    } else if (length(lv) > 1e-6) {
-        n_dot_h = abs(dot(n, lv / length(lv)));
-    }
-    var spec = 0.0;
-    if (n_dot_l > 0.0) {
-        spec = params.specular * pow(n_dot_h, params.shininess);
-    }
+    let has_gradient = length(g) >= 1e-6;
+    // g spans two voxels per axis: the world gradient is g / (2 · voxel_world) with
+    // voxel_world = 2·half / dims, so its direction is that of g · dims / half.
+    let gradient_n = -normalize(select(vec3<f32>(1.0), g, has_gradient) * frame.volume_dims.xyz / frame.half_extent.xyz);
     // Shadows: only the light that gets through reaches the diffuse and specular terms;
     // ambient occlusion: only the unoccluded share of the ambient light.
-    let t = direct_at(u);
-    return vec2<f32>(ambient_at(u) + t * params.diffuse * n_dot_l, t * spec);
+    let lit = illumination_at(u);
+    var diffuse = params.ambient * lit.a;
+    var specular = 0.0;
+    for (var i = 0u; i < frame.light_count; i++) {
+        let l = light_at(u, d_world, i);
+        var n = select(l, gradient_n, has_gradient);
+        // A cut face shows the plane it was cut along (common/ray_box.wgsl).
+#if CUTS
+        n = cap_normal(volume_position(u), d_world, n);
+#endif
+        let n_dot_l = abs(dot(n, l));
+        let lv = l + v;
+        var n_dot_h = 0.0;
+        if (all(l == v)) {
+            n_dot_h = n_dot_l;
+        } else if (length(lv) > 1e-6) {
+            n_dot_h = abs(dot(n, lv / length(lv)));
+        }
+        var spec = 0.0;
+        if (n_dot_l > 0.0) {
+            spec = params.specular * pow(n_dot_h, params.shininess);
+        }
+        diffuse += lit[i] * params.diffuse * n_dot_l;
+        specular += lit[i] * spec;
+    }
+    return vec2<f32>(diffuse, specular);
 }
 
 // The shaded colour of the isosurface at `u`.
 fn shade_iso(u: vec3<f32>, d_world: vec3<f32>) -> vec3<f32> {
-    let light = lighting(u, d_world, light_at(u, light_toward(d_world)));
+    let light = lighting(u, d_world);
     let base = sample_tf(params.iso_value).rgb;
     return clamp(base * light.x + vec3<f32>(light.y), vec3<f32>(0.0), vec3<f32>(1.0));
 }

@@ -163,6 +163,100 @@ impl Light {
     }
 }
 
+/// The most lights a scene holds: the light volume keeps one shadow channel per light beside
+/// ambient occlusion's (`Rgba16Float`: `.rgb` the lights', `.a` occlusion's), and a key, a
+/// fill and a back light are the three a studio or VTK's light kit sets.
+pub const MAX_LIGHTS: usize = 3;
+
+/// The scene's lights, one to [`MAX_LIGHTS`] (the headlight by default), each checked. Every
+/// light shades every sample (Blinn–Phong's diffuse and specular terms are summed over them,
+/// each scaled by its own shadow), and the path tracer estimates each one's direct light. The
+/// first is the key light: the one `--light` and the viewer's light control move.
+#[derive(Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(into = "Vec<Light>", try_from = "Vec<Light>")]
+pub struct Lights {
+    list: [Light; MAX_LIGHTS],
+    count: usize,
+}
+
+impl std::fmt::Debug for Lights {
+    /// The lights the scene has, as a list (the unused slots are not shown).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_list().entries(self.as_slice()).finish()
+    }
+}
+
+impl Default for Lights {
+    fn default() -> Self {
+        Self::one(Light::Headlight)
+    }
+}
+
+impl From<Light> for Lights {
+    fn from(light: Light) -> Self {
+        Self::one(light)
+    }
+}
+
+impl From<Lights> for Vec<Light> {
+    fn from(lights: Lights) -> Self {
+        lights.as_slice().to_vec()
+    }
+}
+
+impl TryFrom<Vec<Light>> for Lights {
+    type Error = String;
+    fn try_from(lights: Vec<Light>) -> Result<Self, String> {
+        Self::new(&lights)
+    }
+}
+
+impl Lights {
+    /// One light.
+    pub const fn one(light: Light) -> Self {
+        Self { list: [light; MAX_LIGHTS], count: 1 }
+    }
+
+    /// `lights` in order: one to [`MAX_LIGHTS`], each passing [`Light::check`] (the error
+    /// names the light by its place, from 1).
+    pub fn new(lights: &[Light]) -> Result<Self, String> {
+        if lights.is_empty() || lights.len() > MAX_LIGHTS {
+            return Err(format!(
+                "{} lights: a scene has 1 to {MAX_LIGHTS} (a key, a fill and a back light; the light volume keeps one \
+                 shadow per light)",
+                lights.len()
+            ));
+        }
+        let mut list = [lights[0]; MAX_LIGHTS];
+        for (i, light) in lights.iter().enumerate() {
+            light.check().map_err(|e| if lights.len() > 1 { format!("light {}: {e}", i + 1) } else { e })?;
+            list[i] = *light;
+        }
+        Ok(Self { list, count: lights.len() })
+    }
+
+    /// The lights, the key light first.
+    pub fn as_slice(&self) -> &[Light] {
+        &self.list[..self.count]
+    }
+
+    /// The key light (the first).
+    pub fn key(&self) -> Light {
+        self.list[0]
+    }
+
+    /// These lights with the key light replaced (the others kept).
+    pub fn with_key(mut self, key: Light) -> Self {
+        self.list[0] = key;
+        self
+    }
+
+    /// Where each light comes from, with `headlight` for the headlight ([`Light::toward_with`]).
+    pub fn toward_with(&self, headlight: DVec3) -> Vec<Toward> {
+        self.as_slice().iter().map(|l| l.toward_with(headlight)).collect()
+    }
+}
+
 /// Blinn–Phong's two factors for the gradient normal `n` (unit, or the light's direction where
 /// the gradient vanishes), the unit direction `l` toward the light and `v` toward the eye:
 /// `|n·l|` and `|n·h|` with `h = normalize(l + v)` — `h = l` exactly for the headlight
@@ -211,8 +305,8 @@ pub fn light_grid_dims(dims: glam::UVec3) -> glam::UVec3 {
 pub struct LightGrid {
     /// Voxels per axis.
     pub dims: glam::UVec3,
-    /// Transmittance toward the light per voxel, x fastest (empty without shadows).
-    pub transmittance: Vec<f64>,
+    /// Transmittance toward each light per voxel, x fastest (no lights without shadows).
+    pub transmittance: Vec<Vec<f64>>,
     /// Ambient occlusion (the unoccluded share, 1 in the open) per voxel (empty without it).
     pub occlusion: Vec<f64>,
 }
@@ -243,10 +337,11 @@ impl LightGrid {
     /// The grid over `volume` of the opacity `alpha` gives at a texture point (per
     /// `opacity_unit_voxels`, before the step's correction: the TF's at the reconstructed field,
     /// or several volumes' combined, `fusion::Fusion::alpha`): transmittance toward the unit
-    /// world direction `toward` where given (shadows), ambient occlusion where `occlusion`.
+    /// world direction toward each light of `towards` (shadows; none without), ambient
+    /// occlusion where `occlusion`.
     pub fn compute(
         volume: &crate::volume::Volume,
-        (toward, occlusion): (Option<Toward>, bool),
+        (towards, occlusion): (&[Toward], bool),
         (opacity_unit_voxels, cuts): (f64, &crate::cuts::Cuts),
         alpha: &(dyn Fn(DVec3) -> f64 + Sync),
     ) -> Self {
@@ -277,27 +372,29 @@ impl LightGrid {
             (exponent * depth).exp()
         };
         let count = (dims.x * dims.y * dims.z) as usize;
-        let transmittance = match toward {
-            Some(Toward::Direction(toward)) => {
-                let step = light_step_tex(volume, toward);
-                (0..count).into_par_iter().map(|i| along(centre(i), step, u32::MAX)).collect()
+        let toward_one = |toward: &Toward| -> Vec<f64> {
+            match *toward {
+                Toward::Direction(toward) => {
+                    let step = light_step_tex(volume, toward);
+                    (0..count).into_par_iter().map(|i| along(centre(i), step, u32::MAX)).collect()
+                }
+                point @ Toward::Point(_) => {
+                    // Toward a point light: each voxel's own direction, up to the light (material
+                    // beyond it casts no shadow); whole steps of one unit_world, as the GPU takes.
+                    let half = volume.half_extent_world();
+                    let unit = volume.unit_step_world();
+                    (0..count)
+                        .into_par_iter()
+                        .map(|i| {
+                            let u0 = centre(i);
+                            let (d, r) = point.from((u0 - 0.5) * 2.0 * half);
+                            along(u0, light_step_tex(volume, d), steps_to_light(r, unit))
+                        })
+                        .collect()
+                }
             }
-            Some(point @ Toward::Point(_)) => {
-                // Toward a point light: each voxel's own direction, up to the light (material
-                // beyond it casts no shadow); whole steps of one unit_world, as the GPU takes.
-                let half = volume.half_extent_world();
-                let unit = volume.unit_step_world();
-                (0..count)
-                    .into_par_iter()
-                    .map(|i| {
-                        let u0 = centre(i);
-                        let (d, r) = point.from((u0 - 0.5) * 2.0 * half);
-                        along(u0, light_step_tex(volume, d), steps_to_light(r, unit))
-                    })
-                    .collect()
-            }
-            None => Vec::new(),
         };
+        let transmittance = towards.iter().map(toward_one).collect();
         let occlusion = if occlusion {
             let steps: Vec<DVec3> = OCCLUSION_DIRECTIONS
                 .iter()
@@ -316,11 +413,15 @@ impl LightGrid {
         Self { dims, transmittance, occlusion }
     }
 
-    /// The transmittance toward the light and the ambient occlusion at texture point `u`, each
-    /// trilinear between the grid's voxel centres, clamped to the edge (as the GPU samples the
-    /// light volume); 1 for a channel the grid does not hold.
-    pub fn sample(&self, u: DVec3) -> (f64, f64) {
-        (self.sample_channel(&self.transmittance, u), self.sample_channel(&self.occlusion, u))
+    /// The transmittance toward each light (in the scene's order) and the ambient occlusion at
+    /// texture point `u`, each trilinear between the grid's voxel centres, clamped to the edge
+    /// (as the GPU samples the light volume); 1 for a channel the grid does not hold.
+    pub fn sample(&self, u: DVec3) -> ([f64; MAX_LIGHTS], f64) {
+        let mut lights = [1.0; MAX_LIGHTS];
+        for (t, values) in lights.iter_mut().zip(&self.transmittance) {
+            *t = self.sample_channel(values, u);
+        }
+        (lights, self.sample_channel(&self.occlusion, u))
     }
 
     fn sample_channel(&self, values: &[f64], u: DVec3) -> f64 {
@@ -421,19 +522,18 @@ mod tests {
         let lut: Vec<[f32; 4]> = (0..256).map(|i| if i >= 128 { [1.0; 4] } else { [0.0; 4] }).collect();
         let toward = DVec3::Z; // light at +z
         let alpha = |u: DVec3| crate::reference::lut_sample(&lut, volume.sample_trilinear(u))[3];
-        let grid = LightGrid::compute(
-            &volume,
-            (Some(Toward::Direction(toward)), true),
-            (1.0, &crate::cuts::Cuts::NONE),
-            &alpha,
-        );
+        // A second light from -z: each light has its own shadow.
+        let towards = [Toward::Direction(toward), Toward::Direction(-toward)];
+        let grid = LightGrid::compute(&volume, (&towards, true), (1.0, &crate::cuts::Cuts::NONE), &alpha);
         assert_eq!(grid.dims, glam::UVec3::splat(n));
-        let at = |z: u32| grid.transmittance[(8 + n * (8 + n * z)) as usize];
+        let at = |z: u32| grid.transmittance[0][(8 + n * (8 + n * z)) as usize];
         assert_eq!(at(2), 0.0, "behind the slab");
         assert_eq!(at(12), 1.0, "on the light's side");
         assert_eq!(at(15), 1.0, "the last voxel toward the light");
+        let from_below = |z: u32| grid.transmittance[1][(8 + n * (8 + n * z)) as usize];
+        assert_eq!((from_below(2), from_below(12)), (1.0, 0.0), "the second light's side is the other");
         let (mid, _) = grid.sample(DVec3::new(0.5, 0.5, 12.5 / 16.0));
-        assert_eq!(mid, 1.0);
+        assert_eq!(mid, [1.0, 0.0, 1.0], "lit from +z, shadowed from -z, 1 for the light not there");
         // Ambient occlusion: one voxel above the slab (z = 10) 5 of the 14 rays (−z and the four
         // diagonals with −z) run into it within their 8 steps; six voxels above (z = 15) only
         // −z reaches it, the diagonals end 10.4 voxels up.
@@ -444,9 +544,28 @@ mod tests {
         // A clip plane keeping z < 0.3 removes the slab: nothing shadows the voxel behind it.
         let keep_low = crate::cuts::ClipPlane::new(DVec3::new(0.0, 0.0, -1.0), -0.3).expect("plane");
         let cuts = crate::cuts::Cuts::new(None, &[keep_low]).expect("cuts");
-        let cut = LightGrid::compute(&volume, (Some(Toward::Direction(toward)), false), (1.0, &cuts), &alpha);
-        assert_eq!(cut.transmittance[(8 + n * (8 + n * 2)) as usize], 1.0, "the cut-away slab casts no shadow");
+        let cut = LightGrid::compute(&volume, (&towards[..1], false), (1.0, &cuts), &alpha);
+        assert_eq!(cut.transmittance[0][(8 + n * (8 + n * 2)) as usize], 1.0, "the cut-away slab casts no shadow");
         assert_eq!(steps_to_exit(DVec3::splat(0.5), DVec3::ZERO), 0);
+    }
+
+    /// One to three lights, each checked and named by its place; the key light is the first.
+    #[test]
+    fn a_scene_has_one_to_three_lights() {
+        let key = Light::Directional { azimuth_deg: 30.0, elevation_deg: 20.0 };
+        let fill = Light::Point { x: 0.0, y: 2.0, z: 1.0 };
+        let lights = Lights::new(&[key, fill]).expect("two");
+        assert_eq!(lights.as_slice(), &[key, fill]);
+        assert_eq!(lights.with_key(Light::Headlight).as_slice(), &[Light::Headlight, fill]);
+        assert_eq!(Lights::default().as_slice(), &[Light::Headlight]);
+        assert!(Lights::new(&[]).expect_err("none").starts_with("0 lights"));
+        assert!(Lights::new(&[key; 4]).expect_err("four").starts_with("4 lights: a scene has 1 to 3"));
+        let bad = Light::Directional { azimuth_deg: 0.0, elevation_deg: 95.0 };
+        assert_eq!(
+            Lights::new(&[key, bad]).expect_err("bad"),
+            "light 2: a light's elevation is -90..90 degrees, not 95"
+        );
+        assert_eq!(Lights::new(&[bad]).expect_err("bad"), "a light's elevation is -90..90 degrees, not 95");
     }
 
     #[test]

@@ -13,7 +13,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::camera::OrbitCamera;
-use crate::light::Light;
+use crate::light::{Light, Lights};
 use crate::reference::{intersect_box, lut_sample, ray_segment};
 use crate::volume::Volume;
 
@@ -41,14 +41,14 @@ pub struct PathTraceSettings {
     pub surface: f64,
     /// Scattering events a path may take.
     pub bounces: u32,
-    /// Irradiance of the light.
+    /// Irradiance of each light.
     pub light_intensity: f64,
     /// What paths leaving the volume see.
     pub environment: Environment,
     /// Radiance scale of the environment.
     pub environment_intensity: f64,
-    /// The scene's light.
-    pub light: Light,
+    /// The scene's lights: each one's direct light is estimated at every scattering event.
+    pub lights: Lights,
     /// The TF's opacity is per this many voxels (1: per voxel).
     pub opacity_unit_voxels: f64,
     /// The scene's crop box and clip planes: paths, primary and scattered, and the light's
@@ -68,7 +68,7 @@ impl Default for PathTraceSettings {
             light_intensity: 2.0,
             environment: Environment::Sky,
             environment_intensity: 0.6,
-            light: Light::Headlight,
+            lights: Lights::one(Light::Headlight),
             opacity_unit_voxels: 1.0,
             cuts: crate::cuts::Cuts::default(),
         }
@@ -111,7 +111,7 @@ struct Medium<'a> {
     half: DVec3,
     unit_world: f64,
     majorant: f64,
-    toward_light: crate::light::Toward,
+    toward_lights: Vec<crate::light::Toward>,
 }
 
 impl Medium<'_> {
@@ -225,24 +225,35 @@ impl Medium<'_> {
             let g = self.gradient(p);
             let strength = g.length();
             let surface = s.surface * (1.0 - (-20.0 * strength).exp());
-            // Toward the light (a point light's direction from here, its irradiance falling as
+            // Toward each light (a point light's direction from here, its irradiance falling as
             // 1/r²); its visibility by delta tracking up to it: reached (1) or not (0).
-            let (l, r) = self.toward_light.from(p);
-            let lit = match self.span(p, l) {
-                Some((t0, t1)) => t0 >= t1.min(r) || self.delta_track(p, l, (t0, t1.min(r)), rng).is_none(),
-                None => true,
-            };
-            let irradiance = if r.is_finite() { s.light_intensity / (r * r).max(1e-12) } else { s.light_intensity };
-            let to_light = if lit { irradiance } else { 0.0 };
+            let to_lights: Vec<(DVec3, f64)> = self
+                .toward_lights
+                .iter()
+                .map(|toward| {
+                    let (l, r) = toward.from(p);
+                    let lit = match self.span(p, l) {
+                        Some((t0, t1)) => t0 >= t1.min(r) || self.delta_track(p, l, (t0, t1.min(r)), rng).is_none(),
+                        None => true,
+                    };
+                    let irradiance =
+                        if r.is_finite() { s.light_intensity / (r * r).max(1e-12) } else { s.light_intensity };
+                    (l, if lit { irradiance } else { 0.0 })
+                })
+                .collect();
             if strength > 1e-6 && rng.uniform() < surface {
                 let mut n = -g / strength;
                 if n.dot(w) > 0.0 {
                     n = -n;
                 }
-                radiance += throughput * to_light * n.dot(l).max(0.0) / std::f64::consts::PI;
+                for &(l, to_light) in &to_lights {
+                    radiance += throughput * to_light * n.dot(l).max(0.0) / std::f64::consts::PI;
+                }
                 w = sample_cosine(n, rng);
             } else {
-                radiance += throughput * to_light * henyey_greenstein(w.dot(l), s.anisotropy);
+                for &(l, to_light) in &to_lights {
+                    radiance += throughput * to_light * henyey_greenstein(w.dot(l), s.anisotropy);
+                }
                 w = sample_henyey_greenstein(w, s.anisotropy, rng);
             }
             match self.span(p, w) {
@@ -311,7 +322,7 @@ pub fn render_path_traced(
         half: volume.half_extent_world(),
         unit_world: volume.unit_step_world(),
         majorant: 0.0,
-        toward_light: settings.light.toward_with(-frame.forward),
+        toward_lights: settings.lights.toward_with(-frame.forward),
     };
     medium.majorant = medium.extinction_of(max_alpha);
     (0..height)

@@ -108,9 +108,10 @@ pub struct RaycastSettings {
     /// stays the uncut ray's ([`crate::cuts`], `docs/rendering_model.md` "Cuts").
     #[serde(skip)]
     pub cuts: Cuts,
-    /// The scene's light: the headlight, or a directional one ([`crate::light`]).
+    /// The scene's lights: the headlight by default, directional and point lights
+    /// ([`crate::light`]).
     #[serde(default)]
-    pub light: crate::light::Light,
+    pub lights: crate::light::Lights,
 }
 
 impl Default for RaycastSettings {
@@ -125,7 +126,7 @@ impl Default for RaycastSettings {
             dvr_shading: Phong::default(),
             opacity_unit_voxels: 1.0,
             cuts: Cuts::NONE,
-            light: crate::light::Light::Headlight,
+            lights: crate::light::Lights::one(crate::light::Light::Headlight),
         }
     }
 }
@@ -361,8 +362,11 @@ impl<'a> March<'a> {
             // Unshaded: the light reaching the sample (and its share of the ambient light)
             // scales its colour.
             let ambient = self.settings.dvr_shading.ambient;
+            // With several lights the share of them that gets through (their mean).
             let (light, ao) = self.illumination(self.seg.u0 + t * self.seg.d_tex);
-            let lit = ambient * ao + (1.0 - ambient) * light;
+            let lights = self.settings.lights.as_slice().len();
+            let through = light[..lights].iter().sum::<f64>() / lights as f64;
+            let lit = ambient * ao + (1.0 - ambient) * through;
             for c in p.iter_mut().take(3) {
                 *c *= lit;
             }
@@ -403,7 +407,8 @@ impl<'a> March<'a> {
 
     /// The light's factors at `u`: `ambient + diffuse·|n·l|` and the white specular term
     /// `|n·h|^shininess`, `n` from the gradient (facing the light where the gradient vanishes);
-    /// `l` the scene's light ([`crate::light::Light`]), the headlight's `l = v` by default.
+    /// `l` toward each of the scene's lights ([`crate::light::Lights`]; the headlight's `l = v`
+    /// by default), their diffuse and specular terms summed.
     fn lighting(&self, u: DVec3, p: &Phong) -> (f64, f64) {
         let dims = self.volume.dims.as_dvec3();
         let off = 1.0 / dims;
@@ -415,25 +420,30 @@ impl<'a> March<'a> {
         );
         let v = -self.seg.dir_world;
         let half = self.volume.half_extent_world();
-        // A point light's direction from this sample's world point (the volume's own space).
-        let l = self.settings.light.toward_with(v).from((u - 0.5) * 2.0 * half).0;
-        let mut n = if g.length() >= ZERO_GRADIENT { -(g * dims / half).normalize() } else { l };
-        if !self.settings.cuts.is_none() {
-            // A cut face shows the plane it was cut along ("capping", crate::cuts).
-            n = self.settings.cuts.cap_normal(u, self.seg.u0, self.seg.d_tex, n, dims, half);
-        }
-        let (n_dot_l, n_dot_h) = crate::light::blinn_phong_terms(n, l, v);
-        let spec = if n_dot_l > 0.0 { p.specular * n_dot_h.powf(p.shininess) } else { 0.0 };
         // Shadows: only the light that gets through reaches the diffuse and specular terms;
         // ambient occlusion: only the unoccluded share of the ambient light.
-        let (t, ao) = self.illumination(u);
-        (p.ambient * ao + t * p.diffuse * n_dot_l, t * spec)
+        let (through, ao) = self.illumination(u);
+        let (mut diffuse, mut specular) = (p.ambient * ao, 0.0);
+        for (light, t) in self.settings.lights.as_slice().iter().zip(through) {
+            // A point light's direction from this sample's world point (the volume's own space).
+            let l = light.toward_with(v).from((u - 0.5) * 2.0 * half).0;
+            let mut n = if g.length() >= ZERO_GRADIENT { -(g * dims / half).normalize() } else { l };
+            if !self.settings.cuts.is_none() {
+                // A cut face shows the plane it was cut along ("capping", crate::cuts).
+                n = self.settings.cuts.cap_normal(u, self.seg.u0, self.seg.d_tex, n, dims, half);
+            }
+            let (n_dot_l, n_dot_h) = crate::light::blinn_phong_terms(n, l, v);
+            let spec = if n_dot_l > 0.0 { p.specular * n_dot_h.powf(p.shininess) } else { 0.0 };
+            diffuse += t * p.diffuse * n_dot_l;
+            specular += t * spec;
+        }
+        (diffuse, specular)
     }
 
-    /// The light reaching texture point `u` from the light and the ambient light's unoccluded
-    /// share there (1, 1 without a light grid).
-    fn illumination(&self, u: DVec3) -> (f64, f64) {
-        self.light_grid.map_or((1.0, 1.0), |g| g.sample(u))
+    /// The light reaching texture point `u` from each light and the ambient light's unoccluded
+    /// share there (all 1 without a light grid).
+    fn illumination(&self, u: DVec3) -> ([f64; crate::light::MAX_LIGHTS], f64) {
+        self.light_grid.map_or(([1.0; crate::light::MAX_LIGHTS], 1.0), |g| g.sample(u))
     }
 
     /// First hit of `s >= iso`, refined linearly; returns colour, hit and samples taken.
@@ -610,7 +620,7 @@ pub fn shadow_grid(
     if !(settings.effects.shadows || settings.effects.ambient_occlusion) {
         return None;
     }
-    let toward = settings.effects.shadows.then(|| settings.light.toward_with(-frame.forward));
+    let towards = if settings.effects.shadows { settings.lights.toward_with(-frame.forward) } else { Vec::new() };
     let tricubic = settings.effects.tricubic;
     let field = |u: DVec3| if tricubic { volume.sample_tricubic(u) } else { volume.sample_trilinear(u) };
     let alpha = |u: DVec3| match fusion {
@@ -619,7 +629,7 @@ pub fn shadow_grid(
     };
     let occlusion = settings.effects.ambient_occlusion;
     let unit = (settings.opacity_unit_voxels, &settings.cuts);
-    Some(crate::light::LightGrid::compute(volume, (toward, occlusion), unit, &alpha))
+    Some(crate::light::LightGrid::compute(volume, (&towards, occlusion), unit, &alpha))
 }
 
 /// [`fused_pixel`] with the light grid of the `shadows` effect given ([`shadow_grid`]).

@@ -78,7 +78,7 @@ pub struct Prepared {
     opacity: OpacityReference,
     cuts: volgraph_accel::cuts::Cuts,
     /// The scene's light.
-    light: volgraph_accel::light::Light,
+    lights: volgraph_accel::light::Lights,
     /// The scene's environment map, read and checked.
     environment: Option<Arc<volgraph_accel::environment::EnvironmentMap>>,
     volume: volgraph_accel::volume::Volume,
@@ -96,7 +96,7 @@ pub struct Prepared {
 /// Reads and checks every input of `volgraph render`; touches no GPU, prints nothing.
 pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
     let kind = ImageKind::from_path("-o", &args.out)?;
-    let Resolved { scene, graph, size, camera, camera_is_default, cuts, light, environment } =
+    let Resolved { scene, graph, size, camera, camera_is_default, cuts, lights, environment } =
         args.inputs.resolve("volgraph render GRAPH -o out.png", "512x512")?;
     let source = inputs::read_graph(&graph)?;
     let mut features = scene.as_ref().map(|s| s.effects.clone()).unwrap_or_default();
@@ -273,7 +273,7 @@ pub fn prepare(args: RenderArgs) -> Result<Prepared, CliError> {
         still,
         opacity,
         cuts,
-        light,
+        lights,
         environment,
         volume,
         lut,
@@ -434,7 +434,7 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
         still,
         opacity,
         cuts,
-        light,
+        lights,
         environment,
         volume,
         lut,
@@ -451,7 +451,7 @@ pub fn execute(prepared: Prepared) -> Result<(), CliError> {
     let mut runtime = Runtime::new(gpu, ShaderLibrary::new(sources));
     runtime.set_opacity_reference(opacity);
     runtime.set_cuts(cuts);
-    runtime.set_light(light);
+    runtime.set_lights(lights);
     runtime.set_environment(environment);
     runtime.set_gpu_memory_budget(args.inputs.gpu_memory_mb.map(|mb| mb << 20));
     match &bindings {

@@ -237,9 +237,9 @@ pub struct Scene {
     /// Transfer-function inputs by name (`tfs: {"mask_tf": "mask.ron"}`): a file beside the
     /// scene, a preset's or a built-in TF's name, as `--tf NAME=…` takes it.
     pub tfs: Vec<(String, PathBuf)>,
-    /// The light (`lights: [Directional(azimuth_deg: 35, elevation_deg: 25)]`; none: the
-    /// headlight).
-    pub light: volgraph_accel::light::Light,
+    /// The lights, up to three (`lights: [Directional(azimuth_deg: 35, elevation_deg: 25),
+    /// Point(x: 0, y: 2, z: 1)]`; none: the headlight).
+    pub lights: volgraph_accel::light::Lights,
     /// The environment map a path tracer's paths see (`environment: "sky.exr"`, beside the
     /// scene); none: the path tracer's own sky.
     pub environment: Option<PathBuf>,
@@ -393,22 +393,20 @@ impl Scene {
                 SceneLight::Environment(source) => environments.push(source),
             }
         }
-        let light = match lights.as_slice() {
-            [] => Light::Headlight,
-            [one] => {
-                one.check().map_err(|e| field("lights", e))?;
-                *one
-            }
-            more => {
-                return Err(field(
+        let lights = if lights.is_empty() {
+            volgraph_accel::light::Lights::default()
+        } else {
+            volgraph_accel::light::Lights::new(&lights).map_err(|e| {
+                let more = lights.len() > volgraph_accel::light::MAX_LIGHTS;
+                field(
                     "lights",
-                    format!(
-                        "{} lights: a scene has one light for now (the headlight, one Directional(azimuth_deg: AZ, \
-                         elevation_deg: EL) or one Point(x: X, y: Y, z: Z)) besides an Environment(…); keep one",
-                        more.len()
-                    ),
-                ));
-            }
+                    if more {
+                        format!("{e}, besides an Environment(…); keep at most {}", volgraph_accel::light::MAX_LIGHTS)
+                    } else {
+                        e
+                    },
+                )
+            })?
         };
         let environment = match (environments.as_slice(), &doc.environment) {
             ([], None) | ([EnvironmentSource::Sky], None) => None,
@@ -488,7 +486,7 @@ impl Scene {
             volume_options: doc.volume_options,
             volumes,
             tfs,
-            light,
+            lights,
             environment,
         })
     }

@@ -83,12 +83,13 @@ pub struct SceneArgs {
     /// planes].
     #[arg(long, value_parser = ClipPlane::parse, allow_hyphen_values = true)]
     pub clip: Vec<ClipPlane>,
-    /// The light: AZ,EL in degrees (a directional light where an orbit camera at those angles
+    /// A light: AZ,EL in degrees (a directional light where an orbit camera at those angles
     /// would stand; elevation -90..90), point:X,Y,Z (a point light in world units: the volume's
-    /// box is centred on the origin, its longest side 2), or headlight [default: the scene's,
+    /// box is centred on the origin, its longest side 2), or headlight. Repeat for up to 3
+    /// lights (key, fill, back), which then replace the scene's [default: the scene's lights,
     /// else the headlight].
     #[arg(long, value_parser = volgraph_accel::light::Light::parse, allow_hyphen_values = true)]
-    pub light: Option<volgraph_accel::light::Light>,
+    pub light: Vec<volgraph_accel::light::Light>,
     /// An environment map (OpenEXR, equirectangular linear radiance) that a path tracer's paths
     /// see when they leave the volume [default: the scene's, else the path tracer's own sky].
     #[arg(long)]
@@ -110,8 +111,8 @@ pub struct Resolved {
     pub camera_is_default: bool,
     /// The crop box and clip planes: `--crop` and `--clip` win over the scene's.
     pub cuts: Cuts,
-    /// The light: `--light` wins over the scene's.
-    pub light: volgraph_accel::light::Light,
+    /// The lights: `--light` wins over the scene's.
+    pub lights: volgraph_accel::light::Lights,
     /// The environment map's file: `--environment` wins over the scene's.
     pub environment: Option<PathBuf>,
 }
@@ -174,9 +175,13 @@ impl SceneArgs {
         let planes: Vec<ClipPlane> =
             if self.clip.is_empty() { scene_cuts.planes().copied().collect() } else { self.clip.clone() };
         let cuts = Cuts::new(crop, &planes).map_err(|e| anyhow!("--clip: {e}"))?;
-        let light = self.light.or(scene.as_ref().map(|s| s.light)).unwrap_or_default();
+        let lights = if self.light.is_empty() {
+            scene.as_ref().map(|s| s.lights).unwrap_or_default()
+        } else {
+            volgraph_accel::light::Lights::new(&self.light).map_err(|e| anyhow!("--light: {e}"))?
+        };
         let environment = self.environment.clone().or_else(|| scene.as_ref().and_then(|s| s.environment.clone()));
-        Ok(Resolved { scene, graph, size, camera, camera_is_default, cuts, light, environment })
+        Ok(Resolved { scene, graph, size, camera, camera_is_default, cuts, lights, environment })
     }
 }
 

@@ -56,7 +56,7 @@ fn open(graph: &Path, volume: &[PathBuf], raw: LoadOptions<'static>, tf: Option<
         gpu_memory_mb: None,
         memory_mb: None,
         cuts: Default::default(),
-        light: Default::default(),
+        lights: Default::default(),
         named: Vec::new(),
         named_tfs: Vec::new(),
     };

@@ -331,7 +331,7 @@ fn light_volume_shadows(bench: &mut Bench) -> anyhow::Result<(f64, f64)> {
     let image = bench.image()?;
     let march = plan.steps.iter().find(|s| s.pass_id == "march").ok_or_else(|| anyhow!("no march step"))?;
     let settings = volgraph_accel::reference::RaycastSettings {
-        light: bench.runtime.light(),
+        lights: bench.runtime.lights(),
         ..volgraph_passes::raycast_params::reference_settings(&march.params)
     };
     let (w, h) = plan.viewport;

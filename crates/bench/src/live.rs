@@ -256,7 +256,7 @@ pub fn run(args: &LiveArgs) -> anyhow::Result<()> {
                 gpu_memory_mb: None,
                 memory_mb: None,
                 cuts: Default::default(),
-                light: Default::default(),
+                lights: Default::default(),
                 environment: None,
                 named: Vec::new(),
                 named_tfs: Vec::new(),

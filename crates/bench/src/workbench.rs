@@ -76,7 +76,7 @@ pub(crate) fn session_args(graph: PathBuf, volume: &std::path::Path, viewport: (
         memory_mb: None,
         scene: None,
         cuts: Default::default(),
-        light: Default::default(),
+        lights: Default::default(),
         named: Vec::new(),
         named_tfs: Vec::new(),
     }

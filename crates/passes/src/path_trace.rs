@@ -3,13 +3,14 @@
 //! view rests (`graphs/cinematic/path_traced.ron`: `while_camera_still`).
 //!
 //! - Free paths by delta (Woodcock) tracking against a majorant — the extinction of the TF's
-//!   largest opacity, recomputed when the TF changes — and the transmittance toward the light by
+//!   largest opacity, recomputed when the TF changes — and the transmittance toward each light by
 //!   ratio tracking, or delta tracking's 0-or-1 visibility (`shadow_rays`; Novák et al. 2014, §3
 //!   and §5.2);
 //! - single and multiple scattering (`bounces`) with a Henyey–Greenstein phase function
 //!   (`anisotropy`), or off a Lambertian surface with probability `surface` · (1 − e^(−20 |∇s|))
 //!   (Kroes et al. 2012, "Exposure Render", §4.3's hybrid scattering);
-//! - the scene's directional light (or the headlight) and an environment: the scene's map
+//! - the scene's lights (one to three: directional, point or the headlight; at every scattering
+//!   event a shadow ray toward each, their direct light summed) and an environment: the scene's map
 //!   (`Runtime::set_environment`, bound as `environment_map`), else a generated sky, or a
 //!   uniform one (the white furnace);
 //! - an interaction scatters with probability `albedo`, tinted by the TF colour, and otherwise
@@ -77,7 +78,7 @@ volgraph_compiler::pass_params! {
         bounces: u32 = 4, 0..=64, "scattering events a path may take before it ends";
         russian_roulette: bool = true,
             "from the second scattering on, end a path with probability 1 − its largest throughput channel (unbiased)";
-        light_intensity: f32 = 2.0, 0.0..=1000.0, "irradiance of the scene's light (directional, or the headlight)";
+        light_intensity: f32 = 2.0, 0.0..=1000.0, "irradiance of each of the scene's lights (a point light's one world unit away)";
         environment: Environment = Sky,
             "what paths leaving the volume see: the scene's environment map where it has one, else a generated sky; or a uniform radiance";
         environment_intensity: f32 = 0.6, 0.0..=1000.0, "radiance scale of the environment";

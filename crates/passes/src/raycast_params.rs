@@ -262,10 +262,10 @@ pub fn reference_settings(p: &Params) -> RaycastSettings {
         dvr_shading: phong,
         opacity_unit_voxels: 1.0,
         mode: if is_iso(p) { RenderMode::Isosurface { iso, shading: phong } } else { RenderMode::Dvr },
-        // Cuts and the light are the frame's, not a pass's: a test sets the runtime's and the
+        // Cuts and the lights are the frame's, not a pass's: a test sets the runtime's and the
         // reference's alike.
         cuts: volgraph_accel::cuts::Cuts::NONE,
-        light: volgraph_accel::light::Light::Headlight,
+        lights: volgraph_accel::light::Lights::one(volgraph_accel::light::Light::Headlight),
     }
 }
 

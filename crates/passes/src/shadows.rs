@@ -1,10 +1,10 @@
 //! The `shadows` scene effect (issue "light that scatters", item 1; Behrens & Ratering 1998's
 //! shadow volume): a light volume — at each voxel of a grid of up to 64³, the transmittance
-//! toward the scene's light through the classified volume (`volgraph_accel::light::LightGrid`,
+//! toward each of the scene's lights (one channel each) through the classified volume (`volgraph_accel::light::LightGrid`,
 //! the very function the f64 reference calls) — that the march reads at every sample
 //! (`shaders/common/shadows.wgsl`) to scale the light reaching it. Not a pass: each raycaster
 //! that shades with it owns one, like the pre-integration table, and rebuilds it only when the
-//! volume's or TF's content (their input versions), the light, the opacity unit or the
+//! volume's or TF's content (their input versions), the lights, the opacity unit or the
 //! reconstruction change. With the headlight the light comes from the eye along the camera's
 //! forward axis, so the volume follows the camera.
 //!
@@ -13,7 +13,7 @@
 //! the brick raycaster's GPU volume is an atlas of resident bricks, not the volume, so there it
 //! is computed on the CPU (rayon) from the voxels and LUT the runtime keeps for every bound
 //! volume and TF — by `LightGrid::compute`, the reference's own function — and uploaded as
-//! `R16Float`.
+//! `Rgba16Float` as well.
 
 use volgraph_compiler::ShaderUse;
 
@@ -27,6 +27,9 @@ pub fn light_shader_use(params: &volgraph_compiler::Params) -> ShaderUse {
     )
 }
 
+// The light volume's four channels: one per light, then ambient occlusion.
+const _: () = assert!(volgraph_accel::light::MAX_LIGHTS == 3);
+
 /// The ports whose versions rebuild the light volume of several volumes besides the volume and
 /// TF: the others' voxels and TFs, and the label table (a label hidden casts no shadow).
 const FUSION_INPUTS: [&str; 8] =
@@ -35,11 +38,17 @@ const FUSION_INPUTS: [&str; 8] =
 #[cfg(feature = "gpu")]
 use volgraph_core::runtime::{ComputePassPipeline, ComputePipelineSpec, CreateContext, PassError, RecordContext};
 
-/// What a light volume was built for: the volume's and TF's versions, the light's direction or
+/// What a light volume was built for: the volume's and TF's versions, each light's direction or
 /// a point light's position (with `true`), the opacity unit's bits and the cuts.
 #[cfg(feature = "gpu")]
-type BuildKey =
-    (Option<u64>, Option<u64>, ([u64; 3], bool), u64, volgraph_accel::cuts::Cuts, [Option<u64>; FUSION_INPUTS.len()]);
+type BuildKey = (
+    Option<u64>,
+    Option<u64>,
+    [([u64; 3], bool); volgraph_accel::light::MAX_LIGHTS],
+    u64,
+    volgraph_accel::cuts::Cuts,
+    [Option<u64>; FUSION_INPUTS.len()],
+);
 
 #[cfg(feature = "gpu")]
 /// A raycaster's light volume and what it was built for.
@@ -114,20 +123,33 @@ impl LightVolume {
         // Only shadows depend on the light (ambient occlusion does not follow the camera). A
         // point light in the bound box's own world (a sort-last window centres it on its origin).
         let window_centre = frame.volume.and_then(|v| v.window).map_or(glam::DVec3::ZERO, |w| w.centre_world);
-        let toward = self.shadows.then(|| match frame.light.toward_with(-frame.camera.forward) {
-            volgraph_accel::light::Toward::Point(at) => volgraph_accel::light::Toward::Point(at - window_centre),
-            direction => direction,
-        });
-        let (toward_key, is_point) = match toward {
-            Some(volgraph_accel::light::Toward::Direction(d)) => (d, false),
-            Some(volgraph_accel::light::Toward::Point(at)) => (at, true),
-            None => (glam::DVec3::ZERO, false),
+        let towards: Vec<volgraph_accel::light::Toward> = if self.shadows {
+            frame
+                .lights
+                .toward_with(-frame.camera.forward)
+                .into_iter()
+                .map(|toward| match toward {
+                    volgraph_accel::light::Toward::Point(at) => {
+                        volgraph_accel::light::Toward::Point(at - window_centre)
+                    }
+                    direction => direction,
+                })
+                .collect()
+        } else {
+            Vec::new()
         };
+        let mut towards_key = [([0; 3], false); volgraph_accel::light::MAX_LIGHTS];
+        for (slot, toward) in towards_key.iter_mut().zip(&towards) {
+            *slot = match *toward {
+                volgraph_accel::light::Toward::Direction(d) => (d.to_array().map(f64::to_bits), false),
+                volgraph_accel::light::Toward::Point(at) => (at.to_array().map(f64::to_bits), true),
+            };
+        }
         let unit = frame.volume.map_or(1.0, |v| v.opacity_unit_voxels);
         let key = (
             ctx.input_version("volume"),
             ctx.input_version("tf"),
-            (toward_key.to_array().map(f64::to_bits), is_point),
+            towards_key,
             unit.to_bits(),
             // What the cuts keep (cut-away material casts no shadow).
             frame.cuts,
@@ -178,11 +200,15 @@ impl LightVolume {
         let field = |u: glam::DVec3| if tricubic { volume.sample_tricubic(u) } else { volume.sample_trilinear(u) };
         let alpha = |u: glam::DVec3| volgraph_accel::reference::lut_sample(&lut, field(u))[3];
         let cuts = frame.cuts;
-        let grid = volgraph_accel::light::LightGrid::compute(&volume, (toward, self.occlusion), (unit, &cuts), &alpha);
-        // The GPU's layout: T in .r, AO in .g, 1 for a channel that is off.
-        let channel = |values: &[f64], i: usize| values.get(i).map_or(1.0, |&v| v as f32);
+        let grid =
+            volgraph_accel::light::LightGrid::compute(&volume, (&towards, self.occlusion), (unit, &cuts), &alpha);
+        // The GPU's layout: each light's T in .rgb, AO in .a, 1 for a channel that is off.
+        let channel = |values: Option<&Vec<f64>>, i: usize| values.and_then(|v| v.get(i)).map_or(1.0, |&v| v as f32);
         let texels: Vec<[f32; 4]> = (0..(grid.dims.x * grid.dims.y * grid.dims.z) as usize)
-            .map(|i| [channel(&grid.transmittance, i), channel(&grid.occlusion, i), 0.0, 1.0])
+            .map(|i| {
+                let t = |light: usize| channel(grid.transmittance.get(light), i);
+                [t(0), t(1), t(2), channel(Some(&grid.occlusion), i)]
+            })
             .collect();
         let texture =
             volgraph_core::runtime::upload::upload_rgba16f_3d(ctx.gpu, "light_volume", grid.dims.to_array(), &texels)

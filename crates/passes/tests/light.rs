@@ -16,7 +16,7 @@
 use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::cuts::{ClipPlane, Cuts};
 use volgraph_accel::image_diff::fraction_over;
-use volgraph_accel::light::Light;
+use volgraph_accel::light::{Light, Lights};
 use volgraph_accel::reference::{Effects, RaycastSettings, render_reference};
 use volgraph_accel::transfer_function::{Preset, TransferFunction};
 use volgraph_accel::volume::Volume;
@@ -37,7 +37,7 @@ fn render_lit(
     graph: &str,
     scene: (&Volume, &[[f32; 4]]),
     camera: &OrbitCamera,
-    light_and_cuts: (Light, Cuts),
+    light_and_cuts: (Lights, Cuts),
     features: &[&str],
 ) -> (Image, RaycastSettings) {
     support::render_in_scene(gpu, (graph, SIZE), scene, camera, light_and_cuts, features)
@@ -48,7 +48,7 @@ fn render_lit(
 /// more than 5 % of pixels by more than `moved` (a test that passes without it proves nothing).
 fn effect_like_reference(
     cases: &[(&str, &[&str])],
-    light: Light,
+    light: impl Into<Lights>,
     (what, off): (&str, fn(Effects) -> Effects),
     moved: f64,
 ) {
@@ -57,6 +57,7 @@ fn effect_like_reference(
     // Opaque material: what shows is the shaded surface the light falls on.
     let lut = TransferFunction::preset(Preset::Opaque, volume.value_range).to_lut_for(&volume, 256);
     let camera = OrbitCamera { azimuth_deg: 25.0, elevation_deg: 15.0, ..OrbitCamera::default() };
+    let light = light.into();
     for &(graph, features) in cases {
         let (image, settings) = render_lit(&gpu, graph, (&volume, &lut), &camera, (light, Cuts::NONE), features);
         assert_ne!(off(settings.effects), settings.effects, "{graph}: {what} reaches the reference settings");
@@ -75,7 +76,8 @@ fn effect_like_reference(
 /// first-hit isosurface and Klein's leaping march — on ML 64³ (opaque) — and the picture moved
 /// by more than 8/255 on over `min_moved` of the pixels from the reference lit by `other` (a
 /// test that passes with the other light proves nothing).
-fn shades_every_family_like_the_reference(light: Light, other: Light, min_moved: f64) {
+fn shades_every_family_like_the_reference(light: impl Into<Lights>, other: impl Into<Lights>, min_moved: f64) {
+    let (light, other) = (light.into(), other.into());
     let gpu = gpu();
     let volume = volgraph_accel::generate::marschner_lobb_f32(64);
     // Opaque material: what shows is the shaded surface the light falls on.
@@ -91,7 +93,7 @@ fn shades_every_family_like_the_reference(light: Light, other: Light, min_moved:
         let (image, settings) = render_lit(&gpu, graph, (&volume, &lut), &camera, (light, Cuts::NONE), features);
         let reference = render_reference(&volume, &lut, &camera, SIZE, SIZE, &settings);
         let by_other =
-            render_reference(&volume, &lut, &camera, SIZE, SIZE, &RaycastSettings { light: other, ..settings });
+            render_reference(&volume, &lut, &camera, SIZE, SIZE, &RaycastSettings { lights: other, ..settings });
         let moved = fraction_over(&by_other.color, &reference.color, 8.0 / 255.0).expect("same size");
         let extra = format!("; {light:?} moved {:.0}% of pixels from {other:?}", moved * 100.0);
         assert_shaded_like_reference(graph, &image.to_rgba_f64(), &reference.color, &extra);
@@ -111,6 +113,37 @@ fn a_directional_light_shades_every_family_like_the_reference() {
 fn a_point_light_shades_every_family_like_the_reference() {
     let light = Light::Point { x: 1.2, y: 1.0, z: 1.1 };
     shades_every_family_like_the_reference(light, Light::Directional { azimuth_deg: 47.5, elevation_deg: 35.0 }, 0.05);
+}
+
+/// Two lights, a key light from the upper left and a point light near the box's corner: every
+/// family sums both lights' Blinn–Phong terms as the reference does, and the image is not the
+/// key light's alone.
+#[test]
+fn two_lights_shade_every_family_like_the_reference() {
+    let key = Light::Directional { azimuth_deg: -70.0, elevation_deg: 40.0 };
+    let lights = Lights::new(&[key, Light::Point { x: 1.2, y: 1.0, z: 1.1 }]).expect("two lights");
+    shades_every_family_like_the_reference(lights, key, 0.1);
+}
+
+/// Three lights, each with its own shadow (one channel of the light volume each): a
+/// directional key light, a point light inside the box and the headlight — computed on the GPU
+/// (fragment, compute; shaded and unshaded, where a sample takes the mean of what reaches it)
+/// and on the CPU (the brick raycaster's grid) as in the reference.
+#[test]
+fn each_of_three_lights_casts_its_own_shadow_like_the_reference() {
+    let cases: [(&str, &[&str]); 4] = [
+        ("basic/fragment_raycast.ron", &["shading", "shadows"]),
+        ("basic/fragment_raycast.ron", &["shadows"]),
+        ("modern/fastest.ron", &["shading", "shadows", "ambient_occlusion"]),
+        ("ruijters_vilanova_2006/bricks_octree_ert.ron", &["shading", "shadows"]),
+    ];
+    let lights = Lights::new(&[
+        Light::Directional { azimuth_deg: -80.0, elevation_deg: 50.0 },
+        Light::Point { x: 0.1, y: 0.35, z: 0.2 },
+        Light::Headlight,
+    ])
+    .expect("three lights");
+    effect_like_reference(&cases, lights, ("shadows", |e| Effects { shadows: false, ..e }), 8.0 / 255.0);
 }
 
 /// Shadows toward a point light: each light-volume voxel looks toward the light from where it
@@ -138,7 +171,7 @@ fn the_headlight_is_the_default_light() {
     let lut = TransferFunction::preset(Preset::Opaque, volume.value_range).to_lut_for(&volume, 256);
     let camera = OrbitCamera::default();
     let (plain, _) =
-        render_lit(&gpu, "basic/isosurface.ron", (&volume, &lut), &camera, (Light::default(), Cuts::NONE), &[]);
+        render_lit(&gpu, "basic/isosurface.ron", (&volume, &lut), &camera, (Lights::default(), Cuts::NONE), &[]);
     let registry = builtin_registry();
     let source = graph_source("basic/isosurface.ron");
     let mut options = CompileOptions::new(SIZE, SIZE);
@@ -197,7 +230,7 @@ fn what_a_cut_removes_casts_no_shadow() {
         Cuts::new(None, &[ClipPlane::new(glam::DVec3::new(0.0, -1.0, 0.0), -0.55).expect("plane")]).expect("cuts");
     for graph in ["basic/fragment_raycast.ron", "modern/fastest.ron"] {
         let features = &["shading", "shadows", "ambient_occlusion"][..];
-        let (image, settings) = render_lit(&gpu, graph, (&volume, &lut), &camera, (light, cuts), features);
+        let (image, settings) = render_lit(&gpu, graph, (&volume, &lut), &camera, (light.into(), cuts), features);
         assert_eq!(settings.cuts, cuts);
         let reference = render_reference(&volume, &lut, &camera, SIZE, SIZE, &settings);
         assert_shaded_like_reference(&format!("{graph} cut"), &image.to_rgba_f64(), &reference.color, "");
@@ -206,7 +239,7 @@ fn what_a_cut_removes_casts_no_shadow() {
     // it, is lit once the top is cut away.
     let frame = camera.frame(SIZE, SIZE);
     let settings = RaycastSettings {
-        light,
+        lights: light.into(),
         effects: volgraph_accel::reference::Effects { shadows: true, ..Default::default() },
         ..Default::default()
     };
@@ -214,6 +247,6 @@ fn what_a_cut_removes_casts_no_shadow() {
     let cut =
         volgraph_accel::reference::shadow_grid(&volume, &lut, None, &frame, &RaycastSettings { cuts, ..settings })
             .expect("a grid");
-    let lit_more = whole.transmittance.iter().zip(&cut.transmittance).filter(|(w, c)| **c > **w + 0.1).count();
+    let lit_more = whole.transmittance[0].iter().zip(&cut.transmittance[0]).filter(|(w, c)| **c > **w + 0.1).count();
     assert!(lit_more > 100, "{lit_more} grid voxels lit more once the top is cut away");
 }

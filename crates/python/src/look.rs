@@ -5,7 +5,7 @@ use glam::DVec3;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use volgraph_accel::cuts::{ClipPlane, CropBox, Cuts};
-use volgraph_accel::light::Light;
+use volgraph_accel::light::{Light, Lights};
 
 /// `effects`: a list of names, or one string of comma-separated names.
 pub fn effects(value: &Bound<'_, PyAny>) -> PyResult<Vec<String>> {
@@ -49,9 +49,18 @@ pub fn cuts(crop: Option<&Bound<'_, PyAny>>, clip: Option<&Bound<'_, PyAny>>) ->
     Cuts::new(crop, &planes).map_err(|e| problem("clip", &e))
 }
 
-/// `light`: "headlight", (azimuth, elevation) in degrees, ("point", x, y, z) in world units, or
-/// the command line's text (`"30,45"`, `"point:0,2,0"`).
-pub fn light(value: &Bound<'_, PyAny>) -> PyResult<Light> {
+/// `light`: one light, or a list of up to three (as `--light` repeated; a tuple is one light).
+pub fn lights(value: &Bound<'_, PyAny>) -> PyResult<Lights> {
+    if let Ok(list) = value.cast::<pyo3::types::PyList>() {
+        let lights = list.iter().map(|item| light(&item)).collect::<PyResult<Vec<_>>>()?;
+        return Lights::new(&lights).map_err(|e| PyValueError::new_err(format!("light: {e}")));
+    }
+    Ok(light(value)?.into())
+}
+
+/// One light: "headlight", (azimuth, elevation) in degrees, ("point", x, y, z) in world units,
+/// or the command line's text (`"30,45"`, `"point:0,2,0"`).
+fn light(value: &Bound<'_, PyAny>) -> PyResult<Light> {
     let text = if let Ok(text) = value.extract::<String>() {
         text
     } else if let Ok((az, el)) = value.extract::<(f64, f64)>() {

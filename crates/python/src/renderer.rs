@@ -218,11 +218,12 @@ impl Renderer {
         Ok(())
     }
 
-    /// The light (as `--light`): "headlight", (azimuth, elevation) or ("point", x, y, z).
+    /// The light (as `--light`): "headlight", (azimuth, elevation) or ("point", x, y, z); a list
+    /// of up to three for several.
     #[setter]
     pub fn set_light(&self, light: &Bound<'_, PyAny>) -> PyResult<()> {
-        let parsed = crate::look::light(light)?;
-        self.with(light.py(), |r| r.set_light(parsed));
+        let parsed = crate::look::lights(light)?;
+        self.with(light.py(), |r| r.set_lights(parsed));
         Ok(())
     }
 

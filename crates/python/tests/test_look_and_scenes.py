@@ -38,6 +38,22 @@ def test_effects_cuts_and_light_equal_the_cli_flags(tmp_path):
     assert np.array_equal(r.render(), plain)
 
 
+def test_several_lights_equal_the_repeated_flag(tmp_path):
+    a = ramp_volume()
+    raw = tmp_path / "ball_24x20x16_uint16.raw"
+    a.tofile(raw)
+    png = tmp_path / "cli.png"
+    cli("render", "modern/fastest", "--volume", raw, "--size", "48x40", "--features", "shading,shadows",
+        "--light", "40,30", "--light", "point:0,1.5,1", "-o", png, cwd=tmp_path)
+    ours = volgraph.render("modern/fastest", a, size=(48, 40), effects=["shading", "shadows"],
+                           light=[(40, 30), ("point", 0, 1.5, 1)])
+    assert np.array_equal(ours[..., :3], read_png(png)[..., :3])
+    key_only = volgraph.render("modern/fastest", a, size=(48, 40), effects=["shading", "shadows"], light=(40, 30))
+    assert not np.array_equal(ours, key_only), "the second light changes the image"
+    with pytest.raises(ValueError, match="4 lights"):
+        volgraph.render("modern/fastest", a, size=(16, 16), light=["headlight"] * 4)
+
+
 def test_bad_effects_cuts_and_lights_are_value_errors():
     a = ramp_volume()
     with pytest.raises(ValueError, match="shadding"):  # the typo named, with the graph's effects

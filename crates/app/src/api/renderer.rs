@@ -8,7 +8,7 @@ use std::sync::Arc;
 use anyhow::anyhow;
 use volgraph_accel::camera::OrbitCamera;
 use volgraph_accel::cuts::Cuts;
-use volgraph_accel::light::Light;
+use volgraph_accel::light::{Light, Lights};
 use volgraph_accel::transfer_function::TransferFunction;
 use volgraph_accel::volume::Volume;
 use volgraph_core::runtime::{CameraData, Gpu, OpacityReference, Runtime, ShaderLibrary, VolumeDesc, scene_values_of};
@@ -56,7 +56,7 @@ pub struct Renderer {
     /// `--features`: effects asked for by the caller (a name the graph lacks is an error).
     features: Vec<String>,
     cuts: Cuts,
-    light: Light,
+    lights: Lights,
     /// `--scene`: its effects (those the graph lacks left out, with a note), TF, camera, volume,
     /// opacity reference and precision, under what the caller sets.
     scene: Option<Scene>,
@@ -104,7 +104,7 @@ impl Renderer {
             scalars: BTreeMap::new(),
             features: Vec::new(),
             cuts: Cuts::NONE,
-            light: Light::default(),
+            lights: Lights::default(),
             scene: None,
             others: Vec::new(),
             named_tfs: Vec::new(),
@@ -141,7 +141,7 @@ impl Renderer {
         let size = size.or(scene.viewport).unwrap_or((512, 512));
         let mut renderer = Self::on(gpu, &graph, size)?;
         renderer.cuts = scene.cuts;
-        renderer.light = scene.light;
+        renderer.lights = scene.lights;
         renderer.runtime.set_opacity_reference(scene.opacity_reference);
         renderer.scene = Some(scene);
         Ok(renderer)
@@ -303,9 +303,14 @@ impl Renderer {
         self.cuts = cuts;
     }
 
-    /// The light (`--light`; it replaces the scene's).
+    /// One light (`--light`; it replaces the scene's).
     pub fn set_light(&mut self, light: Light) {
-        self.light = light;
+        self.lights = light.into();
+    }
+
+    /// Up to three lights (`--light` repeated; they replace the scene's).
+    pub fn set_lights(&mut self, lights: Lights) {
+        self.lights = lights;
     }
 
     /// The notes of the last compile: a scene's effect the graph does not offer, a TF repaired,
@@ -405,7 +410,7 @@ impl Renderer {
             self.plan = Some(plan);
         }
         self.runtime.set_cuts(self.cuts);
-        self.runtime.set_light(self.light);
+        self.runtime.set_lights(self.lights);
         Ok(())
     }
 
@@ -544,7 +549,7 @@ impl Renderer {
             jitter: false,
             max_steps: u32::MAX,
             cuts: self.cuts,
-            light: self.light,
+            lights: self.lights,
             opacity_unit_voxels: match self.runtime.opacity_reference() {
                 OpacityReference::World => 1.0 / volume.unit_step_world(),
                 OpacityReference::Voxel => 1.0,

@@ -328,7 +328,7 @@ struct Job {
     /// `--crop` and `--clip`: each rank takes the samples its own box and the cuts keep.
     cuts: volgraph_accel::cuts::Cuts,
     /// `--light` (or the scene's): every rank shades with it.
-    light: volgraph_accel::light::Light,
+    lights: volgraph_accel::light::Lights,
 }
 
 impl Job {
@@ -392,7 +392,7 @@ impl Job {
             out: args.out.clone(),
             algorithm: args.composite,
             cuts: resolved.cuts,
-            light: resolved.light,
+            lights: resolved.lights,
         })
     }
 
@@ -463,7 +463,7 @@ impl Job {
         let mut runtime = Runtime::new(gpu, ShaderLibrary::new(sources));
         runtime.set_volume_window(Some(window));
         runtime.set_cuts(self.cuts);
-        runtime.set_light(self.light);
+        runtime.set_lights(self.lights);
         runtime.bind_scene(&plan.inputs, volume, lut).map_err(|e| anyhow!(e))?;
         runtime.apply(plan, &crate::program::registry()).map_err(|e| anyhow!(e))?;
         Ok(runtime)

@@ -34,8 +34,8 @@ pub struct SavedView {
     pub opacity_reference: OpacityReference,
     /// The crop box and clip planes.
     pub cuts: Cuts,
-    /// The light.
-    pub light: volgraph_accel::light::Light,
+    /// The lights.
+    pub lights: volgraph_accel::light::Lights,
     /// The environment map's file.
     pub environment: Option<PathBuf>,
 }
@@ -122,16 +122,21 @@ impl SavedView {
         if !planes.is_empty() {
             out += &format!("    clip: [{}],\n", planes.join(", "));
         }
-        match self.light {
-            volgraph_accel::light::Light::Directional { azimuth_deg, elevation_deg } => {
-                out += &format!(
-                    "    lights: [Directional(azimuth_deg: {azimuth_deg:?}, elevation_deg: {elevation_deg:?})],\n"
-                );
-            }
-            volgraph_accel::light::Light::Point { x, y, z } => {
-                out += &format!("    lights: [Point(x: {x:?}, y: {y:?}, z: {z:?})],\n");
-            }
-            volgraph_accel::light::Light::Headlight => {}
+        let lights: Vec<String> = self
+            .lights
+            .as_slice()
+            .iter()
+            .map(|light| match *light {
+                volgraph_accel::light::Light::Directional { azimuth_deg, elevation_deg } => {
+                    format!("Directional(azimuth_deg: {azimuth_deg:?}, elevation_deg: {elevation_deg:?})")
+                }
+                volgraph_accel::light::Light::Point { x, y, z } => format!("Point(x: {x:?}, y: {y:?}, z: {z:?})"),
+                volgraph_accel::light::Light::Headlight => "Headlight".to_string(),
+            })
+            .collect();
+        // The headlight alone is what no `lights:` means.
+        if self.lights != volgraph_accel::light::Lights::default() {
+            out += &format!("    lights: [{}],\n", lights.join(", "));
         }
         if let Some(path) = &self.environment {
             out += &format!("    environment: {},\n", quote(path));
@@ -183,18 +188,21 @@ mod saved_view_tests {
             precision: Some(Precision::F16),
             opacity_reference: OpacityReference::World,
             cuts,
-            light: volgraph_accel::light::Light::Directional { azimuth_deg: -33.3, elevation_deg: 1.0 / 7.0 },
+            lights: volgraph_accel::light::Light::Directional { azimuth_deg: -33.3, elevation_deg: 1.0 / 7.0 }.into(),
             environment: Some(PathBuf::from("/nonexistent/sky.exr")),
         };
         let scene = Scene::from_str(&view.to_ron(), Path::new("/tmp/x.scene.ron")).expect("reads back");
         assert_eq!(scene.cuts, cuts);
-        assert_eq!(scene.light, view.light);
+        assert_eq!(scene.lights, view.lights);
         assert_eq!(scene.environment, view.environment);
-        // A point light is written back as one.
-        let point =
-            SavedView { light: volgraph_accel::light::Light::Point { x: 0.25, y: 1.0 / 3.0, z: -2.0 }, ..view.clone() };
+        // A point light beside a directional one and the headlight is written back as they are.
+        use volgraph_accel::light::{Light, Lights};
+        let three =
+            Lights::new(&[Light::Point { x: 0.25, y: 1.0 / 3.0, z: -2.0 }, view.lights.key(), Light::Headlight])
+                .expect("three lights");
+        let point = SavedView { lights: three, ..view.clone() };
         let scene = Scene::from_str(&point.to_ron(), Path::new("/tmp/x.scene.ron")).expect("reads back");
-        assert_eq!(scene.light, point.light);
+        assert_eq!(scene.lights, three);
         assert_eq!(scene.volume_options.spacing, Some((1.0, 0.1, 1.0 / 3.0)));
         assert_eq!(scene.viewport, Some((320, 200)));
         assert_eq!(scene.effects, vec!["shading".to_string()]);

@@ -147,26 +147,26 @@ fn volume_options_are_checked_like_the_flags() {
     }
 }
 
-/// `lights:` (issue "light that scatters", item 1): one Directional light, checked like
-/// `--light`; none is the headlight; two, or an elevation past 90°, name the field and the fix.
+/// `lights:` (issue "light that scatters", item 1): up to three lights, each checked like
+/// `--light`; none is the headlight; four, or an elevation past 90°, name the field and the fix.
 #[test]
-fn a_scene_has_one_light_checked_like_the_flag() {
+fn a_scene_has_up_to_three_lights_checked_like_the_flag() {
     use volgraph_accel::light::Light;
     let s = parse("Scene(volume: Generated(\"ml32\"))").expect("parses");
-    assert_eq!(s.light, Light::Headlight);
+    assert_eq!(s.lights.as_slice(), &[Light::Headlight]);
     let s = parse("Scene(volume: Generated(\"ml32\"), lights: [Directional(azimuth_deg: 30, elevation_deg: 45)])")
         .expect("parses");
-    assert_eq!(s.light, Light::Directional { azimuth_deg: 30.0, elevation_deg: 45.0 });
+    assert_eq!(s.lights.as_slice(), &[Light::Directional { azimuth_deg: 30.0, elevation_deg: 45.0 }]);
     // The issue's spelling of an environment map: an Environment(…) entry beside the light.
     let lit = parse(
         "Scene(volume: Generated(\"ml32\"), lights: [Directional(azimuth_deg: 30, elevation_deg: 45), \
          Environment(File(\"sky.exr\"))])",
     )
     .expect("a light and an environment");
-    assert_eq!(lit.light, Light::Directional { azimuth_deg: 30.0, elevation_deg: 45.0 });
+    assert_eq!(lit.lights.as_slice(), &[Light::Directional { azimuth_deg: 30.0, elevation_deg: 45.0 }]);
     assert!(lit.environment.as_ref().is_some_and(|p| p.ends_with("sky.exr")), "{:?}", lit.environment);
     let sky = parse("Scene(volume: Generated(\"ml32\"), lights: [Environment(Sky)])").expect("the generated sky");
-    assert_eq!((sky.light, sky.environment), (Light::Headlight, None));
+    assert_eq!((sky.lights.as_slice(), sky.environment), (&[Light::Headlight][..], None));
     let both = "Scene(volume: Generated(\"ml32\"), environment: \"a.exr\", lights: [Environment(File(\"b.exr\"))])";
     let e = parse(both).expect_err("two environments").to_string();
     assert!(e.contains("lights: a scene has one environment"), "{e}");
@@ -174,10 +174,19 @@ fn a_scene_has_one_light_checked_like_the_flag() {
     assert!(parse(typo).is_err(), "an unknown field of a light is an error");
     let point =
         parse("Scene(volume: Generated(\"ml32\"), lights: [Point(x: 0.5, y: 2, z: -1)])").expect("a point light");
-    assert_eq!(point.light, Light::Point { x: 0.5, y: 2.0, z: -1.0 });
-    let two = "Scene(volume: Generated(\"ml32\"), lights: [Headlight, Directional(azimuth_deg: 0, elevation_deg: 0)])";
-    let e = parse(two).expect_err("two lights").to_string();
-    assert!(e.contains("lights: 2 lights: a scene has one light for now"), "{e}");
+    assert_eq!(point.lights.as_slice(), &[Light::Point { x: 0.5, y: 2.0, z: -1.0 }]);
+    let two = "Scene(volume: Generated(\"ml32\"), lights: [Headlight, Directional(azimuth_deg: 0, elevation_deg: 0), \
+               Environment(Sky)])";
+    let two = parse(two).expect("two lights and the sky");
+    let key = Light::Directional { azimuth_deg: 0.0, elevation_deg: 0.0 };
+    assert_eq!(two.lights.as_slice(), &[Light::Headlight, key]);
+    let four = "Scene(volume: Generated(\"ml32\"), lights: [Headlight, Headlight, Headlight, Headlight])";
+    let e = parse(four).expect_err("four lights").to_string();
+    assert!(e.contains("lights: 4 lights: a scene has 1 to 3"), "{e}");
+    assert!(e.contains("keep at most 3"), "{e}");
+    let second = "Scene(volume: Generated(\"ml32\"), lights: [Headlight, Point(x: 0, y: NaN, z: 0)])";
+    let e = parse(second).expect_err("a NaN point").to_string();
+    assert!(e.contains("lights: light 2: a point light's position must be finite"), "{e}");
     let e = parse("Scene(volume: Generated(\"ml32\"), lights: [Directional(azimuth_deg: 0, elevation_deg: 95)])")
         .expect_err("95°")
         .to_string();

@@ -177,7 +177,7 @@ pub fn run(args: ViewArgs) -> Result<(), CliError> {
         gpu_memory_mb: args.inputs.gpu_memory_mb,
         memory_mb: args.inputs.memory_mb,
         cuts: resolved.cuts,
-        light: resolved.light,
+        lights: resolved.lights,
         environment: resolved.environment,
     };
     let view = ViewOptions {

@@ -44,7 +44,7 @@ pub enum Action {
     /// The TF editor edits this named TF input (`None`: the frame volume's).
     TfTarget(Option<String>),
     /// The scene's light.
-    Light(volgraph_accel::light::Light),
+    Lights(volgraph_accel::light::Lights),
     /// Set a value typed as `PASS.PARAM=VALUE` or `input.NAME=VALUE`.
     Assign(String),
     /// The label list's edit.
@@ -336,8 +336,8 @@ pub fn show(
                 if let Some(cuts) = cuts_section(ui, session.runtime.cuts(), session.patient_box()) {
                     actions.push(Action::Cuts(cuts));
                 }
-                if let Some(light) = super::light_control::light_section(ui, session.runtime.light()) {
-                    actions.push(Action::Light(light));
+                if let Some(lights) = super::light_control::lights_section(ui, session.runtime.lights()) {
+                    actions.push(Action::Lights(lights));
                 }
                 actions.extend(super::save_section::section(ui));
                 let scalars: BTreeMap<&String, f64> = plan

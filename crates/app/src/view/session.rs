@@ -144,8 +144,8 @@ pub struct SessionArgs {
     pub scene: Option<crate::scene::Scene>,
     /// The crop box and clip planes at start (`--crop`/`--clip` over the scene's).
     pub cuts: Cuts,
-    /// The light at start (`--light` over the scene's).
-    pub light: volgraph_accel::light::Light,
+    /// The lights at start (`--light` over the scene's).
+    pub lights: volgraph_accel::light::Lights,
     /// The environment map's file (`--environment` over the scene's).
     pub environment: Option<PathBuf>,
     /// Volumes bound by name (`--volume NAME=PATH`); `volume` is then the frame volume's path.

@@ -62,7 +62,7 @@ fn session_args(s: &Scratch, volume: &[&str], tf: Option<PathBuf>) -> SessionArg
         gpu_memory_mb: None,
         memory_mb: None,
         cuts: Default::default(),
-        light: Default::default(),
+        lights: Default::default(),
         named: Vec::new(),
         named_tfs: Vec::new(),
     }

@@ -190,8 +190,8 @@ impl Viewer {
                 Action::Scalar(name, value) => session.set_scalar(&name, value),
                 Action::Feature(name, on) => session.set_feature(&name, on),
                 Action::Cuts(cuts) => session.set_cuts(cuts),
-                Action::Light(light) => {
-                    session.runtime.set_light(light);
+                Action::Lights(lights) => {
+                    session.runtime.set_lights(lights);
                     Vec::new()
                 }
                 Action::Labels(edit) => {
@@ -358,7 +358,11 @@ impl Viewer {
                     self.mouse_wheel(lines);
                 }
                 Ok(Some(ScriptCommand::TfSave)) => self.apply_actions(vec![Action::TransferFunction(TfAction::Save)]),
-                Ok(Some(ScriptCommand::Light(light))) => self.apply_actions(vec![Action::Light(light)]),
+                Ok(Some(ScriptCommand::Light(light))) => {
+                    // The script moves the key light; the others stay.
+                    let lights = self.session.as_ref().map_or(light.into(), |s| s.runtime.lights().with_key(light));
+                    self.apply_actions(vec![Action::Lights(lights)])
+                }
                 Ok(Some(ScriptCommand::Label(edit))) => self.apply_actions(vec![Action::Labels(edit)]),
                 Ok(Some(ScriptCommand::TfEdit(input))) => {
                     let Some(session) = self.session.as_mut() else { continue };

@@ -193,7 +193,7 @@ pub(super) fn run_case(ctx: &mut Context<'_>, case: &Case<'_>) -> Option<Row> {
     };
     // The reference is lit as the GPU is (`--light`).
     let settings = accuracy::raycast_settings(&plan)
-        .map(|s| volgraph_accel::reference::RaycastSettings { light: config.light, ..s });
+        .map(|s| volgraph_accel::reference::RaycastSettings { lights: config.light.into(), ..s });
     let progress = ctx.progress.clone();
     let timing = ctx.runtime.apply(plan, &ctx.registry).and_then(|_| {
         measure::time_frames(&mut ctx.runtime, &config.camera, config.degrees_per_frame, config.frames, || {

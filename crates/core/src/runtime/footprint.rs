@@ -248,7 +248,7 @@ mod tests {
             volume: Some(VolumeDesc::of(&volume)),
             gpu_memory_budget: None,
             cuts: Default::default(),
-            light: Default::default(),
+            lights: Default::default(),
             environment: false,
         }
     }

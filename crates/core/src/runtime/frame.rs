@@ -254,8 +254,8 @@ pub struct FrameData {
     pub gpu_memory_budget: Option<u64>,
     /// The scene's crop box and clip planes (volume fractions of the whole volume).
     pub cuts: Cuts,
-    /// The scene's light (`volgraph_accel::light`).
-    pub light: volgraph_accel::light::Light,
+    /// The scene's lights (`volgraph_accel::light`).
+    pub lights: volgraph_accel::light::Lights,
     /// Whether the scene has an environment map (bound as `environment_map`).
     pub environment: bool,
 }
@@ -353,14 +353,17 @@ pub struct FrameUniforms {
     /// How many `footprint` vertices there are; 0: no pixel's ray meets the box;
     /// [`FOOTPRINT_WHOLE`]: the draw covers the whole viewport.
     pub footprint_vertices: u32,
+    /// How many of `lights` the scene has (1 to [`volgraph_accel::light::MAX_LIGHTS`]).
+    pub light_count: u32,
     /// Padding to 16 bytes.
-    pub _pad_footprint: [u32; 3],
-    /// The unit world direction toward a directional light (xyz); w = 1 for one, 0 for the
-    /// headlight (each ray's own `-direction`).
-    pub light_world: [f32; 4],
+    pub _pad_lights: [u32; 2],
+    /// The scene's lights ([`light_world`]): w = 0 the headlight (each ray's own
+    /// `-direction`), w = 1 the unit world direction toward a directional light (xyz), w = 2 a
+    /// point light's position.
+    pub lights: [[f32; 4]; volgraph_accel::light::MAX_LIGHTS],
 }
 
-const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 672);
+const _: () = assert!(std::mem::size_of::<FrameUniforms>() == 704);
 
 /// [`FrameUniforms::footprint_vertices`] of a footprint draw that covers the whole viewport.
 pub const FOOTPRINT_WHOLE: u32 = u32::MAX;
@@ -430,8 +433,15 @@ impl FrameUniforms {
             clip_planes: [KEEP_ALL; MAX_CLIP_PLANES],
             footprint: [[0.0; 4]; FAN_VERTICES / 2],
             footprint_vertices: FOOTPRINT_WHOLE,
-            _pad_footprint: [0; 3],
-            light_world: light_world(&frame.light, window.map(|w| w.centre_world)),
+            light_count: frame.lights.as_slice().len() as u32,
+            _pad_lights: [0; 2],
+            lights: {
+                let mut lights = [[0.0; 4]; volgraph_accel::light::MAX_LIGHTS];
+                for (slot, light) in lights.iter_mut().zip(frame.lights.as_slice()) {
+                    *slot = light_world(light, window.map(|w| w.centre_world));
+                }
+                lights
+            },
         }
         .with_cuts(&frame.cuts, grid)
     }
@@ -478,7 +488,7 @@ impl FrameUniforms {
     }
 }
 
-/// The frame block's `light_world`: (0, 0, 0, 0) for the headlight, the unit direction toward a
+/// A light in the frame block's `lights`: (0, 0, 0, 0) for the headlight, the unit direction toward a
 /// directional light with w = 1, a point light's position with w = 2 — in the bound box's own
 /// world, which a sort-last window centres on its own origin (`window_centre`).
 fn light_world(light: &volgraph_accel::light::Light, window_centre: Option<DVec3>) -> [f32; 4] {

@@ -158,8 +158,8 @@ pub struct Runtime {
     window: Option<VolumeWindow>,
     /// The scene's crop box and clip planes.
     cuts: Cuts,
-    /// The scene's light (`set_light`).
-    light: volgraph_accel::light::Light,
+    /// The scene's lights (`set_lights`).
+    lights: volgraph_accel::light::Lights,
     /// The scene's environment map (`set_environment`).
     environment: Option<Arc<volgraph_accel::environment::EnvironmentMap>>,
     /// GPU memory passes that stream data may use (`--gpu-memory-mb`); `None`: the adapter's.
@@ -193,7 +193,7 @@ impl Runtime {
             opacity_reference: OpacityReference::default(),
             window: None,
             cuts: Cuts::NONE,
-            light: volgraph_accel::light::Light::Headlight,
+            lights: volgraph_accel::light::Lights::one(volgraph_accel::light::Light::Headlight),
             environment: None,
             gpu_memory_budget: None,
             profile_steps: false,

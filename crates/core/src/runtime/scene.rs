@@ -128,11 +128,16 @@ impl Runtime {
         self.cuts
     }
 
-    /// Sets the scene's light (`volgraph_accel::light`): the next frame is shaded by it, and
-    /// accumulated history restarts when it moved.
+    /// Sets the scene's one light (`volgraph_accel::light`): [`Self::set_lights`] of it.
     pub fn set_light(&mut self, light: volgraph_accel::light::Light) {
-        if self.light != light {
-            self.light = light;
+        self.set_lights(light.into());
+    }
+
+    /// Sets the scene's lights: the next frame is shaded by them, and accumulated history
+    /// restarts when one moved.
+    pub fn set_lights(&mut self, lights: volgraph_accel::light::Lights) {
+        if self.lights != lights {
+            self.lights = lights;
             self.invalidate_history();
         }
     }
@@ -156,9 +161,9 @@ impl Runtime {
         self.environment.as_ref()
     }
 
-    /// The scene's light.
-    pub fn light(&self) -> volgraph_accel::light::Light {
-        self.light
+    /// The scene's lights.
+    pub fn lights(&self) -> volgraph_accel::light::Lights {
+        self.lights
     }
 
     /// The bound volume as the frame contract describes it (windowed when a window is set).

@@ -27,7 +27,7 @@ impl Runtime {
             volume: self.volume_desc(),
             gpu_memory_budget: self.gpu_memory_budget,
             cuts: self.cuts,
-            light: self.light,
+            lights: self.lights,
             environment: self.environment.is_some(),
         })
     }

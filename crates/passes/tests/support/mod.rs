@@ -91,7 +91,7 @@ pub fn render_in_scene(
     (graph, size): (&str, u32),
     (volume, lut): (&Volume, &[[f32; 4]]),
     camera: &OrbitCamera,
-    (light, cuts): (volgraph_accel::light::Light, volgraph_accel::cuts::Cuts),
+    (lights, cuts): (impl Into<volgraph_accel::light::Lights>, volgraph_accel::cuts::Cuts),
     features: &[&str],
 ) -> (Image, volgraph_accel::reference::RaycastSettings) {
     let registry = volgraph_passes::builtin_registry();
@@ -107,13 +107,14 @@ pub fn render_in_scene(
         plan = volgraph_core::compile(graph, &source, &registry, &options).unwrap_or_else(|d| panic!("{graph}: {d}"));
     }
     let march = plan.steps.iter().find(|s| s.pass_id == "march").expect("a march step");
+    let lights = lights.into();
     let settings = volgraph_accel::reference::RaycastSettings {
-        light,
+        lights,
         cuts,
         ..volgraph_passes::raycast_params::reference_settings(&march.params)
     };
     let mut runtime = runtime(gpu);
-    runtime.set_light(light);
+    runtime.set_lights(lights);
     runtime.set_cuts(cuts);
     runtime.bind_scene(&plan.inputs, volume, lut).expect("binds");
     runtime.apply(plan.clone(), &registry).unwrap_or_else(|e| panic!("{graph}: {e}"));

@@ -6,7 +6,8 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
-Light = Literal["headlight"] | str | tuple[float, float] | tuple[Literal["point"], float, float, float]
+OneLight = Literal["headlight"] | str | tuple[float, float] | tuple[Literal["point"], float, float, float]
+Light = OneLight | list[OneLight]
 Crop = tuple[float, float, float, float, float, float]
 Clip = tuple[float, float, float, float] | list[tuple[float, float, float, float]]
 Camera = tuple[float, float, float] | Literal["anterior", "posterior", "left", "right", "superior", "inferior"] | None
@@ -97,7 +98,8 @@ class Renderer:
     effects: list[str] | str | None
     """Write-only: effects on besides the scene's (as --features): ["shading", "jitter"]."""
     light: Light
-    """Write-only: "headlight", (azimuth, elevation) or ("point", x, y, z) (as --light)."""
+    """Write-only: "headlight", (azimuth, elevation) or ("point", x, y, z) (as --light); a list
+    of up to three for several (as --light repeated)."""
     @property
     def value_range(self) -> tuple[float, float] | None: ...
     @property

@@ -165,7 +165,7 @@ impl LiveSession {
             Some(_) => return None,
         };
         let mut settings = volgraph_passes::raycast_params::reference_settings(&march.params);
-        settings.light = self.runtime.light();
+        settings.lights = self.runtime.lights();
         settings.opacity_unit_voxels = match self.opacity_reference {
             volgraph_core::runtime::OpacityReference::World => 1.0 / self.volume.unit_step_world(),
             volgraph_core::runtime::OpacityReference::Voxel => 1.0,

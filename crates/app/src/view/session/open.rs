@@ -91,7 +91,7 @@ impl LiveSession {
             .with_features(args.features.iter().filter(|f| !f.is_empty()).cloned());
         options.features.extend(cut_effects::features_of(&args.cuts));
         runtime.set_cuts(args.cuts);
-        runtime.set_light(args.light);
+        runtime.set_lights(args.lights);
         if let Some(path) = &args.environment {
             runtime.set_environment(Some(std::sync::Arc::new(crate::environment_file::load_environment(path)?)));
         }

@@ -219,7 +219,7 @@ impl LiveSession {
             precision: self.options().precision,
             opacity_reference: self.opacity_reference,
             cuts: self.runtime.cuts(),
-            light: self.runtime.light(),
+            lights: self.runtime.lights(),
             environment: self.environment.clone(),
         })
     }

@@ -19,7 +19,9 @@
 // - paths that leave the box see the environment (the scene's map, a generated sky, or a
 //   uniform one); a
 //   primary ray that meets nothing is transparent, as in the raycasters (`present` draws the
-//   background), and its alpha is the probability of an interaction: 1 − T of the ray.
+//   background), and its alpha is the probability of an interaction: 1 − T of the ray,
+//   estimated by ratio tracking along it (`coverage: "ratio"`: a value per path, where the
+//   0-or-1 of the path's own interaction, `"interaction"`, is the noisier estimator).
 //
 // Accumulation: `previous` is last frame's mean (history, cleared on any change of the camera,
 // TF, volume, light, cuts or this pass's parameters), frame.history_age the samples it holds;
@@ -216,6 +218,39 @@ fn ratio_track(p: vec3<f32>, w: vec3<f32>, span: vec2<f32>) -> f32 {
     return 0.0;
 }
 
+// Delta tracking of a primary ray (`delta_track`'s first interaction, −1 when it leaves: x)
+// that also estimates its transmittance by ratio tracking (`ratio_track`: y) over the same
+// tentative collisions, continued past the first real one to the ray's end: whatever is
+// accepted, the tentative collisions are one Poisson process of rate σ̄ along the whole ray, so
+// the product over all of them is ratio tracking's estimate — without tracking the ray twice.
+fn primary_track(p: vec3<f32>, w: vec3<f32>, span: vec2<f32>) -> vec2<f32> {
+    var t = span.x;
+    var m = majorant_span(p, w, t, span.y);
+    var hit = -1.0;
+    var transmittance = 1.0;
+    for (var i = 0u; i < MAX_TRACKING_STEPS; i += 1u) {
+        t = next_tentative(p, w, t, &m, span.y);
+        if (t >= span.y) {
+            break;
+        }
+        let sigma = medium_at(p + t * w).a;
+        if (hit < 0.0 && random() * m.sigma < sigma) {
+            hit = t;
+        }
+        if (transmittance > 0.0) {
+            transmittance *= max(1.0 - sigma / m.sigma, 0.0);
+            // Russian roulette as ratio_track's: a small estimate survives with probability ½.
+            if (transmittance < 0.1) {
+                transmittance = select(0.0, 2.0 * transmittance, random() < 0.5);
+            }
+        }
+        if (hit >= 0.0 && transmittance == 0.0) {
+            break;
+        }
+    }
+    return vec2<f32>(hit, transmittance);
+}
+
 // The transmittance from `p` toward the light: ratio tracking's estimate, or delta tracking's
 // 0 or 1 (`shadow_rays: "delta"`, the cheaper, noisier estimator bench cinematic compares).
 fn light_transmittance(p: vec3<f32>, l: vec3<f32>, distance: f32) -> f32 {
@@ -296,22 +331,23 @@ fn basis(n: vec3<f32>) -> mat3x3<f32> {
 }
 
 // A direction from the HG lobe around `w`.
-fn sample_henyey_greenstein(w: vec3<f32>, g: f32) -> vec3<f32> {
-    let xi = random();
+// `xi`: two uniform numbers in [0, 1).
+fn sample_henyey_greenstein(w: vec3<f32>, g: f32, xi2: vec2<f32>) -> vec3<f32> {
+    let xi = xi2.x;
     var cos_theta = 1.0 - 2.0 * xi;
     if (abs(g) > 1e-3) {
         let q = (1.0 - g * g) / (1.0 - g + 2.0 * g * xi);
         cos_theta = clamp((1.0 + g * g - q * q) / (2.0 * g), -1.0, 1.0);
     }
     let sin_theta = sqrt(max(0.0, 1.0 - cos_theta * cos_theta));
-    let phi = 2.0 * PI * random();
+    let phi = 2.0 * PI * xi2.y;
     return normalize(basis(w) * vec3<f32>(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta));
 }
 
-// A cosine-weighted direction about unit `n`.
-fn sample_cosine(n: vec3<f32>) -> vec3<f32> {
-    let r = sqrt(random());
-    let phi = 2.0 * PI * random();
+// A cosine-weighted direction about unit `n`; `xi`: two uniform numbers in [0, 1).
+fn sample_cosine(n: vec3<f32>, xi: vec2<f32>) -> vec3<f32> {
+    let r = sqrt(xi.x);
+    let phi = 2.0 * PI * xi.y;
     return normalize(basis(n) * vec3<f32>(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - r * r))));
 }
 
@@ -348,8 +384,16 @@ fn trace_pixel(pixel: vec2<u32>) -> vec4<f32> {
     var radiance = vec3<f32>(0.0);
     var throughput = vec3<f32>(1.0);
     var alpha = 0.0;
+    let ratio_coverage = trace.coverage == 0u;
     for (var bounce = 0u; bounce <= trace.bounces; bounce += 1u) {
-        let t = delta_track(p, w, span);
+        var t: f32;
+        if (bounce == 0u && ratio_coverage) {
+            let tracked = primary_track(p, w, span);
+            t = tracked.x;
+            alpha = 1.0 - tracked.y;
+        } else {
+            t = delta_track(p, w, span);
+        }
         if (t < 0.0) {
             if (bounce > 0u) {
                 radiance += throughput * environment(w);
@@ -358,23 +402,29 @@ fn trace_pixel(pixel: vec2<u32>) -> vec4<f32> {
         }
         p = p + t * w;
         if (bounce == 0u) {
-            alpha = 1.0;
+            alpha = select(1.0, alpha, ratio_coverage);
             first_point = p;
             first_hit = true;
         }
         let medium = medium_at(p);
-        if (random() >= trace.albedo) {
-            // Absorbed: what the medium emits there.
-            radiance += throughput * trace.emission * medium.rgb;
-            break;
-        }
-        throughput *= medium.rgb;
-        if (bounce == trace.bounces) {
+        // Absorbed with probability 1 − albedo, emitting, else scattered: both in expectation
+        // (the path carries the albedo in its throughput instead of ending at random, which
+        // left a tenth of the paths black at albedo 0.9; Russian roulette below ends dim ones).
+        radiance += throughput * (1.0 - trace.albedo) * trace.emission * medium.rgb;
+        throughput *= trace.albedo * medium.rgb;
+        if (bounce == trace.bounces || !(trace.albedo > 0.0)) {
             break;
         }
         let g = voxel_gradient(p);
         let strength = length(g);
-        let surface = trace.surface * (1.0 - exp(-20.0 * strength));
+        // The probability of scattering off the gradient's surface rather than by the phase
+        // function (none where the field is flat).
+        let surface = select(0.0, trace.surface * (1.0 - exp(-20.0 * strength)), strength > 1e-6);
+        // The surface faces the incoming path.
+        var n = -g / max(strength, 1e-30);
+        if (dot(n, w) > 0.0) {
+            n = -n;
+        }
         // Next-event estimation toward every light: its direction (xyz) and the irradiance
         // that reaches here (w). A point light's irradiance falls as 1/r² (light_intensity at
         // one world unit).
@@ -384,23 +434,21 @@ fn trace_pixel(pixel: vec2<u32>) -> vec4<f32> {
             let falloff = select(1.0, 1.0 / max(light.w * light.w, 1e-12), light.w < 1.0e38);
             to_lights[i] = vec4<f32>(light.xyz, light_transmittance(p, light.xyz, light.w) * trace.light_intensity * falloff);
         }
-        if (strength > 1e-6 && random() < surface) {
-            // Off a Lambertian surface facing the incoming path: light × cos / π, and a
-            // cosine-weighted bounce (its weight f·cos/pdf is 1).
-            var n = -g / strength;
-            if (dot(n, w) > 0.0) {
-                n = -n;
-            }
-            for (var i = 0u; i < frame.light_count; i++) {
-                radiance += throughput * to_lights[i].w * max(dot(n, to_lights[i].xyz), 0.0) / PI;
-            }
-            w = sample_cosine(n);
+        // The light scattered toward the eye by the mixture of the two lobes, each weighted by
+        // its probability — off a Lambertian surface light × cos / π, by the phase function
+        // light × p — rather than by the one lobe drawn (the same mean, without the noise of
+        // the draw: the lobes differ by 4× at a lit surface).
+        for (var i = 0u; i < frame.light_count; i++) {
+            let l = to_lights[i].xyz;
+            let lobes = surface * max(dot(n, l), 0.0) / PI + (1.0 - surface) * henyey_greenstein(dot(w, l), trace.anisotropy);
+            radiance += throughput * to_lights[i].w * lobes;
+        }
+        // The next direction from the mixture: each lobe importance-sampled (f·cos/pdf and
+        // p/pdf are 1, so the mixture's weight is 1 too).
+        if (surface > 0.0 && random() < surface) {
+            w = sample_cosine(n, vec2<f32>(random(), random()));
         } else {
-            for (var i = 0u; i < frame.light_count; i++) {
-                radiance += throughput * to_lights[i].w * henyey_greenstein(dot(w, to_lights[i].xyz), trace.anisotropy);
-            }
-            // Importance-sampled: the phase function's weight p/pdf is 1.
-            w = sample_henyey_greenstein(w, trace.anisotropy);
+            w = sample_henyey_greenstein(w, trace.anisotropy, vec2<f32>(random(), random()));
         }
         // Russian roulette from the second scattering on (unbiased): the path goes on with
         // probability q, its largest throughput channel (at least 1/20), and its throughput is

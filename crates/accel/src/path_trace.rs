@@ -2,10 +2,12 @@
 //! (`shaders/path_trace.wgsl`; issue "light that scatters", item 4): the same light transport —
 //! extinction σ = −ln(1 − α) / L from the TF, scattering with probability `albedo` tinted by the
 //! TF colour, absorption emitting `emission` × colour, Henyey–Greenstein or Lambertian-surface
-//! scattering (Kroes et al. 2012 §4.3), a directional light or the headlight, a sky or uniform
-//! environment — estimated another way: f64 throughout, its own random streams (SplitMix64), one
-//! global majorant, and the light's transmittance by delta tracking (a 0-or-1 visibility)
-//! instead of the GPU's ratio tracking. Both are unbiased, so their means agree within their
+//! scattering (Kroes et al. 2012 §4.3), the scene's lights (directional, point, the headlight),
+//! a sky or uniform environment — estimated another way: f64 throughout, its own random streams
+//! (SplitMix64), one global majorant, the light's transmittance by delta tracking (a 0-or-1
+//! visibility) instead of the GPU's ratio tracking, and the plain estimators the GPU improves on
+//! (absorption ends a path at random, the light scattered by the one lobe drawn, alpha 1 when the
+//! path interacted). Both are unbiased, so their means agree within their
 //! confidence intervals (crates/passes/tests/path_trace.rs); [`PixelEstimate`] carries the
 //! sample variance that interval needs.
 

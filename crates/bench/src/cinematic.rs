@@ -67,7 +67,7 @@ struct Case {
     overrides: &'static [(&'static str, &'static str)],
 }
 
-const CASES: [Case; 5] = [
+const CASES: [Case; 6] = [
     Case { name: "one majorant, ratio-tracked shadow rays", graph: "cinematic/path_traced", overrides: &[] },
     Case { name: "block majorants, ratio-tracked shadow rays", graph: "cinematic/path_traced_blocks", overrides: &[] },
     Case {
@@ -85,17 +85,24 @@ const CASES: [Case; 5] = [
         graph: "cinematic/path_traced_distance",
         overrides: &[],
     },
+    Case {
+        name: "leaping, alpha by the path's interaction (0 or 1)",
+        graph: "cinematic/path_traced_distance",
+        overrides: &[("coverage", "\"interaction\"")],
+    },
 ];
 
 /// The seed of the converged image (no case uses it).
 const REFERENCE_SEED: u64 = 0x5eed;
 
-/// One case's curve: (samples, seconds of accumulation, RMSE) at each power of two, and the
-/// error the viewer would estimate there from the images at n/2 and n alone.
+/// One case's curve: (samples, seconds of accumulation, RMSE) at each power of two, the RMSE of
+/// the colour alone (premultiplied RGB), and the error the viewer would estimate there from the
+/// images at n/2 and n alone.
 struct Curve {
     name: &'static str,
     ms_per_sample: f64,
     points: Vec<(u32, f64, f64)>,
+    colour_rmse: Vec<f64>,
     estimated: Vec<Option<f64>>,
 }
 
@@ -164,6 +171,7 @@ impl Bench {
         let warm = OrbitCamera { azimuth_deg: self.camera.azimuth_deg + 90.0, ..self.camera };
         self.runtime.render(CameraData::from_orbit(&warm, plan.viewport)).map_err(|e| anyhow!(e))?;
         let (mut spent, mut times, mut points, mut estimated) = (0.0, Vec::new(), Vec::new(), Vec::new());
+        let mut colour_rmse = Vec::new();
         let mut tracker = ErrorTracker::default();
         let mut next = 1;
         for n in 1..=most {
@@ -173,6 +181,7 @@ impl Bench {
             if n == next {
                 let image = self.image()?;
                 points.push((n, spent / 1e3, rmse(&image, reference)));
+                colour_rmse.push(rgb_rmse(&image, reference));
                 tracker.offer(0, u64::from(n), image);
                 estimated.push(tracker.last(0).filter(|e| e.spp == u64::from(n)).map(|e| e.rmse));
                 if spent / 1e3 > seconds {
@@ -181,8 +190,14 @@ impl Bench {
                 next *= 2;
             }
         }
-        Ok(Curve { name: case.name, ms_per_sample: median(&times), points, estimated })
+        Ok(Curve { name: case.name, ms_per_sample: median(&times), points, colour_rmse, estimated })
     }
+}
+
+/// RMSE over premultiplied RGB alone (alpha left out).
+fn rgb_rmse(a: &[[f64; 4]], b: &[[f64; 4]]) -> f64 {
+    let sum: f64 = a.iter().zip(b).flat_map(|(x, y)| (0..3).map(move |c| (x[c] - y[c]).powi(2))).sum();
+    (sum / (a.len().max(1) * 3) as f64).sqrt()
 }
 
 /// Runs the benchmark, prints the tables and returns the JSON.
@@ -214,8 +229,10 @@ pub fn run(args: &CinematicArgs) -> anyhow::Result<serde_json::Value> {
          run on {adapter}. RMSE over premultiplied linear RGBA against the block-majorant path tracer at {k} samples \
          per pixel (another seed); wall-clock ms per sample after a warm-up frame. \"estimated\" is what the viewer \
          and `render --spp` report with no reference: the RMS difference of the means at n/2 and n samples \
-         (volgraph_accel::progressive_error); the measured RMSE² also holds the reference's own noise².\n\n\
-         | path tracer | ms/sample | samples | seconds | RMSE (/255) | estimated (/255) |\n|---|---:|---:|---:|---:|---:|\n",
+         (volgraph_accel::progressive_error); the measured RMSE² also holds the reference's own noise². \
+         \"colour\" is the RMSE over premultiplied RGB alone.\n\n\
+         | path tracer | ms/sample | samples | seconds | RMSE (/255) | colour (/255) | estimated (/255) |\n\
+         |---|---:|---:|---:|---:|---:|---:|\n",
         args.dataset, bench.volume.dims.x, bench.volume.dims.y, bench.volume.dims.z, args.size, args.light
     );
     let mut json_curves = Vec::new();
@@ -223,13 +240,14 @@ pub fn run(args: &CinematicArgs) -> anyhow::Result<serde_json::Value> {
         "\n| path tracer | σ of one sample (/255) | samples to reach the target | seconds to reach it |\n|---|---:|---:|---:|\n",
     );
     for c in &curves {
-        for ((n, s, e), estimate) in c.points.iter().zip(&c.estimated) {
+        for (((n, s, e), estimate), colour) in c.points.iter().zip(&c.estimated).zip(&c.colour_rmse) {
             let estimate = estimate.map_or("–".to_string(), |x| format!("{:.2}", x * 255.0));
             table.push_str(&format!(
-                "| {} | {:.1} | {n} | {s:.2} | {:.2} | {estimate} |\n",
+                "| {} | {:.1} | {n} | {s:.2} | {:.2} | {:.2} | {estimate} |\n",
                 c.name,
                 c.ms_per_sample,
-                e * 255.0
+                e * 255.0,
+                colour * 255.0
             ));
         }
         // RMSE² at n samples ≈ σ²/n + σ²/K (the reference's own noise): σ from the first point.
@@ -242,7 +260,7 @@ pub fn run(args: &CinematicArgs) -> anyhow::Result<serde_json::Value> {
         summary.push_str(&format!("| {} | {:.1} | {needed:.0} | {seconds:.1} |\n", c.name, sigma * 255.0));
         json_curves.push(serde_json::json!({
             "case": c.name, "ms_per_sample": c.ms_per_sample,
-            "points": c.points.iter().zip(&c.estimated).map(|((n, s, e), estimate)| serde_json::json!({"spp": n, "seconds": s, "rmse": e, "estimated_rmse": estimate})).collect::<Vec<_>>(),
+            "points": c.points.iter().zip(&c.estimated).zip(&c.colour_rmse).map(|(((n, s, e), estimate), colour)| serde_json::json!({"spp": n, "seconds": s, "rmse": e, "colour_rmse": colour, "estimated_rmse": estimate})).collect::<Vec<_>>(),
             "sigma_one_sample": sigma, "spp_to_target": needed, "seconds_to_target": seconds,
         }));
     }

@@ -14,9 +14,14 @@
 //!   (`Runtime::set_environment`, bound as `environment_map`), else a generated sky, or a
 //!   uniform one (the white furnace);
 //! - an interaction scatters with probability `albedo`, tinted by the TF colour, and otherwise
-//!   absorbs, emitting `emission` × the TF colour: with albedo 0 and emission 1 the estimate is
-//!   the emission–absorption integral the raycasters march (tests/path_trace.rs compares it with
-//!   the f64 reference at a fine step).
+//!   absorbs, emitting `emission` × the TF colour — both in expectation: the path carries the
+//!   albedo in its throughput (Russian roulette ends dim paths), and the light toward each light
+//!   is weighted by the mixture of the surface and phase lobes, the next direction drawn from
+//!   one (docs/accuracy.md "Path tracing");
+//! - the pixel's alpha by ratio tracking along the primary ray (`coverage`), over the tentative
+//!   collisions its delta tracking draws anyway;
+//! - with albedo 0 and emission 1 the estimate is the emission–absorption integral the
+//!   raycasters march (tests/path_trace.rs compares it with the f64 reference at a fine step).
 //!
 //! The TF's opacity α per opacity unit L is the extinction σ = −ln(1 − α) / L: the continuous
 //! form of the raycasters' per-step correction 1 − (1 − α)^(Δ/L). Reads last frame's mean
@@ -64,6 +69,19 @@ volgraph_compiler::param_choice! {
     }
 }
 
+volgraph_compiler::param_choice! {
+    /// How a path estimates its pixel's coverage (alpha): the share of the primary ray's light
+    /// the medium stops, 1 − T.
+    pub enum Coverage {
+        /// Ratio tracking along the primary ray: 1 − the product of (1 − σ/σ̄) over its
+        /// tentative collisions (Novák et al. 2014 §5.2) — a value per path, not 0 or 1.
+        Ratio = "ratio",
+        /// 1 when the path interacted, else 0: the colour's own estimator (a white furnace
+        /// sample is then exactly (a, a, a, a)).
+        Interaction = "interaction",
+    }
+}
+
 volgraph_compiler::pass_params! {
     /// The parameters, declared once: spec, typed values and `PathTraceParams` of
     /// `shaders/path_trace.wgsl` (`max_alpha` the node computes from the TF).
@@ -95,6 +113,8 @@ volgraph_compiler::pass_params! {
             "voxels between this frame's surface point and last frame's mean point for a pixel to continue its mean";
         shadow_rays: ShadowRays = Ratio,
             "the light's transmittance by ratio tracking (smooth) or delta tracking (0 or 1: cheaper, noisier)";
+        coverage: Coverage = Ratio,
+            "the pixel's alpha by ratio tracking along the primary ray (smooth) or whether the path interacted (0 or 1)";
         max_alpha: f32 = computed, "the TF's largest opacity: the majorant's";
         environment_map: u32 = computed, "1: paths leaving see the scene's environment map (bound as environment_map)";
     }

@@ -302,6 +302,8 @@ fn furnace_params() -> Vec<(&'static str, Value)> {
         ("light_intensity", f(0.0)),
         ("environment", Value::from("uniform")),
         ("environment_intensity", f(1.0)),
+        // Alpha by the path's own interaction: each sample is then (a, a, a, a) exactly.
+        ("coverage", Value::from("interaction")),
     ]
 }
 
@@ -316,6 +318,38 @@ fn the_white_furnace_renders_as_its_environment() {
     eprintln!("furnace: largest |colour − alpha| {worst:.2e}");
     assert!(worst < 1e-5, "the furnace shows the medium: |colour − alpha| up to {worst}");
     assert!(got.iter().filter(|p| p[3] > 0.05).count() > got.len() / 4, "the medium covers the image");
+}
+
+/// `coverage`: one sample's alpha by the path's own interaction is 0 or 1; by ratio tracking along
+/// the primary ray (the default) it is the ray's estimated 1 − T, a value between — the same
+/// mean (`with_albedo_zero_the_estimate_converges_to_the_dvr_reference` checks the default's
+/// against the f64 reference), less noise: over 64 samples the per-pixel spread of the alpha
+/// estimate is smaller.
+#[test]
+fn ratio_tracked_coverage_is_a_smooth_alpha_with_the_same_mean() {
+    let volume = volgraph_accel::generate::marschner_lobb_f32(32);
+    let lut = ramp_lut();
+    let one = |coverage: &str| {
+        accumulate(&volume, &lut, &[("coverage", Value::from(coverage)), ("seed", u(3))], 1).to_rgba_f64()
+    };
+    let binary = one("interaction");
+    assert!(binary.iter().all(|p| p[3] == 0.0 || p[3] == 1.0), "an interaction's alpha is 0 or 1");
+    let smooth = one("ratio");
+    let between = smooth.iter().filter(|p| p[3] > 0.02 && p[3] < 0.98).count();
+    assert!(between > smooth.len() / 4, "{between} of {} alphas strictly between 0 and 1", smooth.len());
+    // Means over 64 samples agree; the ratio-tracked one's distance from the 256-sample mean is
+    // smaller (its per-sample variance is).
+    let mean = |coverage: &str, spp: u32, seed: u32| {
+        accumulate(&volume, &lut, &[("coverage", Value::from(coverage)), ("seed", u(seed))], spp).to_rgba_f64()
+    };
+    let converged = mean("ratio", 256, 99);
+    let alpha_rmse = |image: &[[f64; 4]]| {
+        (image.iter().zip(&converged).map(|(a, b)| (a[3] - b[3]).powi(2)).sum::<f64>() / image.len() as f64).sqrt()
+    };
+    let (by_interaction, by_ratio) = (alpha_rmse(&mean("interaction", 64, 5)), alpha_rmse(&mean("ratio", 64, 5)));
+    eprintln!("alpha RMSE at 64 spp: interaction {:.2}/255, ratio {:.2}/255", by_interaction * 255.0, by_ratio * 255.0);
+    assert!(by_ratio < 0.8 * by_interaction, "ratio {by_ratio} against interaction {by_interaction}");
+    assert!(by_interaction < 0.05, "the two estimate the same alpha: {by_interaction}");
 }
 
 #[test]

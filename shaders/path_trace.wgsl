@@ -88,9 +88,32 @@ fn extinction_of(alpha: f32) -> f32 {
 
 // σ and the TF colour at world point `p`.
 fn medium_at(p: vec3<f32>) -> vec4<f32> {
-    let c = sample_tf(sample_volume(texture_from_world(p)));
+    let u = texture_from_world(p);
+#if FUSION
+    // Several volumes: their combination at u (common/fusion.wgsl; opacity per opacity unit,
+    // premultiplied: the straight colour is c / α) — for media in one place the extinctions add.
+    let f = fused_sample(u, sample_volume(u));
+    return vec4<f32>(select(vec3<f32>(0.0), f.rgb / f.a, f.a > 0.0), extinction_of(f.a));
+#else
+    let c = sample_tf(sample_volume(u));
     return vec4<f32>(c.rgb, extinction_of(c.a));
+#endif
 }
+
+#if FUSION
+// What common/fusion.wgsl takes from a raycaster's march: a sample's opacity is the TF's, per
+// opacity unit (no step to correct for: the extinction is derived from it), and the texture
+// sampled is the volume's own.
+fn corrected_alpha(a_tf: f32) -> f32 {
+    return clamp(a_tf, 0.0, 1.0);
+}
+
+fn volume_position(u: vec3<f32>) -> vec3<f32> {
+    return u;
+}
+
+#import "common/fusion.wgsl"
+#endif
 
 // The majorant σ̄ over the path from distance `t` on, and where it stops holding (`end`).
 struct MajorantSpan {
@@ -373,6 +396,9 @@ var<private> first_hit: bool;
 // One path's estimate for the pixel's ray: premultiplied RGB and alpha (1 when the primary ray
 // interacted).
 fn trace_pixel(pixel: vec2<u32>) -> vec4<f32> {
+#if FUSION
+    begin_fusion();
+#endif
     let ray = analytic_ray(pixel);
     if (!(ray.len > ray.begin)) {
         return vec4<f32>(0.0);

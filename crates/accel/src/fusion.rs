@@ -351,6 +351,19 @@ impl Fusion<'_> {
     }
 }
 
+/// The largest opacity a combination `combine` can give a sample, from the largest of each
+/// input's table (`maxima`: the frame volume's TF — or label table for `Labels` — first, then each
+/// scalar partner's TF): media in one place `1 − Π(1 − maxᵢ)` (`Fuse`, `Add`), the scan's
+/// (`Tint`, `Inside`: a label never adds opacity), the table's (`Labels`). A path tracer's
+/// majorant is the extinction of it.
+pub fn max_alpha(combine: Combine, maxima: &[f64]) -> f64 {
+    let clamp = |a: f64| if a.is_nan() { 1.0 } else { a.clamp(0.0, 1.0) };
+    match combine {
+        Combine::Fuse | Combine::Add => 1.0 - maxima.iter().map(|&a| 1.0 - clamp(a)).product::<f64>(),
+        Combine::Labels | Combine::Tint | Combine::Inside => maxima.first().map_or(0.0, |&a| clamp(a)),
+    }
+}
+
 /// Premultiplied samples of several media in one place: opacity `1 − Π(1 − αᵢ)`; colour the
 /// opacity-weighted mean (`Fuse`) or the sum (`Add`: each channel's light adds, so an image may
 /// exceed 1 where channels overlap, as additive blending saturates on display).

@@ -114,6 +114,9 @@ struct Medium<'a> {
     unit_world: f64,
     majorant: f64,
     toward_lights: Vec<crate::light::Toward>,
+    /// Several volumes: the medium is their combination (`Fusion::classify` without the
+    /// step's correction: opacity per opacity unit).
+    fusion: Option<crate::fusion::Fusion<'a>>,
 }
 
 impl Medium<'_> {
@@ -127,8 +130,17 @@ impl Medium<'_> {
 
     /// TF colour and σ at world point `p`.
     fn at(&self, p: DVec3) -> ([f64; 3], f64) {
-        let c = lut_sample(self.lut, self.volume.sample_trilinear(self.texture(p)));
-        ([c[0], c[1], c[2]], self.extinction_of(c[3]))
+        let u = self.texture(p);
+        let s = self.volume.sample_trilinear(u);
+        let Some(fusion) = &self.fusion else {
+            let c = lut_sample(self.lut, s);
+            return ([c[0], c[1], c[2]], self.extinction_of(c[3]));
+        };
+        // Premultiplied by the combination's opacity: the straight colour is c / α.
+        let c = fusion.classify(self.volume, self.lut, u, s, 1.0);
+        let a = c[3];
+        let colour = if a > 0.0 { [c[0] / a, c[1] / a, c[2] / a] } else { [0.0; 3] };
+        (colour, self.extinction_of(a))
     }
 
     /// Where along p + t·w the box begins and ends (from t ≥ 0), cut to what the scene's cuts
@@ -310,13 +322,38 @@ pub fn render_path_traced(
     volume: &Volume,
     lut: &[[f32; 4]],
     camera: &OrbitCamera,
+    size: (u32, u32),
+    settings: &PathTraceSettings,
+    samples: (u32, u64),
+) -> Vec<PixelEstimate> {
+    render_path_traced_fused(volume, lut, None, camera, size, settings, samples)
+}
+
+/// [`render_path_traced`] of several volumes: the medium at each point is their combination
+/// `fusion` makes (`Fusion::classify`, opacity per opacity unit), inside the frame volume's box.
+pub fn render_path_traced_fused(
+    volume: &Volume,
+    lut: &[[f32; 4]],
+    fusion: Option<crate::fusion::Fusion<'_>>,
+    camera: &OrbitCamera,
     (width, height): (u32, u32),
     settings: &PathTraceSettings,
     (spp, seed): (u32, u64),
 ) -> Vec<PixelEstimate> {
     let frame = camera.frame(width, height);
-    let max_alpha =
-        lut.iter().map(|t| if t[3].is_nan() { 1.0 } else { f64::from(t[3]).clamp(0.0, 1.0) }).fold(0.0, f64::max);
+    let table_max = |lut: &[[f32; 4]]| {
+        lut.iter().map(|t| if t[3].is_nan() { 1.0 } else { f64::from(t[3]).clamp(0.0, 1.0) }).fold(0.0, f64::max)
+    };
+    let max_alpha = match &fusion {
+        None => table_max(lut),
+        Some(f) => {
+            let first =
+                if f.combine == crate::fusion::Combine::Labels { table_max(f.label_lut) } else { table_max(lut) };
+            let partners = f.second.iter().map(|(_, l, _)| *l).chain(f.more.iter().map(|(_, l, _)| *l));
+            let maxima: Vec<f64> = std::iter::once(first).chain(partners.map(table_max)).collect();
+            crate::fusion::max_alpha(f.combine, &maxima)
+        }
+    };
     let mut medium = Medium {
         volume,
         lut,
@@ -325,6 +362,7 @@ pub fn render_path_traced(
         unit_world: volume.unit_step_world(),
         majorant: 0.0,
         toward_lights: settings.lights.toward_with(-frame.forward),
+        fusion,
     };
     medium.majorant = medium.extinction_of(max_alpha);
     (0..height)

@@ -135,9 +135,15 @@ fn reprojects(params: &Params) -> bool {
     PathTraceParams::from_params(params).reproject
 }
 
-/// Its one pipeline, declared once.
-fn shader() -> ShaderUse {
-    ShaderUse::new("path_trace.wgsl", "cs_path_trace").uniform(PathTraceParams::bound_as("trace"))
+/// Its one pipeline, declared once; with several volumes (`fusion`) it reads their combination
+/// through the `fusion` uniform and label blocks, as the raycasters do.
+fn shader(params: &Params) -> ShaderUse {
+    crate::fusion::with_fusion_uniform(
+        ShaderUse::new("path_trace.wgsl", "cs_path_trace")
+            .binds(&["label_blocks"])
+            .uniform(PathTraceParams::bound_as("trace")),
+        params,
+    )
 }
 
 /// The workgroup (`@workgroup_size`).
@@ -171,23 +177,29 @@ impl PassDecl for PathTrace {
     fn blocks(&self) -> Vec<ParamBlock> {
         // Every value is a uniform (a change restarts the accumulation: the graph's history);
         // block majorants add a port and a define.
-        vec![PathTraceParams::block(OnChange::InPlace).with_defines(|p| {
-            let mut defines = Vec::new();
-            if by_blocks(p) {
-                defines.push(crate::defines::BLOCK_MAJORANTS);
-            }
-            if leaps(p) {
-                defines.push(crate::defines::MAJORANT_LEAP);
-            }
-            if reprojects(p) {
-                defines.push(crate::defines::REPROJECT);
-            }
-            defines
-        })]
+        vec![
+            crate::fusion::fusion_block(),
+            PathTraceParams::block(OnChange::InPlace).with_defines(|p| {
+                let mut defines = Vec::new();
+                if by_blocks(p) {
+                    defines.push(crate::defines::BLOCK_MAJORANTS);
+                }
+                if leaps(p) {
+                    defines.push(crate::defines::MAJORANT_LEAP);
+                }
+                if reprojects(p) {
+                    defines.push(crate::defines::REPROJECT);
+                }
+                defines
+            }),
+        ]
     }
 
     fn updates_in_place(&self, old: &Params, new: &Params) -> bool {
-        by_blocks(old) == by_blocks(new) && leaps(old) == leaps(new) && reprojects(old) == reprojects(new)
+        by_blocks(old) == by_blocks(new)
+            && leaps(old) == leaps(new)
+            && reprojects(old) == reprojects(new)
+            && crate::fusion::FusionSettings::of(old) == crate::fusion::FusionSettings::of(new)
     }
 
     fn ports(&self, params: &Params) -> Vec<PortSpec> {
@@ -207,23 +219,47 @@ impl PassDecl for PathTrace {
             ports.push(PortSpec::read("previous_aux", PortKind::target(&[TargetFormat::Rgba32Float])));
             ports.push(PortSpec::write("aux", PortKind::target(&[TargetFormat::Rgba32Float])));
         }
+        ports.extend(crate::fusion::FusionSettings::of(params).ports());
         ports
     }
 
-    fn shaders(&self, _params: &Params) -> Vec<ShaderUse> {
-        vec![shader()]
+    fn shaders(&self, params: &Params) -> Vec<ShaderUse> {
+        vec![shader(params)]
     }
 }
 
 #[cfg(feature = "gpu")]
 impl PassPlugin for PathTrace {
     fn create(&self, ctx: &CreateContext<'_>) -> Result<Box<dyn PassNode>, PassError> {
-        let defines = self.shader_defines(ctx.params);
-        let pipeline =
-            ctx.compute_pipeline(&ComputePipelineSpec { defines: &defines, ..ComputePipelineSpec::of(&shader()) })?;
         let settings = PathTraceParams::from_params(ctx.params);
+        let fusion_settings = crate::fusion::FusionSettings::of(ctx.params);
+        let refuse = |message: String| PassError { pass: ctx.pass_id.to_string(), message };
+        match fusion_settings.combine() {
+            Some(volgraph_accel::fusion::Combine::Labels) => {
+                return Err(refuse(
+                    "fusion \"labels\" (a label map alone) is not path traced: the path tracer's medium is a scan \
+                     through its TF; use fusion \"tint\" or \"inside\" with the scan as the volume"
+                        .to_string(),
+                ));
+            }
+            Some(combine) if !combine.bounded_by_first() && settings.majorant == Majorant::Blocks => {
+                return Err(refuse(format!(
+                    "fusion \"{}\" can be opaque where the volume is empty, so the volume's block majorants do not \
+                     bound it; use majorant \"global\" (graphs/multi/pet_ct_path_traced.ron)",
+                    volgraph_compiler::declare::ParamChoice::name(fusion_settings.fusion)
+                )));
+            }
+            _ => {}
+        }
+        let fusion = crate::fusion::FusionState::new(ctx)?;
+        let defines = self.shader_defines(ctx.params);
+        let pipeline = ctx.compute_pipeline(&ComputePipelineSpec {
+            defines: &defines,
+            ..ComputePipelineSpec::of(&shader(ctx.params))
+        })?;
         let uniform = ctx.uniform_from_bytes("trace", &settings.uniform_bytes());
-        Ok(Box::new(PathTraceNode { pipeline, uniform, settings, written: None }))
+        let partners = fusion_settings.scalar_partners().iter().map(|(_, tf)| *tf).collect();
+        Ok(Box::new(PathTraceNode { pipeline, uniform, settings, written: None, fusion, partners, fusion_settings }))
     }
 }
 
@@ -232,9 +268,29 @@ struct PathTraceNode {
     pipeline: ComputePassPipeline,
     uniform: wgpu::Buffer,
     settings: PathTraceParams,
-    /// The block last written, with the TF version its majorant came from and whether the
+    /// The block last written, with the TF versions its majorant came from and whether the
     /// scene had an environment map.
-    written: Option<(PathTraceParams, (Option<u64>, bool))>,
+    written: Option<(PathTraceParams, (Vec<Option<u64>>, bool))>,
+    /// Several volumes: their combination's uniform and bindings.
+    fusion: crate::fusion::FusionState,
+    /// The TF ports of the scalar volumes fused with the volume (`fuse`, `add`).
+    partners: Vec<&'static str>,
+    fusion_settings: crate::fusion::FusionSettings,
+}
+
+#[cfg(feature = "gpu")]
+impl PathTraceNode {
+    /// The largest opacity of the medium: the TF's, or the combination's of several volumes
+    /// (`volgraph_accel::fusion::max_alpha`, as the f64 tracer takes it).
+    fn max_alpha(&self, ctx: &RecordContext<'_>) -> Result<f32, PassError> {
+        let first = max_alpha(ctx.table("tf")?);
+        let Some(combine) = self.fusion_settings.combine() else { return Ok(first) };
+        let mut maxima = vec![f64::from(first)];
+        for port in &self.partners {
+            maxima.push(f64::from(max_alpha(ctx.table(port)?)));
+        }
+        Ok(volgraph_accel::fusion::max_alpha(combine, &maxima) as f32)
+    }
 }
 
 #[cfg(feature = "gpu")]
@@ -247,15 +303,19 @@ impl PassNode for PathTraceNode {
                 crate::empty_space::check_block_grid(ctx, "distance", self.settings.block_size, dims.to_array())?;
             }
         }
-        let version = (ctx.input_version("tf"), ctx.frame.environment);
+        self.fusion.update(ctx)?;
+        let tfs = std::iter::once("tf").chain(self.partners.iter().copied()).map(|port| ctx.input_version(port));
+        let version = (tfs.collect::<Vec<_>>(), ctx.frame.environment);
         if self.written.as_ref().is_none_or(|(_, v)| *v != version) {
             // The scene's map stands in for the generated sky (a uniform environment stays one).
             let environment_map = u32::from(ctx.frame.environment && self.settings.environment == Environment::Sky);
-            let block = PathTraceParams { max_alpha: max_alpha(ctx.table("tf")?), environment_map, ..self.settings };
+            let block = PathTraceParams { max_alpha: self.max_alpha(ctx)?, environment_map, ..self.settings };
             ctx.write_buffer(&self.uniform, 0, &block.uniform_bytes());
             self.written = Some((block, version));
         }
-        ctx.dispatch_over(&self.pipeline, &[("trace", self.uniform.as_entire_binding())], "color", WORKGROUP)
+        let mut bindings = vec![("trace", self.uniform.as_entire_binding())];
+        bindings.extend(self.fusion.bindings());
+        ctx.dispatch_over(&self.pipeline, &bindings, "color", WORKGROUP)
     }
 
     fn update_params(&mut self, _gpu: &Gpu, params: &Params) {

@@ -719,51 +719,33 @@ fn a_map_of_labels_up_to_65535_renders_through_its_table() {
     check("labels_65535_smooth", &scene, "multi/labels.ron", &[], &[]);
 }
 
-/// The path tracer through several volumes (issue "light that scatters": effects compose with
-/// several volumes): `multi/pet_ct_path_traced` — the CT and the coarse shifted PET as one medium
-/// — accumulated on the GPU against the independent f64 path tracer through the same combination
+/// `source` (named `name`) path traced at 24² over 256 samples with `bind` binding its inputs,
+/// against the independent f64 path tracer through the same combination `fusion` of `ct`
 /// (`render_path_traced_fused`): per pixel and channel z = (GPU − CPU) / √(2 s² / n), at most
-/// 2 % beyond 3 (two agreeing estimators put 0.3 % there; a medium that left the PET out, or the
+/// 2 % beyond 3 (two agreeing estimators put 0.3 % there; a medium that left a volume out, or a
 /// majorant of the CT alone, moves whole regions by tens of standard errors), no mean offset.
-/// With block majorants (the CT's) a combination that can be opaque where the CT is clear is
-/// refused by name.
-#[test]
-fn the_path_tracer_scatters_through_the_volumes_together() {
+/// Returns the GPU's image.
+fn path_traced_like_the_f64_tracer(
+    (name, source): (&str, &str),
+    bind: &dyn Fn(&mut volgraph_core::runtime::Runtime),
+    (ct, lut, fusion): (&Volume, &[[f32; 4]], Fusion<'_>),
+) -> Vec<[f64; 4]> {
     use volgraph_accel::path_trace::{PathTraceSettings, render_path_traced_fused};
-    let ct = organs_ct(N);
-    let pet = coarse_pet(&ct);
-    // A PET hotter than pet_lut's, so its part of the light shows at 24² through the CT.
-    let hot = tf((0.0, 1.0), &[(0.2, 1.0, 0.3, 0.1, 0.0), (0.5, 1.0, 0.5, 0.1, 0.6), (1.0, 1.0, 1.0, 0.3, 0.9)]);
-    let (lut, second_lut) = (ct_lut(&ct), hot.to_lut_for(&pet, 256));
-    let size = 24;
-    let spp = 256;
-    let graph = "multi/pet_ct_path_traced.ron";
+    let (size, spp) = (24, 256);
     let registry = builtin_registry();
     let mut options = CompileOptions::new(size, size);
-    options.scene = volgraph_core::runtime::scene_values_of(&volgraph_core::runtime::VolumeDesc::of(&ct));
-    let plan = volgraph_core::compile(graph, &graph_source(graph), &registry, &options).expect("compiles");
+    options.scene = volgraph_core::runtime::scene_values_of(&volgraph_core::runtime::VolumeDesc::of(ct));
+    let plan = volgraph_core::compile(name, source, &registry, &options).expect("compiles");
     let gpu = gpu();
     let mut runtime = support::runtime(&gpu);
-    runtime.bind_volume("volume", &ct).expect("binds");
-    runtime.bind_lut("tf", &lut).expect("binds");
-    runtime.bind_volume("pet", &pet).expect("binds");
-    runtime.bind_lut("pet_tf", &second_lut).expect("binds");
+    bind(&mut runtime);
     runtime.apply(plan.clone(), &registry).expect("applies");
     for _ in 0..spp {
         runtime.render(CameraData::from_orbit(&CAMERA, plan.viewport)).expect("renders");
     }
     let got = runtime.read_output("image").expect("image").to_rgba_f64();
-    let map = TextureMap::between(&ct, &pet).expect("one frame");
-    let fusion = Fusion {
-        combine: volgraph_accel::fusion::Combine::Fuse,
-        label_lut: &[],
-        filter: LabelFilter::Smooth,
-        second: Some((&pet, &second_lut, map)),
-        more: &[],
-        overlay: None,
-    };
     let settings = PathTraceSettings::default();
-    let cpu = render_path_traced_fused(&ct, &lut, Some(fusion), &CAMERA, (size, size), &settings, (spp, 41));
+    let cpu = render_path_traced_fused(ct, lut, Some(fusion), &CAMERA, (size, size), &settings, (spp, 41));
     let n = f64::from(spp);
     let (mut over, mut counted, mut sum_z) = (0usize, 0usize, 0.0);
     for (g, c) in got.iter().zip(&cpu) {
@@ -775,14 +757,57 @@ fn the_path_tracer_scatters_through_the_volumes_together() {
         }
     }
     let (fraction, mean_z) = (over as f64 / counted as f64, sum_z / counted as f64);
-    eprintln!("PET/CT path traced: {:.2} % beyond 3 standard errors, mean z {mean_z:+.3}", fraction * 100.0);
-    assert!(fraction < 0.02, "{:.2} % of values beyond 3 standard errors", fraction * 100.0);
-    assert!(mean_z.abs() < 6.0 / (counted as f64).sqrt(), "mean z {mean_z}: one is biased");
-    assert!(got.iter().filter(|p| p[3] > 0.05).count() > got.len() / 8, "the medium covers the image");
+    eprintln!("{name}: {:.2} % beyond 3 standard errors, mean z {mean_z:+.3}", fraction * 100.0);
+    assert!(fraction < 0.02, "{name}: {:.2} % of values beyond 3 standard errors", fraction * 100.0);
+    assert!(mean_z.abs() < 6.0 / (counted as f64).sqrt(), "{name}: mean z {mean_z}: one is biased");
+    assert!(got.iter().filter(|p| p[3] > 0.05).count() > got.len() / 8, "{name}: the medium covers the image");
+    got
+}
+
+/// The path tracer through several volumes (issue "light that scatters": effects compose with
+/// several volumes): `multi/pet_ct_path_traced` — the CT and the coarse shifted PET as one medium
+/// — against the f64 tracer (`path_traced_like_the_f64_tracer`), and the PET's share of the
+/// light; the scan tinted by its label map, with the CT's block majorants (a label never adds
+/// opacity). With block majorants a combination that can be opaque where the CT is clear is
+/// refused by name, and so is a label map alone.
+#[test]
+fn the_path_tracer_scatters_through_the_volumes_together() {
+    let ct = organs_ct(N);
+    let pet = coarse_pet(&ct);
+    // A PET hotter than pet_lut's, so its part of the light shows at 24² through the CT.
+    let hot = tf((0.0, 1.0), &[(0.2, 1.0, 0.3, 0.1, 0.0), (0.5, 1.0, 0.5, 0.1, 0.6), (1.0, 1.0, 1.0, 0.3, 0.9)]);
+    let (lut, second_lut) = (ct_lut(&ct), hot.to_lut_for(&pet, 256));
+    let graph = "multi/pet_ct_path_traced.ron";
+    let fusion = Fusion {
+        combine: volgraph_accel::fusion::Combine::Fuse,
+        label_lut: &[],
+        filter: LabelFilter::Smooth,
+        second: Some((&pet, &second_lut, TextureMap::between(&ct, &pet).expect("one frame"))),
+        more: &[],
+        overlay: None,
+    };
+    let bind = |runtime: &mut volgraph_core::runtime::Runtime| {
+        runtime.bind_volume("volume", &ct).expect("binds");
+        runtime.bind_lut("tf", &lut).expect("binds");
+        runtime.bind_volume("pet", &pet).expect("binds");
+        runtime.bind_lut("pet_tf", &second_lut).expect("binds");
+    };
+    let got = path_traced_like_the_f64_tracer((graph, &graph_source(graph)), &bind, (&ct, &lut, fusion));
+    let (size, spp, n) = (24, 256, 256.0);
+    let settings = volgraph_accel::path_trace::PathTraceSettings::default();
+    let counted = got.len() * 4;
     // The PET is part of the medium: against the CT alone's f64 estimate the GPU's is far more
     // than its noise apart (the mean z² of two agreeing estimates is at most about 1 — the GPU's
     // estimators are the less noisy — with a spread of √(2/2304) ≈ 0.03 over these values).
-    let alone = render_path_traced_fused(&ct, &lut, None, &CAMERA, (size, size), &settings, (spp, 43));
+    let alone = volgraph_accel::path_trace::render_path_traced_fused(
+        &ct,
+        &lut,
+        None,
+        &CAMERA,
+        (size, size),
+        &settings,
+        (spp, 43),
+    );
     let z2: f64 = got
         .iter()
         .zip(&alone)
@@ -793,6 +818,48 @@ fn the_path_tracer_scatters_through_the_volumes_together() {
         / counted as f64;
     eprintln!("against the CT alone: mean z² {z2:.2}");
     assert!(z2 > 1.5, "the PET changes the light: mean z² {z2:.2} against the CT alone");
+    // The scan tinted by its labels, path traced with the CT's block majorants.
+    let labels = organs_labels(N);
+    let table = table();
+    let tint = r#"Graph(
+        name: "ct_with_labels_path_traced",
+        inputs: {"volume": Volume, "tf": TransferFunction, "labels": Volume, "label_table": LabelTable},
+        history: {"accumulated": (of: "trace.color", initial: Clear(0.0, 0.0, 0.0, 0.0))},
+        passes: [
+            Pass(id: "minmax", kind: "minmax_grid", inputs: {"volume": "input.volume"}),
+            Pass(id: "majorants", kind: "majorant_grid", inputs: {"grid": "minmax.grid", "tf": "input.tf"}),
+            Pass(
+                id: "trace",
+                kind: "path_trace",
+                params: {"fusion": "tint", "majorant": "blocks"},
+                inputs: {"volume": "input.volume", "tf": "input.tf", "second": "input.labels",
+                         "label_table": "input.label_table", "majorants": "majorants.majorants",
+                         "previous": "history.accumulated"},
+            ),
+        ],
+        outputs: {"image": "trace.color"},
+    )"#;
+    let tinted = Fusion {
+        combine: volgraph_accel::fusion::Combine::Tint,
+        label_lut: &table,
+        filter: LabelFilter::Smooth,
+        second: Some((&labels, &table, TextureMap::between(&ct, &labels).expect("one frame"))),
+        more: &[],
+        overlay: None,
+    };
+    let bind_tint = |runtime: &mut volgraph_core::runtime::Runtime| {
+        runtime.bind_volume("volume", &ct).expect("binds");
+        runtime.bind_lut("tf", &lut).expect("binds");
+        runtime.bind_volume("labels", &labels).expect("binds");
+        runtime.bind_label_table("label_table", &table).expect("binds");
+    };
+    path_traced_like_the_f64_tracer(("ct_with_labels_path_traced", tint), &bind_tint, (&ct, &lut, tinted));
+    let registry = builtin_registry();
+    let mut options = CompileOptions::new(size, size);
+    options.scene = volgraph_core::runtime::scene_values_of(&volgraph_core::runtime::VolumeDesc::of(&ct));
+    let gpu = gpu();
+    let mut runtime = support::runtime(&gpu);
+    bind(&mut runtime);
     // Block majorants are the CT's: a fused PET could be opaque where they are 0.
     let blocks = r#"Graph(
         name: "pet_ct_blocks",

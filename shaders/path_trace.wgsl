@@ -171,10 +171,13 @@ fn majorant_span(p: vec3<f32>, w: vec3<f32>, t: f32, limit: f32) -> MajorantSpan
 }
 #endif
 
-// The part [t0, t1) of the world ray p + t·w inside the box and kept by the scene's cuts.
+// The part [t0, t1) of the world ray p + t·w inside the box and kept by the scene's cuts. The
+// box is the one primary rays cross (`march_lo/hi`, common/ray_box.wgsl): the volume's, or with
+// several scalar volumes the union of their boxes, so a PET reaching past its CT scatters light
+// where it lies.
 fn world_segment(p: vec3<f32>, w: vec3<f32>) -> vec2<f32> {
     let half = frame.half_extent.xyz;
-    let span = box_span(p, w, -half, half);
+    let span = box_span(p, w, world_from_texture(march_lo()), world_from_texture(march_hi()));
     let kept = cut_segment(texture_from_world(p), w / (2.0 * half), max(span.x, 0.0), span.y);
     return select(vec2<f32>(0.0, 0.0), kept, kept.x < kept.y);
 }

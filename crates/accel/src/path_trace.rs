@@ -16,7 +16,7 @@ use rayon::prelude::*;
 
 use crate::camera::OrbitCamera;
 use crate::light::{Light, Lights};
-use crate::reference::{intersect_box, lut_sample, ray_segment};
+use crate::reference::{intersect_box, lut_sample};
 use crate::volume::Volume;
 
 /// What a path leaving the volume sees (`path_trace`'s `environment`).
@@ -111,6 +111,9 @@ struct Medium<'a> {
     lut: &'a [[f32; 4]],
     settings: PathTraceSettings,
     half: DVec3,
+    /// The box paths cross, in world units (centre, half size): the volume's, or with several
+    /// scalar volumes the union of their boxes (`Fusion::march_box`), as the GPU's `march_lo/hi`.
+    bounds: (DVec3, DVec3),
     unit_world: f64,
     majorant: f64,
     toward_lights: Vec<crate::light::Toward>,
@@ -146,7 +149,7 @@ impl Medium<'_> {
     /// Where along p + t·w the box begins and ends (from t ≥ 0), cut to what the scene's cuts
     /// keep.
     fn span(&self, p: DVec3, w: DVec3) -> Option<(f64, f64)> {
-        let (t0, t1) = intersect_box(p, w, self.half)?;
+        let (t0, t1) = intersect_box(p - self.bounds.0, w, self.bounds.1)?;
         self.kept(p, w, (t0.max(0.0), t1))
     }
 
@@ -341,6 +344,9 @@ pub fn render_path_traced_fused(
     (spp, seed): (u32, u64),
 ) -> Vec<PixelEstimate> {
     let frame = camera.frame(width, height);
+    // The texture-space box rays cross ([`Fusion::march_box`]: the union of several scalar
+    // volumes' boxes; the volume's [0,1]³ otherwise).
+    let box_tex = fusion.as_ref().map_or((DVec3::ZERO, DVec3::ONE), |f| f.march_box());
     let table_max = |lut: &[[f32; 4]]| {
         lut.iter().map(|t| if t[3].is_nan() { 1.0 } else { f64::from(t[3]).clamp(0.0, 1.0) }).fold(0.0, f64::max)
     };
@@ -359,6 +365,11 @@ pub fn render_path_traced_fused(
         lut,
         settings: settings.clone(),
         half: volume.half_extent_world(),
+        bounds: {
+            let half = volume.half_extent_world();
+            let (lo, hi) = box_tex;
+            (((lo + hi) * 0.5 - 0.5) * 2.0 * half, (hi - lo) * half)
+        },
         unit_world: volume.unit_step_world(),
         majorant: 0.0,
         toward_lights: settings.lights.toward_with(-frame.forward),
@@ -371,7 +382,7 @@ pub fn render_path_traced_fused(
             let medium = &medium;
             let frame = &frame;
             (0..width).map(move |x| {
-                let Some(ray) = ray_segment(volume, camera, frame, x, y) else {
+                let Some(ray) = crate::reference::ray_segment_in(volume, camera, frame, (x, y), box_tex) else {
                     return PixelEstimate::default();
                 };
                 let p0 = (ray.u0 - 0.5) * 2.0 * medium.half;

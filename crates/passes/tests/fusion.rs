@@ -721,10 +721,8 @@ fn a_map_of_labels_up_to_65535_renders_through_its_table() {
 
 /// `source` (named `name`) path traced at 24² over 256 samples with `bind` binding its inputs,
 /// against the independent f64 path tracer through the same combination `fusion` of `ct`
-/// (`render_path_traced_fused`): per pixel and channel z = (GPU − CPU) / √(2 s² / n), at most
-/// 2 % beyond 3 (two agreeing estimators put 0.3 % there; a medium that left a volume out, or a
-/// majorant of the CT alone, moves whole regions by tens of standard errors), no mean offset.
-/// Returns the GPU's image.
+/// (`render_path_traced_fused`, `support::assert_agrees_with_the_f64_tracer`). Returns the
+/// GPU's image.
 fn path_traced_like_the_f64_tracer(
     (name, source): (&str, &str),
     bind: &dyn Fn(&mut volgraph_core::runtime::Runtime),
@@ -746,20 +744,7 @@ fn path_traced_like_the_f64_tracer(
     let got = runtime.read_output("image").expect("image").to_rgba_f64();
     let settings = PathTraceSettings::default();
     let cpu = render_path_traced_fused(ct, lut, Some(fusion), &CAMERA, (size, size), &settings, (spp, 41));
-    let n = f64::from(spp);
-    let (mut over, mut counted, mut sum_z) = (0usize, 0usize, 0.0);
-    for (g, c) in got.iter().zip(&cpu) {
-        for k in 0..4 {
-            let z = (g[k] - c.mean[k]) / (2.0 * c.variance[k] / n).sqrt().max(1.0 / n);
-            sum_z += z;
-            counted += 1;
-            over += usize::from(z.abs() > 3.0);
-        }
-    }
-    let (fraction, mean_z) = (over as f64 / counted as f64, sum_z / counted as f64);
-    eprintln!("{name}: {:.2} % beyond 3 standard errors, mean z {mean_z:+.3}", fraction * 100.0);
-    assert!(fraction < 0.02, "{name}: {:.2} % of values beyond 3 standard errors", fraction * 100.0);
-    assert!(mean_z.abs() < 6.0 / (counted as f64).sqrt(), "{name}: mean z {mean_z}: one is biased");
+    support::assert_agrees_with_the_f64_tracer(name, &got, &cpu, spp);
     assert!(got.iter().filter(|p| p[3] > 0.05).count() > got.len() / 8, "{name}: the medium covers the image");
     got
 }
@@ -818,6 +803,23 @@ fn the_path_tracer_scatters_through_the_volumes_together() {
         / counted as f64;
     eprintln!("against the CT alone: mean z² {z2:.2}");
     assert!(z2 > 1.5, "the PET changes the light: mean z² {z2:.2} against the CT alone");
+    // A PET reaching past its CT: paths — primary, scattered and toward the light — cross the
+    // union of the boxes, the hot sphere beside the CT is lit and drawn where it lies.
+    let wide = wide_pet(&ct);
+    let wide_lut = hot.to_lut_for(&wide, 256);
+    let past =
+        Fusion { second: Some((&wide, &wide_lut, TextureMap::between(&ct, &wide).expect("one frame"))), ..fusion };
+    let bind_wide = |runtime: &mut volgraph_core::runtime::Runtime| {
+        runtime.bind_volume("volume", &ct).expect("binds");
+        runtime.bind_lut("tf", &lut).expect("binds");
+        runtime.bind_volume("pet", &wide).expect("binds");
+        runtime.bind_lut("pet_tf", &wide_lut).expect("binds");
+    };
+    let got_wide =
+        path_traced_like_the_f64_tracer(("pet past its CT", &graph_source(graph)), &bind_wide, (&ct, &lut, past));
+    let beside = got_wide.iter().zip(&alone).filter(|(g, a)| a.mean[3] == 0.0 && g[3] > 0.05).count();
+    eprintln!("the sphere beside the CT: {beside} pixels");
+    assert!(beside > 4, "the sphere beside the CT is drawn on {beside} of 24² pixels");
     // The scan tinted by its labels, path traced with the CT's block majorants.
     let labels = organs_labels(N);
     let table = table();

@@ -388,15 +388,8 @@ fn the_running_mean_starts_over_when_the_camera_or_light_moves() {
 
 /// The GPU path tracer with the scene's `light` and `environment`, `params` over the graph's,
 /// at 24² after `spp` samples, against the independent f64 tracer with `settings` (the same
-/// medium, light and environment): its mean agrees within the tracers' confidence interval.
-///
-/// Per pixel and channel, z = (GPU − CPU) / √(2 s² / n) with s² the CPU's sample variance (the
-/// GPU's is the same distribution's), and at least one unit event in n samples (a pixel the
-/// CPU's paths never interacted in may still see one GPU path do so). Two agreeing estimators
-/// put |z| > 3 on 0.3 % of values (the means of hundreds of paths are near normal): at most 2 %
-/// is allowed; a wrong light direction, phase function, majorant or map moves whole regions by
-/// tens of standard errors. No systematic offset: the mean of the z's has standard deviation
-/// 1/√count (a pixel's channels are correlated, so 6 of those are allowed).
+/// medium, light and environment): its mean agrees within the tracers' confidence interval
+/// (`support::assert_agrees_with_the_f64_tracer`).
 fn agrees_with_the_f64_tracer(
     what: &str,
     (lights, environment): (
@@ -429,22 +422,7 @@ fn agrees_with_the_f64_tracer(
     let settings = volgraph_accel::path_trace::PathTraceSettings { lights, ..settings.clone() };
     let cpu =
         volgraph_accel::path_trace::render_path_traced(&volume, &lut, &camera(), (size, size), &settings, (spp, seed));
-    let n = f64::from(spp);
-    let (mut over, mut counted, mut sum_z) = (0usize, 0usize, 0.0);
-    for (g, c) in got.iter().zip(&cpu) {
-        for k in 0..4 {
-            let se = (2.0 * c.variance[k] / n).sqrt().max(1.0 / n);
-            let z = (g[k] - c.mean[k]) / se;
-            sum_z += z;
-            counted += 1;
-            over += usize::from(z.abs() > 3.0);
-        }
-    }
-    let fraction = over as f64 / counted as f64;
-    let mean_z = sum_z / counted as f64;
-    eprintln!("{what}: {counted} values, {:.2} % beyond 3 standard errors, mean z {mean_z:+.3}", fraction * 100.0);
-    assert!(fraction < 0.02, "{what}: {:.2} % of values beyond 3 standard errors", fraction * 100.0);
-    assert!(mean_z.abs() < 6.0 / (counted as f64).sqrt(), "{what}: mean z {mean_z}: one is biased");
+    support::assert_agrees_with_the_f64_tracer(what, &got, &cpu, spp);
     // A comparison of two black images proves nothing: the medium is lit.
     assert!(got.iter().filter(|p| p[3] > 0.05).count() > got.len() / 4, "{what}: the medium covers the image");
     assert!(got.iter().any(|p| p[0] > 0.02), "{what}: light reaches the medium");

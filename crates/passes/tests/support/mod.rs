@@ -30,6 +30,37 @@ pub const EFFECT_GRAPHS: [&str; 9] = [
     "ruijters_vilanova_2006/bricks_octree.ron",
 ];
 
+/// A GPU path tracer's mean image `got` over `spp` samples against the independent f64
+/// tracer's per-pixel estimates `cpu`, asserted to agree: per pixel and channel
+/// z = (GPU − CPU) / √(2 s² / n), s² the CPU's sample variance (the GPU's is the same
+/// distribution's, or less with its better estimators) and at least one unit event in n samples
+/// (a pixel the CPU's paths never interacted in may still see one GPU path do so). Two agreeing
+/// estimators put |z| > 3 on 0.3 % of values (the means of hundreds of paths are near normal): at
+/// most 2 % is allowed; a wrong light, phase function, majorant, map or medium moves whole
+/// regions by tens of standard errors. No systematic offset: the mean of the z's has standard
+/// deviation 1/√count (a pixel's channels are correlated, so 6 of those are allowed).
+pub fn assert_agrees_with_the_f64_tracer(
+    what: &str,
+    got: &[[f64; 4]],
+    cpu: &[volgraph_accel::path_trace::PixelEstimate],
+    spp: u32,
+) {
+    let n = f64::from(spp);
+    let (mut over, mut counted, mut sum_z) = (0usize, 0usize, 0.0);
+    for (g, c) in got.iter().zip(cpu) {
+        for k in 0..4 {
+            let z = (g[k] - c.mean[k]) / (2.0 * c.variance[k] / n).sqrt().max(1.0 / n);
+            sum_z += z;
+            counted += 1;
+            over += usize::from(z.abs() > 3.0);
+        }
+    }
+    let (fraction, mean_z) = (over as f64 / counted as f64, sum_z / counted as f64);
+    eprintln!("{what}: {counted} values, {:.2} % beyond 3 standard errors, mean z {mean_z:+.3}", fraction * 100.0);
+    assert!(fraction < 0.02, "{what}: {:.2} % of values beyond 3 standard errors", fraction * 100.0);
+    assert!(mean_z.abs() < 6.0 / (counted as f64).sqrt(), "{what}: mean z {mean_z}: one is biased");
+}
+
 /// The headless GPU. Under CI a missing adapter is a failure, never a skip.
 pub fn gpu() -> Arc<Gpu> {
     Arc::new(Gpu::new_headless().expect("a Vulkan adapter (Mesa lavapipe on machines without a GPU)"))

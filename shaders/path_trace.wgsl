@@ -356,17 +356,15 @@ fn basis(n: vec3<f32>) -> mat3x3<f32> {
     return mat3x3<f32>(t, u, n);
 }
 
-// A direction from the HG lobe around `w`.
-// `xi`: two uniform numbers in [0, 1).
-fn sample_henyey_greenstein(w: vec3<f32>, g: f32, xi2: vec2<f32>) -> vec3<f32> {
-    let xi = xi2.x;
-    var cos_theta = 1.0 - 2.0 * xi;
+// A direction from the HG lobe around `w`; `xi`: two uniform numbers in [0, 1).
+fn sample_henyey_greenstein(w: vec3<f32>, g: f32, xi: vec2<f32>) -> vec3<f32> {
+    var cos_theta = 1.0 - 2.0 * xi.x;
     if (abs(g) > 1e-3) {
-        let q = (1.0 - g * g) / (1.0 - g + 2.0 * g * xi);
+        let q = (1.0 - g * g) / (1.0 - g + 2.0 * g * xi.x);
         cos_theta = clamp((1.0 + g * g - q * q) / (2.0 * g), -1.0, 1.0);
     }
     let sin_theta = sqrt(max(0.0, 1.0 - cos_theta * cos_theta));
-    let phi = 2.0 * PI * xi2.y;
+    let phi = 2.0 * PI * xi.y;
     return normalize(basis(w) * vec3<f32>(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta));
 }
 

@@ -16,7 +16,7 @@ use std::time::Instant;
 
 use anyhow::{Context as _, anyhow};
 use volgraph_accel::camera::OrbitCamera;
-use volgraph_accel::light::Light;
+use volgraph_accel::light::{Light, Lights};
 use volgraph_accel::progressive_error::{ErrorTracker, rmse};
 use volgraph_core::runtime::{CameraData, Gpu, Runtime, ShaderLibrary, VolumeDesc, scene_values_of};
 use volgraph_core::{CompileOptions, compile};
@@ -274,19 +274,39 @@ pub fn run(args: &CinematicArgs) -> anyhow::Result<serde_json::Value> {
     ));
     table.push_str(&format!("\nTo reach an RMSE of {}/255 (σ/√n = target):\n", args.target));
     table.push_str(&summary);
-    let shadows = light_volume_shadows(&mut bench)?;
+    // The raycasters' light volume beside the path tracer, with the key light alone and with a
+    // fill and the headlight added (each light its own shadow channel and Blinn–Phong terms).
+    let key = bench.runtime.lights();
+    let three =
+        Lights::new(&[key.key(), Light::Directional { azimuth_deg: 70.0, elevation_deg: 10.0 }, Light::Headlight])
+            .map_err(|e| anyhow!(e))?;
+    let shadows = light_volume_shadows(&mut bench, &["shadows"], key)?;
+    let shaded = light_volume_shadows(&mut bench, &["shading", "shadows"], key)?;
+    let shaded_three = light_volume_shadows(&mut bench, &["shading", "shadows"], three)?;
+    bench.runtime.set_lights(key);
     table.push_str(&format!(
-        "\nThe raycasters' light-volume `shadows` effect (modern/fastest, one frame, no accumulation): {:.1} ms/frame, \
-         RMSE {:.2}/255 against its own f64 reference (Behrens & Ratering 1998: one scattering-free shadow, not the \
-         path tracer's light transport).\n",
+        "\nThe raycasters' light-volume `shadows` effect (modern/fastest, one frame, no accumulation; Behrens & \
+         Ratering 1998: a scattering-free shadow per light, not the path tracer's light transport), ms/frame after \
+         the light volume is built and RMSE against its own f64 reference:\n\n\
+         | features | lights | ms/frame | RMSE (/255) |\n|---|---|---:|---:|\n\
+         | shadows | {key:?} | {:.1} | {:.2} |\n| shading, shadows | {key:?} | {:.1} | {:.2} |\n\
+         | shading, shadows | {three:?} | {:.1} | {:.2} |\n",
         shadows.0,
-        shadows.1 * 255.0
+        shadows.1 * 255.0,
+        shaded.0,
+        shaded.1 * 255.0,
+        shaded_three.0,
+        shaded_three.1 * 255.0,
     ));
     println!("{table}");
     let value = serde_json::json!({
         "dataset": args.dataset, "size": args.size, "light": args.light, "adapter": adapter,
         "reference_spp": k, "target_rmse": target, "curves": json_curves,
         "light_volume_shadows": {"graph": "modern/fastest", "ms_per_frame": shadows.0, "rmse_vs_reference": shadows.1},
+        "light_volume_shading_shadows": {"graph": "modern/fastest", "ms_per_frame": shaded.0, "rmse_vs_reference": shaded.1},
+        "light_volume_shading_shadows_three_lights": {
+            "graph": "modern/fastest", "lights": format!("{three:?}"), "ms_per_frame": shaded_three.0, "rmse_vs_reference": shaded_three.1,
+        },
     });
     crate::report_files::write_markdown_and_json((args.markdown.as_deref(), &table), (args.json.as_deref(), &value))?;
     if let Some(path) = &args.plot {
@@ -337,10 +357,13 @@ fn write_plot(
     Ok(())
 }
 
-/// `modern/fastest` with the `shadows` effect: median ms of 8 frames after a warm-up, and the
-/// RMSE of its image against the f64 reference with the same light and shadows.
-fn light_volume_shadows(bench: &mut Bench) -> anyhow::Result<(f64, f64)> {
-    let plan = bench.apply("modern/fastest", &[], None, &["shadows".to_string()])?;
+/// `modern/fastest` with `features` (the `shadows` effect among them) and `lights`: median ms of
+/// 8 frames after a warm-up (which builds the light volume), and the RMSE of its image against
+/// the f64 reference with the same lights and effects.
+fn light_volume_shadows(bench: &mut Bench, features: &[&str], lights: Lights) -> anyhow::Result<(f64, f64)> {
+    bench.runtime.set_lights(lights);
+    let features: Vec<String> = features.iter().map(|f| f.to_string()).collect();
+    let plan = bench.apply("modern/fastest", &[], None, &features)?;
     bench.frame(plan.viewport)?;
     let mut times = Vec::new();
     for _ in 0..8 {

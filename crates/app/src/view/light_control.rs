@@ -15,7 +15,8 @@ const ADDED: Light = Light::Directional { azimuth_deg: 60.0, elevation_deg: 10.0
 /// Draws the section for `lights`; the new lights when the user changed them.
 pub fn lights_section(ui: &mut egui::Ui, lights: Lights) -> Option<Lights> {
     let mut list = lights.as_slice().to_vec();
-    ui.collapsing("Light", |ui| {
+    // Open from the start where the scene brings several lights: they are what it is about.
+    egui::CollapsingHeader::new("Light").default_open(list.len() > 1).show(ui, |ui| {
         let count = list.len();
         let mut remove = None;
         for (i, light) in list.iter_mut().enumerate() {

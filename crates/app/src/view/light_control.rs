@@ -142,4 +142,15 @@ mod tests {
         h.run();
         assert_eq!(h.state().as_slice(), &[Light::Headlight, ADDED], "light 3 moved up");
     }
+
+    /// A scene with several lights opens the section by itself; with one it stays closed.
+    #[test]
+    fn several_lights_open_the_section() {
+        let mut h = harness(Lights::new(&[Light::Headlight, ADDED]).expect("two"));
+        h.run();
+        assert!(h.query_by_label("remove light 2").is_some(), "open with two lights");
+        let mut h = harness(Lights::default());
+        h.run();
+        assert!(h.query_by_label("add a light").is_none(), "closed with one");
+    }
 }

@@ -158,6 +158,13 @@ fn settings_deserialize_with_defaults_and_reject_unknown_fields() {
     let err = ron::from_str::<RaycastSettings>("(mode: Isosurface(iso: 0.4, shade: ()))")
         .expect_err("`shade` is not a field");
     assert!(err.to_string().contains("shade"), "{err}");
+    // The lights are a list of one to three, checked as a scene's.
+    let lit: RaycastSettings =
+        ron::from_str("(lights: [Headlight, Directional(azimuth_deg: 10, elevation_deg: 20)])").expect("two lights");
+    assert_eq!(lit.lights.as_slice().len(), 2);
+    assert_eq!(ron::from_str::<RaycastSettings>(&ron::to_string(&lit).expect("writes")).expect("reads"), lit);
+    let err = ron::from_str::<RaycastSettings>("(lights: [])").expect_err("no light");
+    assert!(err.to_string().contains("0 lights"), "{err}");
 }
 
 #[test]

@@ -1,10 +1,11 @@
-//! The scene's light (issue "light that scatters", item 1): the headlight — from the eye, the
-//! default — or a directional light fixed in the world, placed by azimuth and elevation as an
-//! orbit camera is ([`crate::camera::OrbitCamera::eye`]: `--light 35,25` shines from where a
-//! camera at azimuth 35°, elevation 25° would look from). Blinn–Phong shading (the GPU's
-//! `headlight` in `shaders/common/raymarch.wgsl`, the reference's `lighting`) reads it:
-//! diffuse `|n·l|`, specular `|n·h|^shininess` with `h` halfway between the light and the eye
-//! (with the headlight `h = l`, the shading of every earlier image).
+//! The scene's lights (issue "light that scatters", item 1): one to three ([`Lights`]), each the
+//! headlight — from the eye, the default — a directional light fixed in the world, placed by
+//! azimuth and elevation as an orbit camera is ([`crate::camera::OrbitCamera::eye`]: `--light
+//! 35,25` shines from where a camera at azimuth 35°, elevation 25° would look from), or a point
+//! light. Blinn–Phong shading (the GPU's `lighting` in `shaders/common/raymarch.wgsl`, the
+//! reference's `lighting`) sums over them: diffuse `|n·l|`, specular `|n·h|^shininess` with `h`
+//! halfway between the light and the eye (with the headlight `h = l`, the shading of every
+//! earlier image).
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};

@@ -606,9 +606,9 @@ pub fn fused_pixel(
     fused_pixel_lit(volume, lut, (fusion, grid.as_ref()), camera, frame, (x, y), settings)
 }
 
-/// The light grid the `shadows` and `ambient_occlusion` effects read (`None` without them): lit
-/// from the scene's light, or with the headlight from the eye along the camera's forward axis
-/// (one direction for the whole grid), as the GPU computes it; with several volumes from their
+/// The light grid the `shadows` and `ambient_occlusion` effects read (`None` without them): a
+/// transmittance per scene light — the headlight's from the eye along the camera's forward axis
+/// (one direction for the whole grid) — as the GPU computes it; with several volumes from their
 /// combined opacity (`Fusion::alpha`).
 pub fn shadow_grid(
     volume: &Volume,

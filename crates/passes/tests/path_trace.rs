@@ -335,6 +335,9 @@ fn ratio_tracked_coverage_is_a_smooth_alpha_with_the_same_mean() {
     let binary = one("interaction");
     assert!(binary.iter().all(|p| p[3] == 0.0 || p[3] == 1.0), "an interaction's alpha is 0 or 1");
     let smooth = one("ratio");
+    // The ramp LUT's medium is semi-transparent over most of the image (measured: well over a
+    // quarter of the pixels have a ratio-tracked alpha strictly inside (0.02, 0.98)); a binary
+    // estimator has none.
     let between = smooth.iter().filter(|p| p[3] > 0.02 && p[3] < 0.98).count();
     assert!(between > smooth.len() / 4, "{between} of {} alphas strictly between 0 and 1", smooth.len());
     // Means over 64 samples agree; the ratio-tracked one's distance from the 256-sample mean is
@@ -348,7 +351,12 @@ fn ratio_tracked_coverage_is_a_smooth_alpha_with_the_same_mean() {
     };
     let (by_interaction, by_ratio) = (alpha_rmse(&mean("interaction", 64, 5)), alpha_rmse(&mean("ratio", 64, 5)));
     eprintln!("alpha RMSE at 64 spp: interaction {:.2}/255, ratio {:.2}/255", by_interaction * 255.0, by_ratio * 255.0);
+    // Measured 6.2 against 9.3/255 (0.67×; both hold the 256-sample mean's own noise, so the
+    // true ratio is lower): 0.8 leaves room for the spread of one seed, while an estimator no
+    // better than the binary one cannot pass.
     assert!(by_ratio < 0.8 * by_interaction, "ratio {by_ratio} against interaction {by_interaction}");
+    // A biased alpha would sit a constant away; 64 samples of a 0-or-1 value leave at most
+    // 1/(2·√64) = 0.0625 of noise per pixel, an RMS over the image of 9/255 ≈ 0.036 measured.
     assert!(by_interaction < 0.05, "the two estimate the same alpha: {by_interaction}");
 }
 

@@ -95,7 +95,7 @@ volgraph_compiler::pass_params! {
             "how much a strong gradient scatters as a Lambertian surface instead of the phase function (Kroes et al. 2012)";
         bounces: u32 = 4, 0..=64, "scattering events a path may take before it ends";
         russian_roulette: bool = true,
-            "from the second scattering on, end a path with probability 1 − its largest throughput channel (unbiased)";
+            "from the second scattering on, a path whose largest throughput channel c is below 1/4 goes on with probability 4c, its throughput divided by it (unbiased)";
         light_intensity: f32 = 2.0, 0.0..=1000.0, "irradiance of each of the scene's lights (a point light's one world unit away)";
         environment: Environment = Sky,
             "what paths leaving the volume see: the scene's environment map where it has one, else a generated sky; or a uniform radiance";

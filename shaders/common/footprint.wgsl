@@ -25,7 +25,13 @@ fn footprint_vertex(k: u32) -> vec2<f32> {
 // triangle 0. Passes that draw at a depth of their own (KW03's segments and termination test)
 // take the position from here.
 fn footprint_position(vertex_index: u32) -> vec4<f32> {
-    let n = frame.footprint_vertices;
+    var n = frame.footprint_vertices;
+#if FUSION_SCALAR
+    // With several scalar volumes rays cross the union of their boxes (common/ray_box.wgsl
+    // march_lo/hi), which the footprint — the frame volume's box — does not cover: the whole
+    // viewport, its pixels without a ray writing zeros.
+    n = FOOTPRINT_FAN_VERTICES + 1u;
+#endif
     let t = vertex_index / 3u;
     let corner = vertex_index % 3u;
     let collapsed = vec4<f32>(-2.0, -2.0, 0.0, 1.0);

@@ -14,8 +14,14 @@ fn pixel_ray(pixel: vec2<u32>) -> Ray {
 @group(0) @binding(auto) var dir: texture_2d<f32>;
 
 fn pixel_ray(pixel: vec2<u32>) -> Ray {
+#if FUSION_SCALAR
+    // With several scalar volumes rays cross the union of their boxes (march_lo/hi), which
+    // the rasterized box — the frame volume's — does not cover: met with it from the eye.
+    return analytic_ray(pixel);
+#else
     let e = textureLoad(entry, vec2<i32>(pixel), 0);
     let d = textureLoad(dir, vec2<i32>(pixel), 0);
     return own_segment(Ray(e.xyz, d.xyz, select(0.0, d.w, e.w != 0.0), 0.0, false));
+#endif
 }
 #endif

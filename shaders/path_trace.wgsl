@@ -88,13 +88,32 @@ fn opacity_unit_world() -> f32 {
     return frame.half_extent.w * frame.volume_dims.w;
 }
 
+// The frame's constants the tracking loops use, read once per path (`begin_path`): on llvmpipe
+// a uniform read or a texture's size inside a loop is repeated at every step (a sample's time
+// 59 → 50 ms on the engine, bench/cinematic.md).
+var<private> per_opacity_unit: f32;
+var<private> texture_per_world: vec3<f32>;
+
+fn begin_path() {
+    per_opacity_unit = 1.0 / opacity_unit_world();
+    texture_per_world = vec3<f32>(1.0) / (2.0 * frame.half_extent.xyz);
+#if BLOCK_MAJORANTS
+    begin_blocks();
+#endif
+}
+
+// `texture_from_world` with the path's constants.
+fn path_texture(p: vec3<f32>) -> vec3<f32> {
+    return p * texture_per_world + vec3<f32>(0.5);
+}
+
 fn extinction_of(alpha: f32) -> f32 {
-    return -log(1.0 - clamp(alpha, 0.0, MAX_ALPHA)) / opacity_unit_world();
+    return -log(1.0 - clamp(alpha, 0.0, MAX_ALPHA)) * per_opacity_unit;
 }
 
 // σ and the TF colour at world point `p`.
 fn medium_at(p: vec3<f32>) -> vec4<f32> {
-    let u = texture_from_world(p);
+    let u = path_texture(p);
 #if FUSION
     // Several volumes: their combination at u (common/fusion.wgsl; opacity per opacity unit,
     // premultiplied: the straight colour is c / α) — for media in one place the extinctions add.
@@ -149,25 +168,51 @@ fn block_edge() -> u32 {
 // on, so rounding at a face never stalls a path. With MAJORANT_LEAP a path in an empty block
 // leaves the largest cube of empty blocks around it instead: one step where one per block took
 // dozens.
+// The block grids' constants, read once per path (`begin_path`).
+var<private> majorant_grid: BlockGrid;
+// A world voxel (half_extent.w), of which majorant_span looks a hundredth ahead.
+var<private> majorant_ahead: f32;
+#if MAJORANT_LEAP
+var<private> cube_grid: LeapGrid;
+#endif
+
+fn begin_blocks() {
+    majorant_grid = block_grid(textureDimensions(majorants), trace.block_size);
+    majorant_ahead = frame.half_extent.w;
+#if MAJORANT_LEAP
+    cube_grid = leap_grid();
+#endif
+}
+
+// Where the texture-space line o + t·d (t in world units along the path, d = w_tex) leaves the
+// box [lo, hi] it is in: the nearest far face, axes it runs parallel to never.
+fn exit_from(o: vec3<f32>, d: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> f32 {
+    let parallel = d == vec3<f32>(0.0);
+    let to_face = (select(lo, hi, d > vec3<f32>(0.0)) - o) / select(d, vec3<f32>(1.0), parallel);
+    let t = select(to_face, vec3<f32>(3.0e38), parallel);
+    return min(t.x, min(t.y, t.z));
+}
+
 fn majorant_span(p: vec3<f32>, w: vec3<f32>, t: f32, limit: f32) -> MajorantSpan {
-    let grid = block_grid(textureDimensions(majorants), trace.block_size);
-    let w_tex = w / (2.0 * frame.half_extent.xyz);
-    let ahead = 0.01 * frame.half_extent.w;
-    let u = texture_from_world(p + (t + ahead) * w);
+    let grid = majorant_grid;
+    let w_tex = w * texture_per_world;
+    let ahead = 0.01 * majorant_ahead;
+    let o = path_texture(p);
+    let u = o + (t + ahead) * w_tex;
     let b = block_at(u, grid);
     var lo = blocks_box_lo(b, grid);
     var hi = blocks_box_hi(b, grid);
     let alpha = textureSampleLevel(majorants, nearest_clamp, block_texel(b, grid), 0.0).r;
 #if MAJORANT_LEAP
     if (alpha == 0.0) {
-        let region = empty_region_at(u, leap_grid());
+        let region = empty_region_at(u, cube_grid);
         if (region.empty) {
             lo = region.lo;
             hi = region.hi;
         }
     }
 #endif
-    let leaves = box_span(texture_from_world(p), w_tex, lo, hi).y;
+    let leaves = exit_from(o, w_tex, lo, hi);
     return MajorantSpan(extinction_of(alpha), min(max(leaves, t + ahead), limit));
 }
 #else
@@ -441,6 +486,7 @@ fn trace_pixel(pixel: vec2<u32>) -> vec4<f32> {
 #if FUSION
     begin_fusion();
 #endif
+    begin_path();
     let ray = analytic_ray(pixel);
     if (!(ray.len > ray.begin)) {
         return vec4<f32>(0.0);

@@ -142,35 +142,34 @@ fn sample_label(u: vec3<f32>) -> u32 {
 #if LABELS_NEAREST
     return label_at((floor(p + vec3<f32>(0.5)) + vec3<f32>(0.5)) * label_inv_n);
 #else
-    // Inside one structure (or the background) the 8 corners hold one label: one read. (A GPU
-    // skips the 8 reads below for a warp that is all inside; llvmpipe runs both sides of every
-    // branch, masked, so there the reads' count and cost decide: bench/multi.md.)
+    // Inside one structure (or the background) the 8 corners hold one label: one read.
     let top = vec3<i32>(label_n) - vec3<i32>(1);
     let nearest = clamp(vec3<i32>(floor(p + vec3<f32>(0.5))), vec3<i32>(0), top);
     let uniform = textureLoad(label_blocks, nearest / UNIFORM_BLOCK, 0).r;
-    if (uniform != 0u) {
-        return uniform - 1u;
-    }
     let base = floor(p);
     let f = p - base;
     let g = vec3<f32>(1.0) - f;
     // Corner (0, 0, 0)'s centre; the others one texel further along each axis.
     let c = (base + vec3<f32>(0.5)) * label_inv_n;
     let t = label_inv_n;
-    // The 8 corners' labels and trilinear weights, corner (x, y, z) at x + 2y + 4z: vectors, not
-    // arrays (a private array costs every sample on llvmpipe, taken or not).
-    let la = vec4<u32>(
-        label_at(c),
-        label_at(c + vec3<f32>(t.x, 0.0, 0.0)),
-        label_at(c + vec3<f32>(0.0, t.y, 0.0)),
-        label_at(c + vec3<f32>(t.x, t.y, 0.0)),
-    );
-    let lb = vec4<u32>(
-        label_at(c + vec3<f32>(0.0, 0.0, t.z)),
-        label_at(c + vec3<f32>(t.x, 0.0, t.z)),
-        label_at(c + vec3<f32>(0.0, t.y, t.z)),
-        label_at(c + t),
-    );
+    // The 8 corners' labels, corner (x, y, z) at x + 2y + 4z of (la, lb): vectors, not arrays (a
+    // private array costs every sample on llvmpipe, taken or not). The reads are a loop that a
+    // sample inside one structure takes no turn of: llvmpipe runs both sides of every branch,
+    // masked, but leaves a loop once no lane of the SIMD group is in it — a group of samples all
+    // inside one structure then pays one turn instead of eight reads (a GPU skips them either
+    // way; bench/multi.md).
+    var la = vec4<u32>(0u);
+    var lb = vec4<u32>(0u);
+    let reads = select(8u, 0u, uniform != 0u);
+    for (var i = 0u; i < reads; i++) {
+        let corner = vec3<f32>(f32(i & 1u), f32((i >> 1u) & 1u), f32(i >> 2u));
+        let l = vec4<u32>(label_at(c + corner * t));
+        la = select(la, l, vec4<u32>(i) == vec4<u32>(0u, 1u, 2u, 3u));
+        lb = select(lb, l, vec4<u32>(i) == vec4<u32>(4u, 5u, 6u, 7u));
+    }
+    if (uniform != 0u) {
+        return uniform - 1u;
+    }
     let wa = vec4<f32>(g.x * g.y, f.x * g.y, g.x * f.y, f.x * f.y) * g.z;
     let wb = vec4<f32>(g.x * g.y, f.x * g.y, g.x * f.y, f.x * f.y) * f.z;
     // The nearest voxel's label holds the largest single weight: with more than half of the
@@ -180,11 +179,10 @@ fn sample_label(u: vec3<f32>) -> u32 {
     let nearest_label = select(la[k], lb[k], o.z == 1u);
     var best = nearest_label;
     var best_w = label_weight(nearest_label, la, lb, wa, wb);
-    if (best_w > 0.5) {
-        return best;
-    }
-    // Else every corner's label by its summed weight; a tie goes to the smaller label.
-    for (var i = 0u; i < 4u; i++) {
+    // Else every corner's label by its summed weight; a tie goes to the smaller label (a loop
+    // no lane takes a turn of where the nearest label won, for llvmpipe as above).
+    let turns = select(4u, 0u, best_w > 0.5);
+    for (var i = 0u; i < turns; i++) {
         let wi = label_weight(la[i], la, lb, wa, wb);
         if (wi > best_w || (wi == best_w && la[i] < best)) {
             best = la[i];

@@ -127,6 +127,10 @@ fn label_dims() -> vec3<i32> {
 // one-voxel apron hold one label, else 0 (volgraph_accel::labels::sample::uniform_blocks).
 @group(0) @binding(auto) var label_blocks: texture_3d<u32>;
 const UNIFORM_BLOCK: i32 = 4;
+// Per voxel (x, y, z) the labels of voxels (x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1) of
+// its slice, clamped at the faces (volgraph_accel::labels::sample::label_quads): a sample's 8
+// corners in two reads.
+@group(0) @binding(auto) var label_quads: texture_3d<u32>;
 #endif
 
 // The label value of the voxel whose centre is at texture point `at` (the sampler clamps to the
@@ -142,33 +146,33 @@ fn sample_label(u: vec3<f32>) -> u32 {
 #if LABELS_NEAREST
     return label_at((floor(p + vec3<f32>(0.5)) + vec3<f32>(0.5)) * label_inv_n);
 #else
-    // Inside one structure (or the background) the 8 corners hold one label: one read.
+    // Inside one structure (or the background) the 8 corners hold one label: one read. (A GPU
+    // skips the corners' reads below for a warp that is all inside; llvmpipe runs both sides of
+    // every branch, masked, so there the reads' count decides: bench/multi.md.)
     let top = vec3<i32>(label_n) - vec3<i32>(1);
     let nearest = clamp(vec3<i32>(floor(p + vec3<f32>(0.5))), vec3<i32>(0), top);
     let uniform = textureLoad(label_blocks, nearest / UNIFORM_BLOCK, 0).r;
+    if (uniform != 0u) {
+        return uniform - 1u;
+    }
     let base = floor(p);
     let f = p - base;
     let g = vec3<f32>(1.0) - f;
-    // Corner (0, 0, 0)'s centre; the others one texel further along each axis.
-    let c = (base + vec3<f32>(0.5)) * label_inv_n;
-    let t = label_inv_n;
-    // The 8 corners' labels, corner (x, y, z) at x + 2y + 4z of (la, lb): vectors, not arrays (a
-    // private array costs every sample on llvmpipe, taken or not). The reads are a loop that a
-    // sample inside one structure takes no turn of: llvmpipe runs both sides of every branch,
-    // masked, but leaves a loop once no lane of the SIMD group is in it — a group of samples all
-    // inside one structure then pays one turn instead of eight reads (a GPU skips them either
-    // way; bench/multi.md).
-    var la = vec4<u32>(0u);
-    var lb = vec4<u32>(0u);
-    let reads = select(8u, 0u, uniform != 0u);
-    for (var i = 0u; i < reads; i++) {
-        let corner = vec3<f32>(f32(i & 1u), f32((i >> 1u) & 1u), f32(i >> 2u));
-        let l = vec4<u32>(label_at(c + corner * t));
-        la = select(la, l, vec4<u32>(i) == vec4<u32>(0u, 1u, 2u, 3u));
-        lb = select(lb, l, vec4<u32>(i) == vec4<u32>(4u, 5u, 6u, 7u));
+    // The 8 corners' labels, corner (x, y, z) at x + 2y + 4z of (la, lb): the quads of the two
+    // slices at the low corner (clamped into the map). Below the low faces (p < 0) both corners
+    // of an axis are the face's voxel, as the clamped reads were: the quad's low entries twice.
+    let lo = clamp(vec3<i32>(base), vec3<i32>(0), top);
+    let z1 = min(lo.z + 1, top.z);
+    let low = base < vec3<f32>(0.0);
+    var la = textureLoad(label_quads, lo, 0);
+    var lb = textureLoad(label_quads, vec3<i32>(lo.xy, select(z1, lo.z, low.z)), 0);
+    if (low.x) {
+        la = la.xxzz;
+        lb = lb.xxzz;
     }
-    if (uniform != 0u) {
-        return uniform - 1u;
+    if (low.y) {
+        la = la.xyxy;
+        lb = lb.xyxy;
     }
     let wa = vec4<f32>(g.x * g.y, f.x * g.y, g.x * f.y, f.x * f.y) * g.z;
     let wb = vec4<f32>(g.x * g.y, f.x * g.y, g.x * f.y, f.x * f.y) * f.z;

@@ -288,9 +288,9 @@ pub struct FusionState {
     overlay: Option<Combine>,
     buffer: Option<wgpu::Buffer>,
     versions: Option<Vec<Option<u64>>>,
-    /// Smooth label sampling: the label map's uniform blocks (`label_blocks`), and the version
-    /// of the map they were made from.
-    blocks: Option<(wgpu::TextureView, Option<u64>)>,
+    /// Smooth label sampling: the label map's uniform blocks (`label_blocks`) and 2 × 2 quads
+    /// (`label_quads`), and the version of the map they were made from.
+    blocks: Option<(wgpu::TextureView, wgpu::TextureView, Option<u64>)>,
     smooth: bool,
 }
 
@@ -374,16 +374,25 @@ impl FusionState {
         }
     }
 
-    /// Makes the `label_blocks` texture of the label map on `port` when it changed.
+    /// Makes the `label_blocks` and `label_quads` textures of the label map on `port` when it
+    /// changed.
     fn update_blocks(&mut self, ctx: &RecordContext<'_>, port: &str) -> Result<(), PassError> {
         let version = ctx.input_version(port);
-        if self.blocks.as_ref().is_some_and(|(_, v)| *v == version) {
+        if self.blocks.as_ref().is_some_and(|(_, _, v)| *v == version) {
             return Ok(());
         }
-        let (dims, values) = volgraph_accel::labels::sample::uniform_blocks(ctx.voxels(port)?);
-        let texture = volgraph_core::runtime::upload::upload_u32_3d(ctx.gpu, "label_blocks", dims.to_array(), &values)
-            .map_err(|e| PassError { pass: ctx.label.to_string(), message: e.to_string() })?;
-        self.blocks = Some((texture.create_view(&wgpu::TextureViewDescriptor::default()), version));
+        let map = ctx.voxels(port)?;
+        let fault =
+            |e: volgraph_core::runtime::GpuFault| PassError { pass: ctx.label.to_string(), message: e.to_string() };
+        let (dims, values) = volgraph_accel::labels::sample::uniform_blocks(&map);
+        let blocks = volgraph_core::runtime::upload::upload_u32_3d(ctx.gpu, "label_blocks", dims.to_array(), &values)
+            .map_err(fault)?;
+        let quads = volgraph_accel::labels::sample::label_quads(&map);
+        let quads =
+            volgraph_core::runtime::upload::upload_label_quads(ctx.gpu, "label_quads", map.dims.to_array(), &quads)
+                .map_err(fault)?;
+        let view = |t: wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
+        self.blocks = Some((view(blocks), view(quads), version));
         Ok(())
     }
 
@@ -424,7 +433,12 @@ impl FusionState {
 
     /// The `fusion` binding.
     pub fn bindings(&self) -> Vec<(&'static str, wgpu::BindingResource<'_>)> {
-        let blocks = self.blocks.iter().map(|(view, _)| ("label_blocks", wgpu::BindingResource::TextureView(view)));
+        let blocks = self.blocks.iter().flat_map(|(blocks, quads, _)| {
+            [
+                ("label_blocks", wgpu::BindingResource::TextureView(blocks)),
+                ("label_quads", wgpu::BindingResource::TextureView(quads)),
+            ]
+        });
         self.buffer.iter().map(|b| ("fusion", b.as_entire_binding())).chain(blocks).collect()
     }
 }

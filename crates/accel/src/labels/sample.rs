@@ -100,6 +100,40 @@ pub fn uniform_blocks(volume: &Volume) -> (glam::UVec3, Vec<u32>) {
     (blocks, out)
 }
 
+/// Per voxel (x, y, z), the labels of the 2 × 2 voxels (x, y), (x + 1, y), (x, y + 1),
+/// (x + 1, y + 1) of its slice, clamped at the faces: a smooth sample's 8 corners are then two
+/// reads, one per slice (the GPU's `label_quads`, `shaders/common/fusion.wgsl`) instead of eight.
+/// The narrowest channels that hold the map's largest label: 4, 8 or 16 bytes a voxel.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LabelQuads {
+    /// Every label up to 255.
+    U8(Vec<[u8; 4]>),
+    /// Every label up to 65,535.
+    U16(Vec<[u16; 4]>),
+    /// Larger labels (a float map of whole numbers).
+    U32(Vec<[u32; 4]>),
+}
+
+/// [`LabelQuads`] of a label map, x fastest.
+pub fn label_quads(volume: &Volume) -> LabelQuads {
+    let n = volume.dims;
+    let labels: Vec<u32> = (0..volume.voxel_count()).map(|i| label_at(volume, i)).collect();
+    let quad = |x: u32, y: u32, z: u32| -> [u32; 4] {
+        let (x1, y1) = ((x + 1).min(n.x - 1), (y + 1).min(n.y - 1));
+        [(x, y), (x1, y), (x, y1), (x1, y1)].map(|(x, y)| labels[volume.index(x, y, z)])
+    };
+    let quads = (0..n.z).flat_map(|z| (0..n.y).flat_map(move |y| (0..n.x).map(move |x| (x, y, z))));
+    let quads: Vec<[u32; 4]> = quads.map(|(x, y, z)| quad(x, y, z)).collect();
+    let largest = labels.iter().copied().max().unwrap_or(0);
+    if largest <= u32::from(u8::MAX) {
+        LabelQuads::U8(quads.iter().map(|q| q.map(|l| l as u8)).collect())
+    } else if largest <= u32::from(u16::MAX) {
+        LabelQuads::U16(quads.iter().map(|q| q.map(|l| l as u16)).collect())
+    } else {
+        LabelQuads::U32(quads)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use glam::UVec3;
@@ -189,6 +223,27 @@ mod tests {
         // under the half voxel a nearest boundary can be off along an axis.
         assert!((smooth - 10.0).abs() < 0.35, "smooth boundary at {smooth}");
         assert!((9.0..11.0).contains(&nearest), "nearest boundary at {nearest}");
+    }
+
+    #[test]
+    fn a_voxels_quad_holds_its_slices_two_by_two_neighbours_clamped_at_the_faces() {
+        let v = map();
+        let LabelQuads::U8(quads) = label_quads(&v) else { panic!("labels up to 4 fit a byte") };
+        let label = |x: u32, y: u32, z: u32| v.raw_value(v.index(x.min(31), y.min(31), z)) as u8;
+        for (x, y, z) in [(16u32, 16u32, 16u32), (0, 0, 0), (31, 31, 31), (25, 16, 16), (31, 5, 7), (6, 31, 2)] {
+            let q = quads[v.index(x, y, z)];
+            assert_eq!(
+                q,
+                [label(x, y, z), label(x + 1, y, z), label(x, y + 1, z), label(x + 1, y + 1, z)],
+                "({x}, {y}, {z})"
+            );
+        }
+        // Wider labels take wider channels.
+        let mut wide = v.clone();
+        wide.data = VoxelData::U16((0..32u16 * 32 * 32).map(|i| i % 1000).collect());
+        assert!(matches!(label_quads(&wide), LabelQuads::U16(q) if q[0] == [0, 1, 32, 33]));
+        wide.data = VoxelData::F32((0..32 * 32 * 32).map(|i| if i == 5 { 70_000.0 } else { 0.0 }).collect());
+        assert!(matches!(label_quads(&wide), LabelQuads::U32(q) if q[4] == [0, 70_000, 0, 0]));
     }
 
     #[test]

@@ -229,6 +229,29 @@ pub fn upload_u32_3d(gpu: &Gpu, label: &str, dims: [u32; 3], values: &[u32]) -> 
     )
 }
 
+/// A label map's [`LabelQuads`](volgraph_accel::labels::sample::LabelQuads) as an unsigned
+/// integer 3D texture of its channels' width (`Rgba8Uint`, `Rgba16Uint` or `Rgba32Uint`; read as
+/// `texture_3d<u32>` alike): smooth label sampling's two reads a sample.
+pub fn upload_label_quads(
+    gpu: &Gpu,
+    label: &str,
+    dims: [u32; 3],
+    quads: &volgraph_accel::labels::sample::LabelQuads,
+) -> Result<wgpu::Texture, GpuFault> {
+    use volgraph_accel::labels::sample::LabelQuads;
+    let (format, bytes): (_, &[u8]) = match quads {
+        LabelQuads::U8(q) => (wgpu::TextureFormat::Rgba8Uint, bytemuck::cast_slice(q)),
+        LabelQuads::U16(q) => (wgpu::TextureFormat::Rgba16Uint, bytemuck::cast_slice(q)),
+        LabelQuads::U32(q) => (wgpu::TextureFormat::Rgba32Uint, bytemuck::cast_slice(q)),
+    };
+    texture_with(
+        gpu,
+        || format!("uploading \"{label}\" ({}x{}x{} {format:?})", dims[0], dims[1], dims[2]),
+        (label, dims, wgpu::TextureDimension::D3, format),
+        bytes,
+    )
+}
+
 /// `texels` (x fastest) as a filterable `Rgba16Float` 3D texture: derived fields in \[0, 1\] whose
 /// f16 step (≤ 2⁻¹¹ there) is below a 255th (the illumination volume of the `shadows` and
 /// `ambient_occlusion` effects, as the GPU's own dispatch writes it).

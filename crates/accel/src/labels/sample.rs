@@ -114,24 +114,34 @@ pub enum LabelQuads {
     U32(Vec<[u32; 4]>),
 }
 
-/// [`LabelQuads`] of a label map, x fastest.
+/// [`LabelQuads`] of a label map, x fastest, made in the narrowest width directly (a 512³ map's
+/// quads are 0.5 GiB of bytes; a u32 copy on the way would be 2 GiB).
 pub fn label_quads(volume: &Volume) -> LabelQuads {
-    let n = volume.dims;
-    let labels: Vec<u32> = (0..volume.voxel_count()).map(|i| label_at(volume, i)).collect();
-    let quad = |x: u32, y: u32, z: u32| -> [u32; 4] {
-        let (x1, y1) = ((x + 1).min(n.x - 1), (y + 1).min(n.y - 1));
-        [(x, y), (x1, y), (x, y1), (x1, y1)].map(|(x, y)| labels[volume.index(x, y, z)])
-    };
-    let quads = (0..n.z).flat_map(|z| (0..n.y).flat_map(move |y| (0..n.x).map(move |x| (x, y, z))));
-    let quads: Vec<[u32; 4]> = quads.map(|(x, y, z)| quad(x, y, z)).collect();
-    let largest = labels.iter().copied().max().unwrap_or(0);
+    let largest = (0..volume.voxel_count()).map(|i| label_at(volume, i)).max().unwrap_or(0);
     if largest <= u32::from(u8::MAX) {
-        LabelQuads::U8(quads.iter().map(|q| q.map(|l| l as u8)).collect())
+        LabelQuads::U8(quads_of(volume, |l| l as u8))
     } else if largest <= u32::from(u16::MAX) {
-        LabelQuads::U16(quads.iter().map(|q| q.map(|l| l as u16)).collect())
+        LabelQuads::U16(quads_of(volume, |l| l as u16))
     } else {
-        LabelQuads::U32(quads)
+        LabelQuads::U32(quads_of(volume, |l| l))
     }
+}
+
+fn quads_of<T: Copy>(volume: &Volume, narrow: impl Fn(u32) -> T) -> Vec<[T; 4]> {
+    let n = volume.dims;
+    let mut out = Vec::with_capacity(volume.voxel_count());
+    for z in 0..n.z {
+        for y in 0..n.y {
+            let y1 = (y + 1).min(n.y - 1);
+            for x in 0..n.x {
+                let x1 = (x + 1).min(n.x - 1);
+                out.push(
+                    [(x, y), (x1, y), (x, y1), (x1, y1)].map(|(x, y)| narrow(label_at(volume, volume.index(x, y, z)))),
+                );
+            }
+        }
+    }
+    out
 }
 
 #[cfg(test)]

@@ -123,10 +123,6 @@ fn label_dims() -> vec3<i32> {
 #if FUSION_LABEL_READS
 #if LABELS_NEAREST
 #else
-// Per block of UNIFORM_BLOCK³ voxels of the label map: its label + 1 where the block and a
-// one-voxel apron hold one label, else 0 (volgraph_accel::labels::sample::uniform_blocks).
-@group(0) @binding(auto) var label_blocks: texture_3d<u32>;
-const UNIFORM_BLOCK: i32 = 4;
 // Per voxel (x, y, z) the labels of voxels (x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1) of
 // its slice, clamped at the faces (volgraph_accel::labels::sample::label_quads): a sample's 8
 // corners in two reads.
@@ -146,15 +142,10 @@ fn sample_label(u: vec3<f32>) -> u32 {
 #if LABELS_NEAREST
     return label_at((floor(p + vec3<f32>(0.5)) + vec3<f32>(0.5)) * label_inv_n);
 #else
-    // Inside one structure (or the background) the 8 corners hold one label: one read. (A GPU
-    // skips the corners' reads below for a warp that is all inside; llvmpipe runs both sides of
-    // every branch, masked, so there the reads' count decides: bench/multi.md.)
+    // Two reads whatever the sample. (A first read of a 4³ block's label where it is uniform,
+    // tried, saved the two for samples inside a structure on a GPU's warps, but llvmpipe runs
+    // both sides of every branch: three reads a sample there, 11–20 % slower; bench/multi.md.)
     let top = vec3<i32>(label_n) - vec3<i32>(1);
-    let nearest = clamp(vec3<i32>(floor(p + vec3<f32>(0.5))), vec3<i32>(0), top);
-    let uniform = textureLoad(label_blocks, nearest / UNIFORM_BLOCK, 0).r;
-    if (uniform != 0u) {
-        return uniform - 1u;
-    }
     let base = floor(p);
     let f = p - base;
     let g = vec3<f32>(1.0) - f;

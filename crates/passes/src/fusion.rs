@@ -288,9 +288,9 @@ pub struct FusionState {
     overlay: Option<Combine>,
     buffer: Option<wgpu::Buffer>,
     versions: Option<Vec<Option<u64>>>,
-    /// Smooth label sampling: the label map's uniform blocks (`label_blocks`) and 2 × 2 quads
-    /// (`label_quads`), and the version of the map they were made from.
-    blocks: Option<(wgpu::TextureView, wgpu::TextureView, Option<u64>)>,
+    /// Smooth label sampling: the label map's 2 × 2 quads (`label_quads`), and the version of
+    /// the map they were made from.
+    quads: Option<(wgpu::TextureView, Option<u64>)>,
     smooth: bool,
 }
 
@@ -340,7 +340,7 @@ impl FusionState {
         let buffer = combine.map(|c| ctx.uniform_from_bytes("fusion", &FusionMap::identity(c).uniform_bytes()));
         let smooth = settings.label_filter == LabelFilterChoice::Smooth;
         let more = settings.scalar_partners().iter().skip(1).map(|(port, _)| *port).collect();
-        Ok(Self { combine, more, overlay: settings.overlay(), buffer, versions: None, blocks: None, smooth })
+        Ok(Self { combine, more, overlay: settings.overlay(), buffer, versions: None, quads: None, smooth })
     }
 
     /// [`Self::new`] for a raycaster whose empty-space skipping reads the frame volume alone
@@ -364,7 +364,7 @@ impl FusionState {
         Self::new(ctx)
     }
 
-    /// The port of the label map, when smooth label sampling reads its uniform blocks.
+    /// The port of the label map, when smooth label sampling reads its quads.
     fn label_map_port(&self) -> Option<&'static str> {
         match self.combine? {
             _ if !self.smooth => None,
@@ -374,32 +374,25 @@ impl FusionState {
         }
     }
 
-    /// Makes the `label_blocks` and `label_quads` textures of the label map on `port` when it
-    /// changed.
-    fn update_blocks(&mut self, ctx: &RecordContext<'_>, port: &str) -> Result<(), PassError> {
+    /// Makes the `label_quads` texture of the label map on `port` when it changed.
+    fn update_quads(&mut self, ctx: &RecordContext<'_>, port: &str) -> Result<(), PassError> {
         let version = ctx.input_version(port);
-        if self.blocks.as_ref().is_some_and(|(_, _, v)| *v == version) {
+        if self.quads.as_ref().is_some_and(|(_, v)| *v == version) {
             return Ok(());
         }
         let map = ctx.voxels(port)?;
-        let fault =
-            |e: volgraph_core::runtime::GpuFault| PassError { pass: ctx.label.to_string(), message: e.to_string() };
-        let (dims, values) = volgraph_accel::labels::sample::uniform_blocks(&map);
-        let blocks = volgraph_core::runtime::upload::upload_u32_3d(ctx.gpu, "label_blocks", dims.to_array(), &values)
-            .map_err(fault)?;
         let quads = volgraph_accel::labels::sample::label_quads(&map);
-        let quads =
+        let texture =
             volgraph_core::runtime::upload::upload_label_quads(ctx.gpu, "label_quads", map.dims.to_array(), &quads)
-                .map_err(fault)?;
-        let view = |t: wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
-        self.blocks = Some((view(blocks), view(quads), version));
+                .map_err(|e| PassError { pass: ctx.label.to_string(), message: e.to_string() })?;
+        self.quads = Some((texture.create_view(&wgpu::TextureViewDescriptor::default()), version));
         Ok(())
     }
 
     /// Writes the uniform when the bound volumes changed.
     pub fn update(&mut self, ctx: &RecordContext<'_>) -> Result<(), PassError> {
         if let Some(port) = self.label_map_port() {
-            self.update_blocks(ctx, port)?;
+            self.update_quads(ctx, port)?;
         }
         let (Some(combine), Some(buffer)) = (self.combine, &self.buffer) else { return Ok(()) };
         let versions: Vec<Option<u64>> = ["volume", "second", "overlay"]
@@ -433,12 +426,7 @@ impl FusionState {
 
     /// The `fusion` binding.
     pub fn bindings(&self) -> Vec<(&'static str, wgpu::BindingResource<'_>)> {
-        let blocks = self.blocks.iter().flat_map(|(blocks, quads, _)| {
-            [
-                ("label_blocks", wgpu::BindingResource::TextureView(blocks)),
-                ("label_quads", wgpu::BindingResource::TextureView(quads)),
-            ]
-        });
-        self.buffer.iter().map(|b| ("fusion", b.as_entire_binding())).chain(blocks).collect()
+        let quads = self.quads.iter().map(|(view, _)| ("label_quads", wgpu::BindingResource::TextureView(view)));
+        self.buffer.iter().map(|b| ("fusion", b.as_entire_binding())).chain(quads).collect()
     }
 }

@@ -140,7 +140,7 @@ fn reprojects(params: &Params) -> bool {
 fn shader(params: &Params) -> ShaderUse {
     crate::fusion::with_fusion_uniform(
         ShaderUse::new("path_trace.wgsl", "cs_path_trace")
-            .binds(&["label_blocks", "label_quads"])
+            .binds(&["label_quads"])
             .uniform(PathTraceParams::bound_as("trace")),
         params,
     )

@@ -22,7 +22,7 @@ use volgraph_compiler::ShaderUse;
 /// raycaster's `fusion` uniform and label blocks.
 pub fn light_shader_use(params: &volgraph_compiler::Params) -> ShaderUse {
     crate::fusion::with_fusion_uniform(
-        ShaderUse::new("light_volume.wgsl", "cs_light_volume").binds(&["light_out", "label_blocks", "label_quads"]),
+        ShaderUse::new("light_volume.wgsl", "cs_light_volume").binds(&["light_out", "label_quads"]),
         params,
     )
 }

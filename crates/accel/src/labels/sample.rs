@@ -70,36 +70,6 @@ pub fn sample_label(volume: &Volume, u: DVec3, filter: LabelFilter) -> (u32, f64
         .fold((u32::MAX, -1.0), |best, (l, w)| if w > best.1 || (w == best.1 && l < best.0) { (l, w) } else { best })
 }
 
-/// Voxels per block edge of [`uniform_blocks`].
-pub const UNIFORM_BLOCK: u32 = 4;
-
-/// Per block of [`UNIFORM_BLOCK`]³ voxels, the label plus one where the block and a one-voxel
-/// apron around it (clamped at the faces) hold a single label, else 0: a smooth sample whose
-/// nearest voxel lies in such a block reads only voxels of that label (its 8 corners lie within
-/// one voxel of the nearest), so it is that label without the 8 reads. The GPU's label sampling
-/// looks here first (`shaders/common/fusion.wgsl`); most samples of a segmentation lie inside
-/// one structure or in the background. Returns the blocks per axis and the values, x fastest.
-pub fn uniform_blocks(volume: &Volume) -> (glam::UVec3, Vec<u32>) {
-    let n = volume.dims;
-    let blocks = (n + glam::UVec3::splat(UNIFORM_BLOCK - 1)) / UNIFORM_BLOCK;
-    let mut out = Vec::with_capacity((blocks.x * blocks.y * blocks.z) as usize);
-    for bz in 0..blocks.z {
-        for by in 0..blocks.y {
-            for bx in 0..blocks.x {
-                let b = glam::UVec3::new(bx, by, bz);
-                let lo = (b * UNIFORM_BLOCK).saturating_sub(glam::UVec3::ONE);
-                let hi = ((b + 1) * UNIFORM_BLOCK + 1).min(n);
-                let first = label_at(volume, volume.index(lo.x, lo.y, lo.z));
-                let uniform = (lo.z..hi.z).all(|z| {
-                    (lo.y..hi.y).all(|y| (lo.x..hi.x).all(|x| label_at(volume, volume.index(x, y, z)) == first))
-                });
-                out.push(if uniform { first.saturating_add(1) } else { 0 });
-            }
-        }
-    }
-    (blocks, out)
-}
-
 /// Per voxel (x, y, z), the labels of the 2 × 2 voxels (x, y), (x + 1, y), (x, y + 1),
 /// (x + 1, y + 1) of its slice, clamped at the faces: a smooth sample's 8 corners are then two
 /// reads, one per slice (the GPU's `label_quads`, `shaders/common/fusion.wgsl`) instead of eight.
@@ -254,31 +224,5 @@ mod tests {
         assert!(matches!(label_quads(&wide), LabelQuads::U16(q) if q[0] == [0, 1, 32, 33]));
         wide.data = VoxelData::F32((0..32 * 32 * 32).map(|i| if i == 5 { 70_000.0 } else { 0.0 }).collect());
         assert!(matches!(label_quads(&wide), LabelQuads::U32(q) if q[4] == [0, 70_000, 0, 0]));
-    }
-
-    #[test]
-    fn a_uniform_block_is_its_label_wherever_smooth_sampling_looks() {
-        let v = map();
-        let (blocks, values) = uniform_blocks(&v);
-        assert_eq!(blocks, UVec3::splat(8));
-        // The centre of the sphere and a corner of the background are uniform, a block on the
-        // sphere's surface is not.
-        let at = |b: UVec3| values[(b.x + 8 * (b.y + 8 * b.z)) as usize];
-        assert_eq!(at(UVec3::splat(4)), 3, "label 2 inside the sphere");
-        assert_eq!(at(UVec3::ZERO), 1, "background");
-        assert_eq!(at(UVec3::new(1, 4, 4)), 0, "the sphere's surface");
-        // Everywhere a uniform block says a label, smooth sampling gives it.
-        for k in 0..20_000u32 {
-            let u = DVec3::new(
-                (k as f64 * 0.754_877_666).fract(),
-                (k as f64 * 0.569_840_291).fract(),
-                (k as f64 * 0.362_425_6).fract(),
-            );
-            let c = (u * 32.0).floor().min(DVec3::splat(31.0)).as_uvec3();
-            let b = at(c / UNIFORM_BLOCK);
-            if b != 0 {
-                assert_eq!(sample_label(&v, u, LabelFilter::Smooth).0, b - 1, "{u}");
-            }
-        }
     }
 }

@@ -142,9 +142,9 @@ fn sample_label(u: vec3<f32>) -> u32 {
 #if LABELS_NEAREST
     return label_at((floor(p + vec3<f32>(0.5)) + vec3<f32>(0.5)) * label_inv_n);
 #else
-    // Two reads whatever the sample. (A first read of a 4³ block's label where it is uniform,
-    // tried, saved the two for samples inside a structure on a GPU's warps, but llvmpipe runs
-    // both sides of every branch: three reads a sample there, 11–20 % slower; bench/multi.md.)
+    // Two reads whatever the sample. (A first read of a 4³ block's label where it is uniform
+    // would spare a GPU's warps inside a structure the two, but llvmpipe runs both sides of
+    // every branch: three reads a sample there, tried, 11–20 % slower; bench/multi.md.)
     let top = vec3<i32>(label_n) - vec3<i32>(1);
     let base = floor(p);
     let f = p - base;
@@ -157,14 +157,10 @@ fn sample_label(u: vec3<f32>) -> u32 {
     let low = base < vec3<f32>(0.0);
     var la = textureLoad(label_quads, lo, 0);
     var lb = textureLoad(label_quads, vec3<i32>(lo.xy, select(z1, lo.z, low.z)), 0);
-    if (low.x) {
-        la = la.xxzz;
-        lb = lb.xxzz;
-    }
-    if (low.y) {
-        la = la.xyxy;
-        lb = lb.xyxy;
-    }
+    la = select(la, la.xxzz, low.x);
+    lb = select(lb, lb.xxzz, low.x);
+    la = select(la, la.xyxy, low.y);
+    lb = select(lb, lb.xyxy, low.y);
     let wa = vec4<f32>(g.x * g.y, f.x * g.y, g.x * f.y, f.x * f.y) * g.z;
     let wb = vec4<f32>(g.x * g.y, f.x * g.y, g.x * f.y, f.x * f.y) * f.z;
     // The nearest voxel's label holds the largest single weight: with more than half of the

@@ -218,17 +218,6 @@ fn upload_rgba(
     )
 }
 
-/// `values` (x fastest) as an `R32Uint` 3D texture of `dims`, read with `textureLoad`: per-block
-/// tables a pass derives from a volume (a label map's uniform blocks).
-pub fn upload_u32_3d(gpu: &Gpu, label: &str, dims: [u32; 3], values: &[u32]) -> Result<wgpu::Texture, GpuFault> {
-    texture_with(
-        gpu,
-        || format!("uploading \"{label}\" ({}x{}x{} u32)", dims[0], dims[1], dims[2]),
-        (label, dims, wgpu::TextureDimension::D3, wgpu::TextureFormat::R32Uint),
-        bytemuck::cast_slice(values),
-    )
-}
-
 /// A label map's [`LabelQuads`](volgraph_accel::labels::sample::LabelQuads) as an unsigned
 /// integer 3D texture of its channels' width (`Rgba8Uint`, `Rgba16Uint` or `Rgba32Uint`; read as
 /// `texture_3d<u32>` alike): smooth label sampling's two reads a sample.

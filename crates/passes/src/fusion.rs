@@ -337,6 +337,17 @@ impl FusionState {
                 ),
             });
         }
+        if combine.is_some() && crate::effects::EffectFlags::of(ctx.params).preintegration {
+            return Err(PassError {
+                pass: ctx.pass_id.to_string(),
+                message: format!(
+                    "preintegration integrates one transfer function between two samples of one volume, and fusion \"{}\" \
+                     classifies several volumes at each sample: turn preintegration off here (a smaller step_voxels \
+                     sharpens thin features instead)",
+                    settings.fusion.name()
+                ),
+            });
+        }
         let buffer = combine.map(|c| ctx.uniform_from_bytes("fusion", &FusionMap::identity(c).uniform_bytes()));
         let smooth = settings.label_filter == LabelFilterChoice::Smooth;
         let more = settings.scalar_partners().iter().skip(1).map(|(port, _)| *port).collect();

@@ -601,6 +601,21 @@ fn an_overlay_without_a_fused_pair_is_refused() {
     assert!(err.contains("channels 3 are scalar volumes fused with the volume"), "{err}");
 }
 
+/// Pre-integration is of one TF over a segment of one volume: with several volumes it was left
+/// out without a word (the image drawn by samples); now it is refused by name, in every family
+/// that takes both.
+#[test]
+fn preintegration_with_several_volumes_is_refused() {
+    let (ct, labels) = (organs_ct(16), organs_labels(16));
+    let graph = "multi/ct_with_labels.ron";
+    for kind in ["raycast_compute", "raycast"] {
+        let source = graph_source(graph).replace("kind: \"raycast_compute\"", &format!("kind: \"{kind}\""));
+        let options = CompileOptions::new(SIZE, SIZE).with_param("march", "preintegration", true);
+        let err = refusal((graph, &source), &options, &[("volume", &ct), ("labels", &labels)]);
+        assert!(err.contains("turn preintegration off") && err.contains("fusion \"tint\""), "{kind}: {err}");
+    }
+}
+
 /// A refused value of a parameter that picks the ports is the one error: the wiring it leaves
 /// unmatched (`overlay`, `label_table` at the default) is not reported on top of it.
 #[test]

@@ -231,20 +231,30 @@ fn fused_sample(u: vec3<f32>, s: f32) -> vec4<f32> {
     let uv = volume_position(u);
     let u2 = uv * fusion_scale + fusion_offset;
 #if FUSION_LABEL_MAP
+    // The scan's straight colour and corrected opacity: its TF at s, or with PREINTEGRATION the
+    // segment from the previous sample to this one (volgraph_accel::fusion::classify_scan).
+#if PREINTEGRATION
+    let segment = lookup_preintegrated(ray_prev_scalar, s);
+    ray_prev_scalar = s;
+    let scan = vec4<f32>(select(vec3<f32>(0.0), segment.rgb / segment.a, segment.a > 0.0), segment.a);
+#else
+    let scan = vec4<f32>(c.rgb, corrected_alpha(c.a));
+#endif
     // Where the scan is clear the label changes nothing (tint and inside keep its opacity).
-    if (!(c.a > 0.0)) {
+    if (!(scan.a > 0.0)) {
         return vec4<f32>(0.0);
     }
     let e = label_entry_at(u2);
     let visible = e.a > 0.0;
     if (fusion_combine == COMBINE_INSIDE) {
-        return premultiplied(c.rgb, select(0.0, c.a, visible));
+        let a = select(0.0, scan.a, visible);
+        return vec4<f32>(scan.rgb * a, a);
     }
-    var rgb = c.rgb;
+    var rgb = scan.rgb;
     if (visible) {
-        rgb = mix(c.rgb, e.rgb, min(e.a, 1.0));
+        rgb = mix(scan.rgb, e.rgb, min(e.a, 1.0));
     }
-    return premultiplied(rgb, c.a);
+    return vec4<f32>(rgb * scan.a, scan.a);
 #endif
 #if FUSION_SCALAR
     // Past the frame volume's box (rays cross every scalar volume's) it adds nothing.

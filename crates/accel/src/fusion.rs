@@ -243,10 +243,29 @@ impl Fusion<'_> {
     /// point `u`, where the frame volume's field is `s` and its TF `lut`; `exponent` is the
     /// correction's (step over opacity unit). Shading, when on, is applied by the caller.
     pub fn classify(&self, first: &Volume, lut: &[[f32; 4]], u: DVec3, s: f64, exponent: f64) -> [f64; 4] {
+        self.classify_scan(first, lut, u, s, exponent, None)
+    }
+
+    /// [`Self::classify`] where the scan's own sample is `scan` (premultiplied and corrected: the
+    /// pre-integrated segment ending at this sample) instead of its TF at `s` — for `tint` and
+    /// `inside`, whose opacity is the scan's: the label tints or masks the segment.
+    pub fn classify_scan(
+        &self,
+        first: &Volume,
+        lut: &[[f32; 4]],
+        u: DVec3,
+        s: f64,
+        exponent: f64,
+        scan: Option<[f64; 4]>,
+    ) -> [f64; 4] {
         let premultiplied = |c: [f64; 3], a: f64| [c[0] * a, c[1] * a, c[2] * a, a];
-        let through = |lut: &[[f32; 4]], s: f64| {
-            let c = lut_sample(lut, s);
-            ([c[0], c[1], c[2]], corrected_alpha(c[3], exponent))
+        let through = |lut: &[[f32; 4]], s: f64| match scan {
+            Some(p) if p[3] > 0.0 => ([p[0] / p[3], p[1] / p[3], p[2] / p[3]], p[3]),
+            Some(_) => ([0.0; 3], 0.0),
+            None => {
+                let c = lut_sample(lut, s);
+                ([c[0], c[1], c[2]], corrected_alpha(c[3], exponent))
+            }
         };
         if self.combine == Combine::Labels {
             let (label, _) = sample_label(first, u, self.filter);

@@ -338,8 +338,11 @@ impl<'a> March<'a> {
     fn classify(&self, t: f64, s: f64, s_prev: f64) -> [f64; 4] {
         let exponent = self.settings.step_exponent();
         let mut p = if let Some(fusion) = self.fusion {
-            // Several volumes: classified and combined per sample (pre-integration is of one TF).
-            fusion.classify(self.volume, self.lut, self.seg.u0 + t * self.seg.d_tex, s, exponent)
+            // Several volumes: classified and combined per sample; with pre-integration the
+            // scan's segment is tinted or masked by the label (`tint`, `inside`; the raycasters
+            // refuse it with the others).
+            let scan = self.settings.effects.preintegration.then(|| preintegrate(self.lut, s_prev, s, exponent));
+            fusion.classify_scan(self.volume, self.lut, self.seg.u0 + t * self.seg.d_tex, s, exponent, scan)
         } else if self.settings.effects.preintegration {
             preintegrate(self.lut, s_prev, s, exponent)
         } else {
@@ -380,11 +383,8 @@ impl<'a> March<'a> {
         let mut k = self.k0;
         // Pre-integration: the front value of the first sample's segment is the field one step
         // before it.
-        let mut s_prev = if self.settings.effects.preintegration && self.fusion.is_none() {
-            self.sample(self.t(k) - self.step_tex)
-        } else {
-            0.0
-        };
+        let mut s_prev =
+            if self.settings.effects.preintegration { self.sample(self.t(k) - self.step_tex) } else { 0.0 };
         while k < self.settings.max_steps {
             let t = self.t(k);
             if t >= self.end_tex {

@@ -337,13 +337,18 @@ impl FusionState {
                 ),
             });
         }
-        if combine.is_some() && crate::effects::EffectFlags::of(ctx.params).preintegration {
+        // Pre-integration is of one TF over a segment of one volume: the scan's segment can be
+        // tinted or masked by a label map (its opacity stays the scan's), not combined with
+        // another volume's or made of label numbers.
+        if combine.is_some_and(|c| !matches!(c, Combine::Tint | Combine::Inside))
+            && crate::effects::EffectFlags::of(ctx.params).preintegration
+        {
             return Err(PassError {
                 pass: ctx.pass_id.to_string(),
                 message: format!(
                     "preintegration integrates one transfer function between two samples of one volume, and fusion \"{}\" \
-                     classifies several volumes at each sample: turn preintegration off here (a smaller step_voxels \
-                     sharpens thin features instead)",
+                     classifies several volumes (or label numbers) at each sample: turn preintegration off here, or use \
+                     fusion \"tint\" or \"inside\", which pre-integrate the scan and colour or mask it by its labels",
                     settings.fusion.name()
                 ),
             });

@@ -422,6 +422,8 @@ fn the_brick_pool_tints_the_scan_by_its_labels() {
     let graph = "ruijters_vilanova_2006/bricks_with_labels.ron";
     check("bricks_tint", &scene, graph, &[], &[("brick_cells", "16")]);
     check("bricks_inside_shaded", &scene, graph, &["shading"], &[("brick_cells", "16"), ("fusion", "inside")]);
+    // Pre-integration across brick faces: the front value read where the run resumes.
+    check("bricks_tint_preintegrated", &scene, graph, &["preintegration"], &[("brick_cells", "16")]);
     let options = CompileOptions::new(SIZE, SIZE).with_param("march", "fusion", "fuse");
     let source = graph_source(graph).replace(r#""label_table": "input.label_table","#, r#""second_tf": "input.tf","#);
     let err = refusal((graph, &source), &options, &[("volume", &ct), ("labels", &labels)]);
@@ -459,6 +461,8 @@ fn ray_segments_tint_the_scan_by_its_labels() {
     assert!(source.contains(r#""second": "input.labels""#), "the segment pass is wired to the label map");
     check_source("segments_tint", &scene, graph, &source, &[], &[]);
     check_source("segments_inside_shaded", &scene, graph, &source, &["shading"], &[("fusion", "inside")]);
+    // Pre-integration carries the segment's front value from one pass to the next.
+    check_source("segments_tint_preintegrated", &scene, graph, &source, &["preintegration"], &[]);
     let registry = builtin_registry();
     let options = CompileOptions::new(SIZE, SIZE).with_param("march", "fusion", "labels");
     let plan = volgraph_core::compile(graph, &source.replace(r#""second": "input.labels", "#, ""), &registry, &options)
@@ -601,18 +605,57 @@ fn an_overlay_without_a_fused_pair_is_refused() {
     assert!(err.contains("channels 3 are scalar volumes fused with the volume"), "{err}");
 }
 
-/// Pre-integration is of one TF over a segment of one volume: with several volumes it was left
-/// out without a word (the image drawn by samples); now it is refused by name, in every family
-/// that takes both.
+/// Pre-integration with a label map: the scan's segment from the previous sample to this one
+/// (its pre-integrated colour and opacity) tinted by the label there, or kept only inside a
+/// visible label — GPU against the reference, which classifies the same segments, in the compute
+/// and the fragment raycaster. (Before, the GPU left pre-integration out without a word.)
 #[test]
-fn preintegration_with_several_volumes_is_refused() {
+fn the_scan_preintegrated_tinted_and_inside_its_labels() {
+    let (ct, labels) = (organs_ct(N), organs_labels(N));
+    let (lut, table) = (ct_lut(&ct), table());
+    let scene = Scene::scan_and_labels(&ct, &lut, &labels, &table);
+    let tinted = check("ct_with_labels_preintegrated", &scene, "multi/ct_with_labels.ron", &["preintegration"], &[]);
+    check(
+        "ct_inside_labels_preintegrated_shaded",
+        &scene,
+        "multi/ct_inside_labels.ron",
+        &["preintegration", "shading"],
+        &[],
+    );
+    let fragment = graph_source("multi/ct_with_labels.ron").replace("kind: \"raycast_compute\"", "kind: \"raycast\"");
+    check_source(
+        "ct_with_labels_preintegrated_fragment",
+        &scene,
+        "multi/ct_with_labels_fragment.ron",
+        &fragment,
+        &["preintegration"],
+        &[],
+    );
+    // Pre-integration changes the image (the organ CT's TF has edges a half-voxel step blurs).
+    let (plain, _) = render("multi/ct_with_labels.ron", &scene, &[], &[]);
+    let moved = (0..SIZE * SIZE).filter(|i| {
+        let (a, b) = (tinted.rgba(i % SIZE, i / SIZE), plain.rgba(i % SIZE, i / SIZE));
+        (0..4).any(|c| (a[c] - b[c]).abs() > 2.0 / 255.0)
+    });
+    assert!(moved.count() > 0, "pre-integration changed nothing");
+}
+
+/// Pre-integration is of one TF over a segment of one volume: a fusion of several scalar volumes
+/// or a label map alone refuses it by name, in every family that takes both.
+#[test]
+fn preintegration_of_several_scalar_volumes_is_refused() {
     let (ct, labels) = (organs_ct(16), organs_labels(16));
-    let graph = "multi/ct_with_labels.ron";
+    let pet = coarse_pet(&ct);
     for kind in ["raycast_compute", "raycast"] {
-        let source = graph_source(graph).replace("kind: \"raycast_compute\"", &format!("kind: \"{kind}\""));
         let options = CompileOptions::new(SIZE, SIZE).with_param("march", "preintegration", true);
-        let err = refusal((graph, &source), &options, &[("volume", &ct), ("labels", &labels)]);
-        assert!(err.contains("turn preintegration off") && err.contains("fusion \"tint\""), "{kind}: {err}");
+        let graph = "multi/pet_ct.ron";
+        let source = graph_source(graph).replace("kind: \"raycast_compute\"", &format!("kind: \"{kind}\""));
+        let err = refusal((graph, &source), &options, &[("volume", &ct), ("pet", &pet)]);
+        assert!(err.contains("turn preintegration off") && err.contains("fusion \"fuse\""), "{kind}: {err}");
+        let graph = "multi/labels.ron";
+        let source = graph_source(graph).replace("kind: \"raycast_compute\"", &format!("kind: \"{kind}\""));
+        let err = refusal((graph, &source), &options, &[("volume", &labels)]);
+        assert!(err.contains("turn preintegration off") && err.contains("fusion \"labels\""), "{kind}: {err}");
     }
 }
 

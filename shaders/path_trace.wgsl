@@ -51,7 +51,7 @@ const MAX_TRACKING_STEPS: u32 = 65536u;
 // Russian roulette spares a path whose largest throughput channel is at least this; a dimmer
 // one goes on with probability (that channel / RR_LEVEL). At 1 (every path from the second
 // scattering on) it added 7 % to the noise of a sample on the engine and saved no time, since
-// paths end after `bounces` anyway; at 0.25 the noise is the same as without it (bench/cinematic.md).
+// paths end after `bounces` anyway; at 0.25 the noise is the same as without it (docs/accuracy.md).
 const RR_LEVEL: f32 = 0.25;
 const PI: f32 = 3.14159265358979;
 
@@ -89,8 +89,8 @@ fn opacity_unit_world() -> f32 {
 }
 
 // The frame's constants the tracking loops use, read once per path (`begin_path`): on llvmpipe
-// a uniform read or a texture's size inside a loop is repeated at every step (a sample's time
-// 59 → 50 ms on the engine, bench/cinematic.md).
+// a uniform read or a texture's size inside a loop is repeated at every step (with the block
+// grids' below, 10 % of a sample's time on the engine; docs/accuracy.md).
 var<private> per_opacity_unit: f32;
 var<private> texture_per_world: vec3<f32>;
 
@@ -162,12 +162,6 @@ fn block_edge() -> u32 {
 #import "common/empty_cubes.wgsl"
 #endif
 
-// The block the path p + t·w is in at `t` — looked up a hundredth of a voxel ahead, so a path
-// on a face takes the block it enters (the grid's one-voxel apron covers the difference) — its
-// majorant and where the path leaves it, capped at `limit`; at least that hundredth of a voxel
-// on, so rounding at a face never stalls a path. With MAJORANT_LEAP a path in an empty block
-// leaves the largest cube of empty blocks around it instead: one step where one per block took
-// dozens.
 // The block grids' constants, read once per path (`begin_path`).
 var<private> majorant_grid: BlockGrid;
 // A world voxel (half_extent.w), of which majorant_span looks a hundredth ahead.
@@ -184,15 +178,12 @@ fn begin_blocks() {
 #endif
 }
 
-// Where the texture-space line o + t·d (t in world units along the path, d = w_tex) leaves the
-// box [lo, hi] it is in: the nearest far face, axes it runs parallel to never.
-fn exit_from(o: vec3<f32>, d: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> f32 {
-    let parallel = d == vec3<f32>(0.0);
-    let to_face = (select(lo, hi, d > vec3<f32>(0.0)) - o) / select(d, vec3<f32>(1.0), parallel);
-    let t = select(to_face, vec3<f32>(3.0e38), parallel);
-    return min(t.x, min(t.y, t.z));
-}
-
+// The block the path p + t·w is in at `t` — looked up a hundredth of a voxel ahead, so a path
+// on a face takes the block it enters (the grid's one-voxel apron covers the difference) — its
+// majorant and where the path leaves it, capped at `limit`; at least that hundredth of a voxel
+// on, so rounding at a face never stalls a path. With MAJORANT_LEAP a path in an empty block
+// leaves the largest cube of empty blocks around it instead: one step where one per block took
+// dozens.
 fn majorant_span(p: vec3<f32>, w: vec3<f32>, t: f32, limit: f32) -> MajorantSpan {
     let grid = majorant_grid;
     let w_tex = w * texture_per_world;
@@ -212,7 +203,7 @@ fn majorant_span(p: vec3<f32>, w: vec3<f32>, t: f32, limit: f32) -> MajorantSpan
         }
     }
 #endif
-    let leaves = exit_from(o, w_tex, lo, hi);
+    let leaves = box_exit_by(o, step_exit(w_tex), lo, hi);
     return MajorantSpan(extinction_of(alpha), min(max(leaves, t + ahead), limit));
 }
 #else
@@ -542,9 +533,9 @@ fn trace_pixel(pixel: vec2<u32>) -> vec4<f32> {
         }
         // Russian roulette from the second scattering on (unbiased): the path goes on with
         // probability q, its largest throughput channel over RR_LEVEL (between 1/20 and 1), and
-        // its throughput is divided by q — dim paths end early, and no channel's throughput
-        // exceeds RR_LEVEL after the division, so the furnace and energy bounds hold sample by
-        // sample.
+        // its throughput is divided by q — dim paths end early, and a divided throughput stays
+        // below RR_LEVEL, so no channel exceeds 1 and the furnace and energy bounds hold sample
+        // by sample.
         if (bounce >= 1u && trace.russian_roulette == 1u) {
             let q = clamp(max(throughput.r, max(throughput.g, throughput.b)) / RR_LEVEL, 0.05, 1.0);
             if (random() >= q) {

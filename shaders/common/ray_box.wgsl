@@ -301,8 +301,15 @@ fn step_exit(delta: vec3<f32>) -> StepExit {
 // covers it (common/block_grid.wgsl); a brick's run may end a sample early or late, which its
 // slot's one-voxel border covers (raycast_bricks.wgsl).
 fn past_box_by(k: u32, p: vec3<f32>, step: StepExit, lo: vec3<f32>, hi: vec3<f32>) -> u32 {
+    let steps = box_exit_by(p, step, lo, hi);
+    return k + max(1u, u32(clamp(floor(steps) + 1.0, 0.0, 16777216.0)));
+}
+
+// Where the line p + x·delta leaves the box [lo, hi] it is in, in steps x: its nearest far face
+// (axes it runs parallel to never bound it). `past_box_by`'s samples, and the path tracer's
+// distance to a block's faces (path_trace.wgsl), whose `delta` is a unit of world length.
+fn box_exit_by(p: vec3<f32>, step: StepExit, lo: vec3<f32>, hi: vec3<f32>) -> f32 {
     let bound = select(lo, hi, step.positive);
     let x = select((bound - p) * step.inverse, vec3<f32>(3.0e38), step.parallel);
-    let steps = min(x.x, min(x.y, x.z));
-    return k + max(1u, u32(clamp(floor(steps) + 1.0, 0.0, 16777216.0)));
+    return min(x.x, min(x.y, x.z));
 }

@@ -136,7 +136,7 @@ fn reprojects(params: &Params) -> bool {
 }
 
 /// Its one pipeline, declared once; with several volumes (`fusion`) it reads their combination
-/// through the `fusion` uniform and label blocks, as the raycasters do.
+/// through the `fusion` uniform and label quads, as the raycasters do.
 fn shader(params: &Params) -> ShaderUse {
     crate::fusion::with_fusion_uniform(
         ShaderUse::new("path_trace.wgsl", "cs_path_trace")

@@ -328,7 +328,7 @@ fn range_apron(effects: EffectFlags) -> u32 {
 struct RaycastBricksNode {
     /// The pre-integration table when that effect is on.
     effects: EffectState,
-    /// Several volumes: the fusion uniform and a label map's uniform blocks.
+    /// Several volumes: the fusion uniform and a label map's quads.
     fusion: crate::fusion::FusionState,
     step_voxels: f64,
     /// The effects compiled in ([`apron`], [`range_apron`]).

@@ -185,8 +185,8 @@ impl PassPlugin for RaycastCompute {
         // The square-root variant, for frames whose correction exponent is exactly 0.5 (step
         // 0.5 with opacity per voxel): DVR through the exact correction only. Built whatever the
         // step now, so the step can change in place (`updates_in_place`): a rebuilt node would
-        // also remake what it derives from its inputs (a label map's uniform blocks: 40 ms of a
-        // 256³ map on this machine's CPU).
+        // also remake what it derives from its inputs (a label map's quads, made on the CPU
+        // from the whole map).
         let exact = table.is_none() && !EffectFlags::of(ctx.params).preintegration && !is_iso(ctx.params);
         let half_step = exact.then(|| variant(true)).transpose()?;
         let params = ctx.uniform_from_bytes("params", &RaycastParamsGpu::of(ctx.params).uniform_bytes());

@@ -326,7 +326,7 @@ struct RaycastSegmentNode {
     invocations: Option<wgpu::Buffer>,
     /// The pre-integration table when that effect is on.
     effects: EffectState,
-    /// Several volumes: the fusion uniform and a label map's uniform blocks.
+    /// Several volumes: the fusion uniform and a label map's quads.
     fusion: crate::fusion::FusionState,
     step_voxels: f64,
 }

@@ -19,7 +19,7 @@ use volgraph_compiler::ShaderUse;
 
 /// The light volume's compute entry point, declared by the raycasters whose volume is a texture;
 /// with several volumes (`params` set fusion) it reads their combined opacity, through the
-/// raycaster's `fusion` uniform and label blocks.
+/// raycaster's `fusion` uniform and label quads.
 pub fn light_shader_use(params: &volgraph_compiler::Params) -> ShaderUse {
     crate::fusion::with_fusion_uniform(
         ShaderUse::new("light_volume.wgsl", "cs_light_volume").binds(&["light_out", "label_quads"]),

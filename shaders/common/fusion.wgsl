@@ -62,8 +62,35 @@ fn begin_fusion() {
     label_n = vec3<f32>(label_dims());
     label_inv_n = vec3<f32>(1.0) / label_n;
     label_table_texel = vec2<f32>(1.0) / vec2<f32>(textureDimensions(label_table));
+    label_known = false;
 #endif
 }
+
+#if FUSION_LABEL_READS
+// Where the label map lies: its texture point is volume_position(u) · scale + offset (the frame
+// volume itself with FUSION_LABELS).
+fn label_map_scale() -> vec3<f32> {
+    var scale = vec3<f32>(1.0);
+#if FUSION_LABEL_MAP
+    scale = fusion_scale;
+#endif
+#if FUSION_OVERLAY
+    scale = overlay_scale;
+#endif
+    return scale;
+}
+
+fn label_map_offset() -> vec3<f32> {
+    var offset = vec3<f32>(0.0);
+#if FUSION_LABEL_MAP
+    offset = fusion_offset;
+#endif
+#if FUSION_OVERLAY
+    offset = overlay_offset;
+#endif
+    return offset;
+}
+#endif
 
 #if FUSION_LABEL_MAP
 // The second volume (a label map), normalized texels.
@@ -121,6 +148,11 @@ fn label_dims() -> vec3<i32> {
 #endif
 
 #if FUSION_LABEL_READS
+// A march's stretch of samples inside one label (common/label_cubes.wgsl): its label's table
+// entry, and whether the sample being classified lies in it — then the label map is not read.
+var<private> label_run_entry: vec4<f32>;
+var<private> label_known: bool = false;
+
 #if LABELS_NEAREST
 #else
 // Per voxel (x, y, z) the labels of voxels (x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1) of
@@ -223,7 +255,10 @@ fn in_box(u: vec3<f32>) -> bool {
 // `u`, whose field is `s` (volgraph_accel::fusion::Fusion::classify).
 fn fused_sample(u: vec3<f32>, s: f32) -> vec4<f32> {
 #if FUSION_LABELS
-    let e = label_entry(sample_label(u));
+    var e = label_run_entry;
+    if (!label_known) {
+        e = label_entry(sample_label(u));
+    }
     return premultiplied(e.rgb, e.a);
 #else
     let c = sample_tf(s);
@@ -244,7 +279,10 @@ fn fused_sample(u: vec3<f32>, s: f32) -> vec4<f32> {
     if (!(scan.a > 0.0)) {
         return vec4<f32>(0.0);
     }
-    let e = label_entry_at(u2);
+    var e = label_run_entry;
+    if (!label_known) {
+        e = label_entry_at(u2);
+    }
     let visible = e.a > 0.0;
     if (fusion_combine == COMBINE_INSIDE) {
         let a = select(0.0, scan.a, visible);
@@ -370,7 +408,10 @@ fn overlaid(fused: vec4<f32>, u: vec3<f32>) -> vec4<f32> {
     if (!(a > 0.0)) {
         return vec4<f32>(0.0);
     }
-    let e = label_entry_at(u * overlay_scale + overlay_offset);
+    var e = label_run_entry;
+    if (!label_known) {
+        e = label_entry_at(u * overlay_scale + overlay_offset);
+    }
     let visible = e.a > 0.0;
     if (overlay_combine == COMBINE_INSIDE) {
         return select(vec4<f32>(0.0), fused, visible);

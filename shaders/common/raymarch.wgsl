@@ -153,6 +153,11 @@ fn begin_ray(s: Samples, k0: u32) {
 #if FUSION
     begin_fusion();
 #endif
+#if FUSION_LABEL_READS
+#if SUBGROUPS
+    begin_label_cubes();
+#endif
+#endif
     resume_ray(sample_at(s, k0) - s.delta);
 }
 
@@ -172,6 +177,11 @@ fn classify_sample(u: vec3<f32>) -> vec4<f32> {
 
 #if FUSION
 #import "common/fusion.wgsl"
+#endif
+#if FUSION_LABEL_READS
+#if SUBGROUPS
+#import "common/label_cubes.wgsl"
+#endif
 #endif
 #if SHADOWS
 #import "common/shadows.wgsl"
@@ -307,11 +317,51 @@ fn march_dvr(s: Samples, k0: u32, end: u32, start: vec4<f32>) -> Marched {
         }
         let run_end = min(k + CHECK_EVERY, end);
 #else
+#if FUSION_LABEL_READS
+#if SUBGROUPS
+        // Runs, so that each finds its stretch inside one label (common/label_cubes.wgsl).
+        let run_end = min(k + CHECK_EVERY, end);
+#else
         let run_end = end;
+#endif
+#else
+        let run_end = end;
+#endif
 #endif
         // k < run_end here, so the run tests its two ends once per sample, after it, with `|`
         // (no short circuit: one branch, not two — 3 % fewer instructions on llvmpipe).
         let run_start = k;
+#if FUSION_LABEL_READS
+#if SUBGROUPS
+        // The run's first stretch inside one label (common/label_cubes.wgsl): its samples take
+        // the label found for the stretch, so they read no label map. A loop of its own, left by
+        // the whole subgroup at once when one lane's stretch ends (`subgroupAll`): the lanes of a
+        // subgroup run a loop's body together until the last leaves it (llvmpipe runs both
+        // sides of a branch), so a lane inside its stretch beside one outside would otherwise
+        // pay for both; the rest of the run reads as before.
+        let known_end = min(begin_label_run(s, k), run_end);
+        label_known = true;
+        loop {
+            if (!subgroupAll((k < known_end) & (out.color.a < threshold))) {
+                break;
+            }
+            let p = classify_sample(sample_at(s, k));
+#if FIRST_VISIBLE
+            out.first = select(out.first, k, out.first == NO_SAMPLE && p.a > 0.0);
+#endif
+            out.color = out.color + (1.0 - out.color.a) * p;
+            k += 1u;
+        }
+        label_known = false;
+        if ((k >= run_end) | (out.color.a >= threshold)) {
+            out.samples += k - run_start;
+            if (out.color.a >= threshold) {
+                break;
+            }
+            continue;
+        }
+#endif
+#endif
 #if PREFETCH
         // The pipelined loop: the next sample's fetch is issued before this one is classified,
         // so the lookup's latency hides behind a fetch (one extra fetch per run, a loss where

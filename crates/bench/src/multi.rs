@@ -201,22 +201,47 @@ pub fn run(args: &MultiArgs) -> anyhow::Result<serde_json::Value> {
     }
     let table_lut = table.lut(args.labels as usize + 1);
     let scene = Scene { ct: &ct, lut: &lut, labels: &labels, table: &table_lut };
+    // The organs' own map (what an organ segmentation looks like: large regions, few
+    // boundaries), tinted as strongly.
+    let organs = volgraph_accel::organs::organs_labels(args.voxels);
+    let mut organ_table = volgraph_accel::organs::label_table();
+    for label in organ_table.labels.values_mut() {
+        label.opacity = 0.6;
+    }
+    let organ_lut = organ_table.lut(organ_table.labels.keys().max().map_or(1, |m| *m as usize + 1));
+    let organ_scene = Scene { ct: &ct, lut: &lut, labels: &organs, table: &organ_lut };
     let gpu = std::sync::Arc::new(Gpu::new_headless().map_err(|e| anyhow!(e))?);
     let adapter = gpu.adapter_name.clone();
     let runtime = Runtime::new(gpu.clone(), ShaderLibrary::new(volgraph_passes::builtin_shaders()));
     let mut bench = Bench { runtime, registry: volgraph_app::program::registry(), adapter };
+    let organ_cases = format!("{} organs' map", organ_table.labels.len());
     let cases = [
-        Case { name: "CT alone (modern/fastest)", graph: "modern/fastest", set: &[] },
-        Case { name: "ct_with_labels, smooth", graph: "multi/ct_with_labels", set: &[] },
-        Case { name: "ct_with_labels, nearest", graph: "multi/ct_with_labels", set: &[("label_filter", "nearest")] },
-        Case { name: "ct_inside_labels, smooth", graph: "multi/ct_inside_labels", set: &[] },
+        (Case { name: "CT alone (modern/fastest)", graph: "modern/fastest", set: &[] }, &scene),
+        (Case { name: "ct_with_labels, smooth", graph: "multi/ct_with_labels", set: &[] }, &scene),
+        (
+            Case {
+                name: "ct_with_labels, nearest",
+                graph: "multi/ct_with_labels",
+                set: &[("label_filter", "nearest")],
+            },
+            &scene,
+        ),
+        (Case { name: "ct_inside_labels, smooth", graph: "multi/ct_inside_labels", set: &[] }, &scene),
+        (
+            Case { name: "ct_with_labels, smooth, the organs' map", graph: "multi/ct_with_labels", set: &[] },
+            &organ_scene,
+        ),
+        (
+            Case { name: "ct_inside_labels, smooth, the organs' map", graph: "multi/ct_inside_labels", set: &[] },
+            &organ_scene,
+        ),
     ];
     let mut rows = Vec::new();
-    for case in &cases {
-        let march = bench.apply(case, &scene, &args.size)?;
+    for (case, scene) in &cases {
+        let march = bench.apply(case, scene, &args.size)?;
         let timing = time_frames(&mut bench.runtime, &CAMERA, 0.0, args.frames, || {}).map_err(|e| anyhow!(e))?;
         let image = bench.runtime.read_output("image").map_err(|e| anyhow!(e))?;
-        let (mean, max) = sparse_error(&image, &scene, &march, args.stride);
+        let (mean, max) = sparse_error(&image, scene, &march, args.stride);
         rows.push((case.name, median(&timing.frame_ms), timing.wall_time_fallback, mean, max));
     }
     let toggle = time_toggle(&mut bench, &scene, &table, args)?;
@@ -227,11 +252,23 @@ pub fn run(args: &MultiArgs) -> anyhow::Result<serde_json::Value> {
     let clock = if rows.iter().any(|r| r.2) { "wall" } else { "GPU" };
     let mut text = format!(
         "# Several volumes in one march\n\nThe generated abdominal CT organs{} ({}×{}×{} voxels, HU, ct-soft-tissue) \
-         and a {}-label map on its grid (u16), at {}, {} frames per case (median, {clock} time), side by side in one \
-         run on {}. Error: max abs channel difference to the f64 reference at every {}th pixel of each row and \
-         column (mean and max over them, in 1/255).\n\n\
+         and a {}-label map on its grid (u16: the body cut into that many Voronoi regions, every one bounded by \
+         others — the hard case), or, in the last rows, the {organ_cases} (u8: the organs' own regions, large \
+         and few), at {}, {} frames per case (median, {clock} time), side by side in one run on {}. A device with \
+         subgroups ({}) takes the samples of a stretch inside one label without reading the map \
+         (common/label_cubes.wgsl). Error: max abs channel difference to the f64 reference at every {}th pixel of \
+         each row and column (mean and max over them, in 1/255).\n\n\
          | case | ms/frame | vs CT alone | mean err (1/255) | max err (1/255) |\n|---|---:|---:|---:|---:|\n",
-        args.voxels, ct.dims.x, ct.dims.y, ct.dims.z, args.labels, args.size, args.frames, bench.adapter, args.stride
+        args.voxels,
+        ct.dims.x,
+        ct.dims.y,
+        ct.dims.z,
+        args.labels,
+        args.size,
+        args.frames,
+        bench.adapter,
+        if gpu.subgroups { "this one has" } else { "not this one" },
+        args.stride
     );
     let mut json_rows = Vec::new();
     for (name, ms, _, mean, max) in &rows {
@@ -281,7 +318,7 @@ pub fn run(args: &MultiArgs) -> anyhow::Result<serde_json::Value> {
     println!("{text}");
     let value = serde_json::json!({
         "voxels": args.voxels, "labels": args.labels, "size": args.size, "frames": args.frames,
-        "adapter": bench.adapter, "clock": clock, "rows": json_rows,
+        "adapter": bench.adapter, "clock": clock, "subgroups": gpu.subgroups, "rows": json_rows,
         "toggle": {"size": args.toggle_size, "median_ms": toggle.0, "steady_ms": toggle.1, "upload_ms": toggle.2},
         "toggle_in_viewer": in_viewer,
         "boundary_quality": {"smooth_mean_error": quality.0, "nearest_mean_error": quality.1},

@@ -205,6 +205,7 @@ volgraph_compiler::pass_params! {
         overlay_labels: [f32; 4] = computed, "x, y: a label of the overlay is round(x + texel · y).";
         combine: u32 = computed, "1 labels, 2 tint, 3 inside, 4 fuse, 5 add.";
         overlay_combine: u32 = computed, "0 none, 2 tint, 3 inside.";
+        label_block: u32 = computed, "The edge in voxels of the label map's blocks in label_cubes (volgraph_accel::labels::cubes::LABEL_BLOCK).";
     }
 }
 
@@ -231,6 +232,7 @@ impl FusionMap {
             overlay_labels: [0.0, 255.0, 0.0, 0.0],
             combine: combine as u32 + 1,
             overlay_combine: 0,
+            label_block: volgraph_accel::labels::cubes::LABEL_BLOCK,
         }
     }
 
@@ -288,9 +290,8 @@ pub struct FusionState {
     overlay: Option<Combine>,
     buffer: Option<wgpu::Buffer>,
     versions: Option<Vec<Option<u64>>>,
-    /// Smooth label sampling: the label map's 2 × 2 quads (`label_quads`), and the version of
-    /// the map they were made from.
-    quads: Option<(wgpu::TextureView, Option<u64>)>,
+    /// What is made from the label map on the CPU, and the version of the map it was made from.
+    derived: Option<(LabelMapTextures, Option<u64>)>,
     smooth: bool,
 }
 
@@ -356,7 +357,7 @@ impl FusionState {
         let buffer = combine.map(|c| ctx.uniform_from_bytes("fusion", &FusionMap::identity(c).uniform_bytes()));
         let smooth = settings.label_filter == LabelFilterChoice::Smooth;
         let more = settings.scalar_partners().iter().skip(1).map(|(port, _)| *port).collect();
-        Ok(Self { combine, more, overlay: settings.overlay(), buffer, versions: None, quads: None, smooth })
+        Ok(Self { combine, more, overlay: settings.overlay(), buffer, versions: None, derived: None, smooth })
     }
 
     /// [`Self::new`] for a raycaster whose empty-space skipping reads the frame volume alone
@@ -380,35 +381,32 @@ impl FusionState {
         Self::new(ctx)
     }
 
-    /// The port of the label map, when smooth label sampling reads its quads.
+    /// The port of the label map the march reads, if any.
     fn label_map_port(&self) -> Option<&'static str> {
         match self.combine? {
-            _ if !self.smooth => None,
             Combine::Labels => Some("volume"),
             Combine::Tint | Combine::Inside => Some("second"),
             Combine::Fuse | Combine::Add => self.overlay.map(|_| "overlay"),
         }
     }
 
-    /// Makes the `label_quads` texture of the label map on `port` when it changed.
-    fn update_quads(&mut self, ctx: &RecordContext<'_>, port: &str) -> Result<(), PassError> {
+    /// Makes the textures derived from the label map on `port` when it changed.
+    fn update_label_map(&mut self, ctx: &RecordContext<'_>, port: &str) -> Result<(), PassError> {
         let version = ctx.input_version(port);
-        if self.quads.as_ref().is_some_and(|(_, v)| *v == version) {
+        if self.derived.as_ref().is_some_and(|(_, v)| *v == version) {
             return Ok(());
         }
         let map = ctx.voxels(port)?;
-        let quads = volgraph_accel::labels::sample::label_quads(&map);
-        let texture =
-            volgraph_core::runtime::upload::upload_label_quads(ctx.gpu, "label_quads", map.dims.to_array(), &quads)
-                .map_err(|e| PassError { pass: ctx.label.to_string(), message: e.to_string() })?;
-        self.quads = Some((texture.create_view(&wgpu::TextureViewDescriptor::default()), version));
+        let textures = LabelMapTextures::of(ctx, map, self.smooth)
+            .map_err(|e| PassError { pass: ctx.label.to_string(), message: e.to_string() })?;
+        self.derived = Some((textures, version));
         Ok(())
     }
 
     /// Writes the uniform when the bound volumes changed.
     pub fn update(&mut self, ctx: &RecordContext<'_>) -> Result<(), PassError> {
         if let Some(port) = self.label_map_port() {
-            self.update_quads(ctx, port)?;
+            self.update_label_map(ctx, port)?;
         }
         let (Some(combine), Some(buffer)) = (self.combine, &self.buffer) else { return Ok(()) };
         let versions: Vec<Option<u64>> = ["volume", "second", "overlay"]
@@ -442,7 +440,48 @@ impl FusionState {
 
     /// The `fusion` binding.
     pub fn bindings(&self) -> Vec<(&'static str, wgpu::BindingResource<'_>)> {
-        let quads = self.quads.iter().map(|(view, _)| ("label_quads", wgpu::BindingResource::TextureView(view)));
-        self.buffer.iter().map(|b| ("fusion", b.as_entire_binding())).chain(quads).collect()
+        let derived = self.derived.iter().flat_map(|(textures, _)| textures.bindings());
+        self.buffer.iter().map(|b| ("fusion", b.as_entire_binding())).chain(derived).collect()
+    }
+}
+
+#[cfg(feature = "gpu")]
+/// The textures a march reads a label map through besides the map itself, made from it on the
+/// CPU: its blocks of one label (`label_cubes`, on a device with subgroups: stretches of samples
+/// read nothing there) and, for smooth sampling, its 2 × 2 quads (`label_quads`: a sample's 8
+/// corners in two reads).
+struct LabelMapTextures {
+    cubes: Option<wgpu::TextureView>,
+    quads: Option<wgpu::TextureView>,
+}
+
+#[cfg(feature = "gpu")]
+impl LabelMapTextures {
+    fn of(
+        ctx: &RecordContext<'_>,
+        map: &volgraph_accel::volume::Volume,
+        smooth: bool,
+    ) -> Result<Self, volgraph_core::runtime::GpuFault> {
+        use volgraph_core::runtime::upload::{upload_label_cubes, upload_label_quads};
+        let view = |t: wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor::default());
+        // Read only where subgroups let a march leave a stretch together (label_cubes.wgsl).
+        let cubes = if ctx.gpu.subgroups {
+            let cubes = volgraph_accel::labels::cubes::LabelCubes::of(map);
+            Some(view(upload_label_cubes(ctx.gpu, "label_cubes", &cubes)?))
+        } else {
+            None
+        };
+        let quads = if smooth {
+            let quads = volgraph_accel::labels::sample::label_quads(map);
+            Some(view(upload_label_quads(ctx.gpu, "label_quads", map.dims.to_array(), &quads)?))
+        } else {
+            None
+        };
+        Ok(Self { cubes, quads })
+    }
+
+    fn bindings(&self) -> impl Iterator<Item = (&'static str, wgpu::BindingResource<'_>)> {
+        let cubes = self.cubes.iter().map(|c| ("label_cubes", wgpu::BindingResource::TextureView(c)));
+        cubes.chain(self.quads.iter().map(|q| ("label_quads", wgpu::BindingResource::TextureView(q))))
     }
 }

@@ -167,7 +167,16 @@ impl PassDecl for RaycastBricks {
 fn march_shader(params: &Params) -> ShaderUse {
     crate::fusion::with_fusion_uniform(
         ShaderUse::new("raycast_bricks.wgsl", "cs_main")
-            .binds(&["table", "leaf_words", "acc", "volume", "preintegrated", "light_volume", "label_quads"])
+            .binds(&[
+                "table",
+                "leaf_words",
+                "acc",
+                "volume",
+                "preintegrated",
+                "light_volume",
+                "label_quads",
+                "label_cubes",
+            ])
             .uniform(RaycastParamsGpu::bound("params"))
             .uniform(brick_layout()),
         params,

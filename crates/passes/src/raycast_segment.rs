@@ -198,9 +198,9 @@ impl PassDecl for RaycastSegment {
         // The counting variant (a bench tool's) binds the invocation counter too.
         // The pre-integration table's (an effect's), and the counting variant's counter.
         let binds: &'static [&'static str] = if self.counts() {
-            &["invocations", "preintegrated", "light_volume", "label_quads"]
+            &["invocations", "preintegrated", "light_volume", "label_quads", "label_cubes"]
         } else {
-            &["preintegrated", "light_volume", "label_quads"]
+            &["preintegrated", "light_volume", "label_quads", "label_cubes"]
         };
         let mut uses = [ShaderUse::new(file, "vs_segment"), ShaderUse::new(file, entry_point)]
             .map(|u| {

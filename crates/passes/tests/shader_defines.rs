@@ -1,7 +1,7 @@
 //! Rust and WGSL agree on the `#if` names: every `#if NAME` / `#if !NAME` in a shader under
 //! `shaders/` is a constant of `volgraph_passes::defines` (the built-in passes') or one of the
 //! compiler's frame defines (`volgraph_compiler::cut_effects`: the cuts and the sort-last
-//! window), and every such name is used by some shader. A misspelt define in Rust no longer
+//! window) or the device's (`Gpu::device_defines`), and every such name is used by some shader. A misspelt define in Rust no longer
 //! compiles (the passes name them through the constants); one in WGSL, or a define left behind
 //! when its code went, fails here.
 
@@ -35,8 +35,11 @@ fn every_wgsl_define_has_its_rust_twin_and_the_reverse() {
     let mut found = BTreeSet::new();
     shader_defines(&root, &mut found);
     let frame: Vec<&str> = frame_defines(&["crop".to_string(), "clip".to_string()], true);
-    let known: BTreeSet<&str> = BUILT_IN.iter().copied().chain(frame.iter().copied()).collect();
-    assert_eq!(known.len(), BUILT_IN.len() + frame.len(), "a name is declared twice: {known:?}");
+    // What the device can do (`Gpu::device_defines`).
+    let device = [volgraph_core::runtime::SUBGROUPS_DEFINE];
+    let known: BTreeSet<&str> =
+        BUILT_IN.iter().copied().chain(frame.iter().copied()).chain(device.iter().copied()).collect();
+    assert_eq!(known.len(), BUILT_IN.len() + frame.len() + device.len(), "a name is declared twice: {known:?}");
     let unknown: Vec<_> = found.iter().filter(|(name, _)| !known.contains(name.as_str())).collect();
     assert!(
         unknown.is_empty(),

@@ -57,7 +57,8 @@ fn bindings(module: &naga::Module) -> Vec<(String, u32, u32)> {
 }
 
 /// `#if` combinations the raycasters compile (crates/passes/src/march.rs): leaping over block
-/// flags or the distance map, start estimates with leap hits, several volumes, shadows.
+/// flags or the distance map, start estimates with leap hits, several volumes (on a device with
+/// subgroups too: `Gpu::device_defines`), shadows.
 const SETTINGS: &[&[&str]] = &[
     &["LEAP", "LEAP_BLOCKS"],
     &["LEAP", "LEAP_CUBES"],
@@ -65,6 +66,10 @@ const SETTINGS: &[&[&str]] = &[
     &["FUSION", "FUSION_LABELS", "FUSION_LABEL_READS"],
     &["FUSION", "FUSION_LABEL_MAP", "FUSION_LABEL_READS"],
     &["FUSION", "FUSION_LABEL_MAP", "FUSION_LABEL_READS", "LABELS_NEAREST"],
+    &["FUSION", "FUSION_LABELS", "FUSION_LABEL_READS", "SUBGROUPS"],
+    &["FUSION", "FUSION_LABEL_MAP", "FUSION_LABEL_READS", "SUBGROUPS"],
+    &["FUSION", "FUSION_LABEL_MAP", "FUSION_LABEL_READS", "LABELS_NEAREST", "SUBGROUPS"],
+    &["FUSION", "FUSION_SCALAR", "FUSION_OVERLAY", "FUSION_LABEL_READS", "SUBGROUPS"],
     &["FUSION", "FUSION_SCALAR"],
     &["FUSION", "FUSION_SCALAR", "FUSION_OVERLAY", "FUSION_LABEL_READS"],
     &["FUSION", "FUSION_SCALAR", "FUSION_THIRD"],

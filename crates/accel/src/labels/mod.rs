@@ -9,12 +9,14 @@
 //!   its header.
 //! - [`census`]: the labels a volume holds, counted.
 //! - [`sample`]: a label map sampled without mixing label numbers (nearest, smooth indicators).
+//! - [`cubes`]: where a label map holds one label, per block (a march reads nothing there).
 //! - [`LabelTable::default_for`]: a palette with the map's own values where there is no table.
 //!
 //! A table names labels by value; a value without an entry takes [`default_label`] (and the
 //! caller says so once). Value 0 is the background: transparent unless a table says otherwise.
 
 pub mod census;
+pub mod cubes;
 pub mod itksnap;
 pub mod sample;
 pub mod slicer;

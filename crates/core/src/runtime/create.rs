@@ -174,7 +174,7 @@ impl<'a> CreateContext<'a> {
 
     fn shader(&self, file: &str, defines: &[&str]) -> Result<std::sync::Arc<super::shaders::LoadedShader>, PassError> {
         self.modules.borrow_mut().insert(file.to_string());
-        let defines = [defines, &self.frame_defines].concat();
+        let defines = [defines, &self.frame_defines, self.gpu.device_defines()].concat();
         self.shaders.get_with(self.gpu, file, &defines).map_err(|e| self.error(e))
     }
 

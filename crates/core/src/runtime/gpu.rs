@@ -68,6 +68,9 @@ impl GpuFault {
     }
 }
 
+/// The `#if` name of a device whose shaders may use subgroup operations ([`Gpu::subgroups`]).
+pub const SUBGROUPS_DEFINE: &str = "SUBGROUPS";
+
 /// Options for opening the GPU.
 #[derive(Clone, Debug, Default)]
 pub struct GpuOptions {
@@ -108,6 +111,9 @@ pub struct Gpu {
     /// Vulkan only): needed where a shader with side effects, such as a debug counter, must
     /// still be skipped by early-z (Krüger–Westermann 2003 §2.1).
     pub early_depth_test: bool,
+    /// Whether shaders may use subgroup operations (`subgroupAll`, …; wgpu's `SUBGROUP`): every
+    /// module is then assembled with [`SUBGROUPS_DEFINE`] ([`Gpu::device_defines`]).
+    pub subgroups: bool,
     /// The device limits.
     pub limits: wgpu::Limits,
     uncaptured: Arc<Mutex<Vec<wgpu::Error>>>,
@@ -145,7 +151,8 @@ impl Gpu {
             | wgpu::Features::FLOAT32_BLENDABLE
             | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
             | wgpu::Features::TEXTURE_FORMAT_16BIT_NORM
-            | wgpu::Features::SHADER_EARLY_DEPTH_TEST;
+            | wgpu::Features::SHADER_EARLY_DEPTH_TEST
+            | wgpu::Features::SUBGROUP;
         let features = adapter.features() & wanted & !options.without_features;
         let mut limits = adapter.limits();
         if let Some(cap) = options.max_buffer_size {
@@ -178,9 +185,16 @@ impl Gpu {
             norm16: features.contains(wgpu::Features::TEXTURE_FORMAT_16BIT_NORM),
             is_cpu: info.device_type == wgpu::DeviceType::Cpu,
             early_depth_test: features.contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST),
+            subgroups: features.contains(wgpu::Features::SUBGROUP),
             limits,
             uncaptured,
         })
+    }
+
+    /// The `#if` names of what this device can do, turned on in every module the runtime builds
+    /// (`CreateContext`): [`SUBGROUPS_DEFINE`] where shaders may use subgroup operations.
+    pub fn device_defines(&self) -> &'static [&'static str] {
+        if self.subgroups { &[SUBGROUPS_DEFINE] } else { &[] }
     }
 
     /// Whether textures of `format` may be sampled with a filtering sampler on this device.

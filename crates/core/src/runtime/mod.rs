@@ -63,7 +63,7 @@ pub use frame::{
     OpacityReference, PixelRays, VolumeDesc, VolumeWindow, WindowBoxes, scene_values_of,
 };
 pub use frames::{FrameStats, MAX_FRAMES_IN_FLIGHT};
-pub use gpu::{Gpu, GpuError, GpuFault, GpuFaultKind, GpuOptions};
+pub use gpu::{Gpu, GpuError, GpuFault, GpuFaultKind, GpuOptions, SUBGROUPS_DEFINE};
 pub use inputs::{upload_volume_texture, volume_region_bytes, volume_texture_format};
 pub use live_plan::{ApplyError, ApplyReport};
 pub use present::PresentTarget;

@@ -241,6 +241,23 @@ pub fn upload_label_quads(
     )
 }
 
+/// A label map's [`LabelCubes`](volgraph_accel::labels::cubes::LabelCubes) as an `Rg32Uint` 3D
+/// texture, a texel a block (label, distance): where a march takes samples without reading the
+/// label map (`shaders/common/label_cubes.wgsl`).
+pub fn upload_label_cubes(
+    gpu: &Gpu,
+    label: &str,
+    cubes: &volgraph_accel::labels::cubes::LabelCubes,
+) -> Result<wgpu::Texture, GpuFault> {
+    let dims = cubes.dims.to_array();
+    texture_with(
+        gpu,
+        || format!("uploading \"{label}\" ({}x{}x{} rg32uint)", dims[0], dims[1], dims[2]),
+        (label, dims, wgpu::TextureDimension::D3, wgpu::TextureFormat::Rg32Uint),
+        bytemuck::cast_slice(&cubes.texels),
+    )
+}
+
 /// `texels` (x fastest) as a filterable `Rgba16Float` 3D texture: derived fields in \[0, 1\] whose
 /// f16 step (≤ 2⁻¹¹ there) is below a 255th (the illumination volume of the `shadows` and
 /// `ambient_occlusion` effects, as the GPU's own dispatch writes it).

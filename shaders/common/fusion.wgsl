@@ -109,6 +109,24 @@ fn label_map_offset() -> vec3<f32> {
 @group(0) @binding(auto) var fourth: texture_3d<f32>;
 @group(0) @binding(auto) var fourth_tf: texture_1d<f32>;
 #endif
+#if FUSION_SCALAR
+#if PREINTEGRATION
+// With PREINTEGRATION each scalar medium composites its own TF's segment from its field at the
+// sample before to its field here (`preintegrated` is the frame volume's table; these, built
+// the same way, its partners'), and media in one place combine segments as they combine
+// samples (volgraph_accel::fusion::Fusion::classify_scan). The fields at the sample before:
+@group(0) @binding(auto) var second_preintegrated: texture_2d<f32>;
+var<private> second_front: f32;
+#if FUSION_THIRD
+@group(0) @binding(auto) var third_preintegrated: texture_2d<f32>;
+var<private> third_front: f32;
+#endif
+#if FUSION_FOURTH
+@group(0) @binding(auto) var fourth_preintegrated: texture_2d<f32>;
+var<private> fourth_front: f32;
+#endif
+#endif
+#endif
 
 #if FUSION_LABELS
 // Colour and opacity per label value: label v at texel (v % 256, v / 256); 0 where hidden.
@@ -296,19 +314,24 @@ fn fused_sample(u: vec3<f32>, s: f32) -> vec4<f32> {
 #endif
 #if FUSION_SCALAR
     // Past the frame volume's box (rays cross every scalar volume's) it adds nothing.
+#if PREINTEGRATION
+    let p1 = select(vec4<f32>(0.0), lookup_preintegrated(ray_prev_scalar, s), in_box(uv));
+    ray_prev_scalar = s;
+#else
     let p1 = select(vec4<f32>(0.0), premultiplied(c.rgb, c.a), in_box(uv));
-    let p2 = scalar_medium(second, second_tf, u2);
+#endif
+    let p2 = second_medium(u2);
     // Media in one place: opacity 1 - Π(1 - aᵢ); colour the opacity-weighted mean, or
     // (channels) the sum. `sum` holds Σ premultiplied colours and Σ opacities.
     var sum = p1 + p2;
     var clear = (1.0 - p1.a) * (1.0 - p2.a);
 #if FUSION_THIRD
-    let p3 = scalar_medium(third, third_tf, uv * fusion.third_scale.xyz + fusion.third_offset.xyz);
+    let p3 = third_medium(uv * fusion.third_scale.xyz + fusion.third_offset.xyz);
     sum += p3;
     clear *= 1.0 - p3.a;
 #endif
 #if FUSION_FOURTH
-    let p4 = scalar_medium(fourth, fourth_tf, uv * fusion.fourth_scale.xyz + fusion.fourth_offset.xyz);
+    let p4 = fourth_medium(uv * fusion.fourth_scale.xyz + fusion.fourth_offset.xyz);
     sum += p4;
     clear *= 1.0 - p4.a;
 #endif
@@ -346,6 +369,69 @@ fn scalar_medium(v: texture_3d<f32>, tf: texture_1d<f32>, at: vec3<f32>) -> vec4
     let c = scalar_tf_at(v, tf, at);
     return premultiplied(c.rgb, c.a);
 }
+
+#if PREINTEGRATION
+// A scalar medium's segment to its texture point `at` from its field `front` at the sample
+// before, through its pre-integration `table` (nothing outside its box), and its field at `at`
+// (the next segment's front).
+struct MediumSegment {
+    color: vec4<f32>,
+    field: f32,
+}
+
+fn medium_segment(v: texture_3d<f32>, table: texture_2d<f32>, front: f32, at: vec3<f32>) -> MediumSegment {
+    let field = textureSampleLevel(v, linear_clamp, at, 0.0).r;
+    let color = select(vec4<f32>(0.0), lookup_segment(table, front, field), in_box(at));
+    return MediumSegment(color, field);
+}
+
+// The partners' fields at the frame volume's texture point `u` (not an atlas's): the fronts of
+// their first segments after a ray starts or resumes (`resume_ray`).
+fn resume_media(u: vec3<f32>) {
+    second_front = textureSampleLevel(second, linear_clamp, u * fusion_scale + fusion_offset, 0.0).r;
+#if FUSION_THIRD
+    third_front = textureSampleLevel(third, linear_clamp, u * fusion.third_scale.xyz + fusion.third_offset.xyz, 0.0).r;
+#endif
+#if FUSION_FOURTH
+    fourth_front = textureSampleLevel(fourth, linear_clamp, u * fusion.fourth_scale.xyz + fusion.fourth_offset.xyz, 0.0).r;
+#endif
+}
+#endif
+
+// Each partner's sample (or, with PREINTEGRATION, segment) at its texture point `at`.
+fn second_medium(at: vec3<f32>) -> vec4<f32> {
+#if PREINTEGRATION
+    let m = medium_segment(second, second_preintegrated, second_front, at);
+    second_front = m.field;
+    return m.color;
+#else
+    return scalar_medium(second, second_tf, at);
+#endif
+}
+
+#if FUSION_THIRD
+fn third_medium(at: vec3<f32>) -> vec4<f32> {
+#if PREINTEGRATION
+    let m = medium_segment(third, third_preintegrated, third_front, at);
+    third_front = m.field;
+    return m.color;
+#else
+    return scalar_medium(third, third_tf, at);
+#endif
+}
+#endif
+
+#if FUSION_FOURTH
+fn fourth_medium(at: vec3<f32>) -> vec4<f32> {
+#if PREINTEGRATION
+    let m = medium_segment(fourth, fourth_preintegrated, fourth_front, at);
+    fourth_front = m.field;
+    return m.color;
+#else
+    return scalar_medium(fourth, fourth_tf, at);
+#endif
+}
+#endif
 #endif
 
 #if FUSION_LABEL_READS

@@ -115,9 +115,15 @@ fn corrected_alpha(a_tf: f32) -> f32 {
 @group(0) @binding(auto) var preintegrated: texture_2d<f32>;
 
 fn lookup_preintegrated(s_front: f32, s_back: f32) -> vec4<f32> {
-    let n = vec2<f32>(textureDimensions(preintegrated));
+    return lookup_segment(preintegrated, s_front, s_back);
+}
+
+// The segment from `s_front` to `s_back` in a pre-integration table (several volumes'
+// partners have their own, common/fusion.wgsl).
+fn lookup_segment(table: texture_2d<f32>, s_front: f32, s_back: f32) -> vec4<f32> {
+    let n = vec2<f32>(textureDimensions(table));
     let st = (clamp(vec2<f32>(s_front, s_back), vec2<f32>(0.0), vec2<f32>(1.0)) * (n - 1.0) + 0.5) / n;
-    return textureSampleLevel(preintegrated, linear_clamp, st, 0.0);
+    return textureSampleLevel(table, linear_clamp, st, 0.0);
 }
 #endif
 
@@ -166,6 +172,9 @@ fn begin_ray(s: Samples, k0: u32) {
 fn resume_ray(before: vec3<f32>) {
 #if PREINTEGRATION
     ray_prev_scalar = sample_volume(before);
+#if FUSION_SCALAR
+    resume_media(volume_position(before));
+#endif
 #endif
 }
 

@@ -31,7 +31,7 @@
 use glam::DVec3;
 
 use crate::labels::sample::{LabelFilter, sample_label};
-use crate::reference::{corrected_alpha, lut_sample};
+use crate::reference::{corrected_alpha, lut_sample, preintegrate};
 use crate::volume::Volume;
 
 /// Where the frame volume's texture point `u` lies in another volume's texture space:
@@ -121,6 +121,17 @@ impl TextureMap {
     pub fn apply(&self, u: DVec3) -> DVec3 {
         u * self.scale + self.offset
     }
+}
+
+/// What a sample composites with pre-integration ([`Fusion::classify_scan`]): the scan's segment
+/// ending at it (premultiplied, corrected) and the frame volume's texture point of the sample
+/// before it, where every other medium's segment starts.
+#[derive(Clone, Copy, Debug)]
+pub struct Segment {
+    /// The scan's pre-integrated segment.
+    pub scan: [f64; 4],
+    /// The sample before's texture point.
+    pub front: DVec3,
 }
 
 /// Whether texture point `u` lies in the box (voxel centres ± half a voxel).
@@ -246,9 +257,11 @@ impl Fusion<'_> {
         self.classify_scan(first, lut, u, s, exponent, None)
     }
 
-    /// [`Self::classify`] where the scan's own sample is `scan` (premultiplied and corrected: the
-    /// pre-integrated segment ending at this sample) instead of its TF at `s` — for `tint` and
-    /// `inside`, whose opacity is the scan's: the label tints or masks the segment.
+    /// [`Self::classify`] with pre-integration (Engel et al. 2001) where `segment` is given: the
+    /// scan's own sample is its pre-integrated segment ending at this sample instead of its TF at
+    /// `s` — `tint` and `inside` colour or mask it (their opacity is the scan's) — and every other
+    /// scalar medium (`fuse`, `add`) is its own TF's segment from its field at the sample before
+    /// to its field here, so media in one place combine segments as they combine samples.
     pub fn classify_scan(
         &self,
         first: &Volume,
@@ -256,10 +269,10 @@ impl Fusion<'_> {
         u: DVec3,
         s: f64,
         exponent: f64,
-        scan: Option<[f64; 4]>,
+        segment: Option<Segment>,
     ) -> [f64; 4] {
         let premultiplied = |c: [f64; 3], a: f64| [c[0] * a, c[1] * a, c[2] * a, a];
-        let through = |lut: &[[f32; 4]], s: f64| match scan {
+        let through = |lut: &[[f32; 4]], s: f64| match segment.map(|g| g.scan) {
             Some(p) if p[3] > 0.0 => ([p[0] / p[3], p[1] / p[3], p[2] / p[3]], p[3]),
             Some(_) => ([0.0; 3], 0.0),
             None => {
@@ -289,9 +302,20 @@ impl Fusion<'_> {
                 }
             }
             Combine::Fuse | Combine::Add => {
-                let medium = |volume: &Volume, lut: &[[f32; 4]], map: &TextureMap| {
-                    let c = Self::medium_at(volume, lut, map, u);
-                    premultiplied([c[0], c[1], c[2]], corrected_alpha(c[3], exponent))
+                let medium = |volume: &Volume, lut: &[[f32; 4]], map: &TextureMap| match segment {
+                    // Nothing outside its box; its front is its field at the sample before
+                    // (clamped to its edge, as the GPU's sampler reads it).
+                    Some(g) if in_box(map.apply(u)) => preintegrate(
+                        lut,
+                        volume.sample_trilinear(map.apply(g.front)),
+                        volume.sample_trilinear(map.apply(u)),
+                        exponent,
+                    ),
+                    Some(_) => [0.0; 4],
+                    None => {
+                        let c = Self::medium_at(volume, lut, map, u);
+                        premultiplied([c[0], c[1], c[2]], corrected_alpha(c[3], exponent))
+                    }
                 };
                 // Past the frame volume's box (rays cross every scalar volume's) it adds nothing.
                 let first = if in_box(u) { premultiplied(c1, a1) } else { [0.0; 4] };

@@ -339,10 +339,13 @@ impl<'a> March<'a> {
         let exponent = self.settings.step_exponent();
         let mut p = if let Some(fusion) = self.fusion {
             // Several volumes: classified and combined per sample; with pre-integration the
-            // scan's segment is tinted or masked by the label (`tint`, `inside`; the raycasters
-            // refuse it with the others).
-            let scan = self.settings.effects.preintegration.then(|| preintegrate(self.lut, s_prev, s, exponent));
-            fusion.classify_scan(self.volume, self.lut, self.seg.u0 + t * self.seg.d_tex, s, exponent, scan)
+            // scan's segment is tinted or masked by the label (`tint`, `inside`), or each
+            // medium's segment combined (`fuse`, `add`; label maps alone are refused).
+            let segment = self.settings.effects.preintegration.then(|| crate::fusion::Segment {
+                scan: preintegrate(self.lut, s_prev, s, exponent),
+                front: self.seg.u0 + (t - self.step_tex) * self.seg.d_tex,
+            });
+            fusion.classify_scan(self.volume, self.lut, self.seg.u0 + t * self.seg.d_tex, s, exponent, segment)
         } else if self.settings.effects.preintegration {
             preintegrate(self.lut, s_prev, s, exponent)
         } else {

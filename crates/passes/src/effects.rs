@@ -101,7 +101,8 @@ pub fn jitter_defines(params: &Params) -> Vec<&'static str> {
 /// What a raycaster node keeps for its effects: the pre-integration table and the light volume
 /// when those effects are on.
 pub struct EffectState {
-    table: Option<PreintegrationTable>,
+    /// The frame volume's, then each scalar partner's (`preintegration::TABLES`).
+    tables: Vec<PreintegrationTable>,
     light: Option<crate::shadows::LightVolume>,
 }
 
@@ -111,11 +112,19 @@ impl EffectState {
     /// is the volume's texture (not voxels on the CPU, as the brick raycaster's).
     pub fn new(ctx: &CreateContext<'_>, volume_texture: bool) -> Result<Self, PassError> {
         let flags = EffectFlags::of(ctx.params);
-        let table = flags.preintegration.then(|| PreintegrationTable::new(ctx)).transpose()?;
+        // One table per transfer function: the frame volume's, and several scalar volumes'.
+        let partners = crate::fusion::FusionSettings::of(ctx.params).scalar_partners().len();
+        let tables = match flags.preintegration {
+            true => crate::preintegration::TABLES[..1 + partners]
+                .iter()
+                .map(|&table| PreintegrationTable::new(ctx, table))
+                .collect::<Result<Vec<_>, _>>()?,
+            false => Vec::new(),
+        };
         let light = (flags.shadows || flags.ambient_occlusion)
             .then(|| crate::shadows::LightVolume::new(ctx, &flags, volume_texture))
             .transpose()?;
-        Ok(Self { table, light })
+        Ok(Self { tables, light })
     }
 
     /// Brings derived data up to date before the raycaster records (the table after a TF or step
@@ -131,15 +140,15 @@ impl EffectState {
         if let Some(light) = &mut self.light {
             light.update(ctx, fusion)?;
         }
-        match &mut self.table {
-            Some(t) => t.update(ctx, params, step_voxels),
-            None => Ok(()),
+        for table in &mut self.tables {
+            table.update(ctx, params, step_voxels)?;
         }
+        Ok(())
     }
 
-    /// The bindings the effects add (`preintegrated`, `light_volume`).
+    /// The bindings the effects add (`preintegrated` and the partners' tables, `light_volume`).
     pub fn bindings(&self) -> Vec<(&'static str, wgpu::BindingResource<'_>)> {
-        let table = self.table.iter().map(|t| ("preintegrated", wgpu::BindingResource::TextureView(&t.table.view)));
+        let table = self.tables.iter().map(|t| (t.binding, wgpu::BindingResource::TextureView(&t.table.view)));
         let light =
             self.light.iter().filter_map(|l| l.view()).map(|v| ("light_volume", wgpu::BindingResource::TextureView(v)));
         table.chain(light).collect()
@@ -152,12 +161,12 @@ impl EffectState {
 
     /// Table builds so far (0 without pre-integration).
     pub fn table_builds(&self) -> u64 {
-        self.table.as_ref().map_or(0, |t| t.builds)
+        self.tables.iter().map(|t| t.builds).sum()
     }
 
     /// Forgets derived data after new parameters (the step may have changed).
     pub fn invalidate(&mut self) {
-        if let Some(t) = &mut self.table {
+        for t in &mut self.tables {
             t.invalidate();
         }
     }

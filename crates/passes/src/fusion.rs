@@ -338,20 +338,16 @@ impl FusionState {
                 ),
             });
         }
-        // Pre-integration is of one TF over a segment of one volume: the scan's segment can be
-        // tinted or masked by a label map (its opacity stays the scan's), not combined with
-        // another volume's or made of label numbers.
-        if combine.is_some_and(|c| !matches!(c, Combine::Tint | Combine::Inside))
-            && crate::effects::EffectFlags::of(ctx.params).preintegration
-        {
+        // Pre-integration integrates a TF between two samples of a field: the scan's segment is
+        // tinted or masked by a label map (its opacity stays the scan's), several scalar media
+        // each integrate their own; label numbers have no segment between two of them.
+        if combine == Some(Combine::Labels) && crate::effects::EffectFlags::of(ctx.params).preintegration {
             return Err(PassError {
                 pass: ctx.pass_id.to_string(),
-                message: format!(
-                    "preintegration integrates one transfer function between two samples of one volume, and fusion \"{}\" \
-                     classifies several volumes (or label numbers) at each sample: turn preintegration off here, or use \
-                     fusion \"tint\" or \"inside\", which pre-integrate the scan and colour or mask it by its labels",
-                    settings.fusion.name()
-                ),
+                message: "preintegration integrates a transfer function between two samples of a field, and fusion \
+                          \"labels\" shows label numbers, which no segment lies between: turn preintegration off here \
+                          (or use fusion \"tint\" or \"inside\" to pre-integrate a scan coloured or masked by its labels)"
+                    .to_string(),
             });
         }
         let buffer = combine.map(|c| ctx.uniform_from_bytes("fusion", &FusionMap::identity(c).uniform_bytes()));

@@ -149,7 +149,16 @@ impl PassDecl for RaycastCompute {
 fn march_shader(params: &Params) -> ShaderUse {
     crate::fusion::with_fusion_uniform(
         ShaderUse::new("raycast_compute.wgsl", entry(params))
-            .binds(&["corrected", "preintegrated", "light_volume", "label_quads", "label_cubes"])
+            .binds(&[
+                "corrected",
+                "preintegrated",
+                "second_preintegrated",
+                "third_preintegrated",
+                "fourth_preintegrated",
+                "light_volume",
+                "label_quads",
+                "label_cubes",
+            ])
             .uniform(RaycastParamsGpu::bound("params"))
             .uniform(BlockSize::bound_as("blocks")),
         params,
@@ -230,7 +239,7 @@ impl PassNode for RaycastComputeNode {
             ctx.clear_buffer("samples")?;
         }
         if let Some(table) = &self.table {
-            table.fill(ctx, &self.params)?;
+            table.fill(ctx, &self.params, "tf")?;
         }
         self.fusion.update(ctx)?;
         self.effects.update(ctx, &self.params, self.step_voxels, &self.fusion.bindings())?;

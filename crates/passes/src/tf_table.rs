@@ -62,13 +62,16 @@ impl TfTable {
         Ok(Self { pipeline, storage: view.clone(), binding, groups, view })
     }
 
-    /// Records one fill from the pass's `tf` port with the step in `params`.
-    pub fn fill(&self, ctx: &mut RecordContext<'_>, params: &wgpu::Buffer) -> Result<(), PassError> {
+    /// Records one fill from the pass's transfer function on port `tf_port` (the shader's `tf`)
+    /// with the step in `params`.
+    pub fn fill(&self, ctx: &mut RecordContext<'_>, params: &wgpu::Buffer, tf_port: &str) -> Result<(), PassError> {
+        let tf = ctx.view(tf_port)?;
         let bg = ctx.bind_group(
             &self.pipeline,
             &[
                 ("params", params.as_entire_binding()),
                 (self.binding, wgpu::BindingResource::TextureView(&self.storage)),
+                ("tf", wgpu::BindingResource::TextureView(tf)),
             ],
         )?;
         let mut pass = ctx.begin_compute_pass();

@@ -723,7 +723,7 @@ fn the_scan_preintegrated_tinted_and_inside_its_labels() {
 /// Pre-integration with several scalar volumes (`fuse`, `add`; Engel et al. 2001): each medium
 /// composites its own TF's segment from its field at the sample before, and media in one place
 /// combine segments as they combine samples — against the reference, through both families that
-/// fuse and with four channels. The PET's TF is a thin opaque shell that samples step over where
+/// fuse, with four channels and under a label map. The PET's TF is a thin opaque shell that samples step over where
 /// the PET changes fast, so its segments differ from its samples: a march that classified the
 /// partners per sample fails here. A label map alone still refuses it by name.
 #[test]
@@ -751,6 +751,11 @@ fn several_scalar_volumes_preintegrate_each_by_its_own_tf() {
         (ramp(0.1, 0.9, 0.9).to_lut_for(&third, 256), ramp(0.9, 0.9, 0.1).to_lut_for(&fourth, 256));
     let more = [(&third, third_lut.as_slice()), (&fourth, fourth_lut.as_slice())];
     check("channels4_preintegrated", &Scene { more: &more, ..scene }, "multi/channels4.ron", &["preintegration"], &[]);
+    // A label map over the pre-integrated pair keeps it only inside the visible labels.
+    let (table, labels) =
+        (table(), cropped(&organs_labels(N), UVec3::new(4, 6, 2), UVec3::new(N - 6, N - 4, N / 2 - 2)));
+    let inside = Scene { table: &table, overlay: Some(&labels), ..scene };
+    check("pet_ct_inside_labels_preintegrated", &inside, "multi/pet_ct_inside_labels.ron", &["preintegration"], &[]);
     // The segments show: the shell drawn per sample is off the pre-integrated reference by more
     // than `check` allows.
     let (sampled, _) = render(graph, &scene, &[], &[]);

@@ -97,6 +97,20 @@ pub fn jitter_defines(params: &Params) -> Vec<&'static str> {
     }
 }
 
+/// What a raycaster that fuses several volumes binds itself beside its march (`ShaderUse::binds`):
+/// the compute raycaster's pre-corrected table, the pre-integration tables and the light volume
+/// ([`EffectState::bindings`]) and what is made from a label map (`FusionState::bindings`).
+pub const MARCH_BINDINGS: &[&str] = &[
+    "corrected",
+    "preintegrated",
+    "second_preintegrated",
+    "third_preintegrated",
+    "fourth_preintegrated",
+    "light_volume",
+    "label_quads",
+    "label_cubes",
+];
+
 #[cfg(feature = "gpu")]
 /// What a raycaster node keeps for its effects: the pre-integration table and the light volume
 /// when those effects are on.

@@ -137,15 +137,7 @@ fn own_defines(params: &Params) -> Vec<&'static str> {
 fn march_shader(params: &Params) -> ShaderUse {
     crate::fusion::with_fusion_uniform(
         ShaderUse::new("raycast.wgsl", fragment_entry(params))
-            .binds(&[
-                "preintegrated",
-                "second_preintegrated",
-                "third_preintegrated",
-                "fourth_preintegrated",
-                "light_volume",
-                "label_quads",
-                "label_cubes",
-            ])
+            .binds(crate::effects::MARCH_BINDINGS)
             .uniform(RaycastParamsGpu::bound("params"))
             .uniform(BlockSize::bound_as("blocks")),
         params,

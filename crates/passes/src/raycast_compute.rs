@@ -149,16 +149,7 @@ impl PassDecl for RaycastCompute {
 fn march_shader(params: &Params) -> ShaderUse {
     crate::fusion::with_fusion_uniform(
         ShaderUse::new("raycast_compute.wgsl", entry(params))
-            .binds(&[
-                "corrected",
-                "preintegrated",
-                "second_preintegrated",
-                "third_preintegrated",
-                "fourth_preintegrated",
-                "light_volume",
-                "label_quads",
-                "label_cubes",
-            ])
+            .binds(crate::effects::MARCH_BINDINGS)
             .uniform(RaycastParamsGpu::bound("params"))
             .uniform(BlockSize::bound_as("blocks")),
         params,

@@ -386,8 +386,12 @@ impl FusionState {
         }
     }
 
-    /// Makes the textures derived from the label map on `port` when it changed.
+    /// Makes the textures derived from the label map on `port` when it changed (none for
+    /// nearest sampling on a device without subgroups: the map alone is read).
     fn update_label_map(&mut self, ctx: &RecordContext<'_>, port: &str) -> Result<(), PassError> {
+        if !self.smooth && !ctx.gpu.subgroups {
+            return Ok(());
+        }
         let version = ctx.input_version(port);
         if self.derived.as_ref().is_some_and(|(_, v)| *v == version) {
             return Ok(());

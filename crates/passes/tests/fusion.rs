@@ -383,9 +383,8 @@ fn cells_on_their_own_grid(ct: &Volume) -> Volume {
 /// A march takes the samples of a stretch inside one label without reading the label map
 /// (common/label_cubes.wgsl): the stretch is the cube of the map's blocks of one label carried
 /// back into the scan's texture space, whose faces a map on a grid of its own puts between the
-/// scan's samples: against the reference, for
-/// both filters, and through the brick pool (whose runs sample an atlas) as through the compute
-/// raycaster.
+/// scan's samples: against the reference, for both filters, and through the brick pool (whose
+/// runs sample an atlas) as through the compute raycaster.
 #[test]
 fn labels_on_a_grid_of_their_own_tint_the_scan_where_they_lie() {
     let ct = organs_ct(N);
